@@ -1,0 +1,95 @@
+#pragma once
+// A regular scalar volume in host memory: the one result of every reader and
+// procedural source, and the input of every layout.
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "tessera/core/ScalarType.h"
+
+namespace tessera {
+
+// Closed interval of raw voxel values.
+struct ValueRange {
+  double min = 0.0;
+  double max = 1.0;
+  double width() const { return max - min; }
+};
+
+class Volume {
+ public:
+  Volume() = default;
+
+  // Allocates zeroed storage for dims.x*dims.y*dims.z voxels of `type`,
+  // after checking the size against HostBudget::global(). `what` names the
+  // volume in error messages (usually the file name).
+  static Volume allocate(glm::ivec3 dims, ScalarType type, const std::string& what = "volume");
+
+  glm::ivec3 dims() const { return dims_; }
+  glm::dvec3 spacing() const { return spacing_; }
+  glm::dvec3 origin() const { return origin_; }
+  ScalarType type() const { return type_; }
+  std::uint64_t voxelCount() const;
+  std::uint64_t byteSize() const { return data_.size(); }
+
+  // Physical extent of the volume: dims * spacing (the world box of the
+  // renderer is this size, centred at the world origin).
+  glm::dvec3 extent() const { return glm::dvec3(dims_) * spacing_; }
+
+  // Throws InputError if any spacing component is not finite and > 0.
+  void setSpacing(glm::dvec3 spacing);
+  void setOrigin(glm::dvec3 origin) { origin_ = origin; }
+
+  std::span<std::byte> bytes() { return data_; }
+  std::span<const std::byte> bytes() const { return data_; }
+  template <class T>
+  T* dataAs() {
+    return reinterpret_cast<T*>(data_.data());
+  }
+  template <class T>
+  const T* dataAs() const {
+    return reinterpret_cast<const T*>(data_.data());
+  }
+
+  std::size_t index(int x, int y, int z) const {
+    return (static_cast<std::size_t>(z) * dims_.y + y) * dims_.x + x;
+  }
+  // Raw value of a voxel as double (no window applied).
+  double valueAt(int x, int y, int z) const;
+  double valueAtIndex(std::size_t i) const;
+  void setValueAtIndex(std::size_t i, double v);
+
+  // Min/max of the raw values; computed on first use after data changes
+  // (call invalidateRange() after writing through bytes()/dataAs()).
+  ValueRange valueRange() const;
+  void invalidateRange() { rangeValid_ = false; }
+
+  // The value window maps raw values to [0,1] for classification
+  // (n = clamp((v - min) / (max - min), 0, 1)). Defaults to valueRange().
+  ValueRange window() const;
+  void setWindow(ValueRange w);
+  void resetWindow() { hasWindow_ = false; }
+  bool hasWindow() const { return hasWindow_; }
+
+  // Free-form description kept for `tessera info` (source file, generator).
+  const std::string& description() const { return description_; }
+  void setDescription(std::string d) { description_ = std::move(d); }
+
+ private:
+  glm::ivec3 dims_{0, 0, 0};
+  glm::dvec3 spacing_{1.0, 1.0, 1.0};
+  glm::dvec3 origin_{0.0, 0.0, 0.0};
+  ScalarType type_ = ScalarType::U8;
+  std::vector<std::byte> data_;
+  mutable ValueRange range_;
+  mutable bool rangeValid_ = false;
+  ValueRange window_;
+  bool hasWindow_ = false;
+  std::string description_;
+};
+
+}  // namespace tessera

@@ -1,0 +1,17 @@
+#pragma once
+#include <filesystem>
+
+#include "tessera/core/Volume.h"
+
+namespace tessera {
+
+// NIfTI-1 and NIfTI-2 (.nii, .nii.gz, and .hdr/.img pairs) through nifticlib.
+// Supported datatypes: uint8, int8 (widened to i16), uint16, int16, float32,
+// int32/uint32/float64 (converted to f32 with a note in the description).
+// scl_slope/scl_inter are applied (non-identity scaling gives f32).
+// Header dims, datatype and vox_offset are checked against the file size
+// (for gzip, against the bytes the stream actually inflates to) before the
+// voxel buffer is allocated.
+Volume readNifti(const std::filesystem::path& path);
+
+}  // namespace tessera

@@ -1,0 +1,16 @@
+#pragma once
+#include "tessera/core/Image.h"
+
+namespace tessera {
+
+// Peak signal-to-noise ratio over the RGB channels (alpha ignored), in dB,
+// peak 255. Identical images give +infinity. Images must have equal sizes
+// (InputError otherwise).
+double psnr(const Image& a, const Image& b);
+
+// Mean structural similarity (Wang et al. 2004) of the luminance
+// (0.299R + 0.587G + 0.114B), 11x11 Gaussian window sigma 1.5,
+// K1 = 0.01, K2 = 0.03, L = 255. 1.0 for identical images.
+double ssim(const Image& a, const Image& b);
+
+}  // namespace tessera

@@ -1,0 +1,57 @@
+#include "tessera/core/HostBudget.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+
+#include "tessera/core/Error.h"
+
+namespace tessera {
+
+namespace {
+std::uint64_t defaultLimit() {
+  if (const char* env = std::getenv("TESSERA_HOST_BUDGET_MB")) {
+    char* end = nullptr;
+    const unsigned long long mb = std::strtoull(env, &end, 10);
+    if (end != env && *end == '\0' && mb > 0) return mb * 1024ull * 1024ull;
+  }
+  const long pages = sysconf(_SC_PHYS_PAGES);
+  const long pageSize = sysconf(_SC_PAGE_SIZE);
+  if (pages > 0 && pageSize > 0) {
+    return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(pageSize) / 2;
+  }
+  return 4ull << 30;
+}
+}  // namespace
+
+HostBudget& HostBudget::global() {
+  static HostBudget budget(defaultLimit());
+  return budget;
+}
+
+void HostBudget::check(std::uint64_t bytes, const std::string& what) const {
+  if (bytes > limit_) {
+    throw BudgetError(what + ": needs " + formatBytes(bytes) + " of host memory, budget is " +
+                      formatBytes(limit_) + " (set TESSERA_HOST_BUDGET_MB to change it)");
+  }
+}
+
+std::string formatBytes(std::uint64_t bytes) {
+  const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB"};
+  double v = static_cast<double>(bytes);
+  int u = 0;
+  while (v >= 1024.0 && u < 5) {
+    v /= 1024.0;
+    ++u;
+  }
+  char buf[64];
+  if (u == 0) {
+    std::snprintf(buf, sizeof buf, "%llu B", static_cast<unsigned long long>(bytes));
+  } else {
+    std::snprintf(buf, sizeof buf, "%.1f %s", v, units[u]);
+  }
+  return buf;
+}
+
+}  // namespace tessera

@@ -1,0 +1,135 @@
+#include "tessera/core/Volume.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
+
+namespace tessera {
+
+namespace {
+template <class T>
+ValueRange rangeOf(const T* p, std::size_t n) {
+  if (n == 0) return {0.0, 0.0};
+  T lo = p[0], hi = p[0];
+  for (std::size_t i = 1; i < n; ++i) {
+    lo = std::min(lo, p[i]);
+    hi = std::max(hi, p[i]);
+  }
+  return {static_cast<double>(lo), static_cast<double>(hi)};
+}
+
+ValueRange rangeOfFloat(const float* p, std::size_t n) {
+  double lo = std::numeric_limits<double>::infinity();
+  double hi = -lo;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(p[i])) continue;  // NaN/Inf voxels do not define the range
+    lo = std::min(lo, static_cast<double>(p[i]));
+    hi = std::max(hi, static_cast<double>(p[i]));
+  }
+  if (lo > hi) return {0.0, 0.0};
+  return {lo, hi};
+}
+}  // namespace
+
+Volume Volume::allocate(glm::ivec3 dims, ScalarType type, const std::string& what) {
+  constexpr std::int64_t kMaxDim = 1 << 20;
+  for (int a = 0; a < 3; ++a) {
+    if (dims[a] <= 0 || dims[a] > kMaxDim) {
+      throw InputError(what + ": dimension " + std::to_string(a) + " is " +
+                       std::to_string(dims[a]) + ", expected 1.." + std::to_string(kMaxDim));
+    }
+  }
+  const std::uint64_t voxels = static_cast<std::uint64_t>(dims.x) *
+                               static_cast<std::uint64_t>(dims.y) *
+                               static_cast<std::uint64_t>(dims.z);
+  const std::uint64_t bytes = voxels * bytesPerVoxel(type);
+  HostBudget::global().check(bytes, what + " (" + std::to_string(dims.x) + "x" +
+                                        std::to_string(dims.y) + "x" + std::to_string(dims.z) +
+                                        " " + std::string(scalarTypeName(type)) + ")");
+  Volume v;
+  v.dims_ = dims;
+  v.type_ = type;
+  v.data_.assign(bytes, std::byte{0});
+  return v;
+}
+
+std::uint64_t Volume::voxelCount() const {
+  return static_cast<std::uint64_t>(dims_.x) * static_cast<std::uint64_t>(dims_.y) *
+         static_cast<std::uint64_t>(dims_.z);
+}
+
+void Volume::setSpacing(glm::dvec3 spacing) {
+  for (int a = 0; a < 3; ++a) {
+    if (!std::isfinite(spacing[a]) || spacing[a] <= 0.0) {
+      throw InputError("voxel spacing along axis " + std::to_string(a) + " is " +
+                       std::to_string(spacing[a]) + ", expected a finite value > 0");
+    }
+  }
+  spacing_ = spacing;
+}
+
+double Volume::valueAtIndex(std::size_t i) const {
+  switch (type_) {
+    case ScalarType::U8: return dataAs<std::uint8_t>()[i];
+    case ScalarType::U16: return dataAs<std::uint16_t>()[i];
+    case ScalarType::I16: return dataAs<std::int16_t>()[i];
+    case ScalarType::F32: return dataAs<float>()[i];
+  }
+  return 0.0;
+}
+
+void Volume::setValueAtIndex(std::size_t i, double v) {
+  switch (type_) {
+    case ScalarType::U8:
+      dataAs<std::uint8_t>()[i] = static_cast<std::uint8_t>(std::clamp(std::lround(v), 0l, 255l));
+      break;
+    case ScalarType::U16:
+      dataAs<std::uint16_t>()[i] =
+          static_cast<std::uint16_t>(std::clamp(std::lround(v), 0l, 65535l));
+      break;
+    case ScalarType::I16:
+      dataAs<std::int16_t>()[i] =
+          static_cast<std::int16_t>(std::clamp(std::lround(v), -32768l, 32767l));
+      break;
+    case ScalarType::F32: dataAs<float>()[i] = static_cast<float>(v); break;
+  }
+  rangeValid_ = false;
+}
+
+double Volume::valueAt(int x, int y, int z) const { return valueAtIndex(index(x, y, z)); }
+
+ValueRange Volume::valueRange() const {
+  if (!rangeValid_) {
+    const std::size_t n = static_cast<std::size_t>(voxelCount());
+    switch (type_) {
+      case ScalarType::U8: range_ = rangeOf(dataAs<std::uint8_t>(), n); break;
+      case ScalarType::U16: range_ = rangeOf(dataAs<std::uint16_t>(), n); break;
+      case ScalarType::I16: range_ = rangeOf(dataAs<std::int16_t>(), n); break;
+      case ScalarType::F32: range_ = rangeOfFloat(dataAs<float>(), n); break;
+    }
+    rangeValid_ = true;
+  }
+  return range_;
+}
+
+ValueRange Volume::window() const {
+  if (hasWindow_) return window_;
+  ValueRange r = valueRange();
+  if (r.max <= r.min) r.max = r.min + 1.0;  // constant volume: avoid a zero-width window
+  return r;
+}
+
+void Volume::setWindow(ValueRange w) {
+  if (!std::isfinite(w.min) || !std::isfinite(w.max) || w.max <= w.min) {
+    throw InputError("value window [" + std::to_string(w.min) + ", " + std::to_string(w.max) +
+                     "] is empty or not finite; expected min < max");
+  }
+  window_ = w;
+  hasWindow_ = true;
+}
+
+}  // namespace tessera

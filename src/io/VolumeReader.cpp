@@ -1,0 +1,41 @@
+#include "tessera/io/VolumeReader.h"
+
+#include <algorithm>
+#include <cctype>
+
+#include "tessera/core/Error.h"
+#include "tessera/io/NiftiReader.h"
+#include "tessera/io/NrrdReader.h"
+#include "tessera/io/Procedural.h"
+
+namespace tessera {
+
+namespace {
+bool endsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+}  // namespace
+
+Volume readVolume(const std::string& spec) {
+  if (spec.rfind("gen:", 0) == 0) return makeProcedural(spec);
+  const std::filesystem::path path(spec);
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) {
+    throw InputError(spec + ": no such file (or use gen:sphere, gen:shepp-logan, gen:marschner-lobb)");
+  }
+  if (std::filesystem::is_directory(path, ec)) {
+    throw InputError(spec + ": is a directory, expected a volume file");
+  }
+  std::string lower = path.filename().string();
+  std::transform(lower.begin(), lower.end(), lower.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (endsWith(lower, ".nii") || endsWith(lower, ".nii.gz") || endsWith(lower, ".hdr") ||
+      endsWith(lower, ".hdr.gz")) {
+    return readNifti(path);
+  }
+  if (endsWith(lower, ".nrrd") || endsWith(lower, ".nhdr")) return readNrrd(path);
+  throw InputError(spec +
+                   ": unknown volume format (supported: .nii, .nii.gz, .hdr/.img, .nrrd, .nhdr)");
+}
+
+}  // namespace tessera
