@@ -1,5 +1,6 @@
 # Writes OUT: a C++ file defining tessera::gpu::embeddedShader(name) over the
 # GLSL FILES, keyed by their path relative to ROOT (e.g. "render/raycast.frag.glsl").
+string(REPLACE "|" ";" FILES "${FILES}")
 set(body "")
 foreach(f IN LISTS FILES)
   file(RELATIVE_PATH rel ${ROOT} ${f})

@@ -1,1 +1,32 @@
-int main() { return 0; }
+// tessera: command-line front end (info, render, bench).
+#include <cstdio>
+#include <exception>
+
+#include <CLI/CLI.hpp>
+
+#include "app/Commands.h"
+#include "tessera/core/Error.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "Tessera: volume rendering for GPUs that lack something (3D textures, texture size,\n"
+      "memory, fill rate). Renders headless through EGL and checks itself against a CPU "
+      "reference."};
+  app.require_subcommand(1);
+  app.set_help_all_flag("--help-all", "Show help for every subcommand");
+  tessera::app::addInfoCommand(app);
+  tessera::app::addRenderCommand(app);
+  tessera::app::addBenchCommand(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const tessera::Error& e) {
+    std::fprintf(stderr, "tessera: error: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tessera: internal error: %s\n", e.what());
+    return 2;
+  }
+  return 0;
+}

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 
@@ -14,7 +15,11 @@ std::uint64_t defaultLimit() {
   if (const char* env = std::getenv("TESSERA_HOST_BUDGET_MB")) {
     char* end = nullptr;
     const unsigned long long mb = std::strtoull(env, &end, 10);
-    if (end != env && *end == '\0' && mb > 0) return mb * 1024ull * 1024ull;
+    if (end != env && *end == '\0' && mb > 0) {
+      // Saturate: a huge value means "no practical limit", not a wrapped-around small one.
+      constexpr unsigned long long kMaxMb = UINT64_MAX >> 20;
+      return mb > kMaxMb ? UINT64_MAX : static_cast<std::uint64_t>(mb) << 20;
+    }
   }
   const long pages = sysconf(_SC_PHYS_PAGES);
   const long pageSize = sysconf(_SC_PAGE_SIZE);
@@ -49,9 +54,16 @@ std::string formatBytes(std::uint64_t bytes) {
   if (u == 0) {
     std::snprintf(buf, sizeof buf, "%llu B", static_cast<unsigned long long>(bytes));
   } else {
-    std::snprintf(buf, sizeof buf, "%.1f %s", v, units[u]);
+    std::snprintf(buf, sizeof buf, "%.1f", v);
   }
-  return buf;
+  std::string text = buf;
+  // The header's format: "200 MiB", not "200.0 MiB"; "1.5 GiB" keeps its decimal.
+  if (u > 0) {
+    if (text.size() > 2 && text.compare(text.size() - 2, 2, ".0") == 0)
+      text.resize(text.size() - 2);
+    text += std::string(" ") + units[u];
+  }
+  return text;
 }
 
 }  // namespace tessera

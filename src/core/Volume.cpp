@@ -74,42 +74,71 @@ void Volume::setSpacing(glm::dvec3 spacing) {
 
 double Volume::valueAtIndex(std::size_t i) const {
   switch (type_) {
-    case ScalarType::U8: return dataAs<std::uint8_t>()[i];
-    case ScalarType::U16: return dataAs<std::uint16_t>()[i];
-    case ScalarType::I16: return dataAs<std::int16_t>()[i];
-    case ScalarType::F32: return dataAs<float>()[i];
+    case ScalarType::U8:
+      return dataAs<std::uint8_t>()[i];
+    case ScalarType::U16:
+      return dataAs<std::uint16_t>()[i];
+    case ScalarType::I16:
+      return dataAs<std::int16_t>()[i];
+    case ScalarType::F32:
+      return dataAs<float>()[i];
   }
   return 0.0;
 }
 
+namespace {
+// Rounds to the nearest value of an integer voxel type, saturating. Clamping
+// in double before rounding matters: std::lround of a value beyond `long`
+// (1e30, +-Inf) or of NaN is unspecified (LONG_MIN on x86-64), which used to
+// turn 1e30 into 0 instead of the type's maximum. NaN has no nearest integer
+// and is stored as 0.
+template <class T>
+T roundToInteger(double v) {
+  if (std::isnan(v)) return T{0};
+  constexpr double lo = std::numeric_limits<T>::min();
+  constexpr double hi = std::numeric_limits<T>::max();
+  return static_cast<T>(std::lround(std::clamp(v, lo, hi)));
+}
+}  // namespace
+
 void Volume::setValueAtIndex(std::size_t i, double v) {
   switch (type_) {
     case ScalarType::U8:
-      dataAs<std::uint8_t>()[i] = static_cast<std::uint8_t>(std::clamp(std::lround(v), 0l, 255l));
+      dataAs<std::uint8_t>()[i] = roundToInteger<std::uint8_t>(v);
       break;
     case ScalarType::U16:
-      dataAs<std::uint16_t>()[i] =
-          static_cast<std::uint16_t>(std::clamp(std::lround(v), 0l, 65535l));
+      dataAs<std::uint16_t>()[i] = roundToInteger<std::uint16_t>(v);
       break;
     case ScalarType::I16:
-      dataAs<std::int16_t>()[i] =
-          static_cast<std::int16_t>(std::clamp(std::lround(v), -32768l, 32767l));
+      dataAs<std::int16_t>()[i] = roundToInteger<std::int16_t>(v);
       break;
-    case ScalarType::F32: dataAs<float>()[i] = static_cast<float>(v); break;
+    case ScalarType::F32:
+      dataAs<float>()[i] = static_cast<float>(v);
+      break;
   }
   rangeValid_ = false;
 }
 
-double Volume::valueAt(int x, int y, int z) const { return valueAtIndex(index(x, y, z)); }
+double Volume::valueAt(int x, int y, int z) const {
+  return valueAtIndex(index(x, y, z));
+}
 
 ValueRange Volume::valueRange() const {
   if (!rangeValid_) {
     const std::size_t n = static_cast<std::size_t>(voxelCount());
     switch (type_) {
-      case ScalarType::U8: range_ = rangeOf(dataAs<std::uint8_t>(), n); break;
-      case ScalarType::U16: range_ = rangeOf(dataAs<std::uint16_t>(), n); break;
-      case ScalarType::I16: range_ = rangeOf(dataAs<std::int16_t>(), n); break;
-      case ScalarType::F32: range_ = rangeOfFloat(dataAs<float>(), n); break;
+      case ScalarType::U8:
+        range_ = rangeOf(dataAs<std::uint8_t>(), n);
+        break;
+      case ScalarType::U16:
+        range_ = rangeOf(dataAs<std::uint16_t>(), n);
+        break;
+      case ScalarType::I16:
+        range_ = rangeOf(dataAs<std::int16_t>(), n);
+        break;
+      case ScalarType::F32:
+        range_ = rangeOfFloat(dataAs<float>(), n);
+        break;
     }
     rangeValid_ = true;
   }

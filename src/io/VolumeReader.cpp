@@ -12,7 +12,8 @@ namespace tessera {
 
 namespace {
 bool endsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 }  // namespace
 
@@ -21,7 +22,8 @@ Volume readVolume(const std::string& spec) {
   const std::filesystem::path path(spec);
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) {
-    throw InputError(spec + ": no such file (or use gen:sphere, gen:shepp-logan, gen:marschner-lobb)");
+    throw InputError(spec +
+                     ": no such file (or use gen:sphere, gen:shepp-logan, gen:marschner-lobb)");
   }
   if (std::filesystem::is_directory(path, ec)) {
     throw InputError(spec + ": is a directory, expected a volume file");

@@ -21,8 +21,8 @@ class Camera {
   double zoom = 1.0;          // >1 moves closer / magnifies
   double fovYDeg = 30.0;      // perspective only
   Projection projection = Projection::Perspective;
-  glm::dvec3 target{0.0};     // orbit centre (pan moves it)
-  double radius = 1.0;        // radius of the sphere framed at zoom 1
+  glm::dvec3 target{0.0};  // orbit centre (pan moves it)
+  double radius = 1.0;     // radius of the sphere framed at zoom 1
 
   // Frames a box of the given extent (sets radius = half its diagonal).
   void frame(glm::dvec3 extent);
@@ -30,8 +30,8 @@ class Camera {
   // Camera basis: columns right, up, back (forward = -back).
   glm::dmat3 basis() const;
   glm::dvec3 eye() const;
-  double distance() const;        // eye to target
-  double orthoHalfHeight() const; // orthographic half height of the view
+  double distance() const;         // eye to target
+  double orthoHalfHeight() const;  // orthographic half height of the view
 
   // Ray through the centre of pixel (px, py) of a width x height image,
   // py counted from the top row. Perspective rays start at the eye,

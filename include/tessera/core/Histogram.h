@@ -8,6 +8,7 @@ namespace tessera {
 
 // Histogram of a volume's raw values over `range`, `bins` equal-width bins
 // (values outside the range are counted in the end bins; NaN is skipped).
+// InputError if bins < 1 or the range is not finite with min <= max.
 class Histogram {
  public:
   static Histogram compute(const Volume& volume, int bins, ValueRange range);
@@ -21,7 +22,10 @@ class Histogram {
   int bins() const { return static_cast<int>(counts_.size()); }
   // Raw value below which `fraction` (0..1) of the counted voxels lie
   // (bin-resolution, linear within the bin).
+  // InputError if fraction is outside [0,1] or nothing was counted.
   double percentile(double fraction) const;
+  // Mean of the counted finite values (f32 +-Inf lands in an end bin but not
+  // in the mean); 0 if there are none.
   double mean() const { return mean_; }
   // Centre value of bin i.
   double binCenter(int i) const;

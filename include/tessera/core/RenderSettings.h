@@ -5,6 +5,9 @@
 
 namespace tessera {
 
+// Composite: front-to-back emission-absorption. Mip: maximum intensity
+// projection; the pixel is the TF colour of the largest normalised sample
+// along the ray, opaque where the ray meets the volume.
 enum class RenderMode { Composite, Mip };
 
 struct RenderSettings {

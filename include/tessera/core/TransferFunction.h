@@ -14,8 +14,8 @@
 namespace tessera {
 
 struct ColorPoint {
-  double x = 0.0;         // normalised scalar, [0,1]
-  glm::dvec3 rgb{0.0};    // each in [0,1]
+  double x = 0.0;       // normalised scalar, [0,1]
+  glm::dvec3 rgb{0.0};  // each in [0,1]
 };
 
 struct OpacityPoint {
@@ -33,8 +33,8 @@ class TransferFunction {
   // World length (e.g. mm) over which an opacity value accumulates.
   double opacityUnitLength = 1.0;
 
-  void addColor(double x, glm::dvec3 rgb);     // inserts sorted
-  void addOpacity(double x, double alpha);     // inserts sorted
+  void addColor(double x, glm::dvec3 rgb);  // inserts sorted
+  void addOpacity(double x, double alpha);  // inserts sorted
 
   glm::dvec3 color(double x) const;
   double opacity(double x) const;

@@ -1,0 +1,109 @@
+#pragma once
+// RAII owners of GL objects. Textures, buffers and renderbuffers record their
+// bytes in a MemoryLedger for as long as they live. All must be destroyed
+// while their context is current.
+#include <cstdint>
+#include <string>
+
+#include "tessera/gpu/MemoryLedger.h"
+
+namespace tessera::gpu {
+
+using GLenumT = unsigned int;
+using GLuintT = unsigned int;
+
+// Bytes per texel of a sized internal format (GL_R8, GL_RGBA16F, ...).
+// Throws GpuError for formats it does not know.
+std::uint64_t bytesPerTexel(GLenumT internalFormat);
+
+class LedgerEntry {
+ public:
+  LedgerEntry() = default;
+  LedgerEntry(MemoryLedger& ledger, GpuResource kind, std::uint64_t bytes,
+              const std::string& label);
+  LedgerEntry(LedgerEntry&& o) noexcept;
+  LedgerEntry& operator=(LedgerEntry&& o) noexcept;
+  ~LedgerEntry();
+  std::uint64_t bytes() const { return bytes_; }
+
+ private:
+  MemoryLedger* ledger_ = nullptr;
+  MemoryLedger::Id id_ = 0;
+  std::uint64_t bytes_ = 0;
+};
+
+class Texture {
+ public:
+  Texture() = default;
+  Texture(Texture&& o) noexcept;
+  Texture& operator=(Texture&& o) noexcept;
+  ~Texture();
+
+  // Allocates (and optionally fills) a texture; `data` may be null.
+  // Filtering: linear, wrap: clamp to edge.
+  static Texture create2D(MemoryLedger& ledger, const std::string& label, GLenumT internalFormat,
+                          int width, int height, GLenumT format, GLenumT type, const void* data);
+  static Texture create3D(MemoryLedger& ledger, const std::string& label, GLenumT internalFormat,
+                          int width, int height, int depth, GLenumT format, GLenumT type,
+                          const void* data);
+
+  void setFilter(GLenumT minFilter, GLenumT magFilter);
+  // Replaces the whole level-0 image of a 2D texture.
+  void update2D(GLenumT format, GLenumT type, const void* data);
+
+  GLuintT id() const { return id_; }
+  GLenumT target() const { return target_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  int depth() const { return depth_; }
+  std::uint64_t bytes() const { return entry_.bytes(); }
+  void bind(int unit) const;
+
+ private:
+  GLuintT id_ = 0;
+  GLenumT target_ = 0;
+  int width_ = 0, height_ = 0, depth_ = 0;
+  LedgerEntry entry_;
+};
+
+class Buffer {
+ public:
+  Buffer() = default;
+  Buffer(Buffer&& o) noexcept;
+  Buffer& operator=(Buffer&& o) noexcept;
+  ~Buffer();
+  static Buffer create(MemoryLedger& ledger, const std::string& label, GLenumT target,
+                       std::uint64_t bytes, const void* data, GLenumT usage);
+  GLuintT id() const { return id_; }
+  GLenumT target() const { return target_; }
+  std::uint64_t bytes() const { return entry_.bytes(); }
+
+ private:
+  GLuintT id_ = 0;
+  GLenumT target_ = 0;
+  LedgerEntry entry_;
+};
+
+// Framebuffer with one colour texture attachment (RGBA8 by default).
+class Framebuffer {
+ public:
+  Framebuffer() = default;
+  Framebuffer(Framebuffer&& o) noexcept;
+  Framebuffer& operator=(Framebuffer&& o) noexcept;
+  ~Framebuffer();
+  static Framebuffer create(MemoryLedger& ledger, const std::string& label, int width, int height,
+                            GLenumT colorFormat = 0 /* GL_RGBA8 */);
+  void bind() const;  // also sets the viewport
+  GLuintT id() const { return id_; }
+  int width() const { return color_.width(); }
+  int height() const { return color_.height(); }
+  const Texture& color() const { return color_; }
+  // Reads the colour attachment as RGBA8, bottom row first.
+  void readRgba8(std::uint8_t* out) const;
+
+ private:
+  GLuintT id_ = 0;
+  Texture color_;
+};
+
+}  // namespace tessera::gpu

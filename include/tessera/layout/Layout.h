@@ -1,0 +1,61 @@
+#pragma once
+// The layout <-> technique seam (Noguera & Jiménez 2012's texture coordinate
+// adapter): a Layout owns how a volume lives in textures and provides the
+// GLSL function every technique samples through,
+//
+//   float sampleVolume(vec3 p);   // p in [0,1]^3, voxel centres at (i+0.5)/dims
+//
+// returning a "stored value" s that relates to raw voxel values by the affine
+// map rawFromStored(). Techniques never see textures, only that function.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "tessera/core/Volume.h"
+#include "tessera/gpu/DeviceCaps.h"
+#include "tessera/gpu/Program.h"
+
+namespace tessera::layout {
+
+// raw = scale * stored + offset
+struct ValueMapping {
+  double scale = 1.0;
+  double offset = 0.0;
+};
+
+// One texture a layout will allocate.
+struct PlannedTexture {
+  std::string label;
+  glm::ivec3 size{0};  // z = 1 for 2D textures
+  bool is3D = false;
+  std::string format;  // "R8", "R16", "R16F", "RGBA8", ...
+  std::uint64_t bytes = 0;
+};
+
+struct LayoutPlan {
+  std::string layout;  // "texture3d", ...
+  std::vector<PlannedTexture> textures;
+  std::uint64_t totalBytes = 0;
+  std::string reason;  // one line a human can read
+};
+
+class Layout {
+ public:
+  virtual ~Layout() = default;
+  virtual std::string name() const = 0;
+  virtual const LayoutPlan& plan() const = 0;
+  // GLSL (for the context's API level) defining sampleVolume() and the
+  // samplers/uniforms it needs. Uniform names are prefixed "u_layout".
+  virtual gpu::ShaderPart glsl() const = 0;
+  // Binds the layout's textures to units firstUnit.. and sets its uniforms
+  // in `program` (which must be in use). Returns the number of units used.
+  virtual int bind(const gpu::Program& program, int firstUnit) const = 0;
+  virtual ValueMapping rawFromStored() const = 0;
+  virtual glm::ivec3 volumeDims() const = 0;
+  // Bytes of GPU memory the layout's textures occupy (from the ledger).
+  virtual std::uint64_t textureBytes() const = 0;
+};
+
+}  // namespace tessera::layout

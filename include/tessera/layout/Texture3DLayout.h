@@ -1,0 +1,41 @@
+#pragma once
+// The volume in one 3D texture (ES 3.0 / WebGL 2), hardware trilinear
+// filtering. u8 volumes are stored as R8; other types are normalised over
+// their value range into 16 bits (R16 with EXT_texture_norm16, else R16F).
+#include <memory>
+
+#include "tessera/gpu/GlObjects.h"
+#include "tessera/gpu/MemoryLedger.h"
+#include "tessera/layout/Layout.h"
+
+namespace tessera::layout {
+
+class Texture3DLayout final : public Layout {
+ public:
+  // What the layout would allocate for `volume` on a device with `caps`;
+  // reason says why it fits or why not (fits() == false).
+  static LayoutPlan planFor(const Volume& volume, const gpu::DeviceCaps& caps);
+  static bool fits(const Volume& volume, const gpu::DeviceCaps& caps);
+
+  // Plans and uploads. Throws GpuError if 3D textures are unavailable or
+  // the volume exceeds the 3D texture size.
+  static std::unique_ptr<Texture3DLayout> create(const Volume& volume, const gpu::DeviceCaps& caps,
+                                                 gpu::MemoryLedger& ledger);
+
+  std::string name() const override { return "texture3d"; }
+  const LayoutPlan& plan() const override { return plan_; }
+  gpu::ShaderPart glsl() const override;
+  int bind(const gpu::Program& program, int firstUnit) const override;
+  ValueMapping rawFromStored() const override { return mapping_; }
+  glm::ivec3 volumeDims() const override { return dims_; }
+  std::uint64_t textureBytes() const override { return texture_.bytes(); }
+
+ private:
+  Texture3DLayout() = default;
+  LayoutPlan plan_;
+  gpu::Texture texture_;
+  ValueMapping mapping_;
+  glm::ivec3 dims_{0};
+};
+
+}  // namespace tessera::layout

@@ -1,0 +1,25 @@
+#pragma once
+// CPU ray caster in double precision with exactly the rendering semantics of
+// the GPU techniques (DESIGN.md, Rendering semantics): same camera rays, same
+// sample positions t0 + (k + j) ds, trilinear reconstruction with voxel
+// centres at (i + 0.5) / dims and clamp-to-edge, the value window, the
+// continuous transfer function with opacity correction, front-to-back
+// compositing with the same early termination, MIP, background.
+#include <glm/vec3.hpp>
+
+#include "tessera/core/Camera.h"
+#include "tessera/core/Image.h"
+#include "tessera/core/RenderSettings.h"
+#include "tessera/core/TransferFunction.h"
+#include "tessera/core/Volume.h"
+
+namespace tessera {
+
+// Trilinear interpolation of raw values at p in [0,1]^3.
+double sampleTrilinear(const Volume& volume, glm::dvec3 p);
+
+// Renders width x height pixels; threads = 0 uses every hardware thread.
+Image renderReference(const Volume& volume, const TransferFunction& tf, const Camera& camera,
+                      const RenderSettings& settings, int width, int height, int threads = 0);
+
+}  // namespace tessera

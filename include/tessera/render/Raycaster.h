@@ -1,0 +1,68 @@
+#pragma once
+// The single-pass GPU ray caster. Works on any Layout (it only calls
+// sampleVolume()), with composite and MIP modes, early ray termination,
+// jitter and empty-space skipping over a block min/max grid.
+#include <map>
+#include <memory>
+#include <string>
+
+#include "tessera/core/Camera.h"
+#include "tessera/core/Image.h"
+#include "tessera/core/RenderSettings.h"
+#include "tessera/core/TransferFunction.h"
+#include "tessera/core/Volume.h"
+#include "tessera/gpu/GlContext.h"
+#include "tessera/gpu/GlObjects.h"
+#include "tessera/gpu/Program.h"
+#include "tessera/layout/Layout.h"
+#include "tessera/render/BlockMinMax.h"
+
+namespace tessera::render {
+
+class Raycaster {
+ public:
+  // `volume` and `layout` must outlive the ray caster (the volume supplies
+  // the value window and the block min/max grid).
+  Raycaster(gpu::GlContext& context, const Volume& volume, const layout::Layout& layout);
+  ~Raycaster();
+
+  void setTransferFunction(const TransferFunction& tf);
+  // Block size of the empty-space grid in voxels; 0 disables skipping.
+  void setSkipBlockSize(int voxels);
+  // TF lookup-table entries (256 or 4096).
+  void setLutSize(int entries);
+
+  // Renders into the internal framebuffer and waits for it (glFinish).
+  void renderFrame(const Camera& camera, const RenderSettings& settings, int width, int height);
+  // Reads the last frame (top row first).
+  Image readImage() const;
+  Image render(const Camera& camera, const RenderSettings& settings, int width, int height) {
+    renderFrame(camera, settings, width, height);
+    return readImage();
+  }
+
+  // GPU memory of this ray caster's own resources (TF, block grid, target).
+  std::uint64_t ownTextureBytes() const;
+
+ private:
+  const gpu::Program& programFor(const RenderSettings& settings);
+  void updateLookup(const RenderSettings& settings, double sampleDistance);
+
+  gpu::GlContext& context_;
+  const Volume& volume_;
+  const layout::Layout& layout_;
+  TransferFunction tf_;
+  int lutSize_ = 4096;
+  int blockSize_ = 8;
+  BlockMinMax blocks_;
+  std::vector<float> lut_;
+  gpu::Texture lutTexture_;
+  gpu::Texture blockTexture_;
+  gpu::Framebuffer target_;
+  gpu::Buffer triangle_;
+  std::map<std::string, gpu::Program> programs_;
+  // What the LUT/block texture were built for, to rebuild only on change.
+  std::string lookupKey_;
+};
+
+}  // namespace tessera::render

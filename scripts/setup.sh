@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs everything Tessera needs on Debian 12 (idempotent: installs only
+# what is missing). Run as root, or as a user with sudo.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake pkg-config git clang-format
+  libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri   # headless OpenGL ES (Mesa llvmpipe)
+  libnifti2-dev zlib1g-dev libpng-dev                    # volume and image I/O
+  libcli11-dev nlohmann-json3-dev libglm-dev             # CLI, JSON, maths
+  libgtest-dev libgmock-dev                              # tests
+  mricron-data                                           # the default volume (ch2 T1 MRI head)
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null; then SUDO="sudo"; else
+    echo "setup: need root (or sudo) to install: ${missing[*]}" >&2
+    exit 1
+  fi
+fi
+echo "setup: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -q
+$SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"

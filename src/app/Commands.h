@@ -1,0 +1,17 @@
+#pragma once
+// The `tessera` subcommands; each registers itself on the CLI11 app and
+// returns a callback run after parsing.
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace tessera::app {
+
+void addInfoCommand(CLI::App& app);
+void addRenderCommand(CLI::App& app);
+void addBenchCommand(CLI::App& app);
+
+// ch2 from mricron-data when installed, else a generated Shepp–Logan phantom.
+std::string defaultVolumeSpec();
+
+}  // namespace tessera::app

@@ -1,0 +1,205 @@
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "app/Commands.h"
+#include "app/RenderJob.h"
+#include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
+#include "tessera/io/VolumeReader.h"
+
+namespace tessera::app {
+
+namespace {
+
+struct RenderOptions {
+  std::string file;
+  std::string tf = "mr-default";
+  std::string size = "512x512";
+  double azimuth = 0.0;
+  double elevation = 0.0;
+  double zoom = 1.0;
+  double fov = 30.0;
+  bool ortho = false;
+  std::string mode = "composite";
+  double step = 0.5;
+  int maxSteps = 4096;
+  double opacityScale = 1.0;
+  double ert = 0.99;
+  bool jitter = false;
+  std::vector<double> window;
+  std::vector<double> background{0.0, 0.0, 0.0};
+  std::string out = "render.png";
+  bool reference = false;
+  std::string referenceOut;
+  int repeat = 1;
+  double rotate = 10.0;
+  int skipBlock = 8;
+  int lut = 4096;
+  bool json = false;
+};
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+nlohmann::json numberOrNull(std::optional<double> v) {
+  if (!v) return nullptr;
+  if (std::isinf(*v)) return 999.0;  // identical images; JSON has no infinity
+  return *v;
+}
+
+void runRenderCommand(const RenderOptions& o) {
+  const auto tStart = std::chrono::steady_clock::now();
+  RenderRequest req;
+  parseSize(o.size, req.width, req.height);
+  req.camera.azimuthDeg = o.azimuth;
+  req.camera.elevationDeg = o.elevation;
+  if (!(o.zoom > 0.0)) throw InputError("--zoom must be > 0");
+  req.camera.zoom = o.zoom;
+  if (!(o.fov > 0.0 && o.fov < 180.0)) throw InputError("--fov must be in (0, 180) degrees");
+  req.camera.fovYDeg = o.fov;
+  req.camera.projection = o.ortho ? Projection::Orthographic : Projection::Perspective;
+  if (o.mode == "composite")
+    req.settings.mode = RenderMode::Composite;
+  else if (o.mode == "mip")
+    req.settings.mode = RenderMode::Mip;
+  else
+    throw InputError("--mode '" + o.mode + "': expected composite or mip");
+  req.settings.stepVoxels = o.step;
+  req.settings.maxSteps = o.maxSteps;
+  req.settings.opacityScale = o.opacityScale;
+  req.settings.ertThreshold = o.ert;
+  req.settings.jitter = o.jitter;
+  if (o.background.size() != 3) throw InputError("--background takes three numbers R G B in [0,1]");
+  req.settings.background = glm::dvec4(o.background[0], o.background[1], o.background[2], 1.0);
+  req.repeat = o.repeat;
+  req.rotateDeg = o.repeat > 1 ? o.rotate : 0.0;
+  req.reference = o.reference || !o.referenceOut.empty();
+  req.skipBlock = o.skipBlock;
+  req.lutSize = o.lut;
+
+  const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
+  const TransferFunction tf = TransferFunction::fromPresetOrFile(o.tf);
+  const auto tLoad = std::chrono::steady_clock::now();
+  Volume volume = readVolume(spec);
+  const double loadMs = msSince(tLoad);
+  if (!o.window.empty()) {
+    if (o.window.size() != 2) throw InputError("--window takes two numbers MIN MAX");
+    volume.setWindow({o.window[0], o.window[1]});
+  }
+
+  auto context = gpu::GlContext::createHeadless();
+  const RenderResult r = runRender(*context, volume, tf, req);
+  r.first.writePng(o.out);
+  if (r.referenceImage && !o.referenceOut.empty()) r.referenceImage->writePng(o.referenceOut);
+  const double totalMs = msSince(tStart);
+
+  if (o.json) {
+    nlohmann::json j;
+    j["file"] = spec;
+    j["out"] = o.out;
+    j["width"] = req.width;
+    j["height"] = req.height;
+    j["frames"] = r.frameMs.size();
+    j["ms_median"] = r.median();
+    j["ms_min"] = r.min();
+    j["ms_max"] = r.max();
+    j["frame_ms"] = r.frameMs;
+    j["psnr_db"] = numberOrNull(r.psnrDb);
+    j["ssim"] = numberOrNull(r.ssim);
+    if (r.referenceImage) j["reference_ms"] = r.referenceMs;
+    j["texture_bytes"] = r.textureBytes;
+    j["volume_texture_bytes"] = r.volumeTextureBytes;
+    j["gl_renderer"] = context->caps().renderer;
+    j["gl_version"] = context->caps().version;
+    j["egl_platform"] = context->platform();
+    j["layout"] = r.layout;
+    j["load_ms"] = loadMs;
+    j["total_ms"] = totalMs;
+    j["mode"] = o.mode;
+    j["step_voxels"] = o.step;
+    j["tf"] = tf.name;
+    std::printf("%s\n", j.dump(2).c_str());
+    return;
+  }
+  std::printf("wrote %s (%dx%d) in %.0f ms total\n", o.out.c_str(), req.width, req.height, totalMs);
+  std::printf("volume   %s: %dx%dx%d %s, loaded in %.0f ms\n", spec.c_str(), volume.dims().x,
+              volume.dims().y, volume.dims().z, std::string(scalarTypeName(volume.type())).c_str(),
+              loadMs);
+  std::printf("gpu      %s (%s, EGL %s)\n", context->caps().renderer.c_str(),
+              context->caps().version.c_str(), context->platform().c_str());
+  std::printf("layout   %s: %s\n", r.layout.c_str(), r.layoutReason.c_str());
+  std::printf("textures %s on the GPU (%llu bytes)\n", formatBytes(r.textureBytes).c_str(),
+              static_cast<unsigned long long>(r.textureBytes));
+  if (r.frameMs.size() == 1) {
+    std::printf("render   %.1f ms\n", r.frameMs[0]);
+  } else {
+    std::printf("render   %zu frames, rotating %g deg: median %.1f ms, min %.1f, max %.1f\n",
+                r.frameMs.size(), o.rotate, r.median(), r.min(), r.max());
+  }
+  if (r.psnrDb) {
+    std::printf("reference %.0f ms on the CPU; PSNR %.2f dB, SSIM %.5f\n", r.referenceMs, *r.psnrDb,
+                *r.ssim);
+  }
+}
+
+}  // namespace
+
+void addRenderCommand(CLI::App& app) {
+  auto o = std::make_shared<RenderOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "render", "Render a volume headless to a PNG (GPU ray caster through EGL)");
+  cmd->add_option(
+      "file", o->file,
+      "Volume file (.nii, .nii.gz, .nrrd, .nhdr) or gen:sphere|shepp-logan|marschner-lobb[:N]; "
+      "default: ch2 (mricron-data) or a Shepp-Logan phantom");
+  cmd->add_option(
+         "--tf", o->tf,
+         "Transfer function: preset (grey, mr-default, ct-bone, ct-muscle, bench) or FILE.json")
+      ->capture_default_str();
+  cmd->add_option("--size", o->size, "Image size WIDTHxHEIGHT")->capture_default_str();
+  cmd->add_option("--azimuth", o->azimuth, "Camera azimuth in degrees (about the volume's z axis)")
+      ->capture_default_str();
+  cmd->add_option("--elevation", o->elevation, "Camera elevation in degrees")
+      ->capture_default_str();
+  cmd->add_option("--zoom", o->zoom, "Zoom factor (>1 magnifies)")->capture_default_str();
+  cmd->add_option("--fov", o->fov, "Vertical field of view in degrees (perspective)")
+      ->capture_default_str();
+  cmd->add_flag("--ortho", o->ortho, "Orthographic projection");
+  cmd->add_option("--mode", o->mode, "composite or mip")->capture_default_str();
+  cmd->add_option("--step", o->step, "Sample distance in voxels (of the smallest spacing)")
+      ->capture_default_str();
+  cmd->add_option("--max-steps", o->maxSteps, "Maximum samples per ray")->capture_default_str();
+  cmd->add_option("--opacity-scale", o->opacityScale, "Global opacity scale")
+      ->capture_default_str();
+  cmd->add_option("--ert", o->ert, "Early ray termination threshold (>= 1 disables)")
+      ->capture_default_str();
+  cmd->add_flag("--jitter", o->jitter, "Jitter the first sample per pixel");
+  cmd->add_option("--window", o->window,
+                  "Value window MIN MAX (raw values); default: the value range")
+      ->expected(2);
+  cmd->add_option("--background", o->background, "Background colour R G B in [0,1]")->expected(3);
+  cmd->add_option("--out", o->out, "Output PNG")->capture_default_str();
+  cmd->add_flag("--reference", o->reference,
+                "Also render with the CPU reference and print PSNR/SSIM");
+  cmd->add_option("--reference-out", o->referenceOut,
+                  "Write the reference image to this PNG (implies --reference)");
+  cmd->add_option("--repeat", o->repeat, "Render N frames, rotating the camera, and report timings")
+      ->capture_default_str();
+  cmd->add_option("--rotate", o->rotate, "Azimuth step in degrees between repeated frames")
+      ->capture_default_str();
+  cmd->add_option("--skip-block", o->skipBlock,
+                  "Empty-space skipping block size in voxels (0 = off)")
+      ->capture_default_str();
+  cmd->add_option("--lut", o->lut, "Transfer-function table entries (256 or 4096)")
+      ->capture_default_str();
+  cmd->add_flag("--json", o->json, "Print one JSON object instead of text");
+  cmd->callback([o] { runRenderCommand(*o); });
+}
+
+}  // namespace tessera::app

@@ -1,0 +1,52 @@
+#pragma once
+// One render run shared by `tessera render` and `tessera bench`: load, plan,
+// upload, render N frames (rotating), optionally compare with the reference.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tessera/core/Camera.h"
+#include "tessera/core/Image.h"
+#include "tessera/core/RenderSettings.h"
+#include "tessera/core/TransferFunction.h"
+#include "tessera/core/Volume.h"
+#include "tessera/gpu/GlContext.h"
+
+namespace tessera::app {
+
+struct RenderRequest {
+  int width = 512;
+  int height = 512;
+  Camera camera;  // radius is set from the volume
+  RenderSettings settings;
+  int repeat = 1;
+  double rotateDeg = 0.0;
+  bool reference = false;
+  int skipBlock = 8;
+  int lutSize = 4096;
+};
+
+struct RenderResult {
+  std::vector<double> frameMs;
+  Image first;  // the frame at the requested view
+  std::optional<Image> referenceImage;
+  double referenceMs = 0.0;
+  std::optional<double> psnrDb;
+  std::optional<double> ssim;
+  std::uint64_t textureBytes = 0;  // every GPU texture/buffer alive, from the ledger
+  std::uint64_t volumeTextureBytes = 0;
+  std::string layout;
+  std::string layoutReason;
+
+  double median() const;
+  double min() const;
+  double max() const;
+};
+
+RenderResult runRender(gpu::GlContext& context, const Volume& volume, const TransferFunction& tf,
+                       RenderRequest request);
+
+// Parses "512x512".
+void parseSize(const std::string& text, int& width, int& height);
+
+}  // namespace tessera::app

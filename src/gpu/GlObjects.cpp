@@ -1,0 +1,257 @@
+#include "tessera/gpu/GlObjects.h"
+
+#include <utility>
+
+#include "gpu/gl.h"
+#include "tessera/core/Error.h"
+
+namespace tessera::gpu {
+
+std::uint64_t bytesPerTexel(GLenumT f) {
+  switch (f) {
+    case GL_R8:
+    case GL_ALPHA:
+    case GL_LUMINANCE:
+      return 1;
+    case GL_RG8:
+    case GL_R16F:
+    case GL_R16_EXT:
+    case GL_LUMINANCE_ALPHA:
+      return 2;
+    case GL_RGB8:
+    case GL_RGB:
+      return 3;
+    case GL_RGBA8:
+    case GL_RGBA:
+    case GL_R32F:
+    case GL_RG16F:
+      return 4;
+    case GL_RGBA16F:
+      return 8;
+    case GL_RGBA32F:
+      return 16;
+    case GL_DEPTH_COMPONENT16:
+      return 2;
+    case GL_DEPTH_COMPONENT24:
+    case GL_DEPTH24_STENCIL8:
+      return 4;
+    default:
+      throw GpuError("bytesPerTexel: unknown internal format " + std::to_string(f));
+  }
+}
+
+LedgerEntry::LedgerEntry(MemoryLedger& ledger, GpuResource kind, std::uint64_t bytes,
+                         const std::string& label)
+    : ledger_(&ledger), id_(ledger.add(kind, bytes, label)), bytes_(bytes) {}
+
+LedgerEntry::LedgerEntry(LedgerEntry&& o) noexcept
+    : ledger_(std::exchange(o.ledger_, nullptr)), id_(o.id_), bytes_(std::exchange(o.bytes_, 0)) {}
+
+LedgerEntry& LedgerEntry::operator=(LedgerEntry&& o) noexcept {
+  if (this != &o) {
+    if (ledger_) ledger_->remove(id_);
+    ledger_ = std::exchange(o.ledger_, nullptr);
+    id_ = o.id_;
+    bytes_ = std::exchange(o.bytes_, 0);
+  }
+  return *this;
+}
+
+LedgerEntry::~LedgerEntry() {
+  if (ledger_) ledger_->remove(id_);
+}
+
+// ---------------------------------------------------------------- Texture
+
+Texture::Texture(Texture&& o) noexcept
+    : id_(std::exchange(o.id_, 0)),
+      target_(o.target_),
+      width_(o.width_),
+      height_(o.height_),
+      depth_(o.depth_),
+      entry_(std::move(o.entry_)) {}
+
+Texture& Texture::operator=(Texture&& o) noexcept {
+  if (this != &o) {
+    if (id_) glDeleteTextures(1, &id_);
+    id_ = std::exchange(o.id_, 0);
+    target_ = o.target_;
+    width_ = o.width_;
+    height_ = o.height_;
+    depth_ = o.depth_;
+    entry_ = std::move(o.entry_);
+  }
+  return *this;
+}
+
+Texture::~Texture() {
+  if (id_) glDeleteTextures(1, &id_);
+}
+
+namespace {
+void checkGl(const std::string& what) {
+  const GLenum e = glGetError();
+  if (e == GL_OUT_OF_MEMORY) throw GpuError(what + ": GL_OUT_OF_MEMORY");
+  if (e != GL_NO_ERROR)
+    throw GpuError(what + ": GL error 0x" + [&] {
+      char b[16];
+      std::snprintf(b, sizeof b, "%04X", e);
+      return std::string(b);
+    }());
+}
+}  // namespace
+
+Texture Texture::create2D(MemoryLedger& ledger, const std::string& label, GLenumT internalFormat,
+                          int width, int height, GLenumT format, GLenumT type, const void* data) {
+  const std::uint64_t bytes = static_cast<std::uint64_t>(width) *
+                              static_cast<std::uint64_t>(height) * bytesPerTexel(internalFormat);
+  Texture t;
+  t.entry_ = LedgerEntry(ledger, GpuResource::Texture, bytes, label);  // budget check first
+  glGetError();
+  glGenTextures(1, &t.id_);
+  t.target_ = GL_TEXTURE_2D;
+  t.width_ = width;
+  t.height_ = height;
+  t.depth_ = 1;
+  glBindTexture(GL_TEXTURE_2D, t.id_);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(internalFormat), width, height, 0, format, type,
+               data);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  checkGl("texture '" + label + "' " + std::to_string(width) + "x" + std::to_string(height));
+  return t;
+}
+
+Texture Texture::create3D(MemoryLedger& ledger, const std::string& label, GLenumT internalFormat,
+                          int width, int height, int depth, GLenumT format, GLenumT type,
+                          const void* data) {
+  const std::uint64_t bytes = static_cast<std::uint64_t>(width) *
+                              static_cast<std::uint64_t>(height) *
+                              static_cast<std::uint64_t>(depth) * bytesPerTexel(internalFormat);
+  Texture t;
+  t.entry_ = LedgerEntry(ledger, GpuResource::Texture, bytes, label);
+  glGetError();
+  glGenTextures(1, &t.id_);
+  t.target_ = GL_TEXTURE_3D;
+  t.width_ = width;
+  t.height_ = height;
+  t.depth_ = depth;
+  glBindTexture(GL_TEXTURE_3D, t.id_);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage3D(GL_TEXTURE_3D, 0, static_cast<GLint>(internalFormat), width, height, depth, 0,
+               format, type, data);
+  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+  checkGl("3D texture '" + label + "' " + std::to_string(width) + "x" + std::to_string(height) +
+          "x" + std::to_string(depth));
+  return t;
+}
+
+void Texture::setFilter(GLenumT minFilter, GLenumT magFilter) {
+  glBindTexture(target_, id_);
+  glTexParameteri(target_, GL_TEXTURE_MIN_FILTER, static_cast<GLint>(minFilter));
+  glTexParameteri(target_, GL_TEXTURE_MAG_FILTER, static_cast<GLint>(magFilter));
+}
+
+void Texture::update2D(GLenumT format, GLenumT type, const void* data) {
+  glBindTexture(GL_TEXTURE_2D, id_);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, format, type, data);
+}
+
+void Texture::bind(int unit) const {
+  glActiveTexture(GL_TEXTURE0 + static_cast<GLenum>(unit));
+  glBindTexture(target_, id_);
+}
+
+// ---------------------------------------------------------------- Buffer
+
+Buffer::Buffer(Buffer&& o) noexcept
+    : id_(std::exchange(o.id_, 0)), target_(o.target_), entry_(std::move(o.entry_)) {}
+
+Buffer& Buffer::operator=(Buffer&& o) noexcept {
+  if (this != &o) {
+    if (id_) glDeleteBuffers(1, &id_);
+    id_ = std::exchange(o.id_, 0);
+    target_ = o.target_;
+    entry_ = std::move(o.entry_);
+  }
+  return *this;
+}
+
+Buffer::~Buffer() {
+  if (id_) glDeleteBuffers(1, &id_);
+}
+
+Buffer Buffer::create(MemoryLedger& ledger, const std::string& label, GLenumT target,
+                      std::uint64_t bytes, const void* data, GLenumT usage) {
+  Buffer b;
+  b.entry_ = LedgerEntry(ledger, GpuResource::Buffer, bytes, label);
+  glGetError();
+  glGenBuffers(1, &b.id_);
+  b.target_ = target;
+  glBindBuffer(target, b.id_);
+  glBufferData(target, static_cast<GLsizeiptr>(bytes), data, usage);
+  checkGl("buffer '" + label + "'");
+  return b;
+}
+
+// ---------------------------------------------------------------- Framebuffer
+
+Framebuffer::Framebuffer(Framebuffer&& o) noexcept
+    : id_(std::exchange(o.id_, 0)), color_(std::move(o.color_)) {}
+
+Framebuffer& Framebuffer::operator=(Framebuffer&& o) noexcept {
+  if (this != &o) {
+    if (id_) glDeleteFramebuffers(1, &id_);
+    id_ = std::exchange(o.id_, 0);
+    color_ = std::move(o.color_);
+  }
+  return *this;
+}
+
+Framebuffer::~Framebuffer() {
+  if (id_) glDeleteFramebuffers(1, &id_);
+}
+
+Framebuffer Framebuffer::create(MemoryLedger& ledger, const std::string& label, int width,
+                                int height, GLenumT colorFormat) {
+  if (colorFormat == 0) colorFormat = GL_RGBA8;
+  Framebuffer f;
+  const GLenum type = colorFormat == GL_RGBA16F ? GL_HALF_FLOAT : GL_UNSIGNED_BYTE;
+  // ES 2.0 takes an unsized internal format for colour textures.
+  const GLenum format = GL_RGBA;
+  f.color_ = Texture::create2D(ledger, label + " colour", colorFormat, width, height, format, type,
+                               nullptr);
+  f.color_.setFilter(GL_LINEAR, GL_LINEAR);
+  glGenFramebuffers(1, &f.id_);
+  glBindFramebuffer(GL_FRAMEBUFFER, f.id_);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, f.color_.id(), 0);
+  const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    throw GpuError("framebuffer '" + label + "' " + std::to_string(width) + "x" +
+                   std::to_string(height) + " incomplete (status 0x" + std::to_string(status) +
+                   ")");
+  }
+  return f;
+}
+
+void Framebuffer::bind() const {
+  glBindFramebuffer(GL_FRAMEBUFFER, id_);
+  glViewport(0, 0, color_.width(), color_.height());
+}
+
+void Framebuffer::readRgba8(std::uint8_t* out) const {
+  glBindFramebuffer(GL_FRAMEBUFFER, id_);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, color_.width(), color_.height(), GL_RGBA, GL_UNSIGNED_BYTE, out);
+  checkGl("glReadPixels");
+}
+
+}  // namespace tessera::gpu

@@ -1,0 +1,113 @@
+#include "tessera/layout/Texture3DLayout.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "gpu/gl.h"
+#include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
+
+namespace tessera::layout {
+
+namespace {
+bool hasNorm16(const gpu::DeviceCaps& caps) {
+  return caps.has("GL_EXT_texture_norm16");
+}
+
+std::string dimsText(glm::ivec3 d) {
+  return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
+}
+}  // namespace
+
+bool Texture3DLayout::fits(const Volume& volume, const gpu::DeviceCaps& caps) {
+  const glm::ivec3 d = volume.dims();
+  return caps.api == gpu::ApiLevel::Gles3 && caps.max3DTextureSize > 0 &&
+         std::max({d.x, d.y, d.z}) <= caps.max3DTextureSize;
+}
+
+LayoutPlan Texture3DLayout::planFor(const Volume& volume, const gpu::DeviceCaps& caps) {
+  LayoutPlan plan;
+  plan.layout = "texture3d";
+  PlannedTexture t;
+  t.label = "volume";
+  t.size = volume.dims();
+  t.is3D = true;
+  std::uint64_t bpt = 1;
+  if (volume.type() == ScalarType::U8) {
+    t.format = "R8";
+  } else {
+    t.format = hasNorm16(caps) ? "R16" : "R16F";
+    bpt = 2;
+  }
+  t.bytes = volume.voxelCount() * bpt;
+  plan.totalBytes = t.bytes;
+  plan.textures.push_back(t);
+  const std::string what = dimsText(volume.dims()) + " " +
+                           std::string(scalarTypeName(volume.type())) + " in one " + t.format +
+                           " 3D texture (" + formatBytes(t.bytes) + ")";
+  if (fits(volume, caps)) {
+    plan.reason = what;
+  } else if (caps.api != gpu::ApiLevel::Gles3 || caps.max3DTextureSize == 0) {
+    plan.reason = "no 3D textures on this device";
+  } else {
+    plan.reason =
+        what + " exceeds the max 3D texture size " + std::to_string(caps.max3DTextureSize);
+  }
+  return plan;
+}
+
+std::unique_ptr<Texture3DLayout> Texture3DLayout::create(const Volume& volume,
+                                                         const gpu::DeviceCaps& caps,
+                                                         gpu::MemoryLedger& ledger) {
+  std::unique_ptr<Texture3DLayout> l(new Texture3DLayout());
+  l->plan_ = planFor(volume, caps);
+  if (!fits(volume, caps)) throw GpuError("texture3d layout: " + l->plan_.reason);
+  l->dims_ = volume.dims();
+  const glm::ivec3 d = volume.dims();
+  if (volume.type() == ScalarType::U8) {
+    l->texture_ = gpu::Texture::create3D(ledger, "volume (texture3d R8)", GL_R8, d.x, d.y, d.z,
+                                         GL_RED, GL_UNSIGNED_BYTE, volume.bytes().data());
+    l->mapping_ = {255.0, 0.0};
+    return l;
+  }
+  // Normalise over the value range into 16 bits: raw = min + s * (max - min).
+  const ValueRange r = volume.valueRange();
+  const double width = r.max > r.min ? r.max - r.min : 1.0;
+  l->mapping_ = {width, r.min};
+  const std::size_t n = static_cast<std::size_t>(volume.voxelCount());
+  HostBudget::global().check(n * 2, "texture3d upload staging");
+  if (hasNorm16(caps)) {
+    std::vector<std::uint16_t> staging(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double v = volume.valueAtIndex(i);
+      const double s = std::isfinite(v) ? std::clamp((v - r.min) / width, 0.0, 1.0) : 0.0;
+      staging[i] = static_cast<std::uint16_t>(std::lround(s * 65535.0));
+    }
+    l->mapping_.scale = width;  // R16 normalised: s = stored/65535 exactly as above
+    l->texture_ = gpu::Texture::create3D(ledger, "volume (texture3d R16)", GL_R16_EXT, d.x, d.y,
+                                         d.z, GL_RED, GL_UNSIGNED_SHORT, staging.data());
+  } else {
+    std::vector<float> staging(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double v = volume.valueAtIndex(i);
+      staging[i] =
+          std::isfinite(v) ? static_cast<float>(std::clamp((v - r.min) / width, 0.0, 1.0)) : 0.0f;
+    }
+    l->texture_ = gpu::Texture::create3D(ledger, "volume (texture3d R16F)", GL_R16F, d.x, d.y, d.z,
+                                         GL_RED, GL_FLOAT, staging.data());
+  }
+  return l;
+}
+
+gpu::ShaderPart Texture3DLayout::glsl() const {
+  return gpu::embeddedShaderPart("layout/texture3d.glsl");
+}
+
+int Texture3DLayout::bind(const gpu::Program& program, int firstUnit) const {
+  texture_.bind(firstUnit);
+  program.set("u_layoutVolume", firstUnit);
+  return 1;
+}
+
+}  // namespace tessera::layout

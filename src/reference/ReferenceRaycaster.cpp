@@ -1,0 +1,145 @@
+#include "tessera/reference/ReferenceRaycaster.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <thread>
+#include <vector>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include "tessera/core/Error.h"
+
+namespace tessera {
+
+namespace {
+
+// Volume values as doubles, converted once so sampling does no type switch.
+std::vector<double> toDoubles(const Volume& v) {
+  std::vector<double> out(static_cast<std::size_t>(v.voxelCount()));
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const double s = v.valueAtIndex(i);
+    out[i] = std::isfinite(s) ? s : 0.0;
+  }
+  return out;
+}
+
+double trilinear(const std::vector<double>& data, glm::ivec3 d, glm::dvec3 p) {
+  // Continuous voxel coordinate with centres at integers.
+  const glm::dvec3 u = p * glm::dvec3(d) - 0.5;
+  const glm::dvec3 f = glm::floor(u);
+  const glm::dvec3 w = u - f;
+  const glm::ivec3 i0 = glm::clamp(glm::ivec3(f), glm::ivec3(0), d - 1);
+  const glm::ivec3 i1 = glm::clamp(glm::ivec3(f) + 1, glm::ivec3(0), d - 1);
+  auto at = [&](int x, int y, int z) {
+    return data[(static_cast<std::size_t>(z) * d.y + y) * d.x + x];
+  };
+  const double c00 = at(i0.x, i0.y, i0.z) * (1 - w.x) + at(i1.x, i0.y, i0.z) * w.x;
+  const double c10 = at(i0.x, i1.y, i0.z) * (1 - w.x) + at(i1.x, i1.y, i0.z) * w.x;
+  const double c01 = at(i0.x, i0.y, i1.z) * (1 - w.x) + at(i1.x, i0.y, i1.z) * w.x;
+  const double c11 = at(i0.x, i1.y, i1.z) * (1 - w.x) + at(i1.x, i1.y, i1.z) * w.x;
+  const double c0 = c00 * (1 - w.y) + c10 * w.y;
+  const double c1 = c01 * (1 - w.y) + c11 * w.y;
+  return c0 * (1 - w.z) + c1 * w.z;
+}
+
+std::uint8_t toByte(double v) {
+  return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
+}
+
+}  // namespace
+
+double sampleTrilinear(const Volume& volume, glm::dvec3 p) {
+  const glm::ivec3 d = volume.dims();
+  const glm::dvec3 u = p * glm::dvec3(d) - 0.5;
+  const glm::dvec3 f = glm::floor(u);
+  const glm::dvec3 w = u - f;
+  const glm::ivec3 i0 = glm::clamp(glm::ivec3(f), glm::ivec3(0), d - 1);
+  const glm::ivec3 i1 = glm::clamp(glm::ivec3(f) + 1, glm::ivec3(0), d - 1);
+  double acc = 0.0;
+  for (int c = 0; c < 8; ++c) {
+    const int x = (c & 1) ? i1.x : i0.x, y = (c & 2) ? i1.y : i0.y, z = (c & 4) ? i1.z : i0.z;
+    const double wt =
+        ((c & 1) ? w.x : 1 - w.x) * ((c & 2) ? w.y : 1 - w.y) * ((c & 4) ? w.z : 1 - w.z);
+    acc += wt * volume.valueAt(x, y, z);
+  }
+  return acc;
+}
+
+Image renderReference(const Volume& volume, const TransferFunction& tf, const Camera& camera,
+                      const RenderSettings& settings, int width, int height, int threads) {
+  if (width <= 0 || height <= 0) throw InputError("reference: image size must be positive");
+  if (!(settings.stepVoxels > 0.0)) throw InputError("reference: step must be > 0");
+  const glm::ivec3 dims = volume.dims();
+  const std::vector<double> data = toDoubles(volume);
+  const glm::dvec3 extent = volume.extent();
+  const glm::dvec3 spacing = volume.spacing();
+  const double ds = settings.stepVoxels * std::min({spacing.x, spacing.y, spacing.z});
+  const ValueRange win = volume.window();
+  const double ww = win.max - win.min;
+  const glm::dvec4 bg = settings.background;
+
+  Image image(width, height);
+  std::atomic<int> nextRow{0};
+  auto worker = [&] {
+    for (int py = nextRow++; py < height; py = nextRow++) {
+      for (int px = 0; px < width; ++px) {
+        const Ray ray = camera.pixelRay(px, py, width, height);
+        // Texture space, as on the GPU: t stays in world units.
+        const glm::dvec3 to = ray.origin / extent + 0.5;
+        const glm::dvec3 td = ray.direction / extent;
+        double tNear = -std::numeric_limits<double>::infinity();
+        double tFar = std::numeric_limits<double>::infinity();
+        for (int a = 0; a < 3; ++a) {
+          if (td[a] == 0.0) {
+            if (to[a] < 0.0 || to[a] > 1.0) tNear = std::numeric_limits<double>::infinity();
+            continue;
+          }
+          const double t0 = (0.0 - to[a]) / td[a], t1 = (1.0 - to[a]) / td[a];
+          tNear = std::max(tNear, std::min(t0, t1));
+          tFar = std::min(tFar, std::max(t0, t1));
+        }
+        const double t0 = std::max(tNear, 0.0);
+        glm::dvec4 acc(0.0);
+        double maxValue = -1.0;
+        if (t0 < tFar) {
+          const double j = settings.jitter
+                               ? jitterOffset(static_cast<unsigned>(px), static_cast<unsigned>(py))
+                               : 0.5;
+          for (int k = 0; k < settings.maxSteps; ++k) {
+            const double t = t0 + (k + j) * ds;
+            if (t >= tFar) break;
+            const double raw = trilinear(data, dims, to + t * td);
+            const double n = std::clamp((raw - win.min) / ww, 0.0, 1.0);
+            if (settings.mode == RenderMode::Mip) {
+              maxValue = std::max(maxValue, n);
+              continue;
+            }
+            const glm::dvec3 c = tf.color(n);
+            const double a = tf.correctedOpacity(n, ds, settings.opacityScale);
+            acc += (1.0 - acc.a) * glm::dvec4(c * a, a);
+            if (acc.a >= settings.ertThreshold) break;
+          }
+        }
+        if (settings.mode == RenderMode::Mip && maxValue >= 0.0) {
+          // MIP shows the TF colour of the maximum, opaque.
+          acc = glm::dvec4(tf.color(maxValue), 1.0);
+        }
+        const glm::dvec4 out(glm::dvec3(acc) + (1.0 - acc.a) * glm::dvec3(bg),
+                             acc.a + (1.0 - acc.a) * bg.a);
+        std::uint8_t* pix = image.pixel(px, py);
+        for (int ch = 0; ch < 4; ++ch) pix[ch] = toByte(out[ch]);
+      }
+    }
+  };
+  const int n =
+      threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  std::vector<std::thread> pool;
+  for (int i = 0; i < n; ++i) pool.emplace_back(worker);
+  for (auto& t : pool) t.join();
+  return image;
+}
+
+}  // namespace tessera

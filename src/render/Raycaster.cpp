@@ -1,0 +1,212 @@
+#include "tessera/render/Raycaster.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <glm/gtc/constants.hpp>
+
+#include "gpu/gl.h"
+#include "tessera/core/Error.h"
+
+namespace tessera::render {
+
+namespace {
+constexpr float kTriangle[] = {-1.0f, -1.0f, 3.0f, -1.0f, -1.0f, 3.0f};
+}
+
+Raycaster::Raycaster(gpu::GlContext& context, const Volume& volume, const layout::Layout& layout)
+    : context_(context), volume_(volume), layout_(layout), tf_(TransferFunction::preset("grey")) {
+  if (context.caps().api != gpu::ApiLevel::Gles3) {
+    throw GpuError("the ray caster needs an OpenGL ES 3.0 context");
+  }
+  triangle_ = gpu::Buffer::create(context.ledger(), "full-screen triangle", GL_ARRAY_BUFFER,
+                                  sizeof kTriangle, kTriangle, GL_STATIC_DRAW);
+  setSkipBlockSize(blockSize_);
+}
+
+Raycaster::~Raycaster() = default;
+
+void Raycaster::setTransferFunction(const TransferFunction& tf) {
+  tf_ = tf;
+  lookupKey_.clear();
+}
+
+void Raycaster::setSkipBlockSize(int voxels) {
+  if (voxels < 0)
+    throw InputError("empty-space block size must be >= 0, got " + std::to_string(voxels));
+  blockSize_ = voxels;
+  blocks_ = voxels > 0 ? BlockMinMax(volume_, voxels) : BlockMinMax();
+  blockTexture_ = gpu::Texture();
+  lookupKey_.clear();
+}
+
+void Raycaster::setLutSize(int entries) {
+  if (entries != 256 && entries != 4096) {
+    throw InputError("transfer-function table size must be 256 or 4096, got " +
+                     std::to_string(entries));
+  }
+  lutSize_ = entries;
+  lutTexture_ = gpu::Texture();
+  lookupKey_.clear();
+}
+
+std::uint64_t Raycaster::ownTextureBytes() const {
+  return lutTexture_.bytes() + blockTexture_.bytes() + target_.color().bytes();
+}
+
+void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistance) {
+  const ValueRange w = volume_.window();
+  std::ostringstream key;
+  key.precision(17);
+  key << sampleDistance << '|' << settings.opacityScale << '|' << w.min << '|' << w.max << '|'
+      << lutSize_ << '|' << blockSize_ << '|' << tf_.toJson();
+  if (key.str() == lookupKey_) return;
+  lookupKey_ = key.str();
+
+  lut_ = tf_.bake(lutSize_, sampleDistance, settings.opacityScale);
+  if (lutTexture_.id() == 0) {
+    lutTexture_ = gpu::Texture::create2D(context_.ledger(), "transfer function", GL_RGBA16F,
+                                         lutSize_, 1, GL_RGBA, GL_FLOAT, lut_.data());
+  } else {
+    lutTexture_.update2D(GL_RGBA, GL_FLOAT, lut_.data());
+  }
+
+  if (blockSize_ == 0) return;
+  // A block is empty when no LUT entry its samples can reach has opacity:
+  // normalised values of its samples lie in [n(min), n(max)], and the GPU's
+  // linear LUT lookup mixes the entries floor/ceil of n * (N - 1).
+  std::vector<int> opaquePrefix(static_cast<std::size_t>(lutSize_) + 1, 0);
+  for (int i = 0; i < lutSize_; ++i) {
+    opaquePrefix[static_cast<std::size_t>(i) + 1] =
+        opaquePrefix[static_cast<std::size_t>(i)] +
+        (lut_[static_cast<std::size_t>(i) * 4 + 3] > 0.0f ? 1 : 0);
+  }
+  const double ww = w.max - w.min;
+  const glm::ivec3 c = blocks_.blockCount();
+  std::vector<std::uint8_t> texels(static_cast<std::size_t>(c.x) * c.y * c.z * 2);
+  for (std::size_t b = 0; b < blocks_.mins().size(); ++b) {
+    const double nlo = std::clamp((blocks_.mins()[b] - w.min) / ww, 0.0, 1.0);
+    const double nhi = std::clamp((blocks_.maxs()[b] - w.min) / ww, 0.0, 1.0);
+    const int i0 = static_cast<int>(std::floor(nlo * (lutSize_ - 1)));
+    const int i1 = std::min(lutSize_ - 1, static_cast<int>(std::ceil(nhi * (lutSize_ - 1))));
+    const bool occupied = opaquePrefix[static_cast<std::size_t>(i1) + 1] -
+                              opaquePrefix[static_cast<std::size_t>(i0)] >
+                          0;
+    texels[b * 2] = occupied ? 255 : 0;
+    // Rounded up so that "block max <= current max" never skips a larger sample.
+    texels[b * 2 + 1] = static_cast<std::uint8_t>(std::min(255.0, std::ceil(nhi * 255.0)));
+  }
+  if (blockTexture_.id() == 0) {
+    blockTexture_ = gpu::Texture::create3D(context_.ledger(), "empty-space blocks", GL_RG8, c.x,
+                                           c.y, c.z, GL_RG, GL_UNSIGNED_BYTE, texels.data());
+    blockTexture_.setFilter(GL_NEAREST, GL_NEAREST);
+  } else {
+    glBindTexture(GL_TEXTURE_3D, blockTexture_.id());
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, c.x, c.y, c.z, GL_RG, GL_UNSIGNED_BYTE,
+                    texels.data());
+  }
+}
+
+const gpu::Program& Raycaster::programFor(const RenderSettings& settings) {
+  std::vector<std::string> defines;
+  if (settings.mode == RenderMode::Mip) defines.push_back("MODE_MIP 1");
+  if (blockSize_ > 0) defines.push_back("EMPTY_SPACE_SKIPPING 1");
+  std::string key = layout_.name();
+  for (const auto& d : defines) key += "|" + d;
+  auto it = programs_.find(key);
+  if (it != programs_.end()) return it->second;
+  const gpu::ApiLevel api = context_.caps().api;
+  gpu::Program p = gpu::Program::build(
+      "raycast(" + key + ")",
+      {gpu::shaderPreamble(api, false, {}), gpu::embeddedShaderPart("render/fullscreen.vert.glsl")},
+      {gpu::shaderPreamble(api, true, defines), gpu::embeddedShaderPart("render/camera_ray.glsl"),
+       layout_.glsl(), gpu::embeddedShaderPart("render/classify.glsl"),
+       gpu::embeddedShaderPart("render/raycast.frag.glsl")});
+  return programs_.emplace(key, std::move(p)).first->second;
+}
+
+void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings, int width,
+                            int height) {
+  if (width <= 0 || height <= 0 || width > context_.caps().maxRenderbufferSize ||
+      height > context_.caps().maxRenderbufferSize) {
+    throw InputError("image size " + std::to_string(width) + "x" + std::to_string(height) +
+                     " is outside 1.." + std::to_string(context_.caps().maxRenderbufferSize));
+  }
+  if (!(settings.stepVoxels > 0.0) || !std::isfinite(settings.stepVoxels)) {
+    throw InputError("step must be a positive number of voxels, got " +
+                     std::to_string(settings.stepVoxels));
+  }
+  if (settings.maxSteps <= 0) throw InputError("max steps must be positive");
+  const glm::dvec3 spacing = volume_.spacing();
+  const double ds = settings.stepVoxels * std::min({spacing.x, spacing.y, spacing.z});
+  // MIP shows one classified sample, so its table is not distance-corrected
+  // (correcting for one unit length leaves opacity as it is).
+  updateLookup(settings, settings.mode == RenderMode::Mip ? tf_.opacityUnitLength : ds);
+
+  if (target_.id() == 0 || target_.width() != width || target_.height() != height) {
+    target_ = gpu::Framebuffer();
+    target_ = gpu::Framebuffer::create(context_.ledger(), "ray-cast target", width, height);
+  }
+  target_.bind();
+  const gpu::Program& prog = programFor(settings);
+  prog.use();
+
+  const glm::dmat3 b = camera.basis();
+  prog.set("u_eye", glm::vec3(camera.eye()));
+  prog.set("u_right", glm::vec3(b[0]));
+  prog.set("u_up", glm::vec3(b[1]));
+  prog.set("u_forward", glm::vec3(-b[2]));
+  prog.set("u_tanHalfFov",
+           static_cast<float>(std::tan(0.5 * camera.fovYDeg * glm::pi<double>() / 180.0)));
+  prog.set("u_orthoHalfHeight", static_cast<float>(camera.orthoHalfHeight()));
+  prog.set("u_aspect", static_cast<float>(static_cast<double>(width) / height));
+  prog.set("u_ortho", camera.projection == Projection::Orthographic ? 1 : 0);
+  prog.set("u_viewport", glm::vec2(width, height));
+  prog.set("u_extent", glm::vec3(volume_.extent()));
+  prog.set("u_step", static_cast<float>(ds));
+  prog.set("u_maxSteps", settings.maxSteps);
+  prog.set("u_ert", static_cast<float>(settings.ertThreshold));
+  prog.set("u_jitter", settings.jitter ? 1 : 0);
+  prog.set("u_background", glm::vec4(settings.background));
+
+  // normalised = (raw - wmin) / (wmax - wmin), raw = scale * stored + offset.
+  const layout::ValueMapping m = layout_.rawFromStored();
+  const ValueRange w = volume_.window();
+  const double ww = w.max - w.min;
+  prog.set("u_valueScale", static_cast<float>(m.scale / ww));
+  prog.set("u_valueBias", static_cast<float>((m.offset - w.min) / ww));
+
+  int unit = layout_.bind(prog, 0);
+  lutTexture_.bind(unit);
+  prog.set("u_tf", unit++);
+  prog.set("u_tfSize", static_cast<float>(lutSize_));
+  if (blockSize_ > 0) {
+    blockTexture_.bind(unit);
+    prog.set("u_blocks", unit++);
+    prog.set("u_blocksPerUnit",
+             glm::vec3(glm::dvec3(volume_.dims()) / static_cast<double>(blockSize_)));
+    prog.set("u_blockCount", glm::vec3(blocks_.blockCount()));
+  }
+
+  glDisable(GL_BLEND);
+  glDisable(GL_DEPTH_TEST);
+  glBindBuffer(GL_ARRAY_BUFFER, triangle_.id());
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glDisableVertexAttribArray(0);
+  glFinish();
+  const GLenum err = glGetError();
+  if (err != GL_NO_ERROR) throw GpuError("ray casting failed: GL error " + std::to_string(err));
+}
+
+Image Raycaster::readImage() const {
+  Image img(target_.width(), target_.height());
+  target_.readRgba8(img.rgba().data());
+  img.flipVertically();
+  return img;
+}
+
+}  // namespace tessera::render

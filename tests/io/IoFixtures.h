@@ -1,0 +1,199 @@
+#pragma once
+// Fixtures for the io tests, generated on the fly: a temporary directory that
+// cleans up after itself, hand-built NIfTI-1/2 headers (byte offsets from
+// nifti1.h / nifti2.h), and gzip compression.
+#include <gtest/gtest.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <chrono>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <unistd.h>
+
+#include "tessera/core/HostBudget.h"
+
+namespace tessera::test {
+
+class TempDir {
+ public:
+  TempDir() {
+    static std::atomic<int> counter{0};
+    std::random_device rd;
+    path_ = std::filesystem::temp_directory_path() /
+            ("tessera-io-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + "-" +
+             std::to_string(rd()));
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+inline void writeFile(const std::filesystem::path& path, std::string_view bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  if (!out) throw std::runtime_error("cannot write fixture " + path.string());
+}
+
+inline std::string gzipBytes(std::string_view data) {
+  z_stream zs{};
+  if (deflateInit2(&zs, Z_BEST_SPEED, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) != Z_OK) {
+    throw std::runtime_error("deflateInit2 failed");
+  }
+  std::string out(deflateBound(&zs, static_cast<uLong>(data.size())) + 64, '\0');
+  zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
+  zs.avail_in = static_cast<uInt>(data.size());
+  zs.next_out = reinterpret_cast<Bytef*>(out.data());
+  zs.avail_out = static_cast<uInt>(out.size());
+  const int ret = deflate(&zs, Z_FINISH);
+  out.resize(zs.total_out);
+  deflateEnd(&zs);
+  if (ret != Z_STREAM_END) throw std::runtime_error("deflate failed");
+  return out;
+}
+
+// Bytes that deflate cannot shrink much, so truncating their gzip stream
+// really cuts voxel data.
+inline std::string noiseBytes(std::size_t n, unsigned seed = 1) {
+  std::mt19937 rng(seed);
+  std::string s(n, '\0');
+  for (auto& c : s) c = static_cast<char>(rng() & 0xff);
+  return s;
+}
+
+// Writes values at byte offsets in either byte order.
+class ByteImage {
+ public:
+  ByteImage(std::size_t size, bool bigEndian) : bytes_(size, '\0'), big_(bigEndian) {}
+
+  template <class T>
+  void put(std::size_t offset, T value) {
+    char b[sizeof(T)];
+    std::memcpy(b, &value, sizeof(T));
+    if (big_ != (std::endian::native == std::endian::big)) std::reverse(b, b + sizeof(T));
+    std::memcpy(bytes_.data() + offset, b, sizeof(T));
+  }
+  void putText(std::size_t offset, std::string_view text) {
+    std::memcpy(bytes_.data() + offset, text.data(), text.size());
+  }
+  const std::string& bytes() const { return bytes_; }
+
+ private:
+  std::string bytes_;
+  bool big_;
+};
+
+// Voxel values as they appear in a file of the given byte order.
+template <class T>
+std::string voxelBytes(const std::vector<T>& values, bool bigEndian) {
+  ByteImage img(values.size() * sizeof(T), bigEndian);
+  for (std::size_t i = 0; i < values.size(); ++i) img.put<T>(i * sizeof(T), values[i]);
+  return img.bytes();
+}
+
+struct NiftiFields {
+  int version = 1;  // 1 or 2
+  std::int64_t dim[8] = {3, 4, 3, 2, 1, 1, 1, 1};
+  int datatype = 2;  // DT_UINT8
+  int bitpix = 8;
+  double pixdim[8] = {1, 1, 1, 1, 1, 1, 1, 1};
+  double voxOffset = -1;  // -1: right after the header (352 / 544)
+  double sclSlope = 0;
+  double sclInter = 0;
+  int qformCode = 0;
+  double qoffset[3] = {0, 0, 0};
+  std::string magic;  // empty: "n+1" / "n+2"
+  int sizeofHdr = 0;  // 0: 348 / 540
+  bool bigEndian = false;
+};
+
+// Header plus the 4-byte extension flag, i.e. everything before vox_offset.
+inline std::string niftiHeader(const NiftiFields& f) {
+  if (f.version == 1) {
+    ByteImage h(352, f.bigEndian);
+    h.put<std::int32_t>(0, f.sizeofHdr != 0 ? f.sizeofHdr : 348);
+    for (int i = 0; i < 8; ++i)
+      h.put<std::int16_t>(40 + 2 * i, static_cast<std::int16_t>(f.dim[i]));
+    h.put<std::int16_t>(70, static_cast<std::int16_t>(f.datatype));
+    h.put<std::int16_t>(72, static_cast<std::int16_t>(f.bitpix));
+    for (int i = 0; i < 8; ++i) h.put<float>(76 + 4 * i, static_cast<float>(f.pixdim[i]));
+    h.put<float>(108, static_cast<float>(f.voxOffset < 0 ? 352.0 : f.voxOffset));
+    h.put<float>(112, static_cast<float>(f.sclSlope));
+    h.put<float>(116, static_cast<float>(f.sclInter));
+    h.put<std::int16_t>(252, static_cast<std::int16_t>(f.qformCode));
+    // quatern_b/c/d stay 0: the identity rotation.
+    for (int i = 0; i < 3; ++i) h.put<float>(268 + 4 * i, static_cast<float>(f.qoffset[i]));
+    h.putText(344, f.magic.empty() ? std::string("n+1\0", 4) : f.magic);
+    return h.bytes();
+  }
+  ByteImage h(544, f.bigEndian);
+  h.put<std::int32_t>(0, f.sizeofHdr != 0 ? f.sizeofHdr : 540);
+  h.putText(4, f.magic.empty() ? std::string("n+2\0\r\n\032\n", 8) : f.magic);
+  h.put<std::int16_t>(12, static_cast<std::int16_t>(f.datatype));
+  h.put<std::int16_t>(14, static_cast<std::int16_t>(f.bitpix));
+  for (int i = 0; i < 8; ++i) h.put<std::int64_t>(16 + 8 * i, f.dim[i]);
+  for (int i = 0; i < 8; ++i) h.put<double>(104 + 8 * i, f.pixdim[i]);
+  h.put<std::int64_t>(168, static_cast<std::int64_t>(f.voxOffset < 0 ? 544.0 : f.voxOffset));
+  h.put<double>(176, f.sclSlope);
+  h.put<double>(184, f.sclInter);
+  h.put<std::int32_t>(344, f.qformCode);
+  for (int i = 0; i < 3; ++i) h.put<double>(376 + 8 * i, f.qoffset[i]);
+  return h.bytes();
+}
+
+// Runs `f` and expects it to throw E (not merely some other error) quickly,
+// with every one of `fragments` in the message.
+template <class E, class F>
+void expectRejected(F&& f, const std::vector<std::string>& fragments) {
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    f();
+    ADD_FAILURE() << "expected an exception mentioning '" << fragments.front() << "'";
+  } catch (const E& e) {
+    const std::string msg = e.what();
+    for (const auto& frag : fragments) {
+      EXPECT_NE(msg.find(frag), std::string::npos) << "message: " << msg << "\nmissing: " << frag;
+    }
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "threw the wrong exception type: " << e.what();
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 2.0) << "rejecting bad input took " << seconds << " s";
+}
+
+// Sets the host budget for one test and restores the previous one.
+class BudgetOverride {
+ public:
+  explicit BudgetOverride(std::uint64_t bytes) : saved_(HostBudget::global().limitBytes()) {
+    HostBudget::global().setLimit(bytes);
+  }
+  ~BudgetOverride() { HostBudget::global().setLimit(saved_); }
+  BudgetOverride(const BudgetOverride&) = delete;
+  BudgetOverride& operator=(const BudgetOverride&) = delete;
+
+ private:
+  std::uint64_t saved_;
+};
+
+}  // namespace tessera::test

@@ -1,0 +1,338 @@
+#include "tessera/io/NrrdReader.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "io/IoFixtures.h"
+#include "tessera/core/Error.h"
+
+namespace tessera {
+namespace {
+
+using test::expectRejected;
+using test::TempDir;
+using test::voxelBytes;
+using test::writeFile;
+
+Volume randomVolume(glm::ivec3 dims, ScalarType type, unsigned seed) {
+  Volume v = Volume::allocate(dims, type, "test");
+  std::mt19937 rng(seed);
+  for (std::size_t i = 0; i < v.voxelCount(); ++i) {
+    switch (type) {
+      case ScalarType::U8:
+        v.setValueAtIndex(i, rng() % 256);
+        break;
+      case ScalarType::U16:
+        v.setValueAtIndex(i, rng() % 65536);
+        break;
+      case ScalarType::I16:
+        v.setValueAtIndex(i, static_cast<int>(rng() % 65536) - 32768);
+        break;
+      case ScalarType::F32:
+        v.setValueAtIndex(i, std::ldexp(static_cast<double>(rng()) - 2147483648.0, -20));
+        break;
+    }
+  }
+  return v;
+}
+
+void expectSameVolume(const Volume& a, const Volume& b) {
+  EXPECT_EQ(a.dims(), b.dims());
+  EXPECT_EQ(a.type(), b.type());
+  EXPECT_EQ(a.spacing(), b.spacing());
+  EXPECT_EQ(a.origin(), b.origin());
+  ASSERT_EQ(a.byteSize(), b.byteSize());
+  EXPECT_EQ(std::memcmp(a.bytes().data(), b.bytes().data(), a.byteSize()), 0);
+}
+
+class NrrdRoundTrip : public ::testing::TestWithParam<std::tuple<ScalarType, bool>> {};
+
+TEST_P(NrrdRoundTrip, PreservesDimsTypeSpacingOriginAndVoxels) {
+  const auto [type, gzip] = GetParam();
+  TempDir dir;
+  Volume v = randomVolume({7, 5, 3}, type, 42);
+  v.setSpacing({0.3, 1.25, 2.0 / 3.0});
+  v.setOrigin({-12.5, 0.1, 1e-3});
+  const auto path = dir / (gzip ? "rt.nrrd" : "rt-raw.nrrd");
+  writeNrrd(v, path, gzip);
+  const Volume r = readNrrd(path);
+  expectSameVolume(v, r);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllTypes, NrrdRoundTrip,
+                         ::testing::Combine(::testing::Values(ScalarType::U8, ScalarType::U16,
+                                                              ScalarType::I16, ScalarType::F32),
+                                            ::testing::Bool()));
+
+TEST(NrrdReader, GzipRoundTripOfALargerVolumeSpansSeveralChunks) {
+  TempDir dir;
+  Volume v = randomVolume({160, 150, 70}, ScalarType::U16, 7);  // 3.2 MiB, several chunks
+  writeNrrd(v, dir / "big.nrrd", true);
+  expectSameVolume(v, readNrrd(dir / "big.nrrd"));
+  // Random data barely compresses, so the file really is gzip, not stored.
+  EXPECT_GT(std::filesystem::file_size(dir / "big.nrrd"), 1u << 20);
+}
+
+TEST(NrrdReader, ReadsDetachedHeaderWithRelativeDataFile) {
+  TempDir dir;
+  std::filesystem::create_directories(dir / "data");
+  std::vector<std::int16_t> values(4 * 3 * 2);
+  for (std::size_t i = 0; i < values.size(); ++i)
+    values[i] = static_cast<std::int16_t>(i * 97 - 1000);
+  writeFile(dir / "data" / "vol.raw", voxelBytes(values, false));
+  writeFile(dir / "vol.nhdr",
+            "NRRD0004\n"
+            "type: short\n"
+            "dimension: 3\n"
+            "sizes: 4 3 2\n"
+            "spacings: 0.5 0.5 2\n"
+            "endian: little\n"
+            "encoding: raw\n"
+            "data file: data/vol.raw\n");
+  const Volume v = readNrrd(dir / "vol.nhdr");
+  EXPECT_EQ(v.dims(), glm::ivec3(4, 3, 2));
+  EXPECT_EQ(v.type(), ScalarType::I16);
+  EXPECT_EQ(v.spacing(), glm::dvec3(0.5, 0.5, 2.0));
+  for (std::size_t i = 0; i < values.size(); ++i) EXPECT_EQ(v.valueAtIndex(i), values[i]);
+}
+
+TEST(NrrdReader, ReadsDetachedGzipDataFile) {
+  TempDir dir;
+  std::vector<std::uint8_t> values(6 * 5 * 4);
+  for (std::size_t i = 0; i < values.size(); ++i) values[i] = static_cast<std::uint8_t>(i * 3);
+  writeFile(dir / "vol.raw.gz", test::gzipBytes(voxelBytes(values, false)));
+  writeFile(dir / "vol.nhdr",
+            "NRRD0005\ntype: uchar\ndimension: 3\nsizes: 6 5 4\nencoding: gzip\n"
+            "datafile: vol.raw.gz\n");
+  const Volume v = readNrrd(dir / "vol.nhdr");
+  EXPECT_EQ(v.dims(), glm::ivec3(6, 5, 4));
+  for (std::size_t i = 0; i < values.size(); ++i) EXPECT_EQ(v.valueAtIndex(i), values[i]);
+}
+
+TEST(NrrdReader, SwapsBigEndianData) {
+  TempDir dir;
+  std::vector<float> fvalues(3 * 2 * 2);
+  for (std::size_t i = 0; i < fvalues.size(); ++i) fvalues[i] = 1.5f * static_cast<float>(i) - 7.0f;
+  writeFile(dir / "f.nrrd",
+            "NRRD0004\ntype: float\ndimension: 3\nsizes: 3 2 2\nendian: big\nencoding: raw\n\n" +
+                voxelBytes(fvalues, true));
+  const Volume f = readNrrd(dir / "f.nrrd");
+  EXPECT_EQ(f.type(), ScalarType::F32);
+  for (std::size_t i = 0; i < fvalues.size(); ++i) EXPECT_EQ(f.valueAtIndex(i), fvalues[i]);
+
+  std::vector<std::uint16_t> svalues(3 * 2 * 2);
+  for (std::size_t i = 0; i < svalues.size(); ++i)
+    svalues[i] = static_cast<std::uint16_t>(i * 5000 + 3);
+  writeFile(dir / "s.nrrd",
+            "NRRD0004\ntype: unsigned short\ndimension: 3\nsizes: 3 2 2\n"
+            "endian: big\nencoding: gzip\n\n" +
+                test::gzipBytes(voxelBytes(svalues, true)));
+  const Volume s = readNrrd(dir / "s.nrrd");
+  EXPECT_EQ(s.type(), ScalarType::U16);
+  for (std::size_t i = 0; i < svalues.size(); ++i) EXPECT_EQ(s.valueAtIndex(i), svalues[i]);
+}
+
+TEST(NrrdReader, IgnoresCommentsAndKeyValuesAndAcceptsCrLf) {
+  TempDir dir;
+  std::vector<std::uint8_t> values(8);
+  for (std::size_t i = 0; i < values.size(); ++i) values[i] = static_cast<std::uint8_t>(200 + i);
+  writeFile(dir / "c.nrrd",
+            "NRRD0004\r\n# a comment: with a colon\r\nmodality:=CT: yes\r\nType: uint8_t\r\n"
+            "dimension: 3\r\nsizes: 2 2 2\r\nkinds: domain domain domain\r\n"
+            "encoding: raw\r\ncontent: tiny\r\n\r\n" +
+                voxelBytes(values, false));
+  const Volume v = readNrrd(dir / "c.nrrd");
+  EXPECT_EQ(v.dims(), glm::ivec3(2, 2, 2));
+  for (std::size_t i = 0; i < values.size(); ++i) EXPECT_EQ(v.valueAtIndex(i), values[i]);
+  EXPECT_NE(v.description().find("tiny"), std::string::npos);
+}
+
+TEST(NrrdReader, SpacingIsTheLengthOfEachSpaceDirection) {
+  TempDir dir;
+  // A 4-D file whose first axis is a size-1 "vector" axis without direction.
+  writeFile(dir / "d.nrrd",
+            "NRRD0004\ntype: uchar\ndimension: 4\nspace: left-posterior-superior\n"
+            "sizes: 1 2 2 2\nspace directions: none (0,1.2,1.6) (3,0,0) (0, 0, -0.5)\n"
+            "space origin: (1,2,3)\nencoding: raw\n\n" +
+                std::string(8, '\x07'));
+  const Volume v = readNrrd(dir / "d.nrrd");
+  EXPECT_EQ(v.dims(), glm::ivec3(2, 2, 2));
+  EXPECT_DOUBLE_EQ(v.spacing().x, 2.0);
+  EXPECT_DOUBLE_EQ(v.spacing().y, 3.0);
+  EXPECT_DOUBLE_EQ(v.spacing().z, 0.5);
+  EXPECT_EQ(v.origin(), glm::dvec3(1, 2, 3));
+}
+
+TEST(NrrdReader, ByteSkipMinusOneReadsTheLastBytes) {
+  TempDir dir;
+  std::vector<std::uint8_t> values(2 * 3 * 4);
+  for (std::size_t i = 0; i < values.size(); ++i) values[i] = static_cast<std::uint8_t>(i + 1);
+  writeFile(dir / "v.den", std::string(100, 'J') + voxelBytes(values, false));
+  writeFile(dir / "v.nhdr",
+            "NRRD0001\ntype: uchar\ndimension: 3\nsizes: 2 3 4\nencoding: raw\n"
+            "byte skip: -1\ndata file: ./v.den\n");
+  const Volume v = readNrrd(dir / "v.nhdr");
+  for (std::size_t i = 0; i < values.size(); ++i) EXPECT_EQ(v.valueAtIndex(i), values[i]);
+}
+
+TEST(NrrdReader, LineSkipThenByteSkip) {
+  TempDir dir;
+  std::vector<std::uint8_t> values(2 * 2 * 3);
+  for (std::size_t i = 0; i < values.size(); ++i) values[i] = static_cast<std::uint8_t>(50 + i);
+  writeFile(dir / "v.vtk", "# vtk\nline two\nXXXXX" + voxelBytes(values, false) + "trailer");
+  writeFile(dir / "v.nhdr",
+            "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 3\nencoding: raw\n"
+            "line skip: 2\nbyte skip: 5\ndata file: v.vtk\n");
+  const Volume v = readNrrd(dir / "v.nhdr");
+  for (std::size_t i = 0; i < values.size(); ++i) EXPECT_EQ(v.valueAtIndex(i), values[i]);
+}
+
+// ---- malformed input ----
+
+std::string header3d(const std::string& extra, const std::string& type = "uchar",
+                     const std::string& sizes = "4 4 4", const std::string& encoding = "raw") {
+  return "NRRD0004\ntype: " + type + "\ndimension: 3\nsizes: " + sizes +
+         "\nendian: little\nencoding: " + encoding + "\n" + extra;
+}
+
+TEST(NrrdReaderRejects, WrongMagic) {
+  TempDir dir;
+  writeFile(dir / "p.nrrd", "P5\n4 4\n255\n" + std::string(16, '\0'));
+  expectRejected<InputError>([&] { readNrrd(dir / "p.nrrd"); },
+                             {(dir / "p.nrrd").string(), "not a NRRD file"});
+  writeFile(dir / "v.nrrd", "NRRD0009\ntype: uchar\n\n");
+  expectRejected<InputError>([&] { readNrrd(dir / "v.nrrd"); }, {"NRRD0009"});
+}
+
+TEST(NrrdReaderRejects, MissingRequiredFields) {
+  TempDir dir;
+  writeFile(dir / "m.nrrd", "NRRD0004\ntype: uchar\ndimension: 3\nencoding: raw\n\n");
+  expectRejected<InputError>([&] { readNrrd(dir / "m.nrrd"); },
+                             {(dir / "m.nrrd").string(), "'sizes'"});
+  writeFile(dir / "e.nrrd",
+            "NRRD0004\ntype: short\ndimension: 3\nsizes: 1 1 1\nencoding: raw\n\n\1\2");
+  expectRejected<InputError>([&] { readNrrd(dir / "e.nrrd"); }, {"'endian'"});
+}
+
+TEST(NrrdReaderRejects, SizesLargerThanTheData) {
+  TempDir dir;
+  const auto path = dir / "s.nrrd";
+  writeFile(path, header3d("\n", "ushort", "256 256 100") + std::string(1000, '\0'));
+  expectRejected<InputError>(
+      [&] { readNrrd(path); },
+      {path.string(), "header says 256x256x100 u16 = 12.5 MiB", "file has", "needs 13107"});
+}
+
+TEST(NrrdReaderRejects, HugeAndZeroSizes) {
+  TempDir dir;
+  const auto path = dir / "h.nrrd";
+  writeFile(path, header3d("\n", "uchar", "2147483647 2147483647 8"));
+  expectRejected<InputError>([&] { readNrrd(path); }, {path.string(), "2147483647"});
+  writeFile(path, header3d("\n", "uchar", "4 0 4"));
+  expectRejected<InputError>([&] { readNrrd(path); }, {path.string(), "size of axis 1 is 0"});
+  writeFile(path, header3d("\n", "uchar", "4 99999999999999999999 4"));
+  expectRejected<InputError>([&] { readNrrd(path); }, {path.string(), "not an integer"});
+}
+
+TEST(NrrdReaderRejects, NanZeroOrNoneSpacing) {
+  TempDir dir;
+  const auto path = dir / "sp.nrrd";
+  for (const std::string& line :
+       {std::string("spacings: 1 nan 1\n"), std::string("spacings: 1 1 0\n"),
+        std::string("spacings: -1 1 1\n"),
+        std::string("space dimension: 3\nspace directions: (1,0,0) none (0,0,1)\n"),
+        std::string("space dimension: 3\nspace directions: (1,0,0) (0,0,0) (0,0,1)\n")}) {
+    writeFile(path, header3d(line + "\n") + std::string(64, '\0'));
+    expectRejected<InputError>([&] { readNrrd(path); }, {path.string(), "axis"});
+  }
+}
+
+TEST(NrrdReaderRejects, UnsupportedEncodingTypeAndDimension) {
+  TempDir dir;
+  const auto path = dir / "u.nrrd";
+  writeFile(path, header3d("\n", "uchar", "4 4 4", "bzip2"));
+  expectRejected<InputError>([&] { readNrrd(path); }, {path.string(), "bzip2", "not supported"});
+  writeFile(path, header3d("\n", "uchar", "4 4 4", "ascii"));
+  expectRejected<InputError>([&] { readNrrd(path); }, {"ascii", "not supported"});
+  writeFile(path, header3d("\n", "block", "4 4 4"));
+  expectRejected<InputError>([&] { readNrrd(path); }, {"block", "not supported"});
+  writeFile(path, header3d("\n", "longlong", "4 4 4"));
+  expectRejected<InputError>([&] { readNrrd(path); }, {"longlong", "not supported"});
+  writeFile(path, "NRRD0004\ntype: uchar\ndimension: 2\nsizes: 4 4\nencoding: raw\n\n" +
+                      std::string(16, '\0'));
+  expectRejected<InputError>([&] { readNrrd(path); }, {path.string(), "dimension is 2"});
+  writeFile(path, "NRRD0004\ntype: uchar\ndimension: 4\nsizes: 3 4 4 4\nencoding: raw\n\n" +
+                      std::string(192, '\0'));
+  expectRejected<InputError>([&] { readNrrd(path); }, {"dimension is 4"});
+}
+
+TEST(NrrdReaderRejects, SeveralDataFiles) {
+  TempDir dir;
+  const auto path = dir / "l.nhdr";
+  writeFile(path, header3d("data file: LIST\nslice0.raw\nslice1.raw\n"));
+  expectRejected<InputError>([&] { readNrrd(path); }, {path.string(), "not supported"});
+  writeFile(path, header3d("data file: slice%03d.raw 0 3 1 2\n"));
+  expectRejected<InputError>([&] { readNrrd(path); }, {path.string(), "not supported"});
+}
+
+TEST(NrrdReaderRejects, MissingDetachedDataFile) {
+  TempDir dir;
+  const auto path = dir / "d.nhdr";
+  writeFile(path, header3d("data file: gone.raw\n"));
+  expectRejected<InputError>([&] { readNrrd(path); }, {"gone.raw", "no such file"});
+}
+
+TEST(NrrdReaderRejects, TruncatedGzipData) {
+  TempDir dir;
+  const std::string voxels = test::noiseBytes(64 * 64 * 64);
+  const std::string gz = test::gzipBytes(voxels);
+  const auto path = dir / "cut.nrrd";
+  writeFile(path, header3d("\n", "uchar", "64 64 64", "gzip") + gz.substr(0, gz.size() / 3));
+  expectRejected<InputError>([&] { readNrrd(path); },
+                             {path.string(), "gzip data ends after", "of 262144 bytes"});
+}
+
+TEST(NrrdReaderRejects, GzipDataThatIsNotGzip) {
+  TempDir dir;
+  const auto path = dir / "ng.nrrd";
+  writeFile(path, header3d("\n", "uchar", "4 4 4", "gzip") + std::string(64, 'z'));
+  expectRejected<InputError>([&] { readNrrd(path); }, {path.string(), "gzip magic"});
+}
+
+TEST(NrrdReaderRejects, GzipBombOverTheHostBudget) {
+  TempDir dir;
+  const auto path = dir / "bomb.nrrd";
+  writeFile(path, header3d("\n", "float", "1024 1024 1024", "gzip") +
+                      test::gzipBytes(std::string(1 << 16, '\0')));
+  test::BudgetOverride budget(64ull << 20);
+  expectRejected<BudgetError>([&] { readNrrd(path); }, {path.string(), "budget"});
+}
+
+TEST(NrrdReaderRejects, GzipClaimBeyondWhatDeflateCanHold) {
+  TempDir dir;
+  const auto path = dir / "liar.nrrd";
+  writeFile(path, header3d("\n", "uchar", "512 512 512", "gzip") +
+                      test::gzipBytes(std::string(1024, '\0')));
+  test::BudgetOverride budget(4ull << 30);
+  expectRejected<InputError>([&] { readNrrd(path); }, {path.string(), "can inflate to at most"});
+}
+
+TEST(NrrdReaderRejects, HeaderWithoutEndInBinaryJunk) {
+  TempDir dir;
+  const auto path = dir / "junk.nrrd";
+  writeFile(path, "NRRD0004\ntype: uchar\n" + std::string(200000, 'q'));
+  expectRejected<InputError>([&] { readNrrd(path); }, {path.string(), "header line longer"});
+}
+
+TEST(NrrdReaderRejects, MissingFileAndDirectory) {
+  TempDir dir;
+  expectRejected<InputError>([&] { readNrrd(dir / "nope.nrrd"); }, {"nope.nrrd", "no such file"});
+  expectRejected<InputError>([&] { readNrrd(dir.path()); }, {"is a directory"});
+}
+
+}  // namespace
+}  // namespace tessera

@@ -1,0 +1,40 @@
+#include "tessera/io/VolumeReader.h"
+
+#include <gtest/gtest.h>
+
+#include "io/IoFixtures.h"
+#include "tessera/core/Error.h"
+#include "tessera/io/NrrdReader.h"
+#include "tessera/io/Procedural.h"
+
+namespace tessera {
+namespace {
+
+TEST(VolumeReader, DispatchesOnExtensionAndGeneratorSpecs) {
+  test::TempDir dir;
+  const Volume sphere = makeSphere({8, 8, 8});
+  writeNrrd(sphere, dir / "s.nrrd");
+  const Volume fromNrrd = readVolume((dir / "s.nrrd").string());
+  EXPECT_EQ(fromNrrd.dims(), glm::ivec3(8));
+  EXPECT_EQ(fromNrrd.valueAt(4, 4, 4), sphere.valueAt(4, 4, 4));
+
+  test::NiftiFields f;
+  test::writeFile(dir / "n.nii.gz",
+                  test::gzipBytes(test::niftiHeader(f) + std::string(24, '\x05')));
+  EXPECT_EQ(readVolume((dir / "n.nii.gz").string()).valueAt(3, 2, 1), 5.0);
+
+  EXPECT_EQ(readVolume("gen:sphere:12").dims(), glm::ivec3(12));
+}
+
+TEST(VolumeReader, RejectsUnknownMissingAndDirectories) {
+  test::TempDir dir;
+  test::writeFile(dir / "v.xyz", "hello");
+  test::expectRejected<InputError>([&] { readVolume((dir / "v.xyz").string()); },
+                                   {"v.xyz", "unknown volume format"});
+  test::expectRejected<InputError>([&] { readVolume((dir / "none.nii").string()); },
+                                   {"none.nii", "no such file"});
+  test::expectRejected<InputError>([&] { readVolume(dir.path().string()); }, {"is a directory"});
+}
+
+}  // namespace
+}  // namespace tessera

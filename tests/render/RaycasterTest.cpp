@@ -1,0 +1,162 @@
+// GPU ray caster against the CPU reference on llvmpipe (DESIGN.md, Testing).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+
+#include "tessera/core/Camera.h"
+#include "tessera/gpu/GlContext.h"
+#include "tessera/io/Procedural.h"
+#include "tessera/io/VolumeReader.h"
+#include "tessera/layout/Texture3DLayout.h"
+#include "tessera/reference/ImageMetrics.h"
+#include "tessera/reference/ReferenceRaycaster.h"
+#include "tessera/render/Raycaster.h"
+
+using namespace tessera;
+
+namespace {
+
+gpu::GlContext& context() {
+  static std::unique_ptr<gpu::GlContext> c = gpu::GlContext::createHeadless();
+  c->makeCurrent();
+  return *c;
+}
+
+struct Comparison {
+  double psnr;
+  double ssim;
+};
+
+Comparison compare(const Volume& v, const TransferFunction& tf, Camera cam, const RenderSettings& s,
+                   int size, int skipBlock = 8) {
+  gpu::GlContext& c = context();
+  auto layout = layout::Texture3DLayout::create(v, c.caps(), c.ledger());
+  render::Raycaster caster(c, v, *layout);
+  caster.setSkipBlockSize(skipBlock);
+  caster.setTransferFunction(tf);
+  cam.frame(v.extent());
+  const Image gpuImage = caster.render(cam, s, size, size);
+  const Image ref = renderReference(v, tf, cam, s, size, size);
+  // Guard against vacuous agreement: the view must show a real image.
+  int lit = 0;
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x)
+      lit += ref.pixel(x, y)[0] + ref.pixel(x, y)[1] + ref.pixel(x, y)[2] > 30;
+  }
+  EXPECT_GT(lit, size * size / 20) << "reference image is (nearly) empty";
+  const Comparison result{psnr(gpuImage, ref), ssim(gpuImage, ref)};
+  std::printf("  [measured] GPU vs reference %dx%d: PSNR %.2f dB, SSIM %.5f\n", size, size,
+              result.psnr, result.ssim);
+  return result;
+}
+
+// Grey ramp with enough opacity that the small phantoms show inner structure.
+TransferFunction visibleTf() {
+  TransferFunction tf;
+  tf.addColor(0.0, {0.0, 0.0, 0.0});
+  tf.addColor(0.5, {0.9, 0.6, 0.3});
+  tf.addColor(1.0, {1.0, 1.0, 1.0});
+  tf.addOpacity(0.02, 0.0);
+  tf.addOpacity(0.3, 0.15);
+  tf.addOpacity(1.0, 0.4);
+  return tf;
+}
+
+const char* kCh2 = "/usr/share/mricron/templates/ch2.nii.gz";
+
+}  // namespace
+
+TEST(Raycaster, PhantomCompositeMatchesReference) {
+  const Volume v = makeSheppLogan({64, 64, 64});
+  Camera cam;
+  cam.azimuthDeg = 30;
+  cam.elevationDeg = 20;
+  RenderSettings s;
+  const Comparison r = compare(v, visibleTf(), cam, s, 128);
+  EXPECT_GE(r.psnr, 40.0);
+  EXPECT_GE(r.ssim, 0.98);
+}
+
+TEST(Raycaster, PhantomMipMatchesReference) {
+  const Volume v = makeSheppLogan({64, 64, 64});
+  Camera cam;
+  cam.azimuthDeg = -40;
+  cam.elevationDeg = 10;
+  RenderSettings s;
+  s.mode = RenderMode::Mip;
+  const Comparison r = compare(v, TransferFunction::preset("grey"), cam, s, 128);
+  EXPECT_GE(r.psnr, 40.0);
+}
+
+TEST(Raycaster, OrthographicJitteredMatchesReference) {
+  const Volume v = makeSphere({48, 40, 56});
+  Camera cam;
+  cam.projection = Projection::Orthographic;
+  cam.azimuthDeg = 75;
+  RenderSettings s;
+  s.jitter = true;
+  s.stepVoxels = 1.0;
+  const Comparison r = compare(v, visibleTf(), cam, s, 96);
+  EXPECT_GE(r.psnr, 40.0);
+}
+
+TEST(Raycaster, EmptySpaceSkippingDoesNotChangeTheImage) {
+  const Volume v = makeSheppLogan({64, 64, 64});
+  gpu::GlContext& c = context();
+  auto layout = layout::Texture3DLayout::create(v, c.caps(), c.ledger());
+  render::Raycaster caster(c, v, *layout);
+  caster.setTransferFunction(TransferFunction::preset("bench"));
+  Camera cam;
+  cam.azimuthDeg = 20;
+  cam.frame(v.extent());
+  for (RenderMode mode : {RenderMode::Composite, RenderMode::Mip}) {
+    RenderSettings s;
+    s.mode = mode;
+    caster.setSkipBlockSize(0);
+    const Image plain = caster.render(cam, s, 96, 96);
+    caster.setSkipBlockSize(4);
+    const Image skipped = caster.render(cam, s, 96, 96);
+    // Skipping only jumps over samples that are transparent (or below the
+    // running maximum), so the images agree up to float rounding.
+    EXPECT_GE(psnr(plain, skipped), 55.0) << (mode == RenderMode::Mip ? "mip" : "composite");
+  }
+}
+
+TEST(Raycaster, U16AndFloatVolumesMatchReference) {
+  Volume v16 = Volume::allocate({40, 40, 40}, ScalarType::U16);
+  Volume vf = makeMarschnerLobb({41, 41, 41});
+  const Volume sl = makeSheppLogan({40, 40, 40});
+  for (std::size_t i = 0; i < v16.voxelCount(); ++i)
+    v16.setValueAtIndex(i, sl.valueAtIndex(i) * 200.0 + 1000.0);
+  Camera cam;
+  cam.azimuthDeg = 10;
+  cam.elevationDeg = 30;
+  RenderSettings s;
+  EXPECT_GE(compare(v16, visibleTf(), cam, s, 96).psnr, 40.0);
+  EXPECT_GE(compare(vf, visibleTf(), cam, s, 96).psnr, 40.0);
+}
+
+TEST(Raycaster, Ch2CompositeAndMipMatchReference) {
+  if (!std::filesystem::exists(kCh2)) GTEST_SKIP() << "mricron-data not installed";
+  const Volume v = readVolume(kCh2);
+  Camera cam;
+  cam.azimuthDeg = 30;
+  cam.elevationDeg = 15;
+  RenderSettings s;
+  const Comparison comp = compare(v, TransferFunction::preset("mr-default"), cam, s, 128);
+  EXPECT_GE(comp.psnr, 40.0);
+  s.mode = RenderMode::Mip;
+  const Comparison mip = compare(v, TransferFunction::preset("grey"), cam, s, 128);
+  EXPECT_GE(mip.psnr, 40.0);
+}
+
+TEST(Raycaster, ValueWindowChangesClassificationLikeReference) {
+  Volume v = makeSheppLogan({48, 48, 48});
+  v.setWindow({50.0, 200.0});
+  Camera cam;
+  cam.azimuthDeg = 45;
+  RenderSettings s;
+  s.opacityScale = 3.0;
+  EXPECT_GE(compare(v, visibleTf(), cam, s, 96).psnr, 40.0);
+}
