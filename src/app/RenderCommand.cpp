@@ -120,6 +120,7 @@ void runRenderCommand(const RenderOptions& o) {
     j["egl_platform"] = context->platform();
     j["layout"] = r.layout;
     j["load_ms"] = loadMs;
+    j["prepare_ms"] = r.prepareMs;
     j["total_ms"] = totalMs;
     j["mode"] = o.mode;
     j["step_voxels"] = o.step;
@@ -137,7 +138,8 @@ void runRenderCommand(const RenderOptions& o) {
   std::printf("textures %s on the GPU (%llu bytes)\n", formatBytes(r.textureBytes).c_str(),
               static_cast<unsigned long long>(r.textureBytes));
   if (r.frameMs.size() == 1) {
-    std::printf("render   %.1f ms\n", r.frameMs[0]);
+    std::printf("render   %.1f ms (after %.0f ms of shader compile and set-up)\n", r.frameMs[0],
+                r.prepareMs);
   } else {
     std::printf("render   %zu frames, rotating %g deg: median %.1f ms, min %.1f, max %.1f\n",
                 r.frameMs.size(), o.rotate, r.median(), r.min(), r.max());

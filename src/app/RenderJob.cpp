@@ -62,6 +62,9 @@ RenderResult runRender(gpu::GlContext& context, const Volume& volume, const Tran
   caster.setLutSize(req.lutSize);
   caster.setTransferFunction(tf);
   req.camera.frame(volume.extent());
+  const auto tPrepare = std::chrono::steady_clock::now();
+  caster.prepare(req.settings);
+  result.prepareMs = msSince(tPrepare);
 
   for (int i = 0; i < req.repeat; ++i) {
     Camera cam = req.camera;

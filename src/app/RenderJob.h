@@ -28,7 +28,8 @@ struct RenderRequest {
 
 struct RenderResult {
   std::vector<double> frameMs;
-  Image first;  // the frame at the requested view
+  double prepareMs = 0.0;  // shader compile + lookup tables, before the first frame
+  Image first;             // the frame at the requested view
   std::optional<Image> referenceImage;
   double referenceMs = 0.0;
   std::optional<double> psnrDb;

@@ -201,8 +201,10 @@ Volume makeSheppLogan(glm::ivec3 dims) {
   });
   v.invalidateRange();
   // The phantom spans [-1, 1] on every axis; this spacing keeps its shape
-  // for non-cubic sizes.
-  v.setSpacing(2.0 / glm::dvec3(dims));
+  // for non-cubic sizes, and is 1 (voxel units) along the longest axis so
+  // that TF opacities "per unit length" mean per voxel, as for scanned data.
+  const int longest = std::max({dims.x, dims.y, dims.z});
+  v.setSpacing(static_cast<double>(longest) / glm::dvec3(dims));
   v.setDescription("generated: shepp-logan " + dimsString(dims));
   return v;
 }
@@ -225,7 +227,11 @@ Volume makeMarschnerLobb(glm::ivec3 dims) {
     }
   });
   v.invalidateRange();
-  auto step = [](int n) { return n > 1 ? 2.0 / (n - 1) : 2.0; };
+  // Cube-shaped in world space, spacing 1 along the longest axis (as for
+  // Shepp–Logan: TF opacity per unit length = per voxel).
+  const int longest = std::max({dims.x, dims.y, dims.z});
+  const double unit = longest > 1 ? (longest - 1) / 2.0 : 0.5;
+  auto step = [unit](int n) { return n > 1 ? 2.0 / (n - 1) * unit : 2.0 * unit; };
   v.setSpacing(glm::dvec3(step(dims.x), step(dims.y), step(dims.z)));
   // The signal's range is [0, 1] whatever the samples hit.
   v.setWindow({0.0, 1.0});

@@ -127,6 +127,13 @@ const gpu::Program& Raycaster::programFor(const RenderSettings& settings) {
   return programs_.emplace(key, std::move(p)).first->second;
 }
 
+void Raycaster::prepare(const RenderSettings& settings) {
+  const glm::dvec3 spacing = volume_.spacing();
+  const double ds = settings.stepVoxels * std::min({spacing.x, spacing.y, spacing.z});
+  updateLookup(settings, settings.mode == RenderMode::Mip ? tf_.opacityUnitLength : ds);
+  programFor(settings);
+}
+
 void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings, int width,
                             int height) {
   if (width <= 0 || height <= 0 || width > context_.caps().maxRenderbufferSize ||

@@ -328,6 +328,13 @@ TEST(NrrdReaderRejects, HeaderWithoutEndInBinaryJunk) {
   expectRejected<InputError>([&] { readNrrd(path); }, {path.string(), "header line longer"});
 }
 
+TEST(NrrdWriter, ReportsAnUnwritablePath) {
+  TempDir dir;
+  const Volume v = randomVolume({2, 2, 2}, ScalarType::U8, 1);
+  expectRejected<Error>([&] { writeNrrd(v, dir / "no-such-dir" / "v.nrrd"); },
+                        {"no-such-dir", "cannot open for writing"});
+}
+
 TEST(NrrdReaderRejects, MissingFileAndDirectory) {
   TempDir dir;
   expectRejected<InputError>([&] { readNrrd(dir / "nope.nrrd"); }, {"nope.nrrd", "no such file"});

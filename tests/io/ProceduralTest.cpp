@@ -36,7 +36,7 @@ TEST(SheppLogan, RegionsHaveTheModifiedContrastIntensities) {
   EXPECT_EQ(sheppLoganAt(v, {0.0, 0.35, -0.15}), 77.0);  // ellipsoid 5: 0.3
   EXPECT_EQ(v.valueRange().max, 255.0);
   EXPECT_EQ(v.valueRange().min, 0.0);
-  EXPECT_DOUBLE_EQ(v.spacing().x, 2.0 / 64);
+  EXPECT_DOUBLE_EQ(v.spacing().x, 1.0);  // voxel units along the longest axis
   EXPECT_EQ(v.description(), "generated: shepp-logan 64x64x64");
 }
 
@@ -51,7 +51,7 @@ TEST(SheppLogan, SmallEllipsoidsAppearAtHigherResolution) {
 TEST(SheppLogan, NonCubicSizesKeepTheShape) {
   const Volume v = makeSheppLogan({64, 32, 16});
   EXPECT_EQ(v.dims(), glm::ivec3(64, 32, 16));
-  EXPECT_EQ(v.spacing(), glm::dvec3(2.0 / 64, 2.0 / 32, 2.0 / 16));
+  EXPECT_EQ(v.spacing(), glm::dvec3(1.0, 2.0, 4.0));  // a cube in world space
   EXPECT_EQ(sheppLoganAt(v, {0.0, 0.0, 0.0}), 51.0);
   EXPECT_EQ(sheppLoganAt(v, {0.22, 0.0, 0.0}), 0.0);
 }
@@ -97,7 +97,7 @@ double mlReference(double x, double y, double z) {
 TEST(MarschnerLobb, MatchesTheFormulaAtSamplePoints) {
   const Volume v = makeMarschnerLobb({41, 41, 41});
   EXPECT_EQ(v.type(), ScalarType::F32);
-  EXPECT_DOUBLE_EQ(v.spacing().x, 0.05);
+  EXPECT_DOUBLE_EQ(v.spacing().x, 1.0);
   const int samples[][3] = {{0, 0, 0},   {20, 20, 20}, {40, 40, 40},
                             {3, 17, 29}, {40, 0, 20},  {11, 33, 5}};
   for (const auto& s : samples) {

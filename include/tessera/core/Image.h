@@ -13,7 +13,9 @@ class Image {
 
   int width() const { return width_; }
   int height() const { return height_; }
-  std::uint8_t* pixel(int x, int y) { return &rgba_[(static_cast<std::size_t>(y) * width_ + x) * 4]; }
+  std::uint8_t* pixel(int x, int y) {
+    return &rgba_[(static_cast<std::size_t>(y) * width_ + x) * 4];
+  }
   const std::uint8_t* pixel(int x, int y) const {
     return &rgba_[(static_cast<std::size_t>(y) * width_ + x) * 4];
   }

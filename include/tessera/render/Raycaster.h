@@ -32,6 +32,10 @@ class Raycaster {
   // TF lookup-table entries (256 or 4096).
   void setLutSize(int entries);
 
+  // Compiles the program and builds the lookup tables the settings need, so
+  // that a timed frame measures rendering only.
+  void prepare(const RenderSettings& settings);
+
   // Renders into the internal framebuffer and waits for it (glFinish).
   void renderFrame(const Camera& camera, const RenderSettings& settings, int width, int height);
   // Reads the last frame (top row first).

@@ -1,0 +1,141 @@
+// The `tessera` executable as users and scripts see it: exit codes, one-line
+// errors, JSON fields, and the PNG it writes.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "tessera/core/Image.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CliRun {
+  int exitCode;
+  std::string out;  // stdout + stderr
+  double seconds;
+};
+
+CliRun run(const std::string& args) {
+  const std::string cmd = std::string(TESSERA_CLI_PATH) + " " + args + " 2>&1";
+  const auto t0 = std::chrono::steady_clock::now();
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf{};
+  while (std::size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
+  const int status = pclose(p);
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out, s};
+}
+
+fs::path tempDir() {
+  fs::path d = fs::temp_directory_path() / ("tessera-cli-" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  return d;
+}
+
+int countLines(const std::string& s) {
+  int n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+}  // namespace
+
+TEST(Cli, RenderPhantomJsonReportsRequiredFieldsAndWritesPng) {
+  const fs::path png = tempDir() / "phantom.png";
+  const CliRun r =
+      run("render gen:shepp-logan:48 --size 64x48 --repeat 3 --rotate 10 --reference --json --tf "
+          "bench --out " +
+          png.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* key : {"ms_median", "ms_min", "ms_max", "frames", "psnr_db", "ssim",
+                          "texture_bytes", "gl_renderer", "width", "height"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_EQ(j["frames"], 3);
+  EXPECT_EQ(j["width"], 64);
+  EXPECT_EQ(j["height"], 48);
+  EXPECT_LE(j["ms_min"].get<double>(), j["ms_median"].get<double>());
+  EXPECT_LE(j["ms_median"].get<double>(), j["ms_max"].get<double>());
+  EXPECT_GE(j["psnr_db"].get<double>(), 40.0);
+  // 48^3 u8 volume + 4096-entry RGBA16F table + 6^3 RG8 blocks + 64x48 RGBA8 target + VBO.
+  EXPECT_EQ(j["texture_bytes"].get<std::uint64_t>(),
+            48u * 48 * 48 + 4096u * 8 + 6u * 6 * 6 * 2 + 64u * 48 * 4 + 24u);
+  const tessera::Image img = tessera::Image::readPng(png);
+  EXPECT_EQ(img.width(), 64);
+  EXPECT_EQ(img.height(), 48);
+}
+
+TEST(Cli, MissingFileFailsWithOneLineError) {
+  const CliRun r = run("render /nonexistent/volume.nii.gz --out /tmp/none.png");
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_EQ(countLines(r.out), 1) << r.out;
+  EXPECT_NE(r.out.find("/nonexistent/volume.nii.gz"), std::string::npos) << r.out;
+}
+
+TEST(Cli, TruncatedNiftiFailsFastWithClearError) {
+  const fs::path dir = tempDir();
+  // A NIfTI-1 header claiming 512^3 int16 voxels, followed by only 1 KiB.
+  std::vector<char> bytes(352 + 1024, 0);
+  auto put32 = [&](std::size_t off, std::int32_t v) { std::memcpy(&bytes[off], &v, 4); };
+  auto put16 = [&](std::size_t off, std::int16_t v) { std::memcpy(&bytes[off], &v, 2); };
+  auto putF = [&](std::size_t off, float v) { std::memcpy(&bytes[off], &v, 4); };
+  put32(0, 348);
+  put16(40, 3);
+  put16(42, 512);
+  put16(44, 512);
+  put16(46, 512);
+  put16(48, 1);
+  put16(70, 4);   // DT_INT16
+  put16(72, 16);  // bitpix
+  putF(76, 1.0f);
+  putF(80, 1.0f);
+  putF(84, 1.0f);
+  putF(88, 1.0f);
+  putF(108, 352.0f);  // vox_offset
+  std::memcpy(&bytes[344], "n+1\0", 4);
+  const fs::path f = dir / "truncated.nii";
+  std::ofstream(f, std::ios::binary)
+      .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  const CliRun r = run("render " + f.string() + " --out " + (dir / "t.png").string());
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_EQ(countLines(r.out), 1) << r.out;
+  EXPECT_NE(r.out.find(f.string()), std::string::npos) << r.out;
+  EXPECT_LT(r.seconds, 1.0);
+  EXPECT_FALSE(fs::exists(dir / "t.png"));
+  const CliRun info = run("info " + f.string());
+  EXPECT_NE(info.exitCode, 0);
+}
+
+TEST(Cli, BadOptionsAreRejected) {
+  EXPECT_NE(run("render gen:sphere:16 --size 12by12").exitCode, 0);
+  EXPECT_NE(run("render gen:sphere:16 --mode xray").exitCode, 0);
+  EXPECT_NE(run("render gen:sphere:16 --tf no-such-preset").exitCode, 0);
+  EXPECT_NE(run("render gen:sphere:16 --step 0").exitCode, 0);
+  EXPECT_NE(run("render gen:sphere:16 --window 5 5").exitCode, 0);
+  EXPECT_NE(run("").exitCode, 0);
+  const CliRun help = run("render --help");
+  EXPECT_EQ(help.exitCode, 0);
+  EXPECT_NE(help.out.find("--reference"), std::string::npos);
+}
+
+TEST(Cli, InfoPrintsDimsSpacingAndType) {
+  const CliRun r = run("info gen:shepp-logan:32x24x16 --json");
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["dims"], nlohmann::json({32, 24, 16}));
+  EXPECT_EQ(j["type"], "u8");
+  EXPECT_EQ(j["bytes"], 32 * 24 * 16);
+}
