@@ -22,6 +22,12 @@ struct BenchOptions {
   bool json = false;
 };
 
+double samplesPerRay(const RenderResult& r) {
+  return r.referenceRays
+             ? static_cast<double>(r.referenceSamples) / static_cast<double>(r.referenceRays)
+             : 0.0;
+}
+
 struct Variant {
   const char* name;
   int skipBlock;
@@ -53,8 +59,11 @@ void runBench(const BenchOptions& o) {
     std::printf("ray casting %s at %dx%d, %d frames rotating %g deg, step %g voxel, TF %s\n",
                 spec.c_str(), req.width, req.height, o.frames, o.rotate, o.step, o.tf.c_str());
     std::printf("GL: %s\n\n", context->caps().renderer.c_str());
-    std::printf("| variant | median ms | min ms | max ms | PSNR dB (frame 0) | SSIM |\n");
-    std::printf("|---|---:|---:|---:|---:|---:|\n");
+    std::printf(
+        "| variant | median ms | min ms | max ms | samples/ray (frame 0) | PSNR dB (frame 0) | "
+        "SSIM "
+        "|\n");
+    std::printf("|---|---:|---:|---:|---:|---:|---:|\n");
   }
   for (const Variant& v : variants) {
     req.skipBlock = v.skipBlock;
@@ -63,8 +72,10 @@ void runBench(const BenchOptions& o) {
     // Each variant is compared with the reference of its own semantics
     // (without ERT the reference also runs to the end of the ray).
     if (!o.json) {
-      std::printf("| %s | %.1f | %.1f | %.1f | %.2f | %.5f |\n", v.name, r.median(), r.min(),
-                  r.max(), *r.psnrDb, *r.ssim);
+      // Samples per ray of the reference are what the GPU takes without
+      // skipping; with skipping it takes the same samples minus the skipped ones.
+      std::printf("| %s | %.1f | %.1f | %.1f | %.0f | %.2f | %.5f |\n", v.name, r.median(), r.min(),
+                  r.max(), samplesPerRay(r), *r.psnrDb, *r.ssim);
       std::fflush(stdout);
     }
     rows.push_back({{"variant", v.name},
@@ -74,6 +85,8 @@ void runBench(const BenchOptions& o) {
                     {"ms_min", r.min()},
                     {"ms_max", r.max()},
                     {"psnr_db", *r.psnrDb},
+                    {"reference_samples", r.referenceSamples},
+                    {"reference_rays", r.referenceRays},
                     {"ssim", *r.ssim},
                     {"frames", r.frameMs.size()},
                     {"texture_bytes", r.textureBytes}});

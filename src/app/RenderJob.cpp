@@ -78,8 +78,11 @@ RenderResult runRender(gpu::GlContext& context, const Volume& volume, const Tran
 
   if (req.reference) {
     const auto t0 = std::chrono::steady_clock::now();
+    ReferenceStats stats;
     result.referenceImage =
-        renderReference(volume, tf, req.camera, req.settings, req.width, req.height);
+        renderReference(volume, tf, req.camera, req.settings, req.width, req.height, 0, &stats);
+    result.referenceSamples = stats.samples;
+    result.referenceRays = stats.raysHittingVolume;
     result.referenceMs = msSince(t0);
     result.psnrDb = psnr(result.first, *result.referenceImage);
     result.ssim = ssim(result.first, *result.referenceImage);

@@ -32,6 +32,8 @@ struct RenderResult {
   Image first;             // the frame at the requested view
   std::optional<Image> referenceImage;
   double referenceMs = 0.0;
+  std::uint64_t referenceSamples = 0;  // samples the reference took for frame 0
+  std::uint64_t referenceRays = 0;     // rays of frame 0 that meet the volume
   std::optional<double> psnrDb;
   std::optional<double> ssim;
   std::uint64_t textureBytes = 0;  // every GPU texture/buffer alive, from the ledger

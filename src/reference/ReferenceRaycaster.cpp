@@ -69,7 +69,8 @@ double sampleTrilinear(const Volume& volume, glm::dvec3 p) {
 }
 
 Image renderReference(const Volume& volume, const TransferFunction& tf, const Camera& camera,
-                      const RenderSettings& settings, int width, int height, int threads) {
+                      const RenderSettings& settings, int width, int height, int threads,
+                      ReferenceStats* stats) {
   if (width <= 0 || height <= 0) throw InputError("reference: image size must be positive");
   if (!(settings.stepVoxels > 0.0)) throw InputError("reference: step must be > 0");
   const glm::ivec3 dims = volume.dims();
@@ -83,7 +84,9 @@ Image renderReference(const Volume& volume, const TransferFunction& tf, const Ca
 
   Image image(width, height);
   std::atomic<int> nextRow{0};
+  std::atomic<std::uint64_t> totalSamples{0}, totalHits{0};
   auto worker = [&] {
+    std::uint64_t samples = 0, hits = 0;
     for (int py = nextRow++; py < height; py = nextRow++) {
       for (int px = 0; px < width; ++px) {
         const Ray ray = camera.pixelRay(px, py, width, height);
@@ -105,12 +108,14 @@ Image renderReference(const Volume& volume, const TransferFunction& tf, const Ca
         glm::dvec4 acc(0.0);
         double maxValue = -1.0;
         if (t0 < tFar) {
+          ++hits;
           const double j = settings.jitter
                                ? jitterOffset(static_cast<unsigned>(px), static_cast<unsigned>(py))
                                : 0.5;
           for (int k = 0; k < settings.maxSteps; ++k) {
             const double t = t0 + (k + j) * ds;
             if (t >= tFar) break;
+            ++samples;
             const double raw = trilinear(data, dims, to + t * td);
             const double n = std::clamp((raw - win.min) / ww, 0.0, 1.0);
             if (settings.mode == RenderMode::Mip) {
@@ -133,12 +138,18 @@ Image renderReference(const Volume& volume, const TransferFunction& tf, const Ca
         for (int ch = 0; ch < 4; ++ch) pix[ch] = toByte(out[ch]);
       }
     }
+    totalSamples += samples;
+    totalHits += hits;
   };
   const int n =
       threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::vector<std::thread> pool;
   for (int i = 0; i < n; ++i) pool.emplace_back(worker);
   for (auto& t : pool) t.join();
+  if (stats) {
+    stats->samples = totalSamples;
+    stats->raysHittingVolume = totalHits;
+  }
   return image;
 }
 

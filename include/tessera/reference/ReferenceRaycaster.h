@@ -5,6 +5,8 @@
 // centres at (i + 0.5) / dims and clamp-to-edge, the value window, the
 // continuous transfer function with opacity correction, front-to-back
 // compositing with the same early termination, MIP, background.
+#include <cstdint>
+
 #include <glm/vec3.hpp>
 
 #include "tessera/core/Camera.h"
@@ -18,8 +20,16 @@ namespace tessera {
 // Trilinear interpolation of raw values at p in [0,1]^3.
 double sampleTrilinear(const Volume& volume, glm::dvec3 p);
 
+// Work done by one reference frame (the same samples the GPU takes when
+// empty-space skipping is off): how much work a technique has to do.
+struct ReferenceStats {
+  std::uint64_t raysHittingVolume = 0;
+  std::uint64_t samples = 0;
+};
+
 // Renders width x height pixels; threads = 0 uses every hardware thread.
 Image renderReference(const Volume& volume, const TransferFunction& tf, const Camera& camera,
-                      const RenderSettings& settings, int width, int height, int threads = 0);
+                      const RenderSettings& settings, int width, int height, int threads = 0,
+                      ReferenceStats* stats = nullptr);
 
 }  // namespace tessera
