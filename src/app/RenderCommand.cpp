@@ -121,6 +121,7 @@ void runRenderCommand(const RenderOptions& o) {
     j["layout"] = r.layout;
     j["load_ms"] = loadMs;
     j["prepare_ms"] = r.prepareMs;
+    j["occupied_block_fraction"] = r.occupiedBlockFraction;
     j["total_ms"] = totalMs;
     j["mode"] = o.mode;
     j["step_voxels"] = o.step;

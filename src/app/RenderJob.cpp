@@ -65,6 +65,7 @@ RenderResult runRender(gpu::GlContext& context, const Volume& volume, const Tran
   const auto tPrepare = std::chrono::steady_clock::now();
   caster.prepare(req.settings);
   result.prepareMs = msSince(tPrepare);
+  result.occupiedBlockFraction = caster.occupiedBlockFraction();
 
   for (int i = 0; i < req.repeat; ++i) {
     Camera cam = req.camera;

@@ -38,6 +38,7 @@ struct RenderResult {
   std::optional<double> ssim;
   std::uint64_t textureBytes = 0;  // every GPU texture/buffer alive, from the ledger
   std::uint64_t volumeTextureBytes = 0;
+  double occupiedBlockFraction = 1.0;
   std::string layout;
   std::string layoutReason;
 

@@ -224,7 +224,9 @@ Framebuffer Framebuffer::create(MemoryLedger& ledger, const std::string& label, 
                                 int height, GLenumT colorFormat) {
   if (colorFormat == 0) colorFormat = GL_RGBA8;
   Framebuffer f;
-  const GLenum type = colorFormat == GL_RGBA16F ? GL_HALF_FLOAT : GL_UNSIGNED_BYTE;
+  const GLenum type = colorFormat == GL_RGBA16F   ? GL_HALF_FLOAT
+                      : colorFormat == GL_RGBA32F ? GL_FLOAT
+                                                  : GL_UNSIGNED_BYTE;
   // ES 2.0 takes an unsized internal format for colour textures.
   const GLenum format = GL_RGBA;
   f.color_ = Texture::create2D(ledger, label + " colour", colorFormat, width, height, format, type,

@@ -72,6 +72,7 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
     lutTexture_.update2D(GL_RGBA, GL_FLOAT, lut_.data());
   }
 
+  occupiedFraction_ = 1.0;
   if (blockSize_ == 0) return;
   // A block is empty when no LUT entry its samples can reach has opacity:
   // normalised values of its samples lie in [n(min), n(max)], and the GPU's
@@ -85,6 +86,7 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
   const double ww = w.max - w.min;
   const glm::ivec3 c = blocks_.blockCount();
   std::vector<std::uint8_t> texels(static_cast<std::size_t>(c.x) * c.y * c.z * 2);
+  std::size_t occupiedCount = 0;
   for (std::size_t b = 0; b < blocks_.mins().size(); ++b) {
     const double nlo = std::clamp((blocks_.mins()[b] - w.min) / ww, 0.0, 1.0);
     const double nhi = std::clamp((blocks_.maxs()[b] - w.min) / ww, 0.0, 1.0);
@@ -94,9 +96,12 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
                               opaquePrefix[static_cast<std::size_t>(i0)] >
                           0;
     texels[b * 2] = occupied ? 255 : 0;
+    occupiedCount += occupied ? 1 : 0;
     // Rounded up so that "block max <= current max" never skips a larger sample.
     texels[b * 2 + 1] = static_cast<std::uint8_t>(std::min(255.0, std::ceil(nhi * 255.0)));
   }
+  occupiedFraction_ =
+      static_cast<double>(occupiedCount) / static_cast<double>(blocks_.mins().size());
   if (blockTexture_.id() == 0) {
     blockTexture_ = gpu::Texture::create3D(context_.ledger(), "empty-space blocks", GL_RG8, c.x,
                                            c.y, c.z, GL_RG, GL_UNSIGNED_BYTE, texels.data());

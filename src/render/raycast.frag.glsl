@@ -38,56 +38,27 @@ void main() {
       j = jitterOffset(uint(gl_FragCoord.x), uint(u_viewport.y - gl_FragCoord.y));
     }
     int k = 0;
-#ifdef EMPTY_SPACE_SKIPPING
-    // Block by block: look the block up once, then either jump to the first
-    // sample past its exit or take all of its samples without further lookups.
-    bool done = false;
-    while (k < u_maxSteps && !done) {
+    while (k < u_maxSteps) {
       float t = t0 + (float(k) + j) * u_step;
       if (t >= t1) break;
       vec3 p = to + t * td;
+#ifdef EMPTY_SPACE_SKIPPING
       vec3 cell = clamp(floor(p * u_blocksPerUnit), vec3(0.0), u_blockCount - 1.0);
       vec2 block = texelFetch(u_blocks, ivec3(cell), 0).rg;
-      vec3 exitFace = (cell + step(0.0, td)) / u_blocksPerUnit;
-      vec3 tb = (exitFace - to) * invTd;
-      float tExit = min(min(min(tb.x, tb.y), tb.z), t1);
-      // First sample index at or past the block's exit (at least one step on).
-      int kExit = max(int(ceil((tExit - t0) / u_step - j)), k + 1);
 #ifdef MODE_MIP
       bool empty = block.g <= maxValue;
 #else
       bool empty = block.r < 0.5;
 #endif
       if (empty) {
-        k = kExit;
+        vec3 exitFace = (cell + step(0.0, td)) / u_blocksPerUnit;
+        vec3 tb = (exitFace - to) * invTd;
+        float tExit = min(min(tb.x, tb.y), tb.z);
+        k = max(int(ceil((tExit - t0) / u_step - j)), k + 1);
         continue;
       }
-      int kEnd = min(kExit, u_maxSteps);
-      for (; k < kEnd; ++k) {
-        float ts = t0 + (float(k) + j) * u_step;
-        if (ts >= t1) {
-          done = true;
-          break;
-        }
-        float n = normalizedValue(sampleVolume(to + ts * td));
-#ifdef MODE_MIP
-        maxValue = max(maxValue, n);
-#else
-        vec4 c = classify(n);
-        acc.rgb += (1.0 - acc.a) * c.a * c.rgb;
-        acc.a += (1.0 - acc.a) * c.a;
-        if (acc.a >= u_ert) {
-          done = true;
-          break;
-        }
 #endif
-      }
-    }
-#else
-    for (; k < u_maxSteps; ++k) {
-      float t = t0 + (float(k) + j) * u_step;
-      if (t >= t1) break;
-      float n = normalizedValue(sampleVolume(to + t * td));
+      float n = normalizedValue(sampleVolume(p));
 #ifdef MODE_MIP
       maxValue = max(maxValue, n);
 #else
@@ -96,8 +67,8 @@ void main() {
       acc.a += (1.0 - acc.a) * c.a;
       if (acc.a >= u_ert) break;
 #endif
+      k++;
     }
-#endif
   }
 #ifdef MODE_MIP
   if (maxValue >= 0.0) {

@@ -160,3 +160,24 @@ TEST(Raycaster, ValueWindowChangesClassificationLikeReference) {
   s.opacityScale = 3.0;
   EXPECT_GE(compare(v, visibleTf(), cam, s, 96).psnr, 40.0);
 }
+
+TEST(Raycaster, ComparisonDetectsASmallCameraError) {
+  // The 40 dB threshold must catch real mistakes: the same volume seen 3
+  // degrees off, or with opacities 30 % off, falls below it.
+  const Volume v = makeSheppLogan({64, 64, 64});
+  gpu::GlContext& c = context();
+  auto layout = layout::Texture3DLayout::create(v, c.caps(), c.ledger());
+  render::Raycaster caster(c, v, *layout);
+  caster.setTransferFunction(visibleTf());
+  Camera cam;
+  cam.azimuthDeg = 30;
+  cam.frame(v.extent());
+  RenderSettings s;
+  const Image gpuImage = caster.render(cam, s, 128, 128);
+  Camera off = cam;
+  off.azimuthDeg += 3;
+  EXPECT_LT(psnr(gpuImage, renderReference(v, visibleTf(), off, s, 128, 128)), 35.0);
+  RenderSettings denser = s;
+  denser.opacityScale = 1.3;
+  EXPECT_LT(psnr(gpuImage, renderReference(v, visibleTf(), cam, denser, 128, 128)), 40.0);
+}

@@ -45,6 +45,10 @@ class Raycaster {
     return readImage();
   }
 
+  // Fraction of empty-space blocks the current TF and window leave
+  // occupied (1 when skipping is off); valid after prepare()/renderFrame().
+  double occupiedBlockFraction() const { return occupiedFraction_; }
+
   // GPU memory of this ray caster's own resources (TF, block grid, target).
   std::uint64_t ownTextureBytes() const;
 
@@ -67,6 +71,7 @@ class Raycaster {
   std::map<std::string, gpu::Program> programs_;
   // What the LUT/block texture were built for, to rebuild only on change.
   std::string lookupKey_;
+  double occupiedFraction_ = 1.0;
 };
 
 }  // namespace tessera::render
