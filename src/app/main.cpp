@@ -19,8 +19,14 @@ int main(int argc, char** argv) {
   tessera::app::addBenchCommand(app);
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
+  } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // One line, like every other error (scripts grep stderr).
+    std::fprintf(stderr, "tessera: error: %s (see tessera --help)\n", e.what());
+    return e.get_exit_code();
   } catch (const tessera::Error& e) {
     std::fprintf(stderr, "tessera: error: %s\n", e.what());
     return 1;

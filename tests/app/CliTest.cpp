@@ -126,6 +126,12 @@ TEST(Cli, BadOptionsAreRejected) {
   EXPECT_NE(run("render gen:sphere:16 --step 0").exitCode, 0);
   EXPECT_NE(run("render gen:sphere:16 --window 5 5").exitCode, 0);
   EXPECT_NE(run("").exitCode, 0);
+  for (const char* args : {"render gen:sphere:16 --mode", "render --size 12by12", "nonsense"}) {
+    const CliRun r = run(args);
+    EXPECT_NE(r.exitCode, 0) << args;
+    EXPECT_EQ(countLines(r.out), 1) << args << ": " << r.out;
+    EXPECT_EQ(r.out.rfind("tessera: error: ", 0), 0u) << r.out;
+  }
   const CliRun help = run("render --help");
   EXPECT_EQ(help.exitCode, 0);
   EXPECT_NE(help.out.find("--reference"), std::string::npos);
