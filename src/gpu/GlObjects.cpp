@@ -256,4 +256,22 @@ void Framebuffer::readRgba8(std::uint8_t* out) const {
   checkGl("glReadPixels");
 }
 
+// ---------------------------------------------------------------- FullscreenTriangle
+
+namespace {
+constexpr float kTriangle[] = {-1.0f, -1.0f, 3.0f, -1.0f, -1.0f, 3.0f};
+}
+
+FullscreenTriangle::FullscreenTriangle(MemoryLedger& ledger)
+    : vertices_(Buffer::create(ledger, "full-screen triangle", GL_ARRAY_BUFFER, sizeof kTriangle,
+                               kTriangle, GL_STATIC_DRAW)) {}
+
+void FullscreenTriangle::draw() const {
+  glBindBuffer(GL_ARRAY_BUFFER, vertices_.id());
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glDisableVertexAttribArray(0);
+}
+
 }  // namespace tessera::gpu

@@ -57,20 +57,14 @@ std::vector<float> LayoutProbe::sample(const Layout& layout,
   gpu::Framebuffer target =
       gpu::Framebuffer::create(context_.ledger(), "probe target", width, height, GL_RGBA32F);
 
-  const float triangle[] = {-1.0f, -1.0f, 3.0f, -1.0f, -1.0f, 3.0f};
-  gpu::Buffer vbo = gpu::Buffer::create(context_.ledger(), "probe triangle", GL_ARRAY_BUFFER,
-                                        sizeof triangle, triangle, GL_STATIC_DRAW);
+  const gpu::FullscreenTriangle triangle(context_.ledger());
   target.bind();
   program.use();
   const int unit = layout.bind(program, 0);
   posTex.bind(unit);
   program.set("u_positions", unit);
   glDisable(GL_BLEND);
-  glBindBuffer(GL_ARRAY_BUFFER, vbo.id());
-  glEnableVertexAttribArray(0);
-  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
-  glDisableVertexAttribArray(0);
+  triangle.draw();
 
   std::vector<float> rgba(static_cast<std::size_t>(width) * height * 4);
   glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, rgba.data());

@@ -11,17 +11,12 @@
 
 namespace tessera::render {
 
-namespace {
-constexpr float kTriangle[] = {-1.0f, -1.0f, 3.0f, -1.0f, -1.0f, 3.0f};
-}
-
 Raycaster::Raycaster(gpu::GlContext& context, const Volume& volume, const layout::Layout& layout)
     : context_(context), volume_(volume), layout_(layout), tf_(TransferFunction::preset("grey")) {
   if (context.caps().api != gpu::ApiLevel::Gles3) {
     throw GpuError("the ray caster needs an OpenGL ES 3.0 context");
   }
-  triangle_ = gpu::Buffer::create(context.ledger(), "full-screen triangle", GL_ARRAY_BUFFER,
-                                  sizeof kTriangle, kTriangle, GL_STATIC_DRAW);
+  triangle_ = gpu::FullscreenTriangle(context.ledger());
   setSkipBlockSize(blockSize_);
 }
 
@@ -204,11 +199,7 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
 
   glDisable(GL_BLEND);
   glDisable(GL_DEPTH_TEST);
-  glBindBuffer(GL_ARRAY_BUFFER, triangle_.id());
-  glEnableVertexAttribArray(0);
-  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
-  glDisableVertexAttribArray(0);
+  triangle_.draw();
   glFinish();
   const GLenum err = glGetError();
   if (err != GL_NO_ERROR) throw GpuError("ray casting failed: GL error " + std::to_string(err));

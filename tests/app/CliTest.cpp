@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/TestSupport.h"
 #include "tessera/core/Image.h"
 
 namespace fs = std::filesystem;
@@ -38,12 +39,6 @@ CliRun run(const std::string& args) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out, s};
 }
 
-fs::path tempDir() {
-  fs::path d = fs::temp_directory_path() / ("tessera-cli-" + std::to_string(::getpid()));
-  fs::create_directories(d);
-  return d;
-}
-
 int countLines(const std::string& s) {
   int n = 0;
   for (char c : s) n += c == '\n';
@@ -53,7 +48,8 @@ int countLines(const std::string& s) {
 }  // namespace
 
 TEST(Cli, RenderPhantomJsonReportsRequiredFieldsAndWritesPng) {
-  const fs::path png = tempDir() / "phantom.png";
+  const tessera::test::TempDir tmp;
+  const fs::path png = tmp / "phantom.png";
   const CliRun r =
       run("render gen:shepp-logan:48 --size 64x48 --repeat 3 --rotate 10 --reference --json --tf "
           "bench --out " +
@@ -86,7 +82,8 @@ TEST(Cli, MissingFileFailsWithOneLineError) {
 }
 
 TEST(Cli, TruncatedNiftiFailsFastWithClearError) {
-  const fs::path dir = tempDir();
+  const tessera::test::TempDir tmp;
+  const fs::path& dir = tmp.path();
   // A NIfTI-1 header claiming 512^3 int16 voxels, followed by only 1 KiB.
   std::vector<char> bytes(352 + 1024, 0);
   auto put32 = [&](std::size_t off, std::int32_t v) { std::memcpy(&bytes[off], &v, 4); };

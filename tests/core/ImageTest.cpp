@@ -1,3 +1,4 @@
+#include "support/TestSupport.h"
 #include "tessera/core/Image.h"
 
 #include <gtest/gtest.h>
@@ -13,28 +14,10 @@
 namespace tessera {
 namespace {
 
+using test::BudgetOverride;
+using test::TempDir;
+
 namespace fs = std::filesystem;
-
-class TempDir {
- public:
-  TempDir() {
-    static int counter = 0;
-    path_ = fs::temp_directory_path() /
-            ("tessera-image-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const fs::path& path() const { return path_; }
-  fs::path file(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
-};
 
 std::vector<std::string> entries(const fs::path& dir) {
   std::vector<std::string> names;

@@ -1,3 +1,4 @@
+#include "support/TestSupport.h"
 #include "tessera/core/TransferFunction.h"
 
 #include <gtest/gtest.h>
@@ -14,28 +15,10 @@
 namespace tessera {
 namespace {
 
+using test::BudgetOverride;
+using test::TempDir;
+
 namespace fs = std::filesystem;
-
-// A fresh directory under the system temp dir, removed with its contents.
-class TempDir {
- public:
-  TempDir() {
-    static int counter = 0;
-    path_ = fs::temp_directory_path() /
-            ("tessera-tf-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  fs::path file(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
-};
 
 void writeText(const fs::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);

@@ -1,3 +1,4 @@
+#include "support/TestSupport.h"
 #include "tessera/core/Volume.h"
 
 #include <gtest/gtest.h>
@@ -12,20 +13,8 @@
 namespace tessera {
 namespace {
 
-// Sets the global host budget for one test and restores it afterwards, so
-// that a failing assertion cannot leave other tests with a tiny budget.
-class BudgetOverride {
- public:
-  explicit BudgetOverride(std::uint64_t bytes) : saved_(HostBudget::global().limitBytes()) {
-    HostBudget::global().setLimit(bytes);
-  }
-  ~BudgetOverride() { HostBudget::global().setLimit(saved_); }
-  BudgetOverride(const BudgetOverride&) = delete;
-  BudgetOverride& operator=(const BudgetOverride&) = delete;
-
- private:
-  std::uint64_t saved_;
-};
+using test::BudgetOverride;
+using test::TempDir;
 
 TEST(Volume, AllocateRefusesWhatExceedsTheHostBudget) {
   const std::uint64_t before = HostBudget::global().limitBytes();

@@ -2,6 +2,7 @@
 
 #include <GLES3/gl3.h>
 
+#include "support/GpuTestContext.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/gpu/GlObjects.h"
@@ -12,9 +13,7 @@ using namespace tessera::gpu;
 
 namespace {
 GlContext& context() {
-  static std::unique_ptr<GlContext> c = GlContext::createHeadless();
-  c->makeCurrent();
-  return *c;
+  return test::gpuContext();
 }
 }  // namespace
 

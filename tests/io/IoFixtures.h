@@ -21,33 +21,10 @@
 
 #include <unistd.h>
 
+#include "support/TestSupport.h"
 #include "tessera/core/HostBudget.h"
 
 namespace tessera::test {
-
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    std::random_device rd;
-    path_ = std::filesystem::temp_directory_path() /
-            ("tessera-io-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + "-" +
-             std::to_string(rd()));
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  const std::filesystem::path& path() const { return path_; }
-  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  std::filesystem::path path_;
-};
 
 inline void writeFile(const std::filesystem::path& path, std::string_view bytes) {
   std::ofstream out(path, std::ios::binary);
@@ -181,19 +158,5 @@ void expectRejected(F&& f, const std::vector<std::string>& fragments) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_LT(seconds, 2.0) << "rejecting bad input took " << seconds << " s";
 }
-
-// Sets the host budget for one test and restores the previous one.
-class BudgetOverride {
- public:
-  explicit BudgetOverride(std::uint64_t bytes) : saved_(HostBudget::global().limitBytes()) {
-    HostBudget::global().setLimit(bytes);
-  }
-  ~BudgetOverride() { HostBudget::global().setLimit(saved_); }
-  BudgetOverride(const BudgetOverride&) = delete;
-  BudgetOverride& operator=(const BudgetOverride&) = delete;
-
- private:
-  std::uint64_t saved_;
-};
 
 }  // namespace tessera::test

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "support/GpuTestContext.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/io/Procedural.h"
@@ -14,9 +15,7 @@ using namespace tessera;
 
 namespace {
 gpu::GlContext& context() {
-  static std::unique_ptr<gpu::GlContext> c = gpu::GlContext::createHeadless();
-  c->makeCurrent();
-  return *c;
+  return test::gpuContext();
 }
 
 // A volume whose every voxel differs from its neighbours, so an addressing

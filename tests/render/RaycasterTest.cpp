@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "support/GpuTestContext.h"
 #include "tessera/core/Camera.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/io/Procedural.h"
@@ -18,9 +19,7 @@ using namespace tessera;
 namespace {
 
 gpu::GlContext& context() {
-  static std::unique_ptr<gpu::GlContext> c = gpu::GlContext::createHeadless();
-  c->makeCurrent();
-  return *c;
+  return test::gpuContext();
 }
 
 struct Comparison {

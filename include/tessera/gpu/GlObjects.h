@@ -106,4 +106,16 @@ class Framebuffer {
   Texture color_;
 };
 
+// One triangle covering the viewport, drawn with attribute 0 = a_position
+// (render/fullscreen.vert.glsl): the proxy of every full-screen pass.
+class FullscreenTriangle {
+ public:
+  FullscreenTriangle() = default;
+  explicit FullscreenTriangle(MemoryLedger& ledger);
+  void draw() const;
+
+ private:
+  Buffer vertices_;
+};
+
 }  // namespace tessera::gpu

@@ -67,7 +67,7 @@ class Raycaster {
   gpu::Texture lutTexture_;
   gpu::Texture blockTexture_;
   gpu::Framebuffer target_;
-  gpu::Buffer triangle_;
+  gpu::FullscreenTriangle triangle_;
   std::map<std::string, gpu::Program> programs_;
   // What the LUT/block texture were built for, to rebuild only on change.
   std::string lookupKey_;
