@@ -60,7 +60,8 @@ void runBench(const BenchOptions& o) {
   int width = 0, height = 0;
   parseSize(o.size, width, height);
   if (o.frames < 1) throw InputError("--frames must be >= 1");
-  auto layout = layout::Texture3DLayout::create(volume, context->caps(), context->ledger());
+  auto layout = layout::Texture3DLayout::create(volume, gpu::DeviceLimits::of(context->caps()),
+                                                context->ledger());
 
   std::vector<Variant> variants;
   variants.push_back({"plain (no ERT, no skipping)", 0, 2.0, nullptr, {}, {}, 0, 0, 0});

@@ -10,6 +10,8 @@ namespace tessera::app {
 void addInfoCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);
 void addBenchCommand(CLI::App& app);
+void addProfilesCommand(CLI::App& app);  // ProfilesCommand.cpp
+void addPlanCommand(CLI::App& app);      // PlanCommand.cpp
 
 // ch2 from mricron-data when installed, else a generated Shepp–Logan phantom.
 std::string defaultVolumeSpec();

@@ -52,7 +52,8 @@ RenderResult runRender(gpu::GlContext& context, const Volume& volume, const Tran
                        RenderRequest req) {
   if (req.repeat < 1) throw InputError("--repeat must be >= 1");
   RenderResult result;
-  auto layout = layout::Texture3DLayout::create(volume, context.caps(), context.ledger());
+  auto layout = layout::Texture3DLayout::create(volume, gpu::DeviceLimits::of(context.caps()),
+                                                context.ledger());
   result.layout = layout->name();
   result.layoutReason = layout->plan().reason;
   result.volumeTextureBytes = layout->textureBytes();

@@ -26,14 +26,16 @@ ShaderPart shaderPreamble(ApiLevel api, bool fragment, const std::vector<std::st
   if (api == ApiLevel::Gles3) {
     s = "#version 300 es\n";
     if (fragment) s += "precision highp float;\nprecision highp int;\nprecision highp sampler3D;\n";
-    s += "#define TESSERA_GLSL 300\n";
+    s += "#define TESSERA_GLSL 300\n#define TEX2D(s, p) texture(s, p)\n";
+    if (fragment) s += "out vec4 tessera_FragColor;\n#define FRAG_COLOR tessera_FragColor\n";
   } else {
     s = "#version 100\n";
     if (fragment) {
       s += "#ifdef GL_FRAGMENT_PRECISION_HIGH\nprecision highp float;\n#else\nprecision mediump "
            "float;\n#endif\n";
     }
-    s += "#define TESSERA_GLSL 100\n";
+    s += "#define TESSERA_GLSL 100\n#define TEX2D(s, p) texture2D(s, p)\n";
+    if (fragment) s += "#define FRAG_COLOR gl_FragColor\n";
   }
   for (const std::string& d : defines) s += "#define " + d + "\n";
   return {"<preamble>", s};

@@ -11,22 +11,12 @@
 namespace tessera::layout {
 
 namespace {
-bool hasNorm16(const gpu::DeviceCaps& caps) {
-  return caps.has("GL_EXT_texture_norm16");
-}
-
 std::string dimsText(glm::ivec3 d) {
   return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
 }
 }  // namespace
 
-bool Texture3DLayout::fits(const Volume& volume, const gpu::DeviceCaps& caps) {
-  const glm::ivec3 d = volume.dims();
-  return caps.api == gpu::ApiLevel::Gles3 && caps.max3DTextureSize > 0 &&
-         std::max({d.x, d.y, d.z}) <= caps.max3DTextureSize;
-}
-
-LayoutPlan Texture3DLayout::planFor(const Volume& volume, const gpu::DeviceCaps& caps) {
+LayoutPlan Texture3DLayout::planFor(const Volume& volume, const gpu::DeviceLimits& limits) {
   LayoutPlan plan;
   plan.layout = "texture3d";
   PlannedTexture t;
@@ -37,7 +27,7 @@ LayoutPlan Texture3DLayout::planFor(const Volume& volume, const gpu::DeviceCaps&
   if (volume.type() == ScalarType::U8) {
     t.format = "R8";
   } else {
-    t.format = hasNorm16(caps) ? "R16" : "R16F";
+    t.format = limits.norm16Textures ? "R16" : "R16F";
     bpt = 2;
   }
   t.bytes = volume.voxelCount() * bpt;
@@ -46,23 +36,30 @@ LayoutPlan Texture3DLayout::planFor(const Volume& volume, const gpu::DeviceCaps&
   const std::string what = dimsText(volume.dims()) + " " +
                            std::string(scalarTypeName(volume.type())) + " in one " + t.format +
                            " 3D texture (" + formatBytes(t.bytes) + ")";
-  if (fits(volume, caps)) {
-    plan.reason = what;
-  } else if (caps.api != gpu::ApiLevel::Gles3 || caps.max3DTextureSize == 0) {
-    plan.reason = "no 3D textures on this device";
+  const glm::ivec3 d = volume.dims();
+  if (limits.api != gpu::ApiLevel::Gles3 || limits.max3DTextureSize == 0) {
+    plan.reason = "no 3D textures on " + limits.profile;
+  } else if (std::max({d.x, d.y, d.z}) > limits.max3DTextureSize) {
+    plan.reason = what + " exceeds the max 3D texture size " +
+                  std::to_string(limits.max3DTextureSize) + " of " + limits.profile;
+  } else if (limits.textureBudget != 0 && t.bytes > limits.textureBudget) {
+    plan.reason = what + " exceeds the texture budget " + formatBytes(limits.textureBudget) +
+                  " of " + limits.profile;
+  } else if (limits.textureUnits < 1) {
+    plan.reason = "no texture unit left for the volume on " + limits.profile;
   } else {
-    plan.reason =
-        what + " exceeds the max 3D texture size " + std::to_string(caps.max3DTextureSize);
+    plan.fits = true;
+    plan.reason = what;
   }
   return plan;
 }
 
 std::unique_ptr<Texture3DLayout> Texture3DLayout::create(const Volume& volume,
-                                                         const gpu::DeviceCaps& caps,
+                                                         const gpu::DeviceLimits& limits,
                                                          gpu::MemoryLedger& ledger) {
   std::unique_ptr<Texture3DLayout> l(new Texture3DLayout());
-  l->plan_ = planFor(volume, caps);
-  if (!fits(volume, caps)) throw GpuError("texture3d layout: " + l->plan_.reason);
+  l->plan_ = planFor(volume, limits);
+  if (!l->plan_.fits) throw GpuError("texture3d layout: " + l->plan_.reason);
   l->dims_ = volume.dims();
   const glm::ivec3 d = volume.dims();
   if (volume.type() == ScalarType::U8) {
@@ -77,7 +74,7 @@ std::unique_ptr<Texture3DLayout> Texture3DLayout::create(const Volume& volume,
   l->mapping_ = {width, r.min};
   const std::size_t n = static_cast<std::size_t>(volume.voxelCount());
   HostBudget::global().check(n * 2, "texture3d upload staging");
-  if (hasNorm16(caps)) {
+  if (limits.norm16Textures) {
     std::vector<std::uint16_t> staging(n);
     for (std::size_t i = 0; i < n; ++i) {
       const double v = volume.valueAtIndex(i);

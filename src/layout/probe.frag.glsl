@@ -1,8 +1,7 @@
 // LayoutProbe: one fragment per position, writes sampleVolume(position).
 uniform highp sampler2D u_positions;  // RGB32F, one position per texel
-out vec4 fragColor;
 
 void main() {
   vec3 p = texelFetch(u_positions, ivec2(gl_FragCoord.xy), 0).xyz;
-  fragColor = vec4(sampleVolume(p), 0.0, 0.0, 1.0);
+  FRAG_COLOR = vec4(sampleVolume(p), 0.0, 0.0, 1.0);
 }

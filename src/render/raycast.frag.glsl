@@ -4,7 +4,6 @@
 // MIP with MODE_MIP. With EMPTY_SPACE_SKIPPING, blocks whose every possible
 // sample is transparent (or cannot raise the maximum) are jumped over
 // without changing which samples are taken.
-out vec4 fragColor;
 
 uniform float u_step;      // world units
 uniform int u_maxSteps;
@@ -77,5 +76,5 @@ void main() {
     acc = vec4(classify(maxValue).rgb, 1.0);
   }
 #endif
-  fragColor = vec4(acc.rgb + (1.0 - acc.a) * u_background.rgb, acc.a + (1.0 - acc.a) * u_background.a);
+  FRAG_COLOR = vec4(acc.rgb + (1.0 - acc.a) * u_background.rgb, acc.a + (1.0 - acc.a) * u_background.a);
 }

@@ -42,7 +42,7 @@ TEST(Texture3DLayout, SampleMatchesDirectIndexForEveryVoxel) {
   gpu::GlContext& c = context();
   for (ScalarType type : {ScalarType::U8, ScalarType::U16, ScalarType::I16, ScalarType::F32}) {
     const Volume v = addressPattern({13, 7, 5}, type);
-    auto layout = layout::Texture3DLayout::create(v, c.caps(), c.ledger());
+    auto layout = layout::Texture3DLayout::create(v, gpu::DeviceLimits::of(c.caps()), c.ledger());
     const auto positions = layout::LayoutProbe::voxelCentres(v.dims());
     const std::vector<float> stored = layout::LayoutProbe(c).sample(*layout, positions);
     const layout::ValueMapping m = layout->rawFromStored();
@@ -60,7 +60,7 @@ TEST(Texture3DLayout, SampleMatchesDirectIndexForEveryVoxel) {
 TEST(Texture3DLayout, InterpolationBetweenVoxelsMatchesReferenceTrilinear) {
   gpu::GlContext& c = context();
   const Volume v = makeSheppLogan({24, 20, 16});
-  auto layout = layout::Texture3DLayout::create(v, c.caps(), c.ledger());
+  auto layout = layout::Texture3DLayout::create(v, gpu::DeviceLimits::of(c.caps()), c.ledger());
   std::vector<glm::vec3> positions;
   for (int i = 0; i < 4000; ++i) {
     // A deterministic scatter over the whole box, edges included.
@@ -85,19 +85,25 @@ TEST(Texture3DLayout, InterpolationBetweenVoxelsMatchesReferenceTrilinear) {
 TEST(Texture3DLayout, PlanReportsBytesAndRefusesOversizedVolumes) {
   gpu::GlContext& c = context();
   const Volume v = makeSphere({40, 30, 20});
-  const layout::LayoutPlan plan = layout::Texture3DLayout::planFor(v, c.caps());
+  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());
+  const layout::LayoutPlan plan = layout::Texture3DLayout::planFor(v, limits);
+  EXPECT_TRUE(plan.fits);
   EXPECT_EQ(plan.totalBytes, 40u * 30 * 20);
   ASSERT_EQ(plan.textures.size(), 1u);
   EXPECT_EQ(plan.textures[0].format, "R8");
-  auto layout = layout::Texture3DLayout::create(v, c.caps(), c.ledger());
+  auto layout = layout::Texture3DLayout::create(v, gpu::DeviceLimits::of(c.caps()), c.ledger());
   EXPECT_EQ(layout->textureBytes(), plan.totalBytes);
 
-  gpu::DeviceCaps small = c.caps();
+  gpu::DeviceLimits small = limits;
   small.max3DTextureSize = 32;
-  EXPECT_FALSE(layout::Texture3DLayout::fits(v, small));
+  EXPECT_FALSE(layout::Texture3DLayout::planFor(v, small).fits);
   EXPECT_NE(layout::Texture3DLayout::planFor(v, small).reason.find("exceeds"), std::string::npos);
   EXPECT_THROW(layout::Texture3DLayout::create(v, small, c.ledger()), GpuError);
-  gpu::DeviceCaps es2 = c.caps();
+  gpu::DeviceLimits tight = limits;
+  tight.textureBudget = 40 * 30 * 20 - 1;
+  EXPECT_FALSE(layout::Texture3DLayout::planFor(v, tight).fits);
+  gpu::DeviceLimits es2 = limits;
   es2.api = gpu::ApiLevel::Gles2;
-  EXPECT_FALSE(layout::Texture3DLayout::fits(v, es2));
+  es2.max3DTextureSize = 0;
+  EXPECT_FALSE(layout::Texture3DLayout::planFor(v, es2).fits);
 }

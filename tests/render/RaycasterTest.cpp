@@ -30,7 +30,7 @@ struct Comparison {
 Comparison compare(const Volume& v, const TransferFunction& tf, Camera cam, const RenderSettings& s,
                    int size, int skipBlock = 8) {
   gpu::GlContext& c = context();
-  auto layout = layout::Texture3DLayout::create(v, c.caps(), c.ledger());
+  auto layout = layout::Texture3DLayout::create(v, gpu::DeviceLimits::of(c.caps()), c.ledger());
   render::Raycaster caster(c, v, *layout);
   caster.setSkipBlockSize(skipBlock);
   caster.setTransferFunction(tf);
@@ -103,7 +103,7 @@ TEST(Raycaster, OrthographicJitteredMatchesReference) {
 TEST(Raycaster, EmptySpaceSkippingDoesNotChangeTheImage) {
   const Volume v = makeSheppLogan({64, 64, 64});
   gpu::GlContext& c = context();
-  auto layout = layout::Texture3DLayout::create(v, c.caps(), c.ledger());
+  auto layout = layout::Texture3DLayout::create(v, gpu::DeviceLimits::of(c.caps()), c.ledger());
   render::Raycaster caster(c, v, *layout);
   caster.setTransferFunction(TransferFunction::preset("bench"));
   Camera cam;
@@ -165,7 +165,7 @@ TEST(Raycaster, ComparisonDetectsASmallCameraError) {
   // degrees off, or with opacities 30 % off, falls below it.
   const Volume v = makeSheppLogan({64, 64, 64});
   gpu::GlContext& c = context();
-  auto layout = layout::Texture3DLayout::create(v, c.caps(), c.ledger());
+  auto layout = layout::Texture3DLayout::create(v, gpu::DeviceLimits::of(c.caps()), c.ledger());
   render::Raycaster caster(c, v, *layout);
   caster.setTransferFunction(visibleTf());
   Camera cam;

@@ -27,7 +27,9 @@ struct ShaderPart {
 ShaderPart embeddedShaderPart(const std::string& path);
 
 // "#version ..." and precision statements for the API level, plus `defines`
-// ("NAME VALUE" strings become #define lines).
+// ("NAME VALUE" strings become #define lines). Parts written for both levels
+// use TESSERA_GLSL (100 or 300), TEX2D(sampler, uv) for 2D fetches and, in
+// fragment shaders, FRAG_COLOR for the output.
 ShaderPart shaderPreamble(ApiLevel api, bool fragment, const std::vector<std::string>& defines);
 
 class Program {

@@ -14,7 +14,7 @@
 #include <glm/vec3.hpp>
 
 #include "tessera/core/Volume.h"
-#include "tessera/gpu/DeviceCaps.h"
+#include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/Program.h"
 
 namespace tessera::layout {
@@ -35,7 +35,8 @@ struct PlannedTexture {
 };
 
 struct LayoutPlan {
-  std::string layout;  // "texture3d", ...
+  std::string layout;  // "texture3d", "mosaic", "packed-mosaic"
+  bool fits = false;   // false: `reason` says which limit it breaks
   std::vector<PlannedTexture> textures;
   std::uint64_t totalBytes = 0;
   std::string reason;  // one line a human can read
@@ -46,13 +47,17 @@ class Layout {
   virtual ~Layout() = default;
   virtual std::string name() const = 0;
   virtual const LayoutPlan& plan() const = 0;
-  // GLSL (for the context's API level) defining sampleVolume() and the
-  // samplers/uniforms it needs. Uniform names are prefixed "u_layout".
+  // GLSL for the API level the layout was created for (GLSL ES 1.00 for
+  // gles2: texture2D via the preamble's TEX2D macro, no integer tricks;
+  // GLSL ES 3.00 for gles3) defining sampleVolume() and the samplers and
+  // uniforms it needs. Uniform names are prefixed "u_layout".
   virtual gpu::ShaderPart glsl() const = 0;
   // Binds the layout's textures to units firstUnit.. and sets its uniforms
   // in `program` (which must be in use). Returns the number of units used.
   virtual int bind(const gpu::Program& program, int firstUnit) const = 0;
   virtual ValueMapping rawFromStored() const = 0;
+  // Texture units bind() uses.
+  virtual int textureUnits() const = 0;
   virtual glm::ivec3 volumeDims() const = 0;
   // Bytes of GPU memory the layout's textures occupy (from the ledger).
   virtual std::uint64_t textureBytes() const = 0;

@@ -12,14 +12,13 @@ namespace tessera::layout {
 
 class Texture3DLayout final : public Layout {
  public:
-  // What the layout would allocate for `volume` on a device with `caps`;
-  // reason says why it fits or why not (fits() == false).
-  static LayoutPlan planFor(const Volume& volume, const gpu::DeviceCaps& caps);
-  static bool fits(const Volume& volume, const gpu::DeviceCaps& caps);
+  // What the layout would allocate for `volume` within `limits`;
+  // plan.fits and plan.reason say whether and why (not).
+  static LayoutPlan planFor(const Volume& volume, const gpu::DeviceLimits& limits);
 
-  // Plans and uploads. Throws GpuError if 3D textures are unavailable or
-  // the volume exceeds the 3D texture size.
-  static std::unique_ptr<Texture3DLayout> create(const Volume& volume, const gpu::DeviceCaps& caps,
+  // Plans and uploads. Throws GpuError if the plan does not fit.
+  static std::unique_ptr<Texture3DLayout> create(const Volume& volume,
+                                                 const gpu::DeviceLimits& limits,
                                                  gpu::MemoryLedger& ledger);
 
   std::string name() const override { return "texture3d"; }
@@ -29,6 +28,7 @@ class Texture3DLayout final : public Layout {
   ValueMapping rawFromStored() const override { return mapping_; }
   glm::ivec3 volumeDims() const override { return dims_; }
   std::uint64_t textureBytes() const override { return texture_.bytes(); }
+  int textureUnits() const override { return 1; }
 
  private:
   Texture3DLayout() = default;
