@@ -57,6 +57,15 @@ Volume Volume::allocate(glm::ivec3 dims, ScalarType type, const std::string& wha
   return v;
 }
 
+Volume Volume::shapeOnly(glm::ivec3 dims, ScalarType type) {
+  Volume v;
+  v.dims_ = dims;
+  v.type_ = type;
+  v.range_ = {0.0, type == ScalarType::U8 ? 255.0 : 1.0};
+  v.rangeValid_ = true;  // nothing to scan
+  return v;
+}
+
 std::uint64_t Volume::voxelCount() const {
   return static_cast<std::uint64_t>(dims_.x) * static_cast<std::uint64_t>(dims_.y) *
          static_cast<std::uint64_t>(dims_.z);

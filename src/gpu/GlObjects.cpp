@@ -102,9 +102,11 @@ void checkGl(const std::string& what) {
 }  // namespace
 
 Texture Texture::create2D(MemoryLedger& ledger, const std::string& label, GLenumT internalFormat,
-                          int width, int height, GLenumT format, GLenumT type, const void* data) {
+                          int width, int height, GLenumT format, GLenumT type, const void* data,
+                          std::uint64_t texelBytes) {
   const std::uint64_t bytes = static_cast<std::uint64_t>(width) *
-                              static_cast<std::uint64_t>(height) * bytesPerTexel(internalFormat);
+                              static_cast<std::uint64_t>(height) *
+                              (texelBytes ? texelBytes : bytesPerTexel(internalFormat));
   Texture t;
   t.entry_ = LedgerEntry(ledger, GpuResource::Texture, bytes, label);  // budget check first
   glGetError();

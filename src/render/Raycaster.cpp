@@ -5,17 +5,16 @@
 #include <sstream>
 
 #include <glm/gtc/constants.hpp>
+#include <glm/gtc/packing.hpp>
 
 #include "gpu/gl.h"
 #include "tessera/core/Error.h"
+#include "tessera/gpu/DeviceProfile.h"
 
 namespace tessera::render {
 
 Raycaster::Raycaster(gpu::GlContext& context, const Volume& volume, const layout::Layout& layout)
     : context_(context), volume_(volume), layout_(layout), tf_(TransferFunction::preset("grey")) {
-  if (context.caps().api != gpu::ApiLevel::Gles3) {
-    throw GpuError("the ray caster needs an OpenGL ES 3.0 context");
-  }
   triangle_ = gpu::FullscreenTriangle(context.ledger());
   setSkipBlockSize(blockSize_);
 }
@@ -60,12 +59,7 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
   lookupKey_ = key.str();
 
   lut_ = tf_.bake(lutSize_, sampleDistance, settings.opacityScale);
-  if (lutTexture_.id() == 0) {
-    lutTexture_ = gpu::Texture::create2D(context_.ledger(), "transfer function", GL_RGBA16F,
-                                         lutSize_, 1, GL_RGBA, GL_FLOAT, lut_.data());
-  } else {
-    lutTexture_.update2D(GL_RGBA, GL_FLOAT, lut_.data());
-  }
+  uploadLut();
 
   occupiedFraction_ = 1.0;
   if (blockSize_ == 0) return;
@@ -80,7 +74,7 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
   }
   const double ww = w.max - w.min;
   const glm::ivec3 c = blocks_.blockCount();
-  std::vector<std::uint8_t> texels(static_cast<std::size_t>(c.x) * c.y * c.z * 2);
+  std::vector<std::uint8_t> cells(static_cast<std::size_t>(c.x) * c.y * c.z * 2);
   std::size_t occupiedCount = 0;
   for (std::size_t b = 0; b < blocks_.mins().size(); ++b) {
     const double nlo = std::clamp((blocks_.mins()[b] - w.min) / ww, 0.0, 1.0);
@@ -90,22 +84,92 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
     const bool occupied = opaquePrefix[static_cast<std::size_t>(i1) + 1] -
                               opaquePrefix[static_cast<std::size_t>(i0)] >
                           0;
-    texels[b * 2] = occupied ? 255 : 0;
+    cells[b * 2] = occupied ? 255 : 0;
     occupiedCount += occupied ? 1 : 0;
     // Rounded up so that "block max <= current max" never skips a larger sample.
-    texels[b * 2 + 1] = static_cast<std::uint8_t>(std::min(255.0, std::ceil(nhi * 255.0)));
+    cells[b * 2 + 1] = static_cast<std::uint8_t>(std::min(255.0, std::ceil(nhi * 255.0)));
   }
   occupiedFraction_ =
       static_cast<double>(occupiedCount) / static_cast<double>(blocks_.mins().size());
-  if (blockTexture_.id() == 0) {
-    blockTexture_ = gpu::Texture::create3D(context_.ledger(), "empty-space blocks", GL_RG8, c.x,
-                                           c.y, c.z, GL_RG, GL_UNSIGNED_BYTE, texels.data());
+  uploadBlocks(cells);
+}
+
+void Raycaster::uploadLut() {
+  // RGBA16F where the device filters half floats (all of ES 3, ES 2 with
+  // OES_texture_half_float_linear): 8-bit opacities would lose the small
+  // per-sample alphas of fine steps. RGBA8 otherwise.
+  const gpu::ApiLevel api = context_.caps().api;
+  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(context_.caps());
+  if (api == gpu::ApiLevel::Gles3) {
+    if (lutTexture_.id() == 0) {
+      lutTexture_ = gpu::Texture::create2D(context_.ledger(), "transfer function", GL_RGBA16F,
+                                           lutSize_, 1, GL_RGBA, GL_FLOAT, lut_.data());
+    } else {
+      lutTexture_.update2D(GL_RGBA, GL_FLOAT, lut_.data());
+    }
+    return;
+  }
+  if (limits.halfFloatTextures) {
+    std::vector<std::uint16_t> halves(lut_.size());
+    for (std::size_t i = 0; i < lut_.size(); ++i) halves[i] = glm::packHalf1x16(lut_[i]);
+    if (lutTexture_.id() == 0) {
+      lutTexture_ =
+          gpu::Texture::create2D(context_.ledger(), "transfer function", GL_RGBA, lutSize_, 1,
+                                 GL_RGBA, GL_HALF_FLOAT_OES, halves.data(), 8);
+    } else {
+      lutTexture_.update2D(GL_RGBA, GL_HALF_FLOAT_OES, halves.data());
+    }
+    return;
+  }
+  std::vector<std::uint8_t> bytes(lut_.size());
+  for (std::size_t i = 0; i < lut_.size(); ++i) {
+    bytes[i] = static_cast<std::uint8_t>(std::lround(std::clamp(lut_[i], 0.0f, 1.0f) * 255.0f));
+  }
+  if (lutTexture_.id() == 0) {
+    lutTexture_ = gpu::Texture::create2D(context_.ledger(), "transfer function", GL_RGBA, lutSize_,
+                                         1, GL_RGBA, GL_UNSIGNED_BYTE, bytes.data());
+  } else {
+    lutTexture_.update2D(GL_RGBA, GL_UNSIGNED_BYTE, bytes.data());
+  }
+}
+
+void Raycaster::uploadBlocks(const std::vector<std::uint8_t>& cells) {
+  // The grid's z-slices side by side in one RGBA8 2D texture (no 3D
+  // textures needed, so the same path serves ES 2 and ES 3).
+  const glm::ivec3 c = blocks_.blockCount();
+  const int maxSize = context_.caps().max2DTextureSize;
+  const int tilesX = std::max(1, std::min(c.z, maxSize / c.x));
+  const int tilesY = (c.z + tilesX - 1) / tilesX;
+  if (tilesY * c.y > maxSize) {
+    throw GpuError("empty-space grid " + std::to_string(c.x) + "x" + std::to_string(c.y) + "x" +
+                   std::to_string(c.z) + " does not fit a " + std::to_string(maxSize) +
+                   " texture; use a larger --skip-block");
+  }
+  blockTilesX_ = tilesX;
+  blockTexSize_ = glm::ivec2(tilesX * c.x, tilesY * c.y);
+  std::vector<std::uint8_t> texels(static_cast<std::size_t>(blockTexSize_.x) * blockTexSize_.y * 4,
+                                   0);
+  for (int z = 0; z < c.z; ++z) {
+    const int ox = (z % tilesX) * c.x, oy = (z / tilesX) * c.y;
+    for (int y = 0; y < c.y; ++y) {
+      for (int x = 0; x < c.x; ++x) {
+        const std::size_t b = blocks_.index(x, y, z);
+        const std::size_t t = (static_cast<std::size_t>(oy + y) * blockTexSize_.x + ox + x) * 4;
+        texels[t] = cells[b * 2];
+        texels[t + 1] = cells[b * 2 + 1];
+      }
+    }
+  }
+  const GLenum internal = context_.caps().api == gpu::ApiLevel::Gles3 ? GL_RGBA8 : GL_RGBA;
+  if (blockTexture_.id() == 0 || blockTexture_.width() != blockTexSize_.x ||
+      blockTexture_.height() != blockTexSize_.y) {
+    blockTexture_ = gpu::Texture();
+    blockTexture_ =
+        gpu::Texture::create2D(context_.ledger(), "empty-space blocks", internal, blockTexSize_.x,
+                               blockTexSize_.y, GL_RGBA, GL_UNSIGNED_BYTE, texels.data(), 4);
     blockTexture_.setFilter(GL_NEAREST, GL_NEAREST);
   } else {
-    glBindTexture(GL_TEXTURE_3D, blockTexture_.id());
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, c.x, c.y, c.z, GL_RG, GL_UNSIGNED_BYTE,
-                    texels.data());
+    blockTexture_.update2D(GL_RGBA, GL_UNSIGNED_BYTE, texels.data());
   }
 }
 
@@ -113,6 +177,7 @@ const gpu::Program& Raycaster::programFor(const RenderSettings& settings) {
   std::vector<std::string> defines;
   if (settings.mode == RenderMode::Mip) defines.push_back("MODE_MIP 1");
   if (blockSize_ > 0) defines.push_back("EMPTY_SPACE_SKIPPING 1");
+  defines.push_back("MAX_STEPS " + std::to_string(settings.maxSteps));
   std::string key = layout_.name();
   for (const auto& d : defines) key += "|" + d;
   auto it = programs_.find(key);
@@ -145,7 +210,9 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
     throw InputError("step must be a positive number of voxels, got " +
                      std::to_string(settings.stepVoxels));
   }
-  if (settings.maxSteps <= 0) throw InputError("max steps must be positive");
+  if (settings.maxSteps <= 0 || settings.maxSteps > 65536) {
+    throw InputError("max steps must be 1..65536, got " + std::to_string(settings.maxSteps));
+  }
   const glm::dvec3 spacing = volume_.spacing();
   const double ds = settings.stepVoxels * std::min({spacing.x, spacing.y, spacing.z});
   // MIP shows one classified sample, so its table is not distance-corrected
@@ -154,7 +221,9 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
 
   if (target_.id() == 0 || target_.width() != width || target_.height() != height) {
     target_ = gpu::Framebuffer();
-    target_ = gpu::Framebuffer::create(context_.ledger(), "ray-cast target", width, height);
+    target_ =
+        gpu::Framebuffer::create(context_.ledger(), "ray-cast target", width, height,
+                                 context_.caps().api == gpu::ApiLevel::Gles3 ? GL_RGBA8 : GL_RGBA);
   }
   target_.bind();
   const gpu::Program& prog = programFor(settings);
@@ -173,9 +242,9 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
   prog.set("u_viewport", glm::vec2(width, height));
   prog.set("u_extent", glm::vec3(volume_.extent()));
   prog.set("u_step", static_cast<float>(ds));
-  prog.set("u_maxSteps", settings.maxSteps);
+  prog.set("u_maxSteps", static_cast<float>(settings.maxSteps));
   prog.set("u_ert", static_cast<float>(settings.ertThreshold));
-  prog.set("u_jitter", settings.jitter ? 1 : 0);
+  prog.set("u_jitter", settings.jitter ? 1.0f : 0.0f);
   prog.set("u_background", glm::vec4(settings.background));
 
   // normalised = (raw - wmin) / (wmax - wmin), raw = scale * stored + offset.
@@ -195,6 +264,8 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
     prog.set("u_blocksPerUnit",
              glm::vec3(glm::dvec3(volume_.dims()) / static_cast<double>(blockSize_)));
     prog.set("u_blockCount", glm::vec3(blocks_.blockCount()));
+    prog.set("u_blockTilesX", static_cast<float>(blockTilesX_));
+    prog.set("u_blockTexSize", glm::vec2(blockTexSize_));
   }
 
   glDisable(GL_BLEND);

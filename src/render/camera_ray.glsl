@@ -40,13 +40,20 @@ vec3 safeInverse(vec3 d) {
   return s / max(abs(d), vec3(1e-20));
 }
 
-#if TESSERA_GLSL == 300
-// Same integer hash as tessera::jitterOffset (core/RenderSettings.h).
-float jitterOffset(uint x, uint y) {
-  uint v = x * 1973u + y * 9277u + 26699u;
-  v = v * 747796405u + 2891336453u;
-  uint w = ((v >> ((v >> 28u) + 4u)) ^ v) * 277803737u;
-  w = (w >> 22u) ^ w;
-  return float(w >> 8u) / 16777216.0;
+// Offset of the first sample, in [0,1): an 8x8 ordered-dither (Bayer)
+// pattern over the pixel grid, the twin of tessera::jitterOffset
+// (core/RenderSettings.h). Small integers only, so float maths is exact in
+// GLSL ES 1.00 and 3.00 alike. x, y: pixel column and row from the top.
+float jitterOffset(float x, float y) {
+  float v = 0.0;
+  float scale = 16.0;
+  float bit = 1.0;
+  for (int i = 0; i < 3; ++i) {
+    float xi = mod(floor(x / bit), 2.0);
+    float yi = mod(floor(y / bit), 2.0);
+    v += (2.0 * abs(xi - yi) + yi) * scale;
+    scale *= 0.25;
+    bit *= 2.0;
+  }
+  return (v + 0.5) / 64.0;
 }
-#endif

@@ -1,20 +1,34 @@
-// Single-pass ray caster (GLSL ES 3.00): ray-box intersection here, no proxy
-// pass; samples at t0 + (k + j) * ds; front-to-back compositing of
-// premultiplied colour (Noguera et al. 2012, eq. 1) with early termination;
-// MIP with MODE_MIP. With EMPTY_SPACE_SKIPPING, blocks whose every possible
-// sample is transparent (or cannot raise the maximum) are jumped over
-// without changing which samples are taken.
+// Single-pass ray caster for GLSL ES 1.00 and 3.00: ray-box intersection
+// here, no proxy pass; samples at t0 + (k + j) * ds; front-to-back
+// compositing of premultiplied colour (Noguera et al. 2012, eq. 1) with
+// early termination; MIP with MODE_MIP. The loop bound MAX_STEPS is a
+// compile-time constant, as GLSL ES 1.00 requires (Appendix A).
+// With EMPTY_SPACE_SKIPPING, blocks whose every possible sample is
+// transparent (or cannot raise the maximum) are jumped over without changing
+// which samples are taken, so the image is the same as without skipping.
 
 uniform float u_step;      // world units
-uniform int u_maxSteps;
+uniform float u_maxSteps;  // the user's cap, <= MAX_STEPS
 uniform float u_ert;       // early termination threshold
-uniform int u_jitter;
+uniform float u_jitter;    // 1.0: dithered first sample
 uniform vec4 u_background; // premultiplied
 
 #ifdef EMPTY_SPACE_SKIPPING
-uniform highp sampler3D u_blocks;  // RG8: r = any opacity, g = ceil(max normalised value)
-uniform vec3 u_blocksPerUnit;      // blocks per texture-space unit = dims / blockSize
+// The block grid as a 2D mosaic of its z-slices (works without 3D textures):
+// r = 1 where the TF gives some sample in the block opacity,
+// g = the largest normalised value in the block, rounded up.
+uniform sampler2D u_blocks;
+uniform vec3 u_blocksPerUnit;  // blocks per texture-space unit = dims / blockSize
 uniform vec3 u_blockCount;
+uniform float u_blockTilesX;   // z-slices of the grid per mosaic row
+uniform vec2 u_blockTexSize;
+
+vec4 blockAt(vec3 cell) {
+  float tileX = mod(cell.z, u_blockTilesX);
+  float tileY = floor(cell.z / u_blockTilesX);
+  vec2 texel = vec2(tileX * u_blockCount.x + cell.x, tileY * u_blockCount.y + cell.y) + 0.5;
+  return TEX2D(u_blocks, texel / u_blockTexSize);
+}
 #endif
 
 void main() {
@@ -33,27 +47,29 @@ void main() {
   float maxValue = -1.0;
   if (t0 < t1) {
     float j = 0.5;
-    if (u_jitter == 1) {
-      j = jitterOffset(uint(gl_FragCoord.x), uint(u_viewport.y - gl_FragCoord.y));
+    if (u_jitter > 0.5) {
+      j = jitterOffset(floor(gl_FragCoord.x), u_viewport.y - 1.0 - floor(gl_FragCoord.y));
     }
-    int k = 0;
-    while (k < u_maxSteps) {
-      float t = t0 + (float(k) + j) * u_step;
+    float k = 0.0;  // sample index; a float so GLSL ES 1.00 needs no integer maths
+    for (int i = 0; i < MAX_STEPS; ++i) {
+      if (k >= u_maxSteps) break;
+      float t = t0 + (k + j) * u_step;
       if (t >= t1) break;
       vec3 p = to + t * td;
 #ifdef EMPTY_SPACE_SKIPPING
       vec3 cell = clamp(floor(p * u_blocksPerUnit), vec3(0.0), u_blockCount - 1.0);
-      vec2 block = texelFetch(u_blocks, ivec3(cell), 0).rg;
+      vec4 block = blockAt(cell);
 #ifdef MODE_MIP
       bool empty = block.g <= maxValue;
 #else
       bool empty = block.r < 0.5;
 #endif
       if (empty) {
+        // Jump to the first sample at or past the block's exit face.
         vec3 exitFace = (cell + step(0.0, td)) / u_blocksPerUnit;
         vec3 tb = (exitFace - to) * invTd;
         float tExit = min(min(tb.x, tb.y), tb.z);
-        k = max(int(ceil((tExit - t0) / u_step - j)), k + 1);
+        k = max(ceil((tExit - t0) / u_step - j), k + 1.0);
         continue;
       }
 #endif
@@ -66,7 +82,7 @@ void main() {
       acc.a += (1.0 - acc.a) * c.a;
       if (acc.a >= u_ert) break;
 #endif
-      k++;
+      k += 1.0;
     }
   }
 #ifdef MODE_MIP

@@ -20,21 +20,26 @@ struct RenderSettings {
   double opacityScale = 1.0;
   // Early ray termination: stop once accumulated alpha >= this. >= 1 disables it.
   double ertThreshold = 0.99;
-  // Per-pixel offset of the first sample in [0,1) from an integer hash of the
-  // pixel (same hash on GPU and CPU); otherwise samples sit at t0 + (k + 0.5) ds.
+  // Per-pixel offset of the first sample in [0,1) from an ordered-dither
+  // pattern (jitterOffset, same on GPU and CPU); otherwise samples sit at
+  // t0 + (k + 0.5) ds.
   bool jitter = false;
   // Composited behind the volume: out = C + (1 - A) * background.
   glm::dvec4 background{0.0, 0.0, 0.0, 1.0};
 };
 
-// The pixel hash used for jitter: a PCG-style integer hash of (x, y),
-// returned as a fraction in [0,1). GLSL twin in render/common.glsl.
+// Jitter offset of pixel (x, y) (y from the top row): an 8x8 ordered-dither
+// (Bayer) pattern, (M(x mod 8, y mod 8) + 0.5) / 64, where the base-4 digit i
+// of M is 2 * (x_i xor y_i) + y_i for bit i of x and y. Small integers only,
+// so the GLSL twin (render/camera_ray.glsl) is exact even in GLSL ES 1.00,
+// which has no integer bit operations.
 inline double jitterOffset(unsigned x, unsigned y) {
-  unsigned v = x * 1973u + y * 9277u + 26699u;
-  v = v * 747796405u + 2891336453u;
-  unsigned w = ((v >> ((v >> 28u) + 4u)) ^ v) * 277803737u;
-  w = (w >> 22u) ^ w;
-  return static_cast<double>(w >> 8) / 16777216.0;
+  unsigned v = 0;
+  for (unsigned i = 0; i < 3; ++i) {
+    const unsigned xi = (x >> i) & 1u, yi = (y >> i) & 1u;
+    v += (2u * (xi ^ yi) + yi) << (2u * (2u - i));
+  }
+  return (v + 0.5) / 64.0;
 }
 
 }  // namespace tessera

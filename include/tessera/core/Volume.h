@@ -29,6 +29,11 @@ class Volume {
   // volume in error messages (usually the file name).
   static Volume allocate(glm::ivec3 dims, ScalarType type, const std::string& what = "volume");
 
+  // A volume's shape without voxels (for planning what a volume of these
+  // dims and type would need): hasData() is false, value access is invalid.
+  static Volume shapeOnly(glm::ivec3 dims, ScalarType type);
+  bool hasData() const { return !data_.empty(); }
+
   glm::ivec3 dims() const { return dims_; }
   glm::dvec3 spacing() const { return spacing_; }
   glm::dvec3 origin() const { return origin_; }

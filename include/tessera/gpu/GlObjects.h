@@ -41,8 +41,11 @@ class Texture {
 
   // Allocates (and optionally fills) a texture; `data` may be null.
   // Filtering: linear, wrap: clamp to edge.
+  // `texelBytes` overrides bytesPerTexel(internalFormat) for the unsized
+  // formats of ES 2.0, whose size depends on `type` (GL_RGBA + half floats).
   static Texture create2D(MemoryLedger& ledger, const std::string& label, GLenumT internalFormat,
-                          int width, int height, GLenumT format, GLenumT type, const void* data);
+                          int width, int height, GLenumT format, GLenumT type, const void* data,
+                          std::uint64_t texelBytes = 0);
   static Texture create3D(MemoryLedger& ledger, const std::string& label, GLenumT internalFormat,
                           int width, int height, int depth, GLenumT format, GLenumT type,
                           const void* data);

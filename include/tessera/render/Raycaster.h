@@ -1,7 +1,9 @@
 #pragma once
-// The single-pass GPU ray caster. Works on any Layout (it only calls
-// sampleVolume()), with composite and MIP modes, early ray termination,
-// jitter and empty-space skipping over a block min/max grid.
+// The single-pass GPU ray caster, in OpenGL ES 2.0 and 3.0 contexts alike.
+// Works on any Layout (it only calls sampleVolume()), with composite and MIP
+// modes, early ray termination, jitter and empty-space skipping over a block
+// min/max grid. Besides the layout's units it uses two: the TF and the grid.
+#include <glm/vec2.hpp>
 #include <map>
 #include <memory>
 #include <string>
@@ -49,12 +51,16 @@ class Raycaster {
   // occupied (1 when skipping is off); valid after prepare()/renderFrame().
   double occupiedBlockFraction() const { return occupiedFraction_; }
 
+  static constexpr int kOwnTextureUnits = 2;
+
   // GPU memory of this ray caster's own resources (TF, block grid, target).
   std::uint64_t ownTextureBytes() const;
 
  private:
   const gpu::Program& programFor(const RenderSettings& settings);
   void updateLookup(const RenderSettings& settings, double sampleDistance);
+  void uploadLut();
+  void uploadBlocks(const std::vector<std::uint8_t>& cells);
 
   gpu::GlContext& context_;
   const Volume& volume_;
@@ -72,6 +78,8 @@ class Raycaster {
   // What the LUT/block texture were built for, to rebuild only on change.
   std::string lookupKey_;
   double occupiedFraction_ = 1.0;
+  int blockTilesX_ = 1;
+  glm::ivec2 blockTexSize_{0};
 };
 
 }  // namespace tessera::render
