@@ -14,13 +14,18 @@ uniform float u_jitter;    // 1.0: dithered first sample
 uniform vec4 u_background; // premultiplied
 
 #ifdef EMPTY_SPACE_SKIPPING
-// The block grid as a 2D mosaic of its z-slices (works without 3D textures):
-// r = 1 where the TF gives some sample in the block opacity,
+// The block grid: r = 1 where the TF gives some sample in the block opacity,
 // g = the largest normalised value in the block, rounded up.
-uniform sampler2D u_blocks;
 uniform vec3 u_blocksPerUnit;  // blocks per texture-space unit = dims / blockSize
 uniform vec3 u_blockCount;
-uniform float u_blockTilesX;   // z-slices of the grid per mosaic row
+#if TESSERA_GLSL == 300
+uniform highp sampler3D u_blocks;
+
+vec4 blockAt(vec3 cell) { return texelFetch(u_blocks, ivec3(cell), 0); }
+#else
+// Without 3D textures: the grid's z-slices side by side in a 2D texture.
+uniform sampler2D u_blocks;
+uniform float u_blockTilesX;  // z-slices of the grid per mosaic row
 uniform vec2 u_blockTexSize;
 
 vec4 blockAt(vec3 cell) {
@@ -29,6 +34,7 @@ vec4 blockAt(vec3 cell) {
   vec2 texel = vec2(tileX * u_blockCount.x + cell.x, tileY * u_blockCount.y + cell.y) + 0.5;
   return TEX2D(u_blocks, texel / u_blockTexSize);
 }
+#endif
 #endif
 
 void main() {
