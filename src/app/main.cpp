@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   tessera::app::addInfoCommand(app);
   tessera::app::addRenderCommand(app);
   tessera::app::addBenchCommand(app);
+  tessera::app::addProfilesCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -34,10 +34,22 @@ struct DeviceProfile {
   // JSON: {"name", "note", "api": "gles2"|"gles3", "max_2d_texture_size",
   // "max_3d_texture_size", "texture_units", "texture_budget_mb",
   // "host_budget_mb", "float_render_targets"}; InputError naming the file.
+  // "name" and "api" are required. Sizes and units are integers or
+  // "unlimited" (left out: unlimited; max_3d_texture_size 0 = no 3D textures,
+  // the only value gles2 allows and its default). Budgets are MiB, 0 or left
+  // out = unlimited. float_render_targets defaults to false for gles2 (and
+  // must be) and true for gles3. Unknown keys are errors.
   static DeviceProfile load(const std::filesystem::path& path);
+  // `what` names the source in error messages (the file's path).
   static DeviceProfile fromJson(const std::string& text, const std::string& what);
+  // Pretty-printed JSON that fromJson() reads back to an equal profile.
   std::string toJson() const;
+
+  bool operator==(const DeviceProfile&) const = default;
 };
+
+// "gles2" or "gles3", as in profile files and `tessera profiles`.
+const char* apiLevelName(ApiLevel api);
 
 // What the engine may use on this context under this profile.
 struct DeviceLimits {
