@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
@@ -10,6 +11,8 @@
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/io/VolumeReader.h"
+#include "tessera/layout/MosaicLayout.h"
+#include "tessera/layout/PackedMosaicLayout.h"
 #include "tessera/layout/Texture3DLayout.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
@@ -27,6 +30,7 @@ struct BenchOptions {
   double step = 0.5;
   std::string tf = "bench";
   bool json = false;
+  bool layouts = false;
 };
 
 struct Variant {
@@ -149,6 +153,121 @@ void runBench(const BenchOptions& o) {
   }
 }
 
+struct LayoutVariant {
+  std::string name;
+  std::unique_ptr<layout::Layout> layout;
+  std::unique_ptr<render::Raycaster> caster;
+  std::vector<double> ms;
+  Image first;
+};
+
+// The cost of the texture coordinate adapter (Noguera & Jiménez 2012): the
+// same ray caster and settings on each layout, frames interleaved so that a
+// shared machine's load falls on all alike; ratios to texture3d.
+void runLayoutBench(const BenchOptions& o) {
+  const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
+  const Volume volume = readVolume(spec);
+  const TransferFunction tf = TransferFunction::fromPresetOrFile(o.tf);
+  auto context = gpu::GlContext::createHeadless();
+  int width = 0, height = 0;
+  parseSize(o.size, width, height);
+  if (o.frames < 1) throw InputError("--frames must be >= 1");
+  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(context->caps());
+  gpu::DeviceLimits small = limits;
+  small.max2DTextureSize = 1024;  // forces packed-mosaic across several textures
+
+  std::vector<LayoutVariant> variants;
+  variants.push_back({"texture3d",
+                      layout::Texture3DLayout::create(volume, limits, context->ledger()),
+                      {},
+                      {},
+                      {}});
+  variants.push_back(
+      {"mosaic", layout::MosaicLayout::create(volume, limits, context->ledger()), {}, {}, {}});
+  variants.push_back({"packed-mosaic",
+                      layout::PackedMosaicLayout::create(volume, limits, context->ledger(), 14),
+                      {},
+                      {},
+                      {}});
+  variants.push_back({"packed-mosaic, 1024² textures",
+                      layout::PackedMosaicLayout::create(volume, small, context->ledger(), 14),
+                      {},
+                      {},
+                      {}});
+  RenderSettings settings;
+  settings.stepVoxels = o.step;
+  Camera camera;
+  camera.frame(volume.extent());
+  for (LayoutVariant& v : variants) {
+    v.caster = std::make_unique<render::Raycaster>(*context, volume, *v.layout);
+    v.caster->setTransferFunction(tf);
+    v.caster->prepare(settings);
+  }
+  for (int f = 0; f < o.frames; ++f) {
+    Camera cam = camera;
+    cam.azimuthDeg += f * o.rotate;
+    for (LayoutVariant& v : variants) {
+      const auto t0 = std::chrono::steady_clock::now();
+      v.caster->renderFrame(cam, settings, width, height);
+      v.ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      if (f == 0) v.first = v.caster->readImage();
+    }
+    if (!o.json) std::fprintf(stderr, "\rframe %d/%d", f + 1, o.frames);
+  }
+  if (!o.json) std::fprintf(stderr, "\r%*s\r", 20, "");
+  const Image ref = renderReference(volume, tf, camera, settings, width, height);
+  const double base = median(variants[0].ms);
+  nlohmann::json rows = nlohmann::json::array();
+  if (!o.json) {
+    std::printf(
+        "layouts: ray casting %s at %dx%d, %d frames rotating %g deg, step %g voxel, TF %s, "
+        "ERT + 8^3 skipping\nGL: %s; variants interleaved frame by frame\n\n",
+        spec.c_str(), width, height, o.frames, o.rotate, o.step, o.tf.c_str(),
+        context->caps().renderer.c_str());
+    std::printf(
+        "| layout | textures | median ms | min ms | ÷ texture3d | PSNR vs reference | PSNR vs "
+        "texture3d |\n");
+    std::printf("|---|---|---:|---:|---:|---:|---:|\n");
+  }
+  for (const LayoutVariant& v : variants) {
+    const double med = median(v.ms);
+    const double vsRef = psnr(v.first, ref);
+    const double vs3d = psnr(v.first, variants[0].first);
+    std::string textures;
+    for (const auto& t : v.layout->plan().textures) {
+      if (!textures.empty()) textures += " + ";
+      textures += (t.is3D ? std::to_string(t.size.x) + "x" + std::to_string(t.size.y) + "x" +
+                                std::to_string(t.size.z)
+                          : std::to_string(t.size.x) + "x" + std::to_string(t.size.y)) +
+                  " " + t.format;
+    }
+    if (!o.json) {
+      std::printf(
+          "| %s | %s | %.1f | %.1f | %.2f | %.2f dB | %s |\n", v.name.c_str(), textures.c_str(),
+          med, *std::min_element(v.ms.begin(), v.ms.end()), med / base, vsRef,
+          std::isinf(vs3d) ? "identical" : (std::to_string(vs3d).substr(0, 5) + " dB").c_str());
+    }
+    rows.push_back({{"layout", v.name},
+                    {"textures", textures},
+                    {"ms_median", med},
+                    {"ratio_to_texture3d", med / base},
+                    {"psnr_vs_reference", vsRef},
+                    {"psnr_vs_texture3d", std::isinf(vs3d) ? 999.0 : vs3d},
+                    {"frame_ms", v.ms}});
+  }
+  if (o.json) {
+    nlohmann::json j;
+    j["file"] = spec;
+    j["width"] = width;
+    j["height"] = height;
+    j["frames"] = o.frames;
+    j["gl_renderer"] = context->caps().renderer;
+    j["rows"] = rows;
+    std::printf("%s\n", j.dump(2).c_str());
+  }
+}
+
 }  // namespace
 
 void addBenchCommand(CLI::App& app) {
@@ -164,8 +283,10 @@ void addBenchCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--step", o->step, "Sample distance in voxels")->capture_default_str();
   cmd->add_option("--tf", o->tf, "Transfer function preset or JSON file")->capture_default_str();
+  cmd->add_flag("--layouts", o->layouts,
+                "Compare layouts (texture3d, mosaic, packed-mosaic) instead of accelerations");
   cmd->add_flag("--json", o->json, "Print JSON instead of a Markdown table");
-  cmd->callback([o] { runBench(*o); });
+  cmd->callback([o] { o->layouts ? runLayoutBench(*o) : runBench(*o); });
 }
 
 }  // namespace tessera::app

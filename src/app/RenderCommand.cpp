@@ -40,6 +40,8 @@ struct RenderOptions {
   double rotate = 10.0;
   int skipBlock = 8;
   int lut = 4096;
+  std::string profile = "native";
+  std::string layout = "auto";
   bool json = false;
 };
 
@@ -83,8 +85,12 @@ void runRenderCommand(const RenderOptions& o) {
   req.skipBlock = o.skipBlock;
   req.lutSize = o.lut;
 
+  req.layout = o.layout;
   const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
   const TransferFunction tf = TransferFunction::fromPresetOrFile(o.tf);
+  // The profile first: it sets the host budget the reader must respect.
+  DeviceSession device = openDevice(o.profile);
+  const gpu::GlContext* context = device.context.get();
   const auto tLoad = std::chrono::steady_clock::now();
   Volume volume = readVolume(spec);
   const double loadMs = msSince(tLoad);
@@ -93,8 +99,7 @@ void runRenderCommand(const RenderOptions& o) {
     volume.setWindow({o.window[0], o.window[1]});
   }
 
-  auto context = gpu::GlContext::createHeadless();
-  const RenderResult r = runRender(*context, volume, tf, req);
+  const RenderResult r = runRender(device, volume, tf, req);
   r.first.writePng(o.out);
   if (r.referenceImage && !o.referenceOut.empty()) r.referenceImage->writePng(o.referenceOut);
   const double totalMs = msSince(tStart);
@@ -119,6 +124,12 @@ void runRenderCommand(const RenderOptions& o) {
     j["gl_version"] = context->caps().version;
     j["egl_platform"] = context->platform();
     j["layout"] = r.layout;
+    j["profile"] = device.profile.name;
+    j["api"] = gpu::apiLevelName(device.limits.api);
+    j["plan_reason"] = r.plan.reason;
+    j["downsample"] = {r.plan.downsample.x, r.plan.downsample.y, r.plan.downsample.z};
+    j["rendered_dims"] = {r.renderedDims.x, r.renderedDims.y, r.renderedDims.z};
+    j["texture_budget"] = device.limits.textureBudget;
     j["load_ms"] = loadMs;
     j["prepare_ms"] = r.prepareMs;
     j["occupied_block_fraction"] = r.occupiedBlockFraction;
@@ -133,11 +144,19 @@ void runRenderCommand(const RenderOptions& o) {
   std::printf("volume   %s: %dx%dx%d %s, loaded in %.0f ms\n", spec.c_str(), volume.dims().x,
               volume.dims().y, volume.dims().z, std::string(scalarTypeName(volume.type())).c_str(),
               loadMs);
-  std::printf("gpu      %s (%s, EGL %s)\n", context->caps().renderer.c_str(),
-              context->caps().version.c_str(), context->platform().c_str());
+  std::printf("gpu      %s (%s, EGL %s); %s context, GLSL ES %s\n",
+              context->caps().renderer.c_str(), context->caps().version.c_str(),
+              context->platform().c_str(),
+              device.limits.api == gpu::ApiLevel::Gles2 ? "ES 2.0" : "ES 3.0",
+              device.limits.api == gpu::ApiLevel::Gles2 ? "1.00" : "3.00");
+  std::printf("profile  %s (%s)\n", device.profile.name.c_str(), device.profile.note.c_str());
   std::printf("layout   %s: %s\n", r.layout.c_str(), r.layoutReason.c_str());
-  std::printf("textures %s on the GPU (%llu bytes)\n", formatBytes(r.textureBytes).c_str(),
-              static_cast<unsigned long long>(r.textureBytes));
+  if (!r.planNote.empty()) std::printf("note     %s\n", r.planNote.c_str());
+  std::printf("textures %s on the GPU (%llu bytes)%s\n", formatBytes(r.textureBytes).c_str(),
+              static_cast<unsigned long long>(r.textureBytes),
+              device.limits.textureBudget
+                  ? (", budget " + formatBytes(device.limits.textureBudget)).c_str()
+                  : "");
   if (r.frameMs.size() == 1) {
     std::printf("render   %.1f ms (after %.0f ms of shader compile and set-up)\n", r.frameMs[0],
                 r.prepareMs);
@@ -200,6 +219,13 @@ void addRenderCommand(CLI::App& app) {
                   "Empty-space skipping block size in voxels (0 = off)")
       ->capture_default_str();
   cmd->add_option("--lut", o->lut, "Transfer-function table entries (256 or 4096)")
+      ->capture_default_str();
+  cmd->add_option("--profile", o->profile,
+                  "Device profile to obey (tessera profiles lists them) or FILE.json")
+      ->capture_default_str();
+  cmd->add_option(
+         "--layout", o->layout,
+         "Volume storage: auto, texture3d, mosaic or packed-mosaic (auto: the planner chooses)")
       ->capture_default_str();
   cmd->add_flag("--json", o->json, "Print one JSON object instead of text");
   cmd->callback([o] { runRenderCommand(*o); });

@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <chrono>
 
+#include <glm/vec3.hpp>
+
 #include "tessera/core/Error.h"
-#include "tessera/layout/Texture3DLayout.h"
+#include "tessera/core/HostBudget.h"
+#include "tessera/lod/Downsample.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
 #include "tessera/render/Raycaster.h"
@@ -48,14 +51,23 @@ void parseSize(const std::string& text, int& width, int& height) {
   }
 }
 
-RenderResult runRender(gpu::GlContext& context, const Volume& volume, const TransferFunction& tf,
+RenderResult runRender(DeviceSession& device, const Volume& fullVolume, const TransferFunction& tf,
                        RenderRequest req) {
   if (req.repeat < 1) throw InputError("--repeat must be >= 1");
+  gpu::GlContext& context = *device.context;
   RenderResult result;
-  auto layout = layout::Texture3DLayout::create(volume, gpu::DeviceLimits::of(context.caps()),
-                                                context.ledger());
+  const render::RaycastPlan rp = render::planRaycast(device.limits, fullVolume, req.layout,
+                                                     req.width, req.height, req.skipBlock);
+  result.plan = rp.plan;
+  result.planNote = rp.note;
+  req.skipBlock = rp.skipBlock;
+  Volume reduced;
+  if (result.plan.downsampled()) reduced = lod::downsample(fullVolume, result.plan.downsample);
+  const Volume& volume = result.plan.downsampled() ? reduced : fullVolume;
+  result.renderedDims = volume.dims();
+  auto layout = layout::createLayout(result.plan, volume, device.limits, context.ledger());
   result.layout = layout->name();
-  result.layoutReason = layout->plan().reason;
+  result.layoutReason = result.plan.reason;
   result.volumeTextureBytes = layout->textureBytes();
 
   render::Raycaster caster(context, volume, *layout);

@@ -10,11 +10,19 @@
 #include "tessera/core/RenderSettings.h"
 #include "tessera/core/TransferFunction.h"
 #include "tessera/core/Volume.h"
+#include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/GlContext.h"
+#include "tessera/layout/Planner.h"
+#include "tessera/render/DeviceSession.h"
+#include "tessera/render/RaycastPlan.h"
 
 namespace tessera::app {
 
+using render::DeviceSession;
+using render::openDevice;
+
 struct RenderRequest {
+  std::string layout = "auto";
   int width = 512;
   int height = 512;
   Camera camera;  // radius is set from the volume
@@ -41,13 +49,16 @@ struct RenderResult {
   double occupiedBlockFraction = 1.0;
   std::string layout;
   std::string layoutReason;
+  layout::Plan plan;
+  std::string planNote;
+  glm::ivec3 renderedDims{0};  // after any downsampling the plan asked for
 
   double median() const;
   double min() const;
   double max() const;
 };
 
-RenderResult runRender(gpu::GlContext& context, const Volume& volume, const TransferFunction& tf,
+RenderResult runRender(DeviceSession& device, const Volume& volume, const TransferFunction& tf,
                        RenderRequest request);
 
 // Parses "512x512".

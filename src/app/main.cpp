@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   tessera::app::addRenderCommand(app);
   tessera::app::addBenchCommand(app);
   tessera::app::addProfilesCommand(app);
+  tessera::app::addPlanCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

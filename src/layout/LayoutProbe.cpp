@@ -1,6 +1,7 @@
 #include "tessera/layout/LayoutProbe.h"
 
 #include <algorithm>
+#include <cstdint>
 
 #include "gpu/gl.h"
 #include "tessera/core/Error.h"
@@ -24,10 +25,18 @@ std::vector<glm::vec3> LayoutProbe::voxelCentres(glm::ivec3 d) {
 
 std::vector<float> LayoutProbe::sample(const Layout& layout,
                                        const std::vector<glm::vec3>& positions) {
-  if (!context_.caps().has("GL_EXT_color_buffer_float")) {
-    throw GpuError("LayoutProbe needs GL_EXT_color_buffer_float");
-  }
   if (positions.empty()) return {};
+  if (context_.caps().api == gpu::ApiLevel::Gles3 &&
+      context_.caps().has("GL_EXT_color_buffer_float")) {
+    return sampleFloat(layout, positions);
+  }
+  return sampleRgba8(layout, positions);
+}
+
+// ES 3 with float render targets: positions in an RGBA32F texture read with
+// texelFetch, values written to an RGBA32F target.
+std::vector<float> LayoutProbe::sampleFloat(const Layout& layout,
+                                            const std::vector<glm::vec3>& positions) {
   const gpu::ApiLevel api = context_.caps().api;
   const gpu::Program program = gpu::Program::build(
       "probe(" + layout.name() + ")",
@@ -72,6 +81,77 @@ std::vector<float> LayoutProbe::sample(const Layout& layout,
   if (err != GL_NO_ERROR) throw GpuError("LayoutProbe: GL error " + std::to_string(err));
   std::vector<float> out(positions.size());
   for (std::size_t i = 0; i < out.size(); ++i) out[i] = rgba[i * 4];
+  return out;
+}
+
+// ES 2 (no float render targets, no texelFetch, float textures optional):
+// one point per position, the position a float vertex attribute (exact, and
+// constant over the point's one fragment), the value in two 8-bit channels.
+std::vector<float> LayoutProbe::sampleRgba8(const Layout& layout,
+                                            const std::vector<glm::vec3>& positions) {
+  const gpu::ApiLevel api = context_.caps().api;
+  const gpu::Program program = gpu::Program::build(
+      "probe(" + layout.name() + ", rgba8)",
+      {gpu::shaderPreamble(api, false, {}), gpu::embeddedShaderPart("layout/probe.vert.glsl")},
+      {gpu::shaderPreamble(api, true, {"TESSERA_PROBE_RGBA8 1"}), layout.glsl(),
+       gpu::embeddedShaderPart("layout/probe.frag.glsl")});
+
+  // Position i goes to pixel (i % width, i / width), rows of at most 1024.
+  const int width = static_cast<int>(std::min<std::size_t>(positions.size(), 1024));
+  const int height = static_cast<int>((positions.size() + width - 1) / width);
+  constexpr int kFloats = 5;  // clip-space pixel centre (2), probe position (3)
+  std::vector<float> vertices(positions.size() * kFloats);
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    const auto px = static_cast<float>(i % static_cast<std::size_t>(width));
+    const auto py = static_cast<float>(i / static_cast<std::size_t>(width));
+    float* v = vertices.data() + i * kFloats;
+    v[0] = (px + 0.5f) / static_cast<float>(width) * 2.0f - 1.0f;
+    v[1] = (py + 0.5f) / static_cast<float>(height) * 2.0f - 1.0f;
+    v[2] = positions[i].x;
+    v[3] = positions[i].y;
+    v[4] = positions[i].z;
+  }
+  const gpu::Buffer buffer =
+      gpu::Buffer::create(context_.ledger(), "probe points", GL_ARRAY_BUFFER,
+                          vertices.size() * sizeof(float), vertices.data(), GL_STATIC_DRAW);
+  // ES 2.0 takes an unsized colour format.
+  gpu::Framebuffer target =
+      gpu::Framebuffer::create(context_.ledger(), "probe target", width, height,
+                               api == gpu::ApiLevel::Gles2 ? GL_RGBA : GL_RGBA8);
+
+  target.bind();
+  glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
+  program.use();
+  layout.bind(program, 0);
+  glDisable(GL_BLEND);
+  const GLint probeAttribute = glGetAttribLocation(program.id(), "a_probe");
+  if (probeAttribute < 0) throw GpuError("LayoutProbe: probe.vert.glsl lacks a_probe");
+  const auto probeIndex = static_cast<GLuint>(probeAttribute);
+  glBindBuffer(GL_ARRAY_BUFFER, buffer.id());
+  glEnableVertexAttribArray(0);
+  glEnableVertexAttribArray(probeIndex);
+  const GLsizei stride = kFloats * sizeof(float);
+  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, stride, nullptr);
+  glVertexAttribPointer(probeIndex, 3, GL_FLOAT, GL_FALSE, stride,
+                        reinterpret_cast<const void*>(2 * sizeof(float)));
+  glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(positions.size()));
+  glDisableVertexAttribArray(probeIndex);
+  glDisableVertexAttribArray(0);
+
+  std::vector<std::uint8_t> rgba(static_cast<std::size_t>(width) * height * 4);
+  target.readRgba8(rgba.data());
+  const GLenum err = glGetError();
+  if (err != GL_NO_ERROR) throw GpuError("LayoutProbe: GL error " + std::to_string(err));
+  std::vector<float> out(positions.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const std::uint8_t* px = rgba.data() + i * 4;
+    if (px[3] != 255) {
+      throw GpuError("LayoutProbe: no fragment for position " + std::to_string(i) +
+                     " (points not rasterised where expected)");
+    }
+    out[i] = static_cast<float>((px[0] + px[1] / 255.0) / 255.0);
+  }
   return out;
 }
 

@@ -26,12 +26,12 @@ struct PlanRequest {
 };
 
 struct Plan {
-  LayoutPlan layout;            // the chosen layout (layout.fits is true)
-  glm::ivec3 downsample{1};     // factors to apply to the volume first
-  glm::ivec3 volumeDims{0};     // dims after downsampling
+  LayoutPlan layout;                 // the chosen layout (layout.fits is true)
+  glm::ivec3 downsample{1};          // factors to apply to the volume first
+  glm::ivec3 volumeDims{0};          // dims after downsampling
   std::vector<LayoutPlan> rejected;  // alternatives tried first, with why not
-  std::string reason;           // one line a human can read
-  int volumeUnits = 0;          // texture units left for the volume
+  std::string reason;                // one line a human can read
+  int volumeUnits = 0;               // texture units left for the volume
   bool downsampled() const { return downsample != glm::ivec3(1); }
 };
 

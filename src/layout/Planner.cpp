@@ -1,0 +1,133 @@
+#include "tessera/layout/Planner.h"
+
+#include <algorithm>
+
+#include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
+#include "tessera/layout/MosaicLayout.h"
+#include "tessera/layout/PackedMosaicLayout.h"
+#include "tessera/layout/Texture3DLayout.h"
+
+namespace tessera::layout {
+
+namespace {
+
+const char* kLayouts[] = {"texture3d", "mosaic", "packed-mosaic"};
+
+std::string dimsText(glm::ivec3 d) {
+  return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
+}
+
+LayoutPlan planOne(const std::string& name, const Volume& shape, const gpu::DeviceLimits& limits,
+                   int units) {
+  if (name == "texture3d") return Texture3DLayout::planFor(shape, limits);
+  if (name == "mosaic") return MosaicLayout::planFor(shape, limits);
+  return PackedMosaicLayout::planFor(shape, limits, units);
+}
+
+// Which axes to halve when nothing fits: those longer than the largest
+// texture side the candidate layouts allow; otherwise (the volume has too
+// many voxels for the textures or the budget) the longest axis, so the
+// voxels stay as close to isotropic as they were.
+glm::ivec3 axesToHalve(glm::ivec3 dims, const gpu::DeviceLimits& limits, bool only3d) {
+  const int side = only3d ? limits.max3DTextureSize : limits.max2DTextureSize;
+  glm::ivec3 halve(0);
+  for (int a = 0; a < (only3d ? 3 : 2); ++a) halve[a] = dims[a] > side ? 1 : 0;
+  if (halve == glm::ivec3(0)) {
+    const int longest = std::max({dims.x, dims.y, dims.z});
+    for (int a = 0; a < 3; ++a) {
+      if (dims[a] == longest) {
+        halve[a] = 1;
+        break;
+      }
+    }
+  }
+  return halve;
+}
+
+}  // namespace
+
+Plan planLayout(const Volume& volume, const gpu::DeviceLimits& limits, const PlanRequest& request) {
+  std::vector<std::string> candidates;
+  if (request.layout == "auto") {
+    candidates.assign(std::begin(kLayouts), std::end(kLayouts));
+  } else if (std::find(std::begin(kLayouts), std::end(kLayouts), request.layout) !=
+             std::end(kLayouts)) {
+    candidates.push_back(request.layout);
+  } else {
+    throw InputError("unknown layout '" + request.layout +
+                     "' (expected auto, texture3d, mosaic or packed-mosaic)");
+  }
+  if (request.layout == "texture3d" &&
+      (limits.api != gpu::ApiLevel::Gles3 || limits.max3DTextureSize == 0)) {
+    throw InputError("layout texture3d needs 3D textures, which " + limits.profile +
+                     " does not have (use mosaic or packed-mosaic)");
+  }
+  const int units = limits.textureUnits - request.reservedUnits;
+  if (units < 1) {
+    throw InputError(limits.profile + " has " + std::to_string(limits.textureUnits) +
+                     " texture units and the technique needs " +
+                     std::to_string(request.reservedUnits) + ": none is left for the volume");
+  }
+  gpu::DeviceLimits volumeLimits = limits;
+  volumeLimits.textureUnits = units;
+  if (limits.textureBudget != 0) {
+    if (request.reservedBytes >= limits.textureBudget) {
+      throw InputError("the renderer's own textures (" + formatBytes(request.reservedBytes) +
+                       ") exceed the texture budget of " + limits.profile + " (" +
+                       formatBytes(limits.textureBudget) + ")");
+    }
+    volumeLimits.textureBudget = limits.textureBudget - request.reservedBytes;
+  }
+
+  Plan plan;
+  plan.volumeUnits = units;
+  glm::ivec3 dims = volume.dims();
+  for (int round = 0; round < 64; ++round) {
+    const Volume shape = Volume::shapeOnly(dims, volume.type());
+    for (const std::string& name : candidates) {
+      LayoutPlan p = planOne(name, shape, volumeLimits, units);
+      if (p.fits) {
+        plan.layout = std::move(p);
+        plan.volumeDims = dims;
+        std::string why = plan.layout.reason;
+        if (plan.downsampled()) {
+          why = dimsText(volume.dims()) + " does not fit " + limits.profile +
+                " under any layout; downsampled by " + dimsText(plan.downsample) + " to " + why;
+        } else if (request.layout == "auto") {
+          for (const LayoutPlan& r : plan.rejected) why += "; not " + r.layout + ": " + r.reason;
+        }
+        plan.reason = why;
+        return plan;
+      }
+      if (round == 0) plan.rejected.push_back(std::move(p));
+    }
+    if (dims == glm::ivec3(1)) break;
+    const bool only3d = candidates.size() == 1 && candidates[0] == "texture3d";
+    const glm::ivec3 halve = axesToHalve(dims, volumeLimits, only3d);
+    for (int a = 0; a < 3; ++a) {
+      if (halve[a] && dims[a] > 1) {
+        dims[a] = (dims[a] + 1) / 2;
+        plan.downsample[a] *= 2;
+      }
+    }
+  }
+  throw InputError(dimsText(volume.dims()) + " cannot be stored on " + limits.profile +
+                   " even downsampled to a single voxel");
+}
+
+std::unique_ptr<Layout> createLayout(const Plan& plan, const Volume& volume,
+                                     const gpu::DeviceLimits& limits, gpu::MemoryLedger& ledger) {
+  if (volume.dims() != plan.volumeDims) {
+    throw Error("createLayout: volume is " + dimsText(volume.dims()) + ", the plan is for " +
+                dimsText(plan.volumeDims));
+  }
+  gpu::DeviceLimits volumeLimits = limits;
+  volumeLimits.textureUnits = plan.volumeUnits;
+  const std::string& name = plan.layout.layout;
+  if (name == "texture3d") return Texture3DLayout::create(volume, volumeLimits, ledger);
+  if (name == "mosaic") return MosaicLayout::create(volume, volumeLimits, ledger);
+  return PackedMosaicLayout::create(volume, volumeLimits, ledger, plan.volumeUnits);
+}
+
+}  // namespace tessera::layout

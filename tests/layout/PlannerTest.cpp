@@ -1,0 +1,117 @@
+// The planner: which layout, which sizes, and that it never gives up.
+#include <gtest/gtest.h>
+
+#include "tessera/core/Error.h"
+#include "tessera/gpu/DeviceProfile.h"
+#include "tessera/layout/Planner.h"
+
+using namespace tessera;
+
+namespace {
+
+// Caps of a generous context of the profile's level, so that the profile's
+// own limits are the ones that bind (as on the devices they describe).
+gpu::DeviceLimits limitsOf(const std::string& profileName) {
+  const gpu::DeviceProfile profile = gpu::DeviceProfile::find(profileName);
+  gpu::DeviceCaps caps;
+  caps.api = profile.api;
+  caps.max2DTextureSize = 16384;
+  caps.max3DTextureSize = profile.api == gpu::ApiLevel::Gles3 ? 2048 : 0;
+  caps.maxTextureUnits = 32;
+  caps.maxRenderbufferSize = 16384;
+  if (profile.api == gpu::ApiLevel::Gles3) caps.extensions.insert("GL_EXT_texture_norm16");
+  return gpu::effectiveLimits(profile, caps);
+}
+
+layout::Plan plan(glm::ivec3 dims, const std::string& profile, const std::string& layout = "auto",
+                  ScalarType type = ScalarType::U8) {
+  layout::PlanRequest r;
+  r.layout = layout;
+  r.reservedUnits = 2;
+  return layout::planLayout(Volume::shapeOnly(dims, type), limitsOf(profile), r);
+}
+
+}  // namespace
+
+TEST(Planner, PrefersTexture3dWhereItFits) {
+  const layout::Plan p = plan({181, 217, 181}, "webgl2");
+  EXPECT_EQ(p.layout.layout, "texture3d");
+  EXPECT_FALSE(p.downsampled());
+  EXPECT_EQ(p.layout.totalBytes, 181u * 217 * 181);
+}
+
+TEST(Planner, Ch2OnIpad2IsOnePackedRgbaTexture) {
+  // 2048^2 holds 11 x 9 = 99 tiles of 181 x 217: too few for 181 slices in
+  // one channel, enough in four.
+  const layout::Plan p = plan({181, 217, 181}, "ipad2");
+  EXPECT_EQ(p.layout.layout, "packed-mosaic");
+  EXPECT_FALSE(p.downsampled());
+  ASSERT_EQ(p.layout.textures.size(), 1u);
+  ASSERT_EQ(p.rejected.size(), 2u);
+  EXPECT_EQ(p.rejected[0].layout, "texture3d");
+  EXPECT_EQ(p.rejected[1].layout, "mosaic");
+  EXPECT_FALSE(p.reason.empty());
+}
+
+TEST(Planner, PaperCapacityIpad2Holds512x512x384WithoutDownsampling) {
+  // Noguera & Jiménez 2012: six RGBA 2048^2 textures (8 units minus the TF
+  // and the technique's).
+  const layout::Plan p = plan({512, 512, 384}, "ipad2");
+  EXPECT_EQ(p.layout.layout, "packed-mosaic");
+  EXPECT_FALSE(p.downsampled());
+  EXPECT_EQ(p.layout.textures.size(), 6u);
+  for (const auto& t : p.layout.textures) EXPECT_LE(std::max(t.size.x, t.size.y), 2048);
+}
+
+TEST(Planner, PaperCapacityWebgl1Holds512x512x1024InOne8192Texture) {
+  const layout::Plan p = plan({512, 512, 1024}, "webgl1-desktop-2012");
+  EXPECT_EQ(p.layout.layout, "packed-mosaic");
+  EXPECT_FALSE(p.downsampled());
+  ASSERT_EQ(p.layout.textures.size(), 1u);
+  EXPECT_EQ(p.layout.textures[0].size.x, 8192);
+  EXPECT_EQ(p.layout.textures[0].size.y, 8192);
+  EXPECT_EQ(p.layout.totalBytes, 8192u * 8192 * 4);
+}
+
+TEST(Planner, DownsamplesOnlyWhenNothingFitsAndSaysSo) {
+  const layout::Plan p = plan({512, 512, 512}, "ipad2");  // 6 textures hold 384 slices
+  EXPECT_TRUE(p.downsampled());
+  EXPECT_TRUE(p.layout.fits);
+  EXPECT_NE(p.reason.find("downsampled"), std::string::npos) << p.reason;
+  // Halving one axis is enough; the plan must not throw away more.
+  EXPECT_EQ(p.downsample.x * p.downsample.y * p.downsample.z, 2);
+  EXPECT_EQ(p.volumeDims, (glm::ivec3(512, 512, 512) + p.downsample - 1) / p.downsample);
+}
+
+TEST(Planner, AxesLongerThanTheTextureAreHalved) {
+  const layout::Plan p = plan({4000, 64, 16}, "ipad2");  // a tile wider than 2048
+  EXPECT_TRUE(p.downsampled());
+  EXPECT_GE(p.downsample.x, 2);
+  EXPECT_LE(p.volumeDims.x, 2048);
+}
+
+TEST(Planner, EveryBuiltinProfileGetsAPlanWithinItsBudget) {
+  for (const gpu::DeviceProfile& profile : gpu::DeviceProfile::builtins()) {
+    for (glm::ivec3 dims : {glm::ivec3(181, 217, 181), glm::ivec3(512, 512, 384),
+                            glm::ivec3(37, 53, 29), glm::ivec3(1024, 1024, 600)}) {
+      const gpu::DeviceLimits limits = limitsOf(profile.name);
+      layout::PlanRequest r;
+      r.reservedUnits = std::min(2, limits.textureUnits - 1);
+      const layout::Plan p = layout::planLayout(Volume::shapeOnly(dims, ScalarType::U8), limits, r);
+      EXPECT_TRUE(p.layout.fits) << profile.name;
+      if (limits.textureBudget) {
+        EXPECT_LE(p.layout.totalBytes, limits.textureBudget) << profile.name;
+      }
+      EXPECT_LE(static_cast<int>(p.layout.textures.size()), p.volumeUnits) << profile.name;
+    }
+  }
+}
+
+TEST(Planner, ImpossibleWishesAreClearErrors) {
+  EXPECT_THROW(plan({64, 64, 64}, "ipad2", "texture3d"), InputError);
+  EXPECT_THROW(plan({64, 64, 64}, "webgl2", "bricks"), InputError);
+  const layout::Plan forced = plan({64, 64, 64}, "webgl2", "packed-mosaic");
+  EXPECT_EQ(forced.layout.layout, "packed-mosaic");
+  const layout::Plan mosaic = plan({64, 64, 64}, "webgl2", "mosaic");
+  EXPECT_EQ(mosaic.layout.layout, "mosaic");
+}

@@ -1,0 +1,187 @@
+// The ray caster on every layout, in ES 2.0 and ES 3.0 contexts: against
+// texture3d and against the CPU reference (issue 3's image tests).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+
+#include "support/GpuTestContext.h"
+#include "support/TestSupport.h"
+#include "tessera/io/Procedural.h"
+#include "tessera/io/VolumeReader.h"
+#include "tessera/layout/MosaicLayout.h"
+#include "tessera/layout/PackedMosaicLayout.h"
+#include "tessera/layout/Texture3DLayout.h"
+#include "tessera/lod/Downsample.h"
+#include "tessera/reference/ImageMetrics.h"
+#include "tessera/reference/ReferenceRaycaster.h"
+#include "tessera/render/DeviceSession.h"
+#include "tessera/render/RaycastPlan.h"
+#include "tessera/render/Raycaster.h"
+
+using namespace tessera;
+
+namespace {
+
+const char* kCh2 = "/usr/share/mricron/templates/ch2.nii.gz";
+
+TransferFunction visibleTf() {
+  TransferFunction tf;
+  tf.addColor(0.0, {0.0, 0.0, 0.0});
+  tf.addColor(0.5, {0.9, 0.6, 0.3});
+  tf.addColor(1.0, {1.0, 1.0, 1.0});
+  tf.addOpacity(0.02, 0.0);
+  tf.addOpacity(0.3, 0.15);
+  tf.addOpacity(1.0, 0.4);
+  return tf;
+}
+
+Image renderWith(gpu::GlContext& c, const Volume& v, const layout::Layout& layout,
+                 const TransferFunction& tf, const Camera& cam, const RenderSettings& s, int size,
+                 int skipBlock = 8) {
+  render::Raycaster caster(c, v, layout);
+  caster.setSkipBlockSize(skipBlock);
+  caster.setTransferFunction(tf);
+  return caster.render(cam, s, size, size);
+}
+
+// A volume with slice counts that make packed-mosaic seams fall inside it.
+Volume seamVolume() {
+  return makeSheppLogan({37, 53, 29});
+}
+
+void compareLayouts(gpu::ApiLevel api) {
+  gpu::GlContext::Options o;
+  o.api = api;
+  auto owned = api == gpu::ApiLevel::Gles2 ? gpu::GlContext::createHeadless(o) : nullptr;
+  gpu::GlContext& c = owned ? *owned : test::gpuContext();
+  const Volume v = seamVolume();
+  gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());
+  // Small textures force the packed layout across channels and textures:
+  // 37x53 tiles, 2 per 128x128 texture... 29 slices need 4 textures.
+  gpu::DeviceLimits packedLimits = limits;
+  packedLimits.max2DTextureSize = 128;
+  auto mosaic = layout::MosaicLayout::create(v, limits, c.ledger());
+  auto packed = layout::PackedMosaicLayout::create(v, packedLimits, c.ledger(), 6);
+  std::printf("  [plan] %s\n", packed->plan().reason.c_str());
+  EXPECT_GE(packed->textureUnits(), 2) << "the test must cross texture seams";
+  Camera cam;
+  cam.azimuthDeg = 35;
+  cam.elevationDeg = 25;
+  cam.frame(v.extent());
+  RenderSettings s;
+  const Image ref = renderReference(v, visibleTf(), cam, s, 96, 96);
+  const Image viaMosaic = renderWith(c, v, *mosaic, visibleTf(), cam, s, 96);
+  const Image viaPacked = renderWith(c, v, *packed, visibleTf(), cam, s, 96);
+  EXPECT_GE(psnr(viaMosaic, ref), 40.0);
+  EXPECT_GE(psnr(viaPacked, ref), 40.0);
+  std::printf("  [measured] %s: mosaic vs reference %.2f dB, packed vs reference %.2f dB\n",
+              api == gpu::ApiLevel::Gles2 ? "ES2" : "ES3", psnr(viaMosaic, ref),
+              psnr(viaPacked, ref));
+  if (api == gpu::ApiLevel::Gles3) {
+    auto t3d = layout::Texture3DLayout::create(v, limits, c.ledger());
+    const Image via3d = renderWith(c, v, *t3d, visibleTf(), cam, s, 96);
+    EXPECT_GE(psnr(viaMosaic, via3d), 45.0);
+    EXPECT_GE(psnr(viaPacked, via3d), 45.0);
+    std::printf("  [measured] ES3: mosaic vs texture3d %.2f dB, packed vs texture3d %.2f dB\n",
+                psnr(viaMosaic, via3d), psnr(viaPacked, via3d));
+  }
+  // GL objects go before the context that owns them (and its ledger).
+  mosaic.reset();
+  packed.reset();
+  owned.reset();
+  test::gpuContext();
+}
+
+}  // namespace
+
+TEST(LayoutRender, MosaicAndPackedMatchReferenceAndTexture3dOnEs3) {
+  compareLayouts(gpu::ApiLevel::Gles3);
+}
+
+TEST(LayoutRender, MosaicAndPackedMatchReferenceOnEs2) {
+  compareLayouts(gpu::ApiLevel::Gles2);
+}
+
+TEST(LayoutRender, Es2MatchesEs3ImageOfTheSameLayout) {
+  const Volume v = seamVolume();
+  Camera cam;
+  cam.azimuthDeg = -50;
+  cam.elevationDeg = 10;
+  cam.frame(v.extent());
+  RenderSettings s;
+  s.jitter = true;
+  gpu::GlContext& c3 = test::gpuContext();
+  auto m3 = layout::MosaicLayout::create(v, gpu::DeviceLimits::of(c3.caps()), c3.ledger());
+  const Image es3 = renderWith(c3, v, *m3, visibleTf(), cam, s, 80);
+  gpu::GlContext::Options o;
+  o.api = gpu::ApiLevel::Gles2;
+  auto c2 = gpu::GlContext::createHeadless(o);
+  auto m2 = layout::MosaicLayout::create(v, gpu::DeviceLimits::of(c2->caps()), c2->ledger());
+  const Image es2 = renderWith(*c2, v, *m2, visibleTf(), cam, s, 80);
+  EXPECT_GE(psnr(es2, es3), 45.0);
+  m2.reset();
+  c2.reset();
+  test::gpuContext();
+}
+
+TEST(LayoutRender, PaperCapacityIpad2RendersA512x512x384Volume) {
+  // Noguera & Jiménez 2012's largest iPad 2 model: packed into six RGBA
+  // 2048^2 textures, rendered in an ES 2.0 context, the ledger proving the bytes.
+  const test::BudgetOverride keep(HostBudget::global().limitBytes());
+  render::DeviceSession device = render::openDevice("ipad2");
+  const Volume v = makeSheppLogan({512, 512, 384});
+  const render::RaycastPlan rp = render::planRaycast(device.limits, v, "auto", 96, 96, 8);
+  ASSERT_EQ(rp.plan.layout.layout, "packed-mosaic");
+  ASSERT_FALSE(rp.plan.downsampled());
+  auto layout = layout::createLayout(rp.plan, v, device.limits, device.context->ledger());
+  EXPECT_EQ(layout->textureUnits(), 6);
+  EXPECT_EQ(layout->textureBytes(), 6ull * 2048 * 2048 * 4);
+  Camera cam;
+  cam.azimuthDeg = 20;
+  cam.frame(v.extent());
+  RenderSettings s;
+  s.stepVoxels = 2.0;  // keep the test quick; the comparison is what matters
+  const Image img = renderWith(*device.context, v, *layout, visibleTf(), cam, s, 96, rp.skipBlock);
+  const Image ref = renderReference(v, visibleTf(), cam, s, 96, 96);
+  EXPECT_GE(psnr(img, ref), 40.0);
+  EXPECT_LE(device.context->ledger().peakBytes(), device.limits.textureBudget);
+  layout.reset();
+  device.context.reset();
+  test::gpuContext();
+}
+
+TEST(LayoutRender, EveryBuiltinProfileRendersCh2WithinItsBudget) {
+  if (!std::filesystem::exists(kCh2)) GTEST_SKIP() << "mricron-data not installed";
+  for (const gpu::DeviceProfile& profile : gpu::DeviceProfile::builtins()) {
+    const test::BudgetOverride keep(HostBudget::global().limitBytes());
+    render::DeviceSession device = render::openDevice(profile.name);
+    const Volume full = readVolume(kCh2);
+    const render::RaycastPlan rp = render::planRaycast(device.limits, full, "auto", 96, 96, 8);
+    Volume reduced;
+    if (rp.plan.downsampled()) reduced = lod::downsample(full, rp.plan.downsample);
+    const Volume& v = rp.plan.downsampled() ? reduced : full;
+    if (rp.plan.downsampled()) {
+      EXPECT_NE(rp.plan.reason.find("downsampled"), std::string::npos) << rp.plan.reason;
+    }
+    auto layout = layout::createLayout(rp.plan, v, device.limits, device.context->ledger());
+    Camera cam;
+    cam.azimuthDeg = 30;
+    cam.frame(v.extent());
+    RenderSettings s;
+    const Image img = renderWith(*device.context, v, *layout,
+                                 TransferFunction::preset("mr-default"), cam, s, 96, rp.skipBlock);
+    const Image ref = renderReference(v, TransferFunction::preset("mr-default"), cam, s, 96, 96);
+    const double db = psnr(img, ref);
+    EXPECT_GE(db, 40.0) << profile.name;
+    if (device.limits.textureBudget) {
+      EXPECT_LE(device.context->ledger().peakBytes(), device.limits.textureBudget) << profile.name;
+    }
+    std::printf("  [measured] %-20s %-13s %s, %.2f dB, GPU peak %llu bytes\n", profile.name.c_str(),
+                rp.plan.layout.layout.c_str(), rp.plan.downsampled() ? "downsampled" : "full res",
+                db, static_cast<unsigned long long>(device.context->ledger().peakBytes()));
+    layout.reset();
+    device.context.reset();
+  }
+  test::gpuContext();
+}
