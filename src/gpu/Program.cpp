@@ -42,8 +42,24 @@ ShaderPart shaderPreamble(ApiLevel api, bool fragment, const std::vector<std::st
 }
 
 namespace {
-
 constexpr std::size_t kLinesPerPart = 100000;
+}  // namespace
+
+std::string assembleShader(const std::vector<ShaderPart>& parts) {
+  // The first part holds #version, which must come first; every later part
+  // restarts line numbering with its own source-string index.
+  std::string source;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    if (i > 0) {
+      source += "#line " + std::to_string(i * kLinesPerPart + 1) + " " + std::to_string(i) + "\n";
+    }
+    source += parts[i].text;
+    if (source.empty() || source.back() != '\n') source += '\n';
+  }
+  return source;
+}
+
+namespace {
 
 // Driver logs look like "0:12(3): error: ..." (Mesa) or "ERROR: 0:12: ..."
 // (ANGLE, NVIDIA). The first number is our source-string index (set by
@@ -75,15 +91,7 @@ std::string mapLog(const std::string& log, const std::vector<ShaderPart>& parts)
 }
 
 GLuint compile(GLenum stage, const std::string& programName, const std::vector<ShaderPart>& parts) {
-  // The first part holds #version, which must come first; every later part
-  // restarts line numbering with its own source-string index.
-  std::string source;
-  for (std::size_t i = 0; i < parts.size(); ++i) {
-    if (i > 0)
-      source += "#line " + std::to_string(i * kLinesPerPart + 1) + " " + std::to_string(i) + "\n";
-    source += parts[i].text;
-    if (source.empty() || source.back() != '\n') source += '\n';
-  }
+  const std::string source = assembleShader(parts);
   GLuint s = glCreateShader(stage);
   const char* src = source.c_str();
   glShaderSource(s, 1, &src, nullptr);

@@ -184,22 +184,35 @@ void Raycaster::uploadBlocks(const std::vector<std::uint8_t>& cells) {
   }
 }
 
-const gpu::Program& Raycaster::programFor(const RenderSettings& settings) {
+std::vector<std::string> Raycaster::definesFor(const RenderSettings& settings) const {
   std::vector<std::string> defines;
   if (settings.mode == RenderMode::Mip) defines.push_back("MODE_MIP 1");
   if (blockSize_ > 0) defines.push_back("EMPTY_SPACE_SKIPPING 1");
   defines.push_back("MAX_STEPS " + std::to_string(settings.maxSteps));
+  return defines;
+}
+
+std::vector<gpu::ShaderPart> Raycaster::vertexParts() const {
+  return {gpu::shaderPreamble(context_.caps().api, false, {}),
+          gpu::embeddedShaderPart("render/fullscreen.vert.glsl")};
+}
+
+std::vector<gpu::ShaderPart> Raycaster::fragmentParts(const RenderSettings& settings) const {
+  // The technique composed from parts (DESIGN.md): rays, the layout's
+  // sampleVolume(), classification, and the marching loop.
+  return {gpu::shaderPreamble(context_.caps().api, true, definesFor(settings)),
+          gpu::embeddedShaderPart("render/camera_ray.glsl"), layout_.glsl(),
+          gpu::embeddedShaderPart("render/classify.glsl"),
+          gpu::embeddedShaderPart("render/raycast.frag.glsl")};
+}
+
+const gpu::Program& Raycaster::programFor(const RenderSettings& settings) {
   std::string key = layout_.name();
-  for (const auto& d : defines) key += "|" + d;
+  for (const auto& d : definesFor(settings)) key += "|" + d;
   auto it = programs_.find(key);
   if (it != programs_.end()) return it->second;
-  const gpu::ApiLevel api = context_.caps().api;
-  gpu::Program p = gpu::Program::build(
-      "raycast(" + key + ")",
-      {gpu::shaderPreamble(api, false, {}), gpu::embeddedShaderPart("render/fullscreen.vert.glsl")},
-      {gpu::shaderPreamble(api, true, defines), gpu::embeddedShaderPart("render/camera_ray.glsl"),
-       layout_.glsl(), gpu::embeddedShaderPart("render/classify.glsl"),
-       gpu::embeddedShaderPart("render/raycast.frag.glsl")});
+  gpu::Program p =
+      gpu::Program::build("raycast(" + key + ")", vertexParts(), fragmentParts(settings));
   return programs_.emplace(key, std::move(p)).first->second;
 }
 

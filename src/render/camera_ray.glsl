@@ -48,7 +48,7 @@ float jitterOffset(float x, float y) {
   float v = 0.0;
   float scale = 16.0;
   float bit = 1.0;
-  for (int i = 0; i < 3; ++i) {
+  for (int i = 0; i < 3; i++) {
     float xi = mod(floor(x / bit), 2.0);
     float yi = mod(floor(y / bit), 2.0);
     v += (2.0 * abs(xi - yi) + yi) * scale;

@@ -57,7 +57,7 @@ void main() {
       j = jitterOffset(floor(gl_FragCoord.x), u_viewport.y - 1.0 - floor(gl_FragCoord.y));
     }
     float k = 0.0;  // sample index; a float so GLSL ES 1.00 needs no integer maths
-    for (int i = 0; i < MAX_STEPS; ++i) {
+    for (int i = 0; i < MAX_STEPS; i++) {
       if (k >= u_maxSteps) break;
       float t = t0 + (k + j) * u_step;
       if (t >= t1) break;

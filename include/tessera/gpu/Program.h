@@ -32,6 +32,10 @@ ShaderPart embeddedShaderPart(const std::string& path);
 // fragment shaders, FRAG_COLOR for the output.
 ShaderPart shaderPreamble(ApiLevel api, bool fragment, const std::vector<std::string>& defines);
 
+// The single source string the driver compiles from `parts` (with the #line
+// directives that map its lines back to the parts).
+std::string assembleShader(const std::vector<ShaderPart>& parts);
+
 class Program {
  public:
   Program() = default;

@@ -53,11 +53,17 @@ class Raycaster {
 
   static constexpr int kOwnTextureUnits = 2;
 
+  // The shader parts of the program these settings need (for offline
+  // validation of the GLSL, e.g. with glslangValidator).
+  std::vector<gpu::ShaderPart> vertexParts() const;
+  std::vector<gpu::ShaderPart> fragmentParts(const RenderSettings& settings) const;
+
   // GPU memory of this ray caster's own resources (TF, block grid, target).
   std::uint64_t ownTextureBytes() const;
 
  private:
   const gpu::Program& programFor(const RenderSettings& settings);
+  std::vector<std::string> definesFor(const RenderSettings& settings) const;
   void updateLookup(const RenderSettings& settings, double sampleDistance);
   void uploadLut();
   void uploadBlocks(const std::vector<std::uint8_t>& cells);

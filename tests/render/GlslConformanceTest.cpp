@@ -1,0 +1,126 @@
+// The shaders Tessera compiles, checked by the Khronos reference compiler
+// (glslangValidator) rather than by Mesa alone: Mesa accepts GLSL ES 1.00
+// that WebGL 1 and mobile drivers reject (Appendix A: loop forms, sampler
+// indexing), so conformance is checked where the rules are enforced.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+
+#include <sys/wait.h>
+
+#include "support/GpuTestContext.h"
+#include "support/TestSupport.h"
+#include "tessera/gpu/Program.h"
+#include "tessera/io/Procedural.h"
+#include "tessera/layout/MosaicLayout.h"
+#include "tessera/layout/PackedMosaicLayout.h"
+#include "tessera/layout/Texture3DLayout.h"
+#include "tessera/render/Raycaster.h"
+
+using namespace tessera;
+
+namespace {
+
+struct Validation {
+  int exitCode;
+  std::string log;
+};
+
+Validation run(const std::string& command) {
+  FILE* p = popen((command + " 2>&1").c_str(), "r");
+  std::string log;
+  std::array<char, 4096> buf{};
+  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), p)) log.append(buf.data(), n);
+  const int status = pclose(p);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, log};
+}
+
+// glslang's default resource limits are permissive; GLSL ES 1.00's
+// Appendix A (for-loops of the form "i < constant", samplers and uniforms
+// indexed by constant-index expressions only, no while loops) is enforced
+// when the "limits" of its configuration are set to 0.
+std::string es100Limits() {
+  std::string conf = run("glslangValidator -c").log;
+  for (const char* key : {"nonInductiveForLoops", "whileLoops", "doWhileLoops",
+                          "generalUniformIndexing", "generalAttributeMatrixVectorIndexing",
+                          "generalVaryingIndexing", "generalSamplerIndexing",
+                          "generalVariableIndexing", "generalConstantMatrixVectorIndexing"}) {
+    const std::string on = std::string(key) + " 1";
+    const auto at = conf.find(on);
+    if (at != std::string::npos) conf.replace(at, on.size(), std::string(key) + " 0");
+  }
+  return conf;
+}
+
+Validation validate(const std::string& source, const std::string& stage) {
+  const test::TempDir dir;
+  const auto path = dir / ("shader." + stage);
+  const auto conf = dir / "es100.conf";
+  std::ofstream(path) << source;
+  std::ofstream(conf) << es100Limits();
+  return run("glslangValidator " + conf.string() + " " + path.string());
+}
+
+bool haveValidator() {
+  return std::system("command -v glslangValidator >/dev/null 2>&1") == 0;
+}
+
+void expectConformant(gpu::GlContext& c, const Volume& v, const layout::Layout& layout) {
+  render::Raycaster caster(c, v, layout);
+  for (RenderMode mode : {RenderMode::Composite, RenderMode::Mip}) {
+    for (int skip : {0, 8}) {
+      caster.setSkipBlockSize(skip);
+      RenderSettings s;
+      s.mode = mode;
+      const Validation frag = validate(gpu::assembleShader(caster.fragmentParts(s)), "frag");
+      EXPECT_EQ(frag.exitCode, 0) << layout.name() << " skip " << skip << ":\n" << frag.log;
+    }
+  }
+  const Validation vert = validate(gpu::assembleShader(caster.vertexParts()), "vert");
+  EXPECT_EQ(vert.exitCode, 0) << vert.log;
+}
+
+}  // namespace
+
+TEST(GlslConformance, Es2ShadersPassTheReferenceCompiler) {
+  if (!haveValidator())
+    GTEST_SKIP() << "glslangValidator not installed (scripts/setup.sh installs it)";
+  gpu::GlContext::Options o;
+  o.api = gpu::ApiLevel::Gles2;
+  auto c = gpu::GlContext::createHeadless(o);
+  const Volume v = makeSheppLogan({37, 53, 29});
+  gpu::DeviceLimits limits = gpu::DeviceLimits::of(c->caps());
+  auto mosaic = layout::MosaicLayout::create(v, limits, c->ledger());
+  limits.max2DTextureSize = 128;  // several textures: the sampler if-chain
+  auto packed = layout::PackedMosaicLayout::create(v, limits, c->ledger(), 6);
+  expectConformant(*c, v, *mosaic);
+  expectConformant(*c, v, *packed);
+  mosaic.reset();
+  packed.reset();
+  c.reset();
+  test::gpuContext();
+}
+
+TEST(GlslConformance, Es3ShadersPassTheReferenceCompiler) {
+  if (!haveValidator())
+    GTEST_SKIP() << "glslangValidator not installed (scripts/setup.sh installs it)";
+  gpu::GlContext& c = test::gpuContext();
+  const Volume v = makeSheppLogan({37, 53, 29});
+  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());
+  auto t3d = layout::Texture3DLayout::create(v, limits, c.ledger());
+  auto mosaic = layout::MosaicLayout::create(v, limits, c.ledger());
+  expectConformant(c, v, *t3d);
+  expectConformant(c, v, *mosaic);
+}
+
+TEST(GlslConformance, ValidatorRejectsANonConstantLoopInGlslEs100) {
+  if (!haveValidator()) GTEST_SKIP() << "glslangValidator not installed";
+  // The check has teeth: a loop bounded by a uniform is illegal in ES 1.00.
+  const std::string bad =
+      "#version 100\nprecision highp float;\nuniform int n;\nvoid main() {\n  float a = 0.0;\n"
+      "  for (int i = 0; i < n; ++i) a += 1.0;\n  gl_FragColor = vec4(a);\n}\n";
+  EXPECT_NE(validate(bad, "frag").exitCode, 0);
+}
