@@ -18,9 +18,15 @@ std::string dimsText(glm::ivec3 d) {
   return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
 }
 
-// Writes tile `tile` (slices 4 * tile .. 4 * tile + 3 in R, G, B, A; 0 past
-// the last slice) as dims.x * dims.y RGBA8 texels, row y at out + y * rowStride.
-void packTile(const Volume& volume, int tile, std::uint8_t* out, std::size_t rowStride) {
+const char* packingName(PackedMosaicLayout::Packing p) {
+  return p == PackedMosaicLayout::Packing::Overlapped ? "overlapped" : "dense";
+}
+
+// Writes tile `tile` (the slices Geometry::sliceAt() names in R, G, B, A; 0
+// where it names none) as dims.x * dims.y RGBA8 texels, row y at
+// out + y * rowStride.
+void packTile(const Volume& volume, const PackedMosaicLayout::Geometry& g, int tile,
+              std::uint8_t* out, std::size_t rowStride) {
   const glm::ivec3 d = volume.dims();
   const bool u8 = volume.type() == ScalarType::U8;
   const std::uint8_t* src = u8 ? volume.dataAs<std::uint8_t>() : nullptr;
@@ -31,10 +37,10 @@ void packTile(const Volume& volume, int tile, std::uint8_t* out, std::size_t row
     width = r.max > r.min ? r.max - r.min : 1.0;
   }
   for (int c = 0; c < kC; ++c) {
-    const int z = tile * kC + c;
+    const int z = g.sliceAt(tile, c);
     for (int y = 0; y < d.y; ++y) {
       std::uint8_t* dst = out + static_cast<std::size_t>(y) * rowStride + c;
-      if (z >= d.z) {
+      if (z < 0) {
         for (int x = 0; x < d.x; ++x) dst[kC * x] = 0;
       } else if (u8) {
         const std::uint8_t* row = src + volume.index(0, y, z);
@@ -54,17 +60,39 @@ void packTile(const Volume& volume, int tile, std::uint8_t* out, std::size_t row
 
 }  // namespace
 
-PackedMosaicLayout::TexelAddress PackedMosaicLayout::Geometry::addressOf(int x, int y,
-                                                                         int z) const {
-  const int tile = z / kC;
-  const int cell = tile % tilesPerTexture();
-  return {tile / tilesPerTexture(), z % kC, (cell % tilesX) * dims.x + x,
-          (cell / tilesX) * dims.y + y};
+int PackedMosaicLayout::Geometry::tiles() const {
+  if (packing == Packing::Overlapped) return std::max(1, (dims.z - 1 + 2) / 3);
+  return (dims.z + kC - 1) / kC;
 }
 
-PackedMosaicLayout::Geometry PackedMosaicLayout::geometryFor(glm::ivec3 dims, int max2D) {
+int PackedMosaicLayout::Geometry::sliceAt(int tile, int channel) const {
+  const int z = tile * sliceStride() + channel;
+  if (packing == Packing::Overlapped) return std::min(z, dims.z - 1);
+  return z < dims.z ? z : -1;
+}
+
+PackedMosaicLayout::TexelAddress PackedMosaicLayout::Geometry::tileOrigin(int tile) const {
+  const int cell = tile % tilesPerTexture();
+  return {tile / tilesPerTexture(), 0, (cell % tilesX) * dims.x, (cell / tilesX) * dims.y};
+}
+
+PackedMosaicLayout::TexelAddress PackedMosaicLayout::Geometry::addressOf(int x, int y,
+                                                                         int z) const {
+  // Overlapped: z = D - 1 with (D - 1) % 3 == 0 would start a tile of its
+  // own; it is channel A of the last one.
+  const int tile = std::min(z / sliceStride(), tiles() - 1);
+  TexelAddress a = tileOrigin(tile);
+  a.channel = z - tile * sliceStride();
+  a.x += x;
+  a.y += y;
+  return a;
+}
+
+PackedMosaicLayout::Geometry PackedMosaicLayout::geometryFor(glm::ivec3 dims, int max2D,
+                                                             Packing packing) {
   Geometry g;
   g.dims = dims;
+  g.packing = packing == Packing::Overlapped ? Packing::Overlapped : Packing::Dense;
   if (std::min({dims.x, dims.y, dims.z}) < 1 || dims.x > max2D || dims.y > max2D) return g;
   // Fewest textures first: as many as the tiles need at the largest size...
   const std::int64_t perTexture =
@@ -89,8 +117,8 @@ std::vector<std::vector<std::uint8_t>> PackedMosaicLayout::pack(const Volume& vo
   std::vector<std::vector<std::uint8_t>> images(static_cast<std::size_t>(geometry.textures),
                                                 std::vector<std::uint8_t>(bytes, 0));
   for (int tile = 0; tile < geometry.tiles(); ++tile) {
-    const TexelAddress a = geometry.addressOf(0, 0, tile * kC);
-    packTile(volume, tile,
+    const TexelAddress a = geometry.tileOrigin(tile);
+    packTile(volume, geometry, tile,
              images[static_cast<std::size_t>(a.texture)].data() +
                  static_cast<std::size_t>(a.y) * rowStride + static_cast<std::size_t>(a.x) * kC,
              rowStride);
@@ -98,21 +126,32 @@ std::vector<std::vector<std::uint8_t>> PackedMosaicLayout::pack(const Volume& vo
   return images;
 }
 
-LayoutPlan PackedMosaicLayout::planFor(const Volume& volume, const gpu::DeviceLimits& limits,
-                                       int maxTextures) {
+namespace {
+
+struct PackingPlan {
   LayoutPlan plan;
+  PackedMosaicLayout::Geometry geometry;
+};
+
+// The plan of one packing; the reason says what it allocates and, if it
+// does not fit, which limit it breaks (not yet why this packing).
+PackingPlan planPacking(const Volume& volume, const gpu::DeviceLimits& limits, int maxTextures,
+                        PackedMosaicLayout::Packing packing) {
+  PackingPlan result;
+  LayoutPlan& plan = result.plan;
   plan.layout = "packed-mosaic";
   const glm::ivec3 d = volume.dims();
   const std::string vol = dimsText(d) + " " + std::string(scalarTypeName(volume.type()));
   const int max2D = limits.max2DTextureSize;
-  const Geometry g = geometryFor(d, max2D);
+  result.geometry = PackedMosaicLayout::geometryFor(d, max2D, packing);
+  const PackedMosaicLayout::Geometry& g = result.geometry;
   if (g.textures == 0) {
     plan.reason = std::min({d.x, d.y, d.z}) < 1
                       ? vol + " is empty"
                       : vol + ": a " + std::to_string(d.x) + "x" + std::to_string(d.y) +
                             " slice exceeds the max 2D texture size " + std::to_string(max2D) +
                             " of " + limits.profile;
-    return plan;
+    return result;
   }
   const std::string size = std::to_string(g.width()) + "x" + std::to_string(g.height());
   for (int i = 0; i < g.textures; ++i) {
@@ -124,15 +163,18 @@ LayoutPlan PackedMosaicLayout::planFor(const Volume& volume, const gpu::DeviceLi
     plan.textures.push_back(t);
     plan.totalBytes += t.bytes;
   }
-  const std::string what = vol + " in " + (g.textures == 1 ? "one" : std::to_string(g.textures)) +
-                           " RGBA8 " + size + (g.textures == 1 ? " texture" : " textures") +
-                           " (packed-mosaic, " + std::to_string(g.tilesX) + "x" +
-                           std::to_string(g.tilesY) + " tiles of 4 slices per texture, " +
-                           formatBytes(plan.totalBytes) +
-                           (volume.type() != ScalarType::U8 ? ", quantised to 8 bits" : "") + ")";
+  const bool overlapped = g.packing == PackedMosaicLayout::Packing::Overlapped;
+  const std::string what =
+      vol + " in " + (g.textures == 1 ? "one" : std::to_string(g.textures)) + " RGBA8 " + size +
+      (g.textures == 1 ? " texture" : " textures") + " (packed-mosaic " + packingName(g.packing) +
+      ", " + std::to_string(g.tilesX) + "x" + std::to_string(g.tilesY) + " tiles of 4 slices" +
+      (overlapped ? ", each sharing one with the next," : "") + " per texture, " +
+      formatBytes(plan.totalBytes) +
+      (volume.type() != ScalarType::U8 ? ", quantised to 8 bits" : "") + ")";
   const int units = std::min(maxTextures, limits.textureUnits);
-  if (g.textures > kMaxTextures) {
-    plan.reason = what + " needs more than the " + std::to_string(kMaxTextures) +
+  if (g.textures > PackedMosaicLayout::kMaxTextures) {
+    plan.reason = what + " needs more than the " +
+                  std::to_string(PackedMosaicLayout::kMaxTextures) +
                   " textures packed-mosaic can address";
   } else if (g.textures > units) {
     plan.reason = what + " needs " + std::to_string(g.textures) + " texture units, " +
@@ -144,17 +186,60 @@ LayoutPlan PackedMosaicLayout::planFor(const Volume& volume, const gpu::DeviceLi
     plan.fits = true;
     plan.reason = what;
   }
-  return plan;
+  return result;
+}
+
+// The packing planFor() and create() use, and why (PackedMosaicLayout.h).
+PackingPlan choosePacking(const Volume& volume, const gpu::DeviceLimits& limits, int maxTextures,
+                          PackedMosaicLayout::Packing packing) {
+  using Packing = PackedMosaicLayout::Packing;
+  if (packing != Packing::Auto) {
+    PackingPlan forced = planPacking(volume, limits, maxTextures, packing);
+    if (forced.plan.fits) {
+      forced.plan.reason += packing == Packing::Overlapped
+                                ? "; overlapped (as asked): one fetch per sample"
+                                : "; dense (as asked)";
+    }
+    return forced;
+  }
+  PackingPlan dense = planPacking(volume, limits, maxTextures, Packing::Dense);
+  PackingPlan overlapped = planPacking(volume, limits, maxTextures, Packing::Overlapped);
+  if (overlapped.plan.fits && overlapped.geometry.textures <= dense.geometry.textures) {
+    overlapped.plan.reason += "; overlapped: one fetch per sample";
+    return overlapped;
+  }
+  // Overlapped needs at least dense's tiles, so it fits nowhere dense does
+  // not: a refused dense plan is the one to explain.
+  if (!dense.plan.fits) return dense;
+  if (overlapped.geometry.textures > dense.geometry.textures) {
+    dense.plan.reason += "; dense: overlapped would need " +
+                         std::to_string(overlapped.geometry.textures) + " textures instead of " +
+                         std::to_string(dense.geometry.textures);
+  } else if (limits.textureBudget != 0 && overlapped.plan.totalBytes > limits.textureBudget) {
+    dense.plan.reason += "; dense: overlapped (" + formatBytes(overlapped.plan.totalBytes) +
+                         ") would exceed the texture budget " + formatBytes(limits.textureBudget);
+  } else {
+    dense.plan.reason += "; dense: overlapped does not fit: " + overlapped.plan.reason;
+  }
+  return dense;
+}
+
+}  // namespace
+
+LayoutPlan PackedMosaicLayout::planFor(const Volume& volume, const gpu::DeviceLimits& limits,
+                                       int maxTextures, Packing packing) {
+  return choosePacking(volume, limits, maxTextures, packing).plan;
 }
 
 std::unique_ptr<PackedMosaicLayout> PackedMosaicLayout::create(const Volume& volume,
                                                                const gpu::DeviceLimits& limits,
                                                                gpu::MemoryLedger& ledger,
-                                                               int maxTextures) {
+                                                               int maxTextures, Packing packing) {
   std::unique_ptr<PackedMosaicLayout> l(new PackedMosaicLayout());
-  l->plan_ = planFor(volume, limits, maxTextures);
+  PackingPlan chosen = choosePacking(volume, limits, maxTextures, packing);
+  l->plan_ = std::move(chosen.plan);
   if (!l->plan_.fits) throw GpuError("packed-mosaic layout: " + l->plan_.reason);
-  l->geometry_ = geometryFor(volume.dims(), limits.max2DTextureSize);
+  l->geometry_ = chosen.geometry;
   if (volume.type() == ScalarType::U8) {
     l->mapping_ = {255.0, 0.0};
   } else {
@@ -174,15 +259,15 @@ std::unique_ptr<PackedMosaicLayout> PackedMosaicLayout::create(const Volume& vol
   for (int t = 0; t < g.textures; ++t) {
     l->textures_.push_back(gpu::Texture::create2D(
         ledger,
-        "volume (packed-mosaic RGBA8 " + std::to_string(t + 1) + "/" + std::to_string(g.textures) +
-            ")",
+        "volume (packed-mosaic " + std::string(packingName(g.packing)) + " RGBA8 " +
+            std::to_string(t + 1) + "/" + std::to_string(g.textures) + ")",
         internalFormat, g.width(), g.height(), GL_RGBA, GL_UNSIGNED_BYTE, nullptr, kC));
     glBindTexture(GL_TEXTURE_2D, l->textures_.back().id());
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     for (int cell = 0; cell < g.tilesPerTexture(); ++cell) {
       const int tile = t * g.tilesPerTexture() + cell;
       if (tile < g.tiles()) {
-        packTile(volume, tile, staging.data(), rowStride);
+        packTile(volume, g, tile, staging.data(), rowStride);
       } else {
         std::fill(staging.begin(), staging.end(), std::uint8_t{0});
       }
@@ -202,11 +287,14 @@ std::unique_ptr<PackedMosaicLayout> PackedMosaicLayout::create(const Volume& vol
 gpu::ShaderPart PackedMosaicLayout::glsl() const {
   gpu::ShaderPart part = gpu::embeddedShaderPart("layout/packed_mosaic.glsl");
   // The sampler count must be a compile-time constant (sampler arrays take
-  // constant indices only); it replaces the file's first line, a comment, so
-  // that compile errors keep the file's line numbers.
-  const std::size_t firstLineEnd = part.text.find('\n');
-  part.text.replace(0, firstLineEnd,
-                    "#define TESSERA_PACKED_TEXTURES " + std::to_string(geometry_.textures));
+  // constant indices only), and the packing picks the code; they replace
+  // the file's first two lines, comments, so that compile errors keep the
+  // file's line numbers.
+  const std::size_t secondLineEnd = part.text.find('\n', part.text.find('\n') + 1);
+  part.text.replace(0, secondLineEnd,
+                    "#define TESSERA_PACKED_TEXTURES " + std::to_string(geometry_.textures) +
+                        "\n#define TESSERA_PACKED_OVERLAPPED " +
+                        (geometry_.packing == Packing::Overlapped ? "1" : "0"));
   return part;
 }
 
@@ -216,8 +304,9 @@ int PackedMosaicLayout::bind(const gpu::Program& program, int firstUnit) const {
     program.set(("u_layoutTextures[" + std::to_string(i) + "]").c_str(), firstUnit + i);
   }
   program.set("u_layoutDims", glm::vec3(geometry_.dims));
-  program.set("u_layoutTilesX", static_cast<float>(geometry_.tilesX));
-  program.set("u_layoutTilesPerTexture", static_cast<float>(geometry_.tilesPerTexture()));
+  const glm::vec2 tiles(static_cast<float>(geometry_.tilesX), static_cast<float>(geometry_.tilesY));
+  program.set("u_layoutTiles", tiles);
+  program.set("u_layoutInvTiles", 1.0f / tiles);
   program.set("u_layoutInvSize", glm::vec2(1.0f / static_cast<float>(geometry_.width()),
                                            1.0f / static_cast<float>(geometry_.height())));
   return geometry_.textures;

@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/CliRunner.h"
 #include "support/TestSupport.h"
 #include "tessera/core/Image.h"
 
@@ -21,28 +22,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct CliRun {
-  int exitCode;
-  std::string out;  // stdout + stderr
-  double seconds;
-};
+using tessera::test::CliRun;
+using tessera::test::countLines;
 
+// stdout and stderr together, as a user sees them.
 CliRun run(const std::string& args) {
-  const std::string cmd = std::string(TESSERA_CLI_PATH) + " " + args + " 2>&1";
-  const auto t0 = std::chrono::steady_clock::now();
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf{};
-  while (std::size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
-  const int status = pclose(p);
-  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out, s};
-}
-
-int countLines(const std::string& s) {
-  int n = 0;
-  for (char c : s) n += c == '\n';
-  return n;
+  CliRun r = tessera::test::runCli(args);
+  r.out += r.err;
+  return r;
 }
 
 }  // namespace

@@ -12,36 +12,13 @@
 
 #include <nlohmann/json.hpp>
 
-#include "support/TestSupport.h"
+#include "support/CliRunner.h"
 
 namespace {
 
-struct ProfilesRun {
-  int exitCode;
-  std::string out;
-  std::string err;
-};
-
-// Runs the CLI with stdout and stderr captured separately (stderr via a file).
-ProfilesRun runCli(const std::string& args) {
-  const tessera::test::TempDir tmp;
-  const auto errPath = tmp / "stderr.txt";
-  const std::string cmd = std::string(TESSERA_CLI_PATH) + " " + args + " 2>" + errPath.string();
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf{};
-  while (std::size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
-  const int status = pclose(p);
-  std::ostringstream err;
-  err << std::ifstream(errPath).rdbuf();
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out, err.str()};
-}
-
-int countLines(const std::string& s) {
-  int n = 0;
-  for (char c : s) n += c == '\n';
-  return n;
-}
+using ProfilesRun = tessera::test::CliRun;
+using tessera::test::countLines;
+using tessera::test::runCli;
 
 const std::set<std::string> kBuiltins = {
     "axim-x51v", "ipad2", "webgl1-desktop-2012", "nexus7", "shield-k1", "gles2", "webgl1", "gles3",
