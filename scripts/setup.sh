@@ -6,7 +6,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake pkg-config git clang-format
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri   # headless OpenGL ES (Mesa llvmpipe)
-  libnifti2-dev zlib1g-dev libpng-dev                    # volume and image I/O
+  libnifti2-dev zlib1g-dev libpng-dev libdcmtk-dev dcmtk # volume and image I/O (DICOM: DCMTK)
   libcli11-dev nlohmann-json3-dev libglm-dev             # CLI, JSON, maths
   libgtest-dev libgmock-dev glslang-tools                # tests (glslangValidator checks GLSL ES 1.00 rules)
   mricron-data                                           # the default volume (ch2 T1 MRI head)

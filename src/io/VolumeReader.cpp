@@ -4,9 +4,13 @@
 #include <cctype>
 
 #include "tessera/core/Error.h"
+#include "tessera/io/DicomSeriesReader.h"
+#include "tessera/io/MetaImageReader.h"
 #include "tessera/io/NiftiReader.h"
 #include "tessera/io/NrrdReader.h"
 #include "tessera/io/Procedural.h"
+#include "tessera/io/PvmReader.h"
+#include "tessera/io/VtiReader.h"
 
 namespace tessera {
 
@@ -25,9 +29,8 @@ Volume readVolume(const std::string& spec) {
     throw InputError(spec +
                      ": no such file (or use gen:sphere, gen:shepp-logan, gen:marschner-lobb)");
   }
-  if (std::filesystem::is_directory(path, ec)) {
-    throw InputError(spec + ": is a directory, expected a volume file");
-  }
+  // A folder is a DICOM series (the only format that is a folder).
+  if (std::filesystem::is_directory(path, ec)) return readDicomSeries(path);
   std::string lower = path.filename().string();
   std::transform(lower.begin(), lower.end(), lower.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
@@ -36,8 +39,14 @@ Volume readVolume(const std::string& spec) {
     return readNifti(path);
   }
   if (endsWith(lower, ".nrrd") || endsWith(lower, ".nhdr")) return readNrrd(path);
+  if (endsWith(lower, ".mha") || endsWith(lower, ".mhd")) return readMetaImage(path);
+  if (endsWith(lower, ".vti")) return readVti(path);
+  if (endsWith(lower, ".pvm")) return readPvm(path);
+  if (endsWith(lower, ".raw") || endsWith(lower, ".raw.json")) return readRawWithSidecar(path);
+  if (endsWith(lower, ".dcm") || endsWith(lower, ".ima")) return readDicomSeries(path);
   throw InputError(spec +
-                   ": unknown volume format (supported: .nii, .nii.gz, .hdr/.img, .nrrd, .nhdr)");
+                   ": unknown volume format (supported: .nii, .nii.gz, .hdr/.img, .nrrd, .nhdr, "
+                   ".mha, .mhd, .vti, .pvm, .raw + .json sidecar, .dcm or a DICOM folder)");
 }
 
 }  // namespace tessera

@@ -1,0 +1,22 @@
+#pragma once
+#include <filesystem>
+#include <functional>
+
+#include "tessera/core/Volume.h"
+
+namespace tessera {
+
+// Writes by extension: .nrrd, .nii, .nii.gz, .mha, .vti, .pvm, .raw (+ .json
+// sidecar), or a directory name ending in "/" or ".dcm.d" for a DICOM series.
+// The file appears under its final name only when complete: the writer
+// writes a temporary file in the same directory and renames it, so an
+// interrupted write never leaves a half-written file under the final name.
+void writeVolume(const Volume& volume, const std::filesystem::path& path);
+
+// Runs `write(tempPath)` and renames tempPath to `path` on success (removes
+// it on failure). tempPath is in the same directory and ends with the same
+// file name, so extension-based writers behave the same.
+void writeAtomically(const std::filesystem::path& path,
+                     const std::function<void(const std::filesystem::path&)>& write);
+
+}  // namespace tessera

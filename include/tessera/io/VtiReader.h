@@ -1,0 +1,16 @@
+#pragma once
+#include <filesystem>
+
+#include "tessera/core/Volume.h"
+
+namespace tessera {
+
+// VTK XML ImageData (.vti): the first point-data array of a 3D extent;
+// formats appended (raw or base64) and inline binary (base64) and ascii;
+// zlib compression (vtkZLibDataCompressor, header UInt32 or UInt64);
+// types UInt8/Int8/UInt16/Int16/Float32 (Int32/UInt32/Float64 -> f32);
+// Spacing, Origin. Sizes are checked before allocating.
+Volume readVti(const std::filesystem::path& path);
+void writeVti(const Volume& volume, const std::filesystem::path& path, bool compressed = false);
+
+}  // namespace tessera
