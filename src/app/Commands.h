@@ -12,6 +12,7 @@ void addRenderCommand(CLI::App& app);
 void addBenchCommand(CLI::App& app);
 void addProfilesCommand(CLI::App& app);  // ProfilesCommand.cpp
 void addPlanCommand(CLI::App& app);      // PlanCommand.cpp
+void addConvertCommand(CLI::App& app);   // ConvertCommand.cpp
 
 // ch2 from mricron-data when installed, else a generated Shepp–Logan phantom.
 std::string defaultVolumeSpec();

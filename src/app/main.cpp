@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   tessera::app::addBenchCommand(app);
   tessera::app::addProfilesCommand(app);
   tessera::app::addPlanCommand(app);
+  tessera::app::addConvertCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,154 @@
+// tessera convert IN OUT [--crop ...] [--downsample ...]
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+
+#include "app/Commands.h"
+#include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
+#include "tessera/io/VolumeReader.h"
+#include "tessera/io/VolumeWriter.h"
+#include "tessera/lod/Downsample.h"
+
+namespace tessera::app {
+
+namespace {
+
+struct ConvertOptions {
+  std::string in;
+  std::string out;
+  std::string crop;
+  std::string downsample;
+  bool quiet = false;
+};
+
+// One line on stderr per stage, redrawn in place on a terminal:
+// "convert [####------] 40%  writing out.nii.gz  1.2 s".
+class Progress {
+ public:
+  explicit Progress(bool enabled) : enabled_(enabled), tty_(::isatty(2) != 0) {}
+  void stage(const std::string& what, double fraction) {
+    if (!enabled_) return;
+    const int filled = static_cast<int>(fraction * 20.0 + 0.5);
+    std::string bar(static_cast<std::size_t>(filled), '#');
+    bar.resize(20, '-');
+    const double s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    std::fprintf(stderr, "%sconvert [%s] %3d%%  %-40s %6.1f s%s", tty_ ? "\r" : "", bar.c_str(),
+                 static_cast<int>(fraction * 100.0 + 0.5), what.c_str(), s, tty_ ? "" : "\n");
+    std::fflush(stderr);
+  }
+  void done() {
+    if (enabled_ && tty_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  bool enabled_;
+  bool tty_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+glm::ivec3 parseFactors(const std::string& text) {
+  int a = 0, b = 0, c = 0;
+  char x1 = 0, x2 = 0;
+  std::istringstream in(text);
+  if ((in >> a) && in.eof()) return {a, a, a};
+  in.clear();
+  in.str(text);
+  if (!(in >> a >> x1 >> b >> x2 >> c) || x1 != 'x' || x2 != 'x' || !in.eof() || a < 1 || b < 1 ||
+      c < 1) {
+    throw InputError("--downsample '" + text + "': expected N or AxBxC with factors >= 1");
+  }
+  return {a, b, c};
+}
+
+// "x0:x1,y0:y1,z0:z1", half-open voxel ranges.
+std::pair<glm::ivec3, glm::ivec3> parseCrop(const std::string& text, glm::ivec3 dims) {
+  glm::ivec3 lo, hi;
+  std::istringstream in(text);
+  char c1, c2, c3, c4, c5;
+  if (!(in >> lo.x >> c1 >> hi.x >> c2 >> lo.y >> c3 >> hi.y >> c4 >> lo.z >> c5 >> hi.z) ||
+      c1 != ':' || c3 != ':' || c5 != ':' || c2 != ',' || c4 != ',' || !in.eof()) {
+    throw InputError("--crop '" + text + "': expected x0:x1,y0:y1,z0:z1 (voxels, end exclusive)");
+  }
+  for (int a = 0; a < 3; ++a) {
+    if (lo[a] < 0 || hi[a] > dims[a] || lo[a] >= hi[a]) {
+      throw InputError("--crop '" + text + "': axis " + std::to_string(a) + " range " +
+                       std::to_string(lo[a]) + ":" + std::to_string(hi[a]) +
+                       " is empty or outside 0:" + std::to_string(dims[a]));
+    }
+  }
+  return {lo, hi};
+}
+
+Volume crop(const Volume& v, glm::ivec3 lo, glm::ivec3 hi) {
+  Volume out = Volume::allocate(hi - lo, v.type(), "cropped volume");
+  out.setSpacing(v.spacing());
+  out.setOrigin(v.origin() + glm::dvec3(lo) * v.spacing());
+  if (v.hasWindow()) out.setWindow(v.window());
+  out.setDescription(v.description());
+  const std::size_t bpv = bytesPerVoxel(v.type());
+  const std::size_t row = static_cast<std::size_t>(hi.x - lo.x) * bpv;
+  for (int z = lo.z; z < hi.z; ++z) {
+    for (int y = lo.y; y < hi.y; ++y) {
+      const std::byte* src = v.bytes().data() + v.index(lo.x, y, z) * bpv;
+      std::byte* dst = out.bytes().data() + out.index(0, y - lo.y, z - lo.z) * bpv;
+      std::copy(src, src + row, dst);
+    }
+  }
+  out.invalidateRange();
+  return out;
+}
+
+std::string dimsText(glm::ivec3 d) {
+  return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
+}
+
+void runConvert(const ConvertOptions& o) {
+  Progress progress(!o.quiet);
+  progress.stage("reading " + o.in, 0.0);
+  Volume v = readVolume(o.in);
+  const glm::ivec3 inDims = v.dims();
+  progress.stage("read " + dimsText(inDims), 0.4);
+  if (!o.crop.empty()) {
+    const auto [lo, hi] = parseCrop(o.crop, v.dims());
+    v = crop(v, lo, hi);
+    progress.stage("cropped to " + dimsText(v.dims()), 0.5);
+  }
+  if (!o.downsample.empty()) {
+    const glm::ivec3 f = parseFactors(o.downsample);
+    if (f != glm::ivec3(1)) v = lod::downsample(v, f);
+    progress.stage("downsampled to " + dimsText(v.dims()), 0.6);
+  }
+  progress.stage("writing " + o.out, 0.7);
+  writeVolume(v, o.out);
+  progress.stage("done", 1.0);
+  progress.done();
+  std::printf("%s: %s %s -> %s: %s %s (%s)\n", o.in.c_str(), dimsText(inDims).c_str(),
+              std::string(scalarTypeName(v.type())).c_str(), o.out.c_str(),
+              dimsText(v.dims()).c_str(), std::string(scalarTypeName(v.type())).c_str(),
+              formatBytes(v.byteSize()).c_str());
+}
+
+}  // namespace
+
+void addConvertCommand(CLI::App& app) {
+  auto o = std::make_shared<ConvertOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "convert",
+      "Convert between volume formats (by extension), optionally cropping and downsampling.\n"
+      "Output: .nrrd .nii .nii.gz .mha .vti .pvm .raw(+.json) or FOLDER/ (DICOM series).\n"
+      "The output appears only when complete (temporary file + rename).");
+  cmd->add_option("in", o->in, "Input volume (any format tessera info reads, or gen:...)")
+      ->required();
+  cmd->add_option("out", o->out, "Output file (format from its extension)")->required();
+  cmd->add_option("--crop", o->crop, "Keep voxels x0:x1,y0:y1,z0:z1 (end exclusive)");
+  cmd->add_option("--downsample", o->downsample, "Box-filter by N or AxBxC");
+  cmd->add_flag("--quiet", o->quiet, "No progress on stderr");
+  cmd->callback([o] { runConvert(*o); });
+}
+
+}  // namespace tessera::app

@@ -1,0 +1,99 @@
+#include "tessera/io/VolumeWriter.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <string>
+
+#include "tessera/core/Error.h"
+#include "tessera/io/DicomSeriesReader.h"
+#include "tessera/io/MetaImageReader.h"
+#include "tessera/io/NiftiWriter.h"
+#include "tessera/io/NrrdReader.h"
+#include "tessera/io/PvmReader.h"
+#include "tessera/io/VtiReader.h"
+
+namespace tessera {
+
+namespace fs = std::filesystem;
+
+namespace {
+bool endsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::string lowerName(const fs::path& path) {
+  std::string s = path.filename().string();
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+}  // namespace
+
+void writeAtomically(const fs::path& path, const std::function<void(const fs::path&)>& write) {
+  static std::atomic<int> counter{0};
+  const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) {
+    throw InputError(path.string() + ": cannot write, folder " + dir.string() + " does not exist");
+  }
+  // Same folder (so rename is atomic) and the same file name at the end (so
+  // writers that look at the extension behave as for the final name).
+  const fs::path temp = dir / (".tessera-" + std::to_string(::getpid()) + "-" +
+                               std::to_string(counter++) + "-" + path.filename().string());
+  // Errors name the final path, not the temporary one the user never sees.
+  auto rename = [&](const std::string& message) {
+    std::string m = message;
+    for (auto at = m.find(temp.string()); at != std::string::npos; at = m.find(temp.string())) {
+      m.replace(at, temp.string().size(), path.string());
+    }
+    return m;
+  };
+  try {
+    write(temp);
+    fs::rename(temp, path);
+  } catch (const InputError& e) {
+    fs::remove_all(temp, ec);
+    throw InputError(rename(e.what()));
+  } catch (const BudgetError& e) {
+    fs::remove_all(temp, ec);
+    throw BudgetError(rename(e.what()));
+  } catch (const std::exception& e) {
+    fs::remove_all(temp, ec);
+    throw Error(rename(e.what()));
+  }
+}
+
+void writeVolume(const Volume& volume, const fs::path& path) {
+  if (!volume.hasData()) throw Error(path.string() + ": no voxels to write");
+  const std::string name = lowerName(path);
+  const std::string text = path.string();
+  if (endsWith(name, ".nrrd")) {
+    writeAtomically(path, [&](const fs::path& t) { writeNrrd(volume, t, true); });
+  } else if (endsWith(name, ".nii") || endsWith(name, ".nii.gz")) {
+    writeAtomically(path, [&](const fs::path& t) { writeNifti(volume, t); });
+  } else if (endsWith(name, ".mha")) {
+    writeAtomically(path, [&](const fs::path& t) { writeMetaImage(volume, t, true); });
+  } else if (endsWith(name, ".vti")) {
+    writeAtomically(path, [&](const fs::path& t) { writeVti(volume, t, true); });
+  } else if (endsWith(name, ".pvm")) {
+    writeAtomically(path, [&](const fs::path& t) { writePvm(volume, t); });
+  } else if (endsWith(name, ".raw")) {
+    // Two files: data first, then the sidecar that makes it readable.
+    writeAtomically(path, [&](const fs::path& t) {
+      writeRawWithSidecar(volume, t);
+      fs::rename(fs::path(t.string() + ".json"), fs::path(text + ".json"));
+    });
+  } else if (!text.empty() && (text.back() == '/' || endsWith(name, ".dcm.d"))) {
+    writeDicomSeries(volume, path);  // writes a temporary folder and renames it
+  } else {
+    throw InputError(text +
+                     ": unknown output format (use .nrrd, .nii, .nii.gz, .mha, .vti, .pvm, .raw, "
+                     "or a folder name ending in / for a DICOM series)");
+  }
+}
+
+}  // namespace tessera
