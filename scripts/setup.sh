@@ -9,6 +9,7 @@ PACKAGES=(
   libnifti2-dev zlib1g-dev libpng-dev libdcmtk-dev dcmtk # volume and image I/O (DICOM: DCMTK)
   libcli11-dev nlohmann-json3-dev libglm-dev             # CLI, JSON, maths
   libgtest-dev libgmock-dev glslang-tools                # tests (glslangValidator checks GLSL ES 1.00 rules)
+  clang-14 libclang-rt-14-dev                            # fuzzing: libFuzzer + sanitizers (scripts/fuzz.sh)
   mricron-data                                           # the default volume (ch2 T1 MRI head)
 )
 

@@ -1,8 +1,23 @@
 #!/usr/bin/env bash
-# Sets up, builds everything (warnings as errors) and runs all tests.
+# Sets up, builds everything (warnings as errors) and runs all tests; then
+# the same tests under ASan + UBSan (scripts/sanitize.sh) and a short fuzz
+# run of every parser (scripts/fuzz.sh, FUZZ_SECONDS each, default 30).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh
-scripts/build.sh
-cd build
-ctest --output-on-failure --timeout 900 -j2
+FUZZ_SECONDS=${FUZZ_SECONDS:-30}
+
+timings=()
+timed() {
+  local name=$1 start=$SECONDS
+  shift
+  "$@"
+  timings+=("$name $((SECONDS - start)) s")
+}
+ctest_build() { (cd build && ctest --output-on-failure --timeout 900 -j2); }
+
+timed setup scripts/setup.sh
+timed build scripts/build.sh
+timed ctest ctest_build
+timed sanitize scripts/sanitize.sh
+timed fuzz scripts/fuzz.sh "$FUZZ_SECONDS"
+echo "test.sh timings: $(IFS=,; echo "${timings[*]}" | sed 's/,/, /g'); total ${SECONDS} s"

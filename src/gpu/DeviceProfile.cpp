@@ -280,7 +280,8 @@ DeviceProfile DeviceProfile::fromJson(const std::string& text, const std::string
   Json j;
   try {
     j = Json::parse(text);
-  } catch (const Json::parse_error& e) {
+  } catch (const Json::exception& e) {
+    // parse_error, and out_of_range for numbers no double can hold.
     throw InputError("device profile " + what +
                      ": malformed JSON: " + withoutExceptionId(e.what()));
   }

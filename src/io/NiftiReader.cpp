@@ -274,6 +274,15 @@ Volume readNifti(const std::filesystem::path& path) {
 
   io_detail::VoxelSource source;
   source.file = nim->iname;
+  // nifticlib names the .img it would read even when it does not exist; say
+  // which header wanted it, not only that some .img is missing.
+  if (source.file != path) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(source.file, ec)) {
+      throw InputError(p + ": cannot find the image file for this header (" + source.file.string() +
+                       " is missing or not a regular file)");
+    }
+  }
   source.gzip = io_detail::startsWithGzipMagic(source.file);
   const std::uint64_t offset =
       nim->iname_offset > 0 ? static_cast<std::uint64_t>(nim->iname_offset) : 0;

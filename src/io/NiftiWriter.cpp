@@ -1,10 +1,212 @@
-// PLACEHOLDER until the NIfTI writer lands (issue 7); replaced wholesale.
+// NIfTI-1 output. nifticlib builds the header (nifti_make_new_nim, then
+// nifti_convert_nim2n1hdr); the bytes are written here rather than by
+// nifti_image_write, which returns nothing and ignores failed data writes
+// (a full disk would leave a truncated file that looks written).
 #include "tessera/io/NiftiWriter.h"
 
+#include <fcntl.h>
+#include <nifti2_io.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include "io/VoxelLoader.h"
 #include "tessera/core/Error.h"
 
 namespace tessera {
-void writeNifti(const Volume&, const std::filesystem::path& p) {
-  throw InputError(p.string() + ": NIfTI writing not supported yet");
+
+namespace {
+
+// NIfTI-1 stores dims as int16 (nifti1.h).
+constexpr int kMaxNifti1Dim = 32767;
+
+bool endsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
+
+int datatypeOf(ScalarType t) {
+  switch (t) {
+    case ScalarType::U8:
+      return DT_UINT8;
+    case ScalarType::U16:
+      return DT_UINT16;
+    case ScalarType::I16:
+      return DT_INT16;
+    case ScalarType::F32:
+      return DT_FLOAT32;
+  }
+  return DT_UNKNOWN;
+}
+
+struct NiftiImageFree {
+  void operator()(nifti_image* nim) const { nifti_image_free(nim); }
+};
+
+// Output written under a temporary name beside the target and renamed over
+// it only once complete, so that a failed write never leaves a partial file
+// under the final name. Gzip-compressed when `gzip`.
+class PendingFile {
+ public:
+  PendingFile(const std::filesystem::path& target, bool gzip) : target_(target) {
+    static int counter = 0;
+    const std::filesystem::path dir = target.parent_path().empty() ? "." : target.parent_path();
+    std::string name = target.filename().string();
+    // A hidden name, built piecewise: GCC 12 warns falsely on "." + string.
+    name.insert(0, 1, '.');
+    name += '.';
+    name += std::to_string(::getpid());
+    name += '-';
+    name += std::to_string(counter++);
+    name += ".tmp";
+    temp_ = dir / name;
+    const int fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    int err = errno;
+    if (fd >= 0) {
+      if (gzip) {
+        gz_ = gzdopen(fd, "wb6");
+      } else {
+        file_ = ::fdopen(fd, "wb");
+      }
+      err = errno;
+      if (gz_ == nullptr && file_ == nullptr) {
+        ::close(fd);
+        std::error_code ignored;
+        std::filesystem::remove(temp_, ignored);
+      }
+    }
+    if (gz_ == nullptr && file_ == nullptr) {
+      throw Error(target_.string() + ": cannot create a temporary file in '" + dir.string() +
+                  "' to write it: " + std::strerror(err));
+    }
+  }
+  ~PendingFile() {
+    if (gz_ != nullptr) gzclose(gz_);
+    if (file_ != nullptr) std::fclose(file_);
+    if (!committed_) {
+      std::error_code ignored;
+      std::filesystem::remove(temp_, ignored);
+    }
+  }
+  PendingFile(const PendingFile&) = delete;
+  PendingFile& operator=(const PendingFile&) = delete;
+
+  void write(const void* data, std::size_t n) {
+    const auto* bytes = static_cast<const char*>(data);
+    if (gz_ != nullptr) {
+      // gzwrite takes an unsigned count: feed it in pieces.
+      constexpr std::size_t kPiece = 1 << 30;
+      for (std::size_t at = 0; at < n; at += kPiece) {
+        const auto len = static_cast<unsigned>(std::min(kPiece, n - at));
+        if (gzwrite(gz_, bytes + at, len) != static_cast<int>(len)) failGzip("write failed");
+      }
+    } else if (std::fwrite(bytes, 1, n, file_) != n) {
+      fail("write failed");
+    }
+  }
+
+  void commit() {
+    if (gz_ != nullptr) {
+      const int rc = gzclose(gz_);
+      gz_ = nullptr;
+      if (rc != Z_OK) fail("write failed (gzip)");
+    } else {
+      const int rc = std::fclose(file_);
+      file_ = nullptr;
+      if (rc != 0) fail("write failed");
+    }
+    if (std::rename(temp_.c_str(), target_.c_str()) != 0) fail("cannot rename the temporary file");
+    committed_ = true;
+  }
+
+ private:
+  [[noreturn]] void fail(const char* what) const {
+    throw Error(target_.string() + ": " + what + ": " + std::strerror(errno));
+  }
+  [[noreturn]] void failGzip(const char* what) const {
+    int zerr = Z_OK;
+    const char* msg = gzerror(gz_, &zerr);
+    throw Error(target_.string() + ": " + what + ": " +
+                (zerr == Z_ERRNO ? std::strerror(errno) : msg));
+  }
+
+  std::filesystem::path target_;
+  std::filesystem::path temp_;
+  std::FILE* file_ = nullptr;
+  gzFile gz_ = nullptr;
+  bool committed_ = false;
+};
+
+}  // namespace
+
+void writeNifti(const Volume& volume, const std::filesystem::path& path) {
+  const std::string p = path.string();
+  const std::string name = path.filename().string();
+  const bool gzip = endsWith(name, ".nii.gz");
+  if (!gzip && !endsWith(name, ".nii")) {
+    throw InputError(p + ": a NIfTI file name must end in .nii or .nii.gz");
+  }
+  if (!volume.hasData()) throw InputError(p + ": cannot write a volume without voxels");
+  const glm::ivec3 d = volume.dims();
+  if (d.x > kMaxNifti1Dim || d.y > kMaxNifti1Dim || d.z > kMaxNifti1Dim) {
+    throw InputError(p + ": " + io_detail::dimsString(d) + " exceeds NIfTI-1's limit of " +
+                     std::to_string(kMaxNifti1Dim) + " voxels per axis");
+  }
+
+  nifti_set_debug_level(0);  // errors are ours to report, not nifticlib's to print
+  const std::int64_t dims[8] = {3, d.x, d.y, d.z, 1, 1, 1, 1};
+  std::unique_ptr<nifti_image, NiftiImageFree> nim(
+      nifti_make_new_nim(dims, datatypeOf(volume.type()), 0));
+  if (!nim) throw Error(p + ": nifticlib could not create a NIfTI header");
+  nim->nifti_type = NIFTI_FTYPE_NIFTI1_1;  // one .nii file, magic "n+1"
+  const glm::dvec3 s = volume.spacing();
+  nim->dx = nim->pixdim[1] = s.x;
+  nim->dy = nim->pixdim[2] = s.y;
+  nim->dz = nim->pixdim[3] = s.z;
+  nim->xyz_units = NIFTI_UNITS_MM;
+  // No scaling: scl_slope 0 means "none" (nifti1.h).
+  nim->scl_slope = 0.0;
+  nim->scl_inter = 0.0;
+  // qform: identity rotation, qoffset = origin (NIfTI-1 method 2).
+  const glm::dvec3 o = volume.origin();
+  nim->qform_code = NIFTI_XFORM_SCANNER_ANAT;
+  nim->quatern_b = nim->quatern_c = nim->quatern_d = 0.0;
+  nim->qfac = 1.0;
+  nim->pixdim[0] = 1.0;
+  nim->qoffset_x = o.x;
+  nim->qoffset_y = o.y;
+  nim->qoffset_z = o.z;
+  nim->qto_xyz = nifti_quatern_to_dmat44(0.0, 0.0, 0.0, o.x, o.y, o.z, s.x, s.y, s.z, 1.0);
+  nim->sform_code = NIFTI_XFORM_UNKNOWN;
+  std::snprintf(nim->descrip, sizeof nim->descrip, "written by Tessera");
+  nifti_set_iname_offset(nim.get(), 1);
+
+  nifti_1_header header;
+  if (nifti_convert_nim2n1hdr(nim.get(), &header) != 0) {
+    throw Error(p + ": nifticlib could not build a NIfTI-1 header for " + io_detail::dimsString(d) +
+                " " + std::string(scalarTypeName(volume.type())));
+  }
+  const std::uint64_t voxOffset = static_cast<std::uint64_t>(header.vox_offset);
+  if (voxOffset < sizeof header + 4) {
+    throw Error(p + ": nifticlib set vox_offset " + std::to_string(voxOffset) +
+                ", inside the header");
+  }
+
+  PendingFile out(path, gzip);
+  out.write(&header, sizeof header);
+  // The 4 bytes after the header say whether extensions follow (none), then
+  // padding up to vox_offset (352 with no extensions).
+  const std::string gap(static_cast<std::size_t>(voxOffset - sizeof header), '\0');
+  out.write(gap.data(), gap.size());
+  // Native byte order: sizeof_hdr tells readers which one that is.
+  out.write(volume.bytes().data(), volume.bytes().size());
+  out.commit();
+}
+
 }  // namespace tessera

@@ -399,6 +399,12 @@ Volume readNrrd(const std::filesystem::path& path) {
   };
   checkPerAxis(h.spacings.size(), "spacings");
   checkPerAxis(h.spaceDirections.size(), "space directions");
+  // An empty "space directions:" line still means "space directions give the
+  // spacing", so it must have one entry per axis like any other.
+  if (h.hasSpaceDirections && h.spaceDirections.empty()) {
+    throw InputError(p + ": 'space directions' has no values, but dimension is " +
+                     std::to_string(h.dimension));
+  }
   for (std::size_t a = 0; a < h.sizes.size(); ++a) {
     if (h.sizes[a] <= 0) {
       throw InputError(p + ": size of axis " + std::to_string(a) + " is " +
@@ -475,7 +481,12 @@ Volume readNrrd(const std::filesystem::path& path) {
     if (data.is_relative()) data = path.parent_path() / data;
     source.file = data;
     start = 0;
-    io_detail::regularFileSize(data);
+    try {
+      io_detail::regularFileSize(data);
+    } catch (const InputError& e) {
+      // The user named the header; say which header wants the missing file.
+      throw InputError(p + ": data file: " + e.what());
+    }
   }
   start = skipLines(source.file, start, h.lineSkip, p);
   if (h.encoding == "gzip") {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstring>
+#include <fstream>
 
 #include "tessera/core/Error.h"
 #include "tessera/io/DicomSeriesReader.h"
@@ -18,6 +20,13 @@ namespace {
 bool endsWith(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() &&
          s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+// DICOM files often have no extension: a Part-10 file has "DICM" at byte 128.
+bool hasDicomMarker(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  char buf[132] = {};
+  in.read(buf, sizeof buf);
+  return in.gcount() == 132 && std::memcmp(buf + 128, "DICM", 4) == 0;
 }
 }  // namespace
 
@@ -42,11 +51,13 @@ Volume readVolume(const std::string& spec) {
   if (endsWith(lower, ".mha") || endsWith(lower, ".mhd")) return readMetaImage(path);
   if (endsWith(lower, ".vti")) return readVti(path);
   if (endsWith(lower, ".pvm")) return readPvm(path);
-  if (endsWith(lower, ".raw") || endsWith(lower, ".raw.json")) return readRawWithSidecar(path);
-  if (endsWith(lower, ".dcm") || endsWith(lower, ".ima")) return readDicomSeries(path);
+  if (endsWith(lower, ".raw") || endsWith(lower, ".json")) return readRawWithSidecar(path);
+  if (endsWith(lower, ".dcm") || endsWith(lower, ".ima") || hasDicomMarker(path)) {
+    return readDicomSeries(path);
+  }
   throw InputError(spec +
                    ": unknown volume format (supported: .nii, .nii.gz, .hdr/.img, .nrrd, .nhdr, "
-                   ".mha, .mhd, .vti, .pvm, .raw + .json sidecar, .dcm or a DICOM folder)");
+                   ".mha, .mhd, .vti, .pvm, .raw + .json sidecar, DICOM files or a DICOM folder)");
 }
 
 }  // namespace tessera

@@ -82,11 +82,9 @@ void writeVolume(const Volume& volume, const fs::path& path) {
   } else if (endsWith(name, ".pvm")) {
     writeAtomically(path, [&](const fs::path& t) { writePvm(volume, t); });
   } else if (endsWith(name, ".raw")) {
-    // Two files: data first, then the sidecar that makes it readable.
-    writeAtomically(path, [&](const fs::path& t) {
-      writeRawWithSidecar(volume, t);
-      fs::rename(fs::path(t.string() + ".json"), fs::path(text + ".json"));
-    });
+    // Two files, each through its own temporary file: the data first, then
+    // the sidecar that names it and makes it readable.
+    writeRawWithSidecar(volume, path);
   } else if (!text.empty() && (text.back() == '/' || endsWith(name, ".dcm.d"))) {
     writeDicomSeries(volume, path);  // writes a temporary folder and renames it
   } else {

@@ -311,4 +311,22 @@ Volume loadVoxels(const VoxelSource& source, const VoxelFormat& format, const st
   return v;
 }
 
+Volume decodeVoxels(ByteSource& bytes, const VoxelFormat& format, const std::string& what) {
+  for (int a = 0; a < 3; ++a) {
+    if (format.dims[a] <= 0 || format.dims[a] > kMaxDim) {
+      throw InputError(what + ": size along axis " + std::to_string(a) + " is " +
+                       std::to_string(format.dims[a]) + ", expected 1.." + std::to_string(kMaxDim));
+    }
+  }
+  Volume v = Volume::allocate(format.dims, volumeTypeFor(format), what);
+  const std::uint64_t want = v.voxelCount() * diskTypeSize(format.type);
+  const std::uint64_t got = decode(bytes, format, v);
+  if (got < want) {
+    throw InputError(what + ": voxel data ends after " + std::to_string(got) + " of " +
+                     std::to_string(want) + " bytes (" + dimsString(format.dims) + " " +
+                     std::string(diskTypeName(format.type)) + ")");
+  }
+  return v;
+}
+
 }  // namespace tessera::io_detail

@@ -57,4 +57,14 @@ Volume loadVoxels(const VoxelSource& source, const VoxelFormat& format, const st
 // "181x217x181"
 std::string dimsString(glm::ivec3 dims);
 
+class ByteSource;
+
+// Reads dims × type voxels from an open stream of voxel bytes (decoded
+// base64, inflated zlib blocks, a buffer) into a new Volume, with the same
+// swapping and conversion as loadVoxels. The caller checks first that the
+// stream can hold that many bytes (the host budget is checked here, by
+// Volume::allocate); a stream that still ends early is an InputError naming
+// `what`, never a half-filled volume.
+Volume decodeVoxels(ByteSource& bytes, const VoxelFormat& format, const std::string& what);
+
 }  // namespace tessera::io_detail

@@ -212,11 +212,32 @@ TEST(DeviceProfile, MalformedFilesAreRefusedNamingTheFile) {
       {R"({"name": "x", "api": "gles3", "note": "two\nlines"})", "note"},
       {R"(["name", "x"])", "object"},
       {"", "malformed JSON"},
+      // Found by fuzz_device_profile: a number no double holds is out_of_range,
+      // not parse_error, in nlohmann-json.
+      {R"({"name": "x", "api": "gles3", "texture_units": 4E444444})", "malformed JSON"},
   };
   for (const auto& [text, fragment] : cases) {
     SCOPED_TRACE(text);
     expectRefused(text, fragment);
   }
+}
+
+// Inputs fuzz_device_profile once crashed on (tests/data/bad/fuzz-regressions).
+TEST(DeviceProfile, FuzzRegressionsAreRefusedNamingTheFile) {
+  const auto dir =
+      std::filesystem::path(TESSERA_TEST_DATA_DIR) / "bad" / "fuzz-regressions" / "device_profile";
+  int cases = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    SCOPED_TRACE(entry.path().string());
+    ++cases;
+    try {
+      DeviceProfile::load(entry.path());
+      ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(entry.path().string()), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_GE(cases, 1);
 }
 
 TEST(DeviceProfile, MissingFileIsRefusedNamingIt) {

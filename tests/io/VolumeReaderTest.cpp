@@ -2,10 +2,15 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <filesystem>
+
 #include "io/IoFixtures.h"
 #include "tessera/core/Error.h"
+#include "tessera/io/DicomSeriesReader.h"
 #include "tessera/io/NrrdReader.h"
 #include "tessera/io/Procedural.h"
+#include "tessera/io/PvmReader.h"
 
 namespace tessera {
 namespace {
@@ -24,6 +29,26 @@ TEST(VolumeReader, DispatchesOnExtensionAndGeneratorSpecs) {
   EXPECT_EQ(readVolume((dir / "n.nii.gz").string()).valueAt(3, 2, 1), 5.0);
 
   EXPECT_EQ(readVolume("gen:sphere:12").dims(), glm::ivec3(12));
+}
+
+TEST(VolumeReader, FindsRawSidecarsAndDicomFilesWithoutExtension) {
+  test::TempDir dir;
+  const Volume phantom = makeSheppLogan({9, 7, 5});
+  // data.raw + data.json: the sidecar names the data file.
+  writeRawWithSidecar(phantom, dir / "data.raw");
+  std::filesystem::rename(dir / "data.raw.json", dir / "data.json");
+  const Volume raw = readVolume((dir / "data.json").string());
+  ASSERT_EQ(raw.dims(), phantom.dims());
+  EXPECT_TRUE(std::equal(raw.bytes().begin(), raw.bytes().end(), phantom.bytes().begin()));
+
+  // Scanners often write DICOM files with no extension at all.
+  writeDicomSeries(phantom, dir / "series");
+  const auto first = std::filesystem::directory_iterator(dir / "series")->path();
+  const auto bare = dir / "series" / "IM0001";
+  std::filesystem::rename(first, bare);
+  const Volume dicom = readVolume(bare.string());
+  ASSERT_EQ(dicom.dims(), phantom.dims());
+  EXPECT_EQ(dicom.valueAt(4, 3, 2), phantom.valueAt(4, 3, 2));
 }
 
 TEST(VolumeReader, RejectsUnknownMissingAndDirectories) {

@@ -9,7 +9,16 @@ namespace tessera {
 // or zraw (zlib) data; MET_UCHAR/CHAR/USHORT/SHORT/FLOAT (and INT/UINT/DOUBLE
 // converted to f32), NDims 3, ElementSpacing, Offset, BinaryDataByteOrderMSB,
 // HeaderSize (incl. -1). Sizes are checked against the data before allocating.
+// Also: NDims 4 with DimSize 1 last, ElementSize, Origin/Position,
+// ElementByteOrderMSB, CompressedDataSize (checked against the file),
+// MET_LONG/ULONG (4 bytes, to f32); HeaderSize > 0 is the offset of the
+// voxels in the data file, as in MetaIO. Refused with an InputError: several
+// channels, BinaryData = False, ElementDataFile LIST or a file-name pattern.
 Volume readMetaImage(const std::filesystem::path& path);
+
+// .mha: header and voxels in one file; .mhd: header plus <stem>.raw (or
+// <stem>.zraw when compressed) beside it. Little endian, one zlib stream
+// when compressed; spacing and origin written exactly (%.17g).
 void writeMetaImage(const Volume& volume, const std::filesystem::path& path,
                     bool compressed = false);
 

@@ -8,10 +8,13 @@
 
 namespace tessera {
 
-// Reads `.nii`, `.nii.gz` (NIfTI-1/2), `.nrrd`, `.nhdr`; or generates a
-// procedural volume when `spec` starts with "gen:" (see io/Procedural.h).
-// Throws InputError naming the file and the problem; never allocates more
-// than the file can justify or the host budget allows.
+// Picks the reader by name: `.nii`, `.nii.gz`, `.hdr`/`.img` (NIfTI-1/2),
+// `.nrrd`, `.nhdr` (NRRD), `.mha`, `.mhd` (MetaImage), `.vti` (VTK XML
+// ImageData), `.pvm` (PVM), `.raw` or its `.json` sidecar (raw), a folder,
+// `.dcm`/`.ima` or any file with the DICM marker (DICOM series); or
+// generates a procedural volume when `spec` starts with "gen:" (see
+// io/Procedural.h). Throws InputError naming the file and the problem; never
+// allocates more than the file can justify or the host budget allows.
 Volume readVolume(const std::string& spec);
 
 }  // namespace tessera

@@ -1,0 +1,80 @@
+#pragma once
+// What every fuzz target shares: a small host budget, so that a header
+// claiming gigabytes is refused instead of allocated, and a per-process
+// scratch folder for readers that take a path (the file name's extension
+// picks nothing here; each target calls its reader directly).
+//
+// A target catches tessera::Error, the documented way to reject input. Any
+// other exception escapes LLVMFuzzerTestOneInput, std::terminate aborts, and
+// libFuzzer reports the input as a crash: readers must turn library errors
+// (nlohmann::json, DCMTK, zlib) into InputError.
+#include <unistd.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <system_error>
+
+#include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
+
+namespace tessera::fuzz {
+
+// 64 MiB: far above what the seeds need, far below -rss_limit_mb.
+constexpr std::uint64_t kFuzzHostBudget = 64ull << 20;
+
+// Removed when the process exits normally; crashes leave it for inspection.
+class ScratchDir {
+ public:
+  ScratchDir()
+      : path_(std::filesystem::temp_directory_path() /
+              ("tessera-fuzz-" + std::to_string(::getpid()))) {
+    std::filesystem::create_directories(path_);
+  }
+  ~ScratchDir() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+inline const std::filesystem::path& scratchDir() {
+  static const ScratchDir dir;
+  return dir.path();
+}
+
+inline void initialize() {
+  HostBudget::global().setLimit(kFuzzHostBudget);
+  scratchDir();
+}
+
+// Replaces `path` with exactly these bytes; aborts if it cannot (a broken
+// harness must not look like a reader bug or, worse, like a clean run).
+inline void writeBytes(const std::filesystem::path& path, const std::uint8_t* data,
+                       std::size_t size) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (f == nullptr || (size > 0 && std::fwrite(data, 1, size, f) != size) || std::fclose(f) != 0) {
+    std::fprintf(stderr, "fuzz harness: cannot write %s\n", path.c_str());
+    std::abort();
+  }
+}
+
+// Called with each clean rejection; TESSERA_FUZZ_VERBOSE=1 prints them (to
+// check that seeds are accepted, or why an input is refused).
+inline void rejected(const Error& e) {
+  static const bool verbose = [] {
+    const char* v = std::getenv("TESSERA_FUZZ_VERBOSE");
+    return v != nullptr && v[0] == '1';
+  }();
+  if (verbose) std::fprintf(stderr, "rejected: %s\n", e.what());
+}
+
+}  // namespace tessera::fuzz

@@ -1,0 +1,25 @@
+#pragma once
+// The DCMTK setup shared by the DICOM series reader and writer: one-time
+// process setup (quiet logging, codecs registered, data dictionary present)
+// and the names users see for transfer syntaxes and DCMTK errors.
+#include <string>
+
+#include <dcmtk/config/osconfig.h>  // must come before any other DCMTK header
+#include <dcmtk/dcmdata/dcxfer.h>
+#include <dcmtk/ofstd/ofcond.h>
+
+namespace tessera::io_detail {
+
+// Idempotent and thread-safe. Silences DCMTK's logger (our errors carry the
+// message instead), registers the JPEG, JPEG-LS and RLE decoders and the
+// JPEG-LS and RLE encoders, and throws Error when DCMTK's data dictionary is
+// missing (implicit-VR files cannot be parsed without it).
+void initDicomToolkit();
+
+// "JPEG 2000 Image Compression (Lossless Only) (1.2.840.10008.1.2.4.90)"
+std::string transferSyntaxText(E_TransferSyntax xfer);
+
+// DCMTK's text for a failed condition, e.g. "I/O suspension or premature end of stream".
+std::string conditionText(const OFCondition& cond);
+
+}  // namespace tessera::io_detail

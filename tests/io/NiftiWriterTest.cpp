@@ -1,0 +1,197 @@
+#include "tessera/io/NiftiWriter.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "io/IoFixtures.h"
+#include "tessera/core/Error.h"
+#include "tessera/io/NiftiReader.h"
+
+namespace tessera {
+namespace {
+
+using test::expectRejected;
+using test::TempDir;
+
+const std::filesystem::path kCh2 = "/usr/share/mricron/templates/ch2.nii.gz";
+constexpr ScalarType kAllTypes[] = {ScalarType::U8, ScalarType::U16, ScalarType::I16,
+                                    ScalarType::F32};
+
+Volume randomVolume(glm::ivec3 dims, ScalarType type, unsigned seed) {
+  Volume v = Volume::allocate(dims, type, "test volume");
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> real(-1000.0f, 1000.0f);
+  for (std::uint64_t i = 0; i < v.voxelCount(); ++i) {
+    switch (type) {
+      case ScalarType::U8:
+        v.setValueAtIndex(i, rng() % 256);
+        break;
+      case ScalarType::U16:
+        v.setValueAtIndex(i, rng() % 65536);
+        break;
+      case ScalarType::I16:
+        v.setValueAtIndex(i, static_cast<int>(rng() % 65536) - 32768);
+        break;
+      case ScalarType::F32:
+        v.setValueAtIndex(i, real(rng));
+        break;
+    }
+  }
+  v.invalidateRange();
+  // NIfTI-1 stores spacing and origin as float: these are exact in float.
+  v.setSpacing(glm::dvec3(0.5, 1.25, 3.0));
+  v.setOrigin(glm::dvec3(-90.5, 12.25, 7.0));
+  return v;
+}
+
+void expectSameVolume(const Volume& a, const Volume& b) {
+  EXPECT_EQ(a.dims(), b.dims());
+  EXPECT_EQ(a.type(), b.type());
+  EXPECT_EQ(a.spacing(), b.spacing());
+  EXPECT_EQ(a.origin(), b.origin());
+  ASSERT_EQ(a.byteSize(), b.byteSize());
+  EXPECT_EQ(std::memcmp(a.bytes().data(), b.bytes().data(), a.byteSize()), 0)
+      << "voxel bytes differ";
+}
+
+std::string fileBytes(const std::filesystem::path& path) {
+  std::string bytes(static_cast<std::size_t>(std::filesystem::file_size(path)), '\0');
+  std::ifstream in(path, std::ios::binary);
+  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  return bytes;
+}
+
+template <class T>
+T at(const std::string& bytes, std::size_t offset) {
+  T v;
+  std::memcpy(&v, bytes.data() + offset, sizeof v);
+  return v;
+}
+
+int entriesIn(const std::filesystem::path& dir) {
+  int n = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++n;
+  return n;
+}
+
+TEST(NiftiWriter, RoundTripsEveryTypeExactlyThroughNiiAndNiiGz) {
+  TempDir dir;
+  for (const char* name : {"v.nii", "v.nii.gz"}) {
+    for (ScalarType type : kAllTypes) {
+      SCOPED_TRACE(std::string(name) + " " + std::string(scalarTypeName(type)));
+      const Volume v = randomVolume({7, 5, 3}, type, 1);
+      writeNifti(v, dir / name);
+      expectSameVolume(readNifti(dir / name), v);
+    }
+  }
+}
+
+TEST(NiftiWriter, WritesANifti1HeaderWithQformOriginAndNoScaling) {
+  TempDir dir;
+  const Volume v = randomVolume({7, 5, 3}, ScalarType::I16, 2);
+  writeNifti(v, dir / "h.nii");
+  const std::string b = fileBytes(dir / "h.nii");
+  // Offsets from nifti1.h.
+  ASSERT_EQ(b.size(), 352u + v.byteSize());
+  EXPECT_EQ(at<std::int32_t>(b, 0), 348);
+  EXPECT_EQ(b.substr(344, 4), std::string("n+1\0", 4));
+  EXPECT_EQ(at<std::int16_t>(b, 40), 3);
+  EXPECT_EQ(at<std::int16_t>(b, 42), 7);
+  EXPECT_EQ(at<std::int16_t>(b, 44), 5);
+  EXPECT_EQ(at<std::int16_t>(b, 46), 3);
+  EXPECT_EQ(at<std::int16_t>(b, 70), 4);   // DT_INT16
+  EXPECT_EQ(at<std::int16_t>(b, 72), 16);  // bitpix
+  EXPECT_EQ(at<float>(b, 76), 1.0f);       // qfac
+  EXPECT_EQ(at<float>(b, 80), 0.5f);
+  EXPECT_EQ(at<float>(b, 84), 1.25f);
+  EXPECT_EQ(at<float>(b, 88), 3.0f);
+  EXPECT_EQ(at<float>(b, 108), 352.0f);    // vox_offset
+  EXPECT_EQ(at<float>(b, 112), 0.0f);      // scl_slope: no scaling
+  EXPECT_EQ(at<std::int16_t>(b, 252), 1);  // qform_code: scanner
+  EXPECT_EQ(at<std::int16_t>(b, 254), 0);  // sform_code: none
+  for (std::size_t q = 256; q < 268; q += 4) EXPECT_EQ(at<float>(b, q), 0.0f);  // identity
+  EXPECT_EQ(at<float>(b, 268), -90.5f);
+  EXPECT_EQ(at<float>(b, 272), 12.25f);
+  EXPECT_EQ(at<float>(b, 276), 7.0f);
+  EXPECT_EQ(std::memcmp(b.data() + 352, v.bytes().data(), v.byteSize()), 0);
+}
+
+TEST(NiftiWriter, NiiGzIsGzipCompressed) {
+  TempDir dir;
+  Volume v = Volume::allocate({32, 32, 32}, ScalarType::U8);  // zeros compress well
+  writeNifti(v, dir / "z.nii.gz");
+  const std::string b = fileBytes(dir / "z.nii.gz");
+  EXPECT_EQ(b.substr(0, 2), "\x1f\x8b");
+  EXPECT_LT(b.size(), v.byteSize() / 10);
+}
+
+TEST(NiftiWriter, Ch2RoundTripsExactly) {
+  if (!std::filesystem::exists(kCh2)) GTEST_SKIP() << kCh2 << " is not installed (mricron-data)";
+  TempDir dir;
+  const Volume ch2 = readNifti(kCh2);
+  for (const char* name : {"ch2.nii", "ch2.nii.gz"}) {
+    SCOPED_TRACE(name);
+    writeNifti(ch2, dir / name);
+    expectSameVolume(readNifti(dir / name), ch2);
+  }
+}
+
+TEST(NiftiWriter, ReplacingAFileLeavesNoTemporaryBehind) {
+  TempDir dir;
+  test::writeFile(dir / "a.nii.gz", "old contents");
+  const Volume v = randomVolume({4, 4, 4}, ScalarType::F32, 3);
+  writeNifti(v, dir / "a.nii.gz");
+  expectSameVolume(readNifti(dir / "a.nii.gz"), v);
+  EXPECT_EQ(entriesIn(dir.path()), 1);
+}
+
+TEST(NiftiWriter, WritingIntoAMissingDirectoryFailsNamingThePathAndLeavesNothing) {
+  TempDir dir;
+  const auto path = dir / "no" / "such" / "dir" / "x.nii";
+  expectRejected<Error>(
+      [&] {
+        writeNifti(randomVolume({2, 2, 2}, ScalarType::U8, 1), path);
+      },
+      {path.string(), "No such file or directory"});
+  EXPECT_EQ(entriesIn(dir.path()), 0);
+}
+
+TEST(NiftiWriter, AFailedRenameRemovesTheTemporaryFile) {
+  TempDir dir;
+  // A directory under the target name: the data are written, the rename fails.
+  std::filesystem::create_directory(dir / "taken.nii");
+  expectRejected<Error>(
+      [&] {
+        writeNifti(randomVolume({2, 2, 2}, ScalarType::U8, 1), dir / "taken.nii");
+      },
+      {(dir / "taken.nii").string(), "rename"});
+  EXPECT_EQ(entriesIn(dir.path()), 1);
+  EXPECT_TRUE(std::filesystem::is_directory(dir / "taken.nii"));
+}
+
+TEST(NiftiWriter, RefusesNamesThatAreNotNiiOrNiiGz) {
+  TempDir dir;
+  const Volume v = randomVolume({2, 2, 2}, ScalarType::U8, 1);
+  for (const char* name : {"x.hdr", "x.img", "x.nii.bz2", "x"}) {
+    expectRejected<InputError>([&] { writeNifti(v, dir / name); },
+                               {(dir / name).string(), ".nii or .nii.gz"});
+  }
+  EXPECT_EQ(entriesIn(dir.path()), 0);
+}
+
+TEST(NiftiWriter, RefusesDimsBeyondNifti1sInt16) {
+  TempDir dir;
+  const Volume v = Volume::allocate({32768, 1, 1}, ScalarType::U8);
+  expectRejected<InputError>([&] { writeNifti(v, dir / "wide.nii"); },
+                             {"wide.nii", "32768x1x1", "32767"});
+  EXPECT_EQ(entriesIn(dir.path()), 0);
+}
+
+}  // namespace
+}  // namespace tessera
