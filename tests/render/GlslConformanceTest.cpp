@@ -44,10 +44,10 @@ Validation run(const std::string& command) {
 // when the "limits" of its configuration are set to 0.
 std::string es100Limits() {
   std::string conf = run("glslangValidator -c").log;
-  for (const char* key : {"nonInductiveForLoops", "whileLoops", "doWhileLoops",
-                          "generalUniformIndexing", "generalAttributeMatrixVectorIndexing",
-                          "generalVaryingIndexing", "generalSamplerIndexing",
-                          "generalVariableIndexing", "generalConstantMatrixVectorIndexing"}) {
+  for (const char* key :
+       {"nonInductiveForLoops", "whileLoops", "doWhileLoops", "generalUniformIndexing",
+        "generalAttributeMatrixVectorIndexing", "generalVaryingIndexing", "generalSamplerIndexing",
+        "generalVariableIndexing", "generalConstantMatrixVectorIndexing"}) {
     const std::string on = std::string(key) + " 1";
     const auto at = conf.find(on);
     if (at != std::string::npos) conf.replace(at, on.size(), std::string(key) + " 0");
