@@ -14,6 +14,18 @@ void addProfilesCommand(CLI::App& app);  // ProfilesCommand.cpp
 void addPlanCommand(CLI::App& app);      // PlanCommand.cpp
 void addConvertCommand(CLI::App& app);   // ConvertCommand.cpp
 
+// The volume argument's help, and the --series option every command that
+// reads a volume offers.
+inline constexpr const char* kVolumeHelp =
+    "Volume: .nii .nii.gz .hdr .nrrd .nhdr .mha .mhd .vti .pvm .raw/.json, a DICOM file or "
+    "folder, or gen:sphere|shepp-logan|marschner-lobb[:N]; default: ch2 (mricron-data) or a "
+    "Shepp-Logan phantom";
+inline void addSeriesOption(CLI::App* cmd, std::string& series) {
+  cmd->add_option("--series", series,
+                  "DICOM: Series Instance UID to read when a folder holds several (default: the "
+                  "series with the most slices; `tessera info FOLDER` lists them)");
+}
+
 // ch2 from mricron-data when installed, else a generated Shepp–Logan phantom.
 std::string defaultVolumeSpec();
 

@@ -20,6 +20,7 @@ namespace {
 struct ConvertOptions {
   std::string in;
   std::string out;
+  std::string series;  // DICOM Series Instance UID
   std::string crop;
   std::string downsample;
   bool quiet = false;
@@ -110,7 +111,7 @@ std::string dimsText(glm::ivec3 d) {
 void runConvert(const ConvertOptions& o) {
   Progress progress(!o.quiet);
   progress.stage("reading " + o.in, 0.0);
-  Volume v = readVolume(o.in);
+  Volume v = readVolume(o.in, {.dicomSeries = o.series});
   const glm::ivec3 inDims = v.dims();
   progress.stage("read " + dimsText(inDims), 0.4);
   if (!o.crop.empty()) {
@@ -145,6 +146,7 @@ void addConvertCommand(CLI::App& app) {
   cmd->add_option("in", o->in, "Input volume (any format tessera info reads, or gen:...)")
       ->required();
   cmd->add_option("out", o->out, "Output file (format from its extension)")->required();
+  addSeriesOption(cmd, o->series);
   cmd->add_option("--crop", o->crop, "Keep voxels x0:x1,y0:y1,z0:z1 (end exclusive)");
   cmd->add_option("--downsample", o->downsample, "Box-filter by N or AxBxC");
   cmd->add_flag("--quiet", o->quiet, "No progress on stderr");

@@ -7,6 +7,7 @@
 #include "app/Commands.h"
 #include "tessera/core/Histogram.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/io/DicomSeriesReader.h"
 #include "tessera/io/VolumeReader.h"
 
 namespace tessera::app {
@@ -21,13 +22,18 @@ std::string defaultVolumeSpec() {
 namespace {
 struct InfoOptions {
   std::string file;
+  std::string series;
   bool json = false;
 };
 
 void runInfo(const InfoOptions& o) {
   const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
-  const Volume v = readVolume(spec);
+  const Volume v = readVolume(spec, {.dicomSeries = o.series});
   const Histogram h = Histogram::compute(v, 256);
+  // A DICOM folder may hold several series: list them so --series can pick.
+  std::vector<DicomSeriesInfo> series;
+  std::error_code ec;
+  if (std::filesystem::is_directory(spec, ec)) series = listDicomSeries(spec);
   const ValueRange r = v.valueRange();
   if (o.json) {
     nlohmann::json j;
@@ -43,6 +49,14 @@ void runInfo(const InfoOptions& o) {
         {"1", h.percentile(0.01)}, {"50", h.percentile(0.5)}, {"99", h.percentile(0.99)}};
     j["bytes"] = v.byteSize();
     j["description"] = v.description();
+    if (!series.empty()) {
+      j["dicom_series"] = nlohmann::json::array();
+      for (const auto& s : series) {
+        j["dicom_series"].push_back({{"series_instance_uid", s.seriesInstanceUid},
+                                     {"description", s.description},
+                                     {"slices", s.slices}});
+      }
+    }
     std::printf("%s\n", j.dump(2).c_str());
     return;
   }
@@ -55,6 +69,13 @@ void runInfo(const InfoOptions& o) {
   std::printf("values      %g .. %g (mean %.4g)\n", r.min, r.max, h.mean());
   std::printf("percentiles 1%%: %.4g  50%%: %.4g  99%%: %.4g\n", h.percentile(0.01),
               h.percentile(0.5), h.percentile(0.99));
+  for (const auto& s : series) {
+    std::printf("series      %s: %d slices, %s%s\n", s.seriesInstanceUid.c_str(), s.slices,
+                s.description.c_str(),
+                v.description().rfind("DICOM series " + s.seriesInstanceUid + " ", 0) == 0
+                    ? " (read)"
+                    : "");
+  }
   std::printf("bytes       %s (%llu)\n", formatBytes(v.byteSize()).c_str(),
               static_cast<unsigned long long>(v.byteSize()));
   // A 16-bin sketch of the histogram, log-scaled, so skew is visible at a glance.
@@ -79,9 +100,8 @@ void addInfoCommand(CLI::App& app) {
   auto opts = std::make_shared<InfoOptions>();
   CLI::App* cmd = app.add_subcommand(
       "info", "Print a volume's dims, spacing, type, value range, histogram summary and bytes");
-  cmd->add_option(
-      "file", opts->file,
-      "Volume file (.nii, .nii.gz, .nrrd, .nhdr) or gen:NAME[:N]; default: ch2 or a phantom");
+  cmd->add_option("file", opts->file, kVolumeHelp);
+  addSeriesOption(cmd, opts->series);
   cmd->add_flag("--json", opts->json, "Print one JSON object");
   cmd->callback([opts] { runInfo(*opts); });
 }

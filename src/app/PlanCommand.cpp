@@ -15,6 +15,7 @@ namespace {
 
 struct PlanOptions {
   std::string file;
+  std::string series;  // DICOM Series Instance UID
   std::string profile = "native";
   std::string layout = "auto";
   std::string size = "512x512";
@@ -47,7 +48,7 @@ void runPlan(const PlanOptions& o) {
   parseSize(o.size, width, height);
   DeviceSession device = openDevice(o.profile);
   const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
-  const Volume volume = readVolume(spec);
+  const Volume volume = readVolume(spec, {.dicomSeries = o.series});
   const render::RaycastPlan rp =
       render::planRaycast(device.limits, volume, o.layout, width, height, o.skipBlock);
   const layout::Plan& plan = rp.plan;
@@ -116,7 +117,8 @@ void addPlanCommand(CLI::App& app) {
   auto o = std::make_shared<PlanOptions>();
   CLI::App* cmd = app.add_subcommand(
       "plan", "Show how a volume would be stored on a device: layout, textures, bytes and why");
-  cmd->add_option("file", o->file, "Volume (default: ch2 or a phantom)");
+  cmd->add_option("file", o->file, kVolumeHelp);
+  addSeriesOption(cmd, o->series);
   cmd->add_option("--profile", o->profile, "Device profile (tessera profiles) or FILE.json")
       ->capture_default_str();
   cmd->add_option("--layout", o->layout, "auto, texture3d, mosaic or packed-mosaic")

@@ -18,6 +18,7 @@ namespace {
 
 struct RenderOptions {
   std::string file;
+  std::string series;  // DICOM Series Instance UID
   std::string tf = "mr-default";
   std::string size = "512x512";
   double azimuth = 0.0;
@@ -92,7 +93,7 @@ void runRenderCommand(const RenderOptions& o) {
   DeviceSession device = openDevice(o.profile);
   const gpu::GlContext* context = device.context.get();
   const auto tLoad = std::chrono::steady_clock::now();
-  Volume volume = readVolume(spec);
+  Volume volume = readVolume(spec, {.dicomSeries = o.series});
   const double loadMs = msSince(tLoad);
   if (!o.window.empty()) {
     if (o.window.size() != 2) throw InputError("--window takes two numbers MIN MAX");
@@ -176,10 +177,8 @@ void addRenderCommand(CLI::App& app) {
   auto o = std::make_shared<RenderOptions>();
   CLI::App* cmd = app.add_subcommand(
       "render", "Render a volume headless to a PNG (GPU ray caster through EGL)");
-  cmd->add_option(
-      "file", o->file,
-      "Volume file (.nii, .nii.gz, .nrrd, .nhdr) or gen:sphere|shepp-logan|marschner-lobb[:N]; "
-      "default: ch2 (mricron-data) or a Shepp-Logan phantom");
+  cmd->add_option("file", o->file, kVolumeHelp);
+  addSeriesOption(cmd, o->series);
   cmd->add_option(
          "--tf", o->tf,
          "Transfer function: preset (grey, mr-default, ct-bone, ct-muscle, bench) or FILE.json")

@@ -30,8 +30,17 @@ bool hasDicomMarker(const std::filesystem::path& path) {
 }
 }  // namespace
 
-Volume readVolume(const std::string& spec) {
-  if (spec.rfind("gen:", 0) == 0) return makeProcedural(spec);
+Volume readVolume(const std::string& spec, const ReadOptions& options) {
+  auto notDicom = [&] {
+    if (!options.dicomSeries.empty()) {
+      throw InputError(spec + ": a DICOM series (" + options.dicomSeries +
+                       ") was asked for, but this is not DICOM");
+    }
+  };
+  if (spec.rfind("gen:", 0) == 0) {
+    notDicom();
+    return makeProcedural(spec);
+  }
   const std::filesystem::path path(spec);
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) {
@@ -39,10 +48,14 @@ Volume readVolume(const std::string& spec) {
                      ": no such file (or use gen:sphere, gen:shepp-logan, gen:marschner-lobb)");
   }
   // A folder is a DICOM series (the only format that is a folder).
-  if (std::filesystem::is_directory(path, ec)) return readDicomSeries(path);
+  if (std::filesystem::is_directory(path, ec)) return readDicomSeries(path, options.dicomSeries);
   std::string lower = path.filename().string();
   std::transform(lower.begin(), lower.end(), lower.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (endsWith(lower, ".dcm") || endsWith(lower, ".ima") || hasDicomMarker(path)) {
+    return readDicomSeries(path, options.dicomSeries);
+  }
+  notDicom();
   if (endsWith(lower, ".nii") || endsWith(lower, ".nii.gz") || endsWith(lower, ".hdr") ||
       endsWith(lower, ".hdr.gz")) {
     return readNifti(path);
@@ -52,9 +65,6 @@ Volume readVolume(const std::string& spec) {
   if (endsWith(lower, ".vti")) return readVti(path);
   if (endsWith(lower, ".pvm")) return readPvm(path);
   if (endsWith(lower, ".raw") || endsWith(lower, ".json")) return readRawWithSidecar(path);
-  if (endsWith(lower, ".dcm") || endsWith(lower, ".ima") || hasDicomMarker(path)) {
-    return readDicomSeries(path);
-  }
   throw InputError(spec +
                    ": unknown volume format (supported: .nii, .nii.gz, .hdr/.img, .nrrd, .nhdr, "
                    ".mha, .mhd, .vti, .pvm, .raw + .json sidecar, DICOM files or a DICOM folder)");

@@ -15,6 +15,12 @@ namespace tessera {
 // generates a procedural volume when `spec` starts with "gen:" (see
 // io/Procedural.h). Throws InputError naming the file and the problem; never
 // allocates more than the file can justify or the host budget allows.
-Volume readVolume(const std::string& spec);
+struct ReadOptions {
+  // DICOM: the Series Instance UID to read from a folder holding several
+  // (empty: the series with the most slices). An InputError for other formats.
+  std::string dicomSeries;
+};
+
+Volume readVolume(const std::string& spec, const ReadOptions& options = {});
 
 }  // namespace tessera
