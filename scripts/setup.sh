@@ -11,7 +11,19 @@ PACKAGES=(
   libgtest-dev libgmock-dev glslang-tools                # tests (glslangValidator checks GLSL ES 1.00 rules)
   clang-14 libclang-rt-14-dev                            # fuzzing: libFuzzer + sanitizers (scripts/fuzz.sh)
   mricron-data                                           # the default volume (ch2 T1 MRI head)
+  libglfw3-dev libimgui-dev xvfb xauth                   # desktop viewer (tessera view), tested under Xvfb
+  emscripten nodejs chromium                             # web viewer (scripts/web.sh) and its browser test
 )
+
+# playwright-core for the browser test, pinned by tests/browser/package-lock.json.
+npm_deps() {
+  local dir
+  dir="$(cd "$(dirname "$0")/.." && pwd)/tests/browser"
+  if [ ! -d "$dir/node_modules/playwright-core" ]; then
+    echo "setup: npm ci in tests/browser (playwright-core)"
+    (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error)
+  fi
+}
 
 missing=()
 for p in "${PACKAGES[@]}"; do
@@ -19,9 +31,11 @@ for p in "${PACKAGES[@]}"; do
     missing+=("$p")
   fi
 done
+command -v npm >/dev/null || missing+=(npm)  # nodejs from elsewhere may bring its own npm
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "setup: all ${#PACKAGES[@]} packages present"
+  npm_deps
   exit 0
 fi
 
@@ -36,3 +50,4 @@ echo "setup: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -q
 $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
+npm_deps

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Sets up, builds everything (warnings as errors) and runs all tests; then
-# the same tests under ASan + UBSan (scripts/sanitize.sh) and a short fuzz
+# the browser test of the web viewer (scripts/browser-test.sh), the same
+# tests under ASan + UBSan (scripts/sanitize.sh) and a short fuzz
 # run of every parser (scripts/fuzz.sh, FUZZ_SECONDS each, default 30).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -18,6 +19,7 @@ ctest_build() { (cd build && ctest --output-on-failure --timeout 900 -j2); }
 timed setup scripts/setup.sh
 timed build scripts/build.sh
 timed ctest ctest_build
+timed browser scripts/browser-test.sh  # web viewer in headless Chromium vs build/tessera
 timed sanitize scripts/sanitize.sh
 timed fuzz scripts/fuzz.sh "$FUZZ_SECONDS"
 echo "test.sh timings: $(IFS=,; echo "${timings[*]}" | sed 's/,/, /g'); total ${SECONDS} s"

@@ -6,6 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/BenchHybrid.h"
+#include "app/BenchSlicing.h"
 #include "app/Commands.h"
 #include "app/RenderJob.h"
 #include "tessera/core/Error.h"
@@ -31,6 +33,13 @@ struct BenchOptions {
   std::string tf = "bench";
   bool json = false;
   bool layouts = false;
+  bool slicing = false;
+  std::string slicingOut;
+  bool slicingQuick = false;
+  bool hybrid = false;
+  bool interactive = false;
+  std::string hybridOut;
+  double goalMs = 0.0;
 };
 
 struct Variant {
@@ -286,7 +295,47 @@ void addBenchCommand(CLI::App& app) {
   cmd->add_flag("--layouts", o->layouts,
                 "Compare layouts (texture3d, mosaic, packed-mosaic) instead of accelerations");
   cmd->add_flag("--json", o->json, "Print JSON instead of a Markdown table");
-  cmd->callback([o] { o->layouts ? runLayoutBench(*o) : runBench(*o); });
+  cmd->add_flag("--slicing", o->slicing,
+                "Texture slicing vs ray casting (GRAPP 2012 Tables 1-2), TF-update times "
+                "(Moser & Weiskopf 2008 Fig. 6) and quality per count; --frames per cell");
+  cmd->add_option("--slicing-out", o->slicingOut,
+                  "With --slicing: also write bench-slicing.md and SVG plots to this folder");
+  cmd->add_flag("--slicing-quick", o->slicingQuick, "With --slicing: a small smoke run");
+  cmd->add_flag("--hybrid", o->hybrid,
+                "Hybrid low/high-resolution rendering: each overlay-opacity method vs the ground "
+                "truth (Moser & Weiskopf 2008 Fig. 2) and full vs 128x128/256x256/256x512 "
+                "offscreen speed at 480x640 and 1024x768; --frames per cell");
+  cmd->add_option("--hybrid-out", o->hybridOut,
+                  "With --hybrid: write the pictures (ground truth, each method) to this folder");
+  cmd->add_flag("--interactive", o->interactive,
+                "Quality controller: --frames moving frames held near a frame-time goal, then one "
+                "full-quality idle frame (default size 480x640)");
+  cmd->add_option("--goal-ms", o->goalMs,
+                  "With --interactive: frame-time goal (default: a sixth of a full-quality frame)");
+  cmd->callback([o] {
+    if (o->hybrid || o->interactive) {
+      const HybridBenchOptions h{.file = o->file,
+                                 .frames = o->frames == 36 ? (o->hybrid ? 5 : 20) : o->frames,
+                                 .rotate = o->rotate == 10.0 ? 5.0 : o->rotate,
+                                 .step = o->step,
+                                 .tf = o->tf,
+                                 .outDir = o->hybridOut,
+                                 .goalMs = o->goalMs,
+                                 .size = o->size == "512x512" ? "480x640" : o->size,
+                                 .json = o->json};
+      o->hybrid ? runHybridBench(h) : runInteractiveBench(h);
+      return;
+    }
+    if (o->slicing) {
+      runSlicingBench({.file = o->file,
+                       .frames = o->frames == 36 ? 3 : o->frames,
+                       .tf = o->tf,
+                       .outDir = o->slicingOut,
+                       .quick = o->slicingQuick});
+      return;
+    }
+    o->layouts ? runLayoutBench(*o) : runBench(*o);
+  });
 }
 
 }  // namespace tessera::app

@@ -13,6 +13,7 @@ void addBenchCommand(CLI::App& app);
 void addProfilesCommand(CLI::App& app);  // ProfilesCommand.cpp
 void addPlanCommand(CLI::App& app);      // PlanCommand.cpp
 void addConvertCommand(CLI::App& app);   // ConvertCommand.cpp
+void addViewCommand(CLI::App& app);      // ViewCommand.cpp (desktop viewer)
 
 // The volume argument's help, and the --series option every command that
 // reads a volume offers.

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/Commands.h"
+#include "app/HybridJob.h"
 #include "app/RenderJob.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
@@ -41,9 +42,17 @@ struct RenderOptions {
   double rotate = 10.0;
   int skipBlock = 8;
   int lut = 4096;
+  std::string technique = "raycast";
+  int slices = 0;
+  std::string classify = "post";
   std::string profile = "native";
   std::string layout = "auto";
   bool json = false;
+  // Hybrid low/high-resolution rendering with overlays (HybridJob.h).
+  std::string overlays;
+  std::string overlayOpacity = "alpha";
+  std::string offscreen;
+  std::string roi;
 };
 
 double msSince(std::chrono::steady_clock::time_point t0) {
@@ -85,6 +94,9 @@ void runRenderCommand(const RenderOptions& o) {
   req.reference = o.reference || !o.referenceOut.empty();
   req.skipBlock = o.skipBlock;
   req.lutSize = o.lut;
+  req.technique = o.technique;
+  req.slices = o.slices;
+  req.classify = o.classify;
 
   req.layout = o.layout;
   const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
@@ -100,6 +112,22 @@ void runRenderCommand(const RenderOptions& o) {
     volume.setWindow({o.window[0], o.window[1]});
   }
 
+  if (!o.overlays.empty() || !o.offscreen.empty() || !o.roi.empty()) {
+    if (o.technique != "raycast") {
+      throw InputError(
+          "--overlays/--offscreen: the hybrid compositor runs with --technique raycast");
+    }
+    HybridRequest h;
+    h.overlays = render::OverlayOptions::parse(o.overlays);
+    if (!o.roi.empty()) h.overlays.setRoiVoxels(o.roi, volume);
+    h.hybrid.offscreen = render::OffscreenSize::parse(o.offscreen.empty() ? "full" : o.offscreen);
+    h.hybrid.opacity = render::parseOverlayOpacity(o.overlayOpacity);
+    const HybridResult hr = runHybridRender(device, volume, tf, req, h);
+    hr.image.writePng(o.out);
+    if (hr.groundTruth && !o.referenceOut.empty()) hr.groundTruth->writePng(o.referenceOut);
+    printHybridResult(hr, req, h, device, spec, o.out, o.json);
+    return;
+  }
   const RenderResult r = runRender(device, volume, tf, req);
   r.first.writePng(o.out);
   if (r.referenceImage && !o.referenceOut.empty()) r.referenceImage->writePng(o.referenceOut);
@@ -136,6 +164,7 @@ void runRenderCommand(const RenderOptions& o) {
     j["occupied_block_fraction"] = r.occupiedBlockFraction;
     j["total_ms"] = totalMs;
     j["mode"] = o.mode;
+    j["technique"] = o.technique;
     j["step_voxels"] = o.step;
     j["tf"] = tf.name;
     std::printf("%s\n", j.dump(2).c_str());
@@ -219,6 +248,16 @@ void addRenderCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--lut", o->lut, "Transfer-function table entries (256 or 4096)")
       ->capture_default_str();
+  cmd->add_option("--technique", o->technique,
+                  "raycast, slice3d (view-aligned slicing) or slice2d (axis-aligned slice stacks)")
+      ->capture_default_str();
+  cmd->add_option("--slices", o->slices,
+                  "Slices: slice3d over the volume diagonal (0 = from --step), slice2d drawn "
+                  "per stack (0 = every voxel plane)")
+      ->capture_default_str();
+  cmd->add_option("--classify", o->classify,
+                  "slice2d classification: pre (CPU RGBA), palette (index + palette) or post (LUT)")
+      ->capture_default_str();
   cmd->add_option("--profile", o->profile,
                   "Device profile to obey (tessera profiles lists them) or FILE.json")
       ->capture_default_str();
@@ -227,6 +266,19 @@ void addRenderCommand(CLI::App& app) {
          "Volume storage: auto, texture3d, mosaic or packed-mosaic (auto: the planner chooses)")
       ->capture_default_str();
   cmd->add_flag("--json", o->json, "Print one JSON object instead of text");
+  cmd->add_option("--overlays", o->overlays,
+                  "Lines drawn at full resolution with the volume: box,axes,roi (any subset); "
+                  "with --reference the ground truth stops each ray at its line");
+  cmd->add_option("--overlay-opacity", o->overlayOpacity,
+                  "How lines behind/inside the volume are attenuated: alpha (target alpha), "
+                  "two-pass (renders over black and white), luma-avg, luma-601")
+      ->capture_default_str();
+  cmd->add_option("--offscreen", o->offscreen,
+                  "Render the volume at WxH (e.g. 128x128, 256x512) or a factor (e.g. 0.25) and "
+                  "upscale it bilinearly (hybrid rendering; default with --overlays: full)");
+  cmd->add_option("--roi", o->roi,
+                  "Region of interest x0:x1,y0:y1,z0:z1 in voxels for the roi overlay "
+                  "(implies it)");
   cmd->callback([o] { runRenderCommand(*o); });
 }
 

@@ -54,6 +54,7 @@ void parseSize(const std::string& text, int& width, int& height) {
 RenderResult runRender(DeviceSession& device, const Volume& fullVolume, const TransferFunction& tf,
                        RenderRequest req) {
   if (req.repeat < 1) throw InputError("--repeat must be >= 1");
+  if (req.technique != "raycast") return runSliceRender(device, fullVolume, tf, req);
   gpu::GlContext& context = *device.context;
   RenderResult result;
   const render::RaycastPlan rp = render::planRaycast(device.limits, fullVolume, req.layout,

@@ -32,6 +32,11 @@ struct RenderRequest {
   bool reference = false;
   int skipBlock = 8;
   int lutSize = 4096;
+  // Texture slicing (issue 4; app/SliceRenderJob.cpp): "raycast", "slice3d"
+  // or "slice2d"; slices 0 = from the step (slice3d) or every slice (slice2d).
+  std::string technique = "raycast";
+  int slices = 0;
+  std::string classify = "post";  // slice2d: pre, palette or post
 };
 
 struct RenderResult {
@@ -60,6 +65,9 @@ struct RenderResult {
 
 RenderResult runRender(DeviceSession& device, const Volume& volume, const TransferFunction& tf,
                        RenderRequest request);
+// runRender for technique slice3d / slice2d.
+RenderResult runSliceRender(DeviceSession& device, const Volume& volume, const TransferFunction& tf,
+                            RenderRequest request);
 
 // Parses "512x512".
 void parseSize(const std::string& text, int& width, int& height);

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   tessera::app::addProfilesCommand(app);
   tessera::app::addPlanCommand(app);
   tessera::app::addConvertCommand(app);
+  tessera::app::addViewCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

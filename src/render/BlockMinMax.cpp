@@ -71,7 +71,9 @@ BlockMinMax::BlockMinMax(const Volume& volume, int blockSize) : blockSize_(block
   const int per = (count_.z + threads - 1) / threads;
   for (int t = 0; t < threads; ++t) {
     const int z0 = t * per, z1 = std::min(count_.z, z0 + per);
-    if (z0 < z1) pool.emplace_back(work, z0, z1);
+    // One thread: run here (the web build cannot start threads at all).
+    if (z0 < z1 && threads == 1) work(z0, z1);
+    if (z0 < z1 && threads > 1) pool.emplace_back(work, z0, z1);
   }
   for (auto& th : pool) th.join();
 }

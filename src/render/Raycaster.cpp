@@ -261,7 +261,8 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
   prog.set("u_tanHalfFov",
            static_cast<float>(std::tan(0.5 * camera.fovYDeg * glm::pi<double>() / 180.0)));
   prog.set("u_orthoHalfHeight", static_cast<float>(camera.orthoHalfHeight()));
-  prog.set("u_aspect", static_cast<float>(static_cast<double>(width) / height));
+  prog.set("u_aspect", static_cast<float>(viewAspect_ > 0.0 ? viewAspect_
+                                                            : static_cast<double>(width) / height));
   prog.set("u_ortho", camera.projection == Projection::Orthographic ? 1 : 0);
   prog.set("u_viewport", glm::vec2(width, height));
   prog.set("u_extent", glm::vec3(volume_.extent()));

@@ -19,6 +19,8 @@
 #include "tessera/layout/PackedMosaicLayout.h"
 #include "tessera/layout/Texture3DLayout.h"
 #include "tessera/render/Raycaster.h"
+#include "tessera/render/Slice2DRenderer.h"
+#include "tessera/render/Slice3DRenderer.h"
 
 using namespace tessera;
 
@@ -68,6 +70,30 @@ bool haveValidator() {
   return std::system("command -v glslangValidator >/dev/null 2>&1") == 0;
 }
 
+// The slicing techniques (issue 4): slice3d on this layout, slice2d with
+// every classification, composite and MIP.
+void expectSlicingConformant(gpu::GlContext& c, const Volume& v, const layout::Layout& layout) {
+  render::Slice3DRenderer slice3d(c, v, layout);
+  std::vector<std::string> sources{gpu::assembleShader(slice3d.vertexParts())};
+  for (RenderMode mode : {RenderMode::Composite, RenderMode::Mip}) {
+    RenderSettings s;
+    s.mode = mode;
+    sources.push_back(gpu::assembleShader(slice3d.fragmentParts(s)));
+    for (auto cls : {render::SliceClassification::Pre, render::SliceClassification::Palette,
+                     render::SliceClassification::Post}) {
+      if (mode == RenderMode::Mip && cls != render::SliceClassification::Post) continue;
+      render::Slice2DRenderer slice2d(c, v, {.classification = cls});
+      if (sources.size() == 2) sources.push_back(gpu::assembleShader(slice2d.vertexParts()));
+      sources.push_back(gpu::assembleShader(slice2d.fragmentParts(s)));
+    }
+  }
+  for (const std::string& src : sources) {
+    const bool vertex = src.find("gl_Position") != std::string::npos;
+    const Validation r = validate(src, vertex ? "vert" : "frag");
+    EXPECT_EQ(r.exitCode, 0) << layout.name() << ":\n" << r.log;
+  }
+}
+
 void expectConformant(gpu::GlContext& c, const Volume& v, const layout::Layout& layout) {
   render::Raycaster caster(c, v, layout);
   for (RenderMode mode : {RenderMode::Composite, RenderMode::Mip}) {
@@ -81,6 +107,7 @@ void expectConformant(gpu::GlContext& c, const Volume& v, const layout::Layout& 
   }
   const Validation vert = validate(gpu::assembleShader(caster.vertexParts()), "vert");
   EXPECT_EQ(vert.exitCode, 0) << vert.log;
+  expectSlicingConformant(c, v, layout);
 }
 
 }  // namespace

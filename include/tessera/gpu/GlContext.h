@@ -22,6 +22,11 @@ class GlContext {
   // Throws GpuError saying which platforms were tried and why they failed.
   static std::unique_ptr<GlContext> createHeadless(const Options& options);
   static std::unique_ptr<GlContext> createHeadless() { return createHeadless(Options{}); }
+  // Wraps the context that is current on this thread but was created by
+  // someone else (a GLFW window, an Emscripten WebGL canvas): queries its
+  // caps, never destroys it, and makeCurrent() leaves it to its owner.
+  // `platform` names it ("glfw-egl", "webgl2", ...). See AdoptedGlContext.cpp.
+  static std::unique_ptr<GlContext> adoptCurrent(ApiLevel api, const std::string& platform);
   ~GlContext();
   GlContext(const GlContext&) = delete;
   GlContext& operator=(const GlContext&) = delete;

@@ -42,6 +42,13 @@ class Raycaster {
   void renderFrame(const Camera& camera, const RenderSettings& settings, int width, int height);
   // Reads the last frame (top row first).
   Image readImage() const;
+  // The last frame's colour texture (row 0 at the bottom), valid until the
+  // next renderFrame(): what a compositor samples without a read-back.
+  const gpu::Texture& colorTexture() const { return target_.color(); }
+  // Aspect ratio of the view the rays cover; 0 (the default) means the
+  // frame's width / height. The hybrid compositor renders a fixed-size target
+  // (e.g. 128x128) for a 480x640 screen and stretches it when upscaling.
+  void setViewAspect(double aspect) { viewAspect_ = aspect; }
   Image render(const Camera& camera, const RenderSettings& settings, int width, int height) {
     renderFrame(camera, settings, width, height);
     return readImage();
@@ -84,6 +91,7 @@ class Raycaster {
   // What the LUT/block texture were built for, to rebuild only on change.
   std::string lookupKey_;
   double occupiedFraction_ = 1.0;
+  double viewAspect_ = 0.0;
   int blockTilesX_ = 1;
   glm::ivec2 blockTexSize_{0};
 };

@@ -1,0 +1,76 @@
+# The browser build of the viewer (included from CMakeLists.txt under
+# emcmake; scripts/web.sh runs it). Compiles the layers the viewer needs —
+# core, gpu, lod, layout, render, viewer and io's procedural sources — with
+# Debian's emscripten into web/site's tessera.js + tessera.wasm. nifticlib,
+# zlib, DCMTK and libpng are not available to emscripten here: files are read
+# by viewer/InMemoryVolumeReader (gzip is inflated by the browser), and PNG
+# I/O reports that it is not built in (web/src/PngUnavailable.cpp). The gpu
+# layer's EGL platform (GlContext.cpp) is replaced by the browser's
+# (web/src/GlContextWebGL.cpp: the page's canvas owns the WebGL context).
+# No pthreads: SharedArrayBuffer needs cross-origin isolation a static page
+# cannot count on; code that sizes thread pools sees one core.
+cmake_minimum_required(VERSION 3.25)
+
+# Header-only libraries from the host (glm, nlohmann_json) without the rest
+# of /usr/include, which must not shadow emscripten's sysroot.
+find_path(TESSERA_HOST_GLM glm/glm.hpp PATHS /usr/include NO_CMAKE_FIND_ROOT_PATH REQUIRED)
+find_path(TESSERA_HOST_JSON nlohmann/json.hpp PATHS /usr/include NO_CMAKE_FIND_ROOT_PATH REQUIRED)
+find_path(TESSERA_HOST_PNG png.h PATHS /usr/include/libpng16 NO_CMAKE_FIND_ROOT_PATH REQUIRED)
+set(TESSERA_HOST_INC ${CMAKE_BINARY_DIR}/hostinc)
+file(MAKE_DIRECTORY ${TESSERA_HOST_INC})
+foreach(pair "glm;${TESSERA_HOST_GLM}/glm" "nlohmann;${TESSERA_HOST_JSON}/nlohmann"
+        "png.h;${TESSERA_HOST_PNG}/png.h" "pngconf.h;${TESSERA_HOST_PNG}/pngconf.h"
+        "pnglibconf.h;${TESSERA_HOST_PNG}/pnglibconf.h")
+  list(GET pair 0 name)
+  list(GET pair 1 target)
+  if(NOT EXISTS ${TESSERA_HOST_INC}/${name})
+    file(CREATE_LINK ${target} ${TESSERA_HOST_INC}/${name} SYMBOLIC)
+  endif()
+endforeach()
+
+file(GLOB_RECURSE TESSERA_GLSL CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/*.glsl)
+string(REPLACE ";" "|" TESSERA_GLSL_ARG "${TESSERA_GLSL}")
+set(TESSERA_GLSL_CPP ${CMAKE_BINARY_DIR}/generated/EmbeddedShaders.cpp)
+add_custom_command(
+  OUTPUT ${TESSERA_GLSL_CPP}
+  COMMAND ${CMAKE_COMMAND} -DOUT=${TESSERA_GLSL_CPP} -DROOT=${CMAKE_SOURCE_DIR}/src
+          "-DFILES=${TESSERA_GLSL_ARG}" -P ${CMAKE_SOURCE_DIR}/cmake/EmbedGlsl.cmake
+  DEPENDS ${TESSERA_GLSL} ${CMAKE_SOURCE_DIR}/cmake/EmbedGlsl.cmake
+  COMMENT "Embedding GLSL shaders" VERBATIM)
+
+set(TESSERA_WEB_SOURCES ${TESSERA_GLSL_CPP} ${CMAKE_SOURCE_DIR}/src/io/Procedural.cpp)
+foreach(layer core gpu lod layout render viewer)
+  file(GLOB_RECURSE srcs CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/${layer}/*.cpp)
+  list(APPEND TESSERA_WEB_SOURCES ${srcs})
+endforeach()
+# The EGL platform; web/src/GlContextWebGL.cpp is the browser's.
+list(REMOVE_ITEM TESSERA_WEB_SOURCES ${CMAKE_SOURCE_DIR}/src/gpu/GlContext.cpp)
+file(GLOB TESSERA_WEB_FRONT CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/web/src/*.cpp)
+
+set_source_files_properties(${CMAKE_SOURCE_DIR}/src/core/TransferFunction.cpp PROPERTIES
+  COMPILE_OPTIONS "-include;${CMAKE_SOURCE_DIR}/web/src/compat/FloatToChars.h")
+
+set(TESSERA_WEB_SITE ${CMAKE_BINARY_DIR}/site)
+add_executable(tessera_web ${TESSERA_WEB_SOURCES} ${TESSERA_WEB_FRONT})
+set_target_properties(tessera_web PROPERTIES OUTPUT_NAME tessera SUFFIX ".js"
+                                             RUNTIME_OUTPUT_DIRECTORY ${TESSERA_WEB_SITE})
+target_include_directories(tessera_web PRIVATE ${CMAKE_SOURCE_DIR}/include ${CMAKE_SOURCE_DIR}/src)
+target_include_directories(tessera_web SYSTEM PRIVATE ${TESSERA_HOST_INC})
+target_compile_definitions(tessera_web PRIVATE GLM_FORCE_CXX17)
+# -fexceptions: every user-facing error is a C++ exception that must reach
+# the page as a message instead of aborting the module.
+set(TESSERA_WEB_FLAGS -O2 -fexceptions)
+target_compile_options(tessera_web PRIVATE ${TESSERA_WEB_FLAGS} -Wall -Wextra)
+target_link_options(tessera_web PRIVATE ${TESSERA_WEB_FLAGS}
+  -sMIN_WEBGL_VERSION=1 -sMAX_WEBGL_VERSION=2 -sALLOW_MEMORY_GROWTH=1 -sINITIAL_MEMORY=64MB
+  -sMODULARIZE=1 -sEXPORT_NAME=createTesseraModule -sENVIRONMENT=web
+  "-sEXPORTED_FUNCTIONS=_malloc,_free"
+  "-sEXPORTED_RUNTIME_METHODS=ccall,cwrap,UTF8ToString,HEAPU8,HEAPF32")
+
+# The static page next to the module.
+file(GLOB TESSERA_WEB_STATIC CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/web/*.html
+     ${CMAKE_SOURCE_DIR}/web/*.js ${CMAKE_SOURCE_DIR}/web/*.css)
+foreach(f ${TESSERA_WEB_STATIC})
+  get_filename_component(n ${f} NAME)
+  configure_file(${f} ${TESSERA_WEB_SITE}/${n} COPYONLY)
+endforeach()

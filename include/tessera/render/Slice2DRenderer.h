@@ -1,0 +1,142 @@
+#pragma once
+// Axis-aligned texture slicing (Moser & Weiskopf 2008, section 4): three
+// stacks of 2D slices in atlases; each frame draws the stack most
+// perpendicular to the view front to back (render/SliceAccumulator.h), one
+// draw call per atlas. Needs no 3D textures and no layout: 2D textures only,
+// in ES 2.0 and ES 3.0 contexts.
+//
+// Classification, and what a TF change costs:
+//  - Pre: the TF applied on the CPU into premultiplied RGBA8 slices
+//    (hardware-filtered after classification); a TF change re-creates and
+//    re-uploads every resident slice.
+//  - Palette: 8-bit index slices + a 256-entry palette, the shader doing
+//    what GL_PALETTE8_RGBA8_OES did in hardware — look up the four nearest
+//    indices and filter the classified colours (pre-classification
+//    semantics); a TF change uploads the palette only.
+//  - Post: 8-bit index slices filtered as scalars, then the TF table lookup
+//    (the ray caster's semantics); a TF change uploads the table only.
+// Indices are the value window quantised to 8 bits (exact for u8 volumes).
+//
+// Opacity: tables are baked for ds0 = the smallest voxel spacing; a
+// fragment stands for the distance its ray travels between drawn planes,
+// (stack spacing * stride) / |cos(angle to the stack axis)|, and corrects
+// its opacity by that ratio.
+#include <array>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "tessera/core/Camera.h"
+#include "tessera/core/Image.h"
+#include "tessera/core/RenderSettings.h"
+#include "tessera/core/TransferFunction.h"
+#include "tessera/core/Volume.h"
+#include "tessera/gpu/GlContext.h"
+#include "tessera/gpu/GlObjects.h"
+#include "tessera/gpu/Program.h"
+#include "tessera/render/SliceAccumulator.h"
+#include "tessera/render/SliceStacks.h"
+#include "tessera/render/SliceTransferTable.h"
+
+namespace tessera::render {
+
+enum class SliceClassification { Pre, Palette, Post };
+const char* sliceClassificationName(SliceClassification c);             // "pre", "palette", "post"
+SliceClassification parseSliceClassification(const std::string& name);  // InputError if unknown
+
+struct Slice2DOptions {
+  SliceClassification classification = SliceClassification::Post;
+  // Keep only the stack being drawn on the GPU (a third of the memory);
+  // a change of stack axis re-creates it (the hitch stackUploadMs() reports).
+  bool currentStackOnly = false;
+  bool powerOfTwoAtlases = false;
+  int maxTextureSize = 0;  // 0: the context's limit
+};
+
+class Slice2DRenderer {
+ public:
+  // `volume` must outlive the renderer.
+  Slice2DRenderer(gpu::GlContext& context, const Volume& volume, const Slice2DOptions& options);
+  ~Slice2DRenderer();
+
+  void setTransferFunction(const TransferFunction& tf);
+  // Slices drawn per frame: 0 (the default) draws every slice of the stack;
+  // fewer picks evenly spaced ones (the opacity corrected for the gap).
+  void setSliceCount(int slices);
+
+  // The stack for a view: the axis along which the view direction is largest.
+  static int stackAxisFor(const Camera& camera);
+
+  void prepare(const Camera& camera, const RenderSettings& settings);
+  void renderFrame(const Camera& camera, const RenderSettings& settings, int width, int height);
+  Image readImage() const { return accumulator_.readImage(); }
+  Image render(const Camera& camera, const RenderSettings& settings, int width, int height) {
+    renderFrame(camera, settings, width, height);
+    return readImage();
+  }
+
+  // Re-creates every resident stack texture from the host copy, as a
+  // paletted texture format that fixes its palette at creation needs on
+  // every TF change (for the TF-update benchmark).
+  void recreateStackTextures();
+
+  const SliceAtlasPlan& atlasPlan(int axis) const { return plans_[axis]; }
+  int lastStackAxis() const { return lastAxis_; }
+  int slicesDrawn() const { return lastSlicesDrawn_; }
+  // How many stack (re)creations and TF re-classifications happened, and
+  // the time of the last one (host work + upload, ms).
+  std::uint64_t stackUploads() const { return stackUploads_; }
+  double lastStackUploadMs() const { return lastStackUploadMs_; }
+  std::uint64_t classificationUpdates() const { return classificationUpdates_; }
+  std::uint64_t stackTextureBytes() const;
+  std::uint64_t ownTextureBytes() const;
+  const Slice2DOptions& options() const { return options_; }
+  std::string accumulationFormat() const { return accumulator_.accumulationFormat(); }
+
+  std::vector<gpu::ShaderPart> vertexParts() const;
+  std::vector<gpu::ShaderPart> fragmentParts(const RenderSettings& settings) const;
+
+ private:
+  struct DrawRange {
+    int atlas;
+    int firstIndex;
+    int count;
+  };
+  struct DrawList {
+    gpu::Buffer indices;
+    std::vector<DrawRange> ranges;
+    double gapRatio = 1.0;  // drawn planes are gapRatio * stack spacing apart
+  };
+
+  const gpu::Program& programFor(const RenderSettings& settings);
+  void buildGeometry(int axis);
+  const DrawList& drawList(int axis, bool descending, int slices);
+  void uploadStack(int axis);
+  void updateClassification(const RenderSettings& settings);
+  double baseDistance() const;
+
+  gpu::GlContext& context_;
+  const Volume& volume_;
+  Slice2DOptions options_;
+  SliceStacks stacks_;
+  std::array<SliceAtlasPlan, 3> plans_;
+  std::array<std::vector<gpu::Texture>, 3> atlases_;
+  std::array<gpu::Buffer, 3> vertices_;
+  std::map<std::string, DrawList> drawLists_;
+  TransferFunction tf_;
+  int requestedSlices_ = 0;
+  std::string classificationKey_;
+  std::vector<std::uint8_t> palette8_;  // pre: premultiplied RGBA8, 256 entries
+  SliceTransferTable table_;            // palette or post-classification LUT
+  SliceAccumulator accumulator_;
+  std::map<std::string, gpu::Program> programs_;
+  int lastAxis_ = -1;
+  int lastSlicesDrawn_ = 0;
+  std::uint64_t stackUploads_ = 0;
+  double lastStackUploadMs_ = 0.0;
+  std::uint64_t classificationUpdates_ = 0;
+};
+
+}  // namespace tessera::render

@@ -1,0 +1,89 @@
+#pragma once
+// View-aligned texture slicing with static proxy geometry (Noguera et al.
+// 2012, GRAPP, section 3.2, after Van Gelder & Kim 1996): N quads over a
+// cube whose side is the volume's diagonal are built once into a VBO; per
+// frame only matrices change — the cube is turned to face the viewer and the
+// texture coordinates are rotated with it, so the slices stay perpendicular
+// to the view direction. Fragments outside the volume get alpha 0 (no
+// discard). Samples go through the layout's sampleVolume(), so every layout
+// works, in ES 2.0 and ES 3.0 contexts alike.
+//
+// Opacity: the TF table is baked for the slice spacing ds = diagonal / N; a
+// perspective ray crosses consecutive planes ds / cos(theta) apart, so each
+// fragment corrects its opacity once more by that ratio (DESIGN.md,
+// Rendering semantics). No early termination (blending has no way to stop).
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "tessera/core/Camera.h"
+#include "tessera/core/Image.h"
+#include "tessera/core/RenderSettings.h"
+#include "tessera/core/TransferFunction.h"
+#include "tessera/core/Volume.h"
+#include "tessera/gpu/GlContext.h"
+#include "tessera/gpu/GlObjects.h"
+#include "tessera/gpu/Program.h"
+#include "tessera/layout/Layout.h"
+#include "tessera/render/SliceAccumulator.h"
+#include "tessera/render/SliceTransferTable.h"
+
+namespace tessera::render {
+
+class Slice3DRenderer {
+ public:
+  // `volume` and `layout` must outlive the renderer.
+  Slice3DRenderer(gpu::GlContext& context, const Volume& volume, const layout::Layout& layout);
+
+  void setTransferFunction(const TransferFunction& tf);
+  // Number of slices over the cube's side; 0 (the default) derives it from
+  // RenderSettings::stepVoxels: N = ceil(diagonal / ds).
+  void setSliceCount(int slices);
+  // Slices a frame with these settings draws (1..kMaxSlices).
+  int sliceCountFor(const RenderSettings& settings) const;
+  // World distance between slices for these settings.
+  double sliceSpacingFor(const RenderSettings& settings) const;
+
+  void prepare(const RenderSettings& settings);
+  void renderFrame(const Camera& camera, const RenderSettings& settings, int width, int height);
+  Image readImage() const { return accumulator_.readImage(); }
+  Image render(const Camera& camera, const RenderSettings& settings, int width, int height) {
+    renderFrame(camera, settings, width, height);
+    return readImage();
+  }
+
+  // The proxy geometry: how often it was built, and its buffer. A camera
+  // change never rebuilds it; a new slice count does.
+  std::uint64_t geometryBuilds() const { return geometryBuilds_; }
+  unsigned vertexBufferId() const { return vertices_.id(); }
+  std::uint64_t vertexBufferBytes() const { return vertices_.bytes(); }
+
+  std::vector<gpu::ShaderPart> vertexParts() const;
+  std::vector<gpu::ShaderPart> fragmentParts(const RenderSettings& settings) const;
+  std::string accumulationFormat() const { return accumulator_.accumulationFormat(); }
+  std::uint64_t ownTextureBytes() const;
+
+  static constexpr int kMaxSlices = 8192;
+  static constexpr int kOwnTextureUnits = 1;  // the TF table
+
+ private:
+  const gpu::Program& programFor(const RenderSettings& settings);
+  void buildGeometry(int slices);
+  void updateLookup(const RenderSettings& settings, double spacing);
+
+  gpu::GlContext& context_;
+  const Volume& volume_;
+  const layout::Layout& layout_;
+  TransferFunction tf_;
+  int requestedSlices_ = 0;
+  int builtSlices_ = 0;
+  std::uint64_t geometryBuilds_ = 0;
+  gpu::Buffer vertices_;
+  SliceTransferTable lut_;
+  std::string lookupKey_;
+  SliceAccumulator accumulator_;
+  std::map<std::string, gpu::Program> programs_;
+};
+
+}  // namespace tessera::render

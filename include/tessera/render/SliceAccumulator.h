@@ -1,0 +1,57 @@
+#pragma once
+// Where slicing techniques composite: an accumulation target cleared to
+// transparent black, slices blended into it front to back, then a resolve
+// pass that composites the background (DESIGN.md, Rendering semantics) into
+// the RGBA8 image the caller reads.
+//
+// Blending is C += (1 - A) * c_premultiplied, A += (1 - A) * a, i.e.
+// glBlendFuncSeparate(ONE_MINUS_DST_ALPHA, ONE, ONE_MINUS_DST_ALPHA, ONE).
+// (Noguera et al. 2012, section 3.2, use ONE, ONE for alpha, which sums the
+// slices' alphas instead of compositing them; with the distance-corrected
+// opacities used here that would not match the ray caster.)
+// The target is RGBA16F where the device renders to float targets (ES 3 with
+// EXT_color_buffer_float): hundreds of thin slices rounded to 8 bits each
+// would drift. ES 2 devices accumulate in RGBA8, as the papers' devices did.
+// MIP blends with GL_MAX (ES 3, or ES 2 with EXT_blend_minmax): slices write
+// (n * inside, 0, 0, inside) and the resolve pass classifies the maximum.
+#include <string>
+
+#include "tessera/core/Image.h"
+#include "tessera/core/RenderSettings.h"
+#include "tessera/gpu/GlContext.h"
+#include "tessera/gpu/GlObjects.h"
+#include "tessera/gpu/Program.h"
+
+namespace tessera::render {
+
+class SliceAccumulator {
+ public:
+  explicit SliceAccumulator(gpu::GlContext& context);
+
+  // (Re)allocates the targets for the size, binds and clears the
+  // accumulation target and sets the blending for `mode`. GpuError for MIP
+  // on an ES 2 context without EXT_blend_minmax.
+  void begin(int width, int height, RenderMode mode);
+  // Composites into the RGBA8 image and waits for it (glFinish). For MIP,
+  // `lut` is the TF table (entries as in render/classify.glsl).
+  void resolve(const RenderSettings& settings, const gpu::Texture* lut, int lutEntries);
+  // The last resolved frame, top row first.
+  Image readImage() const;
+
+  // "RGBA16F" or "RGBA8".
+  std::string accumulationFormat() const { return floatTarget_ ? "RGBA16F" : "RGBA8"; }
+  std::uint64_t ownTextureBytes() const;
+
+ private:
+  const gpu::Program& resolveProgram(RenderMode mode);
+
+  gpu::GlContext& context_;
+  bool floatTarget_ = false;
+  gpu::Framebuffer accumulation_;
+  gpu::Framebuffer image_;
+  gpu::FullscreenTriangle triangle_;
+  gpu::Program compositeResolve_;
+  gpu::Program mipResolve_;
+};
+
+}  // namespace tessera::render

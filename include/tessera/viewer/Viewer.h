@@ -1,0 +1,111 @@
+#pragma once
+// The viewer core both front ends (desktop `tessera view`, the web page)
+// drive: it holds the volume on the GPU, the camera and its controller, the
+// TF editor, window/level, render mode, technique and quality, draws the
+// bounding box and axes, and times every frame. A front end only turns its
+// input events into calls here and shows the frame.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/vec2.hpp>
+
+#include "tessera/core/Camera.h"
+#include "tessera/core/RenderSettings.h"
+#include "tessera/core/Volume.h"
+#include "tessera/gpu/DeviceProfile.h"
+#include "tessera/gpu/GlContext.h"
+#include "tessera/layout/Planner.h"
+#include "tessera/viewer/CameraController.h"
+#include "tessera/viewer/TransferFunctionEditor.h"
+#include "tessera/viewer/ViewerTechnique.h"
+
+namespace tessera::viewer {
+
+// What a frame does while the user interacts. Full: every frame at full
+// quality. Adaptive: while a pointer is down, half the resolution and twice
+// the sample distance (then full quality again once released).
+enum class Quality { Full, Adaptive };
+
+struct FrameStats {
+  double ms = 0.0;      // the whole frame, up to a 1-pixel read-back (GL may not block on glFinish)
+  int renderWidth = 0;  // what the technique rendered (smaller while adaptive quality interacts)
+  int renderHeight = 0;
+};
+
+class Viewer {
+ public:
+  // `context` must be current and outlive the viewer; `profile` limits what
+  // the viewer uses (effectiveLimits(profile, caps)).
+  Viewer(gpu::GlContext& context, const gpu::DeviceProfile& profile);
+  ~Viewer();
+  Viewer(const Viewer&) = delete;
+  Viewer& operator=(const Viewer&) = delete;
+
+  // Plans, uploads and frames a new volume. On any error (InputError,
+  // BudgetError, GpuError) the previous volume stays and the error
+  // propagates with its message. Keeps the TF; resets window and camera.
+  void setVolume(Volume volume, const std::string& name);
+  bool hasVolume() const { return technique_ != nullptr; }
+  const Volume& volume() const { return *volume_; }  // empty before the first setVolume
+  const std::string& volumeName() const { return volumeName_; }
+  const layout::Plan& plan() const { return plan_; }
+  const gpu::DeviceLimits& limits() const { return limits_; }
+  gpu::GlContext& context() { return context_; }
+
+  Camera& camera() { return camera_; }
+  CameraController& controller() { return controller_; }
+  void resetCamera();
+  TransferFunctionEditor& tfEditor() { return tfEditor_; }
+  RenderSettings& settings() { return settings_; }
+
+  // Value window (raw values) that maps to the TF's [0,1]; recomputes the
+  // editor's histogram. Window/level: level = centre, window = width.
+  void setWindow(ValueRange w);
+  void setWindowLevel(double window, double level) {
+    setWindow({level - 0.5 * window, level + 0.5 * window});
+  }
+  void resetWindow();
+  ValueRange window() const { return volume_->window(); }
+  ValueRange valueRange() const { return volume_->valueRange(); }
+
+  void setTechnique(const std::string& name);  // InputError if unknown; keeps the old one
+  const std::string& technique() const { return techniqueName_; }
+  Quality quality = Quality::Adaptive;
+  bool showBoundingBox = true;
+  bool showAxes = true;
+
+  // Renders one frame into `framebuffer` (0: the window / canvas) at
+  // width x height with its lower-left corner at `origin`, and times it.
+  FrameStats render(int width, int height, unsigned framebuffer = 0, glm::ivec2 origin = {0, 0});
+  const FrameStats& lastFrame() const { return last_; }
+
+  // "ch2.nii.gz 181x217x181 u8, texture3d (...)" for a status bar.
+  std::string description() const;
+
+ private:
+  struct Gpu;  // present and overlay programs
+  void updateHistogram();
+
+  gpu::GlContext& context_;
+  gpu::DeviceLimits limits_;
+  Camera camera_;
+  CameraController controller_{camera_};
+  TransferFunctionEditor tfEditor_;
+  RenderSettings settings_;
+  std::string techniqueName_ = "raycast";
+  std::uint64_t uploadedTfRevision_ = 0;
+  FrameStats last_;
+
+  // Held by pointer: the layout and technique keep references to them, which
+  // must survive swapping in a new volume.
+  std::unique_ptr<Volume> volume_;       // as loaded
+  std::unique_ptr<Volume> downsampled_;  // when the plan asks for it (else null)
+  std::string volumeName_;
+  layout::Plan plan_;
+  std::unique_ptr<layout::Layout> layout_;
+  std::unique_ptr<ViewerTechnique> technique_;
+  std::unique_ptr<Gpu> gpu_;
+};
+
+}  // namespace tessera::viewer

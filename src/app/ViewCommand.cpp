@@ -1,0 +1,463 @@
+// `tessera view [FILE]`: the desktop front end of the viewer core — a GLFW
+// window with an OpenGL ES context created through EGL, Dear ImGui controls
+// and the TF editor drawn over the histogram. Built when GLFW and ImGui are
+// found (cmake/DesktopViewer.cmake); otherwise the command says what to install.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "app/Commands.h"
+#include "app/RenderJob.h"
+#include "tessera/core/Error.h"
+
+#ifdef TESSERA_DESKTOP_VIEWER
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
+
+#include "gpu/gl.h"
+#include "tessera/core/Image.h"
+#include "tessera/gpu/DeviceProfile.h"
+#include "tessera/gpu/GlContext.h"
+#include "tessera/gpu/GlObjects.h"
+#include "tessera/io/VolumeReader.h"
+#include "tessera/viewer/Viewer.h"
+#endif
+
+namespace tessera::app {
+
+namespace {
+
+struct ViewOptions {
+  std::string file;
+  std::string series;
+  std::string tf = "mr-default";
+  std::string size = "1280x800";
+  std::string profile = "gles3";
+  double azimuth = 0.0;
+  double elevation = 0.0;
+  std::string screenshot;
+  int frames = 3;
+};
+
+#ifdef TESSERA_DESKTOP_VIEWER
+
+constexpr float kPanelWidth = 390.0f;
+
+struct DesktopState {
+  viewer::Viewer* viewer = nullptr;
+  std::string pendingDrop;
+  double wheel = 0.0;
+};
+
+void section(const char* title) {
+  ImGui::Spacing();
+  ImGui::Separator();
+  ImGui::TextUnformatted(title);
+}
+
+std::string fileName(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+// The TF editor over the histogram (Moser & Weiskopf 2008): opacity points
+// over the histogram bars, colour points on a strip below. All editing goes
+// through viewer::TransferFunctionEditor, the model the web page uses too.
+void transferFunctionEditor(viewer::TransferFunctionEditor& ed, bool logHistogram) {
+  const float width = ImGui::GetContentRegionAvail().x;
+  const ImVec2 areaSize(width, 190.0f), stripSize(width, 26.0f);
+  ImDrawList* dl = ImGui::GetWindowDrawList();
+  const TransferFunction& tf = ed.transferFunction();
+
+  const ImVec2 a0 = ImGui::GetCursorScreenPos();
+  ImGui::InvisibleButton("tf-opacity", areaSize);
+  const bool areaActivated = ImGui::IsItemActivated(), areaActive = ImGui::IsItemActive(),
+             areaReleased = ImGui::IsItemDeactivated();
+  const ImVec2 a1(a0.x + areaSize.x, a0.y + areaSize.y);
+  auto toScreen = [&](double x, double y) {
+    return ImVec2(a0.x + static_cast<float>(x) * areaSize.x,
+                  a1.y - static_cast<float>(y) * areaSize.y);
+  };
+  auto color32 = [](glm::dvec3 c, float alpha = 1.0f) {
+    return ImGui::ColorConvertFloat4ToU32(
+        ImVec4(static_cast<float>(c.r), static_cast<float>(c.g), static_cast<float>(c.b), alpha));
+  };
+  dl->AddRectFilled(a0, a1, IM_COL32(13, 14, 16, 255));
+  const std::vector<double> bars = ed.histogramHeights(logHistogram);
+  for (std::size_t i = 0; i < bars.size(); ++i) {
+    const double x0 = static_cast<double>(i) / bars.size(), x1 = (i + 1.0) / bars.size();
+    dl->AddRectFilled(toScreen(x0, bars[i]), toScreen(x1, 0.0), IM_COL32(58, 63, 74, 255));
+  }
+  // The curve, each segment in the TF colour under it.
+  std::vector<ImVec2> line;
+  if (!tf.opacities.empty()) line.push_back(toScreen(0.0, tf.opacities.front().alpha));
+  for (const auto& p : tf.opacities) line.push_back(toScreen(p.x, p.alpha));
+  if (!tf.opacities.empty()) line.push_back(toScreen(1.0, tf.opacities.back().alpha));
+  for (std::size_t i = 1; i < line.size(); ++i) {
+    const double xm = ((line[i - 1].x + line[i].x) * 0.5 - a0.x) / areaSize.x;
+    dl->AddQuadFilled(line[i - 1], line[i], ImVec2(line[i].x, a1.y), ImVec2(line[i - 1].x, a1.y),
+                      color32(tf.color(std::clamp(xm, 0.0, 1.0)), 0.35f));
+  }
+  if (line.size() > 1)
+    dl->AddPolyline(line.data(), static_cast<int>(line.size()), IM_COL32(240, 240, 240, 255), 0,
+                    1.5f);
+  const auto& sel = ed.selection();
+  for (std::size_t i = 0; i < tf.opacities.size(); ++i) {
+    const ImVec2 c = toScreen(tf.opacities[i].x, tf.opacities[i].alpha);
+    const bool selected =
+        sel.channel == viewer::TfChannel::Opacity && sel.index == static_cast<int>(i);
+    dl->AddCircleFilled(c, 6.0f, color32(tf.color(tf.opacities[i].x)));
+    dl->AddCircle(c, 6.0f, selected ? IM_COL32(255, 213, 74, 255) : IM_COL32_WHITE, 0,
+                  selected ? 3.0f : 1.5f);
+  }
+  dl->AddRect(a0, a1, IM_COL32(85, 85, 85, 255));
+
+  const ImVec2 s0 = ImGui::GetCursorScreenPos();
+  ImGui::InvisibleButton("tf-color", stripSize);
+  const bool stripActivated = ImGui::IsItemActivated(), stripActive = ImGui::IsItemActive(),
+             stripReleased = ImGui::IsItemDeactivated();
+  const int steps = static_cast<int>(stripSize.x);
+  for (int i = 0; i < steps; ++i) {
+    const float x = s0.x + static_cast<float>(i);
+    dl->AddRectFilled(ImVec2(x, s0.y), ImVec2(x + 1.0f, s0.y + stripSize.y),
+                      color32(tf.color(static_cast<double>(i) / std::max(steps - 1, 1))));
+  }
+  for (std::size_t i = 0; i < tf.colors.size(); ++i) {
+    const float x = s0.x + static_cast<float>(tf.colors[i].x) * stripSize.x;
+    const float y = s0.y + stripSize.y;
+    const bool selected =
+        sel.channel == viewer::TfChannel::Color && sel.index == static_cast<int>(i);
+    dl->AddTriangleFilled(ImVec2(x, y - 12.0f), ImVec2(x - 7.0f, y), ImVec2(x + 7.0f, y),
+                          color32(tf.colors[i].rgb));
+    dl->AddTriangle(ImVec2(x, y - 12.0f), ImVec2(x - 7.0f, y), ImVec2(x + 7.0f, y),
+                    selected ? IM_COL32(255, 213, 74, 255) : IM_COL32_WHITE,
+                    selected ? 3.0f : 1.5f);
+  }
+
+  // Gestures in editor units (x in [0,1], y = opacity), hit radius 12 px.
+  const ImVec2 m = ImGui::GetIO().MousePos;
+  const glm::dvec2 u((m.x - a0.x) / areaSize.x, (a1.y - m.y) / areaSize.y);
+  const glm::dvec2 radius(12.0 / areaSize.x, 12.0 / areaSize.y);
+  if (areaActivated) {
+    ed.pointerDown(viewer::TfChannel::Opacity, glm::clamp(u, 0.0, 1.0), radius);
+  } else if (stripActivated) {
+    ed.pointerDown(viewer::TfChannel::Color, glm::dvec2(std::clamp(u.x, 0.0, 1.0), 0.0), radius);
+  } else if ((areaActive || stripActive) && ImGui::IsMouseDragging(ImGuiMouseButton_Left, 0.0f)) {
+    ed.pointerMove(u);
+  }
+  if (areaReleased || stripReleased) ed.pointerUp(u);
+}
+
+void runView(const ViewOptions& o) {
+  int width = 0, height = 0;
+  parseSize(o.size, width, height);
+  const gpu::DeviceProfile profile = gpu::DeviceProfile::find(o.profile);
+  const bool es3 = profile.api == gpu::ApiLevel::Gles3;
+
+  glfwSetErrorCallback([](int code, const char* what) {
+    std::fprintf(stderr, "tessera view: GLFW error %d: %s\n", code, what);
+  });
+  if (!glfwInit()) {
+    throw GpuError("GLFW cannot start: no display? (set DISPLAY, or run under xvfb-run -a)");
+  }
+  struct GlfwGuard {
+    ~GlfwGuard() { glfwTerminate(); }
+  } glfwGuard;
+  glfwWindowHint(GLFW_CLIENT_API, GLFW_OPENGL_ES_API);
+  glfwWindowHint(GLFW_CONTEXT_CREATION_API, GLFW_EGL_CONTEXT_API);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, es3 ? 3 : 2);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 0);
+  GLFWwindow* window = glfwCreateWindow(width, height, "Tessera", nullptr, nullptr);
+  if (!window) {
+    throw GpuError(std::string("cannot open a window with an OpenGL ES ") + (es3 ? "3.0" : "2.0") +
+                   " context through EGL");
+  }
+  glfwMakeContextCurrent(window);
+  glfwSwapInterval(1);
+
+  auto context = gpu::GlContext::adoptCurrent(profile.api, "glfw-egl");
+  auto v = std::make_unique<viewer::Viewer>(*context, profile);
+  DesktopState ds;
+  ds.viewer = v.get();
+  glfwSetWindowUserPointer(window, &ds);
+  glfwSetDropCallback(window, [](GLFWwindow* w, int count, const char** paths) {
+    if (count > 0) static_cast<DesktopState*>(glfwGetWindowUserPointer(w))->pendingDrop = paths[0];
+  });
+
+  std::string error;
+  std::string status;
+  auto open = [&](const std::string& spec) {
+    try {
+      v->setVolume(readVolume(spec, {.dicomSeries = o.series}), fileName(spec));
+      error.clear();
+    } catch (const Error& e) {
+      error = std::string(e.what()) + " (the previous volume stays)";
+    }
+  };
+  v->tfEditor().setTransferFunction(TransferFunction::fromPresetOrFile(o.tf));
+  open(o.file.empty() ? defaultVolumeSpec() : o.file);
+  if (!error.empty() && !v->hasVolume()) throw InputError(error);
+  v->camera().azimuthDeg = o.azimuth;
+  v->camera().elevationDeg = o.elevation;
+
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;
+  ImGui::StyleColorsDark();
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL3_Init(es3 ? "#version 300 es" : "#version 100");
+
+  gpu::Framebuffer cache;  // ES 3: the last volume frame, blitted while nothing changes
+  std::string cacheKey;
+  char pathBuf[512] = "";
+  char tfPathBuf[512] = "transfer-function.json";
+  bool logHistogram = true;
+  int frame = 0;
+
+  while (!glfwWindowShouldClose(window)) {
+    glfwPollEvents();
+    if (!ds.pendingDrop.empty()) {
+      open(ds.pendingDrop);
+      ds.pendingDrop.clear();
+    }
+    int fbw = 0, fbh = 0, ww = 0, wh = 0;
+    glfwGetFramebufferSize(window, &fbw, &fbh);
+    glfwGetWindowSize(window, &ww, &wh);
+    const double scale = ww > 0 ? static_cast<double>(fbw) / ww : 1.0;
+    const int panelPx = static_cast<int>(kPanelWidth * scale);
+    const int viewW = std::max(1, fbw - panelPx), viewH = std::max(1, fbh);
+
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    ImGuiIO& io = ImGui::GetIO();
+
+    // The 3D view: mouse drags orbit (right button or shift: pan), wheel zooms.
+    if (!io.WantCaptureMouse) {
+      const glm::dvec2 pos((io.MousePos.x - kPanelWidth) * scale, io.MousePos.y * scale);
+      for (int b = 0; b < 2; ++b) {
+        if (ImGui::IsMouseClicked(b) && pos.x >= 0.0) {
+          v->controller().pointerDown(
+              b, pos,
+              b == 1 || io.KeyShift ? viewer::PointerAction::Pan : viewer::PointerAction::Orbit);
+        }
+      }
+      if (io.MouseWheel != 0.0f) v->controller().wheel(-io.MouseWheel);
+    }
+    {
+      const glm::dvec2 pos((io.MousePos.x - kPanelWidth) * scale, io.MousePos.y * scale);
+      for (int b = 0; b < 2; ++b) {
+        v->controller().pointerMove(b, pos);
+        if (ImGui::IsMouseReleased(b)) v->controller().pointerUp(b);
+      }
+    }
+
+    ImGui::SetNextWindowPos(ImVec2(0, 0));
+    ImGui::SetNextWindowSize(ImVec2(kPanelWidth, static_cast<float>(wh)));
+    ImGui::Begin("Tessera", nullptr,
+                 ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+    ImGui::TextWrapped("%s", v->description().c_str());
+    ImGui::InputText("##path", pathBuf, sizeof pathBuf);
+    ImGui::SameLine();
+    if (ImGui::Button("Open") && pathBuf[0]) open(pathBuf);
+    ImGui::TextDisabled("or drop a file on the window");
+    if (!error.empty()) {
+      ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1.0f));
+      ImGui::TextWrapped("%s", error.c_str());
+      ImGui::PopStyleColor();
+    }
+
+    section("Transfer function");
+    viewer::TransferFunctionEditor& ed = v->tfEditor();
+    transferFunctionEditor(ed, logHistogram);
+    if (ImGui::BeginCombo("preset", ed.transferFunction().name.c_str())) {
+      for (const std::string& name : TransferFunction::presetNames()) {
+        if (ImGui::Selectable(name.c_str())) ed.loadPreset(name);
+      }
+      ImGui::EndCombo();
+    }
+    ImGui::Checkbox("log histogram", &logHistogram);
+    const auto sel = ed.selection();
+    ImGui::BeginDisabled(sel.index < 0);
+    if (ImGui::Button("Delete point")) ed.removeSelected();
+    ImGui::EndDisabled();
+    if (sel.channel == viewer::TfChannel::Color && sel.index >= 0 &&
+        sel.index < static_cast<int>(ed.transferFunction().colors.size())) {
+      const glm::dvec3 c = ed.transferFunction().colors[static_cast<std::size_t>(sel.index)].rgb;
+      float rgb[3] = {static_cast<float>(c.r), static_cast<float>(c.g), static_cast<float>(c.b)};
+      ImGui::SameLine();
+      if (ImGui::ColorEdit3("colour", rgb, ImGuiColorEditFlags_NoInputs)) {
+        ed.setSelectedColor(glm::dvec3(rgb[0], rgb[1], rgb[2]));
+      }
+    }
+    ImGui::InputText("##tfpath", tfPathBuf, sizeof tfPathBuf);
+    ImGui::SameLine();
+    if (ImGui::Button("Save")) {
+      try {
+        ed.transferFunction().save(tfPathBuf);
+        error.clear();
+      } catch (const Error& e) {
+        error = e.what();
+      }
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("Load")) {
+      try {
+        ed.setTransferFunction(TransferFunction::load(tfPathBuf));
+        error.clear();
+      } catch (const Error& e) {
+        error = e.what();
+      }
+    }
+
+    if (v->hasVolume()) {
+      section("Window / level");
+      const ValueRange r = v->valueRange(), w = v->window();
+      const double span = std::max(r.width(), 1e-12);
+      float win = static_cast<float>(w.width()), level = static_cast<float>(0.5 * (w.min + w.max));
+      bool changed = ImGui::SliderFloat("window", &win, static_cast<float>(span / 1000.0),
+                                        static_cast<float>(span));
+      changed |=
+          ImGui::SliderFloat("level", &level, static_cast<float>(r.min), static_cast<float>(r.max));
+      if (changed) v->setWindowLevel(win, level);
+      if (ImGui::Button("Full range")) v->resetWindow();
+    }
+
+    section("Rendering");
+    int mode = v->settings().mode == RenderMode::Mip ? 1 : 0;
+    if (ImGui::Combo("mode", &mode, "composite\0MIP\0")) {
+      v->settings().mode = mode ? RenderMode::Mip : RenderMode::Composite;
+    }
+    if (ImGui::BeginCombo("technique", v->technique().c_str())) {
+      for (const std::string& t : viewer::techniqueNames()) {
+        if (ImGui::Selectable(t.c_str(), t == v->technique())) {
+          try {
+            v->setTechnique(t);
+          } catch (const Error& e) {
+            error = e.what();
+          }
+        }
+      }
+      ImGui::EndCombo();
+    }
+    int quality = v->quality == viewer::Quality::Adaptive ? 0 : 1;
+    if (ImGui::Combo("quality", &quality, "adaptive\0full\0")) {
+      v->quality = quality == 0 ? viewer::Quality::Adaptive : viewer::Quality::Full;
+    }
+    float step = static_cast<float>(v->settings().stepVoxels);
+    if (ImGui::SliderFloat("step (voxels)", &step, 0.25f, 2.0f)) v->settings().stepVoxels = step;
+    float opacity = static_cast<float>(v->settings().opacityScale);
+    if (ImGui::SliderFloat("opacity x", &opacity, 0.0f, 4.0f)) v->settings().opacityScale = opacity;
+    ImGui::Checkbox("bounding box", &v->showBoundingBox);
+    ImGui::SameLine();
+    ImGui::Checkbox("axes", &v->showAxes);
+    if (ImGui::Button("Reset view")) v->resetCamera();
+    ImGui::Separator();
+    ImGui::TextWrapped("%s", status.c_str());
+    ImGui::End();
+    ImGui::Render();
+
+    // The volume: re-rendered only when something it shows changed.
+    const Camera& c = v->camera();
+    std::ostringstream key;
+    key.precision(17);
+    key << v->volumeName() << '|' << c.azimuthDeg << '|' << c.elevationDeg << '|' << c.zoom << '|'
+        << c.target.x << c.target.y << c.target.z << '|' << ed.revision() << '|'
+        << static_cast<int>(v->settings().mode) << '|' << v->settings().stepVoxels << '|'
+        << v->settings().opacityScale << '|' << v->window().min << v->window().max << '|'
+        << v->technique() << static_cast<int>(v->quality) << v->controller().interacting() << '|'
+        << v->showBoundingBox << v->showAxes << '|' << viewW << 'x' << viewH;
+    try {
+      if (es3) {
+        if (key.str() != cacheKey || cache.width() != viewW || cache.height() != viewH) {
+          if (cache.width() != viewW || cache.height() != viewH) {
+            cache = gpu::Framebuffer();
+            cache = gpu::Framebuffer::create(context->ledger(), "view cache", viewW, viewH);
+          }
+          v->render(viewW, viewH, cache.id());
+          cacheKey = key.str();
+        }
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, cache.id());
+        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+        glBlitFramebuffer(0, 0, viewW, viewH, panelPx, 0, panelPx + viewW, viewH,
+                          GL_COLOR_BUFFER_BIT, GL_NEAREST);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+      } else {
+        // ES 2 has no blit: the volume is drawn every frame.
+        v->render(viewW, viewH, 0, glm::ivec2(panelPx, 0));
+      }
+    } catch (const Error& e) {
+      error = e.what();
+    }
+    const viewer::FrameStats& fs = v->lastFrame();
+    char line[160];
+    std::snprintf(line, sizeof line, "frame %.0f ms at %dx%d (%s)\n%s", fs.ms, fs.renderWidth,
+                  fs.renderHeight, context->caps().renderer.c_str(),
+                  context->caps().version.c_str());
+    status = line;
+
+    glViewport(0, 0, fbw, fbh);
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+
+    ++frame;
+    if (!o.screenshot.empty() && frame >= o.frames) {
+      Image shot(fbw, fbh);
+      glBindFramebuffer(GL_FRAMEBUFFER, 0);
+      glPixelStorei(GL_PACK_ALIGNMENT, 1);
+      glReadPixels(0, 0, fbw, fbh, GL_RGBA, GL_UNSIGNED_BYTE, shot.rgba().data());
+      shot.flipVertically();
+      for (std::size_t i = 3; i < shot.rgba().size(); i += 4) shot.rgba()[i] = 255;
+      shot.writePng(o.screenshot);
+      std::printf("wrote %s (%dx%d) after %d frames; last volume frame %.0f ms at %dx%d\n",
+                  o.screenshot.c_str(), fbw, fbh, frame, fs.ms, fs.renderWidth, fs.renderHeight);
+      glfwSetWindowShouldClose(window, 1);
+    }
+    glfwSwapBuffers(window);
+  }
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+  cache = gpu::Framebuffer();
+  v.reset();
+  context.reset();
+  glfwDestroyWindow(window);
+}
+
+#else
+
+void runView(const ViewOptions&) {
+  throw Error(
+      "this tessera was built without the desktop viewer: install libglfw3-dev and "
+      "libimgui-dev (scripts/setup.sh) and re-run cmake; or use the web viewer (scripts/web.sh)");
+}
+
+#endif
+
+}  // namespace
+
+void addViewCommand(CLI::App& app) {
+  auto o = std::make_shared<ViewOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "view", "Interactive viewer: GLFW window with OpenGL ES (EGL) and the TF editor");
+  cmd->add_option("file", o->file, kVolumeHelp);
+  addSeriesOption(cmd, o->series);
+  cmd->add_option("--tf", o->tf, "Transfer function: preset or FILE.json")->capture_default_str();
+  cmd->add_option("--size", o->size, "Window size WIDTHxHEIGHT")->capture_default_str();
+  cmd->add_option("--profile", o->profile,
+                  "Device profile (gles3, gles2, webgl1, ...; its API level picks the context)")
+      ->capture_default_str();
+  cmd->add_option("--azimuth", o->azimuth, "Initial camera azimuth in degrees");
+  cmd->add_option("--elevation", o->elevation, "Initial camera elevation in degrees");
+  cmd->add_option("--screenshot", o->screenshot,
+                  "Write the window to this PNG after --frames frames and exit");
+  cmd->add_option("--frames", o->frames, "Frames before --screenshot")->capture_default_str();
+  cmd->callback([o] { runView(*o); });
+}
+
+}  // namespace tessera::app

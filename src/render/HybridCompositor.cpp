@@ -1,0 +1,277 @@
+#include "tessera/render/HybridCompositor.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/constants.hpp>
+
+#include "gpu/gl.h"
+#include "tessera/core/Error.h"
+
+namespace tessera::render {
+
+namespace {
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+const char* methodDefine(OverlayOpacity m) {
+  switch (m) {
+    case OverlayOpacity::Alpha:
+      return "METHOD_ALPHA 1";
+    case OverlayOpacity::TwoPass:
+      return "METHOD_TWO_PASS 1";
+    case OverlayOpacity::LumaAverage:
+      return "METHOD_LUMA_AVG 1";
+    case OverlayOpacity::Luma601:
+      return "METHOD_LUMA_601 1";
+  }
+  return "METHOD_ALPHA 1";
+}
+
+}  // namespace
+
+std::string overlayOpacityName(OverlayOpacity method) {
+  switch (method) {
+    case OverlayOpacity::Alpha:
+      return "alpha";
+    case OverlayOpacity::TwoPass:
+      return "two-pass";
+    case OverlayOpacity::LumaAverage:
+      return "luma-avg";
+    case OverlayOpacity::Luma601:
+      return "luma-601";
+  }
+  return "alpha";
+}
+
+std::vector<OverlayOpacity> allOverlayOpacities() {
+  return {OverlayOpacity::Alpha, OverlayOpacity::TwoPass, OverlayOpacity::LumaAverage,
+          OverlayOpacity::Luma601};
+}
+
+OverlayOpacity parseOverlayOpacity(const std::string& name) {
+  for (OverlayOpacity m : allOverlayOpacities()) {
+    if (overlayOpacityName(m) == name) return m;
+  }
+  throw InputError("--overlay-opacity '" + name +
+                   "': expected alpha, two-pass, luma-avg or luma-601");
+}
+
+OffscreenSize OffscreenSize::ofFactor(double f) {
+  if (!(f > 0.0 && f <= 1.0)) {
+    throw InputError("offscreen factor must be in (0, 1], got " + std::to_string(f));
+  }
+  OffscreenSize s;
+  s.factor = f;
+  return s;
+}
+
+OffscreenSize OffscreenSize::ofSize(int width, int height) {
+  if (width <= 0 || height <= 0 || width > 16384 || height > 16384) {
+    throw InputError("offscreen size " + std::to_string(width) + "x" + std::to_string(height) +
+                     " must be 1..16384 per axis");
+  }
+  OffscreenSize s;
+  s.fixed = {width, height};
+  return s;
+}
+
+OffscreenSize OffscreenSize::parse(const std::string& text) {
+  if (text == "full") return ofFactor(1.0);
+  int w = 0, h = 0;
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%dx%d%c", &w, &h, &tail) == 2) return ofSize(w, h);
+  double f = 0.0;
+  if (std::sscanf(text.c_str(), "%lf%c", &f, &tail) == 1) return ofFactor(f);
+  throw InputError("--offscreen '" + text +
+                   "': expected WIDTHxHEIGHT (e.g. 128x128, 256x512), a factor in (0,1] "
+                   "(e.g. 0.25) or full");
+}
+
+glm::ivec2 OffscreenSize::resolve(int screenWidth, int screenHeight) const {
+  if (fixed.x > 0) return fixed;
+  return {std::max(1, static_cast<int>(std::lround(screenWidth * factor))),
+          std::max(1, static_cast<int>(std::lround(screenHeight * factor)))};
+}
+
+std::string OffscreenSize::describe() const {
+  if (fixed.x > 0) return std::to_string(fixed.x) + "x" + std::to_string(fixed.y);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "factor %g", factor);
+  return buf;
+}
+
+HybridCompositor::HybridCompositor(gpu::GlContext& context)
+    : context_(context), overlay_(context), triangle_(context.ledger()) {
+  const gpu::ApiLevel api = context.caps().api;
+  composite_ = gpu::Program::build(
+      "hybrid composite",
+      {gpu::shaderPreamble(api, false, {}), gpu::embeddedShaderPart("render/fullscreen.vert.glsl")},
+      {gpu::shaderPreamble(api, true, {}), gpu::embeddedShaderPart("render/camera_ray.glsl"),
+       gpu::embeddedShaderPart("render/hybrid_composite.frag.glsl")});
+}
+
+const gpu::Program& HybridCompositor::resolveProgram(const std::string& define) {
+  for (const auto& [key, program] : resolvePrograms_) {
+    if (key == define) return program;
+  }
+  const gpu::ApiLevel api = context_.caps().api;
+  gpu::Program p = gpu::Program::build(
+      "hybrid resolve(" + define + ")",
+      {gpu::shaderPreamble(api, false, {}), gpu::embeddedShaderPart("render/fullscreen.vert.glsl")},
+      {gpu::shaderPreamble(api, true, {define}),
+       gpu::embeddedShaderPart("render/hybrid_resolve.frag.glsl")});
+  resolvePrograms_.emplace_back(define, std::move(p));
+  return resolvePrograms_.back().second;
+}
+
+namespace {
+
+void ensureTarget(gpu::GlContext& context, gpu::Framebuffer& fb, const char* label, int width,
+                  int height) {
+  if (fb.id() != 0 && fb.width() == width && fb.height() == height) return;
+  fb = gpu::Framebuffer();
+  fb = gpu::Framebuffer::create(context.ledger(), label, width, height,
+                                context.caps().api == gpu::ApiLevel::Gles3 ? GL_RGBA8 : GL_RGBA);
+}
+
+}  // namespace
+
+void HybridCompositor::render(HybridTechnique& technique, const Camera& camera,
+                              const RenderSettings& settings, glm::dvec3 volumeExtent, int width,
+                              int height, const HybridOptions& options) {
+  if (width <= 0 || height <= 0) throw InputError("hybrid: image size must be positive");
+  const auto tStart = std::chrono::steady_clock::now();
+  const glm::ivec2 low = options.offscreen.resolve(width, height);
+  const double aspect = static_cast<double>(width) / height;
+  timings_ = HybridTimings();
+  timings_.offscreen = low;
+
+  // 1. The volume at the offscreen size, and its opacity estimate.
+  RenderSettings s = settings;
+  const gpu::Texture* volume = nullptr;
+  if (options.opacity == OverlayOpacity::TwoPass) {
+    s.background = glm::dvec4(1.0, 1.0, 1.0, 1.0);
+    const gpu::Texture& overWhite = technique.renderVolume(camera, s, low.x, low.y, aspect);
+    // The technique reuses its target, so keep the first render.
+    const glm::ivec2 whiteSize(overWhite.width(), overWhite.height());
+    ensureTarget(context_, white_, "hybrid over-white copy", whiteSize.x, whiteSize.y);
+    white_.bind();
+    const gpu::Program& copy = resolveProgram("METHOD_COPY 1");
+    copy.use();
+    overWhite.bind(0);
+    copy.set("u_volume", 0);
+    copy.set("u_size", glm::vec2(whiteSize));
+    glDisable(GL_BLEND);
+    glDisable(GL_DEPTH_TEST);
+    triangle_.draw();
+    s.background = glm::dvec4(0.0, 0.0, 0.0, 1.0);
+    volume = &technique.renderVolume(camera, s, low.x, low.y, aspect);
+    timings_.volumePasses = 2;
+  } else {
+    // Transparent black: RGB is the colour over black, A the accumulated opacity.
+    s.background = glm::dvec4(0.0);
+    volume = &technique.renderVolume(camera, s, low.x, low.y, aspect);
+    timings_.volumePasses = 1;
+  }
+  // A technique may render another shape than asked (HybridSlice3DTechnique):
+  // the layer follows its texture, and is stretched to the screen anyway.
+  const glm::ivec2 rendered(volume->width(), volume->height());
+  timings_.rendered = rendered;
+  ensureTarget(context_, resolved_, "hybrid volume layer", rendered.x, rendered.y);
+  resolved_.bind();
+  const gpu::Program& resolve = resolveProgram(methodDefine(options.opacity));
+  resolve.use();
+  volume->bind(0);
+  resolve.set("u_volume", 0);
+  if (options.opacity == OverlayOpacity::TwoPass) {
+    white_.color().bind(1);
+    resolve.set("u_white", 1);
+  }
+  resolve.set("u_size", glm::vec2(rendered));
+  glDisable(GL_BLEND);
+  glDisable(GL_DEPTH_TEST);
+  triangle_.draw();
+  glFinish();
+  timings_.volumeMs = msSince(tStart);
+
+  // 2. The lines at full resolution.
+  const auto tOverlay = std::chrono::steady_clock::now();
+  const bool hasLines = !lines_.empty();
+  if (hasLines) overlay_.draw(lines_, camera, width, height);
+  glFinish();
+  timings_.overlayMs = msSince(tOverlay);
+
+  // 3. Upscale and compose at full resolution.
+  const auto tComposite = std::chrono::steady_clock::now();
+  ensureTarget(context_, image_, "hybrid image", width, height);
+  image_.bind();
+  composite_.use();
+  const glm::dmat3 b = camera.basis();
+  const double tanHalfFov = std::tan(0.5 * camera.fovYDeg * glm::pi<double>() / 180.0);
+  composite_.set("u_eye", glm::vec3(camera.eye()));
+  composite_.set("u_right", glm::vec3(b[0]));
+  composite_.set("u_up", glm::vec3(b[1]));
+  composite_.set("u_forward", glm::vec3(-b[2]));
+  composite_.set("u_tanHalfFov", static_cast<float>(tanHalfFov));
+  composite_.set("u_orthoHalfHeight", static_cast<float>(camera.orthoHalfHeight()));
+  composite_.set("u_aspect", static_cast<float>(aspect));
+  composite_.set("u_ortho", camera.projection == Projection::Orthographic ? 1 : 0);
+  composite_.set("u_viewport", glm::vec2(width, height));
+  composite_.set("u_extent", glm::vec3(volumeExtent));
+  composite_.set("u_background", glm::vec4(settings.background));
+  resolved_.color().bind(0);
+  composite_.set("u_volume", 0);
+  composite_.set("u_hasLines", hasLines ? 1.0f : 0.0f);
+  if (hasLines) {
+    overlay_.colorTexture().bind(1);
+    overlay_.distanceTexture().bind(2);
+    composite_.set("u_lineColor", 1);
+    composite_.set("u_lineDistance", 2);
+    composite_.set("u_distanceScale", static_cast<float>(overlay_.distanceScale()));
+    // A line on the box's front faces is "in front"; allow for the pixel's
+    // ray meeting the box up to a couple of pixels' footprint away from the
+    // line's point, and for packing and float rounding.
+    const double viewHeight = camera.projection == Projection::Perspective
+                                  ? 2.0 * camera.distance() * tanHalfFov
+                                  : 2.0 * camera.orthoHalfHeight();
+    const double tolerance = std::max(2.0 * viewHeight / height, 0.005 * glm::length(volumeExtent));
+    composite_.set("u_frontTolerance", static_cast<float>(tolerance));
+  } else {
+    // Samplers must still name distinct units of the right type.
+    resolved_.color().bind(1);
+    resolved_.color().bind(2);
+    composite_.set("u_lineColor", 1);
+    composite_.set("u_lineDistance", 2);
+  }
+  glDisable(GL_BLEND);
+  glDisable(GL_DEPTH_TEST);
+  triangle_.draw();
+  glFinish();
+  const GLenum err = glGetError();
+  if (err != GL_NO_ERROR)
+    throw GpuError("hybrid compositing failed: GL error " + std::to_string(err));
+  timings_.compositeMs = msSince(tComposite);
+  timings_.totalMs = msSince(tStart);
+}
+
+Image HybridCompositor::readImage() const {
+  Image img(image_.width(), image_.height());
+  image_.readRgba8(img.rgba().data());
+  img.flipVertically();
+  return img;
+}
+
+Image HybridCompositor::readOpacityLayer() const {
+  Image img(resolved_.width(), resolved_.height());
+  resolved_.readRgba8(img.rgba().data());
+  img.flipVertically();
+  return img;
+}
+
+}  // namespace tessera::render

@@ -1,0 +1,195 @@
+#include "tessera/render/OverlayRenderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/constants.hpp>
+
+#include "gpu/gl.h"
+#include "tessera/core/Error.h"
+
+namespace tessera::render {
+
+glm::dmat4 viewProjection(const Camera& camera, double aspect, double sceneRadius) {
+  const glm::dmat3 b = camera.basis();
+  const glm::dvec3 eye = camera.eye();
+  glm::dmat4 view(1.0);
+  for (int c = 0; c < 3; ++c) {
+    // Rows of the view matrix: right, up, back (column-major storage).
+    view[c][0] = b[0][c];
+    view[c][1] = b[1][c];
+    view[c][2] = b[2][c];
+  }
+  view[3] = glm::dvec4(-glm::dot(b[0], eye), -glm::dot(b[1], eye), -glm::dot(b[2], eye), 1.0);
+  const double d = glm::length(eye - camera.target);
+  const double farZ = d + sceneRadius;
+  glm::dmat4 proj(0.0);
+  if (camera.projection == Projection::Perspective) {
+    const double nearZ = std::max(d - sceneRadius, 1e-3 * farZ);
+    const double f = 1.0 / std::tan(0.5 * camera.fovYDeg * glm::pi<double>() / 180.0);
+    proj[0][0] = f / aspect;
+    proj[1][1] = f;
+    proj[2][2] = (farZ + nearZ) / (nearZ - farZ);
+    proj[2][3] = -1.0;
+    proj[3][2] = 2.0 * farZ * nearZ / (nearZ - farZ);
+  } else {
+    const double nearZ = d - sceneRadius;
+    const double h = camera.orthoHalfHeight();
+    proj[0][0] = 1.0 / (h * aspect);
+    proj[1][1] = 1.0 / h;
+    proj[2][2] = -2.0 / (farZ - nearZ);
+    proj[3][2] = -(farZ + nearZ) / (farZ - nearZ);
+    proj[3][3] = 1.0;
+  }
+  return proj * view;
+}
+
+OverlayRenderer::OverlayRenderer(gpu::GlContext& context) : context_(context) {
+  const gpu::ApiLevel api = context.caps().api;
+  const std::vector<gpu::ShaderPart> vertex{gpu::shaderPreamble(api, false, {}),
+                                            gpu::embeddedShaderPart("render/overlay.vert.glsl")};
+  colorProgram_ = gpu::Program::build("overlay colour", vertex,
+                                      {gpu::shaderPreamble(api, true, {}),
+                                       gpu::embeddedShaderPart("render/overlay_color.frag.glsl")});
+  distanceProgram_ =
+      gpu::Program::build("overlay distance", vertex,
+                          {gpu::shaderPreamble(api, true, {}),
+                           gpu::embeddedShaderPart("render/overlay_distance.frag.glsl")});
+}
+
+OverlayRenderer::~OverlayRenderer() {
+  if (depthRenderbuffer_ != 0) glDeleteRenderbuffers(1, &depthRenderbuffer_);
+}
+
+void OverlayRenderer::allocate(int width, int height) {
+  if (color_.id() != 0 && color_.width() == width && color_.height() == height) return;
+  const GLenum format = context_.caps().api == gpu::ApiLevel::Gles3 ? GL_RGBA8 : GL_RGBA;
+  color_ = gpu::Framebuffer();
+  distance_ = gpu::Framebuffer();
+  color_ = gpu::Framebuffer::create(context_.ledger(), "overlay colour", width, height, format);
+  distance_ =
+      gpu::Framebuffer::create(context_.ledger(), "overlay distance", width, height, format);
+  // Sampled at pixel centres only: never blend two lines' packed distances.
+  color_.color().bind(0);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  distance_.color().bind(0);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+
+  // One depth buffer, shared by both targets (cleared before each pass), so
+  // that where lines cross the nearest one wins in colour and distance alike.
+  if (depthRenderbuffer_ == 0) glGenRenderbuffers(1, &depthRenderbuffer_);
+  glBindRenderbuffer(GL_RENDERBUFFER, depthRenderbuffer_);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT16, width, height);
+  depthEntry_ = gpu::LedgerEntry();
+  depthEntry_ = gpu::LedgerEntry(context_.ledger(), gpu::GpuResource::Renderbuffer,
+                                 static_cast<std::uint64_t>(width) * height * 2, "overlay depth");
+  for (const gpu::Framebuffer* fb : {&color_, &distance_}) {
+    glBindFramebuffer(GL_FRAMEBUFFER, fb->id());
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+                              depthRenderbuffer_);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      throw GpuError("overlay target " + std::to_string(width) + "x" + std::to_string(height) +
+                     " with a depth buffer is incomplete");
+    }
+  }
+}
+
+void OverlayRenderer::drawPass(const gpu::Program& program, const glm::mat4& mvp,
+                               const Camera& camera, std::size_t vertexCount) {
+  program.use();
+  program.set("u_viewProjection", mvp);
+  const glm::dmat3 b = camera.basis();
+  program.set("u_eye", glm::vec3(camera.eye()));
+  program.set("u_forward", glm::vec3(-b[2]));
+  program.set("u_ortho", camera.projection == Projection::Orthographic ? 1 : 0);
+  program.set("u_distanceScale", static_cast<float>(distanceScale_));
+  glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+  glClearDepthf(1.0f);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  if (vertexCount == 0) return;
+  const GLint position = glGetAttribLocation(program.id(), "a_position");
+  const GLint color = glGetAttribLocation(program.id(), "a_color");
+  glBindBuffer(GL_ARRAY_BUFFER, vertices_.id());
+  const GLsizei stride = 7 * sizeof(float);
+  glEnableVertexAttribArray(static_cast<GLuint>(position));
+  glVertexAttribPointer(static_cast<GLuint>(position), 3, GL_FLOAT, GL_FALSE, stride, nullptr);
+  if (color >= 0) {
+    glEnableVertexAttribArray(static_cast<GLuint>(color));
+    glVertexAttribPointer(static_cast<GLuint>(color), 4, GL_FLOAT, GL_FALSE, stride,
+                          reinterpret_cast<const void*>(3 * sizeof(float)));
+  }
+  glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(vertexCount));
+  glDisableVertexAttribArray(static_cast<GLuint>(position));
+  if (color >= 0) glDisableVertexAttribArray(static_cast<GLuint>(color));
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+}
+
+void OverlayRenderer::draw(const std::vector<OverlayLine>& lines, const Camera& camera, int width,
+                           int height) {
+  if (width <= 0 || height <= 0) throw InputError("overlay: image size must be positive");
+  allocate(width, height);
+  std::vector<float> data;
+  data.reserve(lines.size() * 14);
+  double sceneRadius = camera.radius;
+  for (const OverlayLine& l : lines) {
+    for (const glm::dvec3& p : {l.a, l.b}) {
+      sceneRadius = std::max(sceneRadius, glm::length(p - camera.target));
+      data.insert(data.end(), {static_cast<float>(p.x), static_cast<float>(p.y),
+                               static_cast<float>(p.z), l.color.r, l.color.g, l.color.b, 1.0f});
+    }
+  }
+  sceneRadius *= 1.01;
+  const double eyeDistance = glm::length(camera.eye() - camera.target);
+  distanceScale_ = (eyeDistance + sceneRadius) * 1.001;
+  if (!data.empty() && (vertices_.id() == 0 || vertices_.bytes() != data.size() * sizeof(float))) {
+    vertices_ = gpu::Buffer();
+    vertices_ = gpu::Buffer::create(context_.ledger(), "overlay lines", GL_ARRAY_BUFFER,
+                                    data.size() * sizeof(float), data.data(), GL_DYNAMIC_DRAW);
+  } else if (!data.empty()) {
+    glBindBuffer(GL_ARRAY_BUFFER, vertices_.id());
+    glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(data.size() * sizeof(float)),
+                    data.data());
+  }
+  const glm::mat4 mvp(viewProjection(camera, static_cast<double>(width) / height, sceneRadius));
+
+  glDisable(GL_BLEND);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glLineWidth(1.0f);
+  color_.bind();
+  drawPass(colorProgram_, mvp, camera, data.size() / 7);
+  distance_.bind();
+  drawPass(distanceProgram_, mvp, camera, data.size() / 7);
+  glDisable(GL_DEPTH_TEST);
+  const GLenum err = glGetError();
+  if (err != GL_NO_ERROR) throw GpuError("overlay lines failed: GL error " + std::to_string(err));
+}
+
+Image OverlayRenderer::readColor() const {
+  Image img(color_.width(), color_.height());
+  color_.readRgba8(img.rgba().data());
+  img.flipVertically();
+  return img;
+}
+
+std::vector<float> OverlayRenderer::readDistance() const {
+  Image packed(distance_.width(), distance_.height());
+  distance_.readRgba8(packed.rgba().data());
+  packed.flipVertically();
+  std::vector<float> out(static_cast<std::size_t>(packed.width()) * packed.height(),
+                         std::numeric_limits<float>::infinity());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const std::uint8_t* p = &packed.rgba()[i * 4];
+    if (p[3] == 0) continue;
+    const double v = p[0] * 65536.0 + p[1] * 256.0 + p[2];
+    out[i] = static_cast<float>(v / 16777215.0 * distanceScale_);
+  }
+  return out;
+}
+
+}  // namespace tessera::render

@@ -1,0 +1,341 @@
+#include "tessera/render/Slice2DRenderer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include <glm/geometric.hpp>
+
+#include "gpu/gl.h"
+#include "tessera/core/Error.h"
+#include "tessera/render/SliceProjection.h"
+
+namespace tessera::render {
+
+namespace {
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+constexpr int kFloatsPerVertex = 7;  // position xyz, in-slice uv, tile origin xy
+
+}  // namespace
+
+const char* sliceClassificationName(SliceClassification c) {
+  switch (c) {
+    case SliceClassification::Pre:
+      return "pre";
+    case SliceClassification::Palette:
+      return "palette";
+    case SliceClassification::Post:
+      return "post";
+  }
+  return "?";
+}
+
+SliceClassification parseSliceClassification(const std::string& name) {
+  if (name == "pre") return SliceClassification::Pre;
+  if (name == "palette") return SliceClassification::Palette;
+  if (name == "post") return SliceClassification::Post;
+  throw InputError("--classify '" + name + "': expected pre, palette or post");
+}
+
+Slice2DRenderer::Slice2DRenderer(gpu::GlContext& context, const Volume& volume,
+                                 const Slice2DOptions& options)
+    : context_(context),
+      volume_(volume),
+      options_(options),
+      stacks_(volume),
+      tf_(TransferFunction::preset("grey")),
+      accumulator_(context) {
+  const int maxSize = options.maxTextureSize > 0
+                          ? std::min(options.maxTextureSize, context.caps().max2DTextureSize)
+                          : context.caps().max2DTextureSize;
+  for (int axis = 0; axis < 3; ++axis) {
+    plans_[axis] = planSliceAtlas(volume.dims(), axis, maxSize, options.powerOfTwoAtlases);
+    buildGeometry(axis);
+  }
+}
+
+Slice2DRenderer::~Slice2DRenderer() = default;
+
+void Slice2DRenderer::setTransferFunction(const TransferFunction& tf) {
+  tf_ = tf;
+  classificationKey_.clear();
+}
+
+void Slice2DRenderer::setSliceCount(int slices) {
+  if (slices < 0) throw InputError("slice count must be >= 1 (0 = every slice of the stack)");
+  requestedSlices_ = slices;
+}
+
+int Slice2DRenderer::stackAxisFor(const Camera& camera) {
+  const glm::dvec3 f = glm::abs(camera.basis()[2]);
+  // Ties go to the later axis, so that a view straight down a diagonal is stable.
+  if (f.x > f.y && f.x > f.z) return 0;
+  return f.y > f.z ? 1 : 2;
+}
+
+double Slice2DRenderer::baseDistance() const {
+  const glm::dvec3 s = volume_.spacing();
+  return std::min({s.x, s.y, s.z});
+}
+
+std::uint64_t Slice2DRenderer::stackTextureBytes() const {
+  std::uint64_t bytes = 0;
+  for (const auto& list : atlases_) {
+    for (const auto& t : list) bytes += t.bytes();
+  }
+  return bytes;
+}
+
+std::uint64_t Slice2DRenderer::ownTextureBytes() const {
+  std::uint64_t bytes =
+      stackTextureBytes() + table_.texture().bytes() + accumulator_.ownTextureBytes();
+  for (const auto& v : vertices_) bytes += v.bytes();
+  for (const auto& [key, list] : drawLists_) bytes += list.indices.bytes();
+  return bytes;
+}
+
+void Slice2DRenderer::buildGeometry(int axis) {
+  // One quad per voxel plane, slices in increasing order along the axis,
+  // covering the whole world box face.
+  const SliceAtlasPlan& p = plans_[axis];
+  const glm::ivec2 a = sliceTileAxes(axis);
+  const glm::dvec3 extent = volume_.extent();
+  std::vector<float> v;
+  v.reserve(static_cast<std::size_t>(p.slices) * 4 * kFloatsPerVertex);
+  constexpr int corners[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  for (int s = 0; s < p.slices; ++s) {
+    const glm::ivec2 origin = p.tileOrigin(s);
+    for (const auto& c : corners) {
+      glm::dvec3 pos(0.0);
+      pos[axis] = ((s + 0.5) / p.slices - 0.5) * extent[axis];
+      pos[a.x] = (c[0] - 0.5) * extent[a.x];
+      pos[a.y] = (c[1] - 0.5) * extent[a.y];
+      v.insert(v.end(),
+               {static_cast<float>(pos.x), static_cast<float>(pos.y), static_cast<float>(pos.z),
+                static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(origin.x),
+                static_cast<float>(origin.y)});
+    }
+  }
+  vertices_[axis] =
+      gpu::Buffer::create(context_.ledger(), "slice2d stack geometry", GL_ARRAY_BUFFER,
+                          v.size() * sizeof(float), v.data(), GL_STATIC_DRAW);
+}
+
+const Slice2DRenderer::DrawList& Slice2DRenderer::drawList(int axis, bool descending, int slices) {
+  const std::string key = std::to_string(axis) + (descending ? "-" : "+") + std::to_string(slices);
+  auto it = drawLists_.find(key);
+  if (it != drawLists_.end()) return it->second;
+  const SliceAtlasPlan& p = plans_[axis];
+  // Evenly spaced planes k = 0..N-1 at floor((k + 0.5) n / N); all when N = n.
+  std::vector<int> chosen;
+  for (int k = 0; k < slices; ++k) chosen.push_back(((2 * k + 1) * p.slices) / (2 * slices));
+  if (descending) std::reverse(chosen.begin(), chosen.end());
+  DrawList list;
+  list.gapRatio = static_cast<double>(p.slices) / slices;
+  std::vector<std::uint16_t> indices;
+  for (int s : chosen) {
+    const int atlas = p.atlasOf(s);
+    if (list.ranges.empty() || list.ranges.back().atlas != atlas) {
+      list.ranges.push_back({atlas, static_cast<int>(indices.size()), 0});
+    }
+    const auto base = static_cast<std::uint16_t>(s * 4);
+    for (int i : {0, 1, 2, 0, 2, 3}) indices.push_back(static_cast<std::uint16_t>(base + i));
+    list.ranges.back().count += 6;
+  }
+  list.indices =
+      gpu::Buffer::create(context_.ledger(), "slice2d draw order", GL_ELEMENT_ARRAY_BUFFER,
+                          indices.size() * sizeof(std::uint16_t), indices.data(), GL_STATIC_DRAW);
+  return drawLists_.emplace(key, std::move(list)).first->second;
+}
+
+void Slice2DRenderer::uploadStack(int axis) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const SliceAtlasPlan& p = plans_[axis];
+  const bool pre = options_.classification == SliceClassification::Pre;
+  const bool es3 = context_.caps().api == gpu::ApiLevel::Gles3;
+  const gpu::GLenumT format = pre ? GL_RGBA : (es3 ? GL_RED : GL_LUMINANCE);
+  const gpu::GLenumT internal = pre ? (es3 ? GL_RGBA8 : GL_RGBA) : (es3 ? GL_R8 : GL_LUMINANCE);
+  const bool recreate = atlases_[axis].size() != static_cast<std::size_t>(p.atlases);
+  if (recreate) atlases_[axis].clear();
+  std::vector<std::uint8_t> image;
+  for (int i = 0; i < p.atlases; ++i) {
+    stacks_.fillAtlas(p, i, pre ? palette8_.data() : nullptr, image);
+    if (recreate) {
+      atlases_[axis].push_back(gpu::Texture::create2D(
+          context_.ledger(), "slice2d atlas " + std::string(1, "xyz"[axis]) + std::to_string(i),
+          internal, p.atlasSize.x, p.atlasSize.y, format, GL_UNSIGNED_BYTE, image.data(),
+          pre ? 4 : 1));
+      if (options_.classification == SliceClassification::Palette) {
+        atlases_[axis].back().setFilter(GL_NEAREST, GL_NEAREST);
+      }
+    } else {
+      atlases_[axis][static_cast<std::size_t>(i)].update2D(format, GL_UNSIGNED_BYTE, image.data());
+    }
+  }
+  glFinish();
+  ++stackUploads_;
+  lastStackUploadMs_ = msSince(t0);
+}
+
+void Slice2DRenderer::recreateStackTextures() {
+  for (int axis = 0; axis < 3; ++axis) {
+    if (atlases_[axis].empty()) continue;
+    atlases_[axis].clear();
+    uploadStack(axis);
+  }
+}
+
+void Slice2DRenderer::updateClassification(const RenderSettings& settings) {
+  const ValueRange w = volume_.window();
+  std::ostringstream key;
+  key.precision(17);
+  key << settings.opacityScale << '|' << w.min << '|' << w.max << '|' << tf_.toJson();
+  if (key.str() == classificationKey_) return;
+  classificationKey_ = key.str();
+  ++classificationUpdates_;
+  const double ds0 = baseDistance();
+  switch (options_.classification) {
+    case SliceClassification::Post:
+      table_.upload(context_, tf_.bake(4096, ds0, settings.opacityScale),
+                    "slice2d transfer function");
+      return;
+    case SliceClassification::Palette:
+    case SliceClassification::Pre: {
+      std::vector<float> palette = tf_.bake(256, ds0, settings.opacityScale);
+      for (std::size_t i = 0; i < palette.size(); i += 4) {
+        for (std::size_t c = 0; c < 3; ++c) palette[i + c] *= palette[i + 3];
+      }
+      if (options_.classification == SliceClassification::Palette) {
+        table_.upload(context_, palette, "slice2d palette");
+        return;
+      }
+      palette8_.resize(palette.size());
+      for (std::size_t i = 0; i < palette.size(); ++i) {
+        palette8_[i] =
+            static_cast<std::uint8_t>(std::lround(std::clamp(palette[i], 0.0f, 1.0f) * 255.0f));
+      }
+      // The CPU classification: every resident slice re-created.
+      for (int axis = 0; axis < 3; ++axis) {
+        if (!atlases_[axis].empty()) uploadStack(axis);
+      }
+      return;
+    }
+  }
+}
+
+std::vector<gpu::ShaderPart> Slice2DRenderer::vertexParts() const {
+  return {gpu::shaderPreamble(context_.caps().api, false, {}),
+          gpu::embeddedShaderPart("render/slice2d.vert.glsl")};
+}
+
+std::vector<gpu::ShaderPart> Slice2DRenderer::fragmentParts(const RenderSettings& settings) const {
+  std::vector<std::string> defines;
+  if (options_.classification == SliceClassification::Pre) defines.push_back("CLASSIFY_PRE 1");
+  if (options_.classification == SliceClassification::Palette) {
+    defines.push_back("CLASSIFY_PALETTE 1");
+  }
+  if (settings.mode == RenderMode::Mip) defines.push_back("MODE_MIP 1");
+  return {gpu::shaderPreamble(context_.caps().api, true, defines),
+          gpu::embeddedShaderPart("render/classify.glsl"),
+          gpu::embeddedShaderPart("render/slice_opacity.glsl"),
+          gpu::embeddedShaderPart("render/slice2d.frag.glsl")};
+}
+
+const gpu::Program& Slice2DRenderer::programFor(const RenderSettings& settings) {
+  const std::string key = std::string(sliceClassificationName(options_.classification)) +
+                          (settings.mode == RenderMode::Mip ? "|mip" : "");
+  auto it = programs_.find(key);
+  if (it != programs_.end()) return it->second;
+  gpu::Program p =
+      gpu::Program::build("slice2d(" + key + ")", vertexParts(), fragmentParts(settings));
+  return programs_.emplace(key, std::move(p)).first->second;
+}
+
+void Slice2DRenderer::prepare(const Camera& camera, const RenderSettings& settings) {
+  if (settings.mode == RenderMode::Mip && options_.classification != SliceClassification::Post) {
+    throw InputError(
+        "MIP by axis-aligned slicing needs --classify post (the maximum of "
+        "classified colours is not the colour of the maximum)");
+  }
+  // Classification first: pre-classified stacks are created from its palette.
+  updateClassification(settings);
+  const int axis = stackAxisFor(camera);
+  if (options_.currentStackOnly) {
+    if (atlases_[axis].empty()) {
+      for (auto& list : atlases_) list.clear();  // one stack at a time: a third of the memory
+      uploadStack(axis);
+    }
+  } else {
+    for (int a = 0; a < 3; ++a) {
+      if (atlases_[a].empty()) uploadStack(a);
+    }
+  }
+  programFor(settings);
+}
+
+void Slice2DRenderer::renderFrame(const Camera& camera, const RenderSettings& settings, int width,
+                                  int height) {
+  prepare(camera, settings);
+  const int axis = stackAxisFor(camera);
+  lastAxis_ = axis;
+  const SliceAtlasPlan& plan = plans_[axis];
+  const int slices = requestedSlices_ > 0 ? std::min(requestedSlices_, plan.slices) : plan.slices;
+  lastSlicesDrawn_ = slices;
+  const glm::dvec3 forward = -camera.basis()[2];
+  // Front to back: looking towards +axis, the low slices are nearest.
+  const DrawList& list = drawList(axis, forward[axis] < 0.0, slices);
+
+  accumulator_.begin(width, height, settings.mode);
+  const gpu::Program& prog = programFor(settings);
+  prog.use();
+  const double farPlane = glm::length(camera.eye()) + glm::length(volume_.extent());
+  prog.set("u_worldToClip",
+           glm::mat4(sliceViewToClip(camera, static_cast<double>(width) / height, farPlane) *
+                     sliceWorldToView(camera)));
+  prog.set("u_tileSize", glm::vec2(plan.tile));
+  prog.set("u_atlasInvSize", glm::vec2(1.0 / plan.atlasSize.x, 1.0 / plan.atlasSize.y));
+  glm::vec3 axisVector(0.0f);
+  axisVector[axis] = 1.0f;
+  prog.set("u_axis", axisVector);
+  prog.set("u_gap", static_cast<float>(volume_.spacing()[axis] * list.gapRatio / baseDistance()));
+  prog.set("u_eye", glm::vec3(camera.eye()));
+  prog.set("u_forward", glm::vec3(forward));
+  prog.set("u_ortho", camera.projection == Projection::Orthographic ? 1.0f : 0.0f);
+  prog.set("u_atlas", 0);
+  if (options_.classification == SliceClassification::Post) {
+    table_.texture().bind(1);
+    prog.set("u_tf", 1);
+    prog.set("u_tfSize", static_cast<float>(table_.entries()));
+  } else if (options_.classification == SliceClassification::Palette) {
+    table_.texture().bind(1);
+    prog.set("u_palette", 1);
+  }
+
+  const GLint tileAttribute = glGetAttribLocation(prog.id(), "a_tile");
+  glBindBuffer(GL_ARRAY_BUFFER, vertices_[axis].id());
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, list.indices.id());
+  const GLsizei stride = kFloatsPerVertex * sizeof(float);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride, nullptr);
+  if (tileAttribute >= 0) {
+    glEnableVertexAttribArray(static_cast<GLuint>(tileAttribute));
+    glVertexAttribPointer(static_cast<GLuint>(tileAttribute), 4, GL_FLOAT, GL_FALSE, stride,
+                          reinterpret_cast<const void*>(3 * sizeof(float)));
+  }
+  for (const DrawRange& r : list.ranges) {
+    atlases_[axis][static_cast<std::size_t>(r.atlas)].bind(0);
+    glDrawElements(GL_TRIANGLES, r.count, GL_UNSIGNED_SHORT,
+                   reinterpret_cast<const void*>(r.firstIndex * sizeof(std::uint16_t)));
+  }
+  glDisableVertexAttribArray(0);
+  if (tileAttribute >= 0) glDisableVertexAttribArray(static_cast<GLuint>(tileAttribute));
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, 0);
+  accumulator_.resolve(settings, &table_.texture(), table_.entries());
+}
+
+}  // namespace tessera::render

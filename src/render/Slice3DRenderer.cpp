@@ -1,0 +1,172 @@
+#include "tessera/render/Slice3DRenderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "gpu/gl.h"
+#include "tessera/core/Error.h"
+#include "tessera/render/SliceProjection.h"
+
+namespace tessera::render {
+
+Slice3DRenderer::Slice3DRenderer(gpu::GlContext& context, const Volume& volume,
+                                 const layout::Layout& layout)
+    : context_(context),
+      volume_(volume),
+      layout_(layout),
+      tf_(TransferFunction::preset("grey")),
+      accumulator_(context) {}
+
+void Slice3DRenderer::setTransferFunction(const TransferFunction& tf) {
+  tf_ = tf;
+  lookupKey_.clear();
+}
+
+void Slice3DRenderer::setSliceCount(int slices) {
+  if (slices < 0 || slices > kMaxSlices) {
+    throw InputError("slice count must be 1.." + std::to_string(kMaxSlices) +
+                     " (0 = from the step), got " + std::to_string(slices));
+  }
+  requestedSlices_ = slices;
+}
+
+int Slice3DRenderer::sliceCountFor(const RenderSettings& settings) const {
+  if (requestedSlices_ > 0) return requestedSlices_;
+  if (!(settings.stepVoxels > 0.0) || !std::isfinite(settings.stepVoxels)) {
+    throw InputError("step must be a positive number of voxels, got " +
+                     std::to_string(settings.stepVoxels));
+  }
+  const glm::dvec3 s = volume_.spacing();
+  const double ds = settings.stepVoxels * std::min({s.x, s.y, s.z});
+  const double n = std::ceil(glm::length(volume_.extent()) / ds - 1e-9);
+  if (n > kMaxSlices) {
+    throw InputError("a step of " + std::to_string(settings.stepVoxels) + " voxels needs " +
+                     std::to_string(static_cast<long long>(n)) + " slices, more than " +
+                     std::to_string(kMaxSlices) + "; use a larger --step or --slices");
+  }
+  return std::max(1, static_cast<int>(n));
+}
+
+double Slice3DRenderer::sliceSpacingFor(const RenderSettings& settings) const {
+  return glm::length(volume_.extent()) / sliceCountFor(settings);
+}
+
+std::uint64_t Slice3DRenderer::ownTextureBytes() const {
+  return lut_.texture().bytes() + accumulator_.ownTextureBytes() + vertices_.bytes();
+}
+
+void Slice3DRenderer::buildGeometry(int slices) {
+  // Two triangles per slice in cube units: x, y in [-0.5, 0.5], slice k at
+  // z = 0.5 - (k + 0.5) / N, so the buffer's order is front to back.
+  std::vector<float> v;
+  v.reserve(static_cast<std::size_t>(slices) * 18);
+  constexpr float corners[6][2] = {{-0.5f, -0.5f}, {0.5f, -0.5f}, {0.5f, 0.5f},
+                                   {-0.5f, -0.5f}, {0.5f, 0.5f},  {-0.5f, 0.5f}};
+  for (int k = 0; k < slices; ++k) {
+    const float z = static_cast<float>(0.5 - (k + 0.5) / slices);
+    for (const auto& c : corners) {
+      v.push_back(c[0]);
+      v.push_back(c[1]);
+      v.push_back(z);
+    }
+  }
+  vertices_ = gpu::Buffer();
+  vertices_ = gpu::Buffer::create(context_.ledger(), "slice3d proxy cube", GL_ARRAY_BUFFER,
+                                  v.size() * sizeof(float), v.data(), GL_STATIC_DRAW);
+  builtSlices_ = slices;
+  ++geometryBuilds_;
+}
+
+void Slice3DRenderer::updateLookup(const RenderSettings& settings, double spacing) {
+  const ValueRange w = volume_.window();
+  std::ostringstream key;
+  key.precision(17);
+  key << spacing << '|' << settings.opacityScale << '|' << w.min << '|' << w.max << '|'
+      << tf_.toJson();
+  if (key.str() == lookupKey_) return;
+  lookupKey_ = key.str();
+  lut_.upload(context_, tf_.bake(4096, spacing, settings.opacityScale),
+              "slice3d transfer function");
+}
+
+std::vector<gpu::ShaderPart> Slice3DRenderer::vertexParts() const {
+  return {gpu::shaderPreamble(context_.caps().api, false, {}),
+          gpu::embeddedShaderPart("render/slice3d.vert.glsl")};
+}
+
+std::vector<gpu::ShaderPart> Slice3DRenderer::fragmentParts(const RenderSettings& settings) const {
+  std::vector<std::string> defines;
+  if (settings.mode == RenderMode::Mip) defines.push_back("MODE_MIP 1");
+  return {gpu::shaderPreamble(context_.caps().api, true, defines), layout_.glsl(),
+          gpu::embeddedShaderPart("render/classify.glsl"),
+          gpu::embeddedShaderPart("render/slice_opacity.glsl"),
+          gpu::embeddedShaderPart("render/slice3d.frag.glsl")};
+}
+
+const gpu::Program& Slice3DRenderer::programFor(const RenderSettings& settings) {
+  const std::string key = layout_.name() + (settings.mode == RenderMode::Mip ? "|mip" : "");
+  auto it = programs_.find(key);
+  if (it != programs_.end()) return it->second;
+  gpu::Program p =
+      gpu::Program::build("slice3d(" + key + ")", vertexParts(), fragmentParts(settings));
+  return programs_.emplace(key, std::move(p)).first->second;
+}
+
+void Slice3DRenderer::prepare(const RenderSettings& settings) {
+  const int n = sliceCountFor(settings);
+  if (n != builtSlices_) buildGeometry(n);
+  updateLookup(settings, settings.mode == RenderMode::Mip ? tf_.opacityUnitLength
+                                                          : sliceSpacingFor(settings));
+  programFor(settings);
+}
+
+void Slice3DRenderer::renderFrame(const Camera& camera, const RenderSettings& settings, int width,
+                                  int height) {
+  prepare(settings);
+  accumulator_.begin(width, height, settings.mode);
+
+  // Cube -> world: scale by the diagonal and turn by the camera basis
+  // (columns right, up, back), so cube +z points at the viewer. The volume
+  // box is centred at the world origin, and so is the cube.
+  const double d = glm::length(volume_.extent());
+  const glm::dmat3 b = camera.basis();
+  glm::dmat4 cubeToWorld(1.0);
+  for (int c = 0; c < 3; ++c) cubeToWorld[c] = glm::dvec4(b[c] * d, 0.0);
+  // World -> texture: the unit box of sampleVolume().
+  const glm::dvec3 extent = volume_.extent();
+  glm::dmat4 worldToTexture = glm::translate(glm::dmat4(1.0), glm::dvec3(0.5));
+  worldToTexture = glm::scale(worldToTexture, 1.0 / extent);
+  const glm::dmat4 worldToView = sliceWorldToView(camera);
+  const double aspect = static_cast<double>(width) / height;
+  const glm::dmat4 projection = sliceViewToClip(camera, aspect, glm::length(camera.eye()) + d);
+  const glm::dmat4 cubeToView = worldToView * cubeToWorld;
+
+  const gpu::Program& prog = programFor(settings);
+  prog.use();
+  prog.set("u_cubeToClip", glm::mat4(projection * cubeToView));
+  prog.set("u_cubeToTexture", glm::mat4(worldToTexture * cubeToWorld));
+  prog.set("u_cubeToView", glm::mat4(cubeToView));
+  prog.set("u_ortho", camera.projection == Projection::Orthographic ? 1.0f : 0.0f);
+  const layout::ValueMapping m = layout_.rawFromStored();
+  const ValueRange w = volume_.window();
+  const double ww = w.max - w.min;
+  prog.set("u_valueScale", static_cast<float>(m.scale / ww));
+  prog.set("u_valueBias", static_cast<float>((m.offset - w.min) / ww));
+  int unit = layout_.bind(prog, 0);
+  lut_.texture().bind(unit);
+  prog.set("u_tf", unit);
+  prog.set("u_tfSize", static_cast<float>(lut_.entries()));
+
+  glBindBuffer(GL_ARRAY_BUFFER, vertices_.id());
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+  glDrawArrays(GL_TRIANGLES, 0, builtSlices_ * 6);
+  glDisableVertexAttribArray(0);
+  accumulator_.resolve(settings, &lut_.texture(), lut_.entries());
+}
+
+}  // namespace tessera::render

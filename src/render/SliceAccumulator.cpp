@@ -1,0 +1,108 @@
+#include "tessera/render/SliceAccumulator.h"
+
+#include "gpu/gl.h"
+#include "tessera/core/Error.h"
+#include "tessera/gpu/DeviceProfile.h"
+
+namespace tessera::render {
+
+SliceAccumulator::SliceAccumulator(gpu::GlContext& context) : context_(context) {
+  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(context.caps());
+  floatTarget_ = context.caps().api == gpu::ApiLevel::Gles3 && limits.floatRenderTargets;
+  triangle_ = gpu::FullscreenTriangle(context.ledger());
+}
+
+std::uint64_t SliceAccumulator::ownTextureBytes() const {
+  return accumulation_.color().bytes() + image_.color().bytes();
+}
+
+const gpu::Program& SliceAccumulator::resolveProgram(RenderMode mode) {
+  gpu::Program& p = mode == RenderMode::Mip ? mipResolve_ : compositeResolve_;
+  if (p.id() != 0) return p;
+  const gpu::ApiLevel api = context_.caps().api;
+  std::vector<gpu::ShaderPart> frag{gpu::shaderPreamble(api, true,
+                                                        mode == RenderMode::Mip
+                                                            ? std::vector<std::string>{"MODE_MIP 1"}
+                                                            : std::vector<std::string>{})};
+  if (mode == RenderMode::Mip) frag.push_back(gpu::embeddedShaderPart("render/classify.glsl"));
+  frag.push_back(gpu::embeddedShaderPart("render/slice_resolve.frag.glsl"));
+  p = gpu::Program::build(
+      mode == RenderMode::Mip ? "slice resolve (mip)" : "slice resolve",
+      {gpu::shaderPreamble(api, false, {}), gpu::embeddedShaderPart("render/fullscreen.vert.glsl")},
+      frag);
+  return p;
+}
+
+void SliceAccumulator::begin(int width, int height, RenderMode mode) {
+  const int maxSize = context_.caps().maxRenderbufferSize;
+  if (width <= 0 || height <= 0 || width > maxSize || height > maxSize) {
+    throw InputError("image size " + std::to_string(width) + "x" + std::to_string(height) +
+                     " is outside 1.." + std::to_string(maxSize));
+  }
+  if (mode == RenderMode::Mip && context_.caps().api == gpu::ApiLevel::Gles2 &&
+      !context_.caps().has("GL_EXT_blend_minmax")) {
+    throw GpuError(
+        "MIP by slicing needs max blending (GL_EXT_blend_minmax), which this ES 2.0 "
+        "context lacks; use --technique raycast");
+  }
+  if (accumulation_.id() == 0 || accumulation_.width() != width ||
+      accumulation_.height() != height) {
+    const bool es3 = context_.caps().api == gpu::ApiLevel::Gles3;
+    accumulation_ = gpu::Framebuffer();
+    image_ = gpu::Framebuffer();
+    accumulation_ =
+        gpu::Framebuffer::create(context_.ledger(), "slice accumulation", width, height,
+                                 floatTarget_ ? GL_RGBA16F : (es3 ? GL_RGBA8 : GL_RGBA));
+    // Read back at texel centres (gl_FragCoord / size), where linear
+    // filtering returns the texel itself.
+    image_ = gpu::Framebuffer::create(context_.ledger(), "slice image", width, height,
+                                      es3 ? GL_RGBA8 : GL_RGBA);
+  }
+  accumulation_.bind();
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_CULL_FACE);
+  glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+  glClear(GL_COLOR_BUFFER_BIT);
+  glEnable(GL_BLEND);
+  if (mode == RenderMode::Mip) {
+    glBlendEquation(context_.caps().api == gpu::ApiLevel::Gles3 ? GL_MAX : GL_MAX_EXT);
+    glBlendFunc(GL_ONE, GL_ONE);
+  } else {
+    glBlendEquation(GL_FUNC_ADD);
+    // Front to back (DESIGN.md): the destination's transmittance 1 - A
+    // weighs each new premultiplied slice colour and alpha.
+    glBlendFuncSeparate(GL_ONE_MINUS_DST_ALPHA, GL_ONE, GL_ONE_MINUS_DST_ALPHA, GL_ONE);
+  }
+}
+
+void SliceAccumulator::resolve(const RenderSettings& settings, const gpu::Texture* lut,
+                               int lutEntries) {
+  glDisable(GL_BLEND);
+  glBlendEquation(GL_FUNC_ADD);
+  image_.bind();
+  const gpu::Program& p = resolveProgram(settings.mode);
+  p.use();
+  accumulation_.color().bind(0);
+  p.set("u_accumulation", 0);
+  p.set("u_viewport", glm::vec2(image_.width(), image_.height()));
+  p.set("u_background", glm::vec4(settings.background));
+  if (settings.mode == RenderMode::Mip) {
+    if (lut == nullptr) throw GpuError("slice resolve: MIP needs the transfer-function table");
+    lut->bind(1);
+    p.set("u_tf", 1);
+    p.set("u_tfSize", static_cast<float>(lutEntries));
+  }
+  triangle_.draw();
+  glFinish();
+  const GLenum err = glGetError();
+  if (err != GL_NO_ERROR) throw GpuError("slice rendering failed: GL error " + std::to_string(err));
+}
+
+Image SliceAccumulator::readImage() const {
+  Image img(image_.width(), image_.height());
+  image_.readRgba8(img.rgba().data());
+  img.flipVertically();
+  return img;
+}
+
+}  // namespace tessera::render

@@ -1,0 +1,60 @@
+// Axis-aligned slices: a bilinear sample of the slice from its atlas tile,
+// classified per CLASSIFY_PRE / CLASSIFY_PALETTE / post (render/Slice2DRenderer.h),
+// with the opacity corrected for the distance the ray travels between drawn
+// planes. In-tile coordinates are clamped to the centres of the tile's edge
+// texels, so filtering never reaches the neighbouring tile (the atlas needs
+// no gutters), which is clamp-to-edge for one slice.
+#if TESSERA_GLSL == 300
+in vec3 v_world;
+in vec2 v_local;
+in vec2 v_tileOrigin;
+#else
+varying vec3 v_world;
+varying vec2 v_local;
+varying vec2 v_tileOrigin;
+#endif
+uniform sampler2D u_atlas;
+uniform vec2 u_tileSize;      // texels
+uniform vec2 u_atlasInvSize;  // 1 / atlas size in texels
+uniform vec3 u_axis;          // the stack's axis (unit vector)
+uniform float u_gap;          // distance between drawn planes / the tables' distance
+uniform vec3 u_eye;
+uniform vec3 u_forward;
+uniform float u_ortho;
+#ifdef CLASSIFY_PALETTE
+uniform sampler2D u_palette;  // 256 premultiplied entries
+
+vec4 paletteAt(vec2 texel) {
+  float index = TEX2D(u_atlas, (v_tileOrigin + texel + 0.5) * u_atlasInvSize).r;
+  return TEX2D(u_palette, vec2((index * 255.0 + 0.5) / 256.0, 0.5));
+}
+#endif
+
+void main() {
+  vec2 texel = clamp(v_local * u_tileSize, vec2(0.5), u_tileSize - vec2(0.5));
+#if defined(CLASSIFY_PRE)
+  vec4 c = TEX2D(u_atlas, (v_tileOrigin + texel) * u_atlasInvSize);
+#elif defined(CLASSIFY_PALETTE)
+  // Classify the four nearest indices, then filter (GL_PALETTE8 semantics).
+  vec2 t = texel - 0.5;
+  vec2 i0 = floor(t);
+  vec2 f = t - i0;
+  vec2 i1 = min(i0 + 1.0, u_tileSize - 1.0);
+  vec4 c = mix(mix(paletteAt(i0), paletteAt(vec2(i1.x, i0.y)), f.x),
+               mix(paletteAt(vec2(i0.x, i1.y)), paletteAt(i1), f.x), f.y);
+#else
+  float n = TEX2D(u_atlas, (v_tileOrigin + texel) * u_atlasInvSize).r;
+#ifndef MODE_MIP
+  vec4 c = classify(n);
+  c.rgb *= c.a;
+#endif
+#endif
+#ifdef MODE_MIP
+  // Post-classification only: the resolve pass classifies the maximum.
+  FRAG_COLOR = vec4(n, 0.0, 0.0, 1.0);
+#else
+  vec3 dir = u_ortho > 0.5 ? u_forward : normalize(v_world - u_eye);
+  float ratio = u_gap / max(abs(dot(dir, u_axis)), 1e-3);
+  FRAG_COLOR = correctOpacity(c, ratio);
+#endif
+}

@@ -1,0 +1,29 @@
+// View-aligned slices: one sample per fragment through the layout's
+// sampleVolume(), classified through the TF table baked for the slice
+// spacing and corrected for the perspective ray's longer path between the
+// planes. Outside the volume the fragment keeps alpha 0 instead of
+// discarding (discard is slow on tiled mobile GPUs; Noguera et al. 2012).
+#if TESSERA_GLSL == 300
+in vec3 v_texCoord;
+in vec3 v_view;
+#else
+varying vec3 v_texCoord;
+varying vec3 v_view;
+#endif
+uniform float u_ortho;
+
+void main() {
+  vec3 p = v_texCoord;
+  vec3 inside3 = step(vec3(0.0), p) * step(p, vec3(1.0));
+  float inside = inside3.x * inside3.y * inside3.z;
+  float n = normalizedValue(sampleVolume(clamp(p, 0.0, 1.0)));
+#ifdef MODE_MIP
+  FRAG_COLOR = vec4(n * inside, 0.0, 0.0, inside);
+#else
+  vec4 c = classify(n);
+  c = vec4(c.rgb * c.a, c.a) * inside;
+  // Planes ds apart are ds / cos(theta) apart along a perspective ray.
+  float ratio = u_ortho > 0.5 ? 1.0 : length(v_view) / max(-v_view.z, 1e-6);
+  FRAG_COLOR = correctOpacity(c, ratio);
+#endif
+}

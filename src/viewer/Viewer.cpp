@@ -1,0 +1,301 @@
+#include "tessera/viewer/Viewer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/mat4x4.hpp>
+
+#include "gpu/gl.h"
+#include "tessera/core/Error.h"
+#include "tessera/core/Histogram.h"
+#include "tessera/core/HostBudget.h"
+#include "tessera/gpu/GlObjects.h"
+#include "tessera/gpu/Program.h"
+#include "tessera/lod/Downsample.h"
+#include "tessera/render/RaycastPlan.h"
+#include "tessera/render/Raycaster.h"
+
+namespace tessera::viewer {
+
+namespace {
+
+constexpr int kHistogramBins = 256;
+// Render-target size the plan reserves memory for (the largest frame we expect).
+constexpr int kPlanImageSize = 1024;
+constexpr int kSkipBlock = 8;
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The raster equivalent of Camera's rays (render/camera_ray.glsl), so that
+// overlay lines land where the ray caster puts the volume.
+glm::mat4 viewProjection(const Camera& camera, double aspect) {
+  const glm::dmat3 b = camera.basis();
+  const glm::dvec3 eye = camera.eye();
+  const glm::dmat4 view = glm::lookAt(eye, eye - b[2], b[1]);
+  const double dist = glm::length(eye - camera.target);
+  const double farPlane = dist + 4.0 * camera.radius;
+  glm::dmat4 proj;
+  if (camera.projection == Projection::Perspective) {
+    const double nearPlane = std::max(1e-3 * camera.radius, dist - 2.0 * camera.radius);
+    proj = glm::perspective(glm::radians(camera.fovYDeg), aspect, nearPlane, farPlane);
+  } else {
+    const double h = camera.orthoHalfHeight();
+    proj = glm::ortho(-h * aspect, h * aspect, -h, h, 1e-3, farPlane);
+  }
+  return glm::mat4(proj * view);
+}
+
+void drainGlErrors() {
+  // Front ends (ImGui's GL backend) may leave errors that the techniques'
+  // own checks would blame on themselves.
+  for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) {
+  }
+}
+
+}  // namespace
+
+struct Viewer::Gpu {
+  gpu::Program present;
+  gpu::Program lines;
+  gpu::FullscreenTriangle triangle;
+  gpu::Buffer lineVertices;
+  int lineVertexCount = 0;
+  glm::dvec3 lineExtent{-1.0};
+};
+
+Viewer::Viewer(gpu::GlContext& context, const gpu::DeviceProfile& profile)
+    : context_(context),
+      limits_(gpu::effectiveLimits(profile, context.caps())),
+      volume_(std::make_unique<Volume>()),
+      gpu_(std::make_unique<Gpu>()) {
+  context_.ledger().setBudget(limits_.textureBudget);
+  const gpu::ApiLevel api = context.caps().api;
+  gpu_->present = gpu::Program::build(
+      "viewer present",
+      {gpu::shaderPreamble(api, false, {}), gpu::embeddedShaderPart("viewer/present.vert.glsl")},
+      {gpu::shaderPreamble(api, true, {}), gpu::embeddedShaderPart("viewer/present.frag.glsl")});
+  gpu_->lines = gpu::Program::build(
+      "viewer lines",
+      {gpu::shaderPreamble(api, false, {}), gpu::embeddedShaderPart("viewer/lines.vert.glsl")},
+      {gpu::shaderPreamble(api, true, {}), gpu::embeddedShaderPart("viewer/lines.frag.glsl")});
+  gpu_->triangle = gpu::FullscreenTriangle(context_.ledger());
+}
+
+Viewer::~Viewer() {
+  // GL objects go while the context is still current (the front end's job).
+  technique_.reset();
+  layout_.reset();
+  gpu_.reset();
+}
+
+void Viewer::setVolume(Volume volume, const std::string& name) {
+  if (!volume.hasData()) throw InputError(name + ": the volume has no voxels");
+  auto loaded = std::make_unique<Volume>(std::move(volume));
+  const render::RaycastPlan rp =
+      render::planRaycast(limits_, *loaded, "auto", kPlanImageSize, kPlanImageSize, kSkipBlock);
+  std::unique_ptr<Volume> reduced;
+  if (rp.plan.downsampled()) {
+    reduced = std::make_unique<Volume>(lod::downsample(*loaded, rp.plan.downsample));
+  }
+  const Volume& rendered = reduced ? *reduced : *loaded;
+  // Release the old volume's textures first when both would not fit the budget.
+  std::unique_ptr<layout::Layout> layout;
+  try {
+    layout = layout::createLayout(rp.plan, rendered, limits_, context_.ledger());
+  } catch (const BudgetError&) {
+    if (!technique_) throw;
+    throw BudgetError(name + ": does not fit the GPU budget next to the current volume (" +
+                      formatBytes(context_.ledger().budget()) + "); " + rp.plan.reason);
+  }
+  std::unique_ptr<ViewerTechnique> technique =
+      createTechnique(techniqueName_, context_, rendered, *layout);
+  technique->setTransferFunction(tfEditor_.transferFunction());
+
+  // Everything worked: swap in (technique first: it refers to the others).
+  technique_.reset();
+  layout_ = std::move(layout);
+  technique_ = std::move(technique);
+  volume_ = std::move(loaded);
+  downsampled_ = std::move(reduced);
+  plan_ = rp.plan;
+  volumeName_ = name;
+  uploadedTfRevision_ = tfEditor_.revision();
+  updateHistogram();
+  resetCamera();
+}
+
+void Viewer::resetCamera() {
+  camera_ = Camera{};
+  if (volume_->hasData()) camera_.frame(volume_->extent());
+}
+
+void Viewer::setWindow(ValueRange w) {
+  if (!volume_->hasData()) return;
+  if (!(std::isfinite(w.min) && std::isfinite(w.max)) || !(w.max > w.min)) {
+    throw InputError("window must have finite min < max");
+  }
+  volume_->setWindow(w);
+  if (downsampled_) downsampled_->setWindow(w);
+  updateHistogram();
+}
+
+void Viewer::resetWindow() {
+  if (!volume_->hasData()) return;
+  volume_->resetWindow();
+  if (downsampled_) downsampled_->resetWindow();
+  updateHistogram();
+}
+
+void Viewer::updateHistogram() {
+  tfEditor_.setHistogram(Histogram::compute(*volume_, kHistogramBins, volume_->window()));
+}
+
+void Viewer::setTechnique(const std::string& name) {
+  if (name == techniqueName_) return;
+  if (technique_) {
+    const Volume& rendered = downsampled_ ? *downsampled_ : *volume_;
+    std::unique_ptr<ViewerTechnique> t = createTechnique(name, context_, rendered, *layout_);
+    t->setTransferFunction(tfEditor_.transferFunction());
+    technique_ = std::move(t);
+  } else {
+    const std::vector<std::string> names = techniqueNames();
+    if (std::find(names.begin(), names.end(), name) == names.end()) {
+      throw InputError("unknown technique '" + name + "'");
+    }
+  }
+  techniqueName_ = name;
+}
+
+std::string Viewer::description() const {
+  if (!technique_) return "no volume";
+  std::ostringstream s;
+  const glm::ivec3 d = volume_->dims();
+  s << volumeName_ << " " << d.x << "x" << d.y << "x" << d.z << " "
+    << scalarTypeName(volume_->type()) << "; " << plan_.layout.layout << " on "
+    << gpu::apiLevelName(limits_.api);
+  if (plan_.downsampled()) {
+    const glm::ivec3 r = plan_.volumeDims;
+    s << " (downsampled to " << r.x << "x" << r.y << "x" << r.z << ")";
+  }
+  return s.str();
+}
+
+FrameStats Viewer::render(int width, int height, unsigned framebuffer, glm::ivec2 origin) {
+  const auto t0 = std::chrono::steady_clock::now();
+  FrameStats stats;
+  controller_.setViewport(width, height);
+  drainGlErrors();
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+  glViewport(origin.x, origin.y, width, height);
+  if (!technique_) {
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(origin.x, origin.y, width, height);
+    glClearColor(static_cast<float>(settings_.background.r),
+                 static_cast<float>(settings_.background.g),
+                 static_cast<float>(settings_.background.b), 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    glDisable(GL_SCISSOR_TEST);
+    last_ = stats;
+    return stats;
+  }
+  if (uploadedTfRevision_ != tfEditor_.revision()) {
+    technique_->setTransferFunction(tfEditor_.transferFunction());
+    uploadedTfRevision_ = tfEditor_.revision();
+  }
+  RenderSettings settings = settings_;
+  int rw = width, rh = height;
+  if (quality == Quality::Adaptive && controller_.interacting()) {
+    rw = std::max(1, width / 2);
+    rh = std::max(1, height / 2);
+    settings.stepVoxels *= 2.0;
+  }
+  const unsigned image = technique_->render(camera_, settings, rw, rh);
+  stats.renderWidth = rw;
+  stats.renderHeight = rh;
+
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+  glViewport(origin.x, origin.y, width, height);
+  glDisable(GL_BLEND);
+  glDisable(GL_DEPTH_TEST);
+  gpu_->present.use();
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, image);
+  gpu_->present.set("u_image", 0);
+  gpu_->triangle.draw();
+
+  if (showBoundingBox || showAxes) {
+    const glm::dvec3 e = 0.5 * volume_->extent();
+    if (gpu_->lineExtent != e) {
+      // Box edges grey, then the x/y/z axes in red/green/blue from the
+      // box's minimum corner (the voxel (0,0,0) corner).
+      std::vector<float> v;
+      auto add = [&v](glm::dvec3 p, glm::vec4 c) {
+        v.insert(v.end(), {static_cast<float>(p.x), static_cast<float>(p.y),
+                           static_cast<float>(p.z), c.r, c.g, c.b, c.a});
+      };
+      const glm::vec4 grey(0.8f, 0.8f, 0.8f, 0.7f);
+      for (int axis = 0; axis < 3; ++axis) {
+        for (int i = 0; i < 4; ++i) {
+          glm::dvec3 a(0.0);
+          const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+          a[u] = (i & 1) ? e[u] : -e[u];
+          a[w] = (i & 2) ? e[w] : -e[w];
+          glm::dvec3 b = a;
+          a[axis] = -e[axis];
+          b[axis] = e[axis];
+          add(a, grey);
+          add(b, grey);
+        }
+      }
+      const glm::vec4 axisColors[3] = {
+          {1.0f, 0.25f, 0.25f, 1.0f}, {0.3f, 1.0f, 0.3f, 1.0f}, {0.35f, 0.55f, 1.0f, 1.0f}};
+      for (int axis = 0; axis < 3; ++axis) {
+        glm::dvec3 b = -e;
+        b[axis] += 0.35 * 2.0 * e[axis];
+        add(-e, axisColors[axis]);
+        add(b, axisColors[axis]);
+      }
+      gpu_->lineVertices = gpu::Buffer::create(context_.ledger(), "overlay lines", GL_ARRAY_BUFFER,
+                                               v.size() * sizeof(float), v.data(), GL_STATIC_DRAW);
+      gpu_->lineVertexCount = static_cast<int>(v.size() / 7);
+      gpu_->lineExtent = e;
+    }
+    const gpu::Program& p = gpu_->lines;
+    p.use();
+    p.set("u_viewProjection", viewProjection(camera_, static_cast<double>(width) / height));
+    const GLint color = glGetAttribLocation(p.id(), "a_color");
+    glBindBuffer(GL_ARRAY_BUFFER, gpu_->lineVertices.id());
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 7 * sizeof(float), nullptr);
+    if (color >= 0) {
+      glEnableVertexAttribArray(static_cast<GLuint>(color));
+      glVertexAttribPointer(static_cast<GLuint>(color), 4, GL_FLOAT, GL_FALSE, 7 * sizeof(float),
+                            reinterpret_cast<const void*>(3 * sizeof(float)));
+    }
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    const int first = showBoundingBox ? 0 : 24;
+    const int count = (showBoundingBox ? 24 : 0) + (showAxes ? 6 : 0);
+    glDrawArrays(GL_LINES, first, count);
+    glDisable(GL_BLEND);
+    glDisableVertexAttribArray(0);
+    if (color >= 0) glDisableVertexAttribArray(static_cast<GLuint>(color));
+  }
+
+  // glFinish does not wait in browsers: a read-back of one pixel does.
+  std::uint8_t pixel[4];
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(origin.x, origin.y, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, pixel);
+  const GLenum err = glGetError();
+  if (err != GL_NO_ERROR) throw GpuError("viewer frame failed: GL error " + std::to_string(err));
+  stats.ms = msSince(t0);
+  last_ = stats;
+  return stats;
+}
+
+}  // namespace tessera::viewer

@@ -1,0 +1,42 @@
+// `tessera render --technique slice3d|slice2d` (issue 4): the CLI reaches
+// the slicing techniques, reports them, and their images match the reference.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "support/CliRunner.h"
+
+using tessera::test::runCli;
+
+TEST(SliceCommand, Slice3dOnAnEs2ProfileMatchesTheReference) {
+  const auto r = runCli(
+      "render gen:shepp-logan:48 --technique slice3d --profile webgl1 --size 64x64 --tf bench "
+      "--ert 1 --reference --json --out /dev/null");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["technique"], "slice3d");
+  EXPECT_EQ(j["api"], "gles2");
+  EXPECT_NE(j["layout"], "texture3d");
+  EXPECT_GE(j["psnr_db"].get<double>(), 30.0);
+}
+
+TEST(SliceCommand, Slice2dEveryClassificationMatchesTheReference) {
+  for (const char* cls : {"pre", "palette", "post"}) {
+    const auto r =
+        runCli(std::string("render gen:sphere:40 --technique slice2d --classify ") + cls +
+               " --size 64x64 --tf bench --ert 1 --reference --json --out /dev/null");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["layout"], "slice-stacks");
+    EXPECT_GE(j["psnr_db"].get<double>(), 30.0) << cls;
+  }
+}
+
+TEST(SliceCommand, BadTechniqueOrClassificationFailsWithOneLine) {
+  auto r = runCli("render gen:sphere:16 --technique splat --out /dev/null");
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_NE(r.err.find("--technique 'splat'"), std::string::npos) << r.err;
+  r = runCli("render gen:sphere:16 --technique slice2d --classify later --out /dev/null");
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_NE(r.err.find("--classify 'later'"), std::string::npos) << r.err;
+}

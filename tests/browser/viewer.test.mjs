@@ -1,0 +1,344 @@
+// Browser test of the web viewer (issue 6): playwright-core drives Debian's
+// headless Chromium (SwiftShader WebGL) against build-web/site served on
+// localhost. Every check measures something; any failure exits 1.
+//
+//   node viewer.test.mjs            the test (scripts/browser-test.sh runs it)
+//   node viewer.test.mjs --bench    also times ch2 at 512x512 in WebGL 2 and 1
+//
+// Environment: TESSERA_CLI (native tessera, for the reference image and test
+// files; default build/tessera), TESSERA_SITE (default build-web/site),
+// CHROMIUM (default /usr/bin/chromium), TESSERA_SHOTS (write screenshots there).
+import { spawn, execFileSync } from 'node:child_process';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import net from 'node:net';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
+const cli = process.env.TESSERA_CLI || path.join(root, 'build/tessera');
+const site = process.env.TESSERA_SITE || path.join(root, 'build-web/site');
+const chromiumPath = process.env.CHROMIUM || '/usr/bin/chromium';
+const shots = process.env.TESSERA_SHOTS || '';
+const bench = process.argv.includes('--bench');
+const SIZE = 256;
+const VOLUME = 'gen:shepp-logan:96';
+const CH2 = '/usr/share/mricron/templates/ch2.nii.gz';
+
+let failures = 0;
+const t0 = Date.now();
+function check(name, ok, detail) {
+  console.log(`${ok ? 'ok  ' : 'FAIL'} ${name}${detail ? ` — ${detail}` : ''}`);
+  if (!ok) failures++;
+}
+
+function freePort() {
+  return new Promise((resolve) => {
+    const s = net.createServer();
+    s.listen(0, '127.0.0.1', () => {
+      const { port } = s.address();
+      s.close(() => resolve(port));
+    });
+  });
+}
+
+async function serve(dir) {
+  const port = await freePort();
+  const server = spawn('python3', ['-m', 'http.server', String(port), '--bind', '127.0.0.1',
+    '--directory', dir], { stdio: 'ignore' });
+  for (let i = 0; i < 100; i++) {
+    try {
+      const r = await fetch(`http://127.0.0.1:${port}/index.html`);
+      if (r.ok) return { server, url: `http://127.0.0.1:${port}` };
+    } catch { /* not up yet */ }
+    await new Promise((r) => setTimeout(r, 100));
+  }
+  server.kill();
+  throw new Error('the HTTP server did not start');
+}
+
+// PSNR (dB) over R, G, B of the canvas against a PNG, computed in the page
+// (the browser decodes the PNG), as reference::psnr does.
+async function psnrAgainst(page, pngPath) {
+  const b64 = fs.readFileSync(pngPath).toString('base64');
+  return page.evaluate(async (b64) => {
+    const img = new Image();
+    img.src = `data:image/png;base64,${b64}`;
+    await img.decode();
+    const c = document.createElement('canvas');
+    c.width = img.width;
+    c.height = img.height;
+    const ctx = c.getContext('2d');
+    ctx.drawImage(img, 0, 0);
+    const ref = ctx.getImageData(0, 0, c.width, c.height).data;
+    const px = window.tessera.pixels();
+    if (px.length !== ref.length) return { error: `sizes differ: ${px.length} vs ${ref.length}` };
+    let sum = 0;
+    for (let i = 0; i < px.length; i += 4) {
+      for (let k = 0; k < 3; k++) { const d = px[i + k] - ref[i + k]; sum += d * d; }
+    }
+    const mse = sum / (px.length / 4 * 3);
+    return { psnr: mse === 0 ? 999 : 10 * Math.log10(255 * 255 / mse), mse };
+  }, b64);
+}
+
+// Mean absolute difference of the canvas now against `before` (0..255),
+// and the fraction of non-black pixels.
+async function snapshot(page) {
+  return page.evaluate(() => {
+    const p = window.tessera.pixels();
+    let lit = 0;
+    for (let i = 0; i < p.length; i += 4) if (p[i] + p[i + 1] + p[i + 2] > 24) lit++;
+    return { pixels: Array.from(p), lit: lit / (p.length / 4) };
+  });
+}
+// Fraction of pixels where some channel differs by more than 8 levels.
+function changedFraction(a, b) {
+  let n = 0;
+  for (let i = 0; i < a.length; i += 4) {
+    if (Math.abs(a[i] - b[i]) > 8 || Math.abs(a[i + 1] - b[i + 1]) > 8 || Math.abs(a[i + 2] - b[i + 2]) > 8) n++;
+  }
+  return n / (a.length / 4);
+}
+function meanAbsDiff(a, b) {
+  let s = 0;
+  for (let i = 0; i < a.length; i++) s += Math.abs(a[i] - b[i]);
+  return s / a.length;
+}
+
+async function openPage(context, base, query) {
+  const page = await context.newPage();
+  const logs = [];
+  page.on('console', (m) => logs.push(`${m.type()}: ${m.text()}`));
+  page.on('pageerror', (e) => logs.push(`pageerror: ${e.message}`));
+  await page.goto(`${base}/index.html?${query}`);
+  try {
+    await page.evaluate(() => window.tessera.ready);
+  } catch (e) {
+    console.log(logs.join('\n'));
+    throw e;
+  }
+  return { page, logs };
+}
+
+async function withoutOverlays(page) {
+  await page.uncheck('#box');
+  await page.uncheck('#axes');
+  await page.evaluate(() => window.tessera.render());
+}
+
+async function main() {
+  if (!fs.existsSync(path.join(site, 'tessera.wasm'))) throw new Error(`no web build in ${site} (scripts/web.sh)`);
+  if (!fs.existsSync(cli)) throw new Error(`no native tessera at ${cli} (set TESSERA_CLI)`);
+  const tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'tessera-browser-'));
+  const run = (...args) => execFileSync(cli, args, { stdio: ['ignore', 'pipe', 'pipe'] }).toString();
+  // Reference images of the page's default view, and files to open.
+  run('render', VOLUME, '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2',
+      '--out', path.join(tmp, 'native-webgl2.png'));
+  run('render', VOLUME, '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl1',
+      '--out', path.join(tmp, 'native-webgl1.png'));
+  run('convert', 'gen:shepp-logan:64', path.join(tmp, 'phantom64.nrrd'));
+  run('convert', 'gen:sphere:48', path.join(tmp, 'sphere48.nii.gz'));
+  const goodNii = path.join(tmp, 'sphere40.nii');
+  run('convert', 'gen:sphere:40', goodNii);
+  // Unreadable files: a NIfTI cut short, and bytes that claim to be gzip.
+  fs.writeFileSync(path.join(tmp, 'truncated.nii'), fs.readFileSync(goodNii).subarray(0, 20000));
+  fs.writeFileSync(path.join(tmp, 'broken.nii.gz'), Buffer.from([0x1f, 0x8b, 8, 0, 1, 2, 3, 4, 5, 6, 7]));
+
+  const { server, url } = await serve(site);
+  const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'tessera-chromium-'));
+  const context = await chromium.launchPersistentContext(profile, {
+    executablePath: chromiumPath,
+    headless: true,
+    viewport: { width: 1280, height: 900 },
+    acceptDownloads: true,
+    args: ['--no-sandbox', '--no-first-run', '--disable-background-networking',
+      '--disable-component-update', '--disable-sync', '--disable-quic',
+      '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+  });
+  try {
+    // ---- WebGL 2 page
+    const { page, logs } = await openPage(context, url, `size=${SIZE}`);
+    let s = await page.evaluate(() => window.tessera.state());
+    check('page loads with WebGL 2 (ES 3 path)', s.webgl === 2 && s.api === 'gles3',
+          `${s.renderer}; ${s.gl_version}`);
+    check('default volume is loaded', s.has_volume && s.dims.join('x') === '96x96x96', s.description);
+    let shot = await snapshot(page);
+    check('default volume renders (non-black pixels)', shot.lit > 0.1, `${(100 * shot.lit).toFixed(1)} % lit`);
+
+    await withoutOverlays(page);
+    const m2 = await psnrAgainst(page, path.join(tmp, 'native-webgl2.png'));
+    check('canvas matches the native renderer (PSNR >= 35 dB)', m2.psnr >= 35,
+          m2.error || `${m2.psnr.toFixed(2)} dB`);
+    await page.check('#box');
+    await page.check('#axes');
+    await page.evaluate(() => window.tessera.render());
+
+    // Drag on the canvas rotates.
+    const before = await snapshot(page);
+    const box = await page.locator('#canvas').boundingBox();
+    await page.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
+    await page.mouse.down();
+    await page.mouse.move(box.x + box.width / 2 + 60, box.y + box.height / 2 + 10, { steps: 4 });
+    await page.mouse.up();
+    await page.evaluate(() => window.tessera.render());
+    s = await page.evaluate(() => window.tessera.state());
+    const afterDrag = await snapshot(page);
+    const dDrag = changedFraction(before.pixels, afterDrag.pixels);
+    check('dragging rotates the view', Math.abs(s.camera.azimuth) > 5 && dDrag > 0.02,
+          `azimuth ${s.camera.azimuth.toFixed(1)} deg, ${(100 * dDrag).toFixed(1)} % of pixels changed`);
+
+    // Two fingers spreading apart zoom in (pinch), through real touch events.
+    const cdp = await context.newCDPSession(page);
+    const cx = Math.round(box.x + box.width / 2), cy = Math.round(box.y + box.height / 2);
+    const zoomBefore = (await page.evaluate(() => window.tessera.state())).camera.zoom;
+    const touch = (type, d) => cdp.send('Input.dispatchTouchEvent', {
+      type, touchPoints: type === 'touchEnd' ? [] : [{ x: cx - d, y: cy, id: 1 }, { x: cx + d, y: cy, id: 2 }] });
+    await touch('touchStart', 30);
+    await touch('touchMove', 45);
+    await touch('touchMove', 60);
+    await touch('touchEnd', 0);
+    await page.evaluate(() => window.tessera.render());
+    const zoomAfter = (await page.evaluate(() => window.tessera.state())).camera.zoom;
+    check('pinching with two fingers zooms', Math.abs(zoomAfter / zoomBefore - 2) < 0.05,
+          `zoom ${zoomBefore.toFixed(2)} -> ${zoomAfter.toFixed(2)}`);
+    await page.evaluate(() => window.tessera.setCamera(-24, 4, 1));
+    const beforeTf = await snapshot(page);
+
+    // Tap in the TF editor adds an opacity point; the image changes.
+    const tfBefore = await page.evaluate(() => window.tessera.tf());
+    const tfBox = await page.locator('#tf').boundingBox();
+    await page.mouse.click(tfBox.x + 10 + 0.55 * (tfBox.width - 20), tfBox.y + 10 + 0.2 * (tfBox.height - 58));
+    await page.evaluate(() => window.tessera.render());
+    const tfAfter = await page.evaluate(() => window.tessera.tf());
+    const afterTf = await snapshot(page);
+    const dTf = changedFraction(beforeTf.pixels, afterTf.pixels);
+    check('editing a TF point changes the image',
+          tfAfter.opacity.length === tfBefore.opacity.length + 1 && dTf > 0.02,
+          `${tfBefore.opacity.length} -> ${tfAfter.opacity.length} opacity points, ` +
+          `${(100 * dTf).toFixed(1)} % of pixels changed`);
+    // Dragging that point below the box deletes it again.
+    const px = tfBox.x + 10 + 0.55 * (tfBox.width - 20), py = tfBox.y + 10 + 0.2 * (tfBox.height - 58);
+    await page.mouse.move(px, py);
+    await page.mouse.down();
+    await page.mouse.move(px, tfBox.y + tfBox.height + 30, { steps: 3 });
+    await page.mouse.up();
+    const tfDeleted = await page.evaluate(() => window.tessera.tf());
+    check('dragging an opacity point out of the editor deletes it',
+          tfDeleted.opacity.length === tfBefore.opacity.length, `${tfDeleted.opacity.length} points`);
+
+    // TF JSON: saved as a download, loaded through its picker (the CLI's format).
+    const [download] = await Promise.all([page.waitForEvent('download'), page.click('#saveTf')]);
+    const saved = JSON.parse(fs.readFileSync(await download.path(), 'utf8'));
+    const current = await page.evaluate(() => window.tessera.tf());
+    const tfFile = path.join(tmp, 'bone.json');
+    fs.writeFileSync(tfFile, JSON.stringify({ name: 'two-points', opacity_unit_length: 1,
+      color: [{ x: 0, rgb: [0, 0, 0] }, { x: 1, rgb: [1, 0.5, 0.25] }],
+      opacity: [{ x: 0, alpha: 0 }, { x: 1, alpha: 0.3 }] }));
+    await page.setInputFiles('#loadTf', tfFile);
+    await page.waitForFunction(() => window.tessera.tf().name === 'two-points', null, { timeout: 10000 });
+    check('TF saves as JSON and loads from a JSON file',
+          JSON.stringify(saved) === JSON.stringify(current), `saved ${saved.opacity.length} opacity points`);
+    await page.selectOption('#preset', 'mr-default');
+
+    // Files through the picker.
+    await page.setInputFiles('#file', path.join(tmp, 'phantom64.nrrd'));
+    await page.waitForFunction(() => window.tessera.state().name === 'phantom64.nrrd', null, { timeout: 30000 });
+    await page.evaluate(() => window.tessera.render());
+    s = await page.evaluate(() => window.tessera.state());
+    shot = await snapshot(page);
+    check('a .nrrd opened through the picker renders', s.dims.join('x') === '64x64x64' && shot.lit > 0.05,
+          `${s.description}; ${(100 * shot.lit).toFixed(1)} % lit`);
+    await page.setInputFiles('#file', path.join(tmp, 'sphere48.nii.gz'));
+    await page.waitForFunction(() => window.tessera.state().name === 'sphere48.nii.gz', null, { timeout: 30000 });
+    await page.evaluate(() => window.tessera.render());
+    s = await page.evaluate(() => window.tessera.state());
+    shot = await snapshot(page);
+    check('a .nii.gz opened through the picker renders (inflated in the browser)',
+          s.dims.join('x') === '48x48x48' && shot.lit > 0.02, `${s.description}; ${(100 * shot.lit).toFixed(1)} % lit`);
+
+    // A file dropped on the view opens the same way.
+    const dropped = await page.evaluateHandle((b64) => {
+      const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
+      const dt = new DataTransfer();
+      dt.items.add(new File([bytes], 'dropped.nrrd'));
+      return dt;
+    }, fs.readFileSync(path.join(tmp, 'phantom64.nrrd')).toString('base64'));
+    await page.dispatchEvent('#view', 'drop', { dataTransfer: dropped });
+    await page.waitForFunction(() => window.tessera.state().name === 'dropped.nrrd', null, { timeout: 30000 });
+    s = await page.evaluate(() => window.tessera.state());
+    check('a file dropped on the view opens', s.dims.join('x') === '64x64x64', s.description);
+    await page.setInputFiles('#file', path.join(tmp, 'sphere48.nii.gz'));
+    await page.waitForFunction(() => window.tessera.state().name === 'sphere48.nii.gz', null, { timeout: 30000 });
+    await page.evaluate(() => window.tessera.render());
+
+    // Unreadable files: a message in the page; the previous volume stays.
+    for (const bad of ['truncated.nii', 'broken.nii.gz']) {
+      const good = await snapshot(page);
+      await page.setInputFiles('#file', path.join(tmp, bad));
+      await page.waitForFunction(() => window.tessera.error() !== '', null, { timeout: 30000 });
+      const msg = await page.evaluate(() => window.tessera.error());
+      const visible = await page.locator('#error').isVisible();
+      await page.evaluate(() => window.tessera.render());
+      s = await page.evaluate(() => window.tessera.state());
+      const still = await snapshot(page);
+      check(`${bad}: error shown, previous volume stays`,
+            visible && msg.includes(bad) && s.name === 'sphere48.nii.gz' && meanAbsDiff(good.pixels, still.pixels) < 0.01,
+            `"${msg}"`);
+      await page.evaluate(() => { document.getElementById('error').hidden = true; });
+    }
+    if (shots) {
+      fs.mkdirSync(shots, { recursive: true });
+      await page.screenshot({ path: path.join(shots, 'web-phantom.png') });
+    }
+    const errors = logs.filter((l) => l.startsWith('pageerror') || l.startsWith('error'));
+    check('no script errors on the page', errors.length === 0, errors.join(' | '));
+    await page.close();
+
+    // ---- WebGL 1 (the ES 2.0 path, forced)
+    const p1 = await openPage(context, url, `size=${SIZE}&webgl=1`);
+    s = await p1.page.evaluate(() => window.tessera.state());
+    check('?webgl=1 gives WebGL 1 (ES 2 path, 2D layout)', s.webgl === 1 && s.api === 'gles2' && s.layout !== 'texture3d',
+          `${s.layout}: ${s.plan_reason}`);
+    await withoutOverlays(p1.page);
+    shot = await snapshot(p1.page);
+    const m1 = await psnrAgainst(p1.page, path.join(tmp, 'native-webgl1.png'));
+    check('WebGL 1 renders and matches the native ES 2 image (PSNR >= 35 dB)', shot.lit > 0.1 && m1.psnr >= 35,
+          m1.error || `${m1.psnr.toFixed(2)} dB, ${(100 * shot.lit).toFixed(1)} % lit`);
+    await p1.page.close();
+
+    if (bench) await benchmark(context, url);
+  } finally {
+    await context.close();
+    server.kill();
+    fs.rmSync(profile, { recursive: true, force: true });
+    fs.rmSync(tmp, { recursive: true, force: true });
+  }
+  console.log(`browser test: ${failures ? `${failures} FAILED` : 'all passed'} in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
+  process.exit(failures ? 1 : 0);
+}
+
+// ch2 through the picker at 512x512, WebGL 2 and WebGL 1: median of 7 frames.
+async function benchmark(context, url) {
+  if (!fs.existsSync(CH2)) { console.log(`bench: ${CH2} missing (mricron-data)`); return; }
+  for (const webgl of [2, 1]) {
+    const { page } = await openPage(context, url, `size=512${webgl === 1 ? '&webgl=1' : ''}`);
+    await page.setInputFiles('#file', CH2);
+    await page.waitForFunction(() => window.tessera.state().name === 'ch2.nii.gz', null, { timeout: 60000 });
+    if (shots) {
+      await page.evaluate(() => window.tessera.setCamera(35, 15, 1));
+      await page.screenshot({ path: path.join(shots, `web-ch2-webgl${webgl}.png`) });
+    }
+    const r = await page.evaluate(() => window.tessera.benchmark(7));
+    const s = await page.evaluate(() => window.tessera.state());
+    console.log(`bench: ch2 512x512 WebGL ${webgl} (${s.layout}; ${s.renderer}): median ${r.median.toFixed(0)} ms, ` +
+                `min ${r.min.toFixed(0)}, max ${r.max.toFixed(0)} over ${r.times.length} frames`);
+    await page.close();
+  }
+}
+
+main().catch((e) => {
+  console.error(`browser test: error: ${e.stack || e}`);
+  process.exit(1);
+});

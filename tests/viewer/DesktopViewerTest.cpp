@@ -1,0 +1,79 @@
+// `tessera view` end to end: a screenshot of the window under Xvfb (skipped
+// where xvfb-run or the desktop viewer is missing), and the message without
+// a display.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "support/TestSupport.h"
+#include "tessera/core/Image.h"
+
+namespace tessera::viewer {
+namespace {
+
+struct CommandRun {
+  int status = -1;
+  std::string output;
+};
+
+CommandRun run(const std::string& command) {
+  CommandRun r;
+  FILE* p = popen((command + " 2>&1").c_str(), "r");
+  if (!p) return r;
+  char buf[512];
+  while (std::fgets(buf, sizeof buf, p)) r.output += buf;
+  r.status = pclose(p);
+  return r;
+}
+
+bool desktopViewerBuilt() {
+  return run(std::string(TESSERA_CLI_PATH) + " view --help").output.find("--screenshot") !=
+             std::string::npos &&
+         run(std::string("env -u DISPLAY ") + TESSERA_CLI_PATH + " view gen:sphere:8")
+                 .output.find("without the desktop viewer") == std::string::npos;
+}
+
+// Fraction of pixels in [x0, x1) that are not (near) black.
+double litFraction(const Image& img, int x0, int x1) {
+  long lit = 0, all = 0;
+  for (int y = 0; y < img.height(); ++y) {
+    for (int x = x0; x < x1; ++x, ++all) {
+      const std::uint8_t* p = img.pixel(x, y);
+      lit += p[0] + p[1] + p[2] > 60 ? 1 : 0;
+    }
+  }
+  return static_cast<double>(lit) / static_cast<double>(all);
+}
+
+TEST(DesktopViewer, ScreenshotUnderXvfbShowsTheVolumeBesideThePanel) {
+  if (run("command -v xvfb-run").status != 0) GTEST_SKIP() << "xvfb-run not installed";
+  if (!desktopViewerBuilt()) GTEST_SKIP() << "tessera built without GLFW/ImGui";
+  test::TempDir dir;
+  const auto png = dir / "view.png";
+  const CommandRun r =
+      run("xvfb-run -a -s '-screen 0 1024x640x24' " + std::string(TESSERA_CLI_PATH) +
+          " view gen:shepp-logan:48 --size 960x600 --azimuth 30 --frames 2 --screenshot " +
+          png.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  const Image img = Image::readPng(png);
+  ASSERT_EQ(img.width(), 960);
+  ASSERT_EQ(img.height(), 600);
+  // Panel (390 px wide): ImGui's widgets; view: the phantom, black around it.
+  const double panel = litFraction(img, 0, 390), view = litFraction(img, 390, 960);
+  EXPECT_GT(panel, 0.05) << r.output;
+  EXPECT_GT(view, 0.05) << r.output;
+  EXPECT_LT(view, 0.9) << r.output;
+}
+
+TEST(DesktopViewer, WithoutADisplayItSaysWhatToDo) {
+  if (!desktopViewerBuilt()) GTEST_SKIP() << "tessera built without GLFW/ImGui";
+  const CommandRun r = run("env -u DISPLAY -u WAYLAND_DISPLAY " + std::string(TESSERA_CLI_PATH) +
+                           " view gen:sphere:16");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("xvfb-run"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace tessera::viewer

@@ -1,0 +1,121 @@
+#include <gtest/gtest.h>
+
+#include "gpu/gl.h"
+#include "support/GpuTestContext.h"
+#include "tessera/core/Error.h"
+#include "tessera/gpu/GlObjects.h"
+#include "tessera/io/Procedural.h"
+#include "tessera/layout/Planner.h"
+#include "tessera/reference/ImageMetrics.h"
+#include "tessera/render/Raycaster.h"
+#include "tessera/viewer/Viewer.h"
+
+namespace tessera::viewer {
+namespace {
+
+constexpr int kSize = 96;
+
+Image readFramebuffer(const gpu::Framebuffer& fb) {
+  Image img(fb.width(), fb.height());
+  fb.readRgba8(img.rgba().data());
+  img.flipVertically();
+  return img;
+}
+
+// What `tessera render` shows for the same view: the plain ray caster.
+Image directRender(gpu::GlContext& ctx, const Volume& v, const TransferFunction& tf,
+                   const Camera& cam, const RenderSettings& s) {
+  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(ctx.caps());
+  const layout::Plan plan = layout::planLayout(v, limits, {});
+  auto layout = layout::createLayout(plan, v, limits, ctx.ledger());
+  render::Raycaster caster(ctx, v, *layout);
+  caster.setTransferFunction(tf);
+  return caster.render(cam, s, kSize, kSize);
+}
+
+struct ViewerFixture : ::testing::Test {
+  gpu::GlContext& ctx = test::gpuContext();
+  gpu::Framebuffer fb = gpu::Framebuffer::create(ctx.ledger(), "test view", kSize, kSize);
+};
+
+TEST_F(ViewerFixture, FrameShowsWhatTheRayCasterRenders) {
+  Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
+  v.setVolume(makeSheppLogan({48, 48, 48}), "phantom");
+  v.showBoundingBox = v.showAxes = false;
+  v.camera().azimuthDeg = 30.0;
+  const FrameStats fs = v.render(kSize, kSize, fb.id());
+  EXPECT_GT(fs.ms, 0.0);
+  EXPECT_EQ(fs.renderWidth, kSize);
+  const Image shown = readFramebuffer(fb);
+  const Image direct =
+      directRender(ctx, v.volume(), v.tfEditor().transferFunction(), v.camera(), v.settings());
+  EXPECT_GE(psnr(shown, direct), 60.0);
+}
+
+TEST_F(ViewerFixture, OverlaysTfEditsAndWindowChangeTheFrame) {
+  Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
+  v.setVolume(makeSheppLogan({40, 40, 40}), "phantom");
+  v.showBoundingBox = v.showAxes = false;
+  v.render(kSize, kSize, fb.id());
+  const Image plain = readFramebuffer(fb);
+  v.showBoundingBox = v.showAxes = true;
+  v.render(kSize, kSize, fb.id());
+  const Image boxed = readFramebuffer(fb);
+  EXPECT_LT(psnr(plain, boxed), 40.0);
+  v.showBoundingBox = v.showAxes = false;
+  v.tfEditor().addOpacityPoint(0.5, 1.0);
+  v.render(kSize, kSize, fb.id());
+  const Image edited = readFramebuffer(fb);
+  EXPECT_LT(psnr(plain, edited), 40.0);
+  v.setWindowLevel(50.0, 100.0);
+  v.render(kSize, kSize, fb.id());
+  EXPECT_LT(psnr(edited, readFramebuffer(fb)), 40.0);
+}
+
+TEST_F(ViewerFixture, FailedLoadKeepsThePreviousVolume) {
+  Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
+  v.setVolume(makeSheppLogan({32, 32, 32}), "phantom");
+  EXPECT_THROW(v.setVolume(Volume{}, "empty"), InputError);
+  EXPECT_EQ(v.volumeName(), "phantom");
+  EXPECT_EQ(v.volume().dims(), glm::ivec3(32));
+  EXPECT_THROW(v.setTechnique("no-such-technique"), InputError);
+  EXPECT_EQ(v.technique(), "raycast");
+  v.render(kSize, kSize, fb.id());
+  EXPECT_GT(v.lastFrame().ms, 0.0);
+}
+
+TEST_F(ViewerFixture, AdaptiveQualityRendersHalfSizeWhileInteracting) {
+  Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
+  v.setVolume(makeSheppLogan({32, 32, 32}), "phantom");
+  v.quality = Quality::Adaptive;
+  v.controller().pointerDown(0, {10, 10});
+  EXPECT_EQ(v.render(kSize, kSize, fb.id()).renderWidth, kSize / 2);
+  v.controller().pointerUp(0);
+  EXPECT_EQ(v.render(kSize, kSize, fb.id()).renderWidth, kSize);
+  v.quality = Quality::Full;
+  v.controller().pointerDown(0, {10, 10});
+  EXPECT_EQ(v.render(kSize, kSize, fb.id()).renderWidth, kSize);
+}
+
+TEST(Viewer, Es2ContextUsesATwoDimensionalLayout) {
+  gpu::GlContext::Options o;
+  o.api = gpu::ApiLevel::Gles2;
+  auto ctx = gpu::GlContext::createHeadless(o);
+  {
+    Viewer v(*ctx, gpu::DeviceProfile::find("webgl1"));
+    v.setVolume(makeSheppLogan({40, 40, 40}), "phantom");
+    EXPECT_NE(v.plan().layout.layout, "texture3d");
+    gpu::Framebuffer fb = gpu::Framebuffer::create(ctx->ledger(), "view", kSize, kSize, GL_RGBA);
+    v.showBoundingBox = v.showAxes = false;
+    v.render(kSize, kSize, fb.id());
+    const Image img = readFramebuffer(fb);
+    int lit = 0;
+    for (int y = 0; y < kSize; ++y)
+      for (int x = 0; x < kSize; ++x) lit += img.pixel(x, y)[0] > 8 ? 1 : 0;
+    EXPECT_GT(lit, kSize * kSize / 20);
+  }
+  test::gpuContext();  // the shared context current again for later tests
+}
+
+}  // namespace
+}  // namespace tessera::viewer
