@@ -70,7 +70,7 @@ double sampleTrilinear(const Volume& volume, glm::dvec3 p) {
 
 Image renderReference(const Volume& volume, const TransferFunction& tf, const Camera& camera,
                       const RenderSettings& settings, int width, int height, int threads,
-                      ReferenceStats* stats) {
+                      ReferenceStats* stats, const ReferenceStops* stops) {
   if (width <= 0 || height <= 0) throw InputError("reference: image size must be positive");
   if (!(settings.stepVoxels > 0.0)) throw InputError("reference: step must be > 0");
   const glm::ivec3 dims = volume.dims();
@@ -89,6 +89,13 @@ Image renderReference(const Volume& volume, const TransferFunction& tf, const Ca
     std::uint64_t samples = 0, hits = 0;
     for (int py = nextRow++; py < height; py = nextRow++) {
       for (int px = 0; px < width; ++px) {
+        // An opaque stop (overlay line) ends the ray and replaces the background.
+        const std::uint8_t* stopColor = stops ? stops->color.pixel(px, py) : nullptr;
+        const bool stopped = stopColor != nullptr && stopColor[3] > 0;
+        const double tStop =
+            stopped
+                ? static_cast<double>(stops->distance[static_cast<std::size_t>(py) * width + px])
+                : std::numeric_limits<double>::infinity();
         const Ray ray = camera.pixelRay(px, py, width, height);
         // Texture space, as on the GPU: t stays in world units.
         const glm::dvec3 to = ray.origin / extent + 0.5;
@@ -105,16 +112,17 @@ Image renderReference(const Volume& volume, const TransferFunction& tf, const Ca
           tFar = std::min(tFar, std::max(t0, t1));
         }
         const double t0 = std::max(tNear, 0.0);
+        const double tEnd = std::min(tFar, tStop);
         glm::dvec4 acc(0.0);
         double maxValue = -1.0;
-        if (t0 < tFar) {
+        if (t0 < tEnd) {
           ++hits;
           const double j = settings.jitter
                                ? jitterOffset(static_cast<unsigned>(px), static_cast<unsigned>(py))
                                : 0.5;
           for (int k = 0; k < settings.maxSteps; ++k) {
             const double t = t0 + (k + j) * ds;
-            if (t >= tFar) break;
+            if (t >= tEnd) break;
             ++samples;
             const double raw = trilinear(data, dims, to + t * td);
             const double n = std::clamp((raw - win.min) / ww, 0.0, 1.0);
@@ -132,8 +140,11 @@ Image renderReference(const Volume& volume, const TransferFunction& tf, const Ca
           // MIP shows the TF colour of the maximum, opaque.
           acc = glm::dvec4(tf.color(maxValue), 1.0);
         }
-        const glm::dvec4 out(glm::dvec3(acc) + (1.0 - acc.a) * glm::dvec3(bg),
-                             acc.a + (1.0 - acc.a) * bg.a);
+        const glm::dvec4 under =
+            stopped ? glm::dvec4(glm::dvec3(stopColor[0], stopColor[1], stopColor[2]) / 255.0, 1.0)
+                    : bg;
+        const glm::dvec4 out(glm::dvec3(acc) + (1.0 - acc.a) * glm::dvec3(under),
+                             acc.a + (1.0 - acc.a) * under.a);
         std::uint8_t* pix = image.pixel(px, py);
         for (int ch = 0; ch < 4; ++ch) pix[ch] = toByte(out[ch]);
       }

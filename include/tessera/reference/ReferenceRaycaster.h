@@ -6,6 +6,7 @@
 // continuous transfer function with opacity correction, front-to-back
 // compositing with the same early termination, MIP, background.
 #include <cstdint>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
@@ -27,9 +28,18 @@ struct ReferenceStats {
   std::uint64_t samples = 0;
 };
 
+// Opaque things in the scene besides the volume (overlay lines), per pixel:
+// where color's alpha > 0 the ray stops at `distance` (Camera::pixelRay
+// parameter, world units) and the colour takes the place of the background.
+// Both are width x height, top row first. See ReferenceOverlay.h.
+struct ReferenceStops {
+  const Image& color;
+  const std::vector<float>& distance;
+};
+
 // Renders width x height pixels; threads = 0 uses every hardware thread.
 Image renderReference(const Volume& volume, const TransferFunction& tf, const Camera& camera,
                       const RenderSettings& settings, int width, int height, int threads = 0,
-                      ReferenceStats* stats = nullptr);
+                      ReferenceStats* stats = nullptr, const ReferenceStops* stops = nullptr);
 
 }  // namespace tessera
