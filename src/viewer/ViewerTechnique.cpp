@@ -1,45 +1,57 @@
 #include "tessera/viewer/ViewerTechnique.h"
 
 #include <map>
+#include <memory>
+#include <utility>
 
-#include "gpu/gl.h"
 #include "tessera/core/Error.h"
 #include "tessera/render/Raycaster.h"
+#include "tessera/render/Slice2DRenderer.h"
+#include "tessera/render/Slice3DRenderer.h"
 
 namespace tessera::viewer {
 
 namespace {
 
-class RaycastTechnique : public ViewerTechnique {
+// Adapts any renderer with renderFrame() and colorTexture() (ray caster,
+// view- and axis-aligned slicing) to the viewer's seam.
+template <class Renderer>
+class RendererTechnique : public ViewerTechnique {
  public:
-  RaycastTechnique(gpu::GlContext& context, const Volume& volume, const layout::Layout& layout)
-      : caster_(context, volume, layout) {}
-  void setTransferFunction(const TransferFunction& tf) override { caster_.setTransferFunction(tf); }
+  template <class... Args>
+  explicit RendererTechnique(Args&&... args) : renderer_(std::forward<Args>(args)...) {}
+  void setTransferFunction(const TransferFunction& tf) override {
+    renderer_.setTransferFunction(tf);
+  }
   unsigned render(const Camera& camera, const RenderSettings& settings, int width,
                   int height) override {
-    caster_.renderFrame(camera, settings, width, height);
-    // renderFrame leaves its target framebuffer bound; its colour
-    // attachment is the image (Raycaster keeps the target to itself).
-    GLint type = 0, name = 0;
-    glGetFramebufferAttachmentParameteriv(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0,
-                                          GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
-    glGetFramebufferAttachmentParameteriv(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0,
-                                          GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &name);
-    if (type != GL_TEXTURE || name <= 0) {
-      throw GpuError("ray caster left no colour texture bound (attachment type " +
-                     std::to_string(type) + ")");
-    }
-    return static_cast<unsigned>(name);
+    renderer_.renderFrame(camera, settings, width, height);
+    return renderer_.colorTexture().id();
   }
 
  private:
-  render::Raycaster caster_;
+  Renderer renderer_;
 };
 
 std::map<std::string, TechniqueFactory>& registry() {
   static std::map<std::string, TechniqueFactory> r = {
-      {"raycast", [](gpu::GlContext& c, const Volume& v, const layout::Layout& l) {
-         return std::unique_ptr<ViewerTechnique>(new RaycastTechnique(c, v, l));
+      {"raycast",
+       [](gpu::GlContext& c, const Volume& v, const layout::Layout& l) {
+         return std::unique_ptr<ViewerTechnique>(
+             std::make_unique<RendererTechnique<render::Raycaster>>(c, v, l));
+       }},
+      // View-aligned slicing samples through the layout like the ray caster.
+      {"slice3d",
+       [](gpu::GlContext& c, const Volume& v, const layout::Layout& l) {
+         return std::unique_ptr<ViewerTechnique>(
+             std::make_unique<RendererTechnique<render::Slice3DRenderer>>(c, v, l));
+       }},
+      // Axis-aligned slicing keeps its own atlases (post-classified, so a TF
+      // edit costs only a table upload).
+      {"slice2d", [](gpu::GlContext& c, const Volume& v, const layout::Layout&) {
+         return std::unique_ptr<ViewerTechnique>(
+             std::make_unique<RendererTechnique<render::Slice2DRenderer>>(
+                 c, v, render::Slice2DOptions{}));
        }}};
   return r;
 }

@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <string>
+#include <vector>
+
 #include "gpu/gl.h"
 #include "support/GpuTestContext.h"
 #include "tessera/core/Error.h"
@@ -8,6 +12,8 @@
 #include "tessera/layout/Planner.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/render/Raycaster.h"
+#include "tessera/render/Slice2DRenderer.h"
+#include "tessera/render/Slice3DRenderer.h"
 #include "tessera/viewer/Viewer.h"
 
 namespace tessera::viewer {
@@ -50,6 +56,40 @@ TEST_F(ViewerFixture, FrameShowsWhatTheRayCasterRenders) {
   const Image direct =
       directRender(ctx, v.volume(), v.tfEditor().transferFunction(), v.camera(), v.settings());
   EXPECT_GE(psnr(shown, direct), 60.0);
+}
+
+TEST_F(ViewerFixture, SlicingTechniquesShowWhatTheSlicersRender) {
+  Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
+  v.setVolume(makeSheppLogan({40, 40, 40}), "phantom");
+  v.showBoundingBox = v.showAxes = false;
+  v.camera().azimuthDeg = 20.0;
+  const std::vector<std::string> names = techniqueNames();
+  for (const char* name : {"slice3d", "slice2d"}) {
+    SCOPED_TRACE(name);
+    ASSERT_NE(std::find(names.begin(), names.end(), name), names.end());
+    v.setTechnique(name);
+    EXPECT_EQ(v.technique(), name);
+    v.render(kSize, kSize, fb.id());
+    const Image shown = readFramebuffer(fb);
+    const TransferFunction& tf = v.tfEditor().transferFunction();
+    Image direct;
+    const gpu::DeviceLimits limits = gpu::DeviceLimits::of(ctx.caps());
+    const layout::Plan plan = layout::planLayout(v.volume(), limits, {});
+    auto layout = layout::createLayout(plan, v.volume(), limits, ctx.ledger());
+    if (std::string(name) == "slice3d") {
+      render::Slice3DRenderer slicer(ctx, v.volume(), *layout);
+      slicer.setTransferFunction(tf);
+      direct = slicer.render(v.camera(), v.settings(), kSize, kSize);
+    } else {
+      render::Slice2DRenderer slicer(ctx, v.volume(), render::Slice2DOptions{});
+      slicer.setTransferFunction(tf);
+      direct = slicer.render(v.camera(), v.settings(), kSize, kSize);
+    }
+    EXPECT_GE(psnr(shown, direct), 50.0);
+    // And it is a picture of the volume: close to the ray caster's.
+    const Image cast = directRender(ctx, v.volume(), tf, v.camera(), v.settings());
+    EXPECT_GE(psnr(shown, cast), 25.0);
+  }
 }
 
 TEST_F(ViewerFixture, OverlaysTfEditsAndWindowChangeTheFrame) {

@@ -48,6 +48,7 @@ class Slice3DRenderer {
   void prepare(const RenderSettings& settings);
   void renderFrame(const Camera& camera, const RenderSettings& settings, int width, int height);
   Image readImage() const { return accumulator_.readImage(); }
+  const gpu::Texture& colorTexture() const { return accumulator_.colorTexture(); }
   Image render(const Camera& camera, const RenderSettings& settings, int width, int height) {
     renderFrame(camera, settings, width, height);
     return readImage();

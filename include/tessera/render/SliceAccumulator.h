@@ -37,6 +37,8 @@ class SliceAccumulator {
   void resolve(const RenderSettings& settings, const gpu::Texture* lut, int lutEntries);
   // The last resolved frame, top row first.
   Image readImage() const;
+  // The RGBA8 texture holding the last resolved frame (row 0 at the bottom).
+  const gpu::Texture& colorTexture() const { return image_.color(); }
 
   // "RGBA16F" or "RGBA8".
   std::string accumulationFormat() const { return floatTarget_ ? "RGBA16F" : "RGBA8"; }
