@@ -208,12 +208,14 @@ FrameStats Viewer::render(int width, int height, unsigned framebuffer, glm::ivec
     uploadedTfRevision_ = tfEditor_.revision();
   }
   RenderSettings settings = settings_;
-  int rw = width, rh = height;
-  if (quality == Quality::Adaptive && controller_.interacting()) {
-    rw = std::max(1, width / 2);
-    rh = std::max(1, height / 2);
-    settings.stepVoxels *= 2.0;
+  render::QualityLevel level;  // full quality
+  if (quality == Quality::Adaptive) {
+    qualityController_.setInteracting(controller_.interacting());
+    level = qualityController_.next();
   }
+  const int rw = std::max(1, static_cast<int>(std::lround(width * level.resolutionScale)));
+  const int rh = std::max(1, static_cast<int>(std::lround(height * level.resolutionScale)));
+  settings.stepVoxels *= level.stepScale;
   const unsigned image = technique_->render(camera_, settings, rw, rh);
   stats.renderWidth = rw;
   stats.renderHeight = rh;
@@ -294,6 +296,7 @@ FrameStats Viewer::render(int width, int height, unsigned framebuffer, glm::ivec
   const GLenum err = glGetError();
   if (err != GL_NO_ERROR) throw GpuError("viewer frame failed: GL error " + std::to_string(err));
   stats.ms = msSince(t0);
+  if (quality == Quality::Adaptive) qualityController_.report(level, stats.ms);
   last_ = stats;
   return stats;
 }

@@ -124,6 +124,27 @@ TEST_F(ViewerFixture, FailedLoadKeepsThePreviousVolume) {
   EXPECT_GT(v.lastFrame().ms, 0.0);
 }
 
+// The adaptive quality is the issue-5 controller: measured frame times drive
+// the resolution towards the goal, down to its floor for an impossible goal
+// and up to full size for a generous one.
+TEST_F(ViewerFixture, AdaptiveQualityFollowsTheFrameTimeGoal) {
+  Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
+  v.setVolume(makeSheppLogan({32, 32, 32}), "phantom");
+  v.qualityController() = render::QualityController({.goalMs = 1e-6});
+  v.controller().pointerDown(0, {10, 10});
+  int width = 0;
+  for (int i = 0; i < 30; ++i) width = v.render(kSize, kSize, fb.id()).renderWidth;
+  EXPECT_EQ(width, kSize / 8);                             // minResolutionScale
+  EXPECT_EQ(v.qualityController().next().stepScale, 4.0);  // then the step grew to its cap
+  v.controller().pointerUp(0);
+  EXPECT_EQ(v.render(kSize, kSize, fb.id()).renderWidth, kSize);  // idle: full quality
+
+  v.qualityController() = render::QualityController({.goalMs = 1e6});
+  v.controller().pointerDown(0, {10, 10});
+  for (int i = 0; i < 30; ++i) width = v.render(kSize, kSize, fb.id()).renderWidth;
+  EXPECT_EQ(width, kSize);
+}
+
 TEST_F(ViewerFixture, AdaptiveQualityRendersHalfSizeWhileInteracting) {
   Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
   v.setVolume(makeSheppLogan({32, 32, 32}), "phantom");

@@ -16,6 +16,7 @@
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/layout/Planner.h"
+#include "tessera/render/QualityController.h"
 #include "tessera/viewer/CameraController.h"
 #include "tessera/viewer/TransferFunctionEditor.h"
 #include "tessera/viewer/ViewerTechnique.h"
@@ -23,8 +24,9 @@
 namespace tessera::viewer {
 
 // What a frame does while the user interacts. Full: every frame at full
-// quality. Adaptive: while a pointer is down, half the resolution and twice
-// the sample distance (then full quality again once released).
+// quality. Adaptive: while a pointer is down, render::QualityController
+// picks the resolution and sample distance that meet its frame-time goal
+// (starting at half the resolution); once released, full quality again.
 enum class Quality { Full, Adaptive };
 
 struct FrameStats {
@@ -72,6 +74,8 @@ class Viewer {
   void setTechnique(const std::string& name);  // InputError if unknown; keeps the old one
   const std::string& technique() const { return techniqueName_; }
   Quality quality = Quality::Adaptive;
+  // The adaptive quality's feedback loop (goal: qualityController().options()).
+  render::QualityController& qualityController() { return qualityController_; }
   bool showBoundingBox = true;
   bool showAxes = true;
 
@@ -96,6 +100,7 @@ class Viewer {
   std::string techniqueName_ = "raycast";
   std::uint64_t uploadedTfRevision_ = 0;
   FrameStats last_;
+  render::QualityController qualityController_{{.goalMs = 66.0}};  // 15 frames/s
 
   // Held by pointer: the layout and technique keep references to them, which
   // must survive swapping in a new volume.
