@@ -143,6 +143,37 @@ TEST(GlslConformance, Es3ShadersPassTheReferenceCompiler) {
   expectConformant(c, v, *mosaic);
 }
 
+// The overlay and hybrid-compositor programs (issue 5), assembled as
+// OverlayRenderer and HybridCompositor assemble them, for both API levels.
+TEST(GlslConformance, OverlayAndHybridShadersPassTheReferenceCompiler) {
+  if (!haveValidator())
+    GTEST_SKIP() << "glslangValidator not installed (scripts/setup.sh installs it)";
+  for (gpu::ApiLevel api : {gpu::ApiLevel::Gles2, gpu::ApiLevel::Gles3}) {
+    auto part = [](const char* name) { return gpu::embeddedShaderPart(name); };
+    const std::vector<std::vector<gpu::ShaderPart>> vertex = {
+        {gpu::shaderPreamble(api, false, {}), part("render/overlay.vert.glsl")},
+        {gpu::shaderPreamble(api, false, {}), part("render/fullscreen.vert.glsl")}};
+    std::vector<std::vector<gpu::ShaderPart>> fragment = {
+        {gpu::shaderPreamble(api, true, {}), part("render/overlay_color.frag.glsl")},
+        {gpu::shaderPreamble(api, true, {}), part("render/overlay_distance.frag.glsl")},
+        {gpu::shaderPreamble(api, true, {}), part("render/camera_ray.glsl"),
+         part("render/hybrid_composite.frag.glsl")}};
+    for (const char* method : {"METHOD_COPY 1", "METHOD_ALPHA 1", "METHOD_TWO_PASS 1",
+                               "METHOD_LUMA_AVG 1", "METHOD_LUMA_601 1"}) {
+      fragment.push_back(
+          {gpu::shaderPreamble(api, true, {method}), part("render/hybrid_resolve.frag.glsl")});
+    }
+    for (const auto& parts : vertex) {
+      const Validation r = validate(gpu::assembleShader(parts), "vert");
+      EXPECT_EQ(r.exitCode, 0) << r.log;
+    }
+    for (const auto& parts : fragment) {
+      const Validation r = validate(gpu::assembleShader(parts), "frag");
+      EXPECT_EQ(r.exitCode, 0) << r.log;
+    }
+  }
+}
+
 TEST(GlslConformance, ValidatorRejectsANonConstantLoopInGlslEs100) {
   if (!haveValidator()) GTEST_SKIP() << "glslangValidator not installed";
   // The check has teeth: a loop bounded by a uniform is illegal in ES 1.00.
