@@ -162,9 +162,14 @@ void Texture::setFilter(GLenumT minFilter, GLenumT magFilter) {
 }
 
 void Texture::update2D(GLenumT format, GLenumT type, const void* data) {
+  update2DRegion(0, 0, width_, height_, format, type, data);
+}
+
+void Texture::update2DRegion(int x, int y, int w, int h, GLenumT format, GLenumT type,
+                             const void* data) {
   glBindTexture(GL_TEXTURE_2D, id_);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width_, height_, format, type, data);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, x, y, w, h, format, type, data);
 }
 
 void Texture::bind(int unit) const {

@@ -101,9 +101,20 @@ SliceStacks::SliceStacks(const Volume& volume) : dims_(volume.dims()) {
 
 void SliceStacks::fillAtlas(const SliceAtlasPlan& plan, int atlas, const std::uint8_t* palette,
                             std::vector<std::uint8_t>& out) const {
+  fillAtlasRows(plan, atlas, 0, plan.atlasSize.y, palette, out);
+}
+
+void SliceStacks::fillAtlasBand(const SliceAtlasPlan& plan, int atlas, int band,
+                                const std::uint8_t* palette, std::vector<std::uint8_t>& out) const {
+  const int y0 = band * plan.tile.y;
+  fillAtlasRows(plan, atlas, y0, y0 + plan.bandRows(band), palette, out);
+}
+
+void SliceStacks::fillAtlasRows(const SliceAtlasPlan& plan, int atlas, int y0, int y1,
+                                const std::uint8_t* palette, std::vector<std::uint8_t>& out) const {
   const int texelBytes = palette ? 4 : 1;
   const std::size_t rowBytes = static_cast<std::size_t>(plan.atlasSize.x) * texelBytes;
-  out.assign(rowBytes * static_cast<std::size_t>(plan.atlasSize.y), 0);
+  out.assign(rowBytes * static_cast<std::size_t>(y1 - y0), 0);
   const int first = atlas * plan.tilesPerAtlas;
   const int last = std::min(plan.slices, first + plan.tilesPerAtlas);
   const std::size_t sx = 1, sy = static_cast<std::size_t>(dims_.x),
@@ -113,8 +124,9 @@ void SliceStacks::fillAtlas(const SliceAtlasPlan& plan, int atlas, const std::ui
   const std::size_t du = stride[a.x], dv = stride[a.y], di = stride[plan.axis];
   for (int s = first; s < last; ++s) {
     const glm::ivec2 o = plan.tileOrigin(s);
-    for (int v = 0; v < plan.tile.y; ++v) {
-      std::uint8_t* row = out.data() + static_cast<std::size_t>(o.y + v) * rowBytes +
+    const int v0 = std::max(0, y0 - o.y), v1 = std::min(plan.tile.y, y1 - o.y);
+    for (int v = v0; v < v1; ++v) {
+      std::uint8_t* row = out.data() + static_cast<std::size_t>(o.y + v - y0) * rowBytes +
                           static_cast<std::size_t>(o.x) * texelBytes;
       const std::uint8_t* src = indices_.data() + s * di + v * dv;
       if (palette == nullptr) {

@@ -99,6 +99,35 @@ TEST(SliceStacks, AtlasHoldsEveryVoxelOfEveryStack) {
   }
 }
 
+TEST(SliceStacks, BandsTogetherAreTheWholeAtlas) {
+  const Volume v = testVolume();
+  const render::SliceStacks stacks(v);
+  std::vector<std::uint8_t> palette(256 * 4);
+  for (std::size_t i = 0; i < palette.size(); ++i) palette[i] = static_cast<std::uint8_t>(i * 7);
+  for (int axis = 0; axis < 3; ++axis) {
+    // Power-of-two padding on the y stack leaves a short last band.
+    const render::SliceAtlasPlan p = render::planSliceAtlas(v.dims(), axis, 200, axis == 1);
+    for (const std::uint8_t* pal : {static_cast<const std::uint8_t*>(nullptr),
+                                    static_cast<const std::uint8_t*>(palette.data())}) {
+      const std::size_t texelBytes = pal ? 4 : 1;
+      for (int a = 0; a < p.atlases; ++a) {
+        std::vector<std::uint8_t> whole, band, joined;
+        stacks.fillAtlas(p, a, pal, whole);
+        int rows = 0;
+        for (int b = 0; b < p.bands(); ++b) {
+          stacks.fillAtlasBand(p, a, b, pal, band);
+          ASSERT_EQ(band.size(),
+                    static_cast<std::size_t>(p.bandRows(b)) * p.atlasSize.x * texelBytes);
+          joined.insert(joined.end(), band.begin(), band.end());
+          rows += p.bandRows(b);
+        }
+        EXPECT_EQ(rows, p.atlasSize.y) << p.describe();
+        EXPECT_TRUE(joined == whole) << "axis " << axis << " atlas " << a << " " << p.describe();
+      }
+    }
+  }
+}
+
 TEST(Slice2D, ChoosesTheStackMostPerpendicularToTheView) {
   Camera cam;
   EXPECT_EQ(render::Slice2DRenderer::stackAxisFor(cam), 1);

@@ -53,6 +53,8 @@ class Texture {
   void setFilter(GLenumT minFilter, GLenumT magFilter);
   // Replaces the whole level-0 image of a 2D texture.
   void update2D(GLenumT format, GLenumT type, const void* data);
+  // Replaces the texels [x, x + w) x [y, y + h) of level 0 of a 2D texture.
+  void update2DRegion(int x, int y, int w, int h, GLenumT format, GLenumT type, const void* data);
 
   GLuintT id() const { return id_; }
   GLenumT target() const { return target_; }

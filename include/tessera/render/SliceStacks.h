@@ -9,6 +9,7 @@
 // Tile (u, v) of slice i of stack `axis` is the voxel with coordinate i
 // along the axis and (u, v) along the other two axes in x, y, z order:
 // x stack (y, z), y stack (x, z), z stack (x, y).
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -36,6 +37,11 @@ struct SliceAtlasPlan {
     const int t = slice % tilesPerAtlas;
     return {(t % columns) * tile.x, (t / columns) * tile.y};
   }
+  // Texel rows of an atlas in bands one tile row high (the last may be a
+  // shorter band of power-of-two padding): the unit the slices are uploaded
+  // in, so that a TF change never needs a host copy of a whole atlas.
+  int bands() const { return (atlasSize.y + tile.y - 1) / tile.y; }
+  int bandRows(int band) const { return std::min(tile.y, atlasSize.y - band * tile.y); }
   std::string describe() const;  // "3 x 1024x2048" style, for reports
 };
 
@@ -64,8 +70,16 @@ class SliceStacks {
   // Texels outside every tile stay 0.
   void fillAtlas(const SliceAtlasPlan& plan, int atlas, const std::uint8_t* palette,
                  std::vector<std::uint8_t>& out) const;
+  // Band `band` of that image (texel rows band * tile.y onwards, bandRows of
+  // them), the same bytes fillAtlas writes there.
+  void fillAtlasBand(const SliceAtlasPlan& plan, int atlas, int band, const std::uint8_t* palette,
+                     std::vector<std::uint8_t>& out) const;
 
  private:
+  // Texel rows [y0, y1) of an atlas image into `out`, resized to fit them.
+  void fillAtlasRows(const SliceAtlasPlan& plan, int atlas, int y0, int y1,
+                     const std::uint8_t* palette, std::vector<std::uint8_t>& out) const;
+
   glm::ivec3 dims_{0};
   std::vector<std::uint8_t> indices_;
 };
