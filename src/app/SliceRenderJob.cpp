@@ -70,6 +70,7 @@ RenderResult runSliceRender(DeviceSession& device, const Volume& fullVolume,
     renderer.setSliceCount(req.slices);
     renderFrames(
         renderer, [&] { renderer.prepare(req.settings); }, *volume, tf, req, result);
+    result.textureBytes = context.ledger().totalBytes();  // while the renderer holds its own
     result.planNote += (result.planNote.empty() ? "" : "; ") + std::string("slice3d: ") +
                        std::to_string(renderer.sliceCountFor(req.settings)) +
                        " view-aligned slices, accumulation " + renderer.accumulationFormat() +
@@ -85,6 +86,7 @@ RenderResult runSliceRender(DeviceSession& device, const Volume& fullVolume,
     renderer.setSliceCount(req.slices);
     renderFrames(
         renderer, [&] { renderer.prepare(req.camera, req.settings); }, *volume, tf, req, result);
+    result.textureBytes = context.ledger().totalBytes();
     const int axis = renderer.lastStackAxis();
     result.layout = "slice-stacks";
     result.layoutReason = "three axis-aligned stacks; drawn: " + std::string(1, "xyz"[axis]) +
@@ -95,7 +97,6 @@ RenderResult runSliceRender(DeviceSession& device, const Volume& fullVolume,
                       " slices drawn, accumulation " + renderer.accumulationFormat();
   }
   result.renderedDims = volume->dims();
-  result.textureBytes = context.ledger().totalBytes();
 
   if (req.reference) {
     const auto t0 = std::chrono::steady_clock::now();

@@ -18,6 +18,10 @@ TEST(SliceCommand, Slice3dOnAnEs2ProfileMatchesTheReference) {
   EXPECT_EQ(j["api"], "gles2");
   EXPECT_NE(j["layout"], "texture3d");
   EXPECT_GE(j["psnr_db"].get<double>(), 30.0);
+  // The ledger's count while the slicer lives: the volume plus its own TF
+  // table, proxy VBO and accumulation target.
+  EXPECT_GT(j["texture_bytes"].get<std::uint64_t>(),
+            j["volume_texture_bytes"].get<std::uint64_t>());
 }
 
 TEST(SliceCommand, Slice2dEveryClassificationMatchesTheReference) {
@@ -29,6 +33,10 @@ TEST(SliceCommand, Slice2dEveryClassificationMatchesTheReference) {
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["layout"], "slice-stacks");
     EXPECT_GE(j["psnr_db"].get<double>(), 30.0) << cls;
+    EXPECT_GT(j["volume_texture_bytes"].get<std::uint64_t>(), 0u) << cls;
+    EXPECT_GT(j["texture_bytes"].get<std::uint64_t>(),
+              j["volume_texture_bytes"].get<std::uint64_t>())
+        << cls;
   }
 }
 
