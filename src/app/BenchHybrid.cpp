@@ -19,8 +19,9 @@
 #include "tessera/reference/ReferenceOverlay.h"
 #include "tessera/render/HybridCompositor.h"
 #include "tessera/render/HybridRaycastTechnique.h"
-#include "tessera/render/HybridSlice3DTechnique.h"
+#include "tessera/render/HybridSliceTechnique.h"
 #include "tessera/render/Raycaster.h"
+#include "tessera/render/Slice2DRenderer.h"
 #include "tessera/render/Slice3DRenderer.h"
 
 namespace tessera::app {
@@ -179,8 +180,12 @@ nlohmann::json speedTable(gpu::GlContext& context, const Volume& volume,
   render::Slice3DRenderer slicer(context, volume, layout);
   slicer.setTransferFunction(tf);
   slicer.prepare(settings);
-  render::HybridSlice3DTechnique slice3d(context, slicer);
-  const std::vector<render::HybridTechnique*> techniques{raycast.technique.get(), &slice3d};
+  render::HybridSliceTechnique<render::Slice3DRenderer> slice3d("slice3d", slicer);
+  render::Slice2DRenderer stacks(context, volume, render::Slice2DOptions{});
+  stacks.setTransferFunction(tf);
+  render::HybridSliceTechnique<render::Slice2DRenderer> slice2d("slice2d", stacks);
+  const std::vector<render::HybridTechnique*> techniques{raycast.technique.get(), &slice3d,
+                                                         &slice2d};
   render::HybridCompositor compositor(context);
   compositor.setOverlayLines(
       render::overlayLines(volume, render::OverlayOptions::parse("box,axes")));

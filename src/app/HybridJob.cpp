@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include <nlohmann/json.hpp>
 
@@ -14,7 +15,10 @@
 #include "tessera/reference/ReferenceOverlay.h"
 #include "tessera/reference/ReferenceRaycaster.h"
 #include "tessera/render/HybridRaycastTechnique.h"
+#include "tessera/render/HybridSliceTechnique.h"
 #include "tessera/render/Raycaster.h"
+#include "tessera/render/Slice2DRenderer.h"
+#include "tessera/render/Slice3DRenderer.h"
 
 namespace tessera::app {
 
@@ -34,30 +38,69 @@ HybridResult runHybridRender(DeviceSession& device, const Volume& fullVolume,
                      " needs --mode composite");
   }
   gpu::GlContext& context = *device.context;
-  const render::RaycastPlan rp = render::planRaycast(device.limits, fullVolume, req.layout,
-                                                     req.width, req.height, req.skipBlock);
+  // slice2d keeps its own slice stacks; the others sample a planned layout.
   Volume reduced;
-  if (rp.plan.downsampled()) reduced = lod::downsample(fullVolume, rp.plan.downsample);
-  const Volume& volume = rp.plan.downsampled() ? reduced : fullVolume;
-  auto layout = layout::createLayout(rp.plan, volume, device.limits, context.ledger());
+  const Volume* volumeToRender = &fullVolume;
+  std::unique_ptr<layout::Layout> layout;
+  std::string layoutName = "slice-stacks";
+  if (req.technique != "slice2d") {
+    const render::RaycastPlan rp =
+        render::planRaycast(device.limits, fullVolume, req.layout, req.width, req.height,
+                            req.technique == "raycast" ? req.skipBlock : 0);
+    req.skipBlock = rp.skipBlock;
+    if (rp.plan.downsampled()) {
+      reduced = lod::downsample(fullVolume, rp.plan.downsample);
+      volumeToRender = &reduced;
+    }
+    layout = layout::createLayout(rp.plan, *volumeToRender, device.limits, context.ledger());
+    layoutName = layout->name();
+  } else if (req.layout != "auto") {
+    throw InputError("--layout does not apply to slice2d: it stores its own slice stacks");
+  }
+  const Volume& volume = *volumeToRender;
 
-  render::Raycaster caster(context, volume, *layout);
-  caster.setSkipBlockSize(rp.skipBlock);
-  caster.setLutSize(req.lutSize);
-  caster.setTransferFunction(tf);
-  caster.prepare(req.settings);
-  render::HybridRaycastTechnique technique(caster);
+  std::unique_ptr<render::Raycaster> caster;
+  std::unique_ptr<render::Slice3DRenderer> slice3d;
+  std::unique_ptr<render::Slice2DRenderer> slice2d;
+  std::unique_ptr<render::HybridTechnique> technique;
+  if (req.technique == "raycast") {
+    caster = std::make_unique<render::Raycaster>(context, volume, *layout);
+    caster->setSkipBlockSize(req.skipBlock);
+    caster->setLutSize(req.lutSize);
+    caster->setTransferFunction(tf);
+    caster->prepare(req.settings);
+    technique = std::make_unique<render::HybridRaycastTechnique>(*caster);
+  } else if (req.technique == "slice3d") {
+    slice3d = std::make_unique<render::Slice3DRenderer>(context, volume, *layout);
+    slice3d->setSliceCount(req.slices);
+    slice3d->setTransferFunction(tf);
+    slice3d->prepare(req.settings);
+    technique = std::make_unique<render::HybridSliceTechnique<render::Slice3DRenderer>>("slice3d",
+                                                                                        *slice3d);
+  } else if (req.technique == "slice2d") {
+    render::Slice2DOptions options;
+    options.classification = render::parseSliceClassification(req.classify);
+    options.maxTextureSize = device.limits.max2DTextureSize;
+    slice2d = std::make_unique<render::Slice2DRenderer>(context, volume, options);
+    slice2d->setSliceCount(req.slices);
+    slice2d->setTransferFunction(tf);
+    technique = std::make_unique<render::HybridSliceTechnique<render::Slice2DRenderer>>("slice2d",
+                                                                                        *slice2d);
+  } else {
+    throw InputError("--technique '" + req.technique + "': expected raycast, slice3d or slice2d");
+  }
   render::HybridCompositor compositor(context);
   compositor.setOverlayLines(render::overlayLines(volume, hybrid.overlays));
   req.camera.frame(volume.extent());
 
   HybridResult result;
-  result.layout = layout->name();
+  result.layout = layoutName;
+  result.technique = req.technique;
   for (int i = 0; i < req.repeat; ++i) {
     Camera cam = req.camera;
     cam.azimuthDeg += i * req.rotateDeg;
     const auto t0 = std::chrono::steady_clock::now();
-    compositor.render(technique, cam, req.settings, volume.extent(), req.width, req.height,
+    compositor.render(*technique, cam, req.settings, volume.extent(), req.width, req.height,
                       hybrid.hybrid);
     result.frameMs.push_back(msSince(t0));
     if (i == 0) {
@@ -97,6 +140,7 @@ void printHybridResult(const HybridResult& r, const RenderRequest& req, const Hy
     j["width"] = req.width;
     j["height"] = req.height;
     j["offscreen"] = {low.x, low.y};
+    j["volume_target"] = {r.firstTimings.rendered.x, r.firstTimings.rendered.y};
     j["overlays"] = h.overlays.describe();
     j["overlay_opacity"] = render::overlayOpacityName(h.hybrid.opacity);
     j["frames"] = r.frameMs.size();
@@ -106,6 +150,7 @@ void printHybridResult(const HybridResult& r, const RenderRequest& req, const Hy
     j["overlay_ms"] = r.firstTimings.overlayMs;
     j["composite_ms"] = r.firstTimings.compositeMs;
     j["volume_passes"] = r.firstTimings.volumePasses;
+    j["technique"] = r.technique;
     j["layout"] = r.layout;
     j["texture_bytes"] = r.textureBytes;
     j["gl_renderer"] = device.context->caps().renderer;
@@ -120,8 +165,9 @@ void printHybridResult(const HybridResult& r, const RenderRequest& req, const Hy
     std::printf("%s\n", j.dump(2).c_str());
     return;
   }
-  std::printf("wrote %s (%dx%d): hybrid, volume at %dx%d, overlays %s, opacity %s\n", out.c_str(),
-              req.width, req.height, low.x, low.y, h.overlays.describe().c_str(),
+  std::printf("wrote %s (%dx%d): hybrid %s, volume at %dx%d, overlays %s, opacity %s\n",
+              out.c_str(), req.width, req.height, r.technique.c_str(), r.firstTimings.rendered.x,
+              r.firstTimings.rendered.y, h.overlays.describe().c_str(),
               render::overlayOpacityName(h.hybrid.opacity).c_str());
   std::printf("gpu      %s; layout %s; %s on the GPU\n", device.context->caps().renderer.c_str(),
               r.layout.c_str(), formatBytes(r.textureBytes).c_str());

@@ -25,6 +25,7 @@ struct HybridResult {
   double groundTruthMs = 0.0;
   std::optional<double> psnrDb;
   std::optional<double> ssim;
+  std::string technique;
   std::string layout;
   std::uint64_t textureBytes = 0;
 };

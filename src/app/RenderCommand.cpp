@@ -112,16 +112,14 @@ void runRenderCommand(const RenderOptions& o) {
     volume.setWindow({o.window[0], o.window[1]});
   }
 
+  // Checked even when nothing uses it, so that a typo is not silently ignored.
+  const render::OverlayOpacity overlayOpacity = render::parseOverlayOpacity(o.overlayOpacity);
   if (!o.overlays.empty() || !o.offscreen.empty() || !o.roi.empty()) {
-    if (o.technique != "raycast") {
-      throw InputError(
-          "--overlays/--offscreen: the hybrid compositor runs with --technique raycast");
-    }
     HybridRequest h;
     h.overlays = render::OverlayOptions::parse(o.overlays);
     if (!o.roi.empty()) h.overlays.setRoiVoxels(o.roi, volume);
     h.hybrid.offscreen = render::OffscreenSize::parse(o.offscreen.empty() ? "full" : o.offscreen);
-    h.hybrid.opacity = render::parseOverlayOpacity(o.overlayOpacity);
+    h.hybrid.opacity = overlayOpacity;
     const HybridResult hr = runHybridRender(device, volume, tf, req, h);
     hr.image.writePng(o.out);
     if (hr.groundTruth && !o.referenceOut.empty()) hr.groundTruth->writePng(o.referenceOut);

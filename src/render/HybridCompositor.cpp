@@ -64,7 +64,9 @@ OverlayOpacity parseOverlayOpacity(const std::string& name) {
 
 OffscreenSize OffscreenSize::ofFactor(double f) {
   if (!(f > 0.0 && f <= 1.0)) {
-    throw InputError("offscreen factor must be in (0, 1], got " + std::to_string(f));
+    char got[32];
+    std::snprintf(got, sizeof got, "%g", f);
+    throw InputError(std::string("--offscreen factor must be in (0, 1], got ") + got);
   }
   OffscreenSize s;
   s.factor = f;

@@ -15,8 +15,10 @@
 #include "tessera/reference/ReferenceOverlay.h"
 #include "tessera/render/HybridCompositor.h"
 #include "tessera/render/HybridRaycastTechnique.h"
-#include "tessera/render/HybridSlice3DTechnique.h"
+#include "tessera/render/HybridSliceTechnique.h"
 #include "tessera/render/Raycaster.h"
+#include "tessera/render/Slice2DRenderer.h"
+#include "tessera/render/Slice3DRenderer.h"
 
 using namespace tessera;
 using render::HybridOptions;
@@ -231,21 +233,44 @@ TEST(Hybrid, RunsInAnEs2Context) {
   EXPECT_GT(p, 22.0);
 }
 
-// View-aligned slicing plugs into the same compositor; it renders a target of
-// the screen's shape with the requested number of pixels.
-TEST(Hybrid, Slice3DPlugsIntoTheCompositor) {
-  gpu::GlContext& c = test::gpuContext();
-  Scene scene(c);
-  render::Slice3DRenderer slicer(c, scene.volume, *scene.layout);
+namespace {
+
+// A slicer through the compositor at a 128x128 target vs its own frame at the
+// screen's full resolution: it renders the target in the screen's shape with
+// the requested number of pixels, and the upscaled image stays close.
+template <class Slicer>
+void expectSlicerPlugsIntoTheCompositor(const char* name, Scene& scene, Slicer& slicer) {
   slicer.setTransferFunction(scene.tf);
-  render::HybridSlice3DTechnique technique(c, slicer);
+  render::HybridSliceTechnique<Slicer> technique(name, slicer);
   const int w = 256, h = 192;
   const Image full = slicer.render(scene.camera, scene.settings, w, h);
   scene.compositor->render(technique, scene.camera, scene.settings, scene.volume.extent(), w, h,
                            {OffscreenSize::ofSize(128, 128), OverlayOpacity::Alpha});
   EXPECT_EQ(scene.compositor->timings().rendered, glm::ivec2(148, 111));
   const double p = psnr(scene.compositor->readImage(), full);
-  std::printf("  [measured] slice3d 148x111 upscaled vs full %dx%d: %.2f dB\n", w, h, p);
+  std::printf("  [measured] %s 148x111 upscaled vs full %dx%d: %.2f dB\n", name, w, h, p);
   EXPECT_GT(litPixels(full), w * h / 16);
   EXPECT_GT(p, 30.0);
+}
+
+}  // namespace
+
+TEST(Hybrid, Slice3DPlugsIntoTheCompositor) {
+  gpu::GlContext& c = test::gpuContext();
+  Scene scene(c);
+  render::Slice3DRenderer slicer(c, scene.volume, *scene.layout);
+  expectSlicerPlugsIntoTheCompositor("slice3d", scene, slicer);
+}
+
+TEST(Hybrid, Slice2DPlugsIntoTheCompositor) {
+  gpu::GlContext& c = test::gpuContext();
+  Scene scene(c);
+  render::Slice2DRenderer slicer(c, scene.volume, render::Slice2DOptions{});
+  expectSlicerPlugsIntoTheCompositor("slice2d", scene, slicer);
+}
+
+TEST(Hybrid, SliceTargetKeepsThePixelCountInTheScreensShape) {
+  EXPECT_EQ(render::sliceTargetSize(128, 128, 480.0 / 640.0), glm::ivec2(111, 148));
+  EXPECT_EQ(render::sliceTargetSize(128, 128, 1024.0 / 768.0), glm::ivec2(148, 111));
+  EXPECT_EQ(render::sliceTargetSize(240, 320, 480.0 / 640.0), glm::ivec2(240, 320));
 }
