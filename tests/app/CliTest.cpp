@@ -97,7 +97,12 @@ TEST(Cli, TruncatedNiftiFailsFastWithClearError) {
   EXPECT_NE(r.exitCode, 0);
   EXPECT_EQ(countLines(r.out), 1) << r.out;
   EXPECT_NE(r.out.find(f.string()), std::string::npos) << r.out;
-  EXPECT_LT(r.seconds, 1.0);
+  // A guard against hangs, not a speed test: the wall time of a whole process
+  // (GL start-up included, and ASan's under `scripts/sanitize.sh` on a busy
+  // machine) is no measure of the reader. Refusal within a second and without
+  // large allocations is measured in-process for every corpus file
+  // (io/BadCorpusTest.cpp); the command itself takes ~0.1 s here.
+  EXPECT_LT(r.seconds, 15.0);
   EXPECT_FALSE(fs::exists(dir / "t.png"));
   const CliRun info = run("info " + f.string());
   EXPECT_NE(info.exitCode, 0);
