@@ -54,8 +54,6 @@ HybridResult runHybridRender(DeviceSession& device, const Volume& fullVolume,
     }
     layout = layout::createLayout(rp.plan, *volumeToRender, device.limits, context.ledger());
     layoutName = layout->name();
-  } else if (req.layout != "auto") {
-    throw InputError("--layout does not apply to slice2d: it stores its own slice stacks");
   }
   const Volume& volume = *volumeToRender;
 
@@ -78,10 +76,8 @@ HybridResult runHybridRender(DeviceSession& device, const Volume& fullVolume,
     technique = std::make_unique<render::HybridSliceTechnique<render::Slice3DRenderer>>("slice3d",
                                                                                         *slice3d);
   } else if (req.technique == "slice2d") {
-    render::Slice2DOptions options;
-    options.classification = render::parseSliceClassification(req.classify);
-    options.maxTextureSize = device.limits.max2DTextureSize;
-    slice2d = std::make_unique<render::Slice2DRenderer>(context, volume, options);
+    slice2d = std::make_unique<render::Slice2DRenderer>(context, volume,
+                                                        slice2dOptions(req, device.limits));
     slice2d->setSliceCount(req.slices);
     slice2d->setTransferFunction(tf);
     technique = std::make_unique<render::HybridSliceTechnique<render::Slice2DRenderer>>("slice2d",

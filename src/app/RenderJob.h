@@ -15,6 +15,7 @@
 #include "tessera/layout/Planner.h"
 #include "tessera/render/DeviceSession.h"
 #include "tessera/render/RaycastPlan.h"
+#include "tessera/render/Slice2DRenderer.h"
 
 namespace tessera::app {
 
@@ -65,6 +66,11 @@ struct RenderResult {
 
 RenderResult runRender(DeviceSession& device, const Volume& volume, const TransferFunction& tf,
                        RenderRequest request);
+// Axis-aligned slicing's options from a request and the device: the
+// classification asked for, atlases within the device's texture size. Refuses
+// --layout, which does not apply (slice2d stores its own slice stacks).
+render::Slice2DOptions slice2dOptions(const RenderRequest& req, const gpu::DeviceLimits& limits);
+
 // runRender for technique slice3d / slice2d.
 RenderResult runSliceRender(DeviceSession& device, const Volume& volume, const TransferFunction& tf,
                             RenderRequest request);

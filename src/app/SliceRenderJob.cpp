@@ -40,6 +40,16 @@ void renderFrames(Renderer& renderer, Prepare prepare, const Volume& volume,
 
 }  // namespace
 
+render::Slice2DOptions slice2dOptions(const RenderRequest& req, const gpu::DeviceLimits& limits) {
+  if (req.layout != "auto") {
+    throw InputError("--layout does not apply to slice2d: it stores its own slice stacks");
+  }
+  render::Slice2DOptions options;
+  options.classification = render::parseSliceClassification(req.classify);
+  options.maxTextureSize = limits.max2DTextureSize;
+  return options;
+}
+
 RenderResult runSliceRender(DeviceSession& device, const Volume& fullVolume,
                             const TransferFunction& tf, RenderRequest req) {
   if (req.technique != "slice3d" && req.technique != "slice2d") {
@@ -76,12 +86,7 @@ RenderResult runSliceRender(DeviceSession& device, const Volume& fullVolume,
                        " view-aligned slices, accumulation " + renderer.accumulationFormat() +
                        ", no early termination";
   } else {
-    if (req.layout != "auto") {
-      throw InputError("--layout does not apply to slice2d: it stores its own slice stacks");
-    }
-    render::Slice2DOptions options;
-    options.classification = render::parseSliceClassification(req.classify);
-    options.maxTextureSize = device.limits.max2DTextureSize;
+    const render::Slice2DOptions options = slice2dOptions(req, device.limits);
     render::Slice2DRenderer renderer(context, *volume, options);
     renderer.setSliceCount(req.slices);
     renderFrames(
