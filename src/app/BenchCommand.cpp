@@ -83,7 +83,7 @@ void runBench(const BenchOptions& o) {
   variants.push_back({"ERT + empty-space skipping 8^3", 8, 0.99, nullptr, {}, {}, 0, 0, 0});
   variants.push_back({"ERT + empty-space skipping 16^3", 16, 0.99, nullptr, {}, {}, 0, 0, 0});
   Camera camera;
-  camera.frame(volume.extent());
+  camera.frame(volume);
   for (Variant& v : variants) {
     v.settings.stepVoxels = o.step;
     v.settings.ertThreshold = v.ert;
@@ -206,7 +206,7 @@ void runLayoutBench(const BenchOptions& o) {
   RenderSettings settings;
   settings.stepVoxels = o.step;
   Camera camera;
-  camera.frame(volume.extent());
+  camera.frame(volume);
   for (LayoutVariant& v : variants) {
     v.caster = std::make_unique<render::Raycaster>(*context, volume, *v.layout);
     v.caster->setTransferFunction(tf);

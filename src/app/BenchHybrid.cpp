@@ -94,7 +94,7 @@ nlohmann::json qualityTable(gpu::GlContext& context, const Volume& volume,
       {"coloured, box", colouredTf(), "box"},
       {"coloured, box+axes+roi", colouredTf(), "box,axes,roi"}};
   Camera camera;
-  camera.frame(volume.extent());
+  camera.frame(volume);
   camera.azimuthDeg = 35;
   camera.elevationDeg = 20;
   camera.zoom = 0.8;  // the whole box in the portrait screen
@@ -192,7 +192,7 @@ nlohmann::json speedTable(gpu::GlContext& context, const Volume& volume,
   const std::vector<glm::ivec2> screens{{480, 640}, {1024, 768}};
   const std::vector<std::string> sizes{"full", "128x128", "256x256", "256x512"};
   Camera camera;
-  camera.frame(volume.extent());
+  camera.frame(volume);
   nlohmann::json j = nlohmann::json::array();
   if (print) {
     std::printf(

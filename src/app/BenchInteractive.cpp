@@ -52,7 +52,7 @@ void runInteractiveBench(const HybridBenchOptions& o) {
   compositor.setOverlayLines(
       render::overlayLines(volume, render::OverlayOptions::parse("box,axes")));
   Camera camera;
-  camera.frame(volume.extent());
+  camera.frame(volume);
 
   auto renderAt = [&](const Camera& cam, const render::QualityLevel& q) {
     RenderSettings s = full;

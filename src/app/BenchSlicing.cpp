@@ -53,6 +53,7 @@ std::string fmt(const char* f, double v) {
 Volume resample(const Volume& v, glm::ivec3 dims) {
   Volume out = Volume::allocate(dims, ScalarType::U8, "resampled");
   out.setSpacing(v.extent() / glm::dvec3(dims));
+  out.setDirection(v.direction());
   const ValueRange r = v.valueRange();
   const double scale = r.max > r.min ? 255.0 / (r.max - r.min) : 0.0;
   std::uint8_t* dst = out.dataAs<std::uint8_t>();
@@ -96,7 +97,7 @@ Camera benchCamera(const Volume& v) {
   Camera cam;
   cam.azimuthDeg = 30;
   cam.elevationDeg = 20;
-  cam.frame(v.extent());
+  cam.frame(v);
   return cam;
 }
 

@@ -88,7 +88,9 @@ std::pair<glm::ivec3, glm::ivec3> parseCrop(const std::string& text, glm::ivec3 
 Volume crop(const Volume& v, glm::ivec3 lo, glm::ivec3 hi) {
   Volume out = Volume::allocate(hi - lo, v.type(), "cropped volume");
   out.setSpacing(v.spacing());
-  out.setOrigin(v.origin() + glm::dvec3(lo) * v.spacing());
+  out.setDirection(v.direction());
+  out.setOrigin(v.worldOf(glm::dvec3(lo)));
+  out.setGeometrySource(v.geometrySource());
   if (v.hasWindow()) out.setWindow(v.window());
   out.setDescription(v.description());
   const std::size_t bpv = bytesPerVoxel(v.type());

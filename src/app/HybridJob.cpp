@@ -87,7 +87,7 @@ HybridResult runHybridRender(DeviceSession& device, const Volume& fullVolume,
   }
   render::HybridCompositor compositor(context);
   compositor.setOverlayLines(render::overlayLines(volume, hybrid.overlays));
-  req.camera.frame(volume.extent());
+  req.camera.frame(volume);
 
   HybridResult result;
   result.layout = layoutName;

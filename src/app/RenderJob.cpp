@@ -75,7 +75,7 @@ RenderResult runRender(DeviceSession& device, const Volume& fullVolume, const Tr
   caster.setSkipBlockSize(req.skipBlock);
   caster.setLutSize(req.lutSize);
   caster.setTransferFunction(tf);
-  req.camera.frame(volume.extent());
+  req.camera.frame(volume);
   const auto tPrepare = std::chrono::steady_clock::now();
   caster.prepare(req.settings);
   result.prepareMs = msSince(tPrepare);

@@ -24,7 +24,7 @@ template <class Renderer, class Prepare>
 void renderFrames(Renderer& renderer, Prepare prepare, const Volume& volume,
                   const TransferFunction& tf, RenderRequest& req, RenderResult& result) {
   renderer.setTransferFunction(tf);
-  req.camera.frame(volume.extent());
+  req.camera.frame(volume);
   const auto tPrepare = std::chrono::steady_clock::now();
   prepare();
   result.prepareMs = msSince(tPrepare);

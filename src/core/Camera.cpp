@@ -4,6 +4,9 @@
 
 #include <glm/geometric.hpp>
 #include <glm/gtc/constants.hpp>
+#include <glm/matrix.hpp>
+
+#include "tessera/core/PatientFrame.h"
 
 namespace tessera {
 
@@ -15,6 +18,13 @@ double radians(double deg) {
 
 void Camera::frame(glm::dvec3 extent) {
   radius = 0.5 * glm::length(extent);
+}
+
+void Camera::frame(const Volume& volume) {
+  frame(volume.extent());
+  // The renderer's model box is axis-aligned, so a sheared (gantry-tilted)
+  // frame is drawn with its nearest rotation; `info` reports the shear.
+  modelFromWorld = glm::transpose(nearestOrthonormal(volume.direction()));
 }
 
 glm::dmat3 Camera::basis() const {
@@ -31,7 +41,7 @@ glm::dmat3 Camera::basis() const {
   // screen's right is world -x.
   const glm::dvec3 right(-ca, sa, 0.0);
   const glm::dvec3 up = glm::cross(back, right);
-  return glm::dmat3(right, up, back);
+  return modelFromWorld * glm::dmat3(right, up, back);
 }
 
 double Camera::distance() const {

@@ -5,6 +5,9 @@
 #include <cstring>
 #include <limits>
 
+#include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
+
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 
@@ -79,6 +82,55 @@ void Volume::setSpacing(glm::dvec3 spacing) {
     }
   }
   spacing_ = spacing;
+}
+
+glm::dmat4 Volume::indexToWorld() const {
+  glm::dmat4 m(1.0);
+  for (int a = 0; a < 3; ++a) m[a] = glm::dvec4(direction_[a] * spacing_[a], 0.0);
+  m[3] = glm::dvec4(origin_, 1.0);
+  return m;
+}
+
+glm::dvec3 Volume::worldOf(glm::dvec3 index) const {
+  return direction_ * (spacing_ * index) + origin_;
+}
+
+glm::dvec3 Volume::worldCentre() const {
+  return worldOf(0.5 * (glm::dvec3(dims_) - 1.0));
+}
+
+void Volume::setIndexToWorld(const glm::dmat4& affine) {
+  glm::dmat3 d;
+  glm::dvec3 sp;
+  for (int a = 0; a < 3; ++a) {
+    d[a] = glm::dvec3(affine[a]);
+    sp[a] = glm::length(d[a]);
+  }
+  const glm::dvec3 o(affine[3]);
+  if (!std::isfinite(o.x) || !std::isfinite(o.y) || !std::isfinite(o.z)) {
+    throw InputError("index-to-world affine has a non-finite origin");
+  }
+  setSpacing(sp);
+  setDirection(d);
+  origin_ = o;
+}
+
+void Volume::setDirection(const glm::dmat3& direction) {
+  glm::dmat3 d;
+  for (int a = 0; a < 3; ++a) {
+    const double len = glm::length(direction[a]);
+    if (!std::isfinite(len) || len <= 0.0) {
+      throw InputError("direction of index axis " + std::to_string(a) +
+                       " is zero or not finite; expected a unit vector");
+    }
+    d[a] = direction[a] / len;
+  }
+  // |det| of unit columns is the volume of their parallelepiped: near 0 means
+  // two axes (almost) coincide and the voxels would collapse onto a plane.
+  if (std::abs(glm::determinant(d)) < 1e-6) {
+    throw InputError("index axes' directions are (nearly) parallel; the affine is singular");
+  }
+  direction_ = d;
 }
 
 double Volume::valueAtIndex(std::size_t i) const {

@@ -17,7 +17,11 @@ Volume downsample(const Volume& volume, glm::ivec3 factor) {
   const glm::ivec3 out = (d + factor - 1) / factor;
   Volume result = Volume::allocate(out, volume.type(), "downsampled volume");
   result.setSpacing(volume.spacing() * glm::dvec3(factor));
-  result.setOrigin(volume.origin());
+  result.setDirection(volume.direction());
+  // An output voxel averages `factor` input voxels, so its centre lies
+  // (factor - 1) / 2 input voxels past the first of them.
+  result.setOrigin(volume.worldOf(0.5 * (glm::dvec3(factor) - 1.0)));
+  result.setGeometrySource(volume.geometrySource());
   if (volume.hasWindow()) result.setWindow(volume.window());
   result.setDescription(volume.description() + " (downsampled " + std::to_string(factor.x) + "x" +
                         std::to_string(factor.y) + "x" + std::to_string(factor.z) + ")");

@@ -131,7 +131,7 @@ void Viewer::setVolume(Volume volume, const std::string& name) {
 
 void Viewer::resetCamera() {
   camera_ = Camera{};
-  if (volume_->hasData()) camera_.frame(volume_->extent());
+  if (volume_->hasData()) camera_.frame(*volume_);
 }
 
 void Viewer::setWindow(ValueRange w) {

@@ -1,9 +1,18 @@
 #pragma once
-// Orbit camera around a target (the volume's centre by default). The world
-// box of a volume is extent() centred at the origin; world +z is "up".
-// azimuth 0 / elevation 0 looks from +y towards -y (the face of a RAS head).
+// Orbit camera around a target (the volume's centre by default).
+//
+// Angles are in the patient frame (RAS+, core/PatientFrame.h): world +z
+// (Superior) is "up", azimuth 0 / elevation 0 looks from +y (Anterior)
+// towards -y, i.e. at the face, with the patient's right on the screen's
+// left. Renderers work in a volume's model frame (extent() centred at the
+// origin, axes along the index axes); `modelFromWorld` turns the camera
+// into that frame, so basis(), eye() and the rays are model-frame
+// quantities and every storage order of the same anatomy gives the same
+// image. frame(volume) sets it from the volume's direction cosines.
 #include <glm/mat3x3.hpp>
 #include <glm/vec3.hpp>
+
+#include "tessera/core/Volume.h"
 
 namespace tessera {
 
@@ -24,10 +33,17 @@ class Camera {
   glm::dvec3 target{0.0};  // orbit centre (pan moves it)
   double radius = 1.0;     // radius of the sphere framed at zoom 1
 
+  // World (patient) directions -> model-frame directions: the inverse of the
+  // volume's (orthonormalised) direction matrix. Identity for RAS storage.
+  glm::dmat3 modelFromWorld{1.0};
+
   // Frames a box of the given extent (sets radius = half its diagonal).
   void frame(glm::dvec3 extent);
+  // Frames the volume and orients the camera by its direction cosines.
+  void frame(const Volume& volume);
 
-  // Camera basis: columns right, up, back (forward = -back).
+  // Camera basis in the model frame: columns right, up, back (forward =
+  // -back). Orthonormal; left-handed when the volume's storage is mirrored.
   glm::dmat3 basis() const;
   glm::dvec3 eye() const;
   double distance() const;         // eye to target

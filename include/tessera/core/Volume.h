@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <glm/mat3x3.hpp>
+#include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
 #include "tessera/core/ScalarType.h"
@@ -36,14 +38,35 @@ class Volume {
 
   glm::ivec3 dims() const { return dims_; }
   glm::dvec3 spacing() const { return spacing_; }
+  // World position (RAS+ mm, see core/PatientFrame.h) of voxel (0,0,0)'s centre.
   glm::dvec3 origin() const { return origin_; }
+  // Unit world directions of the index axes (columns); identity = RAS storage.
+  const glm::dmat3& direction() const { return direction_; }
   ScalarType type() const { return type_; }
   std::uint64_t voxelCount() const;
   std::uint64_t byteSize() const { return data_.size(); }
 
-  // Physical extent of the volume: dims * spacing (the world box of the
-  // renderer is this size, centred at the world origin).
+  // Physical extent of the volume: dims * spacing. Renderers work in the
+  // volume's model frame: a box of this size centred at the origin with its
+  // axes along the index axes; Camera::frame(volume) places the camera in
+  // that frame from its patient-space (world) angles.
   glm::dvec3 extent() const { return glm::dvec3(dims_) * spacing_; }
+
+  // The full index -> world affine of voxel centres:
+  // world = direction * diag(spacing) * index + origin.
+  glm::dmat4 indexToWorld() const;
+  glm::dvec3 worldOf(glm::dvec3 index) const;
+  // World position of the volume's centre (the camera's orbit centre).
+  glm::dvec3 worldCentre() const;
+  // Decomposes an affine into spacing (column lengths), direction (unit
+  // columns) and origin. Throws InputError if it is singular or not finite.
+  void setIndexToWorld(const glm::dmat4& affine);
+  // Throws InputError unless the columns are finite and independent; they
+  // are normalised to unit length.
+  void setDirection(const glm::dmat3& direction);
+  // Where the geometry came from, for `info` ("NIfTI sform (code 4, MNI)").
+  const std::string& geometrySource() const { return geometrySource_; }
+  void setGeometrySource(std::string s) { geometrySource_ = std::move(s); }
 
   // Throws InputError if any spacing component is not finite and > 0.
   void setSpacing(glm::dvec3 spacing);
@@ -88,6 +111,8 @@ class Volume {
   glm::ivec3 dims_{0, 0, 0};
   glm::dvec3 spacing_{1.0, 1.0, 1.0};
   glm::dvec3 origin_{0.0, 0.0, 0.0};
+  glm::dmat3 direction_{1.0};
+  std::string geometrySource_;
   ScalarType type_ = ScalarType::U8;
   std::vector<std::byte> data_;
   mutable ValueRange range_;
