@@ -13,6 +13,7 @@ PACKAGES=(
   mricron-data                                           # the default volume (ch2 T1 MRI head)
   libglfw3-dev libimgui-dev xvfb xauth                   # desktop viewer (tessera view), tested under Xvfb
   emscripten nodejs chromium                             # web viewer (scripts/web.sh) and its browser test
+  python3-nibabel python3-pydicom python3-numpy          # independent NIfTI/DICOM readers in geometry tests
 )
 
 # playwright-core for the browser test, pinned by tests/browser/package-lock.json.

@@ -7,6 +7,7 @@
 #include "app/Commands.h"
 #include "tessera/core/Histogram.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/core/PatientFrame.h"
 #include "tessera/io/DicomSeriesReader.h"
 #include "tessera/io/VolumeReader.h"
 
@@ -26,6 +27,14 @@ struct InfoOptions {
   bool json = false;
 };
 
+// The index -> world (RAS+ mm) affine as 4 rows, as nibabel prints it.
+nlohmann::json affineRows(const Volume& v) {
+  const glm::dmat4 a = v.indexToWorld();
+  nlohmann::json rows = nlohmann::json::array();
+  for (int r = 0; r < 4; ++r) rows.push_back({a[0][r], a[1][r], a[2][r], a[3][r]});
+  return rows;
+}
+
 void runInfo(const InfoOptions& o) {
   const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
   const Volume v = readVolume(spec, {.dicomSeries = o.series});
@@ -41,6 +50,13 @@ void runInfo(const InfoOptions& o) {
     j["dims"] = {v.dims().x, v.dims().y, v.dims().z};
     j["spacing"] = {v.spacing().x, v.spacing().y, v.spacing().z};
     j["origin"] = {v.origin().x, v.origin().y, v.origin().z};
+    const Orientation orient = orientationOf(v.direction());
+    j["orientation"] = orient.code;
+    j["oblique"] = orient.oblique;
+    j["orientation_text"] = orient.describe();
+    j["affine"] = affineRows(v);
+    j["world_frame"] = "RAS";
+    j["geometry_source"] = v.geometrySource();
     j["type"] = std::string(scalarTypeName(v.type()));
     j["value_min"] = r.min;
     j["value_max"] = r.max;
@@ -65,6 +81,13 @@ void runInfo(const InfoOptions& o) {
   std::printf("dims        %d x %d x %d\n", v.dims().x, v.dims().y, v.dims().z);
   std::printf("spacing     %g x %g x %g\n", v.spacing().x, v.spacing().y, v.spacing().z);
   std::printf("extent      %g x %g x %g\n", v.extent().x, v.extent().y, v.extent().z);
+  std::printf("orientation %s%s%s\n", orientationOf(v.direction()).describe().c_str(),
+              v.geometrySource().empty() ? "" : ", from ", v.geometrySource().c_str());
+  const glm::dmat4 a = v.indexToWorld();
+  for (int row = 0; row < 3; ++row) {
+    std::printf("%s [%10.4f %10.4f %10.4f %10.4f]\n", row == 0 ? "affine (RAS)" : "            ",
+                a[0][row], a[1][row], a[2][row], a[3][row]);
+  }
   std::printf("type        %s\n", std::string(scalarTypeName(v.type())).c_str());
   std::printf("values      %g .. %g (mean %.4g)\n", r.min, r.max, h.mean());
   std::printf("percentiles 1%%: %.4g  50%%: %.4g  99%%: %.4g\n", h.percentile(0.01),
@@ -98,8 +121,10 @@ void runInfo(const InfoOptions& o) {
 
 void addInfoCommand(CLI::App& app) {
   auto opts = std::make_shared<InfoOptions>();
-  CLI::App* cmd = app.add_subcommand(
-      "info", "Print a volume's dims, spacing, type, value range, histogram summary and bytes");
+  CLI::App* cmd =
+      app.add_subcommand("info",
+                         "Print a volume's dims, spacing, orientation and index-to-world affine "
+                         "(RAS+ mm), type, value range, histogram summary and bytes");
   cmd->add_option("file", opts->file, kVolumeHelp);
   addSeriesOption(cmd, opts->series);
   cmd->add_flag("--json", opts->json, "Print one JSON object");
