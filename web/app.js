@@ -86,6 +86,7 @@
     frames++;
     refreshState();
     updateStatus();
+    updateOrientationLabels();
     return ms;
   }
 
@@ -98,6 +99,12 @@
       waiters.forEach((w) => w(ms));
     }
     requestAnimationFrame(loop);
+  }
+
+  // Patient directions at the view's edges; blank when the file has no orientation.
+  function updateOrientationLabels() {
+    const l = state.orientation_labels || {};
+    for (const edge of ['left', 'right', 'top', 'bottom']) $(`orient-${edge}`).textContent = l[edge] || '';
   }
 
   function updateStatus() {

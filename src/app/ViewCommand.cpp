@@ -66,6 +66,26 @@ std::string fileName(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
+// Patient-direction letters at the middle of each edge of the 3D view (the
+// region right of the panel), so sides can be checked at a glance.
+void drawOrientationLabels(const EdgeLabels& labels, float x0, float x1, float height) {
+  if (labels.left.empty()) return;
+  ImDrawList* draw = ImGui::GetForegroundDrawList();
+  const float pad = 8.0f;
+  const ImU32 colour = IM_COL32(255, 230, 120, 255);
+  auto put = [&](const std::string& text, float x, float y, float alignX, float alignY) {
+    const ImVec2 size = ImGui::CalcTextSize(text.c_str());
+    const ImVec2 at(x - alignX * size.x, y - alignY * size.y);
+    draw->AddText(ImVec2(at.x + 1, at.y + 1), IM_COL32(0, 0, 0, 255), text.c_str());
+    draw->AddText(at, colour, text.c_str());
+  };
+  const float cx = 0.5f * (x0 + x1), cy = 0.5f * height;
+  put(labels.left, x0 + pad, cy, 0.0f, 0.5f);
+  put(labels.right, x1 - pad, cy, 1.0f, 0.5f);
+  put(labels.top, cx, pad, 0.5f, 0.0f);
+  put(labels.bottom, cx, height - pad, 0.5f, 1.0f);
+}
+
 // The TF editor over the histogram (Moser & Weiskopf 2008): opacity points
 // over the histogram bars, colour points on a strip below. All editing goes
 // through viewer::TransferFunctionEditor, the model the web page uses too.
@@ -361,6 +381,8 @@ void runView(const ViewOptions& o) {
     ImGui::Separator();
     ImGui::TextWrapped("%s", status.c_str());
     ImGui::End();
+    drawOrientationLabels(v->orientationLabels(), kPanelWidth, static_cast<float>(ww),
+                          static_cast<float>(wh));
     ImGui::Render();
 
     // The volume: re-rendered only when something it shows changed.

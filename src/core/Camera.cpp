@@ -28,6 +28,10 @@ void Camera::frame(const Volume& volume) {
 }
 
 glm::dmat3 Camera::basis() const {
+  return modelFromWorld * worldBasis();
+}
+
+glm::dmat3 Camera::worldBasis() const {
   // Start looking from +y towards the origin with +z up, then tilt by the
   // elevation about the right axis and turn by the azimuth about world z.
   // Building the basis by rotation keeps it well defined at the poles.
@@ -41,7 +45,7 @@ glm::dmat3 Camera::basis() const {
   // screen's right is world -x.
   const glm::dvec3 right(-ca, sa, 0.0);
   const glm::dvec3 up = glm::cross(back, right);
-  return modelFromWorld * glm::dmat3(right, up, back);
+  return glm::dmat3(right, up, back);
 }
 
 double Camera::distance() const {
@@ -82,6 +86,11 @@ void Camera::pan(double dxFraction, double dyFraction) {
                        ? distance() * std::tan(0.5 * radians(fovYDeg))
                        : orthoHalfHeight();
   target += b[0] * (dxFraction * 2.0 * h) + b[1] * (dyFraction * 2.0 * h);
+}
+
+EdgeLabels edgeLabels(const Camera& camera) {
+  const glm::dmat3 b = camera.worldBasis();
+  return {directionLabel(-b[0]), directionLabel(b[0]), directionLabel(b[1]), directionLabel(-b[1])};
 }
 
 }  // namespace tessera

@@ -105,8 +105,8 @@ char directionLetter(const glm::dvec3& d) {
 
 std::string directionLabel(const glm::dvec3& d) {
   std::array<int, 3> order{0, 1, 2};
-  std::sort(order.begin(), order.end(),
-            [&](int a, int b) { return std::abs(d[a]) > std::abs(d[b]); });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return std::abs(d[a]) > std::abs(d[b]); });
   const double len = glm::length(d);
   std::string label;
   for (std::size_t i = 0; i < 3; ++i) {

@@ -129,6 +129,11 @@ void Viewer::setVolume(Volume volume, const std::string& name) {
   resetCamera();
 }
 
+EdgeLabels Viewer::orientationLabels() const {
+  if (!volume_ || !volume_->hasData() || volume_->geometrySource().empty()) return {};
+  return edgeLabels(camera_);
+}
+
 void Viewer::resetCamera() {
   camera_ = Camera{};
   if (volume_->hasData()) camera_.frame(*volume_);

@@ -95,3 +95,44 @@ TEST(Camera, PanMovesTargetInViewPlane) {
   EXPECT_NEAR(glm::dot(c.target, c.basis()[2]), 0.0, 1e-12);
   EXPECT_GT(glm::dot(c.target, c.basis()[0]), 0.0);
 }
+
+// Radiological convention seen from the face: the patient's right is on the
+// screen's left; from the patient's right side, anterior is on the right.
+TEST(Camera, EdgeLabelsFollowThePatientFrame) {
+  tessera::Camera cam;
+  tessera::EdgeLabels l = tessera::edgeLabels(cam);
+  EXPECT_EQ(l.left, "R");
+  EXPECT_EQ(l.right, "L");
+  EXPECT_EQ(l.top, "S");
+  EXPECT_EQ(l.bottom, "I");
+  cam.azimuthDeg = 90.0;
+  l = tessera::edgeLabels(cam);
+  EXPECT_EQ(l.left, "P");
+  EXPECT_EQ(l.right, "A");
+  cam.azimuthDeg = 180.0;
+  cam.elevationDeg = 90.0;  // from above
+  l = tessera::edgeLabels(cam);
+  EXPECT_EQ(l.left, "L");
+  EXPECT_EQ(l.right, "R");
+  EXPECT_EQ(l.top, "A");  // looking down on the head, the nose is at the top
+  cam.azimuthDeg = 40.0;
+  cam.elevationDeg = 0.0;
+  EXPECT_EQ(tessera::edgeLabels(cam).right, "LA");
+}
+
+// The camera's angles live in the patient frame; a mirrored storage turns
+// the model-frame basis, not the view of the anatomy.
+TEST(Camera, FrameOfAMirroredVolumeMirrorsTheModelBasisOnly) {
+  tessera::Volume v = tessera::Volume::shapeOnly({10, 12, 14}, tessera::ScalarType::U8);
+  v.setDirection(glm::dmat3(glm::dvec3(-1, 0, 0), glm::dvec3(0, 1, 0), glm::dvec3(0, 0, 1)));
+  tessera::Camera cam;
+  cam.azimuthDeg = 30.0;
+  cam.frame(v);
+  const glm::dmat3 world = cam.worldBasis();
+  const glm::dmat3 model = cam.basis();
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_DOUBLE_EQ(model[c].x, -world[c].x);
+    EXPECT_DOUBLE_EQ(model[c].y, world[c].y);
+    EXPECT_DOUBLE_EQ(model[c].z, world[c].z);
+  }
+}

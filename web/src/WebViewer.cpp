@@ -256,6 +256,11 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_state_json(int logHistogram) {
       j["window"] = {v.window().min, v.window().max};
       j["histogram"] = v.tfEditor().histogramHeights(logHistogram != 0);
     }
+    const EdgeLabels labels = v.orientationLabels();
+    j["orientation_labels"] = {{"left", labels.left},
+                               {"right", labels.right},
+                               {"top", labels.top},
+                               {"bottom", labels.bottom}};
     const Camera& c = v.camera();
     j["camera"] = {{"azimuth", c.azimuthDeg}, {"elevation", c.elevationDeg}, {"zoom", c.zoom}};
     j["frame_ms"] = v.lastFrame().ms;

@@ -9,6 +9,8 @@
 // into that frame, so basis(), eye() and the rays are model-frame
 // quantities and every storage order of the same anatomy gives the same
 // image. frame(volume) sets it from the volume's direction cosines.
+#include <string>
+
 #include <glm/mat3x3.hpp>
 #include <glm/vec3.hpp>
 
@@ -45,6 +47,8 @@ class Camera {
   // Camera basis in the model frame: columns right, up, back (forward =
   // -back). Orthonormal; left-handed when the volume's storage is mirrored.
   glm::dmat3 basis() const;
+  // The same basis in the patient (world) frame: right, up, back in RAS.
+  glm::dmat3 worldBasis() const;
   glm::dvec3 eye() const;
   double distance() const;         // eye to target
   double orthoHalfHeight() const;  // orthographic half height of the view
@@ -59,5 +63,14 @@ class Camera {
   // Moves the target in the view plane by a fraction of the view height.
   void pan(double dxFraction, double dyFraction);
 };
+
+// Patient directions at the edges of the screen, as radiology viewers label
+// them ("R" on the left edge when looking at the face): each is the
+// directionLabel() (core/PatientFrame.h) of the world direction that points
+// to that edge, so oblique views get two or three letters ("LA").
+struct EdgeLabels {
+  std::string left, right, top, bottom;
+};
+EdgeLabels edgeLabels(const Camera& camera);
 
 }  // namespace tessera

@@ -84,6 +84,11 @@ class Viewer {
   FrameStats render(int width, int height, unsigned framebuffer = 0, glm::ivec2 origin = {0, 0});
   const FrameStats& lastFrame() const { return last_; }
 
+  // Patient directions at the view's edges (R/L, A/P, S/I) for the current
+  // camera; empty strings when the volume's file carries no orientation
+  // (PVM, raw, generated volumes), where letters would be a guess.
+  EdgeLabels orientationLabels() const;
+
   // "ch2.nii.gz 181x217x181 u8, texture3d (...)" for a status bar.
   std::string description() const;
 
