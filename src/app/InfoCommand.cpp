@@ -60,6 +60,7 @@ void runInfo(const InfoOptions& o) {
     j["type"] = std::string(scalarTypeName(v.type()));
     j["value_min"] = r.min;
     j["value_max"] = r.max;
+    j["non_finite_voxels"] = v.nonFiniteCount();
     j["mean"] = h.mean();
     j["percentiles"] = {
         {"1", h.percentile(0.01)}, {"50", h.percentile(0.5)}, {"99", h.percentile(0.99)}};
@@ -90,6 +91,10 @@ void runInfo(const InfoOptions& o) {
   }
   std::printf("type        %s\n", std::string(scalarTypeName(v.type())).c_str());
   std::printf("values      %g .. %g (mean %.4g)\n", r.min, r.max, h.mean());
+  if (const std::uint64_t bad = v.nonFiniteCount()) {
+    std::printf("missing     %llu NaN/Inf voxels (%.2f %%), rendered transparent\n",
+                static_cast<unsigned long long>(bad), 100.0 * bad / v.voxelCount());
+  }
   std::printf("percentiles 1%%: %.4g  50%%: %.4g  99%%: %.4g\n", h.percentile(0.01),
               h.percentile(0.5), h.percentile(0.99));
   for (const auto& s : series) {

@@ -206,6 +206,19 @@ ValueRange Volume::valueRange() const {
   return range_;
 }
 
+std::uint64_t Volume::nonFiniteCount() const {
+  if (type_ != ScalarType::F32 || !hasData()) return 0;
+  const float* p = dataAs<float>();
+  const std::size_t n = static_cast<std::size_t>(voxelCount());
+  return static_cast<std::uint64_t>(
+      std::count_if(p, p + n, [](float v) { return !std::isfinite(v); }));
+}
+
+double Volume::finiteValueAtIndex(std::size_t i) const {
+  const double v = valueAtIndex(i);
+  return std::isfinite(v) ? v : nonFiniteValue();
+}
+
 ValueRange Volume::window() const {
   if (hasWindow_) return window_;
   ValueRange r = valueRange();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <thread>
 #include <vector>
 
@@ -43,7 +44,9 @@ Volume downsample(const Volume& volume, glm::ivec3 factor) {
             }
           }
           // Integer types round to nearest (setValueAtIndex clamps and rounds).
-          result.setValueAtIndex(result.index(ox, oy, oz), n ? sum / n : 0.0);
+          // A block of only NaN stays missing data (NaN), not a real 0.
+          result.setValueAtIndex(result.index(ox, oy, oz),
+                                 n ? sum / n : std::numeric_limits<double>::quiet_NaN());
         }
       }
     }

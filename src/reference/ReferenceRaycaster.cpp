@@ -19,10 +19,7 @@ namespace {
 // Volume values as doubles, converted once so sampling does no type switch.
 std::vector<double> toDoubles(const Volume& v) {
   std::vector<double> out(static_cast<std::size_t>(v.voxelCount()));
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    const double s = v.valueAtIndex(i);
-    out[i] = std::isfinite(s) ? s : 0.0;
-  }
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = v.finiteValueAtIndex(i);
   return out;
 }
 
@@ -63,7 +60,7 @@ double sampleTrilinear(const Volume& volume, glm::dvec3 p) {
     const int x = (c & 1) ? i1.x : i0.x, y = (c & 2) ? i1.y : i0.y, z = (c & 4) ? i1.z : i0.z;
     const double wt =
         ((c & 1) ? w.x : 1 - w.x) * ((c & 2) ? w.y : 1 - w.y) * ((c & 4) ? w.z : 1 - w.z);
-    acc += wt * volume.valueAt(x, y, z);
+    acc += wt * volume.finiteValueAtIndex(volume.index(x, y, z));
   }
   return acc;
 }

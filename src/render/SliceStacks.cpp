@@ -95,7 +95,7 @@ SliceStacks::SliceStacks(const Volume& volume) : dims_(volume.dims()) {
   }
   for (std::size_t i = 0; i < n; ++i) {
     indices_[i] = static_cast<std::uint8_t>(
-        std::lround(std::clamp((volume.valueAtIndex(i) - w.min) * scale, 0.0, 1.0) * 255.0));
+        std::lround(std::clamp((volume.finiteValueAtIndex(i) - w.min) * scale, 0.0, 1.0) * 255.0));
   }
 }
 

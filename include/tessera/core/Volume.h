@@ -96,6 +96,15 @@ class Volume {
   ValueRange valueRange() const;
   void invalidateRange() { rangeValid_ = false; }
 
+  // NaN and +-Inf voxels (f32 only; 0 for integer types): every renderer,
+  // the reference and the layouts read them as `nonFiniteValue()`, the
+  // bottom of the value range, which every TF preset maps to opacity 0, so
+  // missing data is transparent and all paths agree on it.
+  std::uint64_t nonFiniteCount() const;
+  double nonFiniteValue() const { return valueRange().min; }
+  // valueAtIndex with non-finite values replaced by nonFiniteValue().
+  double finiteValueAtIndex(std::size_t i) const;
+
   // The value window maps raw values to [0,1] for classification
   // (n = clamp((v - min) / (max - min), 0, 1)). Defaults to valueRange().
   ValueRange window() const;
