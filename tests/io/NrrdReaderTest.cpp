@@ -7,6 +7,8 @@
 #include <random>
 #include <vector>
 
+#include <glm/geometric.hpp>
+
 #include "io/IoFixtures.h"
 #include "tessera/core/Error.h"
 
@@ -164,7 +166,11 @@ TEST(NrrdReader, SpacingIsTheLengthOfEachSpaceDirection) {
   EXPECT_DOUBLE_EQ(v.spacing().x, 2.0);
   EXPECT_DOUBLE_EQ(v.spacing().y, 3.0);
   EXPECT_DOUBLE_EQ(v.spacing().z, 0.5);
-  EXPECT_EQ(v.origin(), glm::dvec3(1, 2, 3));
+  // left-posterior-superior: x and y negated into RAS.
+  EXPECT_EQ(v.origin(), glm::dvec3(-1, -2, 3));
+  EXPECT_NEAR(glm::distance(v.direction()[0], glm::dvec3(0, -0.6, 0.8)), 0.0, 1e-12);
+  EXPECT_EQ(v.direction()[1], glm::dvec3(-1, 0, 0));
+  EXPECT_EQ(v.direction()[2], glm::dvec3(0, 0, -1));
 }
 
 TEST(NrrdReader, ByteSkipMinusOneReadsTheLastBytes) {
