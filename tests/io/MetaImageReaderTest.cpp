@@ -185,7 +185,8 @@ TEST(MetaImageReader, ReadsAnItkStyleHeaderWithSynonymsAndUnknownKeys) {
   EXPECT_EQ(v.dims(), glm::ivec3(3, 2, 2));
   EXPECT_EQ(v.type(), ScalarType::I16);  // int8 widened
   EXPECT_EQ(v.spacing(), glm::dvec3(0.5, 0.25, 4.0));
-  EXPECT_EQ(v.origin(), glm::dvec3(1.5, -2.0, 3.0));
+  // Origin is LPS (ITK's frame): (1.5, -2, 3) LPS = (-1.5, 2, 3) RAS.
+  EXPECT_EQ(v.origin(), glm::dvec3(-1.5, 2.0, 3.0));
   for (std::size_t i = 0; i < values.size(); ++i) EXPECT_EQ(v.valueAtIndex(i), values[i]);
   EXPECT_NE(v.description().find("widened to i16"), std::string::npos);
 }
