@@ -508,7 +508,8 @@ namespace {
 
 std::string exactNumber(double v) {
   char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
+  // + 0.0 turns -0 (from negating a 0 into LPS) into 0.
+  std::snprintf(buf, sizeof buf, "%.17g", v + 0.0);
   return buf;
 }
 

@@ -275,6 +275,14 @@ Volume readRawWithSidecar(const std::filesystem::path& path) {
     }
   }
 
+  if (s.direction) {
+    // Singular directions are refused before any voxel is read.
+    try {
+      Volume().setDirection(*s.direction);
+    } catch (const InputError& e) {
+      throw InputError(sp + ": direction: " + e.what());
+    }
+  }
   io_detail::VoxelFormat format;
   format.dims = s.dims;
   format.type = s.type;
@@ -307,13 +315,7 @@ Volume readRawWithSidecar(const std::filesystem::path& path) {
   Volume v = io_detail::loadVoxels(source, format, sp);
   v.setSpacing(s.spacing);
   v.setOrigin(s.origin);
-  if (s.direction) {
-    try {
-      v.setDirection(*s.direction);
-    } catch (const InputError& e) {
-      throw InputError(sp + ": direction: " + e.what());
-    }
-  }
+  if (s.direction) v.setDirection(*s.direction);  // checked above
   v.setGeometrySource(s.direction ? "JSON sidecar direction, spacing and origin (RAS)"
                                   : "JSON sidecar spacing and origin (no direction: identity)");
   v.setDescription(
@@ -400,7 +402,8 @@ void writeRawWithSidecar(const Volume& volume, const std::filesystem::path& path
   sidecar["type"] = std::string(scalarTypeName(volume.type()));
   sidecar["spacing"] = {s.x, s.y, s.z};
   sidecar["origin"] = {o.x, o.y, o.z};
-  const glm::dmat3& dir = volume.direction();
+  // + 0.0 writes -0 as 0.
+  const glm::dmat3 dir = volume.direction() + glm::dmat3(0.0);
   sidecar["direction"] = {{dir[0].x, dir[0].y, dir[0].z},
                           {dir[1].x, dir[1].y, dir[1].z},
                           {dir[2].x, dir[2].y, dir[2].z}};

@@ -89,7 +89,8 @@ std::string numberString(double v) {
 
 std::string exactNumber(double v) {
   char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
+  // + 0.0 turns -0 (from negating a 0 into LPS) into 0.
+  std::snprintf(buf, sizeof buf, "%.17g", v + 0.0);
   return buf;
 }
 
@@ -676,6 +677,10 @@ Volume readVti(const std::filesystem::path& path) {
         throw InputError(p + ": Direction value " + std::to_string(r * 3 + a + 1) + " is " +
                          numberString(doc.direction[a][r]) + ", expected a finite number");
       }
+    }
+    if (doc.direction[a] == glm::dvec3(0.0)) {
+      throw InputError(p + ": Direction column " + std::to_string(a + 1) + " (axis " +
+                       std::string(1, axes[a]) + ") is (0 0 0); expected a unit vector");
     }
   }
 
