@@ -1,7 +1,8 @@
 # The browser build of the viewer (included from CMakeLists.txt under
 # emcmake; scripts/web.sh runs it). Compiles the layers the viewer needs —
-# core, gpu, lod, layout, render, viewer and io's procedural sources — with
-# Debian's emscripten into web/site's tessera.js + tessera.wasm. nifticlib,
+# core, gpu, lod, layout, render, viewer, io's procedural sources and its
+# NIfTI/NRRD geometry maths — with Debian's emscripten into web/site's
+# tessera.js + tessera.wasm. nifticlib,
 # zlib, DCMTK and libpng are not available to emscripten here: files are read
 # by viewer/InMemoryVolumeReader (gzip is inflated by the browser), and PNG
 # I/O reports that it is not built in (web/src/PngUnavailable.cpp). The gpu
@@ -38,7 +39,11 @@ add_custom_command(
   DEPENDS ${TESSERA_GLSL} ${CMAKE_SOURCE_DIR}/cmake/EmbedGlsl.cmake
   COMMENT "Embedding GLSL shaders" VERBATIM)
 
-set(TESSERA_WEB_SOURCES ${TESSERA_GLSL_CPP} ${CMAKE_SOURCE_DIR}/src/io/Procedural.cpp)
+# From io: the procedural sources and the header -> affine maths that
+# viewer/InMemoryVolumeReader shares with the native readers (no nifticlib,
+# zlib or DCMTK in them).
+set(TESSERA_WEB_SOURCES ${TESSERA_GLSL_CPP} ${CMAKE_SOURCE_DIR}/src/io/Procedural.cpp
+    ${CMAKE_SOURCE_DIR}/src/io/NiftiGeometry.cpp ${CMAKE_SOURCE_DIR}/src/io/NrrdGeometry.cpp)
 foreach(layer core gpu lod layout render viewer)
   file(GLOB_RECURSE srcs CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/${layer}/*.cpp)
   list(APPEND TESSERA_WEB_SOURCES ${srcs})

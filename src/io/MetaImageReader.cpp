@@ -20,10 +20,13 @@
 #include <optional>
 #include <vector>
 
+#include <glm/geometric.hpp>
+
 #include "io/ByteSource.h"
 #include "io/VoxelLoader.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/core/PatientFrame.h"
 
 namespace tessera {
 
@@ -45,6 +48,9 @@ struct MetaHeader {
   std::vector<double> elementSize;
   std::vector<double> offset;
   std::string offsetKey = "Offset";
+  std::vector<double> transform;  // TransformMatrix, row i = index axis i (LPS)
+  std::string transformKey = "TransformMatrix";
+  std::string anatomicalOrientation;
   std::optional<std::string> elementType;
   std::int64_t channels = 1;
   bool binaryData = true;
@@ -89,7 +95,8 @@ std::string numberString(double v) {
 
 std::string exactNumber(double v) {
   char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
+  // + 0.0 turns -0 (from negating a 0 into LPS) into 0.
+  std::snprintf(buf, sizeof buf, "%.17g", v + 0.0);
   return buf;
 }
 
@@ -226,6 +233,12 @@ MetaHeader parseHeader(const std::filesystem::path& path, const std::string& p) 
     } else if (key == "Offset" || key == "Origin" || key == "Position") {
       h.offset = parse.reals(value, key);
       h.offsetKey = key;
+    } else if (key == "TransformMatrix" || key == "Rotation" || key == "Orientation") {
+      // MetaIO's metaObject.cxx reads all three names into one matrix.
+      h.transform = parse.reals(value, key);
+      h.transformKey = key;
+    } else if (key == "AnatomicalOrientation") {
+      h.anatomicalOrientation = value;
     } else if (key == "ElementType") {
       h.elementType = value;
     } else if (key == "ElementNumberOfChannels") {
@@ -249,9 +262,8 @@ MetaHeader parseHeader(const std::filesystem::path& path, const std::string& p) 
       h.dataFile = value;
       break;
     }
-    // TransformMatrix, CenterOfRotation, AnatomicalOrientation, Comment,
-    // Modality, ElementMin/Max and others do not change how voxels are laid
-    // out (a volume here is axis-aligned).
+    // CenterOfRotation (ITK ignores it for images), Comment, Modality,
+    // ElementMin/Max and others change neither the voxels nor their place.
   }
   if (!sawField) throw InputError(p + ": not a MetaImage file: it has no 'Key = Value' lines");
   h.headerEnd = consumed;
@@ -349,6 +361,77 @@ Volume loadCompressed(const MetaHeader& h, const std::filesystem::path& file,
                      formatBytes(diskBytes) + ")");
   }
   return io_detail::decodeVoxels(inflated, format, p);
+}
+
+// MetaImage coordinates are ITK's LPS+. ITK's MetaImageIO reads
+// TransformMatrix value ii * NDims + jj as component jj of the direction of
+// index axis ii (MetaImageIO::ReadImageInformation, "Read direction cosines":
+// directionAxis[jj] = transformMatrix[ii * N + jj]; SetDirection(ii, ...);
+// InsightSoftwareConsortium/ITK Modules/IO/Meta/src/itkMetaImageIO.cxx, and
+// Write() fills it the same way from GetDirection(ii)). So the values list
+// the axes' directions one after another: "1 0 0 0 1 0 0 0 1" is identity,
+// "-1 0 0 0 1 0 0 0 1" has index x growing towards patient right. Physical
+// point = Offset + TransformMatrix-as-columns * diag(ElementSpacing) * index.
+glm::dmat4 lpsAffine(const MetaHeader& h, std::int64_t n, glm::dvec3 spacing, glm::dvec3 origin,
+                     const std::string& p) {
+  glm::dmat4 a(1.0);
+  for (int c = 0; c < 3; ++c) a[c][c] = spacing[c];
+  a[3] = glm::dvec4(origin, 1.0);
+  if (h.transform.empty()) return a;
+  // NDims x NDims values; for NDims 4 (a size-1 4th axis) the spatial 3 x 3
+  // alone is accepted too.
+  const auto nn = static_cast<std::size_t>(n);
+  const std::size_t un = h.transform.size() == 9 ? 3 : nn;
+  if (h.transform.size() != un * un) {
+    throw InputError(p + ": " + h.transformKey + " has " + std::to_string(h.transform.size()) +
+                     " values, but NDims " + std::to_string(n) + " needs " +
+                     std::to_string(nn * nn));
+  }
+  for (std::size_t axis = 0; axis < 3; ++axis) {
+    glm::dvec3 d;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const double v = h.transform[axis * un + k];
+      if (!std::isfinite(v)) {
+        throw InputError(p + ": " + h.transformKey + " value " + std::to_string(axis * un + k + 1) +
+                         " is " + numberString(v) + ", expected a finite number");
+      }
+      d[static_cast<int>(k)] = v;
+    }
+    if (glm::length(d) == 0.0) {
+      throw InputError(p + ": " + h.transformKey + " gives index axis " + std::to_string(axis) +
+                       " the direction (0 0 0); expected a unit vector");
+    }
+    a[static_cast<int>(axis)] = glm::dvec4(d * spacing[static_cast<int>(axis)], 0.0);
+  }
+  return a;
+}
+
+// MetaIO's AnatomicalOrientation letters name the side each index axis
+// comes *from* (MET_OrientationTypeName "RL" -> 'R'; ITK writes RightToLeft
+// as 'R'), the opposite of nibabel's axis codes: identity LPS is "RAI".
+char fromLetter(char toLetter) {
+  switch (toLetter) {
+    case 'R':
+      return 'L';
+    case 'L':
+      return 'R';
+    case 'A':
+      return 'P';
+    case 'P':
+      return 'A';
+    case 'S':
+      return 'I';
+    case 'I':
+      return 'S';
+    default:
+      return '?';
+  }
+}
+
+std::string metaOrientation(const glm::dmat3& rasDirection) {
+  std::string code = orientationOf(rasDirection).code;
+  for (char& c : code) c = fromLetter(c);
+  return code;
 }
 
 }  // namespace
@@ -469,8 +552,23 @@ Volume readMetaImage(const std::filesystem::path& path) {
     source.atEndOfFile = h.headerSize == -1;
     v = io_detail::loadVoxels(source, format, p);
   }
-  v.setSpacing(spacing);
-  v.setOrigin(origin);
+  // ITK's reader ignores AnatomicalOrientation, and so do we; only a
+  // disagreement with TransformMatrix is worth saying.
+  const glm::dmat4 ras = glm::dmat4(lpsToRas()) * lpsAffine(h, n, spacing, origin, p);
+  try {
+    v.setIndexToWorld(ras);
+  } catch (const InputError& e) {
+    throw InputError(p + ": " + h.transformKey + ": " + e.what());
+  }
+  std::string source = h.transform.empty()
+                           ? "MetaImage without TransformMatrix (identity in LPS)"
+                           : "MetaImage " + h.transformKey + " (LPS, converted to RAS)";
+  if (!h.anatomicalOrientation.empty() &&
+      h.anatomicalOrientation.substr(0, 3) != metaOrientation(v.direction())) {
+    source += "; AnatomicalOrientation " + h.anatomicalOrientation + " disagrees (" +
+              metaOrientation(v.direction()) + " by the matrix), ignored as ITK does";
+  }
+  v.setGeometrySource(source);
   std::string description = "MetaImage " + p + " (" + io_detail::dimsString(format.dims) + " " +
                             std::string(io_detail::diskTypeName(format.type)) + ", " +
                             (h.compressed ? "zlib" : "raw");
@@ -596,15 +694,27 @@ void writeMetaImage(const Volume& volume, const std::filesystem::path& path, boo
   if (compressed) packed = zlibCompress(volume, path);
 
   const glm::dvec3 s = volume.spacing();
-  const glm::dvec3 o = volume.origin();
+  // LPS, as ITK writes: one unit direction per index axis (see lpsAffine).
+  const glm::dmat3 toLps = lpsToRas();  // its own inverse
+  const glm::dvec3 o = toLps * volume.origin();
+  std::string matrix;
+  for (int a = 0; a < 3; ++a) {
+    const glm::dvec3 axis = toLps * volume.direction()[a];
+    for (int k = 0; k < 3; ++k) {
+      if (!matrix.empty()) matrix += ' ';
+      matrix += exactNumber(axis[k]);
+    }
+  }
   // The field order of ITK's writer; ElementDataFile must come last.
   std::string header = "ObjectType = Image\nNDims = 3\nBinaryData = True\n";
   header += "BinaryDataByteOrderMSB = False\n";
   header += std::string("CompressedData = ") + (compressed ? "True" : "False") + "\n";
   if (compressed) header += "CompressedDataSize = " + std::to_string(packed.size()) + "\n";
-  header += "TransformMatrix = 1 0 0 0 1 0 0 0 1\n";
+  header += "TransformMatrix = " + matrix + "\n";
   header += "Offset = " + exactNumber(o.x) + " " + exactNumber(o.y) + " " + exactNumber(o.z) + "\n";
-  header += "CenterOfRotation = 0 0 0\nAnatomicalOrientation = RAI\n";
+  header +=
+      "CenterOfRotation = 0 0 0\nAnatomicalOrientation = " + metaOrientation(volume.direction()) +
+      "\n";
   header += "ElementSpacing = " + exactNumber(s.x) + " " + exactNumber(s.y) + " " +
             exactNumber(s.z) + "\n";
   header += "DimSize = " + std::to_string(d.x) + " " + std::to_string(d.y) + " " +

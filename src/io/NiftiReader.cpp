@@ -14,6 +14,7 @@
 #include "io/VoxelLoader.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/io/NiftiGeometry.h"
 
 namespace tessera {
 
@@ -39,6 +40,7 @@ struct RawHeader {
   double voxOffset = 0.0;
   double sclSlope = 0.0;
   double sclInter = 0.0;
+  NiftiGeometryFields geometry;
 };
 
 std::string quoteMagic(const char* m, std::size_t n) {
@@ -71,6 +73,46 @@ bool isAnalyzePairName(const std::filesystem::path& path) {
            name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
   };
   return endsWith(".hdr") || endsWith(".hdr.gz") || endsWith(".HDR");
+}
+
+// The placement fields of either header version (already in native byte
+// order); NiftiGeometry turns them into the affine.
+template <class Header>
+NiftiGeometryFields geometryFields(const Header& n) {
+  NiftiGeometryFields g;
+  g.version = sizeof(Header) == sizeof(nifti_2_header) ? 2 : 1;
+  for (int a = 0; a < 3; ++a) g.dim[static_cast<std::size_t>(a)] = n.dim[a + 1];
+  for (int a = 0; a < 4; ++a) g.pixdim[static_cast<std::size_t>(a)] = n.pixdim[a];
+  g.qformCode = n.qform_code;
+  g.sformCode = n.sform_code;
+  g.quaternB = n.quatern_b;
+  g.quaternC = n.quatern_c;
+  g.quaternD = n.quatern_d;
+  g.qoffset = glm::dvec3(n.qoffset_x, n.qoffset_y, n.qoffset_z);
+  for (int c = 0; c < 4; ++c) {
+    const auto i = static_cast<std::size_t>(c);
+    g.srow[0][i] = n.srow_x[c];
+    g.srow[1][i] = n.srow_y[c];
+    g.srow[2][i] = n.srow_z[c];
+  }
+  return g;
+}
+
+// ANALYZE 7.5 has no qform/sform (those bytes hold other fields); SPM keeps
+// an origin voxel in hist.originator, 3 int16 from byte 253 (dbh.h).
+NiftiGeometryFields analyzeGeometryFields(const nifti_1_header& n, const unsigned char* raw,
+                                          bool swapped) {
+  NiftiGeometryFields g;
+  g.version = 0;
+  for (int a = 0; a < 3; ++a) g.dim[static_cast<std::size_t>(a)] = n.dim[a + 1];
+  for (int a = 0; a < 4; ++a) g.pixdim[static_cast<std::size_t>(a)] = n.pixdim[a];
+  for (int a = 0; a < 3; ++a) {
+    std::uint16_t u;
+    std::memcpy(&u, raw + 253 + 2 * a, 2);
+    if (swapped) u = static_cast<std::uint16_t>((u >> 8) | (u << 8));
+    g.spmOrigin[static_cast<std::size_t>(a)] = static_cast<std::int16_t>(u);
+  }
+  return g;
 }
 
 // Reads the first 540 bytes (inflating if gzip: zlib's gz* functions pass
@@ -128,10 +170,12 @@ RawHeader readRawHeader(const std::filesystem::path& path) {
     h.voxOffset = n1.vox_offset;
     h.sclSlope = n1.scl_slope;
     h.sclInter = n1.scl_inter;
+    h.geometry = geometryFields(n1);
     if (h.version == 0 && !isAnalyzePairName(path)) {
       throw InputError(p + ": NIfTI-1 magic is " + quoteMagic(n1.magic, 4) +
                        ", expected 'n+1' (a .nii file) or 'ni1' (a .hdr/.img pair)");
     }
+    if (h.version == 0) h.geometry = analyzeGeometryFields(n1, buf.data(), h.swapped);
   } else {
     nifti_2_header n2;
     std::memcpy(&n2, buf.data(), sizeof n2);
@@ -150,6 +194,7 @@ RawHeader readRawHeader(const std::filesystem::path& path) {
     h.voxOffset = static_cast<double>(n2.vox_offset);
     h.sclSlope = n2.scl_slope;
     h.sclInter = n2.scl_inter;
+    h.geometry = geometryFields(n2);
   }
   return h;
 }
@@ -293,13 +338,11 @@ Volume readNifti(const std::filesystem::path& path) {
   }
   Volume v = io_detail::loadVoxels(source, format, p);
 
-  v.setSpacing(
-      glm::dvec3(std::fabs(raw.pixdim[1]), std::fabs(raw.pixdim[2]), std::fabs(raw.pixdim[3])));
-  if (nim->qform_code > 0) {
-    v.setOrigin(glm::dvec3(nim->qoffset_x, nim->qoffset_y, nim->qoffset_z));
-  } else if (nim->sform_code > 0) {
-    v.setOrigin(glm::dvec3(nim->sto_xyz.m[0][3], nim->sto_xyz.m[1][3], nim->sto_xyz.m[2][3]));
-  }
+  // Geometry from the raw header, not nifticlib's nim: the browser's reader
+  // decodes the same fields the same way (io/NiftiGeometry).
+  const NiftiGeometry geometry = niftiGeometry(raw.geometry);
+  v.setIndexToWorld(geometry.indexToWorld);
+  v.setGeometrySource(geometry.source);
 
   std::string description =
       (raw.version == 0 ? "ANALYZE 7.5 " : "NIfTI-" + std::to_string(raw.version) + " ") + p +

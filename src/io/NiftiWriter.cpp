@@ -18,6 +18,8 @@
 
 #include "io/VoxelLoader.h"
 #include "tessera/core/Error.h"
+#include "tessera/core/PatientFrame.h"
+#include "tessera/io/NiftiGeometry.h"
 
 namespace tessera {
 
@@ -173,17 +175,34 @@ void writeNifti(const Volume& volume, const std::filesystem::path& path) {
   // No scaling: scl_slope 0 means "none" (nifti1.h).
   nim->scl_slope = 0.0;
   nim->scl_inter = 0.0;
-  // qform: identity rotation, qoffset = origin (NIfTI-1 method 2).
-  const glm::dvec3 o = volume.origin();
-  nim->qform_code = NIFTI_XFORM_SCANNER_ANAT;
-  nim->quatern_b = nim->quatern_c = nim->quatern_d = 0.0;
-  nim->qfac = 1.0;
-  nim->pixdim[0] = 1.0;
-  nim->qoffset_x = o.x;
-  nim->qoffset_y = o.y;
-  nim->qoffset_z = o.z;
-  nim->qto_xyz = nifti_quatern_to_dmat44(0.0, 0.0, 0.0, o.x, o.y, o.z, s.x, s.y, s.z, 1.0);
-  nim->sform_code = NIFTI_XFORM_UNKNOWN;
+  // Both forms, as nibabel writes them: the sform holds the affine exactly
+  // (also a sheared one), the qform its nearest rotation (a quaternion,
+  // qfac = -1 for a reflection such as LAS) for readers that only know the
+  // qform. The code keeps the meaning of a NIfTI source ("MNI_152" stays
+  // MNI_152), else 1 (NIFTI_XFORM_SCANNER_ANAT).
+  const int code = niftiXformCodeFor(volume.geometrySource());
+  const glm::dmat4 affine = volume.indexToWorld();
+  nim->sform_code = code;
+  for (int row = 0; row < 4; ++row) {
+    for (int col = 0; col < 4; ++col) nim->sto_xyz.m[row][col] = affine[col][row];
+  }
+  const glm::dmat3 rotation = nearestOrthonormal(volume.direction());
+  nifti_dmat44 q;
+  for (int row = 0; row < 4; ++row) {
+    for (int col = 0; col < 4; ++col) {
+      q.m[row][col] = col < 3 && row < 3 ? rotation[col][row] * s[col] : affine[col][row];
+    }
+  }
+  // nifticlib's polar decomposition gives b, c, d, qoffset and qfac; the
+  // pixdim it derives is ours again (the columns of q have our spacings).
+  double qdx = 0.0, qdy = 0.0, qdz = 0.0;
+  nim->qform_code = code;
+  nifti_dmat44_to_quatern(q, &nim->quatern_b, &nim->quatern_c, &nim->quatern_d, &nim->qoffset_x,
+                          &nim->qoffset_y, &nim->qoffset_z, &qdx, &qdy, &qdz, &nim->qfac);
+  nim->pixdim[0] = nim->qfac;
+  nim->qto_xyz =
+      nifti_quatern_to_dmat44(nim->quatern_b, nim->quatern_c, nim->quatern_d, nim->qoffset_x,
+                              nim->qoffset_y, nim->qoffset_z, s.x, s.y, s.z, nim->qfac);
   std::snprintf(nim->descrip, sizeof nim->descrip, "written by Tessera");
   nifti_set_iname_offset(nim.get(), 1);
 

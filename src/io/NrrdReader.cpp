@@ -18,6 +18,8 @@
 #include "io/ByteSource.h"
 #include "io/VoxelLoader.h"
 #include "tessera/core/Error.h"
+#include "tessera/core/PatientFrame.h"
+#include "tessera/io/NrrdGeometry.h"
 
 namespace tessera {
 
@@ -41,6 +43,8 @@ struct NrrdHeader {
   bool hasSpaceDirections = false;
   std::vector<std::optional<std::vector<double>>> spaceDirections;  // nullopt = "none"
   std::optional<std::vector<double>> spaceOrigin;
+  std::string space;
+  int spaceDimension = 0;
   std::int64_t byteSkip = 0;
   std::int64_t lineSkip = 0;
   std::optional<std::string> dataFile;
@@ -311,6 +315,12 @@ NrrdHeader parseHeader(const std::filesystem::path& path) {
       }
     } else if (field == "space origin") {
       h.spaceOrigin = parse.vector(value, field);
+    } else if (field == "space") {
+      h.space = value;
+    } else if (field == "space dimension") {
+      const std::int64_t d = parse.integer(value, field);
+      if (d < 1 || d > 8) parse.fail("space dimension is " + value + ", expected 1..8");
+      h.spaceDimension = static_cast<int>(d);
     } else if (field == "byte skip") {
       h.byteSkip = parse.integer(value, field);
       if (h.byteSkip < -1) parse.fail("byte skip is " + value + ", expected -1 or >= 0");
@@ -329,8 +339,8 @@ NrrdHeader parseHeader(const std::filesystem::path& path) {
     } else if (field == "block size" || field == "blocksize") {
       // only meaningful for type "block", which typeFromName rejects
     }
-    // Other fields (kinds, centers, labels, units, space, thicknesses, min,
-    // max, measurement frame, ...) do not change how voxels are laid out.
+    // Other fields (kinds, centers, labels, units, thicknesses, min, max,
+    // measurement frame, ...) change neither the voxels nor their placement.
   }
   // For an attached header without its blank line this is the end of the
   // file, and the size check reports the missing data.
@@ -359,18 +369,6 @@ std::uint64_t skipLines(const std::filesystem::path& file, std::uint64_t offset,
     pos += got;
   }
   return pos;
-}
-
-double norm(const std::vector<double>& v) {
-  double s = 0.0;
-  for (double x : v) s += x * x;
-  return std::sqrt(s);
-}
-
-std::string numberString(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
 }
 
 }  // namespace
@@ -447,30 +445,19 @@ Volume readNrrd(const std::filesystem::path& path) {
     format.bigEndian = *h.bigEndian;
   }
 
-  glm::dvec3 spacing(1.0);
+  // Placement (io/NrrdGeometry), checked before the voxels are read.
+  NrrdGeometryFields g;
+  g.space = h.space;
+  g.spaceDimension = h.spaceDimension;
+  g.hasSpaceDirections = h.hasSpaceDirections;
+  g.spaceOrigin = h.spaceOrigin;
+  g.firstAxis = static_cast<int>(first);
   for (int a = 0; a < 3; ++a) {
     const std::size_t axis = first + static_cast<std::size_t>(a);
-    double s = 1.0;
-    std::string source;
-    if (h.hasSpaceDirections) {
-      // §4: the length of an axis' space direction is its sample spacing.
-      const auto& dir = h.spaceDirections[axis];
-      if (!dir) {
-        throw InputError(p + ": space direction of spatial axis " + std::to_string(axis) +
-                         " is 'none'");
-      }
-      s = norm(*dir);
-      source = "length of space direction";
-    } else if (!h.spacings.empty()) {
-      s = h.spacings[axis];
-      source = "spacing";
-    }
-    if (!std::isfinite(s) || s <= 0.0) {
-      throw InputError(p + ": " + source + " of axis " + std::to_string(axis) + " is " +
-                       numberString(s) + ", expected a finite value > 0");
-    }
-    spacing[a] = s;
+    if (h.hasSpaceDirections) g.spaceDirections.push_back(h.spaceDirections[axis]);
+    if (!h.spacings.empty()) g.spacings[a] = h.spacings[axis];
   }
+  const NrrdGeometry geometry = nrrdGeometry(g, p);
 
   io_detail::VoxelSource source;
   std::uint64_t start = h.headerEnd;
@@ -506,14 +493,8 @@ Volume readNrrd(const std::filesystem::path& path) {
   }
 
   Volume v = io_detail::loadVoxels(source, format, p);
-  v.setSpacing(spacing);
-  if (h.spaceOrigin) {
-    glm::dvec3 o(0.0);
-    for (std::size_t i = 0; i < 3 && i < h.spaceOrigin->size(); ++i) {
-      o[static_cast<int>(i)] = (*h.spaceOrigin)[i];
-    }
-    v.setOrigin(o);
-  }
+  v.setIndexToWorld(geometry.indexToWorld);
+  v.setGeometrySource(geometry.source);
   std::string description = "NRRD " + p + " (" + io_detail::dimsString(format.dims) + " " +
                             std::string(io_detail::diskTypeName(format.type)) + ", " + h.encoding;
   if (io_detail::isConvertedToF32(format.type)) description += ", converted to f32";
@@ -527,7 +508,8 @@ namespace {
 
 std::string exactNumber(double v) {
   char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
+  // + 0.0 turns -0 (from negating a 0 into LPS) into 0.
+  std::snprintf(buf, sizeof buf, "%.17g", v + 0.0);
   return buf;
 }
 
@@ -610,23 +592,33 @@ void writeNrrd(const Volume& volume, const std::filesystem::path& path, bool gzi
       type = "float";
       break;
   }
-  const glm::dvec3 s = volume.spacing();
-  const glm::dvec3 o = volume.origin();
-  // Spacing goes into "space directions" rather than "spacings": the format
-  // (§4) lets an axis have one or the other, and "space origin" needs a space.
+  // Written in LPS, the space ITK and Slicer write (§4 "space"): each
+  // axis' space direction is its unit direction times its spacing (§5).
+  const glm::dmat3 toLps = lpsToRas();  // its own inverse
+  const glm::dmat4 affine = volume.indexToWorld();
+  auto vec = [](const glm::dvec3& v) {
+    // Built piecewise: GCC 12 warns falsely (-Wrestrict) on "(" + string.
+    std::string s(1, '(');
+    s += exactNumber(v.x);
+    s += ',';
+    s += exactNumber(v.y);
+    s += ',';
+    s += exactNumber(v.z);
+    s += ')';
+    return s;
+  };
   std::string header = "NRRD0004\n# written by Tessera\n";
   header += std::string("type: ") + type + "\n";
   header += "dimension: 3\n";
-  header += "space dimension: 3\n";
+  header += "space: left-posterior-superior\n";
   header += "sizes: " + std::to_string(d.x) + " " + std::to_string(d.y) + " " +
             std::to_string(d.z) + "\n";
-  header += "space directions: (" + exactNumber(s.x) + ",0,0) (0," + exactNumber(s.y) +
-            ",0) (0,0," + exactNumber(s.z) + ")\n";
+  header += "space directions: " + vec(toLps * glm::dvec3(affine[0])) + " " +
+            vec(toLps * glm::dvec3(affine[1])) + " " + vec(toLps * glm::dvec3(affine[2])) + "\n";
   header += "kinds: domain domain domain\n";
   header += "endian: little\n";
   header += std::string("encoding: ") + (gzip ? "gzip" : "raw") + "\n";
-  header += "space origin: (" + exactNumber(o.x) + "," + exactNumber(o.y) + "," + exactNumber(o.z) +
-            ")\n\n";
+  header += "space origin: " + vec(toLps * glm::dvec3(affine[3])) + "\n\n";
 
   NrrdOutput out(path);
   out.write(header.data(), header.size());

@@ -1,9 +1,15 @@
 // Raw voxels described by a JSON sidecar (declared in tessera/io/PvmReader.h):
 //   data.raw + data.raw.json (or data.json), e.g.
 //   {"dims": [256, 256, 128], "type": "u16", "spacing": [0.5, 0.5, 1.2],
-//    "origin": [0, 0, 0], "endian": "little", "offset": 0, "file": "data.raw"}
+//    "origin": [0, 0, 0], "direction": [[1, 0, 0], [0, 1, 0], [0, 0, 1]],
+//    "endian": "little", "offset": 0, "file": "data.raw"}
 // Only dims and type are required; unknown keys are errors, so that a typo
 // ("spacings") is reported instead of silently ignored.
+// Geometry is Tessera's own (core/PatientFrame.h), RAS+ mm: "origin" is
+// voxel (0,0,0)'s centre, "direction" lists the unit direction of index axis
+// i, then j, then k (the columns of the direction matrix, like NRRD's "space
+// directions" without the spacing), so world = origin + sum over a of
+// direction[a] * spacing[a] * index[a]. Without "direction": identity.
 #include "tessera/io/PvmReader.h"
 
 #include <fcntl.h>
@@ -36,13 +42,16 @@ using nlohmann::json;
 
 constexpr std::int64_t kMaxDim = 1 << 20;  // the limit Volume::allocate applies
 constexpr std::uint64_t kMaxSidecarBytes = 1 << 20;
-constexpr const char* kKeys = "dims, type, spacing, origin, endian, offset, file";
+constexpr const char* kKeys = "dims, type, spacing, origin, direction, endian, offset, file";
+// How far from 1 a direction's length may be (hand-written 0.7071...).
+constexpr double kUnitTolerance = 1e-4;
 
 struct Sidecar {
   glm::ivec3 dims{0, 0, 0};
   DiskType type = DiskType::U8;
   glm::dvec3 spacing{1.0, 1.0, 1.0};
   glm::dvec3 origin{0.0, 0.0, 0.0};
+  std::optional<glm::dmat3> direction;
   bool bigEndian = false;
   std::uint64_t offset = 0;
   std::optional<std::string> file;
@@ -117,6 +126,8 @@ class SidecarParser {
       } else if (key == "origin") {
         const auto v = numbers(value, key);
         s.origin = glm::dvec3(v[0], v[1], v[2]);
+      } else if (key == "direction") {
+        s.direction = direction(value);
       } else if (key == "endian") {
         const std::string e = stringValue(value, key);
         if (e != "little" && e != "big")
@@ -158,6 +169,26 @@ class SidecarParser {
              ", expected a finite number");
     }
     return out;
+  }
+
+  // [[ix, iy, iz], [jx, jy, jz], [kx, ky, kz]]: unit vectors, one per axis.
+  glm::dmat3 direction(const json& value) const {
+    if (!value.is_array() || value.size() != 3) {
+      fail("direction is " + value.dump() +
+           ", expected 3 unit vectors [[ix, iy, iz], [jx, jy, jz], [kx, ky, kz]]");
+    }
+    glm::dmat3 d;
+    for (int a = 0; a < 3; ++a) {
+      const std::string key = "direction[" + std::to_string(a) + "]";
+      const auto v = numbers(value[static_cast<std::size_t>(a)], key);
+      d[a] = glm::dvec3(v[0], v[1], v[2]);
+      const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      if (std::abs(len - 1.0) > kUnitTolerance) {
+        fail(key + " has length " + numberString(len) +
+             ", expected a unit vector (the voxel size goes in \"spacing\")");
+      }
+    }
+    return d;
   }
 
   std::string stringValue(const json& value, const std::string& key) const {
@@ -244,6 +275,14 @@ Volume readRawWithSidecar(const std::filesystem::path& path) {
     }
   }
 
+  if (s.direction) {
+    // Singular directions are refused before any voxel is read.
+    try {
+      Volume().setDirection(*s.direction);
+    } catch (const InputError& e) {
+      throw InputError(sp + ": direction: " + e.what());
+    }
+  }
   io_detail::VoxelFormat format;
   format.dims = s.dims;
   format.type = s.type;
@@ -276,6 +315,9 @@ Volume readRawWithSidecar(const std::filesystem::path& path) {
   Volume v = io_detail::loadVoxels(source, format, sp);
   v.setSpacing(s.spacing);
   v.setOrigin(s.origin);
+  if (s.direction) v.setDirection(*s.direction);  // checked above
+  v.setGeometrySource(s.direction ? "JSON sidecar direction, spacing and origin (RAS)"
+                                  : "JSON sidecar spacing and origin (no direction: identity)");
   v.setDescription(
       "raw " + rawPath.string() + " described by " + sp + " (" + io_detail::dimsString(s.dims) +
       " " + std::string(io_detail::diskTypeName(s.type)) +
@@ -360,6 +402,11 @@ void writeRawWithSidecar(const Volume& volume, const std::filesystem::path& path
   sidecar["type"] = std::string(scalarTypeName(volume.type()));
   sidecar["spacing"] = {s.x, s.y, s.z};
   sidecar["origin"] = {o.x, o.y, o.z};
+  // + 0.0 writes -0 as 0.
+  const glm::dmat3 dir = volume.direction() + glm::dmat3(0.0);
+  sidecar["direction"] = {{dir[0].x, dir[0].y, dir[0].z},
+                          {dir[1].x, dir[1].y, dir[1].z},
+                          {dir[2].x, dir[2].y, dir[2].z}};
   sidecar["endian"] = "little";
   sidecar["offset"] = 0;
   sidecar["file"] = path.filename().string();

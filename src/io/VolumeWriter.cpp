@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <cstdio>
 #include <string>
 
 #include "tessera/core/Error.h"
+#include "tessera/core/PatientFrame.h"
 #include "tessera/io/DicomSeriesReader.h"
 #include "tessera/io/MetaImageReader.h"
 #include "tessera/io/NiftiWriter.h"
@@ -31,7 +33,35 @@ std::string lowerName(const fs::path& path) {
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return s;
 }
+std::string pointText(const glm::dvec3& p) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "(%g, %g, %g)", p.x, p.y, p.z);
+  return buf;
+}
+
+// PVM's header has dims, spacing and components only. writePvm keeps the
+// origin in a "tessera origin:" comment that readPvm reads back but other
+// PVM readers (V^3) ignore; the direction has no place at all.
+std::vector<std::string> pvmLossNotes(const Volume& v) {
+  const bool rotated = v.direction() != glm::dmat3(1.0);
+  const bool moved = v.origin() != glm::dvec3(0.0);
+  if (!rotated && !moved) return {};
+  const std::string origin = "origin " + pointText(v.origin());
+  if (!rotated) {
+    return {"PVM stores spacing only: the " + origin +
+            " is kept in a comment that only Tessera reads back"};
+  }
+  std::string note = "PVM stores spacing only: orientation " +
+                     orientationOf(v.direction()).describe() + " is lost (read back as RAS)";
+  if (moved) note += ", and the " + origin + " is kept only in a comment Tessera reads back";
+  return {note};
+}
 }  // namespace
+
+std::vector<std::string> geometryLossNotes(const Volume& volume, const fs::path& out) {
+  if (endsWith(lowerName(out), ".pvm")) return pvmLossNotes(volume);
+  return {};
+}
 
 void writeAtomically(const fs::path& path, const std::function<void(const fs::path&)>& write) {
   static std::atomic<int> counter{0};

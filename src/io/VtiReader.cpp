@@ -66,7 +66,10 @@ struct VtiDocument {
   Extent wholeExtent{};
   glm::dvec3 origin{0.0};
   glm::dvec3 spacing{1.0};
-  bool rotated = false;  // a Direction other than the identity
+  // Direction's 9 values, row by row (vtkXMLImageDataWriter writes
+  // vtkMatrix3x3::GetData(), which is row-major); glm is column-major.
+  glm::dmat3 direction{1.0};
+  bool hasDirection = false;
   int pieces = 0;
   std::optional<Extent> pieceExtent;
   std::string scalarsName;
@@ -86,7 +89,8 @@ std::string numberString(double v) {
 
 std::string exactNumber(double v) {
   char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
+  // + 0.0 turns -0 (from negating a 0 into LPS) into 0.
+  std::snprintf(buf, sizeof buf, "%.17g", v + 0.0);
   return buf;
 }
 
@@ -211,9 +215,12 @@ void readImageDataAttributes(const AttributeReader& a, VtiDocument& doc) {
   }
   if (a.get("Direction") != nullptr) {
     const auto d = a.reals("Direction", 9);
-    for (int i = 0; i < 9; ++i) {
-      if (d[static_cast<std::size_t>(i)] != (i % 4 == 0 ? 1.0 : 0.0)) doc.rotated = true;
+    for (int row = 0; row < 3; ++row) {
+      for (int col = 0; col < 3; ++col) {
+        doc.direction[col][row] = d[static_cast<std::size_t>(row * 3 + col)];
+      }
     }
+    doc.hasDirection = true;
   }
 }
 
@@ -652,9 +659,29 @@ Volume readVti(const std::filesystem::path& path) {
       throw InputError(p + ": Origin along " + std::string(1, axes[a]) + " is " +
                        numberString(doc.origin[a]) + ", expected a finite value");
     }
-    // The first point of the extent sits at Origin + x0 * Spacing.
-    origin[a] +=
-        static_cast<double>(doc.wholeExtent[static_cast<std::size_t>(2 * a)]) * doc.spacing[a];
+  }
+  // vtkImageData::ComputeTransforms: point (i, j, k) of the extent lies at
+  // Origin + Direction * diag(Spacing) * (i, j, k), so Direction's columns
+  // are the axes. VTK has no patient frame: these coordinates are taken as
+  // Tessera's RAS world unchanged (and written back the same way).
+  glm::dmat4 affine(1.0);
+  for (int a = 0; a < 3; ++a) affine[a] = glm::dvec4(doc.direction[a] * doc.spacing[a], 0.0);
+  const glm::dvec3 first(static_cast<double>(doc.wholeExtent[0]),
+                         static_cast<double>(doc.wholeExtent[2]),
+                         static_cast<double>(doc.wholeExtent[4]));
+  // Tessera's voxel 0 is the extent's first point.
+  affine[3] = glm::dvec4(origin + glm::dvec3(affine * glm::dvec4(first, 0.0)), 1.0);
+  for (int a = 0; a < 3; ++a) {
+    for (int r = 0; r < 3; ++r) {
+      if (!std::isfinite(doc.direction[a][r])) {
+        throw InputError(p + ": Direction value " + std::to_string(r * 3 + a + 1) + " is " +
+                         numberString(doc.direction[a][r]) + ", expected a finite number");
+      }
+    }
+    if (doc.direction[a] == glm::dvec3(0.0)) {
+      throw InputError(p + ": Direction column " + std::to_string(a + 1) + " (axis " +
+                       std::string(1, axes[a]) + ") is (0 0 0); expected a unit vector");
+    }
   }
 
   const DataArrayInfo* array = nullptr;
@@ -738,15 +765,20 @@ Volume readVti(const std::filesystem::path& path) {
                      "', expected ascii, binary or appended");
   }
 
-  v.setSpacing(doc.spacing);
-  v.setOrigin(origin);
+  try {
+    v.setIndexToWorld(affine);
+  } catch (const InputError& e) {
+    throw InputError(p + ": ImageData Direction: " + e.what());
+  }
+  v.setGeometrySource(doc.hasDirection ? "VTK ImageData Direction (no patient frame: taken as RAS)"
+                                       : "VTK ImageData Origin and Spacing (no Direction: "
+                                         "identity, taken as RAS)");
   std::string description = "VTK ImageData " + p + " (" + io_detail::dimsString(format.dims) + " " +
                             std::string(io_detail::diskTypeName(format.type)) + ", " + encoding +
                             (doc.zlib && array->format != "ascii" ? " zlib" : "") + ", array '" +
                             array->name + "'";
   if (io_detail::isConvertedToF32(format.type)) description += ", converted to f32";
   if (format.type == DiskType::I8) description += ", widened to i16";
-  if (doc.rotated) description += ", Direction ignored";
   v.setDescription(description + ")");
   return v;
 }
@@ -827,6 +859,14 @@ void writeVti(const Volume& volume, const std::filesystem::path& path, bool comp
   }
   const glm::dvec3 s = volume.spacing();
   const glm::dvec3 o = volume.origin();
+  const glm::dmat3& dir = volume.direction();
+  std::string direction;  // row by row, as vtkXMLImageDataWriter writes it
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 3; ++col) {
+      if (!direction.empty()) direction += ' ';
+      direction += exactNumber(dir[col][row]);
+    }
+  }
   const ValueRange range = volume.valueRange();
   const std::string extent = "0 " + std::to_string(d.x - 1) + " 0 " + std::to_string(d.y - 1) +
                              " 0 " + std::to_string(d.z - 1);
@@ -839,7 +879,7 @@ void writeVti(const Volume& volume, const std::filesystem::path& path, bool comp
   xml += ">\n";
   xml += "  <ImageData WholeExtent=\"" + extent + "\" Origin=\"" + exactNumber(o.x) + " " +
          exactNumber(o.y) + " " + exactNumber(o.z) + "\" Spacing=\"" + exactNumber(s.x) + " " +
-         exactNumber(s.y) + " " + exactNumber(s.z) + "\" Direction=\"1 0 0 0 1 0 0 0 1\">\n";
+         exactNumber(s.y) + " " + exactNumber(s.z) + "\" Direction=\"" + direction + "\">\n";
   xml += "    <Piece Extent=\"" + extent + "\">\n";
   xml += "      <PointData Scalars=\"scalars\">\n";
   xml += std::string("        <DataArray type=\"") + vtkTypeName(volume.type()) +

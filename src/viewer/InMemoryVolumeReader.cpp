@@ -7,11 +7,14 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <vector>
 
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/io/NiftiGeometry.h"
+#include "tessera/io/NrrdGeometry.h"
 
 namespace tessera::viewer {
 
@@ -75,8 +78,10 @@ const char* sourceName(SourceType t) {
 
 struct Layout {
   glm::ivec3 dims{0};
-  glm::dvec3 spacing{1.0};
-  glm::dvec3 origin{0.0};
+  // Placement, from the same io/NiftiGeometry and io/NrrdGeometry maths as
+  // the native readers.
+  glm::dmat4 indexToWorld{1.0};
+  std::string geometrySource;
   SourceType type = SourceType::U8;
   bool swap = false;  // stored big-endian (this code runs on little-endian hosts)
   double slope = 1.0, inter = 0.0;
@@ -113,8 +118,8 @@ Volume convert(const Layout& l, const std::byte* data, const std::string& name) 
     }
   }
   Volume v = Volume::allocate(l.dims, out, name);
-  v.setSpacing(l.spacing);
-  v.setOrigin(l.origin);
+  v.setIndexToWorld(l.indexToWorld);
+  v.setGeometrySource(l.geometrySource);
   const std::size_t n = static_cast<std::size_t>(v.voxelCount());
   const std::size_t bpv = sourceBytes(l.type);
   for (std::size_t i = 0; i < n; ++i) {
@@ -180,17 +185,6 @@ const std::byte* checkedPayload(const Layout& l, std::span<const std::byte> byte
   }
   HostBudget::global().check(voxels * 4, name);
   return bytes.data() + offset;
-}
-
-void checkSpacing(glm::dvec3 s, const std::string& name) {
-  for (int a = 0; a < 3; ++a) {
-    if (!std::isfinite(s[a]) || s[a] <= 0.0) {
-      std::ostringstream m;
-      m << name << ": voxel size along axis " << a + 1 << " is " << s[a]
-        << ", expected a finite positive value";
-      throw InputError(m.str());
-    }
-  }
 }
 
 Volume readNifti1(const std::string& name, std::span<const std::byte> b) {
@@ -271,18 +265,36 @@ Volume readNifti1(const std::string& name, std::span<const std::byte> b) {
                        " is not supported (uint8, int8, uint16, int16, int32, uint32, float32, "
                        "float64 are)");
   }
-  for (int a = 0; a < 3; ++a) {
-    const double p = load<float>(h + 76 + 4 * (a + 1), swap);
-    if (!std::isfinite(p) || p == 0.0) {
+  // Offsets from nifti1.h.
+  NiftiGeometryFields g;
+  for (int a = 0; a < 4; ++a) {
+    const double p = load<float>(h + 76 + 4 * a, swap);
+    if (a > 0 && (!std::isfinite(p) || p == 0.0)) {
       std::ostringstream m;
-      m << name << ": voxel size pixdim[" << a + 1 << "] is " << p
+      m << name << ": voxel size pixdim[" << a << "] is " << p
         << ", expected a finite non-zero value";
       throw InputError(m.str());
     }
-    l.spacing[a] = std::fabs(p);
+    g.pixdim[static_cast<std::size_t>(a)] = p;
   }
-  l.origin = glm::dvec3(load<float>(h + 268, swap), load<float>(h + 272, swap),
-                        load<float>(h + 276, swap));
+  for (int a = 0; a < 3; ++a)
+    g.dim[static_cast<std::size_t>(a)] = dim[static_cast<std::size_t>(a + 1)];
+  g.qformCode = load<std::int16_t>(h + 252, swap);
+  g.sformCode = load<std::int16_t>(h + 254, swap);
+  g.quaternB = load<float>(h + 256, swap);
+  g.quaternC = load<float>(h + 260, swap);
+  g.quaternD = load<float>(h + 264, swap);
+  g.qoffset = glm::dvec3(load<float>(h + 268, swap), load<float>(h + 272, swap),
+                         load<float>(h + 276, swap));
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 4; ++col) {
+      g.srow[static_cast<std::size_t>(row)][static_cast<std::size_t>(col)] =
+          load<float>(h + 280 + 16 * row + 4 * col, swap);
+    }
+  }
+  const NiftiGeometry geometry = niftiGeometry(g);
+  l.indexToWorld = geometry.indexToWorld;
+  l.geometrySource = geometry.source;
   const double voxOffset = load<float>(h + 108, swap);
   if (!std::isfinite(voxOffset) || voxOffset < 348.0 ||
       voxOffset > static_cast<double>(std::numeric_limits<std::uint32_t>::max())) {
@@ -315,6 +327,24 @@ double number(const std::string& w, const std::string& field, const std::string&
   } catch (const std::exception&) {
   }
   throw InputError(name + ": NRRD field '" + field + "': '" + w + "' is not a number");
+}
+
+// "(1,0,0) none (0,1,0)": one vector per "(...)", nothing for "none".
+std::vector<std::optional<std::vector<double>>> nrrdVectors(const std::string& s,
+                                                            const std::string& fieldName,
+                                                            const std::string& name) {
+  std::vector<std::optional<std::vector<double>>> out;
+  for (const auto& w : words(s)) {
+    if (w == "none") out.emplace_back(std::nullopt);
+    if (w.front() == '(') out.emplace_back(std::vector<double>{});
+    if (out.empty() || !out.back()) continue;
+    std::string inner = w;
+    std::replace(inner.begin(), inner.end(), ',', ' ');
+    std::replace(inner.begin(), inner.end(), '(', ' ');
+    std::replace(inner.begin(), inner.end(), ')', ' ');
+    for (const auto& x : words(inner)) out.back()->push_back(number(x, fieldName, name));
+  }
+  return out;
 }
 
 struct NrrdHeader {
@@ -415,46 +445,36 @@ Volume readNrrd(const std::string& name, std::span<const std::byte> b, bool payl
   }
   const std::string endian = field(h, "endian");
   l.swap = endian == "big" && sourceBytes(l.type) > 1;
+  NrrdGeometryFields g;
+  g.space = field(h, "space");
+  const std::string spaceDim = field(h, "space dimension");
+  if (!spaceDim.empty())
+    g.spaceDimension = static_cast<int>(number(spaceDim, "space dimension", name));
+  g.firstAxis = static_cast<int>(first);
   const std::vector<std::string> sp = words(field(h, "spacings"));
+  if (sp.size() >= first + 3) {
+    for (int a = 0; a < 3; ++a)
+      g.spacings[a] = number(sp[first + static_cast<std::size_t>(a)], "spacings", name);
+  }
   const std::string dirs = field(h, "space directions");
   if (!dirs.empty()) {
-    // "(a,b,c) (d,e,f) (g,h,i)" [none]: spacing = length of each vector.
-    std::vector<double> lengths;
-    std::size_t p = 0;
-    while ((p = dirs.find('(', p)) != std::string::npos) {
-      const std::size_t q = dirs.find(')', p);
-      if (q == std::string::npos) break;
-      std::string inner = dirs.substr(p + 1, q - p - 1);
-      std::replace(inner.begin(), inner.end(), ',', ' ');
-      double sum = 0.0;
-      for (const auto& w : words(inner)) {
-        const double v = number(w, "space directions", name);
-        sum += v * v;
-      }
-      lengths.push_back(std::sqrt(sum));
-      p = q + 1;
+    // "(a,b,c) (d,e,f) (g,h,i)", with "none" for a non-spatial axis.
+    const auto axes = nrrdVectors(dirs, "space directions", name);
+    if (axes.size() < first + 3) {
+      throw InputError(name + ": NRRD 'space directions' has " + std::to_string(axes.size()) +
+                       " entries, expected one per axis");
     }
-    if (lengths.size() != 3) {
-      throw InputError(name + ": NRRD 'space directions' has " + std::to_string(lengths.size()) +
-                       " vectors, expected 3");
-    }
-    l.spacing = glm::dvec3(lengths[0], lengths[1], lengths[2]);
-  } else if (sp.size() >= 3) {
-    for (int a = 0; a < 3; ++a)
-      l.spacing[a] = number(sp[first + static_cast<std::size_t>(a)], "spacings", name);
+    g.hasSpaceDirections = true;
+    for (std::size_t a = first; a < first + 3; ++a) g.spaceDirections.push_back(axes[a]);
   }
-  checkSpacing(l.spacing, name);
   const std::string origin = field(h, "space origin");
   if (!origin.empty()) {
-    std::string inner = origin;
-    std::replace(inner.begin(), inner.end(), ',', ' ');
-    std::replace(inner.begin(), inner.end(), '(', ' ');
-    std::replace(inner.begin(), inner.end(), ')', ' ');
-    const auto w = words(inner);
-    if (w.size() == 3)
-      l.origin = glm::dvec3(number(w[0], "space origin", name), number(w[1], "space origin", name),
-                            number(w[2], "space origin", name));
+    const auto o = nrrdVectors(origin, "space origin", name);
+    if (o.size() == 1 && o[0]) g.spaceOrigin = *o[0];
   }
+  const NrrdGeometry geometry = nrrdGeometry(g, name);
+  l.indexToWorld = geometry.indexToWorld;
+  l.geometrySource = geometry.source;
   std::uint64_t offset = h.payload;
   const std::string skip = field(h, "byte skip");
   if (!skip.empty()) {

@@ -98,9 +98,12 @@ struct NiftiFields {
   double sclSlope = 0;
   double sclInter = 0;
   int qformCode = 0;
+  double quatern[3] = {0, 0, 0};  // quatern_b, c, d: 0 is the identity rotation
   double qoffset[3] = {0, 0, 0};
-  std::string magic;  // empty: "n+1" / "n+2"
-  int sizeofHdr = 0;  // 0: 348 / 540
+  int sformCode = 0;
+  double srow[3][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}};  // srow_x, srow_y, srow_z
+  std::string magic;                                               // empty: "n+1" / "n+2"
+  int sizeofHdr = 0;                                               // 0: 348 / 540
   bool bigEndian = false;
 };
 
@@ -118,8 +121,13 @@ inline std::string niftiHeader(const NiftiFields& f) {
     h.put<float>(112, static_cast<float>(f.sclSlope));
     h.put<float>(116, static_cast<float>(f.sclInter));
     h.put<std::int16_t>(252, static_cast<std::int16_t>(f.qformCode));
-    // quatern_b/c/d stay 0: the identity rotation.
+    h.put<std::int16_t>(254, static_cast<std::int16_t>(f.sformCode));
+    for (int i = 0; i < 3; ++i) h.put<float>(256 + 4 * i, static_cast<float>(f.quatern[i]));
     for (int i = 0; i < 3; ++i) h.put<float>(268 + 4 * i, static_cast<float>(f.qoffset[i]));
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 4; ++c)
+        h.put<float>(280 + 16 * r + 4 * c, static_cast<float>(f.srow[r][c]));
+    }
     h.putText(344, f.magic.empty() ? std::string("n+1\0", 4) : f.magic);
     return h.bytes();
   }
@@ -134,7 +142,12 @@ inline std::string niftiHeader(const NiftiFields& f) {
   h.put<double>(176, f.sclSlope);
   h.put<double>(184, f.sclInter);
   h.put<std::int32_t>(344, f.qformCode);
+  h.put<std::int32_t>(348, f.sformCode);
+  for (int i = 0; i < 3; ++i) h.put<double>(352 + 8 * i, f.quatern[i]);
   for (int i = 0; i < 3; ++i) h.put<double>(376 + 8 * i, f.qoffset[i]);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) h.put<double>(400 + 32 * r + 8 * c, f.srow[r][c]);
+  }
   return h.bytes();
 }
 

@@ -9,8 +9,10 @@
 #include <sstream>
 #include <vector>
 
+#include "io/GeometryFixtures.h"
 #include "io/IoFixtures.h"
 #include "tessera/core/Error.h"
+#include "tessera/core/PatientFrame.h"
 #include "tessera/io/NiftiReader.h"
 
 namespace tessera {
@@ -185,7 +187,8 @@ TEST(MetaImageReader, ReadsAnItkStyleHeaderWithSynonymsAndUnknownKeys) {
   EXPECT_EQ(v.dims(), glm::ivec3(3, 2, 2));
   EXPECT_EQ(v.type(), ScalarType::I16);  // int8 widened
   EXPECT_EQ(v.spacing(), glm::dvec3(0.5, 0.25, 4.0));
-  EXPECT_EQ(v.origin(), glm::dvec3(1.5, -2.0, 3.0));
+  // Origin is LPS (ITK's frame): (1.5, -2, 3) LPS = (-1.5, 2, 3) RAS.
+  EXPECT_EQ(v.origin(), glm::dvec3(-1.5, 2.0, 3.0));
   for (std::size_t i = 0; i < values.size(); ++i) EXPECT_EQ(v.valueAtIndex(i), values[i]);
   EXPECT_NE(v.description().find("widened to i16"), std::string::npos);
 }
@@ -248,6 +251,84 @@ TEST(MetaImageReader, Ch2RoundTripIsExact) {
   }
 }
 
+// ---- placement: TransformMatrix, Offset, AnatomicalOrientation (LPS) ----
+
+TEST(MetaImageReader, TransformMatrixListsEachAxisDirectionInLps) {
+  TempDir dir;
+  // Axis i -> LPS (0, 1, 0) = posterior, j -> (-1, 0, 0) = right, k -> superior;
+  // MetaIO names the sides the axes come from: "ALI".
+  for (const char* keys : {"TransformMatrix = 0 1 0 -1 0 0 0 0 1\nOffset = 10 20 30\n",
+                           "Rotation = 0 1 0 -1 0 0 0 0 1\nPosition = 10 20 30\n"}) {
+    SCOPED_TRACE(keys);
+    writeFile(dir / "t.mha",
+              header(std::string(keys) + "AnatomicalOrientation = ALI\nElementSpacing = 2 3 4\n",
+                     "2 2 2") +
+                  std::string(8, '\x02'));
+    const Volume v = readMetaImage(dir / "t.mha");
+    glm::dmat4 expected(1.0);
+    expected[0] = glm::dvec4(0, -2, 0, 0);  // RAS: anterior-to-posterior is -y
+    expected[1] = glm::dvec4(3, 0, 0, 0);   // towards patient right is +x
+    expected[2] = glm::dvec4(0, 0, 4, 0);
+    expected[3] = glm::dvec4(-10, -20, 30, 1);
+    test::expectAffineNear(v.indexToWorld(), expected, 0.0);
+    EXPECT_EQ(orientationOf(v.direction()).code, "PRS");
+    EXPECT_NE(v.geometrySource().find("(LPS, converted to RAS)"), std::string::npos);
+    EXPECT_EQ(v.geometrySource().find("disagrees"), std::string::npos) << v.geometrySource();
+  }
+}
+
+TEST(MetaImageReader, AnatomicalOrientationIsIgnoredLikeItkButADisagreementIsNoted) {
+  TempDir dir;
+  writeFile(dir / "t.mha", header("TransformMatrix = 0 1 0 -1 0 0 0 0 1\n"
+                                  "AnatomicalOrientation = RAI\n",
+                                  "2 2 2") +
+                               std::string(8, '\x02'));
+  const Volume v = readMetaImage(dir / "t.mha");
+  EXPECT_EQ(orientationOf(v.direction()).code, "PRS");  // the matrix wins
+  EXPECT_NE(v.geometrySource().find("AnatomicalOrientation RAI disagrees (ALI by the matrix)"),
+            std::string::npos)
+      << v.geometrySource();
+}
+
+TEST(MetaImageReader, NoTransformMatrixIsIdentityInLps) {
+  TempDir dir;
+  writeFile(dir / "t.mha", header("Offset = 1 2 3\n", "2 2 2") + std::string(8, '\x02'));
+  const Volume v = readMetaImage(dir / "t.mha");
+  EXPECT_EQ(orientationOf(v.direction()).code, "LPS");
+  EXPECT_EQ(v.origin(), glm::dvec3(-1, -2, 3));
+}
+
+TEST(MetaImageWriter, WritesLpsTransformMatrixOffsetAndItksOrientationLetters) {
+  TempDir dir;
+  struct Case {
+    glm::dmat4 affine;
+    const char* matrix;
+    const char* offset;
+    const char* orientation;
+  };
+  glm::dmat4 lps(1.0);  // identity in LPS: ITK's default image
+  lps[0][0] = -1;
+  lps[1][1] = -1;
+  const Case cases[] = {
+      {lps, "TransformMatrix = 1 0 0 0 1 0 0 0 1\n", "Offset = 0 0 0\n",
+       "AnatomicalOrientation = RAI\n"},
+      {glm::dmat4(1.0), "TransformMatrix = -1 0 0 0 -1 0 0 0 1\n", "Offset = 0 0 0\n",
+       "AnatomicalOrientation = LPI\n"},
+      {test::lasAffine(), "TransformMatrix = 1 0 0 0 -1 0 0 0 1\n", "Offset = -90.5 126.25 -72\n",
+       "AnatomicalOrientation = RPI\n"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.orientation);
+    writeMetaImage(test::volumeWithAffine({3, 2, 2}, ScalarType::U8, c.affine), dir / "w.mha");
+    const std::string text = readText(dir / "w.mha");
+    const std::string head = text.substr(0, text.find("ElementDataFile"));
+    EXPECT_NE(head.find(c.matrix), std::string::npos) << head;
+    EXPECT_NE(head.find(c.offset), std::string::npos) << head;
+    EXPECT_NE(head.find(c.orientation), std::string::npos) << head;
+    EXPECT_EQ(readMetaImage(dir / "w.mha").geometrySource().find("disagrees"), std::string::npos);
+  }
+}
+
 // ---- malformed input ----
 
 // A budget far below what the bad headers claim: any allocation made before
@@ -269,6 +350,21 @@ TEST(MetaImageReaderRejects, WrongMagicAndBinaryJunk) {
   const auto line = dir / "l.mha";
   writeFile(line, "NDims = 3\n" + std::string(200000, 'q'));
   expectRejected<InputError>([&] { readMetaImage(line); }, {line.string(), "header line longer"});
+}
+
+TEST(MetaImageReaderRejects, TransformMatricesThatCannotPlaceAVolume) {
+  TempDir dir;
+  const auto path = dir / "m.mha";
+  const std::pair<std::string, std::string> cases[] = {
+      {"TransformMatrix = 1 0 0 0 1 0\n", "TransformMatrix has 6 values, but NDims 3 needs 9"},
+      {"Orientation = 1 0 0 0 0 0 0 0 1\n", "gives index axis 1 the direction (0 0 0)"},
+      {"TransformMatrix = 1 0 0 1 0 0 0 0 1\n", "parallel"},
+      {"TransformMatrix = 1 0 0 0 nan 0 0 0 1\n", "value 5 is nan"},
+  };
+  for (const auto& [fields, fragment] : cases) {
+    writeFile(path, header(fields, "2 2 2") + std::string(8, '\0'));
+    expectRejected<InputError>([&] { readMetaImage(path); }, {path.string(), fragment});
+  }
 }
 
 TEST(MetaImageReaderRejects, MissingRequiredFields) {

@@ -92,7 +92,7 @@ TEST(NiftiWriter, RoundTripsEveryTypeExactlyThroughNiiAndNiiGz) {
   }
 }
 
-TEST(NiftiWriter, WritesANifti1HeaderWithQformOriginAndNoScaling) {
+TEST(NiftiWriter, WritesANifti1HeaderWithSformQformAndNoScaling) {
   TempDir dir;
   const Volume v = randomVolume({7, 5, 3}, ScalarType::I16, 2);
   writeNifti(v, dir / "h.nii");
@@ -114,11 +114,16 @@ TEST(NiftiWriter, WritesANifti1HeaderWithQformOriginAndNoScaling) {
   EXPECT_EQ(at<float>(b, 108), 352.0f);    // vox_offset
   EXPECT_EQ(at<float>(b, 112), 0.0f);      // scl_slope: no scaling
   EXPECT_EQ(at<std::int16_t>(b, 252), 1);  // qform_code: scanner
-  EXPECT_EQ(at<std::int16_t>(b, 254), 0);  // sform_code: none
+  EXPECT_EQ(at<std::int16_t>(b, 254), 1);  // sform_code: scanner
   for (std::size_t q = 256; q < 268; q += 4) EXPECT_EQ(at<float>(b, q), 0.0f);  // identity
   EXPECT_EQ(at<float>(b, 268), -90.5f);
   EXPECT_EQ(at<float>(b, 272), 12.25f);
   EXPECT_EQ(at<float>(b, 276), 7.0f);
+  // srow_x, srow_y, srow_z: diag(spacing) and the origin.
+  const float srow[3][4] = {{0.5f, 0, 0, -90.5f}, {0, 1.25f, 0, 12.25f}, {0, 0, 3.0f, 7.0f}};
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) EXPECT_EQ(at<float>(b, 280 + 16 * r + 4 * c), srow[r][c]);
+  }
   EXPECT_EQ(std::memcmp(b.data() + 352, v.bytes().data(), v.byteSize()), 0);
 }
 

@@ -4,9 +4,13 @@
 
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <random>
 #include <vector>
 
+#include <glm/geometric.hpp>
+
+#include "io/GeometryFixtures.h"
 #include "io/IoFixtures.h"
 #include "tessera/core/Error.h"
 
@@ -164,7 +168,11 @@ TEST(NrrdReader, SpacingIsTheLengthOfEachSpaceDirection) {
   EXPECT_DOUBLE_EQ(v.spacing().x, 2.0);
   EXPECT_DOUBLE_EQ(v.spacing().y, 3.0);
   EXPECT_DOUBLE_EQ(v.spacing().z, 0.5);
-  EXPECT_EQ(v.origin(), glm::dvec3(1, 2, 3));
+  // left-posterior-superior: x and y negated into RAS.
+  EXPECT_EQ(v.origin(), glm::dvec3(-1, -2, 3));
+  EXPECT_NEAR(glm::distance(v.direction()[0], glm::dvec3(0, -0.6, 0.8)), 0.0, 1e-12);
+  EXPECT_EQ(v.direction()[1], glm::dvec3(-1, 0, 0));
+  EXPECT_EQ(v.direction()[2], glm::dvec3(0, 0, -1));
 }
 
 TEST(NrrdReader, ByteSkipMinusOneReadsTheLastBytes) {
@@ -189,6 +197,85 @@ TEST(NrrdReader, LineSkipThenByteSkip) {
             "line skip: 2\nbyte skip: 5\ndata file: v.vtk\n");
   const Volume v = readNrrd(dir / "v.nhdr");
   for (std::size_t i = 0; i < values.size(); ++i) EXPECT_EQ(v.valueAtIndex(i), values[i]);
+}
+
+// ---- placement: space, space directions, space origin ----
+
+// A header whose axes are (1.2, 1.6, 0), (0, 0, 3), (0.4, -0.3, 0) from
+// (10, -20, 30) in `spaceLine`'s space.
+std::string spaceHeader(const std::string& spaceLine) {
+  return "NRRD0005\ntype: uchar\ndimension: 3\nsizes: 2 2 2\n" + spaceLine +
+         "space directions: (1.2,1.6,0) (0,0,3) (0.4, -0.3, 0)\n"
+         "space origin: (10,-20,30)\nencoding: raw\n\n" +
+         std::string(8, '\x01');
+}
+
+// Columns (glm) of the RAS affine expected for spaceHeader, given the signs
+// that take the space's x and y to R and A.
+glm::dmat4 expectedRas(double sx, double sy) {
+  glm::dmat4 a(1.0);
+  a[0] = glm::dvec4(sx * 1.2, sy * 1.6, 0, 0);
+  a[1] = glm::dvec4(0, 0, 3, 0);
+  a[2] = glm::dvec4(sx * 0.4, sy * -0.3, 0, 0);
+  a[3] = glm::dvec4(sx * 10, sy * -20, 30, 1);
+  return a;
+}
+
+TEST(NrrdReader, SpaceDirectionsAndOriginConvertToRasForEachSpace) {
+  TempDir dir;
+  struct Case {
+    const char* line;
+    double sx, sy;
+    const char* source;
+  };
+  const Case cases[] = {
+      {"space: right-anterior-superior\n", 1, 1, "(right-anterior-superior)"},
+      {"space: RAS\n", 1, 1, "(RAS)"},
+      {"space: left-posterior-superior\n", -1, -1, "left-posterior-superior, converted to RAS"},
+      {"space: LPS\n", -1, -1, "converted to RAS"},
+      {"space: Left-Anterior-Superior\n", -1, 1, "converted to RAS"},
+      {"space: scanner-xyz\n", 1, 1, "scanner-xyz: no patient frame, taken as RAS"},
+      {"space: 3D-right-handed\n", 1, 1, "no patient frame, taken as RAS"},
+      {"space dimension: 3\n", 1, 1, "(space dimension 3: no patient frame, taken as RAS)"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.line);
+    writeFile(dir / "s.nrrd", spaceHeader(c.line));
+    const Volume v = readNrrd(dir / "s.nrrd");
+    test::expectAffineNear(v.indexToWorld(), expectedRas(c.sx, c.sy), 1e-12);
+    EXPECT_NE(v.geometrySource().find(c.source), std::string::npos) << v.geometrySource();
+    EXPECT_DOUBLE_EQ(v.spacing().x, 2.0);
+    EXPECT_DOUBLE_EQ(v.spacing().z, 0.5);
+  }
+}
+
+TEST(NrrdReader, SpacingsWithoutSpaceDirectionsAreAxisAlignedRas) {
+  TempDir dir;
+  writeFile(dir / "s.nrrd",
+            "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\n"
+            "spacings: 0.5 2 3\nencoding: raw\n\n" +
+                std::string(8, '\x01'));
+  const Volume v = readNrrd(dir / "s.nrrd");
+  EXPECT_EQ(v.direction(), glm::dmat3(1.0));
+  EXPECT_EQ(v.spacing(), glm::dvec3(0.5, 2, 3));
+  EXPECT_EQ(v.origin(), glm::dvec3(0.0));
+  EXPECT_NE(v.geometrySource().find("spacings only"), std::string::npos);
+}
+
+TEST(NrrdWriter, WritesLpsSpaceDirectionsAndOriginAsSlicerDoes) {
+  TempDir dir;
+  const Volume v = test::volumeWithAffine({3, 2, 2}, ScalarType::U8, test::lasAffine());
+  writeNrrd(v, dir / "las.nrrd");
+  std::ifstream in(dir / "las.nrrd", std::ios::binary);
+  std::string header, line;
+  while (std::getline(in, line) && !line.empty()) header += line + "\n";
+  // RAS diag(-2, 1.5, 3) from (90.5, -126.25, -72) is LPS diag(2, -1.5, 3)
+  // from (-90.5, 126.25, -72).
+  EXPECT_NE(header.find("space: left-posterior-superior\n"), std::string::npos) << header;
+  EXPECT_NE(header.find("space directions: (2,0,0) (0,-1.5,0) (0,0,3)\n"), std::string::npos)
+      << header;
+  EXPECT_NE(header.find("space origin: (-90.5,126.25,-72)\n"), std::string::npos) << header;
+  EXPECT_EQ(header.find("space dimension"), std::string::npos) << "Teem refuses both";
 }
 
 // ---- malformed input ----
@@ -248,6 +335,33 @@ TEST(NrrdReaderRejects, NanZeroOrNoneSpacing) {
         std::string("space dimension: 3\nspace directions: (1,0,0) (0,0,0) (0,0,1)\n")}) {
     writeFile(path, header3d(line + "\n") + std::string(64, '\0'));
     expectRejected<InputError>([&] { readNrrd(path); }, {path.string(), "axis"});
+  }
+}
+
+TEST(NrrdReaderRejects, SpacesAndDirectionsThatCannotPlaceAVolume) {
+  TempDir dir;
+  const auto path = dir / "g.nrrd";
+  const std::pair<std::string, std::string> cases[] = {
+      {spaceHeader("space: right-anterior-superior-time\n"), "space-time"},
+      {spaceHeader("space: sideways\n"), "'sideways' is not a NRRD 3-D space"},
+      {spaceHeader("space dimension: 2\n"), "space dimension is 2"},
+      {"NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nspace: RAS\n"
+       "space directions: (1,0) (0,1,0) (0,0,1)\nencoding: raw\n\n" +
+           std::string(8, '\0'),
+       "has 2 components"},
+      {"NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nspace: RAS\n"
+       "space directions: (1,0,0) (2,0,0) (0,0,1)\nencoding: raw\n\n" +
+           std::string(8, '\0'),
+       "parallel"},
+      {"NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nspace: RAS\n"
+       "space directions: (1,0,0) (0,1,0) (0,0,1)\nspace origin: (1,nan,0)\n"
+       "encoding: raw\n\n" +
+           std::string(8, '\0'),
+       "space origin (1,nan,0) is not finite"},
+  };
+  for (const auto& [text, fragment] : cases) {
+    writeFile(path, text);
+    expectRejected<InputError>([&] { readNrrd(path); }, {path.string(), fragment});
   }
 }
 

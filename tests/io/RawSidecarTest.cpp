@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "io/GeometryFixtures.h"
 #include "io/IoFixtures.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/NiftiReader.h"
@@ -89,6 +90,34 @@ TEST(RawSidecar, WritesASidecarOtherToolsCanRead) {
   EXPECT_EQ(j["file"], "x.raw");
   EXPECT_EQ(j["spacing"][2].get<double>(), 0.1);
   EXPECT_EQ(j["origin"][2].get<double>(), 1.0 / 3.0);
+}
+
+TEST(RawSidecar, DirectionListsTheUnitDirectionOfEachIndexAxis) {
+  TempDir dir;
+  writeFile(dir / "d.raw", std::string(8, '\x03'));
+  // i -> anterior, j -> left, k -> superior (tilted 30 degrees towards A).
+  writeFile(dir / "d.raw.json",
+            R"({"dims": [2, 2, 2], "type": "u8", "spacing": [2, 3, 4], "origin": [1, 2, 3],
+                "direction": [[0, 1, 0], [-1, 0, 0], [0, 0.5, 0.8660254037844386]]})");
+  const Volume v = readRawWithSidecar(dir / "d.raw");
+  glm::dmat4 expected(1.0);
+  expected[0] = glm::dvec4(0, 2, 0, 0);
+  expected[1] = glm::dvec4(-3, 0, 0, 0);
+  expected[2] = glm::dvec4(0, 2, 4 * 0.8660254037844386, 0);
+  expected[3] = glm::dvec4(1, 2, 3, 1);
+  test::expectAffineNear(v.indexToWorld(), expected, 1e-12);
+  EXPECT_NE(v.geometrySource().find("JSON sidecar direction"), std::string::npos);
+}
+
+TEST(RawSidecar, WritesTheDirectionAxisByAxis) {
+  TempDir dir;
+  writeRawWithSidecar(test::volumeWithAffine({3, 2, 1}, ScalarType::U8, test::lasAffine()),
+                      dir / "las.raw");
+  std::ifstream in(dir / "las.raw.json");
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["direction"], nlohmann::json::parse("[[-1, 0, 0], [0, 1, 0], [0, 0, 1]]"));
+  EXPECT_EQ(j["spacing"], nlohmann::json::parse("[2, 1.5, 3]"));
+  EXPECT_EQ(j["origin"], nlohmann::json::parse("[90.5, -126.25, -72]"));
 }
 
 // Values of every type stored by hand in either byte order after an offset.
@@ -255,6 +284,18 @@ TEST_F(RawSidecarRejects, BadEndianOffsetAndOrigin) {
   expectBad(R"({"dims": [2, 2, 2], "type": "u8", "offset": -4})", 8, {"offset is -4"});
   expectBad(R"({"dims": [2, 2, 2], "type": "u8", "origin": [0, null, 0]})", 8,
             {"origin[1] is null"});
+}
+
+TEST_F(RawSidecarRejects, DirectionsThatAreNotThreeIndependentUnitVectors) {
+  expectBad(R"({"dims": [2, 2, 2], "type": "u8", "direction": [[1, 0, 0], [0, 1, 0]]})", 8,
+            {"direction is [[1,0,0],[0,1,0]], expected 3 unit vectors"});
+  expectBad(R"({"dims": [2, 2, 2], "type": "u8", "direction": [[2, 0, 0], [0, 1, 0], [0, 0, 1]]})",
+            8, {"direction[0] has length 2, expected a unit vector", "\"spacing\""});
+  expectBad(R"({"dims": [2, 2, 2], "type": "u8", "direction": [[1, 0, 0], [1, 0, 0], [0, 0, 1]]})",
+            8, {"direction: index axes' directions are (nearly) parallel"});
+  expectBad(
+      R"({"dims": [2, 2, 2], "type": "u8", "direction": [[1, 0, 0], [0, 1, 0], [0, "z", 1]]})", 8,
+      {"direction[2][1] is \"z\", expected a number"});
 }
 
 TEST_F(RawSidecarRejects, SidecarNamingAnotherFile) {

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <vector>
 
+#include "io/GeometryFixtures.h"
 #include "io/IoFixtures.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/NiftiReader.h"
@@ -379,6 +380,39 @@ TEST(VtiReader, ReadsAFileLikeParaViewWrites) {
   EXPECT_NE(v.description().find("ImageFile"), std::string::npos);
 }
 
+TEST(VtiReader, DirectionIsRowMajorWithTheAxesAsColumns) {
+  TempDir dir;
+  // Rows (0 -1 0), (1 0 0), (0 0 1): axis i -> +y, j -> -x, k -> +z
+  // (vtkImageData::ComputeTransforms: m4(r, c) = Direction[3r + c] * Spacing[c]).
+  VtiParts parts;
+  parts.extent = "1 2 0 1 0 1";
+  parts.imageAttributes = "Origin=\"10 20 30\" Spacing=\"2 3 4\" Direction=\"0 -1 0 1 0 0 0 0 1\"";
+  parts.arrays = dataArray("UInt8", "ascii", asciiOnes(8));
+  writeFile(dir / "d.vti", vtiText(parts));
+  const Volume v = readVti(dir / "d.vti");
+  glm::dmat4 expected(1.0);
+  expected[0] = glm::dvec4(0, 2, 0, 0);
+  expected[1] = glm::dvec4(-3, 0, 0, 0);
+  expected[2] = glm::dvec4(0, 0, 4, 0);
+  // Voxel 0 is extent point (1, 0, 0): Origin + Direction * (1 * 2, 0, 0).
+  expected[3] = glm::dvec4(10, 22, 30, 1);
+  test::expectAffineNear(v.indexToWorld(), expected, 0.0);
+  EXPECT_NE(v.geometrySource().find("taken as RAS"), std::string::npos) << v.geometrySource();
+}
+
+TEST(VtiReader, WritesTheDirectionRowByRow) {
+  TempDir dir;
+  const Volume v = test::volumeWithAffine({3, 2, 2}, ScalarType::U8, test::lasAffine());
+  writeVti(v, dir / "las.vti", false);
+  std::ifstream in(dir / "las.vti", std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_NE(ss.str().find("Origin=\"90.5 -126.25 -72\" Spacing=\"2 1.5 3\" "
+                          "Direction=\"-1 0 0 0 1 0 0 0 1\""),
+            std::string::npos)
+      << ss.str().substr(0, 400);
+}
+
 TEST(VtiReader, WritesAFileVtkCanParse) {
   // The writer's own layout, checked field by field against the format.
   TempDir dir;
@@ -411,6 +445,23 @@ VtiParts appendedU8(const std::string& extent, const std::string& payload) {
   parts.arrays = dataArray("UInt8", "appended", "", "offset=\"0\"");
   parts.appended = payload;
   return parts;
+}
+
+TEST(VtiReaderRejects, ADirectionThatCannotPlaceAVolume) {
+  TempDir dir;
+  const auto path = dir / "d.vti";
+  const std::pair<std::string, std::string> cases[] = {
+      {"Direction=\"1 1 0 0 0 0 0 0 1\"", "parallel"},  // columns 1 and 2 alike
+      {"Direction=\"1 0 0 0 0 0 0 0 1\"", "Direction column 2 (axis y) is (0 0 0)"},
+      {"Direction=\"1 0 0 0 1 0 0 0 inf\"", "Direction value 9 is inf"},
+  };
+  for (const auto& [attribute, fragment] : cases) {
+    VtiParts parts;
+    parts.imageAttributes = "Origin=\"0 0 0\" Spacing=\"1 1 1\" " + attribute;
+    parts.arrays = dataArray("UInt8", "ascii", asciiOnes(24));
+    writeFile(path, vtiText(parts));
+    expectRejected<InputError>([&] { readVti(path); }, {path.string(), fragment});
+  }
 }
 
 TEST(VtiReaderRejects, NotXmlOrNotImageData) {

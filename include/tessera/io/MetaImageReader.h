@@ -12,13 +12,18 @@ namespace tessera {
 // Also: NDims 4 with DimSize 1 last, ElementSize, Origin/Position,
 // ElementByteOrderMSB, CompressedDataSize (checked against the file),
 // MET_LONG/ULONG (4 bytes, to f32); HeaderSize > 0 is the offset of the
-// voxels in the data file, as in MetaIO. Refused with an InputError: several
+// voxels in the data file, as in MetaIO. Geometry as ITK reads it, in LPS
+// converted to RAS: TransformMatrix (or Rotation/Orientation) lists each
+// index axis' direction in turn, Offset (or Position/Origin) is voxel 0's
+// centre; AnatomicalOrientation is ignored, as ITK does (a disagreement is
+// noted in geometrySource()). Refused with an InputError: several
 // channels, BinaryData = False, ElementDataFile LIST or a file-name pattern.
 Volume readMetaImage(const std::filesystem::path& path);
 
 // .mha: header and voxels in one file; .mhd: header plus <stem>.raw (or
 // <stem>.zraw when compressed) beside it. Little endian, one zlib stream
-// when compressed; spacing and origin written exactly (%.17g).
+// when compressed; TransformMatrix, Offset (LPS, %.17g), ElementSpacing and
+// the matching AnatomicalOrientation (MetaIO's letters: "RAI" for identity).
 void writeMetaImage(const Volume& volume, const std::filesystem::path& path,
                     bool compressed = false);
 

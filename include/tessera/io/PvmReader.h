@@ -22,13 +22,16 @@ void writePvm(const Volume& volume, const std::filesystem::path& path);
 // Raw voxels with a JSON sidecar (`data.raw` + `data.raw.json` or
 // `data.json`; or the .json itself): {"dims": [x,y,z], "type":
 // "u8"|"u16"|"i16"|"f32", "spacing": [..] (default 1), "origin": [..]
-// (default 0), "endian": "little"|"big" (default little), "offset": n
-// (default 0), "file": "data.raw" (relative to the sidecar)}. Unknown keys,
-// wrong JSON types, non-finite or non-positive spacing, and a raw file whose
-// size is not exactly offset + dims × type are InputErrors.
+// (default 0; RAS mm), "direction": [[i], [j], [k]] (unit RAS direction of
+// each index axis, default identity), "endian": "little"|"big" (default
+// little), "offset": n (default 0), "file": "data.raw" (relative to the
+// sidecar)}. Unknown keys, wrong JSON types, non-finite or non-positive
+// spacing, a direction that is not 3 independent unit vectors, and a raw
+// file whose size is not exactly offset + dims × type are InputErrors.
 Volume readRawWithSidecar(const std::filesystem::path& path);
 // Writes `path` (raw, little endian) and `path` + ".json" (naming `path` in
-// "file"), both through temporary files renamed once complete.
+// "file", with spacing, origin and direction), both through temporary files
+// renamed once complete.
 void writeRawWithSidecar(const Volume& volume, const std::filesystem::path& path);
 
 }  // namespace tessera

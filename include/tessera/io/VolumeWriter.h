@@ -1,6 +1,8 @@
 #pragma once
 #include <filesystem>
 #include <functional>
+#include <string>
+#include <vector>
 
 #include "tessera/core/Volume.h"
 
@@ -12,6 +14,13 @@ namespace tessera {
 // writes a temporary file in the same directory and renames it, so an
 // interrupted write never leaves a half-written file under the final name.
 void writeVolume(const Volume& volume, const std::filesystem::path& path);
+
+// What writing `volume` to `out` (chosen by extension, as writeVolume)
+// would lose of its geometry, as sentences for the user, e.g. "PVM stores
+// spacing only: orientation LAS and origin (90, -126, -72) are lost"; empty
+// when the format holds the whole affine (NIfTI, NRRD, MetaImage, VTI,
+// raw + JSON, DICOM).
+std::vector<std::string> geometryLossNotes(const Volume& volume, const std::filesystem::path& out);
 
 // Runs `write(tempPath)` and renames tempPath to `path` on success (removes
 // it on failure). tempPath is in the same directory and ends with the same

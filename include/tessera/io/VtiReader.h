@@ -9,14 +9,17 @@ namespace tessera {
 // formats appended (raw or base64) and inline binary (base64) and ascii;
 // zlib compression (vtkZLibDataCompressor, header UInt32 or UInt64);
 // types UInt8/Int8/UInt16/Int16/Float32 (Int32/UInt32/Float64 -> f32);
-// Spacing, Origin. Sizes are checked before allocating.
+// Spacing, Origin, Direction (VTK 9: row-major 3x3 whose columns are the
+// axes). VTK has no patient frame: its coordinates are taken as Tessera's
+// RAS world as they are. Sizes are checked before allocating.
 // The array is the one PointData names with Scalars=, else the first; one
 // Piece covering WholeExtent; a WholeExtent that starts off 0 moves the
-// origin to its first point; Direction is ignored (noted in description()).
+// origin to its first point.
 Volume readVti(const std::filesystem::path& path);
 
 // Appended raw data, header_type UInt64, little endian, as ParaView writes;
-// zlib in vtkZLibDataCompressor's 32 KiB blocks when compressed.
+// zlib in vtkZLibDataCompressor's 32 KiB blocks when compressed. Origin,
+// Spacing and Direction hold the RAS affine unchanged.
 void writeVti(const Volume& volume, const std::filesystem::path& path, bool compressed = false);
 
 }  // namespace tessera
