@@ -9,6 +9,7 @@
 #include "app/Commands.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/core/PatientFrame.h"
 #include "tessera/io/VolumeReader.h"
 #include "tessera/io/VolumeWriter.h"
 #include "tessera/lod/Downsample.h"
@@ -130,10 +131,15 @@ void runConvert(const ConvertOptions& o) {
   writeVolume(v, o.out);
   progress.stage("done", 1.0);
   progress.done();
-  std::printf("%s: %s %s -> %s: %s %s (%s)\n", o.in.c_str(), dimsText(inDims).c_str(),
+  std::printf("%s: %s %s -> %s: %s %s, %s (%s)\n", o.in.c_str(), dimsText(inDims).c_str(),
               std::string(scalarTypeName(v.type())).c_str(), o.out.c_str(),
               dimsText(v.dims()).c_str(), std::string(scalarTypeName(v.type())).c_str(),
-              formatBytes(v.byteSize()).c_str());
+              orientationOf(v.direction()).describe().c_str(), formatBytes(v.byteSize()).c_str());
+  // What the output format could not hold is said even with --quiet: a
+  // silently lost orientation is how left and right get swapped.
+  for (const std::string& note : geometryLossNotes(v, o.out)) {
+    std::fprintf(stderr, "note: %s\n", note.c_str());
+  }
 }
 
 }  // namespace

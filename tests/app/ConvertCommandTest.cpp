@@ -10,6 +10,7 @@
 #include "support/TestSupport.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/io/VolumeReader.h"
+#include "tessera/io/VolumeWriter.h"
 
 namespace fs = std::filesystem;
 using tessera::test::runCli;
@@ -74,4 +75,23 @@ TEST(ConvertCommand, FailuresLeaveNoFileBehind) {
   }
   // Nothing under any name: no partial outputs, no temporary files.
   EXPECT_TRUE(fs::is_empty(tmp.path()));
+}
+
+// A format that cannot hold the orientation says so, even with --quiet, and
+// one that can says nothing.
+TEST(ConvertCommand, SaysWhatTheOutputFormatCannotHold) {
+  const tessera::test::TempDir tmp;
+  tessera::Volume v = tessera::makeSheppLogan({12, 10, 8});
+  v.setDirection(glm::dmat3(glm::dvec3(-1, 0, 0), glm::dvec3(0, 1, 0), glm::dvec3(0, 0, 1)));
+  const auto las = tmp / "las.nrrd";
+  tessera::writeVolume(v, las);
+  const auto pvm = runCli("convert " + las.string() + " " + (tmp / "a.pvm").string() + " --quiet");
+  ASSERT_EQ(pvm.exitCode, 0) << pvm.err;
+  EXPECT_NE(pvm.out.find(", LAS ("), std::string::npos) << pvm.out;
+  EXPECT_NE(pvm.err.find("note: PVM stores spacing only: orientation LAS is lost"),
+            std::string::npos)
+      << pvm.err;
+  const auto nii = runCli("convert " + las.string() + " " + (tmp / "a.nii").string() + " --quiet");
+  ASSERT_EQ(nii.exitCode, 0) << nii.err;
+  EXPECT_EQ(nii.err.find("note:"), std::string::npos) << nii.err;
 }
