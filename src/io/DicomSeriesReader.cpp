@@ -1,10 +1,13 @@
 // DICOM series → one volume (Schultz 2016, 6.1 and 7.1.1), through DCMTK.
 // Attribute meanings follow DICOM PS3.3 C.7.6.2 (Image Plane module: position,
 // orientation, pixel spacing) and C.7.6.3 (Image Pixel module: rows, columns,
-// bits, pixel representation); rescale follows C.11.1.1.2.
+// bits, pixel representation); rescale follows C.11.1.1.2. DICOM's patient
+// frame is LPS+; the volume's affine is RAS+ (core/PatientFrame.h), so every
+// position and direction is converted once, in applyGeometry.
 #include "tessera/io/DicomSeriesReader.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -13,6 +16,7 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <system_error>
 #include <utility>
 
 #include <glm/geometric.hpp>
@@ -20,6 +24,7 @@
 
 #include "io/DicomToolkit.h"
 #include "tessera/core/Error.h"
+#include "tessera/core/PatientFrame.h"
 
 #include <dcmtk/dcmdata/dcdatset.h>
 #include <dcmtk/dcmdata/dcdeftag.h>
@@ -39,8 +44,14 @@ namespace {
 constexpr double kOrientationTolerance = 1e-3;
 // Consecutive slice gaps may differ from the median gap by this fraction.
 constexpr double kGapTolerance = 0.01;
-// Largest in-plane drift of slice positions, in pixels, still read as a stack.
-constexpr double kShearTolerancePixels = 0.5;
+// Largest distance of a slice position from the straight line through the
+// first and last slice, in pixels, still read as one regular stack.
+constexpr double kIrregularTolerancePixels = 0.5;
+// Positions closer than this (mm) are the same slice position.
+constexpr double kSamePositionMm = 0.01;
+// Deflate never compresses by more than 1032:1 (zlib technical details,
+// "Maximum compression factor"), which bounds what a deflated dataset holds.
+constexpr std::uint64_t kMaxDeflateRatio = 1032;
 
 std::string quoted(const std::string& s) {
   return "'" + s + "'";
@@ -54,6 +65,11 @@ std::string number(double v) {
 
 std::string vecText(glm::dvec3 v) {
   return "(" + number(v.x) + ", " + number(v.y) + ", " + number(v.z) + ")";
+}
+
+// "Rows (0028,0010)": the name users know and the tag, each once.
+std::string attributeName(const char* name, const DcmTagKey& tag) {
+  return std::string(name) + " " + tag.toString().c_str();
 }
 
 // One image file of a series: what the header says, before any pixel is read.
@@ -72,9 +88,10 @@ struct Slice {
   int samplesPerPixel = 1;
   long frames = 1;
   std::string photometric;
-  std::optional<glm::dvec3> position;
-  std::optional<glm::dvec3> rowDir;        // direction of increasing column index
-  std::optional<glm::dvec3> colDir;        // direction of increasing row index
+  std::optional<long> instanceNumber;
+  std::optional<glm::dvec3> position;      // Image Position (Patient), LPS mm
+  std::optional<glm::dvec3> rowDir;        // LPS direction of increasing column index
+  std::optional<glm::dvec3> colDir;        // LPS direction of increasing row index
   std::optional<glm::dvec2> pixelSpacing;  // (between rows, between columns)
   double slope = 1.0;
   double intercept = 0.0;
@@ -88,19 +105,23 @@ struct Slice {
   double distance = 0.0;  // along the slice normal, set when sorting
 };
 
+// A file that could not be used (DCMTK cannot parse it, or no codec decodes
+// its pixels), with what its header said as far as it could be parsed.
+struct UnreadableFile {
+  fs::path file;
+  std::string error;
+  std::string seriesUid;               // may be empty
+  std::optional<glm::dvec3> position;  // LPS mm, when parsed
+};
+
 struct FolderScan {
   std::string where;  // "folder X" or "the N files given"
   std::vector<Slice> slices;
   int nonDicomFiles = 0;
   int nonImageObjects = 0;  // DICOMDIR, reports, ... (no Pixel Data)
-  // Part-10 files DCMTK cannot parse (truncated, unknown syntax): an error if
-  // they belong to the series read (or nothing else is readable), a note if
-  // they belong to another one.
-  struct Unreadable {
-    std::string error;
-    std::string seriesUid;  // as far as the file could be parsed; may be empty
-  };
-  std::vector<Unreadable> unreadable;
+  // Skipped, then judged with the series read (see checkUnreadableMembers);
+  // a note when they belong to another series.
+  std::vector<UnreadableFile> unreadable;
   int subfolders = 0;
 };
 
@@ -122,18 +143,24 @@ Probe probeFile(const fs::path& file) {
 // The length an element declares is trusted by DCMTK when its value is first
 // read (values over DCM_MaxReadLength stay on disk until then): a corrupt
 // length would make it allocate gigabytes. No value can be longer than the
-// file, so an element that says otherwise marks the file corrupt.
-void checkDeclaredLengths(DcmItem& item, const fs::path& file, std::uintmax_t fileSize) {
+// file holds: its size, or for a deflated dataset what that size inflates
+// to at most.
+void checkDeclaredLengths(DcmItem& item, const fs::path& file, std::uintmax_t fileSize,
+                          bool deflated) {
+  const std::uint64_t limit = deflated ? fileSize * kMaxDeflateRatio : fileSize;
   DcmStack stack;
   while (item.nextObject(stack, OFTrue).good()) {
     DcmObject* obj = stack.top();
     if (obj == nullptr || !obj->isLeaf()) continue;
     const Uint32 declared = obj->getLengthField();
-    if (declared == DCM_UndefinedLength || declared <= fileSize) continue;
+    if (declared == DCM_UndefinedLength || declared <= limit) continue;
     DcmTag tag = obj->getTag();
     throw InputError(file.string() + ": element " + tag.toString().c_str() + " " +
                      tag.getTagName() + " declares " + std::to_string(declared) +
                      " bytes but the file has only " + std::to_string(fileSize) +
+                     (deflated
+                          ? " deflated bytes (at most " + std::to_string(limit) + " once inflated)"
+                          : std::string()) +
                      " (corrupt file)");
   }
 }
@@ -151,8 +178,9 @@ bool loadDicom(const fs::path& file, DcmFileFormat& ff) {
   const OFCondition c = ff.loadFile(file.c_str(), EXS_Unknown, EGL_noChange, DCM_MaxReadLength,
                                     probe == Probe::Part10 ? ERM_fileOnly : ERM_dataset);
   if (c.good()) {
-    if (ff.getMetaInfo() != nullptr) checkDeclaredLengths(*ff.getMetaInfo(), file, fileSize);
-    checkDeclaredLengths(*ff.getDataset(), file, fileSize);
+    if (ff.getMetaInfo() != nullptr) checkDeclaredLengths(*ff.getMetaInfo(), file, fileSize, false);
+    const bool deflated = ff.getDataset()->getOriginalXfer() == EXS_DeflatedLittleEndianExplicit;
+    checkDeclaredLengths(*ff.getDataset(), file, fileSize, deflated);
     return true;
   }
   if (probe == Probe::MaybeDataset) return false;
@@ -170,22 +198,82 @@ bool loadDicom(const fs::path& file, DcmFileFormat& ff) {
                    "; truncated or corrupt?)");
 }
 
-// The text of a short attribute, "" when absent. The declared length is
-// checked first: this also runs on files that failed to load, whose lengths
-// nobody has vetted (see checkDeclaredLengths).
-std::string stringAttr(DcmItem& ds, const DcmTagKey& tag) {
+// The value of a short attribute as text, without leading/trailing spaces
+// and NULs; nullopt when absent. An element a writer stored with VR UN
+// (it did not know the attribute) holds its implicit-VR little-endian value
+// (PS3.5 6.2.2), which for the string VRs read here is the text itself. The
+// declared length is checked first: this also runs on files that failed to
+// load, whose lengths nobody has vetted (see checkDeclaredLengths).
+std::optional<std::string> attributeText(DcmItem& ds, const DcmTagKey& tag) {
   constexpr Uint32 kLongestAttribute = 64 * 1024;  // LT holds 10240 characters
   DcmElement* elem = nullptr;
   if (ds.findAndGetElement(tag, elem).bad() || elem == nullptr ||
       elem->getLengthField() > kLongestAttribute) {
-    return "";
+    return std::nullopt;
   }
-  OFString s;
-  if (elem->getOFStringArray(s).bad()) return "";
-  std::string r = s.c_str();
-  const auto b = r.find_first_not_of(' ');
-  const auto e = r.find_last_not_of(' ');
-  return b == std::string::npos ? "" : r.substr(b, e - b + 1);
+  std::string r;
+  if (elem->ident() == EVR_UN) {
+    Uint8* bytes = nullptr;
+    if (elem->getUint8Array(bytes).bad()) return std::nullopt;
+    if (bytes != nullptr) r.assign(reinterpret_cast<const char*>(bytes), elem->getLength());
+  } else {
+    OFString s;
+    if (elem->getOFStringArray(s).bad()) return std::nullopt;
+    r.assign(s.c_str(), s.length());
+  }
+  const auto b = r.find_first_not_of(std::string(" \0", 2));
+  const auto e = r.find_last_not_of(std::string(" \0", 2));
+  return b == std::string::npos ? std::string() : r.substr(b, e - b + 1);
+}
+
+std::string stringAttr(DcmItem& ds, const DcmTagKey& tag) {
+  return attributeText(ds, tag).value_or("");
+}
+
+// An unsigned short (US), also when stored as UN (two little-endian bytes).
+std::optional<int> uint16Attr(DcmItem& ds, const DcmTagKey& tag) {
+  Uint16 v = 0;
+  if (ds.findAndGetUint16(tag, v).good()) return v;
+  DcmElement* elem = nullptr;
+  Uint8* bytes = nullptr;
+  if (ds.findAndGetElement(tag, elem).good() && elem != nullptr && elem->ident() == EVR_UN &&
+      elem->getLength() == 2 && elem->getUint8Array(bytes).good() && bytes != nullptr) {
+    return bytes[0] | (bytes[1] << 8);
+  }
+  return std::nullopt;
+}
+
+// The numbers of a decimal (DS) or integer (IS) string "a\b\c"; nullopt
+// unless there are exactly `count` of them. Parsed without the C locale's
+// help (std::from_chars), so a decimal comma never passes.
+std::optional<std::vector<double>> parseNumbers(const std::string& text, std::size_t count) {
+  std::vector<double> out;
+  std::size_t begin = 0;
+  while (begin <= text.size()) {
+    std::size_t end = text.find('\\', begin);
+    if (end == std::string::npos) end = text.size();
+    std::size_t a = text.find_first_not_of(' ', begin);
+    std::size_t b = end;
+    while (b > a && text[b - 1] == ' ') --b;
+    if (a == std::string::npos || a >= b) return std::nullopt;
+    if (text[a] == '+') ++a;
+    double v = 0;
+    const auto r = std::from_chars(text.data() + a, text.data() + b, v);
+    if (r.ec != std::errc() || r.ptr != text.data() + b || !std::isfinite(v)) return std::nullopt;
+    out.push_back(v);
+    begin = end + 1;
+  }
+  if (out.size() != count) return std::nullopt;
+  return out;
+}
+
+// How a malformed value is shown in a message: its text, or its size when
+// it is not text at all.
+std::string shownValue(const std::string& text) {
+  const bool printable = std::all_of(text.begin(), text.end(), [](char c) {
+    return static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7f;
+  });
+  return printable ? quoted(text) : std::to_string(text.size()) + " bytes that are not text";
 }
 
 // Reads the attributes a slice needs; problems are recorded in `defect`, not
@@ -203,25 +291,29 @@ Slice sliceHeader(const fs::path& file, DcmFileFormat& ff) {
   auto defect = [&](const std::string& msg) {
     if (s.defect.empty()) s.defect = msg;
   };
-  auto u16 = [&](const DcmTagKey& tag, const char* name, int& out, bool required) {
-    Uint16 v = 0;
-    if (ds.findAndGetUint16(tag, v).good()) {
-      out = v;
-    } else if (required) {
-      defect(std::string("has no ") + name + " " + DcmTag(tag).getTagName());
+  // The Image Pixel module's type 1 attributes (PS3.3 C.7.6.3), all named at once.
+  std::vector<std::string> missing;
+  auto required = [&](const DcmTagKey& tag, const char* name, int& out) {
+    if (const auto v = uint16Attr(ds, tag)) {
+      out = *v;
+    } else {
+      missing.push_back(attributeName(name, tag));
     }
   };
-  u16(DCM_Rows, "Rows", s.rows, true);
-  u16(DCM_Columns, "Columns", s.columns, true);
-  u16(DCM_BitsAllocated, "Bits Allocated", s.bitsAllocated, true);
-  s.bitsStored = s.bitsAllocated;
-  u16(DCM_BitsStored, "Bits Stored", s.bitsStored, false);
-  s.highBit = s.bitsStored - 1;
-  u16(DCM_HighBit, "High Bit", s.highBit, false);
-  u16(DCM_SamplesPerPixel, "Samples per Pixel", s.samplesPerPixel, false);
-  int pixelRepresentation = 0;
-  u16(DCM_PixelRepresentation, "Pixel Representation", pixelRepresentation, false);
-  s.isSigned = pixelRepresentation == 1;
+  required(DCM_Rows, "Rows", s.rows);
+  required(DCM_Columns, "Columns", s.columns);
+  required(DCM_BitsAllocated, "Bits Allocated", s.bitsAllocated);
+  if (!missing.empty()) {
+    std::string list;
+    for (std::size_t i = 0; i < missing.size(); ++i) {
+      list += (i == 0 ? "" : i + 1 == missing.size() ? " or " : ", ") + missing[i];
+    }
+    defect("has Pixel Data but no " + list + "; not an image this reader can use");
+  }
+  s.bitsStored = uint16Attr(ds, DCM_BitsStored).value_or(s.bitsAllocated);
+  s.highBit = uint16Attr(ds, DCM_HighBit).value_or(s.bitsStored - 1);
+  s.samplesPerPixel = uint16Attr(ds, DCM_SamplesPerPixel).value_or(1);
+  s.isSigned = uint16Attr(ds, DCM_PixelRepresentation).value_or(0) == 1;
 
   DcmElement* pixels = nullptr;
   if (!DcmXfer(s.xfer).isEncapsulated() && ds.findAndGetElement(DCM_PixelData, pixels).good() &&
@@ -229,25 +321,27 @@ Slice sliceHeader(const fs::path& file, DcmFileFormat& ff) {
     s.pixelBytes = pixels->getLength();
   }
 
-  Sint32 frames = 1;
-  if (ds.findAndGetSint32(DCM_NumberOfFrames, frames).good()) s.frames = frames;
+  // Optional integers: a malformed one is treated as absent.
+  auto integer = [&](const DcmTagKey& tag) -> std::optional<long> {
+    const auto t = attributeText(ds, tag);
+    const auto v = t ? parseNumbers(*t, 1) : std::nullopt;
+    if (!v || std::floor((*v)[0]) != (*v)[0] || std::abs((*v)[0]) > 2147483647.0) {
+      return std::nullopt;
+    }
+    return static_cast<long>((*v)[0]);
+  };
+  s.frames = integer(DCM_NumberOfFrames).value_or(1);
+  s.instanceNumber = integer(DCM_InstanceNumber);
 
   // Decimal strings: absent is fine (nullopt), present but malformed is a defect.
   auto numbers = [&](const DcmTagKey& tag, const char* name,
-                     unsigned long count) -> std::optional<std::vector<double>> {
-    DcmElement* elem = nullptr;
-    if (ds.findAndGetElement(tag, elem).bad() || elem == nullptr || elem->getLength() == 0) {
-      return std::nullopt;
-    }
-    std::vector<double> v(count);
-    for (unsigned long i = 0; i < count; ++i) {
-      Float64 x = 0;
-      if (ds.findAndGetFloat64(tag, x, i).bad() || !std::isfinite(x)) {
-        defect(std::string(name) + " " + DcmTag(tag).getTagName() + " is " +
-               quoted(stringAttr(ds, tag)) + ", expected " + std::to_string(count) + " numbers");
-        return std::nullopt;
-      }
-      v[i] = x;
+                     std::size_t count) -> std::optional<std::vector<double>> {
+    const auto text = attributeText(ds, tag);
+    if (!text || text->empty()) return std::nullopt;
+    auto v = parseNumbers(*text, count);
+    if (!v) {
+      defect(attributeName(name, tag) + " is " + shownValue(*text) + ", expected " +
+             std::to_string(count) + (count == 1 ? " number" : " numbers"));
     }
     return v;
   };
@@ -263,7 +357,8 @@ Slice sliceHeader(const fs::path& file, DcmFileFormat& ff) {
              " is not two perpendicular unit vectors");
     } else {
       s.rowDir = glm::normalize(r);
-      s.colDir = glm::normalize(c);
+      // Exactly perpendicular to the row, as the normal and the affine need.
+      s.colDir = glm::normalize(c - glm::dot(c, *s.rowDir) * *s.rowDir);
     }
   }
   if (auto p = numbers(DCM_PixelSpacing, "Pixel Spacing", 2)) {
@@ -286,6 +381,15 @@ Slice sliceHeader(const fs::path& file, DcmFileFormat& ff) {
   return s;
 }
 
+// What an unusable file's header says, as far as it was parsed.
+UnreadableFile unreadableFile(const fs::path& file, std::string error, DcmDataset& ds) {
+  UnreadableFile u{file, std::move(error), stringAttr(ds, DCM_SeriesInstanceUID), std::nullopt};
+  if (const auto t = attributeText(ds, DCM_ImagePositionPatient)) {
+    if (const auto p = parseNumbers(*t, 3)) u.position = glm::dvec3((*p)[0], (*p)[1], (*p)[2]);
+  }
+  return u;
+}
+
 void addFile(const fs::path& file, bool mustBeImage, FolderScan& scan) {
   DcmFileFormat ff;
   bool isDicom = false;
@@ -294,7 +398,7 @@ void addFile(const fs::path& file, bool mustBeImage, FolderScan& scan) {
   } catch (const InputError& e) {
     if (mustBeImage) throw;
     // What was parsed before the failure usually includes the series UID.
-    scan.unreadable.push_back({e.what(), stringAttr(*ff.getDataset(), DCM_SeriesInstanceUID)});
+    scan.unreadable.push_back(unreadableFile(file, e.what(), *ff.getDataset()));
     return;
   }
   if (!isDicom) {
@@ -306,12 +410,21 @@ void addFile(const fs::path& file, bool mustBeImage, FolderScan& scan) {
     ++scan.nonDicomFiles;
     return;
   }
-  if (!ff.getDataset()->tagExists(DCM_PixelData)) {
+  DcmDataset& ds = *ff.getDataset();
+  if (!ds.tagExists(DCM_PixelData)) {
     if (mustBeImage) {
       throw InputError(file.string() + ": a DICOM object without Pixel Data (7FE0,0010) (" +
-                       stringAttr(*ff.getDataset(), DCM_Modality) + "); not an image");
+                       stringAttr(ds, DCM_Modality) + "); not an image");
     }
     ++scan.nonImageObjects;
+    return;
+  }
+  // Known now rather than when the pixels are decoded, so that such a file
+  // beside readable copies of its slice (JPEG 2000 next to JPEG) is skipped.
+  if (!io_detail::canDecodePixels(ds.getOriginalXfer())) {
+    std::string error = io_detail::undecodableSyntaxMessage(file.string(), ds.getOriginalXfer());
+    if (mustBeImage) throw InputError(error);
+    scan.unreadable.push_back(unreadableFile(file, std::move(error), ds));
     return;
   }
   scan.slices.push_back(sliceHeader(file, ff));
@@ -378,18 +491,102 @@ std::string othersText(const std::vector<SeriesGroup>& groups, std::size_t chose
   return t;
 }
 
-// Pixel data must hold Rows x Columns pixels; one byte of padding keeps odd
-// lengths even (PS3.5 8.1.1).
-void checkPixelBytes(const Slice& s, std::uint64_t length) {
+// The group to read: the one with Series Instance UID `uid` when given, else
+// the one holding the `named` file (a file names its own series, also when
+// it has no UID), else the largest.
+std::size_t chooseGroup(const std::vector<SeriesGroup>& groups, const std::string& uid,
+                        const fs::path& named, const std::string& what) {
+  const auto holds = [&](const SeriesGroup& g) {
+    if (!uid.empty()) return g.uid == uid;
+    return std::any_of(g.slices.begin(), g.slices.end(),
+                       [&](const Slice& s) { return s.file == named; });
+  };
+  if (uid.empty() && named.empty()) return 0;
+  const auto it = std::find_if(groups.begin(), groups.end(), holds);
+  if (it != groups.end()) return static_cast<std::size_t>(it - groups.begin());
+  if (!uid.empty()) {
+    throw InputError(what + ": no series with Series Instance UID " + uid +
+                     "; found: " + othersText(groups, groups.size()));
+  }
+  throw InputError(what + ": the file was not found again when its folder was read");
+}
+
+bool sameOrientation(const Slice& a, const Slice& b) {
+  if (a.rowDir.has_value() != b.rowDir.has_value()) return false;
+  if (!a.rowDir) return true;
+  const glm::dvec3 dr = *a.rowDir - *b.rowDir;
+  const glm::dvec3 dc = *a.colDir - *b.colDir;
+  return std::max({std::abs(dr.x), std::abs(dr.y), std::abs(dr.z), std::abs(dc.x), std::abs(dc.y),
+                   std::abs(dc.z)}) <= kOrientationTolerance;
+}
+
+bool samePixelSpacing(const Slice& a, const Slice& b) {
+  if (a.pixelSpacing.has_value() != b.pixelSpacing.has_value()) return false;
+  return !a.pixelSpacing ||
+         glm::length(*a.pixelSpacing - *b.pixelSpacing) <= 1e-3 * glm::length(*b.pixelSpacing);
+}
+
+// One Series Instance UID can hold several stacks (a localizer beside its
+// slices, reconstructions of other sizes or orientations). A named file
+// selects its own: the slices of its size, frame count, pixel type,
+// orientation and pixel spacing. Returns how many others were left out.
+std::size_t keepStackOf(std::vector<Slice>& slices, const fs::path& named) {
+  const auto ref =
+      std::find_if(slices.begin(), slices.end(), [&](const Slice& s) { return s.file == named; });
+  if (ref == slices.end()) return 0;
+  const Slice r = *ref;
+  const std::size_t before = slices.size();
+  std::erase_if(slices, [&](const Slice& s) {
+    return s.rows != r.rows || s.columns != r.columns || s.frames != r.frames ||
+           s.bitsAllocated != r.bitsAllocated || s.isSigned != r.isSigned ||
+           !sameOrientation(s, r) || !samePixelSpacing(s, r);
+  });
+  return before - slices.size();
+}
+
+// Files of the series read that could not be used are judged against the
+// slices that could: one at a readable slice's position is another encoding
+// or a broken copy of that slice (pydicom's MR_truncated.dcm beside
+// MR_small.dcm) and is skipped; one elsewhere, or of unknown position in a
+// positioned series, is a slice the volume would lack, and its error is the
+// reason the series cannot be read.
+void checkUnreadableMembers(const std::vector<UnreadableFile>& members,
+                            const std::vector<Slice>& slices) {
+  const bool positioned =
+      std::any_of(slices.begin(), slices.end(), [](const Slice& s) { return s.position; });
+  for (const auto& u : members) {
+    const bool duplicate =
+        u.position ? std::any_of(slices.begin(), slices.end(),
+                                 [&](const Slice& s) {
+                                   return s.position &&
+                                          glm::length(*s.position - *u.position) <= kSamePositionMm;
+                                 })
+                   : !positioned;
+    if (!duplicate) {
+      throw InputError(
+          u.error + " (a slice of the series read" +
+          (u.position ? " at Image Position (Patient) " + vecText(*u.position) : std::string()) +
+          ": without it the volume would be incomplete)");
+    }
+  }
+}
+
+// Pixel data must hold Rows x Columns pixels. Bytes beyond that, less than
+// another frame, are padding and ignored: one byte keeps odd lengths even
+// (PS3.5 8.1.1), some writers pad more (pydicom's MR_small_padded.dcm). A
+// whole frame more is data this reader would misread. Returns the padding.
+std::uint64_t checkPixelBytes(const Slice& s, std::uint64_t length) {
   const std::uint64_t bytes = static_cast<std::uint64_t>(s.bitsAllocated / 8);
   const std::uint64_t expected =
       static_cast<std::uint64_t>(s.rows) * static_cast<std::uint64_t>(s.columns) * bytes;
-  if (length < expected || length > expected + 1) {
-    throw InputError(s.file.string() + ": pixel data has " + std::to_string(length) +
-                     " bytes, but " + std::to_string(s.columns) + "x" + std::to_string(s.rows) +
-                     " pixels x " + std::to_string(bytes) + " bytes = " + std::to_string(expected) +
-                     " bytes" + (length < expected ? " (truncated)" : " (more than one frame?)"));
+  if (length < expected || (length > expected + 1 && length >= 2 * expected)) {
+    throw InputError(
+        s.file.string() + ": pixel data has " + std::to_string(length) + " bytes, but " +
+        std::to_string(s.columns) + "x" + std::to_string(s.rows) + " pixels x " +
+        std::to_string(bytes) + " bytes = " + std::to_string(expected) + " bytes" +
+        (length < expected ? " (truncated)" : " (more than one frame, but Number of Frames is 1)"));
   }
+  return length - expected;
 }
 
 // Checks one slice on its own: what any single file must satisfy to be read.
@@ -468,61 +665,81 @@ void checkConsistent(const std::vector<Slice>& slices) {
   }
 }
 
+// Where the voxels lie, in DICOM's LPS patient frame; converted to RAS when
+// the volume is made (core/PatientFrame.h).
 struct Geometry {
-  glm::dvec3 rowDir{1, 0, 0};
-  glm::dvec3 colDir{0, 1, 0};
-  glm::dvec3 normal{0, 0, 1};
-  double sliceSpacing = 1.0;
-  std::string note;  // assumptions made, for the description
+  glm::dmat3 direction{1.0};  // LPS; columns: row, column, slice step (unit)
+  glm::dvec3 spacing{1.0};
+  glm::dvec3 origin{0.0};  // LPS position of voxel (0,0,0)'s centre
+  std::string source = "DICOM IPP/IOP (LPS -> RAS)";
+  std::vector<std::string> notes;  // assumptions made, for the description
 };
 
-// Sorts `slices` along the normal and derives the slice spacing; throws for
-// mixed orientations, duplicate positions, missing slices and uneven gaps.
-Geometry sortAlongNormal(std::vector<Slice>& slices) {
-  Geometry g;
+// Row and column directions shared by every slice. Without any Image
+// Orientation (Patient), axial slices (1\0\0\0\1\0, identity direction)
+// are assumed.
+void sliceAxes(const std::vector<Slice>& slices, Geometry& g) {
   const Slice& first = slices.front();
-  if (slices.size() == 1) {
-    if (first.rowDir) {
-      g.rowDir = *first.rowDir;
-      g.colDir = *first.colDir;
-      g.normal = glm::normalize(glm::cross(g.rowDir, g.colDir));
-    }
-    if (first.spacingBetweenSlices > 0) {
-      g.sliceSpacing = first.spacingBetweenSlices;
-    } else if (first.sliceThickness > 0) {
-      g.sliceSpacing = first.sliceThickness;
-    } else {
-      g.note = "one slice without Slice Thickness: z spacing assumed 1";
-    }
-    return g;
-  }
   for (const auto& s : slices) {
-    if (!s.position || !s.rowDir) {
-      throw InputError(s.file.string() + ": no " +
-                       (s.position ? "Image Orientation (Patient) (0020,0037)"
-                                   : "Image Position (Patient) (0020,0032)") +
-                       "; the slices of a series cannot be ordered without it");
+    if (s.rowDir.has_value() != first.rowDir.has_value()) {
+      const Slice& without = s.rowDir ? first : s;
+      const Slice& with = s.rowDir ? s : first;
+      throw InputError(without.file.string() +
+                       ": no Image Orientation (Patient) (0020,0037), but " + with.file.string() +
+                       " of the same series has one; slices of one volume must share it");
     }
-  }
-  g.rowDir = *first.rowDir;
-  g.colDir = *first.colDir;
-  for (const auto& s : slices) {
-    const glm::dvec3 dr = *s.rowDir - g.rowDir;
-    const glm::dvec3 dc = *s.colDir - g.colDir;
-    const double worst = std::max({std::abs(dr.x), std::abs(dr.y), std::abs(dr.z), std::abs(dc.x),
-                                   std::abs(dc.y), std::abs(dc.z)});
-    if (worst > kOrientationTolerance) {
+    if (!sameOrientation(s, first)) {
       throw InputError(s.file.string() + ": Image Orientation (Patient) is " + vecText(*s.rowDir) +
                        " " + vecText(*s.colDir) + ", but " + first.file.string() + " has " +
-                       vecText(g.rowDir) + " " + vecText(g.colDir) +
+                       vecText(*first.rowDir) + " " + vecText(*first.colDir) +
                        "; slices of one volume must share an orientation");
     }
   }
-  g.normal = glm::normalize(glm::cross(g.rowDir, g.colDir));
-  for (auto& s : slices) s.distance = glm::dot(*s.position, g.normal);
+  if (first.rowDir) {
+    g.direction[0] = *first.rowDir;
+    g.direction[1] = *first.colDir;
+  } else {
+    g.source += "; no Image Orientation (Patient): axial assumed";
+    g.notes.push_back("no Image Orientation (Patient): axial 1\\0\\0\\0\\1\\0 assumed");
+  }
+  g.direction[2] = glm::cross(g.direction[0], g.direction[1]);
+}
+
+// One slice: its plane from IPP/IOP, the third axis along the normal with
+// Spacing Between Slices, else Slice Thickness, else 1 mm.
+void singleSliceGeometry(const Slice& s, Geometry& g) {
+  if (s.position) {
+    g.origin = *s.position;
+  } else {
+    g.source += "; no Image Position (Patient): origin 0";
+    g.notes.push_back("no Image Position (Patient): origin assumed at 0");
+  }
+  if (s.spacingBetweenSlices > 0) {
+    g.spacing.z = s.spacingBetweenSlices;
+    g.source += "; one slice: z spacing from Spacing Between Slices";
+  } else if (s.sliceThickness > 0) {
+    g.spacing.z = s.sliceThickness;
+    g.source += "; one slice: z spacing from Slice Thickness";
+  } else {
+    g.source += "; one slice: z spacing 1 assumed";
+    g.notes.push_back("one slice without Slice Thickness: z spacing assumed 1");
+  }
+}
+
+// Sorts `slices` by position along `normal` and checks the gaps: duplicate
+// positions, missing slices and uneven spacing are errors naming two files.
+// Returns the median gap.
+double sortAndCheckGaps(std::vector<Slice>& slices, const glm::dvec3& normal) {
+  for (const auto& s : slices) {
+    if (!s.position) {
+      throw InputError(s.file.string() +
+                       ": no Image Position (Patient) (0020,0032); the slices of a series cannot "
+                       "be ordered without it");
+    }
+  }
+  for (auto& s : slices) s.distance = glm::dot(*s.position, normal);
   std::stable_sort(slices.begin(), slices.end(),
                    [](const Slice& a, const Slice& b) { return a.distance < b.distance; });
-
   std::vector<double> gaps;
   for (std::size_t i = 0; i + 1 < slices.size(); ++i) {
     gaps.push_back(slices[i + 1].distance - slices[i].distance);
@@ -555,21 +772,83 @@ Geometry sortAlongNormal(std::vector<Slice>& slices) {
                        "% different); uneven slice spacing is not supported");
     }
   }
-  // A stack along the normal: positions must not drift within the slice
-  // plane (a tilted gantry shears the volume, which a Volume cannot hold).
-  const double pixel =
-      first.pixelSpacing ? std::min(first.pixelSpacing->x, first.pixelSpacing->y) : 1.0;
-  for (const auto& s : slices) {
-    const glm::dvec3 d = *s.position - *slices.front().position;
-    const glm::dvec3 inPlane = d - glm::dot(d, g.normal) * g.normal;
-    if (glm::length(inPlane) > kShearTolerancePixels * pixel) {
-      throw InputError(s.file.string() + ": position " + vecText(*s.position) + " is offset by " +
-                       number(glm::length(inPlane)) + " mm within the slice plane from " +
-                       slices.front().file.string() +
-                       " (gantry tilt?); sheared series are not supported");
+  return median;
+}
+
+// Of the two ways along the normal, z follows the files' Instance Numbers
+// when every slice has one and they strictly fall along the normal (a scanner
+// going head to foot; any left-handed volume from writeDicomSeries, whose
+// affine then reads back unchanged); otherwise z grows along the normal.
+bool followInstanceNumbers(std::vector<Slice>& slices) {
+  for (std::size_t i = 0; i < slices.size(); ++i) {
+    if (!slices[i].instanceNumber) return false;
+    if (i > 0 && *slices[i].instanceNumber >= *slices[i - 1].instanceNumber) return false;
+  }
+  std::reverse(slices.begin(), slices.end());
+  return true;
+}
+
+// The slice axis is the actual step between consecutive positions. Slices
+// whose positions drift within their plane by the same amount each step (a
+// tilted CT gantry) make it oblique to the slices: the affine is sheared, so
+// every voxel keeps its true position (nothing is resampled); the renderer
+// draws the nearest orthonormal frame (PatientFrame.h).
+// Positions off that straight line are an error.
+void sliceStep(const std::vector<Slice>& slices, double pixel, Geometry& g) {
+  const glm::dvec3 normal = glm::normalize(glm::cross(g.direction[0], g.direction[1]));
+  const glm::dvec3 p0 = *slices.front().position;
+  const glm::dvec3 step = (*slices.back().position - p0) / static_cast<double>(slices.size() - 1);
+  for (std::size_t k = 0; k < slices.size(); ++k) {
+    const glm::dvec3 off = *slices[k].position - (p0 + static_cast<double>(k) * step);
+    const glm::dvec3 inPlane = off - glm::dot(off, normal) * normal;
+    if (glm::length(inPlane) > kIrregularTolerancePixels * pixel) {
+      throw InputError(slices[k].file.string() + ": position " + vecText(*slices[k].position) +
+                       " is " + number(glm::length(inPlane)) +
+                       " mm off the line through the first and last slice (" +
+                       slices.front().file.string() + ", " + slices.back().file.string() +
+                       ") within the slice plane; the slices do not form a regular stack");
     }
   }
-  g.sliceSpacing = median;
+  g.origin = p0;
+  g.spacing.z = glm::length(step);
+  g.direction[2] = step / g.spacing.z;
+  const double along = std::abs(glm::dot(step, normal));
+  const double drift = glm::length(step - glm::dot(step, normal) * normal);
+  const double tiltDeg = std::atan2(drift, along) * 180.0 / 3.14159265358979323846;
+  if (tiltDeg > 0.01) {
+    g.notes.push_back("sheared stack: each slice is offset " + number(drift) +
+                      " mm within its plane (gantry tilt " + number(tiltDeg) +
+                      " deg); the affine keeps the shear");
+  }
+  const double declared = slices.front().spacingBetweenSlices;
+  if (declared > 0 && std::abs(declared - along) > kGapTolerance * along) {
+    g.notes.push_back("Spacing Between Slices says " + number(declared) + " mm, the positions " +
+                      number(along) + " mm; the positions are used");
+  }
+}
+
+// The LPS geometry of a checked series (PS3.3 C.7.6.2.1.1): x along the
+// rows (IOP's first vector), y down the columns (its second), z from slice
+// to slice in the order above; spacing x/y from Pixel Spacing (row spacing
+// first, so y first), z the step between positions. Sorts `slices` into z
+// order.
+Geometry geometryOf(std::vector<Slice>& slices) {
+  Geometry g;
+  const Slice& first = slices.front();
+  sliceAxes(slices, g);
+  if (first.pixelSpacing) {
+    g.spacing.x = first.pixelSpacing->y;
+    g.spacing.y = first.pixelSpacing->x;
+  } else {
+    g.notes.push_back("no Pixel Spacing: 1 mm assumed");
+  }
+  if (slices.size() == 1) {
+    singleSliceGeometry(first, g);
+    return g;
+  }
+  sortAndCheckGaps(slices, g.direction[2]);
+  if (followInstanceNumbers(slices)) g.notes.push_back("z follows Instance Number");
+  sliceStep(slices, std::min(g.spacing.x, g.spacing.y), g);
   return g;
 }
 
@@ -583,6 +862,7 @@ ScalarType storedType(const Slice& s) {
 struct StoredRange {
   std::int64_t min = std::numeric_limits<std::int64_t>::max();
   std::int64_t max = std::numeric_limits<std::int64_t>::min();
+  std::uint64_t padding = 0;  // bytes after the pixels (see checkPixelBytes)
 };
 
 // Values beyond Bits Stored are not part of the pixel (PS3.5 8.1.1): unsigned
@@ -613,11 +893,13 @@ StoredRange readPixels(const Slice& s, Volume& stored, int z) {
   const E_TransferSyntax xfer = ds.getOriginalXfer();
   if (DcmXfer(xfer).isEncapsulated()) {
     const OFCondition c = ds.chooseRepresentation(EXS_LittleEndianExplicit, nullptr);
+    if (!io_detail::canDecodePixels(xfer)) {
+      throw InputError(io_detail::undecodableSyntaxMessage(f, xfer));
+    }
     if (c.bad() || !ds.canWriteXfer(EXS_LittleEndianExplicit)) {
-      throw InputError(f + ": transfer syntax " + transferSyntaxText(xfer) +
-                       " cannot be decoded (DCMTK: " + conditionText(c) +
-                       "); supported: uncompressed, deflate, JPEG baseline/extended/lossless, "
-                       "JPEG-LS and RLE");
+      throw InputError(f + ": the " + transferSyntaxText(xfer) +
+                       " pixel data cannot be decoded (DCMTK: " + conditionText(c) +
+                       "; corrupt or truncated?)");
     }
   }
   DcmElement* elem = nullptr;
@@ -625,28 +907,33 @@ StoredRange readPixels(const Slice& s, Volume& stored, int z) {
     throw InputError(f + ": no Pixel Data (7FE0,0010)");
   }
   const std::size_t n = static_cast<std::size_t>(s.rows) * static_cast<std::size_t>(s.columns);
-  checkPixelBytes(s, elem->getLength());
+  const std::uint64_t padding = checkPixelBytes(s, elem->getLength());
   const std::size_t planeOffset = static_cast<std::size_t>(z) * n;
   const auto loadFailed = [&](const OFCondition& c) {
     return InputError(f + ": pixel data cannot be read (DCMTK: " + conditionText(c) +
                       "; truncated file?)");
   };
-  if (s.bitsAllocated == 8) {
-    Uint8* p = nullptr;
-    const OFCondition c = elem->getUint8Array(p);
+  const auto copy = [&]() {
+    if (s.bitsAllocated == 8) {
+      Uint8* p = nullptr;
+      const OFCondition c = elem->getUint8Array(p);
+      if (c.bad() || p == nullptr) throw loadFailed(c);
+      if (s.isSigned) {
+        return copyPixels(p, stored.dataAs<std::int16_t>() + planeOffset, n, s.bitsStored, true);
+      }
+      return copyPixels(p, stored.dataAs<std::uint8_t>() + planeOffset, n, s.bitsStored, false);
+    }
+    Uint16* p = nullptr;
+    const OFCondition c = elem->getUint16Array(p);
     if (c.bad() || p == nullptr) throw loadFailed(c);
     if (s.isSigned) {
       return copyPixels(p, stored.dataAs<std::int16_t>() + planeOffset, n, s.bitsStored, true);
     }
-    return copyPixels(p, stored.dataAs<std::uint8_t>() + planeOffset, n, s.bitsStored, false);
-  }
-  Uint16* p = nullptr;
-  const OFCondition c = elem->getUint16Array(p);
-  if (c.bad() || p == nullptr) throw loadFailed(c);
-  if (s.isSigned) {
-    return copyPixels(p, stored.dataAs<std::int16_t>() + planeOffset, n, s.bitsStored, true);
-  }
-  return copyPixels(p, stored.dataAs<std::uint16_t>() + planeOffset, n, s.bitsStored, false);
+    return copyPixels(p, stored.dataAs<std::uint16_t>() + planeOffset, n, s.bitsStored, false);
+  };
+  StoredRange r = copy();
+  r.padding = padding;
+  return r;
 }
 
 bool isInteger(double v) {
@@ -702,7 +989,7 @@ Volume rescale(Volume stored, const std::vector<Slice>& slices,
   return out;
 }
 
-Volume readSeries(FolderScan scan, const std::string& seriesUid, const std::string& what) {
+void refuseEmpty(const FolderScan& scan, const std::string& what) {
   if (scan.slices.empty() && !scan.unreadable.empty()) {
     const std::size_t more = scan.unreadable.size() - 1;
     throw InputError(
@@ -725,27 +1012,48 @@ Volume readSeries(FolderScan scan, const std::string& seriesUid, const std::stri
     }
     throw InputError(what + ": is a directory with no DICOM series (" + why + ")");
   }
-  std::vector<SeriesGroup> groups = groupSeries(std::move(scan.slices));
-  std::size_t chosen = 0;
-  if (!seriesUid.empty()) {
-    const auto it = std::find_if(groups.begin(), groups.end(),
-                                 [&](const SeriesGroup& g) { return g.uid == seriesUid; });
-    if (it == groups.end()) {
-      throw InputError(what + ": no series with Series Instance UID " + seriesUid +
-                       "; found: " + othersText(groups, groups.size()));
-    }
-    chosen = static_cast<std::size_t>(it - groups.begin());
-  }
-  std::vector<Slice>& slices = groups[chosen].slices;
-  int unreadableElsewhere = 0;
-  for (const auto& u : scan.unreadable) {
-    if (u.seriesUid == groups[chosen].uid) throw InputError(u.error);
-    ++unreadableElsewhere;
-  }
-  for (const auto& s : slices) checkSlice(s);
-  checkConsistent(slices);
-  const Geometry g = sortAlongNormal(slices);
+}
 
+// The volume's index -> world affine: LPS converted to RAS (PatientFrame.h).
+void applyGeometry(const Geometry& g, Volume& v) {
+  v.setSpacing(g.spacing);
+  v.setDirection(lpsToRas() * g.direction);
+  v.setOrigin(lpsToRas() * g.origin);
+  v.setGeometrySource(g.source);
+}
+
+// The series picked from a folder scan, with what was set aside on the way.
+struct PickedSeries {
+  std::vector<Slice> slices;
+  std::string label;        // the whole group's, for the description
+  std::size_t index = 0;    // among `groups`
+  std::size_t leftOut = 0;  // slices of the group outside the named file's stack
+  std::vector<UnreadableFile> unreadableMembers;    // skipped copies of slices read
+  std::vector<UnreadableFile> unreadableElsewhere;  // other or unknown series
+};
+
+// Picks the series `seriesUid` (empty: the one holding `named`, else the
+// largest) and judges the files of it that could not be used.
+PickedSeries pickSeries(std::vector<SeriesGroup>& groups, std::vector<UnreadableFile> unreadable,
+                        const std::string& seriesUid, const fs::path& named,
+                        const std::string& what) {
+  PickedSeries p;
+  p.index = chooseGroup(groups, seriesUid, named, what);
+  SeriesGroup& g = groups[p.index];
+  p.label = g.label();
+  p.slices = std::move(g.slices);  // othersText() skips this group
+  p.leftOut = keepStackOf(p.slices, named);
+  for (auto& u : unreadable) {
+    const bool member = !g.uid.empty() && u.seriesUid == g.uid;
+    (member ? p.unreadableMembers : p.unreadableElsewhere).push_back(std::move(u));
+  }
+  checkUnreadableMembers(p.unreadableMembers, p.slices);
+  return p;
+}
+
+// Decodes every slice (in z order) and applies rescale slope/intercept.
+Volume readVoxels(const std::vector<Slice>& slices, const std::string& what,
+                  std::vector<std::string>& notes) {
   const Slice& first = slices.front();
   const glm::ivec3 dims(first.columns, first.rows, static_cast<int>(slices.size()));
   // Volume::allocate checks the host budget before any pixel is decoded.
@@ -758,39 +1066,63 @@ Volume readSeries(FolderScan scan, const std::string& seriesUid, const std::stri
   std::string rescaleNote;
   Volume v = rescale(std::move(stored), slices, ranges, what, rescaleNote);
   v.invalidateRange();
-
-  // PixelSpacing is (row spacing, column spacing): y first (PS3.3 10.7.1.3).
-  glm::dvec3 spacing(1.0, 1.0, g.sliceSpacing);
-  std::vector<std::string> notes;
-  if (first.pixelSpacing) {
-    spacing.x = first.pixelSpacing->y;
-    spacing.y = first.pixelSpacing->x;
-  } else {
-    notes.push_back("no Pixel Spacing: 1 mm assumed");
-  }
-  if (!g.note.empty()) notes.push_back(g.note);
-  v.setSpacing(spacing);
-  if (first.position) v.setOrigin(*first.position);
-
-  std::string d = "DICOM series " + groups[chosen].label() + ", " + transferSyntaxText(first.xfer);
-  d += "; series " + std::to_string(chosen + 1) + " of " + std::to_string(groups.size()) + " in " +
-       scan.where;
-  if (groups.size() > 1) d += "; others: " + othersText(groups, chosen);
   if (!rescaleNote.empty()) notes.push_back(rescaleNote);
-  if (first.photometric == "MONOCHROME1") notes.push_back("MONOCHROME1: low values display bright");
-  if (glm::length(g.rowDir - glm::dvec3(1, 0, 0)) > kOrientationTolerance ||
-      glm::length(g.colDir - glm::dvec3(0, 1, 0)) > kOrientationTolerance) {
-    notes.push_back("volume axes follow the slices: x " + vecText(g.rowDir) + ", y " +
-                    vecText(g.colDir) + ", z " + vecText(g.normal) + " in patient space");
+  const auto padded = std::count_if(ranges.begin(), ranges.end(),
+                                    [](const StoredRange& r) { return r.padding > 1; });
+  if (padded > 0) {
+    notes.push_back("ignored trailing padding after the pixel data of " + std::to_string(padded) +
+                    " file(s)");
+  }
+  return v;
+}
+
+// What was skipped or left out, one note each.
+void addSkipNotes(const PickedSeries& p, const FolderScan& scan, const fs::path& named,
+                  std::vector<std::string>& notes) {
+  if (p.slices.front().photometric == "MONOCHROME1") {
+    notes.push_back("MONOCHROME1: low values display bright");
+  }
+  if (p.leftOut > 0) {
+    notes.push_back("left out " + std::to_string(p.leftOut) +
+                    " file(s) of this series with another size, frame count, pixel type, "
+                    "orientation or pixel spacing than " +
+                    named.string());
   }
   if (scan.nonDicomFiles > 0) {
     notes.push_back("skipped " + std::to_string(scan.nonDicomFiles) + " non-DICOM file(s)");
   }
-  if (unreadableElsewhere > 0) {
-    notes.push_back("skipped " + std::to_string(unreadableElsewhere) +
-                    " unreadable DICOM file(s) of other or unknown series, e.g. " +
-                    scan.unreadable.front().error);
+  if (!p.unreadableMembers.empty()) {
+    notes.push_back("skipped " + std::to_string(p.unreadableMembers.size()) +
+                    " unreadable file(s) of this series as copies of slices read (same or no "
+                    "position), e.g. " +
+                    p.unreadableMembers.front().error);
   }
+  if (!p.unreadableElsewhere.empty()) {
+    notes.push_back("skipped " + std::to_string(p.unreadableElsewhere.size()) +
+                    " unreadable DICOM file(s) of other or unknown series, e.g. " +
+                    p.unreadableElsewhere.front().error);
+  }
+}
+
+// Reads the series `seriesUid` (empty: the one holding `named`, else the
+// largest) from what a folder scan found.
+Volume readSeries(FolderScan scan, const std::string& seriesUid, const std::string& what,
+                  const fs::path& named = {}) {
+  refuseEmpty(scan, what);
+  std::vector<SeriesGroup> groups = groupSeries(std::move(scan.slices));
+  PickedSeries p = pickSeries(groups, std::move(scan.unreadable), seriesUid, named, what);
+  for (const auto& s : p.slices) checkSlice(s);
+  checkConsistent(p.slices);
+  const Geometry g = geometryOf(p.slices);
+  std::vector<std::string> notes = g.notes;
+  Volume v = readVoxels(p.slices, what, notes);
+  applyGeometry(g, v);
+  addSkipNotes(p, scan, named, notes);
+
+  std::string d = "DICOM series " + p.label + ", " + transferSyntaxText(p.slices.front().xfer) +
+                  "; series " + std::to_string(p.index + 1) + " of " +
+                  std::to_string(groups.size()) + " in " + scan.where;
+  if (groups.size() > 1) d += "; others: " + othersText(groups, p.index);
   for (const auto& n : notes) d += "; " + n;
   v.setDescription(d);
   return v;
@@ -812,12 +1144,12 @@ Volume readDicomSeries(const fs::path& folderOrFile, const std::string& seriesUi
   if (fs::is_directory(st)) return readSeries(scanFolder(folderOrFile), seriesUid, p);
   if (!fs::is_regular_file(st)) throw InputError(p + ": not a regular file or a directory");
 
-  // One file: the series it belongs to, from the files beside it.
+  // One file: its own errors first, then its series (and stack) from the
+  // files beside it.
   FolderScan own;
   addFile(folderOrFile, true, own);
-  const std::string uid = seriesUid.empty() ? own.slices.front().seriesUid : seriesUid;
-  FolderScan scan = scanFolder(folderOf(folderOrFile));
-  return readSeries(std::move(scan), uid, p);
+  const fs::path folder = folderOf(folderOrFile);
+  return readSeries(scanFolder(folder), seriesUid, p, folder / folderOrFile.filename());
 }
 
 Volume readDicomFiles(const std::vector<fs::path>& files, const std::string& seriesUid) {

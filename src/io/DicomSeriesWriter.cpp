@@ -1,7 +1,8 @@
 // Volume → a series of single-frame DICOM files (CT or MR Image Storage),
 // through DCMTK. Modules after DICOM PS3.3 A.3 (CT Image IOD) and A.4 (MR
 // Image IOD): Patient, General Study, General Series, Frame of Reference,
-// General Image, Image Plane, Image Pixel, CT/MR Image.
+// General Image, Image Plane, Image Pixel, CT/MR Image. The volume's RAS+
+// affine is written in DICOM's LPS+ frame (core/PatientFrame.h).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -14,8 +15,11 @@
 
 #include <unistd.h>
 
+#include <glm/geometric.hpp>
+
 #include "io/DicomToolkit.h"
 #include "tessera/core/Error.h"
+#include "tessera/core/PatientFrame.h"
 #include "tessera/io/DicomSeriesReader.h"
 
 #include <dcmtk/dcmdata/dcdatset.h>
@@ -66,6 +70,51 @@ std::string newUid(const char* root) {
   char buf[100];
   dcmGenerateUniqueIdentifier(buf, root);
   return buf;
+}
+
+// The Image Plane module of every slice (PS3.3 C.7.6.2), in LPS.
+struct PlaneGeometry {
+  glm::dvec3 row{1, 0, 0};            // IOP's first vector: direction of index x
+  glm::dvec3 column{0, 1, 0};         // IOP's second vector: direction of index y
+  glm::dvec3 normal{0, 0, 1};         // row x column
+  std::vector<glm::dvec3> positions;  // IPP of each z-slice
+  double spacingBetweenSlices = 1.0;  // along the normal
+};
+
+// IOP holds the index x and y directions. They are exactly the first two
+// columns of the direction's nearest orthonormal frame unless x and y are
+// not perpendicular (an in-plane shear, which IOP cannot hold): then those
+// columns are written and the shear is lost. Positions come from the full
+// affine (IPP_k = LPS(worldOf(0,0,k))), so the slice axis - including a
+// gantry tilt's shear - and a left-handed z (which the reader recovers from
+// Instance Number) are kept.
+PlaneGeometry planeGeometry(const Volume& volume) {
+  const glm::dmat3 lps = lpsToRas() * volume.direction();  // lpsToRas() is its own inverse
+  PlaneGeometry p;
+  p.row = glm::normalize(lps[0]);
+  p.column = glm::normalize(lps[1]);
+  if (std::abs(glm::dot(p.row, p.column)) > 1e-9) {
+    const glm::dmat3 r = nearestOrthonormal(lps);
+    p.row = r[0];
+    p.column = r[1];
+  }
+  p.column = glm::normalize(p.column - glm::dot(p.column, p.row) * p.row);
+  p.normal = glm::cross(p.row, p.column);
+  for (int z = 0; z < volume.dims().z; ++z) {
+    p.positions.push_back(lpsToRas() * volume.worldOf(glm::dvec3(0, 0, z)));
+  }
+  const glm::dvec3 step = lpsToRas() * volume.direction()[2] * volume.spacing().z;
+  p.spacingBetweenSlices = std::abs(glm::dot(step, p.normal));
+  return p;
+}
+
+// A direction cosine as written: round-off below 1e-12 becomes 0.
+std::string cosineString(double v) {
+  return decimalString(std::abs(v) < 1e-12 ? 0.0 : v);
+}
+
+std::string vectorString(const glm::dvec3& v, std::string (*format)(double)) {
+  return format(v.x) + "\\" + format(v.y) + "\\" + format(v.z);
 }
 
 // How voxel values become stored pixels: stored = round((v - intercept) / slope).
@@ -163,7 +212,7 @@ struct SeriesAttributes {
 };
 
 void writeSlice(const Volume& volume, int z, const PixelEncoding& e, const SeriesAttributes& a,
-                E_TransferSyntax xfer, const fs::path& file) {
+                const PlaneGeometry& plane, E_TransferSyntax xfer, const fs::path& file) {
   DcmFileFormat ff;
   DcmDataset& ds = *ff.getDataset();
   auto put = [&](const DcmTagKey& tag, const std::string& value) {
@@ -174,7 +223,6 @@ void writeSlice(const Volume& volume, int z, const PixelEncoding& e, const Serie
   };
   const glm::ivec3 d = volume.dims();
   const glm::dvec3 sp = volume.spacing();
-  const glm::dvec3 o = volume.origin();
 
   put(DCM_SOPClassUID, a.sopClassUid);
   put(DCM_SOPInstanceUID, newUid(SITE_INSTANCE_UID_ROOT));
@@ -205,12 +253,14 @@ void writeSlice(const Volume& volume, int z, const PixelEncoding& e, const Serie
     }
   }
 
-  const double zPos = o.z + z * sp.z;
-  put(DCM_ImagePositionPatient,
-      decimalString(o.x) + "\\" + decimalString(o.y) + "\\" + decimalString(zPos));
-  put(DCM_ImageOrientationPatient, "1\\0\\0\\0\\1\\0");
-  put(DCM_SliceLocation, decimalString(zPos));
-  put(DCM_SliceThickness, decimalString(sp.z));
+  const glm::dvec3 position = plane.positions[static_cast<std::size_t>(z)];
+  put(DCM_ImagePositionPatient, vectorString(position, decimalString));
+  put(DCM_ImageOrientationPatient,
+      vectorString(plane.row, cosineString) + "\\" + vectorString(plane.column, cosineString));
+  // Slice Location: the position along the normal, as scanners write it.
+  put(DCM_SliceLocation, decimalString(glm::dot(position, plane.normal)));
+  put(DCM_SpacingBetweenSlices, decimalString(plane.spacingBetweenSlices));
+  put(DCM_SliceThickness, decimalString(plane.spacingBetweenSlices));
   // Pixel Spacing is (between rows, between columns) = (y, x).
   put(DCM_PixelSpacing, decimalString(sp.y) + "\\" + decimalString(sp.x));
 
@@ -292,6 +342,7 @@ void writeDicomSeries(const Volume& volume, const fs::path& folderIn,
   }
   const E_TransferSyntax xfer = transferSyntaxFor(options.transferSyntax, what);
   const PixelEncoding encoding = chooseEncoding(volume, options, what);
+  const PlaneGeometry plane = planeGeometry(volume);
 
   SeriesAttributes a;
   a.modality = options.modality;
@@ -351,7 +402,7 @@ void writeDicomSeries(const Volume& volume, const fs::path& folderIn,
   if (ec) throw Error(temp.string() + ": cannot create the temporary folder: " + ec.message());
   try {
     for (int z = 0; z < d.z; ++z) {
-      writeSlice(volume, z, encoding, a, xfer, temp / names[static_cast<std::size_t>(z)]);
+      writeSlice(volume, z, encoding, a, plane, xfer, temp / names[static_cast<std::size_t>(z)]);
     }
     if (!existed) {
       fs::rename(temp, folder, ec);
@@ -375,6 +426,24 @@ void writeDicomSeries(const Volume& volume, const fs::path& folderIn,
     fs::remove_all(temp, ec);
     throw;
   }
+}
+
+double dicomQuantisationError(const Volume& volume, const DicomWriteOptions& options) {
+  io_detail::initDicomToolkit();
+  if (!volume.hasData()) return 0.0;
+  const PixelEncoding e = chooseEncoding(volume, options, "volume");
+  // What the reader computes: stored * slope + intercept, as f32 unless
+  // slope and intercept are integers (then the values stay integers).
+  const bool toFloat = std::floor(e.slope) != e.slope || std::floor(e.intercept) != e.intercept;
+  double worst = 0.0;
+  for (std::size_t i = 0; i < volume.voxelCount(); ++i) {
+    const double v = volume.valueAtIndex(i);
+    const double stored = std::clamp(e.stored(v), e.minStored(), e.maxStored());
+    double back = stored * e.slope + e.intercept;
+    if (toFloat) back = static_cast<float>(back);
+    worst = std::max(worst, std::abs(back - v));
+  }
+  return worst;
 }
 
 }  // namespace tessera

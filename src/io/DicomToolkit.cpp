@@ -2,6 +2,7 @@
 
 #include <mutex>
 
+#include <dcmtk/dcmdata/dccodec.h>
 #include <dcmtk/dcmdata/dcdict.h>
 #include <dcmtk/dcmdata/dcrledrg.h>
 #include <dcmtk/dcmdata/dcrleerg.h>
@@ -42,6 +43,28 @@ std::string transferSyntaxText(E_TransferSyntax xfer) {
   const char* id = x.getXferID();
   if (id != nullptr && *id != '\0') s += std::string(" (") + id + ")";
   return s;
+}
+
+bool canDecodePixels(E_TransferSyntax xfer) {
+  return !DcmXfer(xfer).isEncapsulated() ||
+         DcmCodecList::canChangeCoding(xfer, EXS_LittleEndianExplicit);
+}
+
+std::string undecodableSyntaxMessage(const std::string& file, E_TransferSyntax xfer) {
+  const DcmXfer x(xfer);
+  const std::string uid = x.getXferID() != nullptr ? x.getXferID() : "unknown";
+  // Free DCMTK has no JPEG 2000 codec (dcmdjpeg decodes JPEG 1992 only; the
+  // JPEG 2000 module is commercial); GDCM decodes it through OpenJPEG.
+  const bool j2k = xfer == EXS_JPEG2000LosslessOnly || xfer == EXS_JPEG2000 ||
+                   xfer == EXS_JPEG2000MulticomponentLosslessOnly ||
+                   xfer == EXS_JPEG2000Multicomponent;
+  const std::string what = j2k ? "JPEG 2000 (transfer syntax UID " + uid + ")"
+                               : "transfer syntax " + transferSyntaxText(xfer);
+  return file + ": " + what +
+         " is not supported by this build (it decodes uncompressed, deflate, JPEG "
+         "baseline/extended/lossless, JPEG-LS and RLE); convert it with e.g. `gdcmconv --raw " +
+         file + " out.dcm` (GDCM" +
+         (j2k ? ", which decodes JPEG 2000; DCMTK's dcmdjpeg does not)" : ")");
 }
 
 std::string conditionText(const OFCondition& cond) {

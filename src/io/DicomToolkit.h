@@ -19,6 +19,15 @@ void initDicomToolkit();
 // "JPEG 2000 Image Compression (Lossless Only) (1.2.840.10008.1.2.4.90)"
 std::string transferSyntaxText(E_TransferSyntax xfer);
 
+// Whether the registered codecs can decode pixel data stored in `xfer` (true
+// for every native and deflated syntax).
+bool canDecodePixels(E_TransferSyntax xfer);
+
+// One line for a file whose pixel data no registered codec decodes, e.g.
+// "scan.dcm: JPEG 2000 (transfer syntax UID 1.2.840.10008.1.2.4.90) is not
+// supported by this build; convert it with e.g. `gdcmconv --raw ...`".
+std::string undecodableSyntaxMessage(const std::string& file, E_TransferSyntax xfer);
+
 // DCMTK's text for a failed condition, e.g. "I/O suspension or premature end of stream".
 std::string conditionText(const OFCondition& cond);
 
