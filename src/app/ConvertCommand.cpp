@@ -137,7 +137,7 @@ void runConvert(const ConvertOptions& o) {
               orientationOf(v.direction()).describe().c_str(), formatBytes(v.byteSize()).c_str());
   // What the output format could not hold is said even with --quiet: a
   // silently lost orientation is how left and right get swapped.
-  for (const std::string& note : geometryLossNotes(v, o.out)) {
+  for (const std::string& note : writeLossNotes(v, o.out)) {
     std::fprintf(stderr, "note: %s\n", note.c_str());
   }
 }

@@ -58,8 +58,23 @@ std::vector<std::string> pvmLossNotes(const Volume& v) {
 }
 }  // namespace
 
-std::vector<std::string> geometryLossNotes(const Volume& volume, const fs::path& out) {
-  if (endsWith(lowerName(out), ".pvm")) return pvmLossNotes(volume);
+std::vector<std::string> writeLossNotes(const Volume& volume, const fs::path& out) {
+  const std::string name = lowerName(out);
+  if (endsWith(name, ".pvm")) return pvmLossNotes(volume);
+  const std::string text = out.string();
+  const bool dicom = !text.empty() && (text.back() == '/' || endsWith(name, ".dcm.d"));
+  if (dicom && volume.type() == ScalarType::F32 && volume.hasData()) {
+    // DICOM stores integers with a rescale slope/intercept: f32 is quantised.
+    const double error = dicomQuantisationError(volume);
+    if (error > 0.0) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf,
+                    "DICOM stores 16-bit integers with a rescale slope: these f32 values are "
+                    "quantised, max error %.3g (value range %.6g .. %.6g)",
+                    error, volume.valueRange().min, volume.valueRange().max);
+      return {buf};
+    }
+  }
   return {};
 }
 

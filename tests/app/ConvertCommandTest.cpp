@@ -95,3 +95,25 @@ TEST(ConvertCommand, SaysWhatTheOutputFormatCannotHold) {
   ASSERT_EQ(nii.exitCode, 0) << nii.err;
   EXPECT_EQ(nii.err.find("note:"), std::string::npos) << nii.err;
 }
+
+// f32 into DICOM goes through 16-bit integers: convert says how lossy, and
+// the number is the error actually found in the written series.
+TEST(ConvertCommand, FloatToDicomSaysItIsLossyAndByHowMuch) {
+  const tessera::test::TempDir tmp;
+  tessera::Volume v = tessera::Volume::allocate({9, 8, 7}, tessera::ScalarType::F32);
+  for (std::size_t i = 0; i < v.voxelCount(); ++i) v.setValueAtIndex(i, std::sin(0.37 * i) * 3.3);
+  const auto src = tmp / "f.nii";
+  tessera::writeVolume(v, src);
+  const auto r = runCli("convert " + src.string() + " " + (tmp / "d/").string() + " --quiet");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const auto at = r.err.find("max error ");
+  ASSERT_NE(at, std::string::npos) << r.err;
+  const double claimed = std::stod(r.err.substr(at + 10));
+  const tessera::Volume back = tessera::readVolume((tmp / "d").string());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < v.voxelCount(); ++i) {
+    worst = std::max(worst, std::abs(back.valueAtIndex(i) - v.valueAtIndex(i)));
+  }
+  EXPECT_GT(worst, 0.0);
+  EXPECT_NEAR(claimed, worst, 0.01 * worst + 1e-9);
+}

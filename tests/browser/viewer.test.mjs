@@ -258,6 +258,17 @@ async function main() {
     check('a .nii.gz opened through the picker renders (inflated in the browser)',
           s.dims.join('x') === '48x48x48' && shot.lit > 0.02, `${s.description}; ${(100 * shot.lit).toFixed(1)} % lit`);
 
+    // Patient-direction letters at the view's edges follow the camera (a
+    // NIfTI carries an orientation; azimuth 0 faces the patient).
+    const labels = async () => page.evaluate(() => ['left', 'right', 'top', 'bottom']
+      .map((e) => document.getElementById(`orient-${e}`).textContent).join(' '));
+    await page.evaluate(() => window.tessera.setCamera(0, 0, 1));
+    const front = await labels();
+    await page.evaluate(() => window.tessera.setCamera(90, 0, 1));
+    const side = await labels();
+    check('orientation labels name the patient\'s sides (front: R L S I, from the right: P A S I)',
+          front === 'R L S I' && side === 'P A S I', `front "${front}", side "${side}"`);
+
     // A file dropped on the view opens the same way.
     const dropped = await page.evaluateHandle((b64) => {
       const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));

@@ -67,7 +67,7 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(GeometryLossNotes, PvmNamesTheLostOrientationAndTheOrigin) {
   const Volume las = test::volumeWithAffine({4, 4, 4}, ScalarType::U8, test::lasAffine());
-  const auto notes = geometryLossNotes(las, "out.pvm");
+  const auto notes = writeLossNotes(las, "out.pvm");
   ASSERT_EQ(notes.size(), 1u);
   EXPECT_NE(notes[0].find("PVM stores spacing only"), std::string::npos) << notes[0];
   EXPECT_NE(notes[0].find("orientation LAS"), std::string::npos) << notes[0];
@@ -77,7 +77,7 @@ TEST(GeometryLossNotes, PvmNamesTheLostOrientationAndTheOrigin) {
 TEST(GeometryLossNotes, PvmWithOnlyAnOriginSaysWhereItIsKept) {
   Volume v = test::volumeWithAffine({4, 4, 4}, ScalarType::U8, glm::dmat4(1.0));
   v.setOrigin({1.0, 2.0, 3.0});
-  const auto notes = geometryLossNotes(v, "OUT.PVM");
+  const auto notes = writeLossNotes(v, "OUT.PVM");
   ASSERT_EQ(notes.size(), 1u);
   EXPECT_NE(notes[0].find("origin (1, 2, 3)"), std::string::npos) << notes[0];
   EXPECT_EQ(notes[0].find("orientation"), std::string::npos) << notes[0];
@@ -86,10 +86,10 @@ TEST(GeometryLossNotes, PvmWithOnlyAnOriginSaysWhereItIsKept) {
 TEST(GeometryLossNotes, EmptyWhenTheFormatHoldsTheAffine) {
   const Volume obl = test::volumeWithAffine({4, 4, 4}, ScalarType::U8, test::obliqueAffine());
   for (const char* out : {"a.nii", "a.nii.gz", "a.nrrd", "a.mha", "a.vti", "a.raw", "dir/"}) {
-    EXPECT_TRUE(geometryLossNotes(obl, out).empty()) << out;
+    EXPECT_TRUE(writeLossNotes(obl, out).empty()) << out;
   }
   const Volume plain = test::volumeWithAffine({4, 4, 4}, ScalarType::U8, glm::dmat4(1.0));
-  EXPECT_TRUE(geometryLossNotes(plain, "a.pvm").empty());
+  EXPECT_TRUE(writeLossNotes(plain, "a.pvm").empty());
 }
 
 }  // namespace

@@ -16,11 +16,12 @@ namespace tessera {
 void writeVolume(const Volume& volume, const std::filesystem::path& path);
 
 // What writing `volume` to `out` (chosen by extension, as writeVolume)
-// would lose of its geometry, as sentences for the user, e.g. "PVM stores
-// spacing only: orientation LAS and origin (90, -126, -72) are lost"; empty
-// when the format holds the whole affine (NIfTI, NRRD, MetaImage, VTI,
-// raw + JSON, DICOM).
-std::vector<std::string> geometryLossNotes(const Volume& volume, const std::filesystem::path& out);
+// would lose, as sentences for the user: geometry ("PVM stores spacing only:
+// orientation LAS ... is lost") and values (f32 into DICOM's 16-bit
+// integers: "... quantised, max error 0.0035"). Empty when the format holds
+// the whole affine and every value (NIfTI, NRRD, MetaImage, VTI, raw + JSON;
+// DICOM for integer data).
+std::vector<std::string> writeLossNotes(const Volume& volume, const std::filesystem::path& out);
 
 // Runs `write(tempPath)` and renames tempPath to `path` on success (removes
 // it on failure). tempPath is in the same directory and ends with the same
