@@ -211,9 +211,12 @@ void addRenderCommand(CLI::App& app) {
          "Transfer function: preset (grey, mr-default, ct-bone, ct-muscle, bench) or FILE.json")
       ->capture_default_str();
   cmd->add_option("--size", o->size, "Image size WIDTHxHEIGHT")->capture_default_str();
-  cmd->add_option("--azimuth", o->azimuth, "Camera azimuth in degrees about the patient's superior axis (0: looking at the face from anterior, 90: from the patient's right), for every storage order")
+  cmd->add_option("--azimuth", o->azimuth,
+                  "Camera azimuth in degrees about the patient's superior axis (0: looking at the "
+                  "face from anterior, 90: from the patient's right), for every storage order")
       ->capture_default_str();
-  cmd->add_option("--elevation", o->elevation, "Camera elevation in degrees (90: looking down from superior)")
+  cmd->add_option("--elevation", o->elevation,
+                  "Camera elevation in degrees (90: looking down from superior)")
       ->capture_default_str();
   cmd->add_option("--zoom", o->zoom, "Zoom factor (>1 magnifies)")->capture_default_str();
   cmd->add_option("--fov", o->fov, "Vertical field of view in degrees (perspective)")
