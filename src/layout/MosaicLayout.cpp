@@ -256,4 +256,13 @@ int MosaicLayout::bind(const gpu::Program& program, int firstUnit) const {
   return 1;
 }
 
+LayoutEntry MosaicLayout::registration() {
+  return {
+      .name = "mosaic",
+      .plan = [](const Volume& shape, const gpu::DeviceLimits& limits,
+                 int) { return planFor(shape, limits); },
+      .create = [](const Volume& volume, const gpu::DeviceLimits& limits, gpu::MemoryLedger& ledger,
+                   int) -> std::unique_ptr<Layout> { return create(volume, limits, ledger); }};
+}
+
 }  // namespace tessera::layout

@@ -318,4 +318,14 @@ std::uint64_t PackedMosaicLayout::textureBytes() const {
   return total;
 }
 
+LayoutEntry PackedMosaicLayout::registration() {
+  return {.name = "packed-mosaic",
+          .plan = [](const Volume& shape, const gpu::DeviceLimits& limits,
+                     int units) { return planFor(shape, limits, units); },
+          .create = [](const Volume& volume, const gpu::DeviceLimits& limits,
+                       gpu::MemoryLedger& ledger, int units) -> std::unique_ptr<Layout> {
+            return create(volume, limits, ledger, units);
+          }};
+}
+
 }  // namespace tessera::layout

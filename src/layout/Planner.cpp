@@ -4,25 +4,31 @@
 
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
-#include "tessera/layout/MosaicLayout.h"
-#include "tessera/layout/PackedMosaicLayout.h"
-#include "tessera/layout/Texture3DLayout.h"
+#include "tessera/layout/LayoutRegistry.h"
 
 namespace tessera::layout {
 
 namespace {
 
-const char* kLayouts[] = {"texture3d", "mosaic", "packed-mosaic"};
-
 std::string dimsText(glm::ivec3 d) {
   return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
 }
 
-LayoutPlan planOne(const std::string& name, const Volume& shape, const gpu::DeviceLimits& limits,
-                   int units) {
-  if (name == "texture3d") return Texture3DLayout::planFor(shape, limits);
-  if (name == "mosaic") return MosaicLayout::planFor(shape, limits);
-  return PackedMosaicLayout::planFor(shape, limits, units);
+// "layout texture3d needs 3D textures, which ipad2 does not have (use
+// mosaic or packed-mosaic)".
+std::string unmetNeeds(const LayoutEntry& entry, const gpu::DeviceLimits& limits) {
+  const std::string need = entry.needs3DTextures ? "3D textures" : "OpenGL ES 3";
+  std::vector<std::string> others;
+  for (const LayoutEntry& e : LayoutRegistry::global().entries()) {
+    if (e.runsOn(limits)) others.push_back(e.name);
+  }
+  std::string use;
+  for (std::size_t i = 0; i < others.size(); ++i) {
+    use += (i == 0 ? " (use " : i + 1 == others.size() ? " or " : ", ") + others[i];
+  }
+  if (!use.empty()) use += ")";
+  return "layout " + entry.name + " needs " + need + ", which " + limits.profile +
+         " does not have" + use;
 }
 
 // Which axes to halve when nothing fits: those longer than the largest
@@ -48,20 +54,13 @@ glm::ivec3 axesToHalve(glm::ivec3 dims, const gpu::DeviceLimits& limits, bool on
 }  // namespace
 
 Plan planLayout(const Volume& volume, const gpu::DeviceLimits& limits, const PlanRequest& request) {
-  std::vector<std::string> candidates;
+  std::vector<const LayoutEntry*> candidates;
   if (request.layout == "auto") {
-    candidates.assign(std::begin(kLayouts), std::end(kLayouts));
-  } else if (std::find(std::begin(kLayouts), std::end(kLayouts), request.layout) !=
-             std::end(kLayouts)) {
-    candidates.push_back(request.layout);
+    for (const LayoutEntry& e : LayoutRegistry::global().entries()) candidates.push_back(&e);
   } else {
-    throw InputError("unknown layout '" + request.layout +
-                     "' (expected auto, texture3d, mosaic or packed-mosaic)");
-  }
-  if (request.layout == "texture3d" &&
-      (limits.api != gpu::ApiLevel::Gles3 || limits.max3DTextureSize == 0)) {
-    throw InputError("layout texture3d needs 3D textures, which " + limits.profile +
-                     " does not have (use mosaic or packed-mosaic)");
+    const LayoutEntry& wished = LayoutRegistry::global().find(request.layout);
+    if (!wished.runsOn(limits)) throw InputError(unmetNeeds(wished, limits));
+    candidates.push_back(&wished);
   }
   const int units = limits.textureUnits - request.reservedUnits;
   if (units < 1) {
@@ -85,8 +84,8 @@ Plan planLayout(const Volume& volume, const gpu::DeviceLimits& limits, const Pla
   glm::ivec3 dims = volume.dims();
   for (int round = 0; round < 64; ++round) {
     const Volume shape = Volume::shapeOnly(dims, volume.type());
-    for (const std::string& name : candidates) {
-      LayoutPlan p = planOne(name, shape, volumeLimits, units);
+    for (const LayoutEntry* candidate : candidates) {
+      LayoutPlan p = candidate->plan(shape, volumeLimits, units);
       if (p.fits) {
         plan.layout = std::move(p);
         plan.volumeDims = dims;
@@ -103,7 +102,8 @@ Plan planLayout(const Volume& volume, const gpu::DeviceLimits& limits, const Pla
       if (round == 0) plan.rejected.push_back(std::move(p));
     }
     if (dims == glm::ivec3(1)) break;
-    const bool only3d = candidates.size() == 1 && candidates[0] == "texture3d";
+    const bool only3d = std::all_of(candidates.begin(), candidates.end(),
+                                    [](const LayoutEntry* e) { return e->needs3DTextures; });
     const glm::ivec3 halve = axesToHalve(dims, volumeLimits, only3d);
     for (int a = 0; a < 3; ++a) {
       if (halve[a] && dims[a] > 1) {
@@ -124,10 +124,9 @@ std::unique_ptr<Layout> createLayout(const Plan& plan, const Volume& volume,
   }
   gpu::DeviceLimits volumeLimits = limits;
   volumeLimits.textureUnits = plan.volumeUnits;
-  const std::string& name = plan.layout.layout;
-  if (name == "texture3d") return Texture3DLayout::create(volume, volumeLimits, ledger);
-  if (name == "mosaic") return MosaicLayout::create(volume, volumeLimits, ledger);
-  return PackedMosaicLayout::create(volume, volumeLimits, ledger, plan.volumeUnits);
+  return LayoutRegistry::global()
+      .find(plan.layout.layout)
+      .create(volume, volumeLimits, ledger, plan.volumeUnits);
 }
 
 }  // namespace tessera::layout

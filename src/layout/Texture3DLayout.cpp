@@ -107,4 +107,15 @@ int Texture3DLayout::bind(const gpu::Program& program, int firstUnit) const {
   return 1;
 }
 
+LayoutEntry Texture3DLayout::registration() {
+  return {
+      .name = "texture3d",
+      .minApi = gpu::ApiLevel::Gles3,
+      .needs3DTextures = true,
+      .plan = [](const Volume& shape, const gpu::DeviceLimits& limits,
+                 int) { return planFor(shape, limits); },
+      .create = [](const Volume& volume, const gpu::DeviceLimits& limits, gpu::MemoryLedger& ledger,
+                   int) -> std::unique_ptr<Layout> { return create(volume, limits, ledger); }};
+}
+
 }  // namespace tessera::layout

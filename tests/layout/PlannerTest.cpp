@@ -3,6 +3,7 @@
 
 #include "tessera/core/Error.h"
 #include "tessera/gpu/DeviceProfile.h"
+#include "tessera/layout/LayoutRegistry.h"
 #include "tessera/layout/Planner.h"
 
 using namespace tessera;
@@ -114,4 +115,81 @@ TEST(Planner, ImpossibleWishesAreClearErrors) {
   EXPECT_EQ(forced.layout.layout, "packed-mosaic");
   const layout::Plan mosaic = plan({64, 64, 64}, "webgl2", "mosaic");
   EXPECT_EQ(mosaic.layout.layout, "mosaic");
+}
+
+namespace {
+
+// Restores the global registry after a test registered layouts of its own.
+struct KeepLayoutRegistry {
+  layout::LayoutRegistry saved = layout::LayoutRegistry::global();
+  ~KeepLayoutRegistry() { layout::LayoutRegistry::global() = saved; }
+};
+
+// A stand-in for a layout that keeps only a 64x64 window of the volume
+// resident (as a bricked layout would): it fits anywhere with one unit.
+layout::LayoutEntry residentWindowLayout(bool needs3DTextures = false) {
+  const std::string name = needs3DTextures ? "test-window-3d" : "test-window";
+  return {.name = name,
+          .needs3DTextures = needs3DTextures,
+          .plan =
+              [name](const Volume& shape, const gpu::DeviceLimits& limits, int units) {
+                layout::LayoutPlan p;
+                p.layout = name;
+                p.textures.push_back({"window", {64, 64, 1}, false, "R8", 64 * 64});
+                p.totalBytes = 64 * 64;
+                p.fits = units >= 1 && limits.max2DTextureSize >= 64;
+                p.reason = "a 64x64 window of " + std::to_string(shape.dims().x) + " columns";
+                return p;
+              },
+          .create = [](const Volume&, const gpu::DeviceLimits&, gpu::MemoryLedger&, int)
+              -> std::unique_ptr<layout::Layout> { throw Error("not uploaded in this test"); }};
+}
+
+}  // namespace
+
+TEST(Planner, ChoosesFromTheRegisteredLayoutsInOrder) {
+  EXPECT_EQ(layout::LayoutRegistry::global().names(),
+            (std::vector<std::string>{"texture3d", "mosaic", "packed-mosaic"}));
+  EXPECT_EQ(layout::LayoutRegistry::global().choices(), "auto, texture3d, mosaic or packed-mosaic");
+}
+
+TEST(Planner, ALayoutRegisteredLaterIsPlannedByName) {
+  const KeepLayoutRegistry keep;
+  layout::LayoutRegistry::global().add(residentWindowLayout());
+  const layout::Plan p = plan({181, 217, 181}, "ipad2", "test-window");
+  EXPECT_EQ(p.layout.layout, "test-window");
+  EXPECT_EQ(p.layout.totalBytes, 64u * 64);
+  try {
+    plan({64, 64, 64}, "webgl2", "bricks");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("test-window"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Planner, AutoTriesARegisteredLayoutBeforeDownsampling) {
+  // 4000 columns: no built-in layout holds it on ipad2 (a tile wider than
+  // 2048); the registered one does, so nothing is thrown away.
+  const KeepLayoutRegistry keep;
+  layout::LayoutRegistry::global().add(residentWindowLayout());
+  const layout::Plan p = plan({4000, 64, 16}, "ipad2");
+  EXPECT_EQ(p.layout.layout, "test-window");
+  EXPECT_FALSE(p.downsampled());
+  ASSERT_EQ(p.rejected.size(), 3u);
+  EXPECT_NE(p.reason.find("not packed-mosaic"), std::string::npos) << p.reason;
+}
+
+TEST(Planner, ARegisteredLayoutsNeedsAreChecked) {
+  const KeepLayoutRegistry keep;
+  layout::LayoutRegistry::global().add(residentWindowLayout());
+  layout::LayoutRegistry::global().add(residentWindowLayout(true));
+  try {
+    plan({64, 64, 64}, "ipad2", "test-window-3d");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "layout test-window-3d needs 3D textures, which ipad2 does not have (use mosaic, "
+              "packed-mosaic or test-window)");
+  }
+  EXPECT_EQ(plan({64, 64, 64}, "webgl2", "test-window-3d").layout.layout, "test-window-3d");
 }

@@ -19,6 +19,7 @@
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/gpu/MemoryLedger.h"
 #include "tessera/layout/Layout.h"
+#include "tessera/layout/LayoutRegistry.h"
 
 namespace tessera::layout {
 
@@ -76,6 +77,9 @@ class MosaicLayout final : public Layout {
 
   const Geometry& geometry() const { return geometry_; }
   Storage storage() const { return storage_; }
+
+  // The planner's entry: 2D textures only, costs planFor().
+  static LayoutEntry registration();
 
  private:
   MosaicLayout() = default;

@@ -49,6 +49,7 @@
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/gpu/MemoryLedger.h"
 #include "tessera/layout/Layout.h"
+#include "tessera/layout/LayoutRegistry.h"
 
 namespace tessera::layout {
 
@@ -140,6 +141,9 @@ class PackedMosaicLayout final : public Layout {
 
   const Geometry& geometry() const { return geometry_; }
   Packing packing() const { return geometry_.packing; }
+
+  // The planner's entry: 2D textures only, costs planFor() with the units left.
+  static LayoutEntry registration();
 
  private:
   PackedMosaicLayout() = default;

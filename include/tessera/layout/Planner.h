@@ -1,9 +1,10 @@
 #pragma once
 // The planner: given a volume, a device's limits and the user's wishes,
-// choose how the volume lives in textures — texture3d where allowed and it
-// fits, else mosaic, else packed-mosaic, else downsample by 2 along the axes
-// that need it — and say why in one line (DESIGN.md, Layouts). It never
-// fails with "maximum texture size exceeded".
+// choose how the volume lives in textures — the first registered layout
+// (layout/LayoutRegistry.h: texture3d, mosaic, packed-mosaic) whose cost fits
+// the device, else downsample by 2 along the axes that need it — and say why
+// in one line (DESIGN.md, Layouts). It never fails with "maximum texture
+// size exceeded". layout/VolumeUpload.h runs plan -> reduce -> create.
 #include <memory>
 #include <string>
 #include <vector>
@@ -18,7 +19,7 @@
 namespace tessera::layout {
 
 struct PlanRequest {
-  std::string layout = "auto";  // auto | texture3d | mosaic | packed-mosaic
+  std::string layout = "auto";  // auto, or a registered layout's name
   // Texture units and GPU bytes the technique needs besides the volume
   // (the ray caster: its TF table and empty-space grid, the render target).
   int reservedUnits = 2;

@@ -7,6 +7,7 @@
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/gpu/MemoryLedger.h"
 #include "tessera/layout/Layout.h"
+#include "tessera/layout/LayoutRegistry.h"
 
 namespace tessera::layout {
 
@@ -29,6 +30,9 @@ class Texture3DLayout final : public Layout {
   glm::ivec3 volumeDims() const override { return dims_; }
   std::uint64_t textureBytes() const override { return texture_.bytes(); }
   int textureUnits() const override { return 1; }
+
+  // The planner's entry: needs 3D textures (ES 3), costs planFor().
+  static LayoutEntry registration();
 
  private:
   Texture3DLayout() = default;

@@ -1,0 +1,50 @@
+#pragma once
+// The layouts the planner chooses from (layout/Planner.h). Each layout
+// registers what it needs of a device (API level, 3D textures) and what it
+// costs (a function that plans its textures for a volume shape within the
+// device's limits and a number of texture units), and how it is created.
+// The planner holds no list of its own: a new layout (bricks, fcc) plugs in
+// by registering, and "auto" tries the layouts in registration order.
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "tessera/core/NamedRegistry.h"
+#include "tessera/core/Volume.h"
+#include "tessera/gpu/DeviceProfile.h"
+#include "tessera/gpu/MemoryLedger.h"
+#include "tessera/layout/Layout.h"
+
+namespace tessera::layout {
+
+struct LayoutEntry {
+  std::string name;
+  // What it needs of the device. Asked for by name on a device without it,
+  // the planner refuses with an error that names the layouts that would do.
+  gpu::ApiLevel minApi = gpu::ApiLevel::Gles2;
+  bool needs3DTextures = false;
+  // What it costs: the textures it would allocate for a volume of `shape`
+  // within `limits` using at most `units` texture units; fits = false and a
+  // reason when it cannot.
+  std::function<LayoutPlan(const Volume& shape, const gpu::DeviceLimits& limits, int units)> plan;
+  // Creates and uploads it (the volume already reduced to the planned dims).
+  std::function<std::unique_ptr<Layout>(const Volume& volume, const gpu::DeviceLimits& limits,
+                                        gpu::MemoryLedger& ledger, int units)>
+      create;
+
+  // Whether the device has what the layout needs.
+  bool runsOn(const gpu::DeviceLimits& limits) const;
+};
+
+// add() a layout after the others (or in place of one of its name); find()
+// throws InputError listing choices(): "auto, texture3d, mosaic or ...".
+class LayoutRegistry : public NamedRegistry<LayoutEntry> {
+ public:
+  LayoutRegistry() : NamedRegistry("layout", "auto") {}
+  // The built-in layouts, in the planner's order of preference: texture3d,
+  // mosaic, packed-mosaic.
+  static LayoutRegistry& global();
+};
+
+}  // namespace tessera::layout
