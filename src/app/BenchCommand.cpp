@@ -12,13 +12,16 @@
 #include "app/RenderJob.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/core/Timing.h"
 #include "tessera/io/VolumeReader.h"
 #include "tessera/layout/MosaicLayout.h"
 #include "tessera/layout/PackedMosaicLayout.h"
 #include "tessera/layout/Texture3DLayout.h"
+#include "tessera/layout/VolumeUpload.h"
+#include "tessera/lod/InCoreVolumeSource.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
-#include "tessera/render/Raycaster.h"
+#include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::app {
 
@@ -46,7 +49,7 @@ struct Variant {
   const char* name;
   int skipBlock;
   double ert;
-  std::unique_ptr<render::Raycaster> caster;
+  std::unique_ptr<render::Technique> caster;
   RenderSettings settings;
   std::vector<double> ms;
   double psnrDb = 0.0;
@@ -54,10 +57,16 @@ struct Variant {
   double samplesPerRay = 0.0;
 };
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+// The ray caster from the registry on a volume and layout uploaded already.
+std::unique_ptr<render::Technique> raycaster(gpu::GlContext& context,
+                                             const gpu::DeviceLimits& limits, const Volume& volume,
+                                             const layout::Layout& layout, int skipBlock = 8) {
+  const render::TechniqueOptions options{.skipBlock = skipBlock};
+  return render::TechniqueRegistry::global().create("raycast", {.context = context,
+                                                                .limits = limits,
+                                                                .volume = volume,
+                                                                .layout = &layout,
+                                                                .options = options});
 }
 
 // The ray-casting benchmark of the Foundation issue: ch2 at 512x512, 36
@@ -67,14 +76,16 @@ double median(std::vector<double> v) {
 // machine falls on all of them alike and their ratios stay meaningful.
 void runBench(const BenchOptions& o) {
   const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
-  const Volume volume = readVolume(spec);
+  const lod::InCoreVolumeSource source(readVolume(spec));
+  const Volume& volume = source.volume();
   const TransferFunction tf = TransferFunction::fromPresetOrFile(o.tf);
   auto context = gpu::GlContext::createHeadless();
+  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(context->caps());
   int width = 0, height = 0;
   parseSize(o.size, width, height);
   if (o.frames < 1) throw InputError("--frames must be >= 1");
-  auto layout = layout::Texture3DLayout::create(volume, gpu::DeviceLimits::of(context->caps()),
-                                                context->ledger());
+  const layout::VolumeUpload upload =
+      layout::uploadVolume(*context, limits, source, {}, "texture3d");
 
   std::vector<Variant> variants;
   variants.push_back({"plain (no ERT, no skipping)", 0, 2.0, nullptr, {}, {}, 0, 0, 0});
@@ -87,19 +98,17 @@ void runBench(const BenchOptions& o) {
   for (Variant& v : variants) {
     v.settings.stepVoxels = o.step;
     v.settings.ertThreshold = v.ert;
-    v.caster = std::make_unique<render::Raycaster>(*context, volume, *layout);
-    v.caster->setSkipBlockSize(v.skipBlock);
+    v.caster = raycaster(*context, limits, volume, *upload.layout, v.skipBlock);
     v.caster->setTransferFunction(tf);
-    v.caster->prepare(v.settings);
+    v.caster->prepare(camera, v.settings);
   }
   for (int f = 0; f < o.frames; ++f) {
     Camera cam = camera;
     cam.azimuthDeg += f * o.rotate;
     for (Variant& v : variants) {
       const auto t0 = std::chrono::steady_clock::now();
-      v.caster->renderFrame(cam, v.settings, width, height);
-      v.ms.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      v.caster->render(cam, v.settings, width, height, 0.0);
+      v.ms.push_back(msSince(t0));
       if (f == 0) {
         // Each variant is compared with the reference of its own semantics
         // (without ERT the reference also runs to the end of the ray).
@@ -130,7 +139,7 @@ void runBench(const BenchOptions& o) {
                       {"psnr_db", v.psnrDb},
                       {"ssim", v.ssim},
                       {"samples_per_ray", v.samplesPerRay},
-                      {"occupied_block_fraction", v.caster->occupiedBlockFraction()}});
+                      {"occupied_block_fraction", v.caster->report().occupiedBlockFraction}});
     }
     nlohmann::json j;
     j["file"] = spec;
@@ -153,11 +162,11 @@ void runBench(const BenchOptions& o) {
     std::printf(
         "| %s | %.1f | %.1f | %.1f | %s | %.0f | %.2f | %.5f |\n", v.name, median(v.ms),
         *std::min_element(v.ms.begin(), v.ms.end()), *std::max_element(v.ms.begin(), v.ms.end()),
-        v.skipBlock
-            ? (std::to_string(static_cast<int>(100 * v.caster->occupiedBlockFraction() + 0.5)) +
-               " %")
-                  .c_str()
-            : "—",
+        v.skipBlock ? (std::to_string(
+                           static_cast<int>(100 * v.caster->report().occupiedBlockFraction + 0.5)) +
+                       " %")
+                          .c_str()
+                    : "—",
         v.samplesPerRay, v.psnrDb, v.ssim);
   }
 }
@@ -165,7 +174,7 @@ void runBench(const BenchOptions& o) {
 struct LayoutVariant {
   std::string name;
   std::unique_ptr<layout::Layout> layout;
-  std::unique_ptr<render::Raycaster> caster;
+  std::unique_ptr<render::Technique> caster;
   std::vector<double> ms;
   Image first;
 };
@@ -208,18 +217,17 @@ void runLayoutBench(const BenchOptions& o) {
   Camera camera;
   camera.frame(volume);
   for (LayoutVariant& v : variants) {
-    v.caster = std::make_unique<render::Raycaster>(*context, volume, *v.layout);
+    v.caster = raycaster(*context, limits, volume, *v.layout);
     v.caster->setTransferFunction(tf);
-    v.caster->prepare(settings);
+    v.caster->prepare(camera, settings);
   }
   for (int f = 0; f < o.frames; ++f) {
     Camera cam = camera;
     cam.azimuthDeg += f * o.rotate;
     for (LayoutVariant& v : variants) {
       const auto t0 = std::chrono::steady_clock::now();
-      v.caster->renderFrame(cam, settings, width, height);
-      v.ms.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      v.caster->render(cam, settings, width, height, 0.0);
+      v.ms.push_back(msSince(t0));
       if (f == 0) v.first = v.caster->readImage();
     }
     if (!o.json) std::fprintf(stderr, "\rframe %d/%d", f + 1, o.frames);

@@ -13,30 +13,18 @@
 #include "app/Commands.h"
 #include "app/RenderJob.h"
 #include "tessera/core/Error.h"
+#include "tessera/core/Timing.h"
 #include "tessera/io/VolumeReader.h"
-#include "tessera/layout/Texture3DLayout.h"
+#include "tessera/layout/VolumeUpload.h"
+#include "tessera/lod/InCoreVolumeSource.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceOverlay.h"
 #include "tessera/render/HybridCompositor.h"
-#include "tessera/render/HybridRaycastTechnique.h"
-#include "tessera/render/HybridSliceTechnique.h"
-#include "tessera/render/Raycaster.h"
-#include "tessera/render/Slice2DRenderer.h"
-#include "tessera/render/Slice3DRenderer.h"
+#include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::app {
 
 namespace {
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 // Saturated, semi-transparent hues over the MRI range: dark blue is the most
 // opaque, pale yellow the brightest, so luminance is a poor opacity guess.
@@ -56,19 +44,30 @@ TransferFunction colouredTf() {
   return tf;
 }
 
-struct Setup {
-  std::unique_ptr<render::Raycaster> caster;
-  std::unique_ptr<render::HybridRaycastTechnique> technique;
+// The volume uploaded once as texture3d, which every technique shares.
+struct Scene {
+  gpu::GlContext& context;
+  gpu::DeviceLimits limits;
+  layout::VolumeUpload upload;
+  const Volume& volume() const { return *upload.volume; }
 };
 
-Setup makeRaycast(gpu::GlContext& context, const Volume& volume, const layout::Layout& layout,
-                  const TransferFunction& tf, const RenderSettings& settings) {
-  Setup s;
-  s.caster = std::make_unique<render::Raycaster>(context, volume, layout);
-  s.caster->setTransferFunction(tf);
-  s.caster->prepare(settings);
-  s.technique = std::make_unique<render::HybridRaycastTechnique>(*s.caster);
-  return s;
+// A technique of the registry on the scene's upload, with its TF, prepared.
+std::unique_ptr<render::Technique> makeTechnique(const Scene& scene, const std::string& name,
+                                                 const TransferFunction& tf,
+                                                 const RenderSettings& settings) {
+  const render::TechniqueOptions options;
+  std::unique_ptr<render::Technique> t =
+      render::TechniqueRegistry::global().create(name, {.context = scene.context,
+                                                        .limits = scene.limits,
+                                                        .volume = scene.volume(),
+                                                        .layout = scene.upload.layout.get(),
+                                                        .options = options});
+  t->setTransferFunction(tf);
+  Camera camera;
+  camera.frame(scene.volume());
+  t->prepare(camera, settings);
+  return t;
 }
 
 std::string fmtDb(double db) {
@@ -79,8 +78,8 @@ std::string fmtDb(double db) {
 }
 
 // Figure 2 as numbers: PSNR of each opacity method vs the ground truth.
-nlohmann::json qualityTable(gpu::GlContext& context, const Volume& volume,
-                            const layout::Layout& layout, const HybridBenchOptions& o, bool print) {
+nlohmann::json qualityTable(const Scene& scene, const HybridBenchOptions& o, bool print) {
+  const Volume& volume = scene.volume();
   const int width = 480, height = 640;
   const render::OffscreenSize offscreen = render::OffscreenSize::ofSize(128, 128);
   struct Case {
@@ -100,7 +99,7 @@ nlohmann::json qualityTable(gpu::GlContext& context, const Volume& volume,
   camera.zoom = 0.8;  // the whole box in the portrait screen
   RenderSettings settings;
   settings.stepVoxels = o.step;
-  render::HybridCompositor compositor(context);
+  render::HybridCompositor compositor(scene.context);
   std::vector<std::string> rowNames;
   for (auto m : render::allOverlayOpacities()) rowNames.push_back(render::overlayOpacityName(m));
   rowNames.push_back("lines on top, unattenuated");
@@ -108,14 +107,14 @@ nlohmann::json qualityTable(gpu::GlContext& context, const Volume& volume,
   std::map<std::string, std::vector<double>> rows;
   nlohmann::json j = nlohmann::json::array();
   for (const Case& c : cases) {
-    Setup s = makeRaycast(context, volume, layout, c.tf, settings);
+    const std::unique_ptr<render::Technique> caster =
+        makeTechnique(scene, "raycast", c.tf, settings);
     compositor.setOverlayLines(
         render::overlayLines(volume, render::OverlayOptions::parse(c.overlays)));
     std::fprintf(stderr, "\rquality: %s ...          ", c.name.c_str());
     std::map<std::string, Image> images;
     for (auto m : render::allOverlayOpacities()) {
-      compositor.render(*s.technique, camera, settings, volume.extent(), width, height,
-                        {offscreen, m});
+      compositor.render(*caster, camera, settings, volume.extent(), width, height, {offscreen, m});
       images[render::overlayOpacityName(m)] = compositor.readImage();
     }
     const Image lines = compositor.overlays().readColor();
@@ -126,7 +125,7 @@ nlohmann::json qualityTable(gpu::GlContext& context, const Volume& volume,
       for (int x = 0; x < width; ++x)
         if (lines.pixel(x, y)[3]) std::copy_n(lines.pixel(x, y), 4, pasted.pixel(x, y));
     images["lines on top, unattenuated"] = pasted;
-    compositor.render(*s.technique, camera, settings, volume.extent(), width, height,
+    compositor.render(*caster, camera, settings, volume.extent(), width, height,
                       {render::OffscreenSize::ofFactor(1.0), render::OverlayOpacity::Alpha});
     images["alpha, volume at full resolution"] = compositor.readImage();
     nlohmann::json jc{{"case", c.name}};
@@ -171,21 +170,16 @@ nlohmann::json qualityTable(gpu::GlContext& context, const Volume& volume,
 
 // Full resolution vs hybrid at several offscreen sizes, for each technique,
 // frames interleaved so that a shared machine's load falls on all alike.
-nlohmann::json speedTable(gpu::GlContext& context, const Volume& volume,
-                          const layout::Layout& layout, const HybridBenchOptions& o, bool print) {
+nlohmann::json speedTable(const Scene& scene, const HybridBenchOptions& o, bool print) {
+  const Volume& volume = scene.volume();
+  gpu::GlContext& context = scene.context;
   const TransferFunction tf = TransferFunction::fromPresetOrFile(o.tf);
   RenderSettings settings;
   settings.stepVoxels = o.step;
-  Setup raycast = makeRaycast(context, volume, layout, tf, settings);
-  render::Slice3DRenderer slicer(context, volume, layout);
-  slicer.setTransferFunction(tf);
-  slicer.prepare(settings);
-  render::HybridSliceTechnique<render::Slice3DRenderer> slice3d("slice3d", slicer);
-  render::Slice2DRenderer stacks(context, volume, render::Slice2DOptions{});
-  stacks.setTransferFunction(tf);
-  render::HybridSliceTechnique<render::Slice2DRenderer> slice2d("slice2d", stacks);
-  const std::vector<render::HybridTechnique*> techniques{raycast.technique.get(), &slice3d,
-                                                         &slice2d};
+  std::vector<std::unique_ptr<render::Technique>> techniques;
+  for (const std::string& name : render::TechniqueRegistry::global().names()) {
+    techniques.push_back(makeTechnique(scene, name, tf, settings));
+  }
   render::HybridCompositor compositor(context);
   compositor.setOverlayLines(
       render::overlayLines(volume, render::OverlayOptions::parse("box,axes")));
@@ -213,7 +207,7 @@ nlohmann::json speedTable(gpu::GlContext& context, const Volume& volume,
     for (int f = 0; f < o.frames + 1; ++f) {  // frame 0 warms up (allocations)
       Camera cam = camera;
       cam.azimuthDeg += f * o.rotate;
-      for (render::HybridTechnique* t : techniques) {
+      for (const auto& t : techniques) {
         for (const std::string& size : sizes) {
           const std::string key = t->name() + " " + size;
           const auto t0 = std::chrono::steady_clock::now();
@@ -233,7 +227,7 @@ nlohmann::json speedTable(gpu::GlContext& context, const Volume& volume,
       std::fprintf(stderr, "\rspeed %dx%d: frame %d/%d", screen.x, screen.y, f, o.frames);
     }
     std::fprintf(stderr, "\r%*s\r", 40, "");
-    for (render::HybridTechnique* t : techniques) {
+    for (const auto& t : techniques) {
       const std::string fullKey = t->name() + " full";
       const double full = median(ms[fullKey]);
       for (const std::string& size : sizes) {
@@ -269,13 +263,15 @@ nlohmann::json speedTable(gpu::GlContext& context, const Volume& volume,
 void runHybridBench(const HybridBenchOptions& o) {
   if (o.frames < 1) throw InputError("--frames must be >= 1");
   const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
-  const Volume volume = readVolume(spec);
   auto context = gpu::GlContext::createHeadless();
-  auto layout = layout::Texture3DLayout::create(volume, gpu::DeviceLimits::of(context->caps()),
-                                                context->ledger());
+  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(context->caps());
+  const Scene scene{
+      *context, limits,
+      layout::uploadVolume(*context, limits, lod::InCoreVolumeSource(readVolume(spec)), {},
+                           "texture3d")};
   nlohmann::json j;
-  j["speed"] = speedTable(*context, volume, *layout, o, !o.json);
-  j["quality"] = qualityTable(*context, volume, *layout, o, !o.json);
+  j["speed"] = speedTable(scene, o, !o.json);
+  j["quality"] = qualityTable(scene, o, !o.json);
   if (o.json) {
     j["file"] = spec;
     j["gl_renderer"] = context->caps().renderer;

@@ -9,24 +9,16 @@
 #include "app/Commands.h"
 #include "app/RenderJob.h"
 #include "tessera/core/Error.h"
+#include "tessera/core/Timing.h"
 #include "tessera/io/VolumeReader.h"
-#include "tessera/layout/Texture3DLayout.h"
+#include "tessera/lod/InCoreVolumeSource.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceOverlay.h"
 #include "tessera/render/HybridCompositor.h"
-#include "tessera/render/HybridRaycastTechnique.h"
 #include "tessera/render/QualityController.h"
-#include "tessera/render/Raycaster.h"
+#include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::app {
-
-namespace {
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-}  // namespace
 
 // A simulated interaction: the camera turns by --rotate per frame for
 // --frames frames while the quality controller picks the offscreen size and
@@ -35,29 +27,30 @@ double msSince(std::chrono::steady_clock::time_point t0) {
 void runInteractiveBench(const HybridBenchOptions& o) {
   if (o.frames < 1) throw InputError("--frames must be >= 1");
   const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
-  const Volume volume = readVolume(spec);
+  const lod::InCoreVolumeSource source(readVolume(spec));
   const TransferFunction tf = TransferFunction::fromPresetOrFile(o.tf);
   int width = 0, height = 0;
   parseSize(o.size, width, height);
   auto context = gpu::GlContext::createHeadless();
-  auto layout = layout::Texture3DLayout::create(volume, gpu::DeviceLimits::of(context->caps()),
-                                                context->ledger());
+  const render::TechniqueOnVolume t =
+      render::createTechnique("raycast", *context, gpu::DeviceLimits::of(context->caps()), source,
+                              {.imageSize = {width, height}}, "texture3d");
+  const Volume& volume = *t.upload.volume;
+  render::Technique& technique = *t.technique;
   RenderSettings full;
   full.stepVoxels = o.step;
-  render::Raycaster caster(*context, volume, *layout);
-  caster.setTransferFunction(tf);
-  caster.prepare(full);
-  render::HybridRaycastTechnique technique(caster);
+  Camera camera;
+  camera.frame(volume);
+  technique.setTransferFunction(tf);
+  technique.prepare(camera, full);
   render::HybridCompositor compositor(*context);
   compositor.setOverlayLines(
       render::overlayLines(volume, render::OverlayOptions::parse("box,axes")));
-  Camera camera;
-  camera.frame(volume);
 
   auto renderAt = [&](const Camera& cam, const render::QualityLevel& q) {
     RenderSettings s = full;
     s.stepVoxels = o.step * q.stepScale;
-    caster.prepare(s);  // a new step rebuilds the TF table outside the timed frame
+    technique.prepare(cam, s);  // a new step rebuilds the TF table outside the timed frame
     const auto t0 = std::chrono::steady_clock::now();
     compositor.render(technique, cam, s, volume.extent(), width, height,
                       {render::OffscreenSize::ofFactor(std::min(1.0, q.resolutionScale)),
@@ -119,8 +112,7 @@ void runInteractiveBench(const HybridBenchOptions& o) {
     settled.push_back(r.ms);
     within += std::abs(r.ms - qo.goalMs) <= 0.25 * qo.goalMs;
   }
-  std::sort(settled.begin(), settled.end());
-  const double settledMedian = settled.empty() ? 0.0 : settled[settled.size() / 2];
+  const double settledMedian = median(settled);
 
   if (o.json) {
     nlohmann::json j;

@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <functional>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <optional>
@@ -17,30 +17,22 @@
 #include "app/Commands.h"
 #include "gpu/gl.h"
 #include "tessera/core/Error.h"
+#include "tessera/core/Timing.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/io/VolumeReader.h"
-#include "tessera/layout/Texture3DLayout.h"
+#include "tessera/layout/VolumeUpload.h"
+#include "tessera/lod/InCoreVolumeSource.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
-#include "tessera/render/Raycaster.h"
 #include "tessera/render/Slice2DRenderer.h"
 #include "tessera/render/Slice3DRenderer.h"
+#include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::app {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 std::string fmt(const char* f, double v) {
   char buf[64];
@@ -80,17 +72,23 @@ std::string dimsText(glm::ivec3 d) {
   return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
 }
 
-// One technique at one count on one volume, behind one interface.
-struct Technique {
-  std::string name;
-  std::function<void(const Camera&, int, int)> frame;
-  std::function<Image()> read;
-};
-
+// A volume uploaded as texture3d, which every technique shares.
 struct Scene {
   std::string name;
-  Volume volume;
-  std::unique_ptr<layout::Layout> layout;
+  layout::VolumeUpload upload;
+  const Volume& volume() const { return *upload.volume; }
+};
+
+// A technique of the registry at one count, under its row name in the tables.
+struct Contestant {
+  std::string label;
+  std::unique_ptr<render::Technique> technique;
+};
+
+// The counts (ray-casting steps, slices) and image sizes of the tables.
+struct Grid {
+  std::vector<int> counts;
+  std::vector<std::pair<int, int>> sizes;
 };
 
 Camera benchCamera(const Volume& v) {
@@ -207,235 +205,243 @@ std::string svgChart(const std::string& title, const std::string& xLabel, const 
   return o.str();
 }
 
-}  // namespace
+const char* const kRows[] = {"raycast", "raycast+skip", "slice3d", "slice2d post", "slice2d pre"};
 
-void runSlicingBench(const SlicingBenchOptions& o) {
-  if (o.frames < 1) throw InputError("--frames must be >= 1");
-  const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
-  const TransferFunction tf = TransferFunction::fromPresetOrFile(o.tf);
-  auto context = gpu::GlContext::createHeadless();
-  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(context->caps());
+std::unique_ptr<render::Technique> makeTechnique(gpu::GlContext& context,
+                                                 const gpu::DeviceLimits& limits,
+                                                 const std::string& name, const Volume& volume,
+                                                 const layout::Layout* layout,
+                                                 const render::TechniqueOptions& options,
+                                                 const TransferFunction& tf) {
+  std::unique_ptr<render::Technique> t =
+      render::TechniqueRegistry::global().create(name, {.context = context,
+                                                        .limits = limits,
+                                                        .volume = volume,
+                                                        .layout = layout,
+                                                        .options = options});
+  t->setTransferFunction(tf);
+  return t;
+}
+
+// ch2 and its GRAPP 2012-sized resampling, each uploaded once.
+std::vector<Scene> loadScenes(gpu::GlContext& context, const gpu::DeviceLimits& limits,
+                              const std::string& spec) {
+  Volume full = readVolume(spec);
+  Volume small = resample(full, {128, 128, 186});
+  std::vector<std::pair<std::string, Volume>> volumes;
+  volumes.emplace_back("ch2 " + dimsText(full.dims()), std::move(full));
+  volumes.emplace_back("ch2 resampled " + dimsText(small.dims()), std::move(small));
   std::vector<Scene> scenes;
-  {
-    Volume full = readVolume(spec);
-    Volume small = resample(full, {128, 128, 186});
-    scenes.push_back({"ch2 " + dimsText(full.dims()), std::move(full), nullptr});
-    scenes.push_back({"ch2 resampled " + dimsText(small.dims()), std::move(small), nullptr});
+  for (auto& [name, volume] : volumes) {
+    const lod::InCoreVolumeSource source(std::move(volume));
+    scenes.push_back({name, layout::uploadVolume(context, limits, source, {}, "texture3d")});
   }
-  for (Scene& s : scenes) {
-    s.layout = layout::Texture3DLayout::create(s.volume, limits, context->ledger());
-  }
-  const std::vector<int> counts =
-      o.quick ? std::vector<int>{10, 40} : std::vector<int>{10, 20, 40, 80};
-  const std::vector<std::pair<int, int>> sizes =
-      o.quick ? std::vector<std::pair<int, int>>{{480, 320}}
-              : std::vector<std::pair<int, int>>{{480, 320}, {1024, 768}};
+  return scenes;
+}
 
-  // ---- Tables 1-2: ms/frame per technique, count and resolution.
-  std::vector<SpeedRow> speed;
-  std::vector<QualityRow> quality;
-  for (Scene& scene : scenes) {
-    const Volume& v = scene.volume;
-    render::Raycaster caster(*context, v, *scene.layout);
-    caster.setSkipBlockSize(0);  // the paper's ray caster: early termination only
-    caster.setTransferFunction(tf);
-    render::Raycaster skipping(*context, v, *scene.layout);
-    skipping.setTransferFunction(tf);
-    render::Slice3DRenderer slice3d(*context, v, *scene.layout);
-    slice3d.setTransferFunction(tf);
-    render::Slice2DRenderer slice2d(*context, v, {});
-    slice2d.setTransferFunction(tf);
-    render::Slice2DRenderer slice2dPre(*context, v,
-                                       {.classification = render::SliceClassification::Pre});
-    slice2dPre.setTransferFunction(tf);
+// The five rows of the tables at one count: the ray caster with early
+// termination only (the paper's) and with skipping, slice3d, slice2d post-
+// and pre-classified.
+std::vector<Contestant> contestants(gpu::GlContext& context, const gpu::DeviceLimits& limits,
+                                    const Scene& scene, const TransferFunction& tf, int count) {
+  const std::pair<const char*, render::TechniqueOptions> rows[] = {
+      {"raycast", {.skipBlock = 0}},
+      {"raycast", {}},
+      {"slice3d", {.slices = count}},
+      {"slice2d", {.slices = count}},
+      {"slice2d", {.slices = count, .classify = "pre"}}};
+  std::vector<Contestant> list;
+  for (std::size_t i = 0; i < std::size(rows); ++i) {
+    list.push_back({kRows[i], makeTechnique(context, limits, rows[i].first, scene.volume(),
+                                            scene.upload.layout.get(), rows[i].second, tf)});
+  }
+  return list;
+}
+
+// Warm-up (programs, tables, targets), then frames interleaved so that a
+// shared machine's load falls on all alike; the median per technique.
+void timeCell(std::vector<Contestant>& list, const Scene& scene, const RenderSettings& s, int count,
+              int w, int h, int frames, std::vector<SpeedRow>& speed) {
+  const Volume& v = scene.volume();
+  for (Contestant& c : list) c.technique->render(benchCamera(v), s, w, h, 0.0);
+  std::map<std::string, std::vector<double>> ms;
+  for (int f = 0; f < frames; ++f) {
+    Camera cam = benchCamera(v);
+    cam.azimuthDeg += 10.0 * f;
+    for (Contestant& c : list) {
+      const auto t0 = Clock::now();
+      c.technique->render(cam, s, w, h, 0.0);
+      ms[c.label].push_back(msSince(t0));
+    }
+  }
+  for (Contestant& c : list)
+    speed.push_back({scene.name, c.label, w, h, count, median(ms[c.label])});
+  std::fprintf(stderr, "\r%s %d %dx%d done   ", scene.name.c_str(), count, w, h);
+}
+
+// Quality against the reference at half-voxel steps without early termination.
+void measureQuality(std::vector<Contestant>& list, const Volume& v, const TransferFunction& tf,
+                    const RenderSettings& s, int count, std::pair<int, int> size,
+                    std::optional<Image>& reference, std::vector<QualityRow>& quality) {
+  const auto [w, h] = size;
+  const Camera cam = benchCamera(v);
+  RenderSettings refSettings;
+  refSettings.ertThreshold = 1.0;
+  if (!reference) reference = renderReference(v, tf, cam, refSettings, w, h);
+  for (Contestant& c : list) {
+    const Image img = c.technique->renderImage(cam, s, w, h);
+    quality.push_back({c.label, count, psnr(img, *reference), ssim(img, *reference)});
+  }
+}
+
+// GRAPP 2012 Tables 1-2: ms/frame per technique, count and resolution, and
+// the quality on the smaller volume at the smaller size.
+void measureTables(gpu::GlContext& context, const gpu::DeviceLimits& limits,
+                   const std::vector<Scene>& scenes, const TransferFunction& tf, const Grid& grid,
+                   int frames, std::vector<SpeedRow>& speed, std::vector<QualityRow>& quality) {
+  for (const Scene& scene : scenes) {
     std::optional<Image> reference;
-    for (int count : counts) {
-      RenderSettings s = settingsForCount(v, count);
-      slice3d.setSliceCount(count);
-      slice2d.setSliceCount(count);
-      slice2dPre.setSliceCount(count);
-      std::vector<Technique> techniques{
-          {"raycast", [&](const Camera& c, int w, int h) { caster.renderFrame(c, s, w, h); },
-           [&] { return caster.readImage(); }},
-          {"raycast+skip", [&](const Camera& c, int w, int h) { skipping.renderFrame(c, s, w, h); },
-           [&] { return skipping.readImage(); }},
-          {"slice3d", [&](const Camera& c, int w, int h) { slice3d.renderFrame(c, s, w, h); },
-           [&] { return slice3d.readImage(); }},
-          {"slice2d post", [&](const Camera& c, int w, int h) { slice2d.renderFrame(c, s, w, h); },
-           [&] { return slice2d.readImage(); }},
-          {"slice2d pre",
-           [&](const Camera& c, int w, int h) { slice2dPre.renderFrame(c, s, w, h); },
-           [&] { return slice2dPre.readImage(); }},
-      };
-      for (auto [w, h] : sizes) {
-        // Warm-up (programs, tables, targets), then interleaved frames.
-        for (Technique& t : techniques) t.frame(benchCamera(v), w, h);
-        std::map<std::string, std::vector<double>> ms;
-        for (int f = 0; f < o.frames; ++f) {
-          Camera cam = benchCamera(v);
-          cam.azimuthDeg += 10.0 * f;
-          for (Technique& t : techniques) {
-            const auto t0 = Clock::now();
-            t.frame(cam, w, h);
-            ms[t.name].push_back(msSince(t0));
-          }
-        }
-        for (Technique& t : techniques) {
-          speed.push_back({scene.name, t.name, w, h, count, median(ms[t.name])});
-        }
-        std::fprintf(stderr, "\r%s %d %dx%d done   ", scene.name.c_str(), count, w, h);
-      }
-      // Quality on the smaller volume at the smaller size, against the
-      // reference at half-voxel steps without early termination.
+    for (int count : grid.counts) {
+      const RenderSettings s = settingsForCount(scene.volume(), count);
+      std::vector<Contestant> list = contestants(context, limits, scene, tf, count);
+      for (auto [w, h] : grid.sizes) timeCell(list, scene, s, count, w, h, frames, speed);
       if (&scene == &scenes.back()) {
-        const auto [w, h] = sizes.front();
-        const Camera cam = benchCamera(v);
-        RenderSettings refSettings;
-        refSettings.ertThreshold = 1.0;
-        if (!reference) reference = renderReference(v, tf, cam, refSettings, w, h);
-        for (Technique& t : techniques) {
-          t.frame(cam, w, h);
-          const Image img = t.read();
-          quality.push_back({t.name, count, psnr(img, *reference), ssim(img, *reference)});
-        }
+        measureQuality(list, scene.volume(), tf, s, count, grid.sizes.front(), reference, quality);
       }
     }
   }
   std::fprintf(stderr, "\r%60s\r", "");
+}
 
-  // ---- TF updates (Moser & Weiskopf 2008, Figure 6): TF changed -> frame ready.
-  std::vector<TfRow> tfRows;
-  {
-    const Volume& source = scenes.front().volume;
-    const std::vector<glm::ivec3> dimsList =
-        o.quick ? std::vector<glm::ivec3>{{128, 128, 64}, {128, 128, 128}}
-                : std::vector<glm::ivec3>{{128, 128, 32}, {128, 128, 64},  {128, 128, 128},
-                                          {256, 256, 64}, {256, 256, 128}, {256, 256, 256}};
-    TransferFunction tfB = tf;
-    for (auto& p : tfB.opacities) p.alpha = std::min(1.0, p.alpha * 1.5);
-    for (const glm::ivec3 dims : dimsList) {
-      const Volume v = resample(source, dims);
-      Camera cam = benchCamera(v);
-      cam.azimuthDeg = 10;  // the y stack
-      cam.elevationDeg = 10;
-      RenderSettings s;
-      struct Path {
-        const char* name;
-        render::Slice2DOptions options;
-        bool recreate;
-      };
-      const std::vector<Path> paths{
-          {"pre-classified RGBA, 3 stacks re-created",
-           {.classification = render::SliceClassification::Pre},
-           false},
-          {"pre-classified RGBA, current stack only",
-           {.classification = render::SliceClassification::Pre, .currentStackOnly = true},
-           false},
-          {"index + palette, re-created (GL_PALETTE8 way)",
-           {.classification = render::SliceClassification::Palette},
-           true},
-          {"index + palette, palette upload only",
-           {.classification = render::SliceClassification::Palette},
-           false},
-          {"post-classification, LUT upload only", {}, false},
-      };
-      for (const Path& p : paths) {
-        render::Slice2DRenderer r(*context, v, p.options);
-        r.setTransferFunction(tf);
+// Moser & Weiskopf 2008, Figure 6: TF changed -> frame ready, per slice2d
+// classification path and volume size.
+std::vector<TfRow> measureTfUpdates(gpu::GlContext& context, const gpu::DeviceLimits& limits,
+                                    const Volume& source, const TransferFunction& tf,
+                                    const SlicingBenchOptions& o) {
+  const std::vector<glm::ivec3> dimsList =
+      o.quick ? std::vector<glm::ivec3>{{128, 128, 64}, {128, 128, 128}}
+              : std::vector<glm::ivec3>{{128, 128, 32}, {128, 128, 64},  {128, 128, 128},
+                                        {256, 256, 64}, {256, 256, 128}, {256, 256, 256}};
+  TransferFunction tfB = tf;
+  for (auto& p : tfB.opacities) p.alpha = std::min(1.0, p.alpha * 1.5);
+  struct Path {
+    const char* name;
+    render::TechniqueOptions options;
+    bool recreate;
+  };
+  const std::vector<Path> paths{
+      {"pre-classified RGBA, 3 stacks re-created", {.classify = "pre"}, false},
+      {"pre-classified RGBA, current stack only",
+       {.classify = "pre", .currentStackOnly = true},
+       false},
+      {"index + palette, re-created (GL_PALETTE8 way)", {.classify = "palette"}, true},
+      {"index + palette, palette upload only", {.classify = "palette"}, false},
+      {"post-classification, LUT upload only", {}, false},
+  };
+  std::vector<TfRow> rows;
+  for (const glm::ivec3 dims : dimsList) {
+    const Volume v = resample(source, dims);
+    Camera cam = benchCamera(v);
+    cam.azimuthDeg = 10;  // the y stack
+    cam.elevationDeg = 10;
+    const RenderSettings s;
+    for (const Path& p : paths) {
+      const auto t = makeTechnique(context, limits, "slice2d", v, nullptr, p.options, tf);
+      auto& r = dynamic_cast<render::Slice2DRenderer&>(*t);
+      r.renderFrame(cam, s, 480, 320);
+      // The update alone (classification + uploads, waited for), then the
+      // frame it makes ready; summed, they are "TF changed -> frame ready".
+      std::vector<double> frame, update;
+      for (int i = 0; i < std::max(5, o.frames); ++i) {
+        auto t0 = Clock::now();
+        if (p.recreate) r.recreateStackTextures();
+        r.setTransferFunction(i % 2 ? tf : tfB);
+        r.prepare(cam, s);
+        glFinishForBench();
+        update.push_back(msSince(t0));
+        t0 = Clock::now();
         r.renderFrame(cam, s, 480, 320);
-        // The update alone (classification + uploads, waited for), then the
-        // frame it makes ready; summed, they are "TF changed -> frame ready".
-        std::vector<double> frame, update;
-        for (int i = 0; i < std::max(5, o.frames); ++i) {
-          auto t0 = Clock::now();
-          if (p.recreate) r.recreateStackTextures();
-          r.setTransferFunction(i % 2 ? tf : tfB);
-          r.prepare(cam, s);
-          glFinishForBench();
-          update.push_back(msSince(t0));
-          t0 = Clock::now();
-          r.renderFrame(cam, s, 480, 320);
-          frame.push_back(msSince(t0));
-        }
-        tfRows.push_back({dims, p.name, median(frame), median(update)});
+        frame.push_back(msSince(t0));
       }
-      std::fprintf(stderr, "\rTF updates %s done   ", dimsText(dims).c_str());
+      rows.push_back({dims, p.name, median(frame), median(update)});
     }
-    std::fprintf(stderr, "\r%60s\r", "");
+    std::fprintf(stderr, "\rTF updates %s done   ", dimsText(dims).c_str());
   }
-  // The hitch of the one-stack mode when the view changes stack.
-  double hitchMs = 0.0;
-  std::string hitchVolume;
-  {
-    const Scene& scene = scenes.front();
-    render::Slice2DRenderer r(*context, scene.volume, {.currentStackOnly = true});
-    r.setTransferFunction(tf);
-    Camera cam = benchCamera(scene.volume);
-    cam.azimuthDeg = 10;
-    r.renderFrame(cam, {}, 480, 320);
-    cam.azimuthDeg = 80;  // the x stack
-    r.renderFrame(cam, {}, 480, 320);
-    hitchMs = r.lastStackUploadMs();
-    hitchVolume = scene.name;
-  }
+  std::fprintf(stderr, "\r%60s\r", "");
+  return rows;
+}
 
-  // ---- Report.
-  std::ostringstream md;
-  md << "GL: " << context->caps().renderer << " (" << context->caps().version << "); TF `" << o.tf
-     << "`; camera azimuth 30, elevation 20; median of " << o.frames
-     << " frames rotating 10 deg; texture3d layout; accumulation "
-     << render::Slice3DRenderer(*context, scenes.front().volume, *scenes.front().layout)
-            .accumulationFormat()
-     << ".\n\n";
-  for (const Scene& scene : scenes) {
-    md << "### " << scene.name << ": ms/frame (fps)\n\n| technique | resolution |";
-    for (int c : counts) md << " " << c << " |";
-    md << "\n|---|---|";
-    for (std::size_t i = 0; i < counts.size(); ++i) md << "---:|";
-    md << "\n";
-    for (const char* t : {"raycast", "raycast+skip", "slice3d", "slice2d post", "slice2d pre"}) {
-      for (auto [w, h] : sizes) {
-        md << "| " << t << " | " << w << "x" << h << " |";
-        for (int c : counts) {
-          for (const SpeedRow& r : speed) {
-            if (r.volume == scene.name && r.technique == t && r.width == w && r.count == c) {
-              md << " " << fmt("%.1f", r.ms) << " (" << fmt("%.1f", 1000.0 / r.ms) << ") |";
-            }
-          }
-        }
-        md << "\n";
-      }
+// The hitch of the one-stack mode when the view changes stack (ms).
+double measureStackHitch(gpu::GlContext& context, const gpu::DeviceLimits& limits,
+                         const Scene& scene, const TransferFunction& tf) {
+  const auto t = makeTechnique(context, limits, "slice2d", scene.volume(), nullptr,
+                               {.currentStackOnly = true}, tf);
+  auto& r = dynamic_cast<render::Slice2DRenderer&>(*t);
+  Camera cam = benchCamera(scene.volume());
+  cam.azimuthDeg = 10;
+  r.renderFrame(cam, {}, 480, 320);
+  cam.azimuthDeg = 80;  // the x stack
+  r.renderFrame(cam, {}, 480, 320);
+  return r.lastStackUploadMs();
+}
+
+// A "| technique | c1 | c2 |" table header over the counts.
+void countsHeader(std::ostringstream& md, const char* first, const std::vector<int>& counts,
+                  const char* second = nullptr) {
+  md << "| " << first << " |" << (second ? std::string(" ") + second + " |" : "");
+  for (int c : counts) md << " " << c << " |";
+  md << "\n|---|" << (second ? "---|" : "");
+  for (std::size_t i = 0; i < counts.size(); ++i) md << "---:|";
+  md << "\n";
+}
+
+const SpeedRow* findSpeed(const std::vector<SpeedRow>& speed, const std::string& volume,
+                          const std::string& technique, int width, int count) {
+  for (const SpeedRow& r : speed) {
+    if (r.volume == volume && r.technique == technique && r.width == width && r.count == count) {
+      return &r;
     }
-    md << "\nslice3d ÷ raycast (time ratio; < 1 means slicing is faster):\n\n| resolution |";
-    for (int c : counts) md << " " << c << " |";
-    md << "\n|---|";
-    for (std::size_t i = 0; i < counts.size(); ++i) md << "---:|";
-    md << "\n";
-    for (auto [w, h] : sizes) {
-      md << "| " << w << "x" << h << " |";
-      for (int c : counts) {
-        double a = 0, b = 0;
-        for (const SpeedRow& r : speed) {
-          if (r.volume != scene.name || r.width != w || r.count != c) continue;
-          if (r.technique == "slice3d") a = r.ms;
-          if (r.technique == "raycast") b = r.ms;
+  }
+  return nullptr;
+}
+
+void reportSpeed(std::ostringstream& md, const Scene& scene, const Grid& grid,
+                 const std::vector<SpeedRow>& speed) {
+  md << "### " << scene.name << ": ms/frame (fps)\n\n";
+  countsHeader(md, "technique", grid.counts, "resolution");
+  for (const char* t : kRows) {
+    for (auto [w, h] : grid.sizes) {
+      md << "| " << t << " | " << w << "x" << h << " |";
+      for (int c : grid.counts) {
+        if (const SpeedRow* r = findSpeed(speed, scene.name, t, w, c)) {
+          md << " " << fmt("%.1f", r->ms) << " (" << fmt("%.1f", 1000.0 / r->ms) << ") |";
         }
-        md << " " << fmt("%.2f", a / b) << " |";
       }
       md << "\n";
     }
+  }
+  md << "\nslice3d ÷ raycast (time ratio; < 1 means slicing is faster):\n\n";
+  countsHeader(md, "resolution", grid.counts);
+  for (auto [w, h] : grid.sizes) {
+    md << "| " << w << "x" << h << " |";
+    for (int c : grid.counts) {
+      const SpeedRow* a = findSpeed(speed, scene.name, "slice3d", w, c);
+      const SpeedRow* b = findSpeed(speed, scene.name, "raycast", w, c);
+      md << " " << fmt("%.2f", (a ? a->ms : 0.0) / (b ? b->ms : 0.0)) << " |";
+    }
     md << "\n";
   }
-  md << "### Quality vs the CPU reference (" << scenes.back().name << ", " << sizes.front().first
-     << "x" << sizes.front().second << ", reference at 0.5-voxel steps): PSNR dB / SSIM\n\n"
-     << "| technique |";
-  for (int c : counts) md << " " << c << " |";
-  md << "\n|---|";
-  for (std::size_t i = 0; i < counts.size(); ++i) md << "---:|";
   md << "\n";
-  for (const char* t : {"raycast", "raycast+skip", "slice3d", "slice2d post", "slice2d pre"}) {
+}
+
+void reportQuality(std::ostringstream& md, const Scene& scene, const Grid& grid,
+                   const std::vector<QualityRow>& quality) {
+  md << "### Quality vs the CPU reference (" << scene.name << ", " << grid.sizes.front().first
+     << "x" << grid.sizes.front().second << ", reference at 0.5-voxel steps): PSNR dB / SSIM\n\n";
+  countsHeader(md, "technique", grid.counts);
+  for (const char* t : kRows) {
     md << "| " << t << " |";
-    for (int c : counts) {
+    for (int c : grid.counts) {
       for (const QualityRow& q : quality) {
         if (q.technique == t && q.count == c) {
           md << " " << fmt("%.2f", q.psnrDb) << " / " << fmt("%.4f", q.ssimValue) << " |";
@@ -444,6 +450,10 @@ void runSlicingBench(const SlicingBenchOptions& o) {
     }
     md << "\n";
   }
+}
+
+void reportTfUpdates(std::ostringstream& md, const std::vector<TfRow>& tfRows,
+                     const std::string& hitchVolume, double hitchMs) {
   md << "\n### TF update (slice2d, 480x320): host classification + uploads until the GPU has them, "
         "then the frame\n\n"
      << "| volume | path | update ms | frame ms | TF changed -> frame ready, ms |\n"
@@ -454,6 +464,79 @@ void runSlicingBench(const SlicingBenchOptions& o) {
   }
   md << "\nOne-stack mode (" << hitchVolume << "): changing from the y to the x stack re-creates "
      << "the x stack in " << fmt("%.1f", hitchMs) << " ms (the hitch).\n";
+}
+
+// bench-slicing.svg: ms/frame of three techniques per volume and size.
+std::string speedChart(const std::vector<Scene>& scenes, const Grid& grid,
+                       const std::vector<SpeedRow>& speed) {
+  std::vector<double> xs(grid.counts.begin(), grid.counts.end());
+  std::vector<std::pair<std::string, std::vector<double>>> series;
+  for (const Scene& scene : scenes) {
+    for (const char* t : {"raycast", "slice3d", "slice2d post"}) {
+      for (auto [w, h] : grid.sizes) {
+        std::vector<double> ys;
+        for (int c : grid.counts) {
+          if (const SpeedRow* r = findSpeed(speed, scene.name, t, w, c)) ys.push_back(r->ms);
+        }
+        series.push_back({std::string(t) + " " + std::to_string(w) + "x" + std::to_string(h) +
+                              (&scene == &scenes.front() ? " ch2" : " 128²x186"),
+                          ys});
+      }
+    }
+  }
+  return svgChart("ms/frame vs steps (raycast) or slices (slicing), llvmpipe", "steps / slices",
+                  "ms per frame (log)", xs, series, true);
+}
+
+// bench-slicing-tf.svg: update time per path over the z resolution (128²).
+std::string tfChart(const std::vector<TfRow>& tfRows) {
+  std::vector<double> zs;
+  for (const TfRow& r : tfRows) {
+    if (r.dims.x != 128) continue;
+    if (std::find(zs.begin(), zs.end(), r.dims.z) == zs.end()) zs.push_back(r.dims.z);
+  }
+  std::map<std::string, std::vector<double>> byPath;
+  std::vector<std::string> order;
+  for (const TfRow& r : tfRows) {
+    if (r.dims.x != 128) continue;
+    if (!byPath.count(r.path)) order.push_back(r.path);
+    byPath[r.path].push_back(std::max(r.updateMs, 0.01));
+  }
+  std::vector<std::pair<std::string, std::vector<double>>> series;
+  for (const auto& p : order) series.push_back({p.substr(0, 28) + " 128²", byPath[p]});
+  return svgChart("TF update time vs z resolution (128x128xz), cf. Moser & Weiskopf Fig. 6",
+                  "slices in z", "ms (log)", zs, series, true);
+}
+
+}  // namespace
+
+void runSlicingBench(const SlicingBenchOptions& o) {
+  if (o.frames < 1) throw InputError("--frames must be >= 1");
+  const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
+  const TransferFunction tf = TransferFunction::fromPresetOrFile(o.tf);
+  auto context = gpu::GlContext::createHeadless();
+  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(context->caps());
+  const std::vector<Scene> scenes = loadScenes(*context, limits, spec);
+  const Grid grid =
+      o.quick ? Grid{{10, 40}, {{480, 320}}} : Grid{{10, 20, 40, 80}, {{480, 320}, {1024, 768}}};
+
+  std::vector<SpeedRow> speed;
+  std::vector<QualityRow> quality;
+  measureTables(*context, limits, scenes, tf, grid, o.frames, speed, quality);
+  const std::vector<TfRow> tfRows =
+      measureTfUpdates(*context, limits, scenes.front().volume(), tf, o);
+  const double hitchMs = measureStackHitch(*context, limits, scenes.front(), tf);
+
+  std::ostringstream md;
+  const auto slice3d = makeTechnique(*context, limits, "slice3d", scenes.front().volume(),
+                                     scenes.front().upload.layout.get(), {}, tf);
+  md << "GL: " << context->caps().renderer << " (" << context->caps().version << "); TF `" << o.tf
+     << "`; camera azimuth 30, elevation 20; median of " << o.frames
+     << " frames rotating 10 deg; texture3d layout; accumulation "
+     << dynamic_cast<const render::Slice3DRenderer&>(*slice3d).accumulationFormat() << ".\n\n";
+  for (const Scene& scene : scenes) reportSpeed(md, scene, grid, speed);
+  reportQuality(md, scenes.back(), grid, quality);
+  reportTfUpdates(md, tfRows, scenes.front().name, hitchMs);
   std::printf("%s", md.str().c_str());
 
   if (!o.outDir.empty()) {
@@ -463,49 +546,8 @@ void runSlicingBench(const SlicingBenchOptions& o) {
         << "# Texture slicing benchmark\n\nGenerated by `tessera bench --slicing --slicing-out "
            "docs`.\n\n"
         << md.str();
-    std::vector<double> xs(counts.begin(), counts.end());
-    std::vector<std::pair<std::string, std::vector<double>>> series;
-    for (const Scene& scene : scenes) {
-      for (const char* t : {"raycast", "slice3d", "slice2d post"}) {
-        for (auto [w, h] : sizes) {
-          std::vector<double> ys;
-          for (int c : counts) {
-            for (const SpeedRow& r : speed) {
-              if (r.volume == scene.name && r.technique == t && r.width == w && r.count == c) {
-                ys.push_back(r.ms);
-              }
-            }
-          }
-          series.push_back({std::string(t) + " " + std::to_string(w) + "x" + std::to_string(h) +
-                                (&scene == &scenes.front() ? " ch2" : " 128²x186"),
-                            ys});
-        }
-      }
-    }
-    std::ofstream(dir / "bench-slicing.svg")
-        << svgChart("ms/frame vs steps (raycast) or slices (slicing), llvmpipe", "steps / slices",
-                    "ms per frame (log)", xs, series, true);
-    std::vector<double> zs;
-    std::vector<std::pair<std::string, std::vector<double>>> tfSeries;
-    for (const TfRow& r : tfRows) {
-      if (r.dims.x != 128) continue;
-      if (std::find(zs.begin(), zs.end(), r.dims.z) == zs.end()) zs.push_back(r.dims.z);
-    }
-    for (int xy : {128, 256}) {
-      std::map<std::string, std::vector<double>> byPath;
-      std::vector<std::string> order;
-      for (const TfRow& r : tfRows) {
-        if (r.dims.x != xy) continue;
-        if (!byPath.count(r.path)) order.push_back(r.path);
-        byPath[r.path].push_back(std::max(r.updateMs, 0.01));
-      }
-      for (const auto& p : order) {
-        if (xy == 128) tfSeries.push_back({p.substr(0, 28) + " 128²", byPath[p]});
-      }
-    }
-    std::ofstream(dir / "bench-slicing-tf.svg")
-        << svgChart("TF update time vs z resolution (128x128xz), cf. Moser & Weiskopf Fig. 6",
-                    "slices in z", "ms (log)", zs, tfSeries, true);
+    std::ofstream(dir / "bench-slicing.svg") << speedChart(scenes, grid, speed);
+    std::ofstream(dir / "bench-slicing-tf.svg") << tfChart(tfRows);
     std::fprintf(stderr, "wrote %s/bench-slicing.md, bench-slicing.svg, bench-slicing-tf.svg\n",
                  o.outDir.c_str());
   }

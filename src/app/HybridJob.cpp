@@ -10,25 +10,38 @@
 
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
-#include "tessera/lod/Downsample.h"
+#include "tessera/core/Timing.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceOverlay.h"
 #include "tessera/reference/ReferenceRaycaster.h"
-#include "tessera/render/HybridRaycastTechnique.h"
-#include "tessera/render/HybridSliceTechnique.h"
-#include "tessera/render/Raycaster.h"
-#include "tessera/render/Slice2DRenderer.h"
-#include "tessera/render/Slice3DRenderer.h"
+#include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::app {
 
 namespace {
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+
+// Frame 0 against the CPU ground truth: the volume and, in composite mode,
+// rays stopped at the overlay lines at full resolution.
+void compareWithGroundTruth(const Volume& volume, const TransferFunction& tf,
+                            const RenderRequest& req, const render::HybridCompositor& compositor,
+                            HybridResult& result) {
+  const auto tRef = std::chrono::steady_clock::now();
+  if (req.settings.mode == RenderMode::Composite) {
+    result.groundTruth = renderReferenceWithLines(volume, tf, req.camera, req.settings, req.width,
+                                                  req.height, compositor.overlays().readColor(),
+                                                  compositor.overlays().readDistance());
+  } else {
+    result.groundTruth =
+        renderReference(volume, tf, req.camera, req.settings, req.width, req.height);
+  }
+  result.groundTruthMs = msSince(tRef);
+  result.psnrDb = psnr(result.image, *result.groundTruth);
+  result.ssim = ssim(result.image, *result.groundTruth);
 }
+
 }  // namespace
 
-HybridResult runHybridRender(DeviceSession& device, const Volume& fullVolume,
+HybridResult runHybridRender(DeviceSession& device, const lod::VolumeSource& source,
                              const TransferFunction& tf, RenderRequest req,
                              const HybridRequest& hybrid) {
   if (req.repeat < 1) throw InputError("--repeat must be >= 1");
@@ -38,84 +51,30 @@ HybridResult runHybridRender(DeviceSession& device, const Volume& fullVolume,
                      " needs --mode composite");
   }
   gpu::GlContext& context = *device.context;
-  // slice2d keeps its own slice stacks; the others sample a planned layout.
-  Volume reduced;
-  const Volume* volumeToRender = &fullVolume;
-  std::unique_ptr<layout::Layout> layout;
-  std::string layoutName = "slice-stacks";
-  if (req.technique != "slice2d") {
-    const render::RaycastPlan rp =
-        render::planRaycast(device.limits, fullVolume, req.layout, req.width, req.height,
-                            req.technique == "raycast" ? req.skipBlock : 0);
-    req.skipBlock = rp.skipBlock;
-    if (rp.plan.downsampled()) {
-      reduced = lod::downsample(fullVolume, rp.plan.downsample);
-      volumeToRender = &reduced;
-    }
-    layout = layout::createLayout(rp.plan, *volumeToRender, device.limits, context.ledger());
-    layoutName = layout->name();
-  }
-  const Volume& volume = *volumeToRender;
-
-  std::unique_ptr<render::Raycaster> caster;
-  std::unique_ptr<render::Slice3DRenderer> slice3d;
-  std::unique_ptr<render::Slice2DRenderer> slice2d;
-  std::unique_ptr<render::HybridTechnique> technique;
-  if (req.technique == "raycast") {
-    caster = std::make_unique<render::Raycaster>(context, volume, *layout);
-    caster->setSkipBlockSize(req.skipBlock);
-    caster->setLutSize(req.lutSize);
-    caster->setTransferFunction(tf);
-    caster->prepare(req.settings);
-    technique = std::make_unique<render::HybridRaycastTechnique>(*caster);
-  } else if (req.technique == "slice3d") {
-    slice3d = std::make_unique<render::Slice3DRenderer>(context, volume, *layout);
-    slice3d->setSliceCount(req.slices);
-    slice3d->setTransferFunction(tf);
-    slice3d->prepare(req.settings);
-    technique = std::make_unique<render::HybridSliceTechnique<render::Slice3DRenderer>>("slice3d",
-                                                                                        *slice3d);
-  } else if (req.technique == "slice2d") {
-    slice2d = std::make_unique<render::Slice2DRenderer>(context, volume,
-                                                        slice2dOptions(req, device.limits));
-    slice2d->setSliceCount(req.slices);
-    slice2d->setTransferFunction(tf);
-    technique = std::make_unique<render::HybridSliceTechnique<render::Slice2DRenderer>>("slice2d",
-                                                                                        *slice2d);
-  } else {
-    throw InputError("--technique '" + req.technique + "': expected raycast, slice3d or slice2d");
-  }
+  render::TechniqueOnVolume t = render::createTechnique(req.technique, context, device.limits,
+                                                        source, req.techniqueOptions(), req.layout);
+  const Volume& volume = *t.upload.volume;
+  render::Technique& technique = *t.technique;
+  technique.setTransferFunction(tf);
+  req.camera.frame(volume);
+  technique.prepare(req.camera, req.settings);
   render::HybridCompositor compositor(context);
   compositor.setOverlayLines(render::overlayLines(volume, hybrid.overlays));
-  req.camera.frame(volume);
 
   HybridResult result;
-  result.layout = layoutName;
+  result.layout = t.storageName();
   result.technique = req.technique;
   for (int i = 0; i < req.repeat; ++i) {
     Camera cam = req.camera;
     cam.azimuthDeg += i * req.rotateDeg;
     const auto t0 = std::chrono::steady_clock::now();
-    compositor.render(*technique, cam, req.settings, volume.extent(), req.width, req.height,
+    compositor.render(technique, cam, req.settings, volume.extent(), req.width, req.height,
                       hybrid.hybrid);
     result.frameMs.push_back(msSince(t0));
     if (i == 0) {
       result.image = compositor.readImage();
       result.firstTimings = compositor.timings();
-      if (req.reference) {
-        const auto tRef = std::chrono::steady_clock::now();
-        if (req.settings.mode == RenderMode::Composite) {
-          result.groundTruth = renderReferenceWithLines(
-              volume, tf, req.camera, req.settings, req.width, req.height,
-              compositor.overlays().readColor(), compositor.overlays().readDistance());
-        } else {
-          result.groundTruth =
-              renderReference(volume, tf, req.camera, req.settings, req.width, req.height);
-        }
-        result.groundTruthMs = msSince(tRef);
-        result.psnrDb = psnr(result.image, *result.groundTruth);
-        result.ssim = ssim(result.image, *result.groundTruth);
-      }
+      if (req.reference) compareWithGroundTruth(volume, tf, req, compositor, result);
     }
   }
   result.textureBytes = context.ledger().totalBytes();
@@ -125,9 +84,7 @@ HybridResult runHybridRender(DeviceSession& device, const Volume& fullVolume,
 void printHybridResult(const HybridResult& r, const RenderRequest& req, const HybridRequest& h,
                        const DeviceSession& device, const std::string& spec, const std::string& out,
                        bool json) {
-  std::vector<double> sorted = r.frameMs;
-  std::sort(sorted.begin(), sorted.end());
-  const double median = sorted[sorted.size() / 2];
+  const double median = tessera::median(r.frameMs);
   const glm::ivec2 low = h.hybrid.offscreen.resolve(req.width, req.height);
   if (json) {
     nlohmann::json j;
@@ -173,7 +130,8 @@ void printHybridResult(const HybridResult& r, const RenderRequest& req, const Hy
       r.firstTimings.volumeMs, r.firstTimings.overlayMs, r.firstTimings.compositeMs);
   if (r.frameMs.size() > 1) {
     std::printf("frames   %zu: median %.1f ms, min %.1f, max %.1f\n", r.frameMs.size(), median,
-                sorted.front(), sorted.back());
+                *std::min_element(r.frameMs.begin(), r.frameMs.end()),
+                *std::max_element(r.frameMs.begin(), r.frameMs.end()));
   }
   if (r.psnrDb) {
     std::printf(

@@ -30,7 +30,7 @@ struct HybridResult {
   std::uint64_t textureBytes = 0;
 };
 
-HybridResult runHybridRender(DeviceSession& device, const Volume& volume,
+HybridResult runHybridRender(DeviceSession& device, const lod::VolumeSource& source,
                              const TransferFunction& tf, RenderRequest request,
                              const HybridRequest& hybrid);
 

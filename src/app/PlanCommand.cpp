@@ -7,7 +7,8 @@
 #include "app/RenderJob.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/io/VolumeReader.h"
-#include "tessera/render/RaycastPlan.h"
+#include "tessera/layout/LayoutRegistry.h"
+#include "tessera/render/Raycaster.h"
 
 namespace tessera::app {
 
@@ -49,9 +50,15 @@ void runPlan(const PlanOptions& o) {
   DeviceSession device = openDevice(o.profile);
   const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
   const Volume volume = readVolume(spec, {.dicomSeries = o.series});
-  const render::RaycastPlan rp =
-      render::planRaycast(device.limits, volume, o.layout, width, height, o.skipBlock);
-  const layout::Plan& plan = rp.plan;
+  // What the ray caster needs next to the volume, then the planner's choice.
+  const render::TechniqueRequirements needs = render::Raycaster::requirements(
+      device.limits, volume.dims(), {.imageSize = {width, height}, .skipBlock = o.skipBlock});
+  const bool skipping = render::Raycaster::skipBlockFor(device.limits, o.skipBlock) > 0;
+  layout::PlanRequest request;
+  request.layout = o.layout;
+  request.reservedUnits = needs.textureUnits;
+  request.reservedBytes = needs.bytes;
+  const layout::Plan plan = layout::planLayout(volume, device.limits, request);
   const gpu::DeviceLimits& l = device.limits;
   if (o.json) {
     nlohmann::json j;
@@ -70,10 +77,10 @@ void runPlan(const PlanOptions& o) {
     j["downsample"] = {plan.downsample.x, plan.downsample.y, plan.downsample.z};
     j["planned_dims"] = {plan.volumeDims.x, plan.volumeDims.y, plan.volumeDims.z};
     j["volume_texture_units"] = plan.volumeUnits;
-    j["renderer_reserved_bytes"] = rp.reservedBytes;
-    j["empty_space_skipping"] = rp.skipBlock > 0;
+    j["renderer_reserved_bytes"] = needs.bytes;
+    j["empty_space_skipping"] = skipping;
     j["reason"] = plan.reason;
-    if (!rp.note.empty()) j["note"] = rp.note;
+    if (!needs.note.empty()) j["note"] = needs.note;
     nlohmann::json rejected = nlohmann::json::array();
     for (const auto& r : plan.rejected) rejected.push_back(planJson(r));
     j["rejected"] = rejected;
@@ -99,7 +106,7 @@ void runPlan(const PlanOptions& o) {
   std::printf("bytes    %s for the volume (%d of %d units), %s for the ray caster\n",
               formatBytes(plan.layout.totalBytes).c_str(),
               static_cast<int>(plan.layout.textures.size()), plan.volumeUnits,
-              formatBytes(rp.reservedBytes).c_str());
+              formatBytes(needs.bytes).c_str());
   if (plan.downsampled()) {
     std::printf("downsample %s -> %s\n", dimsText(plan.downsample).c_str(),
                 dimsText(plan.volumeDims).c_str());
@@ -107,7 +114,7 @@ void runPlan(const PlanOptions& o) {
   for (const auto& r : plan.rejected) {
     std::printf("not      %s: %s\n", r.layout.c_str(), r.reason.c_str());
   }
-  if (!rp.note.empty()) std::printf("note     %s\n", rp.note.c_str());
+  if (!needs.note.empty()) std::printf("note     %s\n", needs.note.c_str());
   std::printf("reason   %s\n", plan.reason.c_str());
 }
 
@@ -121,7 +128,7 @@ void addPlanCommand(CLI::App& app) {
   addSeriesOption(cmd, o->series);
   cmd->add_option("--profile", o->profile, "Device profile (tessera profiles) or FILE.json")
       ->capture_default_str();
-  cmd->add_option("--layout", o->layout, "auto, texture3d, mosaic or packed-mosaic")
+  cmd->add_option("--layout", o->layout, layout::LayoutRegistry::global().choices())
       ->capture_default_str();
   cmd->add_option("--size", o->size, "Image size the renderer must also fit (WIDTHxHEIGHT)")
       ->capture_default_str();

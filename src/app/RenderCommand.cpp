@@ -11,7 +11,11 @@
 #include "app/RenderJob.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/core/Timing.h"
 #include "tessera/io/VolumeReader.h"
+#include "tessera/layout/LayoutRegistry.h"
+#include "tessera/lod/InCoreVolumeSource.h"
+#include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::app {
 
@@ -55,18 +59,14 @@ struct RenderOptions {
   std::string roi;
 };
 
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
 nlohmann::json numberOrNull(std::optional<double> v) {
   if (!v) return nullptr;
   if (std::isinf(*v)) return 999.0;  // identical images; JSON has no infinity
   return *v;
 }
 
-void runRenderCommand(const RenderOptions& o) {
-  const auto tStart = std::chrono::steady_clock::now();
+// The camera, settings and technique the options ask for.
+RenderRequest requestFrom(const RenderOptions& o) {
   RenderRequest req;
   parseSize(o.size, req.width, req.height);
   req.camera.azimuthDeg = o.azimuth;
@@ -92,89 +92,102 @@ void runRenderCommand(const RenderOptions& o) {
   req.repeat = o.repeat;
   req.rotateDeg = o.repeat > 1 ? o.rotate : 0.0;
   req.reference = o.reference || !o.referenceOut.empty();
+  // Checked before the volume is read, so that a typo fails at once.
+  if (!render::TechniqueRegistry::global().contains(o.technique)) {
+    throw InputError("--technique '" + o.technique + "': expected " +
+                     render::TechniqueRegistry::global().choices());
+  }
+  req.technique = o.technique;
   req.skipBlock = o.skipBlock;
   req.lutSize = o.lut;
-  req.technique = o.technique;
   req.slices = o.slices;
   req.classify = o.classify;
-
   req.layout = o.layout;
-  const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
-  const TransferFunction tf = TransferFunction::fromPresetOrFile(o.tf);
-  // The profile first: it sets the host budget the reader must respect.
-  DeviceSession device = openDevice(o.profile);
-  const gpu::GlContext* context = device.context.get();
-  const auto tLoad = std::chrono::steady_clock::now();
+  return req;
+}
+
+// The volume, with the window the options ask for.
+lod::InCoreVolumeSource loadVolume(const RenderOptions& o, const std::string& spec) {
   Volume volume = readVolume(spec, {.dicomSeries = o.series});
-  const double loadMs = msSince(tLoad);
   if (!o.window.empty()) {
     if (o.window.size() != 2) throw InputError("--window takes two numbers MIN MAX");
     volume.setWindow({o.window[0], o.window[1]});
   }
+  return lod::InCoreVolumeSource(std::move(volume));
+}
 
-  // Checked even when nothing uses it, so that a typo is not silently ignored.
-  const render::OverlayOpacity overlayOpacity = render::parseOverlayOpacity(o.overlayOpacity);
-  if (!o.overlays.empty() || !o.offscreen.empty() || !o.roi.empty()) {
-    HybridRequest h;
-    h.overlays = render::OverlayOptions::parse(o.overlays);
-    if (!o.roi.empty()) h.overlays.setRoiVoxels(o.roi, volume);
-    h.hybrid.offscreen = render::OffscreenSize::parse(o.offscreen.empty() ? "full" : o.offscreen);
-    h.hybrid.opacity = overlayOpacity;
-    const HybridResult hr = runHybridRender(device, volume, tf, req, h);
-    hr.image.writePng(o.out);
-    if (hr.groundTruth && !o.referenceOut.empty()) hr.groundTruth->writePng(o.referenceOut);
-    printHybridResult(hr, req, h, device, spec, o.out, o.json);
-    return;
-  }
-  const RenderResult r = runRender(device, volume, tf, req);
-  r.first.writePng(o.out);
-  if (r.referenceImage && !o.referenceOut.empty()) r.referenceImage->writePng(o.referenceOut);
-  const double totalMs = msSince(tStart);
+// --overlays, --offscreen or --roi: the hybrid compositor's run.
+void runHybridCommand(const RenderOptions& o, DeviceSession& device,
+                      const lod::InCoreVolumeSource& source, const TransferFunction& tf,
+                      const RenderRequest& req, const std::string& spec,
+                      render::OverlayOpacity overlayOpacity) {
+  HybridRequest h;
+  h.overlays = render::OverlayOptions::parse(o.overlays);
+  if (!o.roi.empty()) h.overlays.setRoiVoxels(o.roi, source.volume());
+  h.hybrid.offscreen = render::OffscreenSize::parse(o.offscreen.empty() ? "full" : o.offscreen);
+  h.hybrid.opacity = overlayOpacity;
+  const HybridResult hr = runHybridRender(device, source, tf, req, h);
+  hr.image.writePng(o.out);
+  if (hr.groundTruth && !o.referenceOut.empty()) hr.groundTruth->writePng(o.referenceOut);
+  printHybridResult(hr, req, h, device, spec, o.out, o.json);
+}
 
-  if (o.json) {
-    nlohmann::json j;
-    j["file"] = spec;
-    j["out"] = o.out;
-    j["width"] = req.width;
-    j["height"] = req.height;
-    j["frames"] = r.frameMs.size();
-    j["ms_median"] = r.median();
-    j["ms_min"] = r.min();
-    j["ms_max"] = r.max();
-    j["frame_ms"] = r.frameMs;
-    j["psnr_db"] = numberOrNull(r.psnrDb);
-    j["ssim"] = numberOrNull(r.ssim);
-    if (r.referenceImage) j["reference_ms"] = r.referenceMs;
-    j["texture_bytes"] = r.textureBytes;
-    j["volume_texture_bytes"] = r.volumeTextureBytes;
-    j["gl_renderer"] = context->caps().renderer;
-    j["gl_version"] = context->caps().version;
-    j["egl_platform"] = context->platform();
-    j["layout"] = r.layout;
-    j["profile"] = device.profile.name;
-    j["api"] = gpu::apiLevelName(device.limits.api);
-    j["plan_reason"] = r.plan.reason;
-    j["downsample"] = {r.plan.downsample.x, r.plan.downsample.y, r.plan.downsample.z};
-    j["rendered_dims"] = {r.renderedDims.x, r.renderedDims.y, r.renderedDims.z};
-    j["texture_budget"] = device.limits.textureBudget;
-    j["load_ms"] = loadMs;
-    j["prepare_ms"] = r.prepareMs;
-    j["occupied_block_fraction"] = r.occupiedBlockFraction;
-    j["total_ms"] = totalMs;
-    j["mode"] = o.mode;
-    j["technique"] = o.technique;
-    j["step_voxels"] = o.step;
-    j["tf"] = tf.name;
-    std::printf("%s\n", j.dump(2).c_str());
-    return;
-  }
-  std::printf("wrote %s (%dx%d) in %.0f ms total\n", o.out.c_str(), req.width, req.height, totalMs);
+struct RenderTimes {
+  double loadMs = 0.0;
+  double totalMs = 0.0;
+};
+
+void printRenderJson(const RenderOptions& o, const RenderRequest& req, const RenderResult& r,
+                     const DeviceSession& device, const TransferFunction& tf,
+                     const std::string& spec, RenderTimes times) {
+  const gpu::GlContext& context = *device.context;
+  nlohmann::json j;
+  j["file"] = spec;
+  j["out"] = o.out;
+  j["width"] = req.width;
+  j["height"] = req.height;
+  j["frames"] = r.frameMs.size();
+  j["ms_median"] = r.median();
+  j["ms_min"] = r.min();
+  j["ms_max"] = r.max();
+  j["frame_ms"] = r.frameMs;
+  j["psnr_db"] = numberOrNull(r.psnrDb);
+  j["ssim"] = numberOrNull(r.ssim);
+  if (r.referenceImage) j["reference_ms"] = r.referenceMs;
+  j["texture_bytes"] = r.textureBytes;
+  j["volume_texture_bytes"] = r.volumeTextureBytes;
+  j["gl_renderer"] = context.caps().renderer;
+  j["gl_version"] = context.caps().version;
+  j["egl_platform"] = context.platform();
+  j["layout"] = r.layout;
+  j["profile"] = device.profile.name;
+  j["api"] = gpu::apiLevelName(device.limits.api);
+  j["plan_reason"] = r.plan.reason;
+  j["downsample"] = {r.plan.downsample.x, r.plan.downsample.y, r.plan.downsample.z};
+  j["rendered_dims"] = {r.renderedDims.x, r.renderedDims.y, r.renderedDims.z};
+  j["texture_budget"] = device.limits.textureBudget;
+  j["load_ms"] = times.loadMs;
+  j["prepare_ms"] = r.prepareMs;
+  j["occupied_block_fraction"] = r.occupiedBlockFraction;
+  j["total_ms"] = times.totalMs;
+  j["mode"] = o.mode;
+  j["technique"] = o.technique;
+  j["step_voxels"] = o.step;
+  j["tf"] = tf.name;
+  std::printf("%s\n", j.dump(2).c_str());
+}
+
+void printRenderText(const RenderOptions& o, const RenderRequest& req, const RenderResult& r,
+                     const DeviceSession& device, const Volume& volume, const std::string& spec,
+                     RenderTimes times) {
+  const gpu::GlContext& context = *device.context;
+  std::printf("wrote %s (%dx%d) in %.0f ms total\n", o.out.c_str(), req.width, req.height,
+              times.totalMs);
   std::printf("volume   %s: %dx%dx%d %s, loaded in %.0f ms\n", spec.c_str(), volume.dims().x,
               volume.dims().y, volume.dims().z, std::string(scalarTypeName(volume.type())).c_str(),
-              loadMs);
-  std::printf("gpu      %s (%s, EGL %s); %s context, GLSL ES %s\n",
-              context->caps().renderer.c_str(), context->caps().version.c_str(),
-              context->platform().c_str(),
+              times.loadMs);
+  std::printf("gpu      %s (%s, EGL %s); %s context, GLSL ES %s\n", context.caps().renderer.c_str(),
+              context.caps().version.c_str(), context.platform().c_str(),
               device.limits.api == gpu::ApiLevel::Gles2 ? "ES 2.0" : "ES 3.0",
               device.limits.api == gpu::ApiLevel::Gles2 ? "1.00" : "3.00");
   std::printf("profile  %s (%s)\n", device.profile.name.c_str(), device.profile.note.c_str());
@@ -195,6 +208,35 @@ void runRenderCommand(const RenderOptions& o) {
   if (r.psnrDb) {
     std::printf("reference %.0f ms on the CPU; PSNR %.2f dB, SSIM %.5f\n", r.referenceMs, *r.psnrDb,
                 *r.ssim);
+  }
+}
+
+void runRenderCommand(const RenderOptions& o) {
+  const auto tStart = std::chrono::steady_clock::now();
+  const RenderRequest req = requestFrom(o);
+  const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
+  const TransferFunction tf = TransferFunction::fromPresetOrFile(o.tf);
+  // The profile first: it sets the host budget the reader must respect.
+  DeviceSession device = openDevice(o.profile);
+  RenderTimes times;
+  const auto tLoad = std::chrono::steady_clock::now();
+  const lod::InCoreVolumeSource source = loadVolume(o, spec);
+  times.loadMs = msSince(tLoad);
+
+  // Checked even when nothing uses it, so that a typo is not silently ignored.
+  const render::OverlayOpacity overlayOpacity = render::parseOverlayOpacity(o.overlayOpacity);
+  if (!o.overlays.empty() || !o.offscreen.empty() || !o.roi.empty()) {
+    runHybridCommand(o, device, source, tf, req, spec, overlayOpacity);
+    return;
+  }
+  const RenderResult r = runRender(device, source, tf, req);
+  r.first.writePng(o.out);
+  if (r.referenceImage && !o.referenceOut.empty()) r.referenceImage->writePng(o.referenceOut);
+  times.totalMs = msSince(tStart);
+  if (o.json) {
+    printRenderJson(o, req, r, device, tf, spec, times);
+  } else {
+    printRenderText(o, req, r, device, source.volume(), spec, times);
   }
 }
 
@@ -249,8 +291,7 @@ void addRenderCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--lut", o->lut, "Transfer-function table entries (256 or 4096)")
       ->capture_default_str();
-  cmd->add_option("--technique", o->technique,
-                  "raycast, slice3d (view-aligned slicing) or slice2d (axis-aligned slice stacks)")
+  cmd->add_option("--technique", o->technique, render::TechniqueRegistry::global().describe())
       ->capture_default_str();
   cmd->add_option("--slices", o->slices,
                   "Slices: slice3d over the volume diagonal (0 = from --step), slice2d drawn "
@@ -262,9 +303,9 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--profile", o->profile,
                   "Device profile to obey (tessera profiles lists them) or FILE.json")
       ->capture_default_str();
-  cmd->add_option(
-         "--layout", o->layout,
-         "Volume storage: auto, texture3d, mosaic or packed-mosaic (auto: the planner chooses)")
+  cmd->add_option("--layout", o->layout,
+                  "Volume storage: " + layout::LayoutRegistry::global().choices() +
+                      " (auto: the planner chooses)")
       ->capture_default_str();
   cmd->add_flag("--json", o->json, "Print one JSON object instead of text");
   cmd->add_option("--overlays", o->overlays,

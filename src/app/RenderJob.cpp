@@ -3,29 +3,68 @@
 #include <algorithm>
 #include <chrono>
 
-#include <glm/vec3.hpp>
-
 #include "tessera/core/Error.h"
-#include "tessera/core/HostBudget.h"
-#include "tessera/lod/Downsample.h"
+#include "tessera/core/Timing.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
-#include "tessera/render/Raycaster.h"
+#include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::app {
 
 namespace {
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+
+// The frames, rotating from the requested view; the first is kept.
+void renderFrames(render::Technique& technique, const RenderRequest& req, RenderResult& result) {
+  for (int i = 0; i < req.repeat; ++i) {
+    Camera cam = req.camera;
+    cam.azimuthDeg += i * req.rotateDeg;
+    const auto t0 = std::chrono::steady_clock::now();
+    technique.render(cam, req.settings, req.width, req.height, 0.0);
+    result.frameMs.push_back(msSince(t0));
+    if (i == 0) result.first = technique.readImage();
+  }
 }
+
+// Where the volume lived and what the technique did, for the report.
+void describeStorage(const render::TechniqueOnVolume& t, RenderResult& result) {
+  const render::TechniqueReport report = t.technique->report();
+  result.plan = t.upload.plan;
+  result.renderedDims = t.upload.volume->dims();
+  result.layout = t.storageName();
+  result.layoutReason = t.upload.layout ? t.upload.plan.reason : report.storageReason;
+  result.volumeTextureBytes =
+      t.upload.layout ? t.upload.layout->textureBytes() : report.storageBytes;
+  result.planNote = t.requirements.note;
+  if (!report.note.empty()) result.planNote += (result.planNote.empty() ? "" : "; ") + report.note;
+  result.occupiedBlockFraction = report.occupiedBlockFraction;
+}
+
+// Frame 0 against the CPU reference of the volume the GPU rendered.
+void compareWithReference(const Volume& volume, const TransferFunction& tf,
+                          const RenderRequest& req, RenderResult& result) {
+  const auto t0 = std::chrono::steady_clock::now();
+  ReferenceStats stats;
+  result.referenceImage =
+      renderReference(volume, tf, req.camera, req.settings, req.width, req.height, 0, &stats);
+  result.referenceSamples = stats.samples;
+  result.referenceRays = stats.raysHittingVolume;
+  result.referenceMs = msSince(t0);
+  result.psnrDb = psnr(result.first, *result.referenceImage);
+  result.ssim = ssim(result.first, *result.referenceImage);
+}
+
 }  // namespace
 
+render::TechniqueOptions RenderRequest::techniqueOptions() const {
+  return {.imageSize = {width, height},
+          .skipBlock = skipBlock,
+          .lutSize = lutSize,
+          .slices = slices,
+          .classify = classify};
+}
+
 double RenderResult::median() const {
-  if (frameMs.empty()) return 0.0;
-  std::vector<double> v = frameMs;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  return tessera::median(frameMs);
 }
 double RenderResult::min() const {
   return frameMs.empty() ? 0.0 : *std::min_element(frameMs.begin(), frameMs.end());
@@ -51,57 +90,23 @@ void parseSize(const std::string& text, int& width, int& height) {
   }
 }
 
-RenderResult runRender(DeviceSession& device, const Volume& fullVolume, const TransferFunction& tf,
-                       RenderRequest req) {
+RenderResult runRender(DeviceSession& device, const lod::VolumeSource& source,
+                       const TransferFunction& tf, RenderRequest req) {
   if (req.repeat < 1) throw InputError("--repeat must be >= 1");
-  if (req.technique != "raycast") return runSliceRender(device, fullVolume, tf, req);
-  gpu::GlContext& context = *device.context;
+  if (req.slices < 0) throw InputError("--slices must be >= 1 (0 = automatic)");
+  render::TechniqueOnVolume t = render::createTechnique(
+      req.technique, *device.context, device.limits, source, req.techniqueOptions(), req.layout);
+  const Volume& volume = *t.upload.volume;
   RenderResult result;
-  const render::RaycastPlan rp = render::planRaycast(device.limits, fullVolume, req.layout,
-                                                     req.width, req.height, req.skipBlock);
-  result.plan = rp.plan;
-  result.planNote = rp.note;
-  req.skipBlock = rp.skipBlock;
-  Volume reduced;
-  if (result.plan.downsampled()) reduced = lod::downsample(fullVolume, result.plan.downsample);
-  const Volume& volume = result.plan.downsampled() ? reduced : fullVolume;
-  result.renderedDims = volume.dims();
-  auto layout = layout::createLayout(result.plan, volume, device.limits, context.ledger());
-  result.layout = layout->name();
-  result.layoutReason = result.plan.reason;
-  result.volumeTextureBytes = layout->textureBytes();
-
-  render::Raycaster caster(context, volume, *layout);
-  caster.setSkipBlockSize(req.skipBlock);
-  caster.setLutSize(req.lutSize);
-  caster.setTransferFunction(tf);
+  t.technique->setTransferFunction(tf);
   req.camera.frame(volume);
   const auto tPrepare = std::chrono::steady_clock::now();
-  caster.prepare(req.settings);
+  t.technique->prepare(req.camera, req.settings);
   result.prepareMs = msSince(tPrepare);
-  result.occupiedBlockFraction = caster.occupiedBlockFraction();
-
-  for (int i = 0; i < req.repeat; ++i) {
-    Camera cam = req.camera;
-    cam.azimuthDeg += i * req.rotateDeg;
-    const auto t0 = std::chrono::steady_clock::now();
-    caster.renderFrame(cam, req.settings, req.width, req.height);
-    result.frameMs.push_back(msSince(t0));
-    if (i == 0) result.first = caster.readImage();
-  }
-  result.textureBytes = context.ledger().totalBytes();
-
-  if (req.reference) {
-    const auto t0 = std::chrono::steady_clock::now();
-    ReferenceStats stats;
-    result.referenceImage =
-        renderReference(volume, tf, req.camera, req.settings, req.width, req.height, 0, &stats);
-    result.referenceSamples = stats.samples;
-    result.referenceRays = stats.raysHittingVolume;
-    result.referenceMs = msSince(t0);
-    result.psnrDb = psnr(result.first, *result.referenceImage);
-    result.ssim = ssim(result.first, *result.referenceImage);
-  }
+  renderFrames(*t.technique, req, result);
+  result.textureBytes = device.context->ledger().totalBytes();  // while the technique holds its own
+  describeStorage(t, result);
+  if (req.reference) compareWithReference(volume, tf, req, result);
   return result;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
-// One render run shared by `tessera render` and `tessera bench`: load, plan,
-// upload, render N frames (rotating), optionally compare with the reference.
+// One render run shared by `tessera render` and `tessera bench`: upload the
+// volume for the technique (render::createTechnique), render N frames
+// (rotating), optionally compare with the reference.
 #include <optional>
 #include <string>
 #include <vector>
@@ -9,18 +10,15 @@
 #include "tessera/core/Image.h"
 #include "tessera/core/RenderSettings.h"
 #include "tessera/core/TransferFunction.h"
-#include "tessera/core/Volume.h"
-#include "tessera/gpu/DeviceProfile.h"
-#include "tessera/gpu/GlContext.h"
+#include "tessera/gpu/DeviceSession.h"
 #include "tessera/layout/Planner.h"
-#include "tessera/render/DeviceSession.h"
-#include "tessera/render/RaycastPlan.h"
-#include "tessera/render/Slice2DRenderer.h"
+#include "tessera/lod/VolumeSource.h"
+#include "tessera/render/Technique.h"
 
 namespace tessera::app {
 
-using render::DeviceSession;
-using render::openDevice;
+using gpu::DeviceSession;
+using gpu::openDevice;
 
 struct RenderRequest {
   std::string layout = "auto";
@@ -31,13 +29,14 @@ struct RenderRequest {
   int repeat = 1;
   double rotateDeg = 0.0;
   bool reference = false;
+  // A technique of render::TechniqueRegistry and its options.
+  std::string technique = "raycast";
   int skipBlock = 8;
   int lutSize = 4096;
-  // Texture slicing (issue 4; app/SliceRenderJob.cpp): "raycast", "slice3d"
-  // or "slice2d"; slices 0 = from the step (slice3d) or every slice (slice2d).
-  std::string technique = "raycast";
-  int slices = 0;
+  int slices = 0;                 // 0 = from the step (slice3d) or every slice (slice2d)
   std::string classify = "post";  // slice2d: pre, palette or post
+
+  render::TechniqueOptions techniqueOptions() const;
 };
 
 struct RenderResult {
@@ -64,16 +63,8 @@ struct RenderResult {
   double max() const;
 };
 
-RenderResult runRender(DeviceSession& device, const Volume& volume, const TransferFunction& tf,
-                       RenderRequest request);
-// Axis-aligned slicing's options from a request and the device: the
-// classification asked for, atlases within the device's texture size. Refuses
-// --layout, which does not apply (slice2d stores its own slice stacks).
-render::Slice2DOptions slice2dOptions(const RenderRequest& req, const gpu::DeviceLimits& limits);
-
-// runRender for technique slice3d / slice2d.
-RenderResult runSliceRender(DeviceSession& device, const Volume& volume, const TransferFunction& tf,
-                            RenderRequest request);
+RenderResult runRender(DeviceSession& device, const lod::VolumeSource& source,
+                       const TransferFunction& tf, RenderRequest request);
 
 // Parses "512x512".
 void parseSize(const std::string& text, int& width, int& height);

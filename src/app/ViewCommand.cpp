@@ -26,6 +26,7 @@
 #include "tessera/gpu/GlContext.h"
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/io/VolumeReader.h"
+#include "tessera/render/TechniqueRegistry.h"
 #include "tessera/viewer/Viewer.h"
 #endif
 
@@ -355,7 +356,7 @@ void runView(const ViewOptions& o) {
       v->settings().mode = mode ? RenderMode::Mip : RenderMode::Composite;
     }
     if (ImGui::BeginCombo("technique", v->technique().c_str())) {
-      for (const std::string& t : viewer::techniqueNames()) {
+      for (const std::string& t : render::TechniqueRegistry::global().names()) {
         if (ImGui::Selectable(t.c_str(), t == v->technique())) {
           try {
             v->setTechnique(t);

@@ -10,14 +10,12 @@
 
 #include "gpu/gl.h"
 #include "tessera/core/Error.h"
+#include "tessera/core/Timing.h"
+#include "tessera/render/CameraRay.h"
 
 namespace tessera::render {
 
 namespace {
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 const char* methodDefine(OverlayOpacity m) {
   switch (m) {
@@ -144,7 +142,7 @@ void ensureTarget(gpu::GlContext& context, gpu::Framebuffer& fb, const char* lab
 
 }  // namespace
 
-void HybridCompositor::render(HybridTechnique& technique, const Camera& camera,
+void HybridCompositor::render(Technique& technique, const Camera& camera,
                               const RenderSettings& settings, glm::dvec3 volumeExtent, int width,
                               int height, const HybridOptions& options) {
   if (width <= 0 || height <= 0) throw InputError("hybrid: image size must be positive");
@@ -159,7 +157,7 @@ void HybridCompositor::render(HybridTechnique& technique, const Camera& camera,
   const gpu::Texture* volume = nullptr;
   if (options.opacity == OverlayOpacity::TwoPass) {
     s.background = glm::dvec4(1.0, 1.0, 1.0, 1.0);
-    const gpu::Texture& overWhite = technique.renderVolume(camera, s, low.x, low.y, aspect);
+    const gpu::Texture& overWhite = technique.render(camera, s, low.x, low.y, aspect);
     // The technique reuses its target, so keep the first render.
     const glm::ivec2 whiteSize(overWhite.width(), overWhite.height());
     ensureTarget(context_, white_, "hybrid over-white copy", whiteSize.x, whiteSize.y);
@@ -173,15 +171,15 @@ void HybridCompositor::render(HybridTechnique& technique, const Camera& camera,
     glDisable(GL_DEPTH_TEST);
     triangle_.draw();
     s.background = glm::dvec4(0.0, 0.0, 0.0, 1.0);
-    volume = &technique.renderVolume(camera, s, low.x, low.y, aspect);
+    volume = &technique.render(camera, s, low.x, low.y, aspect);
     timings_.volumePasses = 2;
   } else {
     // Transparent black: RGB is the colour over black, A the accumulated opacity.
     s.background = glm::dvec4(0.0);
-    volume = &technique.renderVolume(camera, s, low.x, low.y, aspect);
+    volume = &technique.render(camera, s, low.x, low.y, aspect);
     timings_.volumePasses = 1;
   }
-  // A technique may render another shape than asked (HybridSlice3DTechnique):
+  // A technique may render another shape than asked (the slicers):
   // the layer follows its texture, and is stretched to the screen anyway.
   const glm::ivec2 rendered(volume->width(), volume->height());
   timings_.rendered = rendered;
@@ -214,18 +212,8 @@ void HybridCompositor::render(HybridTechnique& technique, const Camera& camera,
   ensureTarget(context_, image_, "hybrid image", width, height);
   image_.bind();
   composite_.use();
-  const glm::dmat3 b = camera.basis();
   const double tanHalfFov = std::tan(0.5 * camera.fovYDeg * glm::pi<double>() / 180.0);
-  composite_.set("u_eye", glm::vec3(camera.eye()));
-  composite_.set("u_right", glm::vec3(b[0]));
-  composite_.set("u_up", glm::vec3(b[1]));
-  composite_.set("u_forward", glm::vec3(-b[2]));
-  composite_.set("u_tanHalfFov", static_cast<float>(tanHalfFov));
-  composite_.set("u_orthoHalfHeight", static_cast<float>(camera.orthoHalfHeight()));
-  composite_.set("u_aspect", static_cast<float>(aspect));
-  composite_.set("u_ortho", camera.projection == Projection::Orthographic ? 1 : 0);
-  composite_.set("u_viewport", glm::vec2(width, height));
-  composite_.set("u_extent", glm::vec3(volumeExtent));
+  setCameraRayUniforms(composite_, camera, aspect, width, height, volumeExtent);
   composite_.set("u_background", glm::vec4(settings.background));
   resolved_.color().bind(0);
   composite_.set("u_volume", 0);

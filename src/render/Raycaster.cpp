@@ -310,4 +310,70 @@ Image Raycaster::readImage() const {
   return img;
 }
 
+// ---- The Technique interface and the registry's entry.
+
+void Raycaster::prepare(const Camera&, const RenderSettings& settings) {
+  prepare(settings);
+}
+
+const gpu::Texture& Raycaster::render(const Camera& camera, const RenderSettings& settings,
+                                      int width, int height, double viewAspect) {
+  // This frame's rays cover the screen's aspect; the next one's its own again.
+  struct RestoreAspect {
+    double& aspect;
+    double saved;
+    ~RestoreAspect() { aspect = saved; }
+  } restore{viewAspect_, viewAspect_};
+  viewAspect_ = viewAspect;
+  renderFrame(camera, settings, width, height);
+  return colorTexture();
+}
+
+TechniqueReport Raycaster::report() const {
+  TechniqueReport r;
+  r.occupiedBlockFraction = occupiedFraction_;
+  return r;
+}
+
+int Raycaster::skipBlockFor(const gpu::DeviceLimits& limits, int requested) {
+  return requested > 0 && limits.textureUnits < kOwnTextureUnits + 1 ? 0 : requested;
+}
+
+TechniqueRequirements Raycaster::requirements(const gpu::DeviceLimits& limits,
+                                              glm::ivec3 volumeDims,
+                                              const TechniqueOptions& options) {
+  TechniqueRequirements r;
+  const int skipBlock = skipBlockFor(limits, options.skipBlock);
+  if (skipBlock != options.skipBlock) {
+    r.note = "empty-space skipping off: " + limits.profile + " has " +
+             std::to_string(limits.textureUnits) + " texture units";
+  }
+  r.textureUnits = skipBlock > 0 ? kOwnTextureUnits : 1;
+  const std::uint64_t target = static_cast<std::uint64_t>(options.imageSize.x) *
+                               static_cast<std::uint64_t>(options.imageSize.y) * 4;
+  const std::uint64_t lut = 4096 * 8;
+  std::uint64_t blocks = 0;
+  if (skipBlock > 0) {
+    const glm::u64vec3 c =
+        (glm::u64vec3(volumeDims) + glm::u64vec3(skipBlock - 1)) / glm::u64vec3(skipBlock);
+    // At most RGBA8 per block (ES 2), plus the slack of the grid mosaic's last row.
+    blocks = c.x * c.y * c.z * 4 + c.x * c.y * 4 * 64;
+  }
+  r.bytes = target + lut + blocks + 4096;  // + vertex buffers
+  return r;
+}
+
+TechniqueEntry Raycaster::registration() {
+  return {.name = "raycast",
+          .summary = "single-pass ray casting",
+          .requirements = &Raycaster::requirements,
+          .create = [](const TechniqueSetup& s) -> std::unique_ptr<Technique> {
+            if (!s.layout) throw Error("raycast samples a layout, and none was made");
+            auto caster = std::make_unique<Raycaster>(s.context, s.volume, *s.layout);
+            caster->setSkipBlockSize(skipBlockFor(s.limits, s.options.skipBlock));
+            caster->setLutSize(s.options.lutSize);
+            return caster;
+          }};
+}
+
 }  // namespace tessera::render

@@ -9,15 +9,12 @@
 
 #include "gpu/gl.h"
 #include "tessera/core/Error.h"
+#include "tessera/core/Timing.h"
 #include "tessera/render/SliceProjection.h"
 
 namespace tessera::render {
 
 namespace {
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 constexpr int kFloatsPerVertex = 7;  // position xyz, in-slice uv, tile origin xy
 
@@ -342,6 +339,53 @@ void Slice2DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
   if (tileAttribute >= 0) glDisableVertexAttribArray(static_cast<GLuint>(tileAttribute));
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, 0);
   accumulator_.resolve(settings, &table_.texture(), table_.entries());
+}
+
+// ---- The Technique interface and the registry's entry.
+
+const gpu::Texture& Slice2DRenderer::render(const Camera& camera, const RenderSettings& settings,
+                                            int width, int height, double viewAspect) {
+  const glm::ivec2 size = sliceTargetSize(width, height, viewAspect);
+  renderFrame(camera, settings, size.x, size.y);
+  return colorTexture();
+}
+
+TechniqueReport Slice2DRenderer::report() const {
+  TechniqueReport r;
+  r.storage = "slice-stacks";
+  r.storageReason = "three axis-aligned stacks";
+  if (lastAxis_ >= 0) {
+    r.storageReason += "; drawn: " + std::string(1, "xyz"[lastAxis_]) + " stack, " +
+                       plans_[lastAxis_].describe() + ", " +
+                       sliceClassificationName(options_.classification) + "-classified";
+  }
+  r.storageBytes = stackTextureBytes();
+  r.note = "slice2d: " + std::to_string(lastSlicesDrawn_) + " slices drawn, accumulation " +
+           accumulationFormat();
+  return r;
+}
+
+TechniqueRequirements Slice2DRenderer::requirements(const gpu::DeviceLimits&, glm::ivec3,
+                                                    const TechniqueOptions&) {
+  TechniqueRequirements r;
+  r.textureUnits = 2;  // an atlas and the TF table or palette
+  r.ownStorage = "it stores its own slice stacks";
+  return r;
+}
+
+TechniqueEntry Slice2DRenderer::registration() {
+  return {.name = "slice2d",
+          .summary = "axis-aligned slice stacks",
+          .requirements = &Slice2DRenderer::requirements,
+          .create = [](const TechniqueSetup& s) -> std::unique_ptr<Technique> {
+            Slice2DOptions options;
+            options.classification = parseSliceClassification(s.options.classify);
+            options.currentStackOnly = s.options.currentStackOnly;
+            options.maxTextureSize = s.limits.max2DTextureSize;
+            auto slicer = std::make_unique<Slice2DRenderer>(s.context, s.volume, options);
+            slicer->setSliceCount(s.options.slices);
+            return slicer;
+          }};
 }
 
 }  // namespace tessera::render

@@ -169,4 +169,48 @@ void Slice3DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
   accumulator_.resolve(settings, &lut_.texture(), lut_.entries());
 }
 
+// ---- The Technique interface and the registry's entry.
+
+void Slice3DRenderer::prepare(const Camera&, const RenderSettings& settings) {
+  prepare(settings);
+}
+
+const gpu::Texture& Slice3DRenderer::render(const Camera& camera, const RenderSettings& settings,
+                                            int width, int height, double viewAspect) {
+  const glm::ivec2 size = sliceTargetSize(width, height, viewAspect);
+  renderFrame(camera, settings, size.x, size.y);
+  return colorTexture();
+}
+
+TechniqueReport Slice3DRenderer::report() const {
+  TechniqueReport r;
+  r.note = "slice3d: " + std::to_string(builtSlices_) + " view-aligned slices, accumulation " +
+           accumulationFormat() + ", no early termination";
+  return r;
+}
+
+TechniqueRequirements Slice3DRenderer::requirements(const gpu::DeviceLimits&, glm::ivec3,
+                                                    const TechniqueOptions& options) {
+  TechniqueRequirements r;
+  r.textureUnits = kOwnTextureUnits;
+  // The frame's target and the TF table, reserved as for the ray caster
+  // without its grid, and the proxy geometry.
+  r.bytes = static_cast<std::uint64_t>(options.imageSize.x) *
+                static_cast<std::uint64_t>(options.imageSize.y) * 4 +
+            4096 * 8 + 4096;
+  return r;
+}
+
+TechniqueEntry Slice3DRenderer::registration() {
+  return {.name = "slice3d",
+          .summary = "view-aligned slicing",
+          .requirements = &Slice3DRenderer::requirements,
+          .create = [](const TechniqueSetup& s) -> std::unique_ptr<Technique> {
+            if (!s.layout) throw Error("slice3d samples a layout, and none was made");
+            auto slicer = std::make_unique<Slice3DRenderer>(s.context, s.volume, *s.layout);
+            slicer->setSliceCount(s.options.slices);
+            return slicer;
+          }};
+}
+
 }  // namespace tessera::render

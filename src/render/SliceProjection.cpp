@@ -1,5 +1,8 @@
 #include "tessera/render/SliceProjection.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/mat3x3.hpp>
@@ -21,6 +24,16 @@ glm::dmat4 sliceViewToClip(const Camera& camera, double aspect, double farPlane)
   }
   const double h = camera.orthoHalfHeight();
   return glm::ortho(-h * aspect, h * aspect, -h, h, 0.0, farPlane);
+}
+
+glm::ivec2 sliceTargetSize(int width, int height, double viewAspect) {
+  if (viewAspect <= 0.0 ||
+      std::abs(static_cast<double>(width) / height - viewAspect) <= 1e-3 * viewAspect) {
+    return {width, height};
+  }
+  const double pixels = static_cast<double>(width) * height;
+  return {std::max(1, static_cast<int>(std::lround(std::sqrt(pixels * viewAspect)))),
+          std::max(1, static_cast<int>(std::lround(std::sqrt(pixels / viewAspect))))};
 }
 
 }  // namespace tessera::render

@@ -12,11 +12,11 @@
 #include "tessera/core/Error.h"
 #include "tessera/core/Histogram.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/core/Timing.h"
+#include "tessera/gpu/DeviceSession.h"
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/gpu/Program.h"
-#include "tessera/lod/Downsample.h"
-#include "tessera/render/RaycastPlan.h"
-#include "tessera/render/Raycaster.h"
+#include "tessera/lod/InCoreVolumeSource.h"
 
 namespace tessera::viewer {
 
@@ -26,10 +26,6 @@ constexpr int kHistogramBins = 256;
 // Render-target size the plan reserves memory for (the largest frame we expect).
 constexpr int kPlanImageSize = 1024;
 constexpr int kSkipBlock = 8;
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // The raster equivalent of Camera's rays (render/camera_ray.glsl), so that
 // overlay lines land where the ray caster puts the volume.
@@ -70,10 +66,9 @@ struct Viewer::Gpu {
 
 Viewer::Viewer(gpu::GlContext& context, const gpu::DeviceProfile& profile)
     : context_(context),
-      limits_(gpu::effectiveLimits(profile, context.caps())),
-      volume_(std::make_unique<Volume>()),
+      limits_(gpu::applyProfile(profile, context)),
+      volume_(std::make_shared<Volume>()),
       gpu_(std::make_unique<Gpu>()) {
-  context_.ledger().setBudget(limits_.textureBudget);
   const gpu::ApiLevel api = context.caps().api;
   gpu_->present = gpu::Program::build(
       "viewer present",
@@ -88,41 +83,33 @@ Viewer::Viewer(gpu::GlContext& context, const gpu::DeviceProfile& profile)
 
 Viewer::~Viewer() {
   // GL objects go while the context is still current (the front end's job).
-  technique_.reset();
-  layout_.reset();
+  active_ = {};
   gpu_.reset();
+}
+
+render::TechniqueOnVolume Viewer::createActive(const std::string& technique,
+                                               const lod::VolumeSource& source) const {
+  render::TechniqueOnVolume t = render::createTechnique(
+      technique, context_, limits_, source,
+      {.imageSize = {kPlanImageSize, kPlanImageSize}, .skipBlock = kSkipBlock});
+  t.technique->setTransferFunction(tfEditor_.transferFunction());
+  return t;
 }
 
 void Viewer::setVolume(Volume volume, const std::string& name) {
   if (!volume.hasData()) throw InputError(name + ": the volume has no voxels");
-  auto loaded = std::make_unique<Volume>(std::move(volume));
-  const render::RaycastPlan rp =
-      render::planRaycast(limits_, *loaded, "auto", kPlanImageSize, kPlanImageSize, kSkipBlock);
-  std::unique_ptr<Volume> reduced;
-  if (rp.plan.downsampled()) {
-    reduced = std::make_unique<Volume>(lod::downsample(*loaded, rp.plan.downsample));
-  }
-  const Volume& rendered = reduced ? *reduced : *loaded;
-  // Release the old volume's textures first when both would not fit the budget.
-  std::unique_ptr<layout::Layout> layout;
+  const lod::InCoreVolumeSource source(std::make_shared<Volume>(std::move(volume)));
+  render::TechniqueOnVolume next;
   try {
-    layout = layout::createLayout(rp.plan, rendered, limits_, context_.ledger());
-  } catch (const BudgetError&) {
-    if (!technique_) throw;
+    next = createActive(techniqueName_, source);
+  } catch (const BudgetError& e) {
+    if (!hasVolume()) throw;
     throw BudgetError(name + ": does not fit the GPU budget next to the current volume (" +
-                      formatBytes(context_.ledger().budget()) + "); " + rp.plan.reason);
+                      formatBytes(context_.ledger().budget()) + "): " + e.what());
   }
-  std::unique_ptr<ViewerTechnique> technique =
-      createTechnique(techniqueName_, context_, rendered, *layout);
-  technique->setTransferFunction(tfEditor_.transferFunction());
-
-  // Everything worked: swap in (technique first: it refers to the others).
-  technique_.reset();
-  layout_ = std::move(layout);
-  technique_ = std::move(technique);
-  volume_ = std::move(loaded);
-  downsampled_ = std::move(reduced);
-  plan_ = rp.plan;
+  // Everything worked: swap in.
+  active_ = std::move(next);
+  volume_ = source.level(glm::ivec3(1));
   volumeName_ = name;
   uploadedTfRevision_ = tfEditor_.revision();
   updateHistogram();
@@ -145,14 +132,14 @@ void Viewer::setWindow(ValueRange w) {
     throw InputError("window must have finite min < max");
   }
   volume_->setWindow(w);
-  if (downsampled_) downsampled_->setWindow(w);
+  if (active_.upload.volume != volume_) active_.upload.volume->setWindow(w);
   updateHistogram();
 }
 
 void Viewer::resetWindow() {
   if (!volume_->hasData()) return;
   volume_->resetWindow();
-  if (downsampled_) downsampled_->resetWindow();
+  if (active_.upload.volume != volume_) active_.upload.volume->resetWindow();
   updateHistogram();
 }
 
@@ -162,32 +149,123 @@ void Viewer::updateHistogram() {
 
 void Viewer::setTechnique(const std::string& name) {
   if (name == techniqueName_) return;
-  if (technique_) {
-    const Volume& rendered = downsampled_ ? *downsampled_ : *volume_;
-    std::unique_ptr<ViewerTechnique> t = createTechnique(name, context_, rendered, *layout_);
-    t->setTransferFunction(tfEditor_.transferFunction());
-    technique_ = std::move(t);
-  } else {
-    const std::vector<std::string> names = techniqueNames();
-    if (std::find(names.begin(), names.end(), name) == names.end()) {
-      throw InputError("unknown technique '" + name + "'");
+  render::TechniqueRegistry::global().find(name);  // InputError listing the names
+  if (hasVolume()) {
+    const lod::InCoreVolumeSource source(volume_);
+    try {
+      active_ = createActive(name, source);
+    } catch (const BudgetError&) {
+      // Both uploads do not fit the budget: the current one goes first, and
+      // comes back if the new one does not fit alone either.
+      active_ = {};
+      try {
+        active_ = createActive(name, source);
+      } catch (const Error&) {
+        active_ = createActive(techniqueName_, source);
+        throw;
+      }
     }
+    uploadedTfRevision_ = tfEditor_.revision();
   }
   techniqueName_ = name;
 }
 
+std::string Viewer::storageName() const {
+  return hasVolume() ? active_.storageName() : "";
+}
+
 std::string Viewer::description() const {
-  if (!technique_) return "no volume";
+  if (!hasVolume()) return "no volume";
   std::ostringstream s;
   const glm::ivec3 d = volume_->dims();
+  const layout::Plan& p = plan();
   s << volumeName_ << " " << d.x << "x" << d.y << "x" << d.z << " "
-    << scalarTypeName(volume_->type()) << "; " << plan_.layout.layout << " on "
+    << scalarTypeName(volume_->type()) << "; " << storageName() << " on "
     << gpu::apiLevelName(limits_.api);
-  if (plan_.downsampled()) {
-    const glm::ivec3 r = plan_.volumeDims;
+  if (p.downsampled()) {
+    const glm::ivec3 r = p.volumeDims;
     s << " (downsampled to " << r.x << "x" << r.y << "x" << r.z << ")";
   }
   return s.str();
+}
+
+// The volume through the technique at the quality level's size and step.
+const gpu::Texture& Viewer::renderVolume(int width, int height, FrameStats& stats,
+                                         render::QualityLevel& level) {
+  if (uploadedTfRevision_ != tfEditor_.revision()) {
+    active_.technique->setTransferFunction(tfEditor_.transferFunction());
+    uploadedTfRevision_ = tfEditor_.revision();
+  }
+  RenderSettings settings = settings_;
+  if (quality == Quality::Adaptive) {
+    qualityController_.setInteracting(controller_.interacting());
+    level = qualityController_.next();
+  }
+  const int rw = std::max(1, static_cast<int>(std::lround(width * level.resolutionScale)));
+  const int rh = std::max(1, static_cast<int>(std::lround(height * level.resolutionScale)));
+  settings.stepVoxels *= level.stepScale;
+  stats.renderWidth = rw;
+  stats.renderHeight = rh;
+  return active_.technique->render(camera_, settings, rw, rh, 0.0);
+}
+
+void Viewer::drawOverlayLines(int width, int height) {
+  const glm::dvec3 e = 0.5 * volume_->extent();
+  if (gpu_->lineExtent != e) {
+    // Box edges grey, then the x/y/z axes in red/green/blue from the
+    // box's minimum corner (the voxel (0,0,0) corner).
+    std::vector<float> v;
+    auto add = [&v](glm::dvec3 p, glm::vec4 c) {
+      v.insert(v.end(), {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z),
+                         c.r, c.g, c.b, c.a});
+    };
+    const glm::vec4 grey(0.8f, 0.8f, 0.8f, 0.7f);
+    for (int axis = 0; axis < 3; ++axis) {
+      for (int i = 0; i < 4; ++i) {
+        glm::dvec3 a(0.0);
+        const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+        a[u] = (i & 1) ? e[u] : -e[u];
+        a[w] = (i & 2) ? e[w] : -e[w];
+        glm::dvec3 b = a;
+        a[axis] = -e[axis];
+        b[axis] = e[axis];
+        add(a, grey);
+        add(b, grey);
+      }
+    }
+    const glm::vec4 axisColors[3] = {
+        {1.0f, 0.25f, 0.25f, 1.0f}, {0.3f, 1.0f, 0.3f, 1.0f}, {0.35f, 0.55f, 1.0f, 1.0f}};
+    for (int axis = 0; axis < 3; ++axis) {
+      glm::dvec3 b = -e;
+      b[axis] += 0.35 * 2.0 * e[axis];
+      add(-e, axisColors[axis]);
+      add(b, axisColors[axis]);
+    }
+    gpu_->lineVertices = gpu::Buffer::create(context_.ledger(), "overlay lines", GL_ARRAY_BUFFER,
+                                             v.size() * sizeof(float), v.data(), GL_STATIC_DRAW);
+    gpu_->lineVertexCount = static_cast<int>(v.size() / 7);
+    gpu_->lineExtent = e;
+  }
+  const gpu::Program& p = gpu_->lines;
+  p.use();
+  p.set("u_viewProjection", viewProjection(camera_, static_cast<double>(width) / height));
+  const GLint color = glGetAttribLocation(p.id(), "a_color");
+  glBindBuffer(GL_ARRAY_BUFFER, gpu_->lineVertices.id());
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 7 * sizeof(float), nullptr);
+  if (color >= 0) {
+    glEnableVertexAttribArray(static_cast<GLuint>(color));
+    glVertexAttribPointer(static_cast<GLuint>(color), 4, GL_FLOAT, GL_FALSE, 7 * sizeof(float),
+                          reinterpret_cast<const void*>(3 * sizeof(float)));
+  }
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  const int first = showBoundingBox ? 0 : 24;
+  const int count = (showBoundingBox ? 24 : 0) + (showAxes ? 6 : 0);
+  glDrawArrays(GL_LINES, first, count);
+  glDisable(GL_BLEND);
+  glDisableVertexAttribArray(0);
+  if (color >= 0) glDisableVertexAttribArray(static_cast<GLuint>(color));
 }
 
 FrameStats Viewer::render(int width, int height, unsigned framebuffer, glm::ivec2 origin) {
@@ -197,7 +275,7 @@ FrameStats Viewer::render(int width, int height, unsigned framebuffer, glm::ivec
   drainGlErrors();
   glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
   glViewport(origin.x, origin.y, width, height);
-  if (!technique_) {
+  if (!hasVolume()) {
     glEnable(GL_SCISSOR_TEST);
     glScissor(origin.x, origin.y, width, height);
     glClearColor(static_cast<float>(settings_.background.r),
@@ -208,91 +286,18 @@ FrameStats Viewer::render(int width, int height, unsigned framebuffer, glm::ivec
     last_ = stats;
     return stats;
   }
-  if (uploadedTfRevision_ != tfEditor_.revision()) {
-    technique_->setTransferFunction(tfEditor_.transferFunction());
-    uploadedTfRevision_ = tfEditor_.revision();
-  }
-  RenderSettings settings = settings_;
   render::QualityLevel level;  // full quality
-  if (quality == Quality::Adaptive) {
-    qualityController_.setInteracting(controller_.interacting());
-    level = qualityController_.next();
-  }
-  const int rw = std::max(1, static_cast<int>(std::lround(width * level.resolutionScale)));
-  const int rh = std::max(1, static_cast<int>(std::lround(height * level.resolutionScale)));
-  settings.stepVoxels *= level.stepScale;
-  const unsigned image = technique_->render(camera_, settings, rw, rh);
-  stats.renderWidth = rw;
-  stats.renderHeight = rh;
+  const gpu::Texture& image = renderVolume(width, height, stats, level);
 
   glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
   glViewport(origin.x, origin.y, width, height);
   glDisable(GL_BLEND);
   glDisable(GL_DEPTH_TEST);
   gpu_->present.use();
-  glActiveTexture(GL_TEXTURE0);
-  glBindTexture(GL_TEXTURE_2D, image);
+  image.bind(0);
   gpu_->present.set("u_image", 0);
   gpu_->triangle.draw();
-
-  if (showBoundingBox || showAxes) {
-    const glm::dvec3 e = 0.5 * volume_->extent();
-    if (gpu_->lineExtent != e) {
-      // Box edges grey, then the x/y/z axes in red/green/blue from the
-      // box's minimum corner (the voxel (0,0,0) corner).
-      std::vector<float> v;
-      auto add = [&v](glm::dvec3 p, glm::vec4 c) {
-        v.insert(v.end(), {static_cast<float>(p.x), static_cast<float>(p.y),
-                           static_cast<float>(p.z), c.r, c.g, c.b, c.a});
-      };
-      const glm::vec4 grey(0.8f, 0.8f, 0.8f, 0.7f);
-      for (int axis = 0; axis < 3; ++axis) {
-        for (int i = 0; i < 4; ++i) {
-          glm::dvec3 a(0.0);
-          const int u = (axis + 1) % 3, w = (axis + 2) % 3;
-          a[u] = (i & 1) ? e[u] : -e[u];
-          a[w] = (i & 2) ? e[w] : -e[w];
-          glm::dvec3 b = a;
-          a[axis] = -e[axis];
-          b[axis] = e[axis];
-          add(a, grey);
-          add(b, grey);
-        }
-      }
-      const glm::vec4 axisColors[3] = {
-          {1.0f, 0.25f, 0.25f, 1.0f}, {0.3f, 1.0f, 0.3f, 1.0f}, {0.35f, 0.55f, 1.0f, 1.0f}};
-      for (int axis = 0; axis < 3; ++axis) {
-        glm::dvec3 b = -e;
-        b[axis] += 0.35 * 2.0 * e[axis];
-        add(-e, axisColors[axis]);
-        add(b, axisColors[axis]);
-      }
-      gpu_->lineVertices = gpu::Buffer::create(context_.ledger(), "overlay lines", GL_ARRAY_BUFFER,
-                                               v.size() * sizeof(float), v.data(), GL_STATIC_DRAW);
-      gpu_->lineVertexCount = static_cast<int>(v.size() / 7);
-      gpu_->lineExtent = e;
-    }
-    const gpu::Program& p = gpu_->lines;
-    p.use();
-    p.set("u_viewProjection", viewProjection(camera_, static_cast<double>(width) / height));
-    const GLint color = glGetAttribLocation(p.id(), "a_color");
-    glBindBuffer(GL_ARRAY_BUFFER, gpu_->lineVertices.id());
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 7 * sizeof(float), nullptr);
-    if (color >= 0) {
-      glEnableVertexAttribArray(static_cast<GLuint>(color));
-      glVertexAttribPointer(static_cast<GLuint>(color), 4, GL_FLOAT, GL_FALSE, 7 * sizeof(float),
-                            reinterpret_cast<const void*>(3 * sizeof(float)));
-    }
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-    const int first = showBoundingBox ? 0 : 24;
-    const int count = (showBoundingBox ? 24 : 0) + (showAxes ? 6 : 0);
-    glDrawArrays(GL_LINES, first, count);
-    glDisable(GL_BLEND);
-    glDisableVertexAttribArray(0);
-    if (color >= 0) glDisableVertexAttribArray(static_cast<GLuint>(color));
-  }
+  if (showBoundingBox || showAxes) drawOverlayLines(width, height);
 
   // glFinish does not wait in browsers: a read-back of one pixel does.
   std::uint8_t pixel[4];

@@ -14,11 +14,10 @@
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceOverlay.h"
 #include "tessera/render/HybridCompositor.h"
-#include "tessera/render/HybridRaycastTechnique.h"
-#include "tessera/render/HybridSliceTechnique.h"
 #include "tessera/render/Raycaster.h"
 #include "tessera/render/Slice2DRenderer.h"
 #include "tessera/render/Slice3DRenderer.h"
+#include "tessera/render/SliceProjection.h"
 
 using namespace tessera;
 using render::HybridOptions;
@@ -49,7 +48,6 @@ struct Scene {
   RenderSettings settings;
   std::unique_ptr<layout::Layout> layout;
   std::unique_ptr<render::Raycaster> caster;
-  std::unique_ptr<render::HybridRaycastTechnique> technique;
   std::unique_ptr<render::HybridCompositor> compositor;
 
   explicit Scene(gpu::GlContext& c) {
@@ -59,11 +57,10 @@ struct Scene {
     layout = layout::Texture3DLayout::create(volume, gpu::DeviceLimits::of(c.caps()), c.ledger());
     caster = std::make_unique<render::Raycaster>(c, volume, *layout);
     caster->setTransferFunction(tf);
-    technique = std::make_unique<render::HybridRaycastTechnique>(*caster);
     compositor = std::make_unique<render::HybridCompositor>(c);
   }
   Image hybrid(int w, int h, OffscreenSize size, OverlayOpacity method) {
-    compositor->render(*technique, camera, settings, volume.extent(), w, h, {size, method});
+    compositor->render(*caster, camera, settings, volume.extent(), w, h, {size, method});
     return compositor->readImage();
   }
 };
@@ -214,14 +211,13 @@ TEST(Hybrid, RunsInAnEs2Context) {
   auto layout = layout::MosaicLayout::create(v, gpu::DeviceLimits::of(c->caps()), c->ledger());
   render::Raycaster caster(*c, v, *layout);
   caster.setTransferFunction(colouredTf());
-  render::HybridRaycastTechnique technique(caster);
   render::HybridCompositor compositor(*c);
   compositor.setOverlayLines(render::overlayLines(v, render::OverlayOptions::parse("box,axes")));
   Camera cam;
   cam.frame(v.extent());
   cam.azimuthDeg = 40;
   RenderSettings s;
-  compositor.render(technique, cam, s, v.extent(), 96, 96,
+  compositor.render(caster, cam, s, v.extent(), 96, 96,
                     {OffscreenSize::ofSize(48, 48), OverlayOpacity::TwoPass});
   const Image img = compositor.readImage();
   const Image truth =
@@ -241,10 +237,9 @@ namespace {
 template <class Slicer>
 void expectSlicerPlugsIntoTheCompositor(const char* name, Scene& scene, Slicer& slicer) {
   slicer.setTransferFunction(scene.tf);
-  render::HybridSliceTechnique<Slicer> technique(name, slicer);
   const int w = 256, h = 192;
   const Image full = slicer.render(scene.camera, scene.settings, w, h);
-  scene.compositor->render(technique, scene.camera, scene.settings, scene.volume.extent(), w, h,
+  scene.compositor->render(slicer, scene.camera, scene.settings, scene.volume.extent(), w, h,
                            {OffscreenSize::ofSize(128, 128), OverlayOpacity::Alpha});
   EXPECT_EQ(scene.compositor->timings().rendered, glm::ivec2(148, 111));
   const double p = psnr(scene.compositor->readImage(), full);

@@ -7,17 +7,17 @@
 
 #include "support/GpuTestContext.h"
 #include "support/TestSupport.h"
+#include "tessera/gpu/DeviceSession.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/io/VolumeReader.h"
 #include "tessera/layout/MosaicLayout.h"
 #include "tessera/layout/PackedMosaicLayout.h"
 #include "tessera/layout/Texture3DLayout.h"
-#include "tessera/lod/Downsample.h"
+#include "tessera/lod/InCoreVolumeSource.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
-#include "tessera/render/DeviceSession.h"
-#include "tessera/render/RaycastPlan.h"
 #include "tessera/render/Raycaster.h"
+#include "tessera/render/TechniqueRegistry.h"
 
 using namespace tessera;
 
@@ -131,26 +131,31 @@ namespace {
 // planned on `profile` without downsampling as packed-mosaic in `textures`
 // RGBA textures of `side`^2, uploaded (the ledger proving the bytes, within
 // the profile's budget) and rendered like the reference.
-void expectPaperCapacity(const char* profile, const Volume& v, int textures, int side) {
+void expectPaperCapacity(const char* profile, Volume volume, int textures, int side) {
   const test::BudgetOverride keep(HostBudget::global().limitBytes());
-  render::DeviceSession device = render::openDevice(profile);
-  const render::RaycastPlan rp = render::planRaycast(device.limits, v, "auto", 96, 96, 8);
-  ASSERT_EQ(rp.plan.layout.layout, "packed-mosaic");
-  ASSERT_FALSE(rp.plan.downsampled());
-  auto layout = layout::createLayout(rp.plan, v, device.limits, device.context->ledger());
-  EXPECT_EQ(layout->textureUnits(), textures);
-  EXPECT_EQ(layout->textureBytes(), static_cast<std::uint64_t>(textures) * side * side * 4);
-  Camera cam;
-  cam.azimuthDeg = 20;
-  cam.frame(v.extent());
-  RenderSettings s;
-  s.stepVoxels = 2.0;  // keep the test quick; the comparison is what matters
-  const Image img = renderWith(*device.context, v, *layout, visibleTf(), cam, s, 96, rp.skipBlock);
-  const Image ref = renderReference(v, visibleTf(), cam, s, 96, 96);
-  EXPECT_GE(psnr(img, ref), 40.0);
-  EXPECT_GE(device.context->ledger().peakBytes(), layout->textureBytes());
-  EXPECT_LE(device.context->ledger().peakBytes(), device.limits.textureBudget);
-  layout.reset();
+  gpu::DeviceSession device = gpu::openDevice(profile);
+  {
+    render::TechniqueOnVolume t = render::createTechnique(
+        "raycast", *device.context, device.limits, lod::InCoreVolumeSource(std::move(volume)),
+        {.imageSize = {96, 96}});
+    const Volume& v = *t.upload.volume;
+    ASSERT_EQ(t.upload.plan.layout.layout, "packed-mosaic");
+    ASSERT_FALSE(t.upload.plan.downsampled());
+    const layout::Layout& layout = *t.upload.layout;
+    EXPECT_EQ(layout.textureUnits(), textures);
+    EXPECT_EQ(layout.textureBytes(), static_cast<std::uint64_t>(textures) * side * side * 4);
+    Camera cam;
+    cam.azimuthDeg = 20;
+    cam.frame(v.extent());
+    RenderSettings s;
+    s.stepVoxels = 2.0;  // keep the test quick; the comparison is what matters
+    t.technique->setTransferFunction(visibleTf());
+    const Image img = t.technique->renderImage(cam, s, 96, 96);
+    const Image ref = renderReference(v, visibleTf(), cam, s, 96, 96);
+    EXPECT_GE(psnr(img, ref), 40.0);
+    EXPECT_GE(device.context->ledger().peakBytes(), layout.textureBytes());
+    EXPECT_LE(device.context->ledger().peakBytes(), device.limits.textureBudget);
+  }
   device.context.reset();
   test::gpuContext();
 }
@@ -173,22 +178,21 @@ TEST(LayoutRender, EveryBuiltinProfileRendersCh2WithinItsBudget) {
   if (!std::filesystem::exists(kCh2)) GTEST_SKIP() << "mricron-data not installed";
   for (const gpu::DeviceProfile& profile : gpu::DeviceProfile::builtins()) {
     const test::BudgetOverride keep(HostBudget::global().limitBytes());
-    render::DeviceSession device = render::openDevice(profile.name);
-    const Volume full = readVolume(kCh2);
-    const render::RaycastPlan rp = render::planRaycast(device.limits, full, "auto", 96, 96, 8);
-    Volume reduced;
-    if (rp.plan.downsampled()) reduced = lod::downsample(full, rp.plan.downsample);
-    const Volume& v = rp.plan.downsampled() ? reduced : full;
-    if (rp.plan.downsampled()) {
-      EXPECT_NE(rp.plan.reason.find("downsampled"), std::string::npos) << rp.plan.reason;
+    gpu::DeviceSession device = gpu::openDevice(profile.name);
+    render::TechniqueOnVolume t =
+        render::createTechnique("raycast", *device.context, device.limits,
+                                lod::InCoreVolumeSource(readVolume(kCh2)), {.imageSize = {96, 96}});
+    const layout::Plan& plan = t.upload.plan;
+    const Volume& v = *t.upload.volume;
+    if (plan.downsampled()) {
+      EXPECT_NE(plan.reason.find("downsampled"), std::string::npos) << plan.reason;
     }
-    auto layout = layout::createLayout(rp.plan, v, device.limits, device.context->ledger());
     Camera cam;
     cam.azimuthDeg = 30;
     cam.frame(v.extent());
     RenderSettings s;
-    const Image img = renderWith(*device.context, v, *layout,
-                                 TransferFunction::preset("mr-default"), cam, s, 96, rp.skipBlock);
+    t.technique->setTransferFunction(TransferFunction::preset("mr-default"));
+    const Image img = t.technique->renderImage(cam, s, 96, 96);
     const Image ref = renderReference(v, TransferFunction::preset("mr-default"), cam, s, 96, 96);
     const double db = psnr(img, ref);
     EXPECT_GE(db, 40.0) << profile.name;
@@ -196,9 +200,9 @@ TEST(LayoutRender, EveryBuiltinProfileRendersCh2WithinItsBudget) {
       EXPECT_LE(device.context->ledger().peakBytes(), device.limits.textureBudget) << profile.name;
     }
     std::printf("  [measured] %-20s %-13s %s, %.2f dB, GPU peak %llu bytes\n", profile.name.c_str(),
-                rp.plan.layout.layout.c_str(), rp.plan.downsampled() ? "downsampled" : "full res",
-                db, static_cast<unsigned long long>(device.context->ledger().peakBytes()));
-    layout.reset();
+                plan.layout.layout.c_str(), plan.downsampled() ? "downsampled" : "full res", db,
+                static_cast<unsigned long long>(device.context->ledger().peakBytes()));
+    t = {};  // the technique and the volume's textures, while their context lives
     device.context.reset();
   }
   test::gpuContext();

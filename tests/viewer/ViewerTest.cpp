@@ -1,12 +1,16 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include "gpu/gl.h"
 #include "support/GpuTestContext.h"
+#include "support/TestSupport.h"
 #include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
+#include "tessera/gpu/DeviceSession.h"
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/layout/Planner.h"
@@ -14,6 +18,7 @@
 #include "tessera/render/Raycaster.h"
 #include "tessera/render/Slice2DRenderer.h"
 #include "tessera/render/Slice3DRenderer.h"
+#include "tessera/render/TechniqueRegistry.h"
 #include "tessera/viewer/Viewer.h"
 
 namespace tessera::viewer {
@@ -63,7 +68,7 @@ TEST_F(ViewerFixture, SlicingTechniquesShowWhatTheSlicersRender) {
   v.setVolume(makeSheppLogan({40, 40, 40}), "phantom");
   v.showBoundingBox = v.showAxes = false;
   v.camera().azimuthDeg = 20.0;
-  const std::vector<std::string> names = techniqueNames();
+  const std::vector<std::string> names = render::TechniqueRegistry::global().names();
   for (const char* name : {"slice3d", "slice2d"}) {
     SCOPED_TRACE(name);
     ASSERT_NE(std::find(names.begin(), names.end(), name), names.end());
@@ -122,6 +127,43 @@ TEST_F(ViewerFixture, FailedLoadKeepsThePreviousVolume) {
   EXPECT_EQ(v.technique(), "raycast");
   v.render(kSize, kSize, fb.id());
   EXPECT_GT(v.lastFrame().ms, 0.0);
+}
+
+// `tessera view --profile` obeys the profile as `tessera render --profile`
+// does: the same effective limits, GPU budget and host budget, so a volume
+// the render command would refuse to hold is refused by the viewer too.
+TEST_F(ViewerFixture, AppliesTheProfilesHostBudgetLikeTheRenderCommand) {
+  const test::TempDir dir;
+  const std::string file = (dir / "small-host.json").string();
+  std::ofstream(file)
+      << R"({"name": "small-host", "api": "gles3", "texture_budget_mb": 64, "host_budget_mb": 48})";
+  const test::BudgetOverride keep(HostBudget::global().limitBytes());
+  ASSERT_GT(HostBudget::global().limitBytes(), 48ull << 20);  // else the test proves nothing
+
+  gpu::DeviceLimits renderLimits;
+  std::uint64_t renderHostBudget = 0;
+  {
+    const test::BudgetOverride inner(HostBudget::global().limitBytes());
+    const gpu::DeviceSession device = gpu::openDevice(file);  // what `tessera render` opens
+    renderLimits = device.limits;
+    renderHostBudget = HostBudget::global().limitBytes();
+  }
+  ctx.makeCurrent();
+  ASSERT_EQ(renderHostBudget, 48ull << 20);
+
+  struct KeepLedgerBudget {
+    gpu::MemoryLedger& ledger;
+    std::uint64_t saved;
+    ~KeepLedgerBudget() { ledger.setBudget(saved); }
+  } keepLedger{ctx.ledger(), ctx.ledger().budget()};
+  Viewer v(ctx, gpu::DeviceProfile::find(file));
+  EXPECT_EQ(HostBudget::global().limitBytes(), renderHostBudget);
+  EXPECT_EQ(v.limits().hostBudget, renderLimits.hostBudget);
+  EXPECT_EQ(v.limits().textureBudget, renderLimits.textureBudget);
+  EXPECT_EQ(ctx.ledger().budget(), 64ull << 20);
+  EXPECT_THROW(Volume::allocate({512, 512, 256}, ScalarType::U8, "too big"), BudgetError);
+  v.setVolume(makeSheppLogan({32, 32, 32}), "phantom");  // what fits still loads
+  EXPECT_EQ(v.volume().dims(), glm::ivec3(32));
 }
 
 // The adaptive quality is the issue-5 controller: measured frame times drive

@@ -18,6 +18,7 @@
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/io/Procedural.h"
+#include "tessera/render/TechniqueRegistry.h"
 #include "tessera/viewer/InMemoryVolumeReader.h"
 #include "tessera/viewer/Viewer.h"
 
@@ -243,14 +244,14 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_state_json(int logHistogram) {
     j["gl_version"] = caps.version;
     j["has_volume"] = v.hasVolume();
     j["description"] = v.description();
-    j["techniques"] = viewer::techniqueNames();
+    j["techniques"] = render::TechniqueRegistry::global().names();
     j["technique"] = v.technique();
     if (v.hasVolume()) {
       const glm::ivec3 d = v.volume().dims();
       j["name"] = v.volumeName();
       j["dims"] = {d.x, d.y, d.z};
       j["type"] = std::string(scalarTypeName(v.volume().type()));
-      j["layout"] = v.plan().layout.layout;
+      j["layout"] = v.storageName();
       j["plan_reason"] = v.plan().reason;
       j["range"] = {v.valueRange().min, v.valueRange().max};
       j["window"] = {v.window().min, v.window().max};

@@ -28,9 +28,9 @@
 #include "tessera/gpu/GlContext.h"
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/gpu/Program.h"
-#include "tessera/render/HybridTechnique.h"
 #include "tessera/render/Overlay.h"
 #include "tessera/render/OverlayRenderer.h"
+#include "tessera/render/Technique.h"
 
 namespace tessera::render {
 
@@ -80,7 +80,7 @@ class HybridCompositor {
   // Renders a width x height frame of the volume (whose world box is
   // `volumeExtent`, centred at the origin) through `technique`, with the
   // overlay lines, composited over settings.background; waits for it.
-  void render(HybridTechnique& technique, const Camera& camera, const RenderSettings& settings,
+  void render(Technique& technique, const Camera& camera, const RenderSettings& settings,
               glm::dvec3 volumeExtent, int width, int height, const HybridOptions& options);
   Image readImage() const;  // the last frame, top row first
   // The last frame's upscaled volume layer: RGB = volume colour over black,

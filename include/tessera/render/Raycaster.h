@@ -3,6 +3,7 @@
 // Works on any Layout (it only calls sampleVolume()), with composite and MIP
 // modes, early ray termination, jitter and empty-space skipping over a block
 // min/max grid. Besides the layout's units it uses two: the TF and the grid.
+// The "raycast" technique of the registry (render/TechniqueRegistry.h).
 #include <glm/vec2.hpp>
 #include <map>
 #include <memory>
@@ -18,17 +19,19 @@
 #include "tessera/gpu/Program.h"
 #include "tessera/layout/Layout.h"
 #include "tessera/render/BlockMinMax.h"
+#include "tessera/render/Technique.h"
+#include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::render {
 
-class Raycaster {
+class Raycaster final : public Technique {
  public:
   // `volume` and `layout` must outlive the ray caster (the volume supplies
   // the value window and the block min/max grid).
   Raycaster(gpu::GlContext& context, const Volume& volume, const layout::Layout& layout);
-  ~Raycaster();
+  ~Raycaster() override;
 
-  void setTransferFunction(const TransferFunction& tf);
+  void setTransferFunction(const TransferFunction& tf) override;
   // Block size of the empty-space grid in voxels; 0 disables skipping.
   void setSkipBlockSize(int voxels);
   // TF lookup-table entries (256 or 4096).
@@ -41,7 +44,7 @@ class Raycaster {
   // Renders into the internal framebuffer and waits for it (glFinish).
   void renderFrame(const Camera& camera, const RenderSettings& settings, int width, int height);
   // Reads the last frame (top row first).
-  Image readImage() const;
+  Image readImage() const override;
   // The last frame's colour texture (row 0 at the bottom), valid until the
   // next renderFrame(): what a compositor samples without a read-back.
   const gpu::Texture& colorTexture() const { return target_.color(); }
@@ -66,7 +69,24 @@ class Raycaster {
   std::vector<gpu::ShaderPart> fragmentParts(const RenderSettings& settings) const;
 
   // GPU memory of this ray caster's own resources (TF, block grid, target).
-  std::uint64_t ownTextureBytes() const;
+  std::uint64_t ownTextureBytes() const override;
+
+  // The Technique interface.
+  std::string name() const override { return "raycast"; }
+  void prepare(const Camera& camera, const RenderSettings& settings) override;
+  const gpu::Texture& render(const Camera& camera, const RenderSettings& settings, int width,
+                             int height, double viewAspect) override;
+  TechniqueReport report() const override;
+
+  // The registry's entry: a TF table and the empty-space grid (two units, or
+  // one with skipping off where the device has fewer than three), the
+  // render target and the grid's bytes.
+  static TechniqueEntry registration();
+  static TechniqueRequirements requirements(const gpu::DeviceLimits& limits, glm::ivec3 volumeDims,
+                                            const TechniqueOptions& options);
+  // The block size a device allows for the one asked: 0 when it has too few
+  // texture units for the grid (one must stay for the volume).
+  static int skipBlockFor(const gpu::DeviceLimits& limits, int requested);
 
  private:
   const gpu::Program& programFor(const RenderSettings& settings);

@@ -17,6 +17,9 @@
 //    (the ray caster's semantics); a TF change uploads the table only.
 // Indices are the value window quantised to 8 bits (exact for u8 volumes).
 //
+// The "slice2d" technique of the registry (render/TechniqueRegistry.h); it
+// keeps its own slice stacks, so no layout is planned for it.
+//
 // Opacity: tables are baked for ds0 = the smallest voxel spacing; a
 // fragment stands for the distance its ray travels between drawn planes,
 // (stack spacing * stride) / |cos(angle to the stack axis)|, and corrects
@@ -39,6 +42,8 @@
 #include "tessera/render/SliceAccumulator.h"
 #include "tessera/render/SliceStacks.h"
 #include "tessera/render/SliceTransferTable.h"
+#include "tessera/render/Technique.h"
+#include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::render {
 
@@ -55,13 +60,13 @@ struct Slice2DOptions {
   int maxTextureSize = 0;  // 0: the context's limit
 };
 
-class Slice2DRenderer {
+class Slice2DRenderer final : public Technique {
  public:
   // `volume` must outlive the renderer.
   Slice2DRenderer(gpu::GlContext& context, const Volume& volume, const Slice2DOptions& options);
-  ~Slice2DRenderer();
+  ~Slice2DRenderer() override;
 
-  void setTransferFunction(const TransferFunction& tf);
+  void setTransferFunction(const TransferFunction& tf) override;
   // Slices drawn per frame: 0 (the default) draws every slice of the stack;
   // fewer picks evenly spaced ones (the opacity corrected for the gap).
   void setSliceCount(int slices);
@@ -69,9 +74,9 @@ class Slice2DRenderer {
   // The stack for a view: the axis along which the view direction is largest.
   static int stackAxisFor(const Camera& camera);
 
-  void prepare(const Camera& camera, const RenderSettings& settings);
+  void prepare(const Camera& camera, const RenderSettings& settings) override;
   void renderFrame(const Camera& camera, const RenderSettings& settings, int width, int height);
-  Image readImage() const { return accumulator_.readImage(); }
+  Image readImage() const override { return accumulator_.readImage(); }
   const gpu::Texture& colorTexture() const { return accumulator_.colorTexture(); }
   Image render(const Camera& camera, const RenderSettings& settings, int width, int height) {
     renderFrame(camera, settings, width, height);
@@ -92,12 +97,24 @@ class Slice2DRenderer {
   double lastStackUploadMs() const { return lastStackUploadMs_; }
   std::uint64_t classificationUpdates() const { return classificationUpdates_; }
   std::uint64_t stackTextureBytes() const;
-  std::uint64_t ownTextureBytes() const;
+  std::uint64_t ownTextureBytes() const override;
   const Slice2DOptions& options() const { return options_; }
   std::string accumulationFormat() const { return accumulator_.accumulationFormat(); }
 
   std::vector<gpu::ShaderPart> vertexParts() const;
   std::vector<gpu::ShaderPart> fragmentParts(const RenderSettings& settings) const;
+
+  // The Technique interface. The target keeps the screen's shape (see
+  // sliceTargetSize): the projection always fills it.
+  std::string name() const override { return "slice2d"; }
+  const gpu::Texture& render(const Camera& camera, const RenderSettings& settings, int width,
+                             int height, double viewAspect) override;
+  TechniqueReport report() const override;
+
+  // The registry's entry: its own stacks (no layout), the atlas and TF units.
+  static TechniqueEntry registration();
+  static TechniqueRequirements requirements(const gpu::DeviceLimits& limits, glm::ivec3 volumeDims,
+                                            const TechniqueOptions& options);
 
  private:
   struct DrawRange {

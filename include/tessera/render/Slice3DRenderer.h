@@ -12,6 +12,7 @@
 // perspective ray crosses consecutive planes ds / cos(theta) apart, so each
 // fragment corrects its opacity once more by that ratio (DESIGN.md,
 // Rendering semantics). No early termination (blending has no way to stop).
+// The "slice3d" technique of the registry (render/TechniqueRegistry.h).
 #include <cstdint>
 #include <map>
 #include <string>
@@ -28,15 +29,17 @@
 #include "tessera/layout/Layout.h"
 #include "tessera/render/SliceAccumulator.h"
 #include "tessera/render/SliceTransferTable.h"
+#include "tessera/render/Technique.h"
+#include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::render {
 
-class Slice3DRenderer {
+class Slice3DRenderer final : public Technique {
  public:
   // `volume` and `layout` must outlive the renderer.
   Slice3DRenderer(gpu::GlContext& context, const Volume& volume, const layout::Layout& layout);
 
-  void setTransferFunction(const TransferFunction& tf);
+  void setTransferFunction(const TransferFunction& tf) override;
   // Number of slices over the cube's side; 0 (the default) derives it from
   // RenderSettings::stepVoxels: N = ceil(diagonal / ds).
   void setSliceCount(int slices);
@@ -47,7 +50,7 @@ class Slice3DRenderer {
 
   void prepare(const RenderSettings& settings);
   void renderFrame(const Camera& camera, const RenderSettings& settings, int width, int height);
-  Image readImage() const { return accumulator_.readImage(); }
+  Image readImage() const override { return accumulator_.readImage(); }
   const gpu::Texture& colorTexture() const { return accumulator_.colorTexture(); }
   Image render(const Camera& camera, const RenderSettings& settings, int width, int height) {
     renderFrame(camera, settings, width, height);
@@ -63,10 +66,24 @@ class Slice3DRenderer {
   std::vector<gpu::ShaderPart> vertexParts() const;
   std::vector<gpu::ShaderPart> fragmentParts(const RenderSettings& settings) const;
   std::string accumulationFormat() const { return accumulator_.accumulationFormat(); }
-  std::uint64_t ownTextureBytes() const;
+  std::uint64_t ownTextureBytes() const override;
 
   static constexpr int kMaxSlices = 8192;
   static constexpr int kOwnTextureUnits = 1;  // the TF table
+
+  // The Technique interface. The target keeps the screen's shape (see
+  // sliceTargetSize): the projection always fills it.
+  std::string name() const override { return "slice3d"; }
+  void prepare(const Camera& camera, const RenderSettings& settings) override;
+  const gpu::Texture& render(const Camera& camera, const RenderSettings& settings, int width,
+                             int height, double viewAspect) override;
+  TechniqueReport report() const override;
+
+  // The registry's entry: one unit for the TF table; the bytes of a frame
+  // target and the table.
+  static TechniqueEntry registration();
+  static TechniqueRequirements requirements(const gpu::DeviceLimits& limits, glm::ivec3 volumeDims,
+                                            const TechniqueOptions& options);
 
  private:
   const gpu::Program& programFor(const RenderSettings& settings);

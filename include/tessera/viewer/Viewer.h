@@ -17,9 +17,9 @@
 #include "tessera/gpu/GlContext.h"
 #include "tessera/layout/Planner.h"
 #include "tessera/render/QualityController.h"
+#include "tessera/render/TechniqueRegistry.h"
 #include "tessera/viewer/CameraController.h"
 #include "tessera/viewer/TransferFunctionEditor.h"
-#include "tessera/viewer/ViewerTechnique.h"
 
 namespace tessera::viewer {
 
@@ -37,21 +37,27 @@ struct FrameStats {
 
 class Viewer {
  public:
-  // `context` must be current and outlive the viewer; `profile` limits what
-  // the viewer uses (effectiveLimits(profile, caps)).
+  // `context` must be current and outlive the viewer. The profile is applied
+  // as `tessera render --profile` applies it (gpu::applyProfile): the
+  // effective limits, the GPU ledger's budget and the process's host budget.
   Viewer(gpu::GlContext& context, const gpu::DeviceProfile& profile);
   ~Viewer();
   Viewer(const Viewer&) = delete;
   Viewer& operator=(const Viewer&) = delete;
 
-  // Plans, uploads and frames a new volume. On any error (InputError,
-  // BudgetError, GpuError) the previous volume stays and the error
-  // propagates with its message. Keeps the TF; resets window and camera.
+  // Uploads the volume for the technique (render::createTechnique) and
+  // frames it. On any error (InputError, BudgetError, GpuError) the previous
+  // volume stays and the error propagates with its message. Keeps the TF;
+  // resets window and camera.
   void setVolume(Volume volume, const std::string& name);
-  bool hasVolume() const { return technique_ != nullptr; }
+  bool hasVolume() const { return active_.technique != nullptr; }
   const Volume& volume() const { return *volume_; }  // empty before the first setVolume
   const std::string& volumeName() const { return volumeName_; }
-  const layout::Plan& plan() const { return plan_; }
+  // How the technique's upload stored the volume (empty for a technique with
+  // its own storage: see storageName()).
+  const layout::Plan& plan() const { return active_.upload.plan; }
+  // The layout, or the technique's own storage ("slice-stacks").
+  std::string storageName() const;
   const gpu::DeviceLimits& limits() const { return limits_; }
   gpu::GlContext& context() { return context_; }
 
@@ -71,7 +77,9 @@ class Viewer {
   ValueRange window() const { return volume_->window(); }
   ValueRange valueRange() const { return volume_->valueRange(); }
 
-  void setTechnique(const std::string& name);  // InputError if unknown; keeps the old one
+  // A technique of render::TechniqueRegistry; the volume is uploaded again
+  // for its requirements. InputError if unknown; on any error the old stays.
+  void setTechnique(const std::string& name);
   const std::string& technique() const { return techniqueName_; }
   Quality quality = Quality::Adaptive;
   // The adaptive quality's feedback loop (goal: qualityController().options()).
@@ -95,6 +103,11 @@ class Viewer {
  private:
   struct Gpu;  // present and overlay programs
   void updateHistogram();
+  render::TechniqueOnVolume createActive(const std::string& technique,
+                                         const lod::VolumeSource& source) const;
+  const gpu::Texture& renderVolume(int width, int height, FrameStats& stats,
+                                   render::QualityLevel& level);
+  void drawOverlayLines(int width, int height);
 
   gpu::GlContext& context_;
   gpu::DeviceLimits limits_;
@@ -107,14 +120,11 @@ class Viewer {
   FrameStats last_;
   render::QualityController qualityController_{{.goalMs = 66.0}};  // 15 frames/s
 
-  // Held by pointer: the layout and technique keep references to them, which
-  // must survive swapping in a new volume.
-  std::unique_ptr<Volume> volume_;       // as loaded
-  std::unique_ptr<Volume> downsampled_;  // when the plan asks for it (else null)
+  // Shared: the upload holds the volume it rendered (this one, or its
+  // reduction), and the technique refers to it.
+  std::shared_ptr<Volume> volume_;  // as loaded
   std::string volumeName_;
-  layout::Plan plan_;
-  std::unique_ptr<layout::Layout> layout_;
-  std::unique_ptr<ViewerTechnique> technique_;
+  render::TechniqueOnVolume active_;  // the volume on the GPU and the technique on it
   std::unique_ptr<Gpu> gpu_;
 };
 
