@@ -175,21 +175,27 @@ void transferFunctionEditor(viewer::TransferFunctionEditor& ed, bool logHistogra
   if (areaReleased || stripReleased) ed.pointerUp(u);
 }
 
-void runView(const ViewOptions& o) {
-  int width = 0, height = 0;
-  parseSize(o.size, width, height);
-  const gpu::DeviceProfile profile = gpu::DeviceProfile::find(o.profile);
-  const bool es3 = profile.api == gpu::ApiLevel::Gles3;
+// Everything a desktop session holds between frames.
+struct DesktopSession {
+  DesktopSession(const ViewOptions& o, bool gles3) : options(o), es3(gles3) {}
+  const ViewOptions& options;
+  bool es3;
+  GLFWwindow* window = nullptr;
+  std::unique_ptr<gpu::GlContext> context;
+  std::unique_ptr<viewer::Viewer> viewer;
+  DesktopState input;
+  std::string error;
+  std::string status;
+  gpu::Framebuffer cache;  // ES 3: the last volume frame, blitted while nothing changes
+  std::string cacheKey;
+  char pathBuf[512] = "";
+  char tfPathBuf[512] = "transfer-function.json";
+  bool logHistogram = true;
+  int frame = 0;
+};
 
-  glfwSetErrorCallback([](int code, const char* what) {
-    std::fprintf(stderr, "tessera view: GLFW error %d: %s\n", code, what);
-  });
-  if (!glfwInit()) {
-    throw GpuError("GLFW cannot start: no display? (set DISPLAY, or run under xvfb-run -a)");
-  }
-  struct GlfwGuard {
-    ~GlfwGuard() { glfwTerminate(); }
-  } glfwGuard;
+// A window with an OpenGL ES context of the profile's level, made current.
+GLFWwindow* openWindow(int width, int height, bool es3) {
   glfwWindowHint(GLFW_CLIENT_API, GLFW_OPENGL_ES_API);
   glfwWindowHint(GLFW_CONTEXT_CREATION_API, GLFW_EGL_CONTEXT_API);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, es3 ? 3 : 2);
@@ -201,255 +207,300 @@ void runView(const ViewOptions& o) {
   }
   glfwMakeContextCurrent(window);
   glfwSwapInterval(1);
+  return window;
+}
 
-  auto context = gpu::GlContext::adoptCurrent(profile.api, "glfw-egl");
-  auto v = std::make_unique<viewer::Viewer>(*context, profile);
-  DesktopState ds;
-  ds.viewer = v.get();
-  glfwSetWindowUserPointer(window, &ds);
-  glfwSetDropCallback(window, [](GLFWwindow* w, int count, const char** paths) {
+// Loads a volume; an error is shown in the panel and the previous volume stays.
+void openVolume(DesktopSession& ds, const std::string& spec) {
+  try {
+    ds.viewer->setVolume(readVolume(spec, {.dicomSeries = ds.options.series}), fileName(spec));
+    ds.error.clear();
+  } catch (const Error& e) {
+    ds.error = std::string(e.what()) + " (the previous volume stays)";
+  }
+}
+
+// The 3D view: mouse drags orbit (right button or shift: pan), wheel zooms.
+void handleViewInput(viewer::Viewer& v, double scale) {
+  ImGuiIO& io = ImGui::GetIO();
+  const glm::dvec2 pos((io.MousePos.x - kPanelWidth) * scale, io.MousePos.y * scale);
+  if (!io.WantCaptureMouse) {
+    for (int b = 0; b < 2; ++b) {
+      if (ImGui::IsMouseClicked(b) && pos.x >= 0.0) {
+        v.controller().pointerDown(
+            b, pos,
+            b == 1 || io.KeyShift ? viewer::PointerAction::Pan : viewer::PointerAction::Orbit);
+      }
+    }
+    if (io.MouseWheel != 0.0f) v.controller().wheel(-io.MouseWheel);
+  }
+  for (int b = 0; b < 2; ++b) {
+    v.controller().pointerMove(b, pos);
+    if (ImGui::IsMouseReleased(b)) v.controller().pointerUp(b);
+  }
+}
+
+void panelFile(DesktopSession& ds) {
+  ImGui::TextWrapped("%s", ds.viewer->description().c_str());
+  ImGui::InputText("##path", ds.pathBuf, sizeof ds.pathBuf);
+  ImGui::SameLine();
+  if (ImGui::Button("Open") && ds.pathBuf[0]) openVolume(ds, ds.pathBuf);
+  ImGui::TextDisabled("or drop a file on the window");
+  if (!ds.error.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1.0f));
+    ImGui::TextWrapped("%s", ds.error.c_str());
+    ImGui::PopStyleColor();
+  }
+}
+
+void panelTransferFunction(DesktopSession& ds) {
+  section("Transfer function");
+  viewer::TransferFunctionEditor& ed = ds.viewer->tfEditor();
+  transferFunctionEditor(ed, ds.logHistogram);
+  if (ImGui::BeginCombo("preset", ed.transferFunction().name.c_str())) {
+    for (const std::string& name : TransferFunction::presetNames()) {
+      if (ImGui::Selectable(name.c_str())) ed.loadPreset(name);
+    }
+    ImGui::EndCombo();
+  }
+  ImGui::Checkbox("log histogram", &ds.logHistogram);
+  const auto sel = ed.selection();
+  ImGui::BeginDisabled(sel.index < 0);
+  if (ImGui::Button("Delete point")) ed.removeSelected();
+  ImGui::EndDisabled();
+  if (sel.channel == viewer::TfChannel::Color && sel.index >= 0 &&
+      sel.index < static_cast<int>(ed.transferFunction().colors.size())) {
+    const glm::dvec3 c = ed.transferFunction().colors[static_cast<std::size_t>(sel.index)].rgb;
+    float rgb[3] = {static_cast<float>(c.r), static_cast<float>(c.g), static_cast<float>(c.b)};
+    ImGui::SameLine();
+    if (ImGui::ColorEdit3("colour", rgb, ImGuiColorEditFlags_NoInputs)) {
+      ed.setSelectedColor(glm::dvec3(rgb[0], rgb[1], rgb[2]));
+    }
+  }
+  ImGui::InputText("##tfpath", ds.tfPathBuf, sizeof ds.tfPathBuf);
+  ImGui::SameLine();
+  if (ImGui::Button("Save")) {
+    try {
+      ed.transferFunction().save(ds.tfPathBuf);
+      ds.error.clear();
+    } catch (const Error& e) {
+      ds.error = e.what();
+    }
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("Load")) {
+    try {
+      ed.setTransferFunction(TransferFunction::load(ds.tfPathBuf));
+      ds.error.clear();
+    } catch (const Error& e) {
+      ds.error = e.what();
+    }
+  }
+}
+
+void panelWindowLevel(viewer::Viewer& v) {
+  if (!v.hasVolume()) return;
+  section("Window / level");
+  const ValueRange r = v.valueRange(), w = v.window();
+  const double span = std::max(r.width(), 1e-12);
+  float win = static_cast<float>(w.width()), level = static_cast<float>(0.5 * (w.min + w.max));
+  bool changed = ImGui::SliderFloat("window", &win, static_cast<float>(span / 1000.0),
+                                    static_cast<float>(span));
+  changed |=
+      ImGui::SliderFloat("level", &level, static_cast<float>(r.min), static_cast<float>(r.max));
+  if (changed) v.setWindowLevel(win, level);
+  if (ImGui::Button("Full range")) v.resetWindow();
+}
+
+void panelRendering(DesktopSession& ds) {
+  viewer::Viewer& v = *ds.viewer;
+  section("Rendering");
+  int mode = v.settings().mode == RenderMode::Mip ? 1 : 0;
+  if (ImGui::Combo("mode", &mode, "composite\0MIP\0")) {
+    v.settings().mode = mode ? RenderMode::Mip : RenderMode::Composite;
+  }
+  if (ImGui::BeginCombo("technique", v.technique().c_str())) {
+    for (const std::string& t : render::TechniqueRegistry::global().names()) {
+      if (ImGui::Selectable(t.c_str(), t == v.technique())) {
+        try {
+          v.setTechnique(t);
+        } catch (const Error& e) {
+          ds.error = e.what();
+        }
+      }
+    }
+    ImGui::EndCombo();
+  }
+  int quality = v.quality == viewer::Quality::Adaptive ? 0 : 1;
+  if (ImGui::Combo("quality", &quality, "adaptive\0full\0")) {
+    v.quality = quality == 0 ? viewer::Quality::Adaptive : viewer::Quality::Full;
+  }
+  float step = static_cast<float>(v.settings().stepVoxels);
+  if (ImGui::SliderFloat("step (voxels)", &step, 0.25f, 2.0f)) v.settings().stepVoxels = step;
+  float opacity = static_cast<float>(v.settings().opacityScale);
+  if (ImGui::SliderFloat("opacity x", &opacity, 0.0f, 4.0f)) v.settings().opacityScale = opacity;
+  ImGui::Checkbox("bounding box", &v.showBoundingBox);
+  ImGui::SameLine();
+  ImGui::Checkbox("axes", &v.showAxes);
+  if (ImGui::Button("Reset view")) v.resetCamera();
+}
+
+// The control panel at the window's left edge.
+void drawPanel(DesktopSession& ds, int windowHeight) {
+  ImGui::SetNextWindowPos(ImVec2(0, 0));
+  ImGui::SetNextWindowSize(ImVec2(kPanelWidth, static_cast<float>(windowHeight)));
+  ImGui::Begin("Tessera", nullptr,
+               ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+  panelFile(ds);
+  panelTransferFunction(ds);
+  panelWindowLevel(*ds.viewer);
+  panelRendering(ds);
+  ImGui::Separator();
+  ImGui::TextWrapped("%s", ds.status.c_str());
+  ImGui::End();
+}
+
+// What the volume view shows; a frame is rendered only when it changes.
+std::string viewKey(viewer::Viewer& v, int viewW, int viewH) {
+  const Camera& c = v.camera();
+  std::ostringstream key;
+  key.precision(17);
+  key << v.volumeName() << '|' << c.azimuthDeg << '|' << c.elevationDeg << '|' << c.zoom << '|'
+      << c.target.x << c.target.y << c.target.z << '|' << v.tfEditor().revision() << '|'
+      << static_cast<int>(v.settings().mode) << '|' << v.settings().stepVoxels << '|'
+      << v.settings().opacityScale << '|' << v.window().min << v.window().max << '|'
+      << v.technique() << static_cast<int>(v.quality) << v.controller().interacting() << '|'
+      << v.showBoundingBox << v.showAxes << '|' << viewW << 'x' << viewH;
+  return key.str();
+}
+
+// The volume right of the panel: re-rendered only when something it shows
+// changed (ES 3 blits the cached frame), every frame on ES 2 (no blit).
+void drawVolumeView(DesktopSession& ds, int panelPx, int viewW, int viewH) {
+  viewer::Viewer& v = *ds.viewer;
+  try {
+    if (ds.es3) {
+      const std::string key = viewKey(v, viewW, viewH);
+      if (key != ds.cacheKey || ds.cache.width() != viewW || ds.cache.height() != viewH) {
+        if (ds.cache.width() != viewW || ds.cache.height() != viewH) {
+          ds.cache = gpu::Framebuffer();
+          ds.cache = gpu::Framebuffer::create(ds.context->ledger(), "view cache", viewW, viewH);
+        }
+        v.render(viewW, viewH, ds.cache.id());
+        ds.cacheKey = key;
+      }
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, ds.cache.id());
+      glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+      glBlitFramebuffer(0, 0, viewW, viewH, panelPx, 0, panelPx + viewW, viewH, GL_COLOR_BUFFER_BIT,
+                        GL_NEAREST);
+      glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    } else {
+      v.render(viewW, viewH, 0, glm::ivec2(panelPx, 0));
+    }
+  } catch (const Error& e) {
+    ds.error = e.what();
+  }
+  const viewer::FrameStats& fs = v.lastFrame();
+  char line[160];
+  std::snprintf(line, sizeof line, "frame %.0f ms at %dx%d (%s)\n%s", fs.ms, fs.renderWidth,
+                fs.renderHeight, ds.context->caps().renderer.c_str(),
+                ds.context->caps().version.c_str());
+  ds.status = line;
+}
+
+// --screenshot: the window after --frames frames, then the session ends.
+void takeScreenshot(DesktopSession& ds, int fbw, int fbh) {
+  Image shot(fbw, fbh);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, fbw, fbh, GL_RGBA, GL_UNSIGNED_BYTE, shot.rgba().data());
+  shot.flipVertically();
+  for (std::size_t i = 3; i < shot.rgba().size(); i += 4) shot.rgba()[i] = 255;
+  shot.writePng(ds.options.screenshot);
+  const viewer::FrameStats& fs = ds.viewer->lastFrame();
+  std::printf("wrote %s (%dx%d) after %d frames; last volume frame %.0f ms at %dx%d\n",
+              ds.options.screenshot.c_str(), fbw, fbh, ds.frame, fs.ms, fs.renderWidth,
+              fs.renderHeight);
+  glfwSetWindowShouldClose(ds.window, 1);
+}
+
+// One pass of the event loop: input, panel, volume, ImGui, screenshot, swap.
+void runFrame(DesktopSession& ds) {
+  glfwPollEvents();
+  if (!ds.input.pendingDrop.empty()) {
+    openVolume(ds, ds.input.pendingDrop);
+    ds.input.pendingDrop.clear();
+  }
+  int fbw = 0, fbh = 0, ww = 0, wh = 0;
+  glfwGetFramebufferSize(ds.window, &fbw, &fbh);
+  glfwGetWindowSize(ds.window, &ww, &wh);
+  const double scale = ww > 0 ? static_cast<double>(fbw) / ww : 1.0;
+  const int panelPx = static_cast<int>(kPanelWidth * scale);
+  const int viewW = std::max(1, fbw - panelPx), viewH = std::max(1, fbh);
+
+  ImGui_ImplOpenGL3_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGui::NewFrame();
+  handleViewInput(*ds.viewer, scale);
+  drawPanel(ds, wh);
+  drawOrientationLabels(ds.viewer->orientationLabels(), kPanelWidth, static_cast<float>(ww),
+                        static_cast<float>(wh));
+  ImGui::Render();
+  drawVolumeView(ds, panelPx, viewW, viewH);
+  glViewport(0, 0, fbw, fbh);
+  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+
+  ++ds.frame;
+  if (!ds.options.screenshot.empty() && ds.frame >= ds.options.frames) {
+    takeScreenshot(ds, fbw, fbh);
+  }
+  glfwSwapBuffers(ds.window);
+}
+
+void runView(const ViewOptions& o) {
+  int width = 0, height = 0;
+  parseSize(o.size, width, height);
+  const gpu::DeviceProfile profile = gpu::DeviceProfile::find(o.profile);
+  DesktopSession ds(o, profile.api == gpu::ApiLevel::Gles3);
+
+  glfwSetErrorCallback([](int code, const char* what) {
+    std::fprintf(stderr, "tessera view: GLFW error %d: %s\n", code, what);
+  });
+  if (!glfwInit()) {
+    throw GpuError("GLFW cannot start: no display? (set DISPLAY, or run under xvfb-run -a)");
+  }
+  struct GlfwGuard {
+    ~GlfwGuard() { glfwTerminate(); }
+  } glfwGuard;
+  ds.window = openWindow(width, height, ds.es3);
+  ds.context = gpu::GlContext::adoptCurrent(profile.api, "glfw-egl");
+  ds.viewer = std::make_unique<viewer::Viewer>(*ds.context, profile);
+  ds.input.viewer = ds.viewer.get();
+  glfwSetWindowUserPointer(ds.window, &ds.input);
+  glfwSetDropCallback(ds.window, [](GLFWwindow* w, int count, const char** paths) {
     if (count > 0) static_cast<DesktopState*>(glfwGetWindowUserPointer(w))->pendingDrop = paths[0];
   });
 
-  std::string error;
-  std::string status;
-  auto open = [&](const std::string& spec) {
-    try {
-      v->setVolume(readVolume(spec, {.dicomSeries = o.series}), fileName(spec));
-      error.clear();
-    } catch (const Error& e) {
-      error = std::string(e.what()) + " (the previous volume stays)";
-    }
-  };
-  v->tfEditor().setTransferFunction(TransferFunction::fromPresetOrFile(o.tf));
-  open(o.file.empty() ? defaultVolumeSpec() : o.file);
-  if (!error.empty() && !v->hasVolume()) throw InputError(error);
-  v->camera().azimuthDeg = o.azimuth;
-  v->camera().elevationDeg = o.elevation;
+  ds.viewer->tfEditor().setTransferFunction(TransferFunction::fromPresetOrFile(o.tf));
+  openVolume(ds, o.file.empty() ? defaultVolumeSpec() : o.file);
+  if (!ds.error.empty() && !ds.viewer->hasVolume()) throw InputError(ds.error);
+  ds.viewer->camera().azimuthDeg = o.azimuth;
+  ds.viewer->camera().elevationDeg = o.elevation;
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;
   ImGui::StyleColorsDark();
-  ImGui_ImplGlfw_InitForOpenGL(window, true);
-  ImGui_ImplOpenGL3_Init(es3 ? "#version 300 es" : "#version 100");
-
-  gpu::Framebuffer cache;  // ES 3: the last volume frame, blitted while nothing changes
-  std::string cacheKey;
-  char pathBuf[512] = "";
-  char tfPathBuf[512] = "transfer-function.json";
-  bool logHistogram = true;
-  int frame = 0;
-
-  while (!glfwWindowShouldClose(window)) {
-    glfwPollEvents();
-    if (!ds.pendingDrop.empty()) {
-      open(ds.pendingDrop);
-      ds.pendingDrop.clear();
-    }
-    int fbw = 0, fbh = 0, ww = 0, wh = 0;
-    glfwGetFramebufferSize(window, &fbw, &fbh);
-    glfwGetWindowSize(window, &ww, &wh);
-    const double scale = ww > 0 ? static_cast<double>(fbw) / ww : 1.0;
-    const int panelPx = static_cast<int>(kPanelWidth * scale);
-    const int viewW = std::max(1, fbw - panelPx), viewH = std::max(1, fbh);
-
-    ImGui_ImplOpenGL3_NewFrame();
-    ImGui_ImplGlfw_NewFrame();
-    ImGui::NewFrame();
-    ImGuiIO& io = ImGui::GetIO();
-
-    // The 3D view: mouse drags orbit (right button or shift: pan), wheel zooms.
-    if (!io.WantCaptureMouse) {
-      const glm::dvec2 pos((io.MousePos.x - kPanelWidth) * scale, io.MousePos.y * scale);
-      for (int b = 0; b < 2; ++b) {
-        if (ImGui::IsMouseClicked(b) && pos.x >= 0.0) {
-          v->controller().pointerDown(
-              b, pos,
-              b == 1 || io.KeyShift ? viewer::PointerAction::Pan : viewer::PointerAction::Orbit);
-        }
-      }
-      if (io.MouseWheel != 0.0f) v->controller().wheel(-io.MouseWheel);
-    }
-    {
-      const glm::dvec2 pos((io.MousePos.x - kPanelWidth) * scale, io.MousePos.y * scale);
-      for (int b = 0; b < 2; ++b) {
-        v->controller().pointerMove(b, pos);
-        if (ImGui::IsMouseReleased(b)) v->controller().pointerUp(b);
-      }
-    }
-
-    ImGui::SetNextWindowPos(ImVec2(0, 0));
-    ImGui::SetNextWindowSize(ImVec2(kPanelWidth, static_cast<float>(wh)));
-    ImGui::Begin("Tessera", nullptr,
-                 ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
-    ImGui::TextWrapped("%s", v->description().c_str());
-    ImGui::InputText("##path", pathBuf, sizeof pathBuf);
-    ImGui::SameLine();
-    if (ImGui::Button("Open") && pathBuf[0]) open(pathBuf);
-    ImGui::TextDisabled("or drop a file on the window");
-    if (!error.empty()) {
-      ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1.0f));
-      ImGui::TextWrapped("%s", error.c_str());
-      ImGui::PopStyleColor();
-    }
-
-    section("Transfer function");
-    viewer::TransferFunctionEditor& ed = v->tfEditor();
-    transferFunctionEditor(ed, logHistogram);
-    if (ImGui::BeginCombo("preset", ed.transferFunction().name.c_str())) {
-      for (const std::string& name : TransferFunction::presetNames()) {
-        if (ImGui::Selectable(name.c_str())) ed.loadPreset(name);
-      }
-      ImGui::EndCombo();
-    }
-    ImGui::Checkbox("log histogram", &logHistogram);
-    const auto sel = ed.selection();
-    ImGui::BeginDisabled(sel.index < 0);
-    if (ImGui::Button("Delete point")) ed.removeSelected();
-    ImGui::EndDisabled();
-    if (sel.channel == viewer::TfChannel::Color && sel.index >= 0 &&
-        sel.index < static_cast<int>(ed.transferFunction().colors.size())) {
-      const glm::dvec3 c = ed.transferFunction().colors[static_cast<std::size_t>(sel.index)].rgb;
-      float rgb[3] = {static_cast<float>(c.r), static_cast<float>(c.g), static_cast<float>(c.b)};
-      ImGui::SameLine();
-      if (ImGui::ColorEdit3("colour", rgb, ImGuiColorEditFlags_NoInputs)) {
-        ed.setSelectedColor(glm::dvec3(rgb[0], rgb[1], rgb[2]));
-      }
-    }
-    ImGui::InputText("##tfpath", tfPathBuf, sizeof tfPathBuf);
-    ImGui::SameLine();
-    if (ImGui::Button("Save")) {
-      try {
-        ed.transferFunction().save(tfPathBuf);
-        error.clear();
-      } catch (const Error& e) {
-        error = e.what();
-      }
-    }
-    ImGui::SameLine();
-    if (ImGui::Button("Load")) {
-      try {
-        ed.setTransferFunction(TransferFunction::load(tfPathBuf));
-        error.clear();
-      } catch (const Error& e) {
-        error = e.what();
-      }
-    }
-
-    if (v->hasVolume()) {
-      section("Window / level");
-      const ValueRange r = v->valueRange(), w = v->window();
-      const double span = std::max(r.width(), 1e-12);
-      float win = static_cast<float>(w.width()), level = static_cast<float>(0.5 * (w.min + w.max));
-      bool changed = ImGui::SliderFloat("window", &win, static_cast<float>(span / 1000.0),
-                                        static_cast<float>(span));
-      changed |=
-          ImGui::SliderFloat("level", &level, static_cast<float>(r.min), static_cast<float>(r.max));
-      if (changed) v->setWindowLevel(win, level);
-      if (ImGui::Button("Full range")) v->resetWindow();
-    }
-
-    section("Rendering");
-    int mode = v->settings().mode == RenderMode::Mip ? 1 : 0;
-    if (ImGui::Combo("mode", &mode, "composite\0MIP\0")) {
-      v->settings().mode = mode ? RenderMode::Mip : RenderMode::Composite;
-    }
-    if (ImGui::BeginCombo("technique", v->technique().c_str())) {
-      for (const std::string& t : render::TechniqueRegistry::global().names()) {
-        if (ImGui::Selectable(t.c_str(), t == v->technique())) {
-          try {
-            v->setTechnique(t);
-          } catch (const Error& e) {
-            error = e.what();
-          }
-        }
-      }
-      ImGui::EndCombo();
-    }
-    int quality = v->quality == viewer::Quality::Adaptive ? 0 : 1;
-    if (ImGui::Combo("quality", &quality, "adaptive\0full\0")) {
-      v->quality = quality == 0 ? viewer::Quality::Adaptive : viewer::Quality::Full;
-    }
-    float step = static_cast<float>(v->settings().stepVoxels);
-    if (ImGui::SliderFloat("step (voxels)", &step, 0.25f, 2.0f)) v->settings().stepVoxels = step;
-    float opacity = static_cast<float>(v->settings().opacityScale);
-    if (ImGui::SliderFloat("opacity x", &opacity, 0.0f, 4.0f)) v->settings().opacityScale = opacity;
-    ImGui::Checkbox("bounding box", &v->showBoundingBox);
-    ImGui::SameLine();
-    ImGui::Checkbox("axes", &v->showAxes);
-    if (ImGui::Button("Reset view")) v->resetCamera();
-    ImGui::Separator();
-    ImGui::TextWrapped("%s", status.c_str());
-    ImGui::End();
-    drawOrientationLabels(v->orientationLabels(), kPanelWidth, static_cast<float>(ww),
-                          static_cast<float>(wh));
-    ImGui::Render();
-
-    // The volume: re-rendered only when something it shows changed.
-    const Camera& c = v->camera();
-    std::ostringstream key;
-    key.precision(17);
-    key << v->volumeName() << '|' << c.azimuthDeg << '|' << c.elevationDeg << '|' << c.zoom << '|'
-        << c.target.x << c.target.y << c.target.z << '|' << ed.revision() << '|'
-        << static_cast<int>(v->settings().mode) << '|' << v->settings().stepVoxels << '|'
-        << v->settings().opacityScale << '|' << v->window().min << v->window().max << '|'
-        << v->technique() << static_cast<int>(v->quality) << v->controller().interacting() << '|'
-        << v->showBoundingBox << v->showAxes << '|' << viewW << 'x' << viewH;
-    try {
-      if (es3) {
-        if (key.str() != cacheKey || cache.width() != viewW || cache.height() != viewH) {
-          if (cache.width() != viewW || cache.height() != viewH) {
-            cache = gpu::Framebuffer();
-            cache = gpu::Framebuffer::create(context->ledger(), "view cache", viewW, viewH);
-          }
-          v->render(viewW, viewH, cache.id());
-          cacheKey = key.str();
-        }
-        glBindFramebuffer(GL_READ_FRAMEBUFFER, cache.id());
-        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
-        glBlitFramebuffer(0, 0, viewW, viewH, panelPx, 0, panelPx + viewW, viewH,
-                          GL_COLOR_BUFFER_BIT, GL_NEAREST);
-        glBindFramebuffer(GL_FRAMEBUFFER, 0);
-      } else {
-        // ES 2 has no blit: the volume is drawn every frame.
-        v->render(viewW, viewH, 0, glm::ivec2(panelPx, 0));
-      }
-    } catch (const Error& e) {
-      error = e.what();
-    }
-    const viewer::FrameStats& fs = v->lastFrame();
-    char line[160];
-    std::snprintf(line, sizeof line, "frame %.0f ms at %dx%d (%s)\n%s", fs.ms, fs.renderWidth,
-                  fs.renderHeight, context->caps().renderer.c_str(),
-                  context->caps().version.c_str());
-    status = line;
-
-    glViewport(0, 0, fbw, fbh);
-    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-
-    ++frame;
-    if (!o.screenshot.empty() && frame >= o.frames) {
-      Image shot(fbw, fbh);
-      glBindFramebuffer(GL_FRAMEBUFFER, 0);
-      glPixelStorei(GL_PACK_ALIGNMENT, 1);
-      glReadPixels(0, 0, fbw, fbh, GL_RGBA, GL_UNSIGNED_BYTE, shot.rgba().data());
-      shot.flipVertically();
-      for (std::size_t i = 3; i < shot.rgba().size(); i += 4) shot.rgba()[i] = 255;
-      shot.writePng(o.screenshot);
-      std::printf("wrote %s (%dx%d) after %d frames; last volume frame %.0f ms at %dx%d\n",
-                  o.screenshot.c_str(), fbw, fbh, frame, fs.ms, fs.renderWidth, fs.renderHeight);
-      glfwSetWindowShouldClose(window, 1);
-    }
-    glfwSwapBuffers(window);
-  }
+  ImGui_ImplGlfw_InitForOpenGL(ds.window, true);
+  ImGui_ImplOpenGL3_Init(ds.es3 ? "#version 300 es" : "#version 100");
+  while (!glfwWindowShouldClose(ds.window)) runFrame(ds);
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();
-  cache = gpu::Framebuffer();
-  v.reset();
-  context.reset();
-  glfwDestroyWindow(window);
+  ds.cache = gpu::Framebuffer();
+  ds.viewer.reset();
+  ds.context.reset();
+  glfwDestroyWindow(ds.window);
 }
 
 #else
