@@ -23,26 +23,48 @@ std::vector<glm::vec3> LayoutProbe::voxelCentres(glm::ivec3 d) {
   return out;
 }
 
+bool LayoutProbe::hasFloatTargets() const {
+  return context_.caps().api == gpu::ApiLevel::Gles3 &&
+         context_.caps().has("GL_EXT_color_buffer_float");
+}
+
 std::vector<float> LayoutProbe::sample(const Layout& layout,
                                        const std::vector<glm::vec3>& positions) {
   if (positions.empty()) return {};
-  if (context_.caps().api == gpu::ApiLevel::Gles3 &&
-      context_.caps().has("GL_EXT_color_buffer_float")) {
-    return sampleFloat(layout, positions);
+  if (!hasFloatTargets()) return sampleRgba8(layout, positions);
+  const std::vector<glm::vec4> probed = probeFloat(layout, positions, false);
+  std::vector<float> out(probed.size());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = probed[i].x;
+  return out;
+}
+
+std::vector<glm::vec4> LayoutProbe::sampleGradient(const Layout& layout,
+                                                   const std::vector<glm::vec3>& positions) {
+  if (!hasFloatTargets()) {
+    throw GpuError(
+        "LayoutProbe: gradients need float render targets (ES 3 + "
+        "EXT_color_buffer_float)");
   }
-  return sampleRgba8(layout, positions);
+  if (positions.empty()) return {};
+  return probeFloat(layout, positions, true);
 }
 
 // ES 3 with float render targets: positions in an RGBA32F texture read with
-// texelFetch, values written to an RGBA32F target.
-std::vector<float> LayoutProbe::sampleFloat(const Layout& layout,
-                                            const std::vector<glm::vec3>& positions) {
+// texelFetch, values (or gradient and value) written to an RGBA32F target.
+std::vector<glm::vec4> LayoutProbe::probeFloat(const Layout& layout,
+                                               const std::vector<glm::vec3>& positions,
+                                               bool gradient) {
   const gpu::ApiLevel api = context_.caps().api;
+  std::vector<gpu::ShaderPart> fragment = {
+      gpu::shaderPreamble(api, true,
+                          gradient ? std::vector<std::string>{"TESSERA_PROBE_GRADIENT 1"}
+                                   : std::vector<std::string>{})};
+  for (gpu::ShaderPart& part : layout.seamParts()) fragment.push_back(std::move(part));
+  fragment.push_back(gpu::embeddedShaderPart("layout/probe.frag.glsl"));
   const gpu::Program program = gpu::Program::build(
-      "probe(" + layout.name() + ")",
+      "probe(" + layout.name() + (gradient ? ", gradient)" : ")"),
       {gpu::shaderPreamble(api, false, {}), gpu::embeddedShaderPart("render/fullscreen.vert.glsl")},
-      {gpu::shaderPreamble(api, true, {}), layout.glsl(),
-       gpu::embeddedShaderPart("layout/probe.frag.glsl")});
+      fragment);
 
   // Lay the positions out in rows of at most 1024.
   const int width = static_cast<int>(std::min<std::size_t>(positions.size(), 1024));
@@ -69,7 +91,7 @@ std::vector<float> LayoutProbe::sampleFloat(const Layout& layout,
   const gpu::FullscreenTriangle triangle(context_.ledger());
   target.bind();
   program.use();
-  const int unit = layout.bind(program, 0);
+  const int unit = layout.bindSeam(program, 0);
   posTex.bind(unit);
   program.set("u_positions", unit);
   glDisable(GL_BLEND);
@@ -79,8 +101,10 @@ std::vector<float> LayoutProbe::sampleFloat(const Layout& layout,
   glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, rgba.data());
   const GLenum err = glGetError();
   if (err != GL_NO_ERROR) throw GpuError("LayoutProbe: GL error " + std::to_string(err));
-  std::vector<float> out(positions.size());
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = rgba[i * 4];
+  std::vector<glm::vec4> out(positions.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    out[i] = glm::vec4(rgba[i * 4], rgba[i * 4 + 1], rgba[i * 4 + 2], rgba[i * 4 + 3]);
+  }
   return out;
 }
 

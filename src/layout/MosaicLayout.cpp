@@ -199,6 +199,7 @@ std::unique_ptr<MosaicLayout> MosaicLayout::create(const Volume& volume,
                                                    const gpu::DeviceLimits& limits,
                                                    gpu::MemoryLedger& ledger) {
   std::unique_ptr<MosaicLayout> l(new MosaicLayout());
+  l->voxels_ = &volume;
   l->plan_ = planFor(volume, limits);
   if (!l->plan_.fits) throw GpuError("mosaic layout: " + l->plan_.reason);
   l->geometry_ = geometryFor(volume.dims(), limits.max2DTextureSize);

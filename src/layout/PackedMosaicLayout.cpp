@@ -236,6 +236,7 @@ std::unique_ptr<PackedMosaicLayout> PackedMosaicLayout::create(const Volume& vol
                                                                gpu::MemoryLedger& ledger,
                                                                int maxTextures, Packing packing) {
   std::unique_ptr<PackedMosaicLayout> l(new PackedMosaicLayout());
+  l->voxels_ = &volume;
   PackingPlan chosen = choosePacking(volume, limits, maxTextures, packing);
   l->plan_ = std::move(chosen.plan);
   if (!l->plan_.fits) throw GpuError("packed-mosaic layout: " + l->plan_.reason);

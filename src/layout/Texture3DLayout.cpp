@@ -58,6 +58,7 @@ std::unique_ptr<Texture3DLayout> Texture3DLayout::create(const Volume& volume,
                                                          const gpu::DeviceLimits& limits,
                                                          gpu::MemoryLedger& ledger) {
   std::unique_ptr<Texture3DLayout> l(new Texture3DLayout());
+  l->voxels_ = &volume;
   l->plan_ = planFor(volume, limits);
   if (!l->plan_.fits) throw GpuError("texture3d layout: " + l->plan_.reason);
   l->dims_ = volume.dims();

@@ -17,7 +17,7 @@
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/gpu/Program.h"
 #include "tessera/layout/Layout.h"
-#include "tessera/render/BlockMinMax.h"
+#include "tessera/layout/ValueBlocks.h"
 
 namespace tessera::render {
 
@@ -81,7 +81,7 @@ class Raycaster {
   TransferFunction tf_;
   int lutSize_ = 4096;
   int blockSize_ = 8;
-  BlockMinMax blocks_;
+  layout::ValueBlocks blocks_;
   std::vector<float> lut_;
   gpu::Texture lutTexture_;
   gpu::Texture blockTexture_;
