@@ -83,6 +83,12 @@ void readPixelsRgba8(glm::ivec4 r, std::uint8_t* out) {
   checkErrors("reading pixels");
 }
 
+void readPixelsRgba32F(glm::ivec4 r, float* out) {
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  glReadPixels(r.x, r.y, r.z, r.w, GL_RGBA, GL_FLOAT, out);
+  checkErrors("reading float pixels");
+}
+
 void finish() {
   glFinish();
 }

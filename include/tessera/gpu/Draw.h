@@ -49,6 +49,8 @@ void bindFramebuffer(unsigned name, glm::ivec4 viewport);
 void blitFramebuffer(unsigned from, glm::ivec4 source, unsigned to, glm::ivec4 destination);
 // RGBA8 pixels of the bound framebuffer's region, bottom row first.
 void readPixelsRgba8(glm::ivec4 region, std::uint8_t* out);
+// The same as floats, from an RGBA32F target (ES 3 + EXT_color_buffer_float).
+void readPixelsRgba32F(glm::ivec4 region, float* out);
 
 // Waits for the GPU (where the driver honours it; browsers do not).
 void finish();

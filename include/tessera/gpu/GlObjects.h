@@ -131,6 +131,7 @@ class Framebuffer {
   int width() const { return color_.width(); }
   int height() const { return color_.height(); }
   const Texture& color() const { return color_; }
+  Texture& color() { return color_; }
   // Reads the colour attachment as RGBA8, bottom row first.
   void readRgba8(std::uint8_t* out) const;
 
