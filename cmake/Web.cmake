@@ -58,6 +58,10 @@ file(GLOB TESSERA_WEB_FRONT CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/web/src/*.cpp)
 
 set_source_files_properties(${CMAKE_SOURCE_DIR}/src/core/TransferFunction.cpp PROPERTIES
   COMPILE_OPTIONS "-include;${CMAKE_SOURCE_DIR}/web/src/compat/FloatToChars.h")
+# The io readers parse numbers with std::from_chars, which this libc++ lacks
+# for floating point.
+set_source_files_properties(${TESSERA_WEB_IO} PROPERTIES
+  COMPILE_OPTIONS "-include;${CMAKE_SOURCE_DIR}/web/src/compat/FloatFromChars.h")
 
 set(TESSERA_WEB_SITE ${CMAKE_BINARY_DIR}/site)
 add_executable(tessera_web ${TESSERA_WEB_SOURCES} ${TESSERA_WEB_FRONT})
@@ -72,9 +76,13 @@ set(TESSERA_WEB_FLAGS -O2 -fexceptions)
 target_compile_options(tessera_web PRIVATE ${TESSERA_WEB_FLAGS} -Wall -Wextra)
 target_link_options(tessera_web PRIVATE ${TESSERA_WEB_FLAGS}
   -sMIN_WEBGL_VERSION=1 -sMAX_WEBGL_VERSION=2 -sALLOW_MEMORY_GROWTH=1 -sINITIAL_MEMORY=64MB
+  --js-library ${CMAKE_SOURCE_DIR}/web/src/InflaterPako.js
   -sMODULARIZE=1 -sEXPORT_NAME=createTesseraModule -sENVIRONMENT=web
   "-sEXPORTED_FUNCTIONS=_malloc,_free"
   "-sEXPORTED_RUNTIME_METHODS=ccall,cwrap,UTF8ToString,HEAPU8,HEAPF32")
+
+set_property(TARGET tessera_web APPEND PROPERTY LINK_DEPENDS
+             ${CMAKE_SOURCE_DIR}/web/src/InflaterPako.js)
 
 # The static page next to the module, and pako from web/node_modules
 # (`npm ci` in web/, which scripts/web.sh and scripts/setup.sh run).
