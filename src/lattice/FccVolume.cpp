@@ -172,7 +172,8 @@ std::string FccVolume::summary(std::string_view label) const {
   char spacing[96];
   std::snprintf(spacing, sizeof spacing, "%.4g x %.4g x %.4g", h.x, h.y, h.z);
   return std::string(label) + ": grid " + dimsText(grid_) + " (spacing " + spacing + "), " +
-         std::to_string(pointCount()) + " points, texels " + dimsText(packed_.dims()) + " " +
+         std::to_string(pointCount()) + (quasiInterpolated_ ? " quasi-interpolated" : "") +
+         " points, texels " + dimsText(packed_.dims()) + " " +
          std::string(scalarTypeName(packed_.type())) + " = " + formatBytes(byteSize());
 }
 

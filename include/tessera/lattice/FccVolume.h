@@ -102,6 +102,12 @@ class FccVolume {
   // World distance between grid planes along each index axis.
   glm::dvec3 gridSpacing() const;
 
+  // Whether the texels are quasi-interpolation coefficients
+  // (quasiInterpolate(), FccResampling.h) or point samples; either way the
+  // box spline takes them as its coefficients.
+  bool quasiInterpolated() const { return quasiInterpolated_; }
+  void setQuasiInterpolated(bool q) { quasiInterpolated_ = q; }
+
   // The source's box: geometry and value window, no voxels. Pass it to
   // renderReference() with a BoxSplineReconstruction.
   const Volume& box() const { return box_; }
@@ -136,6 +142,7 @@ class FccVolume {
   Volume box_;
   Volume packed_;
   glm::ivec3 grid_{0};
+  bool quasiInterpolated_ = false;
 };
 
 }  // namespace tessera::lattice
