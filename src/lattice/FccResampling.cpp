@@ -51,7 +51,13 @@ FccVolume resampleToFcc(const Volume& source, const FccResampleOptions& options,
   const glm::ivec3 grid = fccGridDims(source.dims(), options.density);
   const glm::dvec3 toIndex = glm::dvec3(source.dims()) / glm::dvec3(grid);
   std::vector<float> texels;
-  {
+  (void)source.valueRange();  // cached before threads read it (NaN -> nonFiniteValue)
+  if (grid == source.dims()) {
+    // Half density: the lattice points are voxel centres, nothing to interpolate.
+    texels = texelsOf(grid, options.threads, [&](glm::ivec3 p) {
+      return source.finiteValueAtIndex(source.index(p.x, p.y, p.z));
+    });
+  } else {
     const detail::CartesianInterpolantField field(source, options.interpolant, options.threads);
     texels = texelsOf(grid, options.threads, [&](glm::ivec3 p) {
       // Same texture position, in the source's voxel index.

@@ -14,7 +14,7 @@ namespace tessera::lattice {
 
 // How a Cartesian volume is read between its voxel centres when the FCC
 // points do not fall on them (`same` density; `half` reads the voxels
-// themselves, so every interpolant gives the same lattice).
+// themselves, so the interpolant plays no part).
 //   CubicBSpline (default): cubic B-spline interpolation, i.e. the data are
 //     first prefiltered into B-spline coefficients (Unser, Aldroubi & Eden,
 //     "B-spline signal processing", IEEE TSP 1993; Thevenaz, Blu & Unser,
@@ -49,8 +49,9 @@ struct FccResampleStats {
 };
 
 // The source's box and window on the FCC lattice of options.density. Memory:
-// one f32 copy of the source (B-spline coefficients or samples) plus two f32
-// copies of the lattice at most, all checked against HostBudget.
+// one f32 copy of the source (B-spline coefficients or samples; none at half
+// density, which reads the voxels) plus two f32 copies of the lattice at
+// most, all checked against HostBudget.
 FccVolume resampleToFcc(const Volume& source, const FccResampleOptions& options = {},
                         FccResampleStats* stats = nullptr);
 
