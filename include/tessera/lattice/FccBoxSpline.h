@@ -6,14 +6,15 @@
 // that its FCC shifts sum to 1 (Kim, Entezari & Peters, "Box spline
 // reconstruction on the face-centered cubic lattice", IEEE TVCG 14(6), 2008).
 //
-// Properties (all tested): K is a piecewise cubic, C1 and not C2 (three of
-// the six directions lie in one plane: smoothness m - 2 = 1 by de Boor,
-// Hoellig & Riemenschneider, "Box Splines", 1993). Its support is the
-// truncated octahedron |x|_inf <= 2, |x|_1 <= 3; its second moment is I/3 per
-// axis. The spline space holds every quadratic (approximation order 3): the
-// samples themselves reproduce every linear function, a quadratic q comes back
-// as q + laplacian(q) / 6, and quasiInterpolate() (FccResampling.h) removes
-// that term.
+// Properties (all tested): K is a piecewise cubic and C1, not C2: across a
+// knot plane its smoothness is #(directions off the plane) - 2 (de Boor,
+// Hoellig & Riemenschneider, "Box Splines", 1993), so C2 across the axis
+// planes but only C1 across the x +- y +- z planes, which hold three of the six
+// directions. Its support is the truncated octahedron |x|_inf <= 2,
+// |x|_1 <= 3; its second moment is I/3 per axis. The spline space holds every
+// quadratic (approximation order 3): the samples themselves reproduce every
+// linear function, a quadratic q comes back as q + laplacian(q) / 6, and
+// quasiInterpolate() (FccResampling.h) removes that term.
 //
 // Evaluation (organised as in Kim, "GPU isosurface raycasting of FCC
 // datasets", Graphical Models 75(2), 2013): the knot planes x, y, z in Z and
@@ -24,6 +25,11 @@
 // set of 16 cubics in the cube's local coordinates, give every value: 16
 // lattice points (the minimal number) per sample. The cubics are derived
 // exactly by src/lattice/derive_fcc_box_spline.py.
+//
+// A GPU twin does the same per sample: floor and parity of u, four plane
+// tests, 16 texelFetch (FccVolume.h's addressing and boundary rule) and the
+// two tables of src/lattice/FccBoxSplinePieces.h (small integers / 24) as
+// const arrays; sign and local give the gradient for free.
 #include <array>
 #include <vector>
 

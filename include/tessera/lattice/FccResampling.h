@@ -56,8 +56,8 @@ FccVolume resampleToFcc(const Volume& source, const FccResampleOptions& options 
                         FccResampleStats* stats = nullptr);
 
 // f sampled at every lattice point over `box` (its dims define the density),
-// f taking texture coordinates in [0,1]^3 of the box; quasi-interpolated
-// unless asked not to. f32 texels.
+// f taking texture coordinates in [0,1]^3 of the box (called from several
+// threads at once); quasi-interpolated unless asked not to. f32 texels.
 FccVolume sampleOnFcc(const Volume& box, FccDensity density,
                       const std::function<double(glm::dvec3)>& f, bool quasiInterpolated = true,
                       int threads = 0);
