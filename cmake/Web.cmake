@@ -1,13 +1,17 @@
 # The browser build of the viewer (included from CMakeLists.txt under
 # emcmake; scripts/web.sh runs it). Compiles the layers the viewer needs —
-# core, gpu, lod, layout, render, viewer, io's procedural sources and its
-# NIfTI/NRRD geometry maths — with Debian's emscripten into web/site's
-# tessera.js + tessera.wasm. nifticlib,
-# zlib, DCMTK and libpng are not available to emscripten here: files are read
-# by viewer/InMemoryVolumeReader (gzip is inflated by the browser), and PNG
-# I/O reports that it is not built in (web/src/PngUnavailable.cpp). The gpu
-# layer's EGL platform (GlContext.cpp) is replaced by the browser's
-# (web/src/GlContextWebGL.cpp: the page's canvas owns the WebGL context).
+# core, gpu, lod, layout, render, viewer and io's readers — with Debian's
+# emscripten into web/site's tessera.js + tessera.wasm. nifticlib, zlib,
+# DCMTK and libpng are not available to emscripten here. The io readers
+# need none of them to read (they parse every header themselves, on byte
+# sources): files picked or dropped in the page are read by the same
+# readers as the CLI's, their gzip/zlib inflated by the page's pako
+# (web/src/InflaterPako.cpp replaces io/InflaterZlib.cpp; web/package.json
+# pins pako). The writers (zlib, nifticlib) and DICOM (DCMTK) stay native:
+# web/src/DicomUnavailable.cpp says so, and PNG I/O reports that it is not
+# built in (web/src/PngUnavailable.cpp). The gpu layer's EGL platform
+# (GlContext.cpp) is replaced by the browser's (web/src/GlContextWebGL.cpp:
+# the page's canvas owns the WebGL context).
 # No pthreads: SharedArrayBuffer needs cross-origin isolation a static page
 # cannot count on; code that sizes thread pools sees one core.
 cmake_minimum_required(VERSION 3.25)
@@ -39,11 +43,11 @@ add_custom_command(
   DEPENDS ${TESSERA_GLSL} ${CMAKE_SOURCE_DIR}/cmake/EmbedGlsl.cmake
   COMMENT "Embedding GLSL shaders" VERBATIM)
 
-# From io: the procedural sources and the header -> affine maths that
-# viewer/InMemoryVolumeReader shares with the native readers (no nifticlib,
-# zlib or DCMTK in them).
-set(TESSERA_WEB_SOURCES ${TESSERA_GLSL_CPP} ${CMAKE_SOURCE_DIR}/src/io/Procedural.cpp
-    ${CMAKE_SOURCE_DIR}/src/io/NiftiGeometry.cpp ${CMAKE_SOURCE_DIR}/src/io/NrrdGeometry.cpp)
+# From io: the readers and procedural sources; not the writers, DICOM, nor
+# the zlib inflater.
+file(GLOB TESSERA_WEB_IO CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/io/*.cpp)
+list(FILTER TESSERA_WEB_IO EXCLUDE REGEX "/(.*Writer|Dicom.*|InflaterZlib|OutputFile)\\.cpp$")
+set(TESSERA_WEB_SOURCES ${TESSERA_GLSL_CPP} ${TESSERA_WEB_IO})
 foreach(layer core gpu lod layout render viewer)
   file(GLOB_RECURSE srcs CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/${layer}/*.cpp)
   list(APPEND TESSERA_WEB_SOURCES ${srcs})
@@ -54,6 +58,10 @@ file(GLOB TESSERA_WEB_FRONT CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/web/src/*.cpp)
 
 set_source_files_properties(${CMAKE_SOURCE_DIR}/src/core/TransferFunction.cpp PROPERTIES
   COMPILE_OPTIONS "-include;${CMAKE_SOURCE_DIR}/web/src/compat/FloatToChars.h")
+# The io readers parse numbers with std::from_chars, which this libc++ lacks
+# for floating point.
+set_source_files_properties(${TESSERA_WEB_IO} PROPERTIES
+  COMPILE_OPTIONS "-include;${CMAKE_SOURCE_DIR}/web/src/compat/FloatFromChars.h")
 
 set(TESSERA_WEB_SITE ${CMAKE_BINARY_DIR}/site)
 add_executable(tessera_web ${TESSERA_WEB_SOURCES} ${TESSERA_WEB_FRONT})
@@ -68,14 +76,23 @@ set(TESSERA_WEB_FLAGS -O2 -fexceptions)
 target_compile_options(tessera_web PRIVATE ${TESSERA_WEB_FLAGS} -Wall -Wextra)
 target_link_options(tessera_web PRIVATE ${TESSERA_WEB_FLAGS}
   -sMIN_WEBGL_VERSION=1 -sMAX_WEBGL_VERSION=2 -sALLOW_MEMORY_GROWTH=1 -sINITIAL_MEMORY=64MB
+  --js-library ${CMAKE_SOURCE_DIR}/web/src/InflaterPako.js
   -sMODULARIZE=1 -sEXPORT_NAME=createTesseraModule -sENVIRONMENT=web
   "-sEXPORTED_FUNCTIONS=_malloc,_free"
   "-sEXPORTED_RUNTIME_METHODS=ccall,cwrap,UTF8ToString,HEAPU8,HEAPF32")
 
-# The static page next to the module.
+set_property(TARGET tessera_web APPEND PROPERTY LINK_DEPENDS
+             ${CMAKE_SOURCE_DIR}/web/src/InflaterPako.js)
+
+# The static page next to the module, and pako from web/node_modules
+# (`npm ci` in web/, which scripts/web.sh and scripts/setup.sh run).
+set(TESSERA_PAKO ${CMAKE_SOURCE_DIR}/web/node_modules/pako/dist/pako_inflate.min.js)
+if(NOT EXISTS ${TESSERA_PAKO})
+  message(FATAL_ERROR "${TESSERA_PAKO} is missing: run `npm ci` in web/ (scripts/web.sh does)")
+endif()
 file(GLOB TESSERA_WEB_STATIC CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/web/*.html
      ${CMAKE_SOURCE_DIR}/web/*.js ${CMAKE_SOURCE_DIR}/web/*.css)
-foreach(f ${TESSERA_WEB_STATIC})
+foreach(f ${TESSERA_WEB_STATIC} ${TESSERA_PAKO})
   get_filename_component(n ${f} NAME)
   configure_file(${f} ${TESSERA_WEB_SITE}/${n} COPYONLY)
 endforeach()

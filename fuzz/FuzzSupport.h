@@ -1,8 +1,11 @@
 #pragma once
 // What every fuzz target shares: a small host budget, so that a header
-// claiming gigabytes is refused instead of allocated, and a per-process
-// scratch folder for readers that take a path (the file name's extension
-// picks nothing here; each target calls its reader directly).
+// claiming gigabytes is refused instead of allocated; the input as a memory
+// byte source (the readers' own entry point, the one the browser uses), with
+// a fixed 512-byte data file beside it for headers that name one; and a
+// per-process scratch folder for the DICOM reader, which reads paths (the
+// file name's extension picks nothing here; each target calls its reader
+// directly).
 //
 // A target catches tessera::Error, the documented way to reject input. Any
 // other exception escapes LLVMFuzzerTestOneInput, std::terminate aborts, and
@@ -18,8 +21,12 @@
 #include <string>
 #include <system_error>
 
+#include <span>
+#include <vector>
+
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/io/ByteSource.h"
 
 namespace tessera::fuzz {
 
@@ -65,6 +72,24 @@ inline void writeBytes(const std::filesystem::path& path, const std::uint8_t* da
     std::fprintf(stderr, "fuzz harness: cannot write %s\n", path.c_str());
     std::abort();
   }
+}
+
+// The fuzzed bytes as a file named `name`, without a copy.
+inline MemorySource input(const std::string& name, const std::uint8_t* data, std::size_t size) {
+  return MemorySource(name, std::span(reinterpret_cast<const std::byte*>(data), size));
+}
+
+// The files beside the input: "data.raw", 512 bytes, for the headers that
+// name a data file (.nhdr, .mhd, a JSON sidecar); the seeds' volumes fit it.
+inline const MemoryFiles& besideInput() {
+  static const MemoryFiles files = [] {
+    std::vector<std::byte> voxels(512);
+    for (std::size_t i = 0; i < voxels.size(); ++i) voxels[i] = static_cast<std::byte>(i * 37);
+    MemoryFiles f;
+    f.add("data.raw", std::move(voxels));
+    return f;
+  }();
+  return files;
 }
 
 // Called with each clean rejection; TESSERA_FUZZ_VERBOSE=1 prints them (to

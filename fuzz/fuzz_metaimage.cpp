@@ -1,4 +1,5 @@
-// libFuzzer target: readMetaImage on a .mha (header and data, raw or zlib, in one file).
+// libFuzzer target: readMetaImage on a .mha (header and data, raw or zlib, in one
+// file) or a header naming "data.raw".
 #include <cstddef>
 #include <cstdint>
 
@@ -12,10 +13,9 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static const std::filesystem::path file = tessera::fuzz::scratchDir() / "input.mha";
-  tessera::fuzz::writeBytes(file, data, size);
   try {
-    tessera::readMetaImage(file);
+    tessera::readMetaImage(tessera::fuzz::input("input.mha", data, size),
+                           tessera::fuzz::besideInput());
   } catch (const tessera::Error& e) {
     tessera::fuzz::rejected(e);
   }

@@ -1,4 +1,4 @@
-// libFuzzer target: readNrrd on a .nrrd with attached data (raw or gzip).
+// libFuzzer target: readNrrd on a .nrrd, or a detached header naming "data.raw".
 #include <cstddef>
 #include <cstdint>
 
@@ -12,10 +12,8 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static const std::filesystem::path file = tessera::fuzz::scratchDir() / "input.nrrd";
-  tessera::fuzz::writeBytes(file, data, size);
   try {
-    tessera::readNrrd(file);
+    tessera::readNrrd(tessera::fuzz::input("input.nrrd", data, size), tessera::fuzz::besideInput());
   } catch (const tessera::Error& e) {
     tessera::fuzz::rejected(e);
   }

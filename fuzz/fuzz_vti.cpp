@@ -12,10 +12,8 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static const std::filesystem::path file = tessera::fuzz::scratchDir() / "input.vti";
-  tessera::fuzz::writeBytes(file, data, size);
   try {
-    tessera::readVti(file);
+    tessera::readVti(tessera::fuzz::input("input.vti", data, size));
   } catch (const tessera::Error& e) {
     tessera::fuzz::rejected(e);
   }

@@ -16,13 +16,18 @@ PACKAGES=(
   python3-nibabel python3-pydicom python3-numpy          # independent NIfTI/DICOM readers in geometry tests
 )
 
-# playwright-core for the browser test, pinned by tests/browser/package-lock.json.
+# playwright-core for the browser test, pinned by tests/browser/package-lock.json;
+# pako for the web page (its inflater), pinned by web/package-lock.json.
 npm_deps() {
-  local dir
-  dir="$(cd "$(dirname "$0")/.." && pwd)/tests/browser"
-  if [ ! -d "$dir/node_modules/playwright-core" ]; then
+  local root
+  root="$(cd "$(dirname "$0")/.." && pwd)"
+  if [ ! -d "$root/tests/browser/node_modules/playwright-core" ]; then
     echo "setup: npm ci in tests/browser (playwright-core)"
-    (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error)
+    (cd "$root/tests/browser" && npm ci --no-audit --no-fund --loglevel=error)
+  fi
+  if [ ! -d "$root/web/node_modules/pako" ]; then
+    echo "setup: npm ci in web (pako)"
+    (cd "$root/web" && npm ci --no-audit --no-fund --loglevel=error)
   fi
 }
 

@@ -1,7 +1,8 @@
 // The page around the WebAssembly viewer core (web/src/WebViewer.cpp): input
 // events, the transfer-function editor canvas, file opening (read here,
-// never uploaded; gzip inflated with the browser's DecompressionStream) and
-// error messages. window.tessera exposes the same operations to tests.
+// never uploaded: the bytes go to the same io readers as the CLI's, whose
+// gzip/zlib the page's pako inflates) and error messages. window.tessera
+// exposes the same operations to tests.
 'use strict';
 
 (function () {
@@ -39,8 +40,9 @@
       init: c('tessera_init', 'number', ['number']),
       lastError: c('tessera_last_error', 'string', []),
       loadGenerated: c('tessera_load_generated', 'number', ['string']),
-      loadBytes: c('tessera_load_bytes', 'number', ['string', 'number', 'number', 'number']),
-      gzipPayloadOffset: c('tessera_gzip_payload_offset', 'number', ['number', 'number']),
+      addFile: c('tessera_add_file', null, ['string', 'number', 'number']),
+      loadFiles: c('tessera_load_files', 'number', []),
+      clearFiles: c('tessera_clear_files', null, []),
       render: c('tessera_render', 'number', ['number', 'number']),
       pointerDown: c('tessera_pointer_down', null, ['number', 'number', 'number', 'number']),
       pointerMove: c('tessera_pointer_move', null, ['number', 'number', 'number']),
@@ -117,43 +119,26 @@
 
   // ---------------------------------------------------------------- files
 
-  async function inflate(bytes) {
-    const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream('gzip'));
-    return new Uint8Array(await new Response(stream).arrayBuffer());
-  }
-
-  function withHeap(bytes, f) {
-    const p = M._malloc(Math.max(1, bytes.length));
-    if (!p) throw new Error(`cannot allocate ${bytes.length} bytes for the file`);
-    try {
-      M.HEAPU8.set(bytes, p);
-      return f(p, bytes.length);
-    } finally {
-      M._free(p);
-    }
-  }
-
-  // Reads a user's file; on failure shows why and keeps the current volume.
-  async function openFile(file) {
-    let bytes = new Uint8Array(await file.arrayBuffer());
-    let payloadInflated = 0;
-    try {
-      if (bytes.length >= 2 && bytes[0] === 0x1f && bytes[1] === 0x8b) bytes = await inflate(bytes);
-      const offset = withHeap(bytes, (p, n) => api.gzipPayloadOffset(p, n));
-      if (offset >= 0) {
-        const payload = await inflate(bytes.subarray(offset));
-        const joined = new Uint8Array(offset + payload.length);
-        joined.set(bytes.subarray(0, offset));
-        joined.set(payload, offset);
-        bytes = joined;
-        payloadInflated = 1;
+  // Reads files picked or dropped together (a header and its data: .nhdr +
+  // .raw, .mhd + .raw/.zraw, .hdr + .img, .json sidecar + .raw; or one
+  // self-contained file); the reader picks the one that names the others.
+  // On failure shows why and keeps the current volume.
+  async function openFiles(fileList) {
+    const files = Array.from(fileList);
+    if (files.length === 0) return false;
+    const contents = await Promise.all(files.map(async (f) => new Uint8Array(await f.arrayBuffer())));
+    for (let i = 0; i < files.length; i++) {
+      const bytes = contents[i];
+      const p = M._malloc(Math.max(1, bytes.length));
+      if (!p) {
+        showError(`${files[i].name}: cannot allocate ${bytes.length} bytes for the file; the previous volume stays`);
+        api.clearFiles();  // drops the files handed over so far
+        return false;
       }
-    } catch (e) {
-      showError(`${file.name}: not valid gzip data, it cannot be inflated (${e.message}); the previous volume stays`);
-      return false;
+      M.HEAPU8.set(bytes, p);
+      api.addFile(files[i].name, p, bytes.length);  // owned by the module from here on
     }
-    const ok = withHeap(bytes, (p, n) => api.loadBytes(file.name, p, n, payloadInflated));
-    if (!ok) {
+    if (!api.loadFiles()) {
       showError(`${api.lastError()} — the previous volume stays`);
       return false;
     }
@@ -387,17 +372,16 @@
   ['dragleave', 'drop'].forEach((t) => view.addEventListener(t, () => view.classList.remove('dragover')));
   view.addEventListener('drop', (e) => {
     e.preventDefault();
-    const f = e.dataTransfer && e.dataTransfer.files[0];
-    if (f) openFile(f);
+    if (e.dataTransfer && e.dataTransfer.files.length) openFiles(e.dataTransfer.files);
   });
 
   // ---------------------------------------------------------------- controls
 
   function bindControls() {
-    $('file').addEventListener('change', (e) => {
-      const f = e.target.files[0];
-      if (f) openFile(f);
+    $('file').addEventListener('change', async (e) => {
+      const files = Array.from(e.target.files);
       e.target.value = '';
+      if (files.length) await openFiles(files);
     });
     ['grey', 'mr-default', 'ct-bone', 'ct-muscle', 'bench'].forEach((n) => {
       const o = document.createElement('option');
@@ -492,7 +476,8 @@
     tf: () => JSON.parse(api.tfJson()),
     frames: () => frames,
     render: () => requestRender(),
-    openFile,
+    openFiles,
+    openFile: (file) => openFiles([file]),
     setCamera: (az, el, zoom) => { api.setCamera(az, el, zoom); return requestRender(); },
     setTfJson: (json) => { const ok = api.tfSetJson(json); tfEdited(); return ok; },
     error: () => ($('error').hidden ? '' : $('error').textContent),

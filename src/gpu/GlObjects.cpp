@@ -2,6 +2,7 @@
 
 #include <utility>
 
+#include "gpu/GlFormats.h"
 #include "gpu/gl.h"
 #include "tessera/core/Error.h"
 
@@ -69,6 +70,7 @@ Texture::Texture(Texture&& o) noexcept
       width_(o.width_),
       height_(o.height_),
       depth_(o.depth_),
+      format_(o.format_),
       entry_(std::move(o.entry_)) {}
 
 Texture& Texture::operator=(Texture&& o) noexcept {
@@ -79,6 +81,7 @@ Texture& Texture::operator=(Texture&& o) noexcept {
     width_ = o.width_;
     height_ = o.height_;
     depth_ = o.depth_;
+    format_ = o.format_;
     entry_ = std::move(o.entry_);
   }
   return *this;
@@ -155,6 +158,44 @@ Texture Texture::create3D(MemoryLedger& ledger, const std::string& label, GLenum
   return t;
 }
 
+Texture Texture::create2D(MemoryLedger& ledger, const std::string& label, TexelFormat format,
+                          int width, int height, const void* data) {
+  const GlFormat f = glFormat(format);
+  Texture t = create2D(ledger, label, f.internalFormat, width, height, f.format, f.type, data,
+                       f.texelBytes);
+  t.format_ = format;
+  return t;
+}
+
+Texture Texture::create3D(MemoryLedger& ledger, const std::string& label, TexelFormat format,
+                          int width, int height, int depth, const void* data) {
+  const GlFormat f = glFormat(format);
+  Texture t =
+      create3D(ledger, label, f.internalFormat, width, height, depth, f.format, f.type, data);
+  t.format_ = format;
+  return t;
+}
+
+void Texture::update(const void* data) {
+  updateRegion({0, 0, 0}, {width_, height_, depth_}, data);
+}
+
+void Texture::updateRegion(glm::ivec3 o, glm::ivec3 n, const void* data) {
+  const GlFormat f = glFormat(format_);
+  glBindTexture(target_, id_);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  if (target_ == GL_TEXTURE_3D) {
+    glTexSubImage3D(GL_TEXTURE_3D, 0, o.x, o.y, o.z, n.x, n.y, n.z, f.format, f.type, data);
+  } else {
+    glTexSubImage2D(GL_TEXTURE_2D, 0, o.x, o.y, n.x, n.y, f.format, f.type, data);
+  }
+}
+
+void Texture::setFilter(Filter filter) {
+  const GLenum f = filter == Filter::Nearest ? GL_NEAREST : GL_LINEAR;
+  setFilter(f, f);
+}
+
 void Texture::setFilter(GLenumT minFilter, GLenumT magFilter) {
   glBindTexture(target_, id_);
   glTexParameteri(target_, GL_TEXTURE_MIN_FILTER, static_cast<GLint>(minFilter));
@@ -209,15 +250,34 @@ Buffer Buffer::create(MemoryLedger& ledger, const std::string& label, GLenumT ta
   return b;
 }
 
+Buffer Buffer::create(MemoryLedger& ledger, const std::string& label, BufferKind kind,
+                      std::uint64_t bytes, const void* data, BufferUsage usage) {
+  return create(ledger, label,
+                kind == BufferKind::Vertices ? GL_ARRAY_BUFFER : GL_ELEMENT_ARRAY_BUFFER, bytes,
+                data, usage == BufferUsage::Static ? GL_STATIC_DRAW : GL_DYNAMIC_DRAW);
+}
+
+void Buffer::update(std::uint64_t offset, std::uint64_t bytes, const void* data) {
+  glBindBuffer(target_, id_);
+  glBufferSubData(target_, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), data);
+  glBindBuffer(target_, 0);
+}
+
 // ---------------------------------------------------------------- Framebuffer
 
 Framebuffer::Framebuffer(Framebuffer&& o) noexcept
-    : id_(std::exchange(o.id_, 0)), color_(std::move(o.color_)) {}
+    : id_(std::exchange(o.id_, 0)),
+      depth_(std::exchange(o.depth_, 0)),
+      depthEntry_(std::move(o.depthEntry_)),
+      color_(std::move(o.color_)) {}
 
 Framebuffer& Framebuffer::operator=(Framebuffer&& o) noexcept {
   if (this != &o) {
     if (id_) glDeleteFramebuffers(1, &id_);
+    if (depth_) glDeleteRenderbuffers(1, &depth_);
     id_ = std::exchange(o.id_, 0);
+    depth_ = std::exchange(o.depth_, 0);
+    depthEntry_ = std::move(o.depthEntry_);
     color_ = std::move(o.color_);
   }
   return *this;
@@ -225,6 +285,37 @@ Framebuffer& Framebuffer::operator=(Framebuffer&& o) noexcept {
 
 Framebuffer::~Framebuffer() {
   if (id_) glDeleteFramebuffers(1, &id_);
+  if (depth_) glDeleteRenderbuffers(1, &depth_);
+}
+
+Framebuffer Framebuffer::create(MemoryLedger& ledger, const std::string& label, int width,
+                                int height, TexelFormat color, bool depth) {
+  const GlFormat c = glFormat(color);
+  // Render targets are allocated without data: the upload type only has to
+  // be one ES accepts with the internal format (half floats for RGBA16F).
+  const GLenum type = color == TexelFormat::RGBA16F ? GL_HALF_FLOAT : c.type;
+  Framebuffer f;
+  f.color_ = Texture::create2D(ledger, label + " colour", c.internalFormat, width, height, c.format,
+                               type, nullptr, c.texelBytes);
+  f.color_.format_ = color;
+  glGenFramebuffers(1, &f.id_);
+  glBindFramebuffer(GL_FRAMEBUFFER, f.id_);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, f.color_.id(), 0);
+  if (depth) {
+    f.depthEntry_ = LedgerEntry(ledger, GpuResource::Renderbuffer,
+                                static_cast<std::uint64_t>(width) * height * 2, label + " depth");
+    glGenRenderbuffers(1, &f.depth_);
+    glBindRenderbuffer(GL_RENDERBUFFER, f.depth_);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT16, width, height);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, f.depth_);
+  }
+  const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    throw GpuError("framebuffer '" + label + "' " + std::to_string(width) + "x" +
+                   std::to_string(height) + " " + texelFormatName(color) + " incomplete (status " +
+                   std::to_string(status) + ")");
+  }
+  return f;
 }
 
 Framebuffer Framebuffer::create(MemoryLedger& ledger, const std::string& label, int width,

@@ -165,6 +165,9 @@ void Program::use() const {
 int Program::uniformLocation(const char* n) const {
   return glGetUniformLocation(id_, n);
 }
+int Program::attributeLocation(const char* n) const {
+  return glGetAttribLocation(id_, n);
+}
 void Program::set(const char* n, int v) const {
   glUniform1i(uniformLocation(n), v);
 }

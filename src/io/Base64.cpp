@@ -37,7 +37,7 @@ std::string shownChar(int c) {
 
 }  // namespace
 
-Base64Source::Base64Source(ByteSource& text, std::uint64_t maxChars, std::string what,
+Base64Stream::Base64Stream(ByteStream& text, std::uint64_t maxChars, std::string what,
                            std::uint64_t firstOffset)
     : text_(text),
       charsLeft_(maxChars),
@@ -45,11 +45,11 @@ Base64Source::Base64Source(ByteSource& text, std::uint64_t maxChars, std::string
       offset_(firstOffset),
       buf_(kTextChunk) {}
 
-void Base64Source::fail(const std::string& msg, std::uint64_t offset) const {
+void Base64Stream::fail(const std::string& msg, std::uint64_t offset) const {
   throw InputError(what_ + ": base64 data at byte " + std::to_string(offset) + ": " + msg);
 }
 
-int Base64Source::nextSymbol() {
+int Base64Stream::nextSymbol() {
   while (true) {
     if (pos_ == len_) {
       if (ended_ || charsLeft_ == 0) {
@@ -78,7 +78,7 @@ int Base64Source::nextSymbol() {
   }
 }
 
-bool Base64Source::decodeGroup() {
+bool Base64Stream::decodeGroup() {
   int sextets[4] = {0, 0, 0, 0};
   int n = 0;    // characters in this group
   int pad = 0;  // '=' among them
@@ -116,7 +116,7 @@ bool Base64Source::decodeGroup() {
   return true;
 }
 
-std::size_t Base64Source::read(std::byte* dst, std::size_t n) {
+std::size_t Base64Stream::read(std::byte* dst, std::size_t n) {
   std::size_t done = 0;
   while (done < n) {
     if (pendingPos_ == pendingLen_) {

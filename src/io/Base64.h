@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "io/ByteSource.h"
+#include "io/ByteStream.h"
 
 namespace tessera::io_detail {
 
@@ -24,9 +24,9 @@ constexpr std::uint64_t base64DecodedBound(std::uint64_t chars) {
 // (the tag after the text). Any other character that is not base64 is an
 // InputError naming `what` and the character's file offset (`firstOffset` is
 // the offset of the first character).
-class Base64Source : public ByteSource {
+class Base64Stream : public ByteStream {
  public:
-  Base64Source(ByteSource& text, std::uint64_t maxChars, std::string what,
+  Base64Stream(ByteStream& text, std::uint64_t maxChars, std::string what,
                std::uint64_t firstOffset);
   std::size_t read(std::byte* dst, std::size_t n) override;
 
@@ -37,7 +37,7 @@ class Base64Source : public ByteSource {
   bool decodeGroup();
   [[noreturn]] void fail(const std::string& msg, std::uint64_t offset) const;
 
-  ByteSource& text_;
+  ByteStream& text_;
   std::uint64_t charsLeft_;
   std::string what_;
   std::uint64_t offset_;  // file offset of the next character in buf_

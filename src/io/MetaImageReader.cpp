@@ -5,24 +5,19 @@
 // here, and keys we do not know are ignored, as MetaIO does.
 #include "tessera/io/MetaImageReader.h"
 
-#include <zlib.h>
-
 #include <algorithm>
-#include <array>
-#include <bit>
 #include <cctype>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <fstream>
 #include <optional>
 #include <vector>
 
 #include <glm/geometric.hpp>
 
-#include "io/ByteSource.h"
+#include "io/ByteStream.h"
+#include "io/HeaderText.h"
+#include "io/MetaIoOrientation.h"
 #include "io/VoxelLoader.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
@@ -33,6 +28,10 @@ namespace tessera {
 namespace {
 
 using io_detail::DiskType;
+using io_detail::metaOrientation;
+using io_detail::printable;
+using io_detail::trim;
+using io_detail::words;
 
 // A header is a few hundred bytes; these limits stop us from "parsing" a
 // large binary file as text.
@@ -62,41 +61,9 @@ struct MetaHeader {
   std::uint64_t headerEnd = 0;  // offset of the first byte after the header
 };
 
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r\n");
-  if (b == std::string::npos) return "";
-  const auto e = s.find_last_not_of(" \t\r\n");
-  return s.substr(b, e - b + 1);
-}
-
-std::vector<std::string> words(const std::string& s) {
-  std::vector<std::string> out;
-  std::size_t i = 0;
-  while (i < s.size()) {
-    while (i < s.size() && std::isspace(static_cast<unsigned char>(s[i]))) ++i;
-    const std::size_t b = i;
-    while (i < s.size() && !std::isspace(static_cast<unsigned char>(s[i]))) ++i;
-    if (i > b) out.push_back(s.substr(b, i - b));
-  }
-  return out;
-}
-
-std::string printable(const std::string& s, std::size_t max) {
-  std::string out;
-  for (char c : s.substr(0, max)) out += std::isprint(static_cast<unsigned char>(c)) ? c : '?';
-  return out;
-}
-
 std::string numberString(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
-std::string exactNumber(double v) {
-  char buf[40];
-  // + 0.0 turns -0 (from negating a 0 into LPS) into 0.
-  std::snprintf(buf, sizeof buf, "%.17g", v + 0.0);
   return buf;
 }
 
@@ -157,35 +124,12 @@ class LineParser {
 
 // Reads "Key = Value" lines up to and including ElementDataFile, which
 // MetaIO requires to be the last field of the header.
-MetaHeader parseHeader(const std::filesystem::path& path, const std::string& p) {
-  io_detail::FileByteSource in(path, 0);
-  std::vector<char> buf(64 * 1024);
-  std::size_t pos = 0;
-  std::size_t len = 0;
-  std::uint64_t consumed = 0;
-  auto nextLine = [&](std::string& line) -> bool {
-    line.clear();
-    bool any = false;
-    while (true) {
-      if (pos == len) {
-        len = in.read(reinterpret_cast<std::byte*>(buf.data()), buf.size());
-        pos = 0;
-        if (len == 0) return any;
-      }
-      const char c = buf[pos++];
-      any = true;
-      ++consumed;
-      if (c == '\n') break;
-      if (line.size() >= kMaxLineBytes) {
-        throw InputError(p + ": header line longer than " + std::to_string(kMaxLineBytes) +
-                         " bytes; is this a MetaImage file, and does its header end with "
-                         "ElementDataFile?");
-      }
-      line += c;
-    }
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    return true;
-  };
+MetaHeader parseHeader(const ByteSource& file) {
+  const std::string& p = file.name();
+  io_detail::LineReader lines(file, kMaxLineBytes,
+                              "; is this a MetaImage file, and does its header end with "
+                              "ElementDataFile?");
+  auto nextLine = [&](std::string& line) { return lines.next(line); };
 
   MetaHeader h;
   std::string line;
@@ -194,7 +138,7 @@ MetaHeader parseHeader(const std::filesystem::path& path, const std::string& p) 
   while (nextLine(line)) {
     ++lineNo;
     const LineParser parse(p, lineNo);
-    if (consumed > kMaxHeaderBytes) {
+    if (lines.consumed() > kMaxHeaderBytes) {
       parse.fail("MetaImage header longer than " + std::to_string(kMaxHeaderBytes) +
                  " bytes; does it end with ElementDataFile?");
     }
@@ -266,7 +210,7 @@ MetaHeader parseHeader(const std::filesystem::path& path, const std::string& p) 
     // ElementMin/Max and others change neither the voxels nor their place.
   }
   if (!sawField) throw InputError(p + ": not a MetaImage file: it has no 'Key = Value' lines");
-  h.headerEnd = consumed;
+  h.headerEnd = lines.consumed();
   return h;
 }
 
@@ -285,10 +229,9 @@ std::optional<DiskType> diskTypeFor(const std::string& name) {
   return std::nullopt;
 }
 
-bool startsZlibOrGzip(const std::filesystem::path& file, std::uint64_t offset) {
-  io_detail::FileByteSource src(file, offset);
+bool startsZlibOrGzip(const ByteSource& file, std::uint64_t offset) {
   unsigned char b[2] = {0, 0};
-  if (src.read(reinterpret_cast<std::byte*>(b), 2) < 2) return false;
+  if (file.read(offset, reinterpret_cast<std::byte*>(b), 2) < 2) return false;
   if (b[0] == 0x1f && b[1] == 0x8b) return true;
   // RFC 1950 §2.2: CM = 8 (deflate) and CMF*256 + FLG a multiple of 31.
   return (b[0] & 0x0f) == 8 && (b[0] * 256 + b[1]) % 31 == 0;
@@ -298,15 +241,15 @@ bool startsZlibOrGzip(const std::filesystem::path& file, std::uint64_t offset) {
 // none of them allocating: host budget, the size the header gives against the
 // file, deflate's ratio bound; then the stream is inflated into chunks as
 // bytes arrive, and only a complete stream gets a Volume.
-Volume loadCompressed(const MetaHeader& h, const std::filesystem::path& file,
+Volume loadCompressed(const MetaHeader& h, const ByteSource& file,
                       const io_detail::VoxelFormat& format, const std::string& p,
                       std::uint64_t start) {
   const std::uint64_t voxels = static_cast<std::uint64_t>(format.dims.x) *
                                static_cast<std::uint64_t>(format.dims.y) *
                                static_cast<std::uint64_t>(format.dims.z);
   const std::uint64_t diskBytes = voxels * io_detail::diskTypeSize(format.type);
-  const std::string inFile = file.string() == p ? std::string() : " in " + file.string();
-  const std::uint64_t fileSize = io_detail::regularFileSize(file);
+  const std::string inFile = file.name() == p ? std::string() : " in " + file.name();
+  const std::uint64_t fileSize = file.size();
   if (h.headerSize == -1) {
     if (!h.compressedDataSize) {
       throw InputError(p +
@@ -351,7 +294,7 @@ Volume loadCompressed(const MetaHeader& h, const std::filesystem::path& file,
     throw InputError(p + ": CompressedData = True, but the bytes at offset " +
                      std::to_string(start) + inFile + " do not start a zlib stream");
   }
-  io_detail::GzipByteSource zlib(file, start);
+  io_detail::InflateStream zlib(file, start);
   io_detail::ChunkedBuffer inflated = io_detail::ChunkedBuffer::readUpTo(zlib, diskBytes);
   if (inflated.size() < diskBytes) {
     throw InputError(p + ": zlib data ends after " + std::to_string(inflated.size()) + " of " +
@@ -406,40 +349,15 @@ glm::dmat4 lpsAffine(const MetaHeader& h, std::int64_t n, glm::dvec3 spacing, gl
   return a;
 }
 
-// MetaIO's AnatomicalOrientation letters name the side each index axis
-// comes *from* (MET_OrientationTypeName "RL" -> 'R'; ITK writes RightToLeft
-// as 'R'), the opposite of nibabel's axis codes: identity LPS is "RAI".
-char fromLetter(char toLetter) {
-  switch (toLetter) {
-    case 'R':
-      return 'L';
-    case 'L':
-      return 'R';
-    case 'A':
-      return 'P';
-    case 'P':
-      return 'A';
-    case 'S':
-      return 'I';
-    case 'I':
-      return 'S';
-    default:
-      return '?';
-  }
-}
-
-std::string metaOrientation(const glm::dmat3& rasDirection) {
-  std::string code = orientationOf(rasDirection).code;
-  for (char& c : code) c = fromLetter(c);
-  return code;
-}
-
 }  // namespace
 
 Volume readMetaImage(const std::filesystem::path& path) {
-  const std::string p = path.string();
-  io_detail::regularFileSize(path);  // nonexistent / directory → InputError with the path
-  const MetaHeader h = parseHeader(path, p);
+  return readMetaImage(FileSource(path), FolderFiles());
+}
+
+Volume readMetaImage(const ByteSource& header, const FileSet& files) {
+  const std::string& p = header.name();
+  const MetaHeader h = parseHeader(header);
 
   auto require = [&](bool ok, const char* key) {
     if (!ok) throw InputError(p + ": MetaImage header has no '" + std::string(key) + "' field");
@@ -521,7 +439,7 @@ Volume readMetaImage(const std::filesystem::path& path) {
   // Where the voxels are. MetaIO spreads them over several files for
   // "LIST" and for a printf pattern ("slice%03d.raw 1 40 1").
   const std::string& name = *h.dataFile;
-  std::filesystem::path file = path;
+  std::unique_ptr<ByteSource> dataFile;
   std::uint64_t start = h.headerEnd;
   if (name == "LOCAL" || name == "Local" || name == "local") {
     // data follows the header in this file
@@ -529,15 +447,15 @@ Volume readMetaImage(const std::filesystem::path& path) {
     throw InputError(p + ": ElementDataFile = " + name +
                      " spreads the data over several files; not supported (use one data file)");
   } else {
-    file = std::filesystem::path(name);
-    if (file.is_relative()) file = path.parent_path() / file;  // relative to the header
-    start = 0;
+    // Relative to the header's folder.
     try {
-      io_detail::regularFileSize(file);
+      dataFile = files.open(files.resolve(header, name));
     } catch (const InputError& e) {
       throw InputError(p + ": ElementDataFile " + name + ": " + e.what());
     }
+    start = 0;
   }
+  const ByteSource& file = dataFile ? *dataFile : header;
   // MetaIO seeks to HeaderSize from the start of the data file (for LOCAL
   // data, of this file); -1 means the voxels are the file's last bytes.
   if (h.headerSize > 0) start = static_cast<std::uint64_t>(h.headerSize);
@@ -547,7 +465,7 @@ Volume readMetaImage(const std::filesystem::path& path) {
     v = loadCompressed(h, file, format, p, start);
   } else {
     io_detail::VoxelSource source;
-    source.file = file;
+    source.file = &file;
     source.fileOffset = start;
     source.atEndOfFile = h.headerSize == -1;
     v = io_detail::loadVoxels(source, format, p);
@@ -572,176 +490,12 @@ Volume readMetaImage(const std::filesystem::path& path) {
   std::string description = "MetaImage " + p + " (" + io_detail::dimsString(format.dims) + " " +
                             std::string(io_detail::diskTypeName(format.type)) + ", " +
                             (h.compressed ? "zlib" : "raw");
-  if (file != path) description += ", data in " + file.filename().string();
+  if (dataFile)
+    description += ", data in " + std::filesystem::path(file.name()).filename().string();
   if (io_detail::isConvertedToF32(format.type)) description += ", converted to f32";
   if (format.type == DiskType::I8) description += ", widened to i16";
   v.setDescription(description + ")");
   return v;
-}
-
-namespace {
-
-class MetaOutput {
- public:
-  explicit MetaOutput(const std::filesystem::path& path)
-      : path_(path), out_(path, std::ios::binary) {
-    if (!out_) fail("cannot open for writing");
-  }
-  void write(const void* data, std::size_t n) {
-    out_.write(static_cast<const char*>(data), static_cast<std::streamsize>(n));
-    if (!out_) fail("write failed");
-  }
-  void close() {
-    out_.close();
-    if (!out_) fail("write failed");
-  }
-
- private:
-  [[noreturn]] void fail(const char* what) const {
-    throw Error(path_.string() + ": " + what + ": " + std::strerror(errno));
-  }
-  std::filesystem::path path_;
-  std::ofstream out_;
-};
-
-// Calls `sink(bytes, n)` with the voxels in little-endian order, chunk by chunk.
-template <class Sink>
-void forEachLittleEndianChunk(const Volume& v, Sink&& sink) {
-  const std::span<const std::byte> bytes = v.bytes();
-  const std::size_t elem = bytesPerVoxel(v.type());
-  constexpr std::size_t kChunk = 1 << 20;
-  std::vector<std::byte> swapped;
-  for (std::size_t at = 0; at < bytes.size(); at += kChunk) {
-    const std::size_t n = std::min(kChunk, bytes.size() - at);
-    const std::byte* chunk = bytes.data() + at;
-    if constexpr (std::endian::native == std::endian::big) {
-      swapped.assign(chunk, chunk + n);
-      for (std::size_t i = 0; i + elem <= n; i += elem) {
-        std::reverse(swapped.begin() + static_cast<std::ptrdiff_t>(i),
-                     swapped.begin() + static_cast<std::ptrdiff_t>(i + elem));
-      }
-      chunk = swapped.data();
-    }
-    sink(chunk, n);
-  }
-  (void)elem;
-}
-
-// One zlib stream (RFC 1950), as MetaIO's MET_PerformCompression writes;
-// held in memory because CompressedDataSize precedes it in the header.
-std::vector<unsigned char> zlibCompress(const Volume& v, const std::filesystem::path& path) {
-  z_stream zs{};
-  if (deflateInit(&zs, Z_DEFAULT_COMPRESSION) != Z_OK) {
-    throw Error(path.string() + ": cannot start zlib compression");
-  }
-  std::vector<unsigned char> out;
-  std::vector<unsigned char> buf(256 * 1024);
-  auto pump = [&](const std::byte* data, std::size_t n, int flush) {
-    zs.next_in = reinterpret_cast<Bytef*>(const_cast<std::byte*>(data));
-    zs.avail_in = static_cast<uInt>(n);
-    int ret;
-    do {
-      zs.next_out = buf.data();
-      zs.avail_out = static_cast<uInt>(buf.size());
-      ret = deflate(&zs, flush);
-      if (ret == Z_STREAM_ERROR) {
-        deflateEnd(&zs);
-        throw Error(path.string() + ": zlib compression failed");
-      }
-      out.insert(out.end(), buf.data(), buf.data() + (buf.size() - zs.avail_out));
-    } while (zs.avail_out == 0 || (flush == Z_FINISH && ret != Z_STREAM_END));
-  };
-  forEachLittleEndianChunk(v, [&](const std::byte* p, std::size_t n) { pump(p, n, Z_NO_FLUSH); });
-  pump(nullptr, 0, Z_FINISH);
-  deflateEnd(&zs);
-  return out;
-}
-
-const char* metTypeName(ScalarType t) {
-  switch (t) {
-    case ScalarType::U8:
-      return "MET_UCHAR";
-    case ScalarType::U16:
-      return "MET_USHORT";
-    case ScalarType::I16:
-      return "MET_SHORT";
-    case ScalarType::F32:
-      return "MET_FLOAT";
-  }
-  return "MET_UCHAR";
-}
-
-}  // namespace
-
-void writeMetaImage(const Volume& volume, const std::filesystem::path& path, bool compressed) {
-  const std::string p = path.string();
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (ext != ".mha" && ext != ".mhd") {
-    throw InputError(p +
-                     ": a MetaImage file name ends in .mha (one file) or .mhd (header + data "
-                     "file)");
-  }
-  const glm::ivec3 d = volume.dims();
-  if (d.x <= 0 || d.y <= 0 || d.z <= 0 || !volume.hasData()) {
-    throw InputError(p + ": cannot write an empty volume (" + io_detail::dimsString(d) + ")");
-  }
-  const bool local = ext == ".mha";
-  const std::string dataName = path.stem().string() + (compressed ? ".zraw" : ".raw");
-
-  std::vector<unsigned char> packed;
-  if (compressed) packed = zlibCompress(volume, path);
-
-  const glm::dvec3 s = volume.spacing();
-  // LPS, as ITK writes: one unit direction per index axis (see lpsAffine).
-  const glm::dmat3 toLps = lpsToRas();  // its own inverse
-  const glm::dvec3 o = toLps * volume.origin();
-  std::string matrix;
-  for (int a = 0; a < 3; ++a) {
-    const glm::dvec3 axis = toLps * volume.direction()[a];
-    for (int k = 0; k < 3; ++k) {
-      if (!matrix.empty()) matrix += ' ';
-      matrix += exactNumber(axis[k]);
-    }
-  }
-  // The field order of ITK's writer; ElementDataFile must come last.
-  std::string header = "ObjectType = Image\nNDims = 3\nBinaryData = True\n";
-  header += "BinaryDataByteOrderMSB = False\n";
-  header += std::string("CompressedData = ") + (compressed ? "True" : "False") + "\n";
-  if (compressed) header += "CompressedDataSize = " + std::to_string(packed.size()) + "\n";
-  header += "TransformMatrix = " + matrix + "\n";
-  header += "Offset = " + exactNumber(o.x) + " " + exactNumber(o.y) + " " + exactNumber(o.z) + "\n";
-  header +=
-      "CenterOfRotation = 0 0 0\nAnatomicalOrientation = " + metaOrientation(volume.direction()) +
-      "\n";
-  header += "ElementSpacing = " + exactNumber(s.x) + " " + exactNumber(s.y) + " " +
-            exactNumber(s.z) + "\n";
-  header += "DimSize = " + std::to_string(d.x) + " " + std::to_string(d.y) + " " +
-            std::to_string(d.z) + "\n";
-  header += std::string("ElementType = ") + metTypeName(volume.type()) + "\n";
-  header += "ElementDataFile = " + (local ? std::string("LOCAL") : dataName) + "\n";
-
-  auto writeData = [&](MetaOutput& out) {
-    if (compressed) {
-      out.write(packed.data(), packed.size());
-    } else {
-      forEachLittleEndianChunk(volume, [&](const std::byte* b, std::size_t n) { out.write(b, n); });
-    }
-  };
-  if (local) {
-    MetaOutput out(path);
-    out.write(header.data(), header.size());
-    writeData(out);
-    out.close();
-    return;
-  }
-  MetaOutput data(path.parent_path() / dataName);
-  writeData(data);
-  data.close();
-  MetaOutput out(path);
-  out.write(header.data(), header.size());
-  out.close();
 }
 
 }  // namespace tessera

@@ -1,16 +1,20 @@
+// NIfTI-1 and NIfTI-2 (and ANALYZE 7.5 .hdr/.img pairs), read from the
+// header bytes themselves: both headers are fixed structs (nifti1.h,
+// nifti2.h; the field offsets are below), in the byte order that sizeof_hdr
+// reveals. nifticlib is not used to read: it takes only paths, and it
+// silently repairs headers (dim[i] <= 0 becomes 1, pixdim 0 becomes 1, a
+// NIfTI-1 vox_offset float is cast to int unchecked) where Tessera names the
+// problem. It remains the NIfTI writer and the test oracle for the affines.
 #include "tessera/io/NiftiReader.h"
 
-#include <nifti2_io.h>
-#include <zlib.h>
-
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
 #include <cstring>
-#include <memory>
 #include <sstream>
 
-#include "io/ByteSource.h"
+#include "io/ByteStream.h"
 #include "io/VoxelLoader.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
@@ -26,11 +30,8 @@ constexpr std::int64_t kMaxDim = 1 << 20;
 constexpr int kNifti1HeaderSize = 348;
 constexpr int kNifti2HeaderSize = 540;
 
-// The header fields we check ourselves, in NIfTI-2 widths. We read them from
-// the raw header because nifticlib silently repairs some of them (dim[i] <= 0
-// becomes 1, pixdim 0 becomes 1) and casts a NIfTI-1 vox_offset float to int
-// unchecked; Tessera wants to name such problems instead.
-struct RawHeader {
+// The header fields Tessera uses, in NIfTI-2 widths.
+struct Header {
   int version = 0;  // 0 = ANALYZE 7.5, 1 = NIfTI-1, 2 = NIfTI-2
   bool swapped = false;
   bool singleFile = false;  // magic "n+1"/"n+2": header and voxels in one file
@@ -41,6 +42,29 @@ struct RawHeader {
   double sclSlope = 0.0;
   double sclInter = 0.0;
   NiftiGeometryFields geometry;
+};
+
+// Reads fixed-width fields of the header bytes in the file's byte order.
+class Fields {
+ public:
+  Fields(const std::byte* bytes, bool swapped) : bytes_(bytes), swapped_(swapped) {}
+
+  template <class T>
+  T at(std::size_t offset) const {
+    std::array<std::byte, sizeof(T)> b;
+    std::memcpy(b.data(), bytes_ + offset, sizeof(T));
+    if (swapped_) std::reverse(b.begin(), b.end());
+    T v;
+    std::memcpy(&v, b.data(), sizeof(T));
+    return v;
+  }
+  const char* text(std::size_t offset) const {
+    return reinterpret_cast<const char*>(bytes_ + offset);
+  }
+
+ private:
+  const std::byte* bytes_;
+  bool swapped_;
 };
 
 std::string quoteMagic(const char* m, std::size_t n) {
@@ -64,172 +88,184 @@ std::string numberString(double v) {
   return os.str();
 }
 
+bool endsWith(const std::string& name, const std::string& suffix) {
+  return name.size() >= suffix.size() &&
+         name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
 // ANALYZE 7.5 headers (no NIfTI magic) are only plausible as the .hdr of a
 // .hdr/.img pair; a .nii without magic is a broken file.
-bool isAnalyzePairName(const std::filesystem::path& path) {
-  const std::string name = path.filename().string();
-  auto endsWith = [&](const std::string& suffix) {
-    return name.size() >= suffix.size() &&
-           name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
-  };
-  return endsWith(".hdr") || endsWith(".hdr.gz") || endsWith(".HDR");
+bool isAnalyzePairName(const std::string& name) {
+  return endsWith(name, ".hdr") || endsWith(name, ".hdr.gz") || endsWith(name, ".HDR");
 }
 
-// The placement fields of either header version (already in native byte
-// order); NiftiGeometry turns them into the affine.
-template <class Header>
-NiftiGeometryFields geometryFields(const Header& n) {
-  NiftiGeometryFields g;
-  g.version = sizeof(Header) == sizeof(nifti_2_header) ? 2 : 1;
-  for (int a = 0; a < 3; ++a) g.dim[static_cast<std::size_t>(a)] = n.dim[a + 1];
-  for (int a = 0; a < 4; ++a) g.pixdim[static_cast<std::size_t>(a)] = n.pixdim[a];
-  g.qformCode = n.qform_code;
-  g.sformCode = n.sform_code;
-  g.quaternB = n.quatern_b;
-  g.quaternC = n.quatern_c;
-  g.quaternD = n.quatern_d;
-  g.qoffset = glm::dvec3(n.qoffset_x, n.qoffset_y, n.qoffset_z);
-  for (int c = 0; c < 4; ++c) {
-    const auto i = static_cast<std::size_t>(c);
-    g.srow[0][i] = n.srow_x[c];
-    g.srow[1][i] = n.srow_y[c];
-    g.srow[2][i] = n.srow_z[c];
+// NIfTI-1 field offsets (nifti1.h, struct nifti_1_header).
+Header nifti1(const Fields& f) {
+  Header h;
+  h.version = 1;
+  for (std::size_t i = 0; i < 8; ++i) {
+    h.dim[i] = f.at<std::int16_t>(40 + 2 * i);
+    h.pixdim[i] = f.at<float>(76 + 4 * i);
   }
-  return g;
-}
-
-// ANALYZE 7.5 has no qform/sform (those bytes hold other fields); SPM keeps
-// an origin voxel in hist.originator, 3 int16 from byte 253 (dbh.h).
-NiftiGeometryFields analyzeGeometryFields(const nifti_1_header& n, const unsigned char* raw,
-                                          bool swapped) {
-  NiftiGeometryFields g;
-  g.version = 0;
-  for (int a = 0; a < 3; ++a) g.dim[static_cast<std::size_t>(a)] = n.dim[a + 1];
-  for (int a = 0; a < 4; ++a) g.pixdim[static_cast<std::size_t>(a)] = n.pixdim[a];
-  for (int a = 0; a < 3; ++a) {
-    std::uint16_t u;
-    std::memcpy(&u, raw + 253 + 2 * a, 2);
-    if (swapped) u = static_cast<std::uint16_t>((u >> 8) | (u << 8));
-    g.spmOrigin[static_cast<std::size_t>(a)] = static_cast<std::int16_t>(u);
-  }
-  return g;
-}
-
-// Reads the first 540 bytes (inflating if gzip: zlib's gz* functions pass
-// plain files through) and decodes sizeof_hdr, magic and the fields above.
-RawHeader readRawHeader(const std::filesystem::path& path) {
-  const std::string p = path.string();
-  gzFile gz = gzopen(p.c_str(), "rb");
-  if (gz == nullptr) throw InputError(p + ": cannot open");
-  std::array<unsigned char, kNifti2HeaderSize> buf{};
-  const int got = gzread(gz, buf.data(), static_cast<unsigned>(buf.size()));
-  int zerr = Z_OK;
-  const std::string zmsg = got < 0 ? gzerror(gz, &zerr) : "";
-  gzclose(gz);
-  if (got < 0) throw InputError(p + ": cannot read the NIfTI header: " + zmsg);
-  if (got < 4) {
-    throw InputError(p + ": has only " + std::to_string(got) +
-                     " bytes, too short for a NIfTI header (348 bytes for NIfTI-1)");
-  }
-
-  std::int32_t sizeofHdr;
-  std::memcpy(&sizeofHdr, buf.data(), 4);
-  const std::int32_t swappedSize =
-      static_cast<std::int32_t>(__builtin_bswap32(static_cast<std::uint32_t>(sizeofHdr)));
-  RawHeader h;
-  if (sizeofHdr == kNifti1HeaderSize || sizeofHdr == kNifti2HeaderSize) {
-    h.version = sizeofHdr == kNifti1HeaderSize ? 1 : 2;
-  } else if (swappedSize == kNifti1HeaderSize || swappedSize == kNifti2HeaderSize) {
-    h.version = swappedSize == kNifti1HeaderSize ? 1 : 2;
-    h.swapped = true;
-  } else {
-    throw InputError(p + ": not a NIfTI file: sizeof_hdr is " + std::to_string(sizeofHdr) +
-                     ", expected 348 (NIfTI-1) or 540 (NIfTI-2)");
-  }
-  const int need = h.version == 1 ? kNifti1HeaderSize : kNifti2HeaderSize;
-  if (got < need) {
-    throw InputError(p + ": file ends after " + std::to_string(got) + " of the " +
-                     std::to_string(need) + " bytes of its NIfTI-" + std::to_string(h.version) +
-                     " header");
-  }
-
-  if (h.version == 1) {
-    nifti_1_header n1;
-    std::memcpy(&n1, buf.data(), sizeof n1);
-    if (h.swapped) nifti_swap_as_nifti1(&n1);
-    if (std::memcmp(n1.magic, "n+1", 4) == 0) {
-      h.singleFile = true;
-    } else if (std::memcmp(n1.magic, "ni1", 4) != 0) {
-      h.version = 0;  // no NIfTI magic: an ANALYZE 7.5 header
-    }
-    for (int i = 0; i < 8; ++i) {
-      h.dim[i] = n1.dim[i];
-      h.pixdim[i] = n1.pixdim[i];
-    }
-    h.datatype = n1.datatype;
-    h.voxOffset = n1.vox_offset;
-    h.sclSlope = n1.scl_slope;
-    h.sclInter = n1.scl_inter;
-    h.geometry = geometryFields(n1);
-    if (h.version == 0 && !isAnalyzePairName(path)) {
-      throw InputError(p + ": NIfTI-1 magic is " + quoteMagic(n1.magic, 4) +
-                       ", expected 'n+1' (a .nii file) or 'ni1' (a .hdr/.img pair)");
-    }
-    if (h.version == 0) h.geometry = analyzeGeometryFields(n1, buf.data(), h.swapped);
-  } else {
-    nifti_2_header n2;
-    std::memcpy(&n2, buf.data(), sizeof n2);
-    if (h.swapped) nifti_swap_as_nifti2(&n2);
-    if (std::memcmp(n2.magic, "n+2", 4) == 0) {
-      h.singleFile = true;
-    } else if (std::memcmp(n2.magic, "ni2", 4) != 0) {
-      throw InputError(p + ": NIfTI-2 magic is " + quoteMagic(n2.magic, 4) +
-                       ", expected 'n+2' or 'ni2'");
-    }
-    for (int i = 0; i < 8; ++i) {
-      h.dim[i] = n2.dim[i];
-      h.pixdim[i] = n2.pixdim[i];
-    }
-    h.datatype = n2.datatype;
-    h.voxOffset = static_cast<double>(n2.vox_offset);
-    h.sclSlope = n2.scl_slope;
-    h.sclInter = n2.scl_inter;
-    h.geometry = geometryFields(n2);
+  h.datatype = f.at<std::int16_t>(70);
+  h.voxOffset = f.at<float>(108);
+  h.sclSlope = f.at<float>(112);
+  h.sclInter = f.at<float>(116);
+  NiftiGeometryFields& g = h.geometry;
+  g.qformCode = f.at<std::int16_t>(252);
+  g.sformCode = f.at<std::int16_t>(254);
+  g.quaternB = f.at<float>(256);
+  g.quaternC = f.at<float>(260);
+  g.quaternD = f.at<float>(264);
+  g.qoffset = glm::dvec3(f.at<float>(268), f.at<float>(272), f.at<float>(276));
+  for (std::size_t row = 0; row < 3; ++row) {
+    for (std::size_t col = 0; col < 4; ++col)
+      g.srow[row][col] = f.at<float>(280 + 16 * row + 4 * col);
   }
   return h;
 }
 
+// NIfTI-2 field offsets (nifti2.h, struct nifti_2_header).
+Header nifti2(const Fields& f) {
+  Header h;
+  h.version = 2;
+  for (std::size_t i = 0; i < 8; ++i) {
+    h.dim[i] = f.at<std::int64_t>(16 + 8 * i);
+    h.pixdim[i] = f.at<double>(104 + 8 * i);
+  }
+  h.datatype = f.at<std::int16_t>(12);
+  h.voxOffset = static_cast<double>(f.at<std::int64_t>(168));
+  h.sclSlope = f.at<double>(176);
+  h.sclInter = f.at<double>(184);
+  NiftiGeometryFields& g = h.geometry;
+  g.qformCode = f.at<std::int32_t>(344);
+  g.sformCode = f.at<std::int32_t>(348);
+  g.quaternB = f.at<double>(352);
+  g.quaternC = f.at<double>(360);
+  g.quaternD = f.at<double>(368);
+  g.qoffset = glm::dvec3(f.at<double>(376), f.at<double>(384), f.at<double>(392));
+  for (std::size_t row = 0; row < 3; ++row) {
+    for (std::size_t col = 0; col < 4; ++col)
+      g.srow[row][col] = f.at<double>(400 + 32 * row + 8 * col);
+  }
+  return h;
+}
+
+// Reads the first 540 bytes (inflated if gzip) and decodes sizeof_hdr,
+// magic and the fields above.
+Header readHeader(const ByteSource& file) {
+  const std::string& p = file.name();
+  std::array<std::byte, kNifti2HeaderSize> buf{};
+  std::size_t got = 0;
+  if (io_detail::startsWithGzipMagic(file)) {
+    io_detail::InflateStream gz(file, 0);
+    got = gz.read(buf.data(), buf.size());
+  } else {
+    got = file.read(0, buf.data(), buf.size());
+  }
+  if (got < 4) {
+    throw InputError(p + ": has only " + std::to_string(got) +
+                     " bytes, too short for a NIfTI header (348 bytes for NIfTI-1)");
+  }
+  std::int32_t sizeofHdr;
+  std::memcpy(&sizeofHdr, buf.data(), 4);
+  const std::int32_t swappedSize =
+      static_cast<std::int32_t>(__builtin_bswap32(static_cast<std::uint32_t>(sizeofHdr)));
+  int version = 0;
+  bool swapped = false;
+  if (sizeofHdr == kNifti1HeaderSize || sizeofHdr == kNifti2HeaderSize) {
+    version = sizeofHdr == kNifti1HeaderSize ? 1 : 2;
+  } else if (swappedSize == kNifti1HeaderSize || swappedSize == kNifti2HeaderSize) {
+    version = swappedSize == kNifti1HeaderSize ? 1 : 2;
+    swapped = true;
+  } else {
+    throw InputError(p + ": not a NIfTI file: sizeof_hdr is " + std::to_string(sizeofHdr) +
+                     ", expected 348 (NIfTI-1) or 540 (NIfTI-2)");
+  }
+  const std::size_t need = version == 1 ? kNifti1HeaderSize : kNifti2HeaderSize;
+  if (got < need) {
+    throw InputError(p + ": file ends after " + std::to_string(got) + " of the " +
+                     std::to_string(need) + " bytes of its NIfTI-" + std::to_string(version) +
+                     " header");
+  }
+  const Fields f(buf.data(), swapped);
+  Header h = version == 1 ? nifti1(f) : nifti2(f);
+  h.swapped = swapped;
+  if (version == 1) {
+    const char* magic = f.text(344);
+    if (std::memcmp(magic, "n+1", 4) == 0) {
+      h.singleFile = true;
+    } else if (std::memcmp(magic, "ni1", 4) != 0) {
+      if (!isAnalyzePairName(p)) {
+        throw InputError(p + ": NIfTI-1 magic is " + quoteMagic(magic, 4) +
+                         ", expected 'n+1' (a .nii file) or 'ni1' (a .hdr/.img pair)");
+      }
+      // ANALYZE 7.5: no qform/sform (those bytes hold other fields); SPM
+      // keeps an origin voxel in hist.originator, 3 int16 from byte 253.
+      h.version = 0;
+      h.geometry = NiftiGeometryFields{};
+      for (std::size_t a = 0; a < 3; ++a) h.geometry.spmOrigin[a] = f.at<std::int16_t>(253 + 2 * a);
+    }
+  } else {
+    const char* magic = f.text(4);
+    if (std::memcmp(magic, "n+2", 4) == 0) {
+      h.singleFile = true;
+    } else if (std::memcmp(magic, "ni2", 4) != 0) {
+      throw InputError(p + ": NIfTI-2 magic is " + quoteMagic(magic, 4) +
+                       ", expected 'n+2' or 'ni2'");
+    }
+  }
+  NiftiGeometryFields& g = h.geometry;
+  g.version = h.version;
+  for (std::size_t a = 0; a < 3; ++a) g.dim[a] = h.dim[a + 1];
+  for (std::size_t a = 0; a < 4; ++a) g.pixdim[a] = h.pixdim[a];
+  return h;
+}
+
+// nifti1.h's names of the datatype codes.
+std::string datatypeName(int datatype) {
+  static const std::pair<int, const char*> kNames[] = {
+      {1, "BINARY"},    {2, "UINT8"},       {4, "INT16"},         {8, "INT32"},
+      {16, "FLOAT32"},  {32, "COMPLEX64"},  {64, "FLOAT64"},      {128, "RGB24"},
+      {256, "INT8"},    {512, "UINT16"},    {768, "UINT32"},      {1024, "INT64"},
+      {1280, "UINT64"}, {1536, "FLOAT128"}, {1792, "COMPLEX128"}, {2048, "COMPLEX256"},
+      {2304, "RGBA32"},
+  };
+  for (const auto& [code, name] : kNames) {
+    if (code == datatype) return name;
+  }
+  return "not a NIfTI datatype";
+}
+
 DiskType diskTypeOf(int datatype, const std::string& p) {
   switch (datatype) {
-    case DT_UINT8:
+    case 2:
       return DiskType::U8;
-    case DT_INT8:
+    case 256:
       return DiskType::I8;
-    case DT_UINT16:
+    case 512:
       return DiskType::U16;
-    case DT_INT16:
+    case 4:
       return DiskType::I16;
-    case DT_UINT32:
+    case 768:
       return DiskType::U32;
-    case DT_INT32:
+    case 8:
       return DiskType::I32;
-    case DT_FLOAT32:
+    case 16:
       return DiskType::F32;
-    case DT_FLOAT64:
+    case 64:
       return DiskType::F64;
     default:
       break;
   }
-  const std::string name = nifti_datatype_string(datatype);
   throw InputError(p + ": NIfTI datatype " + std::to_string(datatype) + " (" +
-                   (name.find("ILLEGAL") != std::string::npos ? "not a NIfTI datatype" : name) +
+                   datatypeName(datatype) +
                    ") is not supported; expected uint8, int8, uint16, int16, uint32, int32, "
                    "float32 or float64");
 }
 
-// The checks nifticlib would skip or paper over; every message names the
-// field and its value.
-void validate(const RawHeader& h, const std::string& p) {
+// Every message names the field and its value.
+void validate(const Header& h, const std::string& p) {
   const std::int64_t ndim = h.dim[0];
   if (ndim < 3 || ndim > 7) {
     throw InputError(p + ": dim[0] is " + std::to_string(ndim) +
@@ -265,49 +301,46 @@ void validate(const RawHeader& h, const std::string& p) {
   diskTypeOf(h.datatype, p);
 }
 
-struct NiftiImageFree {
-  void operator()(nifti_image* nim) const { nifti_image_free(nim); }
-};
+// The .img of a .hdr (or of a .nii with magic "ni1"/"ni2"), as nifticlib's
+// nifti_findimgname looks for it: the name without .gz and its extension,
+// plus .img, then .img.gz (upper case for an upper-case header name).
+std::unique_ptr<ByteSource> openImageFile(const ByteSource& header, const FileSet& files) {
+  const std::string& p = header.name();
+  std::string base = std::filesystem::path(p).filename().string();
+  if (endsWith(base, ".gz")) base.resize(base.size() - 3);
+  const bool upper = endsWith(base, ".HDR") || endsWith(base, ".NII");
+  base = std::filesystem::path(base).replace_extension().string();
+  const std::string img = upper ? ".IMG" : ".img";
+  for (const std::string& candidate : {base + img, base + img + ".gz"}) {
+    const std::string resolved = files.resolve(header, candidate);
+    if (files.contains(resolved)) return files.open(resolved);
+  }
+  throw InputError(p + ": cannot find the image file for this header (expected " + base + img +
+                   " or " + base + img + ".gz beside it)");
+}
 
 }  // namespace
 
 Volume readNifti(const std::filesystem::path& path) {
-  const std::string p = path.string();
-  const std::uint64_t fileSize = io_detail::regularFileSize(path);
-  const RawHeader raw = readRawHeader(path);
-  validate(raw, p);
+  return readNifti(FileSource(path), FolderFiles());
+}
 
-  // Bound vox_offset by what the file can hold before nifticlib reads the
-  // extensions that sit between the header and the voxels.
-  const bool gzipped = io_detail::startsWithGzipMagic(path);
-  if (raw.singleFile) {
-    const std::uint64_t limit = gzipped ? fileSize * io_detail::kMaxDeflateRatio : fileSize;
-    if (raw.voxOffset > static_cast<double>(limit)) {
-      throw InputError(
-          p + ": vox_offset " + numberString(raw.voxOffset) + " lies beyond the end of the file (" +
-          formatBytes(fileSize) +
-          (gzipped ? " of gzip data, at most " + formatBytes(limit) + " inflated)" : ")"));
-    }
-  }
-
-  nifti_set_debug_level(0);  // we report problems ourselves, nifticlib would print to stderr
-  std::unique_ptr<nifti_image, NiftiImageFree> nim(nifti_image_read(p.c_str(), 0));
-  if (!nim) throw InputError(p + ": nifticlib could not read the NIfTI header");
-  if (nim->iname == nullptr) {
-    throw InputError(p + ": cannot find the image file for this header (expected .img or .img.gz)");
-  }
+Volume readNifti(const ByteSource& file, const FileSet& files) {
+  const std::string& p = file.name();
+  const Header h = readHeader(file);
+  validate(h, p);
 
   io_detail::VoxelFormat format;
-  format.dims = glm::ivec3(static_cast<int>(raw.dim[1]), static_cast<int>(raw.dim[2]),
-                           static_cast<int>(raw.dim[3]));
-  format.type = diskTypeOf(raw.datatype, p);
+  format.dims = glm::ivec3(static_cast<int>(h.dim[1]), static_cast<int>(h.dim[2]),
+                           static_cast<int>(h.dim[3]));
+  format.type = diskTypeOf(h.datatype, p);
   // sizeof_hdr read byte-swapped means the file's byte order is not ours.
-  format.bigEndian = raw.swapped != (std::endian::native == std::endian::big);
+  format.bigEndian = h.swapped != (std::endian::native == std::endian::big);
   // NIfTI-1 §scl_slope: slope 0 means "no scaling"; (1, 0) is the identity.
   // ANALYZE headers have no scaling fields (nifticlib ignores them too).
-  const double slope = raw.sclSlope;
-  const double inter = raw.sclInter;
-  if (raw.version > 0 && std::isfinite(slope) && slope != 0.0 && !(slope == 1.0 && inter == 0.0)) {
+  const double slope = h.sclSlope;
+  const double inter = h.sclInter;
+  if (h.version > 0 && std::isfinite(slope) && slope != 0.0 && !(slope == 1.0 && inter == 0.0)) {
     if (!std::isfinite(inter)) {
       throw InputError(p + ": scl_inter is " + numberString(inter) + " with scl_slope " +
                        numberString(slope) + ", expected a finite intercept");
@@ -317,20 +350,29 @@ Volume readNifti(const std::filesystem::path& path) {
     format.intercept = inter;
   }
 
-  io_detail::VoxelSource source;
-  source.file = nim->iname;
-  // nifticlib names the .img it would read even when it does not exist; say
-  // which header wanted it, not only that some .img is missing.
-  if (source.file != path) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(source.file, ec)) {
-      throw InputError(p + ": cannot find the image file for this header (" + source.file.string() +
-                       " is missing or not a regular file)");
-    }
+  // Where the voxels are: after the header in this file, from vox_offset
+  // but never inside the header (as nifticlib reads them); or in the .img
+  // of a pair, from vox_offset.
+  std::unique_ptr<ByteSource> image;
+  if (!h.singleFile) image = openImageFile(file, files);
+  const ByteSource& data = image ? *image : file;
+  const bool gzipped = io_detail::startsWithGzipMagic(data);
+  const std::uint64_t limit = gzipped ? data.size() * io_detail::kMaxDeflateRatio : data.size();
+  if (h.voxOffset > static_cast<double>(limit)) {
+    throw InputError(
+        p + ": vox_offset " + numberString(h.voxOffset) + " lies beyond the end of " +
+        (image ? data.name() : std::string("the file")) + " (" + formatBytes(data.size()) +
+        (gzipped ? " of gzip data, at most " + formatBytes(limit) + " inflated)" : ")"));
   }
-  source.gzip = io_detail::startsWithGzipMagic(source.file);
-  const std::uint64_t offset =
-      nim->iname_offset > 0 ? static_cast<std::uint64_t>(nim->iname_offset) : 0;
+  std::uint64_t offset = static_cast<std::uint64_t>(h.voxOffset);
+  if (h.singleFile) {
+    offset = std::max<std::uint64_t>(
+        offset, static_cast<std::uint64_t>(h.version == 2 ? kNifti2HeaderSize : kNifti1HeaderSize));
+  }
+
+  io_detail::VoxelSource source;
+  source.file = &data;
+  source.gzip = gzipped;
   if (source.gzip) {
     source.inflatedSkip = offset;
   } else {
@@ -338,16 +380,13 @@ Volume readNifti(const std::filesystem::path& path) {
   }
   Volume v = io_detail::loadVoxels(source, format, p);
 
-  // Geometry from the raw header, not nifticlib's nim: the browser's reader
-  // decodes the same fields the same way (io/NiftiGeometry).
-  const NiftiGeometry geometry = niftiGeometry(raw.geometry);
+  const NiftiGeometry geometry = niftiGeometry(h.geometry);
   v.setIndexToWorld(geometry.indexToWorld);
   v.setGeometrySource(geometry.source);
 
   std::string description =
-      (raw.version == 0 ? "ANALYZE 7.5 " : "NIfTI-" + std::to_string(raw.version) + " ") + p +
-      " (" + io_detail::dimsString(format.dims) + " " +
-      std::string(io_detail::diskTypeName(format.type));
+      (h.version == 0 ? "ANALYZE 7.5 " : "NIfTI-" + std::to_string(h.version) + " ") + p + " (" +
+      io_detail::dimsString(format.dims) + " " + std::string(io_detail::diskTypeName(format.type));
   if (format.scaled) {
     description += ", scaled by scl_slope " + numberString(slope) + " and scl_inter " +
                    numberString(inter) + " to f32";

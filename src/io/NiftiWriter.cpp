@@ -1,12 +1,11 @@
 // NIfTI-1 output. nifticlib builds the header (nifti_make_new_nim, then
 // nifti_convert_nim2n1hdr); the bytes are written here rather than by
 // nifti_image_write, which returns nothing and ignores failed data writes
-// (a full disk would leave a truncated file that looks written).
+// (a full disk would leave a truncated file that looks written), into a
+// temporary file renamed into place (writeAtomically).
 #include "tessera/io/NiftiWriter.h"
 
-#include <fcntl.h>
 #include <nifti2_io.h>
-#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -16,10 +15,12 @@
 #include <memory>
 #include <string>
 
+#include "io/OutputFile.h"
 #include "io/VoxelLoader.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/PatientFrame.h"
 #include "tessera/io/NiftiGeometry.h"
+#include "tessera/io/VolumeWriter.h"
 
 namespace tessera {
 
@@ -51,98 +52,63 @@ struct NiftiImageFree {
   void operator()(nifti_image* nim) const { nifti_image_free(nim); }
 };
 
-// Output written under a temporary name beside the target and renamed over
-// it only once complete, so that a failed write never leaves a partial file
-// under the final name. Gzip-compressed when `gzip`.
-class PendingFile {
+// The header, padding and voxels into `path`, gzip-compressed when `gzip`.
+// Every failure, a full disk included, is an Error: nifti_image_write would
+// ignore failed data writes and leave a truncated file that looks written.
+class NiftiOutput {
  public:
-  PendingFile(const std::filesystem::path& target, bool gzip) : target_(target) {
-    static int counter = 0;
-    const std::filesystem::path dir = target.parent_path().empty() ? "." : target.parent_path();
-    std::string name = target.filename().string();
-    // A hidden name, built piecewise: GCC 12 warns falsely on "." + string.
-    name.insert(0, 1, '.');
-    name += '.';
-    name += std::to_string(::getpid());
-    name += '-';
-    name += std::to_string(counter++);
-    name += ".tmp";
-    temp_ = dir / name;
-    const int fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    int err = errno;
-    if (fd >= 0) {
-      if (gzip) {
-        gz_ = gzdopen(fd, "wb6");
-      } else {
-        file_ = ::fdopen(fd, "wb");
-      }
-      err = errno;
-      if (gz_ == nullptr && file_ == nullptr) {
-        ::close(fd);
-        std::error_code ignored;
-        std::filesystem::remove(temp_, ignored);
-      }
-    }
-    if (gz_ == nullptr && file_ == nullptr) {
-      throw Error(target_.string() + ": cannot create a temporary file in '" + dir.string() +
-                  "' to write it: " + std::strerror(err));
+  NiftiOutput(const std::filesystem::path& path, bool gzip) : path_(path) {
+    if (gzip) {
+      gz_ = gzopen(path.c_str(), "wb6");
+      if (gz_ == nullptr) fail("cannot open for writing");
+    } else {
+      file_ = std::make_unique<io_detail::OutputFile>(path);
     }
   }
-  ~PendingFile() {
+  ~NiftiOutput() {
     if (gz_ != nullptr) gzclose(gz_);
-    if (file_ != nullptr) std::fclose(file_);
-    if (!committed_) {
-      std::error_code ignored;
-      std::filesystem::remove(temp_, ignored);
-    }
   }
-  PendingFile(const PendingFile&) = delete;
-  PendingFile& operator=(const PendingFile&) = delete;
+  NiftiOutput(const NiftiOutput&) = delete;
+  NiftiOutput& operator=(const NiftiOutput&) = delete;
 
   void write(const void* data, std::size_t n) {
+    if (file_) {
+      file_->write(data, n);
+      return;
+    }
+    // gzwrite takes an unsigned count: feed it in pieces.
     const auto* bytes = static_cast<const char*>(data);
-    if (gz_ != nullptr) {
-      // gzwrite takes an unsigned count: feed it in pieces.
-      constexpr std::size_t kPiece = 1 << 30;
-      for (std::size_t at = 0; at < n; at += kPiece) {
-        const auto len = static_cast<unsigned>(std::min(kPiece, n - at));
-        if (gzwrite(gz_, bytes + at, len) != static_cast<int>(len)) failGzip("write failed");
-      }
-    } else if (std::fwrite(bytes, 1, n, file_) != n) {
-      fail("write failed");
+    constexpr std::size_t kPiece = 1 << 30;
+    for (std::size_t at = 0; at < n; at += kPiece) {
+      const auto len = static_cast<unsigned>(std::min(kPiece, n - at));
+      if (gzwrite(gz_, bytes + at, len) != static_cast<int>(len)) failGzip("write failed");
     }
   }
 
-  void commit() {
-    if (gz_ != nullptr) {
-      const int rc = gzclose(gz_);
-      gz_ = nullptr;
-      if (rc != Z_OK) fail("write failed (gzip)");
-    } else {
-      const int rc = std::fclose(file_);
-      file_ = nullptr;
-      if (rc != 0) fail("write failed");
+  void close() {
+    if (file_) {
+      file_->close();
+      return;
     }
-    if (std::rename(temp_.c_str(), target_.c_str()) != 0) fail("cannot rename the temporary file");
-    committed_ = true;
+    const int rc = gzclose(gz_);
+    gz_ = nullptr;
+    if (rc != Z_OK) fail("write failed (gzip)");
   }
 
  private:
   [[noreturn]] void fail(const char* what) const {
-    throw Error(target_.string() + ": " + what + ": " + std::strerror(errno));
+    throw Error(path_.string() + ": " + what + ": " + std::strerror(errno));
   }
   [[noreturn]] void failGzip(const char* what) const {
     int zerr = Z_OK;
     const char* msg = gzerror(gz_, &zerr);
-    throw Error(target_.string() + ": " + what + ": " +
+    throw Error(path_.string() + ": " + what + ": " +
                 (zerr == Z_ERRNO ? std::strerror(errno) : msg));
   }
 
-  std::filesystem::path target_;
-  std::filesystem::path temp_;
-  std::FILE* file_ = nullptr;
+  std::filesystem::path path_;
+  std::unique_ptr<io_detail::OutputFile> file_;
   gzFile gz_ = nullptr;
-  bool committed_ = false;
 };
 
 }  // namespace
@@ -217,15 +183,17 @@ void writeNifti(const Volume& volume, const std::filesystem::path& path) {
                 ", inside the header");
   }
 
-  PendingFile out(path, gzip);
-  out.write(&header, sizeof header);
-  // The 4 bytes after the header say whether extensions follow (none), then
-  // padding up to vox_offset (352 with no extensions).
-  const std::string gap(static_cast<std::size_t>(voxOffset - sizeof header), '\0');
-  out.write(gap.data(), gap.size());
-  // Native byte order: sizeof_hdr tells readers which one that is.
-  out.write(volume.bytes().data(), volume.bytes().size());
-  out.commit();
+  writeAtomically(path, [&](const std::filesystem::path& temp) {
+    NiftiOutput out(temp, gzip);
+    out.write(&header, sizeof header);
+    // The 4 bytes after the header say whether extensions follow (none),
+    // then padding up to vox_offset (352 with no extensions).
+    const std::string gap(static_cast<std::size_t>(voxOffset - sizeof header), '\0');
+    out.write(gap.data(), gap.size());
+    // Native byte order: sizeof_hdr tells readers which one that is.
+    out.write(volume.bytes().data(), volume.bytes().size());
+    out.close();
+  });
 }
 
 }  // namespace tessera

@@ -1,21 +1,15 @@
-// NRRD reading and writing after the format definition of Teem 1.9+
+// NRRD reading after the format definition of Teem 1.9+
 // (teem.sourceforge.net/nrrd/format.html); section numbers below refer to it.
 #include "tessera/io/NrrdReader.h"
 
-#include <zlib.h>
-
-#include <algorithm>
-#include <bit>
 #include <cctype>
 #include <charconv>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
-#include <fstream>
 #include <optional>
 #include <vector>
 
-#include "io/ByteSource.h"
+#include "io/ByteStream.h"
+#include "io/HeaderText.h"
 #include "io/VoxelLoader.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/PatientFrame.h"
@@ -26,6 +20,9 @@ namespace tessera {
 namespace {
 
 using io_detail::DiskType;
+using io_detail::lower;
+using io_detail::trim;
+using io_detail::words;
 
 // A header is a few hundred bytes; these limits stop us from "parsing" a
 // large binary file as text when the magic happens to match.
@@ -51,31 +48,6 @@ struct NrrdHeader {
   std::string content;
   std::uint64_t headerEnd = 0;  // offset of the first byte after the header
 };
-
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
-
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r\n");
-  if (b == std::string::npos) return "";
-  const auto e = s.find_last_not_of(" \t\r\n");
-  return s.substr(b, e - b + 1);
-}
-
-std::vector<std::string> words(const std::string& s) {
-  std::vector<std::string> out;
-  std::size_t i = 0;
-  while (i < s.size()) {
-    while (i < s.size() && std::isspace(static_cast<unsigned char>(s[i]))) ++i;
-    const std::size_t b = i;
-    while (i < s.size() && !std::isspace(static_cast<unsigned char>(s[i]))) ++i;
-    if (i > b) out.push_back(s.substr(b, i - b));
-  }
-  return out;
-}
 
 class HeaderParser {
  public:
@@ -209,30 +181,11 @@ bool namesSeveralFiles(const std::string& value) {
 
 // Reads the header line by line up to the blank line that ends it (or the
 // end of a detached header file).
-NrrdHeader parseHeader(const std::filesystem::path& path) {
-  const std::string p = path.string();
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(p + ": cannot open");
-
-  std::uint64_t consumed = 0;
-  auto nextLine = [&](std::string& line) -> bool {
-    line.clear();
-    char c;
-    bool any = false;
-    while (in.get(c)) {
-      any = true;
-      ++consumed;
-      if (c == '\n') break;
-      if (line.size() >= kMaxLineBytes) {
-        throw InputError(p + ": header line longer than " + std::to_string(kMaxLineBytes) +
-                         " bytes (is the blank line that ends a NRRD header missing?)");
-      }
-      line += c;
-    }
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    return any;
-  };
-
+NrrdHeader parseHeader(const ByteSource& file) {
+  const std::string& p = file.name();
+  io_detail::LineReader lines(file, kMaxLineBytes,
+                              " (is the blank line that ends a NRRD header missing?)");
+  auto nextLine = [&](std::string& line) { return lines.next(line); };
   std::string line;
   nextLine(line);
   // §1.1: "NRRD000X", X = 1..5 for the versions defined so far.
@@ -256,7 +209,7 @@ NrrdHeader parseHeader(const std::filesystem::path& path) {
     if (!nextLine(line)) break;  // end of file ends a detached header
     ++lineNo;
     parse.setLine(lineNo);
-    if (consumed > kMaxHeaderBytes) {
+    if (lines.consumed() > kMaxHeaderBytes) {
       throw InputError(p + ": NRRD header longer than " + std::to_string(kMaxHeaderBytes) +
                        " bytes; is the blank line that ends it missing?");
     }
@@ -344,23 +297,23 @@ NrrdHeader parseHeader(const std::filesystem::path& path) {
   }
   // For an attached header without its blank line this is the end of the
   // file, and the size check reports the missing data.
-  h.headerEnd = consumed;
+  h.headerEnd = lines.consumed();
   return h;
 }
 
 // Byte offset just past `lines` newlines counted from `offset` (§5 "line
 // skip"); InputError if the file has fewer lines.
-std::uint64_t skipLines(const std::filesystem::path& file, std::uint64_t offset, std::int64_t lines,
+std::uint64_t skipLines(const ByteSource& file, std::uint64_t offset, std::int64_t lines,
                         const std::string& what) {
   if (lines == 0) return offset;
-  io_detail::FileByteSource src(file, offset);
+  io_detail::SourceStream src(file, offset);
   std::vector<std::byte> buf(64 * 1024);
   std::int64_t seen = 0;
   std::uint64_t pos = offset;
   while (seen < lines) {
     const std::size_t got = src.read(buf.data(), buf.size());
     if (got == 0) {
-      throw InputError(what + ": line skip is " + std::to_string(lines) + ", but " + file.string() +
+      throw InputError(what + ": line skip is " + std::to_string(lines) + ", but " + file.name() +
                        " ends after " + std::to_string(seen) + " lines");
     }
     for (std::size_t i = 0; i < got; ++i) {
@@ -374,9 +327,12 @@ std::uint64_t skipLines(const std::filesystem::path& file, std::uint64_t offset,
 }  // namespace
 
 Volume readNrrd(const std::filesystem::path& path) {
-  const std::string p = path.string();
-  io_detail::regularFileSize(path);  // nonexistent / directory → InputError with the path
-  NrrdHeader h = parseHeader(path);
+  return readNrrd(FileSource(path), FolderFiles());
+}
+
+Volume readNrrd(const ByteSource& file, const FileSet& files) {
+  const std::string& p = file.name();
+  NrrdHeader h = parseHeader(file);
 
   auto require = [&](bool ok, const std::string& field) {
     if (!ok) throw InputError(p + ": NRRD header has no '" + field + "' field");
@@ -461,21 +417,20 @@ Volume readNrrd(const std::filesystem::path& path) {
 
   io_detail::VoxelSource source;
   std::uint64_t start = h.headerEnd;
-  source.file = path;
+  source.file = &file;
+  std::unique_ptr<ByteSource> dataFile;
   if (h.dataFile) {
-    std::filesystem::path data(*h.dataFile);
     // §3: a relative data file name is relative to the header's directory.
-    if (data.is_relative()) data = path.parent_path() / data;
-    source.file = data;
-    start = 0;
     try {
-      io_detail::regularFileSize(data);
+      dataFile = files.open(files.resolve(file, *h.dataFile));
     } catch (const InputError& e) {
       // The user named the header; say which header wants the missing file.
       throw InputError(p + ": data file: " + e.what());
     }
+    source.file = dataFile.get();
+    start = 0;
   }
-  start = skipLines(source.file, start, h.lineSkip, p);
+  start = skipLines(*source.file, start, h.lineSkip, p);
   if (h.encoding == "gzip") {
     if (h.byteSkip < 0) {
       throw InputError(p +
@@ -502,153 +457,6 @@ Volume readNrrd(const std::filesystem::path& path) {
   if (!h.content.empty()) description += ", content: " + h.content;
   v.setDescription(description + ")");
   return v;
-}
-
-namespace {
-
-std::string exactNumber(double v) {
-  char buf[40];
-  // + 0.0 turns -0 (from negating a 0 into LPS) into 0.
-  std::snprintf(buf, sizeof buf, "%.17g", v + 0.0);
-  return buf;
-}
-
-class NrrdOutput {
- public:
-  explicit NrrdOutput(const std::filesystem::path& path)
-      : path_(path), out_(path, std::ios::binary) {
-    if (!out_) throw Error(path_.string() + ": cannot open for writing: " + std::strerror(errno));
-  }
-  void write(const void* data, std::size_t n) {
-    out_.write(static_cast<const char*>(data), static_cast<std::streamsize>(n));
-    if (!out_) throw Error(path_.string() + ": write failed: " + std::strerror(errno));
-  }
-  void close() {
-    out_.close();
-    if (!out_) throw Error(path_.string() + ": write failed: " + std::strerror(errno));
-  }
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-  std::ofstream out_;
-};
-
-class GzipWriter {
- public:
-  explicit GzipWriter(NrrdOutput& out) : out_(out), buf_(256 * 1024) {
-    // 15 + 16: gzip wrapper, which is what "encoding: gzip" means (§5).
-    if (deflateInit2(&zs_, Z_DEFAULT_COMPRESSION, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) !=
-        Z_OK) {
-      throw Error(out_.path().string() + ": cannot start zlib compression");
-    }
-  }
-  ~GzipWriter() { deflateEnd(&zs_); }
-  GzipWriter(const GzipWriter&) = delete;
-  GzipWriter& operator=(const GzipWriter&) = delete;
-
-  void write(const std::byte* data, std::size_t n) { pump(data, n, Z_NO_FLUSH); }
-  void finish() { pump(nullptr, 0, Z_FINISH); }
-
- private:
-  void pump(const std::byte* data, std::size_t n, int flush) {
-    zs_.next_in = reinterpret_cast<Bytef*>(const_cast<std::byte*>(data));
-    zs_.avail_in = static_cast<uInt>(n);
-    int ret;
-    do {
-      zs_.next_out = buf_.data();
-      zs_.avail_out = static_cast<uInt>(buf_.size());
-      ret = deflate(&zs_, flush);
-      if (ret == Z_STREAM_ERROR) throw Error(out_.path().string() + ": zlib compression failed");
-      out_.write(buf_.data(), buf_.size() - zs_.avail_out);
-    } while (zs_.avail_out == 0 || (flush == Z_FINISH && ret != Z_STREAM_END));
-  }
-
-  NrrdOutput& out_;
-  z_stream zs_{};
-  std::vector<unsigned char> buf_;
-};
-
-}  // namespace
-
-void writeNrrd(const Volume& volume, const std::filesystem::path& path, bool gzip) {
-  const glm::ivec3 d = volume.dims();
-  if (d.x <= 0 || d.y <= 0 || d.z <= 0) {
-    throw InputError(path.string() + ": cannot write an empty volume (" + io_detail::dimsString(d) +
-                     ")");
-  }
-  const char* type = "uchar";
-  switch (volume.type()) {
-    case ScalarType::U8:
-      type = "uchar";
-      break;
-    case ScalarType::U16:
-      type = "ushort";
-      break;
-    case ScalarType::I16:
-      type = "short";
-      break;
-    case ScalarType::F32:
-      type = "float";
-      break;
-  }
-  // Written in LPS, the space ITK and Slicer write (§4 "space"): each
-  // axis' space direction is its unit direction times its spacing (§5).
-  const glm::dmat3 toLps = lpsToRas();  // its own inverse
-  const glm::dmat4 affine = volume.indexToWorld();
-  auto vec = [](const glm::dvec3& v) {
-    // Built piecewise: GCC 12 warns falsely (-Wrestrict) on "(" + string.
-    std::string s(1, '(');
-    s += exactNumber(v.x);
-    s += ',';
-    s += exactNumber(v.y);
-    s += ',';
-    s += exactNumber(v.z);
-    s += ')';
-    return s;
-  };
-  std::string header = "NRRD0004\n# written by Tessera\n";
-  header += std::string("type: ") + type + "\n";
-  header += "dimension: 3\n";
-  header += "space: left-posterior-superior\n";
-  header += "sizes: " + std::to_string(d.x) + " " + std::to_string(d.y) + " " +
-            std::to_string(d.z) + "\n";
-  header += "space directions: " + vec(toLps * glm::dvec3(affine[0])) + " " +
-            vec(toLps * glm::dvec3(affine[1])) + " " + vec(toLps * glm::dvec3(affine[2])) + "\n";
-  header += "kinds: domain domain domain\n";
-  header += "endian: little\n";
-  header += std::string("encoding: ") + (gzip ? "gzip" : "raw") + "\n";
-  header += "space origin: " + vec(toLps * glm::dvec3(affine[3])) + "\n\n";
-
-  NrrdOutput out(path);
-  out.write(header.data(), header.size());
-
-  const std::span<const std::byte> bytes = volume.bytes();
-  const std::size_t elem = bytesPerVoxel(volume.type());
-  constexpr std::size_t kChunk = 1 << 20;
-  std::vector<std::byte> swapped;
-  std::optional<GzipWriter> gz;
-  if (gzip) gz.emplace(out);
-  for (std::size_t at = 0; at < bytes.size(); at += kChunk) {
-    const std::size_t n = std::min(kChunk, bytes.size() - at);
-    const std::byte* chunk = bytes.data() + at;
-    if constexpr (std::endian::native == std::endian::big) {
-      // The file says little endian; swap each element on big-endian hosts.
-      swapped.assign(chunk, chunk + n);
-      for (std::size_t i = 0; i + elem <= n; i += elem) {
-        std::reverse(swapped.begin() + static_cast<std::ptrdiff_t>(i),
-                     swapped.begin() + static_cast<std::ptrdiff_t>(i + elem));
-      }
-      chunk = swapped.data();
-    }
-    if (gz) {
-      gz->write(chunk, n);
-    } else {
-      out.write(chunk, n);
-    }
-  }
-  if (gz) gz->finish();
-  out.close();
 }
 
 }  // namespace tessera

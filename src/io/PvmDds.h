@@ -33,6 +33,9 @@ namespace tessera::io_detail {
 enum class DdsVersion { V3d, V3e };
 
 constexpr std::size_t kDdsMagicBytes = 8;
+// Tessera keeps the volume origin, which PVM lacks, in the PVM3 comment
+// string: written by writePvm, read by readPvm.
+constexpr std::string_view kPvmOriginTag = "tessera origin: ";
 constexpr std::uint64_t kDdsInterleaveBlock = std::uint64_t{1} << 24;
 
 // The version whose magic `prefix` starts with, if any.

@@ -20,10 +20,8 @@
 #include <string_view>
 #include <vector>
 
-#include <fcntl.h>
-#include <unistd.h>
-
-#include "io/ByteSource.h"
+#include "io/ByteStream.h"
+#include "io/HeaderText.h"
 #include "io/PvmDds.h"
 #include "io/VoxelLoader.h"
 #include "tessera/core/Error.h"
@@ -40,8 +38,6 @@ constexpr std::int64_t kMaxDim = 1 << 20;  // the limit Volume::allocate applies
 constexpr std::size_t kMaxHeaderBytes = 1024;
 // The trailing strings of a PVM3 file are a few lines of text.
 constexpr std::uint64_t kMaxTrailerBytes = 64 * 1024;
-// Tessera keeps the volume origin, which PVM lacks, in the comment string.
-constexpr std::string_view kOriginTag = "tessera origin: ";
 
 struct PvmHeader {
   int version = 1;  // 1, 2, 3 for "PVM", "PVM2", "PVM3"
@@ -67,13 +63,6 @@ std::string numberString(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
   return buf;
-}
-
-// Shortest text that reads back as the same double.
-std::string exactNumber(double v) {
-  char buf[32];
-  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, ec == std::errc() ? end : buf);
 }
 
 std::vector<std::string_view> words(std::string_view line) {
@@ -224,10 +213,9 @@ std::string describe(const PvmHeader& h, const std::string& p, const char* encod
          io_detail::dimsString(h.dims) + (h.components == 1 ? " u8, " : " u16, ") + encoding;
 }
 
-std::string readPrefix(const std::filesystem::path& path, std::uint64_t offset, std::size_t n) {
-  io_detail::FileByteSource src(path, offset);
+std::string readPrefix(const ByteSource& file, std::uint64_t offset, std::size_t n) {
   std::string s(n, '\0');
-  s.resize(src.read(reinterpret_cast<std::byte*>(s.data()), n));
+  s.resize(file.read(offset, reinterpret_cast<std::byte*>(s.data()), n));
   return s;
 }
 
@@ -244,8 +232,9 @@ void applyTrailer(std::string_view trailer, Volume& v, std::string& description,
     const std::string_view text = trailer.substr(at, end - at);
     at = end + 1;
     if (text.empty()) continue;
-    if (std::string_view(name) == "comment" && text.substr(0, kOriginTag.size()) == kOriginTag) {
-      const auto w = words(text.substr(kOriginTag.size()));
+    if (std::string_view(name) == "comment" &&
+        text.substr(0, io_detail::kPvmOriginTag.size()) == io_detail::kPvmOriginTag) {
+      const auto w = words(text.substr(io_detail::kPvmOriginTag.size()));
       glm::dvec3 o(0.0);
       bool ok = w.size() == 3;
       for (int a = 0; ok && a < 3; ++a) {
@@ -254,8 +243,8 @@ void applyTrailer(std::string_view trailer, Volume& v, std::string& description,
       }
       if (!ok) {
         throw InputError(p + ": PVM comment '" + printable(text, 80) +
-                         "' should hold three finite numbers after '" + std::string(kOriginTag) +
-                         "'");
+                         "' should hold three finite numbers after '" +
+                         std::string(io_detail::kPvmOriginTag) + "'");
       }
       v.setOrigin(o);
       continue;
@@ -264,15 +253,13 @@ void applyTrailer(std::string_view trailer, Volume& v, std::string& description,
   }
 }
 
-Volume readDdsPvm(const std::filesystem::path& path, std::uint64_t fileSize) {
-  const std::string p = path.string();
+Volume readDdsPvm(const ByteSource& source) {
+  const std::string& p = source.name();
+  const std::uint64_t fileSize = source.size();
   HostBudget::global().check(fileSize, p + " (DDS-compressed file)");
   std::vector<std::uint8_t> file(static_cast<std::size_t>(fileSize));
-  {
-    io_detail::FileByteSource src(path, 0);
-    if (src.read(reinterpret_cast<std::byte*>(file.data()), file.size()) != file.size()) {
-      throw InputError(p + ": file shrank while being read");
-    }
+  if (source.read(0, reinterpret_cast<std::byte*>(file.data()), file.size()) != file.size()) {
+    throw InputError(p + ": file shrank while being read");
   }
   const io_detail::DdsStreamInfo info = io_detail::scanDds(file, p);
   // The decoded file and the volume it holds coexist while copying.
@@ -319,10 +306,14 @@ Volume readDdsPvm(const std::filesystem::path& path, std::uint64_t fileSize) {
 }  // namespace
 
 Volume readPvm(const std::filesystem::path& path) {
-  const std::string p = path.string();
-  const std::uint64_t fileSize = io_detail::regularFileSize(path);
-  const std::string head = readPrefix(path, 0, kMaxHeaderBytes);
-  if (io_detail::ddsVersionOf(head)) return readDdsPvm(path, fileSize);
+  return readPvm(FileSource(path));
+}
+
+Volume readPvm(const ByteSource& file) {
+  const std::string& p = file.name();
+  const std::uint64_t fileSize = file.size();
+  const std::string head = readPrefix(file, 0, kMaxHeaderBytes);
+  if (io_detail::ddsVersionOf(head)) return readDdsPvm(file);
   if (head.rfind("PVM", 0) != 0) throw InputError(notPvmMessage(p, head));
 
   const PvmHeader h = parseHeader(head, p);
@@ -331,7 +322,7 @@ Volume readPvm(const std::filesystem::path& path) {
   format.type = h.components == 1 ? DiskType::U8 : DiskType::U16;
   format.bigEndian = true;  // ddsbase.cpp: 16-bit voxels are stored MSB first
   io_detail::VoxelSource source;
-  source.file = path;
+  source.file = &file;
   source.fileOffset = h.dataOffset;
   Volume v = io_detail::loadVoxels(source, format, p);
   v.setSpacing(h.spacing);
@@ -340,121 +331,10 @@ Volume readPvm(const std::filesystem::path& path) {
   if (h.version == 3) {
     const std::uint64_t trailerStart = h.dataOffset + voxelBytes(h);
     const std::uint64_t n = std::min(kMaxTrailerBytes, fileSize - trailerStart);
-    applyTrailer(readPrefix(path, trailerStart, static_cast<std::size_t>(n)), v, description, p);
+    applyTrailer(readPrefix(file, trailerStart, static_cast<std::size_t>(n)), v, description, p);
   }
   v.setDescription(description + ")");
   return v;
-}
-
-namespace {
-
-// Output written under a temporary name beside the target and renamed over
-// it only once complete, so that a failed write never leaves a partial file
-// under the final name.
-class PendingFile {
- public:
-  explicit PendingFile(const std::filesystem::path& target) : target_(target) {
-    static int counter = 0;
-    const std::filesystem::path dir = target.parent_path().empty() ? "." : target.parent_path();
-    std::string name = target.filename().string();
-    // A hidden name, built piecewise: GCC 12 warns falsely on "." + string.
-    name.insert(0, 1, '.');
-    name += '.';
-    name += std::to_string(::getpid());
-    name += '-';
-    name += std::to_string(counter++);
-    name += ".tmp";
-    temp_ = dir / name;
-    const int fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd < 0 || (file_ = ::fdopen(fd, "wb")) == nullptr) {
-      const int err = errno;
-      if (fd >= 0) ::close(fd);
-      throw Error(target_.string() + ": cannot create a temporary file in '" + dir.string() +
-                  "' to write it: " + std::strerror(err));
-    }
-  }
-  ~PendingFile() {
-    if (file_ != nullptr) std::fclose(file_);
-    if (!committed_) {
-      std::error_code ignored;
-      std::filesystem::remove(temp_, ignored);
-    }
-  }
-  PendingFile(const PendingFile&) = delete;
-  PendingFile& operator=(const PendingFile&) = delete;
-
-  void write(const void* data, std::size_t n) {
-    if (std::fwrite(data, 1, n, file_) != n) fail("write failed");
-  }
-  void commit() {
-    const int rc = std::fclose(file_);
-    file_ = nullptr;
-    if (rc != 0) fail("write failed");
-    if (std::rename(temp_.c_str(), target_.c_str()) != 0) fail("cannot rename the temporary file");
-    committed_ = true;
-  }
-
- private:
-  [[noreturn]] void fail(const char* what) const {
-    throw Error(target_.string() + ": " + what + ": " + std::strerror(errno));
-  }
-
-  std::filesystem::path target_;
-  std::filesystem::path temp_;
-  std::FILE* file_ = nullptr;
-  bool committed_ = false;
-};
-
-std::string withoutNul(std::string s) {
-  s.erase(std::remove(s.begin(), s.end(), '\0'), s.end());
-  return s;
-}
-
-}  // namespace
-
-void writePvm(const Volume& volume, const std::filesystem::path& path) {
-  const std::string p = path.string();
-  if (volume.type() != ScalarType::U8 && volume.type() != ScalarType::U16) {
-    throw InputError(p + ": PVM stores only u8/u16 voxels, this volume is " +
-                     std::string(scalarTypeName(volume.type())) +
-                     "; write NRRD, NIfTI or raw + JSON instead");
-  }
-  if (!volume.hasData()) throw InputError(p + ": cannot write a volume without voxels");
-  const glm::ivec3 d = volume.dims();
-  const glm::dvec3 s = volume.spacing();
-  const glm::dvec3 o = volume.origin();
-  const int components = volume.type() == ScalarType::U8 ? 1 : 2;
-  const std::string header = "PVM3\n" + std::to_string(d.x) + " " + std::to_string(d.y) + " " +
-                             std::to_string(d.z) + "\n" + exactNumber(s.x) + " " +
-                             exactNumber(s.y) + " " + exactNumber(s.z) + "\n" +
-                             std::to_string(components) + "\n";
-
-  PendingFile out(path);
-  out.write(header.data(), header.size());
-  const std::span<const std::byte> bytes = volume.bytes();
-  if (components == 1 || std::endian::native == std::endian::big) {
-    out.write(bytes.data(), bytes.size());
-  } else {
-    std::vector<std::byte> chunk;
-    constexpr std::size_t kChunk = 1 << 20;
-    for (std::size_t at = 0; at < bytes.size(); at += kChunk) {
-      const std::size_t n = std::min(kChunk, bytes.size() - at);
-      chunk.assign(bytes.begin() + static_cast<std::ptrdiff_t>(at),
-                   bytes.begin() + static_cast<std::ptrdiff_t>(at + n));
-      for (std::size_t i = 0; i + 1 < n; i += 2) std::swap(chunk[i], chunk[i + 1]);
-      out.write(chunk.data(), n);
-    }
-  }
-  // description, courtesy, parameter, comment: each zero-terminated.
-  std::string trailer = withoutNul(volume.description());
-  trailer += '\0';
-  trailer += '\0';
-  trailer += '\0';
-  trailer +=
-      std::string(kOriginTag) + exactNumber(o.x) + " " + exactNumber(o.y) + " " + exactNumber(o.z);
-  trailer += '\0';
-  out.write(trailer.data(), trailer.size());
-  out.commit();
 }
 
 }  // namespace tessera

@@ -1,10 +1,9 @@
 #include "tessera/io/VolumeReader.h"
 
-#include <algorithm>
-#include <cctype>
+#include <array>
 #include <cstring>
-#include <fstream>
 
+#include "io/HeaderText.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/DicomSeriesReader.h"
 #include "tessera/io/MetaImageReader.h"
@@ -12,22 +11,33 @@
 #include "tessera/io/NrrdReader.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/io/PvmReader.h"
+#include "tessera/io/RawSidecarReader.h"
 #include "tessera/io/VtiReader.h"
 
 namespace tessera {
 
 namespace {
+
 bool endsWith(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() &&
          s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
-// DICOM files often have no extension: a Part-10 file has "DICM" at byte 128.
-bool hasDicomMarker(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  char buf[132] = {};
-  in.read(buf, sizeof buf);
-  return in.gcount() == 132 && std::memcmp(buf + 128, "DICM", 4) == 0;
+
+std::string lowerFileName(const std::string& name) {
+  return io_detail::lower(std::filesystem::path(name).filename().string());
 }
+
+bool isDicomName(const std::string& lower) {
+  return endsWith(lower, ".dcm") || endsWith(lower, ".ima");
+}
+
+// DICOM files often have no extension: a Part-10 file has "DICM" at byte 128.
+bool hasDicomMarker(const ByteSource& file) {
+  std::array<char, 4> marker{};
+  return file.read(128, reinterpret_cast<std::byte*>(marker.data()), marker.size()) == 4 &&
+         std::memcmp(marker.data(), "DICM", 4) == 0;
+}
+
 }  // namespace
 
 Volume readVolume(const std::string& spec, const ReadOptions& options) {
@@ -49,25 +59,53 @@ Volume readVolume(const std::string& spec, const ReadOptions& options) {
   }
   // A folder is a DICOM series (the only format that is a folder).
   if (std::filesystem::is_directory(path, ec)) return readDicomSeries(path, options.dicomSeries);
-  std::string lower = path.filename().string();
-  std::transform(lower.begin(), lower.end(), lower.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (endsWith(lower, ".dcm") || endsWith(lower, ".ima") || hasDicomMarker(path)) {
+  const FileSource file(path);
+  if (isDicomName(lowerFileName(spec)) || hasDicomMarker(file)) {
     return readDicomSeries(path, options.dicomSeries);
   }
   notDicom();
+  return readVolume(file, FolderFiles());
+}
+
+Volume readVolume(const ByteSource& file, const FileSet& files) {
+  const std::string lower = lowerFileName(file.name());
+  if (isDicomName(lower) || hasDicomMarker(file)) {
+    throw InputError(file.name() +
+                     ": DICOM is read from files on disk only (through DCMTK): open the folder "
+                     "with the native tessera, or convert it first (tessera convert FOLDER "
+                     "out.nii.gz)");
+  }
   if (endsWith(lower, ".nii") || endsWith(lower, ".nii.gz") || endsWith(lower, ".hdr") ||
       endsWith(lower, ".hdr.gz")) {
-    return readNifti(path);
+    return readNifti(file, files);
   }
-  if (endsWith(lower, ".nrrd") || endsWith(lower, ".nhdr")) return readNrrd(path);
-  if (endsWith(lower, ".mha") || endsWith(lower, ".mhd")) return readMetaImage(path);
-  if (endsWith(lower, ".vti")) return readVti(path);
-  if (endsWith(lower, ".pvm")) return readPvm(path);
-  if (endsWith(lower, ".raw") || endsWith(lower, ".json")) return readRawWithSidecar(path);
-  throw InputError(spec +
+  if (endsWith(lower, ".nrrd") || endsWith(lower, ".nhdr")) return readNrrd(file, files);
+  if (endsWith(lower, ".mha") || endsWith(lower, ".mhd")) return readMetaImage(file, files);
+  if (endsWith(lower, ".vti")) return readVti(file);
+  if (endsWith(lower, ".pvm")) return readPvm(file);
+  if (endsWith(lower, ".raw") || endsWith(lower, ".json")) return readRawWithSidecar(file, files);
+  throw InputError(file.name() +
                    ": unknown volume format (supported: .nii, .nii.gz, .hdr/.img, .nrrd, .nhdr, "
                    ".mha, .mhd, .vti, .pvm, .raw + .json sidecar, DICOM files or a DICOM folder)");
+}
+
+std::string volumeFileAmong(const std::vector<std::string>& names) {
+  if (names.empty()) throw InputError("no file to read");
+  auto rank = [](const std::string& name) {
+    const std::string n = lowerFileName(name);
+    for (const char* header : {".json", ".nhdr", ".mhd", ".hdr", ".hdr.gz"}) {
+      if (endsWith(n, header)) return 0;
+    }
+    for (const char* data : {".raw", ".img", ".img.gz", ".zraw"}) {
+      if (endsWith(n, data)) return 2;
+    }
+    return 1;
+  };
+  const std::string* best = &names.front();
+  for (const std::string& n : names) {
+    if (rank(n) < rank(*best)) best = &n;
+  }
+  return *best;
 }
 
 }  // namespace tessera

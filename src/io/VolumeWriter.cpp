@@ -11,11 +11,12 @@
 #include "tessera/core/Error.h"
 #include "tessera/core/PatientFrame.h"
 #include "tessera/io/DicomSeriesReader.h"
-#include "tessera/io/MetaImageReader.h"
+#include "tessera/io/MetaImageWriter.h"
 #include "tessera/io/NiftiWriter.h"
-#include "tessera/io/NrrdReader.h"
-#include "tessera/io/PvmReader.h"
-#include "tessera/io/VtiReader.h"
+#include "tessera/io/NrrdWriter.h"
+#include "tessera/io/PvmWriter.h"
+#include "tessera/io/RawSidecarWriter.h"
+#include "tessera/io/VtiWriter.h"
 
 namespace tessera {
 
@@ -119,13 +120,13 @@ void writeVolume(const Volume& volume, const fs::path& path) {
   if (endsWith(name, ".nrrd")) {
     writeAtomically(path, [&](const fs::path& t) { writeNrrd(volume, t, true); });
   } else if (endsWith(name, ".nii") || endsWith(name, ".nii.gz")) {
-    writeAtomically(path, [&](const fs::path& t) { writeNifti(volume, t); });
+    writeNifti(volume, path);  // through writeAtomically itself
   } else if (endsWith(name, ".mha")) {
     writeAtomically(path, [&](const fs::path& t) { writeMetaImage(volume, t, true); });
   } else if (endsWith(name, ".vti")) {
     writeAtomically(path, [&](const fs::path& t) { writeVti(volume, t, true); });
   } else if (endsWith(name, ".pvm")) {
-    writeAtomically(path, [&](const fs::path& t) { writePvm(volume, t); });
+    writePvm(volume, path);  // through writeAtomically itself
   } else if (endsWith(name, ".raw")) {
     // Two files, each through its own temporary file: the data first, then
     // the sidecar that names it and makes it readable.

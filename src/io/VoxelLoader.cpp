@@ -5,7 +5,7 @@
 #include <cstring>
 #include <vector>
 
-#include "io/ByteSource.h"
+#include "io/ByteStream.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 
@@ -98,7 +98,7 @@ bool needsSwap(const VoxelFormat& f) {
 
 // Reads every voxel from `src` into `out`; returns the bytes consumed, which
 // is less than dims × size only if the source ended early.
-std::uint64_t decode(ByteSource& src, const VoxelFormat& f, Volume& out) {
+std::uint64_t decode(ByteStream& src, const VoxelFormat& f, Volume& out) {
   const std::size_t inSize = diskTypeSize(f.type);
   const std::uint64_t count = out.voxelCount();
   const bool sameLayout = !f.scaled && bytesPerVoxel(out.type()) == inSize &&
@@ -241,9 +241,9 @@ Volume loadVoxels(const VoxelSource& source, const VoxelFormat& format, const st
   const std::string declared = what + ": header says " + dimsString(format.dims) + " " +
                                std::string(diskTypeName(format.type)) + " = " +
                                formatBytes(diskBytes) + " of voxel data";
-  const std::string inFile =
-      source.file.string() == what ? std::string() : " in " + source.file.string();
-  const std::uint64_t fileSize = regularFileSize(source.file);
+  const ByteSource& file = *source.file;
+  const std::string inFile = file.name() == what ? std::string() : " in " + file.name();
+  const std::uint64_t fileSize = file.size();
 
   if (!source.gzip) {
     std::uint64_t offset = source.fileOffset;
@@ -260,7 +260,7 @@ Volume loadVoxels(const VoxelSource& source, const VoxelFormat& format, const st
                        " bytes, has " + std::to_string(fileSize) + ")");
     }
     Volume v = Volume::allocate(format.dims, outType, what);
-    FileByteSource src(source.file, offset);
+    SourceStream src(file, offset);
     const std::uint64_t got = decode(src, format, v);
     if (got < diskBytes) {  // the file shrank while we read it
       throw InputError(what + ": file ends after " + std::to_string(got) + " of " +
@@ -287,12 +287,12 @@ Volume loadVoxels(const VoxelSource& source, const VoxelFormat& format, const st
                      " can inflate to at most " + formatBytes(mostInflated) +
                      " (deflate's limit is 1032:1)");
   }
-  if (!startsWithGzipMagic(source.file, source.fileOffset)) {
+  if (!startsWithGzipMagic(file, source.fileOffset)) {
     throw InputError(what + ": data is said to be gzip-compressed, but the bytes at offset " +
                      std::to_string(source.fileOffset) + inFile +
                      " do not start with the gzip magic 1f 8b");
   }
-  GzipByteSource gz(source.file, source.fileOffset);
+  InflateStream gz(file, source.fileOffset);
   const std::uint64_t skipped = gz.skip(source.inflatedSkip);
   if (skipped < source.inflatedSkip) {
     throw InputError(what + ": gzip data ends after " + std::to_string(skipped) +
@@ -311,7 +311,7 @@ Volume loadVoxels(const VoxelSource& source, const VoxelFormat& format, const st
   return v;
 }
 
-Volume decodeVoxels(ByteSource& bytes, const VoxelFormat& format, const std::string& what) {
+Volume decodeVoxels(ByteStream& bytes, const VoxelFormat& format, const std::string& what) {
   for (int a = 0; a < 3; ++a) {
     if (format.dims[a] <= 0 || format.dims[a] > kMaxDim) {
       throw InputError(what + ": size along axis " + std::to_string(a) + " is " +

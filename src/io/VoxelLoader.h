@@ -3,7 +3,6 @@
 // voxel data against the file and the host budget, then read it (raw or
 // gzip), swap bytes, widen or convert types and apply a linear scale.
 #include <cstdint>
-#include <filesystem>
 #include <string>
 #include <string_view>
 
@@ -11,6 +10,7 @@
 
 #include "tessera/core/ScalarType.h"
 #include "tessera/core/Volume.h"
+#include "tessera/io/ByteSource.h"
 
 namespace tessera::io_detail {
 
@@ -36,7 +36,7 @@ struct VoxelFormat {
 ScalarType volumeTypeFor(const VoxelFormat& format);
 
 struct VoxelSource {
-  std::filesystem::path file;  // the file holding the voxel bytes
+  const ByteSource* file = nullptr;  // the file holding the voxel bytes
   bool gzip = false;
   // Raw: file offset of the first voxel. Gzip: file offset where the
   // compressed stream starts.
@@ -48,7 +48,7 @@ struct VoxelSource {
 };
 
 // Reads dims × type voxels. `what` starts every error message (usually the
-// header file's path). Order of checks, none of which allocates voxel
+// header file's name). Order of checks, none of which allocates voxel
 // memory: dims sane; raw: offset + bytes ≤ file size; gzip: the host budget,
 // then the deflate ratio bound. Gzip data is inflated into chunks allocated
 // as bytes arrive, and only a complete stream gets a Volume.
@@ -57,7 +57,7 @@ Volume loadVoxels(const VoxelSource& source, const VoxelFormat& format, const st
 // "181x217x181"
 std::string dimsString(glm::ivec3 dims);
 
-class ByteSource;
+class ByteStream;
 
 // Reads dims × type voxels from an open stream of voxel bytes (decoded
 // base64, inflated zlib blocks, a buffer) into a new Volume, with the same
@@ -65,6 +65,6 @@ class ByteSource;
 // stream can hold that many bytes (the host budget is checked here, by
 // Volume::allocate); a stream that still ends early is an InputError naming
 // `what`, never a half-filled volume.
-Volume decodeVoxels(ByteSource& bytes, const VoxelFormat& format, const std::string& what);
+Volume decodeVoxels(ByteStream& bytes, const VoxelFormat& format, const std::string& what);
 
 }  // namespace tessera::io_detail

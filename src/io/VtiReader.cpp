@@ -6,23 +6,20 @@
 // block] for vtkZLibDataCompressor, each block one zlib stream.
 #include "tessera/io/VtiReader.h"
 
-#include <zlib.h>
-
 #include <algorithm>
 #include <array>
-#include <bit>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <limits>
 #include <optional>
 #include <vector>
 
 #include "io/Base64.h"
-#include "io/ByteSource.h"
+#include "io/ByteStream.h"
+#include "io/HeaderText.h"
+#include "io/Inflater.h"
 #include "io/VoxelLoader.h"
 #include "io/XmlPullParser.h"
 #include "tessera/core/Error.h"
@@ -33,14 +30,13 @@ namespace tessera {
 namespace {
 
 using io_detail::DiskType;
+using io_detail::words;
 using io_detail::XmlEvent;
 
 // Extents beyond this cannot describe a volume we could hold, and keeping
 // them below 2^53 keeps the arithmetic on them exact.
 constexpr std::int64_t kMaxExtentMagnitude = std::int64_t{1} << 53;
 constexpr std::int64_t kMaxDim = 1 << 20;
-// vtkXMLWriter's default BlockSize: what VTK and ParaView expect.
-constexpr std::size_t kWriteBlockBytes = 32768;
 
 using Extent = std::array<std::int64_t, 6>;
 
@@ -85,26 +81,6 @@ std::string numberString(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
   return buf;
-}
-
-std::string exactNumber(double v) {
-  char buf[40];
-  // + 0.0 turns -0 (from negating a 0 into LPS) into 0.
-  std::snprintf(buf, sizeof buf, "%.17g", v + 0.0);
-  return buf;
-}
-
-std::vector<std::string> words(const std::string& s) {
-  std::vector<std::string> out;
-  std::size_t i = 0;
-  auto space = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; };
-  while (i < s.size()) {
-    while (i < s.size() && space(s[i])) ++i;
-    const std::size_t b = i;
-    while (i < s.size() && !space(s[i])) ++i;
-    if (i > b) out.push_back(s.substr(b, i - b));
-  }
-  return out;
 }
 
 class AttributeReader {
@@ -247,8 +223,9 @@ DataArrayInfo readDataArrayAttributes(const AttributeReader& a, int line) {
 
 // Walks the markup up to <AppendedData> (whose content is not XML) or the end
 // of the document, keeping only what describes the image and its point data.
-VtiDocument parseDocument(const std::filesystem::path& path, const std::string& p) {
-  io_detail::XmlPullParser xml(path, p);
+VtiDocument parseDocument(const ByteSource& file) {
+  const std::string& p = file.name();
+  io_detail::XmlPullParser xml(file);
   VtiDocument doc;
   std::vector<std::string> open;
   std::optional<DataArrayInfo> array;  // the point-data array being read
@@ -332,9 +309,9 @@ std::optional<DiskType> diskTypeFor(const std::string& vtkType) {
 
 // Inflates vtkZLibDataCompressor blocks one at a time, so at most one block
 // (compressed and inflated) is held besides the volume.
-class ZlibBlockSource : public io_detail::ByteSource {
+class ZlibBlockStream : public io_detail::ByteStream {
  public:
-  ZlibBlockSource(io_detail::ByteSource& compressed, std::vector<std::uint64_t> sizes,
+  ZlibBlockStream(io_detail::ByteStream& compressed, std::vector<std::uint64_t> sizes,
                   std::uint64_t blockBytes, std::uint64_t lastBlockBytes, std::string what)
       : src_(compressed),
         sizes_(std::move(sizes)),
@@ -361,43 +338,54 @@ class ZlibBlockSource : public io_detail::ByteSource {
   void inflateNextBlock() {
     const std::size_t i = next_++;
     const std::string block =
-        "zlib block " + std::to_string(i + 1) + " of " + std::to_string(sizes_.size());
+        what_ + ": zlib block " + std::to_string(i + 1) + " of " + std::to_string(sizes_.size());
     const std::uint64_t packed = sizes_[i];
     const std::uint64_t unpacked = next_ == sizes_.size() ? lastBlockBytes_ : blockBytes_;
     in_.resize(static_cast<std::size_t>(packed));
-    const std::size_t got = src_.read(reinterpret_cast<std::byte*>(in_.data()), in_.size());
+    const std::size_t got = src_.read(in_.data(), in_.size());
     if (got < packed) {
-      throw InputError(what_ + ": " + block + " ends after " + std::to_string(got) + " of its " +
+      throw InputError(block + " ends after " + std::to_string(got) + " of its " +
                        std::to_string(packed) + " compressed bytes");
     }
-    out_.resize(static_cast<std::size_t>(unpacked));
+    // One byte more than the header gives, to see a block that holds more.
+    out_.resize(static_cast<std::size_t>(unpacked) + 1);
     pos_ = 0;
-    uLongf len = static_cast<uLongf>(unpacked);
-    const int ret = uncompress(out_.data(), &len, in_.data(), static_cast<uLong>(packed));
-    if (ret == Z_BUF_ERROR && len == unpacked) {
-      throw InputError(what_ + ": " + block + " inflates to more than the " +
-                       std::to_string(unpacked) + " bytes its header gives (or is cut short)");
+    const auto inflater = io_detail::Inflater::create();
+    std::size_t inPos = 0;
+    std::size_t outPos = 0;
+    bool ended = false;
+    while (!ended) {
+      const io_detail::Inflater::Step step =
+          inflater->inflate(std::span<const std::byte>(in_).subspan(inPos),
+                            std::span<std::byte>(out_).subspan(outPos));
+      if (!step.error.empty()) {
+        throw InputError(block + " is not valid zlib data (corrupt: " + step.error + ")");
+      }
+      inPos += step.consumed;
+      outPos += step.produced;
+      ended = step.ended;
+      if (!ended && step.consumed == 0 && step.produced == 0) break;
     }
-    if (ret != Z_OK) {
-      throw InputError(
-          what_ + ": " + block + " is not valid zlib data (" +
-          (ret == Z_DATA_ERROR ? std::string("corrupt") : "zlib error " + std::to_string(ret)) +
-          ")");
+    if (outPos > unpacked) {
+      throw InputError(block + " inflates to more than the " + std::to_string(unpacked) +
+                       " bytes its header gives");
     }
-    if (len != unpacked) {
-      throw InputError(what_ + ": " + block + " inflates to " + std::to_string(len) +
+    if (!ended) throw InputError(block + " is not valid zlib data (corrupt: cut short)");
+    if (outPos != unpacked) {
+      throw InputError(block + " inflates to " + std::to_string(outPos) +
                        " bytes, its header says " + std::to_string(unpacked));
     }
+    out_.resize(outPos);
   }
 
-  io_detail::ByteSource& src_;
+  io_detail::ByteStream& src_;
   std::vector<std::uint64_t> sizes_;
   std::uint64_t blockBytes_;
   std::uint64_t lastBlockBytes_;
   std::string what_;
   std::size_t next_ = 0;
-  std::vector<unsigned char> in_;
-  std::vector<unsigned char> out_;
+  std::vector<std::byte> in_;
+  std::vector<std::byte> out_;
   std::size_t pos_ = 0;
 };
 
@@ -418,7 +406,7 @@ std::string sizeText(const ArrayContext& c) {
 
 // Binary data (raw or decoded base64) from the array's header on.
 // `available` bounds the bytes `src` can deliver.
-Volume readBinaryArray(io_detail::ByteSource& src, std::uint64_t available, const ArrayContext& c) {
+Volume readBinaryArray(io_detail::ByteStream& src, std::uint64_t available, const ArrayContext& c) {
   const std::uint64_t w = c.headerWordBytes;
   auto word = [&](const char* what) {
     unsigned char b[8] = {};
@@ -498,7 +486,7 @@ Volume readBinaryArray(io_detail::ByteSource& src, std::uint64_t available, cons
       largest + std::min(blockBytes, c.dataBytes) +
           c.voxels * bytesPerVoxel(io_detail::volumeTypeFor(c.format)),
       c.what + " (" + io_detail::dimsString(c.format.dims) + ", zlib blocks plus volume)");
-  ZlibBlockSource inflated(src, std::move(sizes), blockBytes, last, c.what);
+  ZlibBlockStream inflated(src, std::move(sizes), blockBytes, last, c.what);
   return io_detail::decodeVoxels(inflated, c.format, c.what);
 }
 
@@ -560,7 +548,7 @@ bool storeAsciiValue(const std::string& token, DiskType type, Volume& v, std::si
   return false;
 }
 
-Volume readAsciiArray(const std::filesystem::path& path, std::uint64_t begin, std::uint64_t end,
+Volume readAsciiArray(const ByteSource& file, std::uint64_t begin, std::uint64_t end,
                       const ArrayContext& c, const std::string& typeName) {
   const std::uint64_t chars = end - begin;
   // Each value takes a character and a separator: refuse before allocating.
@@ -571,7 +559,7 @@ Volume readAsciiArray(const std::filesystem::path& path, std::uint64_t begin, st
                      io_detail::dimsString(c.format.dims) + ")");
   }
   Volume v = Volume::allocate(c.format.dims, io_detail::volumeTypeFor(c.format), c.what);
-  io_detail::FileByteSource file(path, begin);
+  io_detail::SourceStream text(file, begin);
   std::vector<char> buf(64 * 1024);
   std::uint64_t left = chars;
   std::uint64_t count = 0;
@@ -591,7 +579,7 @@ Volume readAsciiArray(const std::filesystem::path& path, std::uint64_t begin, st
   };
   while (left > 0) {
     const std::size_t want = static_cast<std::size_t>(std::min<std::uint64_t>(left, buf.size()));
-    const std::size_t got = file.read(reinterpret_cast<std::byte*>(buf.data()), want);
+    const std::size_t got = text.read(reinterpret_cast<std::byte*>(buf.data()), want);
     if (got == 0) break;
     left -= got;
     for (std::size_t i = 0; i < got; ++i) {
@@ -618,16 +606,24 @@ Volume readAsciiArray(const std::filesystem::path& path, std::uint64_t begin, st
 
 std::string extentString(const Extent& e) {
   std::string s;
-  for (auto v : e) s += (s.empty() ? "" : " ") + std::to_string(v);
+  // Built piecewise: GCC 12 warns falsely (-Wrestrict) on "" + string.
+  for (auto v : e) {
+    if (!s.empty()) s += ' ';
+    s += std::to_string(v);
+  }
   return s;
 }
 
 }  // namespace
 
 Volume readVti(const std::filesystem::path& path) {
-  const std::string p = path.string();
-  const std::uint64_t fileSize = io_detail::regularFileSize(path);
-  const VtiDocument doc = parseDocument(path, p);
+  return readVti(FileSource(path));
+}
+
+Volume readVti(const ByteSource& file) {
+  const std::string& p = file.name();
+  const std::uint64_t fileSize = file.size();
+  const VtiDocument doc = parseDocument(file);
   if (!doc.hasImageData) throw InputError(p + ": VTK file has no <ImageData> element");
   if (doc.pieces == 0) throw InputError(p + ": <ImageData> has no <Piece>");
   if (doc.pieceExtent && *doc.pieceExtent != doc.wholeExtent) {
@@ -729,12 +725,12 @@ Volume readVti(const std::filesystem::path& path) {
     if (!array->hasText) throw InputError(c.what + " has no data inside it");
     if (array->format == "ascii") {
       encoding = "ascii";
-      v = readAsciiArray(path, array->textBegin, array->textEnd, c, array->type);
+      v = readAsciiArray(file, array->textBegin, array->textEnd, c, array->type);
     } else {
       encoding = "inline base64";
       const std::uint64_t chars = array->textEnd - array->textBegin;
-      io_detail::FileByteSource text(path, array->textBegin);
-      io_detail::Base64Source bytes(text, chars, c.what, array->textBegin);
+      io_detail::SourceStream text(file, array->textBegin);
+      io_detail::Base64Stream bytes(text, chars, c.what, array->textBegin);
       v = readBinaryArray(bytes, io_detail::base64DecodedBound(chars), c);
     }
   } else if (array->format == "appended") {
@@ -748,13 +744,13 @@ Volume readVti(const std::filesystem::path& path) {
                        ", but the appended data has only " + std::to_string(room) + " bytes");
     }
     const std::uint64_t start = doc.appendedStart + *array->offset;
-    io_detail::FileByteSource file(path, start);
+    io_detail::SourceStream data(file, start);
     if (doc.appendedEncoding == "raw") {
       encoding = "appended raw";
-      v = readBinaryArray(file, fileSize - start, c);
+      v = readBinaryArray(data, fileSize - start, c);
     } else if (doc.appendedEncoding == "base64") {
       encoding = "appended base64";
-      io_detail::Base64Source bytes(file, fileSize - start, c.what, start);
+      io_detail::Base64Stream bytes(data, fileSize - start, c.what, start);
       v = readBinaryArray(bytes, io_detail::base64DecodedBound(fileSize - start), c);
     } else {
       throw InputError(p + ": AppendedData encoding '" + doc.appendedEncoding +
@@ -781,154 +777,6 @@ Volume readVti(const std::filesystem::path& path) {
   if (format.type == DiskType::I8) description += ", widened to i16";
   v.setDescription(description + ")");
   return v;
-}
-
-namespace {
-
-class VtiOutput {
- public:
-  explicit VtiOutput(const std::filesystem::path& path)
-      : path_(path), out_(path, std::ios::binary) {
-    if (!out_) fail("cannot open for writing");
-  }
-  void write(const void* data, std::size_t n) {
-    out_.write(static_cast<const char*>(data), static_cast<std::streamsize>(n));
-    if (!out_) fail("write failed");
-  }
-  void write(const std::string& s) { write(s.data(), s.size()); }
-  void word(std::uint64_t v) {  // UInt64, little endian
-    unsigned char b[8];
-    for (int i = 0; i < 8; ++i) b[i] = static_cast<unsigned char>(v >> (8 * i));
-    write(b, 8);
-  }
-  std::streampos position() { return out_.tellp(); }
-  void seek(std::streampos pos) {
-    out_.seekp(pos);
-    if (!out_) fail("seek failed");
-  }
-  void close() {
-    out_.close();
-    if (!out_) fail("write failed");
-  }
-
- private:
-  [[noreturn]] void fail(const char* what) const {
-    throw Error(path_.string() + ": " + what + ": " + std::strerror(errno));
-  }
-  std::filesystem::path path_;
-  std::ofstream out_;
-};
-
-// The bytes [at, at + n) of the volume in little-endian order.
-const std::byte* littleEndian(const Volume& v, std::size_t at, std::size_t n,
-                              std::vector<std::byte>& scratch) {
-  const std::byte* p = v.bytes().data() + at;
-  if constexpr (std::endian::native == std::endian::big) {
-    const std::size_t elem = bytesPerVoxel(v.type());
-    scratch.assign(p, p + n);
-    for (std::size_t i = 0; i + elem <= n; i += elem) {
-      std::reverse(scratch.begin() + static_cast<std::ptrdiff_t>(i),
-                   scratch.begin() + static_cast<std::ptrdiff_t>(i + elem));
-    }
-    return scratch.data();
-  }
-  return p;
-}
-
-const char* vtkTypeName(ScalarType t) {
-  switch (t) {
-    case ScalarType::U8:
-      return "UInt8";
-    case ScalarType::U16:
-      return "UInt16";
-    case ScalarType::I16:
-      return "Int16";
-    case ScalarType::F32:
-      return "Float32";
-  }
-  return "UInt8";
-}
-
-}  // namespace
-
-void writeVti(const Volume& volume, const std::filesystem::path& path, bool compressed) {
-  const glm::ivec3 d = volume.dims();
-  if (d.x <= 0 || d.y <= 0 || d.z <= 0 || !volume.hasData()) {
-    throw InputError(path.string() + ": cannot write an empty volume (" + io_detail::dimsString(d) +
-                     ")");
-  }
-  const glm::dvec3 s = volume.spacing();
-  const glm::dvec3 o = volume.origin();
-  const glm::dmat3& dir = volume.direction();
-  std::string direction;  // row by row, as vtkXMLImageDataWriter writes it
-  for (int row = 0; row < 3; ++row) {
-    for (int col = 0; col < 3; ++col) {
-      if (!direction.empty()) direction += ' ';
-      direction += exactNumber(dir[col][row]);
-    }
-  }
-  const ValueRange range = volume.valueRange();
-  const std::string extent = "0 " + std::to_string(d.x - 1) + " 0 " + std::to_string(d.y - 1) +
-                             " 0 " + std::to_string(d.z - 1);
-  // Appended raw data with UInt64 headers, as ParaView writes by default.
-  std::string xml = "<?xml version=\"1.0\"?>\n";
-  xml +=
-      "<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" "
-      "header_type=\"UInt64\"";
-  if (compressed) xml += " compressor=\"vtkZLibDataCompressor\"";
-  xml += ">\n";
-  xml += "  <ImageData WholeExtent=\"" + extent + "\" Origin=\"" + exactNumber(o.x) + " " +
-         exactNumber(o.y) + " " + exactNumber(o.z) + "\" Spacing=\"" + exactNumber(s.x) + " " +
-         exactNumber(s.y) + " " + exactNumber(s.z) + "\" Direction=\"" + direction + "\">\n";
-  xml += "    <Piece Extent=\"" + extent + "\">\n";
-  xml += "      <PointData Scalars=\"scalars\">\n";
-  xml += std::string("        <DataArray type=\"") + vtkTypeName(volume.type()) +
-         "\" Name=\"scalars\" format=\"appended\" RangeMin=\"" + exactNumber(range.min) +
-         "\" RangeMax=\"" + exactNumber(range.max) + "\" offset=\"0\"/>\n";
-  xml += "      </PointData>\n      <CellData>\n      </CellData>\n    </Piece>\n";
-  xml += "  </ImageData>\n  <AppendedData encoding=\"raw\">\n   _";
-
-  VtiOutput out(path);
-  out.write(xml);
-  const std::size_t total = volume.bytes().size();
-  std::vector<std::byte> scratch;
-  if (!compressed) {
-    out.word(total);
-    constexpr std::size_t kChunk = 1 << 20;
-    for (std::size_t at = 0; at < total; at += kChunk) {
-      const std::size_t n = std::min(kChunk, total - at);
-      out.write(littleEndian(volume, at, n, scratch), n);
-    }
-  } else {
-    const std::size_t blocks = (total + kWriteBlockBytes - 1) / kWriteBlockBytes;
-    // The header holds the compressed sizes: reserve it, write the blocks,
-    // then come back and fill it in.
-    const std::streampos header = out.position();
-    for (std::size_t i = 0; i < 3 + blocks; ++i) out.word(0);
-    std::vector<std::uint64_t> sizes;
-    sizes.reserve(blocks);
-    std::vector<unsigned char> packed(compressBound(kWriteBlockBytes));
-    for (std::size_t at = 0; at < total; at += kWriteBlockBytes) {
-      const std::size_t n = std::min(kWriteBlockBytes, total - at);
-      uLongf len = static_cast<uLongf>(packed.size());
-      const std::byte* src = littleEndian(volume, at, n, scratch);
-      if (compress2(packed.data(), &len, reinterpret_cast<const Bytef*>(src), static_cast<uLong>(n),
-                    Z_DEFAULT_COMPRESSION) != Z_OK) {
-        throw Error(path.string() + ": zlib compression failed");
-      }
-      out.write(packed.data(), len);
-      sizes.push_back(len);
-    }
-    const std::streampos end = out.position();
-    out.seek(header);
-    out.word(blocks);
-    out.word(kWriteBlockBytes);
-    out.word(total % kWriteBlockBytes);
-    for (std::uint64_t sz : sizes) out.word(sz);
-    out.seek(end);
-  }
-  out.write(std::string("\n  </AppendedData>\n</VTKFile>\n"));
-  out.close();
 }
 
 }  // namespace tessera

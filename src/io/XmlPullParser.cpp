@@ -64,8 +64,8 @@ const std::string* XmlEvent::attribute(std::string_view attributeName) const {
   return nullptr;
 }
 
-XmlPullParser::XmlPullParser(const std::filesystem::path& path, std::string what)
-    : what_(std::move(what)), file_(std::make_unique<FileByteSource>(path, 0)), buf_(kBufferBytes) {
+XmlPullParser::XmlPullParser(const ByteSource& file)
+    : what_(file.name()), file_(file, 0), buf_(kBufferBytes) {
   // A UTF-8 byte order mark is allowed before the first '<'.
   if (peek() == 0xef) {
     const unsigned char bom[3] = {0xef, 0xbb, 0xbf};
@@ -86,7 +86,7 @@ void XmlPullParser::failAt(int line, const std::string& msg) const {
 
 bool XmlPullParser::refill() {
   if (eof_) return false;
-  len_ = file_->read(reinterpret_cast<std::byte*>(buf_.data()), buf_.size());
+  len_ = file_.read(reinterpret_cast<std::byte*>(buf_.data()), buf_.size());
   pos_ = 0;
   if (len_ == 0) eof_ = true;
   return len_ > 0;

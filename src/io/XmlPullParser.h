@@ -7,13 +7,12 @@
 // hostile file from costing more than a few kilobytes.
 #include <cstddef>
 #include <cstdint>
-#include <filesystem>
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
-#include "io/ByteSource.h"
+#include "io/ByteStream.h"
 
 namespace tessera::io_detail {
 
@@ -40,8 +39,8 @@ struct XmlEvent {
 
 class XmlPullParser {
  public:
-  // Errors are InputErrors that start with `what` (the file name) and the line.
-  XmlPullParser(const std::filesystem::path& path, std::string what);
+  // Errors are InputErrors that start with the file's name and the line.
+  explicit XmlPullParser(const ByteSource& file);
 
   // The next event. An empty element <X/> gives StartElement then
   // EndElement. Text outside the root element must be whitespace and is not
@@ -77,7 +76,7 @@ class XmlPullParser {
   [[noreturn]] void failAt(int line, const std::string& msg) const;
 
   std::string what_;
-  std::unique_ptr<FileByteSource> file_;
+  SourceStream file_;
   std::vector<unsigned char> buf_;
   std::size_t pos_ = 0;
   std::size_t len_ = 0;

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cstdint>
 
-#include "gpu/gl.h"
 #include "tessera/core/Error.h"
+#include "tessera/gpu/Draw.h"
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/gpu/Program.h"
 
@@ -23,26 +23,48 @@ std::vector<glm::vec3> LayoutProbe::voxelCentres(glm::ivec3 d) {
   return out;
 }
 
+bool LayoutProbe::hasFloatTargets() const {
+  return context_.caps().api == gpu::ApiLevel::Gles3 &&
+         context_.caps().has("GL_EXT_color_buffer_float");
+}
+
 std::vector<float> LayoutProbe::sample(const Layout& layout,
                                        const std::vector<glm::vec3>& positions) {
   if (positions.empty()) return {};
-  if (context_.caps().api == gpu::ApiLevel::Gles3 &&
-      context_.caps().has("GL_EXT_color_buffer_float")) {
-    return sampleFloat(layout, positions);
+  if (!hasFloatTargets()) return sampleRgba8(layout, positions);
+  const std::vector<glm::vec4> probed = probeFloat(layout, positions, false);
+  std::vector<float> out(probed.size());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = probed[i].x;
+  return out;
+}
+
+std::vector<glm::vec4> LayoutProbe::sampleGradient(const Layout& layout,
+                                                   const std::vector<glm::vec3>& positions) {
+  if (!hasFloatTargets()) {
+    throw GpuError(
+        "LayoutProbe: gradients need float render targets (ES 3 + "
+        "EXT_color_buffer_float)");
   }
-  return sampleRgba8(layout, positions);
+  if (positions.empty()) return {};
+  return probeFloat(layout, positions, true);
 }
 
 // ES 3 with float render targets: positions in an RGBA32F texture read with
-// texelFetch, values written to an RGBA32F target.
-std::vector<float> LayoutProbe::sampleFloat(const Layout& layout,
-                                            const std::vector<glm::vec3>& positions) {
+// texelFetch, values (or gradient and value) written to an RGBA32F target.
+std::vector<glm::vec4> LayoutProbe::probeFloat(const Layout& layout,
+                                               const std::vector<glm::vec3>& positions,
+                                               bool gradient) {
   const gpu::ApiLevel api = context_.caps().api;
+  std::vector<gpu::ShaderPart> fragment = {
+      gpu::shaderPreamble(api, true,
+                          gradient ? std::vector<std::string>{"TESSERA_PROBE_GRADIENT 1"}
+                                   : std::vector<std::string>{})};
+  for (gpu::ShaderPart& part : layout.seamParts()) fragment.push_back(std::move(part));
+  fragment.push_back(gpu::embeddedShaderPart("layout/probe.frag.glsl"));
   const gpu::Program program = gpu::Program::build(
-      "probe(" + layout.name() + ")",
+      "probe(" + layout.name() + (gradient ? ", gradient)" : ")"),
       {gpu::shaderPreamble(api, false, {}), gpu::embeddedShaderPart("render/fullscreen.vert.glsl")},
-      {gpu::shaderPreamble(api, true, {}), layout.glsl(),
-       gpu::embeddedShaderPart("layout/probe.frag.glsl")});
+      fragment);
 
   // Lay the positions out in rows of at most 1024.
   const int width = static_cast<int>(std::min<std::size_t>(positions.size(), 1024));
@@ -53,34 +75,34 @@ std::vector<float> LayoutProbe::sampleFloat(const Layout& layout,
     packed[i * 3 + 1] = positions[i].y;
     packed[i * 3 + 2] = positions[i].z;
   }
-  gpu::Texture posTex = gpu::Texture::create2D(context_.ledger(), "probe positions", GL_RGBA32F,
-                                               width, height, GL_RGBA, GL_FLOAT, nullptr);
+  gpu::Texture posTex = gpu::Texture::create2D(context_.ledger(), "probe positions",
+                                               gpu::TexelFormat::RGBA32F, width, height);
   {
     std::vector<float> rgba(static_cast<std::size_t>(width) * height * 4, 0.0f);
     for (std::size_t i = 0; i < packed.size() / 3; ++i) {
       for (int c = 0; c < 3; ++c) rgba[i * 4 + c] = packed[i * 3 + c];
     }
-    posTex.update2D(GL_RGBA, GL_FLOAT, rgba.data());
+    posTex.update(rgba.data());
   }
-  posTex.setFilter(GL_NEAREST, GL_NEAREST);
-  gpu::Framebuffer target =
-      gpu::Framebuffer::create(context_.ledger(), "probe target", width, height, GL_RGBA32F);
+  posTex.setFilter(gpu::Filter::Nearest);
+  gpu::Framebuffer target = gpu::Framebuffer::create(context_.ledger(), "probe target", width,
+                                                     height, gpu::TexelFormat::RGBA32F);
 
   const gpu::FullscreenTriangle triangle(context_.ledger());
   target.bind();
   program.use();
-  const int unit = layout.bind(program, 0);
+  const int unit = layout.bindSeam(program, 0);
   posTex.bind(unit);
   program.set("u_positions", unit);
-  glDisable(GL_BLEND);
+  gpu::apply({});
   triangle.draw();
 
   std::vector<float> rgba(static_cast<std::size_t>(width) * height * 4);
-  glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, rgba.data());
-  const GLenum err = glGetError();
-  if (err != GL_NO_ERROR) throw GpuError("LayoutProbe: GL error " + std::to_string(err));
-  std::vector<float> out(positions.size());
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = rgba[i * 4];
+  gpu::readPixelsRgba32F({0, 0, width, height}, rgba.data());
+  std::vector<glm::vec4> out(positions.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    out[i] = glm::vec4(rgba[i * 4], rgba[i * 4 + 1], rgba[i * 4 + 2], rgba[i * 4 + 3]);
+  }
   return out;
 }
 
@@ -111,38 +133,27 @@ std::vector<float> LayoutProbe::sampleRgba8(const Layout& layout,
     v[3] = positions[i].y;
     v[4] = positions[i].z;
   }
-  const gpu::Buffer buffer =
-      gpu::Buffer::create(context_.ledger(), "probe points", GL_ARRAY_BUFFER,
-                          vertices.size() * sizeof(float), vertices.data(), GL_STATIC_DRAW);
+  const gpu::Buffer buffer = gpu::Buffer::create(
+      context_.ledger(), "probe points", gpu::BufferKind::Vertices, vertices.size() * sizeof(float),
+      vertices.data(), gpu::BufferUsage::Static);
   // ES 2.0 takes an unsized colour format.
-  gpu::Framebuffer target =
-      gpu::Framebuffer::create(context_.ledger(), "probe target", width, height,
-                               api == gpu::ApiLevel::Gles2 ? GL_RGBA : GL_RGBA8);
+  gpu::Framebuffer target = gpu::Framebuffer::create(
+      context_.ledger(), "probe target", width, height,
+      api == gpu::ApiLevel::Gles2 ? gpu::TexelFormat::Rgba8Unsized : gpu::TexelFormat::RGBA8);
 
   target.bind();
-  glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
-  glClear(GL_COLOR_BUFFER_BIT);
+  gpu::apply({});
+  gpu::clearColor(glm::vec4(0.0f));
   program.use();
   layout.bind(program, 0);
-  glDisable(GL_BLEND);
-  const GLint probeAttribute = glGetAttribLocation(program.id(), "a_probe");
+  const int probeAttribute = program.attributeLocation("a_probe");
   if (probeAttribute < 0) throw GpuError("LayoutProbe: probe.vert.glsl lacks a_probe");
-  const auto probeIndex = static_cast<GLuint>(probeAttribute);
-  glBindBuffer(GL_ARRAY_BUFFER, buffer.id());
-  glEnableVertexAttribArray(0);
-  glEnableVertexAttribArray(probeIndex);
-  const GLsizei stride = kFloats * sizeof(float);
-  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, stride, nullptr);
-  glVertexAttribPointer(probeIndex, 3, GL_FLOAT, GL_FALSE, stride,
-                        reinterpret_cast<const void*>(2 * sizeof(float)));
-  glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(positions.size()));
-  glDisableVertexAttribArray(probeIndex);
-  glDisableVertexAttribArray(0);
+  gpu::drawArrays(gpu::Primitive::Points, buffer, {{0, 2, 0}, {probeAttribute, 3, 2}}, kFloats, 0,
+                  static_cast<int>(positions.size()));
 
   std::vector<std::uint8_t> rgba(static_cast<std::size_t>(width) * height * 4);
   target.readRgba8(rgba.data());
-  const GLenum err = glGetError();
-  if (err != GL_NO_ERROR) throw GpuError("LayoutProbe: GL error " + std::to_string(err));
+  gpu::checkErrors("LayoutProbe");
   std::vector<float> out(positions.size());
   for (std::size_t i = 0; i < out.size(); ++i) {
     const std::uint8_t* px = rgba.data() + i * 4;

@@ -5,9 +5,9 @@
 #include <cstring>
 #include <limits>
 
-#include "gpu/gl.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/gpu/Draw.h"
 
 namespace tessera::layout {
 
@@ -17,27 +17,18 @@ std::string dimsText(glm::ivec3 d) {
   return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
 }
 
-struct StorageFormat {
-  const char* name;
-  gpu::GLenumT internalFormat;
-  gpu::GLenumT format;
-  gpu::GLenumT type;
-  std::uint64_t gpuBytes;  // per texel on the GPU
-  std::size_t hostBytes;   // per texel in the upload
-};
-
-StorageFormat formatOf(MosaicLayout::Storage s) {
+gpu::TexelFormat formatOf(MosaicLayout::Storage s) {
   switch (s) {
     case MosaicLayout::Storage::R8:
-      return {"R8", GL_R8, GL_RED, GL_UNSIGNED_BYTE, 1, 1};
+      return gpu::TexelFormat::R8;
     case MosaicLayout::Storage::R16:
-      return {"R16", GL_R16_EXT, GL_RED, GL_UNSIGNED_SHORT, 2, 2};
+      return gpu::TexelFormat::R16;
     case MosaicLayout::Storage::R16F:
-      return {"R16F", GL_R16F, GL_RED, GL_FLOAT, 2, 4};
+      return gpu::TexelFormat::R16F;
     case MosaicLayout::Storage::Luminance8:
-      return {"L8", GL_LUMINANCE, GL_LUMINANCE, GL_UNSIGNED_BYTE, 1, 1};
+      return gpu::TexelFormat::Luminance8;
   }
-  return {"?", 0, 0, 0, 0, 0};
+  return gpu::TexelFormat::R8;
 }
 
 // Writes slice z as dims.x * dims.y texels of the storage's upload type,
@@ -129,8 +120,8 @@ MosaicLayout::Storage MosaicLayout::storageFor(ScalarType type, const gpu::Devic
 
 std::vector<std::uint8_t> MosaicLayout::pack(const Volume& volume, const Geometry& geometry,
                                              Storage storage) {
-  const StorageFormat f = formatOf(storage);
-  const std::size_t rowStride = static_cast<std::size_t>(geometry.width()) * f.hostBytes;
+  const std::size_t hostBytes = gpu::uploadBytesPerTexel(formatOf(storage));
+  const std::size_t rowStride = static_cast<std::size_t>(geometry.width()) * hostBytes;
   const std::size_t bytes = rowStride * static_cast<std::size_t>(geometry.height());
   HostBudget::global().check(bytes, "mosaic image");
   std::vector<std::uint8_t> image(bytes, 0);
@@ -138,7 +129,7 @@ std::vector<std::uint8_t> MosaicLayout::pack(const Volume& volume, const Geometr
     const glm::ivec2 origin = geometry.addressOf(0, 0, z);
     packSlice(volume, z, storage,
               image.data() + static_cast<std::size_t>(origin.y) * rowStride +
-                  static_cast<std::size_t>(origin.x) * f.hostBytes,
+                  static_cast<std::size_t>(origin.x) * hostBytes,
               rowStride);
   }
   return image;
@@ -169,17 +160,18 @@ LayoutPlan MosaicLayout::planFor(const Volume& volume, const gpu::DeviceLimits& 
     return plan;
   }
   const Storage storage = storageFor(volume.type(), limits);
-  const StorageFormat f = formatOf(storage);
+  const gpu::TexelFormat f = formatOf(storage);
+  const std::uint64_t gpuBytes = gpu::bytesPerTexel(f);
   PlannedTexture t;
   t.label = "volume mosaic";
   t.size = {g.width(), g.height(), 1};
-  t.format = f.name;
+  t.format = gpu::texelFormatName(f);
   t.bytes =
-      static_cast<std::uint64_t>(g.width()) * static_cast<std::uint64_t>(g.height()) * f.gpuBytes;
+      static_cast<std::uint64_t>(g.width()) * static_cast<std::uint64_t>(g.height()) * gpuBytes;
   plan.textures.push_back(t);
   plan.totalBytes = t.bytes;
-  const bool quantised = volume.type() != ScalarType::U8 && f.gpuBytes == 1;
-  const std::string what = vol + " in one " + f.name + " " + std::to_string(g.width()) + "x" +
+  const bool quantised = volume.type() != ScalarType::U8 && gpuBytes == 1;
+  const std::string what = vol + " in one " + t.format + " " + std::to_string(g.width()) + "x" +
                            std::to_string(g.height()) + " texture (mosaic, " +
                            std::to_string(g.tilesX) + "x" + std::to_string(g.tilesY) + " tiles, " +
                            formatBytes(t.bytes) + (quantised ? ", quantised to 8 bits" : "") + ")";
@@ -199,6 +191,7 @@ std::unique_ptr<MosaicLayout> MosaicLayout::create(const Volume& volume,
                                                    const gpu::DeviceLimits& limits,
                                                    gpu::MemoryLedger& ledger) {
   std::unique_ptr<MosaicLayout> l(new MosaicLayout());
+  l->voxels_ = &volume;
   l->plan_ = planFor(volume, limits);
   if (!l->plan_.fits) throw GpuError("mosaic layout: " + l->plan_.reason);
   l->geometry_ = geometryFor(volume.dims(), limits.max2DTextureSize);
@@ -210,19 +203,17 @@ std::unique_ptr<MosaicLayout> MosaicLayout::create(const Volume& volume,
     l->mapping_ = {r.max > r.min ? r.max - r.min : 1.0, r.min};
   }
   const Geometry& g = l->geometry_;
-  const StorageFormat f = formatOf(l->storage_);
-  l->texture_ = gpu::Texture::create2D(ledger, std::string("volume (mosaic ") + f.name + ")",
-                                       f.internalFormat, g.width(), g.height(), f.format, f.type,
-                                       nullptr, f.gpuBytes);
+  const gpu::TexelFormat f = formatOf(l->storage_);
+  l->texture_ =
+      gpu::Texture::create2D(ledger, std::string("volume (mosaic ") + gpu::texelFormatName(f) + ")",
+                             f, g.width(), g.height());
   // Slice by slice, so the host needs one slice of staging, not the whole
   // mosaic; the unused tiles of the last row get zeros (glTexImage2D with
   // no data leaves them undefined).
-  const std::size_t rowStride = static_cast<std::size_t>(g.dims.x) * f.hostBytes;
+  const std::size_t rowStride = static_cast<std::size_t>(g.dims.x) * gpu::uploadBytesPerTexel(f);
   const std::size_t sliceBytes = rowStride * static_cast<std::size_t>(g.dims.y);
   HostBudget::global().check(sliceBytes, "mosaic upload staging");
   std::vector<std::uint8_t> staging(sliceBytes);
-  glBindTexture(GL_TEXTURE_2D, l->texture_.id());
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
   for (int z = 0; z < g.tilesX * g.tilesY; ++z) {
     if (z < g.dims.z) {
       packSlice(volume, z, l->storage_, staging.data(), rowStride);
@@ -230,15 +221,10 @@ std::unique_ptr<MosaicLayout> MosaicLayout::create(const Volume& volume,
       std::fill(staging.begin(), staging.end(), std::uint8_t{0});
     }
     const glm::ivec2 origin = g.addressOf(0, 0, z);
-    glTexSubImage2D(GL_TEXTURE_2D, 0, origin.x, origin.y, g.dims.x, g.dims.y, f.format, f.type,
-                    staging.data());
+    l->texture_.updateRegion({origin, 0}, {g.dims.x, g.dims.y, 1}, staging.data());
   }
-  const GLenum err = glGetError();
-  if (err != GL_NO_ERROR) {
-    throw GpuError("mosaic layout: uploading " + std::to_string(g.width()) + "x" +
-                   std::to_string(g.height()) + " " + f.name + " failed with GL error " +
-                   std::to_string(err));
-  }
+  gpu::checkErrors("mosaic layout: uploading " + std::to_string(g.width()) + "x" +
+                   std::to_string(g.height()) + " " + gpu::texelFormatName(f));
   return l;
 }
 

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "gpu/gl.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/gpu/Draw.h"
 #include "tessera/layout/MosaicLayout.h"
 
 namespace tessera::layout {
@@ -236,6 +236,7 @@ std::unique_ptr<PackedMosaicLayout> PackedMosaicLayout::create(const Volume& vol
                                                                gpu::MemoryLedger& ledger,
                                                                int maxTextures, Packing packing) {
   std::unique_ptr<PackedMosaicLayout> l(new PackedMosaicLayout());
+  l->voxels_ = &volume;
   PackingPlan chosen = choosePacking(volume, limits, maxTextures, packing);
   l->plan_ = std::move(chosen.plan);
   if (!l->plan_.fits) throw GpuError("packed-mosaic layout: " + l->plan_.reason);
@@ -248,7 +249,8 @@ std::unique_ptr<PackedMosaicLayout> PackedMosaicLayout::create(const Volume& vol
   }
   const Geometry& g = l->geometry_;
   // ES 2.0 takes only unsized internal formats.
-  const GLenum internalFormat = limits.api == gpu::ApiLevel::Gles2 ? GL_RGBA : GL_RGBA8;
+  const gpu::TexelFormat format =
+      limits.api == gpu::ApiLevel::Gles2 ? gpu::TexelFormat::Rgba8Unsized : gpu::TexelFormat::RGBA8;
   // Tile by tile, so the host needs one tile of staging, not whole textures;
   // the unused tiles of the last texture get zeros (glTexImage2D with no
   // data leaves them undefined).
@@ -261,9 +263,7 @@ std::unique_ptr<PackedMosaicLayout> PackedMosaicLayout::create(const Volume& vol
         ledger,
         "volume (packed-mosaic " + std::string(packingName(g.packing)) + " RGBA8 " +
             std::to_string(t + 1) + "/" + std::to_string(g.textures) + ")",
-        internalFormat, g.width(), g.height(), GL_RGBA, GL_UNSIGNED_BYTE, nullptr, kC));
-    glBindTexture(GL_TEXTURE_2D, l->textures_.back().id());
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        format, g.width(), g.height()));
     for (int cell = 0; cell < g.tilesPerTexture(); ++cell) {
       const int tile = t * g.tilesPerTexture() + cell;
       if (tile < g.tiles()) {
@@ -271,16 +271,13 @@ std::unique_ptr<PackedMosaicLayout> PackedMosaicLayout::create(const Volume& vol
       } else {
         std::fill(staging.begin(), staging.end(), std::uint8_t{0});
       }
-      glTexSubImage2D(GL_TEXTURE_2D, 0, (cell % g.tilesX) * g.dims.x, (cell / g.tilesX) * g.dims.y,
-                      g.dims.x, g.dims.y, GL_RGBA, GL_UNSIGNED_BYTE, staging.data());
+      l->textures_.back().updateRegion(
+          {(cell % g.tilesX) * g.dims.x, (cell / g.tilesX) * g.dims.y, 0}, {g.dims.x, g.dims.y, 1},
+          staging.data());
     }
   }
-  const GLenum err = glGetError();
-  if (err != GL_NO_ERROR) {
-    throw GpuError("packed-mosaic layout: uploading " + std::to_string(g.textures) + " RGBA8 " +
-                   std::to_string(g.width()) + "x" + std::to_string(g.height()) +
-                   " textures failed with GL error " + std::to_string(err));
-  }
+  gpu::checkErrors("packed-mosaic layout: uploading " + std::to_string(g.textures) + " RGBA8 " +
+                   std::to_string(g.width()) + "x" + std::to_string(g.height()) + " textures");
   return l;
 }
 

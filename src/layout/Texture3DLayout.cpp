@@ -4,9 +4,9 @@
 #include <cmath>
 #include <vector>
 
-#include "gpu/gl.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/gpu/Draw.h"
 
 namespace tessera::layout {
 
@@ -58,13 +58,14 @@ std::unique_ptr<Texture3DLayout> Texture3DLayout::create(const Volume& volume,
                                                          const gpu::DeviceLimits& limits,
                                                          gpu::MemoryLedger& ledger) {
   std::unique_ptr<Texture3DLayout> l(new Texture3DLayout());
+  l->voxels_ = &volume;
   l->plan_ = planFor(volume, limits);
   if (!l->plan_.fits) throw GpuError("texture3d layout: " + l->plan_.reason);
   l->dims_ = volume.dims();
   const glm::ivec3 d = volume.dims();
   if (volume.type() == ScalarType::U8) {
-    l->texture_ = gpu::Texture::create3D(ledger, "volume (texture3d R8)", GL_R8, d.x, d.y, d.z,
-                                         GL_RED, GL_UNSIGNED_BYTE, volume.bytes().data());
+    l->texture_ = gpu::Texture::create3D(ledger, "volume (texture3d R8)", gpu::TexelFormat::R8, d.x,
+                                         d.y, d.z, volume.bytes().data());
     l->mapping_ = {255.0, 0.0};
     return l;
   }
@@ -82,8 +83,8 @@ std::unique_ptr<Texture3DLayout> Texture3DLayout::create(const Volume& volume,
       staging[i] = static_cast<std::uint16_t>(std::lround(s * 65535.0));
     }
     l->mapping_.scale = width;  // R16 normalised: s = stored/65535 exactly as above
-    l->texture_ = gpu::Texture::create3D(ledger, "volume (texture3d R16)", GL_R16_EXT, d.x, d.y,
-                                         d.z, GL_RED, GL_UNSIGNED_SHORT, staging.data());
+    l->texture_ = gpu::Texture::create3D(ledger, "volume (texture3d R16)", gpu::TexelFormat::R16,
+                                         d.x, d.y, d.z, staging.data());
   } else {
     std::vector<float> staging(n);
     for (std::size_t i = 0; i < n; ++i) {
@@ -91,8 +92,8 @@ std::unique_ptr<Texture3DLayout> Texture3DLayout::create(const Volume& volume,
       staging[i] =
           std::isfinite(v) ? static_cast<float>(std::clamp((v - r.min) / width, 0.0, 1.0)) : 0.0f;
     }
-    l->texture_ = gpu::Texture::create3D(ledger, "volume (texture3d R16F)", GL_R16F, d.x, d.y, d.z,
-                                         GL_RED, GL_FLOAT, staging.data());
+    l->texture_ = gpu::Texture::create3D(ledger, "volume (texture3d R16F)", gpu::TexelFormat::R16F,
+                                         d.x, d.y, d.z, staging.data());
   }
   return l;
 }

@@ -1,4 +1,5 @@
-// LayoutProbe: one fragment per position, writes sampleVolume(position).
+// LayoutProbe: one fragment per position, writes sampleVolume(position)
+// (with TESSERA_PROBE_GRADIENT: sampleVolumeGradient in rgb, the value in a).
 #ifdef TESSERA_PROBE_RGBA8
 // RGBA8 target (ES 2): v in [0,1] as hi = floor(255 v) / 255 in R and
 // lo = fract(255 v) in G; LayoutProbe decodes (255 hi + lo) / 255, exact to
@@ -20,6 +21,10 @@ uniform highp sampler2D u_positions;  // RGB32F, one position per texel
 
 void main() {
   vec3 p = texelFetch(u_positions, ivec2(gl_FragCoord.xy), 0).xyz;
+#ifdef TESSERA_PROBE_GRADIENT
+  FRAG_COLOR = vec4(sampleVolumeGradient(p), sampleVolume(p));
+#else
   FRAG_COLOR = vec4(sampleVolume(p), 0.0, 0.0, 1.0);
+#endif
 }
 #endif

@@ -16,32 +16,6 @@ namespace tessera {
 
 namespace {
 
-// Volume values as doubles, converted once so sampling does no type switch.
-std::vector<double> toDoubles(const Volume& v) {
-  std::vector<double> out(static_cast<std::size_t>(v.voxelCount()));
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = v.finiteValueAtIndex(i);
-  return out;
-}
-
-double trilinear(const std::vector<double>& data, glm::ivec3 d, glm::dvec3 p) {
-  // Continuous voxel coordinate with centres at integers.
-  const glm::dvec3 u = p * glm::dvec3(d) - 0.5;
-  const glm::dvec3 f = glm::floor(u);
-  const glm::dvec3 w = u - f;
-  const glm::ivec3 i0 = glm::clamp(glm::ivec3(f), glm::ivec3(0), d - 1);
-  const glm::ivec3 i1 = glm::clamp(glm::ivec3(f) + 1, glm::ivec3(0), d - 1);
-  auto at = [&](int x, int y, int z) {
-    return data[(static_cast<std::size_t>(z) * d.y + y) * d.x + x];
-  };
-  const double c00 = at(i0.x, i0.y, i0.z) * (1 - w.x) + at(i1.x, i0.y, i0.z) * w.x;
-  const double c10 = at(i0.x, i1.y, i0.z) * (1 - w.x) + at(i1.x, i1.y, i0.z) * w.x;
-  const double c01 = at(i0.x, i0.y, i1.z) * (1 - w.x) + at(i1.x, i0.y, i1.z) * w.x;
-  const double c11 = at(i0.x, i1.y, i1.z) * (1 - w.x) + at(i1.x, i1.y, i1.z) * w.x;
-  const double c0 = c00 * (1 - w.y) + c10 * w.y;
-  const double c1 = c01 * (1 - w.y) + c11 * w.y;
-  return c0 * (1 - w.z) + c1 * w.z;
-}
-
 std::uint8_t toByte(double v) {
   return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
 }
@@ -68,10 +42,15 @@ double sampleTrilinear(const Volume& volume, glm::dvec3 p) {
 Image renderReference(const Volume& volume, const TransferFunction& tf, const Camera& camera,
                       const RenderSettings& settings, int width, int height, int threads,
                       ReferenceStats* stats, const ReferenceStops* stops) {
+  return renderReference(volume, TrilinearReconstruction(volume), tf, camera, settings, width,
+                         height, threads, stats, stops);
+}
+
+Image renderReference(const Volume& volume, const Reconstruction& field, const TransferFunction& tf,
+                      const Camera& camera, const RenderSettings& settings, int width, int height,
+                      int threads, ReferenceStats* stats, const ReferenceStops* stops) {
   if (width <= 0 || height <= 0) throw InputError("reference: image size must be positive");
   if (!(settings.stepVoxels > 0.0)) throw InputError("reference: step must be > 0");
-  const glm::ivec3 dims = volume.dims();
-  const std::vector<double> data = toDoubles(volume);
   const glm::dvec3 extent = volume.extent();
   const glm::dvec3 spacing = volume.spacing();
   const double ds = settings.stepVoxels * std::min({spacing.x, spacing.y, spacing.z});
@@ -121,7 +100,7 @@ Image renderReference(const Volume& volume, const TransferFunction& tf, const Ca
             const double t = t0 + (k + j) * ds;
             if (t >= tEnd) break;
             ++samples;
-            const double raw = trilinear(data, dims, to + t * td);
+            const double raw = field.value(to + t * td);
             const double n = std::clamp((raw - win.min) / ww, 0.0, 1.0);
             if (settings.mode == RenderMode::Mip) {
               maxValue = std::max(maxValue, n);

@@ -7,8 +7,8 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/constants.hpp>
 
-#include "gpu/gl.h"
 #include "tessera/core/Error.h"
+#include "tessera/gpu/Draw.h"
 
 namespace tessera::render {
 
@@ -59,43 +59,24 @@ OverlayRenderer::OverlayRenderer(gpu::GlContext& context) : context_(context) {
                            gpu::embeddedShaderPart("render/overlay_distance.frag.glsl")});
 }
 
-OverlayRenderer::~OverlayRenderer() {
-  if (depthRenderbuffer_ != 0) glDeleteRenderbuffers(1, &depthRenderbuffer_);
-}
+OverlayRenderer::~OverlayRenderer() = default;
 
 void OverlayRenderer::allocate(int width, int height) {
   if (color_.id() != 0 && color_.width() == width && color_.height() == height) return;
-  const GLenum format = context_.caps().api == gpu::ApiLevel::Gles3 ? GL_RGBA8 : GL_RGBA;
+  const gpu::TexelFormat format = context_.caps().api == gpu::ApiLevel::Gles3
+                                      ? gpu::TexelFormat::RGBA8
+                                      : gpu::TexelFormat::Rgba8Unsized;
   color_ = gpu::Framebuffer();
   distance_ = gpu::Framebuffer();
-  color_ = gpu::Framebuffer::create(context_.ledger(), "overlay colour", width, height, format);
+  // Each target has its depth buffer, cleared before its pass, so that where
+  // lines cross the nearest one wins in colour and distance alike.
+  color_ =
+      gpu::Framebuffer::create(context_.ledger(), "overlay colour", width, height, format, true);
   distance_ =
-      gpu::Framebuffer::create(context_.ledger(), "overlay distance", width, height, format);
+      gpu::Framebuffer::create(context_.ledger(), "overlay distance", width, height, format, true);
   // Sampled at pixel centres only: never blend two lines' packed distances.
-  color_.color().bind(0);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  distance_.color().bind(0);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-
-  // One depth buffer, shared by both targets (cleared before each pass), so
-  // that where lines cross the nearest one wins in colour and distance alike.
-  if (depthRenderbuffer_ == 0) glGenRenderbuffers(1, &depthRenderbuffer_);
-  glBindRenderbuffer(GL_RENDERBUFFER, depthRenderbuffer_);
-  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT16, width, height);
-  depthEntry_ = gpu::LedgerEntry();
-  depthEntry_ = gpu::LedgerEntry(context_.ledger(), gpu::GpuResource::Renderbuffer,
-                                 static_cast<std::uint64_t>(width) * height * 2, "overlay depth");
-  for (const gpu::Framebuffer* fb : {&color_, &distance_}) {
-    glBindFramebuffer(GL_FRAMEBUFFER, fb->id());
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
-                              depthRenderbuffer_);
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-      throw GpuError("overlay target " + std::to_string(width) + "x" + std::to_string(height) +
-                     " with a depth buffer is incomplete");
-    }
-  }
+  color_.color().setFilter(gpu::Filter::Nearest);
+  distance_.color().setFilter(gpu::Filter::Nearest);
 }
 
 void OverlayRenderer::drawPass(const gpu::Program& program, const glm::mat4& mvp,
@@ -107,25 +88,12 @@ void OverlayRenderer::drawPass(const gpu::Program& program, const glm::mat4& mvp
   program.set("u_forward", glm::vec3(-b[2]));
   program.set("u_ortho", camera.projection == Projection::Orthographic ? 1 : 0);
   program.set("u_distanceScale", static_cast<float>(distanceScale_));
-  glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
-  glClearDepthf(1.0f);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  gpu::clearColorAndDepth(glm::vec4(0.0f));
   if (vertexCount == 0) return;
-  const GLint position = glGetAttribLocation(program.id(), "a_position");
-  const GLint color = glGetAttribLocation(program.id(), "a_color");
-  glBindBuffer(GL_ARRAY_BUFFER, vertices_.id());
-  const GLsizei stride = 7 * sizeof(float);
-  glEnableVertexAttribArray(static_cast<GLuint>(position));
-  glVertexAttribPointer(static_cast<GLuint>(position), 3, GL_FLOAT, GL_FALSE, stride, nullptr);
-  if (color >= 0) {
-    glEnableVertexAttribArray(static_cast<GLuint>(color));
-    glVertexAttribPointer(static_cast<GLuint>(color), 4, GL_FLOAT, GL_FALSE, stride,
-                          reinterpret_cast<const void*>(3 * sizeof(float)));
-  }
-  glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(vertexCount));
-  glDisableVertexAttribArray(static_cast<GLuint>(position));
-  if (color >= 0) glDisableVertexAttribArray(static_cast<GLuint>(color));
-  glBindBuffer(GL_ARRAY_BUFFER, 0);
+  gpu::drawArrays(gpu::Primitive::Lines, vertices_,
+                  {{program.attributeLocation("a_position"), 3, 0},
+                   {program.attributeLocation("a_color"), 4, 3}},
+                  7, 0, static_cast<int>(vertexCount));
 }
 
 void OverlayRenderer::draw(const std::vector<OverlayLine>& lines, const Camera& camera, int width,
@@ -147,27 +115,21 @@ void OverlayRenderer::draw(const std::vector<OverlayLine>& lines, const Camera& 
   distanceScale_ = (eyeDistance + sceneRadius) * 1.001;
   if (!data.empty() && (vertices_.id() == 0 || vertices_.bytes() != data.size() * sizeof(float))) {
     vertices_ = gpu::Buffer();
-    vertices_ = gpu::Buffer::create(context_.ledger(), "overlay lines", GL_ARRAY_BUFFER,
-                                    data.size() * sizeof(float), data.data(), GL_DYNAMIC_DRAW);
+    vertices_ =
+        gpu::Buffer::create(context_.ledger(), "overlay lines", gpu::BufferKind::Vertices,
+                            data.size() * sizeof(float), data.data(), gpu::BufferUsage::Dynamic);
   } else if (!data.empty()) {
-    glBindBuffer(GL_ARRAY_BUFFER, vertices_.id());
-    glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(data.size() * sizeof(float)),
-                    data.data());
+    vertices_.update(0, data.size() * sizeof(float), data.data());
   }
   const glm::mat4 mvp(viewProjection(camera, static_cast<double>(width) / height, sceneRadius));
 
-  glDisable(GL_BLEND);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LESS);
-  glDepthMask(GL_TRUE);
-  glLineWidth(1.0f);
+  gpu::apply({.depthTest = true, .lineWidth = 1.0f});
   color_.bind();
   drawPass(colorProgram_, mvp, camera, data.size() / 7);
   distance_.bind();
   drawPass(distanceProgram_, mvp, camera, data.size() / 7);
-  glDisable(GL_DEPTH_TEST);
-  const GLenum err = glGetError();
-  if (err != GL_NO_ERROR) throw GpuError("overlay lines failed: GL error " + std::to_string(err));
+  gpu::apply({});
+  gpu::checkErrors("overlay lines");
 }
 
 Image OverlayRenderer::readColor() const {

@@ -30,7 +30,7 @@ void Raycaster::setSkipBlockSize(int voxels) {
   if (voxels < 0)
     throw InputError("empty-space block size must be >= 0, got " + std::to_string(voxels));
   blockSize_ = voxels;
-  blocks_ = voxels > 0 ? BlockMinMax(volume_, voxels) : BlockMinMax();
+  blocks_ = voxels > 0 ? layout_.valueBlocks(voxels) : layout::ValueBlocks();
   blockTexture_ = gpu::Texture();
   lookupKey_.clear();
 }
@@ -198,12 +198,18 @@ std::vector<gpu::ShaderPart> Raycaster::vertexParts() const {
 }
 
 std::vector<gpu::ShaderPart> Raycaster::fragmentParts(const RenderSettings& settings) const {
-  // The technique composed from parts (DESIGN.md): rays, the layout's
-  // sampleVolume(), classification, and the marching loop.
-  return {gpu::shaderPreamble(context_.caps().api, true, definesFor(settings)),
-          gpu::embeddedShaderPart("render/camera_ray.glsl"), layout_.glsl(),
-          gpu::embeddedShaderPart("render/classify.glsl"),
-          gpu::embeddedShaderPart("render/raycast.frag.glsl")};
+  // The technique composed from parts (DESIGN.md): rays, the layout seam
+  // (sampleVolume() and its gradient), the shared classified sample and
+  // compositing, and the marching loop.
+  std::vector<gpu::ShaderPart> parts = {
+      gpu::shaderPreamble(context_.caps().api, true, definesFor(settings)),
+      gpu::embeddedShaderPart("render/camera_ray.glsl")};
+  for (gpu::ShaderPart& part : layout_.seamParts()) parts.push_back(std::move(part));
+  for (const char* file : {"render/classify.glsl", "render/sample.glsl", "render/composite.glsl",
+                           "render/raycast.frag.glsl"}) {
+    parts.push_back(gpu::embeddedShaderPart(file));
+  }
+  return parts;
 }
 
 const gpu::Program& Raycaster::programFor(const RenderSettings& settings) {
@@ -279,7 +285,7 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
   prog.set("u_valueScale", static_cast<float>(m.scale / ww));
   prog.set("u_valueBias", static_cast<float>((m.offset - w.min) / ww));
 
-  int unit = layout_.bind(prog, 0);
+  int unit = layout_.bindSeam(prog, 0);
   lutTexture_.bind(unit);
   prog.set("u_tf", unit++);
   prog.set("u_tfSize", static_cast<float>(lutSize_));

@@ -101,10 +101,13 @@ std::vector<gpu::ShaderPart> Slice3DRenderer::vertexParts() const {
 std::vector<gpu::ShaderPart> Slice3DRenderer::fragmentParts(const RenderSettings& settings) const {
   std::vector<std::string> defines;
   if (settings.mode == RenderMode::Mip) defines.push_back("MODE_MIP 1");
-  return {gpu::shaderPreamble(context_.caps().api, true, defines), layout_.glsl(),
-          gpu::embeddedShaderPart("render/classify.glsl"),
-          gpu::embeddedShaderPart("render/slice_opacity.glsl"),
-          gpu::embeddedShaderPart("render/slice3d.frag.glsl")};
+  std::vector<gpu::ShaderPart> parts = {gpu::shaderPreamble(context_.caps().api, true, defines)};
+  for (gpu::ShaderPart& part : layout_.seamParts()) parts.push_back(std::move(part));
+  for (const char* file : {"render/classify.glsl", "render/sample.glsl",
+                           "render/slice_opacity.glsl", "render/slice3d.frag.glsl"}) {
+    parts.push_back(gpu::embeddedShaderPart(file));
+  }
+  return parts;
 }
 
 const gpu::Program& Slice3DRenderer::programFor(const RenderSettings& settings) {
@@ -156,7 +159,7 @@ void Slice3DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
   const double ww = w.max - w.min;
   prog.set("u_valueScale", static_cast<float>(m.scale / ww));
   prog.set("u_valueBias", static_cast<float>((m.offset - w.min) / ww));
-  int unit = layout_.bind(prog, 0);
+  int unit = layout_.bindSeam(prog, 0);
   lut_.texture().bind(unit);
   prog.set("u_tf", unit);
   prog.set("u_tfSize", static_cast<float>(lut_.entries()));

@@ -1,8 +1,8 @@
 #include "tessera/render/SliceAccumulator.h"
 
-#include "gpu/gl.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/DeviceProfile.h"
+#include "tessera/gpu/Draw.h"
 
 namespace tessera::render {
 
@@ -50,35 +50,24 @@ void SliceAccumulator::begin(int width, int height, RenderMode mode) {
     const bool es3 = context_.caps().api == gpu::ApiLevel::Gles3;
     accumulation_ = gpu::Framebuffer();
     image_ = gpu::Framebuffer();
-    accumulation_ =
-        gpu::Framebuffer::create(context_.ledger(), "slice accumulation", width, height,
-                                 floatTarget_ ? GL_RGBA16F : (es3 ? GL_RGBA8 : GL_RGBA));
+    const gpu::TexelFormat rgba8 = es3 ? gpu::TexelFormat::RGBA8 : gpu::TexelFormat::Rgba8Unsized;
+    accumulation_ = gpu::Framebuffer::create(context_.ledger(), "slice accumulation", width, height,
+                                             floatTarget_ ? gpu::TexelFormat::RGBA16F : rgba8);
     // Read back at texel centres (gl_FragCoord / size), where linear
     // filtering returns the texel itself.
-    image_ = gpu::Framebuffer::create(context_.ledger(), "slice image", width, height,
-                                      es3 ? GL_RGBA8 : GL_RGBA);
+    image_ = gpu::Framebuffer::create(context_.ledger(), "slice image", width, height, rgba8);
   }
   accumulation_.bind();
-  glDisable(GL_DEPTH_TEST);
-  glDisable(GL_CULL_FACE);
-  glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
-  glClear(GL_COLOR_BUFFER_BIT);
-  glEnable(GL_BLEND);
-  if (mode == RenderMode::Mip) {
-    glBlendEquation(context_.caps().api == gpu::ApiLevel::Gles3 ? GL_MAX : GL_MAX_EXT);
-    glBlendFunc(GL_ONE, GL_ONE);
-  } else {
-    glBlendEquation(GL_FUNC_ADD);
-    // Front to back (DESIGN.md): the destination's transmittance 1 - A
-    // weighs each new premultiplied slice colour and alpha.
-    glBlendFuncSeparate(GL_ONE_MINUS_DST_ALPHA, GL_ONE, GL_ONE_MINUS_DST_ALPHA, GL_ONE);
-  }
+  gpu::apply({});
+  gpu::clearColor(glm::vec4(0.0f));
+  // Front to back (DESIGN.md): the destination's transmittance 1 - A weighs
+  // each new premultiplied slice colour and alpha; MIP keeps the maximum.
+  gpu::apply({.blend = mode == RenderMode::Mip ? gpu::Blend::Max : gpu::Blend::FrontToBack});
 }
 
 void SliceAccumulator::resolve(const RenderSettings& settings, const gpu::Texture* lut,
                                int lutEntries) {
-  glDisable(GL_BLEND);
-  glBlendEquation(GL_FUNC_ADD);
+  gpu::apply({});
   image_.bind();
   const gpu::Program& p = resolveProgram(settings.mode);
   p.use();
@@ -93,9 +82,8 @@ void SliceAccumulator::resolve(const RenderSettings& settings, const gpu::Textur
     p.set("u_tfSize", static_cast<float>(lutEntries));
   }
   triangle_.draw();
-  glFinish();
-  const GLenum err = glGetError();
-  if (err != GL_NO_ERROR) throw GpuError("slice rendering failed: GL error " + std::to_string(err));
+  gpu::finish();
+  gpu::checkErrors("slice rendering");
 }
 
 Image SliceAccumulator::readImage() const {

@@ -79,13 +79,10 @@ void main() {
         continue;
       }
 #endif
-      float n = normalizedValue(sampleVolume(p));
 #ifdef MODE_MIP
-      maxValue = max(maxValue, n);
+      maxValue = max(maxValue, normalizedValue(sampleVolume(p)));
 #else
-      vec4 c = classify(n);
-      acc.rgb += (1.0 - acc.a) * c.a * c.rgb;
-      acc.a += (1.0 - acc.a) * c.a;
+      compositeFrontToBack(acc, classifiedSample(p));
       if (acc.a >= u_ert) break;
 #endif
       k += 1.0;
@@ -98,5 +95,5 @@ void main() {
     acc = vec4(classify(maxValue).rgb, 1.0);
   }
 #endif
-  FRAG_COLOR = vec4(acc.rgb + (1.0 - acc.a) * u_background.rgb, acc.a + (1.0 - acc.a) * u_background.a);
+  FRAG_COLOR = overBackground(acc, u_background);
 }

@@ -16,11 +16,11 @@ void main() {
   vec3 p = v_texCoord;
   vec3 inside3 = step(vec3(0.0), p) * step(p, vec3(1.0));
   float inside = inside3.x * inside3.y * inside3.z;
-  float n = normalizedValue(sampleVolume(clamp(p, 0.0, 1.0)));
+  vec3 q = clamp(p, 0.0, 1.0);
 #ifdef MODE_MIP
-  FRAG_COLOR = vec4(n * inside, 0.0, 0.0, inside);
+  FRAG_COLOR = vec4(normalizedValue(sampleVolume(q)) * inside, 0.0, 0.0, inside);
 #else
-  vec4 c = classify(n);
+  vec4 c = classifiedSample(q);
   c = vec4(c.rgb * c.a, c.a) * inside;
   // Planes ds apart are ds / cos(theta) apart along a perspective ray.
   float ratio = u_ortho > 0.5 ? 1.0 : length(v_view) / max(-v_view.z, 1e-6);

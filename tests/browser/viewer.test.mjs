@@ -13,6 +13,7 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import net from 'node:net';
+import zlib from 'node:zlib';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
 
@@ -122,6 +123,45 @@ async function openPage(context, base, query) {
   return { page, logs };
 }
 
+// A NIfTI-1 file with a PIL orientation (index x runs posterior, y
+// inferior, z left) in its sform, and a bright off-centre ball, so that
+// every format converted from it carries a non-trivial affine.
+function writePilNifti(file) {
+  const [nx, ny, nz] = [40, 32, 24];
+  const h = Buffer.alloc(352);
+  h.writeInt32LE(348, 0);
+  [3, nx, ny, nz, 1, 1, 1, 1].forEach((d, i) => h.writeInt16LE(d, 40 + 2 * i));
+  h.writeInt16LE(2, 70);  // uint8
+  h.writeInt16LE(8, 72);
+  [1, 1.5, 1, 2, 1, 1, 1, 1].forEach((p, i) => h.writeFloatLE(p, 76 + 4 * i));
+  h.writeFloatLE(352, 108);
+  h.writeInt16LE(1, 254);  // sform_code scanner
+  const srow = [[0, 0, -2, 30], [-1.5, 0, 0, 20], [0, -1, 0, 10]];
+  srow.forEach((row, r) => row.forEach((v, c) => h.writeFloatLE(v, 280 + 16 * r + 4 * c)));
+  h.write('n+1\0', 344, 'latin1');
+  const data = Buffer.alloc(nx * ny * nz);
+  for (let z = 0; z < nz; z++) {
+    for (let y = 0; y < ny; y++) {
+      for (let x = 0; x < nx; x++) {
+        const d = Math.hypot((x - 15) / 12, (y - 18) / 10, (z - 11) / 8);
+        data[x + nx * (y + ny * z)] = d < 1 ? 120 + Math.round(120 * (1 - d)) : 10;
+      }
+    }
+  }
+  fs.writeFileSync(file, Buffer.concat([h, data]));
+}
+
+// Opens `files` through the picker; resolves with the page's state once the
+// volume named `name` is shown, or with the error the page shows instead.
+async function openThroughPicker(page, files, name) {
+  await page.evaluate(() => { document.getElementById('error').hidden = true; });
+  await page.setInputFiles('#file', files);
+  await page.waitForFunction((n) => window.tessera.state().name === n || window.tessera.error() !== '',
+    name, { timeout: 30000 });
+  await page.evaluate(() => window.tessera.render());
+  return { state: await page.evaluate(() => window.tessera.state()), error: await page.evaluate(() => window.tessera.error()) };
+}
+
 async function withoutOverlays(page) {
   await page.uncheck('#box');
   await page.uncheck('#axes');
@@ -145,6 +185,41 @@ async function main() {
   // Unreadable files: a NIfTI cut short, and bytes that claim to be gzip.
   fs.writeFileSync(path.join(tmp, 'truncated.nii'), fs.readFileSync(goodNii).subarray(0, 20000));
   fs.writeFileSync(path.join(tmp, 'broken.nii.gz'), Buffer.from([0x1f, 0x8b, 8, 0, 1, 2, 3, 4, 5, 6, 7]));
+  const dicom = Buffer.alloc(200);
+  dicom.write('DICM', 128, 'latin1');
+  fs.writeFileSync(path.join(tmp, 'slice.dcm'), dicom);
+
+  // One volume with a PIL affine in every format the page reads through the
+  // shared io readers: as `tessera convert` writes them (NRRD gzip,
+  // MetaImage zlib, VTI zlib appended, raw + JSON sidecar), and NRRD and
+  // MetaImage with their data uncompressed.
+  const pil = path.join(tmp, 'pil.nii');
+  writePilNifti(pil);
+  for (const out of ['pil.nii.gz', 'pil.nrrd', 'pil.mha', 'pil.vti', 'pil.raw']) run('convert', pil, path.join(tmp, out));
+  const unpack = (from, to, edit, inflate) => {
+    const bytes = fs.readFileSync(path.join(tmp, from));
+    const end = bytes.indexOf(edit.end) + edit.end.length;
+    let header = bytes.subarray(0, end).toString('latin1');
+    for (const [a, b] of edit.replace) header = header.replace(a, b);
+    fs.writeFileSync(path.join(tmp, to), Buffer.concat([Buffer.from(header, 'latin1'), inflate(bytes.subarray(end))]));
+  };
+  unpack('pil.nrrd', 'pil-raw.nrrd', { end: '\n\n', replace: [['encoding: gzip', 'encoding: raw']] }, zlib.gunzipSync);
+  unpack('pil.mha', 'pil-raw.mha', { end: 'ElementDataFile = LOCAL\n',
+    replace: [['CompressedData = True', 'CompressedData = False'], [/CompressedDataSize = \d+\n/, '']] }, zlib.inflateSync);
+  const formats = [
+    { what: '.nii', files: ['pil.nii'] },
+    { what: '.nii.gz', files: ['pil.nii.gz'] },
+    { what: '.nrrd (raw)', files: ['pil-raw.nrrd'] },
+    { what: '.nrrd (gzip)', files: ['pil.nrrd'] },
+    { what: '.mha', files: ['pil-raw.mha'] },
+    { what: '.mha (zlib)', files: ['pil.mha'] },
+    { what: '.vti (zlib appended)', files: ['pil.vti'] },
+    { what: 'raw + JSON sidecar (two files)', files: ['pil.raw', 'pil.raw.json'], name: 'pil.raw.json' },
+  ];
+  for (const f of formats) {
+    f.name = f.name || f.files[0];
+    f.info = JSON.parse(run('info', '--json', path.join(tmp, f.name)));
+  }
 
   const { server, url } = await serve(site);
   const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'tessera-chromium-'));
@@ -284,8 +359,38 @@ async function main() {
     await page.waitForFunction(() => window.tessera.state().name === 'sphere48.nii.gz', null, { timeout: 30000 });
     await page.evaluate(() => window.tessera.render());
 
+    // Every format through the shared readers: it renders, with the dims,
+    // orientation and affine that the native `tessera info` reads.
+    for (const f of formats) {
+      const r = await openThroughPicker(page, f.files.map((n) => path.join(tmp, n)), f.name);
+      const st = r.state;
+      const lit = (await snapshot(page)).lit;
+      const labels = st.orientation_labels || {};
+      const affineOk = Array.isArray(st.affine) && st.affine.every((row, i) => row.every((v, k) => Math.abs(v - f.info.affine[i][k]) < 1e-9));
+      check(`${f.what} opened through the picker renders like tessera info reads it`,
+            !r.error && st.name === f.name && st.dims.join('x') === f.info.dims.join('x') &&
+            st.orientation === f.info.orientation && affineOk && lit > 0.02 &&
+            ['left', 'right', 'top', 'bottom'].every((e) => labels[e]),
+            r.error || `${st.dims.join('x')} ${st.orientation} (native ${f.info.dims.join('x')} ${f.info.orientation}), ` +
+            `affine ${affineOk ? 'equal' : 'differs'}, ${(100 * lit).toFixed(1)} % lit; ${st.geometry_source}`);
+    }
+    // A header and its data dropped together.
+    const droppedPair = await page.evaluateHandle((files) => {
+      const dt = new DataTransfer();
+      for (const [name, b64] of files) dt.items.add(new File([Uint8Array.from(atob(b64), (c) => c.charCodeAt(0))], name));
+      return dt;
+    }, ['pil.raw.json', 'pil.raw'].map((n) => [n, fs.readFileSync(path.join(tmp, n)).toString('base64')]));
+    await openThroughPicker(page, [path.join(tmp, 'sphere48.nii.gz')], 'sphere48.nii.gz');
+    await page.dispatchEvent('#view', 'drop', { dataTransfer: droppedPair });
+    await page.waitForFunction(() => window.tessera.state().name === 'pil.raw.json', null, { timeout: 30000 });
+    s = await page.evaluate(() => window.tessera.state());
+    check('raw data and its JSON sidecar dropped together open', s.orientation === 'PIL', `${s.dims.join('x')} ${s.orientation}`);
+    await page.setInputFiles('#file', path.join(tmp, 'sphere48.nii.gz'));
+    await page.waitForFunction(() => window.tessera.state().name === 'sphere48.nii.gz', null, { timeout: 30000 });
+    await page.evaluate(() => window.tessera.render());
+
     // Unreadable files: a message in the page; the previous volume stays.
-    for (const bad of ['truncated.nii', 'broken.nii.gz']) {
+    for (const bad of ['truncated.nii', 'broken.nii.gz', 'slice.dcm']) {
       const good = await snapshot(page);
       await page.setInputFiles('#file', path.join(tmp, bad));
       await page.waitForFunction(() => window.tessera.error() !== '', null, { timeout: 30000 });

@@ -13,6 +13,7 @@
 #include "io/IoFixtures.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/PatientFrame.h"
+#include "tessera/io/MetaImageWriter.h"
 #include "tessera/io/NiftiReader.h"
 
 namespace tessera {

@@ -163,7 +163,7 @@ TEST(NiftiWriter, WritingIntoAMissingDirectoryFailsNamingThePathAndLeavesNothing
       [&] {
         writeNifti(randomVolume({2, 2, 2}, ScalarType::U8, 1), path);
       },
-      {path.string(), "No such file or directory"});
+      {path.string(), "does not exist"});
   EXPECT_EQ(entriesIn(dir.path()), 0);
 }
 

@@ -13,6 +13,7 @@
 #include "io/GeometryFixtures.h"
 #include "io/IoFixtures.h"
 #include "tessera/core/Error.h"
+#include "tessera/io/NrrdWriter.h"
 
 namespace tessera {
 namespace {

@@ -13,6 +13,7 @@
 #include "io/PvmDds.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/NiftiReader.h"
+#include "tessera/io/PvmWriter.h"
 
 namespace tessera {
 namespace {
@@ -364,7 +365,7 @@ TEST(PvmReader, WriterIntoAMissingDirectoryFailsNamingThePath) {
       [&] {
         writePvm(randomVolume({2, 2, 2}, ScalarType::U8, 1), path);
       },
-      {path.string(), "No such file or directory"});
+      {path.string(), "does not exist"});
   EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
 }
 

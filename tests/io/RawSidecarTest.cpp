@@ -15,6 +15,8 @@
 #include "tessera/core/Error.h"
 #include "tessera/io/NiftiReader.h"
 #include "tessera/io/PvmReader.h"
+#include "tessera/io/RawSidecarReader.h"
+#include "tessera/io/RawSidecarWriter.h"
 
 namespace tessera {
 namespace {
@@ -179,7 +181,7 @@ TEST(RawSidecar, WriterIntoAMissingDirectoryFailsNamingThePath) {
       [&] {
         writeRawWithSidecar(randomVolume({2, 2, 2}, ScalarType::U8, 1), path);
       },
-      {path.string(), "No such file or directory"});
+      {path.string(), "does not exist"});
   EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
 }
 

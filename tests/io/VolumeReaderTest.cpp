@@ -9,8 +9,12 @@
 #include "tessera/core/Error.h"
 #include "tessera/io/DicomSeriesReader.h"
 #include "tessera/io/NrrdReader.h"
+#include "tessera/io/NrrdWriter.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/io/PvmReader.h"
+#include "tessera/io/PvmWriter.h"
+#include "tessera/io/RawSidecarReader.h"
+#include "tessera/io/RawSidecarWriter.h"
 
 namespace tessera {
 namespace {

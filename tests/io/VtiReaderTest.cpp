@@ -14,6 +14,7 @@
 #include "io/IoFixtures.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/NiftiReader.h"
+#include "tessera/io/VtiWriter.h"
 
 namespace tessera {
 namespace {

@@ -6,6 +6,7 @@
 #include <emscripten/html5.h>
 
 #include <cstdint>
+#include <cstdlib>
 #include <memory>
 #include <span>
 #include <string>
@@ -15,22 +16,32 @@
 
 #include "gpu/gl.h"
 #include "tessera/core/Error.h"
+#include "tessera/core/PatientFrame.h"
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/GlContext.h"
+#include "tessera/io/ByteSource.h"
 #include "tessera/io/Procedural.h"
+#include "tessera/io/VolumeReader.h"
 #include "tessera/render/TechniqueRegistry.h"
-#include "tessera/viewer/InMemoryVolumeReader.h"
 #include "tessera/viewer/Viewer.h"
 
 using namespace tessera;
 
 namespace {
 
+// A file the page handed over (malloc'ed by it, freed here).
+struct PickedFile {
+  std::string name;
+  std::unique_ptr<std::uint8_t, decltype(&std::free)> bytes{nullptr, &std::free};
+  std::size_t size = 0;
+};
+
 struct WebApp {
   EMSCRIPTEN_WEBGL_CONTEXT_HANDLE handle = 0;
   int webglVersion = 0;
   std::unique_ptr<gpu::GlContext> context;
   std::unique_ptr<viewer::Viewer> viewer;
+  std::vector<PickedFile> picked;
 };
 
 WebApp& app() {
@@ -114,23 +125,34 @@ EMSCRIPTEN_KEEPALIVE int tessera_load_generated(const char* spec) {
   return guarded([&] { theViewer().setVolume(makeProcedural(spec), spec); });
 }
 
-// `bytes` (malloc'ed by the caller, who frees it) hold a whole file, gzip
-// already inflated; `payloadInflated`: a gzip NRRD whose payload the caller
-// inflated (see tessera_gzip_payload_offset).
-EMSCRIPTEN_KEEPALIVE int tessera_load_bytes(const char* name, const std::uint8_t* bytes, int size,
-                                            int payloadInflated) {
-  return guarded([&] {
-    const std::span<const std::byte> data(reinterpret_cast<const std::byte*>(bytes),
-                                          static_cast<std::size_t>(size));
-    theViewer().setVolume(viewer::readVolumeFromMemory(name, data, payloadInflated != 0), name);
-  });
+// Files picked or dropped together: each is added (`bytes` malloc'ed by the
+// page and owned from here on), then tessera_load_files reads the one that
+// names the others (io/VolumeReader.h, volumeFileAmong) with the same io
+// readers as the CLI, and drops them all.
+EMSCRIPTEN_KEEPALIVE void tessera_add_file(const char* name, std::uint8_t* bytes, int size) {
+  PickedFile f;
+  f.name = name;
+  f.bytes.reset(bytes);
+  f.size = static_cast<std::size_t>(size);
+  app().picked.push_back(std::move(f));
 }
 
-// Offset of a gzip-encoded NRRD payload, or -1.
-EMSCRIPTEN_KEEPALIVE int tessera_gzip_payload_offset(const std::uint8_t* bytes, int size) {
-  const auto off = viewer::gzipPayloadOffset(std::span<const std::byte>(
-      reinterpret_cast<const std::byte*>(bytes), static_cast<std::size_t>(size)));
-  return off ? static_cast<int>(*off) : -1;
+EMSCRIPTEN_KEEPALIVE void tessera_clear_files() {
+  app().picked.clear();
+}
+
+EMSCRIPTEN_KEEPALIVE int tessera_load_files() {
+  const int ok = guarded([&] {
+    MemoryFiles files;
+    for (const PickedFile& f : app().picked) {
+      files.add(f.name, std::span<const std::byte>(
+                            reinterpret_cast<const std::byte*>(f.bytes.get()), f.size));
+    }
+    const std::string name = volumeFileAmong(files.names());
+    theViewer().setVolume(readVolume(*files.open(name), files), name);
+  });
+  app().picked.clear();
+  return ok;
 }
 
 // Renders a frame on the canvas; returns its time in ms (-1 on error).
@@ -251,6 +273,16 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_state_json(int logHistogram) {
       j["name"] = v.volumeName();
       j["dims"] = {d.x, d.y, d.z};
       j["type"] = std::string(scalarTypeName(v.volume().type()));
+      // Its geometry, as `tessera info --json` prints it.
+      const Orientation orient = orientationOf(v.volume().direction());
+      j["orientation"] = orient.code;
+      j["orientation_text"] = orient.describe();
+      j["geometry_source"] = v.volume().geometrySource();
+      const glm::dmat4 a = v.volume().indexToWorld();
+      j["affine"] = nlohmann::json::array();
+      for (int row = 0; row < 4; ++row) {
+        j["affine"].push_back({a[0][row], a[1][row], a[2][row], a[3][row]});
+      }
       j["layout"] = v.storageName();
       j["plan_reason"] = v.plan().reason;
       j["range"] = {v.valueRange().min, v.valueRange().max};

@@ -5,7 +5,10 @@
 #include <cstdint>
 #include <string>
 
+#include <glm/vec3.hpp>
+
 #include "tessera/gpu/MemoryLedger.h"
+#include "tessera/gpu/TexelFormat.h"
 
 namespace tessera::gpu {
 
@@ -50,6 +53,19 @@ class Texture {
                           int width, int height, int depth, GLenumT format, GLenumT type,
                           const void* data);
 
+  // The same by what the texels hold (TexelFormat.h): `data` has
+  // uploadBytesPerTexel(format) bytes per texel, rows tightly packed.
+  static Texture create2D(MemoryLedger& ledger, const std::string& label, TexelFormat format,
+                          int width, int height, const void* data = nullptr);
+  static Texture create3D(MemoryLedger& ledger, const std::string& label, TexelFormat format,
+                          int width, int height, int depth, const void* data = nullptr);
+  // Replaces all of level 0, or the box at `offset` of `size` (2D: z = 0,
+  // size.z = 1), with data in the texture's format.
+  void update(const void* data);
+  void updateRegion(glm::ivec3 offset, glm::ivec3 size, const void* data);
+  void setFilter(Filter filter);
+  TexelFormat format() const { return format_; }
+
   void setFilter(GLenumT minFilter, GLenumT magFilter);
   // Replaces the whole level-0 image of a 2D texture.
   void update2D(GLenumT format, GLenumT type, const void* data);
@@ -65,11 +81,16 @@ class Texture {
   void bind(int unit) const;
 
  private:
+  friend class Framebuffer;  // sets format_ of its colour target
   GLuintT id_ = 0;
   GLenumT target_ = 0;
   int width_ = 0, height_ = 0, depth_ = 0;
+  TexelFormat format_ = TexelFormat::RGBA8;
   LedgerEntry entry_;
 };
+
+enum class BufferKind { Vertices, Indices16 };
+enum class BufferUsage { Static, Dynamic };
 
 class Buffer {
  public:
@@ -79,6 +100,10 @@ class Buffer {
   ~Buffer();
   static Buffer create(MemoryLedger& ledger, const std::string& label, GLenumT target,
                        std::uint64_t bytes, const void* data, GLenumT usage);
+  static Buffer create(MemoryLedger& ledger, const std::string& label, BufferKind kind,
+                       std::uint64_t bytes, const void* data, BufferUsage usage);
+  // Replaces `bytes` bytes from `offset`.
+  void update(std::uint64_t offset, std::uint64_t bytes, const void* data);
   GLuintT id() const { return id_; }
   GLenumT target() const { return target_; }
   std::uint64_t bytes() const { return entry_.bytes(); }
@@ -98,16 +123,22 @@ class Framebuffer {
   ~Framebuffer();
   static Framebuffer create(MemoryLedger& ledger, const std::string& label, int width, int height,
                             GLenumT colorFormat = 0 /* GL_RGBA8 */);
+  // A colour texture of `color` and, with `depth`, a 16-bit depth buffer.
+  static Framebuffer create(MemoryLedger& ledger, const std::string& label, int width, int height,
+                            TexelFormat color, bool depth = false);
   void bind() const;  // also sets the viewport
   GLuintT id() const { return id_; }
   int width() const { return color_.width(); }
   int height() const { return color_.height(); }
   const Texture& color() const { return color_; }
+  Texture& color() { return color_; }
   // Reads the colour attachment as RGBA8, bottom row first.
   void readRgba8(std::uint8_t* out) const;
 
  private:
   GLuintT id_ = 0;
+  GLuintT depth_ = 0;  // renderbuffer, 0 when none
+  LedgerEntry depthEntry_;
   Texture color_;
 };
 

@@ -49,7 +49,8 @@ class Program {
 
   void use() const;
   unsigned id() const { return id_; }
-  int uniformLocation(const char* name) const;  // -1 if absent (optimised out)
+  int uniformLocation(const char* name) const;    // -1 if absent (optimised out)
+  int attributeLocation(const char* name) const;  // -1 if absent
   void set(const char* name, int v) const;
   void set(const char* name, float v) const;
   void set(const char* name, glm::vec2 v) const;

@@ -2,13 +2,15 @@
 #include <filesystem>
 
 #include "tessera/core/Volume.h"
+#include "tessera/io/ByteSource.h"
 
 namespace tessera {
 
 // MetaImage (ITK): .mha (header + data in one file) and .mhd + detached raw
-// or zraw (zlib) data; MET_UCHAR/CHAR/USHORT/SHORT/FLOAT (and INT/UINT/DOUBLE
-// converted to f32), NDims 3, ElementSpacing, Offset, BinaryDataByteOrderMSB,
-// HeaderSize (incl. -1). Sizes are checked against the data before allocating.
+// or zraw (zlib) data, looked up in `files`; MET_UCHAR/CHAR/USHORT/SHORT/
+// FLOAT (and INT/UINT/DOUBLE converted to f32), NDims 3, ElementSpacing,
+// Offset, BinaryDataByteOrderMSB, HeaderSize (incl. -1). Sizes are checked
+// against the data before allocating.
 // Also: NDims 4 with DimSize 1 last, ElementSize, Origin/Position,
 // ElementByteOrderMSB, CompressedDataSize (checked against the file),
 // MET_LONG/ULONG (4 bytes, to f32); HeaderSize > 0 is the offset of the
@@ -18,13 +20,7 @@ namespace tessera {
 // centre; AnatomicalOrientation is ignored, as ITK does (a disagreement is
 // noted in geometrySource()). Refused with an InputError: several
 // channels, BinaryData = False, ElementDataFile LIST or a file-name pattern.
+Volume readMetaImage(const ByteSource& header, const FileSet& files);
 Volume readMetaImage(const std::filesystem::path& path);
-
-// .mha: header and voxels in one file; .mhd: header plus <stem>.raw (or
-// <stem>.zraw when compressed) beside it. Little endian, one zlib stream
-// when compressed; TransformMatrix, Offset (LPS, %.17g), ElementSpacing and
-// the matching AnatomicalOrientation (MetaIO's letters: "RAI" for identity).
-void writeMetaImage(const Volume& volume, const std::filesystem::path& path,
-                    bool compressed = false);
 
 }  // namespace tessera

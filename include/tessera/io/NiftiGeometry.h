@@ -1,9 +1,8 @@
 #pragma once
 // Where a NIfTI (or ANALYZE 7.5) header puts its voxels in the world: the
-// header fields -> index-to-world affine maths shared by the native reader
-// (io/NiftiReader, through nifticlib) and the browser's in-memory reader
-// (viewer/InMemoryVolumeReader, without it). Pure arithmetic on decoded
-// fields: no file access, no nifticlib, so the web build compiles it too.
+// header fields -> index-to-world affine maths of io/NiftiReader, which the
+// tests compare with nifticlib's qto_xyz / sto_xyz and nibabel. Pure
+// arithmetic on decoded fields: no file access, no nifticlib.
 //
 // NIfTI's world frame is RAS+ (nifti1.h, "3D IMAGE (VOLUME) ORIENTATION AND
 // LOCATION IN SPACE"), which is Tessera's (core/PatientFrame.h): no

@@ -2,16 +2,20 @@
 #include <filesystem>
 
 #include "tessera/core/Volume.h"
+#include "tessera/io/ByteSource.h"
 
 namespace tessera {
 
-// NIfTI-1 and NIfTI-2 (.nii, .nii.gz, and .hdr/.img pairs) through nifticlib.
-// Supported datatypes: uint8, int8 (widened to i16), uint16, int16, float32,
-// int32/uint32/float64 (converted to f32 with a note in the description).
-// scl_slope/scl_inter are applied (non-identity scaling gives f32).
-// Header dims, datatype and vox_offset are checked against the file size
-// (for gzip, against the bytes the stream actually inflates to) before the
-// voxel buffer is allocated.
+// NIfTI-1 and NIfTI-2 (.nii, .nii.gz, and .hdr/.img pairs; ANALYZE 7.5
+// .hdr/.img too), parsed from the header bytes in either byte order (not
+// through nifticlib, which reads only paths and repairs bad headers
+// silently). Supported datatypes: uint8, int8 (widened to i16), uint16,
+// int16, float32, int32/uint32/float64 (converted to f32 with a note in the
+// description). scl_slope/scl_inter are applied (non-identity scaling gives
+// f32). Header dims, datatype and vox_offset are checked against the file
+// size (for gzip, against the bytes the stream actually inflates to) before
+// the voxel buffer is allocated. The .img of a pair is looked up in `files`.
+Volume readNifti(const ByteSource& file, const FileSet& files);
 Volume readNifti(const std::filesystem::path& path);
 
 }  // namespace tessera

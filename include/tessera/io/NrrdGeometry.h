@@ -3,8 +3,7 @@
 // directions" and "space origin" fields (Teem's NRRD format definition,
 // teem.sourceforge.net/nrrd/format.html §4 "space" and §5 per-axis fields)
 // -> index-to-world affine in Tessera's RAS+ frame (core/PatientFrame.h).
-// Shared by the native reader (io/NrrdReader) and the browser's in-memory
-// reader (viewer/InMemoryVolumeReader); pure arithmetic, no file access.
+// Used by io/NrrdReader; pure arithmetic, no file access.
 //
 // Spaces: right-anterior-superior (RAS) is ours; left-anterior-superior (LAS)
 // negates x; left-posterior-superior (LPS, DICOM's, what ITK and Slicer

@@ -3,8 +3,10 @@
 // procedural source from a "gen:" spec.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "tessera/core/Volume.h"
+#include "tessera/io/ByteSource.h"
 
 namespace tessera {
 
@@ -22,5 +24,17 @@ struct ReadOptions {
 };
 
 Volume readVolume(const std::string& spec, const ReadOptions& options = {});
+
+// The same readers on a byte source, the other files it names found in
+// `files`: what the browser reads picked or dropped files with. Every format
+// above but DICOM, which DCMTK reads from files on disk only (an InputError
+// saying so).
+Volume readVolume(const ByteSource& file, const FileSet& files);
+
+// Of several files opened together (the browser's picker or a drop), the
+// one to read: a header that names the others (a .json sidecar, .nhdr,
+// .mhd, .hdr) before a self-contained file, before data files (.raw, .img,
+// .zraw); the first of equals. Empty `names`: an InputError.
+std::string volumeFileAmong(const std::vector<std::string>& names);
 
 }  // namespace tessera

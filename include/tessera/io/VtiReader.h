@@ -2,6 +2,7 @@
 #include <filesystem>
 
 #include "tessera/core/Volume.h"
+#include "tessera/io/ByteSource.h"
 
 namespace tessera {
 
@@ -15,11 +16,7 @@ namespace tessera {
 // The array is the one PointData names with Scalars=, else the first; one
 // Piece covering WholeExtent; a WholeExtent that starts off 0 moves the
 // origin to its first point.
+Volume readVti(const ByteSource& file);
 Volume readVti(const std::filesystem::path& path);
-
-// Appended raw data, header_type UInt64, little endian, as ParaView writes;
-// zlib in vtkZLibDataCompressor's 32 KiB blocks when compressed. Origin,
-// Spacing and Direction hold the RAS affine unchanged.
-void writeVti(const Volume& volume, const std::filesystem::path& path, bool compressed = false);
 
 }  // namespace tessera

@@ -16,6 +16,7 @@
 #include "tessera/core/Volume.h"
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/Program.h"
+#include "tessera/layout/ValueBlocks.h"
 
 namespace tessera::layout {
 
@@ -61,6 +62,27 @@ class Layout {
   virtual glm::ivec3 volumeDims() const = 0;
   // Bytes of GPU memory the layout's textures occupy (from the ledger).
   virtual std::uint64_t textureBytes() const = 0;
+
+  // How far, in voxels, the reconstruction behind sampleVolume() reaches
+  // (trilinear, every layout today: 1).
+  virtual int supportVoxels() const { return 1; }
+  // Min/max of raw values per block for empty-space skipping, covering every
+  // sample sampleVolume() can return inside each block. In-core layouts
+  // compute it from the volume they were made from; a layout without one
+  // (bricks streamed from disk) overrides it with its own metadata.
+  virtual ValueBlocks valueBlocks(int blockSize) const;
+
+  // The seam's GLSL as a technique includes it: the layout's glsl() and then
+  // the shared gradient part (layout/gradient.glsl: sampleVolumeGradient() by
+  // central differences through sampleVolume(), unless the layout defines
+  // LAYOUT_HAS_GRADIENT and its own). Use with bindSeam().
+  std::vector<gpu::ShaderPart> seamParts() const;
+  // bind() plus the seam's own uniforms; returns the units used.
+  int bindSeam(const gpu::Program& program, int firstUnit) const;
+
+ protected:
+  // The in-core volume the layout was made from (it must outlive the layout).
+  const Volume* voxels_ = nullptr;
 };
 
 }  // namespace tessera::layout

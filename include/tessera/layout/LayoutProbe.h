@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 #include "tessera/gpu/GlContext.h"
 #include "tessera/layout/Layout.h"
@@ -25,6 +26,13 @@ class LayoutProbe {
   // and decoded as (255 hi + lo) / 255: exact to 0.5 / 65025.
   std::vector<float> sample(const Layout& layout, const std::vector<glm::vec3>& positions);
 
+  // sampleVolumeGradient() (rgb, stored value per texture-space unit) and
+  // sampleVolume() (a) of the layout seam at `positions`. Needs float render
+  // targets (GpuError otherwise: see hasFloatTargets()).
+  std::vector<glm::vec4> sampleGradient(const Layout& layout,
+                                        const std::vector<glm::vec3>& positions);
+  bool hasFloatTargets() const;
+
   // The positions of every voxel centre, x fastest: ((i + 0.5) / dims).
   static std::vector<glm::vec3> voxelCentres(glm::ivec3 dims);
 
@@ -32,7 +40,8 @@ class LayoutProbe {
   static constexpr double kRgba8Error = 0.5 / 65025.0;
 
  private:
-  std::vector<float> sampleFloat(const Layout& layout, const std::vector<glm::vec3>& positions);
+  std::vector<glm::vec4> probeFloat(const Layout& layout, const std::vector<glm::vec3>& positions,
+                                    bool gradient);
   std::vector<float> sampleRgba8(const Layout& layout, const std::vector<glm::vec3>& positions);
   gpu::GlContext& context_;
 };

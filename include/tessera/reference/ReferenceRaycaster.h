@@ -15,10 +15,12 @@
 #include "tessera/core/RenderSettings.h"
 #include "tessera/core/TransferFunction.h"
 #include "tessera/core/Volume.h"
+#include "tessera/reference/Reconstruction.h"
 
 namespace tessera {
 
-// Trilinear interpolation of raw values at p in [0,1]^3.
+// Trilinear interpolation of raw values at p in [0,1]^3, straight from the
+// volume (TrilinearReconstruction's value without its double copy).
 double sampleTrilinear(const Volume& volume, glm::dvec3 p);
 
 // Work done by one reference frame (the same samples the GPU takes when
@@ -37,9 +39,18 @@ struct ReferenceStops {
   const std::vector<float>& distance;
 };
 
-// Renders width x height pixels; threads = 0 uses every hardware thread.
+// Renders width x height pixels of the volume's trilinear field; threads = 0
+// uses every hardware thread.
 Image renderReference(const Volume& volume, const TransferFunction& tf, const Camera& camera,
                       const RenderSettings& settings, int width, int height, int threads = 0,
                       ReferenceStats* stats = nullptr, const ReferenceStops* stops = nullptr);
+
+// The same with another reconstruction of the field: `volume` gives the box
+// (extent, spacing for the sample distance) and the value window, `field`
+// the values (e.g. an FCC box spline over the same box).
+Image renderReference(const Volume& volume, const Reconstruction& field, const TransferFunction& tf,
+                      const Camera& camera, const RenderSettings& settings, int width, int height,
+                      int threads = 0, ReferenceStats* stats = nullptr,
+                      const ReferenceStops* stops = nullptr);
 
 }  // namespace tessera

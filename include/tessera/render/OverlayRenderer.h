@@ -55,8 +55,6 @@ class OverlayRenderer {
   gpu::GlContext& context_;
   gpu::Framebuffer color_;
   gpu::Framebuffer distance_;
-  unsigned depthRenderbuffer_ = 0;
-  gpu::LedgerEntry depthEntry_;
   gpu::Buffer vertices_;
   gpu::Program colorProgram_;
   gpu::Program distanceProgram_;

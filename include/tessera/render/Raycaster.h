@@ -18,7 +18,7 @@
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/gpu/Program.h"
 #include "tessera/layout/Layout.h"
-#include "tessera/render/BlockMinMax.h"
+#include "tessera/layout/ValueBlocks.h"
 #include "tessera/render/Technique.h"
 #include "tessera/render/TechniqueRegistry.h"
 
@@ -101,7 +101,7 @@ class Raycaster final : public Technique {
   TransferFunction tf_;
   int lutSize_ = 4096;
   int blockSize_ = 8;
-  BlockMinMax blocks_;
+  layout::ValueBlocks blocks_;
   std::vector<float> lut_;
   gpu::Texture lutTexture_;
   gpu::Texture blockTexture_;

@@ -1,4 +1,4 @@
-#include "tessera/render/BlockMinMax.h"
+#include "tessera/layout/ValueBlocks.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,12 +8,14 @@
 
 #include <glm/common.hpp>
 
-namespace tessera::render {
+namespace tessera::layout {
 
 namespace {
 template <class T>
 void blockRange(const Volume& v, const T* data, glm::ivec3 lo, glm::ivec3 hi, float& mn,
                 float& mx) {
+  // Only f32 has NaN/Inf; they render as the bottom of the range.
+  const float missing = static_cast<float>(v.nonFiniteValue());
   const glm::ivec3 d = v.dims();
   float a = std::numeric_limits<float>::infinity();
   float b = -a;
@@ -21,7 +23,8 @@ void blockRange(const Volume& v, const T* data, glm::ivec3 lo, glm::ivec3 hi, fl
     for (int y = lo.y; y <= hi.y; ++y) {
       const T* row = data + (static_cast<std::size_t>(z) * d.y + y) * d.x;
       for (int x = lo.x; x <= hi.x; ++x) {
-        const float s = static_cast<float>(row[x]);
+        float s = static_cast<float>(row[x]);
+        if (!std::isfinite(s)) s = missing;
         if (s < a) a = s;
         if (s > b) b = s;
       }
@@ -32,7 +35,8 @@ void blockRange(const Volume& v, const T* data, glm::ivec3 lo, glm::ivec3 hi, fl
 }
 }  // namespace
 
-BlockMinMax::BlockMinMax(const Volume& volume, int blockSize) : blockSize_(blockSize) {
+ValueBlocks::ValueBlocks(const Volume& volume, int blockSize, int supportVoxels)
+    : blockSize_(blockSize), support_(supportVoxels) {
   const glm::ivec3 d = volume.dims();
   count_ = (d + blockSize - 1) / blockSize;
   const std::size_t n = static_cast<std::size_t>(count_.x) * count_.y * count_.z;
@@ -43,8 +47,8 @@ BlockMinMax::BlockMinMax(const Volume& volume, int blockSize) : blockSize_(block
       for (int by = 0; by < count_.y; ++by) {
         for (int bx = 0; bx < count_.x; ++bx) {
           const glm::ivec3 b(bx, by, bz);
-          const glm::ivec3 lo = glm::max(b * blockSize - 1, glm::ivec3(0));
-          const glm::ivec3 hi = glm::min((b + 1) * blockSize, d - 1);
+          const glm::ivec3 lo = glm::max(b * blockSize - supportVoxels, glm::ivec3(0));
+          const glm::ivec3 hi = glm::min((b + 1) * blockSize + supportVoxels - 1, d - 1);
           float mn = 0, mx = 0;
           switch (volume.type()) {
             case ScalarType::U8:
@@ -78,4 +82,4 @@ BlockMinMax::BlockMinMax(const Volume& volume, int blockSize) : blockSize_(block
   for (auto& th : pool) th.join();
 }
 
-}  // namespace tessera::render
+}  // namespace tessera::layout

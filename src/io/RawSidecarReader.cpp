@@ -1,4 +1,4 @@
-// Raw voxels described by a JSON sidecar (declared in tessera/io/PvmReader.h):
+// Raw voxels described by a JSON sidecar (tessera/io/RawSidecarReader.h):
 //   data.raw + data.raw.json (or data.json), e.g.
 //   {"dims": [256, 256, 128], "type": "u16", "spacing": [0.5, 0.5, 1.2],
 //    "origin": [0, 0, 0], "direction": [[1, 0, 0], [0, 1, 0], [0, 0, 1]],
@@ -10,25 +10,16 @@
 // i, then j, then k (the columns of the direction matrix, like NRRD's "space
 // directions" without the spacing), so world = origin + sum over a of
 // direction[a] * spacing[a] * index[a]. Without "direction": identity.
-#include "tessera/io/PvmReader.h"
+#include "tessera/io/RawSidecarReader.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <algorithm>
 #include <array>
-#include <bit>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <optional>
 #include <string>
-#include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "io/ByteSource.h"
 #include "io/VoxelLoader.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
@@ -199,25 +190,21 @@ class SidecarParser {
   std::string p_;
 };
 
-std::string readSidecarText(const std::filesystem::path& path) {
-  const std::uint64_t size = io_detail::regularFileSize(path);
-  if (size > kMaxSidecarBytes) {
-    throw InputError(path.string() + ": " + std::to_string(size) +
+std::string readSidecarText(const ByteSource& file) {
+  if (file.size() > kMaxSidecarBytes) {
+    throw InputError(file.name() + ": " + std::to_string(file.size()) +
                      " bytes is too large for a JSON sidecar (at most " +
                      std::to_string(kMaxSidecarBytes) + ")");
   }
-  io_detail::FileByteSource src(path, 0);
-  std::string text(static_cast<std::size_t>(size), '\0');
-  text.resize(src.read(reinterpret_cast<std::byte*>(text.data()), text.size()));
+  std::string text(static_cast<std::size_t>(file.size()), '\0');
+  text.resize(file.read(0, reinterpret_cast<std::byte*>(text.data()), text.size()));
   return text;
 }
 
-bool isFile(const std::filesystem::path& p) {
-  std::error_code ec;
-  return std::filesystem::is_regular_file(p, ec);
-}
-
-bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
+// Whether two names of the files in a FileSet are the same file: on disk
+// one may be relative, the other absolute, or a link to it.
+bool sameFile(const std::string& a, const std::string& b) {
+  if (a == b) return true;
   std::error_code ec;
   const bool same = std::filesystem::equivalent(a, b, ec);
   return !ec && same;
@@ -226,54 +213,59 @@ bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
 }  // namespace
 
 Volume readRawWithSidecar(const std::filesystem::path& path) {
-  const std::string p = path.string();
-  std::filesystem::path sidecarPath;
-  std::filesystem::path rawPath;
-  const bool givenJson = endsWith(path.filename().string(), ".json");
-  if (givenJson) {
-    sidecarPath = path;
-  } else {
-    io_detail::regularFileSize(path);  // the raw file itself: "no such file" names it
-    std::filesystem::path beside = path;
-    beside += ".json";
-    std::filesystem::path stem = path;
-    stem.replace_extension(".json");
-    if (isFile(beside)) {
-      sidecarPath = beside;
-    } else if (isFile(stem)) {
-      sidecarPath = stem;
+  return readRawWithSidecar(FileSource(path), FolderFiles());
+}
+
+Volume readRawWithSidecar(const ByteSource& file, const FileSet& files) {
+  const std::string& p = file.name();
+  std::unique_ptr<ByteSource> sidecarFile;
+  std::unique_ptr<ByteSource> rawFile;
+  const bool givenJson = endsWith(p, ".json");
+  if (!givenJson) {
+    // data.raw.json, else data.json
+    const std::string name = std::filesystem::path(p).filename().string();
+    const std::string beside = files.resolve(file, name + ".json");
+    const std::string stem =
+        files.resolve(file, std::filesystem::path(name).replace_extension(".json").string());
+    if (files.contains(beside)) {
+      sidecarFile = files.open(beside);
+    } else if (files.contains(stem)) {
+      sidecarFile = files.open(stem);
     } else {
-      throw InputError(p + ": no JSON sidecar describing it (looked for " + beside.string() +
-                       " and " + stem.string() + ")");
+      throw InputError(p + ": no JSON sidecar describing it (looked for " + beside + " and " +
+                       stem + ")");
     }
-    rawPath = path;
   }
-  const std::string sp = sidecarPath.string();
-  const Sidecar s = SidecarParser(sp).parse(readSidecarText(sidecarPath));
+  const ByteSource& sidecar = givenJson ? file : *sidecarFile;
+  const std::string& sp = sidecar.name();
+  const Sidecar s = SidecarParser(sp).parse(readSidecarText(sidecar));
 
   if (givenJson) {
+    std::string rawName;
     if (s.file) {
-      rawPath = std::filesystem::path(*s.file);
       // Like NRRD's "data file", a relative name is relative to the sidecar.
-      if (rawPath.is_relative()) rawPath = sidecarPath.parent_path() / rawPath;
+      rawName = files.resolve(sidecar, *s.file);
+      if (!files.contains(rawName)) {
+        throw InputError(sp + ": raw file " + rawName +
+                         " named by \"file\" does not exist or is not a regular file");
+      }
     } else {
-      rawPath = std::filesystem::path(sp.substr(0, sp.size() - 5));  // data.raw.json → data.raw
-      if (!isFile(rawPath)) {
-        throw InputError(sp + ": no \"file\" key naming the raw data, and no " + rawPath.string() +
+      // data.raw.json → data.raw
+      const std::string name = std::filesystem::path(sp).filename().string();
+      rawName = files.resolve(sidecar, name.substr(0, name.size() - 5));
+      if (!files.contains(rawName)) {
+        throw InputError(sp + ": no \"file\" key naming the raw data, and no " + rawName +
                          " beside it");
       }
     }
-    if (!isFile(rawPath)) {
-      throw InputError(sp + ": raw file " + rawPath.string() +
-                       " named by \"file\" does not exist or is not a regular file");
-    }
+    rawFile = files.open(rawName);
   } else if (s.file) {
-    std::filesystem::path named(*s.file);
-    if (named.is_relative()) named = sidecarPath.parent_path() / named;
-    if (!sameFile(named, rawPath)) {
+    const std::string named = files.resolve(sidecar, *s.file);
+    if (!sameFile(named, p)) {
       throw InputError(sp + ": describes \"file\": \"" + *s.file + "\", not " + p);
     }
   }
+  const ByteSource& raw = givenJson ? *rawFile : file;
 
   if (s.direction) {
     // Singular directions are refused before any voxel is read.
@@ -287,7 +279,7 @@ Volume readRawWithSidecar(const std::filesystem::path& path) {
   format.dims = s.dims;
   format.type = s.type;
   format.bigEndian = s.bigEndian;
-  const std::uint64_t rawSize = io_detail::regularFileSize(rawPath);
+  const std::uint64_t rawSize = raw.size();
   const std::uint64_t needed =
       static_cast<std::uint64_t>(s.dims.x) * static_cast<std::uint64_t>(s.dims.y) *
       static_cast<std::uint64_t>(s.dims.z) * io_detail::diskTypeSize(s.type);
@@ -295,10 +287,10 @@ Volume readRawWithSidecar(const std::filesystem::path& path) {
                                std::string(io_detail::diskTypeName(s.type)) + " = " +
                                std::to_string(needed) + " bytes (" + formatBytes(needed) +
                                ") of voxel data at offset " + std::to_string(s.offset) + ", but " +
-                               rawPath.string() + " has " + std::to_string(rawSize) + " bytes";
+                               raw.name() + " has " + std::to_string(rawSize) + " bytes";
   if (s.offset > rawSize) {
     throw InputError(sp + ": offset " + std::to_string(s.offset) + " lies beyond the end of " +
-                     rawPath.string() + " (" + std::to_string(rawSize) + " bytes)");
+                     raw.name() + " (" + std::to_string(rawSize) + " bytes)");
   }
   if (rawSize - s.offset < needed) {
     throw InputError(declared + " (" + std::to_string(needed - (rawSize - s.offset)) + " too few)");
@@ -310,7 +302,7 @@ Volume readRawWithSidecar(const std::filesystem::path& path) {
                      " more than declared; check dims, type and offset)");
   }
   io_detail::VoxelSource source;
-  source.file = rawPath;
+  source.file = &raw;
   source.fileOffset = s.offset;
   Volume v = io_detail::loadVoxels(source, format, sp);
   v.setSpacing(s.spacing);
@@ -319,127 +311,12 @@ Volume readRawWithSidecar(const std::filesystem::path& path) {
   v.setGeometrySource(s.direction ? "JSON sidecar direction, spacing and origin (RAS)"
                                   : "JSON sidecar spacing and origin (no direction: identity)");
   v.setDescription(
-      "raw " + rawPath.string() + " described by " + sp + " (" + io_detail::dimsString(s.dims) +
-      " " + std::string(io_detail::diskTypeName(s.type)) +
+      "raw " + raw.name() + " described by " + sp + " (" + io_detail::dimsString(s.dims) + " " +
+      std::string(io_detail::diskTypeName(s.type)) +
       (io_detail::diskTypeSize(s.type) > 1 ? s.bigEndian ? ", big endian" : ", little endian"
                                            : "") +
       ")");
   return v;
-}
-
-namespace {
-
-// Output written under a temporary name beside the target and renamed over
-// it only once complete, so that a failed write never leaves a partial file
-// under the final name.
-class PendingFile {
- public:
-  explicit PendingFile(const std::filesystem::path& target) : target_(target) {
-    static int counter = 0;
-    const std::filesystem::path dir = target.parent_path().empty() ? "." : target.parent_path();
-    std::string name = target.filename().string();
-    // A hidden name, built piecewise: GCC 12 warns falsely on "." + string.
-    name.insert(0, 1, '.');
-    name += '.';
-    name += std::to_string(::getpid());
-    name += '-';
-    name += std::to_string(counter++);
-    name += ".tmp";
-    temp_ = dir / name;
-    const int fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd < 0 || (file_ = ::fdopen(fd, "wb")) == nullptr) {
-      const int err = errno;
-      if (fd >= 0) ::close(fd);
-      throw Error(target_.string() + ": cannot create a temporary file in '" + dir.string() +
-                  "' to write it: " + std::strerror(err));
-    }
-  }
-  ~PendingFile() {
-    if (file_ != nullptr) std::fclose(file_);
-    if (!committed_) {
-      std::error_code ignored;
-      std::filesystem::remove(temp_, ignored);
-    }
-  }
-  PendingFile(const PendingFile&) = delete;
-  PendingFile& operator=(const PendingFile&) = delete;
-
-  void write(const void* data, std::size_t n) {
-    if (std::fwrite(data, 1, n, file_) != n) fail("write failed");
-  }
-  // Closes the temporary; rename() then moves it into place.
-  void close() {
-    const int rc = std::fclose(file_);
-    file_ = nullptr;
-    if (rc != 0) fail("write failed");
-  }
-  void rename() {
-    if (std::rename(temp_.c_str(), target_.c_str()) != 0) fail("cannot rename the temporary file");
-    committed_ = true;
-  }
-
- private:
-  [[noreturn]] void fail(const char* what) const {
-    throw Error(target_.string() + ": " + what + ": " + std::strerror(errno));
-  }
-
-  std::filesystem::path target_;
-  std::filesystem::path temp_;
-  std::FILE* file_ = nullptr;
-  bool committed_ = false;
-};
-
-}  // namespace
-
-void writeRawWithSidecar(const Volume& volume, const std::filesystem::path& path) {
-  if (!volume.hasData()) throw InputError(path.string() + ": cannot write a volume without voxels");
-  const glm::ivec3 d = volume.dims();
-  const glm::dvec3 s = volume.spacing();
-  const glm::dvec3 o = volume.origin();
-  // nlohmann writes doubles with enough digits to read back the same value.
-  nlohmann::ordered_json sidecar;
-  sidecar["dims"] = {d.x, d.y, d.z};
-  sidecar["type"] = std::string(scalarTypeName(volume.type()));
-  sidecar["spacing"] = {s.x, s.y, s.z};
-  sidecar["origin"] = {o.x, o.y, o.z};
-  // + 0.0 writes -0 as 0.
-  const glm::dmat3 dir = volume.direction() + glm::dmat3(0.0);
-  sidecar["direction"] = {{dir[0].x, dir[0].y, dir[0].z},
-                          {dir[1].x, dir[1].y, dir[1].z},
-                          {dir[2].x, dir[2].y, dir[2].z}};
-  sidecar["endian"] = "little";
-  sidecar["offset"] = 0;
-  sidecar["file"] = path.filename().string();
-  const std::string text = sidecar.dump(2) + "\n";
-
-  std::filesystem::path sidecarPath = path;
-  sidecarPath += ".json";
-  PendingFile raw(path);
-  const std::span<const std::byte> bytes = volume.bytes();
-  const std::size_t elem = bytesPerVoxel(volume.type());
-  if (elem == 1 || std::endian::native == std::endian::little) {
-    raw.write(bytes.data(), bytes.size());
-  } else {
-    std::vector<std::byte> chunk;
-    constexpr std::size_t kChunk = 1 << 20;
-    for (std::size_t at = 0; at < bytes.size(); at += kChunk) {
-      const std::size_t n = std::min(kChunk, bytes.size() - at);
-      chunk.assign(bytes.begin() + static_cast<std::ptrdiff_t>(at),
-                   bytes.begin() + static_cast<std::ptrdiff_t>(at + n));
-      for (std::size_t i = 0; i + elem <= n; i += elem) {
-        std::reverse(chunk.begin() + static_cast<std::ptrdiff_t>(i),
-                     chunk.begin() + static_cast<std::ptrdiff_t>(i + elem));
-      }
-      raw.write(chunk.data(), n);
-    }
-  }
-  raw.close();
-  PendingFile sidecarOut(sidecarPath);
-  sidecarOut.write(text.data(), text.size());
-  sidecarOut.close();
-  // Both are complete before either replaces an older version.
-  raw.rename();
-  sidecarOut.rename();
 }
 
 }  // namespace tessera

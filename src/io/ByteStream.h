@@ -1,16 +1,15 @@
 #pragma once
-// Bounded byte input for the readers: plain files from an offset, gzip
-// streams inflated chunk by chunk, and buffers of inflated chunks. Nothing
-// here allocates more than the bytes it has actually read.
+// Bounded sequential input for the readers, on a ByteSource: its bytes from
+// an offset, a gzip or zlib stream inflated chunk by chunk, and buffers of
+// inflated chunks. Nothing here allocates more than the bytes it has
+// actually read.
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
-#include <filesystem>
 #include <memory>
-#include <string>
 #include <vector>
 
-#include <zlib.h>
+#include "io/Inflater.h"
+#include "tessera/io/ByteSource.h"
 
 namespace tessera::io_detail {
 
@@ -20,16 +19,12 @@ namespace tessera::io_detail {
 // can say so before inflating anything.
 constexpr std::uint64_t kMaxDeflateRatio = 1032;
 
-// Size of a regular file; InputError naming `path` if it does not exist, is a
-// directory or something else that is not a regular file.
-std::uint64_t regularFileSize(const std::filesystem::path& path);
-
 // True if the bytes at `offset` start with the gzip magic (1f 8b).
-bool startsWithGzipMagic(const std::filesystem::path& path, std::uint64_t offset = 0);
+bool startsWithGzipMagic(const ByteSource& source, std::uint64_t offset = 0);
 
-class ByteSource {
+class ByteStream {
  public:
-  virtual ~ByteSource() = default;
+  virtual ~ByteStream() = default;
   // Reads up to `n` bytes into `dst`; fewer only at the end of the data.
   // Throws InputError on I/O or decompression errors.
   virtual std::size_t read(std::byte* dst, std::size_t n) = 0;
@@ -38,51 +33,51 @@ class ByteSource {
   std::uint64_t skip(std::uint64_t n);
 };
 
-// The bytes of a file from `offset` on.
-class FileByteSource : public ByteSource {
+// The bytes of a source from `offset` on.
+class SourceStream : public ByteStream {
  public:
-  FileByteSource(const std::filesystem::path& path, std::uint64_t offset);
-  ~FileByteSource() override;
-  FileByteSource(const FileByteSource&) = delete;
-  FileByteSource& operator=(const FileByteSource&) = delete;
+  SourceStream(const ByteSource& source, std::uint64_t offset) : source_(source), pos_(offset) {}
   std::size_t read(std::byte* dst, std::size_t n) override;
+  std::uint64_t position() const { return pos_; }
 
  private:
-  std::filesystem::path path_;
-  std::FILE* file_ = nullptr;
+  const ByteSource& source_;
+  std::uint64_t pos_;
 };
 
 // The inflated bytes of gzip (or zlib) data that starts at `offset` in a
-// file; concatenated gzip members are read one after another, as gunzip does.
-class GzipByteSource : public ByteSource {
+// source; concatenated gzip members are read one after another, as gunzip
+// does, and other bytes after the stream are ignored.
+class InflateStream : public ByteStream {
  public:
-  GzipByteSource(const std::filesystem::path& path, std::uint64_t offset);
-  ~GzipByteSource() override;
-  GzipByteSource(const GzipByteSource&) = delete;
-  GzipByteSource& operator=(const GzipByteSource&) = delete;
+  InflateStream(const ByteSource& source, std::uint64_t offset);
   std::size_t read(std::byte* dst, std::size_t n) override;
 
   // Inflated bytes handed out so far (for "ends after X bytes" messages).
   std::uint64_t inflatedSoFar() const { return produced_; }
 
  private:
-  bool refill();
+  // Keeps at least `want` unread input bytes buffered unless the data ends.
+  void fill(std::size_t want);
+  std::size_t buffered() const { return len_ - pos_; }
 
-  std::filesystem::path path_;
-  std::FILE* file_ = nullptr;
-  z_stream zs_{};
-  bool zsReady_ = false;
+  const ByteSource& source_;
+  SourceStream in_;
+  std::unique_ptr<Inflater> inflater_;
+  std::vector<std::byte> buf_;
+  std::size_t pos_ = 0;
+  std::size_t len_ = 0;
+  bool inputEnded_ = false;
   bool finished_ = false;
   std::uint64_t produced_ = 0;
-  std::vector<unsigned char> in_;
 };
 
 // Bytes held in chunks that are allocated only as data arrives, so a stream
 // that ends early never costs more than what it delivered.
-class ChunkedBuffer : public ByteSource {
+class ChunkedBuffer : public ByteStream {
  public:
   // Reads up to `n` bytes from `src`; size() tells how many arrived.
-  static ChunkedBuffer readUpTo(ByteSource& src, std::uint64_t n);
+  static ChunkedBuffer readUpTo(ByteStream& src, std::uint64_t n);
 
   std::uint64_t size() const { return size_; }
   // Reading consumes the chunks front to back and frees each once drained.

@@ -1,0 +1,49 @@
+#pragma once
+// The continuous field the CPU reference samples: how voxel values become a
+// value (and a gradient) at any point of the volume's box. Trilinear is the
+// field of every Cartesian layout; an FCC box spline or a bricked source
+// supplies its own, so that it gets a reference too.
+#include <memory>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "tessera/core/Volume.h"
+
+namespace tessera {
+
+class Reconstruction {
+ public:
+  virtual ~Reconstruction() = default;
+  // Raw value at p in [0,1]^3, the volume box in texture space (voxel
+  // centres at (i + 0.5) / dims, clamp to edge outside).
+  virtual double value(glm::dvec3 p) const = 0;
+  // Gradient of value() per texture-space unit. The default is the GLSL
+  // seam's (layout/gradient.glsl): central differences one voxel apart along
+  // each axis, through value(); a field with an analytic derivative
+  // overrides it.
+  virtual glm::dvec3 gradient(glm::dvec3 p) const;
+  // Samples per texture-space unit along each axis (the grid's dims): the
+  // central-difference step is one over it.
+  virtual glm::ivec3 dims() const = 0;
+  // How far from a point, in voxels, the voxels that influence its value
+  // reach (trilinear: 1). Empty-space skipping widens each block's min/max
+  // by this much so that every sample inside the block lies within it.
+  virtual int supportVoxels() const = 0;
+};
+
+// Trilinear interpolation of a Cartesian volume's raw values; NaN/Inf voxels
+// read as Volume::nonFiniteValue() (as the layouts upload them).
+class TrilinearReconstruction final : public Reconstruction {
+ public:
+  explicit TrilinearReconstruction(const Volume& volume);
+  double value(glm::dvec3 p) const override;
+  glm::ivec3 dims() const override { return dims_; }
+  int supportVoxels() const override { return 1; }
+
+ private:
+  glm::ivec3 dims_;
+  std::vector<double> data_;
+};
+
+}  // namespace tessera

@@ -1,0 +1,56 @@
+#include "tessera/gpu/LookupTexture.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include <glm/gtc/packing.hpp>
+
+#include "tessera/gpu/DeviceProfile.h"
+
+namespace tessera::gpu {
+
+namespace {
+std::vector<std::uint16_t> toHalves(const std::vector<float>& v) {
+  std::vector<std::uint16_t> out(v.size());
+  std::transform(v.begin(), v.end(), out.begin(), [](float x) { return glm::packHalf1x16(x); });
+  return out;
+}
+
+std::vector<std::uint8_t> toBytes(const std::vector<float>& v) {
+  std::vector<std::uint8_t> out(v.size());
+  std::transform(v.begin(), v.end(), out.begin(), [](float x) {
+    return static_cast<std::uint8_t>(std::lround(std::clamp(x, 0.0f, 1.0f) * 255.0f));
+  });
+  return out;
+}
+}  // namespace
+
+void LookupTexture::upload(GlContext& context, const std::vector<float>& rgba,
+                           const std::string& label) {
+  const int entries = static_cast<int>(rgba.size() / 4);
+  ++uploads_;
+  TexelFormat format = TexelFormat::Rgba8Unsized;
+  if (context.caps().api == ApiLevel::Gles3) {
+    format = TexelFormat::RGBA16F;
+  } else if (DeviceLimits::of(context.caps()).halfFloatTextures) {
+    format = TexelFormat::RgbaHalfUnsized;
+  }
+  const std::vector<std::uint16_t> halves =
+      format == TexelFormat::RgbaHalfUnsized ? toHalves(rgba) : std::vector<std::uint16_t>();
+  const std::vector<std::uint8_t> bytes =
+      format == TexelFormat::Rgba8Unsized ? toBytes(rgba) : std::vector<std::uint8_t>();
+  const void* data = format == TexelFormat::RgbaHalfUnsized
+                         ? static_cast<const void*>(halves.data())
+                     : format == TexelFormat::Rgba8Unsized ? static_cast<const void*>(bytes.data())
+                                                           : static_cast<const void*>(rgba.data());
+  if (texture_.id() != 0 && entries == entries_ && texture_.format() == format) {
+    texture_.update(data);
+    return;
+  }
+  entries_ = entries;
+  texture_ = Texture();  // release first: the ledger counts the new one alone
+  texture_ = Texture::create2D(context.ledger(), label, format, entries, 1, data);
+}
+
+}  // namespace tessera::gpu
