@@ -15,9 +15,9 @@
 #include <glm/geometric.hpp>
 
 #include "app/Commands.h"
-#include "gpu/gl.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
+#include "tessera/gpu/Draw.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/io/VolumeReader.h"
 #include "tessera/layout/VolumeUpload.h"
@@ -61,11 +61,6 @@ Volume resample(const Volume& v, glm::ivec3 dims) {
   out.invalidateRange();
   out.setDescription(v.description() + " resampled");
   return out;
-}
-
-// Waits for queued uploads, so that an update's time includes them.
-void glFinishForBench() {
-  glFinish();
 }
 
 std::string dimsText(glm::ivec3 d) {
@@ -357,7 +352,7 @@ std::vector<TfRow> measureTfUpdates(gpu::GlContext& context, const gpu::DeviceLi
         if (p.recreate) r.recreateStackTextures();
         r.setTransferFunction(i % 2 ? tf : tfB);
         r.prepare(cam, s);
-        glFinishForBench();
+        gpu::finish();  // an update's time includes its queued uploads
         update.push_back(msSince(t0));
         t0 = Clock::now();
         r.renderFrame(cam, s, 480, 320);

@@ -20,9 +20,9 @@
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
 
-#include "gpu/gl.h"
 #include "tessera/core/Image.h"
 #include "tessera/gpu/DeviceProfile.h"
+#include "tessera/gpu/Draw.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/io/VolumeReader.h"
@@ -389,11 +389,7 @@ void drawVolumeView(DesktopSession& ds, int panelPx, int viewW, int viewH) {
         v.render(viewW, viewH, ds.cache.id());
         ds.cacheKey = key;
       }
-      glBindFramebuffer(GL_READ_FRAMEBUFFER, ds.cache.id());
-      glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
-      glBlitFramebuffer(0, 0, viewW, viewH, panelPx, 0, panelPx + viewW, viewH, GL_COLOR_BUFFER_BIT,
-                        GL_NEAREST);
-      glBindFramebuffer(GL_FRAMEBUFFER, 0);
+      gpu::blitFramebuffer(ds.cache.id(), {0, 0, viewW, viewH}, 0, {panelPx, 0, viewW, viewH});
     } else {
       v.render(viewW, viewH, 0, glm::ivec2(panelPx, 0));
     }
@@ -411,9 +407,9 @@ void drawVolumeView(DesktopSession& ds, int panelPx, int viewW, int viewH) {
 // --screenshot: the window after --frames frames, then the session ends.
 void takeScreenshot(DesktopSession& ds, int fbw, int fbh) {
   Image shot(fbw, fbh);
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(0, 0, fbw, fbh, GL_RGBA, GL_UNSIGNED_BYTE, shot.rgba().data());
+  gpu::clearErrors();  // ImGui's GL backend may leave some
+  gpu::bindFramebuffer(0, {0, 0, fbw, fbh});
+  gpu::readPixelsRgba8({0, 0, fbw, fbh}, shot.rgba().data());
   shot.flipVertically();
   for (std::size_t i = 3; i < shot.rgba().size(); i += 4) shot.rgba()[i] = 255;
   shot.writePng(ds.options.screenshot);
@@ -447,7 +443,7 @@ void runFrame(DesktopSession& ds) {
                         static_cast<float>(wh));
   ImGui::Render();
   drawVolumeView(ds, panelPx, viewW, viewH);
-  glViewport(0, 0, fbw, fbh);
+  gpu::setViewport({0, 0, fbw, fbh});
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
   ++ds.frame;

@@ -102,6 +102,11 @@ void checkErrors(const std::string& what) {
                  (e == GL_OUT_OF_MEMORY ? " (out of GPU memory)" : ""));
 }
 
+void clearErrors() {
+  for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) {
+  }
+}
+
 namespace {
 GLenum glPrimitive(Primitive p) {
   switch (p) {

@@ -8,39 +8,6 @@
 
 namespace tessera::gpu {
 
-std::uint64_t bytesPerTexel(GLenumT f) {
-  switch (f) {
-    case GL_R8:
-    case GL_ALPHA:
-    case GL_LUMINANCE:
-      return 1;
-    case GL_RG8:
-    case GL_R16F:
-    case GL_R16_EXT:
-    case GL_LUMINANCE_ALPHA:
-      return 2;
-    case GL_RGB8:
-    case GL_RGB:
-      return 3;
-    case GL_RGBA8:
-    case GL_RGBA:
-    case GL_R32F:
-    case GL_RG16F:
-      return 4;
-    case GL_RGBA16F:
-      return 8;
-    case GL_RGBA32F:
-      return 16;
-    case GL_DEPTH_COMPONENT16:
-      return 2;
-    case GL_DEPTH_COMPONENT24:
-    case GL_DEPTH24_STENCIL8:
-      return 4;
-    default:
-      throw GpuError("bytesPerTexel: unknown internal format " + std::to_string(f));
-  }
-}
-
 LedgerEntry::LedgerEntry(MemoryLedger& ledger, GpuResource kind, std::uint64_t bytes,
                          const std::string& label)
     : ledger_(&ledger), id_(ledger.add(kind, bytes, label)), bytes_(bytes) {}
@@ -107,9 +74,8 @@ void checkGl(const std::string& what) {
 Texture Texture::create2D(MemoryLedger& ledger, const std::string& label, GLenumT internalFormat,
                           int width, int height, GLenumT format, GLenumT type, const void* data,
                           std::uint64_t texelBytes) {
-  const std::uint64_t bytes = static_cast<std::uint64_t>(width) *
-                              static_cast<std::uint64_t>(height) *
-                              (texelBytes ? texelBytes : bytesPerTexel(internalFormat));
+  const std::uint64_t bytes =
+      static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height) * texelBytes;
   Texture t;
   t.entry_ = LedgerEntry(ledger, GpuResource::Texture, bytes, label);  // budget check first
   glGetError();
@@ -132,10 +98,10 @@ Texture Texture::create2D(MemoryLedger& ledger, const std::string& label, GLenum
 
 Texture Texture::create3D(MemoryLedger& ledger, const std::string& label, GLenumT internalFormat,
                           int width, int height, int depth, GLenumT format, GLenumT type,
-                          const void* data) {
+                          const void* data, std::uint64_t texelBytes) {
   const std::uint64_t bytes = static_cast<std::uint64_t>(width) *
                               static_cast<std::uint64_t>(height) *
-                              static_cast<std::uint64_t>(depth) * bytesPerTexel(internalFormat);
+                              static_cast<std::uint64_t>(depth) * texelBytes;
   Texture t;
   t.entry_ = LedgerEntry(ledger, GpuResource::Texture, bytes, label);
   glGetError();
@@ -170,8 +136,8 @@ Texture Texture::create2D(MemoryLedger& ledger, const std::string& label, TexelF
 Texture Texture::create3D(MemoryLedger& ledger, const std::string& label, TexelFormat format,
                           int width, int height, int depth, const void* data) {
   const GlFormat f = glFormat(format);
-  Texture t =
-      create3D(ledger, label, f.internalFormat, width, height, depth, f.format, f.type, data);
+  Texture t = create3D(ledger, label, f.internalFormat, width, height, depth, f.format, f.type,
+                       data, f.texelBytes);
   t.format_ = format;
   return t;
 }
@@ -202,17 +168,6 @@ void Texture::setFilter(GLenumT minFilter, GLenumT magFilter) {
   glTexParameteri(target_, GL_TEXTURE_MAG_FILTER, static_cast<GLint>(magFilter));
 }
 
-void Texture::update2D(GLenumT format, GLenumT type, const void* data) {
-  update2DRegion(0, 0, width_, height_, format, type, data);
-}
-
-void Texture::update2DRegion(int x, int y, int w, int h, GLenumT format, GLenumT type,
-                             const void* data) {
-  glBindTexture(GL_TEXTURE_2D, id_);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexSubImage2D(GL_TEXTURE_2D, 0, x, y, w, h, format, type, data);
-}
-
 void Texture::bind(int unit) const {
   glActiveTexture(GL_TEXTURE0 + static_cast<GLenum>(unit));
   glBindTexture(target_, id_);
@@ -237,24 +192,19 @@ Buffer::~Buffer() {
   if (id_) glDeleteBuffers(1, &id_);
 }
 
-Buffer Buffer::create(MemoryLedger& ledger, const std::string& label, GLenumT target,
-                      std::uint64_t bytes, const void* data, GLenumT usage) {
+Buffer Buffer::create(MemoryLedger& ledger, const std::string& label, BufferKind kind,
+                      std::uint64_t bytes, const void* data, BufferUsage usage) {
+  const GLenum target = kind == BufferKind::Vertices ? GL_ARRAY_BUFFER : GL_ELEMENT_ARRAY_BUFFER;
   Buffer b;
   b.entry_ = LedgerEntry(ledger, GpuResource::Buffer, bytes, label);
   glGetError();
   glGenBuffers(1, &b.id_);
   b.target_ = target;
   glBindBuffer(target, b.id_);
-  glBufferData(target, static_cast<GLsizeiptr>(bytes), data, usage);
+  glBufferData(target, static_cast<GLsizeiptr>(bytes), data,
+               usage == BufferUsage::Static ? GL_STATIC_DRAW : GL_DYNAMIC_DRAW);
   checkGl("buffer '" + label + "'");
   return b;
-}
-
-Buffer Buffer::create(MemoryLedger& ledger, const std::string& label, BufferKind kind,
-                      std::uint64_t bytes, const void* data, BufferUsage usage) {
-  return create(ledger, label,
-                kind == BufferKind::Vertices ? GL_ARRAY_BUFFER : GL_ELEMENT_ARRAY_BUFFER, bytes,
-                data, usage == BufferUsage::Static ? GL_STATIC_DRAW : GL_DYNAMIC_DRAW);
 }
 
 void Buffer::update(std::uint64_t offset, std::uint64_t bytes, const void* data) {
@@ -318,30 +268,6 @@ Framebuffer Framebuffer::create(MemoryLedger& ledger, const std::string& label, 
   return f;
 }
 
-Framebuffer Framebuffer::create(MemoryLedger& ledger, const std::string& label, int width,
-                                int height, GLenumT colorFormat) {
-  if (colorFormat == 0) colorFormat = GL_RGBA8;
-  Framebuffer f;
-  const GLenum type = colorFormat == GL_RGBA16F   ? GL_HALF_FLOAT
-                      : colorFormat == GL_RGBA32F ? GL_FLOAT
-                                                  : GL_UNSIGNED_BYTE;
-  // ES 2.0 takes an unsized internal format for colour textures.
-  const GLenum format = GL_RGBA;
-  f.color_ = Texture::create2D(ledger, label + " colour", colorFormat, width, height, format, type,
-                               nullptr);
-  f.color_.setFilter(GL_LINEAR, GL_LINEAR);
-  glGenFramebuffers(1, &f.id_);
-  glBindFramebuffer(GL_FRAMEBUFFER, f.id_);
-  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, f.color_.id(), 0);
-  const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-  if (status != GL_FRAMEBUFFER_COMPLETE) {
-    throw GpuError("framebuffer '" + label + "' " + std::to_string(width) + "x" +
-                   std::to_string(height) + " incomplete (status 0x" + std::to_string(status) +
-                   ")");
-  }
-  return f;
-}
-
 void Framebuffer::bind() const {
   glBindFramebuffer(GL_FRAMEBUFFER, id_);
   glViewport(0, 0, color_.width(), color_.height());
@@ -361,8 +287,8 @@ constexpr float kTriangle[] = {-1.0f, -1.0f, 3.0f, -1.0f, -1.0f, 3.0f};
 }
 
 FullscreenTriangle::FullscreenTriangle(MemoryLedger& ledger)
-    : vertices_(Buffer::create(ledger, "full-screen triangle", GL_ARRAY_BUFFER, sizeof kTriangle,
-                               kTriangle, GL_STATIC_DRAW)) {}
+    : vertices_(Buffer::create(ledger, "full-screen triangle", BufferKind::Vertices,
+                               sizeof kTriangle, kTriangle, BufferUsage::Static)) {}
 
 void FullscreenTriangle::draw() const {
   glBindBuffer(GL_ARRAY_BUFFER, vertices_.id());

@@ -32,6 +32,14 @@ GlFormat glFormat(TexelFormat f) {
   return {GL_R8, GL_RED, GL_UNSIGNED_BYTE, 1, 1};
 }
 
+TexelFormat rgba8For(ApiLevel api) {
+  return api == ApiLevel::Gles3 ? TexelFormat::RGBA8 : TexelFormat::Rgba8Unsized;
+}
+
+TexelFormat r8For(ApiLevel api) {
+  return api == ApiLevel::Gles3 ? TexelFormat::R8 : TexelFormat::Luminance8;
+}
+
 std::uint64_t bytesPerTexel(TexelFormat f) {
   return glFormat(f).texelBytes;
 }

@@ -137,9 +137,8 @@ std::vector<float> LayoutProbe::sampleRgba8(const Layout& layout,
       context_.ledger(), "probe points", gpu::BufferKind::Vertices, vertices.size() * sizeof(float),
       vertices.data(), gpu::BufferUsage::Static);
   // ES 2.0 takes an unsized colour format.
-  gpu::Framebuffer target = gpu::Framebuffer::create(
-      context_.ledger(), "probe target", width, height,
-      api == gpu::ApiLevel::Gles2 ? gpu::TexelFormat::Rgba8Unsized : gpu::TexelFormat::RGBA8);
+  gpu::Framebuffer target = gpu::Framebuffer::create(context_.ledger(), "probe target", width,
+                                                     height, gpu::rgba8For(api));
 
   target.bind();
   gpu::apply({});

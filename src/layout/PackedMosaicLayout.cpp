@@ -249,8 +249,7 @@ std::unique_ptr<PackedMosaicLayout> PackedMosaicLayout::create(const Volume& vol
   }
   const Geometry& g = l->geometry_;
   // ES 2.0 takes only unsized internal formats.
-  const gpu::TexelFormat format =
-      limits.api == gpu::ApiLevel::Gles2 ? gpu::TexelFormat::Rgba8Unsized : gpu::TexelFormat::RGBA8;
+  const gpu::TexelFormat format = gpu::rgba8For(limits.api);
   // Tile by tile, so the host needs one tile of staging, not whole textures;
   // the unused tiles of the last texture get zeros (glTexImage2D with no
   // data leaves them undefined).

@@ -8,9 +8,9 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/constants.hpp>
 
-#include "gpu/gl.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
+#include "tessera/gpu/Draw.h"
 #include "tessera/render/CameraRay.h"
 
 namespace tessera::render {
@@ -137,7 +137,7 @@ void ensureTarget(gpu::GlContext& context, gpu::Framebuffer& fb, const char* lab
   if (fb.id() != 0 && fb.width() == width && fb.height() == height) return;
   fb = gpu::Framebuffer();
   fb = gpu::Framebuffer::create(context.ledger(), label, width, height,
-                                context.caps().api == gpu::ApiLevel::Gles3 ? GL_RGBA8 : GL_RGBA);
+                                gpu::rgba8For(context.caps().api));
 }
 
 }  // namespace
@@ -167,8 +167,7 @@ void HybridCompositor::render(Technique& technique, const Camera& camera,
     overWhite.bind(0);
     copy.set("u_volume", 0);
     copy.set("u_size", glm::vec2(whiteSize));
-    glDisable(GL_BLEND);
-    glDisable(GL_DEPTH_TEST);
+    gpu::apply({});
     triangle_.draw();
     s.background = glm::dvec4(0.0, 0.0, 0.0, 1.0);
     volume = &technique.render(camera, s, low.x, low.y, aspect);
@@ -194,17 +193,16 @@ void HybridCompositor::render(Technique& technique, const Camera& camera,
     resolve.set("u_white", 1);
   }
   resolve.set("u_size", glm::vec2(rendered));
-  glDisable(GL_BLEND);
-  glDisable(GL_DEPTH_TEST);
+  gpu::apply({});
   triangle_.draw();
-  glFinish();
+  gpu::finish();
   timings_.volumeMs = msSince(tStart);
 
   // 2. The lines at full resolution.
   const auto tOverlay = std::chrono::steady_clock::now();
   const bool hasLines = !lines_.empty();
   if (hasLines) overlay_.draw(lines_, camera, width, height);
-  glFinish();
+  gpu::finish();
   timings_.overlayMs = msSince(tOverlay);
 
   // 3. Upscale and compose at full resolution.
@@ -239,13 +237,10 @@ void HybridCompositor::render(Technique& technique, const Camera& camera,
     composite_.set("u_lineColor", 1);
     composite_.set("u_lineDistance", 2);
   }
-  glDisable(GL_BLEND);
-  glDisable(GL_DEPTH_TEST);
+  gpu::apply({});
   triangle_.draw();
-  glFinish();
-  const GLenum err = glGetError();
-  if (err != GL_NO_ERROR)
-    throw GpuError("hybrid compositing failed: GL error " + std::to_string(err));
+  gpu::finish();
+  gpu::checkErrors("hybrid compositing");
   timings_.compositeMs = msSince(tComposite);
   timings_.totalMs = msSince(tStart);
 }

@@ -63,9 +63,7 @@ OverlayRenderer::~OverlayRenderer() = default;
 
 void OverlayRenderer::allocate(int width, int height) {
   if (color_.id() != 0 && color_.width() == width && color_.height() == height) return;
-  const gpu::TexelFormat format = context_.caps().api == gpu::ApiLevel::Gles3
-                                      ? gpu::TexelFormat::RGBA8
-                                      : gpu::TexelFormat::Rgba8Unsized;
+  const gpu::TexelFormat format = gpu::rgba8For(context_.caps().api);
   color_ = gpu::Framebuffer();
   distance_ = gpu::Framebuffer();
   // Each target has its depth buffer, cleared before its pass, so that where

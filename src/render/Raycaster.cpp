@@ -7,9 +7,9 @@
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/packing.hpp>
 
-#include "gpu/gl.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/DeviceProfile.h"
+#include "tessera/gpu/Draw.h"
 
 namespace tessera::render {
 
@@ -41,12 +41,12 @@ void Raycaster::setLutSize(int entries) {
                      std::to_string(entries));
   }
   lutSize_ = entries;
-  lutTexture_ = gpu::Texture();
+  lut_ = gpu::LookupTexture();
   lookupKey_.clear();
 }
 
 std::uint64_t Raycaster::ownTextureBytes() const {
-  return lutTexture_.bytes() + blockTexture_.bytes() + target_.color().bytes();
+  return lut_.bytes() + blockTexture_.bytes() + target_.color().bytes();
 }
 
 void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistance) {
@@ -58,7 +58,7 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
   if (key.str() == lookupKey_) return;
   lookupKey_ = key.str();
 
-  lut_ = tf_.bake(lutSize_, sampleDistance, settings.opacityScale);
+  lutValues_ = tf_.bake(lutSize_, sampleDistance, settings.opacityScale);
   uploadLut();
 
   occupiedFraction_ = 1.0;
@@ -70,7 +70,7 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
   for (int i = 0; i < lutSize_; ++i) {
     opaquePrefix[static_cast<std::size_t>(i) + 1] =
         opaquePrefix[static_cast<std::size_t>(i)] +
-        (lut_[static_cast<std::size_t>(i) * 4 + 3] > 0.0f ? 1 : 0);
+        (lutValues_[static_cast<std::size_t>(i) * 4 + 3] > 0.0f ? 1 : 0);
   }
   const double ww = w.max - w.min;
   const glm::ivec3 c = blocks_.blockCount();
@@ -95,42 +95,7 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
 }
 
 void Raycaster::uploadLut() {
-  // RGBA16F where the device filters half floats (all of ES 3, ES 2 with
-  // OES_texture_half_float_linear): 8-bit opacities would lose the small
-  // per-sample alphas of fine steps. RGBA8 otherwise.
-  const gpu::ApiLevel api = context_.caps().api;
-  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(context_.caps());
-  if (api == gpu::ApiLevel::Gles3) {
-    if (lutTexture_.id() == 0) {
-      lutTexture_ = gpu::Texture::create2D(context_.ledger(), "transfer function", GL_RGBA16F,
-                                           lutSize_, 1, GL_RGBA, GL_FLOAT, lut_.data());
-    } else {
-      lutTexture_.update2D(GL_RGBA, GL_FLOAT, lut_.data());
-    }
-    return;
-  }
-  if (limits.halfFloatTextures) {
-    std::vector<std::uint16_t> halves(lut_.size());
-    for (std::size_t i = 0; i < lut_.size(); ++i) halves[i] = glm::packHalf1x16(lut_[i]);
-    if (lutTexture_.id() == 0) {
-      lutTexture_ =
-          gpu::Texture::create2D(context_.ledger(), "transfer function", GL_RGBA, lutSize_, 1,
-                                 GL_RGBA, GL_HALF_FLOAT_OES, halves.data(), 8);
-    } else {
-      lutTexture_.update2D(GL_RGBA, GL_HALF_FLOAT_OES, halves.data());
-    }
-    return;
-  }
-  std::vector<std::uint8_t> bytes(lut_.size());
-  for (std::size_t i = 0; i < lut_.size(); ++i) {
-    bytes[i] = static_cast<std::uint8_t>(std::lround(std::clamp(lut_[i], 0.0f, 1.0f) * 255.0f));
-  }
-  if (lutTexture_.id() == 0) {
-    lutTexture_ = gpu::Texture::create2D(context_.ledger(), "transfer function", GL_RGBA, lutSize_,
-                                         1, GL_RGBA, GL_UNSIGNED_BYTE, bytes.data());
-  } else {
-    lutTexture_.update2D(GL_RGBA, GL_UNSIGNED_BYTE, bytes.data());
-  }
+  lut_.upload(context_, lutValues_, "transfer function");
 }
 
 void Raycaster::uploadBlocks(const std::vector<std::uint8_t>& cells) {
@@ -139,14 +104,11 @@ void Raycaster::uploadBlocks(const std::vector<std::uint8_t>& cells) {
     // One texelFetch per lookup: measurably cheaper per sample than the
     // mosaic's address arithmetic (see README, Benchmark).
     if (blockTexture_.id() == 0) {
-      blockTexture_ = gpu::Texture::create3D(context_.ledger(), "empty-space blocks", GL_RG8, c.x,
-                                             c.y, c.z, GL_RG, GL_UNSIGNED_BYTE, cells.data());
-      blockTexture_.setFilter(GL_NEAREST, GL_NEAREST);
+      blockTexture_ = gpu::Texture::create3D(context_.ledger(), "empty-space blocks",
+                                             gpu::TexelFormat::RG8, c.x, c.y, c.z, cells.data());
+      blockTexture_.setFilter(gpu::Filter::Nearest);
     } else {
-      glBindTexture(GL_TEXTURE_3D, blockTexture_.id());
-      glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-      glTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, c.x, c.y, c.z, GL_RG, GL_UNSIGNED_BYTE,
-                      cells.data());
+      blockTexture_.update(cells.data());
     }
     return;
   }
@@ -175,12 +137,12 @@ void Raycaster::uploadBlocks(const std::vector<std::uint8_t>& cells) {
     }
   }
   if (blockTexture_.id() == 0) {
-    blockTexture_ =
-        gpu::Texture::create2D(context_.ledger(), "empty-space blocks", GL_RGBA, blockTexSize_.x,
-                               blockTexSize_.y, GL_RGBA, GL_UNSIGNED_BYTE, texels.data(), 4);
-    blockTexture_.setFilter(GL_NEAREST, GL_NEAREST);
+    blockTexture_ = gpu::Texture::create2D(context_.ledger(), "empty-space blocks",
+                                           gpu::TexelFormat::Rgba8Unsized, blockTexSize_.x,
+                                           blockTexSize_.y, texels.data());
+    blockTexture_.setFilter(gpu::Filter::Nearest);
   } else {
-    blockTexture_.update2D(GL_RGBA, GL_UNSIGNED_BYTE, texels.data());
+    blockTexture_.update(texels.data());
   }
 }
 
@@ -251,9 +213,8 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
 
   if (target_.id() == 0 || target_.width() != width || target_.height() != height) {
     target_ = gpu::Framebuffer();
-    target_ =
-        gpu::Framebuffer::create(context_.ledger(), "ray-cast target", width, height,
-                                 context_.caps().api == gpu::ApiLevel::Gles3 ? GL_RGBA8 : GL_RGBA);
+    target_ = gpu::Framebuffer::create(context_.ledger(), "ray-cast target", width, height,
+                                       gpu::rgba8For(context_.caps().api));
   }
   target_.bind();
   const gpu::Program& prog = programFor(settings);
@@ -286,7 +247,7 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
   prog.set("u_valueBias", static_cast<float>((m.offset - w.min) / ww));
 
   int unit = layout_.bindSeam(prog, 0);
-  lutTexture_.bind(unit);
+  lut_.texture().bind(unit);
   prog.set("u_tf", unit++);
   prog.set("u_tfSize", static_cast<float>(lutSize_));
   if (blockSize_ > 0) {
@@ -301,12 +262,10 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
     }
   }
 
-  glDisable(GL_BLEND);
-  glDisable(GL_DEPTH_TEST);
+  gpu::apply({});
   triangle_.draw();
-  glFinish();
-  const GLenum err = glGetError();
-  if (err != GL_NO_ERROR) throw GpuError("ray casting failed: GL error " + std::to_string(err));
+  gpu::finish();
+  gpu::checkErrors("ray casting");
 }
 
 Image Raycaster::readImage() const {

@@ -7,9 +7,9 @@
 
 #include <glm/geometric.hpp>
 
-#include "gpu/gl.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
+#include "tessera/gpu/Draw.h"
 #include "tessera/render/SliceProjection.h"
 
 namespace tessera::render {
@@ -119,8 +119,8 @@ void Slice2DRenderer::buildGeometry(int axis) {
     }
   }
   vertices_[axis] =
-      gpu::Buffer::create(context_.ledger(), "slice2d stack geometry", GL_ARRAY_BUFFER,
-                          v.size() * sizeof(float), v.data(), GL_STATIC_DRAW);
+      gpu::Buffer::create(context_.ledger(), "slice2d stack geometry", gpu::BufferKind::Vertices,
+                          v.size() * sizeof(float), v.data(), gpu::BufferUsage::Static);
 }
 
 const Slice2DRenderer::DrawList& Slice2DRenderer::drawList(int axis, bool descending, int slices) {
@@ -144,9 +144,9 @@ const Slice2DRenderer::DrawList& Slice2DRenderer::drawList(int axis, bool descen
     for (int i : {0, 1, 2, 0, 2, 3}) indices.push_back(static_cast<std::uint16_t>(base + i));
     list.ranges.back().count += 6;
   }
-  list.indices =
-      gpu::Buffer::create(context_.ledger(), "slice2d draw order", GL_ELEMENT_ARRAY_BUFFER,
-                          indices.size() * sizeof(std::uint16_t), indices.data(), GL_STATIC_DRAW);
+  list.indices = gpu::Buffer::create(
+      context_.ledger(), "slice2d draw order", gpu::BufferKind::Indices16,
+      indices.size() * sizeof(std::uint16_t), indices.data(), gpu::BufferUsage::Static);
   return drawLists_.emplace(key, std::move(list)).first->second;
 }
 
@@ -154,9 +154,8 @@ void Slice2DRenderer::uploadStack(int axis) {
   const auto t0 = std::chrono::steady_clock::now();
   const SliceAtlasPlan& p = plans_[axis];
   const bool pre = options_.classification == SliceClassification::Pre;
-  const bool es3 = context_.caps().api == gpu::ApiLevel::Gles3;
-  const gpu::GLenumT format = pre ? GL_RGBA : (es3 ? GL_RED : GL_LUMINANCE);
-  const gpu::GLenumT internal = pre ? (es3 ? GL_RGBA8 : GL_RGBA) : (es3 ? GL_R8 : GL_LUMINANCE);
+  const gpu::TexelFormat format =
+      pre ? gpu::rgba8For(context_.caps().api) : gpu::r8For(context_.caps().api);
   const bool recreate = atlases_[axis].size() != static_cast<std::size_t>(p.atlases);
   if (recreate) atlases_[axis].clear();
   // Filled and uploaded a band (one row of tiles) at a time: the host copy
@@ -168,19 +167,18 @@ void Slice2DRenderer::uploadStack(int axis) {
     if (recreate) {
       atlases_[axis].push_back(gpu::Texture::create2D(
           context_.ledger(), "slice2d atlas " + std::string(1, "xyz"[axis]) + std::to_string(i),
-          internal, p.atlasSize.x, p.atlasSize.y, format, GL_UNSIGNED_BYTE, nullptr, pre ? 4 : 1));
+          format, p.atlasSize.x, p.atlasSize.y));
       if (options_.classification == SliceClassification::Palette) {
-        atlases_[axis].back().setFilter(GL_NEAREST, GL_NEAREST);
+        atlases_[axis].back().setFilter(gpu::Filter::Nearest);
       }
     }
     gpu::Texture& atlas = atlases_[axis][static_cast<std::size_t>(i)];
     for (int b = 0; b < p.bands(); ++b) {
       stacks_.fillAtlasBand(p, i, b, pre ? palette8_.data() : nullptr, band);
-      atlas.update2DRegion(0, b * p.tile.y, p.atlasSize.x, p.bandRows(b), format, GL_UNSIGNED_BYTE,
-                           band.data());
+      atlas.updateRegion({0, b * p.tile.y, 0}, {p.atlasSize.x, p.bandRows(b), 1}, band.data());
     }
   }
-  glFinish();
+  gpu::finish();
   ++stackUploads_;
   lastStackUploadMs_ = msSince(t0);
 }
@@ -319,25 +317,12 @@ void Slice2DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
     prog.set("u_palette", 1);
   }
 
-  const GLint tileAttribute = glGetAttribLocation(prog.id(), "a_tile");
-  glBindBuffer(GL_ARRAY_BUFFER, vertices_[axis].id());
-  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, list.indices.id());
-  const GLsizei stride = kFloatsPerVertex * sizeof(float);
-  glEnableVertexAttribArray(0);
-  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride, nullptr);
-  if (tileAttribute >= 0) {
-    glEnableVertexAttribArray(static_cast<GLuint>(tileAttribute));
-    glVertexAttribPointer(static_cast<GLuint>(tileAttribute), 4, GL_FLOAT, GL_FALSE, stride,
-                          reinterpret_cast<const void*>(3 * sizeof(float)));
-  }
+  const int tileAttribute = prog.attributeLocation("a_tile");
   for (const DrawRange& r : list.ranges) {
     atlases_[axis][static_cast<std::size_t>(r.atlas)].bind(0);
-    glDrawElements(GL_TRIANGLES, r.count, GL_UNSIGNED_SHORT,
-                   reinterpret_cast<const void*>(r.firstIndex * sizeof(std::uint16_t)));
+    gpu::drawIndexed16(gpu::Primitive::Triangles, vertices_[axis], list.indices,
+                       {{0, 3, 0}, {tileAttribute, 4, 3}}, kFloatsPerVertex, r.count, r.firstIndex);
   }
-  glDisableVertexAttribArray(0);
-  if (tileAttribute >= 0) glDisableVertexAttribArray(static_cast<GLuint>(tileAttribute));
-  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, 0);
   accumulator_.resolve(settings, &table_.texture(), table_.entries());
 }
 

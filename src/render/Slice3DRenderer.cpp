@@ -7,8 +7,8 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "gpu/gl.h"
 #include "tessera/core/Error.h"
+#include "tessera/gpu/Draw.h"
 #include "tessera/render/SliceProjection.h"
 
 namespace tessera::render {
@@ -75,8 +75,9 @@ void Slice3DRenderer::buildGeometry(int slices) {
     }
   }
   vertices_ = gpu::Buffer();
-  vertices_ = gpu::Buffer::create(context_.ledger(), "slice3d proxy cube", GL_ARRAY_BUFFER,
-                                  v.size() * sizeof(float), v.data(), GL_STATIC_DRAW);
+  vertices_ =
+      gpu::Buffer::create(context_.ledger(), "slice3d proxy cube", gpu::BufferKind::Vertices,
+                          v.size() * sizeof(float), v.data(), gpu::BufferUsage::Static);
   builtSlices_ = slices;
   ++geometryBuilds_;
 }
@@ -164,11 +165,7 @@ void Slice3DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
   prog.set("u_tf", unit);
   prog.set("u_tfSize", static_cast<float>(lut_.entries()));
 
-  glBindBuffer(GL_ARRAY_BUFFER, vertices_.id());
-  glEnableVertexAttribArray(0);
-  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
-  glDrawArrays(GL_TRIANGLES, 0, builtSlices_ * 6);
-  glDisableVertexAttribArray(0);
+  gpu::drawArrays(gpu::Primitive::Triangles, vertices_, {{0, 3, 0}}, 3, 0, builtSlices_ * 6);
   accumulator_.resolve(settings, &lut_.texture(), lut_.entries());
 }
 

@@ -47,10 +47,9 @@ void SliceAccumulator::begin(int width, int height, RenderMode mode) {
   }
   if (accumulation_.id() == 0 || accumulation_.width() != width ||
       accumulation_.height() != height) {
-    const bool es3 = context_.caps().api == gpu::ApiLevel::Gles3;
     accumulation_ = gpu::Framebuffer();
     image_ = gpu::Framebuffer();
-    const gpu::TexelFormat rgba8 = es3 ? gpu::TexelFormat::RGBA8 : gpu::TexelFormat::Rgba8Unsized;
+    const gpu::TexelFormat rgba8 = gpu::rgba8For(context_.caps().api);
     accumulation_ = gpu::Framebuffer::create(context_.ledger(), "slice accumulation", width, height,
                                              floatTarget_ ? gpu::TexelFormat::RGBA16F : rgba8);
     // Read back at texel centres (gl_FragCoord / size), where linear

@@ -8,12 +8,12 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/mat4x4.hpp>
 
-#include "gpu/gl.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/Histogram.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"
 #include "tessera/gpu/DeviceSession.h"
+#include "tessera/gpu/Draw.h"
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/gpu/Program.h"
 #include "tessera/lod/InCoreVolumeSource.h"
@@ -44,13 +44,6 @@ glm::mat4 viewProjection(const Camera& camera, double aspect) {
     proj = glm::ortho(-h * aspect, h * aspect, -h, h, 1e-3, farPlane);
   }
   return glm::mat4(proj * view);
-}
-
-void drainGlErrors() {
-  // Front ends (ImGui's GL backend) may leave errors that the techniques'
-  // own checks would blame on themselves.
-  for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) {
-  }
 }
 
 }  // namespace
@@ -241,58 +234,42 @@ void Viewer::drawOverlayLines(int width, int height) {
       add(-e, axisColors[axis]);
       add(b, axisColors[axis]);
     }
-    gpu_->lineVertices = gpu::Buffer::create(context_.ledger(), "overlay lines", GL_ARRAY_BUFFER,
-                                             v.size() * sizeof(float), v.data(), GL_STATIC_DRAW);
+    gpu_->lineVertices =
+        gpu::Buffer::create(context_.ledger(), "overlay lines", gpu::BufferKind::Vertices,
+                            v.size() * sizeof(float), v.data(), gpu::BufferUsage::Static);
     gpu_->lineVertexCount = static_cast<int>(v.size() / 7);
     gpu_->lineExtent = e;
   }
   const gpu::Program& p = gpu_->lines;
   p.use();
   p.set("u_viewProjection", viewProjection(camera_, static_cast<double>(width) / height));
-  const GLint color = glGetAttribLocation(p.id(), "a_color");
-  glBindBuffer(GL_ARRAY_BUFFER, gpu_->lineVertices.id());
-  glEnableVertexAttribArray(0);
-  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 7 * sizeof(float), nullptr);
-  if (color >= 0) {
-    glEnableVertexAttribArray(static_cast<GLuint>(color));
-    glVertexAttribPointer(static_cast<GLuint>(color), 4, GL_FLOAT, GL_FALSE, 7 * sizeof(float),
-                          reinterpret_cast<const void*>(3 * sizeof(float)));
-  }
-  glEnable(GL_BLEND);
-  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
   const int first = showBoundingBox ? 0 : 24;
   const int count = (showBoundingBox ? 24 : 0) + (showAxes ? 6 : 0);
-  glDrawArrays(GL_LINES, first, count);
-  glDisable(GL_BLEND);
-  glDisableVertexAttribArray(0);
-  if (color >= 0) glDisableVertexAttribArray(static_cast<GLuint>(color));
+  gpu::apply({.blend = gpu::Blend::StraightAlpha});
+  gpu::drawArrays(gpu::Primitive::Lines, gpu_->lineVertices,
+                  {{0, 3, 0}, {p.attributeLocation("a_color"), 4, 3}}, 7, first, count);
+  gpu::apply({});
 }
 
 FrameStats Viewer::render(int width, int height, unsigned framebuffer, glm::ivec2 origin) {
   const auto t0 = std::chrono::steady_clock::now();
   FrameStats stats;
   controller_.setViewport(width, height);
-  drainGlErrors();
-  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
-  glViewport(origin.x, origin.y, width, height);
+  gpu::clearErrors();
+  const glm::ivec4 box(origin, width, height);
+  gpu::bindFramebuffer(framebuffer, box);
   if (!hasVolume()) {
-    glEnable(GL_SCISSOR_TEST);
-    glScissor(origin.x, origin.y, width, height);
-    glClearColor(static_cast<float>(settings_.background.r),
-                 static_cast<float>(settings_.background.g),
-                 static_cast<float>(settings_.background.b), 1.0f);
-    glClear(GL_COLOR_BUFFER_BIT);
-    glDisable(GL_SCISSOR_TEST);
+    gpu::apply({.scissor = true, .scissorBox = box});
+    gpu::clearColor(glm::vec4(glm::vec3(settings_.background), 1.0f));
+    gpu::apply({});
     last_ = stats;
     return stats;
   }
   render::QualityLevel level;  // full quality
   const gpu::Texture& image = renderVolume(width, height, stats, level);
 
-  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
-  glViewport(origin.x, origin.y, width, height);
-  glDisable(GL_BLEND);
-  glDisable(GL_DEPTH_TEST);
+  gpu::bindFramebuffer(framebuffer, box);
+  gpu::apply({});
   gpu_->present.use();
   image.bind(0);
   gpu_->present.set("u_image", 0);
@@ -301,10 +278,8 @@ FrameStats Viewer::render(int width, int height, unsigned framebuffer, glm::ivec
 
   // glFinish does not wait in browsers: a read-back of one pixel does.
   std::uint8_t pixel[4];
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(origin.x, origin.y, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, pixel);
-  const GLenum err = glGetError();
-  if (err != GL_NO_ERROR) throw GpuError("viewer frame failed: GL error " + std::to_string(err));
+  gpu::readPixelsRgba8({origin, 1, 1}, pixel);
+  gpu::checkErrors("viewer frame");
   stats.ms = msSince(t0);
   if (quality == Quality::Adaptive) qualityController_.report(level, stats.ms);
   last_ = stats;

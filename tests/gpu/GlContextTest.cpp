@@ -57,11 +57,10 @@ TEST(MemoryLedger, CountsEveryTextureAndBufferWhileAlive) {
   GlContext& c = context();
   const std::uint64_t before = c.ledger().totalBytes();
   {
-    Texture t =
-        Texture::create3D(c.ledger(), "t3", GL_R8, 8, 4, 2, GL_RED, GL_UNSIGNED_BYTE, nullptr);
-    Texture lut =
-        Texture::create2D(c.ledger(), "lut", GL_RGBA16F, 256, 1, GL_RGBA, GL_FLOAT, nullptr);
-    Buffer b = Buffer::create(c.ledger(), "vbo", GL_ARRAY_BUFFER, 1000, nullptr, GL_STATIC_DRAW);
+    Texture t = Texture::create3D(c.ledger(), "t3", TexelFormat::R8, 8, 4, 2);
+    Texture lut = Texture::create2D(c.ledger(), "lut", TexelFormat::RGBA16F, 256, 1);
+    Buffer b =
+        Buffer::create(c.ledger(), "vbo", BufferKind::Vertices, 1000, nullptr, BufferUsage::Static);
     EXPECT_EQ(c.ledger().totalBytes() - before, 8u * 4 * 2 + 256u * 8 + 1000u);
     Texture moved = std::move(t);
     EXPECT_EQ(c.ledger().totalBytes() - before, 8u * 4 * 2 + 256u * 8 + 1000u);

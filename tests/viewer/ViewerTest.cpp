@@ -5,7 +5,6 @@
 #include <string>
 #include <vector>
 
-#include "gpu/gl.h"
 #include "support/GpuTestContext.h"
 #include "support/TestSupport.h"
 #include "tessera/core/Error.h"
@@ -208,7 +207,8 @@ TEST(Viewer, Es2ContextUsesATwoDimensionalLayout) {
     Viewer v(*ctx, gpu::DeviceProfile::find("webgl1"));
     v.setVolume(makeSheppLogan({40, 40, 40}), "phantom");
     EXPECT_NE(v.plan().layout.layout, "texture3d");
-    gpu::Framebuffer fb = gpu::Framebuffer::create(ctx->ledger(), "view", kSize, kSize, GL_RGBA);
+    gpu::Framebuffer fb = gpu::Framebuffer::create(ctx->ledger(), "view", kSize, kSize,
+                                                   gpu::TexelFormat::Rgba8Unsized);
     v.showBoundingBox = v.showAxes = false;
     v.render(kSize, kSize, fb.id());
     const Image img = readFramebuffer(fb);

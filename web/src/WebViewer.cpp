@@ -14,10 +14,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "gpu/gl.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/PatientFrame.h"
 #include "tessera/gpu/DeviceProfile.h"
+#include "tessera/gpu/Draw.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/io/ByteSource.h"
 #include "tessera/io/Procedural.h"
@@ -312,9 +312,8 @@ EMSCRIPTEN_KEEPALIVE const std::uint8_t* tessera_read_pixels(int width, int heig
   static std::vector<std::uint8_t> pixels;
   pixels.assign(static_cast<std::size_t>(width) * height * 4, 0);
   std::vector<std::uint8_t> rows(pixels.size());
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rows.data());
+  gpu::bindFramebuffer(0, {0, 0, width, height});
+  gpu::readPixelsRgba8({0, 0, width, height}, rows.data());
   const std::size_t stride = static_cast<std::size_t>(width) * 4;
   for (int y = 0; y < height; ++y) {
     std::copy_n(rows.data() + static_cast<std::size_t>(height - 1 - y) * stride, stride,

@@ -56,6 +56,9 @@ void readPixelsRgba32F(glm::ivec4 region, float* out);
 void finish();
 // GpuError naming `what` if GL has recorded an error.
 void checkErrors(const std::string& what);
+// Forgets recorded errors (front ends such as ImGui's GL backend may leave
+// some that a later check would blame on the engine).
+void clearErrors();
 
 enum class Primitive { Triangles, Lines, Points };
 

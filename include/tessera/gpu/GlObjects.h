@@ -15,10 +15,6 @@ namespace tessera::gpu {
 using GLenumT = unsigned int;
 using GLuintT = unsigned int;
 
-// Bytes per texel of a sized internal format (GL_R8, GL_RGBA16F, ...).
-// Throws GpuError for formats it does not know.
-std::uint64_t bytesPerTexel(GLenumT internalFormat);
-
 class LedgerEntry {
  public:
   LedgerEntry() = default;
@@ -42,19 +38,9 @@ class Texture {
   Texture& operator=(Texture&& o) noexcept;
   ~Texture();
 
-  // Allocates (and optionally fills) a texture; `data` may be null.
-  // Filtering: linear, wrap: clamp to edge.
-  // `texelBytes` overrides bytesPerTexel(internalFormat) for the unsized
-  // formats of ES 2.0, whose size depends on `type` (GL_RGBA + half floats).
-  static Texture create2D(MemoryLedger& ledger, const std::string& label, GLenumT internalFormat,
-                          int width, int height, GLenumT format, GLenumT type, const void* data,
-                          std::uint64_t texelBytes = 0);
-  static Texture create3D(MemoryLedger& ledger, const std::string& label, GLenumT internalFormat,
-                          int width, int height, int depth, GLenumT format, GLenumT type,
-                          const void* data);
-
-  // The same by what the texels hold (TexelFormat.h): `data` has
-  // uploadBytesPerTexel(format) bytes per texel, rows tightly packed.
+  // Allocates (and optionally fills) a texture of `format` (TexelFormat.h):
+  // `data`, when given, has uploadBytesPerTexel(format) bytes per texel, rows
+  // tightly packed. Filtering: linear, wrap: clamp to edge.
   static Texture create2D(MemoryLedger& ledger, const std::string& label, TexelFormat format,
                           int width, int height, const void* data = nullptr);
   static Texture create3D(MemoryLedger& ledger, const std::string& label, TexelFormat format,
@@ -66,14 +52,7 @@ class Texture {
   void setFilter(Filter filter);
   TexelFormat format() const { return format_; }
 
-  void setFilter(GLenumT minFilter, GLenumT magFilter);
-  // Replaces the whole level-0 image of a 2D texture.
-  void update2D(GLenumT format, GLenumT type, const void* data);
-  // Replaces the texels [x, x + w) x [y, y + h) of level 0 of a 2D texture.
-  void update2DRegion(int x, int y, int w, int h, GLenumT format, GLenumT type, const void* data);
-
   GLuintT id() const { return id_; }
-  GLenumT target() const { return target_; }
   int width() const { return width_; }
   int height() const { return height_; }
   int depth() const { return depth_; }
@@ -82,6 +61,14 @@ class Texture {
 
  private:
   friend class Framebuffer;  // sets format_ of its colour target
+  // The GL-enum forms behind the typed ones (GlObjects.cpp).
+  static Texture create2D(MemoryLedger& ledger, const std::string& label, GLenumT internalFormat,
+                          int width, int height, GLenumT format, GLenumT type, const void* data,
+                          std::uint64_t texelBytes);
+  static Texture create3D(MemoryLedger& ledger, const std::string& label, GLenumT internalFormat,
+                          int width, int height, int depth, GLenumT format, GLenumT type,
+                          const void* data, std::uint64_t texelBytes);
+  void setFilter(GLenumT minFilter, GLenumT magFilter);
   GLuintT id_ = 0;
   GLenumT target_ = 0;
   int width_ = 0, height_ = 0, depth_ = 0;
@@ -98,14 +85,11 @@ class Buffer {
   Buffer(Buffer&& o) noexcept;
   Buffer& operator=(Buffer&& o) noexcept;
   ~Buffer();
-  static Buffer create(MemoryLedger& ledger, const std::string& label, GLenumT target,
-                       std::uint64_t bytes, const void* data, GLenumT usage);
   static Buffer create(MemoryLedger& ledger, const std::string& label, BufferKind kind,
                        std::uint64_t bytes, const void* data, BufferUsage usage);
   // Replaces `bytes` bytes from `offset`.
   void update(std::uint64_t offset, std::uint64_t bytes, const void* data);
   GLuintT id() const { return id_; }
-  GLenumT target() const { return target_; }
   std::uint64_t bytes() const { return entry_.bytes(); }
 
  private:
@@ -121,11 +105,9 @@ class Framebuffer {
   Framebuffer(Framebuffer&& o) noexcept;
   Framebuffer& operator=(Framebuffer&& o) noexcept;
   ~Framebuffer();
-  static Framebuffer create(MemoryLedger& ledger, const std::string& label, int width, int height,
-                            GLenumT colorFormat = 0 /* GL_RGBA8 */);
   // A colour texture of `color` and, with `depth`, a 16-bit depth buffer.
   static Framebuffer create(MemoryLedger& ledger, const std::string& label, int width, int height,
-                            TexelFormat color, bool depth = false);
+                            TexelFormat color = TexelFormat::RGBA8, bool depth = false);
   void bind() const;  // also sets the viewport
   GLuintT id() const { return id_; }
   int width() const { return color_.width(); }

@@ -3,7 +3,9 @@
 // N x 1 texture, in the most precise format the device filters: RGBA16F on
 // ES 3 and on ES 2 with half-float textures (8-bit opacities would lose the
 // small per-sample alphas of fine steps), RGBA8 otherwise. Re-uploads in
-// place while the size stays.
+// place while the size stays. Re-uploading it is the whole cost of a TF
+// change on the post-classified and paletted paths (Moser & Weiskopf 2008,
+// section 4).
 #include <string>
 #include <vector>
 

@@ -5,6 +5,8 @@
 // The format fixes what an upload passes (`data` layout per texel).
 #include <cstdint>
 
+#include "tessera/gpu/DeviceCaps.h"
+
 namespace tessera::gpu {
 
 enum class TexelFormat {
@@ -22,6 +24,12 @@ enum class TexelFormat {
 };
 
 enum class Filter { Nearest, Linear };
+
+// RGBA with 8 bits per channel as the API level takes it (sized RGBA8 on
+// ES 3, unsized RGBA on ES 2): render targets, packed mosaics, atlases.
+TexelFormat rgba8For(ApiLevel api);
+// One 8-bit channel: R8 on ES 3, LUMINANCE on ES 2.
+TexelFormat r8For(ApiLevel api);
 
 // Bytes a texel occupies on the GPU (what the ledger counts).
 std::uint64_t bytesPerTexel(TexelFormat format);

@@ -16,6 +16,7 @@
 #include "tessera/core/Volume.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/gpu/GlObjects.h"
+#include "tessera/gpu/LookupTexture.h"
 #include "tessera/gpu/Program.h"
 #include "tessera/layout/Layout.h"
 #include "tessera/layout/ValueBlocks.h"
@@ -102,8 +103,8 @@ class Raycaster final : public Technique {
   int lutSize_ = 4096;
   int blockSize_ = 8;
   layout::ValueBlocks blocks_;
-  std::vector<float> lut_;
-  gpu::Texture lutTexture_;
+  std::vector<float> lutValues_;  // the baked TF, 4 floats per entry
+  gpu::LookupTexture lut_;
   gpu::Texture blockTexture_;
   gpu::Framebuffer target_;
   gpu::FullscreenTriangle triangle_;

@@ -38,10 +38,10 @@
 #include "tessera/core/Volume.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/gpu/GlObjects.h"
+#include "tessera/gpu/LookupTexture.h"
 #include "tessera/gpu/Program.h"
 #include "tessera/render/SliceAccumulator.h"
 #include "tessera/render/SliceStacks.h"
-#include "tessera/render/SliceTransferTable.h"
 #include "tessera/render/Technique.h"
 #include "tessera/render/TechniqueRegistry.h"
 
@@ -147,7 +147,7 @@ class Slice2DRenderer final : public Technique {
   int requestedSlices_ = 0;
   std::string classificationKey_;
   std::vector<std::uint8_t> palette8_;  // pre: premultiplied RGBA8, 256 entries
-  SliceTransferTable table_;            // palette or post-classification LUT
+  gpu::LookupTexture table_;            // palette or post-classification LUT
   SliceAccumulator accumulator_;
   std::map<std::string, gpu::Program> programs_;
   int lastAxis_ = -1;

@@ -25,10 +25,10 @@
 #include "tessera/core/Volume.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/gpu/GlObjects.h"
+#include "tessera/gpu/LookupTexture.h"
 #include "tessera/gpu/Program.h"
 #include "tessera/layout/Layout.h"
 #include "tessera/render/SliceAccumulator.h"
-#include "tessera/render/SliceTransferTable.h"
 #include "tessera/render/Technique.h"
 #include "tessera/render/TechniqueRegistry.h"
 
@@ -98,7 +98,7 @@ class Slice3DRenderer final : public Technique {
   int builtSlices_ = 0;
   std::uint64_t geometryBuilds_ = 0;
   gpu::Buffer vertices_;
-  SliceTransferTable lut_;
+  gpu::LookupTexture lut_;
   std::string lookupKey_;
   SliceAccumulator accumulator_;
   std::map<std::string, gpu::Program> programs_;
