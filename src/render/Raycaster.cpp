@@ -177,11 +177,9 @@ std::vector<gpu::ShaderPart> Raycaster::fragmentParts(const RenderSettings& sett
 const gpu::Program& Raycaster::programFor(const RenderSettings& settings) {
   std::string key = layout_.name();
   for (const auto& d : definesFor(settings)) key += "|" + d;
-  auto it = programs_.find(key);
-  if (it != programs_.end()) return it->second;
-  gpu::Program p =
-      gpu::Program::build("raycast(" + key + ")", vertexParts(), fragmentParts(settings));
-  return programs_.emplace(key, std::move(p)).first->second;
+  return programs_.get(key, [&] {
+    return gpu::Program::build("raycast(" + key + ")", vertexParts(), fragmentParts(settings));
+  });
 }
 
 void Raycaster::prepare(const RenderSettings& settings) {

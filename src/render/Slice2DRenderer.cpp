@@ -250,11 +250,9 @@ std::vector<gpu::ShaderPart> Slice2DRenderer::fragmentParts(const RenderSettings
 const gpu::Program& Slice2DRenderer::programFor(const RenderSettings& settings) {
   const std::string key = std::string(sliceClassificationName(options_.classification)) +
                           (settings.mode == RenderMode::Mip ? "|mip" : "");
-  auto it = programs_.find(key);
-  if (it != programs_.end()) return it->second;
-  gpu::Program p =
-      gpu::Program::build("slice2d(" + key + ")", vertexParts(), fragmentParts(settings));
-  return programs_.emplace(key, std::move(p)).first->second;
+  return programs_.get(key, [&] {
+    return gpu::Program::build("slice2d(" + key + ")", vertexParts(), fragmentParts(settings));
+  });
 }
 
 void Slice2DRenderer::prepare(const Camera& camera, const RenderSettings& settings) {

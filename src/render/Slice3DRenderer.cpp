@@ -113,11 +113,9 @@ std::vector<gpu::ShaderPart> Slice3DRenderer::fragmentParts(const RenderSettings
 
 const gpu::Program& Slice3DRenderer::programFor(const RenderSettings& settings) {
   const std::string key = layout_.name() + (settings.mode == RenderMode::Mip ? "|mip" : "");
-  auto it = programs_.find(key);
-  if (it != programs_.end()) return it->second;
-  gpu::Program p =
-      gpu::Program::build("slice3d(" + key + ")", vertexParts(), fragmentParts(settings));
-  return programs_.emplace(key, std::move(p)).first->second;
+  return programs_.get(key, [&] {
+    return gpu::Program::build("slice3d(" + key + ")", vertexParts(), fragmentParts(settings));
+  });
 }
 
 void Slice3DRenderer::prepare(const RenderSettings& settings) {

@@ -18,6 +18,7 @@
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/gpu/LookupTexture.h"
 #include "tessera/gpu/Program.h"
+#include "tessera/gpu/ProgramCache.h"
 #include "tessera/layout/Layout.h"
 #include "tessera/layout/ValueBlocks.h"
 #include "tessera/render/Technique.h"
@@ -108,7 +109,7 @@ class Raycaster final : public Technique {
   gpu::Texture blockTexture_;
   gpu::Framebuffer target_;
   gpu::FullscreenTriangle triangle_;
-  std::map<std::string, gpu::Program> programs_;
+  gpu::ProgramCache programs_;
   // What the LUT/block texture were built for, to rebuild only on change.
   std::string lookupKey_;
   double occupiedFraction_ = 1.0;

@@ -40,6 +40,7 @@
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/gpu/LookupTexture.h"
 #include "tessera/gpu/Program.h"
+#include "tessera/gpu/ProgramCache.h"
 #include "tessera/render/SliceAccumulator.h"
 #include "tessera/render/SliceStacks.h"
 #include "tessera/render/Technique.h"
@@ -149,7 +150,7 @@ class Slice2DRenderer final : public Technique {
   std::vector<std::uint8_t> palette8_;  // pre: premultiplied RGBA8, 256 entries
   gpu::LookupTexture table_;            // palette or post-classification LUT
   SliceAccumulator accumulator_;
-  std::map<std::string, gpu::Program> programs_;
+  gpu::ProgramCache programs_;
   int lastAxis_ = -1;
   int lastSlicesDrawn_ = 0;
   std::uint64_t stackUploads_ = 0;

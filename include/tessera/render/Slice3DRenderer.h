@@ -27,6 +27,7 @@
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/gpu/LookupTexture.h"
 #include "tessera/gpu/Program.h"
+#include "tessera/gpu/ProgramCache.h"
 #include "tessera/layout/Layout.h"
 #include "tessera/render/SliceAccumulator.h"
 #include "tessera/render/Technique.h"
@@ -101,7 +102,7 @@ class Slice3DRenderer final : public Technique {
   gpu::LookupTexture lut_;
   std::string lookupKey_;
   SliceAccumulator accumulator_;
-  std::map<std::string, gpu::Program> programs_;
+  gpu::ProgramCache programs_;
 };
 
 }  // namespace tessera::render
