@@ -7,6 +7,7 @@
 
 #include "support/GpuTestContext.h"
 #include "support/TestSupport.h"
+#include "support/TestTransferFunctions.h"
 #include "tessera/gpu/DeviceSession.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/io/VolumeReader.h"
@@ -25,16 +26,7 @@ namespace {
 
 const char* kCh2 = "/usr/share/mricron/templates/ch2.nii.gz";
 
-TransferFunction visibleTf() {
-  TransferFunction tf;
-  tf.addColor(0.0, {0.0, 0.0, 0.0});
-  tf.addColor(0.5, {0.9, 0.6, 0.3});
-  tf.addColor(1.0, {1.0, 1.0, 1.0});
-  tf.addOpacity(0.02, 0.0);
-  tf.addOpacity(0.3, 0.15);
-  tf.addOpacity(1.0, 0.4);
-  return tf;
-}
+using test::visibleTf;
 
 Image renderWith(gpu::GlContext& c, const Volume& v, const layout::Layout& layout,
                  const TransferFunction& tf, const Camera& cam, const RenderSettings& s, int size,

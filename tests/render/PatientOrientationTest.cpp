@@ -12,6 +12,7 @@
 #include <string>
 
 #include "support/GpuTestContext.h"
+#include "support/TestTransferFunctions.h"
 #include "tessera/core/Camera.h"
 #include "tessera/core/PatientFrame.h"
 #include "tessera/gpu/GlContext.h"
@@ -96,16 +97,7 @@ Volume store(const Volume& ras, const Storage& s) {
   return out;
 }
 
-TransferFunction visibleTf() {
-  TransferFunction tf;
-  tf.addColor(0.0, {0.0, 0.0, 0.0});
-  tf.addColor(0.5, {0.9, 0.6, 0.3});
-  tf.addColor(1.0, {1.0, 1.0, 1.0});
-  tf.addOpacity(0.02, 0.0);
-  tf.addOpacity(0.3, 0.15);
-  tf.addOpacity(1.0, 0.4);
-  return tf;
-}
+using test::visibleTf;
 
 struct View {
   double azimuth, elevation;

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "support/GpuTestContext.h"
+#include "support/TestTransferFunctions.h"
 #include "tessera/core/Camera.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/io/Procedural.h"
@@ -52,17 +53,7 @@ Comparison compare(const Volume& v, const TransferFunction& tf, Camera cam, cons
   return result;
 }
 
-// Grey ramp with enough opacity that the small phantoms show inner structure.
-TransferFunction visibleTf() {
-  TransferFunction tf;
-  tf.addColor(0.0, {0.0, 0.0, 0.0});
-  tf.addColor(0.5, {0.9, 0.6, 0.3});
-  tf.addColor(1.0, {1.0, 1.0, 1.0});
-  tf.addOpacity(0.02, 0.0);
-  tf.addOpacity(0.3, 0.15);
-  tf.addOpacity(1.0, 0.4);
-  return tf;
-}
+using test::visibleTf;
 
 const char* kCh2 = "/usr/share/mricron/templates/ch2.nii.gz";
 

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "support/GpuTestContext.h"
+#include "support/TestTransferFunctions.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/io/VolumeReader.h"
@@ -20,16 +21,7 @@ using namespace tessera;
 
 namespace {
 
-TransferFunction visibleTf() {
-  TransferFunction tf;
-  tf.addColor(0.0, {0.0, 0.0, 0.0});
-  tf.addColor(0.5, {0.9, 0.6, 0.3});
-  tf.addColor(1.0, {1.0, 1.0, 1.0});
-  tf.addOpacity(0.02, 0.0);
-  tf.addOpacity(0.3, 0.15);
-  tf.addOpacity(1.0, 0.4);
-  return tf;
-}
+using test::visibleTf;
 
 const char* kCh2 = "/usr/share/mricron/templates/ch2.nii.gz";
 

@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 
 #include "support/GpuTestContext.h"
+#include "support/TestTransferFunctions.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/layout/MosaicLayout.h"
@@ -22,16 +23,7 @@ using namespace tessera;
 
 namespace {
 
-TransferFunction visibleTf() {
-  TransferFunction tf;
-  tf.addColor(0.0, {0.0, 0.0, 0.0});
-  tf.addColor(0.5, {0.9, 0.6, 0.3});
-  tf.addColor(1.0, {1.0, 1.0, 1.0});
-  tf.addOpacity(0.02, 0.0);
-  tf.addOpacity(0.3, 0.15);
-  tf.addOpacity(1.0, 0.4);
-  return tf;
-}
+using test::visibleTf;
 
 // Slicing has no early termination; the reference is told the same.
 RenderSettings halfVoxel() {
