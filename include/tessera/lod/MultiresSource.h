@@ -1,0 +1,64 @@
+#pragma once
+// A multiresolution volume that is never held whole: a pyramid of levels,
+// each readable one box at a time (Schultz 2016 section 7.1.2 and 7.3;
+// DESIGN.md "Large data"). Level 0 is the finest; level l+1 halves each
+// axis (rounded up) of level l. A chunked store on disk or over HTTP
+// (OME-Zarr) implements it with bounded reads; an in-core volume implements
+// it by downsampling on request. The bricked layout and the streaming
+// scheduler read through this interface only, so they do not know where
+// the voxels live.
+#include <cstdint>
+#include <string>
+
+#include <glm/vec3.hpp>
+
+#include "tessera/core/Volume.h"
+
+namespace tessera::lod {
+
+// One level of the pyramid.
+struct LevelInfo {
+  glm::ivec3 dims{0};        // voxels along x, y, z
+  glm::vec3 spacing{1.0f};   // mm per voxel along the index axes
+  glm::ivec3 chunk{0};       // the store's natural read unit (0: none)
+};
+
+// A box of voxels [begin, end) in one level's index space.
+struct VoxelBox {
+  glm::ivec3 begin{0};
+  glm::ivec3 end{0};
+  glm::ivec3 size() const { return end - begin; }
+  std::uint64_t count() const {
+    const glm::ivec3 s = size();
+    return s.x <= 0 || s.y <= 0 || s.z <= 0
+               ? 0
+               : std::uint64_t(s.x) * std::uint64_t(s.y) * std::uint64_t(s.z);
+  }
+};
+
+class MultiresSource {
+ public:
+  virtual ~MultiresSource() = default;
+
+  // The finest level's shape: dims, scalar type, geometry (spacing,
+  // direction, origin), value range and window; it holds no voxels. Every
+  // level shares its scalar type, world box and window.
+  virtual const Volume& shape() const = 0;
+
+  virtual int levelCount() const = 0;
+  virtual LevelInfo levelInfo(int level) const = 0;
+
+  // The voxels of `box` (clamped to the level's dims by the caller: a box
+  // outside the level is an error) as a Volume of box.size() voxels with
+  // the source's scalar type; its geometry is the level's spacing with the
+  // origin at the box's first voxel. Thread-safe: the streaming scheduler
+  // calls it from worker threads. Errors (a corrupt or unreachable chunk)
+  // throw tessera::Error naming the chunk or URL; the caller keeps the
+  // coarser level on screen and retries later.
+  virtual Volume readBox(int level, const VoxelBox& box) const = 0;
+
+  // A short description for logs and `tessera info` (path or URL).
+  virtual std::string describe() const = 0;
+};
+
+}  // namespace tessera::lod
