@@ -43,6 +43,7 @@ struct BenchOptions {
   bool interactive = false;
   std::string hybridOut;
   double goalMs = 0.0;
+  bool printTf = false;
 };
 
 struct Variant {
@@ -320,7 +321,14 @@ void addBenchCommand(CLI::App& app) {
                 "full-quality idle frame (default size 480x640)");
   cmd->add_option("--goal-ms", o->goalMs,
                   "With --interactive: frame-time goal (default: a sixth of a full-quality frame)");
+  cmd->add_flag("--print-tf", o->printTf,
+                "Print --tf as JSON (control points, opacity unit length) and exit: what "
+                "bench/peers translates into VTK's transfer functions");
   cmd->callback([o] {
+    if (o->printTf) {
+      std::printf("%s\n", TransferFunction::fromPresetOrFile(o->tf).toJson().c_str());
+      return;
+    }
     if (o->hybrid || o->interactive) {
       const HybridBenchOptions h{.file = o->file,
                                  .frames = o->frames == 36 ? (o->hybrid ? 5 : 20) : o->frames,
