@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/BenchHybrid.h"
+#include "app/BenchRoofline.h"
 #include "app/BenchSlicing.h"
 #include "app/Commands.h"
 #include "app/RenderJob.h"
@@ -44,6 +45,8 @@ struct BenchOptions {
   std::string hybridOut;
   double goalMs = 0.0;
   bool printTf = false;
+  bool roofline = false;
+  int fetches = 128;
 };
 
 struct Variant {
@@ -324,7 +327,25 @@ void addBenchCommand(CLI::App& app) {
   cmd->add_flag("--print-tf", o->printTf,
                 "Print --tf as JSON (control points, opacity unit length) and exit: what "
                 "bench/peers translates into VTK's transfer functions");
+  cmd->add_flag("--roofline", o->roofline,
+                "Platform roofline: peak trilinear 3D fetch and TF lookup rates of this context, "
+                "and each technique's effective samples/s as a fraction of them (default 5 "
+                "frames per technique)");
+  cmd->add_option("--fetches", o->fetches,
+                  "With --roofline: fetches per fragment in the peak "
+                  "passes")
+      ->capture_default_str();
   cmd->callback([o] {
+    if (o->roofline) {
+      runRooflineBench({.file = o->file,
+                        .size = o->size,
+                        .frames = o->frames == 36 ? 5 : o->frames,
+                        .step = o->step,
+                        .tf = o->tf,
+                        .fetches = o->fetches,
+                        .json = o->json});
+      return;
+    }
     if (o->printTf) {
       std::printf("%s\n", TransferFunction::fromPresetOrFile(o->tf).toJson().c_str());
       return;
