@@ -259,6 +259,10 @@ class VtkRenderer:
         from vtk.util import numpy_support
 
         self._look(azimuth)
+        # Twice: the first render of a fresh off-screen window can use the
+        # window's default aspect (seen with the fixed-point mapper at
+        # 1024x768: a stretched image, 19 dB).
+        self.window.Render()
         self.window.Render()
         grab = self.vtk.vtkWindowToImageFilter()
         grab.SetInput(self.window)
@@ -484,7 +488,7 @@ def main():
                     help="sample distances in voxels of the smallest spacing")
     ap.add_argument("--shading", default="off,on", help="off, on or off,on")
     ap.add_argument("--frames", type=int, default=36, help="frames per renderer and configuration")
-    ap.add_argument("--rounds", type=int, default=3,
+    ap.add_argument("--rounds", type=int, default=6,
                     help="alternating rounds the frames are split into")
     ap.add_argument("--rotate", type=float, default=10.0, help="azimuth step per frame, degrees")
     ap.add_argument("--ambient", type=float, default=0.1)
