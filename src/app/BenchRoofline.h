@@ -9,7 +9,8 @@ namespace tessera::app {
 struct RooflineBenchOptions {
   std::string file;  // volume spec; default ch2
   std::string size = "512x512";
-  int frames = 5;  // per technique, at one view (so every frame takes the same samples)
+  int frames =
+      5;  // per technique and peak kernel, at one view (every frame takes the same samples)
   double step = 0.5;
   std::string tf = "bench";
   int fetches = 128;  // per fragment in the peak passes

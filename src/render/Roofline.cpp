@@ -58,35 +58,6 @@ gpu::LookupTexture rampLookup(gpu::GlContext& context) {
   return lut;
 }
 
-struct KernelRun {
-  gpu::Program full;
-  gpu::Program empty;
-  std::vector<double> ms;
-  std::vector<double> emptyMs;
-};
-
-double timedPass(const gpu::Program& program, const gpu::FullscreenTriangle& triangle) {
-  program.use();
-  const auto t0 = std::chrono::steady_clock::now();
-  triangle.draw();
-  gpu::finish();
-  return msSince(t0);
-}
-
-void bindInputs(const gpu::Program& program, const gpu::Texture& volume,
-                const gpu::LookupTexture& lut, const RooflineOptions& o) {
-  program.use();
-  volume.bind(0);
-  program.set("u_volume", 0);
-  lut.texture().bind(1);
-  program.set("u_tf", 1);
-  program.set("u_viewport", glm::vec2(o.width, o.height));
-  // Half a voxel per step along a diagonal that is mostly depth, like the
-  // rays of a front view.
-  const glm::vec3 direction = glm::normalize(glm::vec3(0.3f, 0.2f, 1.0f));
-  program.set("u_delta", 0.5f * direction / glm::vec3(o.volumeDims));
-}
-
 }  // namespace
 
 const char* rooflineKernelName(RooflineKernel kernel) {
@@ -103,52 +74,87 @@ const char* rooflineKernelName(RooflineKernel kernel) {
   return "?";
 }
 
-std::vector<RooflineRate> measureRoofline(gpu::GlContext& context, const RooflineOptions& o) {
+RooflineProbe::RooflineProbe(gpu::GlContext& context, const RooflineOptions& o) : options_(o) {
   if (context.caps().api != gpu::ApiLevel::Gles3 || context.caps().max3DTextureSize == 0) {
     throw GpuError("the roofline needs an ES 3 context with 3D textures");
   }
   if (o.fetchesPerFragment < 1 || o.repeats < 1) {
     throw InputError("roofline: fetches per fragment and repeats must be >= 1");
   }
-  const gpu::Texture volume = randomVolume(context, o.volumeDims);
-  const gpu::LookupTexture lut = rampLookup(context);
-  const gpu::FullscreenTriangle triangle(context.ledger());
+  volume_ = randomVolume(context, o.volumeDims);
+  lut_ = rampLookup(context);
+  triangle_ = gpu::FullscreenTriangle(context.ledger());
   const bool floatTarget = gpu::DeviceLimits::of(context.caps()).floatRenderTargets;
-  const gpu::Framebuffer target = gpu::Framebuffer::create(
+  target_ = gpu::Framebuffer::create(
       context.ledger(), "roofline target", o.width, o.height,
       floatTarget ? gpu::TexelFormat::RGBA16F : gpu::rgba8For(context.caps().api));
-  target.bind();
+  target_.bind();
   gpu::apply({});
-
-  std::vector<KernelRun> runs;
   for (RooflineKernel kernel : kKernels) {
-    KernelRun run{kernelProgram(context, kernel, o.fetchesPerFragment),
+    KernelRun run{kernel,
+                  kernelProgram(context, kernel, o.fetchesPerFragment),
                   kernelProgram(context, kernel, 0),
                   {},
                   {}};
     for (const gpu::Program* p : {&run.full, &run.empty}) {
-      bindInputs(*p, volume, lut, o);
-      timedPass(*p, triangle);  // untimed: the driver's first draw compiles variants
+      bindInputs(*p);
+      timedPass();  // untimed: the driver's first draw compiles variants
     }
-    runs.push_back(std::move(run));
+    runs_.push_back(std::move(run));
   }
-  for (int r = 0; r < o.repeats; ++r) {
-    for (KernelRun& run : runs) {
-      run.ms.push_back(timedPass(run.full, triangle));
-      run.emptyMs.push_back(timedPass(run.empty, triangle));
-    }
+}
+
+void RooflineProbe::bindInputs(const gpu::Program& program) const {
+  program.use();
+  volume_.bind(0);
+  program.set("u_volume", 0);
+  lut_.texture().bind(1);
+  program.set("u_tf", 1);
+  program.set("u_viewport", glm::vec2(options_.width, options_.height));
+  // Half a voxel per step along a diagonal that is mostly depth, like the
+  // rays of a front view.
+  const glm::vec3 direction = glm::normalize(glm::vec3(0.3f, 0.2f, 1.0f));
+  program.set("u_delta", 0.5f * direction / glm::vec3(options_.volumeDims));
+}
+
+double RooflineProbe::timedPass() const {
+  const auto t0 = std::chrono::steady_clock::now();
+  triangle_.draw();
+  gpu::finish();
+  return msSince(t0);
+}
+
+void RooflineProbe::measurePass() {
+  // Other passes may have run since the last one: bind everything again.
+  target_.bind();
+  gpu::apply({});
+  for (KernelRun& run : runs_) {
+    bindInputs(run.full);
+    run.ms.push_back(timedPass());
+    bindInputs(run.empty);
+    run.emptyMs.push_back(timedPass());
   }
   gpu::checkErrors("roofline");
+}
 
+std::vector<RooflineRate> RooflineProbe::rates() const {
   std::vector<RooflineRate> rates;
-  const double fetches = static_cast<double>(o.width) * o.height * o.fetchesPerFragment;
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    RooflineRate rate{kKernels[i], median(runs[i].ms), median(runs[i].emptyMs), 0.0};
+  const double fetches =
+      static_cast<double>(options_.width) * options_.height * options_.fetchesPerFragment;
+  for (const KernelRun& run : runs_) {
+    if (run.ms.empty()) throw InputError("roofline: no pass measured yet");
+    RooflineRate rate{run.kernel, median(run.ms), median(run.emptyMs), 0.0};
     const double busyMs = rate.msMedian - rate.msEmptyMedian;
     rate.fetchesPerSecond = busyMs > 0.0 ? fetches / (busyMs * 1e-3) : 0.0;
     rates.push_back(rate);
   }
   return rates;
+}
+
+std::vector<RooflineRate> measureRoofline(gpu::GlContext& context, const RooflineOptions& o) {
+  RooflineProbe probe(context, o);
+  for (int r = 0; r < o.repeats; ++r) probe.measurePass();
+  return probe.rates();
 }
 
 }  // namespace tessera::render

@@ -12,6 +12,9 @@
 #include <glm/vec3.hpp>
 
 #include "tessera/gpu/GlContext.h"
+#include "tessera/gpu/GlObjects.h"
+#include "tessera/gpu/LookupTexture.h"
+#include "tessera/gpu/Program.h"
 
 namespace tessera::render {
 
@@ -47,8 +50,37 @@ struct RooflineRate {
   double fetchesPerSecond = 0.0;  // width * height * N / (ms - msEmpty)
 };
 
-// Needs an ES 3 context (3D textures); GpuError otherwise. Kernels are
-// interleaved pass by pass so a shared machine's load falls on all alike.
+// The kernels' programs and inputs, built once; each measurePass() times one
+// pass of every kernel and of its no-fetch twin, so a benchmark can
+// interleave them with the frames it compares them with. Needs an ES 3
+// context (3D textures): GpuError otherwise.
+class RooflineProbe {
+ public:
+  RooflineProbe(gpu::GlContext& context, const RooflineOptions& options);
+  void measurePass();
+  // Medians over the passes so far (at least one).
+  std::vector<RooflineRate> rates() const;
+
+ private:
+  struct KernelRun {
+    RooflineKernel kernel;
+    gpu::Program full;
+    gpu::Program empty;
+    std::vector<double> ms;
+    std::vector<double> emptyMs;
+  };
+  void bindInputs(const gpu::Program& program) const;
+  double timedPass() const;  // the bound program, to glFinish
+
+  RooflineOptions options_;
+  gpu::Texture volume_;
+  gpu::LookupTexture lut_;
+  gpu::FullscreenTriangle triangle_;
+  gpu::Framebuffer target_;
+  std::vector<KernelRun> runs_;
+};
+
+// options.repeats passes of a fresh probe.
 std::vector<RooflineRate> measureRoofline(gpu::GlContext& context, const RooflineOptions& options);
 
 }  // namespace tessera::render
