@@ -164,15 +164,18 @@ class Tessera:
 
 
 class VtkRenderer:
-    """One VTK mapper in its own off-screen window, set up like Tessera."""
+    """One VTK mapper in its own off-screen window, set up like Tessera. One
+    window per mapper for the whole run, reconfigured per configuration: a
+    fresh window per configuration made the fixed-point mapper draw the
+    fourth one at a square aspect (a stretched head, 19 dB) and a bare
+    sequence of fresh windows lost the X connection."""
 
-    def __init__(self, kind, volume, image_data, tf, cfg, lighting):
+    def __init__(self, kind, volume, image_data, tf, lighting):
         import vtk
 
         self.vtk = vtk
         self.volume = volume
-        self.cfg = cfg
-        ds = volume.sample_distance(cfg["step"])
+        self.kind = kind
 
         colour = vtk.vtkColorTransferFunction()
         colour.SetColorSpaceToRGB()  # Tessera interpolates RGB linearly
@@ -192,27 +195,21 @@ class VtkRenderer:
         prop.SetScalarOpacityUnitDistance(tf.get("opacity_unit_length", 1.0))
         prop.SetInterpolationTypeToLinear()
         prop.SetIndependentComponents(True)
-        if cfg["shade"]:
-            prop.ShadeOn()
-            prop.SetAmbient(lighting["ambient"])
-            prop.SetDiffuse(lighting["diffuse"])
-            prop.SetSpecular(lighting["specular"])
-            prop.SetSpecularPower(lighting["shininess"])
-        else:
-            prop.ShadeOff()
+        prop.SetAmbient(lighting["ambient"])
+        prop.SetDiffuse(lighting["diffuse"])
+        prop.SetSpecular(lighting["specular"])
+        prop.SetSpecularPower(lighting["shininess"])
 
         if kind == "vtk-gpu":
             mapper = vtk.vtkGPUVolumeRayCastMapper()
             mapper.SetUseJittering(False)
         else:
             mapper = vtk.vtkFixedPointVolumeRayCastMapper()
-            mapper.SetInteractiveSampleDistance(ds)
             mapper.SetMinimumImageSampleDistance(1.0)
             mapper.SetMaximumImageSampleDistance(1.0)
         mapper.SetInputData(image_data)
         mapper.SetBlendModeToComposite()
         mapper.AutoAdjustSampleDistancesOff()
-        mapper.SetSampleDistance(ds)
         mapper.SetImageSampleDistance(1.0)
 
         actor = vtk.vtkVolume()
@@ -232,12 +229,20 @@ class VtkRenderer:
         win = vtk.vtkRenderWindow()
         win.SetOffScreenRendering(True)
         win.SetMultiSamples(0)
-        win.SetSize(cfg["width"], cfg["height"])
         win.AddRenderer(ren)
-        self.mapper, self.renderer, self.window = mapper, ren, win
+        self.mapper, self.renderer, self.window, self.property = mapper, ren, win, prop
         self.camera = ren.GetActiveCamera()
         self.camera.SetViewAngle(30.0)
         self.camera.ParallelProjectionOff()
+
+    def configure(self, cfg):
+        """Image size, sample distance and shading of one configuration."""
+        ds = self.volume.sample_distance(cfg["step"])
+        self.mapper.SetSampleDistance(ds)
+        if self.kind == "vtk-cpu":
+            self.mapper.SetInteractiveSampleDistance(ds)
+        self.property.SetShade(1 if cfg["shade"] else 0)
+        self.window.SetSize(cfg["width"], cfg["height"])
 
     def _look(self, azimuth):
         eye, focal, up = tessera_camera(self.volume, azimuth)
@@ -331,10 +336,11 @@ def configurations(args):
                        "frames": args.frames, "rounds": args.rounds, "rotate": args.rotate}
 
 
-def run_configuration(cfg, tessera, volume, image_data, tf, lighting, workdir, log):
+def run_configuration(cfg, tessera, vtks, workdir, log):
     label = (f"{cfg['width']}x{cfg['height']} step {cfg['step']:g} "
              f"{'shaded' if cfg['shade'] else 'unshaded'}")
-    vtks = {k: VtkRenderer(k, volume, image_data, tf, cfg, lighting) for k in RENDERERS[1:]}
+    for r in vtks.values():
+        r.configure(cfg)
     # Warm-up (not timed): VTK's first Render compiles shaders and uploads the
     # volume, what Tessera does in prepare() before its frames. It also
     # gives the frame at azimuth 0 for the PSNR.
@@ -357,8 +363,6 @@ def run_configuration(cfg, tessera, volume, image_data, tf, lighting, workdir, l
         first += count
         log(f"  {label}: round {rnd + 1}/{cfg['rounds']}: " + ", ".join(
             f"{k} {statistics.median(ms[k][-count:]):.1f} ms" for k in RENDERERS))
-    for r in vtks.values():
-        r.close()
     row = dict(cfg)
     row["label"] = label
     for k in RENDERERS:
@@ -535,10 +539,10 @@ def main():
             print("shaded rows skipped: tessera has no --shade")
             notes.append("Shaded rows skipped: this tessera has no --shade.")
             cfgs = [c for c in cfgs if not c["shade"]]
-        rows = []
-        for cfg in cfgs:
-            rows.append(run_configuration(cfg, tessera, volume, image_data, tf, lighting,
-                                          workdir, log))
+        vtks = {k: VtkRenderer(k, volume, image_data, tf, lighting) for k in RENDERERS[1:]}
+        rows = [run_configuration(cfg, tessera, vtks, workdir, log) for cfg in cfgs]
+        for r in vtks.values():
+            r.close()
         meta = {
             "volume": args.volume, "dims": [int(d) for d in volume.dims],
             "spacing": [float(s) for s in volume.spacing], "tf": args.tf,
