@@ -446,6 +446,7 @@ def write_outputs(rows, meta, out):
         ax.text(xi, max(r[f"{k}_ms_median"] for k in RENDERERS) * 1.02,
                 f"×{r['speedup_vs_vtk_cpu']:.2f} / ×{r['speedup_vs_vtk_gpu']:.2f}",
                 ha="center", va="bottom", fontsize=8)
+    ax.set_ylim(top=1.12 * max(r[f"{k}_ms_median"] for r in rows for k in RENDERERS))
     ax.set_xticks(x)
     ax.set_xticklabels([r["label"].replace(" step", "\nstep") for r in rows], fontsize=8)
     ax.set_ylabel("median ms per frame (lower is better)")

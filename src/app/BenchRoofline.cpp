@@ -170,8 +170,7 @@ void runRooflineBench(const RooflineBenchOptions& o) {
   printPeaks(rates, ro);
   std::printf(
       "\ntechniques: %s at %dx%d, front view, %d frames each interleaved with the peak passes, "
-      "step %g voxel, TF %s, default "
-      "settings (ERT 0.99, 8^3 skipping for raycast); samples/frame counted by the CPU "
+      "step %g voxel, TF %s, ERT 0.99; samples/frame counted by the CPU "
       "reference on the same rays: %.3g with ERT (%.3g without). Effective rate = samples with "
       "ERT / median frame time, so skipping shows as a higher rate; the slicers are credited "
       "with the ray caster's samples at the same step.\n\n",
