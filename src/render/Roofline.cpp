@@ -18,8 +18,11 @@ namespace tessera::render {
 namespace {
 
 constexpr RooflineKernel kKernels[] = {RooflineKernel::Fetch3DIndependent,
-                                       RooflineKernel::Fetch3DDependent, RooflineKernel::TfLookup,
-                                       RooflineKernel::Fetch3DThenTf};
+                                       RooflineKernel::Fetch3DDependent,
+                                       RooflineKernel::TfLookup,
+                                       RooflineKernel::Fetch3DThenTf,
+                                       RooflineKernel::Fetch3DThenTfNearest,
+                                       RooflineKernel::Fetch3DThenTfInShader};
 
 gpu::Program kernelProgram(const gpu::GlContext& context, RooflineKernel kernel, int fetches) {
   const gpu::ApiLevel api = context.caps().api;
@@ -45,17 +48,30 @@ gpu::Texture randomVolume(gpu::GlContext& context, glm::ivec3 dims) {
   return t;
 }
 
-gpu::LookupTexture rampLookup(gpu::GlContext& context) {
-  constexpr int kEntries = 4096;
-  std::vector<float> rgba(4 * kEntries);
-  for (int i = 0; i < kEntries; ++i) {
-    const float x = static_cast<float>(i) / (kEntries - 1);
+constexpr int kLutEntries = 4096;
+
+std::vector<float> rampTable() {
+  std::vector<float> rgba(4 * kLutEntries);
+  for (int i = 0; i < kLutEntries; ++i) {
+    const float x = static_cast<float>(i) / (kLutEntries - 1);
     rgba[4 * i + 0] = rgba[4 * i + 1] = rgba[4 * i + 2] = x;
     rgba[4 * i + 3] = 0.01f * x;
   }
+  return rgba;
+}
+
+gpu::LookupTexture rampLookup(gpu::GlContext& context) {
   gpu::LookupTexture lut;
-  lut.upload(context, rgba, "roofline transfer function");
+  lut.upload(context, rampTable(), "roofline transfer function");
   return lut;
+}
+
+gpu::Texture nearestRampLookup(gpu::GlContext& context) {
+  const std::vector<float> rgba = rampTable();
+  gpu::Texture t = gpu::Texture::create2D(context.ledger(), "roofline nearest transfer function",
+                                          gpu::TexelFormat::RGBA16F, kLutEntries, 1, rgba.data());
+  t.setFilter(gpu::Filter::Nearest);
+  return t;
 }
 
 }  // namespace
@@ -70,6 +86,10 @@ const char* rooflineKernelName(RooflineKernel kernel) {
       return "TF lookup (4096-entry table, linear)";
     case RooflineKernel::Fetch3DThenTf:
       return "3D fetch + TF lookup (a classified sample)";
+    case RooflineKernel::Fetch3DThenTfNearest:
+      return "3D fetch + TF lookup, nearest";
+    case RooflineKernel::Fetch3DThenTfInShader:
+      return "3D fetch + TF evaluated in the shader";
   }
   return "?";
 }
@@ -83,6 +103,7 @@ RooflineProbe::RooflineProbe(gpu::GlContext& context, const RooflineOptions& o) 
   }
   volume_ = randomVolume(context, o.volumeDims);
   lut_ = rampLookup(context);
+  nearestLut_ = nearestRampLookup(context);
   triangle_ = gpu::FullscreenTriangle(context.ledger());
   const bool floatTarget = gpu::DeviceLimits::of(context.caps()).floatRenderTargets;
   target_ = gpu::Framebuffer::create(
@@ -109,7 +130,9 @@ void RooflineProbe::bindInputs(const gpu::Program& program) const {
   volume_.bind(0);
   program.set("u_volume", 0);
   lut_.texture().bind(1);
+  nearestLut_.bind(2);
   program.set("u_tf", 1);
+  program.set("u_tfNearest", 2);
   program.set("u_viewport", glm::vec2(options_.width, options_.height));
   // Half a voxel per step along a diagonal that is mostly depth, like the
   // rays of a front view.

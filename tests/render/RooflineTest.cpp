@@ -20,7 +20,7 @@ TEST(Roofline, CompilesRunsAndTimesEveryKernel) {
                                         .repeats = 2};
   const std::vector<render::RooflineRate> rates =
       render::measureRoofline(test::gpuContext(), options);
-  ASSERT_EQ(rates.size(), 4u);
+  ASSERT_EQ(rates.size(), 6u);
   std::set<int> kernels;
   for (const render::RooflineRate& r : rates) {
     kernels.insert(static_cast<int>(r.kernel));
@@ -30,7 +30,7 @@ TEST(Roofline, CompilesRunsAndTimesEveryKernel) {
     EXPECT_TRUE(std::isfinite(r.fetchesPerSecond) && r.fetchesPerSecond >= 0.0)
         << render::rooflineKernelName(r.kernel);
   }
-  EXPECT_EQ(kernels.size(), 4u);
+  EXPECT_EQ(kernels.size(), 6u);
 }
 
 TEST(Roofline, RefusesNoFetches) {

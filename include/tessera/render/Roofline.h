@@ -31,6 +31,12 @@ enum class RooflineKernel {
   // N trilinear fetches each followed by the TF lookup of its value: the
   // post-classified sample every ray caster takes.
   Fetch3DThenTf,
+  // The same with the table unfiltered (nearest entry of 4096).
+  Fetch3DThenTfNearest,
+  // The same with the TF evaluated in the shader instead of looked up (the
+  // `bench` preset's two-segment opacity ramp and grey ramp): what a
+  // piecewise-linear TF of a few points would cost.
+  Fetch3DThenTfInShader,
 };
 
 const char* rooflineKernelName(RooflineKernel kernel);
@@ -75,6 +81,7 @@ class RooflineProbe {
   RooflineOptions options_;
   gpu::Texture volume_;
   gpu::LookupTexture lut_;
+  gpu::Texture nearestLut_;  // the same table, unfiltered
   gpu::FullscreenTriangle triangle_;
   gpu::Framebuffer target_;
   std::vector<KernelRun> runs_;
