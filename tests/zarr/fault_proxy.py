@@ -3,12 +3,12 @@
 the nginx the test started. Metadata (.zarray, .zattrs, .zgroup) passes
 through; chunk requests are damaged by their path:
 
-  flaky  (every chunk eventually right): by a hash of the path, one chunk in
-         five answers 500 the first time, one in five sends half its body
-         under the full Content-Length and closes, one in five sends its
-         bytes with every byte flipped under the right length (only decoding
-         can tell), one in five waits DELAY seconds before the first answer;
-         the second request of each path is served intact.
+  flaky  (every chunk eventually right): by a hash of the path, two chunks
+         in ten answer 500 the first time, two send half their body under
+         the full Content-Length and close, two send their bytes with every
+         byte flipped under the right length (only decoding can tell), one
+         waits DELAY seconds before the first answer; the second request of
+         each path is served intact.
   broken (one chunk keeps failing): the chunk whose path ends with BROKEN
          answers 500 every time; the others pass through.
 
@@ -50,8 +50,8 @@ class Handler(http.server.BaseHTTPRequestHandler):
         chunk = status == 200 and not name.startswith(".")
         fault = None
         if chunk and MODE == "flaky" and count == 0:
-            fault = ["500", "truncate", "garble", "delay", None][
-                hashlib.md5(self.path.encode()).digest()[0] % 5]
+            fault = ["500", "500", "truncate", "truncate", "garble", "garble", "delay", None,
+                     None, None][hashlib.md5(self.path.encode()).digest()[0] % 10]
         if chunk and MODE == "broken" and self.path.endswith(BROKEN):
             fault = "500"
         if fault == "500":
@@ -61,6 +61,12 @@ class Handler(http.server.BaseHTTPRequestHandler):
             return
         if fault == "delay":
             time.sleep(DELAY)
+        try:
+            self.answer(status, body, fault)
+        except (BrokenPipeError, ConnectionResetError):
+            pass  # the client gave up waiting (a stall it timed out)
+
+    def answer(self, status, body, fault):
         self.send_response(status)
         self.send_header("Content-Length", str(len(body)))
         if fault == "truncate":
