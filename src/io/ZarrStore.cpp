@@ -596,6 +596,11 @@ Volume readZarrVolume(const std::string& spec, ZarrSelection selection, std::str
                      std::to_string(store.levelCount()) +
                      ": the finest that fits the host budget " + formatBytes(budget);
     for (const std::string& n : store.notes()) *chosenNote += "; " + n;
+    if (const auto* http = dynamic_cast<const HttpStorage*>(&store.storage())) {
+      *chosenNote += "; fetched " + formatBytes(http->bytesFetched()) + " in " +
+                     std::to_string(http->requests()) + " requests (" +
+                     std::to_string(http->retries()) + " retried)";
+    }
   }
   return v;
 }

@@ -40,11 +40,11 @@ std::string dimsText(glm::ivec3 d) {
   return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
 }
 
-// Slices [0, n) of `src` reduced 2x2x2 into slices [0, ceil(n/2)) of a new
-// volume of ceil(dims/2): the mean of the voxels present, NaN skipped, as
-// lod::downsample.
-Volume halve(const Volume& src) {
-  const glm::ivec3 d = src.dims();
+// Slices [0, depth) of `src` reduced 2x2x2 into a new volume of
+// ceil(dims/2) (depth for z): the mean of the voxels present, NaN skipped,
+// as lod::downsample.
+Volume halve(const Volume& src, int depth) {
+  const glm::ivec3 d(src.dims().x, src.dims().y, depth);
   const glm::ivec3 o = (d + 1) / 2;
   Volume out = Volume::allocate(o, src.type(), "pyramid slab");
   for (int oz = 0; oz < o.z; ++oz) {
@@ -141,20 +141,9 @@ class PyramidWriter {
   void flush(int l) {
     LevelWriter& w = levels_[std::size_t(l)];
     writeChunks(w);
-    if (l + 1 < levelCount()) {
-      Volume used = w.slab;
-      if (w.filled < w.chunk.z) used = firstSlices(w.slab, w.filled);
-      push(l + 1, halve(used));
-    }
+    if (l + 1 < levelCount()) push(l + 1, halve(w.slab, w.filled));
     w.slabZ0 += w.filled;
     w.filled = 0;
-  }
-
-  Volume firstSlices(const Volume& v, int n) const {
-    Volume out = Volume::allocate({v.dims().x, v.dims().y, n}, type_, "pyramid slab");
-    std::memcpy(out.bytes().data(), v.bytes().data(), out.bytes().size());
-    out.invalidateRange();
-    return out;
   }
 
   // The chunks of one slab, compressed on a few threads.
