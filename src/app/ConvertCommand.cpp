@@ -159,7 +159,8 @@ void printZarrResult(const ConvertOptions& o, const Volume& shape, const OmeZarr
 
 // OME-Zarr to OME-Zarr streams: level 0 of the input is read one slab at a
 // time, so memory stays at a few slabs whatever the volume's size.
-bool convertStoreStreaming(const ConvertOptions& o, Progress& progress) {
+bool convertStoreStreaming(const ConvertOptions& o, const OmeZarrWriteOptions& zarr,
+                           Progress& progress) {
   if (!isZarrStore(o.in) || !o.crop.empty() || !o.downsample.empty() || !isOmeZarrName(o.out)) {
     return false;
   }
@@ -171,7 +172,7 @@ bool convertStoreStreaming(const ConvertOptions& o, Progress& progress) {
       [&](int z0, int z1) {
         return in.readBox(0, {0, 0, z0}, {d.x, d.y, z1});
       },
-      o.out, zarrOptions(o, progress));
+      o.out, zarr);
   progress.stage("done", 1.0);
   progress.done();
   printZarrResult(o, in.shape(), r);
@@ -180,7 +181,9 @@ bool convertStoreStreaming(const ConvertOptions& o, Progress& progress) {
 
 void runConvert(const ConvertOptions& o) {
   Progress progress(!o.quiet);
-  if (convertStoreStreaming(o, progress)) return;
+  // Checked before anything is read, so that a typo fails at once.
+  const OmeZarrWriteOptions zarr = zarrOptions(o, progress);
+  if (convertStoreStreaming(o, zarr, progress)) return;
   progress.stage("reading " + o.in, 0.0);
   Volume v = readVolume(o.in, {.dicomSeries = o.series, .time = o.time, .channel = o.channel});
   const glm::ivec3 inDims = v.dims();
@@ -197,7 +200,7 @@ void runConvert(const ConvertOptions& o) {
   }
   if (isOmeZarrName(o.out)) {
     // The input is in memory already; the pyramid is still built slab by slab.
-    const OmeZarrWriteResult r = writeOmeZarr(v, o.out, zarrOptions(o, progress));
+    const OmeZarrWriteResult r = writeOmeZarr(v, o.out, zarr);
     progress.stage("done", 1.0);
     progress.done();
     printZarrResult(o, v, r);
