@@ -134,7 +134,11 @@ OmeZarrWriteOptions zarrOptions(const ConvertOptions& o, Progress& progress) {
       throw InputError("--levels '" + o.levels + "': expected auto or a count >= 1");
     }
   }
-  z.compressor = parseZarrCompressor(o.compressor);
+  try {
+    z.compressor = parseZarrCompressor(o.compressor);
+  } catch (const InputError& e) {
+    throw InputError(std::string("--") + e.what());
+  }
   z.progress = [&progress](double f, const std::string& what) {
     progress.stage("writing " + what, 0.05 + 0.95 * f);
   };
