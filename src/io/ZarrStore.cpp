@@ -1,9 +1,13 @@
 #include "tessera/io/ZarrStore.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <limits>
@@ -415,7 +419,7 @@ std::string ZarrStore::describe() const {
          levels_.front().array.dtype + ", " + levels_.front().array.compressorText + ")";
 }
 
-Volume ZarrStore::readBox(int l, glm::ivec3 begin, glm::ivec3 end) const {
+Volume ZarrStore::readBox(int l, glm::ivec3 begin, glm::ivec3 end, const Progress& progress) const {
   const ZarrLevel& lv = level(l);
   for (int a = 0; a < 3; ++a) {
     if (begin[a] < 0 || end[a] > lv.dims[a] || begin[a] >= end[a]) {
@@ -448,12 +452,17 @@ Volume ZarrStore::readBox(int l, glm::ivec3 begin, glm::ivec3 end) const {
     }
   }
   std::atomic<std::size_t> next{0};
+  std::size_t done = 0;
   std::exception_ptr failure;
   std::mutex failureMutex;
   auto work = [&] {
     for (std::size_t i = next++; i < chunks.size(); i = next++) {
       try {
         readChunkInto(l, chunks[i], begin, end, out);
+        if (progress) {
+          const std::lock_guard lock(failureMutex);
+          progress(++done, chunks.size());
+        }
       } catch (...) {
         const std::lock_guard lock(failureMutex);
         if (!failure) failure = std::current_exception();
@@ -584,7 +593,17 @@ Volume readZarrVolume(const std::string& spec, ZarrSelection selection, std::str
                       std::to_string(coarse.dims.y) + "x" + std::to_string(coarse.dims.z) +
                       ") does not fit the host budget " + formatBytes(budget));
   }
-  Volume v = store.readLevel(l);
+  // A level of many chunks (over HTTP: many requests) shows its progress
+  // on a terminal.
+  const bool tty = ::isatty(2) != 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  Volume v = store.readLevel(l, [&](std::size_t done, std::size_t total) {
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (tty && total >= 64 && (done % 16 == 0 || done == total)) {
+      std::fprintf(stderr, "\rreading %s level %d: %zu/%zu chunks  %.1f s%s", spec.c_str(), l, done,
+                   total, s, done == total ? "\n" : "");
+    }
+  });
   const ZarrLevel& lv = store.level(l);
   const std::string dims =
       std::to_string(lv.dims.x) + "x" + std::to_string(lv.dims.y) + "x" + std::to_string(lv.dims.z);

@@ -10,6 +10,7 @@
 // to .zattrs, restoring the direction of the volume it came from. `info`
 // prints this as the geometry source.
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -51,13 +52,19 @@ class ZarrStore {
   int levelCount() const { return static_cast<int>(levels_.size()); }
   const ZarrLevel& level(int l) const;
 
+  // Called after each chunk of a readBox with (chunks done, chunks in the
+  // box), from one thread at a time.
+  using Progress = std::function<void(std::size_t done, std::size_t total)>;
+
   // Voxels [begin, end) of level `l` (x, y, z) as a Volume of end - begin
   // voxels, geometry = the level's spacing, origin at `begin`. Reads only
   // the chunks the box touches, `parallelism()` at a time. Thread-safe.
   // InputError naming the chunk's path or URL for a corrupt chunk; a
   // missing chunk is fill_value.
-  Volume readBox(int l, glm::ivec3 begin, glm::ivec3 end) const;
-  Volume readLevel(int l) const { return readBox(l, glm::ivec3(0), level(l).dims); }
+  Volume readBox(int l, glm::ivec3 begin, glm::ivec3 end, const Progress& progress = {}) const;
+  Volume readLevel(int l, const Progress& progress = {}) const {
+    return readBox(l, glm::ivec3(0), level(l).dims, progress);
+  }
 
   // The finest level whose voxels (plus one chunk per reader) fit the host
   // budget; -1 if none does.
