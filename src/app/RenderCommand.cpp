@@ -24,6 +24,8 @@ namespace {
 struct RenderOptions {
   std::string file;
   std::string series;  // DICOM Series Instance UID
+  int time = 0;        // OME-Zarr time point and channel
+  int channel = 0;
   std::string tf = "mr-default";
   std::string size = "512x512";
   double azimuth = 0.0;
@@ -108,7 +110,7 @@ RenderRequest requestFrom(const RenderOptions& o) {
 
 // The volume, with the window the options ask for.
 lod::InCoreVolumeSource loadVolume(const RenderOptions& o, const std::string& spec) {
-  Volume volume = readVolume(spec, {.dicomSeries = o.series});
+  Volume volume = readVolume(spec, {.dicomSeries = o.series, .time = o.time, .channel = o.channel});
   if (!o.window.empty()) {
     if (o.window.size() != 2) throw InputError("--window takes two numbers MIN MAX");
     volume.setWindow({o.window[0], o.window[1]});
@@ -248,6 +250,7 @@ void addRenderCommand(CLI::App& app) {
       "render", "Render a volume headless to a PNG (GPU ray caster through EGL)");
   cmd->add_option("file", o->file, kVolumeHelp);
   addSeriesOption(cmd, o->series);
+  addTimeChannelOptions(cmd, o->time, o->channel);
   cmd->add_option(
          "--tf", o->tf,
          "Transfer function: preset (grey, mr-default, ct-bone, ct-muscle, bench) or FILE.json")
