@@ -5,9 +5,6 @@
 #include <cmath>
 #include <sstream>
 
-#include <glm/gtc/matrix_transform.hpp>
-#include <glm/mat4x4.hpp>
-
 #include "tessera/core/Error.h"
 #include "tessera/core/Histogram.h"
 #include "tessera/core/HostBudget.h"
@@ -15,8 +12,8 @@
 #include "tessera/gpu/DeviceSession.h"
 #include "tessera/gpu/Draw.h"
 #include "tessera/gpu/GlObjects.h"
-#include "tessera/gpu/Program.h"
 #include "tessera/lod/InCoreVolumeSource.h"
+#include "tessera/render/HybridCompositor.h"
 
 namespace tessera::viewer {
 
@@ -27,52 +24,20 @@ constexpr int kHistogramBins = 256;
 constexpr int kPlanImageSize = 1024;
 constexpr int kSkipBlock = 8;
 
-// The raster equivalent of Camera's rays (render/camera_ray.glsl), so that
-// overlay lines land where the ray caster puts the volume.
-glm::mat4 viewProjection(const Camera& camera, double aspect) {
-  const glm::dmat3 b = camera.basis();
-  const glm::dvec3 eye = camera.eye();
-  const glm::dmat4 view = glm::lookAt(eye, eye - b[2], b[1]);
-  const double dist = glm::length(eye - camera.target);
-  const double farPlane = dist + 4.0 * camera.radius;
-  glm::dmat4 proj;
-  if (camera.projection == Projection::Perspective) {
-    const double nearPlane = std::max(1e-3 * camera.radius, dist - 2.0 * camera.radius);
-    proj = glm::perspective(glm::radians(camera.fovYDeg), aspect, nearPlane, farPlane);
-  } else {
-    const double h = camera.orthoHalfHeight();
-    proj = glm::ortho(-h * aspect, h * aspect, -h, h, 1e-3, farPlane);
-  }
-  return glm::mat4(proj * view);
-}
-
 }  // namespace
 
 struct Viewer::Gpu {
-  gpu::Program present;
-  gpu::Program lines;
-  gpu::FullscreenTriangle triangle;
-  gpu::Buffer lineVertices;
-  int lineVertexCount = 0;
-  glm::dvec3 lineExtent{-1.0};
+  // Upscales the volume layer and composes the lines with it by depth
+  // (Moser & Weiskopf 2008), as `tessera render --overlays` does.
+  explicit Gpu(gpu::GlContext& context) : compositor(context) {}
+  render::HybridCompositor compositor;
 };
 
 Viewer::Viewer(gpu::GlContext& context, const gpu::DeviceProfile& profile)
     : context_(context),
       limits_(gpu::applyProfile(profile, context)),
       volume_(std::make_shared<Volume>()),
-      gpu_(std::make_unique<Gpu>()) {
-  const gpu::ApiLevel api = context.caps().api;
-  gpu_->present = gpu::Program::build(
-      "viewer present",
-      {gpu::shaderPreamble(api, false, {}), gpu::embeddedShaderPart("viewer/present.vert.glsl")},
-      {gpu::shaderPreamble(api, true, {}), gpu::embeddedShaderPart("viewer/present.frag.glsl")});
-  gpu_->lines = gpu::Program::build(
-      "viewer lines",
-      {gpu::shaderPreamble(api, false, {}), gpu::embeddedShaderPart("viewer/lines.vert.glsl")},
-      {gpu::shaderPreamble(api, true, {}), gpu::embeddedShaderPart("viewer/lines.frag.glsl")});
-  gpu_->triangle = gpu::FullscreenTriangle(context_.ledger());
-}
+      gpu_(std::make_unique<Gpu>(context)) {}
 
 Viewer::~Viewer() {
   // GL objects go while the context is still current (the front end's job).
@@ -197,22 +162,19 @@ const gpu::Texture& Viewer::renderVolume(int width, int height, FrameStats& stat
   const int rw = std::max(1, static_cast<int>(std::lround(width * level.resolutionScale)));
   const int rh = std::max(1, static_cast<int>(std::lround(height * level.resolutionScale)));
   settings.stepVoxels *= level.stepScale;
+  // Over transparent black: RGB is the colour over black, A the opacity the
+  // compositor weighs lines behind the volume with; it adds the background.
+  settings.background = glm::dvec4(0.0);
   stats.renderWidth = rw;
   stats.renderHeight = rh;
   return active_.technique->render(camera_, settings, rw, rh, 0.0);
 }
 
-void Viewer::drawOverlayLines(int width, int height) {
+std::vector<render::OverlayLine> Viewer::overlayLines() const {
+  std::vector<render::OverlayLine> lines;
   const glm::dvec3 e = 0.5 * volume_->extent();
-  if (gpu_->lineExtent != e) {
-    // Box edges grey, then the x/y/z axes in red/green/blue from the
-    // box's minimum corner (the voxel (0,0,0) corner).
-    std::vector<float> v;
-    auto add = [&v](glm::dvec3 p, glm::vec4 c) {
-      v.insert(v.end(), {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z),
-                         c.r, c.g, c.b, c.a});
-    };
-    const glm::vec4 grey(0.8f, 0.8f, 0.8f, 0.7f);
+  if (showBoundingBox) {
+    const glm::vec4 grey(0.6f, 0.6f, 0.6f, 1.0f);
     for (int axis = 0; axis < 3; ++axis) {
       for (int i = 0; i < 4; ++i) {
         glm::dvec3 a(0.0);
@@ -222,33 +184,21 @@ void Viewer::drawOverlayLines(int width, int height) {
         glm::dvec3 b = a;
         a[axis] = -e[axis];
         b[axis] = e[axis];
-        add(a, grey);
-        add(b, grey);
+        lines.push_back({a, b, grey});
       }
     }
+  }
+  if (showAxes) {
+    // x/y/z in red/green/blue from the box's minimum corner (voxel (0,0,0)).
     const glm::vec4 axisColors[3] = {
         {1.0f, 0.25f, 0.25f, 1.0f}, {0.3f, 1.0f, 0.3f, 1.0f}, {0.35f, 0.55f, 1.0f, 1.0f}};
     for (int axis = 0; axis < 3; ++axis) {
       glm::dvec3 b = -e;
       b[axis] += 0.35 * 2.0 * e[axis];
-      add(-e, axisColors[axis]);
-      add(b, axisColors[axis]);
+      lines.push_back({-e, b, axisColors[axis]});
     }
-    gpu_->lineVertices =
-        gpu::Buffer::create(context_.ledger(), "overlay lines", gpu::BufferKind::Vertices,
-                            v.size() * sizeof(float), v.data(), gpu::BufferUsage::Static);
-    gpu_->lineVertexCount = static_cast<int>(v.size() / 7);
-    gpu_->lineExtent = e;
   }
-  const gpu::Program& p = gpu_->lines;
-  p.use();
-  p.set("u_viewProjection", viewProjection(camera_, static_cast<double>(width) / height));
-  const int first = showBoundingBox ? 0 : 24;
-  const int count = (showBoundingBox ? 24 : 0) + (showAxes ? 6 : 0);
-  gpu::apply({.blend = gpu::Blend::StraightAlpha});
-  gpu::drawArrays(gpu::Primitive::Lines, gpu_->lineVertices,
-                  {{0, 3, 0}, {p.attributeLocation("a_color"), 4, 3}}, 7, first, count);
-  gpu::apply({});
+  return lines;
 }
 
 FrameStats Viewer::render(int width, int height, unsigned framebuffer, glm::ivec2 origin) {
@@ -268,13 +218,9 @@ FrameStats Viewer::render(int width, int height, unsigned framebuffer, glm::ivec
   render::QualityLevel level;  // full quality
   const gpu::Texture& image = renderVolume(width, height, stats, level);
 
-  gpu::bindFramebuffer(framebuffer, box);
-  gpu::apply({});
-  gpu_->present.use();
-  image.bind(0);
-  gpu_->present.set("u_image", 0);
-  gpu_->triangle.draw();
-  if (showBoundingBox || showAxes) drawOverlayLines(width, height);
+  gpu_->compositor.setOverlayLines(overlayLines());
+  gpu_->compositor.composeInto(image, camera_, glm::vec4(settings_.background), volume_->extent(),
+                               framebuffer, box);
 
   // glFinish does not wait in browsers: a read-back of one pixel does.
   std::uint8_t pixel[4];

@@ -16,6 +16,7 @@
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/layout/Planner.h"
+#include "tessera/render/Overlay.h"
 #include "tessera/render/QualityController.h"
 #include "tessera/render/TechniqueRegistry.h"
 #include "tessera/viewer/CameraController.h"
@@ -84,6 +85,8 @@ class Viewer {
   Quality quality = Quality::Adaptive;
   // The adaptive quality's feedback loop (goal: qualityController().options()).
   render::QualityController& qualityController() { return qualityController_; }
+  // Lines drawn at the frame's full resolution and composed with the volume
+  // by depth: hidden behind opaque parts, faded behind translucent ones.
   bool showBoundingBox = true;
   bool showAxes = true;
 
@@ -107,7 +110,7 @@ class Viewer {
                                          const lod::VolumeSource& source) const;
   const gpu::Texture& renderVolume(int width, int height, FrameStats& stats,
                                    render::QualityLevel& level);
-  void drawOverlayLines(int width, int height);
+  std::vector<render::OverlayLine> overlayLines() const;  // box and axes as shown
 
   gpu::GlContext& context_;
   gpu::DeviceLimits limits_;
