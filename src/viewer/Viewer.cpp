@@ -159,8 +159,11 @@ const gpu::Texture& Viewer::renderVolume(int width, int height, FrameStats& stat
     qualityController_.setInteracting(controller_.interacting());
     level = qualityController_.next();
   }
-  const int rw = std::max(1, static_cast<int>(std::lround(width * level.resolutionScale)));
-  const int rh = std::max(1, static_cast<int>(std::lround(height * level.resolutionScale)));
+  double scale = level.resolutionScale;
+  const double pixels = static_cast<double>(width) * height;
+  if (maxVolumePixels > 0 && pixels > maxVolumePixels) scale *= std::sqrt(maxVolumePixels / pixels);
+  const int rw = std::max(1, static_cast<int>(std::lround(width * scale)));
+  const int rh = std::max(1, static_cast<int>(std::lround(height * scale)));
   settings.stepVoxels *= level.stepScale;
   // Over transparent black: RGB is the colour over black, A the opacity the
   // compositor weighs lines behind the volume with; it adds the background.

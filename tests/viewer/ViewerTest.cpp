@@ -181,6 +181,21 @@ TEST_F(ViewerFixture, LinesBehindAnOpaqueVolumeAreHiddenAndLinesInFrontDrawn) {
   EXPECT_GT(differingPixels(frame(false, false), frame(false, true), 8), kSize / 4);
 }
 
+TEST_F(ViewerFixture, VolumePixelCapRendersSmallerAndUpscales) {
+  Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
+  v.setVolume(makeSheppLogan({40, 40, 40}), "phantom");
+  v.quality = Quality::Full;
+  v.showBoundingBox = v.showAxes = false;
+  const Image full = (v.render(kSize, kSize, fb.id()), readFramebuffer(fb));
+  v.maxVolumePixels = kSize * kSize / 4;
+  const FrameStats fs = v.render(kSize, kSize, fb.id());
+  EXPECT_EQ(fs.renderWidth, kSize / 2);
+  EXPECT_EQ(fs.renderHeight, kSize / 2);
+  const double p = psnr(readFramebuffer(fb), full);
+  EXPECT_GT(p, 25.0);
+  EXPECT_LT(p, 60.0);
+}
+
 TEST_F(ViewerFixture, FailedLoadKeepsThePreviousVolume) {
   Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
   v.setVolume(makeSheppLogan({32, 32, 32}), "phantom");

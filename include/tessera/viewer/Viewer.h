@@ -83,6 +83,11 @@ class Viewer {
   void setTechnique(const std::string& name);
   const std::string& technique() const { return techniqueName_; }
   Quality quality = Quality::Adaptive;
+  // At most this many pixels of volume per frame (0: no cap): on a HiDPI
+  // screen the frame (lines, compositing) has the screen's pixels while the
+  // volume is rendered smaller and upscaled, as the hybrid compositor does;
+  // adaptive quality reduces it further while the user interacts.
+  int maxVolumePixels = 0;
   // The adaptive quality's feedback loop (goal: qualityController().options()).
   render::QualityController& qualityController() { return qualityController_; }
   // Lines drawn at the frame's full resolution and composed with the volume
