@@ -5,6 +5,7 @@
 #include <emscripten/emscripten.h>
 #include <emscripten/html5.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <memory>
@@ -245,6 +246,11 @@ EMSCRIPTEN_KEEPALIVE void tessera_set_overlays(int box, int axes) {
   if (!app().viewer) return;
   theViewer().showBoundingBox = box != 0;
   theViewer().showAxes = axes != 0;
+}
+// The most volume pixels a frame renders (0: the canvas's own); the canvas
+// keeps its backing size (CSS size x devicePixelRatio) for lines and compositing.
+EMSCRIPTEN_KEEPALIVE void tessera_set_max_volume_pixels(int pixels) {
+  if (app().viewer) theViewer().maxVolumePixels = std::max(0, pixels);
 }
 EMSCRIPTEN_KEEPALIVE void tessera_set_quality(int adaptive) {
   if (app().viewer)
