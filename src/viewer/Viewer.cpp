@@ -67,6 +67,8 @@ void Viewer::setVolume(Volume volume, const std::string& name) {
   }
   // Everything worked: swap in.
   active_ = std::move(next);
+  pending_ = {};
+  frameMsPerPixel_ = stripMsPerPixel_ = 0.0;
   volume_ = source.level(glm::ivec3(1));
   volumeName_ = name;
   uploadedTfRevision_ = tfEditor_.revision();
@@ -125,6 +127,8 @@ void Viewer::setTechnique(const std::string& name) {
     }
     uploadedTfRevision_ = tfEditor_.revision();
   }
+  pending_ = {};
+  frameMsPerPixel_ = stripMsPerPixel_ = 0.0;
   techniqueName_ = name;
 }
 
@@ -147,30 +151,52 @@ std::string Viewer::description() const {
   return s.str();
 }
 
-// The volume through the technique at the quality level's size and step.
-const gpu::Texture& Viewer::renderVolume(int width, int height, FrameStats& stats,
-                                         render::QualityLevel& level) {
+void Viewer::syncTransferFunction() {
   if (uploadedTfRevision_ != tfEditor_.revision()) {
     active_.technique->setTransferFunction(tfEditor_.transferFunction());
     uploadedTfRevision_ = tfEditor_.revision();
   }
-  RenderSettings settings = settings_;
-  if (quality == Quality::Adaptive) {
-    qualityController_.setInteracting(controller_.interacting());
-    level = qualityController_.next();
-  }
+}
+
+Viewer::VolumePass Viewer::volumePass(int width, int height,
+                                      const render::QualityLevel& level) const {
+  VolumePass p;
+  p.settings = settings_;
   double scale = level.resolutionScale;
   const double pixels = static_cast<double>(width) * height;
   if (maxVolumePixels > 0 && pixels > maxVolumePixels) scale *= std::sqrt(maxVolumePixels / pixels);
-  const int rw = std::max(1, static_cast<int>(std::lround(width * scale)));
-  const int rh = std::max(1, static_cast<int>(std::lround(height * scale)));
-  settings.stepVoxels *= level.stepScale;
+  p.width = std::max(1, static_cast<int>(std::lround(width * scale)));
+  p.height = std::max(1, static_cast<int>(std::lround(height * scale)));
+  p.settings.stepVoxels *= level.stepScale;
   // Over transparent black: RGB is the colour over black, A the opacity the
   // compositor weighs lines behind the volume with; it adds the background.
-  settings.background = glm::dvec4(0.0);
-  stats.renderWidth = rw;
-  stats.renderHeight = rh;
-  return active_.technique->render(camera_, settings, rw, rh, 0.0);
+  p.settings.background = glm::dvec4(0.0);
+  return p;
+}
+
+void Viewer::compose(const gpu::Texture& image, int width, int height, unsigned framebuffer,
+                     glm::ivec2 origin) {
+  gpu_->compositor.setOverlayLines(overlayLines());
+  gpu_->compositor.composeInto(image, camera_, glm::vec4(settings_.background), volume_->extent(),
+                               framebuffer, glm::ivec4(origin, width, height));
+  // glFinish does not wait in browsers: a read-back of one pixel does.
+  std::uint8_t pixel[4];
+  gpu::readPixelsRgba8({origin, 1, 1}, pixel);
+  gpu::checkErrors("viewer frame");
+}
+
+FrameStats Viewer::presentFrame(int width, int height, unsigned framebuffer, glm::ivec2 origin,
+                                const render::QualityLevel& level) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const VolumePass pass = volumePass(width, height, level);
+  const gpu::Texture& image =
+      active_.technique->render(camera_, pass.settings, pass.width, pass.height, 0.0);
+  compose(image, width, height, framebuffer, origin);
+  FrameStats stats;
+  stats.ms = msSince(t0);
+  stats.renderWidth = pass.width;
+  stats.renderHeight = pass.height;
+  return stats;
 }
 
 std::vector<render::OverlayLine> Viewer::overlayLines() const {
@@ -205,8 +231,7 @@ std::vector<render::OverlayLine> Viewer::overlayLines() const {
 }
 
 FrameStats Viewer::render(int width, int height, unsigned framebuffer, glm::ivec2 origin) {
-  const auto t0 = std::chrono::steady_clock::now();
-  FrameStats stats;
+  pending_ = {};
   controller_.setViewport(width, height);
   gpu::clearErrors();
   const glm::ivec4 box(origin, width, height);
@@ -215,22 +240,85 @@ FrameStats Viewer::render(int width, int height, unsigned framebuffer, glm::ivec
     gpu::apply({.scissor = true, .scissorBox = box});
     gpu::clearColor(glm::vec4(glm::vec3(settings_.background), 1.0f));
     gpu::apply({});
-    last_ = stats;
-    return stats;
+    last_ = FrameStats();
+    return last_;
   }
+  syncTransferFunction();
   render::QualityLevel level;  // full quality
-  const gpu::Texture& image = renderVolume(width, height, stats, level);
-
-  gpu_->compositor.setOverlayLines(overlayLines());
-  gpu_->compositor.composeInto(image, camera_, glm::vec4(settings_.background), volume_->extent(),
-                               framebuffer, box);
-
-  // glFinish does not wait in browsers: a read-back of one pixel does.
-  std::uint8_t pixel[4];
-  gpu::readPixelsRgba8({origin, 1, 1}, pixel);
-  gpu::checkErrors("viewer frame");
-  stats.ms = msSince(t0);
+  if (quality == Quality::Adaptive) {
+    qualityController_.setInteracting(controller_.interacting());
+    level = qualityController_.next();
+  }
+  if (progressive && level.full()) {
+    const VolumePass full = volumePass(width, height, level);
+    const double pixels = static_cast<double>(full.width) * full.height;
+    if (!(frameMsPerPixel_ > 0.0) || frameMsPerPixel_ * pixels > frameBudgetMs) {
+      // A preview now, the full frame strip by strip in refine().
+      qualityController_.setInteracting(true);
+      const render::QualityLevel preview = qualityController_.next();
+      qualityController_.setInteracting(false);
+      FrameStats stats = presentFrame(width, height, framebuffer, origin, preview);
+      qualityController_.report(preview, stats.ms);
+      stats.complete = false;
+      pending_ = {.active = true,
+                  .width = width,
+                  .height = height,
+                  .framebuffer = framebuffer,
+                  .origin = origin,
+                  .pass = full};
+      last_ = stats;
+      return stats;
+    }
+  }
+  FrameStats stats = presentFrame(width, height, framebuffer, origin, level);
   if (quality == Quality::Adaptive) qualityController_.report(level, stats.ms);
+  if (level.full()) {
+    frameMsPerPixel_ = stats.ms / (static_cast<double>(stats.renderWidth) * stats.renderHeight);
+  }
+  last_ = stats;
+  return stats;
+}
+
+FrameStats Viewer::refine() {
+  if (!pending_.active) return last_;
+  const auto t0 = std::chrono::steady_clock::now();
+  Pending& p = pending_;
+  const double pixels = static_cast<double>(p.pass.width) * p.pass.height;
+  const double minStrip = 1.0 / p.pass.height;
+  const gpu::Texture* image = nullptr;
+  gpu::clearErrors();
+  while (p.done < 1.0) {
+    // As many rows as the budget left affords at the strips' measured cost.
+    const double left = frameBudgetMs - msSince(t0);
+    double strip = stripMsPerPixel_ > 0.0 ? left / (stripMsPerPixel_ * pixels) : 1.0 / 16.0;
+    strip = std::clamp(strip, minStrip, 1.0 - p.done);
+    if (1.0 - (p.done + strip) < 0.5 * minStrip) strip = 1.0 - p.done;
+    const auto tStrip = std::chrono::steady_clock::now();
+    {
+      const gpu::RegionScope region(
+          glm::vec4(0.0f, static_cast<float>(p.done), 1.0f, static_cast<float>(p.done + strip)));
+      image =
+          &active_.technique->render(camera_, p.pass.settings, p.pass.width, p.pass.height, 0.0);
+      std::uint8_t pixel[4];
+      gpu::readPixelsRgba8({0, 0, 1, 1}, pixel);  // waits for the strip (browsers too)
+    }
+    const double ms = msSince(tStrip);
+    stripMsPerPixel_ = ms / (strip * pixels);
+    p.ms += ms;
+    p.done = p.done + strip >= 1.0 - 1e-9 ? 1.0 : p.done + strip;
+    if (msSince(t0) >= frameBudgetMs) break;
+  }
+  gpu::checkErrors("progressive frame");
+  FrameStats stats;
+  stats.renderWidth = p.pass.width;
+  stats.renderHeight = p.pass.height;
+  stats.complete = p.done >= 1.0;
+  if (stats.complete) {
+    compose(*image, p.width, p.height, p.framebuffer, p.origin);
+    frameMsPerPixel_ = p.ms / pixels;
+    pending_ = {};
+  }
+  stats.ms = msSince(t0);
   last_ = stats;
   return stats;
 }

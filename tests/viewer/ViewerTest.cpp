@@ -196,6 +196,45 @@ TEST_F(ViewerFixture, VolumePixelCapRendersSmallerAndUpscales) {
   EXPECT_LT(p, 60.0);
 }
 
+// A slow full-quality frame is rendered in strips across refine() calls
+// (a preview first), and the finished frame is the one render() draws at once.
+TEST_F(ViewerFixture, ProgressiveFramesRefineInStripsToTheFullFrame) {
+  Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
+  v.setVolume(makeSheppLogan({40, 40, 40}), "phantom");
+  v.camera().azimuthDeg = 30.0;
+  for (const char* technique : {"raycast", "slice3d", "slice2d"}) {
+    SCOPED_TRACE(technique);
+    v.setTechnique(technique);
+    v.progressive = false;
+    v.render(kSize, kSize, fb.id());
+    const Image whole = readFramebuffer(fb);
+    v.progressive = true;
+    v.frameBudgetMs = 1e-3;  // every frame is "slow": one strip per call
+    const FrameStats preview = v.render(kSize, kSize, fb.id());
+    EXPECT_FALSE(preview.complete);
+    EXPECT_TRUE(v.refining());
+    EXPECT_LE(preview.renderWidth, kSize);  // the interaction level: full size when cheap
+    int calls = 0;
+    while (v.refining() && calls < 10 * kSize) {
+      const FrameStats part = v.refine();
+      EXPECT_EQ(part.complete, !v.refining());
+      ++calls;
+    }
+    EXPECT_FALSE(v.refining());
+    EXPECT_GE(calls, 8);
+    EXPECT_TRUE(v.lastFrame().complete);
+    EXPECT_GE(psnr(readFramebuffer(fb), whole), 60.0);
+    // A new frame cancels the refinement in progress.
+    v.render(kSize, kSize, fb.id());
+    v.refine();
+    v.camera().azimuthDeg += 10.0;
+    v.progressive = false;
+    v.render(kSize, kSize, fb.id());
+    EXPECT_FALSE(v.refining());
+    v.camera().azimuthDeg -= 10.0;
+  }
+}
+
 TEST_F(ViewerFixture, FailedLoadKeepsThePreviousVolume) {
   Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
   v.setVolume(makeSheppLogan({32, 32, 32}), "phantom");

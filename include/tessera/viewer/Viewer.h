@@ -34,6 +34,9 @@ struct FrameStats {
   double ms = 0.0;      // the whole frame, up to a 1-pixel read-back (GL may not block on glFinish)
   int renderWidth = 0;  // what the technique rendered (smaller while adaptive quality interacts)
   int renderHeight = 0;
+  // False for a progressive frame's preview or a part of its refinement:
+  // the full-quality frame is still being rendered (Viewer::refine).
+  bool complete = true;
 };
 
 class Viewer {
@@ -100,6 +103,22 @@ class Viewer {
   FrameStats render(int width, int height, unsigned framebuffer = 0, glm::ivec2 origin = {0, 0});
   const FrameStats& lastFrame() const { return last_; }
 
+  // Progressive full-quality frames, so that a slow technique never blocks
+  // the front end's input: when a full-quality frame is expected to cost
+  // more than frameBudgetMs (learnt from the frames before), render() shows
+  // a preview at adaptive quality's interaction level and starts the full
+  // frame, which refine() renders off screen in horizontal strips
+  // (gpu::RegionScope) of about frameBudgetMs each and shows once the last
+  // strip is done. The next render() cancels what is left. Between render()
+  // and the end of the refinement nothing else may draw with this viewer's
+  // technique (the strips accumulate in its target).
+  bool progressive = false;
+  double frameBudgetMs = 25.0;
+  bool refining() const { return pending_.active; }
+  // One slice of work (about frameBudgetMs) on the pending frame, into the
+  // framebuffer render() was given; showing it when it is done.
+  FrameStats refine();
+
   // Patient directions at the view's edges (R/L, A/P, S/I) for the current
   // camera; empty strings when the volume's file carries no orientation
   // (PVM, raw, generated volumes), where letters would be a guess.
@@ -113,8 +132,32 @@ class Viewer {
   void updateHistogram();
   render::TechniqueOnVolume createActive(const std::string& technique,
                                          const lod::VolumeSource& source) const;
-  const gpu::Texture& renderVolume(int width, int height, FrameStats& stats,
-                                   render::QualityLevel& level);
+  // The settings and size the technique renders a frame of width x height at.
+  struct VolumePass {
+    RenderSettings settings;
+    int width = 0;
+    int height = 0;
+  };
+  VolumePass volumePass(int width, int height, const render::QualityLevel& level) const;
+  void syncTransferFunction();
+  // Renders the volume at `level` and composes it into the framebuffer.
+  FrameStats presentFrame(int width, int height, unsigned framebuffer, glm::ivec2 origin,
+                          const render::QualityLevel& level);
+  void compose(const gpu::Texture& image, int width, int height, unsigned framebuffer,
+               glm::ivec2 origin);
+  // A progressive frame being refined.
+  struct Pending {
+    bool active = false;
+    int width = 0, height = 0;
+    unsigned framebuffer = 0;
+    glm::ivec2 origin{0, 0};
+    VolumePass pass;
+    double done = 0.0;  // fraction of the rows rendered
+    double ms = 0.0;    // spent on its strips
+  };
+  Pending pending_;
+  double frameMsPerPixel_ = 0.0;  // last full-quality frame's cost (0: unknown)
+  double stripMsPerPixel_ = 0.0;  // the refinement's strips'
   std::vector<render::OverlayLine> overlayLines() const;  // box and axes as shown
 
   gpu::GlContext& context_;
