@@ -17,6 +17,10 @@
   const maxVolumePixels = Math.max(0, parseInt(params.get('maxvolume') || String(640 * 640), 10) || 0);
   const MAX_BACKING = 4096;  // per side
   const defaultVolume = params.get('volume') || 'gen:shepp-logan:96';
+  // Full-quality frames in strips of about this many ms per animation frame,
+  // so that input is handled during slow frames (?progressive=0: one piece).
+  const progressive = params.get('progressive') !== '0';
+  const frameBudgetMs = Math.max(1, parseFloat(params.get('budget') || '12') || 12);
   const volumeUrls = params.getAll('url').filter((u) => u.length);
 
   const $ = (id) => document.getElementById(id);
@@ -54,6 +58,7 @@
   let needsRender = true;
   let frames = 0;
   let renderWaiters = [];
+  let refineNotBefore = 0;  // performance.now() before which no strip is rendered
 
   function showError(message) {
     const e = $('error');
@@ -99,6 +104,9 @@
       setOverlays: c('tessera_set_overlays', null, ['number', 'number']),
       setQuality: c('tessera_set_quality', null, ['number']),
       setMaxVolumePixels: c('tessera_set_max_volume_pixels', null, ['number']),
+      setProgressive: c('tessera_set_progressive', null, ['number', 'number']),
+      refining: c('tessera_refining', 'number', []),
+      refine: c('tessera_refine', 'number', []),
       setTechnique: c('tessera_set_technique', 'number', ['string']),
       stateJson: c('tessera_state_json', 'string', ['number']),
       readPixels: c('tessera_read_pixels', 'number', ['number', 'number']),
@@ -127,13 +135,39 @@
     return ms;
   }
 
+  // A strip of the pending full-quality frame (about frameBudgetMs).
+  function refineNow() {
+    const ms = api.refine();
+    if (ms < 0) showError(api.lastError());
+    if (!api.refining()) {
+      frames++;
+      refreshState();
+      updateStatus();
+    }
+    return ms;
+  }
+
+  // One animation frame: a new frame when something changed, else a strip
+  // of the pending full-quality one; render() promises resolve once the
+  // frame is complete.
   function loop() {
-    if (needsRender && api) {
-      needsRender = false;
-      const ms = renderNow();
-      const waiters = renderWaiters;
-      renderWaiters = [];
-      waiters.forEach((w) => w(ms));
+    if (api) {
+      let ms = -1;
+      if (needsRender) {
+        needsRender = false;
+        ms = renderNow();
+      } else if (api.refining() && performance.now() >= refineNotBefore) {
+        // The per-animation-frame cap: a strip that cost more than the budget
+        // (a technique's fixed cost per pass can exceed it) is followed by
+        // as much idle time, so input and the page keep at least half.
+        ms = refineNow();
+        refineNotBefore = ms > frameBudgetMs ? performance.now() + ms : 0;
+      }
+      if (!needsRender && !api.refining() && renderWaiters.length) {
+        const waiters = renderWaiters;
+        renderWaiters = [];
+        waiters.forEach((w) => w(ms));
+      }
     }
     requestAnimationFrame(loop);
   }
@@ -149,7 +183,9 @@
     if (!s.webgl) return;
     const api = `WebGL ${s.webgl} (${s.api})`;
     const vol = s.has_volume ? s.description : 'no volume';
-    $('status').textContent = `${vol} · ${api} · ${s.render_size[0]}×${s.render_size[1]} in ${s.frame_ms.toFixed(0)} ms`;
+    const what = s.refining ? 'preview' : 'frame';
+    $('status').textContent = `${vol} · ${api} · ${what} ${s.render_size[0]}×${s.render_size[1]} in ${s.frame_ms.toFixed(0)} ms` +
+      (s.refining ? ' · refining…' : '');
   }
 
   // ---------------------------------------------------------------- files
@@ -584,6 +620,7 @@
       $('technique').appendChild(o);
     });
     api.setMaxVolumePixels(maxVolumePixels);
+    api.setProgressive(progressive ? 1 : 0, frameBudgetMs);
     new ResizeObserver(() => { if (fitCanvas()) requestRender(); }).observe(canvas);
     window.addEventListener('resize', () => { if (fitCanvas()) requestRender(); });
     requestAnimationFrame(loop);
@@ -608,6 +645,7 @@
     openFile: (file) => openFiles([file]),
     openUrls,
     lastLoad: () => lastLoad,
+    setProgressive: (on) => { api.setProgressive(on ? 1 : 0, frameBudgetMs); },
     setCamera: (az, el, zoom) => { api.setCamera(az, el, zoom); return requestRender(); },
     setTfJson: (json) => { const ok = api.tfSetJson(json); tfEdited(); return ok; },
     error: () => ($('error').hidden ? '' : $('error').textContent),
@@ -620,10 +658,12 @@
     // with a 1-pixel read-back, since glFinish does not wait in browsers).
     benchmark: (n) => {
       const times = [];
+      api.setProgressive(0, 0);  // whole frames, timed one by one
       for (let i = 0; i < n; i++) {
         api.setCamera(i * 10, 0, 1);
         times.push(renderNow());
       }
+      api.setProgressive(progressive ? 1 : 0, frameBudgetMs);
       times.sort((a, b) => a - b);
       return { median: times[Math.floor(times.length / 2)], min: times[0], max: times[times.length - 1], times };
     },

@@ -388,6 +388,8 @@ void drawVolumeView(DesktopSession& ds, int panelPx, int viewW, int viewH) {
         }
         v.render(viewW, viewH, ds.cache.id());
         ds.cacheKey = key;
+      } else if (v.refining()) {
+        v.refine();  // a strip of the full-quality frame per window frame
       }
       gpu::blitFramebuffer(ds.cache.id(), {0, 0, viewW, viewH}, 0, {panelPx, 0, viewW, viewH});
     } else {
@@ -398,9 +400,9 @@ void drawVolumeView(DesktopSession& ds, int panelPx, int viewW, int viewH) {
   }
   const viewer::FrameStats& fs = v.lastFrame();
   char line[160];
-  std::snprintf(line, sizeof line, "frame %.0f ms at %dx%d (%s)\n%s", fs.ms, fs.renderWidth,
-                fs.renderHeight, ds.context->caps().renderer.c_str(),
-                ds.context->caps().version.c_str());
+  std::snprintf(line, sizeof line, "%s %.0f ms at %dx%d (%s)\n%s",
+                v.refining() ? "refining, strip" : "frame", fs.ms, fs.renderWidth, fs.renderHeight,
+                ds.context->caps().renderer.c_str(), ds.context->caps().version.c_str());
   ds.status = line;
 }
 
@@ -447,7 +449,7 @@ void runFrame(DesktopSession& ds) {
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
   ++ds.frame;
-  if (!ds.options.screenshot.empty() && ds.frame >= ds.options.frames) {
+  if (!ds.options.screenshot.empty() && ds.frame >= ds.options.frames && !ds.viewer->refining()) {
     takeScreenshot(ds, fbw, fbh);
   }
   glfwSwapBuffers(ds.window);
@@ -471,6 +473,9 @@ void runView(const ViewOptions& o) {
   ds.window = openWindow(width, height, ds.es3);
   ds.context = gpu::GlContext::adoptCurrent(profile.api, "glfw-egl");
   ds.viewer = std::make_unique<viewer::Viewer>(*ds.context, profile);
+  // ES 3 keeps the frame in a cache between window frames, where a full-quality
+  // frame can be refined strip by strip; ES 2 redraws every window frame.
+  ds.viewer->progressive = ds.es3;
   ds.input.viewer = ds.viewer.get();
   glfwSetWindowUserPointer(ds.window, &ds.input);
   glfwSetDropCallback(ds.window, [](GLFWwindow* w, int count, const char** paths) {

@@ -287,27 +287,25 @@ FrameStats Viewer::refine() {
   const double minStrip = 1.0 / p.pass.height;
   const gpu::Texture* image = nullptr;
   gpu::clearErrors();
-  while (p.done < 1.0) {
-    // As many rows as the budget left affords at the strips' measured cost.
-    const double left = frameBudgetMs - msSince(t0);
-    double strip = stripMsPerPixel_ > 0.0 ? left / (stripMsPerPixel_ * pixels) : 1.0 / 16.0;
-    strip = std::clamp(strip, minStrip, 1.0 - p.done);
-    if (1.0 - (p.done + strip) < 0.5 * minStrip) strip = 1.0 - p.done;
-    const auto tStrip = std::chrono::steady_clock::now();
-    {
-      const gpu::RegionScope region(
-          glm::vec4(0.0f, static_cast<float>(p.done), 1.0f, static_cast<float>(p.done + strip)));
-      image =
-          &active_.technique->render(camera_, p.pass.settings, p.pass.width, p.pass.height, 0.0);
-      std::uint8_t pixel[4];
-      gpu::readPixelsRgba8({0, 0, 1, 1}, pixel);  // waits for the strip (browsers too)
-    }
-    const double ms = msSince(tStrip);
-    stripMsPerPixel_ = ms / (strip * pixels);
-    p.ms += ms;
-    p.done = p.done + strip >= 1.0 - 1e-9 ? 1.0 : p.done + strip;
-    if (msSince(t0) >= frameBudgetMs) break;
+  // One strip per call, as many rows as the budget affords at the cost per
+  // pixel of the strips before (a single draw keeps the per-call overhead
+  // of multi-pass techniques, such as the slicers' hundreds of slices, once).
+  double strip = stripMsPerPixel_ > 0.0 ? frameBudgetMs / (stripMsPerPixel_ * pixels) : 1.0 / 16.0;
+  strip = std::clamp(strip, minStrip, 1.0 - p.done);
+  if (1.0 - (p.done + strip) < 0.5 * minStrip) strip = 1.0 - p.done;
+  {
+    const gpu::RegionScope region(
+        glm::vec4(0.0f, static_cast<float>(p.done), 1.0f, static_cast<float>(p.done + strip)));
+    image = &active_.technique->render(camera_, p.pass.settings, p.pass.width, p.pass.height, 0.0);
+    std::uint8_t pixel[4];
+    gpu::readPixelsRgba8({0, 0, 1, 1}, pixel);  // waits for the strip (browsers too)
   }
+  const double ms = msSince(t0);
+  // Smoothed: a strip's time varies with what its rows cover.
+  const double perPixel = ms / (strip * pixels);
+  stripMsPerPixel_ = stripMsPerPixel_ > 0.0 ? 0.5 * (stripMsPerPixel_ + perPixel) : perPixel;
+  p.ms += ms;
+  p.done = p.done + strip >= 1.0 - 1e-9 ? 1.0 : p.done + strip;
   gpu::checkErrors("progressive frame");
   FrameStats stats;
   stats.renderWidth = p.pass.width;
