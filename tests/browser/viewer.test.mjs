@@ -574,8 +574,8 @@ async function responsiveCanvas(context, url) {
         phone.ok && phone.cw <= 390, phone.text);
   if (shots) {
     // Through the protocol: Playwright's own screenshot would reset the emulated metrics.
-    const png = await cdp.send('Page.captureScreenshot', { format: 'png' });
-    fs.writeFileSync(path.join(shots, 'web-phone.png'), Buffer.from(png.data, 'base64'));
+    const shot = await cdp.send('Page.captureScreenshot', { format: 'jpeg', quality: 85 });
+    fs.writeFileSync(path.join(shots, 'web-phone.jpg'), Buffer.from(shot.data, 'base64'));
   }
   const errors = logs.filter((l) => l.startsWith('pageerror') || l.startsWith('error'));
   check('no script errors on the responsive page', errors.length === 0, errors.join(' | '));
@@ -614,7 +614,7 @@ async function loadFromUrl(context, url, tmp, run) {
   check('front view of the head: box and axes behind the face are not drawn over it',
         face > SIZE * SIZE / 8 && changed <= face * 0.002 && all > 2 * SIZE,
         `${changed} of ${face} face pixels changed by the lines (${all} pixels in all)`);
-  if (shots) await page.screenshot({ path: path.join(shots, 'web-ch2-lines-by-depth.png') });
+  if (shots) await page.locator('#view').screenshot({ path: path.join(shots, 'web-ch2-lines-by-depth.png') });
   const errors = logs.filter((l) => l.startsWith('pageerror') || l.startsWith('error'));
   check('no script errors on the ?url= page', errors.length === 0, errors.join(' | '));
   await page.close();
