@@ -8,13 +8,48 @@
 (function () {
   const params = new URLSearchParams(location.search);
   const forceWebgl1 = params.get('webgl') === '1';
-  const size = Math.max(16, Math.min(2048, parseInt(params.get('size') || '512', 10) || 512));
+  // ?size=N: a fixed N x N canvas (tests compare it with native images);
+  // otherwise the canvas fills its box at the screen's pixel density.
+  const fixedSize = params.has('size')
+    ? Math.max(16, Math.min(2048, parseInt(params.get('size'), 10) || 512)) : 0;
+  // The volume is rendered at most this many pixels and upscaled; lines and
+  // compositing keep the canvas's full backing size (?maxvolume=PIXELS).
+  const maxVolumePixels = Math.max(0, parseInt(params.get('maxvolume') || String(640 * 640), 10) || 0);
+  const MAX_BACKING = 4096;  // per side
   const defaultVolume = params.get('volume') || 'gen:shepp-logan:96';
+  // Full-quality frames in strips of about this many ms per animation frame,
+  // so that input is handled during slow frames (?progressive=0: one piece).
+  const progressive = params.get('progressive') !== '0';
+  const frameBudgetMs = Math.max(1, parseFloat(params.get('budget') || '12') || 12);
+  const volumeUrls = params.getAll('url').filter((u) => u.length);
 
   const $ = (id) => document.getElementById(id);
   const canvas = $('canvas');
-  canvas.width = size;
-  canvas.height = size;
+  if (fixedSize) {
+    canvas.classList.add('fixed');
+    canvas.width = fixedSize;
+    canvas.height = fixedSize;
+  } else {
+    canvas.classList.add('responsive');
+    $('view').classList.add('responsive');
+  }
+
+  // Backing size = CSS size x devicePixelRatio (capped per side); returns
+  // true when it changed (the canvas is cleared then and needs a frame).
+  function fitCanvas() {
+    if (fixedSize) return false;
+    const dpr = window.devicePixelRatio || 1;
+    let w = Math.max(1, Math.round(canvas.clientWidth * dpr));
+    let h = Math.max(1, Math.round(canvas.clientHeight * dpr));
+    const s = Math.min(1, MAX_BACKING / Math.max(w, h));
+    w = Math.max(1, Math.round(w * s));
+    h = Math.max(1, Math.round(h * s));
+    if (canvas.width === w && canvas.height === h) return false;
+    canvas.width = w;
+    canvas.height = h;
+    return true;
+  }
+  fitCanvas();
 
   let M = null;     // the emscripten module
   let api = null;   // cwrapped functions
@@ -23,12 +58,15 @@
   let needsRender = true;
   let frames = 0;
   let renderWaiters = [];
+  let refineNotBefore = 0;  // performance.now() before which no strip is rendered
 
   function showError(message) {
     const e = $('error');
     e.textContent = message;
     e.hidden = false;
   }
+  // What a failed load leaves on screen.
+  const keeps = () => (state.has_volume ? ' — the previous volume stays' : '');
   function clearError() {
     $('error').hidden = true;
     $('error').textContent = '';
@@ -65,6 +103,10 @@
       setOpacityScale: c('tessera_set_opacity_scale', null, ['number']),
       setOverlays: c('tessera_set_overlays', null, ['number', 'number']),
       setQuality: c('tessera_set_quality', null, ['number']),
+      setMaxVolumePixels: c('tessera_set_max_volume_pixels', null, ['number']),
+      setProgressive: c('tessera_set_progressive', null, ['number', 'number']),
+      refining: c('tessera_refining', 'number', []),
+      refine: c('tessera_refine', 'number', []),
       setTechnique: c('tessera_set_technique', 'number', ['string']),
       stateJson: c('tessera_state_json', 'string', ['number']),
       readPixels: c('tessera_read_pixels', 'number', ['number', 'number']),
@@ -83,6 +125,7 @@
   }
 
   function renderNow() {
+    fitCanvas();
     const ms = api.render(canvas.width, canvas.height);
     if (ms < 0) showError(api.lastError());
     frames++;
@@ -92,13 +135,39 @@
     return ms;
   }
 
+  // A strip of the pending full-quality frame (about frameBudgetMs).
+  function refineNow() {
+    const ms = api.refine();
+    if (ms < 0) showError(api.lastError());
+    if (!api.refining()) {
+      frames++;
+      refreshState();
+      updateStatus();
+    }
+    return ms;
+  }
+
+  // One animation frame: a new frame when something changed, else a strip
+  // of the pending full-quality one; render() promises resolve once the
+  // frame is complete.
   function loop() {
-    if (needsRender && api) {
-      needsRender = false;
-      const ms = renderNow();
-      const waiters = renderWaiters;
-      renderWaiters = [];
-      waiters.forEach((w) => w(ms));
+    if (api) {
+      let ms = -1;
+      if (needsRender) {
+        needsRender = false;
+        ms = renderNow();
+      } else if (api.refining() && performance.now() >= refineNotBefore) {
+        // The per-animation-frame cap: a strip that cost more than the budget
+        // (a technique's fixed cost per pass can exceed it) is followed by
+        // as much idle time, so input and the page keep at least half.
+        ms = refineNow();
+        refineNotBefore = ms > frameBudgetMs ? performance.now() + ms : 0;
+      }
+      if (!needsRender && !api.refining() && renderWaiters.length) {
+        const waiters = renderWaiters;
+        renderWaiters = [];
+        waiters.forEach((w) => w(ms));
+      }
     }
     requestAnimationFrame(loop);
   }
@@ -114,7 +183,9 @@
     if (!s.webgl) return;
     const api = `WebGL ${s.webgl} (${s.api})`;
     const vol = s.has_volume ? s.description : 'no volume';
-    $('status').textContent = `${vol} · ${api} · ${s.render_size[0]}×${s.render_size[1]} in ${s.frame_ms.toFixed(0)} ms`;
+    const what = s.refining ? 'preview' : 'frame';
+    $('status').textContent = `${vol} · ${api} · ${what} ${s.render_size[0]}×${s.render_size[1]} in ${s.frame_ms.toFixed(0)} ms` +
+      (s.refining ? ' · refining…' : '');
   }
 
   // ---------------------------------------------------------------- files
@@ -126,26 +197,112 @@
   async function openFiles(fileList) {
     const files = Array.from(fileList);
     if (files.length === 0) return false;
-    const contents = await Promise.all(files.map(async (f) => new Uint8Array(await f.arrayBuffer())));
-    for (let i = 0; i < files.length; i++) {
-      const bytes = contents[i];
+    const entries = await Promise.all(files.map(async (f) => ({ name: f.name, bytes: new Uint8Array(await f.arrayBuffer()) })));
+    return openEntries(entries, (message) => message);
+  }
+
+  // Hands {name, bytes} entries to the io readers; `explain` turns a
+  // failure's message into what the page shows.
+  async function openEntries(entries, explain) {
+    for (const { name, bytes } of entries) {
       const p = M._malloc(Math.max(1, bytes.length));
       if (!p) {
-        showError(`${files[i].name}: cannot allocate ${bytes.length} bytes for the file; the previous volume stays`);
+        showError(explain(`${name}: cannot allocate ${bytes.length} bytes for the file`) + keeps());
         api.clearFiles();  // drops the files handed over so far
         return false;
       }
       M.HEAPU8.set(bytes, p);
-      api.addFile(files[i].name, p, bytes.length);  // owned by the module from here on
+      api.addFile(name, p, bytes.length);  // owned by the module from here on
     }
     if (!api.loadFiles()) {
-      showError(`${api.lastError()} — the previous volume stays`);
+      showError(explain(api.lastError()) + keeps());
       return false;
     }
     clearError();
     volumeChanged();
     await requestRender();
     return true;
+  }
+
+  function megabytes(n) { return (n / 1048576).toFixed(1); }
+
+  // GET `url` with progress (ReadableStream, Content-Length); throws an
+  // Error whose message names the URL and what went wrong.
+  async function fetchBytes(url, onProgress) {
+    let response;
+    try {
+      response = await fetch(url);
+    } catch (e) {
+      throw new Error(`${url}: cannot fetch it (${e.message}): the server is unreachable, ` +
+                      'or it does not let this page read the file (CORS)');
+    }
+    if (!response.ok) throw new Error(`${url}: HTTP ${response.status} ${response.statusText}`.trim());
+    const total = parseInt(response.headers.get('Content-Length') || '0', 10) || 0;
+    if (!response.body) {
+      const all = new Uint8Array(await response.arrayBuffer());
+      onProgress(all.length, total);
+      return all;
+    }
+    const reader = response.body.getReader();
+    const chunks = [];
+    let received = 0;
+    for (;;) {
+      const { done, value } = await reader.read();
+      if (done) break;
+      chunks.push(value);
+      received += value.length;
+      onProgress(received, total);
+    }
+    const all = new Uint8Array(received);
+    let at = 0;
+    for (const c of chunks) { all.set(c, at); at += c.length; }
+    return all;
+  }
+
+  // ?url=… (repeat it for a header and its data file): fetched with a
+  // progress bar, then read like picked files.
+  let lastLoad = null;  // for tests: what the last ?url= load fetched
+  async function openUrls(urls) {
+    const progress = $('progress');
+    const entries = [];
+    lastLoad = { urls, bytes: 0, total: 0, updates: 0 };
+    try {
+      for (const u of urls) {
+        let resolved;
+        try {
+          resolved = new URL(u, location.href);
+        } catch {
+          throw new Error(`${u}: not a valid URL`);
+        }
+        const name = decodeURIComponent(resolved.pathname.split('/').pop() || '') || 'volume';
+        progress.hidden = false;
+        progress.removeAttribute('value');
+        const bytes = await fetchBytes(resolved.href, (got, total) => {
+          lastLoad.updates++;
+          if (total > 0) {
+            progress.max = total;
+            progress.value = Math.min(got, total);
+          }
+          $('status').textContent = `loading ${resolved.href}: ${megabytes(got)}` +
+            (total > 0 ? ` of ${megabytes(total)} MB (${Math.round(100 * Math.min(1, got / total))} %)` : ' MB');
+        });
+        entries.push({ name, bytes, url: resolved.href });
+        lastLoad.bytes += bytes.length;
+        lastLoad.total += parseInt(progress.max, 10) || 0;
+      }
+    } catch (e) {
+      progress.hidden = true;
+      showError(e.message + keeps());
+      updateStatus();
+      return false;
+    }
+    progress.hidden = true;
+    const byName = new Map(entries.map((e) => [e.name, e.url]));
+    return openEntries(entries, (message) => {
+      // Name the URL of the file the reader complains about (or all of them).
+      for (const [name, url] of byName) if (message.startsWith(name)) return `${url}: ${message}`;
+      return `${entries.map((e) => e.url).join(', ')}: ${message}`;
+    });
   }
 
   function volumeChanged() {
@@ -462,9 +619,17 @@
       o.textContent = n;
       $('technique').appendChild(o);
     });
-    if (!api.loadGenerated(defaultVolume)) showError(api.lastError());
-    volumeChanged();
+    api.setMaxVolumePixels(maxVolumePixels);
+    api.setProgressive(progressive ? 1 : 0, frameBudgetMs);
+    new ResizeObserver(() => { if (fitCanvas()) requestRender(); }).observe(canvas);
+    window.addEventListener('resize', () => { if (fitCanvas()) requestRender(); });
     requestAnimationFrame(loop);
+    if (volumeUrls.length) {
+      if (!(await openUrls(volumeUrls))) volumeChanged();
+    } else {
+      if (!api.loadGenerated(defaultVolume)) showError(api.lastError());
+      volumeChanged();
+    }
     await requestRender();
     return state;
   })();
@@ -478,6 +643,9 @@
     render: () => requestRender(),
     openFiles,
     openFile: (file) => openFiles([file]),
+    openUrls,
+    lastLoad: () => lastLoad,
+    setProgressive: (on) => { api.setProgressive(on ? 1 : 0, frameBudgetMs); },
     setCamera: (az, el, zoom) => { api.setCamera(az, el, zoom); return requestRender(); },
     setTfJson: (json) => { const ok = api.tfSetJson(json); tfEdited(); return ok; },
     error: () => ($('error').hidden ? '' : $('error').textContent),
@@ -490,10 +658,12 @@
     // with a 1-pixel read-back, since glFinish does not wait in browsers).
     benchmark: (n) => {
       const times = [];
+      api.setProgressive(0, 0);  // whole frames, timed one by one
       for (let i = 0; i < n; i++) {
         api.setCamera(i * 10, 0, 1);
         times.push(renderNow());
       }
+      api.setProgressive(progressive ? 1 : 0, frameBudgetMs);
       times.sort((a, b) => a - b);
       return { median: times[Math.floor(times.length / 2)], min: times[0], max: times[times.length - 1], times };
     },

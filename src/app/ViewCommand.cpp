@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -27,6 +28,7 @@
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/io/VolumeReader.h"
 #include "tessera/render/TechniqueRegistry.h"
+#include "tessera/viewer/RecentFiles.h"
 #include "tessera/viewer/Viewer.h"
 #endif
 
@@ -44,6 +46,7 @@ struct ViewOptions {
   double elevation = 0.0;
   std::string screenshot;
   int frames = 3;
+  bool helpOverlay = false;
 };
 
 #ifdef TESSERA_DESKTOP_VIEWER
@@ -192,6 +195,29 @@ struct DesktopSession {
   char tfPathBuf[512] = "transfer-function.json";
   bool logHistogram = true;
   int frame = 0;
+  bool showHelp = false;
+  viewer::RecentFiles recent{viewer::RecentFiles::defaultPath()};
+};
+
+// The keyboard shortcuts, as the help overlay lists them (handled in
+// handleShortcuts; keys act only while no text field has the focus).
+struct Shortcut {
+  const char* keys;
+  const char* action;
+};
+constexpr Shortcut kShortcuts[] = {
+    {"F1 or ?", "show / hide this help"},
+    {"Esc", "close this help"},
+    {"R", "reset the view"},
+    {"B", "bounding box on / off"},
+    {"A", "axes on / off"},
+    {"M", "composite / MIP"},
+    {"Q", "adaptive / full quality"},
+    {"T", "next technique"},
+    {"Ctrl+1 ... Ctrl+9", "open recent volume 1 ... 9"},
+    {"drag", "rotate"},
+    {"right-drag or Shift+drag", "pan"},
+    {"wheel", "zoom"},
 };
 
 // A window with an OpenGL ES context of the profile's level, made current.
@@ -210,13 +236,119 @@ GLFWwindow* openWindow(int width, int height, bool es3) {
   return window;
 }
 
-// Loads a volume; an error is shown in the panel and the previous volume stays.
+// Loads a volume; an error is shown in the panel and the previous volume
+// stays. Files and folders (not generated volumes) go to the recent list.
 void openVolume(DesktopSession& ds, const std::string& spec) {
   try {
     ds.viewer->setVolume(readVolume(spec, {.dicomSeries = ds.options.series}), fileName(spec));
     ds.error.clear();
   } catch (const Error& e) {
     ds.error = std::string(e.what()) + " (the previous volume stays)";
+    std::error_code ec;
+    if (!std::filesystem::exists(spec, ec)) {
+      try {
+        ds.recent.remove(spec);  // gone: no longer offered
+      } catch (const Error&) {
+      }
+    }
+    return;
+  }
+  if (spec.rfind("gen:", 0) == 0) return;
+  try {
+    std::error_code ec;
+    const std::filesystem::path full = std::filesystem::absolute(spec, ec);
+    ds.recent.add(ec ? spec : full.lexically_normal().string());
+  } catch (const Error& e) {
+    ds.error = e.what();
+  }
+}
+
+void drawHelpOverlay(DesktopSession& ds, float x0, float x1, float height) {
+  if (!ds.showHelp) return;
+  ImGui::SetNextWindowPos(ImVec2(0.5f * (x0 + x1), 0.5f * height), ImGuiCond_Always,
+                          ImVec2(0.5f, 0.5f));
+  ImGui::SetNextWindowBgAlpha(0.92f);
+  if (ImGui::Begin("Keyboard shortcuts", &ds.showHelp,
+                   ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoCollapse |
+                       ImGuiWindowFlags_NoSavedSettings)) {
+    if (ImGui::BeginTable("shortcuts", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV)) {
+      for (const Shortcut& s : kShortcuts) {
+        ImGui::TableNextRow();
+        ImGui::TableSetColumnIndex(0);
+        ImGui::TextUnformatted(s.keys);
+        ImGui::TableSetColumnIndex(1);
+        ImGui::TextUnformatted(s.action);
+      }
+      ImGui::EndTable();
+    }
+    if (!ds.recent.path().empty()) {
+      ImGui::TextDisabled("recent volumes: %s", ds.recent.path().string().c_str());
+    }
+  }
+  ImGui::End();
+}
+
+void nextTechnique(DesktopSession& ds) {
+  const std::vector<std::string> names = render::TechniqueRegistry::global().names();
+  const auto at = std::find(names.begin(), names.end(), ds.viewer->technique());
+  const std::size_t next = at == names.end() ? 0 : (at - names.begin() + 1) % names.size();
+  try {
+    ds.viewer->setTechnique(names[next]);
+  } catch (const Error& e) {
+    ds.error = e.what();
+  }
+}
+
+// The keys of kShortcuts (GLFW key codes and typed characters, ImGui 1.86).
+void handleShortcuts(DesktopSession& ds) {
+  ImGuiIO& io = ImGui::GetIO();
+  if (ImGui::IsKeyPressed(GLFW_KEY_F1, false)) ds.showHelp = !ds.showHelp;
+  if (ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false)) ds.showHelp = false;
+  if (io.WantTextInput) return;
+  if (io.KeyCtrl) {
+    for (int n = 0; n < 9; ++n) {
+      if (ImGui::IsKeyPressed(GLFW_KEY_1 + n, false) &&
+          n < static_cast<int>(ds.recent.entries().size())) {
+        openVolume(ds, ds.recent.entries()[static_cast<std::size_t>(n)]);
+        return;
+      }
+    }
+  }
+  viewer::Viewer& v = *ds.viewer;
+  for (const ImWchar c : io.InputQueueCharacters) {
+    switch (c) {
+      case '?':
+        ds.showHelp = !ds.showHelp;
+        break;
+      case 'r':
+      case 'R':
+        v.resetCamera();
+        break;
+      case 'b':
+      case 'B':
+        v.showBoundingBox = !v.showBoundingBox;
+        break;
+      case 'a':
+      case 'A':
+        v.showAxes = !v.showAxes;
+        break;
+      case 'm':
+      case 'M':
+        v.settings().mode =
+            v.settings().mode == RenderMode::Mip ? RenderMode::Composite : RenderMode::Mip;
+        break;
+      case 'q':
+      case 'Q':
+        v.quality = v.quality == viewer::Quality::Adaptive ? viewer::Quality::Full
+                                                           : viewer::Quality::Adaptive;
+        break;
+      case 't':
+      case 'T':
+        nextTechnique(ds);
+        break;
+      default:
+        break;
+    }
   }
 }
 
@@ -245,7 +377,18 @@ void panelFile(DesktopSession& ds) {
   ImGui::InputText("##path", ds.pathBuf, sizeof ds.pathBuf);
   ImGui::SameLine();
   if (ImGui::Button("Open") && ds.pathBuf[0]) openVolume(ds, ds.pathBuf);
-  ImGui::TextDisabled("or drop a file on the window");
+  ImGui::TextDisabled("or drop a file on the window; F1: keyboard shortcuts");
+  if (!ds.recent.entries().empty() && ImGui::BeginCombo("recent", "open a recent volume")) {
+    std::string chosen;
+    for (std::size_t i = 0; i < ds.recent.entries().size(); ++i) {
+      const std::string& path = ds.recent.entries()[i];
+      const std::string label = std::to_string(i + 1) + "  " + fileName(path) + "##" + path;
+      if (ImGui::Selectable(label.c_str())) chosen = path;
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", path.c_str());
+    }
+    ImGui::EndCombo();
+    if (!chosen.empty()) openVolume(ds, chosen);
+  }
   if (!ds.error.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1.0f));
     ImGui::TextWrapped("%s", ds.error.c_str());
@@ -388,6 +531,8 @@ void drawVolumeView(DesktopSession& ds, int panelPx, int viewW, int viewH) {
         }
         v.render(viewW, viewH, ds.cache.id());
         ds.cacheKey = key;
+      } else if (v.refining()) {
+        v.refine();  // a strip of the full-quality frame per window frame
       }
       gpu::blitFramebuffer(ds.cache.id(), {0, 0, viewW, viewH}, 0, {panelPx, 0, viewW, viewH});
     } else {
@@ -398,9 +543,9 @@ void drawVolumeView(DesktopSession& ds, int panelPx, int viewW, int viewH) {
   }
   const viewer::FrameStats& fs = v.lastFrame();
   char line[160];
-  std::snprintf(line, sizeof line, "frame %.0f ms at %dx%d (%s)\n%s", fs.ms, fs.renderWidth,
-                fs.renderHeight, ds.context->caps().renderer.c_str(),
-                ds.context->caps().version.c_str());
+  std::snprintf(line, sizeof line, "%s %.0f ms at %dx%d (%s)\n%s",
+                v.refining() ? "refining, strip" : "frame", fs.ms, fs.renderWidth, fs.renderHeight,
+                ds.context->caps().renderer.c_str(), ds.context->caps().version.c_str());
   ds.status = line;
 }
 
@@ -438,7 +583,9 @@ void runFrame(DesktopSession& ds) {
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
   handleViewInput(*ds.viewer, scale);
+  handleShortcuts(ds);
   drawPanel(ds, wh);
+  drawHelpOverlay(ds, kPanelWidth, static_cast<float>(ww), static_cast<float>(wh));
   drawOrientationLabels(ds.viewer->orientationLabels(), kPanelWidth, static_cast<float>(ww),
                         static_cast<float>(wh));
   ImGui::Render();
@@ -447,7 +594,7 @@ void runFrame(DesktopSession& ds) {
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
   ++ds.frame;
-  if (!ds.options.screenshot.empty() && ds.frame >= ds.options.frames) {
+  if (!ds.options.screenshot.empty() && ds.frame >= ds.options.frames && !ds.viewer->refining()) {
     takeScreenshot(ds, fbw, fbh);
   }
   glfwSwapBuffers(ds.window);
@@ -471,14 +618,26 @@ void runView(const ViewOptions& o) {
   ds.window = openWindow(width, height, ds.es3);
   ds.context = gpu::GlContext::adoptCurrent(profile.api, "glfw-egl");
   ds.viewer = std::make_unique<viewer::Viewer>(*ds.context, profile);
+  // ES 3 keeps the frame in a cache between window frames, where a full-quality
+  // frame can be refined strip by strip; ES 2 redraws every window frame.
+  ds.viewer->progressive = ds.es3;
   ds.input.viewer = ds.viewer.get();
   glfwSetWindowUserPointer(ds.window, &ds.input);
   glfwSetDropCallback(ds.window, [](GLFWwindow* w, int count, const char** paths) {
     if (count > 0) static_cast<DesktopState*>(glfwGetWindowUserPointer(w))->pendingDrop = paths[0];
   });
 
+  ds.showHelp = o.helpOverlay;
+  std::string recentError;
+  try {
+    ds.recent.load();
+  } catch (const Error& e) {
+    recentError = e.what();
+    std::fprintf(stderr, "tessera view: %s\n", e.what());
+  }
   ds.viewer->tfEditor().setTransferFunction(TransferFunction::fromPresetOrFile(o.tf));
   openVolume(ds, o.file.empty() ? defaultVolumeSpec() : o.file);
+  if (ds.error.empty()) ds.error = recentError;
   if (!ds.error.empty() && !ds.viewer->hasVolume()) throw InputError(ds.error);
   ds.viewer->camera().azimuthDeg = o.azimuth;
   ds.viewer->camera().elevationDeg = o.elevation;
@@ -527,6 +686,8 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--screenshot", o->screenshot,
                   "Write the window to this PNG after --frames frames and exit");
   cmd->add_option("--frames", o->frames, "Frames before --screenshot")->capture_default_str();
+  cmd->add_flag("--help-overlay", o->helpOverlay,
+                "Start with the keyboard shortcuts shown (F1 or ? toggles them)");
   cmd->callback([o] { runView(*o); });
 }
 

@@ -1,11 +1,72 @@
 #include "tessera/gpu/Draw.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "gpu/gl.h"
 #include "tessera/core/Error.h"
 
 namespace tessera::gpu {
+
+namespace {
+
+// What RegionScope and the last apply() asked for, so that a viewport change
+// can re-derive the scissor.
+struct ScissorState {
+  glm::ivec4 viewport{0};
+  bool regionActive = false;
+  glm::vec4 region{0.0f, 0.0f, 1.0f, 1.0f};
+  bool passScissor = false;
+  glm::ivec4 passBox{0};
+};
+
+ScissorState& scissorState() {
+  static ScissorState s;
+  return s;
+}
+
+int edge(int origin, int size, float fraction) {
+  return origin + static_cast<int>(std::lround(std::clamp(fraction, 0.0f, 1.0f) * size));
+}
+
+void updateScissor() {
+  const ScissorState& s = scissorState();
+  glm::ivec4 box = s.passBox;
+  bool enabled = s.passScissor;
+  if (s.regionActive) {
+    const glm::ivec4 v = s.viewport;
+    int x0 = edge(v.x, v.z, s.region.x), y0 = edge(v.y, v.w, s.region.y);
+    int x1 = edge(v.x, v.z, s.region.z), y1 = edge(v.y, v.w, s.region.w);
+    if (enabled) {
+      x0 = std::max(x0, box.x);
+      y0 = std::max(y0, box.y);
+      x1 = std::min(x1, box.x + box.z);
+      y1 = std::min(y1, box.y + box.w);
+    }
+    box = glm::ivec4(x0, y0, std::max(0, x1 - x0), std::max(0, y1 - y0));
+    enabled = true;
+  }
+  if (enabled) {
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(box.x, box.y, box.z, box.w);
+  } else {
+    glDisable(GL_SCISSOR_TEST);
+  }
+}
+
+}  // namespace
+
+RegionScope::RegionScope(glm::vec4 fraction) {
+  scissorState().regionActive = true;
+  scissorState().region = fraction;
+  updateScissor();
+}
+
+RegionScope::~RegionScope() {
+  scissorState().regionActive = false;
+  updateScissor();
+}
 
 void apply(const DrawState& s) {
   if (s.blend == Blend::Off) {
@@ -39,17 +100,16 @@ void apply(const DrawState& s) {
     glDisable(GL_DEPTH_TEST);
   }
   glDisable(GL_CULL_FACE);
-  if (s.scissor) {
-    glEnable(GL_SCISSOR_TEST);
-    glScissor(s.scissorBox.x, s.scissorBox.y, s.scissorBox.z, s.scissorBox.w);
-  } else {
-    glDisable(GL_SCISSOR_TEST);
-  }
+  scissorState().passScissor = s.scissor;
+  scissorState().passBox = s.scissorBox;
+  updateScissor();
   glLineWidth(s.lineWidth);
 }
 
 void setViewport(glm::ivec4 b) {
   glViewport(b.x, b.y, b.z, b.w);
+  scissorState().viewport = b;
+  if (scissorState().regionActive) updateScissor();
 }
 
 void clearColor(glm::vec4 c) {

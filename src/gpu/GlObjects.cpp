@@ -5,6 +5,7 @@
 #include "gpu/GlFormats.h"
 #include "gpu/gl.h"
 #include "tessera/core/Error.h"
+#include "tessera/gpu/Draw.h"
 
 namespace tessera::gpu {
 
@@ -270,7 +271,7 @@ Framebuffer Framebuffer::create(MemoryLedger& ledger, const std::string& label, 
 
 void Framebuffer::bind() const {
   glBindFramebuffer(GL_FRAMEBUFFER, id_);
-  glViewport(0, 0, color_.width(), color_.height());
+  setViewport({0, 0, color_.width(), color_.height()});  // follows a RegionScope
 }
 
 void Framebuffer::readRgba8(std::uint8_t* out) const {

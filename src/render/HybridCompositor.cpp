@@ -209,11 +209,24 @@ void HybridCompositor::render(Technique& technique, const Camera& camera,
   const auto tComposite = std::chrono::steady_clock::now();
   ensureTarget(context_, image_, "hybrid image", width, height);
   image_.bind();
+  drawComposite(resolved_.color(), camera, glm::vec4(settings.background), volumeExtent, width,
+                height, {0, 0});
+  gpu::finish();
+  gpu::checkErrors("hybrid compositing");
+  timings_.compositeMs = msSince(tComposite);
+  timings_.totalMs = msSince(tStart);
+}
+
+void HybridCompositor::drawComposite(const gpu::Texture& volumeLayer, const Camera& camera,
+                                     glm::vec4 background, glm::dvec3 volumeExtent, int width,
+                                     int height, glm::ivec2 origin) {
+  const bool hasLines = !lines_.empty();
+  const double aspect = static_cast<double>(width) / height;
   composite_.use();
-  const double tanHalfFov = std::tan(0.5 * camera.fovYDeg * glm::pi<double>() / 180.0);
   setCameraRayUniforms(composite_, camera, aspect, width, height, volumeExtent);
-  composite_.set("u_background", glm::vec4(settings.background));
-  resolved_.color().bind(0);
+  composite_.set("u_origin", glm::vec2(origin));
+  composite_.set("u_background", background);
+  volumeLayer.bind(0);
   composite_.set("u_volume", 0);
   composite_.set("u_hasLines", hasLines ? 1.0f : 0.0f);
   if (hasLines) {
@@ -225,6 +238,7 @@ void HybridCompositor::render(Technique& technique, const Camera& camera,
     // A line on the box's front faces is "in front"; allow for the pixel's
     // ray meeting the box up to a couple of pixels' footprint away from the
     // line's point, and for packing and float rounding.
+    const double tanHalfFov = std::tan(0.5 * camera.fovYDeg * glm::pi<double>() / 180.0);
     const double viewHeight = camera.projection == Projection::Perspective
                                   ? 2.0 * camera.distance() * tanHalfFov
                                   : 2.0 * camera.orthoHalfHeight();
@@ -232,17 +246,23 @@ void HybridCompositor::render(Technique& technique, const Camera& camera,
     composite_.set("u_frontTolerance", static_cast<float>(tolerance));
   } else {
     // Samplers must still name distinct units of the right type.
-    resolved_.color().bind(1);
-    resolved_.color().bind(2);
+    volumeLayer.bind(1);
+    volumeLayer.bind(2);
     composite_.set("u_lineColor", 1);
     composite_.set("u_lineDistance", 2);
   }
   gpu::apply({});
   triangle_.draw();
-  gpu::finish();
+}
+
+void HybridCompositor::composeInto(const gpu::Texture& volumeLayer, const Camera& camera,
+                                   glm::vec4 background, glm::dvec3 volumeExtent,
+                                   unsigned framebuffer, glm::ivec4 box) {
+  if (box.z <= 0 || box.w <= 0) throw InputError("hybrid: image size must be positive");
+  if (!lines_.empty()) overlay_.draw(lines_, camera, box.z, box.w);
+  gpu::bindFramebuffer(framebuffer, box);
+  drawComposite(volumeLayer, camera, background, volumeExtent, box.z, box.w, {box.x, box.y});
   gpu::checkErrors("hybrid compositing");
-  timings_.compositeMs = msSince(tComposite);
-  timings_.totalMs = msSince(tStart);
 }
 
 Image HybridCompositor::readImage() const {

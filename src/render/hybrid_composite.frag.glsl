@@ -10,6 +10,7 @@ uniform float u_hasLines;
 uniform float u_distanceScale;
 uniform float u_frontTolerance;  // world units
 uniform vec4 u_background;
+uniform vec2 u_origin;  // the viewport's lower-left corner in window pixels
 
 float lineDistance(vec2 uv) {
   vec3 p = floor(TEX2D(u_lineDistance, uv).rgb * 255.0 + 0.5);
@@ -17,7 +18,7 @@ float lineDistance(vec2 uv) {
 }
 
 void main() {
-  vec2 uv = gl_FragCoord.xy / u_viewport;
+  vec2 uv = (gl_FragCoord.xy - u_origin) / u_viewport;
   vec4 v = TEX2D(u_volume, uv);
   vec3 under = u_background.rgb;
   float underAlpha = u_background.a;

@@ -5,9 +5,6 @@
 #include <cmath>
 #include <sstream>
 
-#include <glm/gtc/matrix_transform.hpp>
-#include <glm/mat4x4.hpp>
-
 #include "tessera/core/Error.h"
 #include "tessera/core/Histogram.h"
 #include "tessera/core/HostBudget.h"
@@ -15,8 +12,8 @@
 #include "tessera/gpu/DeviceSession.h"
 #include "tessera/gpu/Draw.h"
 #include "tessera/gpu/GlObjects.h"
-#include "tessera/gpu/Program.h"
 #include "tessera/lod/InCoreVolumeSource.h"
+#include "tessera/render/HybridCompositor.h"
 
 namespace tessera::viewer {
 
@@ -27,52 +24,20 @@ constexpr int kHistogramBins = 256;
 constexpr int kPlanImageSize = 1024;
 constexpr int kSkipBlock = 8;
 
-// The raster equivalent of Camera's rays (render/camera_ray.glsl), so that
-// overlay lines land where the ray caster puts the volume.
-glm::mat4 viewProjection(const Camera& camera, double aspect) {
-  const glm::dmat3 b = camera.basis();
-  const glm::dvec3 eye = camera.eye();
-  const glm::dmat4 view = glm::lookAt(eye, eye - b[2], b[1]);
-  const double dist = glm::length(eye - camera.target);
-  const double farPlane = dist + 4.0 * camera.radius;
-  glm::dmat4 proj;
-  if (camera.projection == Projection::Perspective) {
-    const double nearPlane = std::max(1e-3 * camera.radius, dist - 2.0 * camera.radius);
-    proj = glm::perspective(glm::radians(camera.fovYDeg), aspect, nearPlane, farPlane);
-  } else {
-    const double h = camera.orthoHalfHeight();
-    proj = glm::ortho(-h * aspect, h * aspect, -h, h, 1e-3, farPlane);
-  }
-  return glm::mat4(proj * view);
-}
-
 }  // namespace
 
 struct Viewer::Gpu {
-  gpu::Program present;
-  gpu::Program lines;
-  gpu::FullscreenTriangle triangle;
-  gpu::Buffer lineVertices;
-  int lineVertexCount = 0;
-  glm::dvec3 lineExtent{-1.0};
+  // Upscales the volume layer and composes the lines with it by depth
+  // (Moser & Weiskopf 2008), as `tessera render --overlays` does.
+  explicit Gpu(gpu::GlContext& context) : compositor(context) {}
+  render::HybridCompositor compositor;
 };
 
 Viewer::Viewer(gpu::GlContext& context, const gpu::DeviceProfile& profile)
     : context_(context),
       limits_(gpu::applyProfile(profile, context)),
       volume_(std::make_shared<Volume>()),
-      gpu_(std::make_unique<Gpu>()) {
-  const gpu::ApiLevel api = context.caps().api;
-  gpu_->present = gpu::Program::build(
-      "viewer present",
-      {gpu::shaderPreamble(api, false, {}), gpu::embeddedShaderPart("viewer/present.vert.glsl")},
-      {gpu::shaderPreamble(api, true, {}), gpu::embeddedShaderPart("viewer/present.frag.glsl")});
-  gpu_->lines = gpu::Program::build(
-      "viewer lines",
-      {gpu::shaderPreamble(api, false, {}), gpu::embeddedShaderPart("viewer/lines.vert.glsl")},
-      {gpu::shaderPreamble(api, true, {}), gpu::embeddedShaderPart("viewer/lines.frag.glsl")});
-  gpu_->triangle = gpu::FullscreenTriangle(context_.ledger());
-}
+      gpu_(std::make_unique<Gpu>(context)) {}
 
 Viewer::~Viewer() {
   // GL objects go while the context is still current (the front end's job).
@@ -102,6 +67,8 @@ void Viewer::setVolume(Volume volume, const std::string& name) {
   }
   // Everything worked: swap in.
   active_ = std::move(next);
+  pending_ = {};
+  frameMsPerPixel_ = stripMsPerPixel_ = 0.0;
   volume_ = source.level(glm::ivec3(1));
   volumeName_ = name;
   uploadedTfRevision_ = tfEditor_.revision();
@@ -160,6 +127,8 @@ void Viewer::setTechnique(const std::string& name) {
     }
     uploadedTfRevision_ = tfEditor_.revision();
   }
+  pending_ = {};
+  frameMsPerPixel_ = stripMsPerPixel_ = 0.0;
   techniqueName_ = name;
 }
 
@@ -182,37 +151,59 @@ std::string Viewer::description() const {
   return s.str();
 }
 
-// The volume through the technique at the quality level's size and step.
-const gpu::Texture& Viewer::renderVolume(int width, int height, FrameStats& stats,
-                                         render::QualityLevel& level) {
+void Viewer::syncTransferFunction() {
   if (uploadedTfRevision_ != tfEditor_.revision()) {
     active_.technique->setTransferFunction(tfEditor_.transferFunction());
     uploadedTfRevision_ = tfEditor_.revision();
   }
-  RenderSettings settings = settings_;
-  if (quality == Quality::Adaptive) {
-    qualityController_.setInteracting(controller_.interacting());
-    level = qualityController_.next();
-  }
-  const int rw = std::max(1, static_cast<int>(std::lround(width * level.resolutionScale)));
-  const int rh = std::max(1, static_cast<int>(std::lround(height * level.resolutionScale)));
-  settings.stepVoxels *= level.stepScale;
-  stats.renderWidth = rw;
-  stats.renderHeight = rh;
-  return active_.technique->render(camera_, settings, rw, rh, 0.0);
 }
 
-void Viewer::drawOverlayLines(int width, int height) {
+Viewer::VolumePass Viewer::volumePass(int width, int height,
+                                      const render::QualityLevel& level) const {
+  VolumePass p;
+  p.settings = settings_;
+  double scale = level.resolutionScale;
+  const double pixels = static_cast<double>(width) * height;
+  if (maxVolumePixels > 0 && pixels > maxVolumePixels) scale *= std::sqrt(maxVolumePixels / pixels);
+  p.width = std::max(1, static_cast<int>(std::lround(width * scale)));
+  p.height = std::max(1, static_cast<int>(std::lround(height * scale)));
+  p.settings.stepVoxels *= level.stepScale;
+  // Over transparent black: RGB is the colour over black, A the opacity the
+  // compositor weighs lines behind the volume with; it adds the background.
+  p.settings.background = glm::dvec4(0.0);
+  return p;
+}
+
+void Viewer::compose(const gpu::Texture& image, int width, int height, unsigned framebuffer,
+                     glm::ivec2 origin) {
+  gpu_->compositor.setOverlayLines(overlayLines());
+  gpu_->compositor.composeInto(image, camera_, glm::vec4(settings_.background), volume_->extent(),
+                               framebuffer, glm::ivec4(origin, width, height));
+  // glFinish does not wait in browsers: a read-back of one pixel does.
+  std::uint8_t pixel[4];
+  gpu::readPixelsRgba8({origin, 1, 1}, pixel);
+  gpu::checkErrors("viewer frame");
+}
+
+FrameStats Viewer::presentFrame(int width, int height, unsigned framebuffer, glm::ivec2 origin,
+                                const render::QualityLevel& level) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const VolumePass pass = volumePass(width, height, level);
+  const gpu::Texture& image =
+      active_.technique->render(camera_, pass.settings, pass.width, pass.height, 0.0);
+  compose(image, width, height, framebuffer, origin);
+  FrameStats stats;
+  stats.ms = msSince(t0);
+  stats.renderWidth = pass.width;
+  stats.renderHeight = pass.height;
+  return stats;
+}
+
+std::vector<render::OverlayLine> Viewer::overlayLines() const {
+  std::vector<render::OverlayLine> lines;
   const glm::dvec3 e = 0.5 * volume_->extent();
-  if (gpu_->lineExtent != e) {
-    // Box edges grey, then the x/y/z axes in red/green/blue from the
-    // box's minimum corner (the voxel (0,0,0) corner).
-    std::vector<float> v;
-    auto add = [&v](glm::dvec3 p, glm::vec4 c) {
-      v.insert(v.end(), {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z),
-                         c.r, c.g, c.b, c.a});
-    };
-    const glm::vec4 grey(0.8f, 0.8f, 0.8f, 0.7f);
+  if (showBoundingBox) {
+    const glm::vec4 grey(0.6f, 0.6f, 0.6f, 1.0f);
     for (int axis = 0; axis < 3; ++axis) {
       for (int i = 0; i < 4; ++i) {
         glm::dvec3 a(0.0);
@@ -222,38 +213,25 @@ void Viewer::drawOverlayLines(int width, int height) {
         glm::dvec3 b = a;
         a[axis] = -e[axis];
         b[axis] = e[axis];
-        add(a, grey);
-        add(b, grey);
+        lines.push_back({a, b, grey});
       }
     }
+  }
+  if (showAxes) {
+    // x/y/z in red/green/blue from the box's minimum corner (voxel (0,0,0)).
     const glm::vec4 axisColors[3] = {
         {1.0f, 0.25f, 0.25f, 1.0f}, {0.3f, 1.0f, 0.3f, 1.0f}, {0.35f, 0.55f, 1.0f, 1.0f}};
     for (int axis = 0; axis < 3; ++axis) {
       glm::dvec3 b = -e;
       b[axis] += 0.35 * 2.0 * e[axis];
-      add(-e, axisColors[axis]);
-      add(b, axisColors[axis]);
+      lines.push_back({-e, b, axisColors[axis]});
     }
-    gpu_->lineVertices =
-        gpu::Buffer::create(context_.ledger(), "overlay lines", gpu::BufferKind::Vertices,
-                            v.size() * sizeof(float), v.data(), gpu::BufferUsage::Static);
-    gpu_->lineVertexCount = static_cast<int>(v.size() / 7);
-    gpu_->lineExtent = e;
   }
-  const gpu::Program& p = gpu_->lines;
-  p.use();
-  p.set("u_viewProjection", viewProjection(camera_, static_cast<double>(width) / height));
-  const int first = showBoundingBox ? 0 : 24;
-  const int count = (showBoundingBox ? 24 : 0) + (showAxes ? 6 : 0);
-  gpu::apply({.blend = gpu::Blend::StraightAlpha});
-  gpu::drawArrays(gpu::Primitive::Lines, gpu_->lineVertices,
-                  {{0, 3, 0}, {p.attributeLocation("a_color"), 4, 3}}, 7, first, count);
-  gpu::apply({});
+  return lines;
 }
 
 FrameStats Viewer::render(int width, int height, unsigned framebuffer, glm::ivec2 origin) {
-  const auto t0 = std::chrono::steady_clock::now();
-  FrameStats stats;
+  pending_ = {};
   controller_.setViewport(width, height);
   gpu::clearErrors();
   const glm::ivec4 box(origin, width, height);
@@ -262,26 +240,83 @@ FrameStats Viewer::render(int width, int height, unsigned framebuffer, glm::ivec
     gpu::apply({.scissor = true, .scissorBox = box});
     gpu::clearColor(glm::vec4(glm::vec3(settings_.background), 1.0f));
     gpu::apply({});
-    last_ = stats;
-    return stats;
+    last_ = FrameStats();
+    return last_;
   }
+  syncTransferFunction();
   render::QualityLevel level;  // full quality
-  const gpu::Texture& image = renderVolume(width, height, stats, level);
-
-  gpu::bindFramebuffer(framebuffer, box);
-  gpu::apply({});
-  gpu_->present.use();
-  image.bind(0);
-  gpu_->present.set("u_image", 0);
-  gpu_->triangle.draw();
-  if (showBoundingBox || showAxes) drawOverlayLines(width, height);
-
-  // glFinish does not wait in browsers: a read-back of one pixel does.
-  std::uint8_t pixel[4];
-  gpu::readPixelsRgba8({origin, 1, 1}, pixel);
-  gpu::checkErrors("viewer frame");
-  stats.ms = msSince(t0);
+  if (quality == Quality::Adaptive) {
+    qualityController_.setInteracting(controller_.interacting());
+    level = qualityController_.next();
+  }
+  if (progressive && level.full()) {
+    const VolumePass full = volumePass(width, height, level);
+    const double pixels = static_cast<double>(full.width) * full.height;
+    if (!(frameMsPerPixel_ > 0.0) || frameMsPerPixel_ * pixels > frameBudgetMs) {
+      // A preview now, the full frame strip by strip in refine().
+      qualityController_.setInteracting(true);
+      const render::QualityLevel preview = qualityController_.next();
+      qualityController_.setInteracting(false);
+      FrameStats stats = presentFrame(width, height, framebuffer, origin, preview);
+      qualityController_.report(preview, stats.ms);
+      stats.complete = false;
+      pending_ = {.active = true,
+                  .width = width,
+                  .height = height,
+                  .framebuffer = framebuffer,
+                  .origin = origin,
+                  .pass = full};
+      last_ = stats;
+      return stats;
+    }
+  }
+  FrameStats stats = presentFrame(width, height, framebuffer, origin, level);
   if (quality == Quality::Adaptive) qualityController_.report(level, stats.ms);
+  if (level.full()) {
+    frameMsPerPixel_ = stats.ms / (static_cast<double>(stats.renderWidth) * stats.renderHeight);
+  }
+  last_ = stats;
+  return stats;
+}
+
+FrameStats Viewer::refine() {
+  if (!pending_.active) return last_;
+  const auto t0 = std::chrono::steady_clock::now();
+  Pending& p = pending_;
+  const double pixels = static_cast<double>(p.pass.width) * p.pass.height;
+  const double minStrip = 1.0 / p.pass.height;
+  const gpu::Texture* image = nullptr;
+  gpu::clearErrors();
+  // One strip per call, as many rows as the budget affords at the cost per
+  // pixel of the strips before (a single draw keeps the per-call overhead
+  // of multi-pass techniques, such as the slicers' hundreds of slices, once).
+  double strip = stripMsPerPixel_ > 0.0 ? frameBudgetMs / (stripMsPerPixel_ * pixels) : 1.0 / 16.0;
+  strip = std::clamp(strip, minStrip, 1.0 - p.done);
+  if (1.0 - (p.done + strip) < 0.5 * minStrip) strip = 1.0 - p.done;
+  {
+    const gpu::RegionScope region(
+        glm::vec4(0.0f, static_cast<float>(p.done), 1.0f, static_cast<float>(p.done + strip)));
+    image = &active_.technique->render(camera_, p.pass.settings, p.pass.width, p.pass.height, 0.0);
+    std::uint8_t pixel[4];
+    gpu::readPixelsRgba8({0, 0, 1, 1}, pixel);  // waits for the strip (browsers too)
+  }
+  const double ms = msSince(t0);
+  // Smoothed: a strip's time varies with what its rows cover.
+  const double perPixel = ms / (strip * pixels);
+  stripMsPerPixel_ = stripMsPerPixel_ > 0.0 ? 0.5 * (stripMsPerPixel_ + perPixel) : perPixel;
+  p.ms += ms;
+  p.done = p.done + strip >= 1.0 - 1e-9 ? 1.0 : p.done + strip;
+  gpu::checkErrors("progressive frame");
+  FrameStats stats;
+  stats.renderWidth = p.pass.width;
+  stats.renderHeight = p.pass.height;
+  stats.complete = p.done >= 1.0;
+  if (stats.complete) {
+    compose(*image, p.width, p.height, p.framebuffer, p.origin);
+    frameMsPerPixel_ = p.ms / pixels;
+    pending_ = {};
+  }
+  stats.ms = msSince(t0);
   last_ = stats;
   return stats;
 }

@@ -8,11 +8,11 @@
 // Environment: TESSERA_CLI (native tessera, for the reference image and test
 // files; default build/tessera), TESSERA_SITE (default build-web/site),
 // CHROMIUM (default /usr/bin/chromium), TESSERA_SHOTS (write screenshots there).
-import { spawn, execFileSync } from 'node:child_process';
+import { execFileSync } from 'node:child_process';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import net from 'node:net';
+import http from 'node:http';
 import zlib from 'node:zlib';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
@@ -34,29 +34,31 @@ function check(name, ok, detail) {
   if (!ok) failures++;
 }
 
-function freePort() {
-  return new Promise((resolve) => {
-    const s = net.createServer();
-    s.listen(0, '127.0.0.1', () => {
-      const { port } = s.address();
-      s.close(() => resolve(port));
+// The site, and under /data/ the test's files (one origin, so the page may
+// fetch them with ?url=), with Content-Length for the page's progress bar.
+const TYPES = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript',
+  '.css': 'text/css', '.wasm': 'application/wasm', '.png': 'image/png', '.json': 'application/json' };
+async function serve(dir, dataDirs) {
+  const server = http.createServer((req, res) => {
+    const p = decodeURIComponent(new URL(req.url, 'http://x').pathname);
+    let file = null;
+    for (const [prefix, d] of Object.entries(dataDirs)) {
+      if (p.startsWith(prefix)) file = path.join(d, path.basename(p));
+    }
+    if (!file) file = path.join(dir, path.normalize(p === '/' ? '/index.html' : p));
+    fs.stat(file, (err, st) => {
+      if (err || !st.isFile()) {
+        res.writeHead(404, { 'Content-Type': 'text/plain' });
+        res.end('not found');
+        return;
+      }
+      res.writeHead(200, { 'Content-Type': TYPES[path.extname(file)] || 'application/octet-stream',
+        'Content-Length': st.size, 'Cache-Control': 'no-store' });
+      fs.createReadStream(file).pipe(res);
     });
   });
-}
-
-async function serve(dir) {
-  const port = await freePort();
-  const server = spawn('python3', ['-m', 'http.server', String(port), '--bind', '127.0.0.1',
-    '--directory', dir], { stdio: 'ignore' });
-  for (let i = 0; i < 100; i++) {
-    try {
-      const r = await fetch(`http://127.0.0.1:${port}/index.html`);
-      if (r.ok) return { server, url: `http://127.0.0.1:${port}` };
-    } catch { /* not up yet */ }
-    await new Promise((r) => setTimeout(r, 100));
-  }
-  server.kill();
-  throw new Error('the HTTP server did not start');
+  await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
+  return { server, url: `http://127.0.0.1:${server.address().port}` };
 }
 
 // PSNR (dB) over R, G, B of the canvas against a PNG, computed in the page
@@ -101,6 +103,14 @@ function changedFraction(a, b) {
     if (Math.abs(a[i] - b[i]) > 8 || Math.abs(a[i + 1] - b[i + 1]) > 8 || Math.abs(a[i + 2] - b[i + 2]) > 8) n++;
   }
   return n / (a.length / 4);
+}
+// Pixels where some channel differs by more than `tol` levels.
+function differingPixels(a, b, tol) {
+  let n = 0;
+  for (let i = 0; i < a.length; i += 4) {
+    if (Math.abs(a[i] - b[i]) > tol || Math.abs(a[i + 1] - b[i + 1]) > tol || Math.abs(a[i + 2] - b[i + 2]) > tol) n++;
+  }
+  return n;
 }
 function meanAbsDiff(a, b) {
   let s = 0;
@@ -221,7 +231,8 @@ async function main() {
     f.info = JSON.parse(run('info', '--json', path.join(tmp, f.name)));
   }
 
-  const { server, url } = await serve(site);
+  if (shots) fs.mkdirSync(shots, { recursive: true });
+  const { server, url } = await serve(site, { '/data/': tmp, '/templates/': path.dirname(CH2) });
   const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'tessera-chromium-'));
   const context = await chromium.launchPersistentContext(profile, {
     executablePath: chromiumPath,
@@ -246,6 +257,39 @@ async function main() {
     const m2 = await psnrAgainst(page, path.join(tmp, 'native-webgl2.png'));
     check('canvas matches the native renderer (PSNR >= 35 dB)', m2.psnr >= 35,
           m2.error || `${m2.psnr.toFixed(2)} dB`);
+
+    // Lines composed with the volume by depth: an opaque volume seen from
+    // the (+x, +y, +z) corner (azimuth 45, elevation 30) hides the axes,
+    // which run along the edges at the far, minimum corner; the box's near
+    // edges show. Compared with the same frame without lines.
+    const setLines = (box, axes) => page.evaluate(async ([b, a]) => {
+      document.getElementById('box').checked = b;
+      document.getElementById('axes').checked = a;
+      document.getElementById('axes').dispatchEvent(new Event('change'));
+      await window.tessera.render();
+    }, [box, axes]);
+    const uniformTf = (alpha) => JSON.stringify({ name: 'uniform', opacity_unit_length: 1,
+      color: [{ x: 0, rgb: [0.2, 0.3, 0.9] }, { x: 1, rgb: [0.9, 0.9, 0.2] }],
+      opacity: [{ x: 0, alpha }, { x: 1, alpha }] });
+    const tfBeforeLines = await page.evaluate(() => JSON.stringify(window.tessera.tf()));
+    await page.evaluate((tf) => window.tessera.setTfJson(tf), uniformTf(1));
+    await page.evaluate(() => window.tessera.setCamera(45, 30, 1));
+    const linesAt = async (box, axes) => { await setLines(box, axes); return (await snapshot(page)).pixels; };
+    const noLines = await linesAt(false, false);
+    const axesBehind = await linesAt(false, true);
+    const boxLines = await linesAt(true, false);
+    if (shots) await page.screenshot({ path: path.join(shots, 'web-lines-depth.png') });
+    await page.evaluate((tf) => window.tessera.setTfJson(tf), uniformTf(0));
+    const clearNoLines = await linesAt(false, false);
+    const clearAxes = await linesAt(false, true);
+    const hidden = differingPixels(noLines, axesBehind, 2);
+    const near = differingPixels(noLines, boxLines, 8);
+    const seen = differingPixels(clearNoLines, clearAxes, 8);
+    check('lines by depth: axes behind an opaque volume are hidden, near box edges drawn',
+          hidden === 0 && near > 1.5 * SIZE && seen > SIZE / 4,
+          `${hidden} pixels changed by the hidden axes (${seen} when the volume is clear), ${near} by the box`);
+    await page.evaluate((tf) => window.tessera.setTfJson(tf), tfBeforeLines);
+    await page.evaluate(() => window.tessera.setCamera(0, 0, 1));
     await page.check('#box');
     await page.check('#axes');
     await page.evaluate(() => window.tessera.render());
@@ -404,8 +448,15 @@ async function main() {
             `"${msg}"`);
       await page.evaluate(() => { document.getElementById('error').hidden = true; });
     }
+    // PVM (no orientation in the file): dims as the native reader sees them.
+    run('convert', pil, path.join(tmp, 'pil.pvm'));
+    const pvmInfo = JSON.parse(run('info', '--json', path.join(tmp, 'pil.pvm')));
+    const pvm = await openThroughPicker(page, [path.join(tmp, 'pil.pvm')], 'pil.pvm');
+    const pvmLit = (await snapshot(page)).lit;
+    check('.pvm opened through the picker renders', !pvm.error && pvm.state.dims.join('x') === pvmInfo.dims.join('x') && pvmLit > 0.02,
+          pvm.error || `${pvm.state.dims.join('x')}, ${(100 * pvmLit).toFixed(1)} % lit`);
+    await openThroughPicker(page, [path.join(tmp, 'sphere48.nii.gz')], 'sphere48.nii.gz');
     if (shots) {
-      fs.mkdirSync(shots, { recursive: true });
       await page.screenshot({ path: path.join(shots, 'web-phantom.png') });
     }
     const errors = logs.filter((l) => l.startsWith('pageerror') || l.startsWith('error'));
@@ -424,15 +475,160 @@ async function main() {
           m1.error || `${m1.psnr.toFixed(2)} dB, ${(100 * shot.lit).toFixed(1)} % lit`);
     await p1.page.close();
 
+    await inputDuringSlowFrames(context, url);
+    await responsiveCanvas(context, url);
+    await loadFromUrl(context, url, tmp, run);
+
     if (bench) await benchmark(context, url);
   } finally {
     await context.close();
-    server.kill();
+    server.close();
     fs.rmSync(profile, { recursive: true, force: true });
     fs.rmSync(tmp, { recursive: true, force: true });
   }
   console.log(`browser test: ${failures ? `${failures} FAILED` : 'all passed'} in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
   process.exit(failures ? 1 : 0);
+}
+
+function psnrOf(a, b) {
+  let sum = 0;
+  for (let i = 0; i < a.length; i += 4) for (let k = 0; k < 3; k++) sum += (a[i + k] - b[i + k]) ** 2;
+  const mse = sum / (a.length / 4 * 3);
+  return mse === 0 ? 999 : 10 * Math.log10(255 * 255 / mse);
+}
+
+// Input during a slow full-quality frame (slice3d on the head): mouse moves
+// dispatched at 60 Hz while the frame renders, counted as the page handles
+// them; with progressive frames (the default) and, for comparison, without.
+async function inputDuringSlowFrames(context, url) {
+  if (!fs.existsSync(CH2)) return;
+  const SLOW = 256;
+  const runs = {};
+  for (const progressive of [true, false]) {
+    const { page } = await openPage(context, url, `size=${SLOW}&url=/templates/ch2.nii.gz${progressive ? '' : '&progressive=0'}`);
+    await page.selectOption('#technique', 'slice3d');
+    await page.evaluate(() => window.tessera.render());
+    const wholeMs = await page.evaluate(() => { window.tessera.setProgressive(false); return window.tessera.render(); });
+    await page.evaluate((on) => window.tessera.setProgressive(on), progressive);
+    await page.evaluate(() => {
+      window.inputSeen = 0;
+      document.getElementById('canvas').addEventListener('pointermove', () => { window.inputSeen++; });
+    });
+    const box = await page.locator('#canvas').boundingBox();
+    // A new full-quality frame (not awaited), then 60 Hz mouse moves over it.
+    await page.evaluate(() => { window.tessera.setCamera(25, 5, 1); });
+    const framesBefore = await page.evaluate(() => window.tessera.frames());
+    const t = Date.now();
+    const MOVES = 150;
+    // Sent on a 60 Hz clock, not one after the other's acknowledgement
+    // (which waits for the next frame the page shows).
+    const sent = [];
+    for (let i = 0; i < MOVES; i++) {
+      sent.push(page.mouse.move(box.x + 20 + (i % 40) * 4, box.y + 30 + (i % 7) * 3));
+      const due = t + (i + 1) * 1000 / 60;
+      if (Date.now() < due) await new Promise((r) => setTimeout(r, due - Date.now()));
+    }
+    const seconds = (Date.now() - t) / 1000;
+    const seen = await page.evaluate(() => window.inputSeen);
+    await Promise.all(sent);
+    const stillRefining = await page.evaluate(() => window.tessera.state().refining);
+    await page.evaluate(() => window.tessera.render());
+    const framesAfter = await page.evaluate(() => window.tessera.frames());
+    runs[progressive] = { rate: seen / seconds, seen, seconds, wholeMs, stillRefining, frames: framesAfter - framesBefore,
+      pixels: (await snapshot(page)).pixels };
+    await page.close();
+  }
+  const p = runs[true], b = runs[false];
+  const same = psnrOf(p.pixels, b.pixels);
+  check('input during a slow slice3d full-quality frame: >= 30 events/s handled (progressive frames)',
+        p.rate >= 30 && same >= 50,
+        `${p.rate.toFixed(1)} events/s (${p.seen} of 150 moves handled in the ${p.seconds.toFixed(1)} s they were sent over; one whole frame takes ` +
+        `${p.wholeMs.toFixed(0)} ms at ${SLOW}x${SLOW}); without progressive frames ${b.rate.toFixed(1)} events/s ` +
+        `(${b.seen} in ${b.seconds.toFixed(1)} s); finished frame vs whole frame ${same.toFixed(1)} dB`);
+}
+
+// Canvas backing size = CSS size x devicePixelRatio, following resizes
+// (emulated through the DevTools protocol), and on an emulated phone.
+async function responsiveCanvas(context, url) {
+  const { page, logs } = await openPage(context, url, '');
+  const cdp = await context.newCDPSession(page);
+  const metrics = async (width, height, dpr, mobile) => {
+    await cdp.send('Emulation.setDeviceMetricsOverride', { width, height, deviceScaleFactor: dpr, mobile });
+    await page.evaluate(() => window.tessera.render());
+    const m = await page.evaluate(() => {
+      const c = document.getElementById('canvas');
+      return { w: c.width, h: c.height, cw: c.clientWidth, ch: c.clientHeight, dpr: devicePixelRatio,
+               render: window.tessera.state().render_size };
+    });
+    m.lit = (await snapshot(page)).lit;
+    m.ok = m.dpr === dpr && m.w === Math.round(m.cw * dpr) && m.h === Math.round(m.ch * dpr) && m.lit > 0.02;
+    m.text = `${m.cw}x${m.ch} CSS px at DPR ${m.dpr}: backing ${m.w}x${m.h}, volume ${m.render.join('x')}, ${(100 * m.lit).toFixed(1)} % lit`;
+    return m;
+  };
+  const wide = await metrics(1200, 860, 2, false);
+  const narrow = await metrics(800, 700, 2, false);
+  check('canvas backing = CSS size x devicePixelRatio 2, following a window resize',
+        wide.ok && narrow.ok && narrow.w < wide.w, `${wide.text}; resized: ${narrow.text}`);
+  const phone = await metrics(390, 844, 3, true);
+  check('on an emulated phone (390x844, DPR 3) the canvas fits the screen at 3 pixels per CSS pixel',
+        phone.ok && phone.cw <= 390, phone.text);
+  if (shots) {
+    // Through the protocol: Playwright's own screenshot would reset the emulated metrics.
+    const shot = await cdp.send('Page.captureScreenshot', { format: 'jpeg', quality: 85 });
+    fs.writeFileSync(path.join(shots, 'web-phone.jpg'), Buffer.from(shot.data, 'base64'));
+  }
+  const errors = logs.filter((l) => l.startsWith('pageerror') || l.startsWith('error'));
+  check('no script errors on the responsive page', errors.length === 0, errors.join(' | '));
+  await page.close();
+}
+
+// ?url=: the head from the test's own server, with progress, rendering like
+// the native image; box and axes hidden behind the face; errors for a 404
+// and for a file that is not a volume.
+async function loadFromUrl(context, url, tmp, run) {
+  if (!fs.existsSync(CH2)) { check(`?url= test needs ${CH2} (mricron-data)`, false); return; }
+  run('render', CH2, '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2',
+      '--out', path.join(tmp, 'native-ch2.png'));
+  const { page, logs } = await openPage(context, url, `size=${SIZE}&url=/templates/ch2.nii.gz`);
+  const s = await page.evaluate(() => window.tessera.state());
+  const load = await page.evaluate(() => window.tessera.lastLoad());
+  const bytes = fs.statSync(CH2).size;
+  check('?url= loads a served file with progress', s.name === 'ch2.nii.gz' && s.dims.join('x') === '181x217x181' &&
+        load.bytes === bytes && load.total === bytes && load.updates >= 1,
+        `${s.description}; ${load.bytes} of ${load.total} bytes in ${load.updates} progress updates`);
+  await withoutOverlays(page);
+  const plain = (await snapshot(page)).pixels;
+  const m = await psnrAgainst(page, path.join(tmp, 'native-ch2.png'));
+  check('?url= volume renders like the native image (PSNR >= 35 dB)', m.psnr >= 35, m.error || `${m.psnr.toFixed(2)} dB`);
+  await page.check('#box');
+  await page.check('#axes');
+  await page.evaluate(() => window.tessera.render());
+  const lined = (await snapshot(page)).pixels;
+  // The face: pixels the volume lights; lines behind it must not change them.
+  let face = 0, changed = 0, all = 0;
+  for (let i = 0; i < plain.length; i += 4) {
+    const d = Math.max(Math.abs(plain[i] - lined[i]), Math.abs(plain[i + 1] - lined[i + 1]), Math.abs(plain[i + 2] - lined[i + 2]));
+    if (d > 8) all++;
+    if (plain[i] + plain[i + 1] + plain[i + 2] > 150) { face++; if (d > 8) changed++; }
+  }
+  check('front view of the head: box and axes behind the face are not drawn over it',
+        face > SIZE * SIZE / 8 && changed <= face * 0.002 && all > 2 * SIZE,
+        `${changed} of ${face} face pixels changed by the lines (${all} pixels in all)`);
+  if (shots) await page.locator('#view').screenshot({ path: path.join(shots, 'web-ch2-lines-by-depth.png') });
+  const errors = logs.filter((l) => l.startsWith('pageerror') || l.startsWith('error'));
+  check('no script errors on the ?url= page', errors.length === 0, errors.join(' | '));
+  await page.close();
+
+  fs.writeFileSync(path.join(tmp, 'notes.txt'), 'these are notes, not a volume\n');
+  for (const [file, expect] of [['missing.nii', '404'], ['notes.txt', '']]) {
+    const target = `${url}/data/${file}`;
+    const p = await openPage(context, url, `size=64&url=${encodeURIComponent(target)}`);
+    const msg = await p.page.evaluate(() => window.tessera.error());
+    const visible = await p.page.locator('#error').isVisible();
+    check(`?url= ${file === 'notes.txt' ? 'of a file that is not a volume' : 'that answers 404'}: a visible error naming the URL`,
+          visible && msg.includes(target) && msg.includes(expect), `"${msg}"`);
+    await p.page.close();
+  }
 }
 
 // ch2 through the picker at 512x512, WebGL 2 and WebGL 1: median of 7 frames.

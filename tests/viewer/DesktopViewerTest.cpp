@@ -5,6 +5,9 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include "support/TestSupport.h"
@@ -65,6 +68,50 @@ TEST(DesktopViewer, ScreenshotUnderXvfbShowsTheVolumeBesideThePanel) {
   EXPECT_GT(panel, 0.05) << r.output;
   EXPECT_GT(view, 0.05) << r.output;
   EXPECT_LT(view, 0.9) << r.output;
+}
+
+// F1/? shows the shortcuts over the view (--help-overlay opens it), and an
+// opened file lands in $XDG_CONFIG_HOME/tessera/recent-files.json.
+TEST(DesktopViewer, HelpOverlayListsShortcutsAndOpenedFilesAreRemembered) {
+  if (run("command -v xvfb-run").status != 0) GTEST_SKIP() << "xvfb-run not installed";
+  if (!desktopViewerBuilt()) GTEST_SKIP() << "tessera built without GLFW/ImGui";
+  test::TempDir dir;
+  const auto volume = dir / "phantom.nrrd";
+  ASSERT_EQ(
+      run(std::string(TESSERA_CLI_PATH) + " convert gen:shepp-logan:32 " + volume.string()).status,
+      0);
+  auto view = [&](const std::string& extra, const std::filesystem::path& png) {
+    return run("XDG_CONFIG_HOME=" + (dir / "config").string() +
+               " xvfb-run -a -s '-screen 0 1024x640x24' " + TESSERA_CLI_PATH + " view " +
+               volume.string() + " --size 960x600 --frames 2 --screenshot " + png.string() + " " +
+               extra);
+  };
+  const CommandRun plain = view("", dir / "plain.png");
+  ASSERT_EQ(plain.status, 0) << plain.output;
+  const CommandRun help = view("--help-overlay", dir / "help.png");
+  ASSERT_EQ(help.status, 0) << help.output;
+  // The overlay: a table over the middle of the view changes a good part of it.
+  const Image a = Image::readPng(dir / "plain.png"), b = Image::readPng(dir / "help.png");
+  int changed = 0, all = 0;
+  for (int y = 200; y < 400; ++y) {
+    for (int x = 500; x < 850; ++x, ++all) {
+      for (int c = 0; c < 3; ++c) {
+        if (std::abs(a.pixel(x, y)[c] - b.pixel(x, y)[c]) > 24) {
+          ++changed;
+          break;
+        }
+      }
+    }
+  }
+  EXPECT_GT(changed, all / 5) << help.output;
+
+  std::ifstream in(dir / "config" / "tessera" / "recent-files.json");
+  ASSERT_TRUE(in) << "no recent-files list";
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find(std::filesystem::absolute(volume).lexically_normal().string()),
+            std::string::npos)
+      << text.str();
 }
 
 TEST(DesktopViewer, WithoutADisplayItSaysWhatToDo) {

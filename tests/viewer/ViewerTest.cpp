@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -114,6 +115,124 @@ TEST_F(ViewerFixture, OverlaysTfEditsAndWindowChangeTheFrame) {
   v.setWindowLevel(50.0, 100.0);
   v.render(kSize, kSize, fb.id());
   EXPECT_LT(psnr(edited, readFramebuffer(fb)), 40.0);
+}
+
+// Pixels where two frames differ by more than `tolerance` in R, G or B.
+int differingPixels(const Image& a, const Image& b, int tolerance) {
+  int n = 0;
+  for (std::size_t i = 0; i < a.rgba().size(); i += 4) {
+    for (std::size_t c = 0; c < 3; ++c) {
+      if (std::abs(a.rgba()[i + c] - b.rgba()[i + c]) > tolerance) {
+        ++n;
+        break;
+      }
+    }
+  }
+  return n;
+}
+
+// An opaque box seen from a corner of the (+x, +y, +z) octant: the axes run
+// along the three edges at the far, minimum corner (between back faces) and
+// must vanish behind the volume; the box's edges at the near corner lie on
+// front faces and must show.
+TEST_F(ViewerFixture, LinesBehindAnOpaqueVolumeAreHiddenAndLinesInFrontDrawn) {
+  Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
+  v.setVolume(makeSheppLogan({40, 40, 40}), "phantom");
+  TransferFunction opaque;
+  opaque.addColor(0.0, {0.2, 0.3, 0.9});
+  opaque.addColor(1.0, {0.9, 0.9, 0.2});
+  opaque.addOpacity(0.0, 1.0);
+  opaque.addOpacity(1.0, 1.0);
+  v.tfEditor().setTransferFunction(opaque);
+  v.quality = Quality::Full;
+  bool cornerView = false;
+  for (double azimuth : {45.0, -45.0, 135.0, -135.0}) {
+    v.camera().azimuthDeg = azimuth;
+    v.camera().elevationDeg = 30.0;
+    const glm::dvec3 eye = v.camera().eye();
+    if (eye.x > 0.0 && eye.y > 0.0 && eye.z > 0.0) {
+      cornerView = true;
+      break;
+    }
+  }
+  ASSERT_TRUE(cornerView);
+  auto frame = [&](bool box, bool axes) {
+    v.showBoundingBox = box;
+    v.showAxes = axes;
+    v.render(kSize, kSize, fb.id());
+    return readFramebuffer(fb);
+  };
+  const Image plain = frame(false, false);
+  const Image axes = frame(false, true);
+  const Image box = frame(true, false);
+  // Lit: the volume covers a good part of the view, opaque.
+  int lit = 0;
+  for (std::size_t i = 0; i < plain.rgba().size(); i += 4) lit += plain.rgba()[i + 2] > 40;
+  EXPECT_GT(lit, kSize * kSize / 5);
+  EXPECT_EQ(differingPixels(plain, axes, 2), 0);
+  // The three near edges (and the silhouette's six) are drawn.
+  EXPECT_GT(differingPixels(plain, box, 8), 3 * kSize / 2);
+  // The axes are in view: with a transparent volume they show.
+  TransferFunction clear = opaque;
+  clear.opacities.clear();
+  clear.addOpacity(0.0, 0.0);
+  clear.addOpacity(1.0, 0.0);
+  v.tfEditor().setTransferFunction(clear);
+  EXPECT_GT(differingPixels(frame(false, false), frame(false, true), 8), kSize / 4);
+}
+
+TEST_F(ViewerFixture, VolumePixelCapRendersSmallerAndUpscales) {
+  Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
+  v.setVolume(makeSheppLogan({40, 40, 40}), "phantom");
+  v.quality = Quality::Full;
+  v.showBoundingBox = v.showAxes = false;
+  const Image full = (v.render(kSize, kSize, fb.id()), readFramebuffer(fb));
+  v.maxVolumePixels = kSize * kSize / 4;
+  const FrameStats fs = v.render(kSize, kSize, fb.id());
+  EXPECT_EQ(fs.renderWidth, kSize / 2);
+  EXPECT_EQ(fs.renderHeight, kSize / 2);
+  const double p = psnr(readFramebuffer(fb), full);
+  EXPECT_GT(p, 25.0);
+  EXPECT_LT(p, 60.0);
+}
+
+// A slow full-quality frame is rendered in strips across refine() calls
+// (a preview first), and the finished frame is the one render() draws at once.
+TEST_F(ViewerFixture, ProgressiveFramesRefineInStripsToTheFullFrame) {
+  Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
+  v.setVolume(makeSheppLogan({40, 40, 40}), "phantom");
+  v.camera().azimuthDeg = 30.0;
+  for (const char* technique : {"raycast", "slice3d", "slice2d"}) {
+    SCOPED_TRACE(technique);
+    v.setTechnique(technique);
+    v.progressive = false;
+    v.render(kSize, kSize, fb.id());
+    const Image whole = readFramebuffer(fb);
+    v.progressive = true;
+    v.frameBudgetMs = 1e-3;  // every frame is "slow": one strip per call
+    const FrameStats preview = v.render(kSize, kSize, fb.id());
+    EXPECT_FALSE(preview.complete);
+    EXPECT_TRUE(v.refining());
+    EXPECT_LE(preview.renderWidth, kSize);  // the interaction level: full size when cheap
+    int calls = 0;
+    while (v.refining() && calls < 10 * kSize) {
+      const FrameStats part = v.refine();
+      EXPECT_EQ(part.complete, !v.refining());
+      ++calls;
+    }
+    EXPECT_FALSE(v.refining());
+    EXPECT_GE(calls, 8);
+    EXPECT_TRUE(v.lastFrame().complete);
+    EXPECT_GE(psnr(readFramebuffer(fb), whole), 60.0);
+    // A new frame cancels the refinement in progress.
+    v.render(kSize, kSize, fb.id());
+    v.refine();
+    v.camera().azimuthDeg += 10.0;
+    v.progressive = false;
+    v.render(kSize, kSize, fb.id());
+    EXPECT_FALSE(v.refining());
+    v.camera().azimuthDeg -= 10.0;
+  }
 }
 
 TEST_F(ViewerFixture, FailedLoadKeepsThePreviousVolume) {

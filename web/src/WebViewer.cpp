@@ -5,6 +5,7 @@
 #include <emscripten/emscripten.h>
 #include <emscripten/html5.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <memory>
@@ -162,6 +163,23 @@ EMSCRIPTEN_KEEPALIVE double tessera_render(int width, int height) {
   return ms;
 }
 
+// Progressive full-quality frames (viewer::Viewer::progressive): the page
+// calls tessera_refine once per animation frame while tessera_refining says
+// a frame is pending; each call costs about `budgetMs`.
+EMSCRIPTEN_KEEPALIVE void tessera_set_progressive(int on, double budgetMs) {
+  if (!app().viewer) return;
+  theViewer().progressive = on != 0;
+  if (budgetMs > 0.0) theViewer().frameBudgetMs = budgetMs;
+}
+EMSCRIPTEN_KEEPALIVE int tessera_refining() {
+  return app().viewer && theViewer().refining() ? 1 : 0;
+}
+EMSCRIPTEN_KEEPALIVE double tessera_refine() {
+  double ms = -1.0;
+  guarded([&] { ms = theViewer().refine().ms; });
+  return ms;
+}
+
 // Pointer input in canvas pixels; action 0 orbit, 1 pan.
 EMSCRIPTEN_KEEPALIVE void tessera_pointer_down(int id, double x, double y, int action) {
   if (app().viewer)
@@ -246,6 +264,11 @@ EMSCRIPTEN_KEEPALIVE void tessera_set_overlays(int box, int axes) {
   theViewer().showBoundingBox = box != 0;
   theViewer().showAxes = axes != 0;
 }
+// The most volume pixels a frame renders (0: the canvas's own); the canvas
+// keeps its backing size (CSS size x devicePixelRatio) for lines and compositing.
+EMSCRIPTEN_KEEPALIVE void tessera_set_max_volume_pixels(int pixels) {
+  if (app().viewer) theViewer().maxVolumePixels = std::max(0, pixels);
+}
 EMSCRIPTEN_KEEPALIVE void tessera_set_quality(int adaptive) {
   if (app().viewer)
     theViewer().quality = adaptive ? viewer::Quality::Adaptive : viewer::Quality::Full;
@@ -297,6 +320,7 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_state_json(int logHistogram) {
     const Camera& c = v.camera();
     j["camera"] = {{"azimuth", c.azimuthDeg}, {"elevation", c.elevationDeg}, {"zoom", c.zoom}};
     j["frame_ms"] = v.lastFrame().ms;
+    j["refining"] = v.refining();
     j["render_size"] = {v.lastFrame().renderWidth, v.lastFrame().renderHeight};
     const viewer::TransferFunctionEditor::Selection& s = v.tfEditor().selection();
     j["selection"] = {{"channel", s.channel == viewer::TfChannel::Color ? 1 : 0},

@@ -39,6 +39,22 @@ struct DrawState {
 void apply(const DrawState& state);
 
 void setViewport(glm::ivec4 box);  // x, y, width, height
+
+// While one lives, every draw and clear is confined to a sub-rectangle of
+// the viewport of the moment, given as fractions (x0, y0, x1, y1 in [0, 1],
+// from the bottom left; pixel edges at round(fraction x size), so adjacent
+// regions tile a target exactly): a technique renders one tile of its frame
+// without knowing it (viewer::Viewer's progressive frames). It follows
+// every viewport change, so each target of a multi-pass technique gets the
+// same part of itself; a pass's own scissor box is intersected with it.
+// Regions do not nest.
+class RegionScope {
+ public:
+  explicit RegionScope(glm::vec4 fraction);
+  ~RegionScope();
+  RegionScope(const RegionScope&) = delete;
+  RegionScope& operator=(const RegionScope&) = delete;
+};
 void clearColor(glm::vec4 rgba);
 void clearColorAndDepth(glm::vec4 rgba, float depth = 1.0f);
 

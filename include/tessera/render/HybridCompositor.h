@@ -83,6 +83,13 @@ class HybridCompositor {
   void render(Technique& technique, const Camera& camera, const RenderSettings& settings,
               glm::dvec3 volumeExtent, int width, int height, const HybridOptions& options);
   Image readImage() const;  // the last frame, top row first
+  // The viewers' path: a volume layer the caller rendered (premultiplied
+  // colour over transparent black, its alpha the accumulated opacity; any
+  // size, upscaled bilinearly) composed with the overlay lines by depth, as
+  // render() composes them, over `background` into `framebuffer`'s
+  // box (x, y, width, height); the lines are rasterised at the box's size.
+  void composeInto(const gpu::Texture& volumeLayer, const Camera& camera, glm::vec4 background,
+                   glm::dvec3 volumeExtent, unsigned framebuffer, glm::ivec4 box);
   // The last frame's upscaled volume layer: RGB = volume colour over black,
   // A = the opacity estimate, at the offscreen size (top row first).
   Image readOpacityLayer() const;
@@ -91,6 +98,10 @@ class HybridCompositor {
 
  private:
   const gpu::Program& resolveProgram(const std::string& method);
+  // The full-resolution composite into the bound framebuffer, whose
+  // viewport is width x height at `origin`.
+  void drawComposite(const gpu::Texture& volumeLayer, const Camera& camera, glm::vec4 background,
+                     glm::dvec3 volumeExtent, int width, int height, glm::ivec2 origin);
 
   gpu::GlContext& context_;
   std::vector<OverlayLine> lines_;

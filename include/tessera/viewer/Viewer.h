@@ -16,6 +16,7 @@
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/layout/Planner.h"
+#include "tessera/render/Overlay.h"
 #include "tessera/render/QualityController.h"
 #include "tessera/render/TechniqueRegistry.h"
 #include "tessera/viewer/CameraController.h"
@@ -33,6 +34,9 @@ struct FrameStats {
   double ms = 0.0;      // the whole frame, up to a 1-pixel read-back (GL may not block on glFinish)
   int renderWidth = 0;  // what the technique rendered (smaller while adaptive quality interacts)
   int renderHeight = 0;
+  // False for a progressive frame's preview or a part of its refinement:
+  // the full-quality frame is still being rendered (Viewer::refine).
+  bool complete = true;
 };
 
 class Viewer {
@@ -82,8 +86,15 @@ class Viewer {
   void setTechnique(const std::string& name);
   const std::string& technique() const { return techniqueName_; }
   Quality quality = Quality::Adaptive;
+  // At most this many pixels of volume per frame (0: no cap): on a HiDPI
+  // screen the frame (lines, compositing) has the screen's pixels while the
+  // volume is rendered smaller and upscaled, as the hybrid compositor does;
+  // adaptive quality reduces it further while the user interacts.
+  int maxVolumePixels = 0;
   // The adaptive quality's feedback loop (goal: qualityController().options()).
   render::QualityController& qualityController() { return qualityController_; }
+  // Lines drawn at the frame's full resolution and composed with the volume
+  // by depth: hidden behind opaque parts, faded behind translucent ones.
   bool showBoundingBox = true;
   bool showAxes = true;
 
@@ -91,6 +102,22 @@ class Viewer {
   // width x height with its lower-left corner at `origin`, and times it.
   FrameStats render(int width, int height, unsigned framebuffer = 0, glm::ivec2 origin = {0, 0});
   const FrameStats& lastFrame() const { return last_; }
+
+  // Progressive full-quality frames, so that a slow technique never blocks
+  // the front end's input: when a full-quality frame is expected to cost
+  // more than frameBudgetMs (learnt from the frames before), render() shows
+  // a preview at adaptive quality's interaction level and starts the full
+  // frame, which refine() renders off screen in horizontal strips
+  // (gpu::RegionScope) of about frameBudgetMs each and shows once the last
+  // strip is done. The next render() cancels what is left. Between render()
+  // and the end of the refinement nothing else may draw with this viewer's
+  // technique (the strips accumulate in its target).
+  bool progressive = false;
+  double frameBudgetMs = 12.0;  // leaves most of a 60 Hz animation frame to the page
+  bool refining() const { return pending_.active; }
+  // One strip (about frameBudgetMs of work) of the pending frame, into the
+  // framebuffer render() was given; shows the frame when it is done.
+  FrameStats refine();
 
   // Patient directions at the view's edges (R/L, A/P, S/I) for the current
   // camera; empty strings when the volume's file carries no orientation
@@ -105,9 +132,33 @@ class Viewer {
   void updateHistogram();
   render::TechniqueOnVolume createActive(const std::string& technique,
                                          const lod::VolumeSource& source) const;
-  const gpu::Texture& renderVolume(int width, int height, FrameStats& stats,
-                                   render::QualityLevel& level);
-  void drawOverlayLines(int width, int height);
+  // The settings and size the technique renders a frame of width x height at.
+  struct VolumePass {
+    RenderSettings settings;
+    int width = 0;
+    int height = 0;
+  };
+  VolumePass volumePass(int width, int height, const render::QualityLevel& level) const;
+  void syncTransferFunction();
+  // Renders the volume at `level` and composes it into the framebuffer.
+  FrameStats presentFrame(int width, int height, unsigned framebuffer, glm::ivec2 origin,
+                          const render::QualityLevel& level);
+  void compose(const gpu::Texture& image, int width, int height, unsigned framebuffer,
+               glm::ivec2 origin);
+  // A progressive frame being refined.
+  struct Pending {
+    bool active = false;
+    int width = 0, height = 0;
+    unsigned framebuffer = 0;
+    glm::ivec2 origin{0, 0};
+    VolumePass pass;
+    double done = 0.0;  // fraction of the rows rendered
+    double ms = 0.0;    // spent on its strips
+  };
+  Pending pending_;
+  double frameMsPerPixel_ = 0.0;  // last full-quality frame's cost (0: unknown)
+  double stripMsPerPixel_ = 0.0;  // the refinement's strips'
+  std::vector<render::OverlayLine> overlayLines() const;  // box and axes as shown
 
   gpu::GlContext& context_;
   gpu::DeviceLimits limits_;
