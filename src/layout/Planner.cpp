@@ -56,7 +56,9 @@ glm::ivec3 axesToHalve(glm::ivec3 dims, const gpu::DeviceLimits& limits, bool on
 Plan planLayout(const Volume& volume, const gpu::DeviceLimits& limits, const PlanRequest& request) {
   std::vector<const LayoutEntry*> candidates;
   if (request.layout == "auto") {
-    for (const LayoutEntry& e : LayoutRegistry::global().entries()) candidates.push_back(&e);
+    for (const LayoutEntry& e : LayoutRegistry::global().entries()) {
+      if (e.automatic) candidates.push_back(&e);
+    }
   } else {
     const LayoutEntry& wished = LayoutRegistry::global().find(request.layout);
     if (!wished.runsOn(limits)) throw InputError(unmetNeeds(wished, limits));

@@ -1,0 +1,203 @@
+#include "tessera/layout/FccLayout.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
+#include "tessera/lattice/FccResampling.h"
+
+namespace tessera::layout {
+
+namespace {
+
+std::string dimsText(glm::ivec3 d) {
+  return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
+}
+
+gpu::TexelFormat formatFor(ScalarType type) {
+  return type == ScalarType::U8 ? gpu::TexelFormat::R8 : gpu::TexelFormat::R32F;
+}
+
+// The grid-coordinate range [lo, hi] of the samples a block along one axis
+// can take, widened by the spline's reach (|x|_inf < 2) and clamped to the
+// grid: every point the boundary rule may read for them.
+glm::ivec2 latticeReach(int block, int blockSize, int boxDim, int gridDim) {
+  const double scale = static_cast<double>(gridDim) / boxDim;
+  const double uLo = block * blockSize * scale - 0.5;
+  const double uHi = std::min((block + 1) * blockSize, boxDim) * scale - 0.5;
+  const int lo = std::clamp(static_cast<int>(std::floor(uLo)) - 2, 0, gridDim - 1);
+  const int hi = std::clamp(static_cast<int>(std::ceil(uHi)) + 2, 0, gridDim - 1);
+  return {lo, hi};
+}
+
+}  // namespace
+
+std::string FccLayout::layoutName(lattice::FccDensity density) {
+  return density == lattice::FccDensity::Same ? "fcc" : "fcc-half";
+}
+
+LayoutPlan FccLayout::planFor(glm::ivec3 gridDims, ScalarType type, const gpu::DeviceLimits& limits,
+                              const std::string& name) {
+  LayoutPlan plan;
+  plan.layout = name;
+  PlannedTexture t;
+  t.label = "FCC lattice";
+  t.size = lattice::FccVolume::packedDims(gridDims);
+  t.is3D = true;
+  const gpu::TexelFormat format = formatFor(type);
+  t.format = gpu::texelFormatName(format);
+  t.bytes = static_cast<std::uint64_t>(t.size.x) * static_cast<std::uint64_t>(t.size.y) *
+            static_cast<std::uint64_t>(t.size.z) * gpu::bytesPerTexel(format);
+  plan.totalBytes = t.bytes;
+  plan.textures.push_back(t);
+  const std::string what = "FCC lattice on a " + dimsText(gridDims) + " grid, packed into one " +
+                           dimsText(t.size) + " " + t.format + " 3D texture (" +
+                           formatBytes(t.bytes) + "), box spline through texelFetch";
+  const glm::ivec3 d = t.size;
+  if (limits.api != gpu::ApiLevel::Gles3 || limits.max3DTextureSize == 0) {
+    plan.reason =
+        "the box spline needs OpenGL ES 3 (3D textures, texelFetch, integer maths), "
+        "which " +
+        limits.profile + " does not have";
+  } else if (std::max({d.x, d.y, d.z}) > limits.max3DTextureSize) {
+    plan.reason = what + " exceeds the max 3D texture size " +
+                  std::to_string(limits.max3DTextureSize) + " of " + limits.profile;
+  } else if (limits.textureBudget != 0 && t.bytes > limits.textureBudget) {
+    plan.reason = what + " exceeds the texture budget " + formatBytes(limits.textureBudget) +
+                  " of " + limits.profile;
+  } else if (limits.textureUnits < 1) {
+    plan.reason = "no texture unit left for the lattice on " + limits.profile;
+  } else {
+    plan.fits = true;
+    plan.reason = what;
+  }
+  return plan;
+}
+
+std::unique_ptr<FccLayout> FccLayout::create(lattice::FccVolume fcc,
+                                             const gpu::DeviceLimits& limits,
+                                             gpu::MemoryLedger& ledger, const std::string& name) {
+  std::unique_ptr<FccLayout> l(new FccLayout());
+  l->name_ = name;
+  l->plan_ = planFor(fcc.gridDims(), fcc.packed().type(), limits, name);
+  if (!l->plan_.fits) throw GpuError(name + " layout: " + l->plan_.reason);
+  const Volume& packed = fcc.packed();
+  const glm::ivec3 d = packed.dims();
+  const std::string label = "FCC lattice (" + name + ")";
+  if (packed.type() == ScalarType::U8) {
+    l->texture_ = gpu::Texture::create3D(ledger, label, gpu::TexelFormat::R8, d.x, d.y, d.z,
+                                         packed.bytes().data());
+    l->mapping_ = {255.0, 0.0};
+  } else if (packed.type() == ScalarType::F32) {
+    l->texture_ = gpu::Texture::create3D(ledger, label, gpu::TexelFormat::R32F, d.x, d.y, d.z,
+                                         packed.dataAs<float>());
+    l->mapping_ = {1.0, 0.0};
+  } else {
+    const std::size_t n = static_cast<std::size_t>(packed.voxelCount());
+    HostBudget::global().check(n * sizeof(float), "FCC lattice upload staging");
+    std::vector<float> staging(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      staging[i] = static_cast<float>(packed.finiteValueAtIndex(i));
+    }
+    l->texture_ = gpu::Texture::create3D(ledger, label, gpu::TexelFormat::R32F, d.x, d.y, d.z,
+                                         staging.data());
+    l->mapping_ = {1.0, 0.0};
+  }
+  l->texture_.setFilter(gpu::Filter::Nearest);
+  l->fcc_ = std::move(fcc);
+  return l;
+}
+
+std::unique_ptr<FccLayout> FccLayout::resample(const Volume& volume, lattice::FccDensity density,
+                                               const gpu::DeviceLimits& limits,
+                                               gpu::MemoryLedger& ledger) {
+  const std::string name = layoutName(density);
+  // Refuse before the (seconds-long) resampling when it cannot fit.
+  const LayoutPlan plan =
+      planFor(lattice::fccGridDims(volume.dims(), density), volume.type(), limits, name);
+  if (!plan.fits) throw GpuError(name + " layout: " + plan.reason);
+  lattice::FccResampleOptions options;
+  options.density = density;
+  return create(lattice::resampleToFcc(volume, options), limits, ledger, name);
+}
+
+gpu::ShaderPart FccLayout::glsl() const {
+  return gpu::embeddedShaderPart("layout/fcc.glsl");
+}
+
+std::vector<gpu::ShaderPart> FccLayout::glslParts() const {
+  return {glsl(), gpu::embeddedShaderPart("layout/fcc_pieces.glsl")};
+}
+
+int FccLayout::bind(const gpu::Program& program, int firstUnit) const {
+  texture_.bind(firstUnit);
+  program.set("u_layoutFcc", firstUnit);
+  program.set("u_layoutFccGrid", glm::vec3(fcc_.gridDims()));
+  return 1;
+}
+
+ValueBlocks FccLayout::valueBlocks(int blockSize) const {
+  if (blockSize < 1) throw InputError("block size must be >= 1");
+  const glm::ivec3 box = fcc_.box().dims();
+  const glm::ivec3 grid = fcc_.gridDims();
+  const glm::ivec3 count = (box + blockSize - 1) / blockSize;
+  const Volume& packed = fcc_.packed();
+  const glm::ivec3 pd = packed.dims();
+  std::vector<float> texels(static_cast<std::size_t>(packed.voxelCount()));
+  for (std::size_t i = 0; i < texels.size(); ++i) {
+    texels[i] = static_cast<float>(packed.finiteValueAtIndex(i));
+  }
+  std::vector<glm::ivec2> reach[3];
+  for (int a = 0; a < 3; ++a) {
+    for (int b = 0; b < count[a]; ++b) {
+      reach[a].push_back(latticeReach(b, blockSize, box[a], grid[a]));
+    }
+  }
+  const std::size_t n = static_cast<std::size_t>(count.x) * count.y * count.z;
+  std::vector<float> mins(n), maxs(n);
+  for (int bz = 0; bz < count.z; ++bz) {
+    for (int by = 0; by < count.y; ++by) {
+      for (int bx = 0; bx < count.x; ++bx) {
+        // Texels of the reached grid points: x texel = point.x >> 1.
+        const glm::ivec2 rx = reach[0][static_cast<std::size_t>(bx)] >> 1;
+        const glm::ivec2 ry = reach[1][static_cast<std::size_t>(by)];
+        const glm::ivec2 rz = reach[2][static_cast<std::size_t>(bz)];
+        float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+        for (int z = rz.x; z <= rz.y; ++z) {
+          for (int y = ry.x; y <= ry.y; ++y) {
+            const float* row = texels.data() + (static_cast<std::size_t>(z) * pd.y + y) * pd.x;
+            for (int x = rx.x; x <= std::min(rx.y, pd.x - 1); ++x) {
+              lo = std::min(lo, row[x]);
+              hi = std::max(hi, row[x]);
+            }
+          }
+        }
+        const std::size_t i = (static_cast<std::size_t>(bz) * count.y + by) * count.x + bx;
+        mins[i] = lo;
+        maxs[i] = hi;
+      }
+    }
+  }
+  return ValueBlocks(count, blockSize, supportVoxels(), std::move(mins), std::move(maxs));
+}
+
+LayoutEntry FccLayout::registration(lattice::FccDensity density) {
+  return {.name = layoutName(density),
+          .minApi = gpu::ApiLevel::Gles3,
+          .needs3DTextures = true,
+          .automatic = false,
+          .plan =
+              [density](const Volume& shape, const gpu::DeviceLimits& limits, int) {
+                return planFor(lattice::fccGridDims(shape.dims(), density), shape.type(), limits,
+                               layoutName(density));
+              },
+          .create = [density](const Volume& volume, const gpu::DeviceLimits& limits,
+                              gpu::MemoryLedger& ledger, int) -> std::unique_ptr<Layout> {
+            return resample(volume, density, limits, ledger);
+          }};
+}
+
+}  // namespace tessera::layout

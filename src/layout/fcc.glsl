@@ -1,0 +1,52 @@
+// sampleVolume for FccLayout (GLSL ES 3.00 only): the six-direction box
+// spline of an FCC lattice (lattice/FccBoxSpline.h, whose CPU evaluator this
+// mirrors step by step) from its x-packed texels (lattice/FccVolume.h).
+// Kim, "GPU isosurface raycasting of FCC datasets", Graphical Models 75(2),
+// 2013: the knot planes cut each unit cube into five tetrahedra; an odd cube
+// is the point reflection of an even one and two-axis reflections map the
+// four corner tetrahedra onto the one at the origin, so two reference pieces
+// (layout/fcc_pieces.glsl, generated) with 16 lattice points each give every
+// value. Uniform control flow per piece; no tables in memory.
+uniform highp sampler3D u_layoutFcc;  // packed texels, NEAREST
+uniform vec3 u_layoutFccGrid;         // grid dims D of the lattice
+
+// Lattice point q under the boundary rule: clamp to the grid, then texel
+// (x >> 1, y, z) of the packing.
+float fccPoint(ivec3 q) {
+  ivec3 c = clamp(q, ivec3(0), ivec3(u_layoutFccGrid) - 1);
+  return texelFetch(u_layoutFcc, ivec3(c.x >> 1, c.y, c.z), 0).r;
+}
+
+float fccCorner(ivec3 b, ivec3 s, vec3 l);
+float fccCentral(ivec3 b, ivec3 s, vec3 l);
+
+float sampleVolume(vec3 p) {
+  vec3 u = p * u_layoutFccGrid - 0.5;
+  vec3 o = floor(u);
+  vec3 v = u - o;
+  ivec3 io = ivec3(o);
+  bool odd = ((io.x + io.y + io.z) & 1) != 0;
+  vec3 w = odd ? 1.0 - v : v;
+  // Which two-axis reflection carries w's corner tetrahedron to the origin's
+  // (none for the origin's own), or the central tetrahedron.
+  bvec3 reflect = bvec3(false);
+  bool central = false;
+  if (w.x + w.y + w.z > 1.0) {
+    if (w.x + w.y - w.z >= 1.0) {
+      reflect = bvec3(true, true, false);
+    } else if (w.x - w.y + w.z >= 1.0) {
+      reflect = bvec3(true, false, true);
+    } else if (-w.x + w.y + w.z >= 1.0) {
+      reflect = bvec3(false, true, true);
+    } else {
+      central = true;
+    }
+  }
+  // Both reflections together: lattice point = base + sign * offset.
+  bvec3 flip = notEqual(bvec3(odd), reflect);
+  ivec3 f = ivec3(flip);
+  ivec3 base = io + f;
+  ivec3 sgn = 1 - 2 * f;
+  vec3 local = mix(v, 1.0 - v, vec3(flip));
+  return central ? fccCentral(base, sgn, local) : fccCorner(base, sgn, local);
+}
