@@ -189,6 +189,7 @@ LayoutEntry FccLayout::registration(lattice::FccDensity density) {
           .minApi = gpu::ApiLevel::Gles3,
           .needs3DTextures = true,
           .automatic = false,
+          .needsText = "OpenGL ES 3 (3D textures, texelFetch and integer maths for the box spline)",
           .plan =
               [density](const Volume& shape, const gpu::DeviceLimits& limits, int) {
                 return planFor(lattice::fccGridDims(shape.dims(), density), shape.type(), limits,

@@ -17,7 +17,9 @@ std::string dimsText(glm::ivec3 d) {
 // "layout texture3d needs 3D textures, which ipad2 does not have (use
 // mosaic or packed-mosaic)".
 std::string unmetNeeds(const LayoutEntry& entry, const gpu::DeviceLimits& limits) {
-  const std::string need = entry.needs3DTextures ? "3D textures" : "OpenGL ES 3";
+  const std::string need = !entry.needsText.empty() ? entry.needsText
+                           : entry.needs3DTextures  ? "3D textures"
+                                                    : "OpenGL ES 3";
   std::vector<std::string> others;
   for (const LayoutEntry& e : LayoutRegistry::global().entries()) {
     if (e.runsOn(limits)) others.push_back(e.name);

@@ -27,6 +27,9 @@ struct LayoutEntry {
   // Whether "auto" may choose it; false for a layout that changes the
   // reconstruction (fcc), which must be asked for by name.
   bool automatic = true;
+  // What it needs, in words, for the refusal (default: "3D textures" or
+  // "OpenGL ES 3" from the two fields above).
+  std::string needsText = {};
   // What it costs: the textures it would allocate for a volume of `shape`
   // within `limits` using at most `units` texture units; fits = false and a
   // reason when it cannot.
