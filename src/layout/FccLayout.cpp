@@ -129,7 +129,15 @@ gpu::ShaderPart FccLayout::glsl() const {
 }
 
 std::vector<gpu::ShaderPart> FccLayout::glslParts() const {
-  return {glsl(), gpu::embeddedShaderPart("layout/fcc_pieces.glsl")};
+  std::vector<gpu::ShaderPart> parts;
+  if (evaluation_ == Evaluation::FetchesOnly) {
+    parts.push_back({"fcc cost split", "#define FCC_FETCHES_ONLY 1\n"});
+  } else if (evaluation_ == Evaluation::ArithmeticOnly) {
+    parts.push_back({"fcc cost split", "#define FCC_ARITHMETIC_ONLY 1\n"});
+  }
+  parts.push_back(glsl());
+  parts.push_back(gpu::embeddedShaderPart("layout/fcc_pieces.glsl"));
+  return parts;
 }
 
 int FccLayout::bind(const gpu::Program& program, int firstUnit) const {

@@ -13,8 +13,14 @@ uniform vec3 u_layoutFccGrid;         // grid dims D of the lattice
 // Lattice point q under the boundary rule: clamp to the grid, then texel
 // (x >> 1, y, z) of the packing.
 float fccPoint(ivec3 q) {
+#ifdef FCC_ARITHMETIC_ONLY
+  // The benchmark's cost split (FccLayout::Evaluation::ArithmeticOnly): a
+  // value that depends on q, but no fetch.
+  return float(q.x - q.y + q.z) * 0.01;
+#else
   ivec3 c = clamp(q, ivec3(0), ivec3(u_layoutFccGrid) - 1);
   return texelFetch(u_layoutFcc, ivec3(c.x >> 1, c.y, c.z), 0).r;
+#endif
 }
 
 float fccCorner(ivec3 b, ivec3 s, vec3 l);

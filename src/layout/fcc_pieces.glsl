@@ -22,6 +22,9 @@ float fccCorner(ivec3 b, ivec3 s, vec3 l) {
   float c13 = fccPoint(b + s * ivec3(1, 0, 1));
   float c14 = fccPoint(b + s * ivec3(1, 1, 0));
   float c15 = fccPoint(b + s * ivec3(2, 0, 0));
+#ifdef FCC_FETCHES_ONLY
+  return 0.0625 * (c0 + c1 + c2 + c3 + c4 + c5 + c6 + c7 + c8 + c9 + c10 + c11 + c12 + c13 + c14 + c15);
+#endif
   float l0 = 1.0 - l.x - l.y - l.z;
   float l1 = l.x;
   float l2 = l.y;
@@ -114,6 +117,9 @@ float fccCentral(ivec3 b, ivec3 s, vec3 l) {
   float c14 = fccPoint(b + s * ivec3(2, 0, 0));
   float c15 = fccPoint(b + s * ivec3(2, 1, 1));
   float t = 0.5 * (l.x + l.y + l.z - 1.0);
+#ifdef FCC_FETCHES_ONLY
+  return 0.0625 * (c0 + c1 + c2 + c3 + c4 + c5 + c6 + c7 + c8 + c9 + c10 + c11 + c12 + c13 + c14 + c15);
+#endif
   float l0 = l.x - t;
   float l1 = l.y - t;
   float l2 = l.z - t;

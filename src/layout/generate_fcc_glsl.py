@@ -101,6 +101,10 @@ def piece_glsl(name, glsl_name, rows, xyz, bary, comment):
                 beta.setdefault(alpha, []).append((k, v))
     if glsl_name.endswith("Central"):
         lines.append("  float t = 0.5 * (l.x + l.y + l.z - 1.0);")
+    # The benchmark's cost split (FccLayout::Evaluation::FetchesOnly).
+    lines.append("#ifdef FCC_FETCHES_ONLY")
+    lines.append("  return 0.0625 * (" + " + ".join(f"c{k}" for k in range(16)) + ");")
+    lines.append("#endif")
     for i, expr in enumerate(bary):
         lines.append(f"  float l{i} = {expr};")
     for i in range(4):

@@ -68,6 +68,13 @@ class FccLayout final : public Layout {
 
   const lattice::FccVolume& lattice() const { return fcc_; }
 
+  // For `tessera bench --fcc`'s split of the cost: the 16 fetches without
+  // the weights (their mean), or the weights without fetches (coefficients
+  // made up from the point's coordinates). Neither is a reconstruction; set
+  // before a technique builds its program.
+  enum class Evaluation { BoxSpline, FetchesOnly, ArithmeticOnly };
+  void setEvaluation(Evaluation e) { evaluation_ = e; }
+
   static LayoutEntry registration(lattice::FccDensity density);
 
  private:
@@ -77,6 +84,7 @@ class FccLayout final : public Layout {
   LayoutPlan plan_;
   gpu::Texture texture_;
   ValueMapping mapping_;
+  Evaluation evaluation_ = Evaluation::BoxSpline;
 };
 
 }  // namespace tessera::layout
