@@ -7,8 +7,27 @@
 // four corner tetrahedra onto the one at the origin, so two reference pieces
 // (layout/fcc_pieces.glsl, generated) with 16 lattice points each give every
 // value. Uniform control flow per piece; no tables in memory.
-uniform highp sampler3D u_layoutFcc;  // packed texels, NEAREST
+uniform highp sampler3D u_layoutFcc;  // NEAREST; packed texels, or cubes with FCC_CUBES
 uniform vec3 u_layoutFccGrid;         // grid dims D of the lattice
+
+#ifdef FCC_CUBES
+// Cube storage (FccLayout::Storage::Cubes): texel q + 2 holds, in channel
+// o.x + 2 o.y, the value of the FCC corner q + o of the unit cube at q (o.z
+// from the parity), boundary rule applied, for q in [-2, D]^3: the cube of
+// reference offset q under the piece's reflection s and base b, its
+// channels reordered so that the reference channel reads the right corner
+// (a flip of x swaps the channel's bit 0, of y its bit 1).
+vec4 fccCube(ivec3 b, ivec3 s, ivec3 q) {
+#ifdef FCC_ARITHMETIC_ONLY
+  vec3 o = vec3(b + s * q);
+  return vec4(o.x, o.y, o.z, o.x - o.y) * 0.01;
+#else
+  vec4 t = texelFetch(u_layoutFcc, b + s * q + (s - 1) / 2 + 2, 0);
+  t = s.x < 0 ? t.grab : t;
+  return s.y < 0 ? t.barg : t;
+#endif
+}
+#endif
 
 // Lattice point q under the boundary rule: clamp to the grid, then texel
 // (x >> 1, y, z) of the packing.

@@ -6,6 +6,7 @@
 
 // Corner tetrahedron (0,0,0), (1,0,0), (0,1,0), (0,0,1): l0 = 1 - x - y - z.
 float fccCorner(ivec3 b, ivec3 s, vec3 l) {
+#ifndef FCC_CUBES
   float c0 = fccPoint(b + s * ivec3(-1, -1, 0));
   float c1 = fccPoint(b + s * ivec3(-1, 0, -1));
   float c2 = fccPoint(b + s * ivec3(-1, 0, 1));
@@ -22,6 +23,29 @@ float fccCorner(ivec3 b, ivec3 s, vec3 l) {
   float c13 = fccPoint(b + s * ivec3(1, 0, 1));
   float c14 = fccPoint(b + s * ivec3(1, 1, 0));
   float c15 = fccPoint(b + s * ivec3(2, 0, 0));
+#else
+  vec4 t0 = fccCube(b, s, ivec3(-1, -1, -1));
+  vec4 t1 = fccCube(b, s, ivec3(-1, -1, 1));
+  vec4 t2 = fccCube(b, s, ivec3(-1, 1, -1));
+  vec4 t3 = fccCube(b, s, ivec3(0, 0, 0));
+  vec4 t4 = fccCube(b, s, ivec3(1, -1, -1));
+  float c0 = t0.r;
+  float c1 = t0.b;
+  float c2 = t1.b;
+  float c3 = t2.r;
+  float c4 = t0.g;
+  float c5 = t1.g;
+  float c6 = t0.a;
+  float c7 = t1.a;
+  float c8 = t2.g;
+  float c9 = t3.b;
+  float c10 = t2.a;
+  float c11 = t4.r;
+  float c12 = t4.b;
+  float c13 = t3.g;
+  float c14 = t3.a;
+  float c15 = t4.a;
+#endif
 #ifdef FCC_FETCHES_ONLY
   return 0.0625 * (c0 + c1 + c2 + c3 + c4 + c5 + c6 + c7 + c8 + c9 + c10 + c11 + c12 + c13 + c14 + c15);
 #endif
@@ -100,6 +124,7 @@ float fccCorner(ivec3 b, ivec3 s, vec3 l) {
 
 // Central tetrahedron (1,0,0), (0,1,0), (0,0,1), (1,1,1): l3 = (x + y + z - 1) / 2.
 float fccCentral(ivec3 b, ivec3 s, vec3 l) {
+#ifndef FCC_CUBES
   float c0 = fccPoint(b + s * ivec3(-1, 0, 1));
   float c1 = fccPoint(b + s * ivec3(-1, 1, 0));
   float c2 = fccPoint(b + s * ivec3(0, -1, 1));
@@ -116,6 +141,29 @@ float fccCentral(ivec3 b, ivec3 s, vec3 l) {
   float c13 = fccPoint(b + s * ivec3(1, 2, 1));
   float c14 = fccPoint(b + s * ivec3(2, 0, 0));
   float c15 = fccPoint(b + s * ivec3(2, 1, 1));
+#else
+  vec4 t0 = fccCube(b, s, ivec3(-1, -1, 0));
+  vec4 t1 = fccCube(b, s, ivec3(-1, 1, -1));
+  vec4 t2 = fccCube(b, s, ivec3(0, 0, 1));
+  vec4 t3 = fccCube(b, s, ivec3(1, -1, -1));
+  vec4 t4 = fccCube(b, s, ivec3(1, 1, 0));
+  float c0 = t0.b;
+  float c1 = t1.r;
+  float c2 = t0.g;
+  float c3 = t0.a;
+  float c4 = t2.r;
+  float c5 = t1.g;
+  float c6 = t2.b;
+  float c7 = t1.a;
+  float c8 = t3.r;
+  float c9 = t3.b;
+  float c10 = t2.g;
+  float c11 = t4.r;
+  float c12 = t2.a;
+  float c13 = t4.b;
+  float c14 = t3.a;
+  float c15 = t4.g;
+#endif
   float t = 0.5 * (l.x + l.y + l.z - 1.0);
 #ifdef FCC_FETCHES_ONLY
   return 0.0625 * (c0 + c1 + c2 + c3 + c4 + c5 + c6 + c7 + c8 + c9 + c10 + c11 + c12 + c13 + c14 + c15);

@@ -21,7 +21,7 @@ import os
 import re
 import sys
 from fractions import Fraction as F
-from itertools import product
+from itertools import combinations, product
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 TABLES = os.path.join(HERE, "..", "lattice", "FccBoxSplinePieces.h")
@@ -84,6 +84,32 @@ def bb_form(coefficients, xyz):
     return out
 
 
+def cube_cover(points):
+    """The fewest unit cubes [q, q + 1]^3 whose FCC corners hold `points`
+    (5 for both pieces), and for each point its cube and channel: a cube's
+    four FCC corners q + o are told apart by o.x + 2 o.y (o.z follows from
+    the parity), the channel FccLayout's cube texture stores them in."""
+    wanted = set(points)
+    cubes = []
+    for q in product(range(-2, 3), repeat=3):
+        corners = {tuple(q[a] + o[a] for a in range(3)) for o in product((0, 1), repeat=3)}
+        if corners & wanted:
+            cubes.append(q)
+    def corners_of(q):
+        return {tuple(q[a] + o[a] for a in range(3)) for o in product((0, 1), repeat=3)
+                if sum(q[a] + o[a] for a in range(3)) % 2 == 0}
+    for k in range(1, 8):
+        for combo in combinations(cubes, k):
+            if wanted <= set().union(*(corners_of(q) for q in combo)):
+                where = []
+                for p in points:
+                    j = next(i for i, q in enumerate(combo) if p in corners_of(q))
+                    o = [p[a] - combo[j][a] for a in range(3)]
+                    where.append((j, o[0] + 2 * o[1]))
+                return list(combo), where
+    raise AssertionError("no cube cover")
+
+
 def literal(f):
     v = float(f)
     return repr(v) if "." in repr(v) or "e" in repr(v) else repr(v) + ".0"
@@ -92,8 +118,19 @@ def literal(f):
 def piece_glsl(name, glsl_name, rows, xyz, bary, comment):
     lines = [f"// {comment}",
              f"float {glsl_name}(ivec3 b, ivec3 s, vec3 l) {{"]
+    # Packed storage: one fetch per lattice point.
+    lines.append("#ifndef FCC_CUBES")
     for k, (off, _) in enumerate(rows):
         lines.append(f"  float c{k} = fccPoint(b + s * ivec3({off[0]}, {off[1]}, {off[2]}));")
+    # Cube storage: the 16 points are the FCC corners of 5 unit cubes, one
+    # RGBA fetch each (fccCube reflects the cube and orders its channels).
+    lines.append("#else")
+    cubes, where = cube_cover([off for off, _ in rows])
+    for j, q in enumerate(cubes):
+        lines.append(f"  vec4 t{j} = fccCube(b, s, ivec3({q[0]}, {q[1]}, {q[2]}));")
+    for k, (j, ch) in enumerate(where):
+        lines.append(f"  float c{k} = t{j}.{'rgba'[ch]};")
+    lines.append("#endif")
     beta = {}
     for k, (_, co) in enumerate(rows):
         for alpha, v in bb_form(co, xyz).items():

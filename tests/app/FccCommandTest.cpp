@@ -17,9 +17,10 @@ TEST(FccCommand, RendersBothDensitiesAndComparesWithTheBoxSplineReference) {
     EXPECT_EQ(j["layout"], std::string(density) == "same" ? "fcc" : "fcc-half");
     EXPECT_EQ(j["lattice"], "fcc");
     EXPECT_GE(j["psnr_db"].get<double>(), 40.0) << density;
-    // The lattice's texture: 30^3 grid (same) or 24^3 (half), x-packed, R32F.
-    const std::uint64_t texels = std::string(density) == "same" ? 15u * 30 * 30 : 12u * 24 * 24;
-    EXPECT_EQ(j["volume_texture_bytes"].get<std::uint64_t>(), texels * 4) << density;
+    // The lattice's texture: the unit cubes (origins -2 .. D) of a 30^3 grid
+    // (same) or 24^3 (half), RGBA32F.
+    const std::uint64_t cubes = std::string(density) == "same" ? 33u * 33 * 33 : 27u * 27 * 27;
+    EXPECT_EQ(j["volume_texture_bytes"].get<std::uint64_t>(), cubes * 16) << density;
   }
 }
 

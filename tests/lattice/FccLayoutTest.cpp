@@ -71,10 +71,12 @@ struct ProbeError {
   std::size_t count = 0;
 };
 
-ProbeError probeAgainstCpu(const FccVolume& fcc) {
-  const auto layout = layout::FccLayout::create(fcc, nativeLimits(), test::gpuContext().ledger());
+ProbeError probeAgainstCpu(const FccVolume& fcc, layout::FccLayout::Storage storage) {
+  const auto layout =
+      layout::FccLayout::create(fcc, nativeLimits(), test::gpuContext().ledger(), "fcc", storage);
+  EXPECT_EQ(layout->storage(), storage);
   layout::LayoutProbe probe(test::gpuContext());
-  const std::vector<glm::vec3> at = probePositions(fcc, 20000);
+  const std::vector<glm::vec3> at = probePositions(fcc, 8000);
   const std::vector<float> gpuValues = probe.sample(*layout, at);
   const FccBoxSpline spline(fcc);
   const double scale = layout->rawFromStored().scale;
@@ -137,21 +139,25 @@ Volume blobs(glm::ivec3 dims) {
 
 }  // namespace
 
-// The GLSL pieces (generated BB form), region classification and packed
-// addressing against the CPU evaluator, at 20000 random points and every
-// lattice point of odd grids, f32 (R32F) and u8 (R8) texels.
+// The GLSL pieces (generated BB form), region classification and both
+// storages' addressing (packed: 16 fetches; cubes: 5 RGBA fetches, channels
+// reordered by the reflection) against the CPU evaluator, at 8000 random
+// points and every lattice point of odd grids, f32 and u8 texels.
 TEST(FccLayout, GlslBoxSplineMatchesTheCpuEvaluator) {
   if (!layout::LayoutProbe(test::gpuContext()).hasFloatTargets())
     GTEST_SKIP() << "no float targets";
+  using Storage = layout::FccLayout::Storage;
   for (const glm::ivec3 grid : {glm::ivec3(13, 11, 9), glm::ivec3(8, 15, 7)}) {
-    const ProbeError f = probeAgainstCpu(randomLattice(grid, ScalarType::F32, 3));
-    const ProbeError b = probeAgainstCpu(randomLattice(grid, ScalarType::U8, 4));
-    std::printf(
-        "[measured] GLSL vs CPU box spline, grid %dx%dx%d: f32 max %.2e, u8 max %.2e "
-        "(of the value scale) over %zu points\n",
-        grid.x, grid.y, grid.z, f.max, b.max, f.count);
-    EXPECT_LT(f.max, 2e-5);
-    EXPECT_LT(b.max, 2e-5);
+    for (const Storage storage : {Storage::Packed, Storage::Cubes}) {
+      const ProbeError f = probeAgainstCpu(randomLattice(grid, ScalarType::F32, 3), storage);
+      const ProbeError b = probeAgainstCpu(randomLattice(grid, ScalarType::U8, 4), storage);
+      std::printf(
+          "[measured] GLSL vs CPU box spline, grid %dx%dx%d, %s: f32 max %.2e, u8 max "
+          "%.2e (of the value scale) over %zu points\n",
+          grid.x, grid.y, grid.z, layout::FccLayout::storageName(storage), f.max, b.max, f.count);
+      EXPECT_LT(f.max, 2e-5);
+      EXPECT_LT(b.max, 2e-5);
+    }
   }
 }
 
@@ -274,19 +280,35 @@ TEST(FccLayout, PlannerAccountsItsBytesAndRefusesDevicesWithoutEs3) {
   layout::PlanRequest r;
   EXPECT_NE(layout::planLayout(shape, gles3, r).layout.layout, "fcc");  // auto never picks it
   r.layout = "fcc";
+  // Cube storage where it fits: an RGBA texel per unit cube of the grid
+  // (origins -2 .. D), else the x-packed lattice (one texel per point).
+  const glm::ivec3 grid = fccGridDims({64, 64, 64}, FccDensity::Same);
+  const glm::ivec3 packed = FccVolume::packedDims(grid);
+  const std::uint64_t packedBytes = static_cast<std::uint64_t>(packed.x) * packed.y * packed.z;
+  const std::uint64_t cubeBytes =
+      static_cast<std::uint64_t>(grid.x + 3) * (grid.y + 3) * (grid.z + 3) * 4;  // RGBA8
   const layout::Plan same = layout::planLayout(shape, gles3, r);
   EXPECT_TRUE(same.layout.fits);
-  const glm::ivec3 packed = FccVolume::packedDims(fccGridDims({64, 64, 64}, FccDensity::Same));
-  EXPECT_EQ(same.layout.totalBytes,
-            static_cast<std::uint64_t>(packed.x) * packed.y * packed.z);  // R8
+  EXPECT_EQ(same.layout.totalBytes, cubeBytes);
+  EXPECT_EQ(layout::FccLayout::planFor(grid, ScalarType::U8, gles3, "fcc",
+                                       layout::FccLayout::Storage::Packed)
+                .totalBytes,
+            packedBytes);  // R8
   r.layout = "fcc-half";
   const layout::Plan half =
       layout::planLayout(Volume::shapeOnly({64, 64, 64}, ScalarType::F32), gles3, r);
-  EXPECT_EQ(half.layout.totalBytes, 32ull * 64 * 64 * 4);  // R32F, half the points
-  // Over the budget: the planner halves the volume first, and says so.
+  EXPECT_EQ(half.layout.totalBytes, 67ull * 67 * 67 * 16);  // RGBA32F cubes of the 64^3 grid
+  // A budget the cubes exceed: the packed lattice, and the plan says why.
+  gpu::DeviceLimits tight = gles3;
+  tight.textureBudget = cubeBytes / 2;
+  r.layout = "fcc";
+  const layout::Plan fallback = layout::planLayout(shape, tight, r);
+  EXPECT_FALSE(fallback.downsampled());
+  EXPECT_EQ(fallback.layout.totalBytes, packedBytes);
+  EXPECT_NE(fallback.reason.find("not cubes"), std::string::npos) << fallback.reason;
+  // Over the budget even packed: the planner halves the volume first, and says so.
   gpu::DeviceLimits small = gles3;
   small.textureBudget = 200 * 1024;
-  r.layout = "fcc";
   const layout::Plan reduced = layout::planLayout(shape, small, r);
   EXPECT_TRUE(reduced.downsampled());
   EXPECT_LE(reduced.layout.totalBytes, small.textureBudget);
