@@ -11,6 +11,7 @@
 
 #include "app/RenderJob.h"
 #include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/io/VolumeReader.h"
@@ -69,8 +70,12 @@ struct Run {
   std::vector<Variant> variants;  // trilinear, fcc same, fcc half, fetches only, arithmetic only
 };
 
+// Variants, in this order: trilinear; box spline same and half density
+// from cube storage (5 fetches); the same from packed storage (16 fetches);
+// the cost split of same/cubes.
 Run benchDataset(gpu::GlContext& context, const gpu::DeviceLimits& limits, const Dataset& d,
                  const TransferFunction& tf, const FccBenchOptions& o, int width, int height) {
+  using Storage = layout::FccLayout::Storage;
   Run run;
   run.variants.push_back({"trilinear",
                           layout::Texture3DLayout::create(d.cartesian, limits, context.ledger()),
@@ -78,15 +83,23 @@ Run benchDataset(gpu::GlContext& context, const gpu::DeviceLimits& limits, const
                           {}});
   const lattice::FccVolume same = latticeOf(d, lattice::FccDensity::Same);
   const lattice::FccVolume half = latticeOf(d, lattice::FccDensity::Half);
-  run.variants.push_back(
-      {"box spline, same", layout::FccLayout::create(same, limits, context.ledger()), {}, {}});
-  run.variants.push_back({"box spline, half",
-                          layout::FccLayout::create(half, limits, context.ledger(), "fcc-half"),
-                          {},
-                          {}});
-  for (const auto& [name, e] : {std::pair{"same, 16 fetches only", Evaluation::FetchesOnly},
-                                std::pair{"same, weights only", Evaluation::ArithmeticOnly}}) {
-    auto l = layout::FccLayout::create(same, limits, context.ledger());
+  for (const Storage storage : {Storage::Cubes, Storage::Packed}) {
+    const std::string s = layout::FccLayout::storageName(storage);
+    run.variants.push_back(
+        {"same, " + s,
+         layout::FccLayout::create(same, limits, context.ledger(), "fcc", storage),
+         {},
+         {}});
+    run.variants.push_back(
+        {"half, " + s,
+         layout::FccLayout::create(half, limits, context.ledger(), "fcc-half", storage),
+         {},
+         {}});
+  }
+  for (const auto& [name, e] :
+       {std::pair{"same, cubes, fetches only", Evaluation::FetchesOnly},
+        std::pair{"same, cubes, weights only", Evaluation::ArithmeticOnly}}) {
+    auto l = layout::FccLayout::create(same, limits, context.ledger(), "fcc", Storage::Cubes);
     l->setEvaluation(e);
     run.variants.push_back({name, std::move(l), {}, {}});
   }
@@ -122,29 +135,40 @@ std::string gridOf(const layout::Layout& l) {
   return dimsText(static_cast<const layout::FccLayout&>(l).lattice().gridDims());
 }
 
+std::string cell(const Variant& v, double base) {
+  char text[96];
+  std::snprintf(text, sizeof text, "%.1f (%.2f)", v.median(), v.median() / base);
+  return text;
+}
+
 void printTables(const std::vector<Dataset>& sets, const std::vector<Run>& runs) {
   std::printf(
-      "| volume | Cartesian | trilinear ms | FCC same grid | box spline ms | ÷ trilinear | FCC "
-      "half grid | box spline ms | ÷ trilinear |\n|---|---|---:|---|---:|---:|---|---:|---:|\n");
+      "ms per frame (÷ trilinear). Cubes: 5 RGBA texelFetch per sample; packed: 16 texelFetch.\n\n"
+      "| volume | Cartesian | trilinear | FCC same grid | box spline, cubes | box spline, packed "
+      "| FCC half grid | box spline, cubes | box spline, packed |\n"
+      "|---|---|---:|---|---:|---:|---|---:|---:|\n");
   for (std::size_t i = 0; i < sets.size(); ++i) {
     const auto& v = runs[i].variants;
     const double base = v[0].median();
-    std::printf("| %s | %s %s | %.1f | %s | %.1f | %.2f | %s | %.1f | %.2f |\n",
-                sets[i].name.c_str(), dimsText(sets[i].cartesian.dims()).c_str(),
+    std::printf("| %s | %s %s | %.1f | %s | %s | %s | %s | %s | %s |\n", sets[i].name.c_str(),
+                dimsText(sets[i].cartesian.dims()).c_str(),
                 std::string(scalarTypeName(sets[i].cartesian.type())).c_str(), base,
-                gridOf(*v[1].layout).c_str(), v[1].median(), v[1].median() / base,
-                gridOf(*v[2].layout).c_str(), v[2].median(), v[2].median() / base);
+                gridOf(*v[1].layout).c_str(), cell(v[1], base).c_str(), cell(v[3], base).c_str(),
+                gridOf(*v[2].layout).c_str(), cell(v[2], base).c_str(), cell(v[4], base).c_str());
   }
   std::printf(
-      "\nWhere the box spline's time goes (same density; the split variants are not "
-      "reconstructions):\n\n| volume | trilinear | box spline | 16 fetches only | weights only "
-      "|\n|---|---:|---:|---:|---:|\n");
+      "\nWhere the box spline's time goes (same density, cubes; the split variants are not "
+      "reconstructions), and the textures:\n\n| volume | trilinear | box spline | 5 fetches "
+      "only | weights only | trilinear texture | cubes texture | packed texture |\n"
+      "|---|---:|---:|---:|---:|---:|---:|---:|\n");
   for (std::size_t i = 0; i < sets.size(); ++i) {
     const auto& v = runs[i].variants;
     const double base = v[0].median();
-    std::printf("| %s | %.1f ms (1.00) | %.1f ms (%.2f) | %.1f ms (%.2f) | %.1f ms (%.2f) |\n",
-                sets[i].name.c_str(), base, v[1].median(), v[1].median() / base, v[3].median(),
-                v[3].median() / base, v[4].median(), v[4].median() / base);
+    std::printf("| %s | %.1f | %s | %s | %s | %s | %s | %s |\n", sets[i].name.c_str(), base,
+                cell(v[1], base).c_str(), cell(v[5], base).c_str(), cell(v[6], base).c_str(),
+                formatBytes(v[0].layout->textureBytes()).c_str(),
+                formatBytes(v[1].layout->textureBytes()).c_str(),
+                formatBytes(v[3].layout->textureBytes()).c_str());
   }
 }
 

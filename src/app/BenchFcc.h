@@ -19,4 +19,8 @@ struct FccBenchOptions {
 
 void runFccBench(const FccBenchOptions& options);
 
+// `--fcc-out DIR`: the quality figures (BenchFccQuality.cpp) — Marschner-Lobb
+// RMS and PSNR tables, ch2 on FCC vs the original — and their PNGs in DIR.
+void runFccQuality(const std::string& outDir, int size);
+
 }  // namespace tessera::app
