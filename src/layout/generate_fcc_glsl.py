@@ -90,17 +90,21 @@ def cube_cover(points):
     four FCC corners q + o are told apart by o.x + 2 o.y (o.z follows from
     the parity), the channel FccLayout's cube texture stores them in."""
     wanted = set(points)
-    cubes = []
-    for q in product(range(-2, 3), repeat=3):
-        corners = {tuple(q[a] + o[a] for a in range(3)) for o in product((0, 1), repeat=3)}
-        if corners & wanted:
-            cubes.append(q)
+
     def corners_of(q):
-        return {tuple(q[a] + o[a] for a in range(3)) for o in product((0, 1), repeat=3)
-                if sum(q[a] + o[a] for a in range(3)) % 2 == 0}
+        return frozenset(tuple(q[a] + o[a] for a in range(3)) for o in product((0, 1), repeat=3)
+                         if sum(q[a] + o[a] for a in range(3)) % 2 == 0)
+
+    # Cubes holding at least two wanted points (16 points in 5 cubes of 4
+    # need no cube holding one), the fullest first.
+    cubes = [q for q in product(range(-2, 3), repeat=3) if len(corners_of(q) & wanted) >= 2]
+    cubes.sort(key=lambda q: -len(corners_of(q) & wanted))
+    held = {q: corners_of(q) & wanted for q in cubes}
     for k in range(1, 8):
         for combo in combinations(cubes, k):
-            if wanted <= set().union(*(corners_of(q) for q in combo)):
+            if sum(len(held[q]) for q in combo) < len(wanted):
+                continue
+            if wanted <= set().union(*(held[q] for q in combo)):
                 where = []
                 for p in points:
                     j = next(i for i, q in enumerate(combo) if p in corners_of(q))

@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <random>
 #include <string>
@@ -327,4 +329,15 @@ TEST(FccLayout, PlannerAccountsItsBytesAndRefusesDevicesWithoutEs3) {
       layout::FccLayout::planFor({64, 64, 64}, ScalarType::U8, gles2, "fcc");
   EXPECT_FALSE(direct.fits);
   EXPECT_NE(direct.reason.find("texelFetch"), std::string::npos) << direct.reason;
+}
+
+// The GLSL pieces are generated from the exact tables the CPU evaluator
+// uses; a change of either without rerunning the generator fails here.
+TEST(FccLayout, GeneratedGlslIsUpToDateWithTheExactTables) {
+  const std::filesystem::path root =
+      std::filesystem::path(TESSERA_TEST_DATA_DIR).parent_path().parent_path();
+  if (std::system("python3 --version > /dev/null 2>&1") != 0) GTEST_SKIP() << "no python3";
+  const std::string cmd =
+      "python3 " + (root / "src/layout/generate_fcc_glsl.py").string() + " --check";
+  EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
 }
