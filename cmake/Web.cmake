@@ -1,6 +1,6 @@
 # The browser build of the viewer (included from CMakeLists.txt under
 # emcmake; scripts/web.sh runs it). Compiles the layers the viewer needs —
-# core, gpu, lod, layout, render, viewer and io's readers — with Debian's
+# core, gpu, lod, reference, lattice, layout, render, viewer and io's readers — with Debian's
 # emscripten into web/site's tessera.js + tessera.wasm. nifticlib, zlib,
 # DCMTK and libpng are not available to emscripten here. The io readers
 # need none of them to read (they parse every header themselves, on byte
@@ -50,7 +50,7 @@ file(GLOB TESSERA_WEB_IO CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/io/*.cpp)
 # emscripten cannot link here (see README, OME-Zarr in the browser).
 list(FILTER TESSERA_WEB_IO EXCLUDE REGEX "/(.*Writer|Dicom.*|InflaterZlib|OutputFile|Zarr.*|Http.*)\\.cpp$")
 set(TESSERA_WEB_SOURCES ${TESSERA_GLSL_CPP} ${TESSERA_WEB_IO})
-foreach(layer core gpu lod layout render viewer)
+foreach(layer core gpu lod reference lattice layout render viewer)
   file(GLOB_RECURSE srcs CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/${layer}/*.cpp)
   list(APPEND TESSERA_WEB_SOURCES ${srcs})
 endforeach()

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/BenchFcc.h"
 #include "app/BenchHybrid.h"
 #include "app/BenchRoofline.h"
 #include "app/BenchSlicing.h"
@@ -37,6 +38,8 @@ struct BenchOptions {
   std::string tf = "bench";
   bool json = false;
   bool layouts = false;
+  bool fcc = false;
+  std::string fccOut;
   bool slicing = false;
   std::string slicingOut;
   bool slicingQuick = false;
@@ -306,6 +309,14 @@ void addBenchCommand(CLI::App& app) {
   cmd->add_option("--tf", o->tf, "Transfer function preset or JSON file")->capture_default_str();
   cmd->add_flag("--layouts", o->layouts,
                 "Compare layouts (texture3d, mosaic, packed-mosaic) instead of accelerations");
+  cmd->add_flag("--fcc", o->fcc,
+                "FCC lattice + box spline vs Cartesian + trilinear (Sarfaraz & Shaban 2015 "
+                "Tables 1-2): 64^3-class volumes, FCC at the same and half the sample count, "
+                "and where the box spline's time goes; --frames per variant (default 12)");
+  cmd->add_option("--fcc-out", o->fccOut,
+                  "FCC quality figures instead of speed: Marschner-Lobb RMS/PSNR at 41^3 and "
+                  "64^3 (Cartesian trilinear vs FCC box spline, same and half density), ch2 on "
+                  "FCC vs the original; tables on stdout, PNGs in this folder");
   cmd->add_flag("--json", o->json, "Print JSON instead of a Markdown table");
   cmd->add_flag("--slicing", o->slicing,
                 "Texture slicing vs ray casting (GRAPP 2012 Tables 1-2), TF-update times "
@@ -361,6 +372,21 @@ void addBenchCommand(CLI::App& app) {
                                  .size = o->size == "512x512" ? "480x640" : o->size,
                                  .json = o->json};
       o->hybrid ? runHybridBench(h) : runInteractiveBench(h);
+      return;
+    }
+    if (!o->fccOut.empty()) {
+      int width = 0, height = 0;
+      parseSize(o->size == "512x512" ? "256x256" : o->size, width, height);
+      runFccQuality(o->fccOut, width);
+      return;
+    }
+    if (o->fcc) {
+      runFccBench({.size = o->size,
+                   .frames = o->frames == 36 ? 12 : o->frames,
+                   .rotate = o->rotate,
+                   .step = o->step,
+                   .tf = o->tf,
+                   .json = o->json});
       return;
     }
     if (o->slicing) {

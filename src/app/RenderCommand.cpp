@@ -13,6 +13,7 @@
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"
 #include "tessera/io/VolumeReader.h"
+#include "tessera/layout/FccLayout.h"
 #include "tessera/layout/LayoutRegistry.h"
 #include "tessera/lod/InCoreVolumeSource.h"
 #include "tessera/render/TechniqueRegistry.h"
@@ -53,6 +54,8 @@ struct RenderOptions {
   std::string classify = "post";
   std::string profile = "native";
   std::string layout = "auto";
+  std::string lattice = "cartesian";  // or fcc (FccLayout.h)
+  std::string density;                // with --lattice fcc: same (default) or half
   bool json = false;
   // Hybrid low/high-resolution rendering with overlays (HybridJob.h).
   std::string overlays;
@@ -65,6 +68,40 @@ nlohmann::json numberOrNull(std::optional<double> v) {
   if (!v) return nullptr;
   if (std::isinf(*v)) return 999.0;  // identical images; JSON has no infinity
   return *v;
+}
+
+// --lattice and --density as a layout wish: the FCC lattice is a layout
+// (layout/FccLayout.h: "fcc" at the same sample count, "fcc-half").
+std::string latticeLayout(const RenderOptions& o) {
+  if (o.lattice == "cartesian") {
+    if (!o.density.empty()) throw InputError("--density applies to --lattice fcc only");
+    return o.layout;
+  }
+  if (o.lattice != "fcc") {
+    throw InputError("--lattice '" + o.lattice + "': expected cartesian or fcc");
+  }
+  if (o.layout != "auto") {
+    throw InputError("--layout " + o.layout +
+                     " does not combine with --lattice fcc: the lattice is stored in the fcc "
+                     "layout");
+  }
+  return layout::FccLayout::layoutName(
+      lattice::parseFccDensity(o.density.empty() ? "same" : o.density));
+}
+
+// The FCC lattice lives in a layout: a technique with its own storage
+// (slice2d's slice stacks) cannot render it.
+void checkSamplesLayout(const RenderOptions& o, const DeviceSession& device,
+                        const lod::InCoreVolumeSource& source, const RenderRequest& req) {
+  const render::TechniqueEntry& entry = render::TechniqueRegistry::global().find(o.technique);
+  const render::TechniqueRequirements r =
+      entry.requirements(device.limits, source.volume().dims(), req.techniqueOptions());
+  if (!r.ownStorage.empty()) {
+    throw InputError(
+        "--lattice fcc needs a technique that samples the layout (e.g. raycast or "
+        "slice3d); " +
+        o.technique + " keeps " + r.ownStorage);
+  }
 }
 
 // The camera, settings and technique the options ask for.
@@ -104,7 +141,7 @@ RenderRequest requestFrom(const RenderOptions& o) {
   req.lutSize = o.lut;
   req.slices = o.slices;
   req.classify = o.classify;
-  req.layout = o.layout;
+  req.layout = latticeLayout(o);
   return req;
 }
 
@@ -162,6 +199,7 @@ void printRenderJson(const RenderOptions& o, const RenderRequest& req, const Ren
   j["gl_version"] = context.caps().version;
   j["egl_platform"] = context.platform();
   j["layout"] = r.layout;
+  j["lattice"] = o.lattice;
   j["profile"] = device.profile.name;
   j["api"] = gpu::apiLevelName(device.limits.api);
   j["plan_reason"] = r.plan.reason;
@@ -225,6 +263,7 @@ void runRenderCommand(const RenderOptions& o) {
   const lod::InCoreVolumeSource source = loadVolume(o, spec);
   times.loadMs = msSince(tLoad);
 
+  if (o.lattice == "fcc") checkSamplesLayout(o, device, source, req);
   // Checked even when nothing uses it, so that a typo is not silently ignored.
   const render::OverlayOpacity overlayOpacity = render::parseOverlayOpacity(o.overlayOpacity);
   if (!o.overlays.empty() || !o.offscreen.empty() || !o.roi.empty()) {
@@ -310,6 +349,15 @@ void addRenderCommand(CLI::App& app) {
                   "Volume storage: " + layout::LayoutRegistry::global().choices() +
                       " (auto: the planner chooses)")
       ->capture_default_str();
+  cmd->add_option("--lattice", o->lattice,
+                  "Sample lattice: cartesian (the volume's grid, trilinear) or fcc (resampled "
+                  "onto the face-centred cubic lattice with a cubic B-spline and "
+                  "quasi-interpolation, reconstructed with the six-direction box spline; needs "
+                  "an ES 3 profile; --reference then renders the box spline on the CPU)")
+      ->capture_default_str();
+  cmd->add_option("--density", o->density,
+                  "With --lattice fcc: same (as many lattice points as voxels, default) or half "
+                  "(every voxel with an even index sum, no interpolation)");
   cmd->add_flag("--json", o->json, "Print one JSON object instead of text");
   cmd->add_option("--overlays", o->overlays,
                   "Lines drawn at full resolution with the volume: box,axes,roi (any subset); "

@@ -5,6 +5,8 @@
 
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
+#include "tessera/lattice/BoxSplineReconstruction.h"
+#include "tessera/layout/FccLayout.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
 #include "tessera/render/TechniqueRegistry.h"
@@ -39,13 +41,22 @@ void describeStorage(const render::TechniqueOnVolume& t, RenderResult& result) {
   result.occupiedBlockFraction = report.occupiedBlockFraction;
 }
 
-// Frame 0 against the CPU reference of the volume the GPU rendered.
-void compareWithReference(const Volume& volume, const TransferFunction& tf,
-                          const RenderRequest& req, RenderResult& result) {
+// Frame 0 against the CPU reference of the volume the GPU rendered: its
+// voxels through trilinear interpolation, or an FCC layout's lattice through
+// the box spline.
+void compareWithReference(const Volume& volume, const layout::Layout* layout,
+                          const TransferFunction& tf, const RenderRequest& req,
+                          RenderResult& result) {
   const auto t0 = std::chrono::steady_clock::now();
   ReferenceStats stats;
-  result.referenceImage =
-      renderReference(volume, tf, req.camera, req.settings, req.width, req.height, 0, &stats);
+  if (const auto* fcc = dynamic_cast<const layout::FccLayout*>(layout)) {
+    result.referenceImage =
+        renderReference(fcc->lattice().box(), lattice::BoxSplineReconstruction(fcc->lattice()), tf,
+                        req.camera, req.settings, req.width, req.height, 0, &stats);
+  } else {
+    result.referenceImage =
+        renderReference(volume, tf, req.camera, req.settings, req.width, req.height, 0, &stats);
+  }
   result.referenceSamples = stats.samples;
   result.referenceRays = stats.raysHittingVolume;
   result.referenceMs = msSince(t0);
@@ -106,7 +117,7 @@ RenderResult runRender(DeviceSession& device, const lod::VolumeSource& source,
   renderFrames(*t.technique, req, result);
   result.textureBytes = device.context->ledger().totalBytes();  // while the technique holds its own
   describeStorage(t, result);
-  if (req.reference) compareWithReference(volume, tf, req, result);
+  if (req.reference) compareWithReference(volume, t.upload.layout.get(), tf, req, result);
   return result;
 }
 

@@ -12,7 +12,9 @@ ValueBlocks Layout::valueBlocks(int blockSize) const {
 }
 
 std::vector<gpu::ShaderPart> Layout::seamParts() const {
-  return {glsl(), gpu::embeddedShaderPart("layout/gradient.glsl")};
+  std::vector<gpu::ShaderPart> parts = glslParts();
+  parts.push_back(gpu::embeddedShaderPart("layout/gradient.glsl"));
+  return parts;
 }
 
 int Layout::bindSeam(const gpu::Program& program, int firstUnit) const {

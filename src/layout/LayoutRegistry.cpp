@@ -1,6 +1,7 @@
 #include "tessera/layout/LayoutRegistry.h"
 
 #include "tessera/core/Error.h"
+#include "tessera/layout/FccLayout.h"
 #include "tessera/layout/MosaicLayout.h"
 #include "tessera/layout/PackedMosaicLayout.h"
 #include "tessera/layout/Texture3DLayout.h"
@@ -18,6 +19,8 @@ LayoutRegistry& LayoutRegistry::global() {
     r.add(Texture3DLayout::registration());
     r.add(MosaicLayout::registration());
     r.add(PackedMosaicLayout::registration());
+    r.add(FccLayout::registration(lattice::FccDensity::Same));
+    r.add(FccLayout::registration(lattice::FccDensity::Half));
     return r;
   }();
   return registry;

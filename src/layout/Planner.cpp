@@ -17,7 +17,9 @@ std::string dimsText(glm::ivec3 d) {
 // "layout texture3d needs 3D textures, which ipad2 does not have (use
 // mosaic or packed-mosaic)".
 std::string unmetNeeds(const LayoutEntry& entry, const gpu::DeviceLimits& limits) {
-  const std::string need = entry.needs3DTextures ? "3D textures" : "OpenGL ES 3";
+  const std::string need = !entry.needsText.empty() ? entry.needsText
+                           : entry.needs3DTextures  ? "3D textures"
+                                                    : "OpenGL ES 3";
   std::vector<std::string> others;
   for (const LayoutEntry& e : LayoutRegistry::global().entries()) {
     if (e.runsOn(limits)) others.push_back(e.name);
@@ -56,7 +58,9 @@ glm::ivec3 axesToHalve(glm::ivec3 dims, const gpu::DeviceLimits& limits, bool on
 Plan planLayout(const Volume& volume, const gpu::DeviceLimits& limits, const PlanRequest& request) {
   std::vector<const LayoutEntry*> candidates;
   if (request.layout == "auto") {
-    for (const LayoutEntry& e : LayoutRegistry::global().entries()) candidates.push_back(&e);
+    for (const LayoutEntry& e : LayoutRegistry::global().entries()) {
+      if (e.automatic) candidates.push_back(&e);
+    }
   } else {
     const LayoutEntry& wished = LayoutRegistry::global().find(request.layout);
     if (!wished.runsOn(limits)) throw InputError(unmetNeeds(wished, limits));

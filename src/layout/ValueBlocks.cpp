@@ -8,6 +8,8 @@
 
 #include <glm/common.hpp>
 
+#include "tessera/core/Error.h"
+
 namespace tessera::layout {
 
 namespace {
@@ -34,6 +36,20 @@ void blockRange(const Volume& v, const T* data, glm::ivec3 lo, glm::ivec3 hi, fl
   mx = b;
 }
 }  // namespace
+
+ValueBlocks::ValueBlocks(glm::ivec3 count, int blockSize, int supportVoxels,
+                         std::vector<float> mins, std::vector<float> maxs)
+    : blockSize_(blockSize),
+      support_(supportVoxels),
+      count_(count),
+      min_(std::move(mins)),
+      max_(std::move(maxs)) {
+  const std::size_t n = static_cast<std::size_t>(count.x) * count.y * count.z;
+  if (min_.size() != n || max_.size() != n) {
+    throw Error("value blocks: " + std::to_string(n) + " blocks, " + std::to_string(min_.size()) +
+                " minima and " + std::to_string(max_.size()) + " maxima given");
+  }
+}
 
 ValueBlocks::ValueBlocks(const Volume& volume, int blockSize, int supportVoxels)
     : blockSize_(blockSize), support_(supportVoxels) {

@@ -149,8 +149,9 @@ layout::LayoutEntry residentWindowLayout(bool needs3DTextures = false) {
 
 TEST(Planner, ChoosesFromTheRegisteredLayoutsInOrder) {
   EXPECT_EQ(layout::LayoutRegistry::global().names(),
-            (std::vector<std::string>{"texture3d", "mosaic", "packed-mosaic"}));
-  EXPECT_EQ(layout::LayoutRegistry::global().choices(), "auto, texture3d, mosaic or packed-mosaic");
+            (std::vector<std::string>{"texture3d", "mosaic", "packed-mosaic", "fcc", "fcc-half"}));
+  EXPECT_EQ(layout::LayoutRegistry::global().choices(),
+            "auto, texture3d, mosaic, packed-mosaic, fcc or fcc-half");
 }
 
 TEST(Planner, ALayoutRegisteredLaterIsPlannedByName) {

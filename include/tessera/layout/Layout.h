@@ -53,6 +53,9 @@ class Layout {
   // GLSL ES 3.00 for gles3) defining sampleVolume() and the samplers and
   // uniforms it needs. Uniform names are prefixed "u_layout".
   virtual gpu::ShaderPart glsl() const = 0;
+  // Every GLSL file of the layout's seam in order (glsl() first; a layout
+  // with generated parts, e.g. fcc, adds them).
+  virtual std::vector<gpu::ShaderPart> glslParts() const { return {glsl()}; }
   // Binds the layout's textures to units firstUnit.. and sets its uniforms
   // in `program` (which must be in use). Returns the number of units used.
   virtual int bind(const gpu::Program& program, int firstUnit) const = 0;
@@ -72,7 +75,7 @@ class Layout {
   // (bricks streamed from disk) overrides it with its own metadata.
   virtual ValueBlocks valueBlocks(int blockSize) const;
 
-  // The seam's GLSL as a technique includes it: the layout's glsl() and then
+  // The seam's GLSL as a technique includes it: the layout's glslParts() and then
   // the shared gradient part (layout/gradient.glsl: sampleVolumeGradient() by
   // central differences through sampleVolume(), unless the layout defines
   // LAYOUT_HAS_GRADIENT and its own). Use with bindSeam().

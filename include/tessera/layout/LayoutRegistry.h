@@ -24,6 +24,12 @@ struct LayoutEntry {
   // the planner refuses with an error that names the layouts that would do.
   gpu::ApiLevel minApi = gpu::ApiLevel::Gles2;
   bool needs3DTextures = false;
+  // Whether "auto" may choose it; false for a layout that changes the
+  // reconstruction (fcc), which must be asked for by name.
+  bool automatic = true;
+  // What it needs, in words, for the refusal (default: "3D textures" or
+  // "OpenGL ES 3" from the two fields above).
+  std::string needsText = {};
   // What it costs: the textures it would allocate for a volume of `shape`
   // within `limits` using at most `units` texture units; fits = false and a
   // reason when it cannot.
@@ -43,7 +49,7 @@ class LayoutRegistry : public NamedRegistry<LayoutEntry> {
  public:
   LayoutRegistry() : NamedRegistry("layout", "auto") {}
   // The built-in layouts, in the planner's order of preference: texture3d,
-  // mosaic, packed-mosaic.
+  // mosaic, packed-mosaic; then fcc and fcc-half (by name only).
   static LayoutRegistry& global();
 };
 
