@@ -5,8 +5,11 @@
 #include <cstdint>
 #include <limits>
 #include <thread>
+#include <utility>
 
 #include <glm/common.hpp>
+
+#include "tessera/core/Error.h"
 
 namespace tessera::layout {
 
@@ -34,6 +37,17 @@ void blockRange(const Volume& v, const T* data, glm::ivec3 lo, glm::ivec3 hi, fl
   mx = b;
 }
 }  // namespace
+
+ValueBlocks::ValueBlocks(glm::ivec3 count, int blockSize, int supportVoxels,
+                         std::vector<float> mins, std::vector<float> maxs)
+    : blockSize_(blockSize),
+      support_(supportVoxels),
+      count_(count),
+      min_(std::move(mins)),
+      max_(std::move(maxs)) {
+  const std::size_t n = static_cast<std::size_t>(count.x) * count.y * count.z;
+  if (min_.size() != n || max_.size() != n) throw Error("ValueBlocks: one range per block");
+}
 
 ValueBlocks::ValueBlocks(const Volume& volume, int blockSize, int supportVoxels)
     : blockSize_(blockSize), support_(supportVoxels) {

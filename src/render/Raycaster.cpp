@@ -31,6 +31,7 @@ void Raycaster::setSkipBlockSize(int voxels) {
     throw InputError("empty-space block size must be >= 0, got " + std::to_string(voxels));
   blockSize_ = voxels;
   blocks_ = voxels > 0 ? layout_.valueBlocks(voxels) : layout::ValueBlocks();
+  blocksVersion_ = layout_.contentVersion();
   blockTexture_ = gpu::Texture();
   lookupKey_.clear();
 }
@@ -288,6 +289,8 @@ const gpu::Texture& Raycaster::render(const Camera& camera, const RenderSettings
     ~RestoreAspect() { aspect = saved; }
   } restore{viewAspect_, viewAspect_};
   viewAspect_ = viewAspect;
+  // A streamed layout (bricks) changed what it samples: new value blocks.
+  if (blockSize_ > 0 && layout_.contentVersion() != blocksVersion_) setSkipBlockSize(blockSize_);
   renderFrame(camera, settings, width, height);
   return colorTexture();
 }

@@ -43,7 +43,7 @@ class LayoutRegistry : public NamedRegistry<LayoutEntry> {
  public:
   LayoutRegistry() : NamedRegistry("layout", "auto") {}
   // The built-in layouts, in the planner's order of preference: texture3d,
-  // mosaic, packed-mosaic.
+  // mosaic, packed-mosaic, bricks.
   static LayoutRegistry& global();
 };
 

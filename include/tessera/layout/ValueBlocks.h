@@ -19,6 +19,10 @@ class ValueBlocks {
   ValueBlocks() = default;
   // NaN/Inf voxels count as Volume::nonFiniteValue(), the value they render as.
   ValueBlocks(const Volume& volume, int blockSize, int supportVoxels);
+  // Ranges a layout computed itself (bricks: from per-brick ranges), one per
+  // block of `count`, x fastest, already covering every sample in the block.
+  ValueBlocks(glm::ivec3 count, int blockSize, int supportVoxels, std::vector<float> mins,
+              std::vector<float> maxs);
 
   int blockSize() const { return blockSize_; }
   int supportVoxels() const { return support_; }
