@@ -45,8 +45,10 @@ AtlasShape atlasFor(const gpu::DeviceLimits& limits, int stored, std::uint64_t a
     const int m = std::min(255, limits.max3DTextureSize / stored);
     if (m < 1) return a;
     const int side = std::clamp(static_cast<int>(std::cbrt(static_cast<double>(want))), 1, m);
-    const int depth = static_cast<int>(
-        std::min<std::uint64_t>(m, want / (static_cast<std::uint64_t>(side) * side)));
+    const std::uint64_t layer = static_cast<std::uint64_t>(side) * side;
+    // Enough layers for every brick wanted, as far as the budget goes.
+    const int depth = static_cast<int>(std::min<std::uint64_t>(
+        {static_cast<std::uint64_t>(m), (want + layer - 1) / layer, avail / slotBytes / layer}));
     a.slots = {side, side, std::max(1, depth)};
     a.bytes = slotBytes * static_cast<std::uint64_t>(a.count());
     return a;
@@ -351,26 +353,49 @@ BricksFrame BricksLayout::update(const Camera& camera, int width, int height,
   (void)width;
   const int pinned = static_cast<int>(std::count(slotPinned_.begin(), slotPinned_.end(), true));
   const std::size_t capacity = static_cast<std::size_t>(slotCount() - pinned);
+  // An eighth of the slots stay for the parents of bricks still missing
+  // (coarse to fine: a missing brick shows its parent, not a distant ancestor).
   const lod::LodSelection sel = lod::selectBricks(
       grid_, view, [&](const lod::BrickKey& k) { return !transparent(k, tf, false, nullptr); },
-      capacity + static_cast<std::size_t>(pinned));
+      capacity - capacity / 8);
   frame.wanted = static_cast<int>(sel.bricks.size());
   frame.wantedPerLevel = sel.bricksPerLevel;
   frame.limitedByBudget = sel.limitedByCapacity;
-  for (const lod::BrickKey& k : sel.bricks) {
+  // What to fetch, nearest first and each missing brick after its missing
+  // ancestors (coarse to fine); what is on screen now stays (marked used).
+  std::vector<lod::BrickKey> needed;
+  std::unordered_map<std::uint64_t, bool> inCut;  // id -> part of the cut (not an ancestor)
+  auto markUsed = [&](const lod::BrickKey& k) {
     const auto it = slotOf_.find(k.id());
-    if (it != slotOf_.end()) slotUsed_[static_cast<std::size_t>(it->second)] = frame_;
+    if (it == slotOf_.end()) return false;
+    slotUsed_[static_cast<std::size_t>(it->second)] = frame_;
+    return true;
+  };
+  for (const lod::BrickKey& k : sel.bricks) {
+    if (markUsed(k)) continue;
+    std::vector<lod::BrickKey> chain;
+    for (lod::BrickKey a = grid_.parent(k); a.level < grid_.levelCount(); a = grid_.parent(a)) {
+      if (markUsed(a)) break;
+      chain.push_back(a);
+    }
+    for (auto a = chain.rbegin(); a != chain.rend(); ++a) {
+      if (inCut.emplace(a->id(), false).second) needed.push_back(*a);
+    }
+    const auto [it, added] = inCut.emplace(k.id(), true);
+    it->second = true;
+    if (added) needed.push_back(k);
   }
   std::vector<lod::BrickKey> toRead;
   std::uint64_t bytes = 0;
   const auto t0 = std::chrono::steady_clock::now();
   bool budgetLeft = true;
-  for (const lod::BrickKey& k : sel.bricks) {
+  for (const lod::BrickKey& k : needed) {
+    const bool cut = inCut[k.id()];
     if (slotOf_.count(k.id())) continue;
-    ++frame.missing;
+    if (cut) ++frame.missing;
     std::shared_ptr<const lod::StoredBrick> brick = streamer_->find(k);
     if (!brick) {
-      if (streamer_->failing(k)) ++frame.failing;
+      if (cut && streamer_->failing(k)) ++frame.failing;
       toRead.push_back(k);
       continue;
     }
@@ -385,7 +410,7 @@ BricksFrame BricksLayout::update(const Camera& camera, int width, int height,
     upload(slot, *brick);
     bytes += brick->voxels.size();
     ++frame.uploaded;
-    --frame.missing;
+    if (cut) --frame.missing;
   }
   streamer_->request(toRead);
   rebuildPages(tf, frame);

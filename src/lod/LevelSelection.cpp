@@ -46,7 +46,6 @@ LodSelection selectBricks(const BrickGrid& grid, const LodView& view,
         const BrickKey k{top, {x, y, z}};
         if (!visible(k)) continue;
         open.push({pixelsPerVoxel(grid, k, view), k});
-        ++count;
       }
     }
   }
@@ -62,12 +61,14 @@ LodSelection selectBricks(const BrickGrid& grid, const LodView& view,
     kids.erase(
         std::remove_if(kids.begin(), kids.end(), [&](const BrickKey& k) { return !visible(k); }),
         kids.end());
-    if (count - 1 + kids.size() > capacity) {
+    // The coarsest bricks are pinned: refining one frees no slot.
+    const std::size_t after = count + kids.size() - (item.key.level == top ? 0 : 1);
+    if (after > capacity) {
       out.limitedByCapacity = true;
       done.push_back(item.key);
       continue;
     }
-    count = count - 1 + kids.size();
+    count = after;
     for (const BrickKey& k : kids) open.push({pixelsPerVoxel(grid, k, view), k});
   }
   std::vector<std::pair<double, BrickKey>> byDistance;

@@ -59,9 +59,11 @@ glm::ivec3 parseDims(const std::string& spec) {
     if (e == std::string::npos) break;
     b = e + 1;
   }
-  if (parts.size() == 1) return glm::ivec3(parts[0]);
-  if (parts.size() != 3) throw InputError("'" + spec + "': size must be N or WxHxD");
-  const glm::ivec3 d(parts[0], parts[1], parts[2]);
+  if (parts.size() != 1 && parts.size() != 3) {
+    throw InputError("'" + spec + "': size must be N or WxHxD");
+  }
+  const glm::ivec3 d =
+      parts.size() == 1 ? glm::ivec3(parts[0]) : glm::ivec3(parts[0], parts[1], parts[2]);
   if (glm::any(glm::lessThan(d, glm::ivec3(1))) ||
       glm::any(glm::greaterThan(d, glm::ivec3(100000))))
     throw InputError("'" + spec + "': each side must be 1..100000");

@@ -192,6 +192,8 @@ void Raycaster::prepare(const RenderSettings& settings) {
 
 void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings, int width,
                             int height) {
+  // A streamed layout (bricks) changed what it samples: new value blocks.
+  if (blockSize_ > 0 && layout_.contentVersion() != blocksVersion_) setSkipBlockSize(blockSize_);
   if (width <= 0 || height <= 0 || width > context_.caps().maxRenderbufferSize ||
       height > context_.caps().maxRenderbufferSize) {
     throw InputError("image size " + std::to_string(width) + "x" + std::to_string(height) +
@@ -289,8 +291,6 @@ const gpu::Texture& Raycaster::render(const Camera& camera, const RenderSettings
     ~RestoreAspect() { aspect = saved; }
   } restore{viewAspect_, viewAspect_};
   viewAspect_ = viewAspect;
-  // A streamed layout (bricks) changed what it samples: new value blocks.
-  if (blockSize_ > 0 && layout_.contentVersion() != blocksVersion_) setSkipBlockSize(blockSize_);
   renderFrame(camera, settings, width, height);
   return colorTexture();
 }

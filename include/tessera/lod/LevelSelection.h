@@ -34,6 +34,8 @@ struct LodSelection {
 };
 
 // `visible(key)`: false if the brick is known or estimated to be transparent.
+// `capacity`: how many bricks below the coarsest level the cut may hold (the
+// coarsest level is always resident: it is what everything falls back to).
 LodSelection selectBricks(const BrickGrid& grid, const LodView& view,
                           const std::function<bool(const BrickKey&)>& visible,
                           std::size_t capacity);
