@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include <glm/trigonometric.hpp>
 
@@ -17,6 +18,13 @@ namespace {
 constexpr std::uint64_t kDefaultAtlasCap = 256ull << 20;
 constexpr int kCoarsestSide = 16;
 
+// "prefix7suffix" (snprintf: GCC 12 -Wrestrict misfires on "literal" + std::string).
+std::string numbered(const char* prefix, int n, const char* suffix = "") {
+  char text[64];
+  std::snprintf(text, sizeof text, "%s%d%s", prefix, n, suffix);
+  return text;
+}
+
 std::string dimsText(glm::ivec3 d) {
   return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
 }
@@ -28,12 +36,16 @@ int brickSizeFor(const BricksOptions& options, glm::ivec3 chunk) {
 }
 
 // The atlas the budget allows: its slot grid and, on ES 2, its mosaic.
+// ES 2: slots.x is the number of mosaic textures (one unit each, up to 8),
+// slots.z the slots stacked in each.
 struct AtlasShape {
   glm::ivec3 slots{0};
   MosaicLayout::Geometry mosaic;  // tilesX = 0 on ES 3
   std::uint64_t bytes = 0;
   int count() const { return slots.x * slots.y * slots.z; }
 };
+
+constexpr int kMaxMosaicAtlases = 8;
 
 AtlasShape atlasFor(const gpu::DeviceLimits& limits, int stored, std::uint64_t avail,
                     std::uint64_t bricks) {
@@ -61,7 +73,16 @@ AtlasShape atlasFor(const gpu::DeviceLimits& limits, int stored, std::uint64_t a
     a.bytes = static_cast<std::uint64_t>(a.mosaic.width()) * a.mosaic.height();
     if (a.mosaic.tilesX > 0 && a.bytes <= avail) break;
   }
-  a.slots = {1, 1, depth};
+  if (depth <= 0) return a;
+  // More textures where units and budget allow and bricks want them.
+  const std::uint64_t perTexture = a.bytes;
+  const int units = std::min(kMaxMosaicAtlases, limits.textureUnits - 1);
+  const auto textures = static_cast<int>(std::min<std::uint64_t>(
+      {static_cast<std::uint64_t>(std::max(1, units)),
+       (want + static_cast<std::uint64_t>(depth) - 1) / static_cast<std::uint64_t>(depth),
+       std::max<std::uint64_t>(1, avail / perTexture)}));
+  a.slots = {textures, 1, depth};
+  a.bytes = perTexture * static_cast<std::uint64_t>(textures);
   return a;
 }
 
@@ -109,20 +130,26 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
   }
   const AtlasShape a = atlasFor(limits, stored, avail, pyramidBricks(d, b));
   const bool es3 = a.mosaic.tilesX == 0;
+  const int atlases = es3 ? 1 : std::max(1, a.slots.x);
   PlannedTexture atlas{
       .label = "brick atlas",
       .size = es3 ? a.slots * stored : glm::ivec3(a.mosaic.width(), a.mosaic.height(), 1),
       .is3D = es3,
       .format = es3 ? "R8" : "L8",
-      .bytes = a.bytes};
-  plan.textures = {atlas, pages};
-  plan.totalBytes = atlas.bytes + pages.bytes;
+      .bytes = a.bytes / static_cast<std::uint64_t>(atlases)};
+  for (int t = 0; t < atlases; ++t) {
+    plan.textures.push_back(atlas);
+    if (atlases > 1) plan.textures.back().label += numbered(" ", t + 1);
+  }
+  plan.textures.push_back(pages);
+  plan.totalBytes = a.bytes + pages.bytes;
   const std::string what = vol + " as " + std::to_string(b) + "^3 bricks (+1 voxel apron) of " +
                            std::to_string(levels.size()) + " levels, streamed into a " +
                            std::to_string(a.count()) + "-brick " + atlas.format + " atlas (" +
+                           (atlases > 1 ? numbered("", atlases, " x ") : std::string()) +
                            dimsText(atlas.size) + (es3 ? " 3D" : " mosaic") + ", " +
-                           formatBytes(atlas.bytes) + ") through a " + std::to_string(cells.x) +
-                           "x" + std::to_string(cells.y * cells.z) + " page table" +
+                           formatBytes(a.bytes) + ") through a " + std::to_string(cells.x) + "x" +
+                           std::to_string(cells.y * cells.z) + " page table" +
                            (shape.type() == ScalarType::U8 ? "" : ", quantised to 8 bits");
   if (a.count() <= topBricks) {
     plan.reason = what + ": the budget (" + formatBytes(avail) + ") holds no more than the " +
@@ -161,13 +188,18 @@ std::unique_ptr<BricksLayout> BricksLayout::create(
   const AtlasShape a = atlasFor(limits, stored, avail, bricks);
   l->slotGrid_ = a.slots;
   l->mosaic_ = a.mosaic;
-  l->atlasTexels_ = a.slots * stored;
   if (a.mosaic.tilesX == 0) {
-    l->atlas_ = gpu::Texture::create3D(ledger, "brick atlas (R8)", gpu::TexelFormat::R8,
-                                       l->atlasTexels_.x, l->atlasTexels_.y, l->atlasTexels_.z);
+    l->atlasTexels_ = a.slots * stored;
+    l->atlases_.push_back(gpu::Texture::create3D(ledger, "brick atlas (R8)", gpu::TexelFormat::R8,
+                                                 l->atlasTexels_.x, l->atlasTexels_.y,
+                                                 l->atlasTexels_.z));
   } else {
-    l->atlas_ = gpu::Texture::create2D(ledger, "brick atlas (mosaic)", gpu::r8For(limits.api),
-                                       a.mosaic.width(), a.mosaic.height());
+    l->atlasTexels_ = glm::ivec3(stored, stored, a.slots.z * stored);  // each texture's
+    for (int t = 0; t < a.slots.x; ++t) {
+      l->atlases_.push_back(
+          gpu::Texture::create2D(ledger, numbered("brick atlas ", t + 1, " (mosaic)"),
+                                 gpu::r8For(limits.api), a.mosaic.width(), a.mosaic.height()));
+    }
   }
   const glm::ivec3 cells = l->grid_.bricks(0);
   l->pages_host_.assign(4ull * cells.x * cells.y * cells.z, 0);
@@ -233,16 +265,24 @@ int BricksLayout::slotFor(std::uint64_t id, std::uint64_t frame) {
 
 void BricksLayout::upload(int slot, const lod::StoredBrick& brick) {
   const int n = grid_.stored();
-  const glm::ivec3 origin = slotOrigin(slot) * n;
+  const glm::ivec3 s = slotOrigin(slot);
   if (mosaic_.tilesX == 0) {
-    atlas_.updateRegion(origin, glm::ivec3(n), brick.voxels.data());
+    atlases_[0].updateRegion(s * n, glm::ivec3(n), brick.voxels.data());
     return;
   }
+  // ES 2: s.x is the texture, s.z the slot in its stack of z-slices.
+  gpu::Texture& atlas = atlases_[static_cast<std::size_t>(s.x)];
   const std::size_t slice = static_cast<std::size_t>(n) * n;
   for (int k = 0; k < n; ++k) {
-    const glm::ivec2 at = mosaic_.addressOf(0, 0, origin.z + k);
-    atlas_.updateRegion({at, 0}, {n, n, 1}, brick.voxels.data() + slice * k);
+    const glm::ivec2 at = mosaic_.addressOf(0, 0, s.z * n + k);
+    atlas.updateRegion({at, 0}, {n, n, 1}, brick.voxels.data() + slice * k);
   }
+}
+
+std::uint64_t BricksLayout::textureBytes() const {
+  std::uint64_t bytes = pages_.bytes();
+  for (const gpu::Texture& t : atlases_) bytes += t.bytes();
+  return bytes;
 }
 
 ValueMapping BricksLayout::rawFromStored() const {
@@ -442,7 +482,9 @@ BricksLayout::Lookup BricksLayout::lookup(glm::dvec3 x0) const {
   const double shrink = std::ldexp(1.0, -out.level);
   const glm::dvec3 brick = glm::floor(cell * shrink + 0.001);
   const glm::dvec3 local = glm::clamp(x0 * shrink - brick * b, 0.0, b) + 1.0;
-  out.texel = glm::dvec3(e[0], e[1], e[2]) * (b + 2.0) + local;
+  const bool es3 = mosaic_.tilesX == 0;
+  out.texture = es3 ? 0 : e[0];
+  out.texel = (es3 ? glm::dvec3(e[0], e[1], e[2]) : glm::dvec3(0.0, 0.0, e[2])) * (b + 2.0) + local;
   return out;
 }
 
@@ -481,14 +523,24 @@ ValueBlocks BricksLayout::valueBlocks(int blockSize) const {
 }
 
 gpu::ShaderPart BricksLayout::glsl() const {
-  return gpu::embeddedShaderPart("layout/bricks.glsl");
+  gpu::ShaderPart part = gpu::embeddedShaderPart("layout/bricks.glsl");
+  // The number of ES 2 atlas samplers must be a compile-time constant; it
+  // replaces the file's first line, a comment, so line numbers stay.
+  part.text.replace(0, part.text.find('\n'),
+                    "#define BRICKS_ATLASES " + std::to_string(atlases_.size()));
+  return part;
 }
 
 int BricksLayout::bind(const gpu::Program& program, int firstUnit) const {
   pages_.bind(firstUnit);
-  atlas_.bind(firstUnit + 1);
   program.set("u_layoutPages", firstUnit);
-  program.set("u_layoutAtlas", firstUnit + 1);
+  for (std::size_t t = 0; t < atlases_.size(); ++t) {
+    const int unit = firstUnit + 1 + static_cast<int>(t);
+    atlases_[t].bind(unit);
+    const std::string name = mosaic_.tilesX == 0 ? std::string("u_layoutAtlas")
+                                                 : numbered("u_layoutAtlas", static_cast<int>(t));
+    program.set(name.c_str(), unit);
+  }
   const glm::ivec3 cells = grid_.bricks(0);
   program.set("u_layoutDims0", glm::vec3(grid_.dims(0)));
   program.set("u_layoutBrick", static_cast<float>(grid_.brickSize()));
@@ -501,13 +553,17 @@ int BricksLayout::bind(const gpu::Program& program, int firstUnit) const {
     program.set("u_layoutMosaicInv", glm::vec2(1.0f / static_cast<float>(mosaic_.width()),
                                                1.0f / static_cast<float>(mosaic_.height())));
   }
-  return 2;
+  return textureUnits();
 }
 
 LayoutEntry BricksLayout::registration() {
   return {.name = "bricks",
-          .plan = [](const Volume& shape, const gpu::DeviceLimits& limits,
-                     int) { return planFor(shape, limits); },
+          .plan =
+              [](const Volume& shape, const gpu::DeviceLimits& limits, int units) {
+                gpu::DeviceLimits l = limits;
+                l.textureUnits = units;
+                return planFor(shape, l);
+              },
           .create = [](const Volume& volume, const gpu::DeviceLimits& limits,
                        gpu::MemoryLedger& ledger, int) -> std::unique_ptr<Layout> {
             // The caller keeps `volume` alive for as long as the layout.

@@ -88,8 +88,8 @@ class BricksLayout final : public Layout {
   int bind(const gpu::Program& program, int firstUnit) const override;
   ValueMapping rawFromStored() const override;
   glm::ivec3 volumeDims() const override { return grid_.dims(0); }
-  std::uint64_t textureBytes() const override { return atlas_.bytes() + pages_.bytes(); }
-  int textureUnits() const override { return 2; }
+  std::uint64_t textureBytes() const override;
+  int textureUnits() const override { return 1 + static_cast<int>(atlases_.size()); }
   ValueBlocks valueBlocks(int blockSize) const override;
   std::uint64_t contentVersion() const override { return contentVersion_; }
 
@@ -100,12 +100,13 @@ class BricksLayout final : public Layout {
   // The page table as uploaded (RGBA per level-0 cell, x fastest): the CPU
   // twin of the lookup in bricks.glsl reads it.
   const std::vector<std::uint8_t>& pageTable() const { return pages_host_; }
-  glm::ivec3 atlasTexels() const { return atlasTexels_; }
+  glm::ivec3 atlasTexels() const { return atlasTexels_; }  // ES 2: of each texture
   // Where level-0 continuous voxel coordinate x0 is read: the atlas texel
   // coordinate (3D, continuous) and the level, or level -1 and the constant
   // stored value in texel.x. The CPU twin of bricks.glsl's address maths.
   struct Lookup {
     int level = 0;
+    int texture = 0;  // ES 2: which atlas texture
     glm::dvec3 texel{0.0};
   };
   Lookup lookup(glm::dvec3 x0) const;
@@ -130,7 +131,7 @@ class BricksLayout final : public Layout {
   std::shared_ptr<const lod::MultiresSource> source_;
   lod::BrickGrid grid_;
   std::unique_ptr<lod::BrickStreamer> streamer_;
-  gpu::Texture atlas_;
+  std::vector<gpu::Texture> atlases_;  // ES 3: one 3D texture; ES 2: 1..8 mosaics
   gpu::Texture pages_;
   MosaicLayout::Geometry mosaic_;  // ES 2: the atlas' z-slices as tiles
   glm::ivec3 slotGrid_{1};
