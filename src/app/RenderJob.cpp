@@ -38,6 +38,8 @@ void refineBricks(layout::BricksLayout& bricks, render::Technique& technique,
                   const TransferFunction& tf, const RenderRequest& req, BricksRun& run) {
   const auto t0 = std::chrono::steady_clock::now();
   layout::BricksFrame f;
+  double lastReportMs = 0.0;
+  bool reported = false;
   while (true) {
     f = bricks.update(req.camera, req.width, req.height, tf);
     technique.render(req.camera, req.settings, req.width, req.height, 0.0);
@@ -47,12 +49,14 @@ void refineBricks(layout::BricksLayout& bricks, render::Technique& technique,
       break;
     }
     if (f.uploaded == 0) bricks.waitForBricks(50.0);
-    if (run.refineFrames % 20 == 0) {
-      std::fprintf(stderr, "\rbricks: frame %d, %d of %d bricks missing   ", run.refineFrames,
-                   f.missing, f.wanted);
+    if (msSince(t0) - lastReportMs > 1000.0) {  // progress, once a second
+      lastReportMs = msSince(t0);
+      reported = true;
+      std::fprintf(stderr, "\rbricks: frame %d, %.0f s, %d of %d bricks missing   ",
+                   run.refineFrames, lastReportMs / 1000.0, f.missing, f.wanted);
     }
   }
-  if (run.refineFrames >= 20) std::fprintf(stderr, "\n");
+  if (reported) std::fprintf(stderr, "\n");
   run.completeMs = msSince(t0);
   run.complete = f.complete;
   run.failing = f.failing;

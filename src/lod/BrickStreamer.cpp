@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <exception>
+#include <system_error>
 
 #include "tessera/core/Error.h"
 
@@ -14,7 +15,20 @@ BrickStreamer::BrickStreamer(std::shared_ptr<const MultiresSource> source, Brick
       grid_(std::move(grid)),
       mapping_(StoredMapping::of(source_->shape())),
       options_(options) {
-  for (int i = 0; i < std::max(1, options_.workers); ++i) workers_.emplace_back([this] { work(); });
+  // Without threads (workers = 0, or a platform that cannot start them, such
+  // as the browser build) request() reads a few bricks itself.
+  try {
+    for (int i = 0; i < options_.workers; ++i) workers_.emplace_back([this] { work(); });
+  } catch (const std::system_error&) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    for (std::thread& t : workers_) t.join();
+    workers_.clear();
+    stop_ = false;
+  }
 }
 
 BrickStreamer::~BrickStreamer() {
@@ -48,6 +62,24 @@ void BrickStreamer::request(const std::vector<BrickKey>& keys) {
     }
   }
   wake_.notify_all();
+  if (workers_.empty()) readQueuedInline(options_.inlineReadsPerRequest);
+}
+
+void BrickStreamer::readQueuedInline(int count) {
+  for (int i = 0; i < count; ++i) {
+    BrickKey key;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (queue_.empty()) return;
+      key = queue_.front();
+      queue_.pop_front();
+    }
+    try {
+      readNow(key);
+    } catch (const std::exception&) {
+      // recorded by readNow; the brick is retried after its back-off
+    }
+  }
 }
 
 std::shared_ptr<const StoredBrick> BrickStreamer::find(const BrickKey& key) {

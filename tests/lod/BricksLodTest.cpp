@@ -194,3 +194,21 @@ TEST(BricksLod, GeneratedVolumeComputesAnyBoxConsistently) {
   EXPECT_THROW(lod::ProceduralMultiresSource("head:0"), InputError);
   EXPECT_THROW(lod::ProceduralMultiresSource("head:12x12"), InputError);
 }
+
+TEST(BricksLod, WithoutWorkerThreadsRequestReadsInline) {
+  // The browser build has no threads: request() reads a few bricks itself.
+  const auto v = hashVolume({48, 16, 16});
+  auto src = std::make_shared<lod::InCoreMultiresSource>(v, 8);
+  const lod::BrickGrid grid = lod::BrickGrid::of(*src, 16);
+  lod::BrickStreamerOptions o;
+  o.workers = 0;
+  o.inlineReadsPerRequest = 2;
+  lod::BrickStreamer streamer(src, grid, o);
+  streamer.request({{0, {0, 0, 0}}, {0, {1, 0, 0}}, {0, {2, 0, 0}}});
+  EXPECT_TRUE(streamer.find({0, {0, 0, 0}}));
+  EXPECT_TRUE(streamer.find({0, {1, 0, 0}}));
+  EXPECT_FALSE(streamer.find({0, {2, 0, 0}})) << "two per request";
+  streamer.request({{0, {2, 0, 0}}});
+  EXPECT_TRUE(streamer.find({0, {2, 0, 0}}));
+  EXPECT_TRUE(streamer.idle());
+}

@@ -26,7 +26,8 @@
 namespace tessera::lod {
 
 struct BrickStreamerOptions {
-  int workers = 2;
+  int workers = 2;                         // 0: request() reads inline
+  int inlineReadsPerRequest = 8;           // without workers
   std::uint64_t cacheBytes = 64ull << 20;  // decoded bricks kept on the host
   double firstRetryMs = 20.0;              // back-off: doubles per failure...
   double maxRetryMs = 2000.0;              // ...up to this
@@ -82,6 +83,7 @@ class BrickStreamer {
     double retryAtMs = 0.0;
   };
   void work();
+  void readQueuedInline(int count);
   std::shared_ptr<const StoredBrick> readOne(const BrickKey& key);            // no lock held
   void store(const BrickKey& key, std::shared_ptr<const StoredBrick> brick);  // lock held
   void recordFailure(const BrickKey& key, const std::string& what);           // lock held
