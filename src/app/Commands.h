@@ -20,7 +20,8 @@ void addViewCommand(CLI::App& app);      // ViewCommand.cpp (desktop viewer)
 inline constexpr const char* kVolumeHelp =
     "Volume: .nii .nii.gz .hdr .nrrd .nhdr .mha .mhd .vti .pvm .raw/.json, a DICOM file or "
     "folder, or gen:sphere|shepp-logan|marschner-lobb[:N]; default: ch2 (mricron-data) or a "
-    "Shepp-Logan phantom. render and plan: head:WxHxD (or head:N) is a generated u8 head of any size "
+    "Shepp-Logan phantom. render and plan: head:WxHxD (or head:N) is a generated u8 head of any "
+    "size "
     "computed brick by brick, never held whole (streamed through the bricks layout when it does "
     "not fit in core)";
 inline void addSeriesOption(CLI::App* cmd, std::string& series) {
