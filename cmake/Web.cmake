@@ -46,14 +46,17 @@ add_custom_command(
 # From io: the readers and procedural sources; not the writers, DICOM, nor
 # the zlib inflater.
 file(GLOB TESSERA_WEB_IO CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/io/*.cpp)
-list(FILTER TESSERA_WEB_IO EXCLUDE REGEX "/(.*Writer|Dicom.*|InflaterZlib|OutputFile)\\.cpp$")
+# OME-Zarr (Zarr*, Http*) needs libblosc, libzstd and libcurl, which
+# emscripten cannot link here (see README, OME-Zarr in the browser).
+list(FILTER TESSERA_WEB_IO EXCLUDE REGEX "/(.*Writer|Dicom.*|InflaterZlib|OutputFile|Zarr.*|Http.*)\\.cpp$")
 set(TESSERA_WEB_SOURCES ${TESSERA_GLSL_CPP} ${TESSERA_WEB_IO})
 foreach(layer core gpu lod layout render viewer)
   file(GLOB_RECURSE srcs CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/${layer}/*.cpp)
   list(APPEND TESSERA_WEB_SOURCES ${srcs})
 endforeach()
 # The EGL platform; web/src/GlContextWebGL.cpp is the browser's.
-list(REMOVE_ITEM TESSERA_WEB_SOURCES ${CMAKE_SOURCE_DIR}/src/gpu/GlContext.cpp)
+list(REMOVE_ITEM TESSERA_WEB_SOURCES ${CMAKE_SOURCE_DIR}/src/gpu/GlContext.cpp
+            ${CMAKE_SOURCE_DIR}/src/lod/ZarrMultiresSource.cpp)
 file(GLOB TESSERA_WEB_FRONT CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/web/src/*.cpp)
 
 set_source_files_properties(${CMAKE_SOURCE_DIR}/src/core/TransferFunction.cpp PROPERTIES

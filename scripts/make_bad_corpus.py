@@ -691,6 +691,108 @@ def make_dicom(c):
 
 # --------------------------------------------------------------- fuzz seeds
 
+
+# ------------------------------------------------------------------ OME-Zarr
+# Stores are folders; chunks are built with the standard library only (zlib,
+# gzip; blosc and zstd frames in their uncompressed forms) so that the
+# corpus is the same wherever the script runs.
+
+ZATTRS = json.dumps({"multiscales": [{"version": "0.4", "axes": [
+    {"name": a, "type": "space", "unit": "millimeter"} for a in "zyx"],
+    "datasets": [{"path": "0", "coordinateTransformations": [
+        {"type": "scale", "scale": [1.0, 1.0, 1.0]}]}]}]})
+
+
+def zarray(shape=(4, 4, 4), chunks=(4, 4, 4), dtype="|u1", compressor=None, order="C", **extra):
+    d = {"zarr_format": 2, "shape": list(shape), "chunks": list(chunks), "dtype": dtype,
+         "order": order, "fill_value": 0, "filters": None, "compressor": compressor}
+    d.update(extra)
+    return json.dumps(d)
+
+
+def blosc_memcpy(raw, typesize=1):
+    """A blosc frame holding `raw` uncompressed (flags: memcpyed)."""
+    return struct.pack("<BBBBIII", 2, 1, 0x02, typesize, len(raw), len(raw), len(raw) + 16) + raw
+
+
+def zstd_raw(raw):
+    """A zstd frame of one raw block with its content size (single segment)."""
+    header = struct.pack("<IB", 0xFD2FB528, 0xE0) + struct.pack("<Q", len(raw))
+    block = (len(raw) << 3) | 1  # last block, type raw
+    return header + struct.pack("<I", block)[:3] + raw
+
+
+def make_zarr(c):
+    f = "zarr"
+
+    def store(name, problem, expect, files):
+        folder = f"zarr/{name}.zarr"
+        base = {".zgroup": '{"zarr_format": 2}', ".zattrs": ZATTRS}
+        base.update(files)
+        for rel, data in base.items():
+            if data is not None:
+                c.write(f"{folder}/{rel}", data)
+        c.case(folder, f, problem, expect)
+
+    raw = bytes(range(64))
+    store("bad-json-zattrs", ".zattrs is cut off mid-list", "not valid JSON",
+          {".zattrs": '{"multiscales": [{"version": "0.4", "datasets": ['})
+    store("bad-json-zarray", "0/.zarray is not JSON", "not valid JSON", {"0/.zarray": "shape=4,4,4"})
+    store("no-metadata", "a folder with .zgroup only: no multiscales and no .zarray",
+          "not an OME-Zarr store", {".zattrs": "{}"})
+    store("missing-zarray", "multiscales names dataset 0, which has no .zarray", "missing", {})
+    store("dims-beyond-budget", "65536^3 u16 (512 TiB) in 64^3 chunks", "host budget",
+          {"0/.zarray": zarray((65536,) * 3, (64,) * 3, "<u2")})
+    store("huge-chunk", "one chunk of 2^40 x 2^40 x 2^40 f8", "larger than any host",
+          {"0/.zarray": zarray((8,) * 3, (1 << 40,) * 3, "<f8")})
+    store("chunk-too-big-for-budget", "one chunk of 65536^3 u8 (256 TiB)", "one chunk",
+          {"0/.zarray": zarray((65536,) * 3, (65536,) * 3)})
+    store("zero-chunk", "chunks [0, 4, 4]", "positive integer",
+          {"0/.zarray": zarray(chunks=(0, 4, 4))})
+    store("negative-chunk", "chunks [-4, 4, 4]", "positive integer",
+          {"0/.zarray": zarray(chunks=(-4, 4, 4))})
+    store("negative-shape", "shape [4, -4, 4]", "positive integer",
+          {"0/.zarray": zarray(shape=(4, -4, 4))})
+    store("two-axes", "a 2D array", "axes", {"0/.zarray": zarray((4, 4), (4, 4))})
+    store("fortran-order", "order F", "order", {"0/.zarray": zarray(order="F")})
+    store("complex-dtype", "dtype <c8", "not supported", {"0/.zarray": zarray(dtype="<c8")})
+    store("unknown-compressor", "compressor lzma", "not supported",
+          {"0/.zarray": zarray(compressor={"id": "lzma"})})
+    store("bad-separator", 'dimension_separator "-"', "dimension_separator",
+          {"0/.zarray": zarray(dimension_separator="-")})
+    store("wrong-size-raw-chunk", "uncompressed chunk of 60 bytes where 64 belong", "expected 64",
+          {"0/.zarray": zarray(), "0/0.0.0": raw[:60]})
+    store("truncated-zlib-chunk", "zlib chunk cut in half", "truncated|corrupt",
+          {"0/.zarray": zarray(compressor={"id": "zlib", "level": 1}),
+           "0/0.0.0": zl(noise(64))[:30]})
+    store("wrong-size-zlib-chunk", "zlib chunk that inflates to 32 of the 64 bytes", "expected 64",
+          {"0/.zarray": zarray(compressor={"id": "zlib", "level": 1}), "0/0.0.0": zl(raw[:32])})
+    store("zlib-chunk-too-long", "zlib chunk that inflates to 128 bytes where 64 belong",
+          "more than",
+          {"0/.zarray": zarray(compressor={"id": "zlib", "level": 1}), "0/0.0.0": zl(raw * 2)})
+    store("garbage-gzip-chunk", "gzip chunk of random bytes", "corrupt|truncated",
+          {"0/.zarray": zarray(compressor={"id": "gzip", "level": 1}), "0/0.0.0": noise(50)})
+    store("truncated-blosc-chunk", "blosc chunk cut after 40 of its 80 bytes", "truncated",
+          {"0/.zarray": zarray(compressor={"id": "blosc", "cname": "lz4", "shuffle": 1}),
+           "0/0.0.0": blosc_memcpy(raw)[:40]})
+    store("wrong-size-blosc-chunk", "blosc chunk holding 32 bytes where 64 belong", "expected 64",
+          {"0/.zarray": zarray(compressor={"id": "blosc", "cname": "lz4", "shuffle": 1}),
+           "0/0.0.0": blosc_memcpy(raw[:32])})
+    store("short-blosc-header", "blosc chunk of 9 bytes", "16-byte header",
+          {"0/.zarray": zarray(compressor={"id": "blosc", "cname": "lz4", "shuffle": 1}),
+           "0/0.0.0": blosc_memcpy(raw)[:9]})
+    store("truncated-zstd-chunk", "zstd chunk cut after 30 bytes", "zstd",
+          {"0/.zarray": zarray(compressor={"id": "zstd", "level": 1}),
+           "0/0.0.0": zstd_raw(raw)[:30]})
+    store("wrong-size-zstd-chunk", "zstd frame declaring 32 bytes where 64 belong", "expected 64",
+          {"0/.zarray": zarray(compressor={"id": "zstd", "level": 1}),
+           "0/0.0.0": zstd_raw(raw[:32])})
+    store("oversized-chunk", "a 200 KiB file where a 64-byte chunk belongs", "more than",
+          {"0/.zarray": zarray(compressor={"id": "zlib", "level": 1}),
+           "0/0.0.0": None})
+    c.write("zarr/oversized-chunk.zarr/0/0.0.0", b"\x78" * (63 * 1024))
+
+
 def fuzz_seeds(root):
     def put(target, name, data):
         path = os.path.join(root, target, name)
@@ -752,6 +854,18 @@ def fuzz_seeds(root):
          "host_budget_mb": 1024, "float_render_targets": True}))
     put("device_profile", "es2.json", json.dumps(
         {"name": "es2", "api": "gles2", "max_2d_texture_size": "unlimited", "texture_units": 8}))
+    # fuzz_zarr: a .zarray, a NUL byte, then the array's one chunk.
+    u16 = b"".join(struct.pack("<H", i * 7) for i in range(120))
+    for name, comp, chunk in [
+            ("none.bin", None, u16),
+            ("zlib.bin", {"id": "zlib", "level": 1}, zl(u16)),
+            ("gzip.bin", {"id": "gzip", "level": 1}, gz(u16)),
+            ("blosc.bin", {"id": "blosc", "cname": "lz4", "shuffle": 1}, blosc_memcpy(u16, 2)),
+            ("zstd.bin", {"id": "zstd", "level": 1}, zstd_raw(u16))]:
+        put("zarr", name, zarray((4, 5, 6), (4, 5, 6), "<u2", comp).encode() + b"\0" + chunk)
+    put("zarr", "big-endian-slash.bin",
+        zarray((4, 5, 6), (4, 5, 6), ">i2", None, dimension_separator="/").encode() + b"\0" +
+        b"".join(struct.pack(">h", i - 60) for i in range(120)))
 
 
 # ---------------------------------------------------------------------- main
@@ -770,7 +884,8 @@ def generate(bad_root, seed_root):
     if os.path.isdir(seed_root):
         shutil.rmtree(seed_root)
     c = Corpus(bad_root)
-    for make in (make_nifti, make_nrrd, make_metaimage, make_vti, make_pvm, make_raw, make_dicom):
+    for make in (make_nifti, make_nrrd, make_metaimage, make_vti, make_pvm, make_raw, make_dicom,
+                 make_zarr):
         make(c)
     for rel, fmt, problem, expect in FUZZ_REGRESSIONS:
         if not os.path.exists(os.path.join(bad_root, rel)):

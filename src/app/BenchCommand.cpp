@@ -8,6 +8,7 @@
 
 #include "app/BenchBricks.h"
 #include "app/BenchHybrid.h"
+#include "app/BenchRoofline.h"
 #include "app/BenchSlicing.h"
 #include "app/Commands.h"
 #include "app/RenderJob.h"
@@ -46,6 +47,9 @@ struct BenchOptions {
   double goalMs = 0.0;
   std::vector<std::string> bricks;  // --bricks: generated volumes to stream
   std::vector<std::string> bricksProfiles{"shield-k1", "ipad2"};
+  bool printTf = false;
+  bool roofline = false;
+  int fetches = 128;
 };
 
 struct Variant {
@@ -331,7 +335,32 @@ void addBenchCommand(CLI::App& app) {
                 "full-quality idle frame (default size 480x640)");
   cmd->add_option("--goal-ms", o->goalMs,
                   "With --interactive: frame-time goal (default: a sixth of a full-quality frame)");
+  cmd->add_flag("--print-tf", o->printTf,
+                "Print --tf as JSON (control points, opacity unit length) and exit: what "
+                "bench/peers translates into VTK's transfer functions");
+  cmd->add_flag("--roofline", o->roofline,
+                "Platform roofline: peak trilinear 3D fetch and TF lookup rates of this context, "
+                "and each technique's effective samples/s as a fraction of them (default 5 "
+                "frames per technique)");
+  cmd->add_option("--fetches", o->fetches,
+                  "With --roofline: fetches per fragment in the peak "
+                  "passes")
+      ->capture_default_str();
   cmd->callback([o] {
+    if (o->roofline) {
+      runRooflineBench({.file = o->file,
+                        .size = o->size,
+                        .frames = o->frames == 36 ? 5 : o->frames,
+                        .step = o->step,
+                        .tf = o->tf,
+                        .fetches = o->fetches,
+                        .json = o->json});
+      return;
+    }
+    if (o->printTf) {
+      std::printf("%s\n", TransferFunction::fromPresetOrFile(o->tf).toJson().c_str());
+      return;
+    }
     if (o->hybrid || o->interactive) {
       const HybridBenchOptions h{.file = o->file,
                                  .frames = o->frames == 36 ? (o->hybrid ? 5 : 20) : o->frames,

@@ -19,15 +19,24 @@ void addViewCommand(CLI::App& app);      // ViewCommand.cpp (desktop viewer)
 // reads a volume offers.
 inline constexpr const char* kVolumeHelp =
     "Volume: .nii .nii.gz .hdr .nrrd .nhdr .mha .mhd .vti .pvm .raw/.json, a DICOM file or "
-    "folder, or gen:sphere|shepp-logan|marschner-lobb[:N]; default: ch2 (mricron-data) or a "
-    "Shepp-Logan phantom. render and plan: head:WxHxD (or head:N) is a generated u8 head of any "
-    "size "
-    "computed brick by brick, never held whole (streamed through the bricks layout when it does "
-    "not fit in core)";
+    "folder, an OME-Zarr store (folder or http(s):// URL; the finest level that fits the host "
+    "budget, or streamed with --layout bricks), or gen:sphere|shepp-logan|marschner-lobb[:N]; "
+    "default: ch2 (mricron-data) or a Shepp-Logan phantom. render and plan: head:WxHxD (or "
+    "head:N) is a generated u8 head of any size computed brick by brick, never held whole "
+    "(streamed through the bricks layout when it does not fit in core)";
 inline void addSeriesOption(CLI::App* cmd, std::string& series) {
   cmd->add_option("--series", series,
                   "DICOM: Series Instance UID to read when a folder holds several (default: the "
                   "series with the most slices; `tessera info FOLDER` lists them)");
+}
+
+// --time and --channel: which 3D volume of a 4D/5D (t, c, z, y, x) OME-Zarr
+// image the command reads.
+inline void addTimeChannelOptions(CLI::App* cmd, int& time, int& channel) {
+  cmd->add_option("--time", time, "OME-Zarr: time point to read from a t axis (default 0)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--channel", channel, "OME-Zarr: channel to read from a c axis (default 0)")
+      ->check(CLI::NonNegativeNumber);
 }
 
 // ch2 from mricron-data when installed, else a generated Shepp–Logan phantom.

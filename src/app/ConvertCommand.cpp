@@ -12,6 +12,8 @@
 #include "tessera/core/PatientFrame.h"
 #include "tessera/io/VolumeReader.h"
 #include "tessera/io/VolumeWriter.h"
+#include "tessera/io/ZarrStore.h"
+#include "tessera/io/ZarrWriter.h"
 #include "tessera/lod/Downsample.h"
 
 namespace tessera::app {
@@ -24,6 +26,12 @@ struct ConvertOptions {
   std::string series;  // DICOM Series Instance UID
   std::string crop;
   std::string downsample;
+  int time = 0;  // OME-Zarr input: time point and channel
+  int channel = 0;
+  // OME-Zarr output.
+  int chunk = 64;
+  std::string levels = "auto";
+  std::string compressor = "zstd";
   bool quiet = false;
 };
 
@@ -111,10 +119,77 @@ std::string dimsText(glm::ivec3 d) {
   return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
 }
 
+OmeZarrWriteOptions zarrOptions(const ConvertOptions& o, Progress& progress) {
+  OmeZarrWriteOptions z;
+  if (o.chunk != 64 && o.chunk != 128) {
+    throw InputError("--chunk " + std::to_string(o.chunk) + ": expected 64 or 128");
+  }
+  z.chunk = o.chunk;
+  if (o.levels != "auto") {
+    try {
+      std::size_t used = 0;
+      z.levels = std::stoi(o.levels, &used);
+      if (used != o.levels.size() || z.levels < 1) throw InputError("");
+    } catch (const std::exception&) {
+      throw InputError("--levels '" + o.levels + "': expected auto or a count >= 1");
+    }
+  }
+  try {
+    z.compressor = parseZarrCompressor(o.compressor);
+  } catch (const InputError& e) {
+    throw InputError(std::string("--") + e.what());
+  }
+  z.progress = [&progress](double f, const std::string& what) {
+    progress.stage("writing " + what, 0.05 + 0.95 * f);
+  };
+  return z;
+}
+
+void printZarrResult(const ConvertOptions& o, const Volume& shape, const OmeZarrWriteResult& r) {
+  std::printf("%s: %s %s -> %s: OME-Zarr, %zu levels (", o.in.c_str(),
+              dimsText(shape.dims()).c_str(), std::string(scalarTypeName(shape.type())).c_str(),
+              o.out.c_str(), r.levelDims.size());
+  for (std::size_t l = 0; l < r.levelDims.size(); ++l) {
+    std::printf("%s%s", l ? ", " : "", dimsText(r.levelDims[l]).c_str());
+  }
+  std::printf("), chunks %d^3 %s: %llu written, %llu all-zero skipped, %s\n", o.chunk,
+              o.compressor.c_str(), static_cast<unsigned long long>(r.chunksWritten),
+              static_cast<unsigned long long>(r.chunksSkipped),
+              formatBytes(r.bytesWritten).c_str());
+  for (const std::string& note : writeLossNotes(shape, o.out)) {
+    std::fprintf(stderr, "note: %s\n", note.c_str());
+  }
+}
+
+// OME-Zarr to OME-Zarr streams: level 0 of the input is read one slab at a
+// time, so memory stays at a few slabs whatever the volume's size.
+bool convertStoreStreaming(const ConvertOptions& o, const OmeZarrWriteOptions& zarr,
+                           Progress& progress) {
+  if (!isZarrStore(o.in) || !o.crop.empty() || !o.downsample.empty() || !isOmeZarrName(o.out)) {
+    return false;
+  }
+  const ZarrStore in(openZarrStorage(o.in), {.time = o.time, .channel = o.channel});
+  const glm::ivec3 d = in.level(0).dims;
+  progress.stage("streaming " + dimsText(d) + " from " + o.in, 0.05);
+  const OmeZarrWriteResult r = writeOmeZarr(
+      in.shape(),
+      [&](int z0, int z1) {
+        return in.readBox(0, {0, 0, z0}, {d.x, d.y, z1});
+      },
+      o.out, zarr);
+  progress.stage("done", 1.0);
+  progress.done();
+  printZarrResult(o, in.shape(), r);
+  return true;
+}
+
 void runConvert(const ConvertOptions& o) {
   Progress progress(!o.quiet);
+  // Checked before anything is read, so that a typo fails at once.
+  const OmeZarrWriteOptions zarr = zarrOptions(o, progress);
+  if (convertStoreStreaming(o, zarr, progress)) return;
   progress.stage("reading " + o.in, 0.0);
-  Volume v = readVolume(o.in, {.dicomSeries = o.series});
+  Volume v = readVolume(o.in, {.dicomSeries = o.series, .time = o.time, .channel = o.channel});
   const glm::ivec3 inDims = v.dims();
   progress.stage("read " + dimsText(inDims), 0.4);
   if (!o.crop.empty()) {
@@ -126,6 +201,14 @@ void runConvert(const ConvertOptions& o) {
     const glm::ivec3 f = parseFactors(o.downsample);
     if (f != glm::ivec3(1)) v = lod::downsample(v, f);
     progress.stage("downsampled to " + dimsText(v.dims()), 0.6);
+  }
+  if (isOmeZarrName(o.out)) {
+    // The input is in memory already; the pyramid is still built slab by slab.
+    const OmeZarrWriteResult r = writeOmeZarr(v, o.out, zarr);
+    progress.stage("done", 1.0);
+    progress.done();
+    printZarrResult(o, v, r);
+    return;
   }
   progress.stage("writing " + o.out, 0.7);
   writeVolume(v, o.out);
@@ -149,14 +232,26 @@ void addConvertCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "convert",
       "Convert between volume formats (by extension), optionally cropping and downsampling.\n"
-      "Output: .nrrd .nii .nii.gz .mha .vti .pvm .raw(+.json) or FOLDER/ (DICOM series).\n"
-      "The output appears only when complete (temporary file + rename).");
+      "Output: .nrrd .nii .nii.gz .mha .vti .pvm .raw(+.json), FOLDER/ (DICOM series) or\n"
+      "NAME.ome.zarr (OME-Zarr, NGFF 0.4: a factor-2 pyramid of 2x2x2 means down to one chunk,\n"
+      "written slab by slab; OME-Zarr input is streamed too, other inputs are read whole).\n"
+      "The output appears only when complete (temporary file or folder + rename).");
   cmd->add_option("in", o->in, "Input volume (any format tessera info reads, or gen:...)")
       ->required();
   cmd->add_option("out", o->out, "Output file (format from its extension)")->required();
   addSeriesOption(cmd, o->series);
   cmd->add_option("--crop", o->crop, "Keep voxels x0:x1,y0:y1,z0:z1 (end exclusive)");
   cmd->add_option("--downsample", o->downsample, "Box-filter by N or AxBxC");
+  addTimeChannelOptions(cmd, o->time, o->channel);
+  cmd->add_option("--chunk", o->chunk, "OME-Zarr output: chunk edge, 64 or 128 voxels")
+      ->default_val(64);
+  cmd->add_option("--levels", o->levels,
+                  "OME-Zarr output: pyramid levels, N or auto (halve until one chunk holds the "
+                  "level)")
+      ->default_val("auto");
+  cmd->add_option("--compressor", o->compressor,
+                  "OME-Zarr output: zstd (level 3), blosc (lz4 + byte shuffle), zlib or none")
+      ->default_val("zstd");
   cmd->add_flag("--quiet", o->quiet, "No progress on stderr");
   cmd->callback([o] { runConvert(*o); });
 }

@@ -10,6 +10,7 @@
 #include "tessera/core/PatientFrame.h"
 #include "tessera/io/DicomSeriesReader.h"
 #include "tessera/io/VolumeReader.h"
+#include "tessera/io/ZarrStore.h"
 
 namespace tessera::app {
 
@@ -24,6 +25,8 @@ namespace {
 struct InfoOptions {
   std::string file;
   std::string series;
+  int time = 0;
+  int channel = 0;
   bool json = false;
 };
 
@@ -35,9 +38,42 @@ nlohmann::json affineRows(const Volume& v) {
   return rows;
 }
 
+nlohmann::json zarrJson(const ZarrStore& store) {
+  nlohmann::json levels = nlohmann::json::array();
+  for (int l = 0; l < store.levelCount(); ++l) {
+    const ZarrLevel& lv = store.level(l);
+    levels.push_back({{"path", lv.path},
+                      {"dims", {lv.dims.x, lv.dims.y, lv.dims.z}},
+                      {"chunks", {lv.chunk.x, lv.chunk.y, lv.chunk.z}},
+                      {"spacing", {lv.spacing.x, lv.spacing.y, lv.spacing.z}},
+                      {"origin", {lv.origin.x, lv.origin.y, lv.origin.z}},
+                      {"dtype", lv.array.dtype},
+                      {"compressor", lv.array.compressorText}});
+  }
+  return {{"store", store.describe()}, {"levels", levels}, {"notes", store.notes()}};
+}
+
+void printZarrLevels(const ZarrStore& store) {
+  std::printf("store       %s\n", store.describe().c_str());
+  for (int l = 0; l < store.levelCount(); ++l) {
+    const ZarrLevel& lv = store.level(l);
+    std::printf("level %-5d %d x %d x %d, chunks %d x %d x %d, spacing %g x %g x %g, %s\n", l,
+                lv.dims.x, lv.dims.y, lv.dims.z, lv.chunk.x, lv.chunk.y, lv.chunk.z, lv.spacing.x,
+                lv.spacing.y, lv.spacing.z, lv.array.compressorText.c_str());
+  }
+  for (const std::string& n : store.notes()) std::printf("note        %s\n", n.c_str());
+}
+
 void runInfo(const InfoOptions& o) {
   const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
-  const Volume v = readVolume(spec, {.dicomSeries = o.series});
+  const Volume v =
+      readVolume(spec, {.dicomSeries = o.series, .time = o.time, .channel = o.channel});
+  // An OME-Zarr store: its levels, chunks and codec beside the level read.
+  std::unique_ptr<ZarrStore> store;
+  if (isZarrStore(spec)) {
+    store = std::make_unique<ZarrStore>(openZarrStorage(spec),
+                                        ZarrSelection{.time = o.time, .channel = o.channel});
+  }
   const Histogram h = Histogram::compute(v, 256);
   // A DICOM folder may hold several series: list them so --series can pick.
   std::vector<DicomSeriesInfo> series;
@@ -66,6 +102,7 @@ void runInfo(const InfoOptions& o) {
         {"1", h.percentile(0.01)}, {"50", h.percentile(0.5)}, {"99", h.percentile(0.99)}};
     j["bytes"] = v.byteSize();
     j["description"] = v.description();
+    if (store) j["zarr"] = zarrJson(*store);
     if (!series.empty()) {
       j["dicom_series"] = nlohmann::json::array();
       for (const auto& s : series) {
@@ -104,6 +141,7 @@ void runInfo(const InfoOptions& o) {
                     ? " (read)"
                     : "");
   }
+  if (store) printZarrLevels(*store);
   std::printf("bytes       %s (%llu)\n", formatBytes(v.byteSize()).c_str(),
               static_cast<unsigned long long>(v.byteSize()));
   // A 16-bin sketch of the histogram, log-scaled, so skew is visible at a glance.
@@ -132,6 +170,7 @@ void addInfoCommand(CLI::App& app) {
                          "(RAS+ mm), type, value range, histogram summary and bytes");
   cmd->add_option("file", opts->file, kVolumeHelp);
   addSeriesOption(cmd, opts->series);
+  addTimeChannelOptions(cmd, opts->time, opts->channel);
   cmd->add_flag("--json", opts->json, "Print one JSON object");
   cmd->callback([opts] { runInfo(*opts); });
 }

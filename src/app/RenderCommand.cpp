@@ -13,10 +13,12 @@
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"
 #include "tessera/io/VolumeReader.h"
+#include "tessera/io/ZarrStore.h"
 #include "tessera/layout/LayoutRegistry.h"
 #include "tessera/lod/InCoreVolumeSource.h"
 #include "tessera/lod/MultiresVolumeSource.h"
 #include "tessera/lod/ProceduralMultiresSource.h"
+#include "tessera/lod/ZarrMultiresSource.h"
 #include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::app {
@@ -26,6 +28,8 @@ namespace {
 struct RenderOptions {
   std::string file;
   std::string series;  // DICOM Series Instance UID
+  int time = 0;        // OME-Zarr time point and channel
+  int channel = 0;
   std::string tf = "mr-default";
   std::string size = "512x512";
   double azimuth = 0.0;
@@ -108,9 +112,22 @@ RenderRequest requestFrom(const RenderOptions& o) {
   return req;
 }
 
+// A volume read brick by brick instead of whole: a generated head:WxHxD, or
+// an OME-Zarr store (folder or URL) with --layout bricks. Null otherwise.
+std::shared_ptr<const lod::MultiresSource> streamedSource(const RenderOptions& o,
+                                                          const std::string& spec) {
+  if (lod::ProceduralMultiresSource::isSpec(spec)) {
+    return std::make_shared<lod::ProceduralMultiresSource>(spec);
+  }
+  if (o.layout == "bricks" && isZarrStore(spec)) {
+    return lod::ZarrMultiresSource::open(spec, {.time = o.time, .channel = o.channel});
+  }
+  return nullptr;
+}
+
 // The volume, with the window the options ask for.
 lod::InCoreVolumeSource loadVolume(const RenderOptions& o, const std::string& spec) {
-  Volume volume = readVolume(spec, {.dicomSeries = o.series});
+  Volume volume = readVolume(spec, {.dicomSeries = o.series, .time = o.time, .channel = o.channel});
   if (!o.window.empty()) {
     if (o.window.size() != 2) throw InputError("--window takes two numbers MIN MAX");
     volume.setWindow({o.window[0], o.window[1]});
@@ -260,8 +277,8 @@ void runRenderCommand(const RenderOptions& o) {
   DeviceSession device = openDevice(o.profile);
   RenderTimes times;
   const auto tLoad = std::chrono::steady_clock::now();
-  if (lod::ProceduralMultiresSource::isSpec(spec)) {  // computed brick by brick, never whole
-    const lod::MultiresVolumeSource streamed(std::make_shared<lod::ProceduralMultiresSource>(spec));
+  if (auto pyramid = streamedSource(o, spec)) {  // read brick by brick, never whole
+    const lod::MultiresVolumeSource streamed(std::move(pyramid));
     times.loadMs = msSince(tLoad);
     const RenderResult r = runRender(device, streamed, tf, req);
     r.first.writePng(o.out);
@@ -301,6 +318,7 @@ void addRenderCommand(CLI::App& app) {
       "render", "Render a volume headless to a PNG (GPU ray caster through EGL)");
   cmd->add_option("file", o->file, kVolumeHelp);
   addSeriesOption(cmd, o->series);
+  addTimeChannelOptions(cmd, o->time, o->channel);
   cmd->add_option(
          "--tf", o->tf,
          "Transfer function: preset (grey, mr-default, ct-bone, ct-muscle, bench) or FILE.json")

@@ -1,6 +1,7 @@
 #include "tessera/io/VolumeReader.h"
 
 #include <array>
+#include <cstdio>
 #include <cstring>
 
 #include "io/HeaderText.h"
@@ -13,6 +14,7 @@
 #include "tessera/io/PvmReader.h"
 #include "tessera/io/RawSidecarReader.h"
 #include "tessera/io/VtiReader.h"
+#include "tessera/io/ZarrStore.h"
 
 namespace tessera {
 
@@ -47,6 +49,17 @@ Volume readVolume(const std::string& spec, const ReadOptions& options) {
                        ") was asked for, but this is not DICOM");
     }
   };
+  if (isZarrStore(spec)) {
+    notDicom();
+    std::string note;
+    Volume v = readZarrVolume(spec, {.time = options.time, .channel = options.channel}, &note);
+    // Which level was read, and what was converted, is for the user to know.
+    std::fprintf(stderr, "note: %s: %s\n", spec.c_str(), note.c_str());
+    return v;
+  }
+  if (options.time != 0 || options.channel != 0) {
+    throw InputError(spec + ": --time/--channel select within an OME-Zarr store; this is not one");
+  }
   if (spec.rfind("gen:", 0) == 0) {
     notDicom();
     return makeProcedural(spec);

@@ -17,6 +17,7 @@
 #include "tessera/io/PvmWriter.h"
 #include "tessera/io/RawSidecarWriter.h"
 #include "tessera/io/VtiWriter.h"
+#include "tessera/io/ZarrWriter.h"
 
 namespace tessera {
 
@@ -61,6 +62,11 @@ std::vector<std::string> pvmLossNotes(const Volume& v) {
 
 std::vector<std::string> writeLossNotes(const Volume& volume, const fs::path& out) {
   const std::string name = lowerName(out);
+  if (isOmeZarrName(out) && volume.direction() != glm::dmat3(1.0)) {
+    return {"OME-NGFF 0.4 has no orientation: other readers see the axes of orientation " +
+            orientationOf(volume.direction()).describe() +
+            " as RAS; Tessera reads the direction back from its \"tessera\" attribute"};
+  }
   if (endsWith(name, ".pvm")) return pvmLossNotes(volume);
   const std::string text = out.string();
   const bool dicom = !text.empty() && (text.back() == '/' || endsWith(name, ".dcm.d"));
@@ -117,7 +123,9 @@ void writeVolume(const Volume& volume, const fs::path& path) {
   if (!volume.hasData()) throw Error(path.string() + ": no voxels to write");
   const std::string name = lowerName(path);
   const std::string text = path.string();
-  if (endsWith(name, ".nrrd")) {
+  if (isOmeZarrName(path)) {
+    writeOmeZarr(volume, path);  // a temporary folder renamed into place
+  } else if (endsWith(name, ".nrrd")) {
     writeAtomically(path, [&](const fs::path& t) { writeNrrd(volume, t, true); });
   } else if (endsWith(name, ".nii") || endsWith(name, ".nii.gz")) {
     writeNifti(volume, path);  // through writeAtomically itself
@@ -136,7 +144,7 @@ void writeVolume(const Volume& volume, const fs::path& path) {
   } else {
     throw InputError(text +
                      ": unknown output format (use .nrrd, .nii, .nii.gz, .mha, .vti, .pvm, .raw, "
-                     "or a folder name ending in / for a DICOM series)");
+                     "a folder name ending in .ome.zarr (OME-Zarr) or in / for a DICOM series)");
   }
 }
 

@@ -86,9 +86,9 @@ AtlasShape atlasFor(const gpu::DeviceLimits& limits, int stored, std::uint64_t a
   return a;
 }
 
-std::uint64_t pyramidBricks(glm::ivec3 dims, int brick) {
+std::uint64_t pyramidBricks(const std::vector<glm::ivec3>& levels, int brick) {
   std::uint64_t n = 0;
-  for (glm::ivec3 d : lod::pyramidDims(dims, kCoarsestSide)) {
+  for (glm::ivec3 d : levels) {
     const glm::ivec3 b = (d + brick - 1) / brick;
     n += static_cast<std::uint64_t>(b.x) * b.y * b.z;
   }
@@ -98,7 +98,8 @@ std::uint64_t pyramidBricks(glm::ivec3 dims, int brick) {
 }  // namespace
 
 LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& limits,
-                                 const BricksOptions& options, glm::ivec3 chunk) {
+                                 const BricksOptions& options, glm::ivec3 chunk,
+                                 const std::vector<glm::ivec3>& sourceLevels) {
   LayoutPlan plan;
   plan.layout = "bricks";
   const int b = brickSizeFor(options, chunk);
@@ -106,7 +107,8 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
   const glm::ivec3 d = shape.dims();
   const std::string vol = dimsText(d) + " " + std::string(scalarTypeName(shape.type()));
   const glm::ivec3 cells = (d + b - 1) / b;
-  const std::vector<glm::ivec3> levels = lod::pyramidDims(d, kCoarsestSide);
+  const std::vector<glm::ivec3> levels =
+      sourceLevels.empty() ? lod::pyramidDims(d, kCoarsestSide) : sourceLevels;
   const glm::ivec3 top = (levels.back() + b - 1) / b;
   const int topBricks = top.x * top.y * top.z;
   PlannedTexture pages{.label = "brick page table",
@@ -128,7 +130,7 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
     avail = std::min(avail,
                      limits.textureBudget > pages.bytes ? limits.textureBudget - pages.bytes : 0);
   }
-  const AtlasShape a = atlasFor(limits, stored, avail, pyramidBricks(d, b));
+  const AtlasShape a = atlasFor(limits, stored, avail, pyramidBricks(levels, b));
   const bool es3 = a.mosaic.tilesX == 0;
   const int atlases = es3 ? 1 : std::max(1, a.slots.x);
   PlannedTexture atlas{
@@ -174,7 +176,9 @@ std::unique_ptr<BricksLayout> BricksLayout::create(
   l->api_ = limits.api;
   l->source_ = source;
   const glm::ivec3 chunk = source->levelInfo(0).chunk;
-  l->plan_ = planFor(source->shape(), limits, options, chunk);
+  std::vector<glm::ivec3> levels;
+  for (int lv = 0; lv < source->levelCount(); ++lv) levels.push_back(source->levelInfo(lv).dims);
+  l->plan_ = planFor(source->shape(), limits, options, chunk, levels);
   if (!l->plan_.fits) throw GpuError("bricks layout: " + l->plan_.reason);
   const int b = brickSizeFor(options, chunk);
   l->grid_ = lod::BrickGrid::of(*source, b);

@@ -34,6 +34,13 @@ VolumeUpload uploadVolume(gpu::GlContext& context, const gpu::DeviceLimits& limi
     volumeLimits.textureUnits = upload.plan.volumeUnits;
     if (limits.textureBudget != 0) volumeLimits.textureBudget -= technique.bytes;
     upload.layout = BricksLayout::create(pyramid, volumeLimits, context.ledger());
+    // The plan made from the shape alone did not know the source's chunks
+    // (which set the brick size) nor its levels: report what was built.
+    const std::string planned = upload.plan.layout.reason;
+    upload.plan.layout = upload.layout->plan();
+    if (upload.plan.reason.rfind(planned, 0) == 0) {
+      upload.plan.reason = upload.plan.layout.reason + upload.plan.reason.substr(planned.size());
+    }
     return upload;
   }
   upload.volume = source.level(upload.plan.downsample);

@@ -13,7 +13,9 @@ namespace tessera {
 // Picks the reader by name: `.nii`, `.nii.gz`, `.hdr`/`.img` (NIfTI-1/2),
 // `.nrrd`, `.nhdr` (NRRD), `.mha`, `.mhd` (MetaImage), `.vti` (VTK XML
 // ImageData), `.pvm` (PVM), `.raw` or its `.json` sidecar (raw), a folder,
-// `.dcm`/`.ima` or any file with the DICM marker (DICOM series); or
+// `.dcm`/`.ima` or any file with the DICM marker (DICOM series), an
+// OME-Zarr store (a folder with .zgroup/.zattrs/.zarray, or an http(s)://
+// URL: the finest level that fits the host budget, see io/ZarrStore.h); or
 // generates a procedural volume when `spec` starts with "gen:" (see
 // io/Procedural.h). Throws InputError naming the file and the problem; never
 // allocates more than the file can justify or the host budget allows.
@@ -21,6 +23,10 @@ struct ReadOptions {
   // DICOM: the Series Instance UID to read from a folder holding several
   // (empty: the series with the most slices). An InputError for other formats.
   std::string dicomSeries;
+  // OME-Zarr: the time point and channel of a 4D/5D image (0: the first).
+  // An InputError for other formats when not 0.
+  int time = 0;
+  int channel = 0;
 };
 
 Volume readVolume(const std::string& spec, const ReadOptions& options = {});

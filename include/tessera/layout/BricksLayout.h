@@ -64,8 +64,10 @@ struct BricksFrame {
 class BricksLayout final : public Layout {
  public:
   // The atlas and page table for a volume of `shape` within `limits`.
+  // `levels`: the source's level dims (empty: a factor-2 pyramid down to 16).
   static LayoutPlan planFor(const Volume& shape, const gpu::DeviceLimits& limits,
-                            const BricksOptions& options = {}, glm::ivec3 chunk = glm::ivec3(0));
+                            const BricksOptions& options = {}, glm::ivec3 chunk = glm::ivec3(0),
+                            const std::vector<glm::ivec3>& levels = {});
 
   // Plans, allocates, and reads and uploads the coarsest level (pinned, so
   // there is always something to fall back to). Throws GpuError if the plan

@@ -1,0 +1,69 @@
+#pragma once
+// Where a Zarr store's keys live ("0/.zarray", "0/1/2/3"): a folder on
+// disk, bytes in memory (tests, fuzzers, and the browser, where a JS
+// fetch() source fills it), or an HTTP(S) server (io/HttpStorage.h). The
+// store reader (io/ZarrStore.h) sees only this interface.
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace tessera {
+
+class ZarrStorage {
+ public:
+  virtual ~ZarrStorage() = default;
+
+  // The bytes stored under `key`, or nullopt when there are none (a
+  // missing chunk is fill_value in Zarr). More than `maxBytes` is an
+  // InputError naming the key's location, before it is all held.
+  // Unreachable or failing storage: Error naming the location.
+  // Thread-safe.
+  virtual std::optional<std::vector<std::byte>> get(const std::string& key,
+                                                    std::uint64_t maxBytes) const = 0;
+  // Where `key` lives, for messages: a path or a URL.
+  virtual std::string locate(const std::string& key) const = 0;
+  // How often a chunk that fails to decode is fetched again: 0 where the
+  // same bytes would come back (disk, memory); a network may have
+  // delivered a damaged body.
+  virtual int refetches() const { return 0; }
+  // How many chunk reads are worth having in flight at once.
+  virtual int parallelism() const { return 2; }
+  // The store's root for `info`: a folder or a URL.
+  virtual std::string describe() const = 0;
+};
+
+// A store on disk: keys are relative paths under `root`, read through
+// io's FileSource.
+class FolderStorage final : public ZarrStorage {
+ public:
+  explicit FolderStorage(std::filesystem::path root);
+  std::optional<std::vector<std::byte>> get(const std::string& key,
+                                            std::uint64_t maxBytes) const override;
+  std::string locate(const std::string& key) const override;
+  std::string describe() const override { return root_.string(); }
+
+ private:
+  std::filesystem::path root_;
+};
+
+// A store in memory, keyed by the same relative names.
+class MemoryStorage final : public ZarrStorage {
+ public:
+  explicit MemoryStorage(std::string name) : name_(std::move(name)) {}
+  void put(const std::string& key, std::vector<std::byte> bytes);
+  std::optional<std::vector<std::byte>> get(const std::string& key,
+                                            std::uint64_t maxBytes) const override;
+  std::string locate(const std::string& key) const override { return name_ + "/" + key; }
+  std::string describe() const override { return name_; }
+
+ private:
+  std::string name_;
+  mutable std::mutex mutex_;
+  std::map<std::string, std::vector<std::byte>> entries_;
+};
+
+}  // namespace tessera

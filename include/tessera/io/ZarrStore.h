@@ -1,0 +1,116 @@
+#pragma once
+// An OME-Zarr multiscale image (OME-NGFF 0.4 on Zarr v2), read one box at a
+// time through a ZarrStorage (folder, memory or HTTP).
+//
+// World frame: NGFF axes carry no patient orientation. Tessera maps the
+// array's x, y, z space axes to index axes i, j, k and assigns the RAS+
+// frame to them (i -> Right, j -> Anterior, k -> Superior), so world =
+// scale * index + translation with direction = identity, in the axes' unit
+// converted to mm. A store Tessera wrote may add "tessera": {"direction"}
+// to .zattrs, restoring the direction of the volume it came from. `info`
+// prints this as the geometry source.
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "tessera/core/Volume.h"
+#include "tessera/io/ZarrArray.h"
+#include "tessera/io/ZarrStorage.h"
+
+namespace tessera {
+
+// Which 3D volume of a 4D/5D (t, c, z, y, x) image to read.
+struct ZarrSelection {
+  int time = 0;
+  int channel = 0;
+};
+
+struct ZarrLevel {
+  std::string path;  // the dataset's path in the group ("0", "s1", ...)
+  ZarrArrayMeta array;
+  glm::ivec3 dims{0};   // x, y, z voxels
+  glm::ivec3 chunk{0};  // x, y, z chunk voxels
+  glm::dvec3 spacing{1.0};
+  glm::dvec3 origin{0.0};  // world position of voxel (0,0,0)'s centre
+};
+
+class ZarrStore {
+ public:
+  // Reads the group's metadata (.zattrs multiscales; or a lone .zarray at
+  // the root as a one-level store) and every level's .zarray; checks the
+  // selection and every level against the host budget. InputError naming
+  // the key's path or URL.
+  explicit ZarrStore(std::shared_ptr<const ZarrStorage> storage, ZarrSelection selection = {});
+
+  // The finest level's dims, type and geometry with the value window of
+  // the store (from its metadata or its coarsest level); no voxels.
+  const Volume& shape() const { return shape_; }
+  int levelCount() const { return static_cast<int>(levels_.size()); }
+  const ZarrLevel& level(int l) const;
+
+  // Called after each chunk of a readBox with (chunks done, chunks in the
+  // box), from one thread at a time.
+  using Progress = std::function<void(std::size_t done, std::size_t total)>;
+
+  // Voxels [begin, end) of level `l` (x, y, z) as a Volume of end - begin
+  // voxels, geometry = the level's spacing, origin at `begin`. Reads only
+  // the chunks the box touches, `parallelism()` at a time. Thread-safe.
+  // InputError naming the chunk's path or URL for a corrupt chunk; a
+  // missing chunk is fill_value.
+  Volume readBox(int l, glm::ivec3 begin, glm::ivec3 end, const Progress& progress = {}) const;
+  Volume readLevel(int l, const Progress& progress = {}) const {
+    return readBox(l, glm::ivec3(0), level(l).dims, progress);
+  }
+
+  // The finest level whose voxels (plus one chunk per reader) fit the host
+  // budget; -1 if none does.
+  int finestLevelWithin(std::uint64_t budgetBytes) const;
+
+  // Things the user should know ("dtype <i4 is read as f32", "axes have no
+  // unit: taken as mm").
+  const std::vector<std::string>& notes() const { return notes_; }
+  // "OME-NGFF 0.4 (multiscales 'name'), 3 levels, blosc lz4 shuffle".
+  std::string describe() const;
+  const ZarrStorage& storage() const { return *storage_; }
+  const ZarrSelection& selection() const { return selection_; }
+
+ private:
+  struct AxisMap;
+  void readMultiscales(const std::string& attrsText);
+  void readLoneArray();
+  void addLevel(const std::string& path, glm::dvec3 scale, glm::dvec3 translation);
+  void checkSelection();
+  void makeShape(const std::string& attrsText);
+  void readChunkInto(int l, const std::vector<std::int64_t>& chunkIndex, glm::ivec3 begin,
+                     glm::ivec3 end, Volume& out) const;
+
+  std::shared_ptr<const ZarrStorage> storage_;
+  ZarrSelection selection_;
+  std::string version_;
+  std::string name_;
+  // Array axis of x, y, z, t, c (-1: the array has no such axis).
+  int axis_[5] = {-1, -1, -1, -1, -1};
+  double unitToMm_ = 1.0;
+  glm::dmat3 direction_{1.0};
+  std::vector<ZarrLevel> levels_;
+  Volume shape_;
+  std::vector<std::string> notes_;
+};
+
+// True when `spec` is an http:// or https:// URL, or a folder holding
+// .zgroup, .zattrs or .zarray.
+bool isZarrStore(const std::string& spec);
+
+// The storage for a folder or a URL.
+std::shared_ptr<const ZarrStorage> openZarrStorage(const std::string& spec);
+
+// The finest level of the store that fits the host budget, read in-core;
+// `chosenNote` (if given) says which level and why.
+Volume readZarrVolume(const std::string& spec, ZarrSelection selection = {},
+                      std::string* chosenNote = nullptr);
+
+}  // namespace tessera

@@ -1,0 +1,65 @@
+#pragma once
+// Writes an OME-Zarr store (OME-NGFF 0.4 multiscales on Zarr v2): a
+// factor-2 pyramid from the finest level down to one chunk, streamed slab
+// by slab so that host memory holds one chunk-deep slab per level (about
+// 4/3 of a finest-level slab), never the volume.
+//
+// The reduction filter is the 2x2x2 mean (partial blocks at odd edges
+// average the voxels present; NaN is skipped), exactly lod::downsample(v,
+// 2): it is what the renderer's own pyramid uses, so a level read from the
+// store equals the level Tessera would compute in-core; it is the box
+// filter whose voxel centre sits half a voxel of the finer level into the
+// block, which NGFF's per-level translation states; and, unlike taking
+// every other voxel, it does not alias thin structures away. Integer types
+// round to nearest.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "tessera/core/Volume.h"
+#include "tessera/io/ZarrArray.h"
+
+namespace tessera {
+
+struct OmeZarrWriteOptions {
+  int chunk = 64;  // chunk edge in voxels (capped per axis at a level's size)
+  int levels = 0;  // 0: down to a level that fits one chunk
+  ZarrCompressor compressor = ZarrCompressor::Zstd;
+  // Called with the fraction of the finest level's slices done.
+  std::function<void(double fraction, const std::string& what)> progress;
+};
+
+// z slices [z0, z1) of the finest level, as a Volume of dims.x x dims.y x
+// (z1 - z0) voxels of the shape's type.
+using SlabReader = std::function<Volume(int z0, int z1)>;
+
+struct OmeZarrWriteResult {
+  std::vector<glm::ivec3> levelDims;
+  std::uint64_t chunksWritten = 0;
+  std::uint64_t chunksSkipped = 0;  // all zero (= fill_value): not stored
+  std::uint64_t bytesWritten = 0;
+  ValueRange range;
+};
+
+// The number of levels `auto` gives: halve until every axis fits one chunk.
+int omeZarrAutoLevels(glm::ivec3 dims, int chunk);
+
+// Writes the store at `path` (a folder, by convention NAME.ome.zarr): built
+// in a temporary folder beside it and renamed into place when complete; an
+// existing OME-Zarr store there is replaced, anything else is an error.
+// `shape` gives dims, type, geometry and window.
+OmeZarrWriteResult writeOmeZarr(const Volume& shape, const SlabReader& slabs,
+                                const std::filesystem::path& path,
+                                const OmeZarrWriteOptions& options);
+OmeZarrWriteResult writeOmeZarr(const Volume& volume, const std::filesystem::path& path,
+                                const OmeZarrWriteOptions& options = {});
+
+// True when `path` names an OME-Zarr output (".zarr", ".ome.zarr", maybe
+// with a trailing "/").
+bool isOmeZarrName(const std::filesystem::path& path);
+
+}  // namespace tessera

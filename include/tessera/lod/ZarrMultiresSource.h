@@ -1,0 +1,33 @@
+#pragma once
+// An OME-Zarr store (io::ZarrStore: a folder or an HTTP(S) URL) as the
+// pyramid the bricked layout and the streaming scheduler read: each level
+// is one of the store's datasets, read one box at a time, only the chunks
+// the box touches.
+#include <memory>
+#include <string>
+
+#include "tessera/io/ZarrStore.h"
+#include "tessera/lod/MultiresSource.h"
+
+namespace tessera::lod {
+
+class ZarrMultiresSource final : public MultiresSource {
+ public:
+  explicit ZarrMultiresSource(std::shared_ptr<const ZarrStore> store);
+  // Opens a folder or URL (see io/ZarrStore.h), with a time point and channel.
+  static std::unique_ptr<ZarrMultiresSource> open(const std::string& spec,
+                                                  ZarrSelection selection = {});
+
+  const Volume& shape() const override { return store_->shape(); }
+  int levelCount() const override { return store_->levelCount(); }
+  LevelInfo levelInfo(int level) const override;
+  Volume readBox(int level, const VoxelBox& box) const override;
+  std::string describe() const override { return store_->describe(); }
+
+  const ZarrStore& store() const { return *store_; }
+
+ private:
+  std::shared_ptr<const ZarrStore> store_;
+};
+
+}  // namespace tessera::lod

@@ -1,0 +1,170 @@
+#include "tessera/io/HttpStorage.h"
+
+#include <curl/curl.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <mutex>
+#include <random>
+#include <thread>
+#include <vector>
+
+#include "tessera/core/Error.h"
+
+namespace tessera {
+
+namespace {
+
+int envInt(const char* name, int fallback, int lo, int hi) {
+  const char* v = std::getenv(name);
+  if (!v) return fallback;
+  char* end = nullptr;
+  const long n = std::strtol(v, &end, 10);
+  if (end == v || *end != '\0' || n < lo || n > hi) {
+    throw InputError(std::string(name) + "='" + v + "': expected an integer in " +
+                     std::to_string(lo) + ".." + std::to_string(hi));
+  }
+  return static_cast<int>(n);
+}
+
+void globalInit() {
+  static std::once_flag once;
+  std::call_once(once, [] { curl_global_init(CURL_GLOBAL_DEFAULT); });
+}
+
+struct Body {
+  std::vector<std::byte> bytes;
+  std::uint64_t limit = 0;
+  bool tooBig = false;
+};
+
+std::size_t onBody(char* data, std::size_t size, std::size_t count, void* user) {
+  auto* body = static_cast<Body*>(user);
+  const std::size_t n = size * count;
+  if (body->bytes.size() + n > body->limit) {
+    body->tooBig = true;
+    return 0;  // aborts the transfer (CURLE_WRITE_ERROR)
+  }
+  const auto* p = reinterpret_cast<const std::byte*>(data);
+  body->bytes.insert(body->bytes.end(), p, p + n);
+  return n;
+}
+
+}  // namespace
+
+HttpOptions HttpOptions::fromEnvironment() {
+  HttpOptions o;
+  o.connections = envInt("TESSERA_HTTP_CONNECTIONS", o.connections, 1, 64);
+  o.attempts = envInt("TESSERA_HTTP_ATTEMPTS", o.attempts, 1, 20);
+  o.requestTimeoutMs = envInt("TESSERA_HTTP_TIMEOUT_MS", o.requestTimeoutMs, 100, 3600000);
+  o.stallTimeoutMs = envInt("TESSERA_HTTP_STALL_MS", o.stallTimeoutMs, 1000, 3600000);
+  return o;
+}
+
+bool isHttpUrl(const std::string& spec) {
+  return spec.rfind("http://", 0) == 0 || spec.rfind("https://", 0) == 0;
+}
+
+// Idle easy handles; each keeps its connections alive between requests.
+struct HttpStorage::Pool {
+  std::mutex mutex;
+  std::vector<CURL*> idle;
+  ~Pool() {
+    for (CURL* h : idle) curl_easy_cleanup(h);
+  }
+  CURL* acquire() {
+    {
+      const std::lock_guard lock(mutex);
+      if (!idle.empty()) {
+        CURL* h = idle.back();
+        idle.pop_back();
+        return h;
+      }
+    }
+    CURL* h = curl_easy_init();
+    if (!h) throw Error("libcurl: curl_easy_init failed");
+    return h;
+  }
+  void release(CURL* h) {
+    const std::lock_guard lock(mutex);
+    idle.push_back(h);
+  }
+};
+
+HttpStorage::HttpStorage(std::string rootUrl, HttpOptions options)
+    : root_(std::move(rootUrl)), options_(options), pool_(std::make_unique<Pool>()) {
+  globalInit();
+  while (!root_.empty() && root_.back() == '/') root_.pop_back();
+}
+
+HttpStorage::~HttpStorage() = default;
+
+std::optional<std::vector<std::byte>> HttpStorage::get(const std::string& key,
+                                                       std::uint64_t maxBytes) const {
+  const std::string url = locate(key);
+  CURL* h = pool_->acquire();
+  struct Return {
+    Pool& pool;
+    CURL* h;
+    ~Return() { pool.release(h); }
+  } giveBack{*pool_, h};
+  std::string problem;
+  thread_local std::mt19937 jitter(std::random_device{}());
+  for (int attempt = 0; attempt < options_.attempts; ++attempt) {
+    if (attempt > 0) {
+      ++retries_;
+      const int wait = options_.backoffMs << std::min(attempt - 1, 10);
+      std::this_thread::sleep_for(std::chrono::milliseconds(
+          wait + static_cast<int>(jitter() % static_cast<unsigned>(wait / 2 + 1))));
+    }
+    Body body;
+    body.limit = maxBytes;
+    char error[CURL_ERROR_SIZE] = {0};
+    curl_easy_reset(h);
+    curl_easy_setopt(h, CURLOPT_URL, url.c_str());
+    curl_easy_setopt(h, CURLOPT_WRITEFUNCTION, onBody);
+    curl_easy_setopt(h, CURLOPT_WRITEDATA, &body);
+    curl_easy_setopt(h, CURLOPT_ERRORBUFFER, error);
+    curl_easy_setopt(h, CURLOPT_NOSIGNAL, 1L);
+    curl_easy_setopt(h, CURLOPT_FOLLOWLOCATION, 1L);
+    curl_easy_setopt(h, CURLOPT_MAXREDIRS, 5L);
+    curl_easy_setopt(h, CURLOPT_CONNECTTIMEOUT_MS, long(options_.connectTimeoutMs));
+    curl_easy_setopt(h, CURLOPT_TIMEOUT_MS, long(options_.requestTimeoutMs));
+    // A stall: under 1 byte/s for stallTimeoutMs.
+    curl_easy_setopt(h, CURLOPT_LOW_SPEED_LIMIT, 1L);
+    curl_easy_setopt(h, CURLOPT_LOW_SPEED_TIME, long((options_.stallTimeoutMs + 999) / 1000));
+    ++requests_;
+    const CURLcode rc = curl_easy_perform(h);
+    bytes_ += body.bytes.size();
+    if (body.tooBig) {
+      throw InputError(url + ": more than " + std::to_string(maxBytes) +
+                       " bytes, more than any valid content of this key can have");
+    }
+    if (rc != CURLE_OK) {
+      problem = std::string(curl_easy_strerror(rc)) + (error[0] ? std::string(": ") + error : "");
+      continue;
+    }
+    long status = 0;
+    curl_easy_getinfo(h, CURLINFO_RESPONSE_CODE, &status);
+    if (status == 404 || status == 410) return std::nullopt;
+    if (status >= 500 || status == 408 || status == 429) {
+      problem = "HTTP " + std::to_string(status);
+      continue;
+    }
+    if (status < 200 || status >= 300) {
+      throw InputError(url + ": HTTP " + std::to_string(status));
+    }
+    curl_off_t declared = -1;
+    curl_easy_getinfo(h, CURLINFO_CONTENT_LENGTH_DOWNLOAD_T, &declared);
+    if (declared >= 0 && std::uint64_t(declared) != body.bytes.size()) {
+      problem = "received " + std::to_string(body.bytes.size()) + " of the " +
+                std::to_string(declared) + " bytes of Content-Length";
+      continue;
+    }
+    return std::move(body.bytes);
+  }
+  throw Error(url + ": " + problem + " (gave up after " + std::to_string(options_.attempts) +
+              " attempts)");
+}
+
+}  // namespace tessera

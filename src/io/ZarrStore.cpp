@@ -1,0 +1,565 @@
+#include "tessera/io/ZarrStore.h"
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <exception>
+#include <limits>
+#include <mutex>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
+
+namespace tessera {
+
+namespace {
+
+using nlohmann::json;
+
+// Metadata documents are small; a multi-megabyte .zattrs is not one.
+constexpr std::uint64_t kMaxMetadataBytes = 16ull << 20;
+
+enum Role { kX = 0, kY = 1, kZ = 2, kT = 3, kC = 4 };
+
+std::string text(const std::vector<std::byte>& b) {
+  return {reinterpret_cast<const char*>(b.data()), b.size()};
+}
+
+json parseJson(const std::string& body, const std::string& where) {
+  try {
+    return json::parse(body);
+  } catch (const json::exception& e) {
+    throw InputError(where + ": not valid JSON (" + e.what() + ")");
+  }
+}
+
+double unitInMm(const std::string& unit) {
+  if (unit == "millimeter") return 1.0;
+  if (unit == "micrometer") return 1e-3;
+  if (unit == "nanometer") return 1e-6;
+  if (unit == "centimeter") return 10.0;
+  if (unit == "meter") return 1000.0;
+  if (unit == "angstrom") return 1e-7;
+  if (unit == "inch") return 25.4;
+  return 0.0;
+}
+
+// The numbers of a "scale" or "translation" transform, one per axis.
+std::vector<double> transformValues(const json& t, const char* key, std::size_t rank,
+                                    const std::string& where) {
+  if (!t.contains(key) || !t[key].is_array() || t[key].size() != rank) {
+    throw InputError(where + ": coordinateTransformations " + t.dump() + " needs \"" + key +
+                     "\" with " + std::to_string(rank) + " numbers (one per axis)");
+  }
+  std::vector<double> v;
+  for (const json& x : t[key]) {
+    if (!x.is_number() || !std::isfinite(x.get<double>())) {
+      throw InputError(where + ": " + key + " " + t[key].dump() + " holds a non-finite value");
+    }
+    v.push_back(x.get<double>());
+  }
+  return v;
+}
+
+// Applies a coordinateTransformations list to (scale, translation).
+void applyTransforms(const json& list, std::size_t rank, const std::string& where,
+                     std::vector<double>& scale, std::vector<double>& translation) {
+  if (list.is_null()) return;
+  if (!list.is_array()) throw InputError(where + ": coordinateTransformations is not a list");
+  for (const json& t : list) {
+    const std::string type = t.is_object() ? t.value("type", std::string()) : std::string();
+    if (type == "scale") {
+      const std::vector<double> s = transformValues(t, "scale", rank, where);
+      for (std::size_t a = 0; a < rank; ++a) {
+        scale[a] *= s[a];
+        translation[a] *= s[a];
+      }
+    } else if (type == "translation") {
+      const std::vector<double> d = transformValues(t, "translation", rank, where);
+      for (std::size_t a = 0; a < rank; ++a) translation[a] += d[a];
+    } else if (type != "identity") {
+      throw InputError(where + ": coordinateTransformation " + t.dump() +
+                       " is not scale, translation or identity");
+    }
+  }
+}
+
+template <class T>
+T roundedFill(double v) {
+  if (std::isnan(v)) return T(0);
+  const double lo = double(std::numeric_limits<T>::min());
+  const double hi = double(std::numeric_limits<T>::max());
+  return static_cast<T>(std::clamp(std::nearbyint(v), lo, hi));
+}
+
+// One element of a decoded chunk as double (any supported dtype, either
+// byte order).
+double elementValue(const std::byte* p, const ZarrArrayMeta& m) {
+  std::byte b[8];
+  std::memcpy(b, p, static_cast<std::size_t>(m.itemSize));
+  if (m.bigEndian != (std::endian::native == std::endian::big)) {
+    std::reverse(b, b + m.itemSize);
+  }
+  auto as = [&b]<class T>(T) {
+    T v;
+    std::memcpy(&v, b, sizeof(T));
+    return static_cast<double>(v);
+  };
+  switch (m.kind) {
+    case 'b':
+      return b[0] != std::byte{0} ? 1.0 : 0.0;
+    case 'u':
+      return m.itemSize == 1   ? as(std::uint8_t{})
+             : m.itemSize == 2 ? as(std::uint16_t{})
+             : m.itemSize == 4 ? as(std::uint32_t{})
+                               : as(std::uint64_t{});
+    case 'i':
+      return m.itemSize == 1   ? as(std::int8_t{})
+             : m.itemSize == 2 ? as(std::int16_t{})
+             : m.itemSize == 4 ? as(std::int32_t{})
+                               : as(std::int64_t{});
+    default:
+      return m.itemSize == 4 ? as(float{}) : as(double{});
+  }
+}
+
+}  // namespace
+
+ZarrStore::ZarrStore(std::shared_ptr<const ZarrStorage> storage, ZarrSelection selection)
+    : storage_(std::move(storage)), selection_(selection) {
+  const auto attrs = storage_->get(".zattrs", kMaxMetadataBytes);
+  const std::string attrsText = attrs ? text(*attrs) : std::string();
+  const bool multiscales =
+      attrs && parseJson(attrsText, storage_->locate(".zattrs")).contains("multiscales");
+  if (multiscales) {
+    readMultiscales(attrsText);
+  } else {
+    readLoneArray();
+  }
+  checkSelection();
+  makeShape(attrsText);
+}
+
+const ZarrLevel& ZarrStore::level(int l) const {
+  if (l < 0 || l >= levelCount()) {
+    throw InputError(storage_->describe() + ": level " + std::to_string(l) + " does not exist (" +
+                     std::to_string(levelCount()) + " levels)");
+  }
+  return levels_[static_cast<std::size_t>(l)];
+}
+
+void ZarrStore::readLoneArray() {
+  if (!storage_->get(".zarray", kMaxMetadataBytes)) {
+    throw InputError(storage_->describe() +
+                     ": not an OME-Zarr store (no .zattrs with \"multiscales\" and no .zarray)");
+  }
+  version_ = "plain Zarr array";
+  notes_.push_back("no OME-NGFF multiscales: one level, spacing 1 mm, origin 0");
+  const auto meta = storage_->get(".zarray", kMaxMetadataBytes);
+  const ZarrArrayMeta m = parseZarray(text(*meta), storage_->locate(".zarray"));
+  const int rank = m.rank();
+  if (rank < 3) {
+    throw InputError(storage_->locate(".zarray") + ": " + std::to_string(rank) +
+                     " axes; a volume needs 3 (z, y, x) to 5 (t, c, z, y, x)");
+  }
+  axis_[kX] = rank - 1;
+  axis_[kY] = rank - 2;
+  axis_[kZ] = rank - 3;
+  if (rank == 5) axis_[kT] = 0;
+  if (rank >= 4) axis_[kC] = rank - 4;
+  levels_.push_back({});
+  levels_.back().array = m;
+  addLevel("", glm::dvec3(1.0), glm::dvec3(0.0));
+}
+
+void ZarrStore::readMultiscales(const std::string& attrsText) {
+  const std::string where = storage_->locate(".zattrs");
+  const json attrs = parseJson(attrsText, where);
+  const json& all = attrs["multiscales"];
+  if (!all.is_array() || all.empty() || !all[0].is_object()) {
+    throw InputError(where + ": \"multiscales\" must be a non-empty list of objects");
+  }
+  if (all.size() > 1) notes_.push_back("the store holds several multiscales; reading the first");
+  const json& ms = all[0];
+  version_ = ms.value("version", std::string("?"));
+  name_ = ms.contains("name") && ms["name"].is_string() ? ms["name"].get<std::string>() : "";
+  if (!ms.contains("datasets") || !ms["datasets"].is_array() || ms["datasets"].empty()) {
+    throw InputError(where + ": multiscales[0] has no \"datasets\"");
+  }
+  // Axes: 0.4 objects {name, type, unit}, 0.3 names, or (0.1/0.2) none.
+  std::vector<std::string> names;
+  std::string unit;
+  if (ms.contains("axes")) {
+    if (!ms["axes"].is_array()) throw InputError(where + ": \"axes\" is not a list");
+    for (const json& a : ms["axes"]) {
+      if (a.is_string()) {
+        names.push_back(a.get<std::string>());
+      } else if (a.is_object() && a.contains("name") && a["name"].is_string()) {
+        names.push_back(a["name"].get<std::string>());
+        const std::string type = a.value("type", std::string());
+        if (type == "time") names.back() = "t";
+        if (type == "channel") names.back() = "c";
+        if (a.contains("unit") && a["unit"].is_string() && type == "space") {
+          unit = a["unit"].get<std::string>();
+        }
+      } else {
+        throw InputError(where + ": axis " + a.dump() + " has no name");
+      }
+    }
+  }
+  if (names.empty()) names = {"t", "c", "z", "y", "x"};
+  if (names.size() < 3 || names.size() > 5) {
+    throw InputError(where + ": " + std::to_string(names.size()) +
+                     " axes; a volume needs 3 (z, y, x) to 5 (t, c, z, y, x)");
+  }
+  const char* roleNames[] = {"x", "y", "z", "t", "c"};
+  for (std::size_t a = 0; a < names.size(); ++a) {
+    int role = -1;
+    for (int r = 0; r < 5; ++r) {
+      if (names[a] == roleNames[r]) role = r;
+    }
+    if (role < 0 || axis_[role] >= 0) {
+      throw InputError(where + ": axis \"" + names[a] +
+                       "\" is not one of t, c, z, y, x (each at most once)");
+    }
+    axis_[role] = static_cast<int>(a);
+  }
+  if (axis_[kX] < 0 || axis_[kY] < 0 || axis_[kZ] < 0) {
+    throw InputError(where + ": axes need x, y and z (a 2D image is not a volume)");
+  }
+  unitToMm_ = unit.empty() ? 1.0 : unitInMm(unit);
+  if (unit.empty()) notes_.push_back("the space axes have no unit: taken as millimetres");
+  if (unitToMm_ == 0.0) {
+    notes_.push_back("unknown unit \"" + unit + "\": taken as millimetres");
+    unitToMm_ = 1.0;
+  }
+  const std::size_t rank = names.size();
+  for (const json& d : ms["datasets"]) {
+    if (!d.is_object() || !d.contains("path") || !d["path"].is_string()) {
+      throw InputError(where + ": dataset " + d.dump() + " has no \"path\"");
+    }
+    const std::string path = d["path"].get<std::string>();
+    std::vector<double> scale(rank, 1.0), translation(rank, 0.0);
+    applyTransforms(
+        d.contains("coordinateTransformations") ? d["coordinateTransformations"] : json(), rank,
+        where, scale, translation);
+    applyTransforms(
+        ms.contains("coordinateTransformations") ? ms["coordinateTransformations"] : json(), rank,
+        where, scale, translation);
+    const std::string key = path + "/.zarray";
+    const auto meta = storage_->get(key, kMaxMetadataBytes);
+    if (!meta) throw InputError(storage_->locate(key) + ": missing (dataset \"" + path + "\")");
+    levels_.push_back({});
+    levels_.back().array = parseZarray(text(*meta), storage_->locate(key));
+    if (levels_.back().array.rank() != static_cast<int>(rank)) {
+      throw InputError(storage_->locate(key) + ": " + std::to_string(levels_.back().array.rank()) +
+                       " axes, multiscales has " + std::to_string(rank));
+    }
+    const glm::dvec3 s(scale[std::size_t(axis_[kX])], scale[std::size_t(axis_[kY])],
+                       scale[std::size_t(axis_[kZ])]);
+    const glm::dvec3 t(translation[std::size_t(axis_[kX])], translation[std::size_t(axis_[kY])],
+                       translation[std::size_t(axis_[kZ])]);
+    addLevel(path, s * unitToMm_, t * unitToMm_);
+  }
+  if (attrs.contains("tessera") && attrs["tessera"].is_object() &&
+      attrs["tessera"].contains("direction")) {
+    const json& dir = attrs["tessera"]["direction"];
+    glm::dmat3 m(1.0);
+    if (!dir.is_array() || dir.size() != 3) {
+      throw InputError(where + ": tessera.direction must be 3 columns of 3 numbers");
+    }
+    for (int c = 0; c < 3; ++c) {
+      for (int r = 0; r < 3; ++r) {
+        const json& x = dir[std::size_t(c)];
+        if (!x.is_array() || x.size() != 3 || !x[std::size_t(r)].is_number()) {
+          throw InputError(where + ": tessera.direction must be 3 columns of 3 numbers");
+        }
+        m[c][r] = x[std::size_t(r)].get<double>();
+      }
+    }
+    direction_ = m;
+  }
+}
+
+void ZarrStore::addLevel(const std::string& path, glm::dvec3 scale, glm::dvec3 translation) {
+  ZarrLevel& lv = levels_.back();
+  const std::string where = storage_->locate(path.empty() ? ".zarray" : path + "/.zarray");
+  lv.path = path;
+  for (int r = 0; r < 3; ++r) {
+    const std::int64_t n = lv.array.shape[std::size_t(axis_[r])];
+    if (n > std::numeric_limits<int>::max() / 2) {
+      throw InputError(where + ": " + std::to_string(n) + " voxels along " + "xyz"[r] +
+                       " is more than Tessera indexes");
+    }
+    lv.dims[r] = static_cast<int>(n);
+    lv.chunk[r] =
+        static_cast<int>(std::min<std::int64_t>(lv.array.chunks[std::size_t(axis_[r])], 1 << 30));
+    if (!(scale[r] > 0.0) || !std::isfinite(scale[r])) {
+      throw InputError(where + ": scale along " + "xyz"[r] + " is " + std::to_string(scale[r]) +
+                       " (must be > 0)");
+    }
+  }
+  lv.spacing = scale;
+  lv.origin = translation;
+  if (lv.array.converted) {
+    notes_.push_back("level " + path + ": dtype " + lv.array.dtype + " is read as f32");
+  }
+}
+
+void ZarrStore::checkSelection() {
+  const ZarrArrayMeta& a = levels_.front().array;
+  const auto check = [&](int role, int value, const char* option, const char* axis) {
+    const std::int64_t n = axis_[role] >= 0 ? a.shape[std::size_t(axis_[role])] : 1;
+    if (value < 0 || value >= n) {
+      throw InputError(storage_->describe() + ": " + option + " " + std::to_string(value) +
+                       " is outside the store's " + std::to_string(n) + " " + axis +
+                       (axis_[role] >= 0 ? "" : " (it has no such axis)"));
+    }
+  };
+  check(kT, selection_.time, "--time", "time points");
+  check(kC, selection_.channel, "--channel", "channels");
+  for (const ZarrLevel& lv : levels_) {
+    if (lv.array.target != a.target) {
+      throw InputError(storage_->describe() + ": level " + lv.path + " has dtype " +
+                       lv.array.dtype + ", level " + levels_.front().path + " " + a.dtype);
+    }
+  }
+}
+
+void ZarrStore::makeShape(const std::string& attrsText) {
+  const ZarrLevel& fine = levels_.front();
+  shape_ = Volume::shapeOnly(fine.dims, fine.array.target);
+  shape_.setSpacing(fine.spacing);
+  shape_.setDirection(direction_);
+  shape_.setOrigin(fine.origin);
+  shape_.setGeometrySource(
+      "OME-NGFF " + version_ +
+      " scale+translation; NGFF has no orientation: x,y,z taken as R,A,S (RAS+)" +
+      (direction_ == glm::dmat3(1.0) ? "" : ", direction from tessera attributes"));
+  shape_.setDescription("OME-Zarr " + storage_->describe() + (name_.empty() ? "" : " " + name_));
+  // The window: Tessera's own attribute, else omero's channel window, else
+  // the value range of the coarsest level (one chunk in a full pyramid).
+  if (!attrsText.empty()) {
+    const json attrs = parseJson(attrsText, storage_->locate(".zattrs"));
+    const json* range = nullptr;
+    if (attrs.contains("tessera") && attrs["tessera"].contains("value_range")) {
+      range = &attrs["tessera"]["value_range"];
+    }
+    if (range && range->is_array() && range->size() == 2 && (*range)[0].is_number() &&
+        (*range)[1].is_number() && (*range)[0].get<double>() < (*range)[1].get<double>()) {
+      shape_.setWindow({(*range)[0].get<double>(), (*range)[1].get<double>()});
+      return;
+    }
+    if (attrs.contains("omero") && attrs["omero"].contains("channels")) {
+      const json& ch = attrs["omero"]["channels"];
+      const std::size_t c = std::size_t(selection_.channel);
+      if (ch.is_array() && c < ch.size() && ch[c].contains("window")) {
+        const json& w = ch[c]["window"];
+        if (w.contains("start") && w.contains("end") && w["start"].is_number() &&
+            w["end"].is_number() && w["start"].get<double>() < w["end"].get<double>()) {
+          shape_.setWindow({w["start"].get<double>(), w["end"].get<double>()});
+          return;
+        }
+      }
+    }
+  }
+  const int coarse = levelCount() - 1;
+  const glm::ivec3 d = levels_.back().dims;
+  const std::uint64_t bytes = std::uint64_t(d.x) * std::uint64_t(d.y) * std::uint64_t(d.z) *
+                              bytesPerVoxel(fine.array.target);
+  if (bytes <= (64ull << 20)) {
+    const ValueRange r = readLevel(coarse).valueRange();
+    if (r.max > r.min) shape_.setWindow(r);
+  }
+}
+
+int ZarrStore::finestLevelWithin(std::uint64_t budgetBytes) const {
+  for (int l = 0; l < levelCount(); ++l) {
+    const ZarrLevel& lv = levels_[std::size_t(l)];
+    const std::uint64_t voxels =
+        std::uint64_t(lv.dims.x) * std::uint64_t(lv.dims.y) * std::uint64_t(lv.dims.z);
+    const std::uint64_t need = voxels * bytesPerVoxel(lv.array.target) +
+                               std::uint64_t(storage_->parallelism()) *
+                                   (lv.array.chunkBytes() + lv.array.maxStoredChunkBytes());
+    if (need <= budgetBytes) return l;
+  }
+  return -1;
+}
+
+std::string ZarrStore::describe() const {
+  return "OME-Zarr " + storage_->describe() + " (" +
+         (version_ == "plain Zarr array" ? version_ : "NGFF " + version_) + ", " +
+         std::to_string(levelCount()) + " level" + (levelCount() == 1 ? "" : "s") + ", " +
+         levels_.front().array.dtype + ", " + levels_.front().array.compressorText + ")";
+}
+
+Volume ZarrStore::readBox(int l, glm::ivec3 begin, glm::ivec3 end, const Progress& progress) const {
+  const ZarrLevel& lv = level(l);
+  for (int a = 0; a < 3; ++a) {
+    if (begin[a] < 0 || end[a] > lv.dims[a] || begin[a] >= end[a]) {
+      throw InputError(storage_->describe() + ": box [" + std::to_string(begin.x) + "," +
+                       std::to_string(begin.y) + "," + std::to_string(begin.z) + ") - (" +
+                       std::to_string(end.x) + "," + std::to_string(end.y) + "," +
+                       std::to_string(end.z) + ") is empty or outside level " + std::to_string(l) +
+                       "'s dims");
+    }
+  }
+  const int workers = std::max(1, storage_->parallelism());
+  HostBudget::global().check(
+      std::uint64_t(end.x - begin.x) * std::uint64_t(end.y - begin.y) *
+              std::uint64_t(end.z - begin.z) * bytesPerVoxel(lv.array.target) +
+          std::uint64_t(workers) * (lv.array.chunkBytes() + lv.array.maxStoredChunkBytes()),
+      storage_->describe() + " level " + std::to_string(l) + " box");
+  Volume out = Volume::allocate(end - begin, lv.array.target, storage_->describe());
+  out.setSpacing(lv.spacing);
+  out.setDirection(direction_);
+  out.setOrigin(lv.origin + direction_ * (lv.spacing * glm::dvec3(begin)));
+  out.setGeometrySource(shape_.geometrySource());
+  if (shape_.hasWindow()) out.setWindow(shape_.window());
+  out.setDescription(shape_.description() + " level " + std::to_string(l));
+  const glm::ivec3 c0 = begin / lv.chunk;
+  const glm::ivec3 c1 = (end - 1) / lv.chunk + 1;
+  std::vector<std::vector<std::int64_t>> chunks;
+  for (int z = c0.z; z < c1.z; ++z) {
+    for (int y = c0.y; y < c1.y; ++y) {
+      for (int x = c0.x; x < c1.x; ++x) chunks.push_back({x, y, z});
+    }
+  }
+  std::atomic<std::size_t> next{0};
+  std::size_t done = 0;
+  std::exception_ptr failure;
+  std::mutex failureMutex;
+  auto work = [&] {
+    for (std::size_t i = next++; i < chunks.size(); i = next++) {
+      try {
+        readChunkInto(l, chunks[i], begin, end, out);
+        if (progress) {
+          const std::lock_guard lock(failureMutex);
+          progress(++done, chunks.size());
+        }
+      } catch (...) {
+        const std::lock_guard lock(failureMutex);
+        if (!failure) failure = std::current_exception();
+        next = chunks.size();
+      }
+    }
+  };
+  const int threads = static_cast<int>(std::min<std::size_t>(std::size_t(workers), chunks.size()));
+  if (threads <= 1) {
+    work();
+  } else {
+    std::vector<std::jthread> pool;
+    for (int t = 0; t < threads; ++t) pool.emplace_back(work);
+  }
+  if (failure) std::rethrow_exception(failure);
+  out.invalidateRange();
+  return out;
+}
+
+void ZarrStore::readChunkInto(int l, const std::vector<std::int64_t>& spatial, glm::ivec3 begin,
+                              glm::ivec3 end, Volume& out) const {
+  const ZarrLevel& lv = levels_[std::size_t(l)];
+  const ZarrArrayMeta& m = lv.array;
+  const int rank = m.rank();
+  // The chunk's grid index over every array axis, and the element strides
+  // inside a chunk (C order).
+  std::vector<std::int64_t> index(std::size_t(rank), 0);
+  std::vector<std::int64_t> stride(std::size_t(rank), 1);
+  for (int a = rank - 2; a >= 0; --a)
+    stride[std::size_t(a)] = stride[std::size_t(a) + 1] * m.chunks[std::size_t(a) + 1];
+  std::int64_t base = 0;
+  for (int r = 0; r < 3; ++r) index[std::size_t(axis_[r])] = spatial[std::size_t(r)];
+  const int sel[2] = {selection_.time, selection_.channel};
+  for (int r = kT; r <= kC; ++r) {
+    if (axis_[r] < 0) continue;
+    const std::int64_t ch = m.chunks[std::size_t(axis_[r])];
+    index[std::size_t(axis_[r])] = sel[r - kT] / ch;
+    base += (sel[r - kT] % ch) * stride[std::size_t(axis_[r])];
+  }
+  const std::string key = (lv.path.empty() ? "" : lv.path + "/") + m.chunkKey(index);
+  const glm::ivec3 origin =
+      glm::ivec3(int(spatial[0]), int(spatial[1]), int(spatial[2])) * lv.chunk;
+  const glm::ivec3 lo = glm::max(begin, origin);
+  const glm::ivec3 hi = glm::min(end, origin + lv.chunk);
+  std::optional<std::vector<std::byte>> raw;
+  for (int attempt = 0;; ++attempt) {
+    const auto stored = storage_->get(key, m.maxStoredChunkBytes());
+    if (!stored) break;
+    try {
+      raw = decodeZarrChunk(m, *stored, storage_->locate(key));
+      break;
+    } catch (const InputError&) {
+      // A network may have damaged the body: fetch it again.
+      if (attempt >= storage_->refetches()) throw;
+    }
+  }
+  const std::size_t bpv = bytesPerVoxel(m.target);
+  const std::int64_t sx = stride[std::size_t(axis_[kX])];
+  const std::int64_t sy = stride[std::size_t(axis_[kY])];
+  const std::int64_t sz = stride[std::size_t(axis_[kZ])];
+  const bool direct = raw && !m.converted && sx == 1 &&
+                      (m.itemSize == 1 || m.bigEndian == (std::endian::native == std::endian::big));
+  for (int z = lo.z; z < hi.z; ++z) {
+    for (int y = lo.y; y < hi.y; ++y) {
+      std::byte* dst =
+          out.bytes().data() + out.index(lo.x - begin.x, y - begin.y, z - begin.z) * bpv;
+      const std::size_t n = std::size_t(hi.x - lo.x);
+      if (!raw) {
+        for (std::size_t i = 0; i < n; ++i) {
+          switch (m.target) {
+            case ScalarType::U8: {
+              const auto v = roundedFill<std::uint8_t>(m.fill);
+              std::memcpy(dst + i, &v, 1);
+              break;
+            }
+            case ScalarType::U16: {
+              const auto v = roundedFill<std::uint16_t>(m.fill);
+              std::memcpy(dst + 2 * i, &v, 2);
+              break;
+            }
+            case ScalarType::I16: {
+              const auto v = roundedFill<std::int16_t>(m.fill);
+              std::memcpy(dst + 2 * i, &v, 2);
+              break;
+            }
+            case ScalarType::F32: {
+              const auto v = static_cast<float>(m.fill);
+              std::memcpy(dst + 4 * i, &v, 4);
+              break;
+            }
+          }
+        }
+        continue;
+      }
+      const std::int64_t first =
+          base + (z - origin.z) * sz + (y - origin.y) * sy + (lo.x - origin.x) * sx;
+      const std::byte* src = raw->data() + first * m.itemSize;
+      if (direct) {
+        std::memcpy(dst, src, n * bpv);
+        continue;
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::byte* e = src + std::int64_t(i) * sx * m.itemSize;
+        if (m.converted) {
+          const float v = static_cast<float>(elementValue(e, m));
+          std::memcpy(dst + 4 * i, &v, 4);
+        } else {
+          // Same type, other byte order or axis order: copy, swapped if needed.
+          std::byte b[4];
+          std::memcpy(b, e, bpv);
+          if (m.itemSize > 1 && m.bigEndian != (std::endian::native == std::endian::big)) {
+            std::reverse(b, b + bpv);
+          }
+          std::memcpy(dst + bpv * i, b, bpv);
+        }
+      }
+    }
+  }
+}
+
+}  // namespace tessera

@@ -1,0 +1,365 @@
+#include "tessera/io/ZarrWriter.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
+#include "tessera/io/VolumeWriter.h"
+#include "tessera/io/ZarrStore.h"
+
+namespace tessera {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+void writeBytes(const fs::path& path, const void* data, std::size_t n) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(static_cast<const char*>(data), static_cast<std::streamsize>(n));
+  out.close();
+  if (!out) throw Error(path.string() + ": cannot write");
+}
+
+void writeText(const fs::path& path, const std::string& s) {
+  writeBytes(path, s.data(), s.size());
+}
+
+std::string dimsText(glm::ivec3 d) {
+  return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
+}
+
+// Slices [0, depth) of `src` reduced 2x2x2 into a new volume of
+// ceil(dims/2) (depth for z): the mean of the voxels present, NaN skipped,
+// as lod::downsample.
+Volume halve(const Volume& src, int depth) {
+  const glm::ivec3 d(src.dims().x, src.dims().y, depth);
+  const glm::ivec3 o = (d + 1) / 2;
+  Volume out = Volume::allocate(o, src.type(), "pyramid slab");
+  for (int oz = 0; oz < o.z; ++oz) {
+    for (int oy = 0; oy < o.y; ++oy) {
+      for (int ox = 0; ox < o.x; ++ox) {
+        double sum = 0.0;
+        int n = 0;
+        for (int z = 2 * oz; z < std::min(d.z, 2 * oz + 2); ++z) {
+          for (int y = 2 * oy; y < std::min(d.y, 2 * oy + 2); ++y) {
+            for (int x = 2 * ox; x < std::min(d.x, 2 * ox + 2); ++x) {
+              const double v = src.valueAt(x, y, z);
+              if (std::isfinite(v)) {
+                sum += v;
+                ++n;
+              }
+            }
+          }
+        }
+        out.setValueAtIndex(out.index(ox, oy, oz),
+                            n ? sum / n : std::numeric_limits<double>::quiet_NaN());
+      }
+    }
+  }
+  return out;
+}
+
+// One level of the pyramid being written: a slab of chunk.z slices that
+// fills up, is cut into chunks, and is halved into the next level.
+struct LevelWriter {
+  int index = 0;
+  glm::ivec3 dims{0};
+  glm::ivec3 chunk{0};
+  fs::path dir;
+  Volume slab;  // dims.x x dims.y x chunk.z
+  int slabZ0 = 0;
+  int filled = 0;
+};
+
+class PyramidWriter {
+ public:
+  PyramidWriter(const Volume& shape, const fs::path& root, const OmeZarrWriteOptions& o)
+      : type_(shape.type()), root_(root), options_(o) {
+    glm::ivec3 d = shape.dims();
+    const int count = o.levels > 0 ? o.levels : omeZarrAutoLevels(d, o.chunk);
+    for (int l = 0; l < count; ++l) {
+      LevelWriter w;
+      w.index = l;
+      w.dims = d;
+      w.chunk = glm::min(d, glm::ivec3(o.chunk));
+      w.dir = root / std::to_string(l);
+      w.slab = Volume::allocate({d.x, d.y, w.chunk.z}, type_,
+                                "OME-Zarr level " + std::to_string(l) + " slab");
+      levels_.push_back(std::move(w));
+      if (d == glm::ivec3(1)) break;
+      d = (d + 1) / 2;
+    }
+  }
+
+  int levelCount() const { return static_cast<int>(levels_.size()); }
+  const LevelWriter& level(int l) const { return levels_[std::size_t(l)]; }
+  OmeZarrWriteResult result() {
+    result_.chunksWritten = written_;
+    result_.chunksSkipped = skipped_;
+    result_.bytesWritten = bytes_;
+    return result_;
+  }
+  static OmeZarrWriteResult emptyResult() {
+    OmeZarrWriteResult r;
+    r.range = {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+    return r;
+  }
+
+  // Appends the slices of `part` to level l.
+  void push(int l, const Volume& part) {
+    LevelWriter& w = levels_[std::size_t(l)];
+    const std::size_t sliceBytes =
+        std::size_t(w.dims.x) * std::size_t(w.dims.y) * bytesPerVoxel(type_);
+    for (int z = 0; z < part.dims().z; ++z) {
+      std::memcpy(w.slab.bytes().data() + std::size_t(w.filled) * sliceBytes,
+                  part.bytes().data() + std::size_t(z) * sliceBytes, sliceBytes);
+      ++w.filled;
+      if (w.filled == w.chunk.z || w.slabZ0 + w.filled == w.dims.z) flush(l);
+    }
+    if (l == 0) trackRange(part);
+  }
+
+ private:
+  void trackRange(const Volume& part) {
+    const ValueRange r = part.valueRange();
+    result_.range.min = std::min(result_.range.min, r.min);
+    result_.range.max = std::max(result_.range.max, r.max);
+  }
+
+  void flush(int l) {
+    LevelWriter& w = levels_[std::size_t(l)];
+    writeChunks(w);
+    if (l + 1 < levelCount()) push(l + 1, halve(w.slab, w.filled));
+    w.slabZ0 += w.filled;
+    w.filled = 0;
+  }
+
+  // The chunks of one slab, compressed on a few threads.
+  void writeChunks(const LevelWriter& w) {
+    const int cz = w.slabZ0 / w.chunk.z;
+    const int ny = (w.dims.y + w.chunk.y - 1) / w.chunk.y;
+    const int nx = (w.dims.x + w.chunk.x - 1) / w.chunk.x;
+    const fs::path zdir = w.dir / std::to_string(cz);
+    std::atomic<int> next{0};
+    std::mutex mutex;
+    std::exception_ptr failure;
+    auto work = [&] {
+      for (int i = next++; i < nx * ny; i = next++) {
+        try {
+          writeChunk(w, zdir, i % nx, i / nx);
+        } catch (...) {
+          const std::lock_guard lock(mutex);
+          if (!failure) failure = std::current_exception();
+        }
+      }
+    };
+    const int threads = static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 4u));
+    {
+      std::vector<std::jthread> pool;
+      for (int t = 1; t < std::min(threads, nx * ny); ++t) pool.emplace_back(work);
+      work();
+    }
+    if (failure) std::rethrow_exception(failure);
+  }
+
+  void writeChunk(const LevelWriter& w, const fs::path& zdir, int cx, int cy) {
+    const std::size_t bpv = bytesPerVoxel(type_);
+    const glm::ivec3 c = w.chunk;
+    std::vector<std::byte> raw(std::size_t(c.x) * std::size_t(c.y) * std::size_t(c.z) * bpv);
+    const int x0 = cx * c.x, y0 = cy * c.y;
+    const int nx = std::min(c.x, w.dims.x - x0);
+    bool zero = true;
+    for (int z = 0; z < w.filled; ++z) {
+      for (int y = 0; y < std::min(c.y, w.dims.y - y0); ++y) {
+        const std::byte* src = w.slab.bytes().data() + w.slab.index(x0, y0 + y, z) * bpv;
+        std::byte* dst = raw.data() + ((std::size_t(z) * c.y + y) * c.x) * bpv;
+        std::memcpy(dst, src, std::size_t(nx) * bpv);
+      }
+    }
+    for (std::byte b : raw) {
+      if (b != std::byte{0}) {
+        zero = false;
+        break;
+      }
+    }
+    if (zero) {
+      // Zarr reads an absent chunk as fill_value (0): nothing to store.
+      ++skipped_;
+      return;
+    }
+    const std::vector<std::byte> stored = encodeZarrChunk(options_.compressor, int(bpv), raw);
+    {
+      const std::lock_guard lock(dirMutex_);
+      fs::create_directories(zdir / std::to_string(cy));
+    }
+    writeBytes(zdir / std::to_string(cy) / std::to_string(cx), stored.data(), stored.size());
+    bytes_ += stored.size();
+    ++written_;
+  }
+
+  ScalarType type_;
+  fs::path root_;
+  OmeZarrWriteOptions options_;
+  std::vector<LevelWriter> levels_;
+  std::mutex dirMutex_;
+  std::atomic<std::uint64_t> written_{0}, skipped_{0}, bytes_{0};
+  OmeZarrWriteResult result_ = emptyResult();
+};
+
+nlohmann::json zyx(glm::dvec3 v) {
+  return {v.z, v.y, v.x};
+}
+
+std::string attributes(const Volume& shape, const PyramidWriter& p, const std::string& name,
+                       const ValueRange& range) {
+  using nlohmann::json;
+  json axes = json::array();
+  for (const char* a : {"z", "y", "x"}) {
+    axes.push_back({{"name", a}, {"type", "space"}, {"unit", "millimeter"}});
+  }
+  json datasets = json::array();
+  for (int l = 0; l < p.levelCount(); ++l) {
+    const double f = std::ldexp(1.0, l);
+    const glm::dvec3 spacing = shape.spacing() * f;
+    // A level-l voxel is the mean of 2^l finer voxels per axis: its centre
+    // lies (2^l - 1)/2 finest voxels past the first of them.
+    const glm::dvec3 origin =
+        shape.origin() + shape.direction() * (shape.spacing() * (0.5 * (f - 1.0)));
+    datasets.push_back({{"path", std::to_string(l)},
+                        {"coordinateTransformations",
+                         json::array({{{"type", "scale"}, {"scale", zyx(spacing)}},
+                                      {{"type", "translation"}, {"translation", zyx(origin)}}})}});
+  }
+  json ms = {{"version", "0.4"},
+             {"name", name},
+             {"axes", axes},
+             {"datasets", datasets},
+             {"type", "mean"},
+             {"metadata",
+              {{"method",
+                "tessera convert: 2x2x2 mean (lod::downsample), partial edge blocks "
+                "average the voxels present"},
+               {"world_frame", "RAS+ millimetres; x->R, y->A, z->S when direction is identity"}}}};
+  json tessera = {{"world_frame", "RAS"}};
+  json dir = json::array();
+  for (int c = 0; c < 3; ++c) {
+    dir.push_back({shape.direction()[c][0], shape.direction()[c][1], shape.direction()[c][2]});
+  }
+  tessera["direction"] = dir;
+  if (range.max >= range.min) tessera["value_range"] = {range.min, range.max};
+  if (shape.hasWindow()) tessera["window"] = {shape.window().min, shape.window().max};
+  return json({{"multiscales", json::array({ms})}, {"tessera", tessera}}).dump(2);
+}
+
+void build(const Volume& shape, const SlabReader& slabs, const fs::path& root,
+           const OmeZarrWriteOptions& o, const std::string& name, OmeZarrWriteResult& result) {
+  fs::create_directories(root);
+  PyramidWriter pyramid(shape, root, o);
+  for (int l = 0; l < pyramid.levelCount(); ++l) {
+    const LevelWriter& w = pyramid.level(l);
+    fs::create_directories(w.dir);
+    writeText(w.dir / ".zarray",
+              zarrayJson({w.dims.z, w.dims.y, w.dims.x}, {w.chunk.z, w.chunk.y, w.chunk.x},
+                         shape.type(), o.compressor));
+  }
+  const glm::ivec3 d = shape.dims();
+  const int step = pyramid.level(0).chunk.z;
+  for (int z0 = 0; z0 < d.z; z0 += step) {
+    const int z1 = std::min(d.z, z0 + step);
+    const Volume part = slabs(z0, z1);
+    if (part.dims() != glm::ivec3(d.x, d.y, z1 - z0) || part.type() != shape.type()) {
+      throw Error("OME-Zarr writer: slab " + std::to_string(z0) + ".." + std::to_string(z1) +
+                  " is " + dimsText(part.dims()) + ", expected " + dimsText({d.x, d.y, z1 - z0}));
+    }
+    pyramid.push(0, part);
+    if (o.progress) {
+      o.progress(double(z1) / d.z, "slices " + std::to_string(z1) + "/" + std::to_string(d.z));
+    }
+  }
+  writeText(root / ".zgroup", "{\n  \"zarr_format\": 2\n}");
+  result = pyramid.result();
+  writeText(root / ".zattrs", attributes(shape, pyramid, name, result.range));
+  for (int l = 0; l < pyramid.levelCount(); ++l) result.levelDims.push_back(pyramid.level(l).dims);
+}
+
+}  // namespace
+
+bool isOmeZarrName(const fs::path& path) {
+  std::string s = path.string();
+  while (!s.empty() && s.back() == '/') s.pop_back();
+  return s.size() >= 5 && s.compare(s.size() - 5, 5, ".zarr") == 0;
+}
+
+int omeZarrAutoLevels(glm::ivec3 dims, int chunk) {
+  int levels = 1;
+  while (dims.x > chunk || dims.y > chunk || dims.z > chunk) {
+    dims = (dims + 1) / 2;
+    ++levels;
+  }
+  return levels;
+}
+
+OmeZarrWriteResult writeOmeZarr(const Volume& shape, const SlabReader& slabs, const fs::path& out,
+                                const OmeZarrWriteOptions& o) {
+  if (o.chunk < 8 || o.chunk > 1024 || o.chunk % 2 != 0) {
+    throw InputError("--chunk " + std::to_string(o.chunk) + ": expected an even size in 8..1024");
+  }
+  if (o.levels < 0 || o.levels > 30) {
+    throw InputError("--levels " + std::to_string(o.levels) + ": expected auto or 1..30");
+  }
+  std::string trimmed = out.string();
+  while (trimmed.size() > 1 && trimmed.back() == '/') trimmed.pop_back();
+  const fs::path path(trimmed);
+  // Slab buffers: one chunk-deep slab per level (a geometric series
+  // under 4/3 of the finest) plus the slab being read and its halving.
+  const glm::ivec3 d = shape.dims();
+  const std::uint64_t slab = std::uint64_t(d.x) * std::uint64_t(d.y) *
+                             std::uint64_t(std::min(d.z, o.chunk)) * bytesPerVoxel(shape.type());
+  HostBudget::global().check(3 * slab, path.string() + ": OME-Zarr slabs of " + dimsText(d));
+  std::error_code ec;
+  const bool replace = fs::exists(path, ec);
+  if (replace && !isZarrStore(path.string())) {
+    throw InputError(path.string() + ": exists and is not an OME-Zarr store; not replacing it");
+  }
+  const fs::path old = path.string() + ".old-" + std::to_string(::getpid());
+  std::string name = path.filename().string();
+  if (const auto dot = name.find('.'); dot != std::string::npos && dot > 0) name.resize(dot);
+  OmeZarrWriteResult result;
+  writeAtomically(path, [&](const fs::path& temp) {
+    build(shape, slabs, temp, o, name, result);
+    if (replace) fs::rename(path, old);
+  });
+  if (replace) fs::remove_all(old, ec);
+  return result;
+}
+
+OmeZarrWriteResult writeOmeZarr(const Volume& volume, const fs::path& path,
+                                const OmeZarrWriteOptions& options) {
+  const std::size_t sliceBytes =
+      std::size_t(volume.dims().x) * std::size_t(volume.dims().y) * bytesPerVoxel(volume.type());
+  return writeOmeZarr(
+      volume,
+      [&](int z0, int z1) {
+        Volume part =
+            Volume::allocate({volume.dims().x, volume.dims().y, z1 - z0}, volume.type(), "slab");
+        std::memcpy(part.bytes().data(), volume.bytes().data() + std::size_t(z0) * sliceBytes,
+                    std::size_t(z1 - z0) * sliceBytes);
+        part.invalidateRange();
+        return part;
+      },
+      path, options);
+}
+
+}  // namespace tessera
