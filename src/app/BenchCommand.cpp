@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/BenchBricks.h"
 #include "app/BenchFcc.h"
 #include "app/BenchHybrid.h"
 #include "app/BenchRoofline.h"
@@ -47,6 +48,8 @@ struct BenchOptions {
   bool interactive = false;
   std::string hybridOut;
   double goalMs = 0.0;
+  std::vector<std::string> bricks;  // --bricks: generated volumes to stream
+  std::vector<std::string> bricksProfiles{"shield-k1", "ipad2"};
   bool printTf = false;
   bool roofline = false;
   int fetches = 128;
@@ -318,6 +321,14 @@ void addBenchCommand(CLI::App& app) {
                   "64^3 (Cartesian trilinear vs FCC box spline, same and half density), ch2 on "
                   "FCC vs the original; tables on stdout, PNGs in this folder");
   cmd->add_flag("--json", o->json, "Print JSON instead of a Markdown table");
+  cmd->add_option(
+      "--bricks", o->bricks,
+      "Large volumes through the bricks layout: generated head:WxHxD specs (e.g. "
+      "head:512x512x894 head:1024); per profile the first and refined image, rotating "
+      "frame time while streaming (default 8 frames), levels, texture bytes vs the "
+      "budget, bricks read, peak RSS, and the in-core layout as baseline where it fits");
+  cmd->add_option("--bricks-profiles", o->bricksProfiles, "Profiles for --bricks")
+      ->capture_default_str();
   cmd->add_flag("--slicing", o->slicing,
                 "Texture slicing vs ray casting (GRAPP 2012 Tables 1-2), TF-update times "
                 "(Moser & Weiskopf 2008 Fig. 6) and quality per count; --frames per cell");
@@ -395,6 +406,17 @@ void addBenchCommand(CLI::App& app) {
                        .tf = o->tf,
                        .outDir = o->slicingOut,
                        .quick = o->slicingQuick});
+      return;
+    }
+    if (!o->bricks.empty()) {
+      BricksBenchOptions b;
+      b.volumes = o->bricks;
+      b.profiles = o->bricksProfiles;
+      b.size = o->size;
+      b.frames = o->frames == 36 ? 8 : o->frames;
+      b.rotate = o->rotate;
+      b.tf = o->tf == "bench" ? "ct-bone" : o->tf;
+      runBricksBench(b);
       return;
     }
     o->layouts ? runLayoutBench(*o) : runBench(*o);

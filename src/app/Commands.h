@@ -20,8 +20,10 @@ void addViewCommand(CLI::App& app);      // ViewCommand.cpp (desktop viewer)
 inline constexpr const char* kVolumeHelp =
     "Volume: .nii .nii.gz .hdr .nrrd .nhdr .mha .mhd .vti .pvm .raw/.json, a DICOM file or "
     "folder, an OME-Zarr store (folder or http(s):// URL; the finest level that fits the host "
-    "budget), or gen:sphere|shepp-logan|marschner-lobb[:N]; default: ch2 (mricron-data) or a "
-    "Shepp-Logan phantom";
+    "budget, or streamed with --layout bricks), or gen:sphere|shepp-logan|marschner-lobb[:N]; "
+    "default: ch2 (mricron-data) or a Shepp-Logan phantom. render and plan: head:WxHxD (or "
+    "head:N) is a generated u8 head of any size computed brick by brick, never held whole "
+    "(streamed through the bricks layout when it does not fit in core)";
 inline void addSeriesOption(CLI::App* cmd, std::string& series) {
   cmd->add_option("--series", series,
                   "DICOM: Series Instance UID to read when a folder holds several (default: the "

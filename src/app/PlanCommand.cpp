@@ -8,6 +8,7 @@
 #include "tessera/core/HostBudget.h"
 #include "tessera/io/VolumeReader.h"
 #include "tessera/layout/LayoutRegistry.h"
+#include "tessera/lod/ProceduralMultiresSource.h"
 #include "tessera/render/Raycaster.h"
 
 namespace tessera::app {
@@ -49,7 +50,10 @@ void runPlan(const PlanOptions& o) {
   parseSize(o.size, width, height);
   DeviceSession device = openDevice(o.profile);
   const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
-  const Volume volume = readVolume(spec, {.dicomSeries = o.series});
+  // A generated head:WxHxD is planned from its shape, as a streamed source.
+  const bool streamed = lod::ProceduralMultiresSource::isSpec(spec);
+  const Volume volume = streamed ? lod::ProceduralMultiresSource(spec).shape()
+                                 : readVolume(spec, {.dicomSeries = o.series});
   // What the ray caster needs next to the volume, then the planner's choice.
   const render::TechniqueRequirements needs = render::Raycaster::requirements(
       device.limits, volume.dims(), {.imageSize = {width, height}, .skipBlock = o.skipBlock});
@@ -58,6 +62,7 @@ void runPlan(const PlanOptions& o) {
   request.layout = o.layout;
   request.reservedUnits = needs.textureUnits;
   request.reservedBytes = needs.bytes;
+  request.streamed = streamed;
   const layout::Plan plan = layout::planLayout(volume, device.limits, request);
   const gpu::DeviceLimits& l = device.limits;
   if (o.json) {

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
 #include "tessera/lattice/BoxSplineReconstruction.h"
+#include "tessera/layout/BricksLayout.h"
 #include "tessera/layout/FccLayout.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
@@ -15,12 +17,68 @@ namespace tessera::app {
 
 namespace {
 
-// The frames, rotating from the requested view; the first is kept.
-void renderFrames(render::Technique& technique, const RenderRequest& req, RenderResult& result) {
+std::string levelsText(const std::vector<int>& perLevel, bool lastIsTransparent) {
+  std::string s;
+  for (std::size_t l = 0; l < perLevel.size(); ++l) {
+    if (perLevel[l] == 0) continue;
+    const bool empty = lastIsTransparent && l + 1 == perLevel.size();
+    char item[48];
+    if (empty) {
+      std::snprintf(item, sizeof item, "%sempty:%d", s.empty() ? "" : " ", perLevel[l]);
+    } else {
+      std::snprintf(item, sizeof item, "%sL%zu:%d", s.empty() ? "" : " ", l, perLevel[l]);
+    }
+    s += item;
+  }
+  return s;
+}
+
+// Frame 0 of a bricked volume: draw, stream, upload, draw again until every
+// brick the view wants is resident (progressive refinement while the view
+// stays still), so the image written is the refined one.
+void refineBricks(layout::BricksLayout& bricks, render::Technique& technique,
+                  const TransferFunction& tf, const RenderRequest& req, BricksRun& run) {
+  const auto t0 = std::chrono::steady_clock::now();
+  layout::BricksFrame f;
+  double lastReportMs = 0.0;
+  bool reported = false;
+  while (true) {
+    f = bricks.update(req.camera, req.width, req.height, tf);
+    technique.render(req.camera, req.settings, req.width, req.height, 0.0);
+    if (++run.refineFrames == 1) run.firstFrameMs = msSince(t0);
+    if (f.complete || run.refineFrames >= req.maxRefineFrames ||
+        msSince(t0) > 1000.0 * req.maxRefineSeconds) {
+      break;
+    }
+    if (f.uploaded == 0) bricks.waitForBricks(50.0);
+    if (msSince(t0) - lastReportMs > 1000.0) {  // progress, once a second
+      lastReportMs = msSince(t0);
+      reported = true;
+      std::fprintf(stderr, "\rbricks: frame %d, %.0f s, %d of %d bricks missing   ",
+                   run.refineFrames, lastReportMs / 1000.0, f.missing, f.wanted);
+    }
+  }
+  if (reported) std::fprintf(stderr, "\n");
+  run.completeMs = msSince(t0);
+  run.complete = f.complete;
+  run.failing = f.failing;
+  run.wantedPerLevel = f.wantedPerLevel;
+  run.cellsPerLevel = f.cellsPerLevel;
+}
+
+// The frames, rotating from the requested view; the first is kept. A
+// bricked volume streams during the rotation: each frame selects, requests
+// and uploads within the layout's per-frame budget, and that time counts.
+void renderFrames(render::Technique& technique, layout::BricksLayout* bricks,
+                  const TransferFunction& tf, const RenderRequest& req, RenderResult& result) {
   for (int i = 0; i < req.repeat; ++i) {
     Camera cam = req.camera;
     cam.azimuthDeg += i * req.rotateDeg;
     const auto t0 = std::chrono::steady_clock::now();
+    if (bricks && i > 0) {
+      const layout::BricksFrame f = bricks->update(cam, req.width, req.height, tf);
+      result.bricks->rotatingLevels.push_back(levelsText(f.cellsPerLevel, true));
+    }
     technique.render(cam, req.settings, req.width, req.height, 0.0);
     result.frameMs.push_back(msSince(t0));
     if (i == 0) result.first = technique.readImage();
@@ -114,10 +172,30 @@ RenderResult runRender(DeviceSession& device, const lod::VolumeSource& source,
   const auto tPrepare = std::chrono::steady_clock::now();
   t.technique->prepare(req.camera, req.settings);
   result.prepareMs = msSince(tPrepare);
-  renderFrames(*t.technique, req, result);
+  auto* bricks = dynamic_cast<layout::BricksLayout*>(t.upload.layout.get());
+  if (bricks) {
+    result.bricks.emplace();
+    refineBricks(*bricks, *t.technique, tf, req, *result.bricks);
+  }
+  renderFrames(*t.technique, bricks, tf, req, result);
   result.textureBytes = device.context->ledger().totalBytes();  // while the technique holds its own
   describeStorage(t, result);
-  if (req.reference) compareWithReference(volume, t.upload.layout.get(), tf, req, result);
+  if (bricks) {
+    const lod::StreamerStats s = bricks->streamerStats();
+    result.bricks->slots = bricks->slotCount();
+    result.bricks->bytesRead = s.bytesRead;
+    result.bricks->bricksRead = s.bricksRead;
+    result.bricks->readErrors = s.readErrors;
+    result.bricks->cachePeakBytes = s.cachePeakBytes;
+    result.bricks->lastError = s.lastError;
+  }
+  if (req.reference) {
+    if (!volume.hasData()) {
+      throw InputError("--reference needs the volume in host memory; " + result.layout +
+                       " streams it");
+    }
+    compareWithReference(volume, t.upload.layout.get(), tf, req, result);
+  }
   return result;
 }
 

@@ -35,8 +35,31 @@ struct RenderRequest {
   int lutSize = 4096;
   int slices = 0;                 // 0 = from the step (slice3d) or every slice (slice2d)
   std::string classify = "post";  // slice2d: pre, palette or post
+  // bricks: stop refining frame 0 after this many frames or seconds.
+  int maxRefineFrames = 10000;
+  double maxRefineSeconds = 600.0;
 
   render::TechniqueOptions techniqueOptions() const;
+};
+
+// The bricks layout's streaming (layout/BricksLayout.h): how frame 0 was
+// refined until every brick the view wants was resident, and what the
+// rotating frames then used.
+struct BricksRun {
+  int refineFrames = 0;       // frames drawn until complete (the first image is frame 1)
+  double firstFrameMs = 0.0;  // to the first image (coarsest level)
+  double completeMs = 0.0;    // to the refined image
+  bool complete = false;      // false: stopped at the frame or time limit
+  int failing = 0;            // bricks left at a coarser level because their reads keep failing
+  std::vector<int> wantedPerLevel;          // the final view's cut, bricks per level
+  std::vector<int> cellsPerLevel;           // page-table cells per level (last: transparent)
+  std::vector<std::string> rotatingLevels;  // per rotating frame, "L0:12 L1:40 ..."
+  int slots = 0;
+  std::uint64_t bytesRead = 0;
+  std::uint64_t bricksRead = 0;
+  std::uint64_t readErrors = 0;
+  std::uint64_t cachePeakBytes = 0;
+  std::string lastError;
 };
 
 struct RenderResult {
@@ -56,7 +79,8 @@ struct RenderResult {
   std::string layoutReason;
   layout::Plan plan;
   std::string planNote;
-  glm::ivec3 renderedDims{0};  // after any downsampling the plan asked for
+  glm::ivec3 renderedDims{0};       // after any downsampling the plan asked for
+  std::optional<BricksRun> bricks;  // when the layout is bricks
 
   double median() const;
   double min() const;

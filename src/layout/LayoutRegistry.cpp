@@ -1,6 +1,7 @@
 #include "tessera/layout/LayoutRegistry.h"
 
 #include "tessera/core/Error.h"
+#include "tessera/layout/BricksLayout.h"
 #include "tessera/layout/FccLayout.h"
 #include "tessera/layout/MosaicLayout.h"
 #include "tessera/layout/PackedMosaicLayout.h"
@@ -19,6 +20,8 @@ LayoutRegistry& LayoutRegistry::global() {
     r.add(Texture3DLayout::registration());
     r.add(MosaicLayout::registration());
     r.add(PackedMosaicLayout::registration());
+    // Last: chosen only when the volume fits no in-core layout.
+    r.add(BricksLayout::registration());
     r.add(FccLayout::registration(lattice::FccDensity::Same));
     r.add(FccLayout::registration(lattice::FccDensity::Half));
     return r;

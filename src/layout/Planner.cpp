@@ -58,8 +58,11 @@ glm::ivec3 axesToHalve(glm::ivec3 dims, const gpu::DeviceLimits& limits, bool on
 Plan planLayout(const Volume& volume, const gpu::DeviceLimits& limits, const PlanRequest& request) {
   std::vector<const LayoutEntry*> candidates;
   if (request.layout == "auto") {
+    // Bricks only for streamed sources: an in-core volume that fits no layout
+    // is downsampled, because only a front end that drives the bricks'
+    // per-frame streaming (tessera render, bench) refines them (--layout bricks).
     for (const LayoutEntry& e : LayoutRegistry::global().entries()) {
-      if (e.automatic) candidates.push_back(&e);
+      if (e.automatic && (e.name != "bricks" || request.streamed)) candidates.push_back(&e);
     }
   } else {
     const LayoutEntry& wished = LayoutRegistry::global().find(request.layout);
@@ -90,6 +93,14 @@ Plan planLayout(const Volume& volume, const gpu::DeviceLimits& limits, const Pla
     const Volume shape = Volume::shapeOnly(dims, volume.type());
     for (const LayoutEntry* candidate : candidates) {
       LayoutPlan p = candidate->plan(shape, volumeLimits, units);
+      const std::uint64_t hostBytes = shape.voxelCount() * bytesPerVoxel(shape.type());
+      if (p.fits && request.streamed && candidate->name != "bricks" && limits.hostBudget != 0 &&
+          hostBytes > limits.hostBudget) {
+        p.fits = false;
+        p.reason = dimsText(dims) + " needs " + formatBytes(hostBytes) +
+                   " of host memory in core, over the host budget " +
+                   formatBytes(limits.hostBudget) + " of " + limits.profile;
+      }
       if (p.fits) {
         plan.layout = std::move(p);
         plan.volumeDims = dims;

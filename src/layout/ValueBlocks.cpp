@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <limits>
 #include <thread>
+#include <utility>
 
 #include <glm/common.hpp>
 

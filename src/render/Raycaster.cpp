@@ -31,6 +31,7 @@ void Raycaster::setSkipBlockSize(int voxels) {
     throw InputError("empty-space block size must be >= 0, got " + std::to_string(voxels));
   blockSize_ = voxels;
   blocks_ = voxels > 0 ? layout_.valueBlocks(voxels) : layout::ValueBlocks();
+  blocksVersion_ = layout_.contentVersion();
   blockTexture_ = gpu::Texture();
   lookupKey_.clear();
 }
@@ -191,6 +192,8 @@ void Raycaster::prepare(const RenderSettings& settings) {
 
 void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings, int width,
                             int height) {
+  // A streamed layout (bricks) changed what it samples: new value blocks.
+  if (blockSize_ > 0 && layout_.contentVersion() != blocksVersion_) setSkipBlockSize(blockSize_);
   if (width <= 0 || height <= 0 || width > context_.caps().maxRenderbufferSize ||
       height > context_.caps().maxRenderbufferSize) {
     throw InputError("image size " + std::to_string(width) + "x" + std::to_string(height) +

@@ -36,7 +36,7 @@ TEST(PlanCommand, Webgl2UsesA3dTexture) {
 TEST(PlanCommand, ImpossibleWishesFailWithOneLine) {
   for (const char* args :
        {"plan gen:sphere:32 --profile ipad2 --layout texture3d",
-        "plan gen:sphere:32 --profile no-such-device", "plan gen:sphere:32 --layout bricks",
+        "plan gen:sphere:32 --profile no-such-device", "plan gen:sphere:32 --layout no-such-layout",
         "render gen:sphere:32 --profile webgl1 --layout texture3d"}) {
     const auto r = runCli(args);
     EXPECT_NE(r.exitCode, 0) << args;

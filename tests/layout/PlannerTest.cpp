@@ -110,7 +110,8 @@ TEST(Planner, EveryBuiltinProfileGetsAPlanWithinItsBudget) {
 
 TEST(Planner, ImpossibleWishesAreClearErrors) {
   EXPECT_THROW(plan({64, 64, 64}, "ipad2", "texture3d"), InputError);
-  EXPECT_THROW(plan({64, 64, 64}, "webgl2", "bricks"), InputError);
+  EXPECT_THROW(plan({64, 64, 64}, "webgl2", "no-such-layout"), InputError);
+  EXPECT_EQ(plan({64, 64, 64}, "webgl2", "bricks").layout.layout, "bricks");
   const layout::Plan forced = plan({64, 64, 64}, "webgl2", "packed-mosaic");
   EXPECT_EQ(forced.layout.layout, "packed-mosaic");
   const layout::Plan mosaic = plan({64, 64, 64}, "webgl2", "mosaic");
@@ -149,9 +150,10 @@ layout::LayoutEntry residentWindowLayout(bool needs3DTextures = false) {
 
 TEST(Planner, ChoosesFromTheRegisteredLayoutsInOrder) {
   EXPECT_EQ(layout::LayoutRegistry::global().names(),
-            (std::vector<std::string>{"texture3d", "mosaic", "packed-mosaic", "fcc", "fcc-half"}));
+            (std::vector<std::string>{"texture3d", "mosaic", "packed-mosaic", "bricks", "fcc",
+                                      "fcc-half"}));
   EXPECT_EQ(layout::LayoutRegistry::global().choices(),
-            "auto, texture3d, mosaic, packed-mosaic, fcc or fcc-half");
+            "auto, texture3d, mosaic, packed-mosaic, bricks, fcc or fcc-half");
 }
 
 TEST(Planner, ALayoutRegisteredLaterIsPlannedByName) {
@@ -161,7 +163,7 @@ TEST(Planner, ALayoutRegisteredLaterIsPlannedByName) {
   EXPECT_EQ(p.layout.layout, "test-window");
   EXPECT_EQ(p.layout.totalBytes, 64u * 64);
   try {
-    plan({64, 64, 64}, "webgl2", "bricks");
+    plan({64, 64, 64}, "webgl2", "no-such-layout");
     FAIL() << "no error";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("test-window"), std::string::npos) << e.what();
@@ -190,7 +192,39 @@ TEST(Planner, ARegisteredLayoutsNeedsAreChecked) {
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()),
               "layout test-window-3d needs 3D textures, which ipad2 does not have (use mosaic, "
-              "packed-mosaic or test-window)");
+              "packed-mosaic, bricks or test-window)");
   }
   EXPECT_EQ(plan({64, 64, 64}, "webgl2", "test-window-3d").layout.layout, "test-window-3d");
+}
+
+namespace {
+
+layout::Plan planStreamed(glm::ivec3 dims, const std::string& profile) {
+  layout::PlanRequest r;
+  r.streamed = true;
+  return layout::planLayout(Volume::shapeOnly(dims, ScalarType::U8), limitsOf(profile), r);
+}
+
+}  // namespace
+
+TEST(Planner, StreamedVolumesThatFitNoInCoreLayoutAreBrickedAndItSaysWhy) {
+  // 1024^3 u8 = 1 GiB: over shield-k1's texture budget (and its 469 MB host).
+  const layout::Plan big = planStreamed({1024, 1024, 1024}, "shield-k1");
+  EXPECT_EQ(big.layout.layout, "bricks");
+  EXPECT_FALSE(big.downsampled());
+  EXPECT_NE(big.reason.find("not texture3d"), std::string::npos) << big.reason;
+  EXPECT_LE(big.layout.totalBytes, limitsOf("shield-k1").textureBudget);
+  // The paper's dog head fits the SHIELD in core (Schultz 2016 §8.2)...
+  EXPECT_EQ(planStreamed({512, 512, 894}, "shield-k1").layout.layout, "texture3d");
+  // ...not the iPad 2: packed-mosaic would need 14 textures (units) of 2048^2.
+  const layout::Plan ipad = planStreamed({512, 512, 894}, "ipad2");
+  EXPECT_EQ(ipad.layout.layout, "bricks") << ipad.reason;
+  EXPECT_LE(ipad.layout.totalBytes, limitsOf("ipad2").textureBudget);
+  // A streamed volume over the host budget is not read in core even where
+  // the textures would hold it: 800^3 = 488 MiB on shield-k1 (469 MiB host).
+  const layout::Plan host = planStreamed({800, 800, 800}, "shield-k1");
+  EXPECT_EQ(host.layout.layout, "bricks");
+  EXPECT_NE(host.reason.find("host memory"), std::string::npos) << host.reason;
+  // In-core volumes keep downsampling (their front ends do not stream).
+  EXPECT_TRUE(plan({512, 512, 512}, "ipad2").downsampled());
 }

@@ -15,9 +15,11 @@
 #include "support/TestSupport.h"
 #include "tessera/gpu/Program.h"
 #include "tessera/io/Procedural.h"
+#include "tessera/layout/BricksLayout.h"
 #include "tessera/layout/MosaicLayout.h"
 #include "tessera/layout/PackedMosaicLayout.h"
 #include "tessera/layout/Texture3DLayout.h"
+#include "tessera/lod/InCoreMultiresSource.h"
 #include "tessera/render/Raycaster.h"
 #include "tessera/render/Slice2DRenderer.h"
 #include "tessera/render/Slice3DRenderer.h"
@@ -123,10 +125,19 @@ TEST(GlslConformance, Es2ShadersPassTheReferenceCompiler) {
   auto mosaic = layout::MosaicLayout::create(v, limits, c->ledger());
   limits.max2DTextureSize = 128;  // several textures: the sampler if-chain
   auto packed = layout::PackedMosaicLayout::create(v, limits, c->ledger(), 6);
+  // Bricks in 14^2-tile mosaics of 128^2: all 8 atlas samplers' if-chain.
+  layout::BricksOptions brickOptions;
+  brickOptions.brickSize = 12;
+  auto bricks = layout::BricksLayout::create(
+      std::make_shared<lod::InCoreMultiresSource>(std::make_shared<const Volume>(v)), limits,
+      c->ledger(), brickOptions);
+  EXPECT_EQ(bricks->textureUnits(), 9) << bricks->plan().reason;
   expectConformant(*c, v, *mosaic);
   expectConformant(*c, v, *packed);
+  expectConformant(*c, v, *bricks);
   mosaic.reset();
   packed.reset();
+  bricks.reset();
   c.reset();
   test::gpuContext();
 }
@@ -139,8 +150,12 @@ TEST(GlslConformance, Es3ShadersPassTheReferenceCompiler) {
   const gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());
   auto t3d = layout::Texture3DLayout::create(v, limits, c.ledger());
   auto mosaic = layout::MosaicLayout::create(v, limits, c.ledger());
+  auto bricks = layout::BricksLayout::create(
+      std::make_shared<lod::InCoreMultiresSource>(std::make_shared<const Volume>(v)), limits,
+      c.ledger());
   expectConformant(c, v, *t3d);
   expectConformant(c, v, *mosaic);
+  expectConformant(c, v, *bricks);
 }
 
 // The overlay and hybrid-compositor programs (issue 5), assembled as

@@ -74,6 +74,9 @@ class Layout {
   // compute it from the volume they were made from; a layout without one
   // (bricks streamed from disk) overrides it with its own metadata.
   virtual ValueBlocks valueBlocks(int blockSize) const;
+  // Changes whenever what sampleVolume() returns may have changed (a
+  // streamed layout's page table), so techniques rebuild their value blocks.
+  virtual std::uint64_t contentVersion() const { return 0; }
 
   // The seam's GLSL as a technique includes it: the layout's glslParts() and then
   // the shared gradient part (layout/gradient.glsl: sampleVolumeGradient() by

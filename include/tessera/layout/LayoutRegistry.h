@@ -49,7 +49,7 @@ class LayoutRegistry : public NamedRegistry<LayoutEntry> {
  public:
   LayoutRegistry() : NamedRegistry("layout", "auto") {}
   // The built-in layouts, in the planner's order of preference: texture3d,
-  // mosaic, packed-mosaic; then fcc and fcc-half (by name only).
+  // mosaic, packed-mosaic, bricks; then fcc and fcc-half (by name only).
   static LayoutRegistry& global();
 };
 

@@ -24,6 +24,9 @@ struct PlanRequest {
   // (the ray caster: its TF table and empty-space grid, the render target).
   int reservedUnits = 2;
   std::uint64_t reservedBytes = 0;
+  // The voxels are not in host memory (a streamed source): an in-core layout
+  // must also fit them in the device's host budget, else bricks stream them.
+  bool streamed = false;
 };
 
 struct Plan {

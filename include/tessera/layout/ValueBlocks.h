@@ -20,7 +20,7 @@ class ValueBlocks {
   // NaN/Inf voxels count as Volume::nonFiniteValue(), the value they render as.
   ValueBlocks(const Volume& volume, int blockSize, int supportVoxels);
   // Ranges computed by the layout itself (count.x * count.y * count.z each,
-  // x fastest), e.g. from an FCC lattice's coefficients.
+  // x fastest), e.g. from an FCC lattice's coefficients or per-brick ranges.
   ValueBlocks(glm::ivec3 count, int blockSize, int supportVoxels, std::vector<float> mins,
               std::vector<float> maxs);
 

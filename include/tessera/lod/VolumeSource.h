@@ -10,6 +10,7 @@
 #include <glm/vec3.hpp>
 
 #include "tessera/core/Volume.h"
+#include "tessera/lod/MultiresSource.h"
 
 namespace tessera::lod {
 
@@ -28,6 +29,12 @@ class VolumeSource {
   // an in-core source hands out its own volume at (1,1,1), so a change of
   // its window shows in both.
   virtual std::shared_ptr<Volume> level(glm::ivec3 factor) const = 0;
+
+  // The same volume as a pyramid read box by box, when it is not held in
+  // host memory (lod/MultiresVolumeSource.h); null for in-core sources. The
+  // planner then counts the host memory an in-core layout would need, and
+  // the bricks layout streams from it.
+  virtual std::shared_ptr<const MultiresSource> multires() const { return nullptr; }
 };
 
 }  // namespace tessera::lod

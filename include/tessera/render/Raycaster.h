@@ -104,7 +104,8 @@ class Raycaster final : public Technique {
   int lutSize_ = 4096;
   int blockSize_ = 8;
   layout::ValueBlocks blocks_;
-  std::vector<float> lutValues_;  // the baked TF, 4 floats per entry
+  std::uint64_t blocksVersion_ = 0;  // layout_.contentVersion() the blocks were made for
+  std::vector<float> lutValues_;     // the baked TF, 4 floats per entry
   gpu::LookupTexture lut_;
   gpu::Texture blockTexture_;
   gpu::Framebuffer target_;

@@ -1,0 +1,153 @@
+#pragma once
+// The volume as bricks of a multiresolution pyramid streamed into a fixed
+// atlas behind a page table (Schultz 2016 §7.1.2, §7.3; DESIGN.md "Large
+// data"): for volumes that do not fit the device in core. The atlas is a 3D
+// texture on ES 3 and a mosaic of its z-slices (MosaicLayout's addressing)
+// on ES 2; the page table maps each level-0 brick cell to the finest resident
+// brick over it, so missing bricks show their coarser level instead of
+// holes (bricks.glsl). Every technique renders it through sampleVolume().
+//
+// Each frame the caller (the render loop) calls update() with the view: the
+// layout picks the level per brick (lod::selectBricks, about one voxel per
+// pixel, coarser when the atlas cannot hold the working set), requests the
+// missing bricks nearest first from a lod::BrickStreamer (worker threads, an
+// LRU host cache within the host budget), uploads at most a byte and time
+// budget of bricks into free or least recently used atlas slots, and rewrites
+// the page table. Bricks whose exact (or, before they are read, their
+// parent's) value range the TF makes transparent are neither fetched nor
+// uploaded. The atlas is allocated once, within the texture budget: the
+// ledger never grows after create().
+//
+// Values are stored in 8 bits: u8 exactly, other types normalised over the
+// volume's window (a quantisation of up to half a step of width / 255).
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include "tessera/core/Camera.h"
+#include "tessera/core/TransferFunction.h"
+#include "tessera/gpu/GlObjects.h"
+#include "tessera/gpu/MemoryLedger.h"
+#include "tessera/layout/Layout.h"
+#include "tessera/layout/LayoutRegistry.h"
+#include "tessera/layout/MosaicLayout.h"
+#include "tessera/lod/BrickStreamer.h"
+#include "tessera/lod/LevelSelection.h"
+
+namespace tessera::layout {
+
+struct BricksOptions {
+  int brickSize = 0;                // B; 0: the source's chunk if cubic 16..128, else 32
+  std::uint64_t atlasBytesCap = 0;  // 0: min(texture budget, 256 MiB)
+  std::uint64_t cacheBytes = 0;     // host cache; 0: a quarter of the host budget (64 MiB)
+  std::uint64_t uploadBytesPerFrame = 16ull << 20;
+  double uploadMsPerFrame = 40.0;  // stop uploading after this long in a frame
+  double pixelsPerVoxel = 1.0;     // refine while a voxel covers more pixels
+  int workers = 2;                 // reader threads
+};
+
+// What one update() did and what the page table now holds.
+struct BricksFrame {
+  bool complete = false;  // every brick the view wants is resident (or its read keeps failing)
+  int wanted = 0;         // bricks in the view's cut
+  int uploaded = 0;       // bricks uploaded this frame
+  int missing = 0;        // wanted, not resident
+  int failing = 0;        // missing because their reads keep failing
+  bool limitedByBudget = false;     // some brick stayed coarser because the atlas is full
+  std::vector<int> wantedPerLevel;  // the cut, bricks per level
+  std::vector<int> cellsPerLevel;   // page-table cells drawn from each level (last: transparent)
+};
+
+class BricksLayout final : public Layout {
+ public:
+  // The atlas and page table for a volume of `shape` within `limits`.
+  // `levels`: the source's level dims (empty: a factor-2 pyramid down to 16).
+  static LayoutPlan planFor(const Volume& shape, const gpu::DeviceLimits& limits,
+                            const BricksOptions& options = {}, glm::ivec3 chunk = glm::ivec3(0),
+                            const std::vector<glm::ivec3>& levels = {});
+
+  // Plans, allocates, and reads and uploads the coarsest level (pinned, so
+  // there is always something to fall back to). Throws GpuError if the plan
+  // does not fit, Error if the coarsest level cannot be read.
+  static std::unique_ptr<BricksLayout> create(std::shared_ptr<const lod::MultiresSource> source,
+                                              const gpu::DeviceLimits& limits,
+                                              gpu::MemoryLedger& ledger,
+                                              const BricksOptions& options = {});
+  ~BricksLayout() override;
+
+  // One frame's level selection, requests, uploads and page table. The
+  // camera must be framed on shape() (Camera::frame).
+  BricksFrame update(const Camera& camera, int width, int height, const TransferFunction& tf);
+  // Waits (up to ms) for a brick read to finish: the render loop's idle.
+  void waitForBricks(double ms);
+
+  std::string name() const override { return "bricks"; }
+  const LayoutPlan& plan() const override { return plan_; }
+  gpu::ShaderPart glsl() const override;
+  int bind(const gpu::Program& program, int firstUnit) const override;
+  ValueMapping rawFromStored() const override;
+  glm::ivec3 volumeDims() const override { return grid_.dims(0); }
+  std::uint64_t textureBytes() const override;
+  int textureUnits() const override { return 1 + static_cast<int>(atlases_.size()); }
+  ValueBlocks valueBlocks(int blockSize) const override;
+  std::uint64_t contentVersion() const override { return contentVersion_; }
+
+  const lod::BrickGrid& grid() const { return grid_; }
+  const lod::MultiresSource& source() const { return *source_; }
+  int slotCount() const { return static_cast<int>(slotKey_.size()); }
+  lod::StreamerStats streamerStats() const { return streamer_->stats(); }
+  // The page table as uploaded (RGBA per level-0 cell, x fastest): the CPU
+  // twin of the lookup in bricks.glsl reads it.
+  const std::vector<std::uint8_t>& pageTable() const { return pages_host_; }
+  glm::ivec3 atlasTexels() const { return atlasTexels_; }  // ES 2: of each texture
+  // Where level-0 continuous voxel coordinate x0 is read: the atlas texel
+  // coordinate (3D, continuous) and the level, or level -1 and the constant
+  // stored value in texel.x. The CPU twin of bricks.glsl's address maths.
+  struct Lookup {
+    int level = 0;
+    int texture = 0;  // ES 2: which atlas texture
+    glm::dvec3 texel{0.0};
+  };
+  Lookup lookup(glm::dvec3 x0) const;
+  // The stored (8-bit) value the atlas holds at integer atlas texel t.
+  std::uint8_t atlasTexel(glm::ivec3 t) const;
+
+  static LayoutEntry registration();
+
+ private:
+  BricksLayout() = default;
+  int slotFor(std::uint64_t id, std::uint64_t frame);
+  void upload(int slot, const lod::StoredBrick& brick);
+  bool transparent(const lod::BrickKey& key, const TransferFunction& tf, bool exactOnly,
+                   std::uint8_t* value) const;
+  std::optional<lod::BrickRange> rangeOrEstimate(const lod::BrickKey& key) const;
+  void rebuildPages(const TransferFunction& tf, BricksFrame& frame);
+  glm::ivec3 slotOrigin(int slot) const;
+
+  LayoutPlan plan_;
+  BricksOptions options_;
+  gpu::ApiLevel api_ = gpu::ApiLevel::Gles3;
+  std::shared_ptr<const lod::MultiresSource> source_;
+  lod::BrickGrid grid_;
+  std::unique_ptr<lod::BrickStreamer> streamer_;
+  std::vector<gpu::Texture> atlases_;  // ES 3: one 3D texture; ES 2: 1..8 mosaics
+  gpu::Texture pages_;
+  MosaicLayout::Geometry mosaic_;  // ES 2: the atlas' z-slices as tiles
+  glm::ivec3 slotGrid_{1};
+  glm::ivec3 atlasTexels_{0};
+  std::vector<std::int64_t> slotKey_;    // brick id per slot, -1 free
+  std::vector<std::uint64_t> slotUsed_;  // frame last wanted
+  std::vector<bool> slotPinned_;
+  std::unordered_map<std::uint64_t, int> slotOf_;
+  std::vector<std::uint8_t> pages_host_;
+  std::vector<std::uint8_t> cellMin_, cellMax_;  // stored range of what each cell samples
+  std::uint64_t frame_ = 0;
+  std::uint64_t contentVersion_ = 1;
+  // The TF's opacity > 0 over stored values 0..255 (prefix counts).
+  std::vector<int> opaquePrefix_;
+};
+
+}  // namespace tessera::layout

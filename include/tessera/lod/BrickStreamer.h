@@ -1,0 +1,111 @@
+#pragma once
+// Reads bricks of a MultiresSource on worker threads into an LRU cache of
+// stored bricks that stays within a host byte budget (DESIGN.md "Large
+// data"; Schultz 2016 §7.3 loads sub-volumes on demand). The render loop
+// asks each frame for the bricks it wants, nearest first (request()); the
+// workers take them in that order. A read that throws is retried later with
+// exponential back-off, so the coarser level stays on screen meanwhile. The
+// range of every brick ever read is kept (16 bytes a brick) after the brick
+// itself leaves the cache, for empty-space decisions.
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <list>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+#include "tessera/lod/BrickGrid.h"
+#include "tessera/lod/MultiresSource.h"
+
+namespace tessera::lod {
+
+struct BrickStreamerOptions {
+  int workers = 2;                         // 0: request() reads inline
+  int inlineReadsPerRequest = 8;           // without workers
+  std::uint64_t cacheBytes = 64ull << 20;  // decoded bricks kept on the host
+  double firstRetryMs = 20.0;              // back-off: doubles per failure...
+  double maxRetryMs = 2000.0;              // ...up to this
+  int attemptsBeforeFailing = 3;           // then failing() is true (still retried)
+};
+
+struct BrickRange {
+  std::uint8_t min = 0;
+  std::uint8_t max = 0;
+};
+
+struct StreamerStats {
+  std::uint64_t bricksRead = 0;
+  std::uint64_t bytesRead = 0;  // stored bytes of the bricks read
+  std::uint64_t readErrors = 0;
+  std::uint64_t cacheBytes = 0;
+  std::uint64_t cachePeakBytes = 0;
+  std::string lastError;
+};
+
+class BrickStreamer {
+ public:
+  BrickStreamer(std::shared_ptr<const MultiresSource> source, BrickGrid grid,
+                BrickStreamerOptions options);
+  ~BrickStreamer();
+  BrickStreamer(const BrickStreamer&) = delete;
+  BrickStreamer& operator=(const BrickStreamer&) = delete;
+
+  const BrickGrid& grid() const { return grid_; }
+  const StoredMapping& mapping() const { return mapping_; }
+
+  // The bricks wanted now, most urgent first: replaces the queue of reads not
+  // yet started with those of `keys` that are neither cached, being read,
+  // nor waiting out a back-off.
+  void request(const std::vector<BrickKey>& keys);
+  // The cached brick (and marks it recently used), or null.
+  std::shared_ptr<const StoredBrick> find(const BrickKey& key);
+  // Reads on this thread (or waits for a worker already reading it),
+  // retrying up to attemptsBeforeFailing times; throws the last error.
+  std::shared_ptr<const StoredBrick> readNow(const BrickKey& key);
+  // The brick's exact range if it was ever read.
+  std::optional<BrickRange> range(const BrickKey& key) const;
+  // True once the brick's reads failed attemptsBeforeFailing times in a row.
+  bool failing(const BrickKey& key) const;
+  // Waits until a read finishes or `ms` pass.
+  void waitForProgress(double ms);
+  bool idle() const;  // nothing queued or being read
+  StreamerStats stats() const;
+
+ private:
+  struct Failure {
+    int attempts = 0;
+    double retryAtMs = 0.0;
+  };
+  void work();
+  void readQueuedInline(int count);
+  std::shared_ptr<const StoredBrick> readOne(const BrickKey& key);            // no lock held
+  void store(const BrickKey& key, std::shared_ptr<const StoredBrick> brick);  // lock held
+  void recordFailure(const BrickKey& key, const std::string& what);           // lock held
+  double nowMs() const;
+
+  std::shared_ptr<const MultiresSource> source_;
+  BrickGrid grid_;
+  StoredMapping mapping_;
+  BrickStreamerOptions options_;
+
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;      // workers: the queue changed or stop
+  std::condition_variable progress_;  // readers: a read finished
+  std::deque<BrickKey> queue_;
+  std::unordered_set<std::uint64_t> reading_;
+  std::list<std::pair<std::uint64_t, std::shared_ptr<const StoredBrick>>> lru_;
+  std::unordered_map<std::uint64_t, decltype(lru_)::iterator> cached_;
+  std::unordered_map<std::uint64_t, BrickRange> ranges_;
+  std::unordered_map<std::uint64_t, Failure> failures_;
+  StreamerStats stats_;
+  bool stop_ = false;
+  std::vector<std::thread> workers_;
+};
+
+}  // namespace tessera::lod

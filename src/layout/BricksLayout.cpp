@@ -1,0 +1,579 @@
+#include "tessera/layout/BricksLayout.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <glm/trigonometric.hpp>
+
+#include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
+#include "tessera/gpu/Draw.h"
+#include "tessera/lod/InCoreMultiresSource.h"
+
+namespace tessera::layout {
+
+namespace {
+
+constexpr std::uint64_t kDefaultAtlasCap = 256ull << 20;
+constexpr int kCoarsestSide = 16;
+
+// "prefix7suffix" (snprintf: GCC 12 -Wrestrict misfires on "literal" + std::string).
+std::string numbered(const char* prefix, int n, const char* suffix = "") {
+  char text[64];
+  std::snprintf(text, sizeof text, "%s%d%s", prefix, n, suffix);
+  return text;
+}
+
+std::string dimsText(glm::ivec3 d) {
+  return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
+}
+
+int brickSizeFor(const BricksOptions& options, glm::ivec3 chunk) {
+  if (options.brickSize > 0) return options.brickSize;
+  if (chunk.x == chunk.y && chunk.y == chunk.z && chunk.x >= 16 && chunk.x <= 128) return chunk.x;
+  return 32;
+}
+
+// The atlas the budget allows: its slot grid and, on ES 2, its mosaic.
+// ES 2: slots.x is the number of mosaic textures (one unit each, up to 8),
+// slots.z the slots stacked in each.
+struct AtlasShape {
+  glm::ivec3 slots{0};
+  MosaicLayout::Geometry mosaic;  // tilesX = 0 on ES 3
+  std::uint64_t bytes = 0;
+  int count() const { return slots.x * slots.y * slots.z; }
+};
+
+constexpr int kMaxMosaicAtlases = 8;
+
+AtlasShape atlasFor(const gpu::DeviceLimits& limits, int stored, std::uint64_t avail,
+                    std::uint64_t bricks) {
+  AtlasShape a;
+  const std::uint64_t slotBytes = static_cast<std::uint64_t>(stored) * stored * stored;
+  const std::uint64_t want = std::min<std::uint64_t>(avail / slotBytes, bricks);
+  if (want == 0) return a;
+  if (limits.api == gpu::ApiLevel::Gles3 && limits.max3DTextureSize > 0) {
+    const int m = std::min(255, limits.max3DTextureSize / stored);
+    if (m < 1) return a;
+    const int side = std::clamp(static_cast<int>(std::cbrt(static_cast<double>(want))), 1, m);
+    const std::uint64_t layer = static_cast<std::uint64_t>(side) * side;
+    // Enough layers for every brick wanted, as far as the budget goes.
+    const int depth = static_cast<int>(std::min<std::uint64_t>(
+        {static_cast<std::uint64_t>(m), (want + layer - 1) / layer, avail / slotBytes / layer}));
+    a.slots = {side, side, std::max(1, depth)};
+    a.bytes = slotBytes * static_cast<std::uint64_t>(a.count());
+    return a;
+  }
+  const std::uint64_t tiles = static_cast<std::uint64_t>(limits.max2DTextureSize / stored) *
+                              static_cast<std::uint64_t>(limits.max2DTextureSize / stored);
+  int depth = static_cast<int>(std::min<std::uint64_t>({255, tiles / stored, want}));
+  for (; depth > 0; --depth) {
+    a.mosaic = MosaicLayout::geometryFor({stored, stored, depth * stored}, limits.max2DTextureSize);
+    a.bytes = static_cast<std::uint64_t>(a.mosaic.width()) * a.mosaic.height();
+    if (a.mosaic.tilesX > 0 && a.bytes <= avail) break;
+  }
+  if (depth <= 0) return a;
+  // More textures where units and budget allow and bricks want them.
+  const std::uint64_t perTexture = a.bytes;
+  const int units = std::min(kMaxMosaicAtlases, limits.textureUnits - 1);
+  const auto textures = static_cast<int>(std::min<std::uint64_t>(
+      {static_cast<std::uint64_t>(std::max(1, units)),
+       (want + static_cast<std::uint64_t>(depth) - 1) / static_cast<std::uint64_t>(depth),
+       std::max<std::uint64_t>(1, avail / perTexture)}));
+  a.slots = {textures, 1, depth};
+  a.bytes = perTexture * static_cast<std::uint64_t>(textures);
+  return a;
+}
+
+std::uint64_t pyramidBricks(const std::vector<glm::ivec3>& levels, int brick) {
+  std::uint64_t n = 0;
+  for (glm::ivec3 d : levels) {
+    const glm::ivec3 b = (d + brick - 1) / brick;
+    n += static_cast<std::uint64_t>(b.x) * b.y * b.z;
+  }
+  return n;
+}
+
+}  // namespace
+
+LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& limits,
+                                 const BricksOptions& options, glm::ivec3 chunk,
+                                 const std::vector<glm::ivec3>& sourceLevels) {
+  LayoutPlan plan;
+  plan.layout = "bricks";
+  const int b = brickSizeFor(options, chunk);
+  const int stored = b + 2;
+  const glm::ivec3 d = shape.dims();
+  const std::string vol = dimsText(d) + " " + std::string(scalarTypeName(shape.type()));
+  const glm::ivec3 cells = (d + b - 1) / b;
+  const std::vector<glm::ivec3> levels =
+      sourceLevels.empty() ? lod::pyramidDims(d, kCoarsestSide) : sourceLevels;
+  const glm::ivec3 top = (levels.back() + b - 1) / b;
+  const int topBricks = top.x * top.y * top.z;
+  PlannedTexture pages{.label = "brick page table",
+                       .size = {cells.x, cells.y * cells.z, 1},
+                       .is3D = false,
+                       .format = "RGBA8",
+                       .bytes = 4ull * cells.x * cells.y * cells.z};
+  if (pages.size.x > limits.max2DTextureSize || pages.size.y > limits.max2DTextureSize) {
+    plan.reason = vol + ": a " + dimsText(pages.size) + " page table of " + std::to_string(b) +
+                  "^3 bricks exceeds the max 2D texture size of " + limits.profile;
+    return plan;
+  }
+  if (limits.textureUnits < 2) {
+    plan.reason = "bricks need two texture units (atlas and page table) on " + limits.profile;
+    return plan;
+  }
+  std::uint64_t avail = options.atlasBytesCap ? options.atlasBytesCap : kDefaultAtlasCap;
+  if (limits.textureBudget != 0) {
+    avail = std::min(avail,
+                     limits.textureBudget > pages.bytes ? limits.textureBudget - pages.bytes : 0);
+  }
+  const AtlasShape a = atlasFor(limits, stored, avail, pyramidBricks(levels, b));
+  const bool es3 = a.mosaic.tilesX == 0;
+  const int atlases = es3 ? 1 : std::max(1, a.slots.x);
+  PlannedTexture atlas{
+      .label = "brick atlas",
+      .size = es3 ? a.slots * stored : glm::ivec3(a.mosaic.width(), a.mosaic.height(), 1),
+      .is3D = es3,
+      .format = es3 ? "R8" : "L8",
+      .bytes = a.bytes / static_cast<std::uint64_t>(atlases)};
+  for (int t = 0; t < atlases; ++t) {
+    plan.textures.push_back(atlas);
+    if (atlases > 1) plan.textures.back().label += numbered(" ", t + 1);
+  }
+  plan.textures.push_back(pages);
+  plan.totalBytes = a.bytes + pages.bytes;
+  const std::string what = vol + " as " + std::to_string(b) + "^3 bricks (+1 voxel apron) of " +
+                           std::to_string(levels.size()) + " levels, streamed into a " +
+                           std::to_string(a.count()) + "-brick " + atlas.format + " atlas (" +
+                           (atlases > 1 ? numbered("", atlases, " x ") : std::string()) +
+                           dimsText(atlas.size) + (es3 ? " 3D" : " mosaic") + ", " +
+                           formatBytes(a.bytes) + ") through a " + std::to_string(cells.x) + "x" +
+                           std::to_string(cells.y * cells.z) + " page table" +
+                           (shape.type() == ScalarType::U8 ? "" : ", quantised to 8 bits");
+  if (a.count() <= topBricks) {
+    plan.reason = what + ": the budget (" + formatBytes(avail) + ") holds no more than the " +
+                  std::to_string(topBricks) + " coarsest bricks";
+    return plan;
+  }
+  plan.fits = true;
+  plan.reason = what;
+  return plan;
+}
+
+BricksLayout::~BricksLayout() {
+  streamer_.reset();  // stop the readers before the textures go
+}
+
+std::unique_ptr<BricksLayout> BricksLayout::create(
+    std::shared_ptr<const lod::MultiresSource> source, const gpu::DeviceLimits& limits,
+    gpu::MemoryLedger& ledger, const BricksOptions& options) {
+  if (!source) throw Error("bricks layout: no source");
+  std::unique_ptr<BricksLayout> l(new BricksLayout());
+  l->options_ = options;
+  l->api_ = limits.api;
+  l->source_ = source;
+  const glm::ivec3 chunk = source->levelInfo(0).chunk;
+  std::vector<glm::ivec3> levels;
+  for (int lv = 0; lv < source->levelCount(); ++lv) levels.push_back(source->levelInfo(lv).dims);
+  l->plan_ = planFor(source->shape(), limits, options, chunk, levels);
+  if (!l->plan_.fits) throw GpuError("bricks layout: " + l->plan_.reason);
+  const int b = brickSizeFor(options, chunk);
+  l->grid_ = lod::BrickGrid::of(*source, b);
+  const int stored = l->grid_.stored();
+  std::uint64_t avail = options.atlasBytesCap ? options.atlasBytesCap : kDefaultAtlasCap;
+  if (limits.textureBudget != 0) {
+    avail = std::min(avail, limits.textureBudget - l->plan_.textures[1].bytes);
+  }
+  std::uint64_t bricks = 0;
+  for (int lv = 0; lv < l->grid_.levelCount(); ++lv) bricks += l->grid_.brickCount(lv);
+  const AtlasShape a = atlasFor(limits, stored, avail, bricks);
+  l->slotGrid_ = a.slots;
+  l->mosaic_ = a.mosaic;
+  if (a.mosaic.tilesX == 0) {
+    l->atlasTexels_ = a.slots * stored;
+    l->atlases_.push_back(gpu::Texture::create3D(ledger, "brick atlas (R8)", gpu::TexelFormat::R8,
+                                                 l->atlasTexels_.x, l->atlasTexels_.y,
+                                                 l->atlasTexels_.z));
+  } else {
+    l->atlasTexels_ = glm::ivec3(stored, stored, a.slots.z * stored);  // each texture's
+    for (int t = 0; t < a.slots.x; ++t) {
+      l->atlases_.push_back(
+          gpu::Texture::create2D(ledger, numbered("brick atlas ", t + 1, " (mosaic)"),
+                                 gpu::r8For(limits.api), a.mosaic.width(), a.mosaic.height()));
+    }
+  }
+  const glm::ivec3 cells = l->grid_.bricks(0);
+  l->pages_host_.assign(4ull * cells.x * cells.y * cells.z, 0);
+  l->pages_ = gpu::Texture::create2D(ledger, "brick page table", gpu::rgba8For(limits.api), cells.x,
+                                     cells.y * cells.z, l->pages_host_.data());
+  l->pages_.setFilter(gpu::Filter::Nearest);
+  l->slotKey_.assign(static_cast<std::size_t>(a.count()), -1);
+  l->slotUsed_.assign(l->slotKey_.size(), 0);
+  l->slotPinned_.assign(l->slotKey_.size(), false);
+
+  lod::BrickStreamerOptions so;
+  so.workers = options.workers;
+  so.cacheBytes = options.cacheBytes       ? options.cacheBytes
+                  : limits.hostBudget != 0 ? limits.hostBudget / 4
+                                           : 64ull << 20;
+  l->streamer_ = std::make_unique<lod::BrickStreamer>(source, l->grid_, so);
+  // The coarsest level, pinned: what every cell falls back to.
+  const int top = l->grid_.levelCount() - 1;
+  const glm::ivec3 n = l->grid_.bricks(top);
+  for (int z = 0; z < n.z; ++z) {
+    for (int y = 0; y < n.y; ++y) {
+      for (int x = 0; x < n.x; ++x) {
+        const lod::BrickKey key{top, {x, y, z}};
+        const int slot = l->slotFor(key.id(), 0);
+        l->upload(slot, *l->streamer_->readNow(key));
+        l->slotPinned_[static_cast<std::size_t>(slot)] = true;
+      }
+    }
+  }
+  BricksFrame unused;
+  l->rebuildPages(TransferFunction(), unused);
+  gpu::checkErrors("bricks layout: allocating the atlas and the coarsest level");
+  return l;
+}
+
+glm::ivec3 BricksLayout::slotOrigin(int slot) const {
+  const glm::ivec3 s(slot % slotGrid_.x, (slot / slotGrid_.x) % slotGrid_.y,
+                     slot / (slotGrid_.x * slotGrid_.y));
+  return s;
+}
+
+int BricksLayout::slotFor(std::uint64_t id, std::uint64_t frame) {
+  int chosen = -1;
+  std::uint64_t oldest = frame;
+  for (std::size_t s = 0; s < slotKey_.size(); ++s) {
+    if (slotKey_[s] < 0) {
+      chosen = static_cast<int>(s);
+      break;
+    }
+    if (!slotPinned_[s] && slotUsed_[s] < oldest) {
+      oldest = slotUsed_[s];
+      chosen = static_cast<int>(s);
+    }
+  }
+  if (chosen < 0) return -1;
+  const auto c = static_cast<std::size_t>(chosen);
+  if (slotKey_[c] >= 0) slotOf_.erase(static_cast<std::uint64_t>(slotKey_[c]));
+  slotKey_[c] = static_cast<std::int64_t>(id);
+  slotUsed_[c] = frame;
+  slotOf_[id] = chosen;
+  return chosen;
+}
+
+void BricksLayout::upload(int slot, const lod::StoredBrick& brick) {
+  const int n = grid_.stored();
+  const glm::ivec3 s = slotOrigin(slot);
+  if (mosaic_.tilesX == 0) {
+    atlases_[0].updateRegion(s * n, glm::ivec3(n), brick.voxels.data());
+    return;
+  }
+  // ES 2: s.x is the texture, s.z the slot in its stack of z-slices.
+  gpu::Texture& atlas = atlases_[static_cast<std::size_t>(s.x)];
+  const std::size_t slice = static_cast<std::size_t>(n) * n;
+  for (int k = 0; k < n; ++k) {
+    const glm::ivec2 at = mosaic_.addressOf(0, 0, s.z * n + k);
+    atlas.updateRegion({at, 0}, {n, n, 1}, brick.voxels.data() + slice * k);
+  }
+}
+
+std::uint64_t BricksLayout::textureBytes() const {
+  std::uint64_t bytes = pages_.bytes();
+  for (const gpu::Texture& t : atlases_) bytes += t.bytes();
+  return bytes;
+}
+
+ValueMapping BricksLayout::rawFromStored() const {
+  const lod::StoredMapping& m = streamer_->mapping();
+  return m.identity ? ValueMapping{255.0, 0.0} : ValueMapping{m.width, m.min};
+}
+
+std::optional<lod::BrickRange> BricksLayout::rangeOrEstimate(const lod::BrickKey& key) const {
+  // A brick not read yet: its parent's range (with the parent's apron),
+  // the estimate Schultz-style streaming decides with before the fetch.
+  for (lod::BrickKey k = key; k.level < grid_.levelCount(); k = grid_.parent(k)) {
+    if (auto r = streamer_->range(k)) return r;
+  }
+  return std::nullopt;
+}
+
+bool BricksLayout::transparent(const lod::BrickKey& key, const TransferFunction&, bool exactOnly,
+                               std::uint8_t* value) const {
+  if (opaquePrefix_.empty()) return false;
+  const std::optional<lod::BrickRange> r = exactOnly ? streamer_->range(key) : rangeOrEstimate(key);
+  if (!r) return false;
+  const int lo = 2 * r->min, hi = 2 * r->max;
+  const bool any = opaquePrefix_[static_cast<std::size_t>(hi) + 1] -
+                       opaquePrefix_[static_cast<std::size_t>(lo)] >
+                   0;
+  if (value) *value = r->min;
+  return !any;
+}
+
+void BricksLayout::rebuildPages(const TransferFunction& tf, BricksFrame& frame) {
+  const glm::ivec3 cells = grid_.bricks(0);
+  const int levels = grid_.levelCount();
+  std::vector<std::uint8_t> pages(pages_host_.size(), 0);
+  cellMin_.assign(pages.size() / 4, 0);
+  cellMax_.assign(pages.size() / 4, 255);
+  frame.cellsPerLevel.assign(static_cast<std::size_t>(levels) + 1, 0);
+  std::size_t i = 0;
+  for (int z = 0; z < cells.z; ++z) {
+    for (int y = 0; y < cells.y; ++y) {
+      for (int x = 0; x < cells.x; ++x, ++i) {
+        std::uint8_t* e = &pages[4 * i];
+        for (int l = 0; l < levels; ++l) {
+          const lod::BrickKey key = grid_.ancestorOf({x, y, z}, l);
+          const auto it = slotOf_.find(key.id());
+          if (it != slotOf_.end()) {
+            const glm::ivec3 s = slotOrigin(it->second);
+            e[0] = static_cast<std::uint8_t>(s.x);
+            e[1] = static_cast<std::uint8_t>(s.y);
+            e[2] = static_cast<std::uint8_t>(s.z);
+            e[3] = static_cast<std::uint8_t>(l);
+            if (auto r = streamer_->range(key)) {
+              cellMin_[i] = r->min;
+              cellMax_[i] = r->max;
+            }
+            ++frame.cellsPerLevel[static_cast<std::size_t>(l)];
+            break;
+          }
+          std::uint8_t v = 0;
+          if (transparent(key, tf, true, &v)) {
+            e[0] = v;
+            e[3] = 255;
+            cellMin_[i] = cellMax_[i] = v;
+            ++frame.cellsPerLevel[static_cast<std::size_t>(levels)];
+            break;
+          }
+        }
+      }
+    }
+  }
+  if (pages != pages_host_) {
+    pages_host_ = std::move(pages);
+    pages_.update(pages_host_.data());
+    ++contentVersion_;
+  }
+}
+
+BricksFrame BricksLayout::update(const Camera& camera, int width, int height,
+                                 const TransferFunction& tf) {
+  ++frame_;
+  BricksFrame frame;
+  // Which stored values (and the spans between neighbours) the TF shows:
+  // mark 2s for value s, 2s + 1 for the interval (s, s + 1), which a TF
+  // control point with opacity inside it makes visible.
+  const lod::StoredMapping& m = streamer_->mapping();
+  const ValueRange w = source_->shape().window();
+  const double ww = w.max > w.min ? w.max - w.min : 1.0;
+  auto norm = [&](double s) { return (m.raw(s) - w.min) / ww; };
+  std::vector<int> marks(512, 0);
+  for (int s = 0; s < 256; ++s) marks[2 * s] = tf.opacity(norm(s)) > 0.0;
+  for (const OpacityPoint& p : tf.opacities) {
+    if (p.alpha <= 0.0) continue;
+    for (int s = 0; s < 255; ++s) {
+      if (p.x > norm(s) && p.x < norm(s + 1)) marks[2 * s + 1] = 1;
+    }
+  }
+  opaquePrefix_.assign(513, 0);
+  for (int k = 0; k < 512; ++k) opaquePrefix_[k + 1] = opaquePrefix_[k] + marks[k];
+
+  lod::LodView view;
+  const glm::dvec3 spacing = source_->shape().spacing();
+  const glm::dvec3 dims0(grid_.dims(0));
+  view.eye = camera.eye() / spacing + 0.5 * dims0;
+  view.spacing = spacing;
+  view.orthographic = camera.projection == Projection::Orthographic;
+  view.pixelSize = view.orthographic ? 2.0 * camera.orthoHalfHeight() / height
+                                     : 2.0 * std::tan(glm::radians(camera.fovYDeg) / 2.0) / height;
+  view.pixelsPerVoxel = options_.pixelsPerVoxel;
+  (void)width;
+  const int pinned = static_cast<int>(std::count(slotPinned_.begin(), slotPinned_.end(), true));
+  const std::size_t capacity = static_cast<std::size_t>(slotCount() - pinned);
+  // An eighth of the slots stay for the parents of bricks still missing
+  // (coarse to fine: a missing brick shows its parent, not a distant ancestor).
+  const lod::LodSelection sel = lod::selectBricks(
+      grid_, view, [&](const lod::BrickKey& k) { return !transparent(k, tf, false, nullptr); },
+      capacity - capacity / 8);
+  frame.wanted = static_cast<int>(sel.bricks.size());
+  frame.wantedPerLevel = sel.bricksPerLevel;
+  frame.limitedByBudget = sel.limitedByCapacity;
+  // What to fetch, nearest first and each missing brick after its missing
+  // ancestors (coarse to fine); what is on screen now stays (marked used).
+  std::vector<lod::BrickKey> needed;
+  std::unordered_map<std::uint64_t, bool> inCut;  // id -> part of the cut (not an ancestor)
+  auto markUsed = [&](const lod::BrickKey& k) {
+    const auto it = slotOf_.find(k.id());
+    if (it == slotOf_.end()) return false;
+    slotUsed_[static_cast<std::size_t>(it->second)] = frame_;
+    return true;
+  };
+  for (const lod::BrickKey& k : sel.bricks) {
+    if (markUsed(k)) continue;
+    std::vector<lod::BrickKey> chain;
+    for (lod::BrickKey a = grid_.parent(k); a.level < grid_.levelCount(); a = grid_.parent(a)) {
+      if (markUsed(a)) break;
+      chain.push_back(a);
+    }
+    for (auto a = chain.rbegin(); a != chain.rend(); ++a) {
+      if (inCut.emplace(a->id(), false).second) needed.push_back(*a);
+    }
+    const auto [it, added] = inCut.emplace(k.id(), true);
+    it->second = true;
+    if (added) needed.push_back(k);
+  }
+  std::vector<lod::BrickKey> toRead;
+  std::uint64_t bytes = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  bool budgetLeft = true;
+  for (const lod::BrickKey& k : needed) {
+    const bool cut = inCut[k.id()];
+    if (slotOf_.count(k.id())) continue;
+    if (cut) ++frame.missing;
+    std::shared_ptr<const lod::StoredBrick> brick = streamer_->find(k);
+    if (!brick) {
+      if (cut && streamer_->failing(k)) ++frame.failing;
+      toRead.push_back(k);
+      continue;
+    }
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (bytes >= options_.uploadBytesPerFrame || ms >= options_.uploadMsPerFrame) {
+      budgetLeft = false;
+    }
+    if (!budgetLeft) continue;
+    const int slot = slotFor(k.id(), frame_);
+    if (slot < 0) continue;  // every slot holds a brick this frame wants
+    upload(slot, *brick);
+    bytes += brick->voxels.size();
+    ++frame.uploaded;
+    if (cut) --frame.missing;
+  }
+  streamer_->request(toRead);
+  rebuildPages(tf, frame);
+  frame.complete = frame.missing == frame.failing;
+  return frame;
+}
+
+void BricksLayout::waitForBricks(double ms) {
+  streamer_->waitForProgress(ms);
+}
+
+BricksLayout::Lookup BricksLayout::lookup(glm::dvec3 x0) const {
+  const double b = grid_.brickSize();
+  const glm::dvec3 dims0(grid_.dims(0));
+  const glm::dvec3 cellsF(grid_.bricks(0));
+  x0 = glm::clamp(x0, glm::dvec3(0.0), dims0);
+  const glm::dvec3 cell = glm::min(glm::floor(x0 / b), cellsF - 1.0);
+  const glm::ivec3 c(cell);
+  const std::size_t i =
+      (static_cast<std::size_t>(c.z) * grid_.bricks(0).y + c.y) * grid_.bricks(0).x + c.x;
+  const std::uint8_t* e = &pages_host_[4 * i];
+  Lookup out;
+  if (e[3] == 255) {
+    out.level = -1;
+    out.texel = glm::dvec3(e[0], 0.0, 0.0);
+    return out;
+  }
+  out.level = e[3];
+  const double shrink = std::ldexp(1.0, -out.level);
+  const glm::dvec3 brick = glm::floor(cell * shrink + 0.001);
+  const glm::dvec3 local = glm::clamp(x0 * shrink - brick * b, 0.0, b) + 1.0;
+  const bool es3 = mosaic_.tilesX == 0;
+  out.texture = es3 ? 0 : e[0];
+  out.texel = (es3 ? glm::dvec3(e[0], e[1], e[2]) : glm::dvec3(0.0, 0.0, e[2])) * (b + 2.0) + local;
+  return out;
+}
+
+ValueBlocks BricksLayout::valueBlocks(int blockSize) const {
+  const glm::ivec3 d = grid_.dims(0);
+  const glm::ivec3 count = (d + blockSize - 1) / blockSize;
+  const glm::ivec3 cells = grid_.bricks(0);
+  const int b = grid_.brickSize();
+  const lod::StoredMapping& m = streamer_->mapping();
+  const std::size_t n = static_cast<std::size_t>(count.x) * count.y * count.z;
+  std::vector<float> mins(n), maxs(n);
+  std::size_t i = 0;
+  for (int z = 0; z < count.z; ++z) {
+    for (int y = 0; y < count.y; ++y) {
+      for (int x = 0; x < count.x; ++x, ++i) {
+        // Samples inside the block read the cells its box [bS, (b+1)S] touches.
+        const glm::ivec3 lo = glm::ivec3(x, y, z) * blockSize / b;
+        const glm::ivec3 hi =
+            glm::min(glm::min((glm::ivec3(x, y, z) + 1) * blockSize, d) / b, cells - 1);
+        int mn = 255, mx = 0;
+        for (int cz = lo.z; cz <= hi.z; ++cz) {
+          for (int cy = lo.y; cy <= hi.y; ++cy) {
+            for (int cx = lo.x; cx <= hi.x; ++cx) {
+              const std::size_t c = (static_cast<std::size_t>(cz) * cells.y + cy) * cells.x + cx;
+              mn = std::min<int>(mn, cellMin_[c]);
+              mx = std::max<int>(mx, cellMax_[c]);
+            }
+          }
+        }
+        mins[i] = static_cast<float>(m.raw(mn));
+        maxs[i] = static_cast<float>(m.raw(mx));
+      }
+    }
+  }
+  return ValueBlocks(count, blockSize, supportVoxels(), std::move(mins), std::move(maxs));
+}
+
+gpu::ShaderPart BricksLayout::glsl() const {
+  gpu::ShaderPart part = gpu::embeddedShaderPart("layout/bricks.glsl");
+  // The number of ES 2 atlas samplers must be a compile-time constant; it
+  // replaces the file's first line, a comment, so line numbers stay.
+  part.text.replace(0, part.text.find('\n'),
+                    "#define BRICKS_ATLASES " + std::to_string(atlases_.size()));
+  return part;
+}
+
+int BricksLayout::bind(const gpu::Program& program, int firstUnit) const {
+  pages_.bind(firstUnit);
+  program.set("u_layoutPages", firstUnit);
+  for (std::size_t t = 0; t < atlases_.size(); ++t) {
+    const int unit = firstUnit + 1 + static_cast<int>(t);
+    atlases_[t].bind(unit);
+    const std::string name = mosaic_.tilesX == 0 ? std::string("u_layoutAtlas")
+                                                 : numbered("u_layoutAtlas", static_cast<int>(t));
+    program.set(name.c_str(), unit);
+  }
+  const glm::ivec3 cells = grid_.bricks(0);
+  program.set("u_layoutDims0", glm::vec3(grid_.dims(0)));
+  program.set("u_layoutBrick", static_cast<float>(grid_.brickSize()));
+  program.set("u_layoutCells", glm::vec3(cells));
+  program.set("u_layoutPagesInv", glm::vec2(1.0f / static_cast<float>(cells.x),
+                                            1.0f / static_cast<float>(cells.y * cells.z)));
+  program.set("u_layoutAtlasTexels", glm::vec3(atlasTexels_));
+  if (mosaic_.tilesX > 0) {
+    program.set("u_layoutTilesX", static_cast<float>(mosaic_.tilesX));
+    program.set("u_layoutMosaicInv", glm::vec2(1.0f / static_cast<float>(mosaic_.width()),
+                                               1.0f / static_cast<float>(mosaic_.height())));
+  }
+  return textureUnits();
+}
+
+LayoutEntry BricksLayout::registration() {
+  return {.name = "bricks",
+          .plan =
+              [](const Volume& shape, const gpu::DeviceLimits& limits, int units) {
+                gpu::DeviceLimits l = limits;
+                l.textureUnits = units;
+                return planFor(shape, l);
+              },
+          .create = [](const Volume& volume, const gpu::DeviceLimits& limits,
+                       gpu::MemoryLedger& ledger, int) -> std::unique_ptr<Layout> {
+            // The caller keeps `volume` alive for as long as the layout.
+            std::shared_ptr<const Volume> borrowed(&volume, [](const Volume*) {});
+            return create(std::make_shared<lod::InCoreMultiresSource>(borrowed), limits, ledger);
+          }};
+}
+
+}  // namespace tessera::layout

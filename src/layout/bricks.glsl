@@ -1,0 +1,127 @@
+// Line 1 is replaced by "#define BRICKS_ATLASES <N>" (BricksLayout::glsl()).
+// sampleVolume for BricksLayout: bricks of several resolution levels in one
+// atlas, found through a page table (Schultz 2016 §7.3; the page-table
+// scheme of ImageVis3D and Neuroglancer). Valid GLSL ES 1.00 and 3.00.
+//
+// The page table has one RGBA8 texel per level-0 brick cell c (texel
+// (c.x, c.y + c.z * cells.y), NEAREST): rgb = the atlas slot and a = the
+// level l of the finest resident brick that covers the cell (the CPU falls
+// back to coarser levels when finer bricks are missing, so there are no
+// holes), or a = 255 when the cell is known to be transparent, with r the
+// constant stored value to return. The brick of level l covering cell c is
+// floor(c / 2^l); a level-l voxel spans 2^l level-0 voxels, so the level-0
+// coordinate x0 is x0 / 2^l there. The slot stores (B + 2)^3 voxels, the
+// brick and a one-voxel apron, so the hardware filter inside the slot is the
+// trilinear interpolation of the level: no seams between bricks.
+//
+// On ES 3 the atlas is a 3D texture of slots (page rgb = slot); on ES 2 the
+// slots are stacked along z in up to 8 textures, each a mosaic of z-slices
+// (MosaicLayout's addressing, layout/mosaic.glsl): page r = texture, b =
+// slot in its stack; two bilinear fetches and a mix.
+#if TESSERA_GLSL == 300
+uniform highp sampler2D u_layoutPages;
+uniform highp sampler3D u_layoutAtlas;
+#else
+#ifdef GL_FRAGMENT_PRECISION_HIGH
+#define BRICKS_SAMPLER uniform highp sampler2D
+#else
+#define BRICKS_SAMPLER uniform mediump sampler2D
+#endif
+BRICKS_SAMPLER u_layoutPages;
+BRICKS_SAMPLER u_layoutAtlas0;
+#if BRICKS_ATLASES > 1
+BRICKS_SAMPLER u_layoutAtlas1;
+#endif
+#if BRICKS_ATLASES > 2
+BRICKS_SAMPLER u_layoutAtlas2;
+#endif
+#if BRICKS_ATLASES > 3
+BRICKS_SAMPLER u_layoutAtlas3;
+#endif
+#if BRICKS_ATLASES > 4
+BRICKS_SAMPLER u_layoutAtlas4;
+#endif
+#if BRICKS_ATLASES > 5
+BRICKS_SAMPLER u_layoutAtlas5;
+#endif
+#if BRICKS_ATLASES > 6
+BRICKS_SAMPLER u_layoutAtlas6;
+#endif
+#if BRICKS_ATLASES > 7
+BRICKS_SAMPLER u_layoutAtlas7;
+#endif
+uniform float u_layoutTilesX;      // atlas mosaic: tiles per texture row
+uniform vec2 u_layoutMosaicInv;    // 1 / mosaic texture size
+#endif
+uniform vec3 u_layoutDims0;        // level-0 voxels
+uniform float u_layoutBrick;       // B
+uniform vec3 u_layoutCells;        // level-0 brick cells
+uniform vec2 u_layoutPagesInv;     // 1 / page table size
+uniform vec3 u_layoutAtlasTexels;  // atlas (3D) size in texels
+
+#if TESSERA_GLSL != 300
+// Slice z of atlas texture t (samplers take constant indices only in GLSL
+// ES 1.00: an if-chain, as in packed_mosaic.glsl).
+float layoutAtlasSlice(float t, float z, vec2 texel) {
+  float row = floor((z + 0.5) / u_layoutTilesX);
+  float col = z - row * u_layoutTilesX;
+  vec2 uv = (vec2(col, row) * u_layoutAtlasTexels.xy + texel) * u_layoutMosaicInv;
+#if BRICKS_ATLASES > 1
+  if (t > 0.5) {
+#if BRICKS_ATLASES > 2
+    if (t > 1.5) {
+#if BRICKS_ATLASES > 3
+      if (t > 2.5) {
+#if BRICKS_ATLASES > 4
+        if (t > 3.5) {
+#if BRICKS_ATLASES > 5
+          if (t > 4.5) {
+#if BRICKS_ATLASES > 6
+            if (t > 5.5) {
+#if BRICKS_ATLASES > 7
+              if (t > 6.5) return TEX2D(u_layoutAtlas7, uv).r;
+#endif
+              return TEX2D(u_layoutAtlas6, uv).r;
+            }
+#endif
+            return TEX2D(u_layoutAtlas5, uv).r;
+          }
+#endif
+          return TEX2D(u_layoutAtlas4, uv).r;
+        }
+#endif
+        return TEX2D(u_layoutAtlas3, uv).r;
+      }
+#endif
+      return TEX2D(u_layoutAtlas2, uv).r;
+    }
+#endif
+    return TEX2D(u_layoutAtlas1, uv).r;
+  }
+#endif
+  return TEX2D(u_layoutAtlas0, uv).r;
+}
+#endif
+
+float sampleVolume(vec3 p) {
+  vec3 x0 = clamp(p, 0.0, 1.0) * u_layoutDims0;
+  vec3 cell = min(floor(x0 / u_layoutBrick), u_layoutCells - 1.0);
+  vec4 page = TEX2D(u_layoutPages,
+                    (vec2(cell.x, cell.y + cell.z * u_layoutCells.y) + 0.5) * u_layoutPagesInv);
+  vec4 e = floor(page * 255.0 + 0.5);
+  if (e.a > 254.5) return page.r;
+  float shrink = exp2(-e.a);
+  vec3 brick = floor(cell * shrink + 0.001);  // c >> l (the +0.001 guards exp2 rounding)
+  vec3 local = clamp(x0 * shrink - brick * u_layoutBrick, 0.0, u_layoutBrick) + 1.0;
+#if TESSERA_GLSL == 300
+  vec3 texel = e.rgb * (u_layoutBrick + 2.0) + local;
+  return texture(u_layoutAtlas, texel / u_layoutAtlasTexels).r;
+#else
+  // e.r: the atlas texture; e.b: the slot in its stack.
+  vec3 texel = vec3(0.0, 0.0, e.b * (u_layoutBrick + 2.0)) + local;
+  float zc = texel.z - 0.5;
+  float z0 = floor(zc);
+  return mix(layoutAtlasSlice(e.r, z0, texel.xy), layoutAtlasSlice(e.r, z0 + 1.0, texel.xy),
+             zc - z0);
+#endif
+}

@@ -1,0 +1,119 @@
+#include "tessera/lod/BrickGrid.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "tessera/core/Error.h"
+
+namespace tessera::lod {
+
+BrickGrid::BrickGrid(std::vector<glm::ivec3> levelDims, int brickSize)
+    : brickSize_(brickSize), dims_(std::move(levelDims)) {
+  if (brickSize < 2) throw InputError("brick size must be >= 2, got " + std::to_string(brickSize));
+  if (dims_.empty()) throw Error("a brick grid needs at least one level");
+  for (glm::ivec3 d : dims_) bricks_.push_back((d + brickSize - 1) / brickSize);
+}
+
+BrickGrid BrickGrid::of(const MultiresSource& source, int brickSize) {
+  std::vector<glm::ivec3> dims;
+  for (int l = 0; l < source.levelCount(); ++l) dims.push_back(source.levelInfo(l).dims);
+  return BrickGrid(std::move(dims), brickSize);
+}
+
+std::uint64_t BrickGrid::brickCount(int level) const {
+  const glm::ivec3 b = bricks(level);
+  return static_cast<std::uint64_t>(b.x) * b.y * b.z;
+}
+
+bool BrickGrid::contains(const BrickKey& key) const {
+  return key.level >= 0 && key.level < levelCount() &&
+         glm::all(glm::greaterThanEqual(key.brick, glm::ivec3(0))) &&
+         glm::all(glm::lessThan(key.brick, bricks(key.level)));
+}
+
+VoxelBox BrickGrid::readBox(const BrickKey& key) const {
+  const glm::ivec3 d = dims(key.level);
+  VoxelBox box;
+  box.begin = glm::max(key.brick * brickSize_ - 1, glm::ivec3(0));
+  box.end = glm::min(key.brick * brickSize_ + brickSize_ + 1, d);
+  return box;
+}
+
+glm::dvec3 BrickGrid::lowerCorner(const BrickKey& key) const {
+  return glm::dvec3(key.brick * brickSize_) * std::ldexp(1.0, key.level);
+}
+
+glm::dvec3 BrickGrid::upperCorner(const BrickKey& key) const {
+  return glm::min(glm::dvec3((key.brick + 1) * brickSize_) * std::ldexp(1.0, key.level),
+                  glm::dvec3(dims(0)));
+}
+
+std::vector<BrickKey> BrickGrid::children(const BrickKey& key) const {
+  std::vector<BrickKey> out;
+  if (key.level == 0) return out;
+  for (int dz = 0; dz < 2; ++dz) {
+    for (int dy = 0; dy < 2; ++dy) {
+      for (int dx = 0; dx < 2; ++dx) {
+        const BrickKey c{key.level - 1, key.brick * 2 + glm::ivec3(dx, dy, dz)};
+        if (contains(c)) out.push_back(c);
+      }
+    }
+  }
+  return out;
+}
+
+StoredMapping StoredMapping::of(const Volume& shape) {
+  StoredMapping m;
+  if (shape.type() == ScalarType::U8) return m;
+  const ValueRange w = shape.window();
+  m.identity = false;
+  m.min = w.min;
+  m.width = w.max > w.min ? w.max - w.min : 1.0;
+  return m;
+}
+
+std::uint8_t StoredMapping::store(double raw) const {
+  if (!std::isfinite(raw)) return 0;
+  const double s = identity ? raw : (raw - min) / width * 255.0;
+  return static_cast<std::uint8_t>(std::lround(std::clamp(s, 0.0, 255.0)));
+}
+
+StoredBrick readStoredBrick(const MultiresSource& source, const BrickGrid& grid,
+                            const BrickKey& key, const StoredMapping& mapping) {
+  const VoxelBox box = grid.readBox(key);
+  const Volume v = source.readBox(key.level, box);
+  if (v.dims() != box.size()) {
+    throw Error(source.describe() + ": readBox returned " + std::to_string(v.dims().x) + "x" +
+                std::to_string(v.dims().y) + "x" + std::to_string(v.dims().z) + " voxels for a " +
+                std::to_string(box.size().x) + "x" + std::to_string(box.size().y) + "x" +
+                std::to_string(box.size().z) + " box");
+  }
+  const int n = grid.stored();
+  const glm::ivec3 first = key.brick * grid.brickSize() - 1;  // level index of stored voxel 0
+  const glm::ivec3 last = box.end - 1;
+  StoredBrick out;
+  out.voxels.resize(grid.storedVoxels());
+  std::uint8_t lo = 255, hi = 0;
+  const bool u8 = v.type() == ScalarType::U8 && mapping.identity;
+  const std::uint8_t* src = u8 ? v.dataAs<std::uint8_t>() : nullptr;
+  std::size_t i = 0;
+  for (int z = 0; z < n; ++z) {
+    const int sz = std::clamp(first.z + z, box.begin.z, last.z) - box.begin.z;
+    for (int y = 0; y < n; ++y) {
+      const int sy = std::clamp(first.y + y, box.begin.y, last.y) - box.begin.y;
+      for (int x = 0; x < n; ++x) {
+        const int sx = std::clamp(first.x + x, box.begin.x, last.x) - box.begin.x;
+        const std::size_t at = v.index(sx, sy, sz);
+        const std::uint8_t s = u8 ? src[at] : mapping.store(v.valueAtIndex(at));
+        out.voxels[i++] = s;
+        lo = std::min(lo, s);
+        hi = std::max(hi, s);
+      }
+    }
+  }
+  out.min = lo;
+  out.max = hi;
+  return out;
+}
+
+}  // namespace tessera::lod

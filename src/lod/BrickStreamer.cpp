@@ -1,0 +1,216 @@
+#include "tessera/lod/BrickStreamer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <exception>
+#include <system_error>
+
+#include "tessera/core/Error.h"
+
+namespace tessera::lod {
+
+BrickStreamer::BrickStreamer(std::shared_ptr<const MultiresSource> source, BrickGrid grid,
+                             BrickStreamerOptions options)
+    : source_(std::move(source)),
+      grid_(std::move(grid)),
+      mapping_(StoredMapping::of(source_->shape())),
+      options_(options) {
+  // Without threads (workers = 0, or a platform that cannot start them, such
+  // as the browser build) request() reads a few bricks itself.
+  try {
+    for (int i = 0; i < options_.workers; ++i) workers_.emplace_back([this] { work(); });
+  } catch (const std::system_error&) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    for (std::thread& t : workers_) t.join();
+    workers_.clear();
+    stop_ = false;
+  }
+}
+
+BrickStreamer::~BrickStreamer() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+    queue_.clear();
+  }
+  wake_.notify_all();
+  for (std::thread& t : workers_) t.join();
+}
+
+double BrickStreamer::nowMs() const {
+  return std::chrono::duration<double, std::milli>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+void BrickStreamer::request(const std::vector<BrickKey>& keys) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    queue_.clear();
+    const double now = nowMs();
+    std::unordered_set<std::uint64_t> queued;
+    for (const BrickKey& k : keys) {
+      const std::uint64_t id = k.id();
+      if (cached_.count(id) || reading_.count(id) || !queued.insert(id).second) continue;
+      const auto f = failures_.find(id);
+      if (f != failures_.end() && f->second.retryAtMs > now) continue;
+      queue_.push_back(k);
+    }
+  }
+  wake_.notify_all();
+  if (workers_.empty()) readQueuedInline(options_.inlineReadsPerRequest);
+}
+
+void BrickStreamer::readQueuedInline(int count) {
+  for (int i = 0; i < count; ++i) {
+    BrickKey key;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (queue_.empty()) return;
+      key = queue_.front();
+      queue_.pop_front();
+    }
+    try {
+      readNow(key);
+    } catch (const std::exception&) {
+      // recorded by readNow; the brick is retried after its back-off
+    }
+  }
+}
+
+std::shared_ptr<const StoredBrick> BrickStreamer::find(const BrickKey& key) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = cached_.find(key.id());
+  if (it == cached_.end()) return nullptr;
+  lru_.splice(lru_.begin(), lru_, it->second);
+  return it->second->second;
+}
+
+std::optional<BrickRange> BrickStreamer::range(const BrickKey& key) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = ranges_.find(key.id());
+  if (it == ranges_.end()) return std::nullopt;
+  return it->second;
+}
+
+bool BrickStreamer::failing(const BrickKey& key) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = failures_.find(key.id());
+  return it != failures_.end() && it->second.attempts >= options_.attemptsBeforeFailing;
+}
+
+bool BrickStreamer::idle() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return queue_.empty() && reading_.empty();
+}
+
+StreamerStats BrickStreamer::stats() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return stats_;
+}
+
+void BrickStreamer::waitForProgress(double ms) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  progress_.wait_for(lock, std::chrono::duration<double, std::milli>(ms));
+}
+
+std::shared_ptr<const StoredBrick> BrickStreamer::readOne(const BrickKey& key) {
+  return std::make_shared<const StoredBrick>(readStoredBrick(*source_, grid_, key, mapping_));
+}
+
+void BrickStreamer::store(const BrickKey& key, std::shared_ptr<const StoredBrick> brick) {
+  const std::uint64_t id = key.id();
+  ranges_[id] = {brick->min, brick->max};
+  failures_.erase(id);
+  ++stats_.bricksRead;
+  stats_.bytesRead += brick->voxels.size();
+  if (cached_.count(id)) return;
+  stats_.cacheBytes += brick->voxels.size();
+  lru_.emplace_front(id, std::move(brick));
+  cached_[id] = lru_.begin();
+  // Least recently used out while over the budget (the newest always stays).
+  while (stats_.cacheBytes > options_.cacheBytes && lru_.size() > 1) {
+    stats_.cacheBytes -= lru_.back().second->voxels.size();
+    cached_.erase(lru_.back().first);
+    lru_.pop_back();
+  }
+  stats_.cachePeakBytes = std::max(stats_.cachePeakBytes, stats_.cacheBytes);
+}
+
+void BrickStreamer::recordFailure(const BrickKey& key, const std::string& what) {
+  Failure& f = failures_[key.id()];
+  ++f.attempts;
+  const double wait =
+      std::min(options_.maxRetryMs, options_.firstRetryMs * std::ldexp(1.0, f.attempts - 1));
+  f.retryAtMs = nowMs() + wait;
+  ++stats_.readErrors;
+  stats_.lastError = what;
+}
+
+void BrickStreamer::work() {
+  while (true) {
+    BrickKey key;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait(lock, [this] { return stop_ || !queue_.empty(); });
+      if (stop_) return;
+      key = queue_.front();
+      queue_.pop_front();
+      if (cached_.count(key.id()) || !reading_.insert(key.id()).second) continue;
+    }
+    std::shared_ptr<const StoredBrick> brick;
+    std::string error;
+    try {
+      brick = readOne(key);
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      reading_.erase(key.id());
+      if (brick) {
+        store(key, std::move(brick));
+      } else {
+        recordFailure(key, error);
+      }
+    }
+    progress_.notify_all();
+  }
+}
+
+std::shared_ptr<const StoredBrick> BrickStreamer::readNow(const BrickKey& key) {
+  std::string error;
+  for (int attempt = 0; attempt < std::max(1, options_.attemptsBeforeFailing); ++attempt) {
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      progress_.wait(lock, [&] { return !reading_.count(key.id()); });
+      const auto it = cached_.find(key.id());
+      if (it != cached_.end()) return it->second->second;
+      reading_.insert(key.id());
+    }
+    std::shared_ptr<const StoredBrick> brick;
+    try {
+      brick = readOne(key);
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      reading_.erase(key.id());
+      if (brick)
+        store(key, brick);
+      else
+        recordFailure(key, error);
+    }
+    progress_.notify_all();
+    if (brick) return brick;
+  }
+  throw Error("reading brick (level " + std::to_string(key.level) + ") failed " +
+              std::to_string(options_.attemptsBeforeFailing) + " times: " + error);
+}
+
+}  // namespace tessera::lod

@@ -1,0 +1,137 @@
+#include "tessera/lod/ProceduralMultiresSource.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "tessera/core/Error.h"
+#include "tessera/lod/InCoreMultiresSource.h"
+
+namespace tessera::lod {
+
+namespace {
+
+constexpr const char* kPrefix = "head:";
+
+// Integer lattice hash -> [0, 1).
+double hash3(int x, int y, int z) {
+  std::uint32_t h = static_cast<std::uint32_t>(x) * 73856093u ^
+                    static_cast<std::uint32_t>(y) * 19349663u ^
+                    static_cast<std::uint32_t>(z) * 83492791u;
+  h ^= h >> 13;
+  h *= 0x5bd1e995u;
+  h ^= h >> 15;
+  return static_cast<double>(h & 0xffffffu) / 16777216.0;
+}
+
+// Trilinear value noise with smoothstep weights, [0, 1).
+double valueNoise(glm::dvec3 p) {
+  const glm::dvec3 f = glm::floor(p);
+  const glm::ivec3 i(f);
+  glm::dvec3 t = p - f;
+  t = t * t * (3.0 - 2.0 * t);
+  double c[2][2][2];
+  for (int dz = 0; dz < 2; ++dz) {
+    for (int dy = 0; dy < 2; ++dy) {
+      for (int dx = 0; dx < 2; ++dx) c[dz][dy][dx] = hash3(i.x + dx, i.y + dy, i.z + dz);
+    }
+  }
+  auto lerp = [](double a, double b, double w) { return a + (b - a) * w; };
+  const double y0 = lerp(lerp(c[0][0][0], c[0][0][1], t.x), lerp(c[0][1][0], c[0][1][1], t.x), t.y);
+  const double y1 = lerp(lerp(c[1][0][0], c[1][0][1], t.x), lerp(c[1][1][0], c[1][1][1], t.x), t.y);
+  return lerp(y0, y1, t.z);
+}
+
+glm::ivec3 parseDims(const std::string& spec) {
+  if (!ProceduralMultiresSource::isSpec(spec)) {
+    throw InputError("'" + spec + "': expected head:WxHxD or head:N (a generated large volume)");
+  }
+  const std::string size = spec.substr(std::string(kPrefix).size());
+  std::vector<int> parts;
+  std::size_t b = 0;
+  while (true) {
+    const std::size_t e = size.find('x', b);
+    const std::string p = size.substr(b, e == std::string::npos ? std::string::npos : e - b);
+    if (p.empty() || p.find_first_not_of("0123456789") != std::string::npos || p.size() > 6) {
+      throw InputError("'" + spec + "': size must be N or WxHxD with N in 1..100000");
+    }
+    parts.push_back(std::stoi(p));
+    if (e == std::string::npos) break;
+    b = e + 1;
+  }
+  if (parts.size() != 1 && parts.size() != 3) {
+    throw InputError("'" + spec + "': size must be N or WxHxD");
+  }
+  const glm::ivec3 d =
+      parts.size() == 1 ? glm::ivec3(parts[0]) : glm::ivec3(parts[0], parts[1], parts[2]);
+  if (glm::any(glm::lessThan(d, glm::ivec3(1))) ||
+      glm::any(glm::greaterThan(d, glm::ivec3(100000))))
+    throw InputError("'" + spec + "': each side must be 1..100000");
+  return d;
+}
+
+}  // namespace
+
+bool ProceduralMultiresSource::isSpec(const std::string& spec) {
+  return spec.rfind(kPrefix, 0) == 0;
+}
+
+ProceduralMultiresSource::ProceduralMultiresSource(const std::string& spec, int coarsestSide)
+    : spec_(spec) {
+  const glm::ivec3 d = parseDims(spec);
+  dims_ = pyramidDims(d, coarsestSide);
+  shape_ = Volume::shapeOnly(d, ScalarType::U8);
+  shape_.setWindow({0.0, 255.0});
+  shape_.setDescription("generated: " + spec + " (computed brick by brick)");
+  shape_.setGeometrySource("generated");
+}
+
+LevelInfo ProceduralMultiresSource::levelInfo(int level) const {
+  if (level < 0 || level >= levelCount()) throw Error("no level " + std::to_string(level));
+  return {.dims = dims_[static_cast<std::size_t>(level)],
+          .spacing = glm::vec3(static_cast<float>(1 << level)),
+          .chunk = glm::ivec3(0)};
+}
+
+double ProceduralMultiresSource::valueAt(glm::dvec3 x) const {
+  const glm::dvec3 d(shape_.dims());
+  const double half = 0.5 * std::max({d.x, d.y, d.z});
+  // Isotropic coordinates, the longest axis spanning [-1, 1].
+  const glm::dvec3 q = (x - 0.5 * d) / half;
+  const glm::dvec3 axes = 0.92 * d / (2.0 * half);  // the head fills the box
+  const double r = glm::length(q / axes);
+  if (r >= 1.0) return 0.0;
+  if (r >= 0.88) return 230.0;  // skull
+  // Soft tissue: 40 .. 140 with a texture of ~16 features across the head.
+  const double tissue = 40.0 + 100.0 * valueNoise(q * 16.0 + 7.3);
+  // Speckles: where fine noise is high, ~4 voxels across at 512^3.
+  const double fine = valueNoise(q * 110.0 + 1.7);
+  if (fine > 0.86 && r < 0.8) return 250.0;
+  return tissue;
+}
+
+Volume ProceduralMultiresSource::readBox(int level, const VoxelBox& box) const {
+  const LevelInfo info = levelInfo(level);
+  if (box.count() == 0 || glm::any(glm::lessThan(box.begin, glm::ivec3(0))) ||
+      glm::any(glm::greaterThan(box.end, info.dims))) {
+    throw Error(spec_ + ": box outside level " + std::to_string(level));
+  }
+  const glm::ivec3 s = box.size();
+  Volume out = Volume::allocate(s, ScalarType::U8, spec_ + " box");
+  const double scale = static_cast<double>(1 << level);
+  out.setSpacing(glm::dvec3(scale));
+  out.setOrigin((glm::dvec3(box.begin) + 0.5) * scale - 0.5);
+  out.setWindow(shape_.window());
+  std::uint8_t* dst = out.dataAs<std::uint8_t>();
+  for (int z = 0; z < s.z; ++z) {
+    for (int y = 0; y < s.y; ++y) {
+      for (int x = 0; x < s.x; ++x) {
+        const glm::dvec3 c = (glm::dvec3(box.begin + glm::ivec3(x, y, z)) + 0.5) * scale;
+        *dst++ = static_cast<std::uint8_t>(std::lround(valueAt(c)));
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace tessera::lod
