@@ -57,6 +57,12 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
   const ValueRange win = volume.window();
   const double ww = win.max - win.min;
   const glm::dvec4 bg = settings.background;
+  // Shading (core/RenderSettings.h): the field's gradient per texture unit ->
+  // normalised value per model length, times the smallest voxel.
+  const bool shade = settings.shading.enabled && settings.mode == RenderMode::Composite;
+  const ShadingLight light =
+      shadingLight(settings.shading, camera.basis()[2], camera.modelFromWorld);
+  const glm::dvec3 gradientScale = std::min({spacing.x, spacing.y, spacing.z}) / (ww * extent);
 
   Image image(width, height);
   std::atomic<int> nextRow{0};
@@ -100,14 +106,18 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
             const double t = t0 + (k + j) * ds;
             if (t >= tEnd) break;
             ++samples;
-            const double raw = field.value(to + t * td);
+            const glm::dvec3 p = to + t * td;
+            const double raw = field.value(p);
             const double n = std::clamp((raw - win.min) / ww, 0.0, 1.0);
             if (settings.mode == RenderMode::Mip) {
               maxValue = std::max(maxValue, n);
               continue;
             }
-            const glm::dvec3 c = tf.color(n);
+            glm::dvec3 c = tf.color(n);
             const double a = tf.correctedOpacity(n, ds, settings.opacityScale);
+            if (shade && a > 0.0) {
+              c = shadeBlinnPhong(c, field.gradient(p) * gradientScale, settings.shading, light);
+            }
             acc += (1.0 - acc.a) * glm::dvec4(c * a, a);
             if (acc.a >= settings.ertThreshold) break;
           }

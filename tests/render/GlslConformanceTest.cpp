@@ -79,6 +79,9 @@ void expectSlicingConformant(gpu::GlContext& c, const Volume& v, const layout::L
     RenderSettings s;
     s.mode = mode;
     sources.push_back(gpu::assembleShader(slice3d.fragmentParts(s)));
+    s.shading.enabled = true;  // render/shading.glsl (composite only)
+    sources.push_back(gpu::assembleShader(slice3d.fragmentParts(s)));
+    s.shading.enabled = false;
     for (auto cls : {render::SliceClassification::Pre, render::SliceClassification::Palette,
                      render::SliceClassification::Post}) {
       if (mode == RenderMode::Mip && cls != render::SliceClassification::Post) continue;
@@ -99,10 +102,15 @@ void expectConformant(gpu::GlContext& c, const Volume& v, const layout::Layout& 
   for (RenderMode mode : {RenderMode::Composite, RenderMode::Mip}) {
     for (int skip : {0, 8}) {
       caster.setSkipBlockSize(skip);
-      RenderSettings s;
-      s.mode = mode;
-      const Validation frag = validate(gpu::assembleShader(caster.fragmentParts(s)), "frag");
-      EXPECT_EQ(frag.exitCode, 0) << layout.name() << " skip " << skip << ":\n" << frag.log;
+      for (bool shade : {false, true}) {
+        RenderSettings s;
+        s.mode = mode;
+        s.shading.enabled = shade;
+        const Validation frag = validate(gpu::assembleShader(caster.fragmentParts(s)), "frag");
+        EXPECT_EQ(frag.exitCode, 0)
+            << layout.name() << " skip " << skip << " shade " << shade << ":\n"
+            << frag.log;
+      }
     }
   }
   const Validation vert = validate(gpu::assembleShader(caster.vertexParts()), "vert");

@@ -1,6 +1,12 @@
 #pragma once
 // Parameters every renderer (GPU techniques and the CPU reference) honours
 // with identical meaning, so that their images can be compared pixel by pixel.
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
 namespace tessera {
@@ -10,8 +16,27 @@ namespace tessera {
 // along the ray, opaque where the ray meets the volume.
 enum class RenderMode { Composite, Mip };
 
+// Blinn-Phong shading of composited samples from the gradient of the
+// reconstructed field (the layout seam's sampleVolumeGradient, the
+// reference's Reconstruction::gradient): central differences one voxel apart
+// on the same continuous field, so every path lights the same normals.
+// Two-sided (|N.L|): a volume has no inside or outside. MIP is not shaded.
+struct Shading {
+  bool enabled = false;
+  double ambient = 0.3;
+  double diffuse = 0.6;
+  double specular = 0.3;
+  double shininess = 24.0;
+  // Headlight: light from the viewer, along the view direction. Otherwise a
+  // fixed light from lightDirection (towards the light, patient frame RAS+),
+  // which turns with the volume.
+  bool headlight = true;
+  glm::dvec3 lightDirection{0.0, -1.0, 1.0};
+};
+
 struct RenderSettings {
   RenderMode mode = RenderMode::Composite;
+  Shading shading;
   // Sample distance in voxels of the smallest spacing: ds = stepVoxels * min(spacing).
   double stepVoxels = 0.5;
   // Upper bound on samples per ray (Schultz 2016, 7.2.3).
@@ -40,6 +65,45 @@ inline double jitterOffset(unsigned x, unsigned y) {
     v += (2u * (xi ^ yi) + yi) << (2u * (2u - i));
   }
   return (v + 0.5) / 64.0;
+}
+
+// The light of one frame in the volume's model frame: l towards the light, h
+// the Blinn half vector between l and the direction to the viewer.
+struct ShadingLight {
+  glm::dvec3 l{0.0, 0.0, 1.0};
+  glm::dvec3 h{0.0, 0.0, 1.0};
+};
+
+// `back` is the camera's back vector (towards the viewer, model frame),
+// `modelFromWorld` Camera::modelFromWorld.
+inline ShadingLight shadingLight(const Shading& shading, glm::dvec3 back,
+                                 const glm::dmat3& modelFromWorld) {
+  ShadingLight light;
+  const glm::dvec3 v = glm::normalize(back);
+  light.l = shading.headlight ? v : glm::normalize(modelFromWorld * shading.lightDirection);
+  const glm::dvec3 half = light.l + v;
+  light.h = glm::length(half) > 1e-9 ? glm::normalize(half) : light.l;
+  return light;
+}
+
+// Below this gradient magnitude (normalised value per voxel of the smallest
+// spacing) a sample fades to ambient light: the normal is g / sqrt(|g|^2 +
+// eps^2), continuous, so noise in flat regions is not lit as surfaces and the
+// GPU's float and the reference's double agree near zero.
+constexpr double kShadingGradientEpsilon = 0.01;
+
+// The shaded colour of straight colour `rgb` at a sample whose field gradient
+// is `g` (normalised value per smallest-voxel length, model frame). The GLSL
+// twin is render/shading.glsl.
+inline glm::dvec3 shadeBlinnPhong(glm::dvec3 rgb, glm::dvec3 g, const Shading& shading,
+                                  const ShadingLight& light) {
+  const glm::dvec3 n =
+      g / std::sqrt(glm::dot(g, g) + kShadingGradientEpsilon * kShadingGradientEpsilon);
+  const double diffuse = std::abs(glm::dot(n, light.l));
+  const double specular = std::pow(std::abs(glm::dot(n, light.h)), shading.shininess);
+  const glm::dvec3 lit =
+      rgb * (shading.ambient + shading.diffuse * diffuse) + glm::dvec3(shading.specular * specular);
+  return glm::min(lit, glm::dvec3(1.0));
 }
 
 }  // namespace tessera
