@@ -9,6 +9,7 @@
 #include "app/Commands.h"
 #include "app/HybridJob.h"
 #include "app/RenderJob.h"
+#include "app/ShadingOptions.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"
@@ -57,6 +58,7 @@ struct RenderOptions {
   std::string overlayOpacity = "alpha";
   std::string offscreen;
   std::string roi;
+  ShadingOptions shading;
 };
 
 nlohmann::json numberOrNull(std::optional<double> v) {
@@ -87,6 +89,7 @@ RenderRequest requestFrom(const RenderOptions& o) {
   req.settings.opacityScale = o.opacityScale;
   req.settings.ertThreshold = o.ert;
   req.settings.jitter = o.jitter;
+  req.settings.shading = shadingFrom(o.shading);
   if (o.background.size() != 3) throw InputError("--background takes three numbers R G B in [0,1]");
   req.settings.background = glm::dvec4(o.background[0], o.background[1], o.background[2], 1.0);
   req.repeat = o.repeat;
@@ -173,6 +176,7 @@ void printRenderJson(const RenderOptions& o, const RenderRequest& req, const Ren
   j["mode"] = o.mode;
   j["technique"] = o.technique;
   j["step_voxels"] = o.step;
+  j["shade"] = o.shading.shade;
   j["tf"] = tf.name;
   std::printf("%s\n", j.dump(2).c_str());
 }
@@ -273,6 +277,7 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--ert", o->ert, "Early ray termination threshold (>= 1 disables)")
       ->capture_default_str();
   cmd->add_flag("--jitter", o->jitter, "Jitter the first sample per pixel");
+  addShadingOptions(cmd, o->shading);
   cmd->add_option("--window", o->window,
                   "Value window MIN MAX (raw values); default: the value range")
       ->expected(2);

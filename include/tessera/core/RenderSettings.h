@@ -31,7 +31,7 @@ struct Shading {
   // fixed light from lightDirection (towards the light, patient frame RAS+),
   // which turns with the volume.
   bool headlight = true;
-  glm::dvec3 lightDirection{0.0, -1.0, 1.0};
+  glm::dvec3 lightDirection{0.0, 1.0, 1.0};
 };
 
 struct RenderSettings {
