@@ -10,6 +10,7 @@
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
 #include "tessera/gpu/Draw.h"
+#include "tessera/render/ShadingUniforms.h"
 #include "tessera/render/SliceProjection.h"
 
 namespace tessera::render {
@@ -155,7 +156,7 @@ void Slice2DRenderer::uploadStack(int axis) {
   const SliceAtlasPlan& p = plans_[axis];
   const bool pre = options_.classification == SliceClassification::Pre;
   const gpu::TexelFormat format =
-      pre ? gpu::rgba8For(context_.caps().api) : gpu::r8For(context_.caps().api);
+      pre || shadedStacks_ ? gpu::rgba8For(context_.caps().api) : gpu::r8For(context_.caps().api);
   const bool recreate = atlases_[axis].size() != static_cast<std::size_t>(p.atlases);
   if (recreate) atlases_[axis].clear();
   // Filled and uploaded a band (one row of tiles) at a time: the host copy
@@ -174,7 +175,11 @@ void Slice2DRenderer::uploadStack(int axis) {
     }
     gpu::Texture& atlas = atlases_[axis][static_cast<std::size_t>(i)];
     for (int b = 0; b < p.bands(); ++b) {
-      stacks_.fillAtlasBand(p, i, b, pre ? palette8_.data() : nullptr, band);
+      if (shadedStacks_) {
+        stacks_.fillShadingAtlasBand(p, i, b, band);
+      } else {
+        stacks_.fillAtlasBand(p, i, b, pre ? palette8_.data() : nullptr, band);
+      }
       atlas.updateRegion({0, b * p.tile.y, 0}, {p.atlasSize.x, p.bandRows(b), 1}, band.data());
     }
   }
@@ -241,15 +246,18 @@ std::vector<gpu::ShaderPart> Slice2DRenderer::fragmentParts(const RenderSettings
     defines.push_back("CLASSIFY_PALETTE 1");
   }
   if (settings.mode == RenderMode::Mip) defines.push_back("MODE_MIP 1");
+  addShadingDefines(settings, defines);
   return {gpu::shaderPreamble(context_.caps().api, true, defines),
           gpu::embeddedShaderPart("render/classify.glsl"),
+          gpu::embeddedShaderPart("render/shading.glsl"),
           gpu::embeddedShaderPart("render/slice_opacity.glsl"),
           gpu::embeddedShaderPart("render/slice2d.frag.glsl")};
 }
 
 const gpu::Program& Slice2DRenderer::programFor(const RenderSettings& settings) {
   const std::string key = std::string(sliceClassificationName(options_.classification)) +
-                          (settings.mode == RenderMode::Mip ? "|mip" : "");
+                          (settings.mode == RenderMode::Mip ? "|mip" : "") +
+                          (shadingActive(settings) ? "|shade" : "");
   return programs_.get(key, [&] {
     return gpu::Program::build("slice2d(" + key + ")", vertexParts(), fragmentParts(settings));
   });
@@ -260,6 +268,17 @@ void Slice2DRenderer::prepare(const Camera& camera, const RenderSettings& settin
     throw InputError(
         "MIP by axis-aligned slicing needs --classify post (the maximum of "
         "classified colours is not the colour of the maximum)");
+  }
+  const bool shade = shadingActive(settings);
+  if (shade && options_.classification != SliceClassification::Post) {
+    throw InputError(
+        "shading by axis-aligned slicing needs --classify post (the gradient is taken from "
+        "the slices' values)");
+  }
+  if (shade != shadedStacks_) {
+    // Shaded stacks carry each slice's neighbours (SliceStacks::fillShadingAtlasBand).
+    for (auto& list : atlases_) list.clear();
+    shadedStacks_ = shade;
   }
   // Classification first: pre-classified stacks are created from its palette.
   updateClassification(settings);
@@ -289,6 +308,7 @@ void Slice2DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
   // Front to back: looking towards +axis, the low slices are nearest.
   const DrawList& list = drawList(axis, forward[axis] < 0.0, slices);
 
+  const bool shade = shadingActive(settings);
   accumulator_.begin(width, height, settings.mode);
   const gpu::Program& prog = programFor(settings);
   prog.use();
@@ -306,6 +326,18 @@ void Slice2DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
   prog.set("u_forward", glm::vec3(forward));
   prog.set("u_ortho", camera.projection == Projection::Orthographic ? 1.0f : 0.0f);
   prog.set("u_atlas", 0);
+  if (shade) {
+    // The stacks hold the window's normalised value quantised: one per stored unit.
+    setShadingUniforms(prog, settings, camera, 1.0, volume_.extent(), volume_.spacing());
+    const glm::ivec2 a = sliceTileAxes(axis);
+    glm::vec3 u(0.0f), v(0.0f);
+    u[a.x] = 1.0f;
+    v[a.y] = 1.0f;
+    prog.set("u_tileAxisU", u);
+    prog.set("u_tileAxisV", v);
+    prog.set("u_halfDims",
+             glm::vec3(volume_.dims()[a.x], volume_.dims()[a.y], volume_.dims()[axis]) * 0.5f);
+  }
   if (options_.classification == SliceClassification::Post) {
     table_.texture().bind(1);
     prog.set("u_tf", 1);

@@ -1,11 +1,13 @@
 // Blinn-Phong shading of a classified sample from the gradient of the
-// reconstructed field, through the layout seam's sampleVolumeGradient()
-// (central differences through sampleVolume(), 6 fetches, unless the layout
-// has an analytic derivative), so every layout gets it. The CPU twin is
+// reconstructed field: layout-based techniques take it through the layout
+// seam's sampleVolumeGradient() (render/sample.glsl: central differences
+// through sampleVolume(), 6 fetches, unless the layout has an analytic
+// derivative), so every layout gets it; slice2d from its stacks' neighbour
+// values (render/slice2d.frag.glsl), the same differences. The CPU twin is
 // shadeBlinnPhong (core/RenderSettings.h); the reference lights the same
 // normals (Reconstruction::gradient). Two-sided: |N.L|, |N.H|.
 #ifdef SHADING
-// Stored value per texture-space unit -> normalised value per voxel of the
+// Stored (slice2d: normalised) value per texture-space unit -> normalised value per voxel of the
 // smallest spacing, per model axis (texture space is stretched by the extent).
 uniform vec3 u_shadeGradientScale;
 uniform vec3 u_shadeLight;         // towards the light, model frame, unit
@@ -22,12 +24,5 @@ vec3 shadeBlinnPhong(vec3 rgb, vec3 g) {
   vec3 lit = rgb * (u_shadeCoefficients.x + u_shadeCoefficients.y * diffuse) +
              vec3(u_shadeCoefficients.z * specular);
   return min(lit, vec3(1.0));
-}
-
-// Straight colour c classified at p, lit; transparent samples skip the
-// gradient's fetches.
-vec4 shadeSample(vec4 c, vec3 p) {
-  if (c.a <= 0.0) return c;
-  return vec4(shadeBlinnPhong(c.rgb, sampleVolumeGradient(p) * u_shadeGradientScale), c.a);
 }
 #endif

@@ -88,6 +88,11 @@ void expectSlicingConformant(gpu::GlContext& c, const Volume& v, const layout::L
       render::Slice2DRenderer slice2d(c, v, {.classification = cls});
       if (sources.size() == 2) sources.push_back(gpu::assembleShader(slice2d.vertexParts()));
       sources.push_back(gpu::assembleShader(slice2d.fragmentParts(s)));
+      if (mode == RenderMode::Composite && cls == render::SliceClassification::Post) {
+        RenderSettings shaded = s;
+        shaded.shading.enabled = true;
+        sources.push_back(gpu::assembleShader(slice2d.fragmentParts(shaded)));
+      }
     }
   }
   for (const std::string& src : sources) {

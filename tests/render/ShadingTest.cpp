@@ -12,6 +12,7 @@
 
 #include "support/GpuTestContext.h"
 #include "support/TestTransferFunctions.h"
+#include "tessera/core/Error.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/layout/MosaicLayout.h"
 #include "tessera/layout/PackedMosaicLayout.h"
@@ -200,5 +201,59 @@ TEST(Shading, LinearRampIsLitByItsAnalyticNormal) {
         expectRampLitByAnalyticNormal(caster.render(cam, s, 96, 96), v, cam, s, what.c_str());
       }
     });
+  }
+}
+
+// slice2d keeps its own stacks (no layout): its planes are the voxel planes,
+// which are the reference's samples for an orthographic view along a stack
+// axis at a 1-voxel step; its gradient comes from each slice's neighbours.
+TEST(Shading, Slice2DMatchesShadedReferenceAlongEachStackOnEs3AndEs2) {
+  const Volume v = makeSphere({37, 53, 29});  // isotropic: the planes are 1-voxel steps
+  RenderSettings s = shadedSettings();
+  s.stepVoxels = 1.0;
+  // A fixed light off every axis: a gradient component on the wrong axis shows.
+  s.shading.headlight = false;
+  s.shading.lightDirection = {1.0, 2.0, 3.0};
+  for (gpu::ApiLevel api : {gpu::ApiLevel::Gles3, gpu::ApiLevel::Gles2}) {
+    withContext(api, [&](gpu::GlContext& c) {
+      render::Slice2DRenderer slicer(c, v, {});
+      slicer.setTransferFunction(visibleTf());
+      for (int axis = 0; axis < 3; ++axis) {
+        Camera cam;
+        cam.projection = Projection::Orthographic;
+        if (axis == 0) cam.azimuthDeg = 90;
+        if (axis == 2) cam.elevationDeg = 90;
+        cam.frame(v.extent());
+        const Image img = slicer.render(cam, s, 96, 96);
+        ASSERT_EQ(slicer.lastStackAxis(), axis);
+        const double db = psnr(img, renderReference(v, visibleTf(), cam, s, 96, 96));
+        std::printf("  [measured] shaded sphere  %s slice2d stack %c: %.2f dB vs reference\n",
+                    apiName(api), "xyz"[axis], db);
+        EXPECT_GE(db, 40.0) << apiName(api) << " axis " << axis;
+      }
+      RenderSettings unshaded = s;
+      unshaded.shading.enabled = false;
+      Camera cam;
+      cam.projection = Projection::Orthographic;
+      cam.frame(v.extent());
+      EXPECT_GE(psnr(slicer.render(cam, unshaded, 96, 96),
+                     renderReference(v, visibleTf(), cam, unshaded, 96, 96)),
+                40.0)
+          << "back to unshaded stacks";
+    });
+  }
+}
+
+TEST(Shading, Slice2DAsksForPostClassification) {
+  gpu::GlContext& c = test::gpuContext();
+  const Volume v = makeSphere({16, 16, 16});
+  render::Slice2DRenderer slicer(c, v, {.classification = render::SliceClassification::Pre});
+  Camera cam;
+  cam.frame(v.extent());
+  try {
+    slicer.render(cam, shadedSettings(), 32, 32);
+    FAIL() << "pre-classified slices cannot be shaded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--classify post"), std::string::npos) << e.what();
   }
 }
