@@ -11,6 +11,7 @@
 
 #include "app/Commands.h"
 #include "app/RenderJob.h"
+#include "app/ShadingOptions.h"
 #include "tessera/core/Error.h"
 
 #ifdef TESSERA_DESKTOP_VIEWER
@@ -44,6 +45,7 @@ struct ViewOptions {
   double elevation = 0.0;
   std::string screenshot;
   int frames = 3;
+  ShadingOptions shading;
 };
 
 #ifdef TESSERA_DESKTOP_VIEWER
@@ -345,6 +347,31 @@ void panelRendering(DesktopSession& ds) {
   if (ImGui::Button("Reset view")) v.resetCamera();
 }
 
+// Blinn-Phong shading (RenderSettings::shading): on/off, the light, the terms.
+void panelShading(viewer::Viewer& v) {
+  section("Shading");
+  Shading& s = v.settings().shading;
+  ImGui::Checkbox("shade (gradient lighting)", &s.enabled);
+  if (!s.enabled) return;
+  ImGui::Checkbox("headlight", &s.headlight);
+  if (!s.headlight) {
+    float dir[3] = {static_cast<float>(s.lightDirection.x), static_cast<float>(s.lightDirection.y),
+                    static_cast<float>(s.lightDirection.z)};
+    if (ImGui::SliderFloat3("light (RAS)", dir, -1.0f, 1.0f) &&
+        std::abs(dir[0]) + std::abs(dir[1]) + std::abs(dir[2]) > 1e-3f) {
+      s.lightDirection = {dir[0], dir[1], dir[2]};
+    }
+  }
+  auto slider = [](const char* label, double& value, float lo, float hi) {
+    float f = static_cast<float>(value);
+    if (ImGui::SliderFloat(label, &f, lo, hi)) value = f;
+  };
+  slider("ambient", s.ambient, 0.0f, 1.0f);
+  slider("diffuse", s.diffuse, 0.0f, 1.0f);
+  slider("specular", s.specular, 0.0f, 1.0f);
+  slider("shininess", s.shininess, 1.0f, 128.0f);
+}
+
 // The control panel at the window's left edge.
 void drawPanel(DesktopSession& ds, int windowHeight) {
   ImGui::SetNextWindowPos(ImVec2(0, 0));
@@ -355,6 +382,7 @@ void drawPanel(DesktopSession& ds, int windowHeight) {
   panelTransferFunction(ds);
   panelWindowLevel(*ds.viewer);
   panelRendering(ds);
+  panelShading(*ds.viewer);
   ImGui::Separator();
   ImGui::TextWrapped("%s", ds.status.c_str());
   ImGui::End();
@@ -371,6 +399,10 @@ std::string viewKey(viewer::Viewer& v, int viewW, int viewH) {
       << v.settings().opacityScale << '|' << v.window().min << v.window().max << '|'
       << v.technique() << static_cast<int>(v.quality) << v.controller().interacting() << '|'
       << v.showBoundingBox << v.showAxes << '|' << viewW << 'x' << viewH;
+  const Shading& sh = v.settings().shading;
+  key << '|' << sh.enabled << sh.headlight << sh.lightDirection.x << ',' << sh.lightDirection.y
+      << ',' << sh.lightDirection.z << '|' << sh.ambient << ',' << sh.diffuse << ',' << sh.specular
+      << ',' << sh.shininess;
   return key.str();
 }
 
@@ -482,6 +514,7 @@ void runView(const ViewOptions& o) {
   if (!ds.error.empty() && !ds.viewer->hasVolume()) throw InputError(ds.error);
   ds.viewer->camera().azimuthDeg = o.azimuth;
   ds.viewer->camera().elevationDeg = o.elevation;
+  ds.viewer->settings().shading = shadingFrom(o.shading);
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -527,6 +560,7 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--screenshot", o->screenshot,
                   "Write the window to this PNG after --frames frames and exit");
   cmd->add_option("--frames", o->frames, "Frames before --screenshot")->capture_default_str();
+  addShadingOptions(cmd, o->shading);
   cmd->callback([o] { runView(*o); });
 }
 
