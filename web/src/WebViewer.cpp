@@ -238,6 +238,10 @@ EMSCRIPTEN_KEEPALIVE int tessera_set_step(double voxels) {
     theViewer().settings().stepVoxels = voxels;
   });
 }
+// Blinn-Phong shading with a headlight and the default terms (RenderSettings::shading).
+EMSCRIPTEN_KEEPALIVE void tessera_set_shading(int on) {
+  if (app().viewer) theViewer().settings().shading.enabled = on != 0;
+}
 EMSCRIPTEN_KEEPALIVE void tessera_set_opacity_scale(double s) {
   if (app().viewer && s >= 0.0) theViewer().settings().opacityScale = s;
 }
