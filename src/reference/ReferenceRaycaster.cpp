@@ -62,6 +62,8 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
   const bool shade = settings.shading.enabled && settings.mode == RenderMode::Composite;
   const ShadingLight light =
       shadingLight(settings.shading, camera.basis()[2], camera.modelFromWorld);
+  const std::vector<glm::dvec4> clipPlanes =
+      clipHalfSpaces(settings.clipping, camera.modelFromWorld, extent);
   const glm::dvec3 gradientScale = std::min({spacing.x, spacing.y, spacing.z}) / (ww * extent);
 
   Image image(width, height);
@@ -107,6 +109,7 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
             if (t >= tEnd) break;
             ++samples;
             const glm::dvec3 p = to + t * td;
+            if (!clipKeeps(settings.clipping, clipPlanes, p)) continue;  // dropped, not moved
             const double raw = field.value(p);
             const double n = std::clamp((raw - win.min) / ww, 0.0, 1.0);
             if (settings.mode == RenderMode::Mip) {

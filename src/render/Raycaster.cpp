@@ -10,6 +10,7 @@
 #include "tessera/core/Error.h"
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/Draw.h"
+#include "tessera/render/ClippingUniforms.h"
 #include "tessera/render/ShadingUniforms.h"
 
 namespace tessera::render {
@@ -152,6 +153,7 @@ std::vector<std::string> Raycaster::definesFor(const RenderSettings& settings) c
   if (settings.mode == RenderMode::Mip) defines.push_back("MODE_MIP 1");
   if (blockSize_ > 0) defines.push_back("EMPTY_SPACE_SKIPPING 1");
   addShadingDefines(settings, defines);
+  addClippingDefines(settings, defines);
   defines.push_back("MAX_STEPS " + std::to_string(settings.maxSteps));
   return defines;
 }
@@ -169,8 +171,9 @@ std::vector<gpu::ShaderPart> Raycaster::fragmentParts(const RenderSettings& sett
       gpu::shaderPreamble(context_.caps().api, true, definesFor(settings)),
       gpu::embeddedShaderPart("render/camera_ray.glsl")};
   for (gpu::ShaderPart& part : layout_.seamParts()) parts.push_back(std::move(part));
-  for (const char* file : {"render/classify.glsl", "render/shading.glsl", "render/sample.glsl",
-                           "render/composite.glsl", "render/raycast.frag.glsl"}) {
+  for (const char* file :
+       {"render/classify.glsl", "render/shading.glsl", "render/clipping.glsl", "render/sample.glsl",
+        "render/composite.glsl", "render/raycast.frag.glsl"}) {
     parts.push_back(gpu::embeddedShaderPart(file));
   }
   return parts;
@@ -246,6 +249,7 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
   prog.set("u_valueScale", static_cast<float>(m.scale / ww));
   prog.set("u_valueBias", static_cast<float>((m.offset - w.min) / ww));
   setShadingUniforms(prog, settings, camera, m.scale / ww, volume_.extent(), spacing);
+  setClippingUniforms(prog, settings, camera, volume_.extent());
 
   int unit = layout_.bindSeam(prog, 0);
   lut_.texture().bind(unit);

@@ -10,6 +10,7 @@
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
 #include "tessera/gpu/Draw.h"
+#include "tessera/render/ClippingUniforms.h"
 #include "tessera/render/ShadingUniforms.h"
 #include "tessera/render/SliceProjection.h"
 
@@ -247,9 +248,11 @@ std::vector<gpu::ShaderPart> Slice2DRenderer::fragmentParts(const RenderSettings
   }
   if (settings.mode == RenderMode::Mip) defines.push_back("MODE_MIP 1");
   addShadingDefines(settings, defines);
+  addClippingDefines(settings, defines);
   return {gpu::shaderPreamble(context_.caps().api, true, defines),
           gpu::embeddedShaderPart("render/classify.glsl"),
           gpu::embeddedShaderPart("render/shading.glsl"),
+          gpu::embeddedShaderPart("render/clipping.glsl"),
           gpu::embeddedShaderPart("render/slice_opacity.glsl"),
           gpu::embeddedShaderPart("render/slice2d.frag.glsl")};
 }
@@ -257,7 +260,8 @@ std::vector<gpu::ShaderPart> Slice2DRenderer::fragmentParts(const RenderSettings
 const gpu::Program& Slice2DRenderer::programFor(const RenderSettings& settings) {
   const std::string key = std::string(sliceClassificationName(options_.classification)) +
                           (settings.mode == RenderMode::Mip ? "|mip" : "") +
-                          (shadingActive(settings) ? "|shade" : "");
+                          (shadingActive(settings) ? "|shade" : "") +
+                          (settings.clipping.active() ? "|clip" : "");
   return programs_.get(key, [&] {
     return gpu::Program::build("slice2d(" + key + ")", vertexParts(), fragmentParts(settings));
   });
@@ -326,6 +330,10 @@ void Slice2DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
   prog.set("u_forward", glm::vec3(forward));
   prog.set("u_ortho", camera.projection == Projection::Orthographic ? 1.0f : 0.0f);
   prog.set("u_atlas", 0);
+  if (settings.clipping.active()) {
+    setClippingUniforms(prog, settings, camera, volume_.extent());
+    prog.set("u_invExtent", glm::vec3(1.0 / volume_.extent()));
+  }
   if (shade) {
     // The stacks hold the window's normalised value quantised: one per stored unit.
     setShadingUniforms(prog, settings, camera, 1.0, volume_.extent(), volume_.spacing());

@@ -9,6 +9,7 @@
 
 #include "tessera/core/Error.h"
 #include "tessera/gpu/Draw.h"
+#include "tessera/render/ClippingUniforms.h"
 #include "tessera/render/ShadingUniforms.h"
 #include "tessera/render/SliceProjection.h"
 
@@ -104,10 +105,12 @@ std::vector<gpu::ShaderPart> Slice3DRenderer::fragmentParts(const RenderSettings
   std::vector<std::string> defines;
   if (settings.mode == RenderMode::Mip) defines.push_back("MODE_MIP 1");
   addShadingDefines(settings, defines);
+  addClippingDefines(settings, defines);
   std::vector<gpu::ShaderPart> parts = {gpu::shaderPreamble(context_.caps().api, true, defines)};
   for (gpu::ShaderPart& part : layout_.seamParts()) parts.push_back(std::move(part));
-  for (const char* file : {"render/classify.glsl", "render/shading.glsl", "render/sample.glsl",
-                           "render/slice_opacity.glsl", "render/slice3d.frag.glsl"}) {
+  for (const char* file :
+       {"render/classify.glsl", "render/shading.glsl", "render/clipping.glsl", "render/sample.glsl",
+        "render/slice_opacity.glsl", "render/slice3d.frag.glsl"}) {
     parts.push_back(gpu::embeddedShaderPart(file));
   }
   return parts;
@@ -115,7 +118,8 @@ std::vector<gpu::ShaderPart> Slice3DRenderer::fragmentParts(const RenderSettings
 
 const gpu::Program& Slice3DRenderer::programFor(const RenderSettings& settings) {
   const std::string key = layout_.name() + (settings.mode == RenderMode::Mip ? "|mip" : "") +
-                          (shadingActive(settings) ? "|shade" : "");
+                          (shadingActive(settings) ? "|shade" : "") +
+                          (settings.clipping.active() ? "|clip" : "");
   return programs_.get(key, [&] {
     return gpu::Program::build("slice3d(" + key + ")", vertexParts(), fragmentParts(settings));
   });
@@ -162,6 +166,7 @@ void Slice3DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
   prog.set("u_valueScale", static_cast<float>(m.scale / ww));
   prog.set("u_valueBias", static_cast<float>((m.offset - w.min) / ww));
   setShadingUniforms(prog, settings, camera, m.scale / ww, extent, volume_.spacing());
+  setClippingUniforms(prog, settings, camera, extent);
   int unit = layout_.bindSeam(prog, 0);
   lut_.texture().bind(unit);
   prog.set("u_tf", unit);

@@ -1,7 +1,8 @@
 // Single-pass ray caster for GLSL ES 1.00 and 3.00: ray-box intersection
 // here, no proxy pass; samples at t0 + (k + j) * ds; front-to-back
 // compositing of premultiplied colour (Noguera et al. 2012, eq. 1) with
-// early termination; MIP with MODE_MIP. The loop bound MAX_STEPS is a
+// early termination; MIP with MODE_MIP; with CLIPPING the samples that clip
+// planes or the crop box reject are dropped (render/clipping.glsl). The loop bound MAX_STEPS is a
 // compile-time constant, as GLSL ES 1.00 requires (Appendix A).
 // With EMPTY_SPACE_SKIPPING, blocks whose every possible sample is
 // transparent (or cannot raise the maximum) are jumped over without changing
@@ -57,6 +58,15 @@ void main() {
       j = jitterOffset(floor(gl_FragCoord.x), u_viewport.y - 1.0 - floor(gl_FragCoord.y));
     }
     float k = 0.0;  // sample index; a float so GLSL ES 1.00 needs no integer maths
+#ifdef CLIPPING
+    // March only through the crop box, from the box-aligned sample at or just
+    // before its entry (clipKeeps drops any sample outside): no sample moves.
+    vec3 cropLo = min((u_cropMin - to) * invTd, (u_cropMax - to) * invTd);
+    vec3 cropHi = max((u_cropMin - to) * invTd, (u_cropMax - to) * invTd);
+    vec2 crop = vec2(max(max(cropLo.x, cropLo.y), cropLo.z), min(min(cropHi.x, cropHi.y), cropHi.z));
+    k = max(0.0, floor((crop.x - t0) / u_step - j));
+    t1 = min(t1, crop.y + 0.5 * u_step);
+#endif
     for (int i = 0; i < MAX_STEPS; i++) {
       if (k >= u_maxSteps) break;
       float t = t0 + (k + j) * u_step;
@@ -76,6 +86,12 @@ void main() {
         vec3 tb = (exitFace - to) * invTd;
         float tExit = min(min(tb.x, tb.y), tb.z);
         k = max(ceil((tExit - t0) / u_step - j), k + 1.0);
+        continue;
+      }
+#endif
+#ifdef CLIPPING
+      if (!clipKeeps(p)) {
+        k += 1.0;
         continue;
       }
 #endif

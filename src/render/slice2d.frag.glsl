@@ -21,6 +21,9 @@ uniform float u_gap;          // distance between drawn planes / the tables' dis
 uniform vec3 u_eye;
 uniform vec3 u_forward;
 uniform float u_ortho;
+#ifdef CLIPPING
+uniform vec3 u_invExtent;  // world (model frame, box centred at 0) -> texture space
+#endif
 #ifdef CLASSIFY_PALETTE
 uniform sampler2D u_palette;  // 256 premultiplied entries
 
@@ -75,12 +78,16 @@ void main() {
   c.rgb *= c.a;
 #endif
 #endif
+  float kept = 1.0;
+#ifdef CLIPPING
+  if (!clipKeeps(v_world * u_invExtent + 0.5)) kept = 0.0;
+#endif
 #ifdef MODE_MIP
   // Post-classification only: the resolve pass classifies the maximum.
-  FRAG_COLOR = vec4(n, 0.0, 0.0, 1.0);
+  FRAG_COLOR = vec4(n, 0.0, 0.0, 1.0) * kept;
 #else
   vec3 dir = u_ortho > 0.5 ? u_forward : normalize(v_world - u_eye);
   float ratio = u_gap / max(abs(dot(dir, u_axis)), 1e-3);
-  FRAG_COLOR = correctOpacity(c, ratio);
+  FRAG_COLOR = correctOpacity(c, ratio) * kept;
 #endif
 }

@@ -79,9 +79,11 @@ void expectSlicingConformant(gpu::GlContext& c, const Volume& v, const layout::L
     RenderSettings s;
     s.mode = mode;
     sources.push_back(gpu::assembleShader(slice3d.fragmentParts(s)));
-    s.shading.enabled = true;  // render/shading.glsl (composite only)
+    s.shading.enabled = true;  // render/shading.glsl (composite only), render/clipping.glsl
+    s.clipping.planes.push_back({});
     sources.push_back(gpu::assembleShader(slice3d.fragmentParts(s)));
     s.shading.enabled = false;
+    s.clipping.planes.clear();
     for (auto cls : {render::SliceClassification::Pre, render::SliceClassification::Palette,
                      render::SliceClassification::Post}) {
       if (mode == RenderMode::Mip && cls != render::SliceClassification::Post) continue;
@@ -91,6 +93,7 @@ void expectSlicingConformant(gpu::GlContext& c, const Volume& v, const layout::L
       if (mode == RenderMode::Composite && cls == render::SliceClassification::Post) {
         RenderSettings shaded = s;
         shaded.shading.enabled = true;
+        shaded.clipping.cropMax = {0.5, 1.0, 1.0};
         sources.push_back(gpu::assembleShader(slice2d.fragmentParts(shaded)));
       }
     }
@@ -111,6 +114,7 @@ void expectConformant(gpu::GlContext& c, const Volume& v, const layout::Layout& 
         RenderSettings s;
         s.mode = mode;
         s.shading.enabled = shade;
+        if (shade) s.clipping.planes.push_back({});  // render/clipping.glsl too
         const Validation frag = validate(gpu::assembleShader(caster.fragmentParts(s)), "frag");
         EXPECT_EQ(frag.exitCode, 0)
             << layout.name() << " skip " << skip << " shade " << shade << ":\n"

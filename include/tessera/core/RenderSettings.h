@@ -3,6 +3,7 @@
 // with identical meaning, so that their images can be compared pixel by pixel.
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
@@ -34,9 +35,33 @@ struct Shading {
   glm::dvec3 lightDirection{0.0, 1.0, 1.0};
 };
 
+// A clip plane: keeps the points x (world units from the volume box's
+// centre, patient-frame axes RAS+) with dot(normal, x) <= distance, i.e. cuts
+// away what lies beyond `distance` along `normal`.
+struct ClipPlane {
+  glm::dvec3 normal{0.0, 0.0, 1.0};
+  double distance = 0.0;
+};
+
+constexpr int kMaxClipPlanes = 6;
+
+// Clip planes and an axis-aligned crop box. Clipping drops samples, it never
+// moves them: samples stay at t0 + (k + j) ds from the volume box's entry, so
+// moving a plane only adds or removes the samples it passes (no shimmering).
+struct Clipping {
+  std::vector<ClipPlane> planes;  // at most kMaxClipPlanes
+  // The crop box in normalised volume coordinates ([0,1] along each index
+  // axis, voxel centres at (i + 0.5) / dims); samples outside are dropped.
+  glm::dvec3 cropMin{0.0};
+  glm::dvec3 cropMax{1.0};
+  bool cropped() const { return cropMin != glm::dvec3(0.0) || cropMax != glm::dvec3(1.0); }
+  bool active() const { return !planes.empty() || cropped(); }
+};
+
 struct RenderSettings {
   RenderMode mode = RenderMode::Composite;
   Shading shading;
+  Clipping clipping;
   // Sample distance in voxels of the smallest spacing: ds = stepVoxels * min(spacing).
   double stepVoxels = 0.5;
   // Upper bound on samples per ray (Schultz 2016, 7.2.3).
@@ -104,6 +129,33 @@ inline glm::dvec3 shadeBlinnPhong(glm::dvec3 rgb, glm::dvec3 g, const Shading& s
   const glm::dvec3 lit =
       rgb * (shading.ambient + shading.diffuse * diffuse) + glm::dvec3(shading.specular * specular);
   return glm::min(lit, glm::dvec3(1.0));
+}
+
+// The clip planes as half-spaces of texture space (p in [0,1]^3, the volume
+// box): p is kept where dot(h.xyz, p) <= h.w for every h. `modelFromWorld`:
+// Camera::modelFromWorld (a rotation), `extent`: the box's world size.
+inline std::vector<glm::dvec4> clipHalfSpaces(const Clipping& clipping,
+                                              const glm::dmat3& modelFromWorld, glm::dvec3 extent) {
+  std::vector<glm::dvec4> out;
+  for (const ClipPlane& c : clipping.planes) {
+    // x = (p - 0.5) * extent in the model frame.
+    const glm::dvec3 a = (modelFromWorld * c.normal) * extent;
+    out.emplace_back(a, c.distance + glm::dot(a, glm::dvec3(0.5)));
+  }
+  return out;
+}
+
+// Whether the sample at texture-space p survives clipping (the GLSL twin is
+// render/clipping.glsl).
+inline bool clipKeeps(const Clipping& clipping, const std::vector<glm::dvec4>& halfSpaces,
+                      glm::dvec3 p) {
+  for (int a = 0; a < 3; ++a) {
+    if (p[a] < clipping.cropMin[a] || p[a] > clipping.cropMax[a]) return false;
+  }
+  for (const glm::dvec4& h : halfSpaces) {
+    if (glm::dot(glm::dvec3(h), p) > h.w) return false;
+  }
+  return true;
 }
 
 }  // namespace tessera
