@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/ClippingOptions.h"
 #include "app/Commands.h"
 #include "app/HybridJob.h"
 #include "app/RenderJob.h"
@@ -59,6 +60,7 @@ struct RenderOptions {
   std::string offscreen;
   std::string roi;
   ShadingOptions shading;
+  ClippingOptions clipping;
 };
 
 nlohmann::json numberOrNull(std::optional<double> v) {
@@ -90,6 +92,7 @@ RenderRequest requestFrom(const RenderOptions& o) {
   req.settings.ertThreshold = o.ert;
   req.settings.jitter = o.jitter;
   req.settings.shading = shadingFrom(o.shading);
+  req.settings.clipping = clippingFrom(o.clipping);
   if (o.background.size() != 3) throw InputError("--background takes three numbers R G B in [0,1]");
   req.settings.background = glm::dvec4(o.background[0], o.background[1], o.background[2], 1.0);
   req.repeat = o.repeat;
@@ -278,6 +281,7 @@ void addRenderCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--jitter", o->jitter, "Jitter the first sample per pixel");
   addShadingOptions(cmd, o->shading);
+  addClippingOptions(cmd, o->clipping);
   cmd->add_option("--window", o->window,
                   "Value window MIN MAX (raw values); default: the value range")
       ->expected(2);

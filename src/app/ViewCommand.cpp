@@ -9,6 +9,7 @@
 #include <sstream>
 #include <string>
 
+#include "app/ClippingOptions.h"
 #include "app/Commands.h"
 #include "app/RenderJob.h"
 #include "app/ShadingOptions.h"
@@ -46,6 +47,7 @@ struct ViewOptions {
   std::string screenshot;
   int frames = 3;
   ShadingOptions shading;
+  ClippingOptions clipping;
 };
 
 #ifdef TESSERA_DESKTOP_VIEWER
@@ -515,6 +517,7 @@ void runView(const ViewOptions& o) {
   ds.viewer->camera().azimuthDeg = o.azimuth;
   ds.viewer->camera().elevationDeg = o.elevation;
   ds.viewer->settings().shading = shadingFrom(o.shading);
+  ds.viewer->settings().clipping = clippingFrom(o.clipping);
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -561,6 +564,7 @@ void addViewCommand(CLI::App& app) {
                   "Write the window to this PNG after --frames frames and exit");
   cmd->add_option("--frames", o->frames, "Frames before --screenshot")->capture_default_str();
   addShadingOptions(cmd, o->shading);
+  addClippingOptions(cmd, o->clipping);
   cmd->callback([o] { runView(*o); });
 }
 
