@@ -349,6 +349,30 @@ void panelRendering(DesktopSession& ds) {
   if (ImGui::Button("Reset view")) v.resetCamera();
 }
 
+// The crop box (fractions of each axis) and a clip plane that follows the camera.
+void panelClipping(viewer::Viewer& v) {
+  section("Clipping");
+  Clipping& c = v.settings().clipping;
+  for (int a = 0; a < 3; ++a) {
+    float range[2] = {static_cast<float>(c.cropMin[a]), static_cast<float>(c.cropMax[a])};
+    const std::string label = std::string("crop ") + "xyz"[a];
+    if (ImGui::SliderFloat2(label.c_str(), range, 0.0f, 1.0f) && range[0] < range[1] - 0.01f) {
+      c.cropMin[a] = range[0];
+      c.cropMax[a] = range[1];
+    }
+  }
+  if (c.cropped() && ImGui::Button("Reset crop")) {
+    c.cropMin = glm::dvec3(0.0);
+    c.cropMax = glm::dvec3(1.0);
+  }
+  ImGui::Checkbox("plane follows camera", &v.clipPlaneFollowsCamera);
+  if (v.clipPlaneFollowsCamera) {
+    const float reach = static_cast<float>(0.5 * glm::length(v.volume().extent()));
+    float d = static_cast<float>(v.followingPlaneDistance);
+    if (ImGui::SliderFloat("plane depth (mm)", &d, -reach, reach)) v.followingPlaneDistance = d;
+  }
+}
+
 // Blinn-Phong shading (RenderSettings::shading): on/off, the light, the terms.
 void panelShading(viewer::Viewer& v) {
   section("Shading");
@@ -385,6 +409,7 @@ void drawPanel(DesktopSession& ds, int windowHeight) {
   panelWindowLevel(*ds.viewer);
   panelRendering(ds);
   panelShading(*ds.viewer);
+  panelClipping(*ds.viewer);
   ImGui::Separator();
   ImGui::TextWrapped("%s", ds.status.c_str());
   ImGui::End();
@@ -401,6 +426,12 @@ std::string viewKey(viewer::Viewer& v, int viewW, int viewH) {
       << v.settings().opacityScale << '|' << v.window().min << v.window().max << '|'
       << v.technique() << static_cast<int>(v.quality) << v.controller().interacting() << '|'
       << v.showBoundingBox << v.showAxes << '|' << viewW << 'x' << viewH;
+  const RenderSettings fs = v.frameSettings();
+  for (const ClipPlane& p : fs.clipping.planes) {
+    key << "|p" << p.normal.x << ',' << p.normal.y << ',' << p.normal.z << ',' << p.distance;
+  }
+  key << "|c" << fs.clipping.cropMin.x << fs.clipping.cropMin.y << fs.clipping.cropMin.z << ','
+      << fs.clipping.cropMax.x << fs.clipping.cropMax.y << fs.clipping.cropMax.z;
   const Shading& sh = v.settings().shading;
   key << '|' << sh.enabled << sh.headlight << sh.lightDirection.x << ',' << sh.lightDirection.y
       << ',' << sh.lightDirection.z << '|' << sh.ambient << ',' << sh.diffuse << ',' << sh.specular

@@ -183,13 +183,23 @@ std::string Viewer::description() const {
 }
 
 // The volume through the technique at the quality level's size and step.
+RenderSettings Viewer::frameSettings() const {
+  RenderSettings settings = settings_;
+  if (clipPlaneFollowsCamera &&
+      settings.clipping.planes.size() < static_cast<std::size_t>(kMaxClipPlanes)) {
+    // The camera's back vector in the patient frame: towards the viewer.
+    settings.clipping.planes.push_back({camera_.worldBasis()[2], followingPlaneDistance});
+  }
+  return settings;
+}
+
 const gpu::Texture& Viewer::renderVolume(int width, int height, FrameStats& stats,
                                          render::QualityLevel& level) {
   if (uploadedTfRevision_ != tfEditor_.revision()) {
     active_.technique->setTransferFunction(tfEditor_.transferFunction());
     uploadedTfRevision_ = tfEditor_.revision();
   }
-  RenderSettings settings = settings_;
+  RenderSettings settings = frameSettings();
   if (quality == Quality::Adaptive) {
     qualityController_.setInteracting(controller_.interacting());
     level = qualityController_.next();
