@@ -84,8 +84,12 @@ RenderRequest requestFrom(const RenderOptions& o) {
     req.settings.mode = RenderMode::Composite;
   else if (o.mode == "mip")
     req.settings.mode = RenderMode::Mip;
+  else if (o.mode == "minip")
+    req.settings.mode = RenderMode::MinIp;
+  else if (o.mode == "average")
+    req.settings.mode = RenderMode::Average;
   else
-    throw InputError("--mode '" + o.mode + "': expected composite or mip");
+    throw InputError("--mode '" + o.mode + "': expected composite, mip, minip or average");
   req.settings.stepVoxels = o.step;
   req.settings.maxSteps = o.maxSteps;
   req.settings.opacityScale = o.opacityScale;
@@ -271,7 +275,11 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--fov", o->fov, "Vertical field of view in degrees (perspective)")
       ->capture_default_str();
   cmd->add_flag("--ortho", o->ortho, "Orthographic projection");
-  cmd->add_option("--mode", o->mode, "composite or mip")->capture_default_str();
+  cmd->add_option("--mode", o->mode,
+                  "composite, mip (maximum), minip (minimum) or average (mean of the ray's "
+                  "samples): the projections show the TF colour of their value; minip and "
+                  "average by raycast only")
+      ->capture_default_str();
   cmd->add_option("--step", o->step, "Sample distance in voxels (of the smallest spacing)")
       ->capture_default_str();
   cmd->add_option("--max-steps", o->maxSteps, "Maximum samples per ray")->capture_default_str();

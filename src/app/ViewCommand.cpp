@@ -319,9 +319,9 @@ void panelWindowLevel(viewer::Viewer& v) {
 void panelRendering(DesktopSession& ds) {
   viewer::Viewer& v = *ds.viewer;
   section("Rendering");
-  int mode = v.settings().mode == RenderMode::Mip ? 1 : 0;
-  if (ImGui::Combo("mode", &mode, "composite\0MIP\0")) {
-    v.settings().mode = mode ? RenderMode::Mip : RenderMode::Composite;
+  int mode = static_cast<int>(v.settings().mode);
+  if (ImGui::Combo("mode", &mode, "composite\0MIP\0MinIP\0average\0")) {
+    v.settings().mode = static_cast<RenderMode>(mode);
   }
   if (ImGui::BeginCombo("technique", v.technique().c_str())) {
     for (const std::string& t : render::TechniqueRegistry::global().names()) {

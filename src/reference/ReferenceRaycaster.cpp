@@ -99,6 +99,8 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
         const double tEnd = std::min(tFar, tStop);
         glm::dvec4 acc(0.0);
         double maxValue = -1.0;
+        double minValue = 2.0, sumValue = 0.0;
+        std::uint64_t kept = 0;
         if (t0 < tEnd) {
           ++hits;
           const double j = settings.jitter
@@ -112,8 +114,11 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
             if (!clipKeeps(settings.clipping, clipPlanes, p)) continue;  // dropped, not moved
             const double raw = field.value(p);
             const double n = std::clamp((raw - win.min) / ww, 0.0, 1.0);
-            if (settings.mode == RenderMode::Mip) {
+            if (isProjection(settings.mode)) {
               maxValue = std::max(maxValue, n);
+              minValue = std::min(minValue, n);
+              sumValue += n;
+              ++kept;
               continue;
             }
             glm::dvec3 c = tf.color(n);
@@ -125,9 +130,12 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
             if (acc.a >= settings.ertThreshold) break;
           }
         }
-        if (settings.mode == RenderMode::Mip && maxValue >= 0.0) {
-          // MIP shows the TF colour of the maximum, opaque.
-          acc = glm::dvec4(tf.color(maxValue), 1.0);
+        if (isProjection(settings.mode) && kept > 0) {
+          // The projections show the TF colour of their value, opaque.
+          const double shown = settings.mode == RenderMode::Mip     ? maxValue
+                               : settings.mode == RenderMode::MinIp ? minValue
+                                                                    : sumValue / kept;
+          acc = glm::dvec4(tf.color(shown), 1.0);
         }
         const glm::dvec4 under =
             stopped ? glm::dvec4(glm::dvec3(stopColor[0], stopColor[1], stopColor[2]) / 255.0, 1.0)

@@ -151,7 +151,12 @@ void Raycaster::uploadBlocks(const std::vector<std::uint8_t>& cells) {
 std::vector<std::string> Raycaster::definesFor(const RenderSettings& settings) const {
   std::vector<std::string> defines;
   if (settings.mode == RenderMode::Mip) defines.push_back("MODE_MIP 1");
-  if (blockSize_ > 0) defines.push_back("EMPTY_SPACE_SKIPPING 1");
+  if (settings.mode == RenderMode::MinIp) defines.push_back("MODE_MINIP 1");
+  if (settings.mode == RenderMode::Average) defines.push_back("MODE_AVERAGE 1");
+  // The block grid knows which blocks are transparent and their maxima: it
+  // serves composite and MIP; MinIP and the average need every sample.
+  const bool skippable = settings.mode == RenderMode::Composite || settings.mode == RenderMode::Mip;
+  if (blockSize_ > 0 && skippable) defines.push_back("EMPTY_SPACE_SKIPPING 1");
   addShadingDefines(settings, defines);
   addClippingDefines(settings, defines);
   defines.push_back("MAX_STEPS " + std::to_string(settings.maxSteps));
@@ -190,7 +195,7 @@ const gpu::Program& Raycaster::programFor(const RenderSettings& settings) {
 void Raycaster::prepare(const RenderSettings& settings) {
   const glm::dvec3 spacing = volume_.spacing();
   const double ds = settings.stepVoxels * std::min({spacing.x, spacing.y, spacing.z});
-  updateLookup(settings, settings.mode == RenderMode::Mip ? tf_.opacityUnitLength : ds);
+  updateLookup(settings, isProjection(settings.mode) ? tf_.opacityUnitLength : ds);
   programFor(settings);
 }
 
@@ -212,7 +217,7 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
   const double ds = settings.stepVoxels * std::min({spacing.x, spacing.y, spacing.z});
   // MIP shows one classified sample, so its table is not distance-corrected
   // (correcting for one unit length leaves opacity as it is).
-  updateLookup(settings, settings.mode == RenderMode::Mip ? tf_.opacityUnitLength : ds);
+  updateLookup(settings, isProjection(settings.mode) ? tf_.opacityUnitLength : ds);
 
   if (target_.id() == 0 || target_.width() != width || target_.height() != height) {
     target_ = gpu::Framebuffer();

@@ -268,6 +268,11 @@ const gpu::Program& Slice2DRenderer::programFor(const RenderSettings& settings) 
 }
 
 void Slice2DRenderer::prepare(const Camera& camera, const RenderSettings& settings) {
+  if (settings.mode == RenderMode::MinIp || settings.mode == RenderMode::Average) {
+    throw InputError(
+        "slice2d blends composite and MIP only; MinIP and the average need the ray "
+        "caster (--technique raycast)");
+  }
   if (settings.mode == RenderMode::Mip && options_.classification != SliceClassification::Post) {
     throw InputError(
         "MIP by axis-aligned slicing needs --classify post (the maximum of "

@@ -126,6 +126,11 @@ const gpu::Program& Slice3DRenderer::programFor(const RenderSettings& settings) 
 }
 
 void Slice3DRenderer::prepare(const RenderSettings& settings) {
+  if (settings.mode == RenderMode::MinIp || settings.mode == RenderMode::Average) {
+    throw InputError(
+        "slice3d blends composite and MIP only; MinIP and the average need the ray "
+        "caster (--technique raycast)");
+  }
   const int n = sliceCountFor(settings);
   if (n != builtSlices_) buildGeometry(n);
   updateLookup(settings, settings.mode == RenderMode::Mip ? tf_.opacityUnitLength

@@ -1,7 +1,8 @@
 // Single-pass ray caster for GLSL ES 1.00 and 3.00: ray-box intersection
 // here, no proxy pass; samples at t0 + (k + j) * ds; front-to-back
 // compositing of premultiplied colour (Noguera et al. 2012, eq. 1) with
-// early termination; MIP with MODE_MIP; with CLIPPING the samples that clip
+// early termination; MIP, MinIP and the average with MODE_MIP, MODE_MINIP,
+// MODE_AVERAGE; with CLIPPING the samples that clip
 // planes or the crop box reject are dropped (render/clipping.glsl). The loop bound MAX_STEPS is a
 // compile-time constant, as GLSL ES 1.00 requires (Appendix A).
 // With EMPTY_SPACE_SKIPPING, blocks whose every possible sample is
@@ -52,6 +53,9 @@ void main() {
 
   vec4 acc = vec4(0.0);
   float maxValue = -1.0;
+  float minValue = 2.0;   // MinIP
+  float sumValue = 0.0;   // average
+  float kept = 0.0;       // samples the projections kept
   if (t0 < t1) {
     float j = 0.5;
     if (u_jitter > 0.5) {
@@ -95,8 +99,14 @@ void main() {
         continue;
       }
 #endif
-#ifdef MODE_MIP
+#if defined(MODE_MIP)
       maxValue = max(maxValue, normalizedValue(sampleVolume(p)));
+#elif defined(MODE_MINIP)
+      minValue = min(minValue, normalizedValue(sampleVolume(p)));
+      kept += 1.0;
+#elif defined(MODE_AVERAGE)
+      sumValue += normalizedValue(sampleVolume(p));
+      kept += 1.0;
 #else
       compositeFrontToBack(acc, classifiedSample(p));
       if (acc.a >= u_ert) break;
@@ -110,6 +120,10 @@ void main() {
     // with the grey preset the pixel is the maximum intensity).
     acc = vec4(classify(maxValue).rgb, 1.0);
   }
+#elif defined(MODE_MINIP)
+  if (kept > 0.0) acc = vec4(classify(minValue).rgb, 1.0);
+#elif defined(MODE_AVERAGE)
+  if (kept > 0.0) acc = vec4(classify(sumValue / kept).rgb, 1.0);
 #endif
   FRAG_COLOR = overBackground(acc, u_background);
 }

@@ -107,7 +107,8 @@ void expectSlicingConformant(gpu::GlContext& c, const Volume& v, const layout::L
 
 void expectConformant(gpu::GlContext& c, const Volume& v, const layout::Layout& layout) {
   render::Raycaster caster(c, v, layout);
-  for (RenderMode mode : {RenderMode::Composite, RenderMode::Mip}) {
+  for (RenderMode mode :
+       {RenderMode::Composite, RenderMode::Mip, RenderMode::MinIp, RenderMode::Average}) {
     for (int skip : {0, 8}) {
       caster.setSkipBlockSize(skip);
       for (bool shade : {false, true}) {

@@ -12,10 +12,16 @@
 
 namespace tessera {
 
-// Composite: front-to-back emission-absorption. Mip: maximum intensity
-// projection; the pixel is the TF colour of the largest normalised sample
-// along the ray, opaque where the ray meets the volume.
-enum class RenderMode { Composite, Mip };
+// Composite: front-to-back emission-absorption. The projections show one
+// value per ray, as the TF colour of that normalised value, opaque where the
+// ray keeps a sample: Mip the largest sample (maximum intensity projection),
+// MinIp the smallest, Average the mean of the ray's samples (average
+// intensity projection, an X-ray-like view).
+enum class RenderMode { Composite, Mip, MinIp, Average };
+
+inline bool isProjection(RenderMode mode) {
+  return mode != RenderMode::Composite;
+}
 
 // Blinn-Phong shading of composited samples from the gradient of the
 // reconstructed field (the layout seam's sampleVolumeGradient, the
