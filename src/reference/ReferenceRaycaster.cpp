@@ -42,6 +42,10 @@ double sampleTrilinear(const Volume& volume, glm::dvec3 p) {
 Image renderReference(const Volume& volume, const TransferFunction& tf, const Camera& camera,
                       const RenderSettings& settings, int width, int height, int threads,
                       ReferenceStats* stats, const ReferenceStops* stops) {
+  if (settings.nearest) {
+    return renderReference(volume, NearestReconstruction(volume), tf, camera, settings, width,
+                           height, threads, stats, stops);
+  }
   return renderReference(volume, TrilinearReconstruction(volume), tf, camera, settings, width,
                          height, threads, stats, stops);
 }

@@ -159,6 +159,7 @@ std::vector<std::string> Raycaster::definesFor(const RenderSettings& settings) c
   if (blockSize_ > 0 && skippable) defines.push_back("EMPTY_SPACE_SKIPPING 1");
   addShadingDefines(settings, defines);
   addClippingDefines(settings, defines);
+  if (settings.nearest) defines.push_back("NEAREST 1");
   defines.push_back("MAX_STEPS " + std::to_string(settings.maxSteps));
   return defines;
 }
@@ -255,6 +256,7 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
   prog.set("u_valueBias", static_cast<float>((m.offset - w.min) / ww));
   setShadingUniforms(prog, settings, camera, m.scale / ww, volume_.extent(), spacing);
   setClippingUniforms(prog, settings, camera, volume_.extent());
+  if (settings.nearest) prog.set("u_sampleDims", glm::vec3(volume_.dims()));
 
   int unit = layout_.bindSeam(prog, 0);
   lut_.texture().bind(unit);

@@ -201,14 +201,16 @@ void Slice2DRenderer::updateClassification(const RenderSettings& settings) {
   const ValueRange w = volume_.window();
   std::ostringstream key;
   key.precision(17);
-  key << settings.opacityScale << '|' << w.min << '|' << w.max << '|' << tf_.toJson();
+  key << settings.opacityScale << '|' << w.min << '|' << w.max << '|' << settings.nearest << '|'
+      << tf_.toJson();
   if (key.str() == classificationKey_) return;
   classificationKey_ = key.str();
   ++classificationUpdates_;
   const double ds0 = baseDistance();
   switch (options_.classification) {
     case SliceClassification::Post:
-      table_.upload(context_, tf_.bake(4096, ds0, settings.opacityScale),
+      // Nearest (labels): one entry per 8-bit value, never mixed with a neighbour's.
+      table_.upload(context_, tf_.bake(settings.nearest ? 256 : 4096, ds0, settings.opacityScale),
                     "slice2d transfer function");
       return;
     case SliceClassification::Palette:
@@ -249,6 +251,7 @@ std::vector<gpu::ShaderPart> Slice2DRenderer::fragmentParts(const RenderSettings
   if (settings.mode == RenderMode::Mip) defines.push_back("MODE_MIP 1");
   addShadingDefines(settings, defines);
   addClippingDefines(settings, defines);
+  if (settings.nearest) defines.push_back("NEAREST 1");
   return {gpu::shaderPreamble(context_.caps().api, true, defines),
           gpu::embeddedShaderPart("render/classify.glsl"),
           gpu::embeddedShaderPart("render/shading.glsl"),
@@ -258,10 +261,10 @@ std::vector<gpu::ShaderPart> Slice2DRenderer::fragmentParts(const RenderSettings
 }
 
 const gpu::Program& Slice2DRenderer::programFor(const RenderSettings& settings) {
-  const std::string key = std::string(sliceClassificationName(options_.classification)) +
-                          (settings.mode == RenderMode::Mip ? "|mip" : "") +
-                          (shadingActive(settings) ? "|shade" : "") +
-                          (settings.clipping.active() ? "|clip" : "");
+  const std::string key =
+      std::string(sliceClassificationName(options_.classification)) +
+      (settings.mode == RenderMode::Mip ? "|mip" : "") + (shadingActive(settings) ? "|shade" : "") +
+      (settings.clipping.active() ? "|clip" : "") + (settings.nearest ? "|nearest" : "");
   return programs_.get(key, [&] {
     return gpu::Program::build("slice2d(" + key + ")", vertexParts(), fragmentParts(settings));
   });

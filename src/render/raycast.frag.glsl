@@ -100,12 +100,12 @@ void main() {
       }
 #endif
 #if defined(MODE_MIP)
-      maxValue = max(maxValue, normalizedValue(sampleVolume(p)));
+      maxValue = max(maxValue, normalizedValue(fieldValue(p)));
 #elif defined(MODE_MINIP)
-      minValue = min(minValue, normalizedValue(sampleVolume(p)));
+      minValue = min(minValue, normalizedValue(fieldValue(p)));
       kept += 1.0;
 #elif defined(MODE_AVERAGE)
-      sumValue += normalizedValue(sampleVolume(p));
+      sumValue += normalizedValue(fieldValue(p));
       kept += 1.0;
 #else
       compositeFrontToBack(acc, classifiedSample(p));

@@ -57,6 +57,9 @@ vec3 sliceGradient(vec2 texel, vec4 here) {
 
 void main() {
   vec2 texel = clamp(v_local * u_tileSize, vec2(0.5), u_tileSize - vec2(0.5));
+#ifdef NEAREST
+  texel = floor(texel) + 0.5;  // the voxel's own value (the planes are voxel planes)
+#endif
 #if defined(CLASSIFY_PRE)
   vec4 c = TEX2D(u_atlas, (v_tileOrigin + texel) * u_atlasInvSize);
 #elif defined(CLASSIFY_PALETTE)
@@ -70,6 +73,11 @@ void main() {
 #else
   vec4 here = TEX2D(u_atlas, (v_tileOrigin + texel) * u_atlasInvSize);
   float n = here.r;
+#ifdef NEAREST
+  // Labels are whole indices: undo the filter's sub-texel rounding, which
+  // would mix in a neighbour's table entry.
+  n = floor(n * 255.0 + 0.5) / 255.0;
+#endif
 #ifndef MODE_MIP
   vec4 c = classify(n);
 #ifdef SHADING

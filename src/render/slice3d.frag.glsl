@@ -21,7 +21,7 @@ void main() {
 #endif
   vec3 q = clamp(p, 0.0, 1.0);
 #ifdef MODE_MIP
-  FRAG_COLOR = vec4(normalizedValue(sampleVolume(q)) * inside, 0.0, 0.0, inside);
+  FRAG_COLOR = vec4(normalizedValue(fieldValue(q)) * inside, 0.0, 0.0, inside);
 #else
   vec4 c = classifiedSample(q);
   c = vec4(c.rgb * c.a, c.a) * inside;

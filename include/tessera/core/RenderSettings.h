@@ -68,6 +68,9 @@ struct RenderSettings {
   RenderMode mode = RenderMode::Composite;
   Shading shading;
   Clipping clipping;
+  // Nearest-neighbour reconstruction: a sample takes the value of the voxel
+  // whose cell holds it (label volumes: no interpolation across labels).
+  bool nearest = false;
   // Sample distance in voxels of the smallest spacing: ds = stepVoxels * min(spacing).
   double stepVoxels = 0.5;
   // Upper bound on samples per ray (Schultz 2016, 7.2.3).
