@@ -17,6 +17,7 @@
 #include "tessera/io/VolumeReader.h"
 #include "tessera/layout/LayoutRegistry.h"
 #include "tessera/lod/InCoreVolumeSource.h"
+#include "tessera/render/LabelTable.h"
 #include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::app {
@@ -61,6 +62,10 @@ struct RenderOptions {
   std::string roi;
   ShadingOptions shading;
   ClippingOptions clipping;
+  // --labels [TABLE]: a label volume through a categorical table.
+  std::string labels;
+  CLI::Option* labelsOption = nullptr;
+  bool labelVolume() const { return labelsOption != nullptr && labelsOption->count() > 0; }
 };
 
 nlohmann::json numberOrNull(std::optional<double> v) {
@@ -97,6 +102,10 @@ RenderRequest requestFrom(const RenderOptions& o) {
   req.settings.jitter = o.jitter;
   req.settings.shading = shadingFrom(o.shading);
   req.settings.clipping = clippingFrom(o.clipping);
+  if (o.labelVolume()) {
+    req.settings.nearest = true;  // no interpolation across labels
+    req.lutSize = 256;            // one table entry per label value
+  }
   if (o.background.size() != 3) throw InputError("--background takes three numbers R G B in [0,1]");
   req.settings.background = glm::dvec4(o.background[0], o.background[1], o.background[2], 1.0);
   req.repeat = o.repeat;
@@ -109,7 +118,7 @@ RenderRequest requestFrom(const RenderOptions& o) {
   }
   req.technique = o.technique;
   req.skipBlock = o.skipBlock;
-  req.lutSize = o.lut;
+  req.lutSize = o.labelVolume() ? 256 : o.lut;
   req.slices = o.slices;
   req.classify = o.classify;
   req.layout = o.layout;
@@ -123,6 +132,7 @@ lod::InCoreVolumeSource loadVolume(const RenderOptions& o, const std::string& sp
     if (o.window.size() != 2) throw InputError("--window takes two numbers MIN MAX");
     volume.setWindow({o.window[0], o.window[1]});
   }
+  if (o.labelVolume()) render::prepareLabelVolume(volume);
   return lod::InCoreVolumeSource(std::move(volume));
 }
 
@@ -226,12 +236,19 @@ void runRenderCommand(const RenderOptions& o) {
   const auto tStart = std::chrono::steady_clock::now();
   const RenderRequest req = requestFrom(o);
   const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
-  const TransferFunction tf = TransferFunction::fromPresetOrFile(o.tf);
+  TransferFunction tf =
+      o.labelVolume() ? TransferFunction() : TransferFunction::fromPresetOrFile(o.tf);
   // The profile first: it sets the host budget the reader must respect.
   DeviceSession device = openDevice(o.profile);
   RenderTimes times;
   const auto tLoad = std::chrono::steady_clock::now();
   const lod::InCoreVolumeSource source = loadVolume(o, spec);
+  if (o.labelVolume()) {
+    const render::LabelTable table = o.labels.empty()
+                                         ? render::LabelTable::defaultFor(source.volume())
+                                         : render::LabelTable::load(o.labels);
+    tf = table.toTransferFunction();
+  }
   times.loadMs = msSince(tLoad);
 
   // Checked even when nothing uses it, so that a typo is not silently ignored.
@@ -290,6 +307,15 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_flag("--jitter", o->jitter, "Jitter the first sample per pixel");
   addShadingOptions(cmd, o->shading);
   addClippingOptions(cmd, o->clipping);
+  o->labelsOption =
+      cmd->add_option("--labels", o->labels,
+                      "Render a label volume (atlas, 8-bit integer labels): nearest-neighbour "
+                      "sampling and a categorical colour table instead of --tf. TABLE (optional): "
+                      "JSON {\"labels\": [{\"value\", \"name\", \"color\": [r,g,b] 0..1, "
+                      "\"opacity\", \"visible\"}]} or a label text file (ITK-SNAP, FreeSurfer "
+                      "LUT, or mricron's IDX NAME); labels it does not name are hidden. Without "
+                      "TABLE: a default palette for every label present")
+          ->expected(0, 1);
   cmd->add_option("--window", o->window,
                   "Value window MIN MAX (raw values); default: the value range")
       ->expected(2);

@@ -170,3 +170,82 @@ TEST(Labels, NoColourOutsideTheTableAppears) {
     forEveryPath(api, v, tf, cam, s, 80, check);
   }
 }
+
+TEST(LabelTable, ReadsJsonItkSnapFreeSurferAndMricronText) {
+  const render::LabelTable json = render::LabelTable::fromJson(
+      R"({"labels": [{"value": 3, "name": "a", "color": [1, 0, 0.5], "opacity": 0.5},
+                     {"value": 7, "visible": false}]})",
+      "t.json");
+  ASSERT_EQ(json.labels.size(), 2u);
+  EXPECT_EQ(json.labels.at(3).color, glm::dvec3(1.0, 0.0, 0.5));
+  EXPECT_EQ(json.labels.at(3).opacity, 0.5);
+  EXPECT_FALSE(json.labels.at(7).visible);
+  const render::LabelTable itk = render::LabelTable::fromText(
+      "# ITK-SnAP Label Description File\n"
+      "    0     0    0    0        0  0  0    \"Clear Label\"\n"
+      "    1   255    0    0        1  1  1    \"Left hippocampus\"\n"
+      "    2     0  255    0     0.25  0  1    \"Right\"\n",
+      "t.txt");
+  ASSERT_EQ(itk.labels.size(), 2u);  // 0 is the background
+  EXPECT_EQ(itk.labels.at(1).name, "Left hippocampus");
+  EXPECT_EQ(itk.labels.at(1).color, glm::dvec3(1.0, 0.0, 0.0));
+  EXPECT_EQ(itk.labels.at(2).opacity, 0.25);
+  EXPECT_FALSE(itk.labels.at(2).visible);
+  const render::LabelTable fs =
+      render::LabelTable::fromText("0 Unknown 0 0 0 0\n17 Left-Hippocampus 220 216 20 0\n", "lut");
+  EXPECT_EQ(fs.labels.at(17).color, glm::dvec3(220, 216, 20) / 255.0);
+  const render::LabelTable mricron =
+      render::LabelTable::fromText("1 Precentral_L 2001\n2 Precentral_R 2002\n", "aal.nii.txt");
+  EXPECT_EQ(mricron.labels.at(2).name, "Precentral_R");
+  EXPECT_EQ(mricron.labels.at(2).color, render::LabelTable::paletteColor(2));
+  // The table as a TF: each label's colour and opacity exactly at value / 255, 0 transparent,
+  // hidden and unnamed labels transparent.
+  const TransferFunction tf = json.toTransferFunction();
+  EXPECT_EQ(tf.color(3 / 255.0), glm::dvec3(1.0, 0.0, 0.5));
+  EXPECT_EQ(tf.opacity(3 / 255.0), 0.5);
+  EXPECT_EQ(tf.opacity(7 / 255.0), 0.0);
+  EXPECT_EQ(tf.opacity(4 / 255.0), 0.0);
+  EXPECT_EQ(tf.opacity(0.0), 0.0);
+}
+
+TEST(LabelTable, BadFilesSayWhatAndWhere) {
+  auto message = [](auto parse) {
+    try {
+      parse();
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message([] {
+              render::LabelTable::fromText("1 255 0 0 1 1 1 \"a\"\nx y\n", "f.txt");
+            }).find("f.txt:2"),
+            std::string::npos);
+  EXPECT_NE(message([] { render::LabelTable::fromText("300 big\n", "f.txt"); }).find("0..255"),
+            std::string::npos);
+  EXPECT_NE(message([] {
+              render::LabelTable::fromText("1 300 0 0 1 1 1 \"a\"\n", "f.txt");
+            }).find("colour channel"),
+            std::string::npos);
+  EXPECT_NE(
+      message([] { render::LabelTable::fromText("# only comments\n", "f.txt"); }).find("no labels"),
+      std::string::npos);
+  EXPECT_NE(message([] {
+              render::LabelTable::fromJson("{\"labels\": [{\"name\": 1}]}", "f.json");
+            }).find("labels[0]"),
+            std::string::npos);
+  EXPECT_NE(message([] { render::LabelTable::fromJson("not json", "f.json"); }).find("not JSON"),
+            std::string::npos);
+  Volume f = Volume::allocate({2, 2, 2}, ScalarType::F32, "f");
+  f.setValueAtIndex(0, 1.5);
+  f.invalidateRange();
+  EXPECT_NE(message([&] { render::prepareLabelVolume(f); }).find("non-integer"), std::string::npos);
+}
+
+TEST(LabelTable, ReadsMricronsAalTable) {
+  const char* path = "/usr/share/mricron/templates/aal.nii.txt";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "mricron-data not installed";
+  const render::LabelTable t = render::LabelTable::load(path);
+  EXPECT_EQ(t.labels.size(), 116u);
+  EXPECT_EQ(t.labels.at(1).name, "Precentral_L");
+}
