@@ -1,11 +1,12 @@
 // Single-pass ray caster for GLSL ES 1.00 and 3.00: the volume only through
 // the layout's sampleVolume() (render/sample.glsl: classifiedSample,
 // fieldValue); ray-box intersection here, no proxy pass; samples at
-// t0 + (k + j) * ds; front-to-back compositing of premultiplied colour (Noguera et al. 2012, eq. 1) with
-// early termination; MIP, MinIP and the average with MODE_MIP, MODE_MINIP,
-// MODE_AVERAGE; with CLIPPING the samples that clip
-// planes or the crop box reject are dropped (render/clipping.glsl). The loop bound MAX_STEPS is a
-// compile-time constant, as GLSL ES 1.00 requires (Appendix A).
+// t0 + (k + j) * ds; front-to-back compositing of premultiplied colour
+// (Noguera et al. 2012, eq. 1) with early termination; MIP, MinIP and the
+// average with MODE_MIP, MODE_MINIP, MODE_AVERAGE; with CLIPPING the samples
+// that clip planes or the crop box reject are dropped (render/clipping.glsl).
+// The loop bound MAX_STEPS is a compile-time constant, as GLSL ES 1.00
+// requires (Appendix A).
 // With EMPTY_SPACE_SKIPPING, blocks whose every possible sample is
 // transparent (or cannot raise the maximum) are jumped over without changing
 // which samples are taken, so the image is the same as without skipping.
