@@ -11,11 +11,11 @@
 // transparent (or cannot raise the maximum) are jumped over without changing
 // which samples are taken, so the image is the same as without skipping.
 
-uniform float u_step;      // world units
-uniform float u_maxSteps;  // the user's cap, <= MAX_STEPS
-uniform float u_ert;       // early termination threshold
-uniform float u_jitter;    // 1.0: dithered first sample
-uniform vec4 u_background; // premultiplied
+uniform float u_step;       // world units
+uniform float u_maxSteps;   // the user's cap, <= MAX_STEPS
+uniform float u_ert;        // early termination threshold
+uniform float u_jitter;     // 1.0: dithered first sample
+uniform vec4 u_background;  // premultiplied
 
 #ifdef EMPTY_SPACE_SKIPPING
 // The block grid: r = 1 where the TF gives some sample in the block opacity,
@@ -25,7 +25,9 @@ uniform vec3 u_blockCount;
 #if TESSERA_GLSL == 300
 uniform highp sampler3D u_blocks;
 
-vec4 blockAt(vec3 cell) { return texelFetch(u_blocks, ivec3(cell), 0); }
+vec4 blockAt(vec3 cell) {
+  return texelFetch(u_blocks, ivec3(cell), 0);
+}
 #else
 // Without 3D textures: the grid's z-slices side by side in a 2D texture.
 uniform sampler2D u_blocks;
@@ -55,9 +57,9 @@ void main() {
 
   vec4 acc = vec4(0.0);
   float maxValue = -1.0;
-  float minValue = 2.0;   // MinIP
-  float sumValue = 0.0;   // average
-  float kept = 0.0;       // samples the projections kept
+  float minValue = 2.0;  // MinIP
+  float sumValue = 0.0;  // average
+  float kept = 0.0;      // samples the projections kept
   if (t0 < t1) {
     float j = 0.5;
     if (u_jitter > 0.5) {
@@ -69,7 +71,8 @@ void main() {
     // before its entry (clipKeeps drops any sample outside): no sample moves.
     vec3 cropLo = min((u_cropMin - to) * invTd, (u_cropMax - to) * invTd);
     vec3 cropHi = max((u_cropMin - to) * invTd, (u_cropMax - to) * invTd);
-    vec2 crop = vec2(max(max(cropLo.x, cropLo.y), cropLo.z), min(min(cropHi.x, cropHi.y), cropHi.z));
+    vec2 crop =
+        vec2(max(max(cropLo.x, cropLo.y), cropLo.z), min(min(cropHi.x, cropHi.y), cropHi.z));
     k = max(0.0, floor((crop.x - t0) / u_step - j));
     t1 = min(t1, crop.y + 0.5 * u_step);
 #endif

@@ -1,8 +1,8 @@
 // One sample as every layout-based technique takes it: the layout's
-// reconstruction (sampleVolume; with NEAREST the voxel's own value), the value window, the transfer function,
-// and with SHADING the light (render/shading.glsl, from
-// sampleVolumeGradient). Techniques call this instead of writing the chain
-// in their main(), so a stage added here reaches all of them.
+// reconstruction (sampleVolume; with NEAREST the voxel's own value), the value window, the transfer
+// function, and with SHADING the light (render/shading.glsl, from sampleVolumeGradient). Techniques
+// call this instead of writing the chain in their main(), so a stage added here reaches all of
+// them.
 #ifdef NEAREST
 uniform vec3 u_sampleDims;  // the volume's dims
 
@@ -13,7 +13,9 @@ float fieldValue(vec3 p) {
   return sampleVolume((cell + 0.5) / u_sampleDims);
 }
 #else
-float fieldValue(vec3 p) { return sampleVolume(p); }
+float fieldValue(vec3 p) {
+  return sampleVolume(p);
+}
 #endif
 
 #ifdef SHADING
