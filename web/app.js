@@ -101,6 +101,7 @@
       setMode: c('tessera_set_mode', null, ['number']),
       setStep: c('tessera_set_step', 'number', ['number']),
       setOpacityScale: c('tessera_set_opacity_scale', null, ['number']),
+      setShading: c('tessera_set_shading', null, ['number']),
       setOverlays: c('tessera_set_overlays', null, ['number', 'number']),
       setQuality: c('tessera_set_quality', null, ['number']),
       setMaxVolumePixels: c('tessera_set_max_volume_pixels', null, ['number']),
@@ -593,6 +594,7 @@
       requestRender();
     });
     $('opacity').addEventListener('input', (e) => { api.setOpacityScale(+e.target.value); requestRender(); });
+    $('shade').addEventListener('change', (e) => { api.setShading(e.target.checked ? 1 : 0); requestRender(); });
     const overlays = () => { api.setOverlays($('box').checked ? 1 : 0, $('axes').checked ? 1 : 0); requestRender(); };
     $('box').addEventListener('change', overlays);
     $('axes').addEventListener('change', overlays);

@@ -13,6 +13,7 @@
 #include "app/BenchSlicing.h"
 #include "app/Commands.h"
 #include "app/RenderJob.h"
+#include "app/ShadingOptions.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"
@@ -53,6 +54,7 @@ struct BenchOptions {
   bool printTf = false;
   bool roofline = false;
   int fetches = 128;
+  ShadingOptions shading;
 };
 
 struct Variant {
@@ -103,11 +105,18 @@ void runBench(const BenchOptions& o) {
   variants.push_back({"ERT + empty-space skipping 4^3", 4, 0.99, nullptr, {}, {}, 0, 0, 0});
   variants.push_back({"ERT + empty-space skipping 8^3", 8, 0.99, nullptr, {}, {}, 0, 0, 0});
   variants.push_back({"ERT + empty-space skipping 16^3", 16, 0.99, nullptr, {}, {}, 0, 0, 0});
+  const Shading shading = shadingFrom(o.shading);
+  if (shading.enabled) {
+    // What shading costs, in the same run: the default accelerations unshaded.
+    variants.push_back({"ERT + skipping 8^3, unshaded", 8, 0.99, nullptr, {}, {}, 0, 0, 0});
+  }
   Camera camera;
   camera.frame(volume);
   for (Variant& v : variants) {
     v.settings.stepVoxels = o.step;
     v.settings.ertThreshold = v.ert;
+    v.settings.shading = shading;
+    if (std::string(v.name).ends_with("unshaded")) v.settings.shading.enabled = false;
     v.caster = raycaster(*context, limits, volume, *upload.layout, v.skipBlock);
     v.caster->setTransferFunction(tf);
     v.caster->prepare(camera, v.settings);
@@ -149,6 +158,7 @@ void runBench(const BenchOptions& o) {
                       {"psnr_db", v.psnrDb},
                       {"ssim", v.ssim},
                       {"samples_per_ray", v.samplesPerRay},
+                      {"shade", v.settings.shading.enabled},
                       {"occupied_block_fraction", v.caster->report().occupiedBlockFraction}});
     }
     nlohmann::json j;
@@ -161,8 +171,9 @@ void runBench(const BenchOptions& o) {
     std::printf("%s\n", j.dump(2).c_str());
     return;
   }
-  std::printf("ray casting %s at %dx%d, %d frames rotating %g deg, step %g voxel, TF %s\n",
-              spec.c_str(), width, height, o.frames, o.rotate, o.step, o.tf.c_str());
+  std::printf("ray casting %s at %dx%d, %d frames rotating %g deg, step %g voxel, TF %s%s\n",
+              spec.c_str(), width, height, o.frames, o.rotate, o.step, o.tf.c_str(),
+              shading.enabled ? ", shaded (but the unshaded row)" : "");
   std::printf("GL: %s; variants interleaved frame by frame\n\n", context->caps().renderer.c_str());
   std::printf(
       "| variant | median ms | min ms | max ms | occupied blocks | samples/ray (ref, frame 0) | "
@@ -224,6 +235,7 @@ void runLayoutBench(const BenchOptions& o) {
                       {}});
   RenderSettings settings;
   settings.stepVoxels = o.step;
+  settings.shading = shadingFrom(o.shading);
   Camera camera;
   camera.frame(volume);
   for (LayoutVariant& v : variants) {
@@ -310,6 +322,7 @@ void addBenchCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--step", o->step, "Sample distance in voxels")->capture_default_str();
   cmd->add_option("--tf", o->tf, "Transfer function preset or JSON file")->capture_default_str();
+  addShadingOptions(cmd, o->shading);
   cmd->add_flag("--layouts", o->layouts,
                 "Compare layouts (texture3d, mosaic, packed-mosaic) instead of accelerations");
   cmd->add_flag("--fcc", o->fcc,

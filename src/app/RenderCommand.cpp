@@ -6,9 +6,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/ClippingOptions.h"
 #include "app/Commands.h"
 #include "app/HybridJob.h"
 #include "app/RenderJob.h"
+#include "app/ShadingOptions.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"
@@ -20,6 +22,7 @@
 #include "tessera/lod/MultiresVolumeSource.h"
 #include "tessera/lod/ProceduralMultiresSource.h"
 #include "tessera/lod/ZarrMultiresSource.h"
+#include "tessera/render/LabelTable.h"
 #include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::app {
@@ -66,6 +69,12 @@ struct RenderOptions {
   std::string overlayOpacity = "alpha";
   std::string offscreen;
   std::string roi;
+  ShadingOptions shading;
+  ClippingOptions clipping;
+  // --labels [TABLE]: a label volume through a categorical table.
+  std::string labels;
+  CLI::Option* labelsOption = nullptr;
+  bool labelVolume() const { return labelsOption != nullptr && labelsOption->count() > 0; }
 };
 
 nlohmann::json numberOrNull(std::optional<double> v) {
@@ -123,13 +132,23 @@ RenderRequest requestFrom(const RenderOptions& o) {
     req.settings.mode = RenderMode::Composite;
   else if (o.mode == "mip")
     req.settings.mode = RenderMode::Mip;
+  else if (o.mode == "minip")
+    req.settings.mode = RenderMode::MinIp;
+  else if (o.mode == "average")
+    req.settings.mode = RenderMode::Average;
   else
-    throw InputError("--mode '" + o.mode + "': expected composite or mip");
+    throw InputError("--mode '" + o.mode + "': expected composite, mip, minip or average");
   req.settings.stepVoxels = o.step;
   req.settings.maxSteps = o.maxSteps;
   req.settings.opacityScale = o.opacityScale;
   req.settings.ertThreshold = o.ert;
   req.settings.jitter = o.jitter;
+  req.settings.shading = shadingFrom(o.shading);
+  req.settings.clipping = clippingFrom(o.clipping);
+  if (o.labelVolume()) {
+    req.settings.nearest = true;  // no interpolation across labels
+    req.lutSize = 256;            // one table entry per label value
+  }
   if (o.background.size() != 3) throw InputError("--background takes three numbers R G B in [0,1]");
   req.settings.background = glm::dvec4(o.background[0], o.background[1], o.background[2], 1.0);
   req.repeat = o.repeat;
@@ -142,7 +161,7 @@ RenderRequest requestFrom(const RenderOptions& o) {
   }
   req.technique = o.technique;
   req.skipBlock = o.skipBlock;
-  req.lutSize = o.lut;
+  req.lutSize = o.labelVolume() ? 256 : o.lut;
   req.slices = o.slices;
   req.classify = o.classify;
   req.layout = latticeLayout(o);
@@ -169,6 +188,7 @@ lod::InCoreVolumeSource loadVolume(const RenderOptions& o, const std::string& sp
     if (o.window.size() != 2) throw InputError("--window takes two numbers MIN MAX");
     volume.setWindow({o.window[0], o.window[1]});
   }
+  if (o.labelVolume()) render::prepareLabelVolume(volume);
   return lod::InCoreVolumeSource(std::move(volume));
 }
 
@@ -246,6 +266,7 @@ void printRenderJson(const RenderOptions& o, const RenderRequest& req, const Ren
   j["mode"] = o.mode;
   j["technique"] = o.technique;
   j["step_voxels"] = o.step;
+  j["shade"] = o.shading.shade;
   j["tf"] = tf.name;
   std::printf("%s\n", j.dump(2).c_str());
 }
@@ -310,7 +331,8 @@ void runRenderCommand(const RenderOptions& o) {
   const auto tStart = std::chrono::steady_clock::now();
   const RenderRequest req = requestFrom(o);
   const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
-  const TransferFunction tf = TransferFunction::fromPresetOrFile(o.tf);
+  TransferFunction tf =
+      o.labelVolume() ? TransferFunction() : TransferFunction::fromPresetOrFile(o.tf);
   // The profile first: it sets the host budget the reader must respect.
   DeviceSession device = openDevice(o.profile);
   RenderTimes times;
@@ -329,6 +351,12 @@ void runRenderCommand(const RenderOptions& o) {
     return;
   }
   const lod::InCoreVolumeSource source = loadVolume(o, spec);
+  if (o.labelVolume()) {
+    const render::LabelTable table = o.labels.empty()
+                                         ? render::LabelTable::defaultFor(source.volume())
+                                         : render::LabelTable::load(o.labels);
+    tf = table.toTransferFunction();
+  }
   times.loadMs = msSince(tLoad);
 
   if (o.lattice == "fcc") checkSamplesLayout(o, device, source, req);
@@ -374,7 +402,11 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--fov", o->fov, "Vertical field of view in degrees (perspective)")
       ->capture_default_str();
   cmd->add_flag("--ortho", o->ortho, "Orthographic projection");
-  cmd->add_option("--mode", o->mode, "composite or mip")->capture_default_str();
+  cmd->add_option("--mode", o->mode,
+                  "composite, mip (maximum), minip (minimum) or average (mean of the ray's "
+                  "samples): the projections show the TF colour of their value; minip and "
+                  "average by raycast only")
+      ->capture_default_str();
   cmd->add_option("--step", o->step, "Sample distance in voxels (of the smallest spacing)")
       ->capture_default_str();
   cmd->add_option("--max-steps", o->maxSteps, "Maximum samples per ray")->capture_default_str();
@@ -383,6 +415,17 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--ert", o->ert, "Early ray termination threshold (>= 1 disables)")
       ->capture_default_str();
   cmd->add_flag("--jitter", o->jitter, "Jitter the first sample per pixel");
+  addShadingOptions(cmd, o->shading);
+  addClippingOptions(cmd, o->clipping);
+  o->labelsOption =
+      cmd->add_option("--labels", o->labels,
+                      "Render a label volume (atlas, 8-bit integer labels): nearest-neighbour "
+                      "sampling and a categorical colour table instead of --tf. TABLE (optional): "
+                      "JSON {\"labels\": [{\"value\", \"name\", \"color\": [r,g,b] 0..1, "
+                      "\"opacity\", \"visible\"}]} or a label text file (ITK-SNAP, FreeSurfer "
+                      "LUT, or mricron's IDX NAME); labels it does not name are hidden. Without "
+                      "TABLE: a default palette for every label present")
+          ->expected(0, 1);
   cmd->add_option("--window", o->window,
                   "Value window MIN MAX (raw values); default: the value range")
       ->expected(2);

@@ -10,8 +10,10 @@
 #include <sstream>
 #include <string>
 
+#include "app/ClippingOptions.h"
 #include "app/Commands.h"
 #include "app/RenderJob.h"
+#include "app/ShadingOptions.h"
 #include "tessera/core/Error.h"
 
 #ifdef TESSERA_DESKTOP_VIEWER
@@ -47,6 +49,8 @@ struct ViewOptions {
   std::string screenshot;
   int frames = 3;
   bool helpOverlay = false;
+  ShadingOptions shading;
+  ClippingOptions clipping;
 };
 
 #ifdef TESSERA_DESKTOP_VIEWER
@@ -458,9 +462,9 @@ void panelWindowLevel(viewer::Viewer& v) {
 void panelRendering(DesktopSession& ds) {
   viewer::Viewer& v = *ds.viewer;
   section("Rendering");
-  int mode = v.settings().mode == RenderMode::Mip ? 1 : 0;
-  if (ImGui::Combo("mode", &mode, "composite\0MIP\0")) {
-    v.settings().mode = mode ? RenderMode::Mip : RenderMode::Composite;
+  int mode = static_cast<int>(v.settings().mode);
+  if (ImGui::Combo("mode", &mode, "composite\0MIP\0MinIP\0average\0")) {
+    v.settings().mode = static_cast<RenderMode>(mode);
   }
   if (ImGui::BeginCombo("technique", v.technique().c_str())) {
     for (const std::string& t : render::TechniqueRegistry::global().names()) {
@@ -488,6 +492,55 @@ void panelRendering(DesktopSession& ds) {
   if (ImGui::Button("Reset view")) v.resetCamera();
 }
 
+// The crop box (fractions of each axis) and a clip plane that follows the camera.
+void panelClipping(viewer::Viewer& v) {
+  section("Clipping");
+  Clipping& c = v.settings().clipping;
+  for (int a = 0; a < 3; ++a) {
+    float range[2] = {static_cast<float>(c.cropMin[a]), static_cast<float>(c.cropMax[a])};
+    const std::string label = std::string("crop ") + "xyz"[a];
+    if (ImGui::SliderFloat2(label.c_str(), range, 0.0f, 1.0f) && range[0] < range[1] - 0.01f) {
+      c.cropMin[a] = range[0];
+      c.cropMax[a] = range[1];
+    }
+  }
+  if (c.cropped() && ImGui::Button("Reset crop")) {
+    c.cropMin = glm::dvec3(0.0);
+    c.cropMax = glm::dvec3(1.0);
+  }
+  ImGui::Checkbox("plane follows camera", &v.clipPlaneFollowsCamera);
+  if (v.clipPlaneFollowsCamera) {
+    const float reach = static_cast<float>(0.5 * glm::length(v.volume().extent()));
+    float d = static_cast<float>(v.followingPlaneDistance);
+    if (ImGui::SliderFloat("plane depth (mm)", &d, -reach, reach)) v.followingPlaneDistance = d;
+  }
+}
+
+// Blinn-Phong shading (RenderSettings::shading): on/off, the light, the terms.
+void panelShading(viewer::Viewer& v) {
+  section("Shading");
+  Shading& s = v.settings().shading;
+  ImGui::Checkbox("shade (gradient lighting)", &s.enabled);
+  if (!s.enabled) return;
+  ImGui::Checkbox("headlight", &s.headlight);
+  if (!s.headlight) {
+    float dir[3] = {static_cast<float>(s.lightDirection.x), static_cast<float>(s.lightDirection.y),
+                    static_cast<float>(s.lightDirection.z)};
+    if (ImGui::SliderFloat3("light (RAS)", dir, -1.0f, 1.0f) &&
+        std::abs(dir[0]) + std::abs(dir[1]) + std::abs(dir[2]) > 1e-3f) {
+      s.lightDirection = {dir[0], dir[1], dir[2]};
+    }
+  }
+  auto slider = [](const char* label, double& value, float lo, float hi) {
+    float f = static_cast<float>(value);
+    if (ImGui::SliderFloat(label, &f, lo, hi)) value = f;
+  };
+  slider("ambient", s.ambient, 0.0f, 1.0f);
+  slider("diffuse", s.diffuse, 0.0f, 1.0f);
+  slider("specular", s.specular, 0.0f, 1.0f);
+  slider("shininess", s.shininess, 1.0f, 128.0f);
+}
+
 // The control panel at the window's left edge.
 void drawPanel(DesktopSession& ds, int windowHeight) {
   ImGui::SetNextWindowPos(ImVec2(0, 0));
@@ -498,6 +551,8 @@ void drawPanel(DesktopSession& ds, int windowHeight) {
   panelTransferFunction(ds);
   panelWindowLevel(*ds.viewer);
   panelRendering(ds);
+  panelShading(*ds.viewer);
+  panelClipping(*ds.viewer);
   ImGui::Separator();
   ImGui::TextWrapped("%s", ds.status.c_str());
   ImGui::End();
@@ -514,6 +569,16 @@ std::string viewKey(viewer::Viewer& v, int viewW, int viewH) {
       << v.settings().opacityScale << '|' << v.window().min << v.window().max << '|'
       << v.technique() << static_cast<int>(v.quality) << v.controller().interacting() << '|'
       << v.showBoundingBox << v.showAxes << '|' << viewW << 'x' << viewH;
+  const RenderSettings fs = v.frameSettings();
+  for (const ClipPlane& p : fs.clipping.planes) {
+    key << "|p" << p.normal.x << ',' << p.normal.y << ',' << p.normal.z << ',' << p.distance;
+  }
+  key << "|c" << fs.clipping.cropMin.x << fs.clipping.cropMin.y << fs.clipping.cropMin.z << ','
+      << fs.clipping.cropMax.x << fs.clipping.cropMax.y << fs.clipping.cropMax.z;
+  const Shading& sh = v.settings().shading;
+  key << '|' << sh.enabled << sh.headlight << sh.lightDirection.x << ',' << sh.lightDirection.y
+      << ',' << sh.lightDirection.z << '|' << sh.ambient << ',' << sh.diffuse << ',' << sh.specular
+      << ',' << sh.shininess;
   return key.str();
 }
 
@@ -641,6 +706,8 @@ void runView(const ViewOptions& o) {
   if (!ds.error.empty() && !ds.viewer->hasVolume()) throw InputError(ds.error);
   ds.viewer->camera().azimuthDeg = o.azimuth;
   ds.viewer->camera().elevationDeg = o.elevation;
+  ds.viewer->settings().shading = shadingFrom(o.shading);
+  ds.viewer->settings().clipping = clippingFrom(o.clipping);
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -688,6 +755,8 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--frames", o->frames, "Frames before --screenshot")->capture_default_str();
   cmd->add_flag("--help-overlay", o->helpOverlay,
                 "Start with the keyboard shortcuts shown (F1 or ? toggles them)");
+  addShadingOptions(cmd, o->shading);
+  addClippingOptions(cmd, o->clipping);
   cmd->callback([o] { runView(*o); });
 }
 

@@ -40,4 +40,15 @@ double TrilinearReconstruction::value(glm::dvec3 p) const {
   return c0 * (1 - w.z) + c1 * w.z;
 }
 
+NearestReconstruction::NearestReconstruction(const Volume& volume) : dims_(volume.dims()) {
+  data_.resize(static_cast<std::size_t>(volume.voxelCount()));
+  for (std::size_t i = 0; i < data_.size(); ++i) data_[i] = volume.finiteValueAtIndex(i);
+}
+
+double NearestReconstruction::value(glm::dvec3 p) const {
+  const glm::ivec3 i =
+      glm::clamp(glm::ivec3(glm::floor(p * glm::dvec3(dims_))), glm::ivec3(0), dims_ - 1);
+  return data_[(static_cast<std::size_t>(i.z) * dims_.y + i.y) * dims_.x + i.x];
+}
+
 }  // namespace tessera

@@ -42,6 +42,10 @@ double sampleTrilinear(const Volume& volume, glm::dvec3 p) {
 Image renderReference(const Volume& volume, const TransferFunction& tf, const Camera& camera,
                       const RenderSettings& settings, int width, int height, int threads,
                       ReferenceStats* stats, const ReferenceStops* stops) {
+  if (settings.nearest) {
+    return renderReference(volume, NearestReconstruction(volume), tf, camera, settings, width,
+                           height, threads, stats, stops);
+  }
   return renderReference(volume, TrilinearReconstruction(volume), tf, camera, settings, width,
                          height, threads, stats, stops);
 }
@@ -57,6 +61,14 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
   const ValueRange win = volume.window();
   const double ww = win.max - win.min;
   const glm::dvec4 bg = settings.background;
+  // Shading (core/RenderSettings.h): the field's gradient per texture unit ->
+  // normalised value per model length, times the smallest voxel.
+  const bool shade = settings.shading.enabled && settings.mode == RenderMode::Composite;
+  const ShadingLight light =
+      shadingLight(settings.shading, camera.basis()[2], camera.modelFromWorld);
+  const std::vector<glm::dvec4> clipPlanes =
+      clipHalfSpaces(settings.clipping, camera.modelFromWorld, extent);
+  const glm::dvec3 gradientScale = std::min({spacing.x, spacing.y, spacing.z}) / (ww * extent);
 
   Image image(width, height);
   std::atomic<int> nextRow{0};
@@ -91,6 +103,8 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
         const double tEnd = std::min(tFar, tStop);
         glm::dvec4 acc(0.0);
         double maxValue = -1.0;
+        double minValue = 2.0, sumValue = 0.0;
+        std::uint64_t kept = 0;
         if (t0 < tEnd) {
           ++hits;
           const double j = settings.jitter
@@ -100,21 +114,32 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
             const double t = t0 + (k + j) * ds;
             if (t >= tEnd) break;
             ++samples;
-            const double raw = field.value(to + t * td);
+            const glm::dvec3 p = to + t * td;
+            if (!clipKeeps(settings.clipping, clipPlanes, p)) continue;  // dropped, not moved
+            const double raw = field.value(p);
             const double n = std::clamp((raw - win.min) / ww, 0.0, 1.0);
-            if (settings.mode == RenderMode::Mip) {
+            if (isProjection(settings.mode)) {
               maxValue = std::max(maxValue, n);
+              minValue = std::min(minValue, n);
+              sumValue += n;
+              ++kept;
               continue;
             }
-            const glm::dvec3 c = tf.color(n);
+            glm::dvec3 c = tf.color(n);
             const double a = tf.correctedOpacity(n, ds, settings.opacityScale);
+            if (shade && a > 0.0) {
+              c = shadeBlinnPhong(c, field.gradient(p) * gradientScale, settings.shading, light);
+            }
             acc += (1.0 - acc.a) * glm::dvec4(c * a, a);
             if (acc.a >= settings.ertThreshold) break;
           }
         }
-        if (settings.mode == RenderMode::Mip && maxValue >= 0.0) {
-          // MIP shows the TF colour of the maximum, opaque.
-          acc = glm::dvec4(tf.color(maxValue), 1.0);
+        if (isProjection(settings.mode) && kept > 0) {
+          // The projections show the TF colour of their value, opaque.
+          const double shown = settings.mode == RenderMode::Mip     ? maxValue
+                               : settings.mode == RenderMode::MinIp ? minValue
+                                                                    : sumValue / kept;
+          acc = glm::dvec4(tf.color(shown), 1.0);
         }
         const glm::dvec4 under =
             stopped ? glm::dvec4(glm::dvec3(stopColor[0], stopColor[1], stopColor[2]) / 255.0, 1.0)

@@ -10,6 +10,8 @@
 #include "tessera/core/Error.h"
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/Draw.h"
+#include "tessera/render/ClippingUniforms.h"
+#include "tessera/render/ShadingUniforms.h"
 
 namespace tessera::render {
 
@@ -150,7 +152,15 @@ void Raycaster::uploadBlocks(const std::vector<std::uint8_t>& cells) {
 std::vector<std::string> Raycaster::definesFor(const RenderSettings& settings) const {
   std::vector<std::string> defines;
   if (settings.mode == RenderMode::Mip) defines.push_back("MODE_MIP 1");
-  if (blockSize_ > 0) defines.push_back("EMPTY_SPACE_SKIPPING 1");
+  if (settings.mode == RenderMode::MinIp) defines.push_back("MODE_MINIP 1");
+  if (settings.mode == RenderMode::Average) defines.push_back("MODE_AVERAGE 1");
+  // The block grid knows which blocks are transparent and their maxima: it
+  // serves composite and MIP; MinIP and the average need every sample.
+  const bool skippable = settings.mode == RenderMode::Composite || settings.mode == RenderMode::Mip;
+  if (blockSize_ > 0 && skippable) defines.push_back("EMPTY_SPACE_SKIPPING 1");
+  addShadingDefines(settings, defines);
+  addClippingDefines(settings, defines);
+  if (settings.nearest) defines.push_back("NEAREST 1");
   defines.push_back("MAX_STEPS " + std::to_string(settings.maxSteps));
   return defines;
 }
@@ -168,8 +178,9 @@ std::vector<gpu::ShaderPart> Raycaster::fragmentParts(const RenderSettings& sett
       gpu::shaderPreamble(context_.caps().api, true, definesFor(settings)),
       gpu::embeddedShaderPart("render/camera_ray.glsl")};
   for (gpu::ShaderPart& part : layout_.seamParts()) parts.push_back(std::move(part));
-  for (const char* file : {"render/classify.glsl", "render/sample.glsl", "render/composite.glsl",
-                           "render/raycast.frag.glsl"}) {
+  for (const char* file :
+       {"render/classify.glsl", "render/shading.glsl", "render/clipping.glsl", "render/sample.glsl",
+        "render/composite.glsl", "render/raycast.frag.glsl"}) {
     parts.push_back(gpu::embeddedShaderPart(file));
   }
   return parts;
@@ -186,7 +197,7 @@ const gpu::Program& Raycaster::programFor(const RenderSettings& settings) {
 void Raycaster::prepare(const RenderSettings& settings) {
   const glm::dvec3 spacing = volume_.spacing();
   const double ds = settings.stepVoxels * std::min({spacing.x, spacing.y, spacing.z});
-  updateLookup(settings, settings.mode == RenderMode::Mip ? tf_.opacityUnitLength : ds);
+  updateLookup(settings, isProjection(settings.mode) ? tf_.opacityUnitLength : ds);
   programFor(settings);
 }
 
@@ -210,7 +221,7 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
   const double ds = settings.stepVoxels * std::min({spacing.x, spacing.y, spacing.z});
   // MIP shows one classified sample, so its table is not distance-corrected
   // (correcting for one unit length leaves opacity as it is).
-  updateLookup(settings, settings.mode == RenderMode::Mip ? tf_.opacityUnitLength : ds);
+  updateLookup(settings, isProjection(settings.mode) ? tf_.opacityUnitLength : ds);
 
   if (target_.id() == 0 || target_.width() != width || target_.height() != height) {
     target_ = gpu::Framebuffer();
@@ -246,6 +257,9 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
   const double ww = w.max - w.min;
   prog.set("u_valueScale", static_cast<float>(m.scale / ww));
   prog.set("u_valueBias", static_cast<float>((m.offset - w.min) / ww));
+  setShadingUniforms(prog, settings, camera, m.scale / ww, volume_.extent(), spacing);
+  setClippingUniforms(prog, settings, camera, volume_.extent());
+  if (settings.nearest) prog.set("u_sampleDims", glm::vec3(volume_.dims()));
 
   int unit = layout_.bindSeam(prog, 0);
   lut_.texture().bind(unit);

@@ -10,6 +10,8 @@
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
 #include "tessera/gpu/Draw.h"
+#include "tessera/render/ClippingUniforms.h"
+#include "tessera/render/ShadingUniforms.h"
 #include "tessera/render/SliceProjection.h"
 
 namespace tessera::render {
@@ -155,7 +157,7 @@ void Slice2DRenderer::uploadStack(int axis) {
   const SliceAtlasPlan& p = plans_[axis];
   const bool pre = options_.classification == SliceClassification::Pre;
   const gpu::TexelFormat format =
-      pre ? gpu::rgba8For(context_.caps().api) : gpu::r8For(context_.caps().api);
+      pre || shadedStacks_ ? gpu::rgba8For(context_.caps().api) : gpu::r8For(context_.caps().api);
   const bool recreate = atlases_[axis].size() != static_cast<std::size_t>(p.atlases);
   if (recreate) atlases_[axis].clear();
   // Filled and uploaded a band (one row of tiles) at a time: the host copy
@@ -174,7 +176,11 @@ void Slice2DRenderer::uploadStack(int axis) {
     }
     gpu::Texture& atlas = atlases_[axis][static_cast<std::size_t>(i)];
     for (int b = 0; b < p.bands(); ++b) {
-      stacks_.fillAtlasBand(p, i, b, pre ? palette8_.data() : nullptr, band);
+      if (shadedStacks_) {
+        stacks_.fillShadingAtlasBand(p, i, b, band);
+      } else {
+        stacks_.fillAtlasBand(p, i, b, pre ? palette8_.data() : nullptr, band);
+      }
       atlas.updateRegion({0, b * p.tile.y, 0}, {p.atlasSize.x, p.bandRows(b), 1}, band.data());
     }
   }
@@ -195,14 +201,16 @@ void Slice2DRenderer::updateClassification(const RenderSettings& settings) {
   const ValueRange w = volume_.window();
   std::ostringstream key;
   key.precision(17);
-  key << settings.opacityScale << '|' << w.min << '|' << w.max << '|' << tf_.toJson();
+  key << settings.opacityScale << '|' << w.min << '|' << w.max << '|' << settings.nearest << '|'
+      << tf_.toJson();
   if (key.str() == classificationKey_) return;
   classificationKey_ = key.str();
   ++classificationUpdates_;
   const double ds0 = baseDistance();
   switch (options_.classification) {
     case SliceClassification::Post:
-      table_.upload(context_, tf_.bake(4096, ds0, settings.opacityScale),
+      // Nearest (labels): one entry per 8-bit value, never mixed with a neighbour's.
+      table_.upload(context_, tf_.bake(settings.nearest ? 256 : 4096, ds0, settings.opacityScale),
                     "slice2d transfer function");
       return;
     case SliceClassification::Palette:
@@ -241,25 +249,48 @@ std::vector<gpu::ShaderPart> Slice2DRenderer::fragmentParts(const RenderSettings
     defines.push_back("CLASSIFY_PALETTE 1");
   }
   if (settings.mode == RenderMode::Mip) defines.push_back("MODE_MIP 1");
+  addShadingDefines(settings, defines);
+  addClippingDefines(settings, defines);
+  if (settings.nearest) defines.push_back("NEAREST 1");
   return {gpu::shaderPreamble(context_.caps().api, true, defines),
           gpu::embeddedShaderPart("render/classify.glsl"),
+          gpu::embeddedShaderPart("render/shading.glsl"),
+          gpu::embeddedShaderPart("render/clipping.glsl"),
           gpu::embeddedShaderPart("render/slice_opacity.glsl"),
           gpu::embeddedShaderPart("render/slice2d.frag.glsl")};
 }
 
 const gpu::Program& Slice2DRenderer::programFor(const RenderSettings& settings) {
-  const std::string key = std::string(sliceClassificationName(options_.classification)) +
-                          (settings.mode == RenderMode::Mip ? "|mip" : "");
+  const std::string key =
+      std::string(sliceClassificationName(options_.classification)) +
+      (settings.mode == RenderMode::Mip ? "|mip" : "") + (shadingActive(settings) ? "|shade" : "") +
+      (settings.clipping.active() ? "|clip" : "") + (settings.nearest ? "|nearest" : "");
   return programs_.get(key, [&] {
     return gpu::Program::build("slice2d(" + key + ")", vertexParts(), fragmentParts(settings));
   });
 }
 
 void Slice2DRenderer::prepare(const Camera& camera, const RenderSettings& settings) {
+  if (settings.mode == RenderMode::MinIp || settings.mode == RenderMode::Average) {
+    throw InputError(
+        "slice2d blends composite and MIP only; MinIP and the average need the ray "
+        "caster (--technique raycast)");
+  }
   if (settings.mode == RenderMode::Mip && options_.classification != SliceClassification::Post) {
     throw InputError(
         "MIP by axis-aligned slicing needs --classify post (the maximum of "
         "classified colours is not the colour of the maximum)");
+  }
+  const bool shade = shadingActive(settings);
+  if (shade && options_.classification != SliceClassification::Post) {
+    throw InputError(
+        "shading by axis-aligned slicing needs --classify post (the gradient is taken from "
+        "the slices' values)");
+  }
+  if (shade != shadedStacks_) {
+    // Shaded stacks carry each slice's neighbours (SliceStacks::fillShadingAtlasBand).
+    for (auto& list : atlases_) list.clear();
+    shadedStacks_ = shade;
   }
   // Classification first: pre-classified stacks are created from its palette.
   updateClassification(settings);
@@ -289,6 +320,7 @@ void Slice2DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
   // Front to back: looking towards +axis, the low slices are nearest.
   const DrawList& list = drawList(axis, forward[axis] < 0.0, slices);
 
+  const bool shade = shadingActive(settings);
   accumulator_.begin(width, height, settings.mode);
   const gpu::Program& prog = programFor(settings);
   prog.use();
@@ -306,6 +338,22 @@ void Slice2DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
   prog.set("u_forward", glm::vec3(forward));
   prog.set("u_ortho", camera.projection == Projection::Orthographic ? 1.0f : 0.0f);
   prog.set("u_atlas", 0);
+  if (settings.clipping.active()) {
+    setClippingUniforms(prog, settings, camera, volume_.extent());
+    prog.set("u_invExtent", glm::vec3(1.0 / volume_.extent()));
+  }
+  if (shade) {
+    // The stacks hold the window's normalised value quantised: one per stored unit.
+    setShadingUniforms(prog, settings, camera, 1.0, volume_.extent(), volume_.spacing());
+    const glm::ivec2 a = sliceTileAxes(axis);
+    glm::vec3 u(0.0f), v(0.0f);
+    u[a.x] = 1.0f;
+    v[a.y] = 1.0f;
+    prog.set("u_tileAxisU", u);
+    prog.set("u_tileAxisV", v);
+    prog.set("u_halfDims",
+             glm::vec3(volume_.dims()[a.x], volume_.dims()[a.y], volume_.dims()[axis]) * 0.5f);
+  }
   if (options_.classification == SliceClassification::Post) {
     table_.texture().bind(1);
     prog.set("u_tf", 1);

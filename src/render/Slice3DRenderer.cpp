@@ -9,6 +9,8 @@
 
 #include "tessera/core/Error.h"
 #include "tessera/gpu/Draw.h"
+#include "tessera/render/ClippingUniforms.h"
+#include "tessera/render/ShadingUniforms.h"
 #include "tessera/render/SliceProjection.h"
 
 namespace tessera::render {
@@ -87,10 +89,12 @@ void Slice3DRenderer::updateLookup(const RenderSettings& settings, double spacin
   std::ostringstream key;
   key.precision(17);
   key << spacing << '|' << settings.opacityScale << '|' << w.min << '|' << w.max << '|'
-      << tf_.toJson();
+      << settings.nearest << '|' << tf_.toJson();
   if (key.str() == lookupKey_) return;
   lookupKey_ = key.str();
-  lut_.upload(context_, tf_.bake(4096, spacing, settings.opacityScale),
+  // Nearest (labels): 256 entries, one per 8-bit value, so that a label's
+  // entry is never mixed with its neighbour's.
+  lut_.upload(context_, tf_.bake(settings.nearest ? 256 : 4096, spacing, settings.opacityScale),
               "slice3d transfer function");
 }
 
@@ -102,23 +106,35 @@ std::vector<gpu::ShaderPart> Slice3DRenderer::vertexParts() const {
 std::vector<gpu::ShaderPart> Slice3DRenderer::fragmentParts(const RenderSettings& settings) const {
   std::vector<std::string> defines;
   if (settings.mode == RenderMode::Mip) defines.push_back("MODE_MIP 1");
+  addShadingDefines(settings, defines);
+  addClippingDefines(settings, defines);
+  if (settings.nearest) defines.push_back("NEAREST 1");
   std::vector<gpu::ShaderPart> parts = {gpu::shaderPreamble(context_.caps().api, true, defines)};
   for (gpu::ShaderPart& part : layout_.seamParts()) parts.push_back(std::move(part));
-  for (const char* file : {"render/classify.glsl", "render/sample.glsl",
-                           "render/slice_opacity.glsl", "render/slice3d.frag.glsl"}) {
+  for (const char* file :
+       {"render/classify.glsl", "render/shading.glsl", "render/clipping.glsl", "render/sample.glsl",
+        "render/slice_opacity.glsl", "render/slice3d.frag.glsl"}) {
     parts.push_back(gpu::embeddedShaderPart(file));
   }
   return parts;
 }
 
 const gpu::Program& Slice3DRenderer::programFor(const RenderSettings& settings) {
-  const std::string key = layout_.name() + (settings.mode == RenderMode::Mip ? "|mip" : "");
+  const std::string key = layout_.name() + (settings.mode == RenderMode::Mip ? "|mip" : "") +
+                          (shadingActive(settings) ? "|shade" : "") +
+                          (settings.clipping.active() ? "|clip" : "") +
+                          (settings.nearest ? "|nearest" : "");
   return programs_.get(key, [&] {
     return gpu::Program::build("slice3d(" + key + ")", vertexParts(), fragmentParts(settings));
   });
 }
 
 void Slice3DRenderer::prepare(const RenderSettings& settings) {
+  if (settings.mode == RenderMode::MinIp || settings.mode == RenderMode::Average) {
+    throw InputError(
+        "slice3d blends composite and MIP only; MinIP and the average need the ray "
+        "caster (--technique raycast)");
+  }
   const int n = sliceCountFor(settings);
   if (n != builtSlices_) buildGeometry(n);
   updateLookup(settings, settings.mode == RenderMode::Mip ? tf_.opacityUnitLength
@@ -158,6 +174,9 @@ void Slice3DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
   const double ww = w.max - w.min;
   prog.set("u_valueScale", static_cast<float>(m.scale / ww));
   prog.set("u_valueBias", static_cast<float>((m.offset - w.min) / ww));
+  setShadingUniforms(prog, settings, camera, m.scale / ww, extent, volume_.spacing());
+  setClippingUniforms(prog, settings, camera, extent);
+  if (settings.nearest) prog.set("u_sampleDims", glm::vec3(volume_.dims()));
   int unit = layout_.bindSeam(prog, 0);
   lut_.texture().bind(unit);
   prog.set("u_tf", unit);

@@ -110,6 +110,38 @@ void SliceStacks::fillAtlasBand(const SliceAtlasPlan& plan, int atlas, int band,
   fillAtlasRows(plan, atlas, y0, y0 + plan.bandRows(band), palette, out);
 }
 
+void SliceStacks::fillShadingAtlasBand(const SliceAtlasPlan& plan, int atlas, int band,
+                                       std::vector<std::uint8_t>& out) const {
+  const int y0 = band * plan.tile.y;
+  const int y1 = y0 + plan.bandRows(band);
+  const std::size_t rowBytes = static_cast<std::size_t>(plan.atlasSize.x) * 4;
+  out.assign(rowBytes * static_cast<std::size_t>(y1 - y0), 0);
+  const int first = atlas * plan.tilesPerAtlas;
+  const int last = std::min(plan.slices, first + plan.tilesPerAtlas);
+  const std::size_t stride[3] = {1, static_cast<std::size_t>(dims_.x),
+                                 static_cast<std::size_t>(dims_.x) * dims_.y};
+  const glm::ivec2 a = sliceTileAxes(plan.axis);
+  const std::size_t du = stride[a.x], dv = stride[a.y], di = stride[plan.axis];
+  for (int s = first; s < last; ++s) {
+    const glm::ivec2 o = plan.tileOrigin(s);
+    const std::size_t below = static_cast<std::size_t>(std::max(s - 1, 0)) * di;
+    const std::size_t here = static_cast<std::size_t>(s) * di;
+    const std::size_t above = static_cast<std::size_t>(std::min(s + 1, plan.slices - 1)) * di;
+    const int v0 = std::max(0, y0 - o.y), v1 = std::min(plan.tile.y, y1 - o.y);
+    for (int v = v0; v < v1; ++v) {
+      std::uint8_t* row = out.data() + static_cast<std::size_t>(o.y + v - y0) * rowBytes +
+                          static_cast<std::size_t>(o.x) * 4;
+      for (int u = 0; u < plan.tile.x; ++u) {
+        const std::size_t i = static_cast<std::size_t>(u) * du + static_cast<std::size_t>(v) * dv;
+        row[u * 4] = indices_[here + i];
+        row[u * 4 + 1] = indices_[below + i];
+        row[u * 4 + 2] = indices_[above + i];
+        row[u * 4 + 3] = 255;
+      }
+    }
+  }
+}
+
 void SliceStacks::fillAtlasRows(const SliceAtlasPlan& plan, int atlas, int y0, int y1,
                                 const std::uint8_t* palette, std::vector<std::uint8_t>& out) const {
   const int texelBytes = palette ? 4 : 1;

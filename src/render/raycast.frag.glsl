@@ -1,17 +1,21 @@
-// Single-pass ray caster for GLSL ES 1.00 and 3.00: ray-box intersection
-// here, no proxy pass; samples at t0 + (k + j) * ds; front-to-back
-// compositing of premultiplied colour (Noguera et al. 2012, eq. 1) with
-// early termination; MIP with MODE_MIP. The loop bound MAX_STEPS is a
-// compile-time constant, as GLSL ES 1.00 requires (Appendix A).
+// Single-pass ray caster for GLSL ES 1.00 and 3.00: the volume only through
+// the layout's sampleVolume() (render/sample.glsl: classifiedSample,
+// fieldValue); ray-box intersection here, no proxy pass; samples at
+// t0 + (k + j) * ds; front-to-back compositing of premultiplied colour
+// (Noguera et al. 2012, eq. 1) with early termination; MIP, MinIP and the
+// average with MODE_MIP, MODE_MINIP, MODE_AVERAGE; with CLIPPING the samples
+// that clip planes or the crop box reject are dropped (render/clipping.glsl).
+// The loop bound MAX_STEPS is a compile-time constant, as GLSL ES 1.00
+// requires (Appendix A).
 // With EMPTY_SPACE_SKIPPING, blocks whose every possible sample is
 // transparent (or cannot raise the maximum) are jumped over without changing
 // which samples are taken, so the image is the same as without skipping.
 
-uniform float u_step;      // world units
-uniform float u_maxSteps;  // the user's cap, <= MAX_STEPS
-uniform float u_ert;       // early termination threshold
-uniform float u_jitter;    // 1.0: dithered first sample
-uniform vec4 u_background; // premultiplied
+uniform float u_step;       // world units
+uniform float u_maxSteps;   // the user's cap, <= MAX_STEPS
+uniform float u_ert;        // early termination threshold
+uniform float u_jitter;     // 1.0: dithered first sample
+uniform vec4 u_background;  // premultiplied
 
 #ifdef EMPTY_SPACE_SKIPPING
 // The block grid: r = 1 where the TF gives some sample in the block opacity,
@@ -21,7 +25,9 @@ uniform vec3 u_blockCount;
 #if TESSERA_GLSL == 300
 uniform highp sampler3D u_blocks;
 
-vec4 blockAt(vec3 cell) { return texelFetch(u_blocks, ivec3(cell), 0); }
+vec4 blockAt(vec3 cell) {
+  return texelFetch(u_blocks, ivec3(cell), 0);
+}
 #else
 // Without 3D textures: the grid's z-slices side by side in a 2D texture.
 uniform sampler2D u_blocks;
@@ -51,12 +57,25 @@ void main() {
 
   vec4 acc = vec4(0.0);
   float maxValue = -1.0;
+  float minValue = 2.0;  // MinIP
+  float sumValue = 0.0;  // average
+  float kept = 0.0;      // samples the projections kept
   if (t0 < t1) {
     float j = 0.5;
     if (u_jitter > 0.5) {
       j = jitterOffset(floor(gl_FragCoord.x), u_viewport.y - 1.0 - floor(gl_FragCoord.y));
     }
     float k = 0.0;  // sample index; a float so GLSL ES 1.00 needs no integer maths
+#ifdef CLIPPING
+    // March only through the crop box, from the box-aligned sample at or just
+    // before its entry (clipKeeps drops any sample outside): no sample moves.
+    vec3 cropLo = min((u_cropMin - to) * invTd, (u_cropMax - to) * invTd);
+    vec3 cropHi = max((u_cropMin - to) * invTd, (u_cropMax - to) * invTd);
+    vec2 crop =
+        vec2(max(max(cropLo.x, cropLo.y), cropLo.z), min(min(cropHi.x, cropHi.y), cropHi.z));
+    k = max(0.0, floor((crop.x - t0) / u_step - j));
+    t1 = min(t1, crop.y + 0.5 * u_step);
+#endif
     for (int i = 0; i < MAX_STEPS; i++) {
       if (k >= u_maxSteps) break;
       float t = t0 + (k + j) * u_step;
@@ -79,8 +98,20 @@ void main() {
         continue;
       }
 #endif
-#ifdef MODE_MIP
-      maxValue = max(maxValue, normalizedValue(sampleVolume(p)));
+#ifdef CLIPPING
+      if (!clipKeeps(p)) {
+        k += 1.0;
+        continue;
+      }
+#endif
+#if defined(MODE_MIP)
+      maxValue = max(maxValue, normalizedValue(fieldValue(p)));
+#elif defined(MODE_MINIP)
+      minValue = min(minValue, normalizedValue(fieldValue(p)));
+      kept += 1.0;
+#elif defined(MODE_AVERAGE)
+      sumValue += normalizedValue(fieldValue(p));
+      kept += 1.0;
 #else
       compositeFrontToBack(acc, classifiedSample(p));
       if (acc.a >= u_ert) break;
@@ -94,6 +125,10 @@ void main() {
     // with the grey preset the pixel is the maximum intensity).
     acc = vec4(classify(maxValue).rgb, 1.0);
   }
+#elif defined(MODE_MINIP)
+  if (kept > 0.0) acc = vec4(classify(minValue).rgb, 1.0);
+#elif defined(MODE_AVERAGE)
+  if (kept > 0.0) acc = vec4(classify(sumValue / kept).rgb, 1.0);
 #endif
   FRAG_COLOR = overBackground(acc, u_background);
 }

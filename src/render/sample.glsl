@@ -1,7 +1,36 @@
 // One sample as every layout-based technique takes it: the layout's
-// reconstruction (sampleVolume), the value window, the transfer function.
-// Techniques call this instead of writing the chain in their main(), so a
-// stage added here (shading from sampleVolumeGradient) reaches all of them.
+// reconstruction (sampleVolume; with NEAREST the voxel's own value), the value window, the transfer
+// function, and with SHADING the light (render/shading.glsl, from sampleVolumeGradient). Techniques
+// call this instead of writing the chain in their main(), so a stage added here reaches all of
+// them.
+#ifdef NEAREST
+uniform vec3 u_sampleDims;  // the volume's dims
+
+// The value of the voxel whose cell holds p, read at its centre (where the
+// layout's interpolation weights vanish): no interpolation across labels.
+float fieldValue(vec3 p) {
+  vec3 cell = clamp(floor(p * u_sampleDims), vec3(0.0), u_sampleDims - 1.0);
+  return sampleVolume((cell + 0.5) / u_sampleDims);
+}
+#else
+float fieldValue(vec3 p) {
+  return sampleVolume(p);
+}
+#endif
+
+#ifdef SHADING
+// Straight colour c classified at p, lit; transparent samples skip the
+// gradient's fetches.
+vec4 shadeSample(vec4 c, vec3 p) {
+  if (c.a <= 0.0) return c;
+  return vec4(shadeBlinnPhong(c.rgb, sampleVolumeGradient(p) * u_shadeGradientScale), c.a);
+}
+#endif
+
 vec4 classifiedSample(vec3 p) {
-  return classify(normalizedValue(sampleVolume(p)));
+  vec4 c = classify(normalizedValue(fieldValue(p)));
+#ifdef SHADING
+  c = shadeSample(c, p);
+#endif
+  return c;
 }

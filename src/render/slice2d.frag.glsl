@@ -21,6 +21,9 @@ uniform float u_gap;          // distance between drawn planes / the tables' dis
 uniform vec3 u_eye;
 uniform vec3 u_forward;
 uniform float u_ortho;
+#ifdef CLIPPING
+uniform vec3 u_invExtent;  // world (model frame, box centred at 0) -> texture space
+#endif
 #ifdef CLASSIFY_PALETTE
 uniform sampler2D u_palette;  // 256 premultiplied entries
 
@@ -29,9 +32,34 @@ vec4 paletteAt(vec2 texel) {
   return TEX2D(u_palette, vec2((index * 255.0 + 0.5) / 256.0, 0.5));
 }
 #endif
+#ifdef SHADING
+// Shaded stacks (SliceStacks::fillShadingAtlasBand): r the slice, g and b the
+// slices below and above along the axis. Central differences one voxel
+// apart, as the layout seam's gradient takes them: in the tile (clamped to
+// its edge texels: clamp to edge) and across it from g and b.
+uniform vec3 u_tileAxisU;  // model axis of the tile's x, y
+uniform vec3 u_tileAxisV;
+uniform vec3 u_halfDims;  // dims / 2 along tile x, tile y, the stack axis
+
+float tileValue(vec2 texel) {
+  vec2 t = clamp(texel, vec2(0.5), u_tileSize - vec2(0.5));
+  return TEX2D(u_atlas, (v_tileOrigin + t) * u_atlasInvSize).r;
+}
+
+// The gradient of the normalised value per texture-space unit.
+vec3 sliceGradient(vec2 texel, vec4 here) {
+  float gu = (tileValue(texel + vec2(1.0, 0.0)) - tileValue(texel - vec2(1.0, 0.0))) * u_halfDims.x;
+  float gv = (tileValue(texel + vec2(0.0, 1.0)) - tileValue(texel - vec2(0.0, 1.0))) * u_halfDims.y;
+  float gw = (here.b - here.g) * u_halfDims.z;
+  return u_tileAxisU * gu + u_tileAxisV * gv + u_axis * gw;
+}
+#endif
 
 void main() {
   vec2 texel = clamp(v_local * u_tileSize, vec2(0.5), u_tileSize - vec2(0.5));
+#ifdef NEAREST
+  texel = floor(texel) + 0.5;  // the voxel's own value (the planes are voxel planes)
+#endif
 #if defined(CLASSIFY_PRE)
   vec4 c = TEX2D(u_atlas, (v_tileOrigin + texel) * u_atlasInvSize);
 #elif defined(CLASSIFY_PALETTE)
@@ -43,18 +71,31 @@ void main() {
   vec4 c = mix(mix(paletteAt(i0), paletteAt(vec2(i1.x, i0.y)), f.x),
                mix(paletteAt(vec2(i0.x, i1.y)), paletteAt(i1), f.x), f.y);
 #else
-  float n = TEX2D(u_atlas, (v_tileOrigin + texel) * u_atlasInvSize).r;
+  vec4 here = TEX2D(u_atlas, (v_tileOrigin + texel) * u_atlasInvSize);
+  float n = here.r;
+#ifdef NEAREST
+  // Labels are whole indices: undo the filter's sub-texel rounding, which
+  // would mix in a neighbour's table entry.
+  n = floor(n * 255.0 + 0.5) / 255.0;
+#endif
 #ifndef MODE_MIP
   vec4 c = classify(n);
+#ifdef SHADING
+  if (c.a > 0.0) c.rgb = shadeBlinnPhong(c.rgb, sliceGradient(texel, here) * u_shadeGradientScale);
+#endif
   c.rgb *= c.a;
 #endif
 #endif
+  float kept = 1.0;
+#ifdef CLIPPING
+  if (!clipKeeps(v_world * u_invExtent + 0.5)) kept = 0.0;
+#endif
 #ifdef MODE_MIP
   // Post-classification only: the resolve pass classifies the maximum.
-  FRAG_COLOR = vec4(n, 0.0, 0.0, 1.0);
+  FRAG_COLOR = vec4(n, 0.0, 0.0, 1.0) * kept;
 #else
   vec3 dir = u_ortho > 0.5 ? u_forward : normalize(v_world - u_eye);
   float ratio = u_gap / max(abs(dot(dir, u_axis)), 1e-3);
-  FRAG_COLOR = correctOpacity(c, ratio);
+  FRAG_COLOR = correctOpacity(c, ratio) * kept;
 #endif
 }

@@ -16,9 +16,12 @@ void main() {
   vec3 p = v_texCoord;
   vec3 inside3 = step(vec3(0.0), p) * step(p, vec3(1.0));
   float inside = inside3.x * inside3.y * inside3.z;
+#ifdef CLIPPING
+  if (!clipKeeps(p)) inside = 0.0;
+#endif
   vec3 q = clamp(p, 0.0, 1.0);
 #ifdef MODE_MIP
-  FRAG_COLOR = vec4(normalizedValue(sampleVolume(q)) * inside, 0.0, 0.0, inside);
+  FRAG_COLOR = vec4(normalizedValue(fieldValue(q)) * inside, 0.0, 0.0, inside);
 #else
   vec4 c = classifiedSample(q);
   c = vec4(c.rgb * c.a, c.a) * inside;

@@ -151,6 +151,18 @@ std::string Viewer::description() const {
   return s.str();
 }
 
+// The settings a frame renders with: the user's, plus the clip plane that
+// follows the camera when asked.
+RenderSettings Viewer::frameSettings() const {
+  RenderSettings settings = settings_;
+  if (clipPlaneFollowsCamera &&
+      settings.clipping.planes.size() < static_cast<std::size_t>(kMaxClipPlanes)) {
+    // The camera's back vector in the patient frame: towards the viewer.
+    settings.clipping.planes.push_back({camera_.worldBasis()[2], followingPlaneDistance});
+  }
+  return settings;
+}
+
 void Viewer::syncTransferFunction() {
   if (uploadedTfRevision_ != tfEditor_.revision()) {
     active_.technique->setTransferFunction(tfEditor_.transferFunction());
@@ -161,7 +173,7 @@ void Viewer::syncTransferFunction() {
 Viewer::VolumePass Viewer::volumePass(int width, int height,
                                       const render::QualityLevel& level) const {
   VolumePass p;
-  p.settings = settings_;
+  p.settings = frameSettings();
   double scale = level.resolutionScale;
   const double pixels = static_cast<double>(width) * height;
   if (maxVolumePixels > 0 && pixels > maxVolumePixels) scale *= std::sqrt(maxVolumePixels / pixels);

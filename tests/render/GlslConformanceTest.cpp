@@ -81,12 +81,23 @@ void expectSlicingConformant(gpu::GlContext& c, const Volume& v, const layout::L
     RenderSettings s;
     s.mode = mode;
     sources.push_back(gpu::assembleShader(slice3d.fragmentParts(s)));
+    s.shading.enabled = true;  // render/shading.glsl (composite only), render/clipping.glsl
+    s.clipping.planes.push_back({});
+    sources.push_back(gpu::assembleShader(slice3d.fragmentParts(s)));
+    s.shading.enabled = false;
+    s.clipping.planes.clear();
     for (auto cls : {render::SliceClassification::Pre, render::SliceClassification::Palette,
                      render::SliceClassification::Post}) {
       if (mode == RenderMode::Mip && cls != render::SliceClassification::Post) continue;
       render::Slice2DRenderer slice2d(c, v, {.classification = cls});
       if (sources.size() == 2) sources.push_back(gpu::assembleShader(slice2d.vertexParts()));
       sources.push_back(gpu::assembleShader(slice2d.fragmentParts(s)));
+      if (mode == RenderMode::Composite && cls == render::SliceClassification::Post) {
+        RenderSettings shaded = s;
+        shaded.shading.enabled = true;
+        shaded.clipping.cropMax = {0.5, 1.0, 1.0};
+        sources.push_back(gpu::assembleShader(slice2d.fragmentParts(shaded)));
+      }
     }
   }
   for (const std::string& src : sources) {
@@ -98,13 +109,20 @@ void expectSlicingConformant(gpu::GlContext& c, const Volume& v, const layout::L
 
 void expectConformant(gpu::GlContext& c, const Volume& v, const layout::Layout& layout) {
   render::Raycaster caster(c, v, layout);
-  for (RenderMode mode : {RenderMode::Composite, RenderMode::Mip}) {
+  for (RenderMode mode :
+       {RenderMode::Composite, RenderMode::Mip, RenderMode::MinIp, RenderMode::Average}) {
     for (int skip : {0, 8}) {
       caster.setSkipBlockSize(skip);
-      RenderSettings s;
-      s.mode = mode;
-      const Validation frag = validate(gpu::assembleShader(caster.fragmentParts(s)), "frag");
-      EXPECT_EQ(frag.exitCode, 0) << layout.name() << " skip " << skip << ":\n" << frag.log;
+      for (bool shade : {false, true}) {
+        RenderSettings s;
+        s.mode = mode;
+        s.shading.enabled = shade;
+        if (shade) s.clipping.planes.push_back({});  // render/clipping.glsl too
+        const Validation frag = validate(gpu::assembleShader(caster.fragmentParts(s)), "frag");
+        EXPECT_EQ(frag.exitCode, 0)
+            << layout.name() << " skip " << skip << " shade " << shade << ":\n"
+            << frag.log;
+      }
     }
   }
   const Validation vert = validate(gpu::assembleShader(caster.vertexParts()), "vert");

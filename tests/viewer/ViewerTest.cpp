@@ -49,6 +49,34 @@ struct ViewerFixture : ::testing::Test {
   gpu::Framebuffer fb = gpu::Framebuffer::create(ctx.ledger(), "test view", kSize, kSize);
 };
 
+// The clip plane that follows the camera faces the viewer from every angle:
+// the frame equals the ray caster with that plane, and turning the camera
+// turns the plane (an explicit plane along the first view would not turn).
+TEST_F(ViewerFixture, ClipPlaneFollowsTheCamera) {
+  Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
+  v.setVolume(makeSheppLogan({40, 40, 40}), "phantom");
+  v.showBoundingBox = v.showAxes = false;
+  v.quality = Quality::Full;
+  v.clipPlaneFollowsCamera = true;
+  v.followingPlaneDistance = 0.0;
+  for (double azimuth : {0.0, 70.0}) {
+    v.camera().azimuthDeg = azimuth;
+    const RenderSettings s = v.frameSettings();
+    ASSERT_EQ(s.clipping.planes.size(), 1u);
+    const glm::dvec3 back = v.camera().worldBasis()[2];
+    EXPECT_NEAR(glm::dot(s.clipping.planes[0].normal, back), 1.0, 1e-12);
+    v.render(kSize, kSize, fb.id());
+    const Image shown = readFramebuffer(fb);
+    EXPECT_GE(
+        psnr(shown, directRender(ctx, v.volume(), v.tfEditor().transferFunction(), v.camera(), s)),
+        60.0);
+    EXPECT_LT(psnr(shown, directRender(ctx, v.volume(), v.tfEditor().transferFunction(), v.camera(),
+                                       v.settings())),
+              40.0)
+        << "the plane must cut";
+  }
+}
+
 TEST_F(ViewerFixture, FrameShowsWhatTheRayCasterRenders) {
   Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
   v.setVolume(makeSheppLogan({48, 48, 48}), "phantom");

@@ -247,14 +247,21 @@ EMSCRIPTEN_KEEPALIVE int tessera_set_window(double min, double max) {
 EMSCRIPTEN_KEEPALIVE void tessera_reset_window() {
   if (app().viewer) theViewer().resetWindow();
 }
-EMSCRIPTEN_KEEPALIVE void tessera_set_mode(int mip) {
-  if (app().viewer) theViewer().settings().mode = mip ? RenderMode::Mip : RenderMode::Composite;
+// 0 composite, 1 MIP, 2 MinIP, 3 average (RenderMode's order).
+EMSCRIPTEN_KEEPALIVE void tessera_set_mode(int mode) {
+  if (app().viewer && mode >= 0 && mode <= 3) {
+    theViewer().settings().mode = static_cast<RenderMode>(mode);
+  }
 }
 EMSCRIPTEN_KEEPALIVE int tessera_set_step(double voxels) {
   return guarded([&] {
     if (!(voxels > 0.0 && voxels <= 8.0)) throw InputError("step must be in (0, 8] voxels");
     theViewer().settings().stepVoxels = voxels;
   });
+}
+// Blinn-Phong shading with a headlight and the default terms (RenderSettings::shading).
+EMSCRIPTEN_KEEPALIVE void tessera_set_shading(int on) {
+  if (app().viewer) theViewer().settings().shading.enabled = on != 0;
 }
 EMSCRIPTEN_KEEPALIVE void tessera_set_opacity_scale(double s) {
   if (app().viewer && s >= 0.0) theViewer().settings().opacityScale = s;

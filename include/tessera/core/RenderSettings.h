@@ -1,17 +1,76 @@
 #pragma once
 // Parameters every renderer (GPU techniques and the CPU reference) honours
 // with identical meaning, so that their images can be compared pixel by pixel.
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
 namespace tessera {
 
-// Composite: front-to-back emission-absorption. Mip: maximum intensity
-// projection; the pixel is the TF colour of the largest normalised sample
-// along the ray, opaque where the ray meets the volume.
-enum class RenderMode { Composite, Mip };
+// Composite: front-to-back emission-absorption. The projections show one
+// value per ray, as the TF colour of that normalised value, opaque where the
+// ray keeps a sample: Mip the largest sample (maximum intensity projection),
+// MinIp the smallest, Average the mean of the ray's samples (average
+// intensity projection, an X-ray-like view).
+enum class RenderMode { Composite, Mip, MinIp, Average };
+
+inline bool isProjection(RenderMode mode) {
+  return mode != RenderMode::Composite;
+}
+
+// Blinn-Phong shading of composited samples from the gradient of the
+// reconstructed field (the layout seam's sampleVolumeGradient, the
+// reference's Reconstruction::gradient): central differences one voxel apart
+// on the same continuous field, so every path lights the same normals.
+// Two-sided (|N.L|): a volume has no inside or outside. MIP is not shaded.
+struct Shading {
+  bool enabled = false;
+  double ambient = 0.3;
+  double diffuse = 0.6;
+  double specular = 0.3;
+  double shininess = 24.0;
+  // Headlight: light from the viewer, along the view direction. Otherwise a
+  // fixed light from lightDirection (towards the light, patient frame RAS+),
+  // which turns with the volume.
+  bool headlight = true;
+  glm::dvec3 lightDirection{0.0, 1.0, 1.0};
+};
+
+// A clip plane: keeps the points x (world units from the volume box's
+// centre, patient-frame axes RAS+) with dot(normal, x) <= distance, i.e. cuts
+// away what lies beyond `distance` along `normal`.
+struct ClipPlane {
+  glm::dvec3 normal{0.0, 0.0, 1.0};
+  double distance = 0.0;
+};
+
+constexpr int kMaxClipPlanes = 6;
+
+// Clip planes and an axis-aligned crop box. Clipping drops samples, it never
+// moves them: samples stay at t0 + (k + j) ds from the volume box's entry, so
+// moving a plane only adds or removes the samples it passes (no shimmering).
+struct Clipping {
+  std::vector<ClipPlane> planes;  // at most kMaxClipPlanes
+  // The crop box in normalised volume coordinates ([0,1] along each index
+  // axis, voxel centres at (i + 0.5) / dims); samples outside are dropped.
+  glm::dvec3 cropMin{0.0};
+  glm::dvec3 cropMax{1.0};
+  bool cropped() const { return cropMin != glm::dvec3(0.0) || cropMax != glm::dvec3(1.0); }
+  bool active() const { return !planes.empty() || cropped(); }
+};
 
 struct RenderSettings {
   RenderMode mode = RenderMode::Composite;
+  Shading shading;
+  Clipping clipping;
+  // Nearest-neighbour reconstruction: a sample takes the value of the voxel
+  // whose cell holds it (label volumes: no interpolation across labels).
+  bool nearest = false;
   // Sample distance in voxels of the smallest spacing: ds = stepVoxels * min(spacing).
   double stepVoxels = 0.5;
   // Upper bound on samples per ray (Schultz 2016, 7.2.3).
@@ -40,6 +99,72 @@ inline double jitterOffset(unsigned x, unsigned y) {
     v += (2u * (xi ^ yi) + yi) << (2u * (2u - i));
   }
   return (v + 0.5) / 64.0;
+}
+
+// The light of one frame in the volume's model frame: l towards the light, h
+// the Blinn half vector between l and the direction to the viewer.
+struct ShadingLight {
+  glm::dvec3 l{0.0, 0.0, 1.0};
+  glm::dvec3 h{0.0, 0.0, 1.0};
+};
+
+// `back` is the camera's back vector (towards the viewer, model frame),
+// `modelFromWorld` Camera::modelFromWorld.
+inline ShadingLight shadingLight(const Shading& shading, glm::dvec3 back,
+                                 const glm::dmat3& modelFromWorld) {
+  ShadingLight light;
+  const glm::dvec3 v = glm::normalize(back);
+  light.l = shading.headlight ? v : glm::normalize(modelFromWorld * shading.lightDirection);
+  const glm::dvec3 half = light.l + v;
+  light.h = glm::length(half) > 1e-9 ? glm::normalize(half) : light.l;
+  return light;
+}
+
+// Below this gradient magnitude (normalised value per voxel of the smallest
+// spacing) a sample fades to ambient light: the normal is g / sqrt(|g|^2 +
+// eps^2), continuous, so noise in flat regions is not lit as surfaces and the
+// GPU's float and the reference's double agree near zero.
+constexpr double kShadingGradientEpsilon = 0.01;
+
+// The shaded colour of straight colour `rgb` at a sample whose field gradient
+// is `g` (normalised value per smallest-voxel length, model frame). The GLSL
+// twin is render/shading.glsl.
+inline glm::dvec3 shadeBlinnPhong(glm::dvec3 rgb, glm::dvec3 g, const Shading& shading,
+                                  const ShadingLight& light) {
+  const glm::dvec3 n =
+      g / std::sqrt(glm::dot(g, g) + kShadingGradientEpsilon * kShadingGradientEpsilon);
+  const double diffuse = std::abs(glm::dot(n, light.l));
+  const double specular = std::pow(std::abs(glm::dot(n, light.h)), shading.shininess);
+  const glm::dvec3 lit =
+      rgb * (shading.ambient + shading.diffuse * diffuse) + glm::dvec3(shading.specular * specular);
+  return glm::min(lit, glm::dvec3(1.0));
+}
+
+// The clip planes as half-spaces of texture space (p in [0,1]^3, the volume
+// box): p is kept where dot(h.xyz, p) <= h.w for every h. `modelFromWorld`:
+// Camera::modelFromWorld (a rotation), `extent`: the box's world size.
+inline std::vector<glm::dvec4> clipHalfSpaces(const Clipping& clipping,
+                                              const glm::dmat3& modelFromWorld, glm::dvec3 extent) {
+  std::vector<glm::dvec4> out;
+  for (const ClipPlane& c : clipping.planes) {
+    // x = (p - 0.5) * extent in the model frame.
+    const glm::dvec3 a = (modelFromWorld * c.normal) * extent;
+    out.emplace_back(a, c.distance + glm::dot(a, glm::dvec3(0.5)));
+  }
+  return out;
+}
+
+// Whether the sample at texture-space p survives clipping (the GLSL twin is
+// render/clipping.glsl).
+inline bool clipKeeps(const Clipping& clipping, const std::vector<glm::dvec4>& halfSpaces,
+                      glm::dvec3 p) {
+  for (int a = 0; a < 3; ++a) {
+    if (p[a] < clipping.cropMin[a] || p[a] > clipping.cropMax[a]) return false;
+  }
+  for (const glm::dvec4& h : halfSpaces) {
+    if (glm::dot(glm::dvec3(h), p) > h.w) return false;
+  }
+  return true;
 }
 
 }  // namespace tessera

@@ -46,4 +46,18 @@ class TrilinearReconstruction final : public Reconstruction {
   std::vector<double> data_;
 };
 
+// Nearest neighbour: the value of the voxel whose cell holds p (label
+// volumes); the GLSL twin is fieldValue() with NEAREST (render/sample.glsl).
+class NearestReconstruction final : public Reconstruction {
+ public:
+  explicit NearestReconstruction(const Volume& volume);
+  double value(glm::dvec3 p) const override;
+  glm::ivec3 dims() const override { return dims_; }
+  int supportVoxels() const override { return 1; }
+
+ private:
+  glm::ivec3 dims_;
+  std::vector<double> data_;
+};
+
 }  // namespace tessera

@@ -151,6 +151,7 @@ class Slice2DRenderer final : public Technique {
   gpu::LookupTexture table_;            // palette or post-classification LUT
   SliceAccumulator accumulator_;
   gpu::ProgramCache programs_;
+  bool shadedStacks_ = false;  // the stacks carry neighbours for shading
   int lastAxis_ = -1;
   int lastSlicesDrawn_ = 0;
   std::uint64_t stackUploads_ = 0;

@@ -74,6 +74,14 @@ class SliceStacks {
   // them), the same bytes fillAtlas writes there.
   void fillAtlasBand(const SliceAtlasPlan& plan, int atlas, int band, const std::uint8_t* palette,
                      std::vector<std::uint8_t>& out) const;
+  // The same band for shaded slicing: 4 bytes per texel, the index of the
+  // slice (R) and of its neighbours along the stack axis below (G) and above
+  // (B), clamped at the stack's ends, A = 255. Filtered bilinearly, G and B
+  // are the field one voxel either side of the plane, so the shader takes
+  // central differences along the axis from the slice's own texel (the
+  // gradient the reference takes at a voxel plane).
+  void fillShadingAtlasBand(const SliceAtlasPlan& plan, int atlas, int band,
+                            std::vector<std::uint8_t>& out) const;
 
  private:
   // Texel rows [y0, y1) of an atlas image into `out`, resized to fit them.

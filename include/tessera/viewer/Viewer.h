@@ -97,6 +97,14 @@ class Viewer {
   // by depth: hidden behind opaque parts, faded behind translucent ones.
   bool showBoundingBox = true;
   bool showAxes = true;
+  // A clip plane facing the viewer that turns with the camera: it cuts away
+  // what lies nearer the viewer than `followingPlaneDistance` (world units
+  // from the volume's centre along the view direction), on top of
+  // settings().clipping's planes.
+  bool clipPlaneFollowsCamera = false;
+  double followingPlaneDistance = 0.0;
+  // settings() as the next frame renders them (the following plane added).
+  RenderSettings frameSettings() const;
 
   // Renders one frame into `framebuffer` (0: the window / canvas) at
   // width x height with its lower-left corner at `origin`, and times it.

@@ -1,0 +1,69 @@
+#include "app/ShadingOptions.h"
+
+#include <cmath>
+#include <sstream>
+#include <vector>
+
+#include "tessera/core/Error.h"
+#include "tessera/render/ShadingUniforms.h"
+
+namespace tessera::app {
+
+namespace {
+
+glm::dvec3 parseLightDirection(const std::string& text) {
+  std::vector<double> v;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    std::size_t used = 0;
+    double d = 0.0;
+    try {
+      d = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || !std::isfinite(d)) {
+      throw InputError("--light '" + text + "': expected headlight or X,Y,Z (e.g. 0,1,1)");
+    }
+    v.push_back(d);
+  }
+  if (v.size() != 3) {
+    throw InputError("--light '" + text + "': expected headlight or three numbers X,Y,Z");
+  }
+  return {v[0], v[1], v[2]};
+}
+
+}  // namespace
+
+void addShadingOptions(CLI::App* cmd, ShadingOptions& o) {
+  cmd->add_flag("--shade", o.shade,
+                "Blinn-Phong shading from the gradient of the reconstructed field (central "
+                "differences, 6 extra fetches per visible sample); composite mode only");
+  cmd->add_option("--light", o.light,
+                  "With --shade: 'headlight' (light from the viewer) or a fixed direction "
+                  "towards the light X,Y,Z in the patient frame (RAS+: x right, y anterior, "
+                  "z superior), e.g. 0,1,1 from the front and above")
+      ->capture_default_str();
+  cmd->add_option("--ambient", o.coefficients.ambient, "With --shade: ambient term")
+      ->capture_default_str();
+  cmd->add_option("--diffuse", o.coefficients.diffuse, "With --shade: diffuse term")
+      ->capture_default_str();
+  cmd->add_option("--specular", o.coefficients.specular,
+                  "With --shade: specular term (white highlights)")
+      ->capture_default_str();
+  cmd->add_option("--shininess", o.coefficients.shininess,
+                  "With --shade: specular exponent, 1..512")
+      ->capture_default_str();
+}
+
+Shading shadingFrom(const ShadingOptions& o) {
+  Shading s = o.coefficients;
+  s.enabled = o.shade;
+  s.headlight = o.light == "headlight";
+  if (!s.headlight) s.lightDirection = parseLightDirection(o.light);
+  render::checkShading(s);
+  return s;
+}
+
+}  // namespace tessera::app

@@ -1,0 +1,259 @@
+// Blinn-Phong shading (issue 16, item 1): every technique on every layout,
+// in ES 3.0 and ES 2.0 contexts, against the shaded CPU reference; the
+// gradient of a linear ramp lights the analytic normal.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+#include "support/GpuTestContext.h"
+#include "support/TestTransferFunctions.h"
+#include "tessera/core/Error.h"
+#include "tessera/io/Procedural.h"
+#include "tessera/layout/MosaicLayout.h"
+#include "tessera/layout/PackedMosaicLayout.h"
+#include "tessera/layout/Texture3DLayout.h"
+#include "tessera/reference/ImageMetrics.h"
+#include "tessera/reference/ReferenceRaycaster.h"
+#include "tessera/render/Raycaster.h"
+#include "tessera/render/Slice2DRenderer.h"
+#include "tessera/render/Slice3DRenderer.h"
+
+using namespace tessera;
+
+namespace {
+
+using test::visibleTf;
+
+// Slicing cannot stop early; the ray caster and the reference are told the same.
+RenderSettings shadedSettings() {
+  RenderSettings s;
+  s.stepVoxels = 0.5;
+  s.ertThreshold = 1.0;
+  s.shading.enabled = true;
+  return s;
+}
+
+Camera obliqueCamera(const Volume& v) {
+  Camera cam;
+  cam.azimuthDeg = 35;
+  cam.elevationDeg = 25;
+  cam.frame(v.extent());
+  return cam;
+}
+
+// The three Cartesian layouts a context offers (texture3d on ES 3.0 only);
+// small textures force packed-mosaic across channels and textures.
+std::vector<std::unique_ptr<layout::Layout>> layoutsFor(gpu::GlContext& c, const Volume& v) {
+  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());
+  gpu::DeviceLimits packedLimits = limits;
+  packedLimits.max2DTextureSize = 128;
+  std::vector<std::unique_ptr<layout::Layout>> layouts;
+  if (c.caps().api == gpu::ApiLevel::Gles3) {
+    layouts.push_back(layout::Texture3DLayout::create(v, limits, c.ledger()));
+  }
+  layouts.push_back(layout::MosaicLayout::create(v, limits, c.ledger()));
+  layouts.push_back(layout::PackedMosaicLayout::create(v, packedLimits, c.ledger(), 6));
+  return layouts;
+}
+
+Image raycastWith(gpu::GlContext& c, const Volume& v, const layout::Layout& l, const Camera& cam,
+                  const RenderSettings& s, int size) {
+  render::Raycaster caster(c, v, l);
+  caster.setTransferFunction(visibleTf());
+  return caster.render(cam, s, size, size);
+}
+
+Image sliceWith(gpu::GlContext& c, const Volume& v, const layout::Layout& l, const Camera& cam,
+                const RenderSettings& s, int size) {
+  render::Slice3DRenderer slicer(c, v, l);
+  slicer.setTransferFunction(visibleTf());
+  return slicer.render(cam, s, size, size);
+}
+
+const char* apiName(gpu::ApiLevel api) {
+  return api == gpu::ApiLevel::Gles2 ? "gles2" : "gles3";
+}
+
+// Runs `body` with a context of `api` (the shared ES 3.0 one or a fresh ES 2.0 one).
+template <class Body>
+void withContext(gpu::ApiLevel api, Body body) {
+  gpu::GlContext::Options o;
+  o.api = api;
+  auto owned = api == gpu::ApiLevel::Gles2 ? gpu::GlContext::createHeadless(o) : nullptr;
+  body(owned ? *owned : test::gpuContext());
+  owned.reset();
+  test::gpuContext();
+}
+
+// `sliceBar`: view-aligned slices sample other positions than rays, which
+// shows at the phantom's ideal steps (where normals turn within a voxel), and
+// ES 2 accumulates them in RGBA8 (unshaded slice3d ES 2 on the phantom: 43.7 dB).
+void expectShadedLayoutsMatchReference(gpu::ApiLevel api, const Volume& v, double sliceBar) {
+  withContext(api, [&](gpu::GlContext& c) {
+    const Camera cam = obliqueCamera(v);
+    const RenderSettings s = shadedSettings();
+    RenderSettings unshaded = s;
+    unshaded.shading.enabled = false;
+    const Image ref = renderReference(v, visibleTf(), cam, s, 96, 96);
+    const Image refUnshaded = renderReference(v, visibleTf(), cam, unshaded, 96, 96);
+    ASSERT_LT(psnr(ref, refUnshaded), 30.0) << "shading must change the image";
+    for (const auto& l : layoutsFor(c, v)) {
+      const double cast = psnr(raycastWith(c, v, *l, cam, s, 96), ref);
+      const double slice = psnr(sliceWith(c, v, *l, cam, s, 96), ref);
+      std::printf(
+          "  [measured] shaded %-7s %s %-13s raycast %.2f dB, slice3d %.2f dB vs reference\n",
+          v.dims().x == 37 ? "sphere" : "phantom", apiName(api), l->name().c_str(), cast, slice);
+      EXPECT_GE(cast, 40.0) << l->name();
+      EXPECT_GE(slice, sliceBar) << l->name();
+    }
+  });
+}
+
+}  // namespace
+
+// A smooth field (the sphere's radial ramp) and sharp steps (the phantom).
+TEST(Shading, EveryLayoutMatchesShadedReferenceOnEs3) {
+  expectShadedLayoutsMatchReference(gpu::ApiLevel::Gles3, makeSphere({37, 53, 29}), 40.0);
+  expectShadedLayoutsMatchReference(gpu::ApiLevel::Gles3, makeSheppLogan({38, 53, 29}), 40.0);
+}
+
+TEST(Shading, EveryLayoutMatchesShadedReferenceOnEs2) {
+  expectShadedLayoutsMatchReference(gpu::ApiLevel::Gles2, makeSphere({37, 53, 29}), 40.0);
+  expectShadedLayoutsMatchReference(gpu::ApiLevel::Gles2, makeSheppLogan({38, 53, 29}), 35.0);
+}
+
+namespace {
+
+// f = 8 i + 5 j (u8): its gradient is (8, 5, 0) raw units per voxel
+// everywhere, exactly what central differences give a voxel or more from
+// the x and y faces (z: f does not change, clamping or not).
+Volume rampVolume() {
+  Volume v = Volume::allocate({16, 16, 8}, ScalarType::U8, "ramp");
+  for (int z = 0; z < 8; ++z) {
+    for (int y = 0; y < 16; ++y) {
+      for (int x = 0; x < 16; ++x) v.setValueAtIndex(v.index(x, y, z), 8.0 * x + 5.0 * y);
+    }
+  }
+  v.invalidateRange();
+  return v;
+}
+
+// Every interior pixel of a top view of the ramp through an opaque grey TF
+// (the first sample is the pixel) against Blinn-Phong of the analytic normal.
+void expectRampLitByAnalyticNormal(const Image& img, const Volume& v, const Camera& cam,
+                                   const RenderSettings& s, const char* what) {
+  const glm::dvec3 g = glm::dvec3(8.0, 5.0, 0.0) / v.window().width();
+  const ShadingLight light = shadingLight(s.shading, cam.basis()[2], cam.modelFromWorld);
+  const double expected = shadeBlinnPhong(glm::dvec3(0.5), g, s.shading, light).x;
+  ASSERT_GT(std::abs(expected - 0.5) * 255.0, 10.0) << "the light must show against unlit grey";
+  int checked = 0, worst = 0;
+  for (int py = 0; py < img.height(); ++py) {
+    for (int px = 0; px < img.width(); ++px) {
+      const Ray ray = cam.pixelRay(px, py, img.width(), img.height());
+      const glm::dvec3 extent = v.extent();
+      // The top face (z = +extent/2) in voxel units.
+      const double t = (extent.z / 2 - ray.origin.z) / ray.direction.z;
+      const glm::dvec3 voxel = (ray.origin + t * ray.direction) / extent + 0.5;
+      const glm::dvec3 i = voxel * glm::dvec3(v.dims()) - 0.5;
+      if (i.x < 1.5 || i.y < 1.5 || i.x > 12.5 || i.y > 12.5) continue;
+      ++checked;
+      worst = std::max(
+          worst, std::abs(img.pixel(px, py)[0] - static_cast<int>(std::lround(expected * 255.0))));
+    }
+  }
+  std::printf("  [measured] ramp %s: %d interior pixels, worst %d/255 from the analytic light\n",
+              what, checked, worst);
+  EXPECT_GT(checked, 1000);
+  EXPECT_LE(worst, 2) << what;
+}
+
+}  // namespace
+
+TEST(Shading, LinearRampIsLitByItsAnalyticNormal) {
+  const Volume v = rampVolume();
+  Camera cam;
+  cam.elevationDeg = 90;  // looking down -z
+  cam.projection = Projection::Orthographic;
+  cam.frame(v.extent());
+  TransferFunction opaqueGrey;
+  opaqueGrey.addColor(0.0, {0.5, 0.5, 0.5});
+  opaqueGrey.addColor(1.0, {0.5, 0.5, 0.5});
+  opaqueGrey.addOpacity(0.0, 1.0);
+  opaqueGrey.addOpacity(1.0, 1.0);
+  RenderSettings s;
+  s.shading.enabled = true;
+  s.shading.headlight = false;
+  s.shading.lightDirection = {1.0, 2.0, 3.0};
+  s.shading.shininess = 8.0;
+  expectRampLitByAnalyticNormal(renderReference(v, opaqueGrey, cam, s, 96, 96), v, cam, s,
+                                "reference");
+  for (gpu::ApiLevel api : {gpu::ApiLevel::Gles3, gpu::ApiLevel::Gles2}) {
+    withContext(api, [&](gpu::GlContext& c) {
+      for (const auto& l : layoutsFor(c, v)) {
+        render::Raycaster caster(c, v, *l);
+        caster.setTransferFunction(opaqueGrey);
+        const std::string what = std::string("raycast ") + apiName(api) + " " + l->name();
+        expectRampLitByAnalyticNormal(caster.render(cam, s, 96, 96), v, cam, s, what.c_str());
+      }
+    });
+  }
+}
+
+// slice2d keeps its own stacks (no layout): its planes are the voxel planes,
+// which are the reference's samples for an orthographic view along a stack
+// axis at a 1-voxel step; its gradient comes from each slice's neighbours.
+TEST(Shading, Slice2DMatchesShadedReferenceAlongEachStackOnEs3AndEs2) {
+  const Volume v = makeSphere({37, 53, 29});  // isotropic: the planes are 1-voxel steps
+  RenderSettings s = shadedSettings();
+  s.stepVoxels = 1.0;
+  // A fixed light off every axis: a gradient component on the wrong axis shows.
+  s.shading.headlight = false;
+  s.shading.lightDirection = {1.0, 2.0, 3.0};
+  for (gpu::ApiLevel api : {gpu::ApiLevel::Gles3, gpu::ApiLevel::Gles2}) {
+    withContext(api, [&](gpu::GlContext& c) {
+      render::Slice2DRenderer slicer(c, v, {});
+      slicer.setTransferFunction(visibleTf());
+      for (int axis = 0; axis < 3; ++axis) {
+        Camera cam;
+        cam.projection = Projection::Orthographic;
+        if (axis == 0) cam.azimuthDeg = 90;
+        if (axis == 2) cam.elevationDeg = 90;
+        cam.frame(v.extent());
+        const Image img = slicer.render(cam, s, 96, 96);
+        ASSERT_EQ(slicer.lastStackAxis(), axis);
+        const double db = psnr(img, renderReference(v, visibleTf(), cam, s, 96, 96));
+        std::printf("  [measured] shaded sphere  %s slice2d stack %c: %.2f dB vs reference\n",
+                    apiName(api), "xyz"[axis], db);
+        EXPECT_GE(db, 40.0) << apiName(api) << " axis " << axis;
+      }
+      RenderSettings unshaded = s;
+      unshaded.shading.enabled = false;
+      Camera cam;
+      cam.projection = Projection::Orthographic;
+      cam.frame(v.extent());
+      EXPECT_GE(psnr(slicer.render(cam, unshaded, 96, 96),
+                     renderReference(v, visibleTf(), cam, unshaded, 96, 96)),
+                40.0)
+          << "back to unshaded stacks";
+    });
+  }
+}
+
+TEST(Shading, Slice2DAsksForPostClassification) {
+  gpu::GlContext& c = test::gpuContext();
+  const Volume v = makeSphere({16, 16, 16});
+  render::Slice2DRenderer slicer(c, v, {.classification = render::SliceClassification::Pre});
+  Camera cam;
+  cam.frame(v.extent());
+  try {
+    slicer.render(cam, shadedSettings(), 32, 32);
+    FAIL() << "pre-classified slices cannot be shaded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--classify post"), std::string::npos) << e.what();
+  }
+}
