@@ -14,6 +14,7 @@ void addProfilesCommand(CLI::App& app);  // ProfilesCommand.cpp
 void addPlanCommand(CLI::App& app);      // PlanCommand.cpp
 void addConvertCommand(CLI::App& app);   // ConvertCommand.cpp
 void addViewCommand(CLI::App& app);      // ViewCommand.cpp (desktop viewer)
+void addSliceCommand(CLI::App& app);     // SliceCommand.cpp
 
 // The volume argument's help, and the --series option every command that
 // reads a volume offers.

@@ -11,6 +11,7 @@
 #include "app/HybridJob.h"
 #include "app/RenderJob.h"
 #include "app/ShadingOptions.h"
+#include "app/VolumePyramid.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"
@@ -69,6 +70,9 @@ struct RenderOptions {
   std::string overlayOpacity = "alpha";
   std::string offscreen;
   std::string roi;
+  // --region and --level: render only a box of one level, read with readBox.
+  std::string region;
+  std::string level = "native";
   ShadingOptions shading;
   ClippingOptions clipping;
   // --labels [TABLE]: a label volume through a categorical table.
@@ -181,9 +185,44 @@ std::shared_ptr<const lod::MultiresSource> streamedSource(const RenderOptions& o
   return nullptr;
 }
 
-// The volume, with the window the options ask for.
-lod::InCoreVolumeSource loadVolume(const RenderOptions& o, const std::string& spec) {
-  Volume volume = readVolume(spec, {.dicomSeries = o.series, .time = o.time, .channel = o.channel});
+// --region: the box of the level, read with readBox (a store reads only the
+// chunks it touches), placed where it lies in the full volume; its window is
+// the full volume's so that it is coloured as in the overview.
+Volume readRegion(const RenderOptions& o, const std::string& spec, nlohmann::json& report) {
+  const VolumePyramid pyramid =
+      openVolumePyramid(spec, {.series = o.series, .time = o.time, .channel = o.channel});
+  const lod::MultiresSource& source = *pyramid.source;
+  const int level = parseLevel(o.level, source.levelCount(), spec);
+  const lod::LevelInfo info = source.levelInfo(level);
+  std::string clamped;
+  const lod::VoxelBox box = parseRegion(o.region, info.dims, &clamped);
+  if (!clamped.empty()) std::fprintf(stderr, "tessera: note: --region %s\n", clamped.c_str());
+  Volume region = source.readBox(level, box);
+  region.setWindow(source.shape().window());
+  report = {{"level", level},
+            {"level_dims", {info.dims.x, info.dims.y, info.dims.z}},
+            {"begin", {box.begin.x, box.begin.y, box.begin.z}},
+            {"end", {box.end.x, box.end.y, box.end.z}},
+            {"voxels_read", box.count()},
+            {"level_voxels", lod::VoxelBox{glm::ivec3(0), info.dims}.count()}};
+  if (!clamped.empty()) report["clamped"] = clamped;
+  if (pyramid.storage) {
+    report["chunks_read"] = pyramid.storage->chunksRead();
+    report["chunk_bytes_read"] = pyramid.storage->chunkBytesRead();
+    report["chunks_touched"] = chunksTouched(box, info.chunk, info.dims);
+    report["chunks_in_level"] =
+        chunksTouched(lod::VoxelBox{glm::ivec3(0), info.dims}, info.chunk, info.dims);
+  }
+  return region;
+}
+
+// The volume (or its --region), with the window the options ask for.
+lod::InCoreVolumeSource loadVolume(const RenderOptions& o, const std::string& spec,
+                                   nlohmann::json& regionReport) {
+  Volume volume =
+      o.region.empty()
+          ? readVolume(spec, {.dicomSeries = o.series, .time = o.time, .channel = o.channel})
+          : readRegion(o, spec, regionReport);
   if (!o.window.empty()) {
     if (o.window.size() != 2) throw InputError("--window takes two numbers MIN MAX");
     volume.setWindow({o.window[0], o.window[1]});
@@ -215,9 +254,10 @@ struct RenderTimes {
 
 void printRenderJson(const RenderOptions& o, const RenderRequest& req, const RenderResult& r,
                      const DeviceSession& device, const TransferFunction& tf,
-                     const std::string& spec, RenderTimes times) {
+                     const std::string& spec, RenderTimes times, const nlohmann::json& region) {
   const gpu::GlContext& context = *device.context;
   nlohmann::json j;
+  if (!region.is_null()) j["region"] = region;
   j["file"] = spec;
   j["out"] = o.out;
   j["width"] = req.width;
@@ -337,20 +377,25 @@ void runRenderCommand(const RenderOptions& o) {
   DeviceSession device = openDevice(o.profile);
   RenderTimes times;
   const auto tLoad = std::chrono::steady_clock::now();
-  if (auto pyramid = streamedSource(o, spec)) {  // read brick by brick, never whole
+  // --region reads its one box in core instead.
+  if (auto pyramid = o.region.empty() ? streamedSource(o, spec) : nullptr) {  // never whole
     const lod::MultiresVolumeSource streamed(std::move(pyramid));
     times.loadMs = msSince(tLoad);
     const RenderResult r = runRender(device, streamed, tf, req);
     r.first.writePng(o.out);
     times.totalMs = msSince(tStart);
     if (o.json) {
-      printRenderJson(o, req, r, device, tf, spec, times);
+      printRenderJson(o, req, r, device, tf, spec, times, nullptr);
     } else {
       printRenderText(o, req, r, device, streamed.shape(), spec, times);
     }
     return;
   }
-  const lod::InCoreVolumeSource source = loadVolume(o, spec);
+  if (o.region.empty() && o.level != "native") {
+    throw InputError("--level " + o.level + " applies to --region (and to `tessera slice`)");
+  }
+  nlohmann::json regionReport;
+  const lod::InCoreVolumeSource source = loadVolume(o, spec, regionReport);
   if (o.labelVolume()) {
     const render::LabelTable table = o.labels.empty()
                                          ? render::LabelTable::defaultFor(source.volume())
@@ -371,9 +416,10 @@ void runRenderCommand(const RenderOptions& o) {
   if (r.referenceImage && !o.referenceOut.empty()) r.referenceImage->writePng(o.referenceOut);
   times.totalMs = msSince(tStart);
   if (o.json) {
-    printRenderJson(o, req, r, device, tf, spec, times);
+    printRenderJson(o, req, r, device, tf, spec, times, regionReport);
   } else {
     printRenderText(o, req, r, device, source.volume(), spec, times);
+    if (!regionReport.is_null()) std::printf("region   %s\n", regionReport.dump().c_str());
   }
 }
 
@@ -483,6 +529,13 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--roi", o->roi,
                   "Region of interest x0:x1,y0:y1,z0:z1 in voxels for the roi overlay "
                   "(implies it)");
+  cmd->add_option("--region", o->region,
+                  "Render only the voxels x0:x1,y0:y1,z0:z1 (end exclusive) of --level, read as "
+                  "one box (a store reads only the chunks it touches, never the whole level), "
+                  "placed where it lies in the volume; the camera frames it. Ends past the "
+                  "level are clamped (with a note)");
+  cmd->add_option("--level", o->level, "With --region: pyramid level, native (0, the finest) or N")
+      ->capture_default_str();
   cmd->callback([o] { runRenderCommand(*o); });
 }
 

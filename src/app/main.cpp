@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   tessera::app::addPlanCommand(app);
   tessera::app::addConvertCommand(app);
   tessera::app::addViewCommand(app);
+  tessera::app::addSliceCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
