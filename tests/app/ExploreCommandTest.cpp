@@ -5,7 +5,9 @@
 // region renders like the same box cut out with `convert --crop`.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -34,6 +36,7 @@ d[14:18, 10:14, 8:11] = 255
 nib.save(nib.Nifti1Image(d, np.eye(4)), sys.argv[1] + '/ras.nii')
 las = np.diag([-1.0, 1, 1, 1]); las[0, 3] = 19
 nib.save(nib.Nifti1Image(d[::-1].copy(), las), sys.argv[1] + '/las.nii')
+nib.save(nib.Nifti1Image(d, np.diag([0.5, 1, 2, 1])), sys.argv[1] + '/aniso.nii')
 )";
 
 class ExploreCommand : public ::testing::Test {
@@ -158,6 +161,37 @@ TEST_F(ExploreCommand, SameAnatomyGivesTheSameRadiologicalImageWhateverTheStorag
       EXPECT_LT(m.x, w / 2) << plane[a];
       EXPECT_LT(m.y, h / 2) << plane[a];  // anterior (axial) or superior (coronal) up
     }
+  }
+}
+
+// Spacing 0.5 x 1 x 2 mm: square pixels of the finer in-plane spacing, each
+// the voxel whose extent holds the pixel's centre.
+TEST_F(ExploreCommand, AnisotropicSlicesKeepTheAspectWithNearestVoxels) {
+  const tessera::Volume v = tessera::readVolume(file("aniso.nii"));
+  const glm::dvec3 spacing(0.5, 1.0, 2.0);
+  for (const auto& [axis, index] : {std::pair{2, 9}, std::pair{0, 15}}) {
+    const Slice s = slice(file("aniso.nii") + " --axis " + std::string(1, char('x' + axis)) +
+                              " --index " + std::to_string(index),
+                          tmp / "a.png");
+    const int colAxis = axisOf(s.report["columns"]["axis"]);
+    const int rowAxis = axisOf(s.report["rows"]["axis"]);
+    const double pixelMm = std::min(spacing[colAxis], spacing[rowAxis]);
+    EXPECT_DOUBLE_EQ(s.report["pixel_mm"].get<double>(), pixelMm);
+    ASSERT_EQ(s.image.width(), int(std::lround(v.dims()[colAxis] * spacing[colAxis] / pixelMm)));
+    ASSERT_EQ(s.image.height(), int(std::lround(v.dims()[rowAxis] * spacing[rowAxis] / pixelMm)));
+    int mismatches = 0;
+    for (int row = 0; row < s.image.height(); ++row) {
+      for (int col = 0; col < s.image.width(); ++col) {
+        glm::ivec3 p(0);
+        p[axis] = index;
+        p[colAxis] = int((col + 0.5) * pixelMm / spacing[colAxis]);
+        p[rowAxis] = int((row + 0.5) * pixelMm / spacing[rowAxis]);
+        if (s.report["columns"]["reversed"]) p[colAxis] = v.dims()[colAxis] - 1 - p[colAxis];
+        if (s.report["rows"]["reversed"]) p[rowAxis] = v.dims()[rowAxis] - 1 - p[rowAxis];
+        if (s.image.pixel(col, row)[0] != v.valueAt(p.x, p.y, p.z)) ++mismatches;
+      }
+    }
+    EXPECT_EQ(mismatches, 0) << "axis " << axis;
   }
 }
 
