@@ -262,6 +262,17 @@ TEST_F(ExploreCommand, RegionRendersLikeTheCroppedVolumeAndReadsOnlyItsChunks) {
   EXPECT_EQ(n["chunks_read"], 2);
   EXPECT_EQ(n["chunks_in_level"], 12);
   EXPECT_EQ(n["voxels_read"], 6 * 6 * 3);
+
+  // Level 1 (10x8x6 in 8^3 chunks: 2 chunks): a box in its first chunk
+  // reads that one chunk.
+  const auto coarse = runCli("render " + store.string() + " --region 0:4,0:4,0:3 --level 1" + view +
+                             " --json --out /dev/null");
+  ASSERT_EQ(coarse.exitCode, 0) << coarse.err;
+  const auto c = nlohmann::json::parse(coarse.out)["region"];
+  EXPECT_EQ(c["level"], 1);
+  EXPECT_EQ(c["level_dims"], nlohmann::json::array({10, 8, 6}));
+  EXPECT_EQ(c["chunks_in_level"], 2);
+  EXPECT_EQ(c["chunks_read"], 1);
 }
 
 }  // namespace
