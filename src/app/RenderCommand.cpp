@@ -18,6 +18,7 @@
 #include "tessera/io/ZarrStore.h"
 #include "tessera/layout/FccLayout.h"
 #include "tessera/layout/LayoutRegistry.h"
+#include "tessera/layout/Planner.h"
 #include "tessera/lod/InCoreVolumeSource.h"
 #include "tessera/lod/MultiresVolumeSource.h"
 #include "tessera/lod/ProceduralMultiresSource.h"
@@ -168,17 +169,52 @@ RenderRequest requestFrom(const RenderOptions& o) {
   return req;
 }
 
-// A volume read brick by brick instead of whole: a generated head:WxHxD, or
-// an OME-Zarr store (folder or URL) with --layout bricks. Null otherwise.
+// Options that need the voxels in host memory (a window or label table
+// applied to them, the hybrid compositor, the CPU reference, the FCC
+// resampling): with these a store is read in core, at the finest level that
+// fits the host budget.
+bool needsInCore(const RenderOptions& o) {
+  return o.labelVolume() || !o.window.empty() || !o.overlays.empty() || !o.offscreen.empty() ||
+         !o.roi.empty() || o.reference || !o.referenceOut.empty() || o.lattice != "cartesian";
+}
+
+// With --layout auto a store streams when the planner, given its finest
+// level as a streamed shape and the technique's own units and bytes (what
+// uploadVolume will ask it), rejects every in-core layout under the profile
+// (its textures or its host budget; the plan's reason says which) and picks
+// bricks; a store that fits keeps the in-core path, and so does a technique
+// with its own storage.
+bool plannerStreams(const RenderRequest& req, const DeviceSession& device,
+                    const lod::MultiresSource& store) {
+  const render::TechniqueEntry& entry = render::TechniqueRegistry::global().find(req.technique);
+  const render::TechniqueRequirements r =
+      entry.requirements(device.limits, store.shape().dims(), req.techniqueOptions());
+  if (!r.ownStorage.empty()) return false;
+  layout::PlanRequest request;
+  request.reservedUnits = r.textureUnits;
+  request.reservedBytes = r.bytes;
+  request.streamed = true;
+  return layout::planLayout(store.shape(), device.limits, request).layout.layout == "bricks";
+}
+
+// A volume read brick by brick instead of whole: a generated head:WxHxD, an
+// OME-Zarr store (folder or URL) with --layout bricks, or with --layout auto
+// when its finest level does not fit in core. Null otherwise.
 std::shared_ptr<const lod::MultiresSource> streamedSource(const RenderOptions& o,
+                                                          const RenderRequest& req,
+                                                          const DeviceSession& device,
                                                           const std::string& spec) {
   if (lod::ProceduralMultiresSource::isSpec(spec)) {
     return std::make_shared<lod::ProceduralMultiresSource>(spec);
   }
-  if (o.layout == "bricks" && isZarrStore(spec)) {
+  if (!isZarrStore(spec)) return nullptr;
+  if (o.layout == "bricks") {
     return lod::ZarrMultiresSource::open(spec, {.time = o.time, .channel = o.channel});
   }
-  return nullptr;
+  if (o.layout != "auto" || needsInCore(o)) return nullptr;
+  auto store = lod::ZarrMultiresSource::open(spec, {.time = o.time, .channel = o.channel});
+  if (!plannerStreams(req, device, *store)) return nullptr;
+  return store;
 }
 
 // The volume, with the window the options ask for.
@@ -335,9 +371,13 @@ void runRenderCommand(const RenderOptions& o) {
       o.labelVolume() ? TransferFunction() : TransferFunction::fromPresetOrFile(o.tf);
   // The profile first: it sets the host budget the reader must respect.
   DeviceSession device = openDevice(o.profile);
+  // The planner weighs a streamed source's in-core read against the budget
+  // the reader obeys: the profile's, or lower (TESSERA_HOST_BUDGET_MB, half
+  // the physical memory).
+  device.limits.hostBudget = HostBudget::global().limitBytes();
   RenderTimes times;
   const auto tLoad = std::chrono::steady_clock::now();
-  if (auto pyramid = streamedSource(o, spec)) {  // read brick by brick, never whole
+  if (auto pyramid = streamedSource(o, req, device, spec)) {  // read brick by brick, never whole
     const lod::MultiresVolumeSource streamed(std::move(pyramid));
     times.loadMs = msSince(tLoad);
     const RenderResult r = runRender(device, streamed, tf, req);
