@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -14,7 +15,9 @@
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"
+#include "tessera/io/HttpStorage.h"
 #include "tessera/io/VolumeReader.h"
+#include "tessera/io/ZarrCachedStorage.h"
 #include "tessera/io/ZarrStore.h"
 #include "tessera/layout/FccLayout.h"
 #include "tessera/layout/LayoutRegistry.h"
@@ -249,9 +252,26 @@ struct RenderTimes {
   double totalMs = 0.0;
 };
 
+// What a store streamed over HTTP(S) cost: bodies received (all attempts).
+struct HttpFetch {
+  std::uint64_t bytes = 0;
+  std::uint64_t requests = 0;
+  std::uint64_t retries = 0;
+};
+
+std::optional<HttpFetch> httpFetch(const lod::MultiresSource& source) {
+  const auto* zarr = dynamic_cast<const lod::ZarrMultiresSource*>(&source);
+  const ZarrStorage* storage = zarr ? &zarr->store().storage() : nullptr;
+  if (const auto* cached = dynamic_cast<const CachedStorage*>(storage)) storage = &cached->inner();
+  const auto* http = dynamic_cast<const HttpStorage*>(storage);
+  if (!http) return std::nullopt;
+  return HttpFetch{http->bytesFetched(), http->requests(), http->retries()};
+}
+
 void printRenderJson(const RenderOptions& o, const RenderRequest& req, const RenderResult& r,
                      const DeviceSession& device, const TransferFunction& tf,
-                     const std::string& spec, RenderTimes times) {
+                     const std::string& spec, RenderTimes times,
+                     std::optional<HttpFetch> fetch = std::nullopt) {
   const gpu::GlContext& context = *device.context;
   nlohmann::json j;
   j["file"] = spec;
@@ -299,6 +319,11 @@ void printRenderJson(const RenderOptions& o, const RenderRequest& req, const Ren
                    {"read_errors", b.readErrors},
                    {"cache_peak_bytes", b.cachePeakBytes}};
   }
+  if (fetch) {
+    j["http"] = {{"bytes_fetched", fetch->bytes},
+                 {"requests", fetch->requests},
+                 {"retries", fetch->retries}};
+  }
   j["mode"] = o.mode;
   j["technique"] = o.technique;
   j["step_voxels"] = o.step;
@@ -309,7 +334,7 @@ void printRenderJson(const RenderOptions& o, const RenderRequest& req, const Ren
 
 void printRenderText(const RenderOptions& o, const RenderRequest& req, const RenderResult& r,
                      const DeviceSession& device, const Volume& volume, const std::string& spec,
-                     RenderTimes times) {
+                     RenderTimes times, std::optional<HttpFetch> fetch = std::nullopt) {
   const gpu::GlContext& context = *device.context;
   std::printf("wrote %s (%dx%d) in %.0f ms total\n", o.out.c_str(), req.width, req.height,
               times.totalMs);
@@ -357,6 +382,11 @@ void printRenderText(const RenderOptions& o, const RenderRequest& req, const Ren
         formatBytes(b.cachePeakBytes).c_str(), b.slots);
     std::printf("levels   bricks wanted:%s; page-table cells:%s\n", wanted.c_str(), cells.c_str());
   }
+  if (fetch) {
+    std::printf("http     fetched %s in %llu requests (%llu retries)\n",
+                formatBytes(fetch->bytes).c_str(), static_cast<unsigned long long>(fetch->requests),
+                static_cast<unsigned long long>(fetch->retries));
+  }
   if (r.psnrDb) {
     std::printf("reference %.0f ms on the CPU; PSNR %.2f dB, SSIM %.5f\n", r.referenceMs, *r.psnrDb,
                 *r.ssim);
@@ -378,15 +408,15 @@ void runRenderCommand(const RenderOptions& o) {
   RenderTimes times;
   const auto tLoad = std::chrono::steady_clock::now();
   if (auto pyramid = streamedSource(o, req, device, spec)) {  // read brick by brick, never whole
-    const lod::MultiresVolumeSource streamed(std::move(pyramid));
+    const lod::MultiresVolumeSource streamed(pyramid);
     times.loadMs = msSince(tLoad);
     const RenderResult r = runRender(device, streamed, tf, req);
     r.first.writePng(o.out);
     times.totalMs = msSince(tStart);
     if (o.json) {
-      printRenderJson(o, req, r, device, tf, spec, times);
+      printRenderJson(o, req, r, device, tf, spec, times, httpFetch(*pyramid));
     } else {
-      printRenderText(o, req, r, device, streamed.shape(), spec, times);
+      printRenderText(o, req, r, device, streamed.shape(), spec, times, httpFetch(*pyramid));
     }
     return;
   }

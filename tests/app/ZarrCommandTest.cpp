@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "io/ZarrTestSupport.h"
 #include "support/CliRunner.h"
 #include "support/TestSupport.h"
 #include "tessera/core/Image.h"
@@ -128,6 +129,55 @@ TEST(ZarrCommand, AutoStreamsAStoreThatDoesNotFitAndMatchesTheInCoreRender) {
                                   tessera::Image::readPng(tmp / "roomy.png"));
   std::printf("streamed vs in-core: %.1f dB\n", db);
   EXPECT_GE(db, 45.0);
+}
+
+std::uint64_t filesBytes(const std::filesystem::path& folder) {
+  std::uint64_t bytes = 0;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(folder)) {
+    if (e.is_regular_file()) bytes += e.file_size();
+  }
+  return bytes;
+}
+
+// The bricked render of a store served by nginx (started here on a free
+// port of 127.0.0.1) equals the bricked render of the same folder, and
+// fetches only the chunks the view wants: fewer bytes than the finest
+// level's chunks.
+TEST(ZarrCommand, BricksOverHttpEqualTheFolderAndFetchLessThanTheFinestLevel) {
+  if (!std::filesystem::exists(tessera::test::Nginx::kBinary)) {
+    GTEST_SKIP() << "nginx not installed (nginx-light)";
+  }
+  const TempDir tmp;
+  const auto store = tmp / "www" / "store.ome.zarr";
+  std::filesystem::create_directories(tmp / "www");
+  // Marschner-Lobb (f32, smooth: every level compresses alike, unlike the
+  // piecewise-constant phantom whose finest level zstd shrinks the most).
+  ASSERT_EQ(runCli("convert gen:marschner-lobb:160 " + store.string() + " --quiet").exitCode, 0);
+  const tessera::test::Nginx nginx(tmp / "www", tmp / "nginx");
+  const std::string view = " --layout bricks --size 96x96 --azimuth 30 --elevation 20 --json";
+  const auto local =
+      runCli("render " + store.string() + view + " --out " + (tmp / "local.png").string());
+  ASSERT_EQ(local.exitCode, 0) << local.err;
+  const auto remote = runCli("render " + nginx.url("store.ome.zarr") + view + " --out " +
+                             (tmp / "remote.png").string());
+  ASSERT_EQ(remote.exitCode, 0) << remote.err;
+  const auto jl = nlohmann::json::parse(local.out);
+  const auto jr = nlohmann::json::parse(remote.out);
+  EXPECT_EQ(jr["layout"], "bricks");
+  EXPECT_TRUE(jr["bricks"]["complete"].get<bool>());
+  EXPECT_EQ(jr["bricks"]["wanted_per_level"], jl["bricks"]["wanted_per_level"]);
+  EXPECT_FALSE(jl.contains("http"));  // a folder is not fetched
+  const double db = tessera::psnr(tessera::Image::readPng(tmp / "local.png"),
+                                  tessera::Image::readPng(tmp / "remote.png"));
+  EXPECT_GE(db, 60.0);
+  const std::uint64_t fetched = jr["http"]["bytes_fetched"].get<std::uint64_t>();
+  const std::uint64_t finest = filesBytes(store / "0");
+  std::printf("http vs folder: %.1f dB; fetched %llu bytes in %llu requests, level 0 holds %llu\n",
+              db, static_cast<unsigned long long>(fetched),
+              static_cast<unsigned long long>(jr["http"]["requests"].get<std::uint64_t>()),
+              static_cast<unsigned long long>(finest));
+  EXPECT_GT(fetched, 0u);
+  EXPECT_LT(fetched, finest);
 }
 
 TEST(ZarrCommand, BadOptionsAreRefusedBeforeReading) {
