@@ -20,8 +20,9 @@ void addSliceCommand(CLI::App& app);     // SliceCommand.cpp
 // reads a volume offers.
 inline constexpr const char* kVolumeHelp =
     "Volume: .nii .nii.gz .hdr .nrrd .nhdr .mha .mhd .vti .pvm .raw/.json, a DICOM file or "
-    "folder, an OME-Zarr store (folder or http(s):// URL; the finest level that fits the host "
-    "budget, or streamed with --layout bricks), or gen:sphere|shepp-logan|marschner-lobb[:N]; "
+    "folder, an OME-Zarr store (folder or http(s):// URL; render streams it through bricks "
+    "when its finest level does not fit in core or with --layout bricks, otherwise the finest "
+    "level that fits the host budget), or gen:sphere|shepp-logan|marschner-lobb[:N]; "
     "default: ch2 (mricron-data) or a Shepp-Logan phantom. render and plan: head:WxHxD (or "
     "head:N) is a generated u8 head of any size computed brick by brick, never held whole "
     "(streamed through the bricks layout when it does not fit in core)";

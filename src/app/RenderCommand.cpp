@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -15,10 +16,13 @@
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"
+#include "tessera/io/HttpStorage.h"
 #include "tessera/io/VolumeReader.h"
+#include "tessera/io/ZarrCachedStorage.h"
 #include "tessera/io/ZarrStore.h"
 #include "tessera/layout/FccLayout.h"
 #include "tessera/layout/LayoutRegistry.h"
+#include "tessera/layout/Planner.h"
 #include "tessera/lod/InCoreVolumeSource.h"
 #include "tessera/lod/MultiresVolumeSource.h"
 #include "tessera/lod/ProceduralMultiresSource.h"
@@ -172,17 +176,52 @@ RenderRequest requestFrom(const RenderOptions& o) {
   return req;
 }
 
-// A volume read brick by brick instead of whole: a generated head:WxHxD, or
-// an OME-Zarr store (folder or URL) with --layout bricks. Null otherwise.
+// Options that need the voxels in host memory (a window or label table
+// applied to them, the hybrid compositor, the CPU reference, the FCC
+// resampling): with these a store is read in core, at the finest level that
+// fits the host budget.
+bool needsInCore(const RenderOptions& o) {
+  return o.labelVolume() || !o.window.empty() || !o.overlays.empty() || !o.offscreen.empty() ||
+         !o.roi.empty() || o.reference || !o.referenceOut.empty() || o.lattice != "cartesian";
+}
+
+// With --layout auto a store streams when the planner, given its finest
+// level as a streamed shape and the technique's own units and bytes (what
+// uploadVolume will ask it), rejects every in-core layout under the profile
+// (its textures or its host budget; the plan's reason says which) and picks
+// bricks; a store that fits keeps the in-core path, and so does a technique
+// with its own storage.
+bool plannerStreams(const RenderRequest& req, const DeviceSession& device,
+                    const lod::MultiresSource& store) {
+  const render::TechniqueEntry& entry = render::TechniqueRegistry::global().find(req.technique);
+  const render::TechniqueRequirements r =
+      entry.requirements(device.limits, store.shape().dims(), req.techniqueOptions());
+  if (!r.ownStorage.empty()) return false;
+  layout::PlanRequest request;
+  request.reservedUnits = r.textureUnits;
+  request.reservedBytes = r.bytes;
+  request.streamed = true;
+  return layout::planLayout(store.shape(), device.limits, request).layout.layout == "bricks";
+}
+
+// A volume read brick by brick instead of whole: a generated head:WxHxD, an
+// OME-Zarr store (folder or URL) with --layout bricks, or with --layout auto
+// when its finest level does not fit in core. Null otherwise.
 std::shared_ptr<const lod::MultiresSource> streamedSource(const RenderOptions& o,
+                                                          const RenderRequest& req,
+                                                          const DeviceSession& device,
                                                           const std::string& spec) {
   if (lod::ProceduralMultiresSource::isSpec(spec)) {
     return std::make_shared<lod::ProceduralMultiresSource>(spec);
   }
-  if (o.layout == "bricks" && isZarrStore(spec)) {
+  if (!isZarrStore(spec)) return nullptr;
+  if (o.layout == "bricks") {
     return lod::ZarrMultiresSource::open(spec, {.time = o.time, .channel = o.channel});
   }
-  return nullptr;
+  if (o.layout != "auto" || needsInCore(o)) return nullptr;
+  auto store = lod::ZarrMultiresSource::open(spec, {.time = o.time, .channel = o.channel});
+  if (!plannerStreams(req, device, *store)) return nullptr;
+  return store;
 }
 
 // --region: the box of the level, read with readBox (a store reads only the
@@ -252,9 +291,26 @@ struct RenderTimes {
   double totalMs = 0.0;
 };
 
+// What a store streamed over HTTP(S) cost: bodies received (all attempts).
+struct HttpFetch {
+  std::uint64_t bytes = 0;
+  std::uint64_t requests = 0;
+  std::uint64_t retries = 0;
+};
+
+std::optional<HttpFetch> httpFetch(const lod::MultiresSource& source) {
+  const auto* zarr = dynamic_cast<const lod::ZarrMultiresSource*>(&source);
+  const ZarrStorage* storage = zarr ? &zarr->store().storage() : nullptr;
+  if (const auto* cached = dynamic_cast<const CachedStorage*>(storage)) storage = &cached->inner();
+  const auto* http = dynamic_cast<const HttpStorage*>(storage);
+  if (!http) return std::nullopt;
+  return HttpFetch{http->bytesFetched(), http->requests(), http->retries()};
+}
+
 void printRenderJson(const RenderOptions& o, const RenderRequest& req, const RenderResult& r,
                      const DeviceSession& device, const TransferFunction& tf,
-                     const std::string& spec, RenderTimes times, const nlohmann::json& region) {
+                     const std::string& spec, RenderTimes times, const nlohmann::json& region,
+                     std::optional<HttpFetch> fetch = std::nullopt) {
   const gpu::GlContext& context = *device.context;
   nlohmann::json j;
   if (!region.is_null()) j["region"] = region;
@@ -303,6 +359,11 @@ void printRenderJson(const RenderOptions& o, const RenderRequest& req, const Ren
                    {"read_errors", b.readErrors},
                    {"cache_peak_bytes", b.cachePeakBytes}};
   }
+  if (fetch) {
+    j["http"] = {{"bytes_fetched", fetch->bytes},
+                 {"requests", fetch->requests},
+                 {"retries", fetch->retries}};
+  }
   j["mode"] = o.mode;
   j["technique"] = o.technique;
   j["step_voxels"] = o.step;
@@ -313,7 +374,7 @@ void printRenderJson(const RenderOptions& o, const RenderRequest& req, const Ren
 
 void printRenderText(const RenderOptions& o, const RenderRequest& req, const RenderResult& r,
                      const DeviceSession& device, const Volume& volume, const std::string& spec,
-                     RenderTimes times) {
+                     RenderTimes times, std::optional<HttpFetch> fetch = std::nullopt) {
   const gpu::GlContext& context = *device.context;
   std::printf("wrote %s (%dx%d) in %.0f ms total\n", o.out.c_str(), req.width, req.height,
               times.totalMs);
@@ -361,6 +422,11 @@ void printRenderText(const RenderOptions& o, const RenderRequest& req, const Ren
         formatBytes(b.cachePeakBytes).c_str(), b.slots);
     std::printf("levels   bricks wanted:%s; page-table cells:%s\n", wanted.c_str(), cells.c_str());
   }
+  if (fetch) {
+    std::printf("http     fetched %s in %llu requests (%llu retries)\n",
+                formatBytes(fetch->bytes).c_str(), static_cast<unsigned long long>(fetch->requests),
+                static_cast<unsigned long long>(fetch->retries));
+  }
   if (r.psnrDb) {
     std::printf("reference %.0f ms on the CPU; PSNR %.2f dB, SSIM %.5f\n", r.referenceMs, *r.psnrDb,
                 *r.ssim);
@@ -375,19 +441,23 @@ void runRenderCommand(const RenderOptions& o) {
       o.labelVolume() ? TransferFunction() : TransferFunction::fromPresetOrFile(o.tf);
   // The profile first: it sets the host budget the reader must respect.
   DeviceSession device = openDevice(o.profile);
+  // The planner weighs a streamed source's in-core read against the budget
+  // the reader obeys: the profile's, or lower (TESSERA_HOST_BUDGET_MB, half
+  // the physical memory).
+  device.limits.hostBudget = HostBudget::global().limitBytes();
   RenderTimes times;
   const auto tLoad = std::chrono::steady_clock::now();
   // --region reads its one box in core instead.
-  if (auto pyramid = o.region.empty() ? streamedSource(o, spec) : nullptr) {  // never whole
-    const lod::MultiresVolumeSource streamed(std::move(pyramid));
+  if (auto pyramid = o.region.empty() ? streamedSource(o, req, device, spec) : nullptr) {
+    const lod::MultiresVolumeSource streamed(pyramid);  // read brick by brick, never whole
     times.loadMs = msSince(tLoad);
     const RenderResult r = runRender(device, streamed, tf, req);
     r.first.writePng(o.out);
     times.totalMs = msSince(tStart);
     if (o.json) {
-      printRenderJson(o, req, r, device, tf, spec, times, nullptr);
+      printRenderJson(o, req, r, device, tf, spec, times, nullptr, httpFetch(*pyramid));
     } else {
-      printRenderText(o, req, r, device, streamed.shape(), spec, times);
+      printRenderText(o, req, r, device, streamed.shape(), spec, times, httpFetch(*pyramid));
     }
     return;
   }

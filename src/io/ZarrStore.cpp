@@ -496,6 +496,7 @@ void ZarrStore::readChunkInto(int l, const std::vector<std::int64_t>& spatial, g
     } catch (const InputError&) {
       // A network may have damaged the body: fetch it again.
       if (attempt >= storage_->refetches()) throw;
+      storage_->forget(key);
     }
   }
   const std::size_t bpv = bytesPerVoxel(m.target);

@@ -17,6 +17,60 @@ namespace {
 
 constexpr std::uint64_t kDefaultAtlasCap = 256ull << 20;
 constexpr int kCoarsestSide = 16;
+// What the process holds besides the atlas and the brick cache while it
+// streams: code, the GL driver, the render target and its read-back, bricks
+// in flight in the reader threads and in upload, the page table, a store's
+// chunk cache. Measured on llvmpipe: head:1024 on shield-k1 (512² image)
+// peaked at 468 MiB with a 255 MiB atlas and a 54 MiB cache, so 159 MiB;
+// with a margin.
+constexpr std::uint64_t kHostOverhead = 176ull << 20;
+// The cache never goes below a frame's uploads and the bricks behind them.
+constexpr std::uint64_t kMinCacheBytes = 32ull << 20;
+
+// The atlas counts against the host budget as well as the texture budget.
+// On llvmpipe the "GPU" is the CPU and the atlas lives in the process. On
+// unified-memory mobile GPUs (Tegra K1 in the Shield, the iPad's PowerVR)
+// texture memory is the same DRAM as the heap: the driver allocates the
+// atlas out of the RAM the OS allows the app (Android's low-memory killer
+// and iOS's jetsam count it against the process), and a desktop driver
+// often keeps a shadow copy in system memory too. So the host budget pays
+// for atlas + brick cache + overhead; the cache gets what the atlas leaves.
+// A host budget below the process's own footprint (tests of the planner
+// with a few MiB) cannot be honoured this way: the atlas is then not
+// weighed against it and the cache takes a quarter of it.
+bool weighsAtlas(const gpu::DeviceLimits& limits, const BricksOptions& options,
+                 std::uint64_t pageBytes) {
+  return limits.hostBudget > kHostOverhead + kMinCacheBytes + pageBytes && options.cacheBytes == 0;
+}
+
+std::uint64_t atlasCap(const gpu::DeviceLimits& limits, const BricksOptions& options,
+                       std::uint64_t pageBytes) {
+  std::uint64_t avail = options.atlasBytesCap ? options.atlasBytesCap : kDefaultAtlasCap;
+  if (limits.textureBudget != 0) {
+    avail =
+        std::min(avail, limits.textureBudget > pageBytes ? limits.textureBudget - pageBytes : 0);
+  }
+  if (weighsAtlas(limits, options, pageBytes)) {
+    // When the atlas does not fit beside a minimal cache, it shrinks.
+    avail = std::min(avail, limits.hostBudget - kHostOverhead - kMinCacheBytes - pageBytes);
+  }
+  return avail;
+}
+
+// The host cache of decoded bricks: the host budget less the atlas, the
+// page table and the overhead (see atlasCap), at most a quarter of the
+// budget; 64 MiB without a host budget.
+std::uint64_t cacheBytesFor(const gpu::DeviceLimits& limits, const BricksOptions& options,
+                            std::uint64_t atlasBytes, std::uint64_t pageBytes) {
+  if (options.cacheBytes != 0) return options.cacheBytes;
+  if (limits.hostBudget == 0) return 64ull << 20;
+  if (!weighsAtlas(limits, options, pageBytes)) return limits.hostBudget / 4;
+  // At most a quarter of the budget, as before the atlas was weighed: a
+  // roomy host (half of a desktop's RAM) keeps a cache of the usual size.
+  const std::uint64_t used = atlasBytes + pageBytes + kHostOverhead;
+  const std::uint64_t left = limits.hostBudget > used ? limits.hostBudget - used : 0;
+  return std::max(kMinCacheBytes, std::min(left, limits.hostBudget / 4));
+}
 
 // "prefix7suffix" (snprintf: GCC 12 -Wrestrict misfires on "literal" + std::string).
 std::string numbered(const char* prefix, int n, const char* suffix = "") {
@@ -125,11 +179,7 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
     plan.reason = "bricks need two texture units (atlas and page table) on " + limits.profile;
     return plan;
   }
-  std::uint64_t avail = options.atlasBytesCap ? options.atlasBytesCap : kDefaultAtlasCap;
-  if (limits.textureBudget != 0) {
-    avail = std::min(avail,
-                     limits.textureBudget > pages.bytes ? limits.textureBudget - pages.bytes : 0);
-  }
+  const std::uint64_t avail = atlasCap(limits, options, pages.bytes);
   const AtlasShape a = atlasFor(limits, stored, avail, pyramidBricks(levels, b));
   const bool es3 = a.mosaic.tilesX == 0;
   const int atlases = es3 ? 1 : std::max(1, a.slots.x);
@@ -183,10 +233,8 @@ std::unique_ptr<BricksLayout> BricksLayout::create(
   const int b = brickSizeFor(options, chunk);
   l->grid_ = lod::BrickGrid::of(*source, b);
   const int stored = l->grid_.stored();
-  std::uint64_t avail = options.atlasBytesCap ? options.atlasBytesCap : kDefaultAtlasCap;
-  if (limits.textureBudget != 0) {
-    avail = std::min(avail, limits.textureBudget - l->plan_.textures[1].bytes);
-  }
+  const std::uint64_t pageBytes = l->plan_.textures.back().bytes;
+  const std::uint64_t avail = atlasCap(limits, options, pageBytes);
   std::uint64_t bricks = 0;
   for (int lv = 0; lv < l->grid_.levelCount(); ++lv) bricks += l->grid_.brickCount(lv);
   const AtlasShape a = atlasFor(limits, stored, avail, bricks);
@@ -216,9 +264,7 @@ std::unique_ptr<BricksLayout> BricksLayout::create(
 
   lod::BrickStreamerOptions so;
   so.workers = options.workers;
-  so.cacheBytes = options.cacheBytes       ? options.cacheBytes
-                  : limits.hostBudget != 0 ? limits.hostBudget / 4
-                                           : 64ull << 20;
+  so.cacheBytes = cacheBytesFor(limits, options, a.bytes, pageBytes);
   l->streamer_ = std::make_unique<lod::BrickStreamer>(source, l->grid_, so);
   // The coarsest level, pinned: what every cell falls back to.
   const int top = l->grid_.levelCount() - 1;

@@ -3,6 +3,7 @@
 
 #include "tessera/core/Error.h"
 #include "tessera/gpu/DeviceProfile.h"
+#include "tessera/layout/BricksLayout.h"
 #include "tessera/layout/LayoutRegistry.h"
 #include "tessera/layout/Planner.h"
 
@@ -227,4 +228,24 @@ TEST(Planner, StreamedVolumesThatFitNoInCoreLayoutAreBrickedAndItSaysWhy) {
   EXPECT_NE(host.reason.find("host memory"), std::string::npos) << host.reason;
   // In-core volumes keep downsampling (their front ends do not stream).
   EXPECT_TRUE(plan({512, 512, 512}, "ipad2").downsampled());
+}
+
+// The bricks atlas counts against the host budget too (on llvmpipe and on
+// unified-memory GPUs it is process memory): it leaves room for the host's
+// fixed overhead and a brick cache, and shrinks when that room is short.
+TEST(Planner, BricksAtlasLeavesTheHostBudgetRoomForItsCache) {
+  const Volume shape = Volume::shapeOnly({1024, 1024, 1024}, ScalarType::U8);
+  gpu::DeviceLimits limits = limitsOf("shield-k1");  // 1 GiB textures, 469 MB host
+  const std::uint64_t k1 = layout::BricksLayout::planFor(shape, limits).totalBytes;
+  EXPECT_LE(k1, limits.hostBudget - (176ull + 32ull) * (1ull << 20));
+  EXPECT_GT(k1, 200ull << 20);  // the 255 MiB atlas still fits beside it
+  // A 300 MiB host: the atlas shrinks to what is left, and still fits.
+  limits.hostBudget = 300ull << 20;
+  const layout::LayoutPlan small = layout::BricksLayout::planFor(shape, limits);
+  EXPECT_TRUE(small.fits) << small.reason;
+  EXPECT_LE(small.totalBytes, (300ull - 176 - 32) << 20);
+  EXPECT_LT(small.totalBytes, k1);
+  // No host budget: the texture budget and the 256 MiB cap alone.
+  limits.hostBudget = 0;
+  EXPECT_GE(layout::BricksLayout::planFor(shape, limits).totalBytes, k1);
 }

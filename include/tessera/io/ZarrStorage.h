@@ -26,6 +26,9 @@ class ZarrStorage {
                                                     std::uint64_t maxBytes) const = 0;
   // Where `key` lives, for messages: a path or a URL.
   virtual std::string locate(const std::string& key) const = 0;
+  // Drops what a cache holds for `key` (its bytes failed to decode and are
+  // fetched again); storage without a cache has nothing to drop.
+  virtual void forget(const std::string& key) const { (void)key; }
   // How often a chunk that fails to decode is fetched again: 0 where the
   // same bytes would come back (disk, memory); a network may have
   // delivered a damaged body.

@@ -40,9 +40,13 @@
 namespace tessera::layout {
 
 struct BricksOptions {
-  int brickSize = 0;                // B; 0: the source's chunk if cubic 16..128, else 32
-  std::uint64_t atlasBytesCap = 0;  // 0: min(texture budget, 256 MiB)
-  std::uint64_t cacheBytes = 0;     // host cache; 0: a quarter of the host budget (64 MiB)
+  int brickSize = 0;  // B; 0: the source's chunk if cubic 16..128, else 32
+  // 0: min(texture budget, 256 MiB, host budget - overhead - a minimal cache)
+  std::uint64_t atlasBytesCap = 0;
+  // Host cache; 0: the host budget less the atlas and a fixed overhead, at
+  // most a quarter of it (64 MiB without a host budget). Set, the atlas is
+  // not weighed against the host.
+  std::uint64_t cacheBytes = 0;
   std::uint64_t uploadBytesPerFrame = 16ull << 20;
   double uploadMsPerFrame = 40.0;  // stop uploading after this long in a frame
   double pixelsPerVoxel = 1.0;     // refine while a voxel covers more pixels
