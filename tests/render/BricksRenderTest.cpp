@@ -71,6 +71,10 @@ layout::BricksOptions smallBricks(int b) {
   layout::BricksOptions o;
   o.brickSize = b;
   o.pixelsPerVoxel = 0.05;  // every brick at level 0 for these tiny volumes
+  // Reads inline, in request order: which bricks a frame finds resident then
+  // does not depend on how two reader threads were scheduled (under load one
+  // cell once ended a refinement a level coarser). Threads: FlakySource test.
+  o.workers = 0;
   return o;
 }
 
@@ -269,6 +273,7 @@ TEST(BricksRender, FailingReadsLeaveTheCoarserLevelAndComplete) {
   auto flaky =
       std::make_shared<FlakySource>(std::make_shared<lod::InCoreMultiresSource>(v, 16), 16);
   layout::BricksOptions o = smallBricks(16);
+  o.workers = 2;  // failures arrive from reader threads, as in use
   auto bricks = layout::BricksLayout::create(flaky, limits, c.ledger(), o);
   const Camera cam = viewOf(*v, 30, 20);
   layout::BricksFrame f;
