@@ -150,7 +150,22 @@ std::string ZarrArrayMeta::chunkKey(std::span<const std::int64_t> index) const {
   return key;
 }
 
+namespace {
+ZarrArrayMeta parseZarrayFields(std::string_view text, const std::string& name);
+}  // namespace
+
+// A field of the wrong JSON type ("order": 0) is a bad file, not a crash:
+// nlohmann's type errors become an InputError naming the .zarray.
 ZarrArrayMeta parseZarray(std::string_view text, const std::string& name) {
+  try {
+    return parseZarrayFields(text, name);
+  } catch (const json::exception& e) {
+    throw InputError(name + ": a field has the wrong type or value (" + e.what() + ")");
+  }
+}
+
+namespace {
+ZarrArrayMeta parseZarrayFields(std::string_view text, const std::string& name) {
   json doc;
   try {
     doc = json::parse(text);
@@ -200,6 +215,7 @@ ZarrArrayMeta parseZarray(std::string_view text, const std::string& name) {
   HostBudget::global().check(m.chunkBytes(), name + ": one chunk " + doc["chunks"].dump());
   return m;
 }
+}  // namespace
 
 std::string zarrayJson(const std::vector<std::int64_t>& shape,
                        const std::vector<std::int64_t>& chunks, ScalarType type,

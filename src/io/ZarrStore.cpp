@@ -134,15 +134,21 @@ ZarrStore::ZarrStore(std::shared_ptr<const ZarrStorage> storage, ZarrSelection s
     : storage_(std::move(storage)), selection_(selection) {
   const auto attrs = storage_->get(".zattrs", kMaxMetadataBytes);
   const std::string attrsText = attrs ? text(*attrs) : std::string();
-  const bool multiscales =
-      attrs && parseJson(attrsText, storage_->locate(".zattrs")).contains("multiscales");
-  if (multiscales) {
-    readMultiscales(attrsText);
-  } else {
-    readLoneArray();
+  // A metadata field of the wrong JSON type is a bad store, not a crash.
+  try {
+    const bool multiscales =
+        attrs && parseJson(attrsText, storage_->locate(".zattrs")).contains("multiscales");
+    if (multiscales) {
+      readMultiscales(attrsText);
+    } else {
+      readLoneArray();
+    }
+    checkSelection();
+    makeShape(attrsText);
+  } catch (const json::exception& e) {
+    throw InputError(storage_->describe() + ": metadata field of the wrong type or value (" +
+                     e.what() + ")");
   }
-  checkSelection();
-  makeShape(attrsText);
 }
 
 const ZarrLevel& ZarrStore::level(int l) const {

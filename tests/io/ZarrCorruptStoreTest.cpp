@@ -95,6 +95,23 @@ TEST(ZarrCorruptStore, ZeroNegativeOrFractionalChunksAreRefused) {
   expectRefused<InputError>(store(tmp, zarray("[10, 10]", "[5, 5]")), {"0/.zarray", "2 axes"});
 }
 
+// fuzz_zarr found these: a field of the wrong JSON type made nlohmann throw a
+// type_error that escaped the reader (std::terminate).
+TEST(ZarrCorruptStore, FieldsOfTheWrongJsonTypeAreInputErrors) {
+  const TempDir tmp;
+  expectRefused<InputError>(
+      store(tmp, R"({"zarr_format": 2, "shape": [4,5,6], "chunks": [4,5,6], "dtype": "<u2",
+        "order": 0, "filters": null, "compressor": {"id": "zlib", "level": 1}})"),
+      {"0/.zarray", "wrong type"});
+  expectRefused<InputError>(
+      store(tmp, R"({"zarr_format": 2, "shape": "big", "chunks": [4,4,4], "dtype": "|u1",
+        "order": "C", "fill_value": 0, "compressor": null})"),
+      {"0/.zarray"});
+  const fs::path root = store(tmp, zarray("[4, 4, 4]", "[4, 4, 4]"));
+  put(root / ".zattrs", R"({"multiscales": [{"version": "0.4", "axes": 7, "datasets": 3}]})");
+  expectRefused<InputError>(root, {"s.ome.zarr"});
+}
+
 TEST(ZarrCorruptStore, UnsupportedLayoutsSayWhat) {
   const TempDir tmp;
   expectRefused<InputError>(
