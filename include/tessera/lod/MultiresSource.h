@@ -18,9 +18,9 @@ namespace tessera::lod {
 
 // One level of the pyramid.
 struct LevelInfo {
-  glm::ivec3 dims{0};        // voxels along x, y, z
-  glm::vec3 spacing{1.0f};   // mm per voxel along the index axes
-  glm::ivec3 chunk{0};       // the store's natural read unit (0: none)
+  glm::ivec3 dims{0};       // voxels along x, y, z
+  glm::vec3 spacing{1.0f};  // mm per voxel along the index axes
+  glm::ivec3 chunk{0};      // the store's natural read unit (0: none)
 };
 
 // A box of voxels [begin, end) in one level's index space.
