@@ -6,6 +6,7 @@
 #include <limits>
 #include <vector>
 
+#include "layout/Fit3DTexture.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/lattice/FccResampling.h"
@@ -93,24 +94,13 @@ LayoutPlan planStorage(glm::ivec3 gridDims, ScalarType type, const gpu::DeviceLi
       (cubes ? ", the corners of its unit cubes in one " : ", packed into one ") +
       dimsText(t.size) + " " + t.format + " 3D texture (" + formatBytes(t.bytes) +
       "), box spline from " + (cubes ? "5" : "16") + " texelFetch per sample";
-  const glm::ivec3 d = t.size;
-  if (limits.api != gpu::ApiLevel::Gles3 || limits.max3DTextureSize == 0) {
-    plan.reason =
-        "the box spline needs OpenGL ES 3 (3D textures, texelFetch, integer maths), "
-        "which " +
-        limits.profile + " does not have";
-  } else if (std::max({d.x, d.y, d.z}) > limits.max3DTextureSize) {
-    plan.reason = what + " exceeds the max 3D texture size " +
-                  std::to_string(limits.max3DTextureSize) + " of " + limits.profile;
-  } else if (limits.textureBudget != 0 && t.bytes > limits.textureBudget) {
-    plan.reason = what + " exceeds the texture budget " + formatBytes(limits.textureBudget) +
-                  " of " + limits.profile;
-  } else if (limits.textureUnits < 1) {
-    plan.reason = "no texture unit left for the lattice on " + limits.profile;
-  } else {
-    plan.fits = true;
-    plan.reason = what;
-  }
+  plan.reason = refusalFor3DTexture(
+      limits, t.size, t.bytes, what,
+      "the box spline needs OpenGL ES 3 (3D textures, texelFetch, integer maths), which " +
+          limits.profile + " does not have",
+      "the lattice");
+  plan.fits = plan.reason.empty();
+  if (plan.fits) plan.reason = what;
   return plan;
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "layout/Fit3DTexture.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/gpu/Draw.h"
@@ -36,21 +37,10 @@ LayoutPlan Texture3DLayout::planFor(const Volume& volume, const gpu::DeviceLimit
   const std::string what = dimsText(volume.dims()) + " " +
                            std::string(scalarTypeName(volume.type())) + " in one " + t.format +
                            " 3D texture (" + formatBytes(t.bytes) + ")";
-  const glm::ivec3 d = volume.dims();
-  if (limits.api != gpu::ApiLevel::Gles3 || limits.max3DTextureSize == 0) {
-    plan.reason = "no 3D textures on " + limits.profile;
-  } else if (std::max({d.x, d.y, d.z}) > limits.max3DTextureSize) {
-    plan.reason = what + " exceeds the max 3D texture size " +
-                  std::to_string(limits.max3DTextureSize) + " of " + limits.profile;
-  } else if (limits.textureBudget != 0 && t.bytes > limits.textureBudget) {
-    plan.reason = what + " exceeds the texture budget " + formatBytes(limits.textureBudget) +
-                  " of " + limits.profile;
-  } else if (limits.textureUnits < 1) {
-    plan.reason = "no texture unit left for the volume on " + limits.profile;
-  } else {
-    plan.fits = true;
-    plan.reason = what;
-  }
+  plan.reason = refusalFor3DTexture(limits, volume.dims(), t.bytes, what,
+                                    "no 3D textures on " + limits.profile, "the volume");
+  plan.fits = plan.reason.empty();
+  if (plan.fits) plan.reason = what;
   return plan;
 }
 
