@@ -15,20 +15,28 @@ std::string dimsText(glm::ivec3 d) {
 }
 
 // "layout texture3d needs 3D textures, which ipad2 does not have (use
-// mosaic or packed-mosaic)".
+// mosaic or packed-mosaic)". Only layouts of the same kind are offered: one
+// that "auto" may not pick (fcc: it changes the reconstruction) is not
+// replaced by a Cartesian layout behind the user's back, and the other way
+// round.
 std::string unmetNeeds(const LayoutEntry& entry, const gpu::DeviceLimits& limits) {
   const std::string need = !entry.needsText.empty() ? entry.needsText
                            : entry.needs3DTextures  ? "3D textures"
                                                     : "OpenGL ES 3";
   std::vector<std::string> others;
   for (const LayoutEntry& e : LayoutRegistry::global().entries()) {
-    if (e.runsOn(limits)) others.push_back(e.name);
+    if (e.automatic == entry.automatic && e.runsOn(limits)) others.push_back(e.name);
   }
   std::string use;
   for (std::size_t i = 0; i < others.size(); ++i) {
     use += (i == 0 ? " (use " : i + 1 == others.size() ? " or " : ", ") + others[i];
   }
   if (!use.empty()) use += ")";
+  if (others.empty() && !entry.automatic) {
+    use =
+        " (no layout of this kind runs there; without it the volume is rendered on its "
+        "Cartesian grid)";
+  }
   return "layout " + entry.name + " needs " + need + ", which " + limits.profile +
          " does not have" + use;
 }

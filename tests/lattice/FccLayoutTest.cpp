@@ -324,6 +324,10 @@ TEST(FccLayout, PlannerAccountsItsBytesAndRefusesDevicesWithoutEs3) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("3D textures"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("gles2"), std::string::npos) << e.what();
+    // No Cartesian layout is offered in its place: that would change the
+    // reconstruction the user asked for.
+    EXPECT_EQ(std::string(e.what()).find("mosaic"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no layout of this kind"), std::string::npos) << e.what();
   }
   const layout::LayoutPlan direct =
       layout::FccLayout::planFor({64, 64, 64}, ScalarType::U8, gles2, "fcc");
