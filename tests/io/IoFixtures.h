@@ -9,6 +9,7 @@
 #include <atomic>
 #include <bit>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -23,6 +24,7 @@
 
 #include "support/TestSupport.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/core/Volume.h"
 
 namespace tessera::test {
 
@@ -30,6 +32,53 @@ inline void writeFile(const std::filesystem::path& path, std::string_view bytes)
   std::ofstream out(path, std::ios::binary);
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   if (!out) throw std::runtime_error("cannot write fixture " + path.string());
+}
+
+// What randomVolume() gives its volume besides the voxels.
+struct RandomVolumeOptions {
+  glm::dvec3 spacing{1.0};
+  glm::dvec3 origin{0.0};
+  bool withNaN = false;  // f32: about one voxel in 97 is NaN
+};
+
+// dims of random voxels over the whole range of `type` (f32: uniform in
+// [-1000, 1000)), for the readers' and writers' round trips.
+inline Volume randomVolume(glm::ivec3 dims, ScalarType type, unsigned seed,
+                           const RandomVolumeOptions& options = {}) {
+  Volume v = Volume::allocate(dims, type, "test volume");
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> real(-1000.0f, 1000.0f);
+  for (std::uint64_t i = 0; i < v.voxelCount(); ++i) {
+    switch (type) {
+      case ScalarType::U8:
+        v.setValueAtIndex(i, rng() % 256);
+        break;
+      case ScalarType::U16:
+        v.setValueAtIndex(i, rng() % 65536);
+        break;
+      case ScalarType::I16:
+        v.setValueAtIndex(i, static_cast<int>(rng() % 65536) - 32768);
+        break;
+      case ScalarType::F32:
+        v.setValueAtIndex(i, options.withNaN && rng() % 97 == 0 ? std::nan("") : real(rng));
+        break;
+    }
+  }
+  v.invalidateRange();
+  v.setSpacing(options.spacing);
+  v.setOrigin(options.origin);
+  return v;
+}
+
+// Same shape, type, geometry and voxel bytes.
+inline void expectSameVolume(const Volume& a, const Volume& b) {
+  EXPECT_EQ(a.dims(), b.dims());
+  EXPECT_EQ(a.type(), b.type());
+  EXPECT_EQ(a.spacing(), b.spacing());
+  EXPECT_EQ(a.origin(), b.origin());
+  ASSERT_EQ(a.byteSize(), b.byteSize());
+  EXPECT_EQ(std::memcmp(a.bytes().data(), b.bytes().data(), a.byteSize()), 0)
+      << "voxel bytes differ";
 }
 
 inline std::string gzipBytes(std::string_view data) {

@@ -19,40 +19,11 @@ namespace tessera {
 namespace {
 
 using test::expectRejected;
+using test::expectSameVolume;
+using test::randomVolume;
 using test::TempDir;
 using test::voxelBytes;
 using test::writeFile;
-
-Volume randomVolume(glm::ivec3 dims, ScalarType type, unsigned seed) {
-  Volume v = Volume::allocate(dims, type, "test");
-  std::mt19937 rng(seed);
-  for (std::size_t i = 0; i < v.voxelCount(); ++i) {
-    switch (type) {
-      case ScalarType::U8:
-        v.setValueAtIndex(i, rng() % 256);
-        break;
-      case ScalarType::U16:
-        v.setValueAtIndex(i, rng() % 65536);
-        break;
-      case ScalarType::I16:
-        v.setValueAtIndex(i, static_cast<int>(rng() % 65536) - 32768);
-        break;
-      case ScalarType::F32:
-        v.setValueAtIndex(i, std::ldexp(static_cast<double>(rng()) - 2147483648.0, -20));
-        break;
-    }
-  }
-  return v;
-}
-
-void expectSameVolume(const Volume& a, const Volume& b) {
-  EXPECT_EQ(a.dims(), b.dims());
-  EXPECT_EQ(a.type(), b.type());
-  EXPECT_EQ(a.spacing(), b.spacing());
-  EXPECT_EQ(a.origin(), b.origin());
-  ASSERT_EQ(a.byteSize(), b.byteSize());
-  EXPECT_EQ(std::memcmp(a.bytes().data(), b.bytes().data(), a.byteSize()), 0);
-}
 
 class NrrdRoundTrip : public ::testing::TestWithParam<std::tuple<ScalarType, bool>> {};
 

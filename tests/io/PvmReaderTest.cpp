@@ -22,32 +22,16 @@ using namespace std::string_literals;
 using io_detail::DdsVersion;
 using test::BudgetOverride;
 using test::expectRejected;
+using test::expectSameVolume;
 using test::TempDir;
 using test::writeFile;
 
-const std::filesystem::path kCh2 = "/usr/share/mricron/templates/ch2.nii.gz";
-
 Volume randomVolume(glm::ivec3 dims, ScalarType type, unsigned seed) {
-  Volume v = Volume::allocate(dims, type, "test volume");
-  std::mt19937 rng(seed);
-  for (std::uint64_t i = 0; i < v.voxelCount(); ++i) {
-    v.setValueAtIndex(i, type == ScalarType::U8 ? rng() % 256 : rng() % 65536);
-  }
-  v.invalidateRange();
-  v.setSpacing(glm::dvec3(0.5, 1.25, 3.0));
-  v.setOrigin(glm::dvec3(-90.5, 12.25, 0.1));
-  return v;
+  return test::randomVolume(dims, type, seed,
+                            {.spacing = {0.5, 1.25, 3.0}, .origin = {-90.5, 12.25, 0.1}});
 }
 
-void expectSameVolume(const Volume& a, const Volume& b) {
-  EXPECT_EQ(a.dims(), b.dims());
-  EXPECT_EQ(a.type(), b.type());
-  EXPECT_EQ(a.spacing(), b.spacing());
-  EXPECT_EQ(a.origin(), b.origin());
-  ASSERT_EQ(a.byteSize(), b.byteSize());
-  EXPECT_EQ(std::memcmp(a.bytes().data(), b.bytes().data(), a.byteSize()), 0)
-      << "voxel bytes differ";
-}
+const std::filesystem::path kCh2 = "/usr/share/mricron/templates/ch2.nii.gz";
 
 std::string fileBytes(const std::filesystem::path& path) {
   std::string bytes(static_cast<std::size_t>(std::filesystem::file_size(path)), '\0');

@@ -24,48 +24,18 @@ namespace {
 using test::BudgetOverride;
 using test::ByteImage;
 using test::expectRejected;
+using test::expectSameVolume;
 using test::TempDir;
 using test::writeFile;
+
+Volume randomVolume(glm::ivec3 dims, ScalarType type, unsigned seed) {
+  return test::randomVolume(dims, type, seed,
+                            {.spacing = {0.5, 1.25, 0.1}, .origin = {-90.5, 12.25, 1.0 / 3.0}});
+}
 
 const std::filesystem::path kCh2 = "/usr/share/mricron/templates/ch2.nii.gz";
 constexpr ScalarType kAllTypes[] = {ScalarType::U8, ScalarType::U16, ScalarType::I16,
                                     ScalarType::F32};
-
-Volume randomVolume(glm::ivec3 dims, ScalarType type, unsigned seed) {
-  Volume v = Volume::allocate(dims, type, "test volume");
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> real(-1000.0f, 1000.0f);
-  for (std::uint64_t i = 0; i < v.voxelCount(); ++i) {
-    switch (type) {
-      case ScalarType::U8:
-        v.setValueAtIndex(i, rng() % 256);
-        break;
-      case ScalarType::U16:
-        v.setValueAtIndex(i, rng() % 65536);
-        break;
-      case ScalarType::I16:
-        v.setValueAtIndex(i, static_cast<int>(rng() % 65536) - 32768);
-        break;
-      case ScalarType::F32:
-        v.setValueAtIndex(i, real(rng));
-        break;
-    }
-  }
-  v.invalidateRange();
-  v.setSpacing(glm::dvec3(0.5, 1.25, 0.1));
-  v.setOrigin(glm::dvec3(-90.5, 12.25, 1.0 / 3.0));
-  return v;
-}
-
-void expectSameVolume(const Volume& a, const Volume& b) {
-  EXPECT_EQ(a.dims(), b.dims());
-  EXPECT_EQ(a.type(), b.type());
-  EXPECT_EQ(a.spacing(), b.spacing());
-  EXPECT_EQ(a.origin(), b.origin());
-  ASSERT_EQ(a.byteSize(), b.byteSize());
-  EXPECT_EQ(std::memcmp(a.bytes().data(), b.bytes().data(), a.byteSize()), 0)
-      << "voxel bytes differ";
-}
 
 TEST(RawSidecar, RoundTripsEveryTypeExactlyThroughEitherFile) {
   TempDir dir;

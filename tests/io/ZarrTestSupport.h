@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "io/IoFixtures.h"
 #include "tessera/core/Volume.h"
 
 namespace tessera::test {
@@ -151,30 +152,5 @@ class Nginx {
   int port_;
   std::unique_ptr<ChildProcess> process_;
 };
-
-// dims of random voxels of `type` (f32: normal * 100, with NaN where asked).
-inline Volume randomVolume(glm::ivec3 dims, ScalarType type, unsigned seed, bool withNaN = false) {
-  Volume v = Volume::allocate(dims, type, "random");
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> normal(0.0, 100.0);
-  for (std::size_t i = 0; i < v.voxelCount(); ++i) {
-    switch (type) {
-      case ScalarType::U8:
-        v.setValueAtIndex(i, double(rng() % 256));
-        break;
-      case ScalarType::U16:
-        v.setValueAtIndex(i, double(rng() % 65536));
-        break;
-      case ScalarType::I16:
-        v.setValueAtIndex(i, double(int(rng() % 65536) - 32768));
-        break;
-      case ScalarType::F32:
-        v.setValueAtIndex(i, withNaN && rng() % 97 == 0 ? std::nan("") : normal(rng));
-        break;
-    }
-  }
-  v.invalidateRange();
-  return v;
-}
 
 }  // namespace tessera::test
