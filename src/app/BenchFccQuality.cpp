@@ -45,70 +45,12 @@ class MarschnerLobbField final : public Reconstruction {
   glm::ivec3 dims_;
 };
 
-TransferFunction softTf() {
-  TransferFunction tf;
-  tf.name = "soft";
-  tf.addColor(0.0, {0.2, 0.4, 1.0});
-  tf.addColor(1.0, {1.0, 0.9, 0.6});
-  tf.addOpacity(0.0, 0.0);
-  tf.addOpacity(0.3, 0.0);
-  tf.addOpacity(1.0, 0.25);
-  return tf;
-}
-
-TransferFunction isoTf() {
-  TransferFunction tf;
-  tf.name = "iso";
-  tf.addColor(0.0, {1.0, 0.8, 0.5});
-  tf.addColor(1.0, {1.0, 0.8, 0.5});
-  tf.addOpacity(0.0, 0.0);
-  tf.addOpacity(0.46, 0.0);
-  tf.addOpacity(0.5, 1.0);
-  tf.addOpacity(0.54, 0.0);
-  tf.addOpacity(1.0, 0.0);
-  return tf;
-}
-
 Camera obliqueCamera(const Volume& v) {
   Camera cam;
   cam.azimuthDeg = 30;
   cam.elevationDeg = 50;  // from above: the rings of the signal show
   cam.frame(v);
   return cam;
-}
-
-// Texture positions of the samples the ray caster takes (step 0.5 voxel,
-// t0 + (k + 0.5) ds) for a size x size image.
-std::vector<glm::dvec3> raySamples(const Volume& box, const Camera& camera, int size) {
-  const glm::dvec3 extent = box.extent();
-  const double ds = 0.5 * std::min({box.spacing().x, box.spacing().y, box.spacing().z});
-  std::vector<glm::dvec3> out;
-  for (int py = 0; py < size; ++py) {
-    for (int px = 0; px < size; ++px) {
-      const Ray ray = camera.pixelRay(px, py, size, size);
-      const glm::dvec3 to = ray.origin / extent + 0.5, td = ray.direction / extent;
-      double tNear = -1e300, tFar = 1e300;
-      for (int a = 0; a < 3; ++a) {
-        if (td[a] == 0.0) continue;
-        const double t0 = -to[a] / td[a], t1 = (1.0 - to[a]) / td[a];
-        tNear = std::max(tNear, std::min(t0, t1));
-        tFar = std::min(tFar, std::max(t0, t1));
-      }
-      for (double t = std::max(tNear, 0.0) + 0.5 * ds; t < tFar; t += ds)
-        out.push_back(to + t * td);
-    }
-  }
-  return out;
-}
-
-double rms(const Reconstruction& field, const std::vector<glm::dvec3>& at, glm::ivec3 dims) {
-  double sum = 0.0;
-  for (const glm::dvec3& p : at) {
-    const double e =
-        field.value(p) - lattice::marschnerLobb(lattice::marschnerLobbCoordinate(dims, p));
-    sum += e * e;
-  }
-  return std::sqrt(sum / static_cast<double>(at.size()));
 }
 
 Image gpuImage(gpu::GlContext& context, const gpu::DeviceLimits& limits, const Volume& box,
@@ -147,7 +89,7 @@ void marschnerLobb(gpu::GlContext& context, const gpu::DeviceLimits& limits,
   for (const int n : {41, 64}) {
     const Volume cartesian = makeMarschnerLobb(glm::ivec3(n));
     const Camera cam = obliqueCamera(cartesian);
-    const std::vector<glm::dvec3> rays = raySamples(cartesian, cam, 128);
+    const std::vector<glm::dvec3> rays = lattice::raySamplePositions(cartesian, cam, 128);
     std::vector<Row> rows;
     rows.push_back({"Cartesian " + std::to_string(n) + "^3, trilinear", cartesian.voxelCount(),
                     std::make_unique<TrilinearReconstruction>(cartesian),
@@ -165,7 +107,8 @@ void marschnerLobb(gpu::GlContext& context, const gpu::DeviceLimits& limits,
       rows.push_back(std::move(r));
     }
     std::vector<Image> truths;
-    for (const TransferFunction& tf : {softTf(), isoTf()}) {
+    for (const TransferFunction& tf :
+         {lattice::marschnerLobbSoftTf(), lattice::marschnerLobbIsoTf()}) {
       truths.push_back(renderReference(cartesian, MarschnerLobbField(cartesian.dims()), tf, cam, {},
                                        size, size));
       truths.back().writePng(dir / ("fcc-ml" + std::to_string(n) + "-truth-" + tf.name + ".png"));
@@ -173,15 +116,17 @@ void marschnerLobb(gpu::GlContext& context, const gpu::DeviceLimits& limits,
     for (const Row& r : rows) {
       double db[2];
       int i = 0;
-      for (const TransferFunction& tf : {softTf(), isoTf()}) {
+      for (const TransferFunction& tf :
+           {lattice::marschnerLobbSoftTf(), lattice::marschnerLobbIsoTf()}) {
         const Image img = gpuImage(context, limits, cartesian, *r.gpu, tf, cam, size);
         img.writePng(dir / (r.file + "-" + tf.name + ".png"));
         db[i] = psnr(img, truths[static_cast<std::size_t>(i)]);
         ++i;
       }
       std::printf("| %s | %llu | %.5f | %.5f | %.2f dB | %.2f dB |\n", r.label.c_str(),
-                  static_cast<unsigned long long>(r.samples), rms(*r.cpu, rays, cartesian.dims()),
-                  rms(*r.cpu, random, cartesian.dims()), db[0], db[1]);
+                  static_cast<unsigned long long>(r.samples),
+                  lattice::marschnerLobbRms(*r.cpu, rays, cartesian.dims()),
+                  lattice::marschnerLobbRms(*r.cpu, random, cartesian.dims()), db[0], db[1]);
     }
   }
 }

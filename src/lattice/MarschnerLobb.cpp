@@ -1,5 +1,6 @@
 #include "tessera/lattice/MarschnerLobb.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -32,6 +33,63 @@ FccVolume makeMarschnerLobbFcc(const Volume& cartesian, FccDensity density,
       cartesian, density,
       [dims](glm::dvec3 p) { return marschnerLobb(marschnerLobbCoordinate(dims, p)); },
       quasiInterpolated);
+}
+
+std::vector<glm::dvec3> raySamplePositions(const Volume& box, const Camera& camera, int size) {
+  const glm::dvec3 extent = box.extent();
+  const double ds = 0.5 * std::min({box.spacing().x, box.spacing().y, box.spacing().z});
+  std::vector<glm::dvec3> out;
+  for (int py = 0; py < size; ++py) {
+    for (int px = 0; px < size; ++px) {
+      const Ray ray = camera.pixelRay(px, py, size, size);
+      const glm::dvec3 to = ray.origin / extent + 0.5, td = ray.direction / extent;
+      double tNear = -1e300, tFar = 1e300;
+      for (int a = 0; a < 3; ++a) {
+        if (td[a] == 0.0) continue;
+        const double t0 = -to[a] / td[a], t1 = (1.0 - to[a]) / td[a];
+        tNear = std::max(tNear, std::min(t0, t1));
+        tFar = std::min(tFar, std::max(t0, t1));
+      }
+      for (double t = std::max(tNear, 0.0) + 0.5 * ds; t < tFar; t += ds) {
+        out.push_back(to + t * td);
+      }
+    }
+  }
+  return out;
+}
+
+double marschnerLobbRms(const Reconstruction& field, const std::vector<glm::dvec3>& at,
+                        glm::ivec3 dims) {
+  double sum = 0.0;
+  for (const glm::dvec3& p : at) {
+    const double e = field.value(p) - marschnerLobb(marschnerLobbCoordinate(dims, p));
+    sum += e * e;
+  }
+  return std::sqrt(sum / static_cast<double>(at.size()));
+}
+
+TransferFunction marschnerLobbSoftTf() {
+  TransferFunction tf;
+  tf.name = "soft";
+  tf.addColor(0.0, {0.2, 0.4, 1.0});
+  tf.addColor(1.0, {1.0, 0.9, 0.6});
+  tf.addOpacity(0.0, 0.0);
+  tf.addOpacity(0.3, 0.0);
+  tf.addOpacity(1.0, 0.25);
+  return tf;
+}
+
+TransferFunction marschnerLobbIsoTf() {
+  TransferFunction tf;
+  tf.name = "iso";
+  tf.addColor(0.0, {1.0, 0.8, 0.5});
+  tf.addColor(1.0, {1.0, 0.8, 0.5});
+  tf.addOpacity(0.0, 0.0);
+  tf.addOpacity(0.46, 0.0);
+  tf.addOpacity(0.5, 1.0);
+  tf.addOpacity(0.54, 0.0);
+  tf.addOpacity(1.0, 0.0);
+  return tf;
 }
 
 }  // namespace tessera::lattice

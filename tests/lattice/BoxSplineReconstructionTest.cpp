@@ -59,29 +59,6 @@ class MarschnerLobbField final : public Reconstruction {
   glm::ivec3 dims_;
 };
 
-TransferFunction soft() {
-  TransferFunction tf;
-  tf.addColor(0.0, {0.2, 0.4, 1.0});
-  tf.addColor(1.0, {1.0, 0.9, 0.6});
-  tf.addOpacity(0.0, 0.0);
-  tf.addOpacity(0.3, 0.0);
-  tf.addOpacity(1.0, 0.25);
-  return tf;
-}
-
-// Opacity only in a narrow band around 0.5: an isosurface look.
-TransferFunction isosurfaceLike() {
-  TransferFunction tf;
-  tf.addColor(0.0, {1.0, 0.8, 0.5});
-  tf.addColor(1.0, {1.0, 0.8, 0.5});
-  tf.addOpacity(0.0, 0.0);
-  tf.addOpacity(0.46, 0.0);
-  tf.addOpacity(0.5, 1.0);
-  tf.addOpacity(0.54, 0.0);
-  tf.addOpacity(1.0, 0.0);
-  return tf;
-}
-
 Camera obliqueCamera(const Volume& v) {
   Camera cam;
   cam.azimuthDeg = 30;
@@ -123,7 +100,8 @@ TEST(BoxSplineReconstruction, FccResamplingOfASmoothVolumeRendersLikeTheCartesia
   const Volume source = blobs(glm::ivec3(48));
   const Camera cam = obliqueCamera(source);
   const RenderSettings s;
-  for (const auto& [tfName, tf] : {std::pair{"soft", soft()}, std::pair{"iso", isosurfaceLike()}}) {
+  for (const auto& [tfName, tf] :
+       {std::pair{"soft", marschnerLobbSoftTf()}, std::pair{"iso", marschnerLobbIsoTf()}}) {
     const Image cartesian = renderReference(source, tf, cam, s, kImage, kImage);
     for (const FccDensity density : {FccDensity::Same, FccDensity::Half}) {
       FccResampleOptions options;
@@ -151,7 +129,7 @@ TEST(BoxSplineReconstruction, MarschnerLobbOnFccRendersCloserToTheSignalThanTril
     const RenderSettings s;
     const FccVolume fcc = makeMarschnerLobbFcc(cartesian, FccDensity::Same);
     for (const auto& [tfName, tf] :
-         {std::pair{"soft", soft()}, std::pair{"iso", isosurfaceLike()}}) {
+         {std::pair{"soft", marschnerLobbSoftTf()}, std::pair{"iso", marschnerLobbIsoTf()}}) {
       const Image truth = renderReference(cartesian, MarschnerLobbField(cartesian.dims()), tf, cam,
                                           s, kImage, kImage);
       const double trilinear = psnr(renderReference(cartesian, tf, cam, s, kImage, kImage), truth);

@@ -99,20 +99,6 @@ std::unique_ptr<render::Raycaster> makeCaster(const Volume& box, const layout::L
   return caster;
 }
 
-// Opacity only in a narrow band around 0.5: an isosurface look, which shows
-// small differences of the reconstructed field.
-TransferFunction isosurfaceLike() {
-  TransferFunction tf;
-  tf.addColor(0.0, {1.0, 0.8, 0.5});
-  tf.addColor(1.0, {1.0, 0.8, 0.5});
-  tf.addOpacity(0.0, 0.0);
-  tf.addOpacity(0.46, 0.0);
-  tf.addOpacity(0.5, 1.0);
-  tf.addOpacity(0.54, 0.0);
-  tf.addOpacity(1.0, 0.0);
-  return tf;
-}
-
 Camera obliqueCamera(const Volume& v) {
   Camera cam;
   cam.azimuthDeg = 30;
@@ -187,7 +173,7 @@ TEST(FccLayout, RendersLikeTheCpuReferencesFccRender) {
     const Camera cam = obliqueCamera(box);
     auto caster = makeCaster(box, *layout, 8);
     for (const auto& [tfName, tf] :
-         {std::pair{"soft", test::visibleTf()}, std::pair{"iso", isosurfaceLike()}}) {
+         {std::pair{"soft", test::visibleTf()}, std::pair{"iso", lattice::marschnerLobbIsoTf()}}) {
       caster->setTransferFunction(tf);
       const Image gpuImage = caster->render(cam, settings, 96, 96);
       const Image ref =
@@ -207,7 +193,7 @@ TEST(FccLayout, TheComparisonSeesTheReconstruction) {
   const Volume ml = makeMarschnerLobb(glm::ivec3(41));
   const FccVolume fcc = makeMarschnerLobbFcc(ml, FccDensity::Same);
   const FccVolume raw = makeMarschnerLobbFcc(ml, FccDensity::Same, false);
-  const TransferFunction tf = isosurfaceLike();
+  const TransferFunction tf = lattice::marschnerLobbIsoTf();
   const Camera cam = obliqueCamera(ml);
   const Image ref = renderReference(fcc.box(), BoxSplineReconstruction(fcc), tf, cam, {}, 96, 96);
   auto render = [&](const FccVolume& lattice) {

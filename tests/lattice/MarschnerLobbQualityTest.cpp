@@ -22,46 +22,12 @@ using namespace tessera::lattice;
 
 namespace {
 
-// Texture positions of the samples the reference ray caster takes for a
-// width x height image (RenderSettings defaults: step 0.5 voxel, samples at
-// t0 + (k + 0.5) ds inside the box).
-std::vector<glm::dvec3> raySamples(const Volume& box, const Camera& camera, int size) {
-  const glm::dvec3 extent = box.extent();
-  const double ds = 0.5 * std::min({box.spacing().x, box.spacing().y, box.spacing().z});
-  std::vector<glm::dvec3> out;
-  for (int py = 0; py < size; ++py) {
-    for (int px = 0; px < size; ++px) {
-      const Ray ray = camera.pixelRay(px, py, size, size);
-      const glm::dvec3 to = ray.origin / extent + 0.5, td = ray.direction / extent;
-      double tNear = -1e300, tFar = 1e300;
-      for (int a = 0; a < 3; ++a) {
-        if (td[a] == 0.0) continue;
-        const double t0 = -to[a] / td[a], t1 = (1.0 - to[a]) / td[a];
-        tNear = std::max(tNear, std::min(t0, t1));
-        tFar = std::min(tFar, std::max(t0, t1));
-      }
-      for (double t = std::max(tNear, 0.0) + 0.5 * ds; t < tFar; t += ds)
-        out.push_back(to + t * td);
-    }
-  }
-  return out;
-}
-
 std::vector<glm::dvec3> randomSamples(int n) {
   std::mt19937 rng(41);
   std::uniform_real_distribution<double> d(0.0, 1.0);
   std::vector<glm::dvec3> out;
   for (int i = 0; i < n; ++i) out.push_back({d(rng), d(rng), d(rng)});
   return out;
-}
-
-double rms(const Reconstruction& field, const std::vector<glm::dvec3>& at, glm::ivec3 dims) {
-  double sum = 0.0;
-  for (const glm::dvec3 p : at) {
-    const double e = field.value(p) - marschnerLobb(marschnerLobbCoordinate(dims, p));
-    sum += e * e;
-  }
-  return std::sqrt(sum / static_cast<double>(at.size()));
 }
 
 struct Row {
@@ -78,10 +44,10 @@ class Quality {
     camera.azimuthDeg = 30;
     camera.elevationDeg = 20;
     camera.frame(cartesian);
-    rays_ = raySamples(cartesian, camera, 48);
+    rays_ = raySamplePositions(cartesian, camera, 48);
   }
   Row row(const std::string& name, std::uint64_t samples, const Reconstruction& field) const {
-    const Row r{rms(field, rays_, dims_), rms(field, random_, dims_)};
+    const Row r{marschnerLobbRms(field, rays_, dims_), marschnerLobbRms(field, random_, dims_)};
     std::printf("[measured] %-44s %8llu %10.5f %10.5f\n", name.c_str(),
                 static_cast<unsigned long long>(samples), r.rays, r.random);
     return r;

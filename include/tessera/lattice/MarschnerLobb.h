@@ -1,10 +1,16 @@
 #pragma once
 // The Marschner-Lobb test signal as a function, to sample it on the FCC
 // lattice directly and to measure reconstructions against it.
+#include <vector>
+
 #include <glm/vec3.hpp>
+
+#include "tessera/core/Camera.h"
+#include "tessera/core/TransferFunction.h"
 
 #include "tessera/core/Volume.h"
 #include "tessera/lattice/FccVolume.h"
+#include "tessera/reference/Reconstruction.h"
 
 namespace tessera::lattice {
 
@@ -22,5 +28,24 @@ glm::dvec3 marschnerLobbCoordinate(glm::ivec3 dims, glm::dvec3 p);
 // quasi-interpolated unless asked not to (FccResampling.h).
 FccVolume makeMarschnerLobbFcc(const Volume& cartesian, FccDensity density,
                                bool quasiInterpolated = true);
+
+// The quality study of docs/fcc.md (tessera bench --fcc, the
+// MarschnerLobbQuality tests), in one place:
+//
+// Texture positions of the samples the ray caster takes for a size x size
+// image of `box` (step 0.5 voxel of the smallest spacing, samples at
+// t0 + (k + 0.5) ds inside the box).
+std::vector<glm::dvec3> raySamplePositions(const Volume& box, const Camera& camera, int size);
+
+// RMS error of `field` against the signal at texture positions `at` of the
+// box of makeMarschnerLobb(dims).
+double marschnerLobbRms(const Reconstruction& field, const std::vector<glm::dvec3>& at,
+                        glm::ivec3 dims);
+
+// The study's transfer functions: "soft", a ramp to opacity 0.25 over the
+// upper 70 % of values, and "iso", opacity only in a narrow band around 0.5
+// (an isosurface look, which shows small differences of the field).
+TransferFunction marschnerLobbSoftTf();
+TransferFunction marschnerLobbIsoTf();
 
 }  // namespace tessera::lattice
