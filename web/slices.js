@@ -270,7 +270,7 @@ window.TesseraSlices = (function () {
         ctx.lineWidth = 2.5 * dpr;
         ctx.stroke();
       }
-      const inside = !showing || [0, 1, 2].every((a) => cross[a] >= showing.begin[a] && cross[a] < showing.end[a]);
+      const inside = $('crosshair3d').checked && (!showing || [0, 1, 2].every((a) => cross[a] >= showing.begin[a] && cross[a] < showing.end[a]));
       if (inside) {
         const dims = showing ? [0, 1, 2].map((a) => showing.end[a] - showing.begin[a]) : explore.dims;
         const arm = 0.08 * Math.max(...dims.map((d, a) => d * explore.spacing[a]));
@@ -340,13 +340,14 @@ window.TesseraSlices = (function () {
       redrawOverlays();
     }
 
-    function setCross(v, redrawAxes) {
+    function setCross(v) {
+      if (!explore.has_volume) return false;
       const next = v.map((x, a) => Math.min(explore.dims[a] - 1, Math.max(0, Math.round(x))));
       const changed = [0, 1, 2].filter((a) => next[a] !== cross[a]);
       cross = next;
       for (const plane of PLANES) {
         const p = panels[plane];
-        if (changed.includes(p.axis) || (redrawAxes && redrawAxes.includes(p.axis))) drawSlice(p);
+        if (changed.includes(p.axis)) drawSlice(p);
       }
       redrawOverlays();
       return changed.length > 0;
@@ -484,6 +485,7 @@ window.TesseraSlices = (function () {
     $('pickRegion').addEventListener('click', () => { picking = !picking; updateInfo(); });
     $('showRegion').addEventListener('click', () => { if (region) showRegion(region); });
     $('overview').addEventListener('click', () => overview());
+    $('crosshair3d').addEventListener('change', () => draw3dOverlay());
     $('regionSide').addEventListener('change', (e) => {
       const v = parseInt(e.target.value, 10);
       if (!(v >= 1)) e.target.value = explore.region_side;

@@ -623,22 +623,61 @@ async function sliceViewsAndRegion(context, url, tmp, run) {
   check('Overview returns to the whole volume and shows the region as a red box',
         back.dims.join('x') === '40x32x24' && redBefore === 0 && redAfter > SIZE / 2,
         `3D view ${back.dims.join('x')}; ${redBefore} red overlay pixels before the pick, ${redAfter} after`);
+  // On a phone (390x844): one view at a time under tabs; the axial tab
+  // shows the axial slice across the screen, and a tap moves the crosshair
+  // to the voxel under the finger.
+  await cdp.send('Emulation.setDeviceMetricsOverride', { width: 390, height: 844, deviceScaleFactor: 3, mobile: true });
+  await page.evaluate((v) => window.tessera.slices.setCross(...v), cross);
+  await page.click('#view-tabs button[data-tab="axial"]');
+  const phone = await page.evaluate(() => {
+    const box = (id) => document.getElementById(id).getBoundingClientRect();
+    return { axial: box('slice-axial').width, view: box('view').width, coronal: box('slice-coronal').width, page: document.documentElement.scrollWidth };
+  });
+  await page.locator('#slice-axial').scrollIntoViewIfNeeded();
+  const pb = await page.locator('#slice-axial .slice-overlay').boundingBox();
+  const ps = (await slices()).panels.axial;
+  // Tap at image pixel (4.5, 4.5): the voxel of the top-left corner's pixels.
+  const tap = [Math.round(pb.x + ps.fit.left + 4.5 * ps.fit.scale), Math.round(pb.y + ps.fit.top + 4.5 * ps.fit.scale)];
+  await cdp.send('Input.dispatchTouchEvent', { type: 'touchStart', touchPoints: [{ x: tap[0], y: tap[1], id: 3 }] });
+  await cdp.send('Input.dispatchTouchEvent', { type: 'touchEnd', touchPoints: [] });
+  const tapped = (await slices()).cross;
+  // The axial view's top left is the patient's right and anterior: in this
+  // PIL volume low z (z runs left) and low x (x runs posterior); pixel 4
+  // is voxel x 4 (1.5 mm pixels and voxels), z 3 (2 mm voxels).
+  const expected = [4, cross[1], 3];
+  await cdp.send('Emulation.clearDeviceMetricsOverride');
+  check('phone (390x844): tabs show one view across the screen; a tap moves the crosshair',
+        phone.axial > 300 && phone.axial <= 390 && phone.view === 0 && phone.coronal === 0 && phone.page <= 390 &&
+        tapped.join() === expected.join(),
+        `axial ${phone.axial.toFixed(0)} CSS px wide, 3D view and coronal hidden, page ${phone.page} px; ` +
+        `tap at the top-left pixels -> crosshair (${tapped.join(', ')}), expected (${expected.join(', ')})`);
   const errors = logs.filter((l) => l.startsWith('pageerror') || l.startsWith('error'));
   check('no script errors on the slice-view page', errors.length === 0, errors.join(' | '));
   await page.close();
 
   if (shots && fs.existsSync(CH2)) {
-    // The page as a user sees it: the head, a region picked and shown in the overview.
+    // The page as a user sees it: the head, a region rendered at native
+    // resolution, then the overview with the region highlighted; and the
+    // axial tab on a phone.
     const { page: p2 } = await openPage(context, url, 'url=/templates/ch2.nii.gz');
     await p2.setViewportSize({ width: 1280, height: 860 });
     await p2.evaluate(async () => {
-      const s = window.tessera.slices;
-      s.setCross(70, 120, 95);
-      await s.showRegion({ begin: [40, 90, 70], end: [100, 150, 130] });
-      await s.overview();
+      window.tessera.slices.setCross(70, 120, 95);
+      await window.tessera.slices.showRegion({ begin: [40, 90, 70], end: [100, 150, 130] });
+      await window.tessera.setCamera(35, 15, 1);
+    });
+    await p2.screenshot({ path: path.join(shots, 'web-region-native.jpg'), type: 'jpeg', quality: 85 });
+    await p2.evaluate(async () => {
+      await window.tessera.slices.overview();
       await window.tessera.setCamera(35, 15, 1);
     });
     await p2.screenshot({ path: path.join(shots, 'web-slices-region.png') });
+    const cdp2 = await context.newCDPSession(p2);
+    await cdp2.send('Emulation.setDeviceMetricsOverride', { width: 390, height: 844, deviceScaleFactor: 2, mobile: true });
+    await p2.click('#view-tabs button[data-tab="axial"]');
+    await p2.evaluate(() => window.tessera.render());
+    const phoneShot = await cdp2.send('Page.captureScreenshot', { format: 'jpeg', quality: 80 });
+    fs.writeFileSync(path.join(shots, 'web-phone-axial.jpg'), Buffer.from(phoneShot.data, 'base64'));
     await p2.close();
   }
   console.log(`     (slice views and region: ${((Date.now() - t) / 1000).toFixed(1)} s)`);
