@@ -660,7 +660,7 @@ async function sliceViewsAndRegion(context, url, tmp, run) {
     // resolution, then the overview with the region highlighted; and the
     // axial tab on a phone.
     const { page: p2 } = await openPage(context, url, 'url=/templates/ch2.nii.gz');
-    await p2.setViewportSize({ width: 1280, height: 860 });
+    await p2.setViewportSize({ width: 1280, height: 1220 });  // the controls' Slices and region too
     await p2.evaluate(async () => {
       window.tessera.slices.setCross(70, 120, 95);
       await window.tessera.slices.showRegion({ begin: [40, 90, 70], end: [100, 150, 130] });
@@ -671,7 +671,7 @@ async function sliceViewsAndRegion(context, url, tmp, run) {
       await window.tessera.slices.overview();
       await window.tessera.setCamera(35, 15, 1);
     });
-    await p2.screenshot({ path: path.join(shots, 'web-slices-region.png') });
+    await p2.screenshot({ path: path.join(shots, 'web-slices-region.jpg'), type: 'jpeg', quality: 85 });
     const cdp2 = await context.newCDPSession(p2);
     await cdp2.send('Emulation.setDeviceMetricsOverride', { width: 390, height: 844, deviceScaleFactor: 2, mobile: true });
     await p2.click('#view-tabs button[data-tab="axial"]');
