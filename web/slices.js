@@ -4,7 +4,7 @@
 // - Axial, coronal and sagittal slices of the loaded volume, drawn by the
 //   wasm core (tessera_slice: core/SliceImage, the pixels and patient
 //   letters of `tessera slice`, radiological convention) through the
-//   viewer's window, grey, nearest voxel. The crosshair is one voxel
+//   viewer's window, grey or in the TF's colours, nearest voxel. The crosshair is one voxel
 //   (x, y, z); each view shows the slice through it, so moving it in one
 //   view moves the others, and the 3D view marks it with a small 3D cross.
 //   Slice index: wheel, vertical drag (mouse or one finger), arrow keys,
@@ -30,7 +30,7 @@ window.TesseraSlices = (function () {
     const $ = (id) => document.getElementById(id);
     const c = (name, ret, args) => M.cwrap(name, ret, args);
     const api = {
-      slice: c('tessera_slice', 'string', ['number', 'number']),
+      slice: c('tessera_slice', 'string', ['number', 'number', 'number']),
       value: c('tessera_voxel_value', 'number', ['number', 'number', 'number']),
       explore: c('tessera_explore_json', 'string', []),
       regionShow: c('tessera_region_show', 'number', ['number', 'number', 'number', 'number', 'number', 'number']),
@@ -63,6 +63,9 @@ window.TesseraSlices = (function () {
         fit: { left: 0, top: 0, scale: 1 },
       };
     }
+
+    // Grey (0), or the TF's colours (1, as `tessera slice --tf`).
+    const colour = () => ($('sliceColour').checked ? 1 : 0);
 
     // ------------------------------------------------------------ geometry
 
@@ -113,7 +116,7 @@ window.TesseraSlices = (function () {
 
     function assignAxes() {
       // Each index axis's plane, from the core's slice frames.
-      const frames = [0, 1, 2].map((a) => JSON.parse(api.slice(a, cross[a]) || 'null'));
+      const frames = [0, 1, 2].map((a) => JSON.parse(api.slice(a, cross[a], colour()) || 'null'));
       if (frames.some((f) => !f)) { showError(api.lastError()); return false; }
       const byPlane = {};
       frames.forEach((f) => { byPlane[f.plane] = f.axis; });
@@ -129,7 +132,7 @@ window.TesseraSlices = (function () {
     }
 
     function drawSlice(p) {
-      const json = api.slice(p.axis, cross[p.axis]);
+      const json = api.slice(p.axis, cross[p.axis], colour());
       if (!json) { showError(api.lastError()); return; }
       const f = JSON.parse(json);
       p.frame = f;
@@ -317,7 +320,7 @@ window.TesseraSlices = (function () {
 
     // After every frame of the 3D view (app.js): a new volume resets the
     // crosshair to its centre; a new window redraws the slices; the 3D
-    // marks follow the camera.
+    // marks follow the camera; in colour, a TF edit redraws them too.
     function frameShown(state) {
       explore = JSON.parse(api.explore());
       if (!explore.has_volume) { redrawOverlays(); return; }
@@ -334,7 +337,7 @@ window.TesseraSlices = (function () {
         if (!assignAxes()) return;
         redraw = true;
       }
-      const wk = (state.window || []).join(',');
+      const wk = `${(state.window || []).join(',')}|${colour() ? explore.tf_revision : 'grey'}`;
       if (wk !== windowKey) { windowKey = wk; redraw = true; }
       if (redraw) drawAllSlices();
       redrawOverlays();
@@ -486,6 +489,7 @@ window.TesseraSlices = (function () {
     $('showRegion').addEventListener('click', () => { if (region) showRegion(region); });
     $('overview').addEventListener('click', () => overview());
     $('crosshair3d').addEventListener('change', () => draw3dOverlay());
+    $('sliceColour').addEventListener('change', () => { windowKey = ''; requestRender(); });
     $('regionSide').addEventListener('change', (e) => {
       const v = parseInt(e.target.value, 10);
       if (!(v >= 1)) e.target.value = explore.region_side;

@@ -553,6 +553,20 @@ async function sliceViewsAndRegion(context, url, tmp, run) {
               `cube ${quadrant ? 'bottom right' : 'NOT bottom right'} (${n} pixels)`);
   }
   check('slice views equal `tessera slice` (pixels >= 50 dB, plane, edge letters; a posterior-inferior-left cube bottom right in each)', allOk, rows.join('; '));
+  // In the TF's colours: as `tessera slice --tf` with the page's TF (mr-default).
+  await page.check('#sliceColour');
+  await page.evaluate(() => window.tessera.render());
+  const colourPng = path.join(tmp, 'slice-colour.png');
+  run('slice', file, '--axis', 'z', '--index', String(cross[2]), '--tf', 'mr-default', '--out', colourPng);
+  const colourRef = await decode(colourPng);
+  st = await slices();
+  const zPlane = Object.keys(st.panels).find((q) => st.panels[q].axis === 2);
+  const colourShown = await page.evaluate((q) => window.tessera.slices.imagePixels(q), zPlane);
+  const colourDb = colourShown.length === colourRef.data.length ? psnrOf(colourShown, colourRef.data) : 0;
+  check('a slice in the TF\'s colours equals `tessera slice --tf mr-default` (>= 50 dB)', colourDb >= 50,
+        `${zPlane} z=${cross[2]}: ${colourDb === 999 ? 'identical' : `${colourDb.toFixed(1)} dB`}`);
+  await page.uncheck('#sliceColour');
+  await page.evaluate(() => window.tessera.render());
 
   // One finger dragging up in the coronal view pages through its slices.
   const coronal = st.panels.coronal;

@@ -441,12 +441,13 @@ std::pair<int, std::string> defaultRegionSide(const Volume& volume) {
 extern "C" {
 
 // Slice `index` along index axis `axis` (0 x, 1 y, 2 z) of the overview
-// volume through the viewer's window, grey, nearest voxel at voxel centres:
+// volume through the viewer's window, nearest voxel at voxel centres, grey
+// or (colour != 0) in the colours of the viewer's TF (`tessera slice --tf`):
 // JSON with the image (`pixels`: RGBA, top row first, width x height, valid
 // until the next call for this axis), its frame (plane, the index axes of
 // columns and rows and whether they run reversed, pixel_mm) and the patient
 // directions of its edges; "" on error (tessera_last_error).
-EMSCRIPTEN_KEEPALIVE const char* tessera_slice(int axis, int index) {
+EMSCRIPTEN_KEEPALIVE const char* tessera_slice(int axis, int index, int colour) {
   scratch().clear();
   guarded([&] {
     const Volume& volume = overviewVolume();
@@ -454,7 +455,9 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_slice(int axis, int index) {
     const glm::ivec3 d = volume.dims();
     const SliceRaster r = sliceRaster(f, d, volume.spacing());
     Image& image = sliceViews().images[axis];
-    image = sliceImage(volume, f, index, theViewer().window());
+    viewer::Viewer& v = theViewer();
+    image = sliceImage(volume, f, index, v.window(),
+                       colour ? &v.tfEditor().transferFunction() : nullptr);
     nlohmann::json j;
     j["axis"] = axis;
     j["index"] = index;
@@ -470,6 +473,7 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_slice(int axis, int index) {
     j["width"] = r.width;
     j["height"] = r.height;
     j["pixel_mm"] = r.pixelMm;
+    j["tf_revision"] = v.tfEditor().revision();
     j["pixels"] = reinterpret_cast<std::uintptr_t>(image.rgba().data());
     scratch() = j.dump();
   });
@@ -489,8 +493,8 @@ EMSCRIPTEN_KEEPALIVE double tessera_voxel_value(int x, int y, int z) {
   return value;
 }
 
-// The overview volume and the region: JSON {has_volume, name, dims,
-// spacing, region: null or {begin, end}, showing_region, region_side,
+// The overview volume and the region: JSON {has_volume, tf_revision, name,
+// dims, spacing, region: null or {begin, end}, showing_region, region_side,
 // region_side_reason}.
 EMSCRIPTEN_KEEPALIVE const char* tessera_explore_json() {
   nlohmann::json j;
@@ -502,6 +506,7 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_explore_json() {
     const glm::ivec3 d = volume.dims();
     const glm::dvec3 sp = volume.spacing();
     j["has_volume"] = true;
+    j["tf_revision"] = theViewer().tfEditor().revision();
     j["name"] = inRegion ? sliceViews().overviewName : theViewer().volumeName();
     j["dims"] = {d.x, d.y, d.z};
     j["spacing"] = {sp.x, sp.y, sp.z};
