@@ -4,9 +4,10 @@
 // - Axial, coronal and sagittal slices of the loaded volume, drawn by the
 //   wasm core (tessera_slice: core/SliceImage, the pixels and patient
 //   letters of `tessera slice`, radiological convention) through the
-//   viewer's window, grey or in the TF's colours, nearest voxel. The crosshair is one voxel
-//   (x, y, z); each view shows the slice through it, so moving it in one
-//   view moves the others, and the 3D view marks it with a small 3D cross.
+//   viewer's window, grey or in the TF's colours, nearest voxel. The
+//   crosshair is one voxel (x, y, z); each view shows the slice through it,
+//   so moving it in one view moves the others, and the 3D view marks it
+//   with a small 3D cross.
 //   Slice index: wheel, vertical drag (mouse or one finger), arrow keys,
 //   PageUp/PageDown, Home/End. Tap/click moves the crosshair.
 // - "Pick region": drag a box in a slice view (or tap for a box of the
@@ -362,9 +363,9 @@ window.TesseraSlices = (function () {
       setCross(v);
     }
 
-    // The box a drag (or tap) in panel p describes: in-plane from the drag
-    // (a tap: a square of the side around it), `side` voxels deep around
-    // the slice, clamped to the volume.
+    // The box a drag (or tap) in panel p describes: in-plane from the drag,
+    // at most `side` voxels (a tap: a square of the side around it), `side`
+    // voxels deep around the slice, clamped to the volume.
     function rubberBox(p) {
       const f = p.frame;
       const side = Math.max(1, parseInt($('regionSide').value, 10) || explore.region_side);
@@ -382,9 +383,12 @@ window.TesseraSlices = (function () {
         if (tap) {
           span(a, voxelOfPixel(a0, f, which) + 0.5);
         } else {
+          // From the voxel under the press towards the one under the
+          // finger, at most `side` voxels (what the profile allows).
           const v0 = voxelOfPixel(a0, f, which), v1 = voxelOfPixel(a1, f, which);
-          begin[a] = Math.min(v0, v1);
-          end[a] = Math.max(v0, v1) + 1;
+          const length = Math.min(Math.abs(v1 - v0) + 1, side);
+          begin[a] = v1 >= v0 ? v0 : v0 - length + 1;
+          end[a] = begin[a] + length;
         }
       }
       return { begin, end };
