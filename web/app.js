@@ -22,6 +22,9 @@
   const progressive = params.get('progressive') !== '0';
   const frameBudgetMs = Math.max(1, parseFloat(params.get('budget') || '12') || 12);
   const volumeUrls = params.getAll('url').filter((u) => u.length);
+  // Axial, coronal and sagittal views beside the 3D view (web/slices.js;
+  // ?slices=0: the 3D view alone).
+  const withSlices = params.get('slices') !== '0' && !!window.TesseraSlices;
 
   const $ = (id) => document.getElementById(id);
   const canvas = $('canvas');
@@ -29,6 +32,8 @@
     canvas.classList.add('fixed');
     canvas.width = fixedSize;
     canvas.height = fixedSize;
+    $('views').classList.add('fixed');
+    $('views').style.setProperty('--cell', `${fixedSize + 2}px`);  // the canvas and its border
   } else {
     canvas.classList.add('responsive');
     $('view').classList.add('responsive');
@@ -59,6 +64,7 @@
   let frames = 0;
   let renderWaiters = [];
   let refineNotBefore = 0;  // performance.now() before which no strip is rendered
+  let slices = null;        // web/slices.js, once the module is up
 
   function showError(message) {
     const e = $('error');
@@ -133,6 +139,7 @@
     refreshState();
     updateStatus();
     updateOrientationLabels();
+    if (slices) slices.frameShown(state);
     return ms;
   }
 
@@ -614,6 +621,12 @@
       throw new Error(api.lastError());
     }
     bindControls();
+    if (withSlices) {
+      slices = window.TesseraSlices.attach({ M, canvas, requestRender, showError, clearError });
+      window.tessera.slices = slices.testApi;
+    } else {
+      $('slice-controls').hidden = true;
+    }
     refreshState();
     state.techniques.forEach((n) => {
       const o = document.createElement('option');

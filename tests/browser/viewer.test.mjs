@@ -478,6 +478,7 @@ async function main() {
     await inputDuringSlowFrames(context, url);
     await responsiveCanvas(context, url);
     await loadFromUrl(context, url, tmp, run);
+    await sliceViewsAndRegion(context, url, tmp, run);
 
     if (bench) await benchmark(context, url);
   } finally {
@@ -488,6 +489,213 @@ async function main() {
   }
   console.log(`browser test: ${failures ? `${failures} FAILED` : 'all passed'} in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
   process.exit(failures ? 1 : 0);
+}
+
+// Slice views and the bread-slice region (issue 15 item 6). A PIL NIfTI
+// (writePilNifti's, anisotropic voxels) with a bright cube near its
+// (+x, +y, +z) index corner: the page's axial, coronal and sagittal images
+// through the cube equal `tessera slice` PNGs of the same file and index
+// pixel for pixel, with the same edge letters; a box dragged in a slice
+// view renders like `tessera render --region` of that box; the overview then
+// shows it as a red box; a one-finger drag pages through the slices.
+async function sliceViewsAndRegion(context, url, tmp, run) {
+  const t = Date.now();
+  const file = path.join(tmp, 'marked.nii');
+  writePilNifti(file);
+  const bytes = fs.readFileSync(file);
+  const [nx, ny] = [40, 32];
+  for (let z = 18; z < 22; z++) for (let y = 24; y < 28; y++) for (let x = 32; x < 36; x++) bytes[352 + x + nx * (y + ny * z)] = 255;
+  fs.writeFileSync(file, bytes);
+  const { page, logs } = await openPage(context, url, `size=${SIZE}&url=/data/marked.nii`);
+  const slices = () => page.evaluate(() => window.tessera.slices.state());
+  // Decodes a PNG in the page: {width, height, data}.
+  const decode = (png) => page.evaluate(async (b64) => {
+    const img = new Image();
+    img.src = `data:image/png;base64,${b64}`;
+    await img.decode();
+    const c = document.createElement('canvas');
+    c.width = img.width;
+    c.height = img.height;
+    const ctx = c.getContext('2d');
+    ctx.drawImage(img, 0, 0);
+    return { width: c.width, height: c.height, data: Array.from(ctx.getImageData(0, 0, c.width, c.height).data) };
+  }, fs.readFileSync(png).toString('base64'));
+
+  const cross = [33, 25, 19];  // through the cube
+  await page.evaluate((v) => window.tessera.slices.setCross(...v), cross);
+  let st = await slices();
+  const rows = [];
+  let allOk = true;
+  for (let axis = 0; axis < 3; axis++) {
+    const png = path.join(tmp, `slice-${axis}.png`);
+    const cli = JSON.parse(run('slice', file, '--axis', 'xyz'[axis], '--index', String(cross[axis]), '--out', png, '--json'));
+    const plane = Object.keys(st.panels).find((q) => st.panels[q].axis === axis);
+    const ref = await decode(png);
+    const shown = await page.evaluate((q) => window.tessera.slices.imagePixels(q), plane);
+    const f = st.panels[plane].frame;
+    const sameSize = f.width === ref.width && f.height === ref.height && shown.length === ref.data.length;
+    const db = sameSize ? psnrOf(shown, ref.data) : 0;
+    const differing = sameSize ? differingPixels(shown, ref.data, 0) : -1;
+    const letters = st.panels[plane].letters;
+    const lettersOk = ['left', 'right', 'top', 'bottom'].every((e) => letters[e] === cli.edges[e] && letters[e] !== '');
+    // The cube lies posterior, inferior and left of the patient: bottom
+    // right in all three views of the radiological convention.
+    let n = 0, sx = 0, sy = 0;
+    for (let i = 0; i < shown.length; i += 4) {
+      if (shown[i] === 255) { n++; sx += (i / 4) % f.width; sy += Math.floor(i / 4 / f.width); }
+    }
+    const quadrant = n > 0 && sx / n > f.width / 2 && sy / n > f.height / 2;
+    const ok = plane === cli.plane && sameSize && db >= 50 && lettersOk && quadrant;
+    allOk = allOk && ok;
+    rows.push(`${plane} ${'xyz'[axis]}=${cross[axis]} ${f.width}x${f.height}: ${differing} pixels differ (${db === 999 ? 'identical' : `${db.toFixed(1)} dB`}), ` +
+              `letters ${['left', 'right', 'top', 'bottom'].map((e) => letters[e]).join('')} (CLI ${cli.plane} ` +
+              `${['left', 'right', 'top', 'bottom'].map((e) => cli.edges[e]).join('')}), ` +
+              `cube ${quadrant ? 'bottom right' : 'NOT bottom right'} (${n} pixels)`);
+  }
+  check('slice views equal `tessera slice` (pixels >= 50 dB, plane, edge letters; a posterior-inferior-left cube bottom right in each)', allOk, rows.join('; '));
+  // In the TF's colours: as `tessera slice --tf` with the page's TF (mr-default).
+  await page.check('#sliceColour');
+  await page.evaluate(() => window.tessera.render());
+  const colourPng = path.join(tmp, 'slice-colour.png');
+  run('slice', file, '--axis', 'z', '--index', String(cross[2]), '--tf', 'mr-default', '--out', colourPng);
+  const colourRef = await decode(colourPng);
+  st = await slices();
+  const zPlane = Object.keys(st.panels).find((q) => st.panels[q].axis === 2);
+  const colourShown = await page.evaluate((q) => window.tessera.slices.imagePixels(q), zPlane);
+  const colourDb = colourShown.length === colourRef.data.length ? psnrOf(colourShown, colourRef.data) : 0;
+  check('a slice in the TF\'s colours equals `tessera slice --tf mr-default` (>= 50 dB)', colourDb >= 50,
+        `${zPlane} z=${cross[2]}: ${colourDb === 999 ? 'identical' : `${colourDb.toFixed(1)} dB`}`);
+  await page.uncheck('#sliceColour');
+  await page.evaluate(() => window.tessera.render());
+
+  // One finger dragging up in the coronal view pages through its slices.
+  const coronal = st.panels.coronal;
+  const before = await page.evaluate(() => window.tessera.slices.imagePixels('coronal'));
+  await page.locator('#slice-coronal').scrollIntoViewIfNeeded();
+  const ob = await page.locator('#slice-coronal .slice-overlay').boundingBox();
+  const cdp = await context.newCDPSession(page);
+  const tx = Math.round(ob.x + ob.width / 2), ty = Math.round(ob.y + ob.height * 0.7);
+  const touch = (type, dy) => cdp.send('Input.dispatchTouchEvent', {
+    type, touchPoints: type === 'touchEnd' ? [] : [{ x: tx, y: ty - dy, id: 7 }] });
+  await touch('touchStart', 0);
+  for (const dy of [10, 20, 30, 40, 50]) await touch('touchMove', dy);
+  await touch('touchEnd', 0);
+  st = await slices();
+  const after = await page.evaluate(() => window.tessera.slices.imagePixels('coronal'));
+  const moved = st.cross[coronal.axis] - cross[coronal.axis];
+  check('a one-finger drag in a slice view changes its slice (pointer events from touch)',
+        moved > 0 && changedFraction(before, after) > 0.01,
+        `${'xyz'[coronal.axis]} ${cross[coronal.axis]} -> ${st.cross[coronal.axis]} after 50 px up, ` +
+        `${(100 * changedFraction(before, after)).toFixed(1)} % of the coronal image changed`);
+  await page.evaluate((v) => window.tessera.slices.setCross(...v), cross);
+
+  // A region dragged in the axial view: at most 16 voxels each way (the
+  // side), 16 deep around its slice.
+  const regionPixels = async () => page.evaluate(() => {
+    const p = window.tessera.slices.overlayPixels();
+    let n = 0;
+    for (let i = 0; i < p.length; i += 4) if (p[i + 3] > 128 && p[i] > 200 && p[i + 1] < 70 && p[i + 2] < 70) n++;
+    return n;
+  });
+  await withoutOverlays(page);
+  const redBefore = await regionPixels();
+  st = await slices();
+  const ax = st.panels.axial;
+  await page.evaluate(() => { window.tessera.slices.setRegionSide(16); });
+  await page.click('#pickRegion');
+  await page.locator('#slice-axial').scrollIntoViewIfNeeded();
+  const ab = await page.locator('#slice-axial .slice-overlay').boundingBox();
+  // Image pixels -> page coordinates.
+  const at = (ix, iy) => [ab.x + ax.fit.left + ix * ax.fit.scale, ab.y + ax.fit.top + iy * ax.fit.scale];
+  const [x0, y0] = at(0.2 * ax.frame.width, 0.15 * ax.frame.height);
+  const [x1, y1] = at(0.75 * ax.frame.width, 0.6 * ax.frame.height);
+  await page.mouse.move(x0, y0);
+  await page.mouse.down();
+  await page.mouse.move(x1, y1, { steps: 4 });
+  await page.mouse.up();
+  await page.waitForFunction(() => window.tessera.slices.state().showing_region || window.tessera.error() !== '',
+    null, { timeout: 20000 });
+  const pickError = await page.evaluate(() => window.tessera.error());
+  if (pickError) throw new Error(`picking a region: ${pickError}`);
+  await page.evaluate(() => window.tessera.render());
+  st = await slices();
+  const r = st.region;
+  const spec = [0, 1, 2].map((a) => `${r.begin[a]}:${r.end[a]}`).join(',');
+  const s3d = await page.evaluate(() => window.tessera.state());
+  const refPng = path.join(tmp, 'native-region.png');
+  run('render', file, '--region', spec, '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', '--out', refPng);
+  const m = await psnrAgainst(page, refPng);
+  const size = [0, 1, 2].map((a) => r.end[a] - r.begin[a]);
+  check('a box dragged in the axial view renders like `tessera render --region` of it (PSNR >= 35 dB)',
+        m.psnr >= 35 && s3d.dims.join('x') === size.join('x') && size[ax.axis] === 16 && size.every((d) => d > 1 && d <= 16),
+        m.error || `region ${spec} (${size.join('x')} voxels, 3D view ${s3d.dims.join('x')}): ${m.psnr.toFixed(2)} dB`);
+
+  await page.click('#overview');
+  await page.waitForFunction(() => !window.tessera.slices.state().showing_region, null, { timeout: 20000 });
+  await page.evaluate(() => window.tessera.render());
+  const back = await page.evaluate(() => window.tessera.state());
+  const redAfter = await regionPixels();
+  check('Overview returns to the whole volume and shows the region as a red box',
+        back.dims.join('x') === '40x32x24' && redBefore === 0 && redAfter > SIZE / 2,
+        `3D view ${back.dims.join('x')}; ${redBefore} red overlay pixels before the pick, ${redAfter} after`);
+  // On a phone (390x844): one view at a time under tabs; the axial tab
+  // shows the axial slice across the screen, and a tap moves the crosshair
+  // to the voxel under the finger.
+  await cdp.send('Emulation.setDeviceMetricsOverride', { width: 390, height: 844, deviceScaleFactor: 3, mobile: true });
+  await page.evaluate((v) => window.tessera.slices.setCross(...v), cross);
+  await page.click('#view-tabs button[data-tab="axial"]');
+  const phone = await page.evaluate(() => {
+    const box = (id) => document.getElementById(id).getBoundingClientRect();
+    return { axial: box('slice-axial').width, view: box('view').width, coronal: box('slice-coronal').width, page: document.documentElement.scrollWidth };
+  });
+  await page.locator('#slice-axial').scrollIntoViewIfNeeded();
+  const pb = await page.locator('#slice-axial .slice-overlay').boundingBox();
+  const ps = (await slices()).panels.axial;
+  // Tap at image pixel (4.5, 4.5): the voxel of the top-left corner's pixels.
+  const tap = [Math.round(pb.x + ps.fit.left + 4.5 * ps.fit.scale), Math.round(pb.y + ps.fit.top + 4.5 * ps.fit.scale)];
+  await cdp.send('Input.dispatchTouchEvent', { type: 'touchStart', touchPoints: [{ x: tap[0], y: tap[1], id: 3 }] });
+  await cdp.send('Input.dispatchTouchEvent', { type: 'touchEnd', touchPoints: [] });
+  const tapped = (await slices()).cross;
+  // The axial view's top left is the patient's right and anterior: in this
+  // PIL volume low z (z runs left) and low x (x runs posterior); pixel 4
+  // is voxel x 4 (1.5 mm pixels and voxels), z 3 (2 mm voxels).
+  const expected = [4, cross[1], 3];
+  await cdp.send('Emulation.clearDeviceMetricsOverride');
+  check('phone (390x844): tabs show one view across the screen; a tap moves the crosshair',
+        phone.axial > 300 && phone.axial <= 390 && phone.view === 0 && phone.coronal === 0 && phone.page <= 390 &&
+        tapped.join() === expected.join(),
+        `axial ${phone.axial.toFixed(0)} CSS px wide, 3D view and coronal hidden, page ${phone.page} px; ` +
+        `tap at the top-left pixels -> crosshair (${tapped.join(', ')}), expected (${expected.join(', ')})`);
+  const errors = logs.filter((l) => l.startsWith('pageerror') || l.startsWith('error'));
+  check('no script errors on the slice-view page', errors.length === 0, errors.join(' | '));
+  await page.close();
+
+  if (shots && fs.existsSync(CH2)) {
+    // The page as a user sees it: the head, a region rendered at native
+    // resolution, then the overview with the region highlighted; and the
+    // axial tab on a phone.
+    const { page: p2 } = await openPage(context, url, 'url=/templates/ch2.nii.gz');
+    await p2.setViewportSize({ width: 1280, height: 1220 });  // the controls' Slices and region too
+    await p2.evaluate(async () => {
+      window.tessera.slices.setCross(70, 120, 95);
+      await window.tessera.slices.showRegion({ begin: [40, 90, 70], end: [100, 150, 130] });
+      await window.tessera.setCamera(35, 15, 1);
+    });
+    await p2.screenshot({ path: path.join(shots, 'web-region-native.jpg'), type: 'jpeg', quality: 85 });
+    await p2.evaluate(async () => {
+      await window.tessera.slices.overview();
+      await window.tessera.setCamera(35, 15, 1);
+    });
+    await p2.screenshot({ path: path.join(shots, 'web-slices-region.jpg'), type: 'jpeg', quality: 85 });
+    const cdp2 = await context.newCDPSession(p2);
+    await cdp2.send('Emulation.setDeviceMetricsOverride', { width: 390, height: 844, deviceScaleFactor: 2, mobile: true });
+    await p2.click('#view-tabs button[data-tab="axial"]');
+    await p2.evaluate(() => window.tessera.render());
+    const phoneShot = await cdp2.send('Page.captureScreenshot', { format: 'jpeg', quality: 80 });
+    fs.writeFileSync(path.join(shots, 'web-phone-axial.jpg'), Buffer.from(phoneShot.data, 'base64'));
+    await p2.close();
+  }
+  console.log(`     (slice views and region: ${((Date.now() - t) / 1000).toFixed(1)} s)`);
 }
 
 function psnrOf(a, b) {

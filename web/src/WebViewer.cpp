@@ -6,23 +6,30 @@
 #include <emscripten/html5.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <memory>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
 #include "tessera/core/Error.h"
 #include "tessera/core/PatientFrame.h"
+#include "tessera/core/SliceImage.h"
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/Draw.h"
 #include "tessera/gpu/GlContext.h"
+#include "tessera/gpu/MemoryLedger.h"
 #include "tessera/io/ByteSource.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/io/VolumeReader.h"
+#include "tessera/lod/InCoreMultiresSource.h"
+#include "tessera/render/OverlayRenderer.h"
 #include "tessera/render/TechniqueRegistry.h"
 #include "tessera/viewer/Viewer.h"
 
@@ -351,6 +358,268 @@ EMSCRIPTEN_KEEPALIVE const std::uint8_t* tessera_read_pixels(int width, int heig
                 pixels.data() + static_cast<std::size_t>(y) * stride);
   }
   return pixels.data();
+}
+
+}  // extern "C"
+
+// ---------------------------------------------------------------- slice views and region
+// Issue 15 item 6 (web/slices.js): axial, coronal and sagittal slices of the
+// loaded volume drawn on the CPU with core/SliceImage (the same pixels and
+// patient-direction letters as `tessera slice`), and the bread-slice region
+// (Schultz 2016 §7.4): a box of the volume at native resolution shown as the
+// 3D view (lod::copyBox, what `tessera render --region` reads for a file),
+// the overview kept here to return to.
+
+namespace {
+
+struct SliceViews {
+  // The overview's volume while a region is shown (the viewer holds the
+  // region then), its name and camera; null when the overview is shown.
+  std::unique_ptr<Volume> overview;
+  std::string overviewName;
+  Camera overviewCamera;
+  lod::VoxelBox region;           // of the overview, voxels (end exclusive)
+  const Volume* shown = nullptr;  // the viewer's volume when the region went in
+  std::string shownName;
+  Image images[3];  // the last slice per axis (tessera_slice's pixels)
+};
+
+SliceViews& sliceViews() {
+  static SliceViews s;
+  return s;
+}
+
+// True while the viewer still shows the region this block put in; a volume
+// loaded since then (another file) ends region mode.
+bool regionShown() {
+  SliceViews& s = sliceViews();
+  if (!s.overview) return false;
+  const viewer::Viewer& v = theViewer();
+  if (v.hasVolume() && &v.volume() == s.shown && v.volumeName() == s.shownName) return true;
+  s.overview.reset();
+  s.shown = nullptr;
+  return false;
+}
+
+// The volume the slices show: the overview's, also while a region is shown.
+const Volume& overviewVolume() {
+  viewer::Viewer& v = theViewer();
+  if (regionShown()) return *sliceViews().overview;
+  if (!v.hasVolume()) throw InputError("no volume is loaded");
+  return v.volume();
+}
+
+// The largest cube side (<= 256, as Schultz's bread-slice textures) whose
+// voxels fit the profile: its 3D texture size (or a WebGL 1 atlas of
+// side x side tiles in a 2D texture) and what the texture budget leaves
+// next to the overview's upload. The planner still has the last word.
+std::pair<int, std::string> defaultRegionSide(const Volume& volume) {
+  const viewer::Viewer& v = theViewer();
+  const gpu::DeviceLimits& l = v.limits();
+  const std::uint64_t bpv = bytesPerVoxel(volume.type());
+  const gpu::MemoryLedger& ledger = app().context->ledger();
+  const std::uint64_t used = ledger.totalBytes();
+  const std::uint64_t left =
+      ledger.budget() == 0 ? 0 : (ledger.budget() > used ? ledger.budget() - used : 1);
+  for (int s = 256; s >= 16; s -= 16) {
+    const std::uint64_t bytes = std::uint64_t(s) * s * s * bpv;
+    const int tiles = static_cast<int>(std::ceil(std::sqrt(double(s))));
+    const bool fitsTexture =
+        l.max3DTextureSize > 0 ? s <= l.max3DTextureSize : s * tiles <= l.max2DTextureSize;
+    if (fitsTexture && (ledger.budget() == 0 || bytes <= left)) {
+      std::string why = s == 256 ? "256³ voxels (Schultz 2016's bread-slice texture)"
+                                 : std::to_string(s) + "³ voxels: what the " + l.profile +
+                                       " profile's texture size and budget allow";
+      return {s, why};
+    }
+  }
+  return {16, "16³ voxels: the " + l.profile + " profile leaves little texture memory"};
+}
+
+}  // namespace
+
+extern "C" {
+
+// Slice `index` along index axis `axis` (0 x, 1 y, 2 z) of the overview
+// volume through the viewer's window, nearest voxel at voxel centres, grey
+// or (colour != 0) in the colours of the viewer's TF (`tessera slice --tf`):
+// JSON with the image (`pixels`: RGBA, top row first, width x height, valid
+// until the next call for this axis), its frame (plane, the index axes of
+// columns and rows and whether they run reversed, pixel_mm) and the patient
+// directions of its edges; "" on error (tessera_last_error).
+EMSCRIPTEN_KEEPALIVE const char* tessera_slice(int axis, int index, int colour) {
+  scratch().clear();
+  guarded([&] {
+    const Volume& volume = overviewVolume();
+    const SliceFrame f = sliceFrame(volume.direction(), axis);
+    const glm::ivec3 d = volume.dims();
+    const SliceRaster r = sliceRaster(f, d, volume.spacing());
+    Image& image = sliceViews().images[axis];
+    viewer::Viewer& v = theViewer();
+    image = sliceImage(volume, f, index, v.window(),
+                       colour ? &v.tfEditor().transferFunction() : nullptr);
+    nlohmann::json j;
+    j["axis"] = axis;
+    j["index"] = index;
+    j["count"] = d[axis];
+    j["plane"] = f.plane;
+    j["edges"] = {{"left", f.left}, {"right", f.right}, {"top", f.top}, {"bottom", f.bottom}};
+    // Letters only where the file says how the patient lay (as the 3D view).
+    j["oriented"] = !volume.geometrySource().empty();
+    j["col_axis"] = f.colAxis;
+    j["row_axis"] = f.rowAxis;
+    j["col_reversed"] = f.colReversed;
+    j["row_reversed"] = f.rowReversed;
+    j["width"] = r.width;
+    j["height"] = r.height;
+    j["pixel_mm"] = r.pixelMm;
+    j["tf_revision"] = v.tfEditor().revision();
+    j["pixels"] = reinterpret_cast<std::uintptr_t>(image.rgba().data());
+    scratch() = j.dump();
+  });
+  return scratch().c_str();
+}
+
+// Raw value of voxel (x, y, z) of the overview volume (NaN outside it).
+EMSCRIPTEN_KEEPALIVE double tessera_voxel_value(int x, int y, int z) {
+  double value = std::nan("");
+  guarded([&] {
+    const Volume& volume = overviewVolume();
+    const glm::ivec3 d = volume.dims();
+    if (x >= 0 && y >= 0 && z >= 0 && x < d.x && y < d.y && z < d.z) {
+      value = volume.valueAt(x, y, z);
+    }
+  });
+  return value;
+}
+
+// The overview volume and the region: JSON {has_volume, tf_revision, name,
+// dims, spacing, region: null or {begin, end}, showing_region, region_side,
+// region_side_reason}.
+EMSCRIPTEN_KEEPALIVE const char* tessera_explore_json() {
+  nlohmann::json j;
+  j["has_volume"] = false;
+  guarded([&] {
+    if (!app().viewer || !theViewer().hasVolume()) return;
+    const bool inRegion = regionShown();
+    const Volume& volume = overviewVolume();
+    const glm::ivec3 d = volume.dims();
+    const glm::dvec3 sp = volume.spacing();
+    j["has_volume"] = true;
+    j["tf_revision"] = theViewer().tfEditor().revision();
+    j["name"] = inRegion ? sliceViews().overviewName : theViewer().volumeName();
+    j["dims"] = {d.x, d.y, d.z};
+    j["spacing"] = {sp.x, sp.y, sp.z};
+    j["showing_region"] = inRegion;
+    if (inRegion) {
+      const lod::VoxelBox& b = sliceViews().region;
+      j["region"] = {{"begin", {b.begin.x, b.begin.y, b.begin.z}},
+                     {"end", {b.end.x, b.end.y, b.end.z}}};
+    } else {
+      j["region"] = nullptr;
+    }
+    const auto [side, why] = defaultRegionSide(volume);
+    j["region_side"] = side;
+    j["region_side_reason"] = why;
+  });
+  scratch() = j.dump();
+  return scratch().c_str();
+}
+
+// Shows voxels [x0,x1) x [y0,y1) x [z0,z1) of the overview volume, at its
+// native resolution, as the 3D view (ends past the volume are clamped; an
+// empty box or one that starts outside is an error). The window, the TF and
+// the overview stay; tessera_region_overview goes back.
+EMSCRIPTEN_KEEPALIVE int tessera_region_show(int x0, int x1, int y0, int y1, int z0, int z1) {
+  return guarded([&] {
+    viewer::Viewer& v = theViewer();
+    SliceViews& s = sliceViews();
+    const bool inRegion = regionShown();
+    const Volume& full = overviewVolume();
+    const glm::ivec3 d = full.dims();
+    lod::VoxelBox box{{x0, y0, z0}, {x1, y1, z1}};
+    const char* names = "xyz";
+    for (int a = 0; a < 3; ++a) {
+      if (box.begin[a] < 0 || box.begin[a] >= d[a] || box.end[a] <= box.begin[a]) {
+        throw InputError(std::string("region: ") + names[a] + " range " +
+                         std::to_string(box.begin[a]) + ":" + std::to_string(box.end[a]) +
+                         " is empty or starts outside 0:" + std::to_string(d[a]));
+      }
+      box.end[a] = std::min(box.end[a], d[a]);
+    }
+    const ValueRange window = v.window();
+    Volume region = lod::copyBox(full, box);
+    region.setGeometrySource(full.geometrySource());
+    region.setWindow(window);
+    const std::string overviewName = inRegion ? s.overviewName : v.volumeName();
+    const std::string name = overviewName + " region " + std::to_string(box.begin.x) + ":" +
+                             std::to_string(box.end.x) + "," + std::to_string(box.begin.y) + ":" +
+                             std::to_string(box.end.y) + "," + std::to_string(box.begin.z) + ":" +
+                             std::to_string(box.end.z);
+    // The viewer takes its volume by value: the overview is copied out
+    // before the region replaces it (kept while the region is shown).
+    std::unique_ptr<Volume> overview =
+        inRegion ? std::move(s.overview) : std::make_unique<Volume>(full);
+    const Camera camera = inRegion ? s.overviewCamera : v.camera();
+    try {
+      v.setVolume(std::move(region), name);
+    } catch (...) {
+      if (inRegion) s.overview = std::move(overview);
+      throw;
+    }
+    v.setWindow(window);
+    s.overview = std::move(overview);
+    s.overviewName = overviewName;
+    s.overviewCamera = camera;
+    s.region = box;
+    s.shown = &v.volume();
+    s.shownName = name;
+  });
+}
+
+// Back to the overview (with its camera and the current window); the
+// region stays known to the page, which draws it as a highlighted box.
+EMSCRIPTEN_KEEPALIVE int tessera_region_overview() {
+  return guarded([&] {
+    if (!regionShown()) return;
+    viewer::Viewer& v = theViewer();
+    SliceViews& s = sliceViews();
+    const ValueRange window = v.window();
+    // A copy, so that the overview survives an upload that fails.
+    v.setVolume(Volume(*s.overview), s.overviewName);
+    v.setWindow(window);
+    v.camera() = s.overviewCamera;
+    s.overview.reset();
+    s.shown = nullptr;
+  });
+}
+
+// How the 3D view projects the overview's voxel coordinates onto a
+// width x height canvas: JSON {mvp (column-major 4x4, model frame to clip
+// space, as the viewer's overlay lines), spacing, offset}: a point at
+// continuous voxel coordinates p (voxel i spans [i, i+1]) of the overview
+// lies at model point p * spacing + offset of the volume the view shows.
+EMSCRIPTEN_KEEPALIVE const char* tessera_projection_json(int width, int height) {
+  nlohmann::json j;
+  guarded([&] {
+    viewer::Viewer& v = theViewer();
+    if (!v.hasVolume() || width <= 0 || height <= 0) return;
+    const Volume& shownVolume = v.volume();
+    const glm::dvec3 spacing = shownVolume.spacing();
+    glm::dvec3 offset = -0.5 * shownVolume.extent();
+    if (regionShown()) offset -= glm::dvec3(sliceViews().region.begin) * spacing;
+    const Camera& c = v.camera();
+    const double radius = 0.5 * glm::length(shownVolume.extent());
+    const glm::dmat4 m = render::viewProjection(c, double(width) / height, radius);
+    j["mvp"] = nlohmann::json::array();
+    for (int col = 0; col < 4; ++col) {
+      for (int row = 0; row < 4; ++row) j["mvp"].push_back(m[col][row]);
+    }
+    j["spacing"] = {spacing.x, spacing.y, spacing.z};
+    j["offset"] = {offset.x, offset.y, offset.z};
+  });
+  scratch() = j.dump();
+  return scratch().c_str();
 }
 
 }  // extern "C"

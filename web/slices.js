@@ -1,0 +1,546 @@
+// Slice views and the bread-slice region (issue 15 item 6; Schultz 2016
+// §7.4), beside the 3D view of web/app.js:
+//
+// - Axial, coronal and sagittal slices of the loaded volume, drawn by the
+//   wasm core (tessera_slice: core/SliceImage, the pixels and patient
+//   letters of `tessera slice`, radiological convention) through the
+//   viewer's window, grey or in the TF's colours, nearest voxel. The
+//   crosshair is one voxel (x, y, z); each view shows the slice through it,
+//   so moving it in one view moves the others, and the 3D view marks it
+//   with a small 3D cross.
+//   Slice index: wheel, vertical drag (mouse or one finger), arrow keys,
+//   PageUp/PageDown, Home/End. Tap/click moves the crosshair.
+// - "Pick region": drag a box in a slice view (or tap for a box of the
+//   side set below, default what the profile allows, at most 256³) → that
+//   box of the volume at native resolution becomes the 3D view
+//   (tessera_region_show); "Overview" (or Esc) returns, and the overview
+//   shows the region as a red box.
+//
+// The page (app.js) calls TesseraSlices.attach() once the module is up and
+// frameShown() after every frame; window.tessera.slices is for tests.
+'use strict';
+
+window.TesseraSlices = (function () {
+  // Slicer's colours: axial red, coronal green, sagittal yellow.
+  const COLORS = { axial: '#e8574f', coronal: '#5cc45c', sagittal: '#e6c84a' };
+  const PLANES = ['axial', 'coronal', 'sagittal'];
+  const TAP_PX = 6;  // a pointer that moved less is a tap
+
+  function attach(opts) {
+    const { M, canvas, requestRender, showError, clearError } = opts;
+    const $ = (id) => document.getElementById(id);
+    const c = (name, ret, args) => M.cwrap(name, ret, args);
+    const api = {
+      slice: c('tessera_slice', 'string', ['number', 'number', 'number']),
+      value: c('tessera_voxel_value', 'number', ['number', 'number', 'number']),
+      explore: c('tessera_explore_json', 'string', []),
+      regionShow: c('tessera_region_show', 'number', ['number', 'number', 'number', 'number', 'number', 'number']),
+      regionOverview: c('tessera_region_overview', 'number', []),
+      projection: c('tessera_projection_json', 'string', ['number', 'number']),
+      lastError: c('tessera_last_error', 'string', []),
+    };
+
+    const views = $('views');
+    views.classList.add('quad');
+    const overlay3d = $('overlay3d');
+    let explore = { has_volume: false };
+    let volumeKey = '';
+    let windowKey = '';
+    let cross = [0, 0, 0];      // the crosshair voxel (overview voxels)
+    let region = null;          // the picked box {begin, end} (overview voxels, end exclusive)
+    let picking = false;        // "Pick region" pressed
+    let rubber = null;          // a box being dragged: {panel, a: [px, py], b: [px, py]} in image pixels
+    const panels = {};          // by plane
+
+    // The three panels; which index axis each shows is decided per volume
+    // from the slice frames the core reports (the plane nearest each axis).
+    for (const plane of PLANES) {
+      const el = $(`slice-${plane}`);
+      panels[plane] = {
+        plane, el, axis: -1, frame: null,
+        image: el.querySelector('.slice-image'),
+        overlay: el.querySelector('.slice-overlay'),
+        label: el.querySelector('.slice-label'),
+        fit: { left: 0, top: 0, scale: 1 },
+      };
+    }
+
+    // Grey (0), or the TF's colours (1, as `tessera slice --tf`).
+    const colour = () => ($('sliceColour').checked ? 1 : 0);
+
+    // ------------------------------------------------------------ geometry
+
+    // Image pixel (continuous, raster units) <-> voxel along the column or
+    // row axis, as core/SliceImage's sliceVoxelOf (nearest voxel centre).
+    function voxelOfPixel(p, f, which) {
+      const a = which === 'col' ? f.col_axis : f.row_axis;
+      const rev = which === 'col' ? f.col_reversed : f.row_reversed;
+      const n = explore.dims[a];
+      const s = explore.spacing[a];
+      const t = Math.min(n - 1, Math.max(0, Math.floor((Math.floor(p) + 0.5) * f.pixel_mm / s)));
+      return rev ? n - 1 - t : t;
+    }
+    // Continuous voxel coordinate (voxel i spans [i, i+1]) -> image pixel.
+    function pixelOfVoxel(v, f, which) {
+      const a = which === 'col' ? f.col_axis : f.row_axis;
+      const rev = which === 'col' ? f.col_reversed : f.row_reversed;
+      const n = explore.dims[a];
+      const t = rev ? n - v : v;
+      return t * explore.spacing[a] / f.pixel_mm;
+    }
+
+    function fitPanel(p) {
+      const f = p.frame;
+      const W = p.el.clientWidth, H = p.el.clientHeight;
+      if (!f || W === 0 || H === 0) return;
+      const scale = Math.min(W / f.width, H / f.height);
+      p.fit = { left: (W - f.width * scale) / 2, top: (H - f.height * scale) / 2, scale };
+      Object.assign(p.image.style, {
+        left: `${p.fit.left}px`, top: `${p.fit.top}px`,
+        width: `${f.width * scale}px`, height: `${f.height * scale}px`,
+      });
+      const dpr = window.devicePixelRatio || 1;
+      const bw = Math.round(W * dpr), bh = Math.round(H * dpr);
+      if (p.overlay.width !== bw || p.overlay.height !== bh) {
+        p.overlay.width = bw;
+        p.overlay.height = bh;
+      }
+    }
+
+    // Pointer position -> image pixels of the panel's slice.
+    function imagePos(p, e) {
+      const r = p.overlay.getBoundingClientRect();
+      return [(e.clientX - r.left - p.fit.left) / p.fit.scale, (e.clientY - r.top - p.fit.top) / p.fit.scale];
+    }
+
+    // ------------------------------------------------------------ drawing
+
+    function assignAxes() {
+      // Each index axis's plane, from the core's slice frames.
+      const frames = [0, 1, 2].map((a) => JSON.parse(api.slice(a, cross[a], colour()) || 'null'));
+      if (frames.some((f) => !f)) { showError(api.lastError()); return false; }
+      const byPlane = {};
+      frames.forEach((f) => { byPlane[f.plane] = f.axis; });
+      // An oblique volume may put two axes nearest one plane: then the
+      // panels show z, y, x under the names the core gives them.
+      const distinct = Object.keys(byPlane).length === 3;
+      PLANES.forEach((plane, i) => {
+        const axis = distinct ? byPlane[plane] : 2 - i;
+        panels[plane].axis = axis;
+        panels[plane].frame = frames[axis];
+      });
+      return true;
+    }
+
+    function drawSlice(p) {
+      const json = api.slice(p.axis, cross[p.axis], colour());
+      if (!json) { showError(api.lastError()); return; }
+      const f = JSON.parse(json);
+      p.frame = f;
+      const n = f.width * f.height * 4;
+      const pixels = new Uint8ClampedArray(M.HEAPU8.slice(f.pixels, f.pixels + n).buffer);
+      if (p.image.width !== f.width || p.image.height !== f.height) {
+        p.image.width = f.width;
+        p.image.height = f.height;
+      }
+      p.image.getContext('2d').putImageData(new ImageData(pixels, f.width, f.height), 0, 0);
+      for (const edge of ['left', 'right', 'top', 'bottom']) {
+        p.el.querySelector(`.orient-${edge}`).textContent = f.oriented ? f.edges[edge] : '';
+      }
+      p.label.textContent = `${f.plane} ${f.index}`;
+      p.label.title = `index ${f.index} of 0–${f.count - 1} along the volume's ${'xyz'[f.axis]} axis`;
+      fitPanel(p);
+    }
+
+    function drawAllSlices() {
+      for (const plane of PLANES) drawSlice(panels[plane]);
+    }
+
+    // In-plane rectangle (image pixels) of a voxel box, or null.
+    function boxRect(p, box) {
+      const f = p.frame;
+      const x0 = pixelOfVoxel(box.begin[f.col_axis], f, 'col'), x1 = pixelOfVoxel(box.end[f.col_axis], f, 'col');
+      const y0 = pixelOfVoxel(box.begin[f.row_axis], f, 'row'), y1 = pixelOfVoxel(box.end[f.row_axis], f, 'row');
+      return [Math.min(x0, x1), Math.min(y0, y1), Math.abs(x1 - x0), Math.abs(y1 - y0)];
+    }
+
+    function drawPanelOverlay(p) {
+      const f = p.frame;
+      const ctx = p.overlay.getContext('2d');
+      const dpr = window.devicePixelRatio || 1;
+      ctx.setTransform(1, 0, 0, 1, 0, 0);
+      ctx.clearRect(0, 0, p.overlay.width, p.overlay.height);
+      if (!f || !explore.has_volume) return;
+      // Image pixels -> overlay pixels.
+      ctx.setTransform(dpr * p.fit.scale, 0, 0, dpr * p.fit.scale, dpr * p.fit.left, dpr * p.fit.top);
+      const px = 1 / p.fit.scale;  // one CSS pixel in image pixels
+      // The region: filled where this slice cuts it, dashed where it does not.
+      if (region) {
+        const [x, y, w, h] = boxRect(p, region);
+        const inside = cross[p.axis] >= region.begin[p.axis] && cross[p.axis] < region.end[p.axis];
+        ctx.lineWidth = 2 * px;
+        ctx.strokeStyle = '#ff3b3b';
+        ctx.setLineDash(inside ? [] : [4 * px, 4 * px]);
+        if (inside) {
+          ctx.fillStyle = 'rgba(255, 40, 40, 0.22)';
+          ctx.fillRect(x, y, w, h);
+        }
+        ctx.strokeRect(x, y, w, h);
+        ctx.setLineDash([]);
+      }
+      if (rubber && rubber.panel === p) {
+        const b = rubberBox(p);
+        const [x, y, w, h] = boxRect(p, b);
+        ctx.lineWidth = 1.5 * px;
+        ctx.strokeStyle = '#ffffff';
+        ctx.setLineDash([3 * px, 3 * px]);
+        ctx.strokeRect(x, y, w, h);
+        ctx.setLineDash([]);
+      }
+      // Crosshair: the other two planes' slices, in their colours, with a
+      // gap around the point so the voxel under it stays visible.
+      const cx = pixelOfVoxel(cross[f.col_axis] + 0.5, f, 'col');
+      const cy = pixelOfVoxel(cross[f.row_axis] + 0.5, f, 'row');
+      const gap = 6 * px;
+      const colPlane = PLANES.find((q) => panels[q].axis === f.col_axis);
+      const rowPlane = PLANES.find((q) => panels[q].axis === f.row_axis);
+      ctx.lineWidth = px;
+      ctx.strokeStyle = COLORS[colPlane];
+      ctx.beginPath();
+      ctx.moveTo(cx, 0); ctx.lineTo(cx, cy - gap);
+      ctx.moveTo(cx, cy + gap); ctx.lineTo(cx, f.height);
+      ctx.stroke();
+      ctx.strokeStyle = COLORS[rowPlane];
+      ctx.beginPath();
+      ctx.moveTo(0, cy); ctx.lineTo(cx - gap, cy);
+      ctx.moveTo(cx + gap, cy); ctx.lineTo(f.width, cy);
+      ctx.stroke();
+    }
+
+    // The 3D view's marks, over its canvas: the crosshair as a small 3D
+    // cross (x red, y green, z blue, as the axes), and in the overview the
+    // picked region as a red box.
+    function draw3dOverlay() {
+      const dpr = window.devicePixelRatio || 1;
+      const W = canvas.clientWidth, H = canvas.clientHeight;
+      // Over the canvas's content box (inside its border).
+      Object.assign(overlay3d.style, {
+        left: `${canvas.offsetLeft + canvas.clientLeft}px`, top: `${canvas.offsetTop + canvas.clientTop}px`,
+        width: `${W}px`, height: `${H}px`,
+      });
+      const bw = Math.max(1, Math.round(W * dpr)), bh = Math.max(1, Math.round(H * dpr));
+      if (overlay3d.width !== bw || overlay3d.height !== bh) {
+        overlay3d.width = bw;
+        overlay3d.height = bh;
+      }
+      const ctx = overlay3d.getContext('2d');
+      ctx.setTransform(1, 0, 0, 1, 0, 0);
+      ctx.clearRect(0, 0, bw, bh);
+      if (!explore.has_volume) return;
+      const pj = JSON.parse(api.projection(canvas.width, canvas.height) || '{}');
+      if (!pj.mvp) return;
+      const m = pj.mvp;
+      const project = (v) => {
+        const p = v.map((x, a) => x * pj.spacing[a] + pj.offset[a]);
+        const cx = m[0] * p[0] + m[4] * p[1] + m[8] * p[2] + m[12];
+        const cy = m[1] * p[0] + m[5] * p[1] + m[9] * p[2] + m[13];
+        const cw = m[3] * p[0] + m[7] * p[1] + m[11] * p[2] + m[15];
+        if (!(cw > 1e-9)) return null;
+        return [(cx / cw + 1) / 2 * bw, (1 - cy / cw) / 2 * bh];
+      };
+      const line = (a, b) => {
+        const pa = project(a), pb = project(b);
+        if (!pa || !pb) return;
+        ctx.moveTo(pa[0], pa[1]);
+        ctx.lineTo(pb[0], pb[1]);
+      };
+      const showing = explore.showing_region ? explore.region : null;
+      if (region && !showing) {
+        const b = region.begin, e = region.end;
+        ctx.beginPath();
+        for (let axis = 0; axis < 3; axis++) {
+          const u = (axis + 1) % 3, w = (axis + 2) % 3;
+          for (let i = 0; i < 4; i++) {
+            const a = [0, 0, 0];
+            a[u] = i & 1 ? e[u] : b[u];
+            a[w] = i & 2 ? e[w] : b[w];
+            const z = a.slice();
+            a[axis] = b[axis];
+            z[axis] = e[axis];
+            line(a, z);
+          }
+        }
+        ctx.strokeStyle = '#ff3b3b';
+        ctx.lineWidth = 2.5 * dpr;
+        ctx.stroke();
+      }
+      const inside = $('crosshair3d').checked && (!showing || [0, 1, 2].every((a) => cross[a] >= showing.begin[a] && cross[a] < showing.end[a]));
+      if (inside) {
+        const dims = showing ? [0, 1, 2].map((a) => showing.end[a] - showing.begin[a]) : explore.dims;
+        const arm = 0.08 * Math.max(...dims.map((d, a) => d * explore.spacing[a]));
+        const centre = cross.map((v) => v + 0.5);
+        ['#ff5050', '#50ff50', '#5c8cff'].forEach((color, a) => {
+          const lo = centre.slice(), hi = centre.slice();
+          lo[a] -= arm / explore.spacing[a];
+          hi[a] += arm / explore.spacing[a];
+          ctx.beginPath();
+          line(lo, hi);
+          ctx.strokeStyle = '#000';
+          ctx.lineWidth = 4 * dpr;
+          ctx.stroke();
+          ctx.strokeStyle = color;
+          ctx.lineWidth = 2 * dpr;
+          ctx.stroke();
+        });
+      }
+    }
+
+    function updateInfo() {
+      const v = explore.has_volume ? api.value(cross[0], cross[1], cross[2]) : NaN;
+      $('crosshairInfo').textContent = explore.has_volume
+        ? `crosshair voxel (${cross.join(', ')}): value ${Number.isFinite(v) ? +v.toPrecision(6) : '–'}` : '';
+      const r = region;
+      const text = r ? `region x ${r.begin[0]}:${r.end[0]}, y ${r.begin[1]}:${r.end[1]}, z ${r.begin[2]}:${r.end[2]} ` +
+        `(${r.end.map((e, a) => e - r.begin[a]).join('×')} voxels, native resolution)` : 'no region picked';
+      $('regionInfo').textContent = explore.showing_region ? `3D view: ${text}` : text;
+      $('overview').disabled = !explore.showing_region;
+      $('showRegion').disabled = !region || explore.showing_region;
+      $('pickRegion').setAttribute('aria-pressed', picking ? 'true' : 'false');
+      $('pickRegion').classList.toggle('pressed', picking);
+      views.classList.toggle('picking', picking);
+      views.classList.toggle('region-shown', !!explore.showing_region);
+    }
+
+    function redrawOverlays() {
+      for (const plane of PLANES) drawPanelOverlay(panels[plane]);
+      draw3dOverlay();
+      updateInfo();
+    }
+
+    // ------------------------------------------------------------ state changes
+
+    // After every frame of the 3D view (app.js): a new volume resets the
+    // crosshair to its centre; a new window redraws the slices; the 3D
+    // marks follow the camera; in colour, a TF edit redraws them too.
+    function frameShown(state) {
+      explore = JSON.parse(api.explore());
+      if (!explore.has_volume) { redrawOverlays(); return; }
+      const key = `${explore.name}|${explore.dims.join('x')}`;
+      let redraw = false;
+      if (key !== volumeKey) {
+        volumeKey = key;
+        cross = explore.dims.map((d) => Math.floor(d / 2));
+        region = null;
+        picking = false;
+        $('regionSide').value = explore.region_side;
+        $('regionSide').max = Math.max(...explore.dims);
+        $('regionSide').title = `default: ${explore.region_side_reason}`;
+        if (!assignAxes()) return;
+        redraw = true;
+      }
+      const wk = `${(state.window || []).join(',')}|${colour() ? explore.tf_revision : 'grey'}`;
+      if (wk !== windowKey) { windowKey = wk; redraw = true; }
+      if (redraw) drawAllSlices();
+      redrawOverlays();
+    }
+
+    function setCross(v) {
+      if (!explore.has_volume) return false;
+      const next = v.map((x, a) => Math.min(explore.dims[a] - 1, Math.max(0, Math.round(x))));
+      const changed = [0, 1, 2].filter((a) => next[a] !== cross[a]);
+      cross = next;
+      for (const plane of PLANES) {
+        const p = panels[plane];
+        if (changed.includes(p.axis)) drawSlice(p);
+      }
+      redrawOverlays();
+      return changed.length > 0;
+    }
+
+    function step(p, delta) {
+      const v = cross.slice();
+      v[p.axis] += delta;
+      setCross(v);
+    }
+
+    // The box a drag (or tap) in panel p describes: in-plane from the drag,
+    // at most `side` voxels (a tap: a square of the side around it), `side`
+    // voxels deep around the slice, clamped to the volume.
+    function rubberBox(p) {
+      const f = p.frame;
+      const side = Math.max(1, parseInt($('regionSide').value, 10) || explore.region_side);
+      const begin = [0, 0, 0], end = [0, 0, 0];
+      const span = (a, centre) => {
+        const n = explore.dims[a], s = Math.min(side, n);
+        begin[a] = Math.min(n - s, Math.max(0, Math.round(centre - s / 2)));
+        end[a] = begin[a] + s;
+      };
+      span(p.axis, cross[p.axis] + 0.5);
+      const [ax, ay] = rubber.a, [bx, by] = rubber.b;
+      const tap = Math.hypot((bx - ax) * p.fit.scale, (by - ay) * p.fit.scale) < TAP_PX;
+      for (const [which, a0, a1] of [['col', ax, bx], ['row', ay, by]]) {
+        const a = which === 'col' ? f.col_axis : f.row_axis;
+        if (tap) {
+          span(a, voxelOfPixel(a0, f, which) + 0.5);
+        } else {
+          // From the voxel under the press towards the one under the
+          // finger, at most `side` voxels (what the profile allows).
+          const v0 = voxelOfPixel(a0, f, which), v1 = voxelOfPixel(a1, f, which);
+          const length = Math.min(Math.abs(v1 - v0) + 1, side);
+          begin[a] = v1 >= v0 ? v0 : v0 - length + 1;
+          end[a] = begin[a] + length;
+        }
+      }
+      return { begin, end };
+    }
+
+    async function showRegion(box) {
+      if (!api.regionShow(box.begin[0], box.end[0], box.begin[1], box.end[1], box.begin[2], box.end[2])) {
+        showError(`region: ${api.lastError()}`);
+        return false;
+      }
+      clearError();
+      region = JSON.parse(api.explore()).region;
+      await requestRender();
+      return true;
+    }
+
+    async function overview() {
+      if (!api.regionOverview()) { showError(api.lastError()); return false; }
+      await requestRender();
+      return true;
+    }
+
+    // ------------------------------------------------------------ input
+
+    for (const plane of PLANES) {
+      const p = panels[plane];
+      const el = p.overlay;
+      let drag = null;  // {id, y, startX, start (the index), moved}
+      el.addEventListener('contextmenu', (e) => e.preventDefault());
+      el.addEventListener('pointerdown', (e) => {
+        if (!explore.has_volume || drag) return;
+        el.focus({ preventScroll: true });
+        el.setPointerCapture(e.pointerId);
+        drag = { id: e.pointerId, y: e.clientY, startX: e.clientX, start: cross[p.axis], moved: false };
+        if (picking) {
+          const at = imagePos(p, e);
+          rubber = { panel: p, a: at, b: at };
+          drawPanelOverlay(p);
+        }
+        e.preventDefault();
+      });
+      el.addEventListener('pointermove', (e) => {
+        if (!drag || drag.id !== e.pointerId) return;
+        const dy = e.clientY - drag.y, dx = e.clientX - drag.startX;
+        if (Math.hypot(dx, dy) >= TAP_PX) drag.moved = true;
+        if (picking) {
+          rubber.b = imagePos(p, e);
+          drawPanelOverlay(p);
+        } else if (drag.moved) {
+          // Vertical drag pages through the slices: the panel's height
+          // spans the whole stack (at least one slice per 12 CSS px).
+          const perPx = Math.max(1 / 12, p.frame.count / Math.max(1, el.clientHeight));
+          const v = cross.slice();
+          v[p.axis] = drag.start - Math.round(dy * perPx);
+          setCross(v);
+        }
+      });
+      const end = async (e, cancelled) => {
+        if (!drag || drag.id !== e.pointerId) return;
+        const moved = drag.moved;
+        drag = null;
+        if (picking && rubber) {
+          const box = rubberBox(p);
+          rubber = null;
+          if (cancelled) { drawPanelOverlay(p); return; }
+          picking = false;
+          await showRegion(box);
+        } else if (!moved && !cancelled) {
+          // A tap or click moves the crosshair to that voxel.
+          const [ix, iy] = imagePos(p, e);
+          const f = p.frame;
+          if (ix >= 0 && iy >= 0 && ix < f.width && iy < f.height) {
+            const v = cross.slice();
+            v[f.col_axis] = voxelOfPixel(ix, f, 'col');
+            v[f.row_axis] = voxelOfPixel(iy, f, 'row');
+            setCross(v);
+          }
+        }
+      };
+      el.addEventListener('pointerup', (e) => end(e, false));
+      el.addEventListener('pointercancel', (e) => end(e, true));
+      el.addEventListener('wheel', (e) => {
+        if (!explore.has_volume) return;
+        step(p, e.deltaY < 0 ? 1 : -1);
+        e.preventDefault();
+      }, { passive: false });
+      el.addEventListener('keydown', (e) => {
+        if (!explore.has_volume) return;
+        const n = p.frame ? p.frame.count : 1;
+        const moves = { ArrowUp: 1, ArrowRight: 1, ArrowDown: -1, ArrowLeft: -1, PageUp: 10, PageDown: -10 };
+        if (e.key in moves) step(p, moves[e.key]);
+        else if (e.key === 'Home') step(p, -n);
+        else if (e.key === 'End') step(p, n);
+        else return;
+        e.preventDefault();
+      });
+      new ResizeObserver(() => { fitPanel(p); drawPanelOverlay(p); }).observe(p.el);
+    }
+    new ResizeObserver(() => draw3dOverlay()).observe(canvas);
+
+    $('pickRegion').addEventListener('click', () => { picking = !picking; updateInfo(); });
+    $('showRegion').addEventListener('click', () => { if (region) showRegion(region); });
+    $('overview').addEventListener('click', () => overview());
+    $('crosshair3d').addEventListener('change', () => draw3dOverlay());
+    $('sliceColour').addEventListener('change', () => { windowKey = ''; requestRender(); });
+    $('regionSide').addEventListener('change', (e) => {
+      const v = parseInt(e.target.value, 10);
+      if (!(v >= 1)) e.target.value = explore.region_side;
+    });
+    window.addEventListener('keydown', (e) => {
+      const t = e.target;
+      if (t && (t.tagName === 'INPUT' || t.tagName === 'SELECT' || t.tagName === 'TEXTAREA')) return;
+      if (e.key === 'Escape' && explore.showing_region) { overview(); e.preventDefault(); }
+    });
+    // Phone layout: one view at a time, chosen by the tabs.
+    for (const b of document.querySelectorAll('#view-tabs button')) {
+      b.addEventListener('click', () => {
+        views.dataset.tab = b.dataset.tab;
+        for (const o of document.querySelectorAll('#view-tabs button')) o.setAttribute('aria-selected', o === b ? 'true' : 'false');
+        requestRender();
+      });
+    }
+
+    // For tests: the page's slice images as shown (their canvases' pixels),
+    // the letters at their edges, the crosshair and the region.
+    const testApi = {
+      state: () => ({
+        cross: cross.slice(),
+        region,
+        showing_region: !!explore.showing_region,
+        explore,
+        panels: Object.fromEntries(PLANES.map((q) => {
+          const p = panels[q];
+          const letters = {};
+          for (const edge of ['left', 'right', 'top', 'bottom']) letters[edge] = p.el.querySelector(`.orient-${edge}`).textContent;
+          return [q, { axis: p.axis, index: cross[p.axis], frame: p.frame, letters, fit: p.fit }];
+        })),
+      }),
+      imagePixels: (plane) => {
+        const img = panels[plane].image;
+        return Array.from(img.getContext('2d').getImageData(0, 0, img.width, img.height).data);
+      },
+      // RGBA pixels of the 3D view's overlay (crosshair marker, region box).
+      overlayPixels: () => Array.from(overlay3d.getContext('2d').getImageData(0, 0, overlay3d.width, overlay3d.height).data),
+      setCross: (x, y, z) => setCross([x, y, z]),
+      setPicking: (on) => { picking = !!on; updateInfo(); },
+      setRegionSide: (side) => { $('regionSide').value = side; },
+      showRegion,
+      overview,
+    };
+    return { frameShown, testApi };
+  }
+
+  return { attach };
+})();
