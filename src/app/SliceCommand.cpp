@@ -2,11 +2,8 @@
 // one index-axis slice at native voxel resolution (nearest voxel, no
 // interpolation), read as a one-voxel-thick box of one pyramid level, shown
 // in the radiological convention with the patient directions of its edges.
-#include <algorithm>
-#include <cmath>
 #include <cstdio>
 
-#include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
 #include "app/Commands.h"
@@ -14,6 +11,7 @@
 #include "tessera/core/Error.h"
 #include "tessera/core/Image.h"
 #include "tessera/core/PatientFrame.h"
+#include "tessera/core/SliceImage.h"
 #include "tessera/core/TransferFunction.h"
 
 namespace tessera::app {
@@ -39,67 +37,6 @@ int parseAxis(const std::string& text) {
   if (text == "y" || text == "j") return 1;
   if (text == "z" || text == "k") return 2;
   throw InputError("--axis '" + text + "': expected x, y or z (an index axis of the volume)");
-}
-
-// How the slice's two in-plane index axes land on the image. Radiological
-// convention, whatever the storage order: axial and coronal slices have
-// the patient's left on the image's right (as if facing the patient; axial
-// seen from the feet), anterior up (axial) or superior up (coronal);
-// sagittal slices have anterior on the image's left and superior up.
-struct SliceFrame {
-  std::string plane;         // axial, coronal or sagittal (by the normal's nearest world axis)
-  int colAxis = 0;           // index axis along image columns (left to right)
-  int rowAxis = 1;           // index axis along image rows (top to bottom)
-  bool colReversed = false;  // column 0 shows the last voxel of colAxis
-  bool rowReversed = false;  // row 0 shows the last voxel of rowAxis
-  std::string left, right, top, bottom;  // patient directions of the edges
-};
-
-SliceFrame sliceFrame(const glm::dmat3& direction, int axis) {
-  const glm::dmat3 frame = nearestOrthonormal(direction);
-  const glm::dvec3 normal = frame[axis];
-  int dominant = 0;
-  for (int w = 1; w < 3; ++w) {
-    if (std::abs(normal[w]) > std::abs(normal[dominant])) dominant = w;
-  }
-  SliceFrame f;
-  glm::dvec3 screenRight, screenUp;  // world (RAS) directions of image right and up
-  if (dominant == 2) {
-    f.plane = "axial";
-    screenRight = {-1, 0, 0};
-    screenUp = {0, 1, 0};
-  } else if (dominant == 1) {
-    f.plane = "coronal";
-    screenRight = {-1, 0, 0};
-    screenUp = {0, 0, 1};
-  } else {
-    f.plane = "sagittal";
-    screenRight = {0, -1, 0};
-    screenUp = {0, 0, 1};
-  }
-  const int p = (axis + 1) % 3, q = (axis + 2) % 3;
-  const bool pHorizontal =
-      std::abs(glm::dot(frame[p], screenRight)) >= std::abs(glm::dot(frame[q], screenRight));
-  f.colAxis = pHorizontal ? p : q;
-  f.rowAxis = pHorizontal ? q : p;
-  f.colReversed = glm::dot(frame[f.colAxis], screenRight) < 0.0;
-  // Rows grow downwards: the index grows downwards unless it points up.
-  f.rowReversed = glm::dot(frame[f.rowAxis], screenUp) > 0.0;
-  const glm::dvec3 right = frame[f.colAxis] * (f.colReversed ? -1.0 : 1.0);
-  const glm::dvec3 down = frame[f.rowAxis] * (f.rowReversed ? -1.0 : 1.0);
-  f.right = directionLabel(right);
-  f.left = directionLabel(-right);
-  f.bottom = directionLabel(down);
-  f.top = directionLabel(-down);
-  return f;
-}
-
-// Pixel -> voxel along one image axis: pixels of `pixelMm` over `n` voxels
-// of `spacing`, nearest voxel centre, optionally reversed.
-int voxelOf(int pixel, double pixelMm, double spacing, int n, bool reversed) {
-  const int t =
-      std::clamp(static_cast<int>(std::floor((pixel + 0.5) * pixelMm / spacing)), 0, n - 1);
-  return reversed ? n - 1 - t : t;
 }
 
 void runSliceCommand(const SliceOptions& o) {
@@ -130,32 +67,15 @@ void runSliceCommand(const SliceOptions& o) {
     }
     window = {o.window[0], o.window[1]};
   }
+  // The frame of the whole volume (core/SliceImage.h); the slab is its
+  // slice `index`, at index 0 of the slab.
   const SliceFrame f = sliceFrame(source.shape().direction(), axis);
   const glm::dvec3 spacing = slab.spacing();
-  const double pixelMm = std::min(spacing[f.colAxis], spacing[f.rowAxis]);
-  const int nc = info.dims[f.colAxis], nr = info.dims[f.rowAxis];
-  const int width = std::max(1, static_cast<int>(std::lround(nc * spacing[f.colAxis] / pixelMm)));
-  const int height = std::max(1, static_cast<int>(std::lround(nr * spacing[f.rowAxis] / pixelMm)));
-  Image image(width, height);
+  const SliceRaster raster = sliceRaster(f, info.dims, spacing);
+  const int width = raster.width, height = raster.height;
+  const double pixelMm = raster.pixelMm;
   const bool grey = o.tf == "grey";
-  for (int row = 0; row < height; ++row) {
-    const int vr = voxelOf(row, pixelMm, spacing[f.rowAxis], nr, f.rowReversed);
-    for (int col = 0; col < width; ++col) {
-      glm::ivec3 v(0);
-      v[f.colAxis] = voxelOf(col, pixelMm, spacing[f.colAxis], nc, f.colReversed);
-      v[f.rowAxis] = vr;
-      const double value = slab.finiteValueAtIndex(slab.index(v.x, v.y, v.z));
-      const double n = window.max > window.min
-                           ? std::clamp((value - window.min) / (window.max - window.min), 0.0, 1.0)
-                           : 0.0;
-      const glm::dvec3 rgb = grey ? glm::dvec3(n) : tf.color(n);
-      std::uint8_t* px = image.pixel(col, row);
-      for (int c = 0; c < 3; ++c) {
-        px[c] = static_cast<std::uint8_t>(std::lround(std::clamp(rgb[c], 0.0, 1.0) * 255.0));
-      }
-      px[3] = 255;
-    }
-  }
+  const Image image = sliceImage(slab, f, 0, window, grey ? nullptr : &tf);
   image.writePng(o.out);
 
   nlohmann::json j;
