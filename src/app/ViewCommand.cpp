@@ -553,7 +553,7 @@ void drawSliceTile(DesktopSession& ds, DesktopSession::SliceTile& tile, const Re
   dl->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(tile.texture.id())),
                screen({0.0, 0.0}), screen(glm::dvec2(g.imageSize())));
   // The picked region where this slice cuts it.
-  const viewer::SliceFrame& f = g.frame();
+  const SliceFrame& f = g.frame();
   if (ds.picked && index >= ds.picked->begin[g.axis()] && index < ds.picked->end[g.axis()]) {
     glm::ivec3 lo = ds.picked->begin, hi = ds.picked->end - 1;
     lo[g.axis()] = hi[g.axis()] = index;

@@ -10,58 +10,6 @@
 
 namespace tessera::viewer {
 
-namespace {
-
-// The nearest world axis (0 R-L, 1 A-P, 2 S-I) of a direction.
-int dominantWorldAxis(const glm::dvec3& d) {
-  int w = 0;
-  for (int a = 1; a < 3; ++a) {
-    if (std::abs(d[a]) > std::abs(d[w])) w = a;
-  }
-  return w;
-}
-
-}  // namespace
-
-SliceFrame sliceFrame(const glm::dmat3& direction, int axis) {
-  if (axis < 0 || axis > 2) throw InputError("slice axis must be 0, 1 or 2 (x, y or z)");
-  const glm::dmat3 frame = nearestOrthonormal(direction);
-  SliceFrame f;
-  f.axis = axis;
-  // World (RAS) directions of the image's right and up, as radiologists
-  // read each plane (the same rules as `tessera slice`).
-  glm::dvec3 screenRight, screenUp;
-  const int normal = dominantWorldAxis(frame[axis]);
-  if (normal == 2) {
-    f.plane = "axial";
-    screenRight = {-1, 0, 0};
-    screenUp = {0, 1, 0};
-  } else if (normal == 1) {
-    f.plane = "coronal";
-    screenRight = {-1, 0, 0};
-    screenUp = {0, 0, 1};
-  } else {
-    f.plane = "sagittal";
-    screenRight = {0, -1, 0};
-    screenUp = {0, 0, 1};
-  }
-  const int p = (axis + 1) % 3, q = (axis + 2) % 3;
-  const bool pHorizontal =
-      std::abs(glm::dot(frame[p], screenRight)) >= std::abs(glm::dot(frame[q], screenRight));
-  f.colAxis = pHorizontal ? p : q;
-  f.rowAxis = pHorizontal ? q : p;
-  f.colReversed = glm::dot(frame[f.colAxis], screenRight) < 0.0;
-  // Rows grow downwards: the index grows downwards unless it points up.
-  f.rowReversed = glm::dot(frame[f.rowAxis], screenUp) > 0.0;
-  const glm::dvec3 right = frame[f.colAxis] * (f.colReversed ? -1.0 : 1.0);
-  const glm::dvec3 down = frame[f.rowAxis] * (f.rowReversed ? -1.0 : 1.0);
-  f.right = directionLabel(right);
-  f.left = directionLabel(-right);
-  f.bottom = directionLabel(down);
-  f.top = directionLabel(-down);
-  return f;
-}
-
 int axisForPlane(const glm::dmat3& direction, const std::string& plane) {
   const int world = plane == "sagittal" ? 0 : plane == "coronal" ? 1 : plane == "axial" ? 2 : -1;
   if (world < 0) throw InputError("plane '" + plane + "': expected axial, coronal or sagittal");
@@ -83,17 +31,13 @@ SliceGeometry::SliceGeometry(glm::ivec3 dims, glm::dvec3 spacing, const glm::dma
           "along every axis");
     }
   }
-  const double sc = spacing_[frame_.colAxis], sr = spacing_[frame_.rowAxis];
-  pixelMm_ = std::min(sc, sr);
-  size_.x = std::max(1, static_cast<int>(std::lround(dims_[frame_.colAxis] * sc / pixelMm_)));
-  size_.y = std::max(1, static_cast<int>(std::lround(dims_[frame_.rowAxis] * sr / pixelMm_)));
+  const SliceRaster raster = sliceRaster(frame_, dims_, spacing_);
+  pixelMm_ = raster.pixelMm;
+  size_ = {raster.width, raster.height};
 }
 
 int SliceGeometry::voxelAlong(int pixel, int a, bool reversed) const {
-  const int n = dims_[a];
-  const int t =
-      std::clamp(static_cast<int>(std::floor((pixel + 0.5) * pixelMm_ / spacing_[a])), 0, n - 1);
-  return reversed ? n - 1 - t : t;
+  return sliceVoxelOf(pixel, pixelMm_, spacing_[a], dims_[a], reversed);
 }
 
 glm::ivec3 SliceGeometry::voxelAt(glm::ivec2 pixel, int index) const {
@@ -146,22 +90,7 @@ Image SliceGeometry::renderSlab(const Volume& slab, ValueRange window,
   glm::ivec3 expected = dims_;
   expected[frame_.axis] = 1;
   if (slab.dims() != expected) throw InputError("slice view: slab of the wrong size");
-  Image image(size_.x, size_.y);
-  const double width = window.max - window.min;
-  for (int row = 0; row < size_.y; ++row) {
-    for (int col = 0; col < size_.x; ++col) {
-      glm::ivec3 v = voxelAt({col, row}, 0);
-      const double value = slab.finiteValueAtIndex(slab.index(v.x, v.y, v.z));
-      const double n = width > 0.0 ? std::clamp((value - window.min) / width, 0.0, 1.0) : 0.0;
-      const glm::dvec3 rgb = tf ? tf->color(n) : glm::dvec3(n);
-      std::uint8_t* px = image.pixel(col, row);
-      for (int c = 0; c < 3; ++c) {
-        px[c] = static_cast<std::uint8_t>(std::lround(std::clamp(rgb[c], 0.0, 1.0) * 255.0));
-      }
-      px[3] = 255;
-    }
-  }
-  return image;
+  return sliceImage(slab, frame_, 0, window, tf);
 }
 
 SliceViewport SliceViewport::fit(glm::ivec2 imageSize, glm::dvec2 rectOrigin, glm::dvec2 rectSize) {

@@ -1,12 +1,12 @@
 #pragma once
 // The 2D slice views next to the 3D view (issue 15; Schultz 2016 §7.4's
 // "bread slice" flipping): an index-axis slice of a volume at native voxel
-// resolution (nearest voxel), in the radiological convention that `tessera
-// slice` writes: axial and coronal slices show the patient's left on the
-// image's right (axial seen from the feet, anterior up; coronal superior
-// up), sagittal slices anterior on the left and superior up, whatever the
-// storage order. The slice is read as a one-voxel-thick box of a
-// lod::MultiresSource level, so a store reads only the chunks it touches.
+// resolution (nearest voxel), in the radiological convention of
+// core/SliceImage.h, the one `tessera slice` and the web page draw with
+// (tessera::SliceFrame, sliceFrame, sliceVoxelOf, sliceImage). The slice is
+// read as a one-voxel-thick box of a lod::MultiresSource level, so a store
+// reads only the chunks it touches; this adds the inverse mappings the
+// crosshair needs and the fit of the image into a view.
 //
 // Pixels are square, of the finer in-plane spacing; a voxel covers one or
 // more pixels along an axis of coarser spacing. Pixel <-> voxel mappings
@@ -19,25 +19,12 @@
 #include <glm/vec3.hpp>
 
 #include "tessera/core/Image.h"
+#include "tessera/core/SliceImage.h"
 #include "tessera/core/TransferFunction.h"
 #include "tessera/core/Volume.h"
 #include "tessera/lod/MultiresSource.h"
 
 namespace tessera::viewer {
-
-// How the slice normal to index axis `axis` lands on the image.
-struct SliceFrame {
-  int axis = 2;
-  std::string plane;         // axial, coronal or sagittal (the normal's nearest world axis)
-  int colAxis = 0;           // index axis along image columns (left to right)
-  int rowAxis = 1;           // index axis along image rows (top to bottom)
-  bool colReversed = false;  // column 0 shows the last voxel of colAxis
-  bool rowReversed = false;  // row 0 shows the last voxel of rowAxis
-  std::string left, right, top, bottom;  // patient directions of the edges
-};
-
-// `direction`: the volume's direction cosines (columns: index axes in RAS).
-SliceFrame sliceFrame(const glm::dmat3& direction, int axis);
 
 // The index axis whose slices are the given plane ("axial", "coronal",
 // "sagittal"): the axis nearest the plane's normal (S, A, R).
