@@ -364,21 +364,24 @@ Framing framingOf(const DesktopSession& ds, const std::optional<lod::VoxelBox>& 
           0.5 * glm::length(glm::dvec3(b.size()) * spacing)};
 }
 
-// Shows `volume` (the whole volume or `box` of it) in the 3D view with the
-// camera's direction kept. recentre: the box's centre and the zoom at which
-// it fills the view (a grid move); otherwise the same point of the patient
-// stays at the view's centre at the same scale (overview <-> native swaps
-// change the data, not the view).
+// How the camera follows a swap of the 3D view's volume (its direction
+// always stays). Keep: the same point of the patient stays at the view's
+// centre at the same scale (the zoom policy's swaps change the data, not
+// the view: no jump). Centre: the new volume's centre, the zoom kept (a grid
+// move). Fill: the new volume's centre at zoom 1 (a key or button).
+enum class Follow { Keep, Centre, Fill };
+
+// Shows `volume` (the whole volume or `box` of it) in the 3D view.
 void showIn3D(DesktopSession& ds, Volume volume, const std::string& name,
-              const std::optional<lod::VoxelBox>& box, bool recentre) {
+              const std::optional<lod::VoxelBox>& box, Follow follow) {
   const Camera before = ds.viewer->camera();
   const Framing from = framingOf(ds, ds.shown), to = framingOf(ds, box);
   ds.viewer->setVolume(std::move(volume), name);
   Camera& c = ds.viewer->camera();
   c.azimuthDeg = before.azimuthDeg;
   c.elevationDeg = before.elevationDeg;
-  c.zoom = before.zoom;
-  if (!recentre) {
+  c.zoom = follow == Follow::Fill ? 1.0 : before.zoom;
+  if (follow == Follow::Keep) {
     c.target = before.target + from.centre - to.centre;
     c.zoom = before.zoom * to.radius / from.radius;
   }
@@ -391,13 +394,13 @@ std::string boxText(const lod::VoxelBox& b) {
   return t;
 }
 
-void showOverview(DesktopSession& ds) {
+void showOverview(DesktopSession& ds, Follow follow = Follow::Fill) {
   if (!ds.overview) return;
   try {
     showIn3D(ds, *ds.overview,
              ds.volumeLabel +
                  (ds.overviewLevel > 0 ? " (level " + std::to_string(ds.overviewLevel) + ")" : ""),
-             std::nullopt, false);
+             std::nullopt, follow);
     ds.mode = DesktopSession::Mode::Overview;
     ds.shown.reset();
     ds.exploreNote.clear();
@@ -409,10 +412,10 @@ void showOverview(DesktopSession& ds) {
 
 // Reads `box` at native resolution (one bounded read) into the 3D view.
 void showNative(DesktopSession& ds, const lod::VoxelBox& box, DesktopSession::Mode mode,
-                bool recentre = false) {
+                Follow follow) {
   try {
     showIn3D(ds, ds.explorer->readRegion(box), ds.volumeLabel + " " + boxText(box) + " (native)",
-             box, recentre);
+             box, follow);
     ds.mode = mode;
     ds.shown = box;
     ds.error.clear();
@@ -425,17 +428,17 @@ void showNative(DesktopSession& ds, const lod::VoxelBox& box, DesktopSession::Mo
 void viewPickedRegion(DesktopSession& ds) {
   if (!ds.explorer) return;
   if (!ds.picked) ds.picked = ds.explorer->regionAt(ds.explorer->crosshair());
-  showNative(ds, *ds.picked, DesktopSession::Mode::Region);
+  showNative(ds, *ds.picked, DesktopSession::Mode::Region, Follow::Fill);
 }
 
 // The grid view starts at the grid point nearest the crosshair.
-void enterGrid(DesktopSession& ds) {
+void enterGrid(DesktopSession& ds, Follow follow = Follow::Fill) {
   if (!ds.explorer) return;
   lod::GridNavigator& g = ds.explorer->grid();
   const glm::dvec3 c = (glm::dvec3(ds.explorer->crosshair()) + 0.5) / glm::dvec3(g.cellSize());
   g.moveTo(glm::clamp(glm::ivec3(glm::round(c)), glm::ivec3(0), g.cells()));
   ds.exploreNote = g.describe(g.point());
-  showNative(ds, g.blockBox(g.point()), DesktopSession::Mode::Grid);
+  showNative(ds, g.blockBox(g.point()), DesktopSession::Mode::Grid, follow);
 }
 
 void gridMove(DesktopSession& ds, lod::ViewMove move) {
@@ -448,7 +451,7 @@ void gridMove(DesktopSession& ds, lod::ViewMove move) {
   }
   ds.exploreNote =
       std::string(lod::viewMoveName(move)) + " = " + m.name() + "; " + g.describe(g.point());
-  showNative(ds, g.blockBox(g.point()), DesktopSession::Mode::Grid, true);
+  showNative(ds, g.blockBox(g.point()), DesktopSession::Mode::Grid, Follow::Centre);
 }
 
 // Loads a volume as a pyramid (viewer/Explorer.h reads regions and slices
@@ -1038,8 +1041,10 @@ void panelExplore(DesktopSession& ds) {
     const double overviewZoom = native ? zoom * volumeRadius / blockRadius : zoom;
     const int last = static_cast<int>(policy.stages().size()) - 1;
     const int stage = policy.stageFor(native ? last : last - 1, overviewZoom);
-    if (!native && stage == last && ds.mode == DesktopSession::Mode::Overview) enterGrid(ds);
-    if (native && stage < last) showOverview(ds);
+    if (!native && stage == last && ds.mode == DesktopSession::Mode::Overview) {
+      enterGrid(ds, Follow::Keep);
+    }
+    if (native && stage < last) showOverview(ds, Follow::Keep);
   }
 }
 
