@@ -146,53 +146,54 @@ RenderRequest requestFor(const ExploreBenchOptions& o, const Volume& v, double a
   return req;
 }
 
-SubjectResult benchSubject(DeviceSession& device, const ExploreBenchOptions& o, const Subject& s) {
-  SubjectResult r;
-  r.subject = &s;
+// One cell of the table for one subject: a fixed view (median of the
+// frames after the first) or a spin (mean over the turn, as the paper).
+void benchCell(DeviceSession& device, const ExploreBenchOptions& o, const Subject& s,
+               const Cell& cell, SubjectResult& r) {
   const lod::InCoreVolumeSource source(s.volume);
-  struct View {
-    const char* name;
-    double azimuth;
-  };
+  const bool spin = cell.view == "spin";
+  const int spinFrames = std::max(1, static_cast<int>(std::lround(360.0 / o.spinDeg)));
   // Frontal: from anterior (azimuth 0, rays along -y); sagittal: from the
   // patient's left (azimuth 90, rays along the x axis).
-  const View views[] = {{"sagittal", 90.0}, {"frontal", 0.0}};
-  for (const View& v : views) {
+  const double azimuth = cell.view == "sagittal" ? 90.0 : 0.0;
+  RenderRequest req = requestFor(o, *s.volume, azimuth, cell.zoom,
+                                 spin ? spinFrames + 1 : o.frames + 1, spin ? o.spinDeg : 0.0);
+  const glm::dvec3 sp = s.volume->spacing();
+  const TransferFunction tf =
+      paperTf(o.alpha, cell.minValue, req.settings.stepVoxels * std::min({sp.x, sp.y, sp.z}));
+  const RenderResult rr = runRender(device, source, tf, req);
+  // Frame 0 pays for the first use of the texture: it is left out.
+  const std::vector<double> frames(rr.frameMs.begin() + 1, rr.frameMs.end());
+  Cell done = cell;
+  done.ms =
+      spin ? std::accumulate(frames.begin(), frames.end(), 0.0) / frames.size() : median(frames);
+  r.cells.push_back(done);
+  r.volumeTextureBytes = rr.volumeTextureBytes;
+  r.textureBytes = std::max(r.textureBytes, rr.textureBytes);
+  r.layout = rr.layout;
+  std::fprintf(stderr, "bench explore: %s %s zoom %.1f min %.2f: %.0f ms\n", s.name.c_str(),
+               cell.view.c_str(), cell.zoom, cell.minValue, done.ms);
+}
+
+// Every cell for every subject, the subjects interleaved cell by cell so
+// that the load of a shared machine falls on all of them alike.
+std::vector<SubjectResult> benchSubjects(DeviceSession& device, const ExploreBenchOptions& o,
+                                         const std::vector<Subject>& subjects) {
+  std::vector<Cell> cells;
+  for (const char* view : {"sagittal", "frontal"}) {
     for (double zoom : {1.0, 1.5}) {
-      for (double minValue : {0.0, 0.84}) {
-        RenderRequest req = requestFor(o, *s.volume, v.azimuth, zoom, o.frames + 1, 0.0);
-        const TransferFunction tf = paperTf(
-            o.alpha, minValue,
-            req.settings.stepVoxels *
-                std::min({s.volume->spacing().x, s.volume->spacing().y, s.volume->spacing().z}));
-        const RenderResult rr = runRender(device, source, tf, req);
-        // Frame 0 pays for the first use of the texture: the median of the rest.
-        const double ms = median(std::vector<double>(rr.frameMs.begin() + 1, rr.frameMs.end()));
-        r.cells.push_back({v.name, zoom, minValue, ms});
-        r.volumeTextureBytes = rr.volumeTextureBytes;
-        r.textureBytes = std::max(r.textureBytes, rr.textureBytes);
-        r.layout = rr.layout;
-        std::fprintf(stderr, "bench explore: %s %s zoom %.1f min %.2f: %.0f ms\n", s.name.c_str(),
-                     v.name, zoom, minValue, ms);
-      }
+      for (double minValue : {0.0, 0.84}) cells.push_back({view, zoom, minValue, 0.0});
     }
   }
-  const int spinFrames = std::max(1, static_cast<int>(std::lround(360.0 / o.spinDeg)));
-  for (double zoom : {1.0, 1.5}) {
-    RenderRequest req = requestFor(o, *s.volume, 0.0, zoom, spinFrames + 1, o.spinDeg);
-    const TransferFunction tf = paperTf(
-        o.alpha, 0.0,
-        req.settings.stepVoxels *
-            std::min({s.volume->spacing().x, s.volume->spacing().y, s.volume->spacing().z}));
-    const RenderResult rr = runRender(device, source, tf, req);
-    // The paper averages the frame rate over a full turn.
-    const std::vector<double> turn(rr.frameMs.begin() + 1, rr.frameMs.end());
-    const double mean = std::accumulate(turn.begin(), turn.end(), 0.0) / turn.size();
-    r.cells.push_back({"spin", zoom, 0.0, mean});
-    std::fprintf(stderr, "bench explore: %s spin zoom %.1f: %.0f ms mean\n", s.name.c_str(), zoom,
-                 mean);
+  for (double zoom : {1.0, 1.5}) cells.push_back({"spin", zoom, 0.0, 0.0});
+  std::vector<SubjectResult> results(subjects.size());
+  for (const Cell& cell : cells) {
+    for (std::size_t i = 0; i < subjects.size(); ++i) {
+      results[i].subject = &subjects[i];
+      if (subjects[i].skipped.empty()) benchCell(device, o, subjects[i], cell, results[i]);
+    }
   }
-  return r;
+  return results;
 }
 
 double cellMs(const SubjectResult& r, const std::string& view, double zoom, double minValue) {
@@ -220,7 +221,8 @@ std::string report(const ExploreBenchOptions& o, const std::vector<Subject>& sub
     << " per sample above the min value, early ray "
     << "termination at 0.99. Fixed views: median of " << o.frames
     << " frames after the first; spin: mean over a full turn at " << o.spinDeg
-    << " deg per frame. Frontal: from anterior (rays along y); sagittal: from the side (rays "
+    << " deg per frame; subjects interleaved cell by cell. Frontal: from anterior (rays along y); "
+       "sagittal: from the side (rays "
        "along x).\n\n";
   s << "| subject | volume | texture bytes (volume / all) | sagittal z1 | sagittal z1.5 | frontal "
        "z1 | frontal z1.5 | spin z1 | spin z1.5 |\n|---|---|---|---|---|---|---|---|---|\n";
@@ -298,11 +300,7 @@ void runExploreBench(const ExploreBenchOptions& o) {
                         std::make_shared<Volume>(readParallel(source, 0, {begin, begin + side})),
                         ""});
   }
-  std::vector<SubjectResult> results(subjects.size());
-  for (std::size_t i = 0; i < subjects.size(); ++i) {
-    if (subjects[i].skipped.empty()) results[i] = benchSubject(device, o, subjects[i]);
-    subjects[i].volume.reset();  // host memory back before the next subject
-  }
+  const std::vector<SubjectResult> results = benchSubjects(device, o, subjects);
   const std::string table = report(o, subjects, results, device.context->caps().renderer);
   std::printf("%s", table.c_str());
   if (!o.out.empty()) {
