@@ -9,8 +9,11 @@
 #include <memory>
 
 #include "support/GpuTestContext.h"
+#include "support/TestSupport.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/GlObjects.h"
+#include "tessera/io/VolumeReader.h"
+#include "tessera/io/VolumeWriter.h"
 #include "tessera/lod/InCoreMultiresSource.h"
 #include "tessera/viewer/Explorer.h"
 #include "tessera/viewer/SliceView.h"
@@ -110,46 +113,78 @@ TEST(SliceView, RadiologicalLettersForRasStorage) {
   EXPECT_EQ(sliceFrame(coronalStack, 2).plane, "coronal");
 }
 
-// A bright cube at the patient's right-anterior-superior corner, stored RAS
-// and LPI (every index axis reversed): every slice view shows it in its
-// top-left quadrant (R on the left of axial and coronal, A on the left of
-// sagittal; A up in axial, S up in coronal and sagittal).
-TEST(SliceView, MarkerAtRightAnteriorSuperiorIsTopLeftInEveryView) {
-  const glm::ivec3 dims(20, 24, 16);
-  for (const glm::dmat3& dir : {kRas, kLpi}) {
-    auto vol = std::make_shared<Volume>(Volume::allocate(dims, ScalarType::U8));
-    vol->setDirection(dir);
-    const bool ras = dir == kRas;
-    for (int z = 0; z < dims.z; ++z) {
-      for (int y = 0; y < dims.y; ++y) {
-        for (int x = 0; x < dims.x; ++x) {
-          // The marker's world position does not depend on the storage.
-          const int wx = ras ? x : dims.x - 1 - x, wy = ras ? y : dims.y - 1 - y,
-                    wz = ras ? z : dims.z - 1 - z;
-          const bool marker = wx >= dims.x - 5 && wy >= dims.y - 5 && wz >= dims.z - 5;
-          vol->setValueAtIndex(vol->index(x, y, z), marker ? 255.0 : 10.0);
+// A volume of `dims` stored with `dir` (RAS or LPI) whose bright cube sits
+// at the patient's right-anterior-superior corner, whatever the storage.
+Volume markerVolume(glm::ivec3 dims, const glm::dmat3& dir) {
+  Volume vol = Volume::allocate(dims, ScalarType::U8);
+  vol.setDirection(dir);
+  vol.setGeometrySource("test");
+  const bool ras = dir == kRas;
+  for (int z = 0; z < dims.z; ++z) {
+    for (int y = 0; y < dims.y; ++y) {
+      for (int x = 0; x < dims.x; ++x) {
+        const int wx = ras ? x : dims.x - 1 - x, wy = ras ? y : dims.y - 1 - y,
+                  wz = ras ? z : dims.z - 1 - z;
+        const bool marker = wx >= dims.x - 5 && wy >= dims.y - 5 && wz >= dims.z - 5;
+        vol.setValueAtIndex(vol.index(x, y, z), marker ? 255.0 : 10.0);
+      }
+    }
+  }
+  return vol;
+}
+
+// Where the bright pixels of every slice view through the marker lie, as
+// fractions of the image (x from the left, y from the top).
+void expectMarkerTopLeft(const Volume& volume, const std::string& what) {
+  auto shared = std::make_shared<Volume>(volume);
+  const lod::InCoreMultiresSource source(shared);
+  // The marker's voxel nearest the RAS corner: where index -> world is largest.
+  glm::ivec3 marker(0);
+  for (int a = 0; a < 3; ++a) {
+    const glm::dvec3 col = volume.direction()[a];
+    const double toward = col.x + col.y + col.z;  // > 0: the index grows towards R, A or S
+    marker[a] = toward > 0.0 ? volume.dims()[a] - 2 : 1;
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    const SliceGeometry g(volume.dims(), volume.spacing(), volume.direction(), axis);
+    const Image img = g.render(source, 0, marker[axis], {0.0, 255.0}, nullptr);
+    double sx = 0.0, sy = 0.0, n = 0.0;
+    for (int row = 0; row < img.height(); ++row) {
+      for (int col = 0; col < img.width(); ++col) {
+        if (img.pixel(col, row)[0] > 128) {
+          sx += col;
+          sy += row;
+          n += 1.0;
         }
       }
     }
-    const lod::InCoreMultiresSource source(vol);
-    for (int axis = 0; axis < 3; ++axis) {
-      const SliceGeometry g(dims, vol->spacing(), dir, axis);
-      // The slice through the marker.
-      const int index = ras ? dims[axis] - 2 : 1;
-      const Image img = g.render(source, 0, index, {0.0, 255.0}, nullptr);
-      double sx = 0.0, sy = 0.0, n = 0.0;
-      for (int row = 0; row < img.height(); ++row) {
-        for (int col = 0; col < img.width(); ++col) {
-          if (img.pixel(col, row)[0] > 128) {
-            sx += col;
-            sy += row;
-            n += 1.0;
-          }
-        }
-      }
-      ASSERT_GT(n, 0.0) << "axis " << axis;
-      EXPECT_LT(sx / n, 0.5 * img.width()) << g.frame().plane << (ras ? " RAS" : " LPI");
-      EXPECT_LT(sy / n, 0.5 * img.height()) << g.frame().plane << (ras ? " RAS" : " LPI");
+    ASSERT_GT(n, 0.0) << what << " axis " << axis;
+    EXPECT_LT(sx / n, 0.5 * img.width()) << what << " " << g.frame().plane;
+    EXPECT_LT(sy / n, 0.5 * img.height()) << what << " " << g.frame().plane;
+    // And the crosshair at the marker's voxel sits in that quadrant too.
+    const glm::dvec2 c = g.pointOf(marker);
+    EXPECT_LT(c.x, 0.5 * img.width()) << what << " " << g.frame().plane;
+    EXPECT_LT(c.y, 0.5 * img.height()) << what << " " << g.frame().plane;
+  }
+}
+
+// A bright cube at the patient's right-anterior-superior corner, stored RAS
+// and LPI (every index axis reversed), and written as NIfTI (RAS srow), NRRD
+// (LPS space directions) and a DICOM series (LPS IOP/IPP), read back: every
+// slice view shows it in its top-left quadrant (R on the left of axial and
+// coronal, A on the left of sagittal; A up in axial, S up in coronal and
+// sagittal).
+TEST(SliceView, MarkerAtRightAnteriorSuperiorIsTopLeftInEveryView) {
+  const glm::ivec3 dims(20, 24, 16);
+  test::TempDir dir;
+  for (const glm::dmat3& storage : {kRas, kLpi}) {
+    const Volume vol = markerVolume(dims, storage);
+    const std::string order = storage == kRas ? "RAS" : "LPI";
+    expectMarkerTopLeft(vol, order + " in memory");
+    for (const std::string ext : {".nii", ".nrrd", ".dcm.d"}) {
+      const auto path = dir / (order + ext);
+      writeVolume(vol, path);
+      expectMarkerTopLeft(readVolume(path.string()), order + ext);
     }
   }
 }
