@@ -54,10 +54,12 @@ struct ViewOptions {
   std::string screenshot;
   int frames = 3;
   bool helpOverlay = false;
-  std::string layout = "four";    // four: axial, 3D, sagittal, coronal; single: 3D only
-  std::vector<int> crosshair;     // X Y Z (level-0 voxel)
-  bool pick = false;              // pick the region around the crosshair
-  int regionSide = 0;             // 0: 256 or what the profile allows
+  std::string layout = "four";  // four: axial, 3D, sagittal, coronal; single: 3D only
+  std::vector<int> crosshair;   // X Y Z (level-0 voxel)
+  bool pick = false;            // pick the region around the crosshair
+  int regionSide = 0;           // 0: 256 or what the profile allows
+  double zoom = 1.0;
+  bool zoomGrid = false;          // the zoom policy switches overview <-> grid view
   std::string mode = "overview";  // overview, region, grid
   ShadingOptions shading;
   ClippingOptions clipping;
@@ -227,6 +229,11 @@ struct DesktopSession {
   bool sliceColour = false;       // slices in the TF's colour instead of grey
   bool zoomSwitchesGrid = false;  // lod::ZoomLevelPolicy enters / leaves the grid view
   double viewPixels = 0.0;        // the 3D view's height in pixels (the policy's view)
+  std::optional<lod::ZoomLevelPolicy> zoomPolicy;
+  std::string zoomPolicyKey;  // the stages it was made for
+  double lastFrameMs = 0.0;
+  gpu::Framebuffer fadeFrom;  // the 3D view before a zoom-driven swap
+  double fadeOld = 0.0;       // its weight still on screen (1 -> 0 over the fade)
   // The three slice views: axial, coronal, sagittal.
   struct SliceTile {
     std::string plane;
@@ -322,6 +329,18 @@ GLFWwindow* openWindow(int width, int height, bool es3) {
 std::uint64_t overviewVoxels(const gpu::DeviceLimits& limits) {
   const std::uint64_t budget = limits.textureBudget ? limits.textureBudget / 2 : (1ull << 30);
   return std::min<std::uint64_t>(budget, 64ull << 20);
+}
+
+// What a native region or grid block may take: a quarter of the texture
+// budget, and no more than one 3D texture of the profile holds (so that it
+// is shown at native resolution, not reduced by the planner).
+std::uint64_t regionBudget(const gpu::DeviceLimits& limits) {
+  std::uint64_t budget = limits.textureBudget ? limits.textureBudget / 4 : (1ull << 30);
+  if (limits.max3DTextureSize > 0) {
+    const auto side = static_cast<std::uint64_t>(limits.max3DTextureSize);
+    budget = std::min(budget, side * side * side);
+  }
+  return budget;
 }
 
 // The lines the overview shows: the region or grid block and the crosshair.
@@ -462,8 +481,7 @@ void openVolume(DesktopSession& ds, const std::string& spec) {
   try {
     const VolumePyramid pyramid = openVolumePyramid(spec, {.series = ds.options.series});
     const gpu::DeviceLimits& limits = ds.viewer->limits();
-    auto explorer = std::make_unique<viewer::Explorer>(
-        pyramid.source, limits.textureBudget ? limits.textureBudget / 4 : (1ull << 30));
+    auto explorer = std::make_unique<viewer::Explorer>(pyramid.source, regionBudget(limits));
     const int level = explorer->overviewLevel(overviewVoxels(limits));
     auto overview = std::make_shared<const Volume>(explorer->readLevel(level));
     const std::string label = fileName(spec);
@@ -977,6 +995,19 @@ void panelShading(viewer::Viewer& v) {
   slider("shininess", s.shininess, 1.0f, 128.0f);
 }
 
+// Keeps the 3D view's last frame for the cross-fade of a zoom-driven swap
+// (ES 3: the frame cache; ES 2 redraws every frame and has no copy to fade).
+void captureFade(DesktopSession& ds) {
+  if (!ds.es3 || ds.cache.width() == 0) return;
+  if (ds.fadeFrom.width() != ds.cache.width() || ds.fadeFrom.height() != ds.cache.height()) {
+    ds.fadeFrom = gpu::Framebuffer();
+    ds.fadeFrom = gpu::Framebuffer::create(ds.context->ledger(), "zoom fade", ds.cache.width(),
+                                           ds.cache.height());
+  }
+  const glm::ivec4 box(0, 0, ds.cache.width(), ds.cache.height());
+  gpu::blitFramebuffer(ds.cache.id(), box, ds.fadeFrom.id(), box);
+}
+
 // The exploring controls (issue 15): mode, crosshair, region size, the
 // grid view's moves as buttons (touch-style controls beside the keys), and
 // the zoom policy's stages (lod/ZoomLevelPolicy.h), which can switch the
@@ -1033,19 +1064,32 @@ void panelExplore(DesktopSession& ds) {
     stages += t;
   }
   ImGui::TextWrapped("zoom stages: %s", stages.c_str());
-  ImGui::Checkbox("zoom into the grid view", &ds.zoomSwitchesGrid);
-  if (ds.zoomSwitchesGrid && policy.stages().back().subVolume) {
-    const bool native = ds.mode == DesktopSession::Mode::Grid;
-    const double zoom = ds.viewer->camera().zoom;
-    // In the grid view the camera frames the block: its zoom in overview terms.
-    const double overviewZoom = native ? zoom * volumeRadius / blockRadius : zoom;
-    const int last = static_cast<int>(policy.stages().size()) - 1;
-    const int stage = policy.stageFor(native ? last : last - 1, overviewZoom);
-    if (!native && stage == last && ds.mode == DesktopSession::Mode::Overview) {
-      enterGrid(ds, Follow::Keep);
-    }
-    if (native && stage < last) showOverview(ds, Follow::Keep);
+  if (ImGui::Checkbox("zoom into the grid view", &ds.zoomSwitchesGrid)) ds.zoomPolicy.reset();
+  if (!ds.zoomSwitchesGrid || !policy.stages().back().subVolume) {
+    ds.fadeOld = 0.0;
+    return;
   }
+  // The policy lives across frames (its hysteresis and fade are state);
+  // new stages (another volume or view size) start it afresh.
+  if (!ds.zoomPolicy || ds.zoomPolicyKey != stages) {
+    ds.zoomPolicy.emplace(policy.stages());
+    ds.zoomPolicyKey = stages;
+  }
+  const bool native = ds.mode == DesktopSession::Mode::Grid;
+  const double zoom = ds.viewer->camera().zoom;
+  // In the grid view the camera frames the block: its zoom in overview terms.
+  const double overviewZoom = native ? zoom * volumeRadius / blockRadius : zoom;
+  const double now = 1000.0 * glfwGetTime();
+  const lod::ZoomFrame f = ds.zoomPolicy->update(overviewZoom, now - ds.lastFrameMs);
+  ds.lastFrameMs = now;
+  const bool wantNative = policy.stages()[static_cast<std::size_t>(f.stage)].subVolume;
+  if (wantNative != native && ds.mode != DesktopSession::Mode::Region) {
+    captureFade(ds);
+    wantNative ? enterGrid(ds, Follow::Keep) : showOverview(ds, Follow::Keep);
+  }
+  // The image from before the swap fades out over the policy's fade time.
+  const bool nativeSwap = policy.stages()[static_cast<std::size_t>(f.from)].subVolume != wantNative;
+  ds.fadeOld = f.from != f.stage && nativeSwap ? 1.0 - f.mix : 0.0;
 }
 
 // The control panel at the window's left edge.
@@ -1174,6 +1218,13 @@ void runFrame(DesktopSession& ds) {
   updateOverlay(ds);
   drawPanel(ds, wh);
   for (int t = 0; t < 3 && ds.fourUp; ++t) drawSliceTile(ds, ds.slices[t], tiles.slice[t]);
+  if (ds.fadeOld > 0.0 && ds.fadeFrom.width() > 0) {
+    // GL textures start at the bottom row: flipped texture coordinates.
+    ImGui::GetBackgroundDrawList()->AddImage(
+        reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(ds.fadeFrom.color().id())),
+        tiles.view3d.p0, tiles.view3d.p1, ImVec2(0.0f, 1.0f), ImVec2(1.0f, 0.0f),
+        IM_COL32(255, 255, 255, static_cast<int>(std::lround(255.0 * ds.fadeOld))));
+  }
   drawHelpOverlay(ds, kPanelWidth, static_cast<float>(ww), static_cast<float>(wh));
   const EdgeLabels labels = ds.viewer->orientationLabels();
   drawEdgeLetters(labels.left, labels.right, labels.top, labels.bottom, tiles.view3d.p0,
@@ -1209,6 +1260,9 @@ void startExploring(DesktopSession& ds, const ViewOptions& o) {
     ds.explorer->setCrosshair(c);
   }
   if (o.regionSide > 0) ds.explorer->setRegionSide(o.regionSide);
+  if (!(o.zoom > 0.0)) throw InputError("--zoom must be > 0");
+  ds.viewer->camera().zoom = o.zoom;
+  ds.zoomSwitchesGrid = o.zoomGrid;
   if (o.pick) ds.picked = ds.explorer->regionAt(ds.explorer->crosshair());
   if (o.mode == "region") {
     viewPickedRegion(ds);
@@ -1278,6 +1332,7 @@ void runView(const ViewOptions& o) {
   ImGui::DestroyContext();
   ds.cache = gpu::Framebuffer();
   for (auto& tile : ds.slices) tile.texture = gpu::Texture();  // before the context's ledger goes
+  ds.fadeFrom = gpu::Framebuffer();
   ds.viewer.reset();
   ds.context.reset();
   glfwDestroyWindow(ds.window);
@@ -1321,6 +1376,11 @@ void addViewCommand(CLI::App& app) {
   cmd->add_flag("--pick", o->pick,
                 "Start with the region (default side: 256 or what the profile allows) picked "
                 "around the crosshair");
+  cmd->add_option("--zoom", o->zoom, "Initial camera zoom (1: the volume fills the view)")
+      ->capture_default_str();
+  cmd->add_flag("--zoom-grid", o->zoomGrid,
+                "Let the zoom switch between the overview and the grid view (lod/ZoomLevelPolicy: "
+                "thresholds with hysteresis, cross-fade)");
   cmd->add_option("--region-side", o->regionSide,
                   "Side of the picked region in voxels (16 .. 256 or what the profile allows)");
   cmd->add_option("--mode", o->mode,
