@@ -450,11 +450,19 @@ void viewPickedRegion(DesktopSession& ds) {
   showNative(ds, *ds.picked, DesktopSession::Mode::Region, Follow::Fill);
 }
 
-// The grid view starts at the grid point nearest the crosshair.
+// The grid view starts at the grid point nearest the crosshair, or, when
+// the zoom switches to it (Follow::Keep), nearest the point the 3D view is
+// centred on, so that the block holds what the user zoomed into.
 void enterGrid(DesktopSession& ds, Follow follow = Follow::Fill) {
   if (!ds.explorer) return;
   lod::GridNavigator& g = ds.explorer->grid();
-  const glm::dvec3 c = (glm::dvec3(ds.explorer->crosshair()) + 0.5) / glm::dvec3(g.cellSize());
+  glm::dvec3 voxel = glm::dvec3(ds.explorer->crosshair()) + 0.5;
+  if (follow == Follow::Keep && ds.mode == DesktopSession::Mode::Overview) {
+    // The camera's target in the overview's model frame (mm from its centre).
+    const glm::dvec3 spacing = ds.explorer->source().shape().spacing();
+    voxel = ds.viewer->camera().target / spacing + 0.5 * glm::dvec3(ds.explorer->dims());
+  }
+  const glm::dvec3 c = voxel / glm::dvec3(g.cellSize());
   g.moveTo(glm::clamp(glm::ivec3(glm::round(c)), glm::ivec3(0), g.cells()));
   ds.exploreNote = g.describe(g.point());
   showNative(ds, g.blockBox(g.point()), DesktopSession::Mode::Grid, follow);
@@ -1020,7 +1028,7 @@ void panelExplore(DesktopSession& ds) {
   ImGui::Text("native %dx%dx%d; overview level %d of %d", d.x, d.y, d.z, ds.overviewLevel,
               ex.source().levelCount() - 1);
   const glm::dvec4 w = ex.source().shape().indexToWorld() * glm::dvec4(glm::dvec3(c), 1.0);
-  ImGui::Text("crosshair (%d, %d, %d) = RAS (%.1f, %.1f, %.1f) mm", c.x, c.y, c.z, w.x, w.y, w.z);
+  ImGui::Text("crosshair (%d, %d, %d), RAS (%.0f, %.0f, %.0f) mm", c.x, c.y, c.z, w.x, w.y, w.z);
   int side = ex.regionSide();
   if (ImGui::SliderInt("region side", &side, 16, ex.maxRegionSide())) ex.setRegionSide(side);
   if (ds.picked) ImGui::Text("region %s", boxText(*ds.picked).c_str());
