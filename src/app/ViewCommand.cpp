@@ -368,21 +368,6 @@ void updateOverlay(DesktopSession& ds) {
   }
 }
 
-// Where a level-0 box (none: the whole volume) sits in the whole volume's
-// model frame, and the radius the camera frames it with.
-struct Framing {
-  glm::dvec3 centre{0.0};
-  double radius = 1.0;
-};
-Framing framingOf(const DesktopSession& ds, const std::optional<lod::VoxelBox>& box) {
-  const glm::ivec3 dims = ds.explorer->dims();
-  const glm::dvec3 spacing = ds.explorer->source().shape().spacing();
-  const lod::VoxelBox b = box ? *box : lod::VoxelBox{glm::ivec3(0), dims};
-  const glm::dvec3 centre = 0.5 * glm::dvec3(b.begin + b.end);
-  return {(centre - 0.5 * glm::dvec3(dims)) * spacing,
-          0.5 * glm::length(glm::dvec3(b.size()) * spacing)};
-}
-
 // How the camera follows a swap of the 3D view's volume (its direction
 // always stays). Keep: the same point of the patient stays at the view's
 // centre at the same scale (the zoom policy's swaps change the data, not
@@ -394,16 +379,19 @@ enum class Follow { Keep, Centre, Fill };
 void showIn3D(DesktopSession& ds, Volume volume, const std::string& name,
               const std::optional<lod::VoxelBox>& box, Follow follow) {
   const Camera before = ds.viewer->camera();
-  const Framing from = framingOf(ds, ds.shown), to = framingOf(ds, box);
+  const std::optional<lod::VoxelBox> from = ds.shown;
   ds.viewer->setVolume(std::move(volume), name);
   Camera& c = ds.viewer->camera();
+  if (follow == Follow::Keep) {
+    const Camera kept = viewer::cameraAcrossSwap(before, from, box, ds.explorer->dims(),
+                                                 ds.explorer->source().shape().spacing());
+    c.target = kept.target;
+    c.zoom = kept.zoom;
+  } else {
+    c.zoom = follow == Follow::Fill ? 1.0 : before.zoom;
+  }
   c.azimuthDeg = before.azimuthDeg;
   c.elevationDeg = before.elevationDeg;
-  c.zoom = follow == Follow::Fill ? 1.0 : before.zoom;
-  if (follow == Follow::Keep) {
-    c.target = before.target + from.centre - to.centre;
-    c.zoom = before.zoom * to.radius / from.radius;
-  }
 }
 
 std::string boxText(const lod::VoxelBox& b) {

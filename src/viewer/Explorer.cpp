@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include <glm/geometric.hpp>
+
 #include "tessera/core/Error.h"
 
 namespace tessera::viewer {
@@ -67,6 +69,26 @@ std::vector<render::OverlayLine> crosshairLines(glm::ivec3 voxel, glm::ivec3 dim
     lines.push_back({toModel(a, dims, extent), toModel(b, dims, extent), colour});
   }
   return lines;
+}
+
+BoxFraming boxFraming(const std::optional<lod::VoxelBox>& box, glm::ivec3 dims,
+                      glm::dvec3 spacing) {
+  const lod::VoxelBox b = box ? *box : lod::VoxelBox{glm::ivec3(0), dims};
+  const glm::dvec3 centre = 0.5 * glm::dvec3(b.begin + b.end);
+  return {(centre - 0.5 * glm::dvec3(dims)) * spacing,
+          0.5 * glm::length(glm::dvec3(b.size()) * spacing)};
+}
+
+Camera cameraAcrossSwap(const Camera& before, const std::optional<lod::VoxelBox>& from,
+                        const std::optional<lod::VoxelBox>& to, glm::ivec3 dims,
+                        glm::dvec3 spacing) {
+  const BoxFraming a = boxFraming(from, dims, spacing), b = boxFraming(to, dims, spacing);
+  Camera c = before;
+  c.radius = b.radius;
+  c.target = before.target + a.centre - b.centre;
+  // Camera::distance is radius / sin(fov / 2) / zoom: the same distance.
+  c.zoom = before.zoom * b.radius / a.radius;
+  return c;
 }
 
 Explorer::Explorer(std::shared_ptr<const lod::MultiresSource> source,

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <memory>
+#include <utility>
 
 #include "support/GpuTestContext.h"
 #include "support/TestSupport.h"
@@ -296,6 +297,41 @@ TEST(Explorer, OverlayLinesSitOnVoxelBoundariesAndCentres) {
   EXPECT_DOUBLE_EQ(cross[0].a.x, -5.0);
   EXPECT_DOUBLE_EQ(cross[0].b.x, 5.0);
   EXPECT_DOUBLE_EQ(cross[2].a.x, (0.5 / 10.0 - 0.5) * 10.0);
+}
+
+// A swap between the overview and a native box keeps the view: every pixel's
+// ray is the same ray of the patient (shifted by the box's offset in the
+// model frame), and swapping back restores the camera.
+TEST(Explorer, SwapKeepsEveryPatientPointOnScreen) {
+  const glm::ivec3 dims(100, 80, 60);
+  const glm::dvec3 spacing(1.0, 1.5, 2.0);
+  for (const Projection projection : {Projection::Perspective, Projection::Orthographic}) {
+    Camera a;
+    a.frame(glm::dvec3(dims) * spacing);
+    a.projection = projection;
+    a.azimuthDeg = 37.0;
+    a.elevationDeg = -20.0;
+    a.zoom = 2.3;
+    a.target = {5.0, -3.0, 7.0};
+    const lod::VoxelBox box{{10, 20, 5}, {60, 70, 45}};
+    const Camera b = cameraAcrossSwap(a, std::nullopt, box, dims, spacing);
+    const BoxFraming f = boxFraming(box, dims, spacing);
+    EXPECT_DOUBLE_EQ(b.radius, 0.5 * glm::length(glm::dvec3(box.size()) * spacing));
+    for (const auto& [px, py] : {std::pair{0, 0}, std::pair{63, 17}, std::pair{127, 95}}) {
+      const Ray ra = a.pixelRay(px, py, 128, 96), rb = b.pixelRay(px, py, 128, 96);
+      EXPECT_NEAR(glm::length(ra.direction - rb.direction), 0.0, 1e-12);
+      // Orthographic rays start on the eye plane, which moves along the view
+      // axis with the radius: compare the rays as lines.
+      const glm::dvec3 d = rb.origin + f.centre - ra.origin;
+      EXPECT_NEAR(glm::length(d - glm::dot(d, ra.direction) * ra.direction), 0.0, 1e-9);
+      if (projection == Projection::Perspective) {
+        EXPECT_NEAR(glm::length(d), 0.0, 1e-9);
+      }
+    }
+    const Camera back = cameraAcrossSwap(b, box, std::nullopt, dims, spacing);
+    EXPECT_NEAR(back.zoom, a.zoom, 1e-12);
+    EXPECT_NEAR(glm::length(back.target - a.target), 0.0, 1e-12);
+  }
 }
 
 // The highlighted region shows in the overview: the frame with the box's

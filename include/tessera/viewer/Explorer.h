@@ -8,12 +8,14 @@
 // block and the crosshair in the overview.
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include "tessera/core/Camera.h"
 #include "tessera/core/Volume.h"
 #include "tessera/lod/GridNavigator.h"
 #include "tessera/lod/MultiresSource.h"
@@ -38,6 +40,25 @@ std::vector<render::OverlayLine> boxLines(const lod::VoxelBox& box, glm::ivec3 d
 // along one index axis: the crosshair of the slice views, in 3D.
 std::vector<render::OverlayLine> crosshairLines(glm::ivec3 voxel, glm::ivec3 dims,
                                                 glm::dvec3 extent, glm::vec4 colour);
+
+// Where a level-0 box (nullopt: the whole volume) of a volume of `dims`
+// voxels and `spacing` sits in the whole volume's model frame (its centre,
+// mm from the volume's centre) and the radius a camera frames it with.
+struct BoxFraming {
+  glm::dvec3 centre{0.0};
+  double radius = 1.0;
+};
+BoxFraming boxFraming(const std::optional<lod::VoxelBox>& box, glm::ivec3 dims, glm::dvec3 spacing);
+
+// The camera for the 3D view after its volume changes from box `from` to box
+// `to` of the same volume (overview <-> native sub-volume), framed for `to`
+// (radius set as Camera::frame does): the view direction kept, the target
+// moved by the boxes' offset and the zoom scaled by their radii, so that
+// every point of the patient stays where it was on screen (a swap changes
+// the data, not the view).
+Camera cameraAcrossSwap(const Camera& before, const std::optional<lod::VoxelBox>& from,
+                        const std::optional<lod::VoxelBox>& to, glm::ivec3 dims,
+                        glm::dvec3 spacing);
 
 class Explorer {
  public:
