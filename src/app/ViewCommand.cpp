@@ -224,6 +224,7 @@ struct DesktopSession {
   std::shared_ptr<const Volume> overview;  // what the 3D view returns to
   std::optional<lod::VoxelBox> picked;     // the bread-slice region (slice views, overview)
   std::optional<lod::VoxelBox> shown;      // the region or grid block the 3D view shows
+  std::optional<lod::VoxelBox> gridBlock;  // the grid view's last block (slices, overview)
   std::string exploreNote;                 // e.g. why a grid move was refused
   bool fourUp = true;
   bool sliceColour = false;       // slices in the TF's colour instead of grey
@@ -356,6 +357,11 @@ void updateOverlay(DesktopSession& ds) {
       const auto box = viewer::boxLines(*ds.picked, dims, extent, red);
       v.extraLines.insert(v.extraLines.end(), box.begin(), box.end());
     }
+    if (ds.gridBlock) {
+      const glm::vec4 cyan(0.25f, 0.85f, 0.95f, 1.0f);
+      const auto box = viewer::boxLines(*ds.gridBlock, dims, extent, cyan);
+      v.extraLines.insert(v.extraLines.end(), box.begin(), box.end());
+    }
     const auto lines = viewer::crosshairLines(ds.explorer->crosshair(), dims, extent, cross);
     v.extraLines.insert(v.extraLines.end(), lines.begin(), lines.end());
   } else if (ds.shown) {
@@ -425,6 +431,7 @@ void showNative(DesktopSession& ds, const lod::VoxelBox& box, DesktopSession::Mo
              box, follow);
     ds.mode = mode;
     ds.shown = box;
+    if (mode == DesktopSession::Mode::Grid) ds.gridBlock = box;
     ds.error.clear();
   } catch (const Error& e) {
     ds.error = e.what();
@@ -490,6 +497,7 @@ void openVolume(DesktopSession& ds, const std::string& spec) {
     ds.mode = DesktopSession::Mode::Overview;
     ds.picked.reset();
     ds.shown.reset();
+    ds.gridBlock.reset();
     ds.exploreNote.clear();
     for (auto& tile : ds.slices) {
       tile.geometry.reset();
@@ -569,18 +577,22 @@ void drawSliceTile(DesktopSession& ds, DesktopSession::SliceTile& tile, const Re
   };
   dl->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(tile.texture.id())),
                screen({0.0, 0.0}), screen(glm::dvec2(g.imageSize())));
-  // The picked region where this slice cuts it.
+  // The picked region (red) and the last grid block (cyan) where this slice
+  // cuts them.
   const SliceFrame& f = g.frame();
-  if (ds.picked && index >= ds.picked->begin[g.axis()] && index < ds.picked->end[g.axis()]) {
-    glm::ivec3 lo = ds.picked->begin, hi = ds.picked->end - 1;
+  const glm::dvec2 voxelPx(src.levelInfo(0).spacing[f.colAxis] / g.pixelMm(),
+                           src.levelInfo(0).spacing[f.rowAxis] / g.pixelMm());
+  auto drawBox = [&](const lod::VoxelBox& box, ImU32 fill, ImU32 line) {
+    if (index < box.begin[g.axis()] || index >= box.end[g.axis()]) return;
+    glm::ivec3 lo = box.begin, hi = box.end - 1;
     lo[g.axis()] = hi[g.axis()] = index;
     const glm::dvec2 a = g.pointOf(lo), b = g.pointOf(hi);
-    const glm::dvec2 voxelPx(src.levelInfo(0).spacing[f.colAxis] / g.pixelMm(),
-                             src.levelInfo(0).spacing[f.rowAxis] / g.pixelMm());
     const glm::dvec2 p0 = glm::min(a, b) - 0.5 * voxelPx, p1 = glm::max(a, b) + 0.5 * voxelPx;
-    dl->AddRectFilled(screen(p0), screen(p1), IM_COL32(255, 60, 40, 50));
-    dl->AddRect(screen(p0), screen(p1), IM_COL32(255, 70, 50, 255), 0.0f, 0, 2.0f);
-  }
+    if (fill) dl->AddRectFilled(screen(p0), screen(p1), fill);
+    dl->AddRect(screen(p0), screen(p1), line, 0.0f, 0, 2.0f);
+  };
+  if (ds.gridBlock) drawBox(*ds.gridBlock, 0, IM_COL32(60, 220, 240, 255));
+  if (ds.picked) drawBox(*ds.picked, IM_COL32(255, 60, 40, 50), IM_COL32(255, 70, 50, 255));
   // The crosshair through the centre of its voxel.
   const glm::dvec2 c = g.pointOf(ex.crosshair());
   const ImU32 cross = IM_COL32(255, 215, 50, 200);
