@@ -612,18 +612,11 @@ void drawSliceTile(DesktopSession& ds, DesktopSession::SliceTile& tile, const Re
 // side across it, centred on the slice; clamped to the budget and volume.
 void pickRegion(DesktopSession& ds, const DesktopSession::SliceTile& tile, glm::dvec2 a,
                 glm::dvec2 b) {
-  viewer::Explorer& ex = *ds.explorer;
   const viewer::SliceGeometry& g = *tile.geometry;
-  const int index = ex.crosshair()[g.axis()];
-  const glm::ivec2 pa = tile.viewport.pixelAt(a), pb = tile.viewport.pixelAt(b);
-  if (glm::length(b - a) < 4.0) {
-    ds.picked = ex.regionAt(g.voxelAt(pa, index));
-    return;
-  }
-  const lod::VoxelBox under = g.voxelsUnder(pa, pb, index);
-  glm::ivec3 side = glm::min(under.size(), glm::ivec3(ex.maxRegionSide()));
-  side[g.axis()] = ex.regionSide();
-  ds.picked = viewer::regionAround((under.begin + under.end) / 2, side, ex.dims());
+  const int index = ds.explorer->crosshair()[g.axis()];
+  const glm::ivec2 pa = tile.viewport.pixelAt(a);
+  const glm::ivec2 pb = glm::length(b - a) < 4.0 ? pa : tile.viewport.pixelAt(b);
+  ds.picked = ds.explorer->regionFromSlice(g, pa, pb, index);
 }
 
 // Mouse input on the slice views: left click/drag moves the crosshair, right

@@ -137,6 +137,16 @@ lod::VoxelBox Explorer::regionAt(glm::ivec3 centre) const {
   return regionAround(centre, glm::ivec3(regionSide_), dims_);
 }
 
+lod::VoxelBox Explorer::regionFromSlice(const SliceGeometry& slice, glm::ivec2 a, glm::ivec2 b,
+                                        int index) const {
+  if (slice.dims() != dims_) throw InputError("region: the slice view is not of level 0");
+  if (a == b) return regionAt(slice.voxelAt(a, index));
+  const lod::VoxelBox under = slice.voxelsUnder(a, b, index);
+  glm::ivec3 side = glm::min(under.size(), glm::ivec3(maxRegionSide_));
+  side[slice.axis()] = regionSide_;
+  return regionAround((under.begin + under.end) / 2, side, dims_);
+}
+
 Volume Explorer::readRegion(const lod::VoxelBox& box) const {
   if (box.count() == 0 || glm::any(glm::lessThan(box.begin, glm::ivec3(0))) ||
       glm::any(glm::greaterThan(box.end, dims_))) {

@@ -278,6 +278,38 @@ TEST(Explorer, RegionPickReadsOnlyTheBoundedBox) {
   EXPECT_EQ(b8.dims(), block.size());
 }
 
+// A region marked in a slice view: a drag takes the voxels under the
+// rectangle in the slice's plane and the region side across it; a click the
+// default cube around the voxel; both clamped to the budget and the volume.
+TEST(Explorer, RegionFromASliceDragCoversTheDraggedVoxels) {
+  auto vol = hashVolume({200, 160, 120}, {1.0, 1.0, 2.0}, kLpi);
+  Explorer ex(std::make_shared<const lod::InCoreMultiresSource>(vol), 64ull * 64 * 64);
+  ex.setRegionSide(32);
+  const int axial = axisForPlane(kLpi, "axial");
+  const SliceGeometry g(vol->dims(), vol->spacing(), kLpi, axial);
+  const glm::ivec2 a(30, 40), b(70, 60);
+  const lod::VoxelBox box = ex.regionFromSlice(g, a, b, 50);
+  const lod::VoxelBox under = g.voxelsUnder(a, b, 50);
+  for (int axis = 0; axis < 3; ++axis) {
+    if (axis == axial) {
+      EXPECT_EQ(box.size()[axis], 32);
+      EXPECT_EQ(box.begin[axis], 50 - 16);
+    } else {
+      EXPECT_EQ(box.begin[axis], under.begin[axis]);
+      EXPECT_EQ(box.end[axis], under.end[axis]);
+    }
+  }
+  // Every corner pixel of the rectangle shows a voxel inside the box.
+  for (const glm::ivec2 p : {a, b, glm::ivec2(a.x, b.y), glm::ivec2(b.x, a.y)}) {
+    const glm::ivec3 v = g.voxelAt(p, 50);
+    EXPECT_TRUE(glm::all(glm::greaterThanEqual(v, box.begin)) &&
+                glm::all(glm::lessThan(v, box.end)));
+  }
+  // A drag larger than the budget's side is cut to it; a click is a cube.
+  EXPECT_LE(ex.regionFromSlice(g, {0, 0}, {199, 159}, 50).size().x, 64);
+  EXPECT_EQ(ex.regionFromSlice(g, a, a, 50).size(), glm::ivec3(32));
+}
+
 TEST(Explorer, OverlayLinesSitOnVoxelBoundariesAndCentres) {
   const glm::ivec3 dims(10, 20, 40);
   const glm::dvec3 extent(10.0, 20.0, 80.0);

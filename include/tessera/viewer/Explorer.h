@@ -20,6 +20,7 @@
 #include "tessera/lod/GridNavigator.h"
 #include "tessera/lod/MultiresSource.h"
 #include "tessera/render/Overlay.h"
+#include "tessera/viewer/SliceView.h"
 
 namespace tessera::viewer {
 
@@ -85,6 +86,12 @@ class Explorer {
   void setRegionSide(int side);
   int maxRegionSide() const { return maxRegionSide_; }
   lod::VoxelBox regionAt(glm::ivec3 centre) const;
+  // The region a user marks in a slice view of level 0: a click (pixels a
+  // and b equal) picks the default cube around the voxel; a drag picks the
+  // voxels under the rectangle in the slice's plane (each side at most
+  // maxRegionSide) and regionSide across it, centred on slice `index`.
+  lod::VoxelBox regionFromSlice(const SliceGeometry& slice, glm::ivec2 a, glm::ivec2 b,
+                                int index) const;
   // Reads `box` of level 0: exactly box.count() voxels from the source. The
   // volume keeps the full volume's direction and sits where the box sits in
   // the patient frame. InputError for an empty box or one outside the volume.
