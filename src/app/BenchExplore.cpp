@@ -154,7 +154,7 @@ void benchCell(DeviceSession& device, const ExploreBenchOptions& o, const Subjec
   const bool spin = cell.view == "spin";
   const int spinFrames = std::max(1, static_cast<int>(std::lround(360.0 / o.spinDeg)));
   // Frontal: from anterior (azimuth 0, rays along -y); sagittal: from the
-  // patient's left (azimuth 90, rays along the x axis).
+  // patient's right (azimuth 90: the eye on +x, rays along -x).
   const double azimuth = cell.view == "sagittal" ? 90.0 : 0.0;
   RenderRequest req = requestFor(o, *s.volume, azimuth, cell.zoom,
                                  spin ? spinFrames + 1 : o.frames + 1, spin ? o.spinDeg : 0.0);
