@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/BenchBricks.h"
+#include "app/BenchExplore.h"
 #include "app/BenchFcc.h"
 #include "app/BenchHybrid.h"
 #include "app/BenchRoofline.h"
@@ -370,7 +371,9 @@ void addBenchCommand(CLI::App& app) {
                   "With --roofline: fetches per fragment in the peak "
                   "passes")
       ->capture_default_str();
+  addExploreBenchOptions(cmd);
   cmd->callback([o] {
+    if (runExploreBenchIfAsked()) return;
     if (o->roofline) {
       runRooflineBench({.file = o->file,
                         .size = o->size,

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -14,6 +15,7 @@
 #include "app/Commands.h"
 #include "app/RenderJob.h"
 #include "app/ShadingOptions.h"
+#include "app/VolumePyramid.h"
 #include "tessera/core/Error.h"
 
 #ifdef TESSERA_DESKTOP_VIEWER
@@ -29,8 +31,11 @@
 #include "tessera/gpu/GlContext.h"
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/io/VolumeReader.h"
+#include "tessera/lod/ZoomLevelPolicy.h"
 #include "tessera/render/TechniqueRegistry.h"
+#include "tessera/viewer/Explorer.h"
 #include "tessera/viewer/RecentFiles.h"
+#include "tessera/viewer/SliceView.h"
 #include "tessera/viewer/Viewer.h"
 #endif
 
@@ -49,6 +54,13 @@ struct ViewOptions {
   std::string screenshot;
   int frames = 3;
   bool helpOverlay = false;
+  std::string layout = "four";  // four: axial, 3D, sagittal, coronal; single: 3D only
+  std::vector<int> crosshair;   // X Y Z (level-0 voxel)
+  bool pick = false;            // pick the region around the crosshair
+  int regionSide = 0;           // 0: 256 or what the profile allows
+  double zoom = 1.0;
+  bool zoomGrid = false;          // the zoom policy switches overview <-> grid view
+  std::string mode = "overview";  // overview, region, grid
   ShadingOptions shading;
   ClippingOptions clipping;
 };
@@ -74,10 +86,11 @@ std::string fileName(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
-// Patient-direction letters at the middle of each edge of the 3D view (the
-// region right of the panel), so sides can be checked at a glance.
-void drawOrientationLabels(const EdgeLabels& labels, float x0, float x1, float height) {
-  if (labels.left.empty()) return;
+// Patient-direction letters at the middle of each edge of a view
+// rectangle (window units), so sides can be checked at a glance.
+void drawEdgeLetters(const std::string& left, const std::string& right, const std::string& top,
+                     const std::string& bottom, ImVec2 p0, ImVec2 p1) {
+  if (left.empty()) return;
   ImDrawList* draw = ImGui::GetForegroundDrawList();
   const float pad = 8.0f;
   const ImU32 colour = IM_COL32(255, 230, 120, 255);
@@ -87,11 +100,11 @@ void drawOrientationLabels(const EdgeLabels& labels, float x0, float x1, float h
     draw->AddText(ImVec2(at.x + 1, at.y + 1), IM_COL32(0, 0, 0, 255), text.c_str());
     draw->AddText(at, colour, text.c_str());
   };
-  const float cx = 0.5f * (x0 + x1), cy = 0.5f * height;
-  put(labels.left, x0 + pad, cy, 0.0f, 0.5f);
-  put(labels.right, x1 - pad, cy, 1.0f, 0.5f);
-  put(labels.top, cx, pad, 0.5f, 0.0f);
-  put(labels.bottom, cx, height - pad, 0.5f, 1.0f);
+  const float cx = 0.5f * (p0.x + p1.x), cy = 0.5f * (p0.y + p1.y);
+  put(left, p0.x + pad, cy, 0.0f, 0.5f);
+  put(right, p1.x - pad, cy, 1.0f, 0.5f);
+  put(top, cx, p0.y + pad, 0.5f, 0.0f);
+  put(bottom, cx, p1.y - pad, 0.5f, 1.0f);
 }
 
 // The TF editor over the histogram (Moser & Weiskopf 2008): opacity points
@@ -201,7 +214,68 @@ struct DesktopSession {
   int frame = 0;
   bool showHelp = false;
   viewer::RecentFiles recent{viewer::RecentFiles::defaultPath()};
+
+  // Exploring at native resolution (issue 15; viewer/Explorer.h).
+  enum class Mode { Overview, Region, Grid };
+  Mode mode = Mode::Overview;
+  std::unique_ptr<viewer::Explorer> explorer;
+  std::string volumeLabel;
+  int overviewLevel = 0;
+  std::shared_ptr<const Volume> overview;  // what the 3D view returns to
+  std::optional<lod::VoxelBox> picked;     // the bread-slice region (slice views, overview)
+  std::optional<lod::VoxelBox> shown;      // the region or grid block the 3D view shows
+  std::optional<lod::VoxelBox> gridBlock;  // the grid view's last block (slices, overview)
+  std::string exploreNote;                 // e.g. why a grid move was refused
+  bool fourUp = true;
+  bool sliceColour = false;       // slices in the TF's colour instead of grey
+  bool zoomSwitchesGrid = false;  // lod::ZoomLevelPolicy enters / leaves the grid view
+  double viewPixels = 0.0;        // the 3D view's height in pixels (the policy's view)
+  std::optional<lod::ZoomLevelPolicy> zoomPolicy;
+  std::string zoomPolicyKey;  // the stages it was made for
+  double lastFrameMs = 0.0;
+  gpu::Framebuffer fadeFrom;  // the 3D view before a zoom-driven swap
+  double fadeOld = 0.0;       // its weight still on screen (1 -> 0 over the fade)
+  // The three slice views: axial, coronal, sagittal.
+  struct SliceTile {
+    std::string plane;
+    std::unique_ptr<viewer::SliceGeometry> geometry;
+    gpu::Texture texture;
+    std::string key;
+    viewer::SliceViewport viewport;
+  };
+  SliceTile slices[3] = {
+      {"axial", {}, {}, "", {}}, {"coronal", {}, {}, "", {}}, {"sagittal", {}, {}, "", {}}};
+  int dragTile = -1;          // a slice view being dragged in (-1: none)
+  bool dragRegion = false;    // right button: drawing a region box
+  glm::dvec2 dragStart{0.0};  // window units
 };
+
+// A rectangle of the window in ImGui (window) units, top-left origin.
+struct Rect {
+  ImVec2 p0, p1;
+  bool contains(ImVec2 p) const { return p.x >= p0.x && p.y >= p0.y && p.x < p1.x && p.y < p1.y; }
+};
+// Where the views go right of the panel: one 3D view, or four up (axial
+// top-left, 3D top-right, sagittal bottom-left, coronal bottom-right, as
+// 3D Slicer's four-up layout).
+struct Tiles {
+  Rect view3d;
+  Rect slice[3];  // axial, coronal, sagittal (empty when not four-up)
+};
+Tiles layoutTiles(const DesktopSession& ds, int ww, int wh) {
+  const float x0 = kPanelWidth, x1 = static_cast<float>(ww), h = static_cast<float>(wh);
+  Tiles t;
+  if (!ds.fourUp) {
+    t.view3d = {{x0, 0.0f}, {x1, h}};
+    return t;
+  }
+  const float xm = std::floor(0.5f * (x0 + x1)), ym = std::floor(0.5f * h);
+  t.slice[0] = {{x0, 0.0f}, {xm, ym}};
+  t.view3d = {{xm, 0.0f}, {x1, ym}};
+  t.slice[2] = {{x0, ym}, {xm, h}};
+  t.slice[1] = {{xm, ym}, {x1, h}};
+  return t;
+}
 
 // The keyboard shortcuts, as the help overlay lists them (handled in
 // handleShortcuts; keys act only while no text field has the focus).
@@ -219,9 +293,19 @@ constexpr Shortcut kShortcuts[] = {
     {"Q", "adaptive / full quality"},
     {"T", "next technique"},
     {"Ctrl+1 ... Ctrl+9", "open recent volume 1 ... 9"},
-    {"drag", "rotate"},
-    {"right-drag or Shift+drag", "pan"},
-    {"wheel", "zoom"},
+    {"drag", "rotate (3D view)"},
+    {"right-drag or Shift+drag", "pan (3D view)"},
+    {"wheel", "zoom (3D view); next / previous slice (slice view)"},
+    {"click / drag in a slice", "move the crosshair (all views)"},
+    {"right-click / right-drag in a slice", "pick a region (box)"},
+    {"Up / Down", "next / previous slice under the pointer"},
+    {"[ / ]", "smaller / larger region"},
+    {"V", "view the region at native resolution"},
+    {"G", "grid view at native resolution"},
+    {"arrows, PgUp / PgDn", "grid view: move back/forward, left/right, up/down"},
+    {"O", "back to the overview"},
+    {"L", "four views / 3D only"},
+    {"C", "slices in grey / in the TF's colour"},
 };
 
 // A window with an OpenGL ES context of the profile's level, made current.
@@ -240,11 +324,186 @@ GLFWwindow* openWindow(int width, int height, bool es3) {
   return window;
 }
 
-// Loads a volume; an error is shown in the panel and the previous volume
-// stays. Files and folders (not generated volumes) go to the recent list.
+// The overview (the 3D view's whole volume): the finest level of the
+// pyramid with at most this many voxels, so that a store is never read whole
+// at native resolution; in-core files are shown as loaded.
+std::uint64_t overviewVoxels(const gpu::DeviceLimits& limits) {
+  const std::uint64_t budget = limits.textureBudget ? limits.textureBudget / 2 : (1ull << 30);
+  return std::min<std::uint64_t>(budget, 64ull << 20);
+}
+
+// What a native region or grid block may take: a quarter of the texture
+// budget, and no more than one 3D texture of the profile holds (so that it
+// is shown at native resolution, not reduced by the planner).
+std::uint64_t regionBudget(const gpu::DeviceLimits& limits) {
+  std::uint64_t budget = limits.textureBudget ? limits.textureBudget / 4 : (1ull << 30);
+  if (limits.max3DTextureSize > 0) {
+    const auto side = static_cast<std::uint64_t>(limits.max3DTextureSize);
+    budget = std::min(budget, side * side * side);
+  }
+  return budget;
+}
+
+// The lines the overview shows: the region or grid block and the crosshair.
+void updateOverlay(DesktopSession& ds) {
+  viewer::Viewer& v = *ds.viewer;
+  v.extraLines.clear();
+  if (!ds.explorer || !v.hasVolume()) return;
+  const glm::vec4 red(1.0f, 0.25f, 0.2f, 1.0f), cross(1.0f, 0.85f, 0.2f, 1.0f);
+  const glm::dvec3 extent = v.volume().extent();
+  if (ds.mode == DesktopSession::Mode::Overview) {
+    const glm::ivec3 dims = ds.explorer->dims();
+    if (ds.picked) {
+      const auto box = viewer::boxLines(*ds.picked, dims, extent, red);
+      v.extraLines.insert(v.extraLines.end(), box.begin(), box.end());
+    }
+    if (ds.gridBlock) {
+      const glm::vec4 cyan(0.25f, 0.85f, 0.95f, 1.0f);
+      const auto box = viewer::boxLines(*ds.gridBlock, dims, extent, cyan);
+      v.extraLines.insert(v.extraLines.end(), box.begin(), box.end());
+    }
+    const auto lines = viewer::crosshairLines(ds.explorer->crosshair(), dims, extent, cross);
+    v.extraLines.insert(v.extraLines.end(), lines.begin(), lines.end());
+  } else if (ds.shown) {
+    // The crosshair within the native sub-volume, where it falls inside it.
+    const glm::ivec3 c = ds.explorer->crosshair() - ds.shown->begin;
+    if (glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) &&
+        glm::all(glm::lessThan(c, ds.shown->size()))) {
+      v.extraLines = viewer::crosshairLines(c, ds.shown->size(), extent, cross);
+    }
+  }
+}
+
+// How the camera follows a swap of the 3D view's volume (its direction
+// always stays). Keep: the same point of the patient stays at the view's
+// centre at the same scale (the zoom policy's swaps change the data, not
+// the view: no jump). Centre: the new volume's centre, the zoom kept (a grid
+// move). Fill: the new volume's centre at zoom 1 (a key or button).
+enum class Follow { Keep, Centre, Fill };
+
+// Shows `volume` (the whole volume or `box` of it) in the 3D view.
+void showIn3D(DesktopSession& ds, Volume volume, const std::string& name,
+              const std::optional<lod::VoxelBox>& box, Follow follow) {
+  const Camera before = ds.viewer->camera();
+  const std::optional<lod::VoxelBox> from = ds.shown;
+  ds.viewer->setVolume(std::move(volume), name);
+  Camera& c = ds.viewer->camera();
+  if (follow == Follow::Keep) {
+    const Camera kept = viewer::cameraAcrossSwap(before, from, box, ds.explorer->dims(),
+                                                 ds.explorer->source().shape().spacing());
+    c.target = kept.target;
+    c.zoom = kept.zoom;
+  } else {
+    c.zoom = follow == Follow::Fill ? 1.0 : before.zoom;
+  }
+  c.azimuthDeg = before.azimuthDeg;
+  c.elevationDeg = before.elevationDeg;
+}
+
+std::string boxText(const lod::VoxelBox& b) {
+  char t[96];
+  std::snprintf(t, sizeof t, "%d:%d,%d:%d,%d:%d", b.begin.x, b.end.x, b.begin.y, b.end.y, b.begin.z,
+                b.end.z);
+  return t;
+}
+
+void showOverview(DesktopSession& ds, Follow follow = Follow::Fill) {
+  if (!ds.overview) return;
+  try {
+    showIn3D(ds, *ds.overview,
+             ds.volumeLabel +
+                 (ds.overviewLevel > 0 ? " (level " + std::to_string(ds.overviewLevel) + ")" : ""),
+             std::nullopt, follow);
+    ds.mode = DesktopSession::Mode::Overview;
+    ds.shown.reset();
+    ds.exploreNote.clear();
+  } catch (const Error& e) {
+    ds.error = e.what();
+  }
+  updateOverlay(ds);
+}
+
+// Reads `box` at native resolution (one bounded read) into the 3D view.
+void showNative(DesktopSession& ds, const lod::VoxelBox& box, DesktopSession::Mode mode,
+                Follow follow) {
+  try {
+    showIn3D(ds, ds.explorer->readRegion(box), ds.volumeLabel + " " + boxText(box) + " (native)",
+             box, follow);
+    ds.mode = mode;
+    ds.shown = box;
+    if (mode == DesktopSession::Mode::Grid) ds.gridBlock = box;
+    ds.error.clear();
+  } catch (const Error& e) {
+    ds.error = e.what();
+  }
+  updateOverlay(ds);
+}
+
+void viewPickedRegion(DesktopSession& ds) {
+  if (!ds.explorer) return;
+  if (!ds.picked) ds.picked = ds.explorer->regionAt(ds.explorer->crosshair());
+  showNative(ds, *ds.picked, DesktopSession::Mode::Region, Follow::Fill);
+}
+
+// The grid view starts at the grid point nearest the crosshair, or, when
+// the zoom switches to it (Follow::Keep), nearest the point the 3D view is
+// centred on, so that the block holds what the user zoomed into.
+void enterGrid(DesktopSession& ds, Follow follow = Follow::Fill) {
+  if (!ds.explorer) return;
+  lod::GridNavigator& g = ds.explorer->grid();
+  glm::dvec3 voxel = glm::dvec3(ds.explorer->crosshair()) + 0.5;
+  if (follow == Follow::Keep && ds.mode == DesktopSession::Mode::Overview) {
+    // The camera's target in the overview's model frame (mm from its centre).
+    const glm::dvec3 spacing = ds.explorer->source().shape().spacing();
+    voxel = ds.viewer->camera().target / spacing + 0.5 * glm::dvec3(ds.explorer->dims());
+  }
+  const glm::dvec3 c = voxel / glm::dvec3(g.cellSize());
+  g.moveTo(glm::clamp(glm::ivec3(glm::round(c)), glm::ivec3(0), g.cells()));
+  ds.exploreNote = g.describe(g.point());
+  showNative(ds, g.blockBox(g.point()), DesktopSession::Mode::Grid, follow);
+}
+
+void gridMove(DesktopSession& ds, lod::ViewMove move) {
+  lod::GridNavigator& g = ds.explorer->grid();
+  const lod::GridMove m = lod::viewMoveToGridMove(ds.viewer->camera().basis(), move);
+  const lod::MoveResult r = g.apply(m);
+  if (!r.moved) {
+    ds.exploreNote = std::string(lod::viewMoveName(move)) + " = " + m.name() + ": " + r.reason;
+    return;
+  }
+  ds.exploreNote =
+      std::string(lod::viewMoveName(move)) + " = " + m.name() + "; " + g.describe(g.point());
+  showNative(ds, g.blockBox(g.point()), DesktopSession::Mode::Grid, Follow::Centre);
+}
+
+// Loads a volume as a pyramid (viewer/Explorer.h reads regions and slices
+// from it; a store or head:WxHxD is read box by box), shows its overview;
+// an error is shown in the panel and the previous volume stays. Files and
+// folders (not generated volumes) go to the recent list.
 void openVolume(DesktopSession& ds, const std::string& spec) {
   try {
-    ds.viewer->setVolume(readVolume(spec, {.dicomSeries = ds.options.series}), fileName(spec));
+    const VolumePyramid pyramid = openVolumePyramid(spec, {.series = ds.options.series});
+    const gpu::DeviceLimits& limits = ds.viewer->limits();
+    auto explorer = std::make_unique<viewer::Explorer>(pyramid.source, regionBudget(limits));
+    const int level = explorer->overviewLevel(overviewVoxels(limits));
+    auto overview = std::make_shared<const Volume>(explorer->readLevel(level));
+    const std::string label = fileName(spec);
+    ds.viewer->setVolume(*overview,
+                         label + (level > 0 ? " (level " + std::to_string(level) + ")" : ""));
+    ds.explorer = std::move(explorer);
+    ds.overview = std::move(overview);
+    ds.overviewLevel = level;
+    ds.volumeLabel = label;
+    ds.mode = DesktopSession::Mode::Overview;
+    ds.picked.reset();
+    ds.shown.reset();
+    ds.gridBlock.reset();
+    ds.exploreNote.clear();
+    for (auto& tile : ds.slices) {
+      tile.geometry.reset();
+      tile.key.clear();
+    }
+    updateOverlay(ds);
     ds.error.clear();
   } catch (const Error& e) {
     ds.error = std::string(e.what()) + " (the previous volume stays)";
@@ -257,13 +516,209 @@ void openVolume(DesktopSession& ds, const std::string& spec) {
     }
     return;
   }
-  if (spec.rfind("gen:", 0) == 0) return;
+  if (spec.rfind("gen:", 0) == 0 || spec.rfind("head:", 0) == 0) return;
   try {
     std::error_code ec;
     const std::filesystem::path full = std::filesystem::absolute(spec, ec);
     ds.recent.add(ec ? spec : full.lexically_normal().string());
   } catch (const Error& e) {
     ds.error = e.what();
+  }
+}
+
+// One slice view: the slice through the crosshair at native resolution
+// (re-read only when it changed), the crosshair, the picked region, the
+// patient letters and the plane's name and index.
+void drawSliceTile(DesktopSession& ds, DesktopSession::SliceTile& tile, const Rect& r) {
+  ImDrawList* dl = ImGui::GetBackgroundDrawList();
+  dl->AddRectFilled(r.p0, r.p1, IM_COL32(0, 0, 0, 255));
+  dl->AddRect(r.p0, r.p1, IM_COL32(60, 60, 60, 255));
+  if (!ds.explorer) return;
+  const viewer::Explorer& ex = *ds.explorer;
+  const lod::MultiresSource& src = ex.source();
+  if (!tile.geometry) {
+    const Volume& shape = src.shape();
+    tile.geometry = std::make_unique<viewer::SliceGeometry>(
+        ex.dims(), glm::dvec3(src.levelInfo(0).spacing), shape.direction(),
+        viewer::axisForPlane(shape.direction(), tile.plane));
+  }
+  const viewer::SliceGeometry& g = *tile.geometry;
+  const int index = ex.crosshair()[g.axis()];
+  viewer::Viewer& v = *ds.viewer;
+  const ValueRange w = v.window();
+  std::ostringstream key;
+  key.precision(17);
+  key << index << '|' << w.min << '|' << w.max << '|' << ds.sliceColour << '|'
+      << (ds.sliceColour ? v.tfEditor().revision() : 0);
+  if (key.str() != tile.key) {
+    try {
+      const TransferFunction& tf = v.tfEditor().transferFunction();
+      const Image img = g.render(src, 0, index, w, ds.sliceColour ? &tf : nullptr);
+      tile.texture = gpu::Texture();
+      tile.texture = gpu::Texture::create2D(
+          ds.context->ledger(), "slice view",
+          gpu::rgba8For(ds.es3 ? gpu::ApiLevel::Gles3 : gpu::ApiLevel::Gles2), img.width(),
+          img.height(), img.rgba().data());
+      tile.texture.setFilter(gpu::Filter::Nearest);  // voxels as they are
+      tile.key = key.str();
+    } catch (const Error& e) {
+      ds.error = e.what();
+      return;
+    }
+  }
+  const float margin = 22.0f;
+  tile.viewport = viewer::SliceViewport::fit(
+      g.imageSize(), {r.p0.x + margin, r.p0.y + margin},
+      {std::max(1.0f, r.p1.x - r.p0.x - 2 * margin), std::max(1.0f, r.p1.y - r.p0.y - 2 * margin)});
+  const viewer::SliceViewport& vp = tile.viewport;
+  auto screen = [&](glm::dvec2 image) {
+    const glm::dvec2 p = vp.toScreen(image);
+    return ImVec2(static_cast<float>(p.x), static_cast<float>(p.y));
+  };
+  dl->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(tile.texture.id())),
+               screen({0.0, 0.0}), screen(glm::dvec2(g.imageSize())));
+  // The picked region (red) and the last grid block (cyan) where this slice
+  // cuts them.
+  const SliceFrame& f = g.frame();
+  const glm::dvec2 voxelPx(src.levelInfo(0).spacing[f.colAxis] / g.pixelMm(),
+                           src.levelInfo(0).spacing[f.rowAxis] / g.pixelMm());
+  auto drawBox = [&](const lod::VoxelBox& box, ImU32 fill, ImU32 line) {
+    if (index < box.begin[g.axis()] || index >= box.end[g.axis()]) return;
+    glm::ivec3 lo = box.begin, hi = box.end - 1;
+    lo[g.axis()] = hi[g.axis()] = index;
+    const glm::dvec2 a = g.pointOf(lo), b = g.pointOf(hi);
+    const glm::dvec2 p0 = glm::min(a, b) - 0.5 * voxelPx, p1 = glm::max(a, b) + 0.5 * voxelPx;
+    if (fill) dl->AddRectFilled(screen(p0), screen(p1), fill);
+    dl->AddRect(screen(p0), screen(p1), line, 0.0f, 0, 2.0f);
+  };
+  if (ds.gridBlock) drawBox(*ds.gridBlock, 0, IM_COL32(60, 220, 240, 255));
+  if (ds.picked) drawBox(*ds.picked, IM_COL32(255, 60, 40, 50), IM_COL32(255, 70, 50, 255));
+  // The crosshair through the centre of its voxel.
+  const glm::dvec2 c = g.pointOf(ex.crosshair());
+  const ImU32 cross = IM_COL32(255, 215, 50, 200);
+  dl->AddLine(screen({c.x, 0.0}), screen({c.x, static_cast<double>(g.imageSize().y)}), cross);
+  dl->AddLine(screen({0.0, c.y}), screen({static_cast<double>(g.imageSize().x), c.y}), cross);
+  const char* axisName = "xyz";
+  char title[96];
+  std::snprintf(title, sizeof title, "%s  %c = %d / %d", f.plane.c_str(), axisName[g.axis()], index,
+                g.dims()[g.axis()] - 1);
+  dl->AddText(ImVec2(r.p0.x + 6, r.p0.y + 4), IM_COL32(200, 200, 200, 255), title);
+  drawEdgeLetters(f.left, f.right, f.top, f.bottom, screen({0.0, 0.0}),
+                  screen(glm::dvec2(g.imageSize())));
+}
+
+// A region from a right-drag in a slice view: the dragged rectangle in the
+// slice's plane (a click: the default cube around the point), the region's
+// side across it, centred on the slice; clamped to the budget and volume.
+void pickRegion(DesktopSession& ds, const DesktopSession::SliceTile& tile, glm::dvec2 a,
+                glm::dvec2 b) {
+  const viewer::SliceGeometry& g = *tile.geometry;
+  const int index = ds.explorer->crosshair()[g.axis()];
+  const glm::ivec2 pa = tile.viewport.pixelAt(a);
+  const glm::ivec2 pb = glm::length(b - a) < 4.0 ? pa : tile.viewport.pixelAt(b);
+  ds.picked = ds.explorer->regionFromSlice(g, pa, pb, index);
+}
+
+// Mouse input on the slice views: left click/drag moves the crosshair, right
+// drag picks a region, the wheel flips slices.
+void handleSliceInput(DesktopSession& ds, const Tiles& tiles) {
+  if (!ds.explorer || !ds.fourUp) return;
+  ImGuiIO& io = ImGui::GetIO();
+  const glm::dvec2 m(io.MousePos.x, io.MousePos.y);
+  if (!io.WantCaptureMouse) {
+    for (int t = 0; t < 3; ++t) {
+      if (!tiles.slice[t].contains(io.MousePos) || !ds.slices[t].geometry) continue;
+      if (ImGui::IsMouseClicked(0) || ImGui::IsMouseClicked(1)) {
+        ds.dragTile = t;
+        ds.dragRegion = ImGui::IsMouseClicked(1);
+        ds.dragStart = m;
+      }
+      if (io.MouseWheel != 0.0f) {
+        glm::ivec3 c = ds.explorer->crosshair();
+        c[ds.slices[t].geometry->axis()] += io.MouseWheel > 0.0f ? 1 : -1;
+        ds.explorer->setCrosshair(c);
+      }
+    }
+  }
+  if (ds.dragTile < 0) return;
+  DesktopSession::SliceTile& tile = ds.slices[ds.dragTile];
+  if (!ds.dragRegion && ImGui::IsMouseDown(0)) {
+    const int index = ds.explorer->crosshair()[tile.geometry->axis()];
+    ds.explorer->setCrosshair(tile.geometry->voxelAt(tile.viewport.pixelAt(m), index));
+  }
+  if (ds.dragRegion) {
+    const ImVec2 a(static_cast<float>(ds.dragStart.x), static_cast<float>(ds.dragStart.y));
+    ImGui::GetForegroundDrawList()->AddRect(a, io.MousePos, IM_COL32(255, 80, 60, 255));
+    if (ImGui::IsMouseReleased(1)) {
+      pickRegion(ds, tile, ds.dragStart, m);
+      ds.dragTile = -1;
+    }
+  } else if (ImGui::IsMouseReleased(0)) {
+    ds.dragTile = -1;
+  }
+}
+
+// The slice under the pointer (axial if none) one step up or down.
+void stepSlice(DesktopSession& ds, const Tiles& tiles, int step) {
+  const ImVec2 m = ImGui::GetIO().MousePos;
+  int t = 0;
+  for (int i = 0; i < 3; ++i) {
+    if (tiles.slice[i].contains(m)) t = i;
+  }
+  if (!ds.slices[t].geometry) return;
+  glm::ivec3 c = ds.explorer->crosshair();
+  c[ds.slices[t].geometry->axis()] += step;
+  ds.explorer->setCrosshair(c);
+}
+
+// The keys of the exploring modes (kShortcuts).
+void handleExploreKeys(DesktopSession& ds, const Tiles& tiles) {
+  ImGuiIO& io = ImGui::GetIO();
+  if (io.WantTextInput || !ds.explorer) return;
+  const bool grid = ds.mode == DesktopSession::Mode::Grid;
+  auto pressed = [](int key) { return ImGui::IsKeyPressed(key, true); };
+  if (grid) {
+    if (pressed(GLFW_KEY_UP)) gridMove(ds, lod::ViewMove::Forward);
+    if (pressed(GLFW_KEY_DOWN)) gridMove(ds, lod::ViewMove::Back);
+    if (pressed(GLFW_KEY_LEFT)) gridMove(ds, lod::ViewMove::Left);
+    if (pressed(GLFW_KEY_RIGHT)) gridMove(ds, lod::ViewMove::Right);
+    if (pressed(GLFW_KEY_PAGE_UP)) gridMove(ds, lod::ViewMove::Up);
+    if (pressed(GLFW_KEY_PAGE_DOWN)) gridMove(ds, lod::ViewMove::Down);
+  } else {
+    if (pressed(GLFW_KEY_UP)) stepSlice(ds, tiles, 1);
+    if (pressed(GLFW_KEY_DOWN)) stepSlice(ds, tiles, -1);
+  }
+  for (const ImWchar c : io.InputQueueCharacters) {
+    switch (c) {
+      case 'v':
+      case 'V':
+        viewPickedRegion(ds);
+        break;
+      case 'g':
+      case 'G':
+        grid ? showOverview(ds) : enterGrid(ds);
+        break;
+      case 'o':
+      case 'O':
+        showOverview(ds);
+        break;
+      case 'l':
+      case 'L':
+        ds.fourUp = !ds.fourUp;
+        break;
+      case 'c':
+      case 'C':
+        ds.sliceColour = !ds.sliceColour;
+        break;
+      case '[':
+        ds.explorer->setRegionSide(ds.explorer->regionSide() - 16);
+        break;
+      case ']':
+        ds.explorer->setRegionSide(ds.explorer->regionSide() + 16);
+        break;
+      default:
+        break;
+    }
   }
 }
 
@@ -357,12 +812,12 @@ void handleShortcuts(DesktopSession& ds) {
 }
 
 // The 3D view: mouse drags orbit (right button or shift: pan), wheel zooms.
-void handleViewInput(viewer::Viewer& v, double scale) {
+void handleViewInput(viewer::Viewer& v, const Rect& view, double scale) {
   ImGuiIO& io = ImGui::GetIO();
-  const glm::dvec2 pos((io.MousePos.x - kPanelWidth) * scale, io.MousePos.y * scale);
-  if (!io.WantCaptureMouse) {
+  const glm::dvec2 pos((io.MousePos.x - view.p0.x) * scale, (io.MousePos.y - view.p0.y) * scale);
+  if (!io.WantCaptureMouse && view.contains(io.MousePos)) {
     for (int b = 0; b < 2; ++b) {
-      if (ImGui::IsMouseClicked(b) && pos.x >= 0.0) {
+      if (ImGui::IsMouseClicked(b)) {
         v.controller().pointerDown(
             b, pos,
             b == 1 || io.KeyShift ? viewer::PointerAction::Pan : viewer::PointerAction::Orbit);
@@ -541,6 +996,103 @@ void panelShading(viewer::Viewer& v) {
   slider("shininess", s.shininess, 1.0f, 128.0f);
 }
 
+// Keeps the 3D view's last frame for the cross-fade of a zoom-driven swap
+// (ES 3: the frame cache; ES 2 redraws every frame and has no copy to fade).
+void captureFade(DesktopSession& ds) {
+  if (!ds.es3 || ds.cache.width() == 0) return;
+  if (ds.fadeFrom.width() != ds.cache.width() || ds.fadeFrom.height() != ds.cache.height()) {
+    ds.fadeFrom = gpu::Framebuffer();
+    ds.fadeFrom = gpu::Framebuffer::create(ds.context->ledger(), "zoom fade", ds.cache.width(),
+                                           ds.cache.height());
+  }
+  const glm::ivec4 box(0, 0, ds.cache.width(), ds.cache.height());
+  gpu::blitFramebuffer(ds.cache.id(), box, ds.fadeFrom.id(), box);
+}
+
+// The exploring controls (issue 15): mode, crosshair, region size, the
+// grid view's moves as buttons (touch-style controls beside the keys), and
+// the zoom policy's stages (lod/ZoomLevelPolicy.h), which can switch the
+// overview to the grid view and back by zoom alone.
+void panelExplore(DesktopSession& ds) {
+  if (!ds.explorer) return;
+  section("Explore at native resolution");
+  viewer::Explorer& ex = *ds.explorer;
+  const glm::ivec3 d = ex.dims(), c = ex.crosshair();
+  ImGui::Text("native %dx%dx%d; overview level %d of %d", d.x, d.y, d.z, ds.overviewLevel,
+              ex.source().levelCount() - 1);
+  const glm::dvec4 w = ex.source().shape().indexToWorld() * glm::dvec4(glm::dvec3(c), 1.0);
+  ImGui::Text("crosshair (%d, %d, %d), RAS (%.0f, %.0f, %.0f) mm", c.x, c.y, c.z, w.x, w.y, w.z);
+  int side = ex.regionSide();
+  if (ImGui::SliderInt("region side", &side, 16, ex.maxRegionSide())) ex.setRegionSide(side);
+  if (ds.picked) ImGui::Text("region %s", boxText(*ds.picked).c_str());
+  if (ImGui::Button("View region (V)")) viewPickedRegion(ds);
+  ImGui::SameLine();
+  if (ImGui::Button("Grid view (G)")) enterGrid(ds);
+  ImGui::SameLine();
+  if (ImGui::Button("Overview (O)")) showOverview(ds);
+  if (ds.mode == DesktopSession::Mode::Grid) {
+    const lod::ViewMove moves[6] = {lod::ViewMove::Forward, lod::ViewMove::Back,
+                                    lod::ViewMove::Left,    lod::ViewMove::Right,
+                                    lod::ViewMove::Up,      lod::ViewMove::Down};
+    for (int i = 0; i < 6; ++i) {
+      const lod::GridMove m = lod::viewMoveToGridMove(ds.viewer->camera().basis(), moves[i]);
+      const std::string label = std::string(lod::viewMoveName(moves[i])) + " " + m.name();
+      const bool legal = ex.grid().check(ex.grid().point(), m).moved;
+      ImGui::BeginDisabled(!legal);
+      if (ImGui::Button(label.c_str(), ImVec2(110.0f, 0.0f))) gridMove(ds, moves[i]);
+      ImGui::EndDisabled();
+      if (i % 3 != 2) ImGui::SameLine();
+    }
+  }
+  if (!ds.exploreNote.empty()) ImGui::TextWrapped("%s", ds.exploreNote.c_str());
+  ImGui::Checkbox("four views (L)", &ds.fourUp);
+  ImGui::SameLine();
+  ImGui::Checkbox("slices in TF colour (C)", &ds.sliceColour);
+  // The zoom policy's stages for this volume and view.
+  const lod::GridNavigator& g = ex.grid();
+  const glm::dvec3 sp = ex.source().shape().spacing();
+  const double volumeRadius = 0.5 * glm::length(glm::dvec3(d) * sp);
+  const double blockRadius = 0.5 * glm::length(glm::dvec3(glm::min(2 * g.cellSize(), d)) * sp);
+  const int coarse = std::min(ds.overviewLevel + 1, ex.source().levelCount() - 1);
+  const double pxPerVoxel = std::max(1.0, ds.viewPixels) / glm::length(glm::dvec3(d));
+  const lod::ZoomLevelPolicy policy(lod::ZoomLevelPolicy::overviewStages(
+      coarse, ds.overviewLevel, pxPerVoxel, volumeRadius, blockRadius));
+  std::string stages;
+  for (const lod::ZoomStage& st : policy.stages()) {
+    char t[80];
+    std::snprintf(t, sizeof t, "%s%s L%d from zoom %.2f", stages.empty() ? "" : "; ",
+                  st.name.c_str(), st.level, st.enterZoom);
+    stages += t;
+  }
+  ImGui::TextWrapped("zoom stages: %s", stages.c_str());
+  if (ImGui::Checkbox("zoom into the grid view", &ds.zoomSwitchesGrid)) ds.zoomPolicy.reset();
+  if (!ds.zoomSwitchesGrid || !policy.stages().back().subVolume) {
+    ds.fadeOld = 0.0;
+    return;
+  }
+  // The policy lives across frames (its hysteresis and fade are state);
+  // new stages (another volume or view size) start it afresh.
+  if (!ds.zoomPolicy || ds.zoomPolicyKey != stages) {
+    ds.zoomPolicy.emplace(policy.stages());
+    ds.zoomPolicyKey = stages;
+  }
+  const bool native = ds.mode == DesktopSession::Mode::Grid;
+  const double zoom = ds.viewer->camera().zoom;
+  // In the grid view the camera frames the block: its zoom in overview terms.
+  const double overviewZoom = native ? zoom * volumeRadius / blockRadius : zoom;
+  const double now = 1000.0 * glfwGetTime();
+  const lod::ZoomFrame f = ds.zoomPolicy->update(overviewZoom, now - ds.lastFrameMs);
+  ds.lastFrameMs = now;
+  const bool wantNative = policy.stages()[static_cast<std::size_t>(f.stage)].subVolume;
+  if (wantNative != native && ds.mode != DesktopSession::Mode::Region) {
+    captureFade(ds);
+    wantNative ? enterGrid(ds, Follow::Keep) : showOverview(ds, Follow::Keep);
+  }
+  // The image from before the swap fades out over the policy's fade time.
+  const bool nativeSwap = policy.stages()[static_cast<std::size_t>(f.from)].subVolume != wantNative;
+  ds.fadeOld = f.from != f.stage && nativeSwap ? 1.0 - f.mix : 0.0;
+}
+
 // The control panel at the window's left edge.
 void drawPanel(DesktopSession& ds, int windowHeight) {
   ImGui::SetNextWindowPos(ImVec2(0, 0));
@@ -548,6 +1100,7 @@ void drawPanel(DesktopSession& ds, int windowHeight) {
   ImGui::Begin("Tessera", nullptr,
                ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
   panelFile(ds);
+  panelExplore(ds);
   panelTransferFunction(ds);
   panelWindowLevel(*ds.viewer);
   panelRendering(ds);
@@ -559,6 +1112,7 @@ void drawPanel(DesktopSession& ds, int windowHeight) {
 }
 
 // What the volume view shows; a frame is rendered only when it changes.
+// (The overlay lines too: the crosshair and region move with the slices.)
 std::string viewKey(viewer::Viewer& v, int viewW, int viewH) {
   const Camera& c = v.camera();
   std::ostringstream key;
@@ -569,6 +1123,10 @@ std::string viewKey(viewer::Viewer& v, int viewW, int viewH) {
       << v.settings().opacityScale << '|' << v.window().min << v.window().max << '|'
       << v.technique() << static_cast<int>(v.quality) << v.controller().interacting() << '|'
       << v.showBoundingBox << v.showAxes << '|' << viewW << 'x' << viewH;
+  for (const render::OverlayLine& l : v.extraLines) {
+    key << "|l" << l.a.x << ',' << l.a.y << ',' << l.a.z << ',' << l.b.x << ',' << l.b.y << ','
+        << l.b.z;
+  }
   const RenderSettings fs = v.frameSettings();
   for (const ClipPlane& p : fs.clipping.planes) {
     key << "|p" << p.normal.x << ',' << p.normal.y << ',' << p.normal.z << ',' << p.distance;
@@ -584,7 +1142,7 @@ std::string viewKey(viewer::Viewer& v, int viewW, int viewH) {
 
 // The volume right of the panel: re-rendered only when something it shows
 // changed (ES 3 blits the cached frame), every frame on ES 2 (no blit).
-void drawVolumeView(DesktopSession& ds, int panelPx, int viewW, int viewH) {
+void drawVolumeView(DesktopSession& ds, glm::ivec2 origin, int viewW, int viewH) {
   viewer::Viewer& v = *ds.viewer;
   try {
     if (ds.es3) {
@@ -599,9 +1157,10 @@ void drawVolumeView(DesktopSession& ds, int panelPx, int viewW, int viewH) {
       } else if (v.refining()) {
         v.refine();  // a strip of the full-quality frame per window frame
       }
-      gpu::blitFramebuffer(ds.cache.id(), {0, 0, viewW, viewH}, 0, {panelPx, 0, viewW, viewH});
+      gpu::blitFramebuffer(ds.cache.id(), {0, 0, viewW, viewH}, 0,
+                           {origin.x, origin.y, viewW, viewH});
     } else {
-      v.render(viewW, viewH, 0, glm::ivec2(panelPx, 0));
+      v.render(viewW, viewH, 0, origin);
     }
   } catch (const Error& e) {
     ds.error = e.what();
@@ -641,20 +1200,40 @@ void runFrame(DesktopSession& ds) {
   glfwGetFramebufferSize(ds.window, &fbw, &fbh);
   glfwGetWindowSize(ds.window, &ww, &wh);
   const double scale = ww > 0 ? static_cast<double>(fbw) / ww : 1.0;
-  const int panelPx = static_cast<int>(kPanelWidth * scale);
-  const int viewW = std::max(1, fbw - panelPx), viewH = std::max(1, fbh);
+  const Tiles tiles = layoutTiles(ds, ww, wh);
+  // The 3D view's rectangle in framebuffer pixels (GL: origin bottom-left).
+  const int vx0 = static_cast<int>(std::lround(tiles.view3d.p0.x * scale));
+  const int vx1 = static_cast<int>(std::lround(tiles.view3d.p1.x * scale));
+  const int vy0 = static_cast<int>(std::lround(tiles.view3d.p0.y * scale));
+  const int vy1 = static_cast<int>(std::lround(tiles.view3d.p1.y * scale));
+  const int viewW = std::max(1, vx1 - vx0), viewH = std::max(1, vy1 - vy0);
+  ds.viewPixels = viewH;
 
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
-  handleViewInput(*ds.viewer, scale);
+  handleViewInput(*ds.viewer, tiles.view3d, scale);
+  handleSliceInput(ds, tiles);
   handleShortcuts(ds);
+  handleExploreKeys(ds, tiles);
+  updateOverlay(ds);
   drawPanel(ds, wh);
+  for (int t = 0; t < 3 && ds.fourUp; ++t) drawSliceTile(ds, ds.slices[t], tiles.slice[t]);
+  if (ds.fadeOld > 0.0 && ds.fadeFrom.width() > 0) {
+    // GL textures start at the bottom row: flipped texture coordinates.
+    ImGui::GetBackgroundDrawList()->AddImage(
+        reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(ds.fadeFrom.color().id())),
+        tiles.view3d.p0, tiles.view3d.p1, ImVec2(0.0f, 1.0f), ImVec2(1.0f, 0.0f),
+        IM_COL32(255, 255, 255, static_cast<int>(std::lround(255.0 * ds.fadeOld))));
+  }
   drawHelpOverlay(ds, kPanelWidth, static_cast<float>(ww), static_cast<float>(wh));
-  drawOrientationLabels(ds.viewer->orientationLabels(), kPanelWidth, static_cast<float>(ww),
-                        static_cast<float>(wh));
+  const EdgeLabels labels = ds.viewer->orientationLabels();
+  drawEdgeLetters(labels.left, labels.right, labels.top, labels.bottom, tiles.view3d.p0,
+                  tiles.view3d.p1);
   ImGui::Render();
-  drawVolumeView(ds, panelPx, viewW, viewH);
+  gpu::bindFramebuffer(0, {0, 0, fbw, fbh});
+  gpu::clearColor(glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+  drawVolumeView(ds, {vx0, fbh - vy1}, viewW, viewH);
   gpu::setViewport({0, 0, fbw, fbh});
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
@@ -663,6 +1242,38 @@ void runFrame(DesktopSession& ds) {
     takeScreenshot(ds, fbw, fbh);
   }
   glfwSwapBuffers(ds.window);
+}
+
+// --layout, --crosshair, --pick and --mode: the exploring state to start in.
+void startExploring(DesktopSession& ds, const ViewOptions& o) {
+  if (o.layout != "four" && o.layout != "single") {
+    throw InputError("--layout '" + o.layout + "': expected four or single");
+  }
+  ds.fourUp = o.layout == "four";
+  if (!o.crosshair.empty()) {
+    if (o.crosshair.size() != 3) throw InputError("--crosshair takes three voxel indices X Y Z");
+    const glm::ivec3 c(o.crosshair[0], o.crosshair[1], o.crosshair[2]);
+    const glm::ivec3 d = ds.explorer->dims();
+    if (glm::any(glm::lessThan(c, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(c, d))) {
+      throw InputError("--crosshair is outside the volume's voxels 0.." + std::to_string(d.x - 1) +
+                       ", 0.." + std::to_string(d.y - 1) + ", 0.." + std::to_string(d.z - 1));
+    }
+    ds.explorer->setCrosshair(c);
+  }
+  if (o.regionSide > 0) ds.explorer->setRegionSide(o.regionSide);
+  if (!(o.zoom > 0.0)) throw InputError("--zoom must be > 0");
+  ds.viewer->camera().zoom = o.zoom;
+  ds.zoomSwitchesGrid = o.zoomGrid;
+  if (o.pick) ds.picked = ds.explorer->regionAt(ds.explorer->crosshair());
+  if (o.mode == "region") {
+    viewPickedRegion(ds);
+  } else if (o.mode == "grid") {
+    enterGrid(ds);
+  } else if (o.mode != "overview") {
+    throw InputError("--mode '" + o.mode + "': expected overview, region or grid");
+  }
+  if (!ds.error.empty()) throw InputError(ds.error);
+  updateOverlay(ds);
 }
 
 void runView(const ViewOptions& o) {
@@ -708,6 +1319,7 @@ void runView(const ViewOptions& o) {
   ds.viewer->camera().elevationDeg = o.elevation;
   ds.viewer->settings().shading = shadingFrom(o.shading);
   ds.viewer->settings().clipping = clippingFrom(o.clipping);
+  startExploring(ds, o);
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -720,6 +1332,8 @@ void runView(const ViewOptions& o) {
   ImGui_ImplGlfw_Shutdown();
   ImGui::DestroyContext();
   ds.cache = gpu::Framebuffer();
+  for (auto& tile : ds.slices) tile.texture = gpu::Texture();  // before the context's ledger goes
+  ds.fadeFrom = gpu::Framebuffer();
   ds.viewer.reset();
   ds.context.reset();
   glfwDestroyWindow(ds.window);
@@ -755,6 +1369,25 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--frames", o->frames, "Frames before --screenshot")->capture_default_str();
   cmd->add_flag("--help-overlay", o->helpOverlay,
                 "Start with the keyboard shortcuts shown (F1 or ? toggles them)");
+  cmd->add_option("--layout", o->layout,
+                  "four: axial, 3D, sagittal and coronal views (2x2); single: the 3D view only")
+      ->capture_default_str();
+  cmd->add_option("--crosshair", o->crosshair, "Start with the crosshair at voxel X Y Z (native)")
+      ->expected(3);
+  cmd->add_flag("--pick", o->pick,
+                "Start with the region (default side: 256 or what the profile allows) picked "
+                "around the crosshair");
+  cmd->add_option("--zoom", o->zoom, "Initial camera zoom (1: the volume fills the view)")
+      ->capture_default_str();
+  cmd->add_flag("--zoom-grid", o->zoomGrid,
+                "Let the zoom switch between the overview and the grid view (lod/ZoomLevelPolicy: "
+                "thresholds with hysteresis, cross-fade)");
+  cmd->add_option("--region-side", o->regionSide,
+                  "Side of the picked region in voxels (16 .. 256 or what the profile allows)");
+  cmd->add_option("--mode", o->mode,
+                  "Start in: overview, region (the picked region at native resolution) or grid "
+                  "(the grid view's block nearest the crosshair)")
+      ->capture_default_str();
   addShadingOptions(cmd, o->shading);
   addClippingOptions(cmd, o->clipping);
   cmd->callback([o] { runView(*o); });

@@ -239,6 +239,7 @@ std::vector<render::OverlayLine> Viewer::overlayLines() const {
       lines.push_back({-e, b, axisColors[axis]});
     }
   }
+  lines.insert(lines.end(), extraLines.begin(), extraLines.end());
   return lines;
 }
 

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "support/TestSupport.h"
 #include "tessera/core/Image.h"
@@ -112,6 +113,45 @@ TEST(DesktopViewer, HelpOverlayListsShortcutsAndOpenedFilesAreRemembered) {
   EXPECT_NE(text.str().find(std::filesystem::absolute(volume).lexically_normal().string()),
             std::string::npos)
       << text.str();
+}
+
+// The four-up layout: slice views in three quadrants with the picked
+// region's red box; the grid view starts; a crosshair outside the volume
+// is refused with the volume's range.
+TEST(DesktopViewer, FourUpShowsSlicesWithThePickedRegion) {
+  if (run("command -v xvfb-run").status != 0) GTEST_SKIP() << "xvfb-run not installed";
+  if (!desktopViewerBuilt()) GTEST_SKIP() << "tessera built without GLFW/ImGui";
+  test::TempDir dir;
+  const std::string base = "xvfb-run -a -s '-screen 0 1024x640x24' " +
+                           std::string(TESSERA_CLI_PATH) +
+                           " view gen:shepp-logan:48 --size 960x600 --frames 2 ";
+  const auto png = dir / "four.png";
+  const CommandRun r =
+      run(base + "--crosshair 12 24 24 --pick --region-side 16 --screenshot " + png.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  const Image img = Image::readPng(png);
+  // Right of the 390-px panel: axial top-left, 3D top-right, sagittal
+  // bottom-left, coronal bottom-right.
+  auto count = [&](int x0, int x1, int y0, int y1, auto&& pred) {
+    int n = 0;
+    for (int y = y0; y < y1; ++y) {
+      for (int x = x0; x < x1; ++x) n += pred(img.pixel(x, y)) ? 1 : 0;
+    }
+    return n;
+  };
+  auto red = [](const std::uint8_t* p) { return p[0] > 180 && p[1] < 120 && p[2] < 110; };
+  auto grey = [](const std::uint8_t* p) {
+    return p[0] > 40 && std::abs(p[0] - p[1]) < 6 && std::abs(p[1] - p[2]) < 6;
+  };
+  for (const auto& [x0, y0] : {std::pair{390, 0}, std::pair{390, 300}, std::pair{675, 300}}) {
+    EXPECT_GT(count(x0, x0 + 285, y0, y0 + 300, red), 40) << x0 << "," << y0;
+    EXPECT_GT(count(x0, x0 + 285, y0, y0 + 300, grey), 2000) << x0 << "," << y0;
+  }
+  const CommandRun grid = run(base + "--mode grid --screenshot " + (dir / "grid.png").string());
+  EXPECT_EQ(grid.status, 0) << grid.output;
+  const CommandRun bad = run(base + "--crosshair 48 0 0 --screenshot " + (dir / "x.png").string());
+  EXPECT_NE(bad.status, 0);
+  EXPECT_NE(bad.output.find("outside the volume"), std::string::npos) << bad.output;
 }
 
 TEST(DesktopViewer, WithoutADisplayItSaysWhatToDo) {

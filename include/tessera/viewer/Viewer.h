@@ -97,6 +97,9 @@ class Viewer {
   // by depth: hidden behind opaque parts, faded behind translucent ones.
   bool showBoundingBox = true;
   bool showAxes = true;
+  // More lines in the volume's model frame (viewer/Explorer.h: the picked
+  // region or grid block, the crosshair), drawn like the bounding box.
+  std::vector<render::OverlayLine> extraLines;
   // A clip plane facing the viewer that turns with the camera: it cuts away
   // what lies nearer the viewer than `followingPlaneDistance` (world units
   // from the volume's centre along the view direction), on top of
