@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -251,6 +252,39 @@ TEST(DicomBasicReader, DroppedFilesInMemoryGiveTheFolderVolume) {
   EXPECT_EQ(std::memcmp(fromMemory.bytes().data(), fromDisk.bytes().data(), v.byteSize()), 0);
   EXPECT_NE(fromMemory.description().find("skipped 1 non-DICOM file(s)"), std::string::npos)
       << fromMemory.description();
+}
+
+// pydicom's own test files (python3-pydicom), one at a time: whatever this
+// reader reads, DCMTK reads the same; whatever it refuses is an InputError
+// naming the file; the uncompressed and RLE greyscale images are read.
+TEST(DicomBasicReader, PydicomTestFilesReadAsDcmtkDoesOrAreRefusedNamingTheFile) {
+  const fs::path dir = "/usr/lib/python3/dist-packages/pydicom/data/test_files";
+  if (!fs::is_directory(dir)) GTEST_SKIP() << dir << " missing (apt install python3-pydicom)";
+  std::vector<std::string> read;
+  for (const auto& f : filesIn(dir)) {
+    if (f.extension() != ".dcm") continue;
+    SCOPED_TRACE(f.filename().string());
+    try {
+      const Volume basic = readDicomFilesBasic({f});
+      read.push_back(f.filename().string());
+      try {
+        expectSameVolume(basic, readDicomFiles({f}));
+      } catch (const Error& e) {
+        ADD_FAILURE() << "read here, but DCMTK says: " << e.what();
+      }
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(f.string(), 0), 0u) << e.what();
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "not an InputError: " << e.what();
+    }
+  }
+  for (const char* name :
+       {"CT_small.dcm", "MR_small.dcm", "MR_small_RLE.dcm", "MR_small_implicit.dcm"}) {
+    EXPECT_NE(std::find(read.begin(), read.end(), name), read.end()) << name << " not read";
+  }
+  std::string list;
+  for (const auto& n : read) list += " " + n;
+  std::printf("read %zu pydicom test files:%s\n", read.size(), list.c_str());
 }
 
 // ---- malformed input --------------------------------------------------------
