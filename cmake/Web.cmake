@@ -7,8 +7,9 @@
 # sources): files picked or dropped in the page are read by the same
 # readers as the CLI's, their gzip/zlib inflated by the page's pako
 # (web/src/InflaterPako.cpp replaces io/InflaterZlib.cpp; web/package.json
-# pins pako). The writers (zlib, nifticlib) and DICOM (DCMTK) stay native:
-# web/src/DicomUnavailable.cpp says so, and PNG I/O reports that it is not
+# pins pako). The writers (zlib, nifticlib) stay native; DICOM is read by
+# io/DicomBasicReader.cpp instead of DCMTK (web/src/DicomBasicSeries.cpp
+# routes the path entry points to it), and PNG I/O reports that it is not
 # built in (web/src/PngUnavailable.cpp). The gpu layer's EGL platform
 # (GlContext.cpp) is replaced by the browser's (web/src/GlContextWebGL.cpp:
 # the page's canvas owns the WebGL context).
@@ -48,7 +49,8 @@ add_custom_command(
 file(GLOB TESSERA_WEB_IO CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/io/*.cpp)
 # OME-Zarr (Zarr*, Http*) needs libblosc, libzstd and libcurl, which
 # emscripten cannot link here (see README, OME-Zarr in the browser).
-list(FILTER TESSERA_WEB_IO EXCLUDE REGEX "/(.*Writer|Dicom.*|InflaterZlib|OutputFile|Zarr.*|Http.*)\\.cpp$")
+# DICOM: the reader without DCMTK (DicomBasicReader, DicomSeries), not DCMTK's.
+list(FILTER TESSERA_WEB_IO EXCLUDE REGEX "/(.*Writer|DicomSeriesReader|DicomToolkit|InflaterZlib|OutputFile|Zarr.*|Http.*)\\.cpp$")
 set(TESSERA_WEB_SOURCES ${TESSERA_GLSL_CPP} ${TESSERA_WEB_IO})
 foreach(layer core gpu lod reference lattice layout render viewer)
   file(GLOB_RECURSE srcs CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/${layer}/*.cpp)

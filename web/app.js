@@ -209,6 +209,35 @@
     return openEntries(entries, (message) => message);
   }
 
+  // A dropped or picked folder (a DICOM series; web/dicom-drop.js walks it):
+  // every file read with progress, then the series opened.
+  async function openFolder(named) {
+    const progress = $('progress');
+    if (named.length === 0) {
+      showError('the folder has no files' + keeps());
+      return false;
+    }
+    let entries;
+    try {
+      progress.hidden = false;
+      progress.max = named.length;
+      entries = await TesseraFolders.readAll(named, (done, total, bytes) => {
+        progress.value = done;
+        $('status').textContent = `reading ${done} of ${total} files (${megabytes(bytes)} MB)`;
+      });
+    } catch (e) {
+      progress.hidden = true;
+      showError(e.message + keeps());
+      updateStatus();
+      return false;
+    }
+    entries = TesseraFolders.forReading(entries);
+    $('status').textContent = `opening ${entries.length} files…`;
+    await new Promise((r) => requestAnimationFrame(() => setTimeout(r, 0)));  // paint it first
+    progress.hidden = true;
+    return openEntries(entries, (message) => message);
+  }
+
   // Hands {name, bytes} entries to the io readers; `explain` turns a
   // failure's message into what the page shows.
   async function openEntries(entries, explain) {
@@ -537,7 +566,12 @@
   ['dragleave', 'drop'].forEach((t) => view.addEventListener(t, () => view.classList.remove('dragover')));
   view.addEventListener('drop', (e) => {
     e.preventDefault();
-    if (e.dataTransfer && e.dataTransfer.files.length) openFiles(e.dataTransfer.files);
+    const folder = TesseraFolders.droppedFolderEntries(e.dataTransfer);
+    if (folder) {
+      TesseraFolders.walk(folder).then(openFolder, (err) => showError(`cannot read the dropped folder: ${err.message}`));
+    } else if (e.dataTransfer && e.dataTransfer.files.length) {
+      openFiles(e.dataTransfer.files);
+    }
   });
 
   // ---------------------------------------------------------------- controls
@@ -547,6 +581,11 @@
       const files = Array.from(e.target.files);
       e.target.value = '';
       if (files.length) await openFiles(files);
+    });
+    $('folder').addEventListener('change', async (e) => {
+      const named = TesseraFolders.pickedFiles(e.target.files);
+      e.target.value = '';
+      await openFolder(named);
     });
     ['grey', 'mr-default', 'ct-bone', 'ct-muscle', 'bench'].forEach((n) => {
       const o = document.createElement('option');

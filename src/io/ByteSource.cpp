@@ -93,6 +93,25 @@ std::unique_ptr<ByteSource> FolderFiles::open(const std::string& resolved) const
   return std::make_unique<FileSource>(resolved);
 }
 
+std::vector<std::string> FolderFiles::filesBeside(const ByteSource& from) const {
+  // Named as `from` is: "x.dcm" beside "x.dcm", not "./x.dcm".
+  const fs::path parent = fs::path(from.name()).parent_path();
+  const fs::path folder = parent.empty() ? fs::path(".") : parent;
+  std::vector<std::string> out;
+  std::error_code ec;
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    std::error_code tec;
+    if (it->is_regular_file(tec)) out.push_back((parent / it->path().filename()).string());
+  }
+  if (ec) throw InputError(folder.string() + ": cannot list the folder: " + ec.message());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<std::string> MemoryFiles::filesBeside(const ByteSource&) const {
+  return names();
+}
+
 void MemoryFiles::add(std::string name, std::vector<std::byte> bytes) {
   auto owned = std::make_shared<const std::vector<std::byte>>(std::move(bytes));
   const std::span<const std::byte> view(*owned);
@@ -110,6 +129,10 @@ std::vector<std::string> MemoryFiles::names() const {
 }
 
 const MemoryFiles::Entry* MemoryFiles::find(const std::string& name) const {
+  // A dropped folder's files may share a file name in different subfolders.
+  for (const Entry& e : files_) {
+    if (e.name == name) return &e;
+  }
   const std::string wanted = fileNameOf(name);
   for (const Entry& e : files_) {
     if (fileNameOf(e.name) == wanted) return &e;

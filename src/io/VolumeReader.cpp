@@ -6,6 +6,7 @@
 
 #include "io/HeaderText.h"
 #include "tessera/core/Error.h"
+#include "tessera/io/DicomBasicReader.h"
 #include "tessera/io/DicomSeriesReader.h"
 #include "tessera/io/MetaImageReader.h"
 #include "tessera/io/NiftiReader.h"
@@ -82,12 +83,9 @@ Volume readVolume(const std::string& spec, const ReadOptions& options) {
 
 Volume readVolume(const ByteSource& file, const FileSet& files) {
   const std::string lower = lowerFileName(file.name());
-  if (isDicomName(lower) || hasDicomMarker(file)) {
-    throw InputError(file.name() +
-                     ": DICOM is read from files on disk only (through DCMTK): open the folder "
-                     "with the native tessera, or convert it first (tessera convert FOLDER "
-                     "out.nii.gz)");
-  }
+  // The reader without DCMTK (the browser has none): the file's series from
+  // the files beside it.
+  if (isDicomName(lower) || hasDicomMarker(file)) return readDicomSeriesBasic(file, files);
   if (endsWith(lower, ".nii") || endsWith(lower, ".nii.gz") || endsWith(lower, ".hdr") ||
       endsWith(lower, ".hdr.gz")) {
     return readNifti(file, files);

@@ -76,6 +76,10 @@ class FileSet {
   virtual bool contains(const std::string& resolved) const = 0;
   // The file; InputError starting with `resolved` if it is missing.
   virtual std::unique_ptr<ByteSource> open(const std::string& resolved) const = 0;
+  // The files beside `from` (its folder's regular files, `from` included,
+  // not searched recursively; all files held in memory), as names `open`
+  // takes, in a stable order: a DICOM series is read from them.
+  virtual std::vector<std::string> filesBeside(const ByteSource& from) const = 0;
 };
 
 // Files on disk.
@@ -84,10 +88,11 @@ class FolderFiles final : public FileSet {
   std::string resolve(const ByteSource& from, const std::string& name) const override;
   bool contains(const std::string& resolved) const override;
   std::unique_ptr<ByteSource> open(const std::string& resolved) const override;
+  std::vector<std::string> filesBeside(const ByteSource& from) const override;
 };
 
-// Files held in memory and found by file name (folders in a name are
-// ignored): the browser's picked or dropped files, and those of tests and
+// Files held in memory and found by their whole name, else by file name
+// (folders in a name are ignored): the browser's picked or dropped files, and those of tests and
 // fuzzers.
 class MemoryFiles final : public FileSet {
  public:
@@ -99,6 +104,7 @@ class MemoryFiles final : public FileSet {
   std::string resolve(const ByteSource& from, const std::string& name) const override;
   bool contains(const std::string& resolved) const override;
   std::unique_ptr<ByteSource> open(const std::string& resolved) const override;
+  std::vector<std::string> filesBeside(const ByteSource& from) const override;
 
  private:
   struct Entry {

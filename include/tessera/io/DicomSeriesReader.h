@@ -1,5 +1,8 @@
 #pragma once
 // DICOM series -> one volume, through DCMTK (Schultz 2016, 6.1 and 7.1.1).
+// The browser build, which has no DCMTK, implements these with the reader
+// of DicomBasicReader.h (uncompressed and RLE only); both share the series
+// assembly and geometry described here (io/DicomSeries.cpp).
 #include <filesystem>
 #include <string>
 #include <vector>

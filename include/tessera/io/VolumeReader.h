@@ -32,9 +32,9 @@ struct ReadOptions {
 Volume readVolume(const std::string& spec, const ReadOptions& options = {});
 
 // The same readers on a byte source, the other files it names found in
-// `files`: what the browser reads picked or dropped files with. Every format
-// above but DICOM, which DCMTK reads from files on disk only (an InputError
-// saying so).
+// `files`: what the browser reads picked or dropped files with. DICOM is read
+// by the reader without DCMTK (DicomBasicReader.h: uncompressed and RLE
+// Part-10 files), the series of `file` from the files beside it.
 Volume readVolume(const ByteSource& file, const FileSet& files);
 
 // Of several files opened together (the browser's picker or a drop), the

@@ -1,0 +1,159 @@
+#pragma once
+// What a DICOM series reader does once a file's attributes can be read,
+// whichever parser read them: DCMTK natively (DicomSeriesReader.cpp) or the
+// small reader that also builds for the browser (DicomBasicReader.cpp).
+// Series grouping, stack selection, the checks, the LPS geometry (converted
+// to the volume's RAS+ once, core/PatientFrame.h) and the rescale live here
+// once, so both readers give the same volume with the same affine.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "tessera/core/Volume.h"
+#include "tessera/io/DicomSeriesReader.h"
+
+namespace tessera::io_detail {
+
+struct DicomTag {
+  std::uint16_t group = 0;
+  std::uint16_t element = 0;
+  std::string text() const;  // "(0028,0010)"
+};
+
+inline constexpr DicomTag kTagRows{0x0028, 0x0010};
+inline constexpr DicomTag kTagColumns{0x0028, 0x0011};
+inline constexpr DicomTag kTagBitsAllocated{0x0028, 0x0100};
+inline constexpr DicomTag kTagBitsStored{0x0028, 0x0101};
+inline constexpr DicomTag kTagHighBit{0x0028, 0x0102};
+inline constexpr DicomTag kTagPixelRepresentation{0x0028, 0x0103};
+inline constexpr DicomTag kTagSamplesPerPixel{0x0028, 0x0002};
+inline constexpr DicomTag kTagPhotometric{0x0028, 0x0004};
+inline constexpr DicomTag kTagNumberOfFrames{0x0028, 0x0008};
+inline constexpr DicomTag kTagPixelSpacing{0x0028, 0x0030};
+inline constexpr DicomTag kTagRescaleIntercept{0x0028, 0x1052};
+inline constexpr DicomTag kTagRescaleSlope{0x0028, 0x1053};
+inline constexpr DicomTag kTagModality{0x0008, 0x0060};
+inline constexpr DicomTag kTagSeriesDescription{0x0008, 0x103e};
+inline constexpr DicomTag kTagSliceThickness{0x0018, 0x0050};
+inline constexpr DicomTag kTagSpacingBetweenSlices{0x0018, 0x0088};
+inline constexpr DicomTag kTagSeriesInstanceUid{0x0020, 0x000e};
+inline constexpr DicomTag kTagInstanceNumber{0x0020, 0x0013};
+inline constexpr DicomTag kTagImagePositionPatient{0x0020, 0x0032};
+inline constexpr DicomTag kTagImageOrientationPatient{0x0020, 0x0037};
+inline constexpr DicomTag kTagPixelData{0x7fe0, 0x0010};
+
+// A parsed file's top-level attributes, as each parser provides them.
+class DicomAttributes {
+ public:
+  virtual ~DicomAttributes() = default;
+  // The value as text without leading/trailing spaces and NULs (an element
+  // stored with VR UN gives its bytes, PS3.5 6.2.2); nullopt when absent,
+  // unreadable or longer than any attribute read here can be.
+  virtual std::optional<std::string> text(DicomTag tag) const = 0;
+  // An unsigned short (US, or UN of two bytes); nullopt when absent.
+  virtual std::optional<int> uint16(DicomTag tag) const = 0;
+};
+
+// One image file of a series: what the header says, before any pixel is read.
+struct Slice {
+  std::filesystem::path file;
+  std::string seriesUid;
+  std::string seriesDescription;
+  std::string modality;
+  // For the description: "Little Endian Explicit (1.2.840.10008.1.2.1)".
+  std::string transferSyntax;
+  int rows = 0;
+  int columns = 0;
+  int bitsAllocated = 0;
+  int bitsStored = 0;
+  int highBit = -1;
+  bool isSigned = false;
+  int samplesPerPixel = 1;
+  long frames = 1;
+  std::string photometric;
+  std::optional<long> instanceNumber;
+  std::optional<glm::dvec3> position;      // Image Position (Patient), LPS mm
+  std::optional<glm::dvec3> rowDir;        // LPS direction of increasing column index
+  std::optional<glm::dvec3> colDir;        // LPS direction of increasing row index
+  std::optional<glm::dvec2> pixelSpacing;  // (between rows, between columns)
+  double slope = 1.0;
+  double intercept = 0.0;
+  double sliceThickness = 0.0;
+  double spacingBetweenSlices = 0.0;
+  // Declared length of uncompressed pixel data, checked before anything is
+  // allocated (compressed data is checked once decoded).
+  std::optional<std::uint64_t> pixelBytes;
+  // For compressed pixel data whose codec bounds its expansion (RLE): the
+  // most bytes it can decode to, checked before anything is allocated.
+  std::optional<std::uint64_t> decodedBytesBound;
+  std::string compression;  // names the codec in that check's message
+  // The first malformed attribute, reported only if this slice is read.
+  std::string defect;
+  double distance = 0.0;  // along the slice normal, set when sorting
+};
+
+// A file that could not be used (unparsable, or no codec for its pixels),
+// with what its header said as far as it could be parsed.
+struct UnreadableFile {
+  std::filesystem::path file;
+  std::string error;
+  std::string seriesUid;               // may be empty
+  std::optional<glm::dvec3> position;  // LPS mm, when parsed
+};
+
+struct FolderScan {
+  std::string where;  // "folder X" or "the N files given"
+  std::vector<Slice> slices;
+  int nonDicomFiles = 0;
+  int nonImageObjects = 0;  // DICOMDIR, reports, ... (no Pixel Data)
+  // Skipped, then judged with the series read (see checkUnreadableMembers);
+  // a note when they belong to another series.
+  std::vector<UnreadableFile> unreadable;
+  int subfolders = 0;
+};
+
+// The attributes a slice needs; problems are recorded in `defect`, not
+// thrown, so that a broken file of a series nobody asked for does no harm.
+// The transfer syntax and pixel lengths are the parser's to fill in.
+Slice sliceHeader(const std::filesystem::path& file, const DicomAttributes& attributes);
+
+// What an unusable file's header says, as far as it was parsed.
+UnreadableFile unreadableFile(const std::filesystem::path& file, std::string error,
+                              const DicomAttributes& attributes);
+
+struct StoredRange {
+  std::int64_t min = std::numeric_limits<std::int64_t>::max();
+  std::int64_t max = std::numeric_limits<std::int64_t>::min();
+  std::uint64_t padding = 0;  // bytes after the pixels (see storePixels)
+};
+
+// One slice's decoded pixels, `length` bytes of 8-bit samples or 16-bit
+// samples in host byte order, stored into z-plane `z` of `stored` (masked to
+// Bits Stored, sign-extended when signed). Pixel data must hold Rows x
+// Columns pixels; less than another frame of bytes after them is padding.
+StoredRange storePixels(const Slice& s, const void* samples, std::uint64_t length, Volume& stored,
+                        int z);
+
+// Decodes `slice` into z-plane `z` of `stored` (through storePixels).
+using PixelDecoder = std::function<StoredRange(const Slice& slice, Volume& stored, int z)>;
+
+// InputError unless the scan found images (naming why not: no files,
+// non-DICOM files, unreadable ones, subfolders).
+void refuseEmpty(const FolderScan& scan, const std::string& what);
+
+// Reads the series `seriesUid` (empty: the one holding `named`, else the
+// largest) from what a folder scan found; see DicomSeriesReader.h.
+Volume readSeries(FolderScan scan, const std::string& seriesUid, const std::string& what,
+                  const PixelDecoder& decode, const std::filesystem::path& named = {});
+
+// The series of a scan, the largest first.
+std::vector<DicomSeriesInfo> listSeries(FolderScan scan);
+
+}  // namespace tessera::io_detail
