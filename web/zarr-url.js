@@ -65,14 +65,19 @@
     throw new Error(`${url}: ${why} (after at most ${ATTEMPTS} attempts)`);
   }
 
-  // blosc and zstd: Debian's libraries are native only, so the page decodes
-  // such chunks as they arrive with numcodecs' WebAssembly builds of them
-  // (npm numcodecs, MIT, pinned in web/package-lock.json, copied into the
-  // site's numcodecs/), loaded when a store needs them.
-  const PAGE_CODECS = new Set(['blosc', 'zstd']);
+  // Chunks are decoded here as they arrive, once each (a brick read with
+  // its apron touches up to 27 chunks: decoding them in every read cost
+  // most of the refinement): zlib and gzip with the page's pako, blosc and
+  // zstd — Debian's libraries are native only — with numcodecs' WebAssembly
+  // builds of them (npm numcodecs, MIT, pinned in web/package-lock.json,
+  // copied into the site's numcodecs/), loaded when a store needs them. The
+  // wasm side checks each decoded chunk's size.
+  const PAGE_CODECS = new Set(['zlib', 'gzip', 'blosc', 'zstd']);
   const codecModules = {};
   const codecErrors = {};
+  const pakoCodec = { fromConfig: () => ({ decode: (bytes) => globalThis.pako.inflate(bytes) }) };
   function loadCodec(id) {
+    if (id === 'zlib' || id === 'gzip') return Promise.resolve(globalThis.pako ? pakoCodec : null);
     if (!codecModules[id]) {
       codecModules[id] = import(`./numcodecs/${id}.js`).then((m) => m.default, (e) => {
         codecErrors[id] = e.message;
@@ -269,16 +274,21 @@
       bricksRead = 0;
     }
 
-    // Whether a frame now would show something new: keys arrived, bricks
-    // were read last frame (uploaded by the next), or a refinement that waits
-    // on nothing in flight (bricks backing off after errors) every 250 ms.
+    // Whether a frame now would show something new: keys arrived, or bricks
+    // were read last frame (uploaded by the next), or a refinement waits on
+    // nothing in flight (bricks backing off after errors: every 250 ms). While
+    // fetches are under way a frame waits until they are done or twice the
+    // last frame's time has passed: fetches are answered only between frames,
+    // and a slow frame (SwiftShader: a second) would otherwise hold them up.
     function wantsFrame() {
       if (!open) return false;
       if (!last) return true;
-      if (arrived) return true;
-      if (last.complete) return last.failing > 0 && performance.now() - lastFrameAt > 3000;
-      if (last.uploaded > 0 || last.bricks_read !== bricksRead) return true;
-      return inFlight.size === 0 && queue.length === 0 && performance.now() - lastFrameAt > 250;
+      const since = performance.now() - lastFrameAt;
+      const fetching = inFlight.size > 0 || queue.length > 0;
+      const paced = !fetching || since >= 2 * last.ms;
+      if (last.complete) return arrived ? paced : last.failing > 0 && since > 3000;
+      if (arrived || last.uploaded > 0 || last.bricks_read !== bricksRead) return paced;
+      return !fetching && since > 250;
     }
 
     function levelsText(f) {

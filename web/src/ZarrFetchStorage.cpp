@@ -24,8 +24,7 @@ void FetchStorage::want(const std::string& key) const {
 }
 
 bool FetchStorage::decodesChunks(ZarrCompressor c) const {
-  return (c == ZarrCompressor::Blosc || c == ZarrCompressor::Zstd) &&
-         pageDecodes_[static_cast<int>(c)];
+  return c != ZarrCompressor::None && pageDecodes_[static_cast<int>(c)];
 }
 
 bool FetchStorage::ready(const std::string& key) const {

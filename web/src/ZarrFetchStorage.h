@@ -45,8 +45,10 @@ class FetchStorage final : public ZarrStorage {
   std::string locate(const std::string& key) const override { return url_ + "/" + key; }
   std::string describe() const override { return url_; }
   int parallelism() const override { return 1; }  // no threads; the page fetches in parallel
-  // The page decodes blosc and zstd chunks (numcodecs) when it has loaded
-  // numcodecs' decoder for them (setPageDecodes).
+  // The page decodes chunks as they arrive, once each (web/zarr-url.js:
+  // zlib and gzip with pako, blosc and zstd with numcodecs) when it has the
+  // decoder (setPageDecodes); the io decoders (web/src/ZarrCodecsWeb.cpp)
+  // are the fallback.
   bool decodesChunks(ZarrCompressor c) const override;
   void setPageDecodes(ZarrCompressor c) { pageDecodes_[static_cast<int>(c)] = true; }
 

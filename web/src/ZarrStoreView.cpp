@@ -19,6 +19,8 @@ constexpr std::uint64_t kFetchedBytes = 48ull << 20;
 // As the viewer core plans its uploads (viewer/Viewer.cpp).
 constexpr int kPlanImageSize = 1024;
 constexpr int kSkipBlock = 8;
+// Streaming (reading and uploading arrived bricks) before a frame is drawn.
+constexpr double kStreamMs = 150.0;
 
 }  // namespace
 
@@ -85,6 +87,19 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
   f.renderHeight = std::max(1, static_cast<int>(std::lround(height * scale)));
   gpu::clearErrors();
   f.bricks = bricks_->update(camera, f.renderWidth, f.renderHeight, tf);
+  // Each update reads a few bricks whose chunks have arrived and uploads
+  // what the last one read; a ray march costs far more (SwiftShader: most of
+  // a second), so stream on for up to kStreamMs before drawing, and a frame
+  // shows everything that has arrived.
+  const auto tStream = std::chrono::steady_clock::now();
+  int uploaded = f.bricks.uploaded;
+  while (!f.bricks.complete && msSince(tStream) < kStreamMs) {
+    const std::uint64_t read = bricks_->streamerStats().bricksRead;
+    f.bricks = bricks_->update(camera, f.renderWidth, f.renderHeight, tf);
+    uploaded += f.bricks.uploaded;
+    if (f.bricks.uploaded == 0 && bricks_->streamerStats().bricksRead == read) break;
+  }
+  f.bricks.uploaded = uploaded;
   // Over transparent black; the compositor adds the background and lines.
   RenderSettings pass = settings;
   pass.background = glm::dvec4(0.0);

@@ -36,10 +36,10 @@ class ZarrStorage {
   // delivered a damaged body.
   virtual int refetches() const { return 0; }
   // True when get() hands over the chunks of arrays with this compressor
-  // decoded already: the browser's storage, whose page
-  // decodes blosc and zstd with numcodecs' WebAssembly builds as they
-  // arrive (Debian's libblosc and libzstd are native only). ZarrStore then
-  // checks their size instead of decoding them.
+  // decoded already: the browser's storage, whose page decodes each chunk
+  // once as it arrives (pako; numcodecs' WebAssembly blosc and zstd, as
+  // Debian's libblosc and libzstd are native only). ZarrStore then checks
+  // their size instead of decoding them.
   virtual bool decodesChunks(ZarrCompressor compressor) const {
     (void)compressor;
     return false;
