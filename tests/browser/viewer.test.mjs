@@ -639,7 +639,7 @@ async function loadFromUrl(context, url, tmp, run) {
 
 // ?url= of an OME-Zarr store (issue 14): ch2 written by `tessera convert
 // --compressor zlib`, served as a folder tree and read key by key with
-// fetch(). The finest level's chunks are served 1.5 s late, so the page must
+// fetch(). The finest level's chunks are served 0.75 s late, so the page must
 // show the coarser levels first; it then refines to what the native CLI
 // renders of the same store (bricks layout, same profile). blosc and zstd
 // stores read the same.
@@ -654,7 +654,7 @@ async function zarrStoreFromUrl(context, url, tmp, run) {
     .filter((f) => fs.statSync(f).isFile() && !path.basename(f).startsWith('.')).reduce((n, f) => n + fs.statSync(f).size, 0);
   const finestBytes = bytesUnder(path.join(store, '0'));
   const chunkBytes = bytesUnder(store);
-  served.delayMs = (p) => (p.startsWith('/data/ch2.ome.zarr/0/') && !p.endsWith('.zarray') ? 1500 : 0);
+  served.delayMs = (p) => (p.startsWith('/data/ch2.ome.zarr/0/') && !p.endsWith('.zarray') ? 750 : 0);
   const before = { requests: served.requests, bytes: served.bytes };
   const { page, logs } = await openPage(context, url, `size=${SIZE}&url=/data/ch2.ome.zarr`);
   const coarse = await snapshot(page);
@@ -684,7 +684,7 @@ async function zarrStoreFromUrl(context, url, tmp, run) {
         `${z.requests} requests, ${(z.bytes / 1048576).toFixed(2)} MiB fetched; chunks of all levels ` +
         `${(chunkBytes / 1048576).toFixed(2)} MiB, of the finest ${(finestBytes / 1048576).toFixed(2)} MiB`);
   console.log(`zarr: ch2 ${SIZE}x${SIZE}: first image ${z.firstImageMs.toFixed(0)} ms, refined ${z.completeMs.toFixed(0)} ms ` +
-              `(finest chunks served 1.5 s late), ${z.requests} requests, ${z.bytes} bytes fetched, finest level ${finestBytes} bytes`);
+              `(finest chunks served 0.75 s late), ${z.requests} requests, ${z.bytes} bytes fetched, finest level ${finestBytes} bytes`);
   // Chromium logs every 404 (the store's all-zero chunks, left out as Zarr allows).
   const errors = logs.filter((l) => (l.startsWith('pageerror') || l.startsWith('error')) && !/status of 404/.test(l));
   check('no script errors on the OME-Zarr page', errors.length === 0, errors.join(' | '));
