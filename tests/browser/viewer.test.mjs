@@ -40,7 +40,7 @@ const TYPES = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/ja
   '.css': 'text/css', '.wasm': 'application/wasm', '.png': 'image/png', '.json': 'application/json' };
 // Data prefixes serve their folder trees (an OME-Zarr store is one); a test
 // may slow some paths down (served.delayMs) and count what was served.
-const served = { delayMs: () => 0, requests: 0, bytes: 0 };
+const served = { delayMs: () => 0, fails: () => false, requests: 0, bytes: 0 };
 async function serve(dir, dataDirs) {
   const server = http.createServer((req, res) => {
     const p = decodeURIComponent(new URL(req.url, 'http://x').pathname);
@@ -51,6 +51,11 @@ async function serve(dir, dataDirs) {
     if (!file) file = path.join(dir, path.normalize(p === '/' ? '/index.html' : p));
     fs.stat(file, (err, st) => setTimeout(() => {
       served.requests++;
+      if (served.fails(p)) {
+        res.writeHead(500, { 'Content-Type': 'text/plain' });
+        res.end('injected failure');
+        return;
+      }
       if (err || !st.isFile()) {
         res.writeHead(404, { 'Content-Type': 'text/plain' });
         res.end('not found');
@@ -641,8 +646,9 @@ async function loadFromUrl(context, url, tmp, run) {
 // --compressor zlib`, served as a folder tree and read key by key with
 // fetch(). The finest level's chunks are served 0.75 s late, so the page must
 // show the coarser levels first; it then refines to what the native CLI
-// renders of the same store (bricks layout, same profile). blosc and zstd
-// stores read the same.
+// renders of the same store (bricks layout, same profile). A chunk that
+// always fails and a store that is not there give errors naming the URL;
+// blosc and zstd stores read the same.
 async function zarrStoreFromUrl(context, url, tmp, run) {
   if (!fs.existsSync(CH2)) { check(`OME-Zarr test needs ${CH2} (mricron-data)`, false); return; }
   const store = path.join(tmp, 'ch2.ome.zarr');
@@ -689,6 +695,27 @@ async function zarrStoreFromUrl(context, url, tmp, run) {
   const errors = logs.filter((l) => (l.startsWith('pageerror') || l.startsWith('error')) && !/status of 404/.test(l));
   check('no script errors on the OME-Zarr page', errors.length === 0, errors.join(' | '));
   await page.close();
+
+  // A chunk that always answers 500: the page retries it, then completes
+  // with the bricks over it at the coarser level and says which URL fails;
+  // a store that is not there: an error naming its URL.
+  served.fails = (p) => p === '/data/ch2.ome.zarr/0/1/1/1';
+  const f = await openPage(context, url, `size=${SIZE}&url=/data/ch2.ome.zarr`);
+  await f.page.waitForFunction(() => window.tessera.zarr().completeMs !== null, null, { timeout: 60000 });
+  const zf = await f.page.evaluate(() => window.tessera.zarr());
+  const statusText = await f.page.locator('#status').textContent();
+  served.fails = () => false;
+  check('OME-Zarr ?url= with a chunk that always fails: completes at the coarser level there, naming the URL',
+        zf.last.complete && zf.last.failing > 0 && zf.last.cells_per_level[1] > 0 &&
+        zf.last.last_error.includes(`${url}/data/ch2.ome.zarr/0/1/1/1`) && statusText.includes('0/1/1/1'),
+        `${zf.last.failing} bricks failing, cells ${JSON.stringify(zf.last.cells_per_level)}: "${zf.last.last_error}"`);
+  await f.page.close();
+  const gone = `${url}/data/not-there.ome.zarr`;
+  const g = await openPage(context, url, `size=64&url=${encodeURIComponent(gone)}`);
+  const goneMsg = await g.page.evaluate(() => window.tessera.error());
+  check('OME-Zarr ?url= of a store that is not there: a visible error naming the URL',
+        goneMsg.includes(gone) && await g.page.locator('#error').isVisible(), `"${goneMsg}"`);
+  await g.page.close();
 
   // blosc and zstd chunks, decoded in the page by numcodecs (Debian's
   // libblosc and libzstd are native only): the same voxels, the same image.

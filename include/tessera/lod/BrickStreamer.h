@@ -26,15 +26,15 @@
 namespace tessera::lod {
 
 struct BrickStreamerOptions {
-  int workers = 2;                // 0: request() reads inline
-  int inlineReadsPerRequest = 8;  // without workers
-  // Without workers: queued bricks whose source is not ready yet
-  // (MultiresSource::prefetch) looked at per request before it gives up.
-  int prefetchAhead = 16;
+  int workers = 2;                         // 0: request() reads inline
+  int inlineReadsPerRequest = 8;           // without workers
   std::uint64_t cacheBytes = 64ull << 20;  // decoded bricks kept on the host
   double firstRetryMs = 20.0;              // back-off: doubles per failure...
   double maxRetryMs = 2000.0;              // ...up to this
   int attemptsBeforeFailing = 3;           // then failing() is true (still retried)
+  // Without workers: queued bricks whose source is not ready yet
+  // (MultiresSource::prefetch) looked at per request before it gives up.
+  int prefetchAhead = 16;
 };
 
 struct BrickRange {
