@@ -234,6 +234,7 @@
       showError(explain(api.lastError()) + keeps());
       return false;
     }
+    if (zarr) zarr.close();  // the files' volume replaces the store
     clearError();
     volumeChanged();
     await requestRender();
