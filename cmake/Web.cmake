@@ -47,18 +47,21 @@ add_custom_command(
 # From io: the readers and procedural sources; not the writers, DICOM, nor
 # the zlib inflater.
 file(GLOB TESSERA_WEB_IO CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/io/*.cpp)
-# OME-Zarr (Zarr*, Http*) needs libblosc, libzstd and libcurl, which
-# emscripten cannot link here (see README, OME-Zarr in the browser).
-# DICOM: the reader without DCMTK (DicomBasicReader, DicomSeries), not DCMTK's.
-list(FILTER TESSERA_WEB_IO EXCLUDE REGEX "/(.*Writer|DicomSeriesReader|DicomToolkit|InflaterZlib|OutputFile|Zarr.*|Http.*)\\.cpp$")
+# OME-Zarr: the store reader is shared; its storage is the page's fetch()
+# (web/src/ZarrFetchStorage.cpp) instead of folders and libcurl (Http*,
+# ZarrVolume), and its codecs web/src/ZarrCodecsWeb.cpp (pako) instead of
+# Debian's zlib, libzstd and libblosc (ZarrCodecs), which emscripten cannot
+# link here. DICOM: the reader without DCMTK (DicomBasicReader,
+# DicomSeries), not DCMTK's (DicomSeriesReader, DicomToolkit).
+list(FILTER TESSERA_WEB_IO EXCLUDE REGEX
+     "/(.*Writer|DicomSeriesReader|DicomToolkit|InflaterZlib|OutputFile|ZarrVolume|ZarrCodecs|Http.*)\\.cpp$")
 set(TESSERA_WEB_SOURCES ${TESSERA_GLSL_CPP} ${TESSERA_WEB_IO})
 foreach(layer core gpu lod reference lattice layout render viewer)
   file(GLOB_RECURSE srcs CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/${layer}/*.cpp)
   list(APPEND TESSERA_WEB_SOURCES ${srcs})
 endforeach()
 # The EGL platform; web/src/GlContextWebGL.cpp is the browser's.
-list(REMOVE_ITEM TESSERA_WEB_SOURCES ${CMAKE_SOURCE_DIR}/src/gpu/GlContext.cpp
-            ${CMAKE_SOURCE_DIR}/src/lod/ZarrMultiresSource.cpp)
+list(REMOVE_ITEM TESSERA_WEB_SOURCES ${CMAKE_SOURCE_DIR}/src/gpu/GlContext.cpp)
 file(GLOB TESSERA_WEB_FRONT CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/web/src/*.cpp)
 
 set_source_files_properties(${CMAKE_SOURCE_DIR}/src/core/TransferFunction.cpp PROPERTIES
@@ -95,6 +98,21 @@ set(TESSERA_PAKO ${CMAKE_SOURCE_DIR}/web/node_modules/pako/dist/pako_inflate.min
 if(NOT EXISTS ${TESSERA_PAKO})
   message(FATAL_ERROR "${TESSERA_PAKO} is missing: run `npm ci` in web/ (scripts/web.sh does)")
 endif()
+# numcodecs' blosc and zstd decoders (WebAssembly builds of c-blosc and
+# zstd; MIT), which the page loads for stores with those compressors
+# (web/zarr-url.js), into the site's numcodecs/.
+set(TESSERA_NUMCODECS ${CMAKE_SOURCE_DIR}/web/node_modules/numcodecs/dist)
+if(NOT EXISTS ${TESSERA_NUMCODECS}/blosc.js)
+  message(FATAL_ERROR "${TESSERA_NUMCODECS} is missing: run `npm ci` in web/ (scripts/web.sh does)")
+endif()
+file(GLOB TESSERA_NUMCODECS_JS ${TESSERA_NUMCODECS}/blosc.js ${TESSERA_NUMCODECS}/zstd.js
+     ${TESSERA_NUMCODECS}/chunk-*.js)
+foreach(f ${TESSERA_NUMCODECS_JS})
+  get_filename_component(n ${f} NAME)
+  configure_file(${f} ${TESSERA_WEB_SITE}/numcodecs/${n} COPYONLY)
+endforeach()
+configure_file(${CMAKE_SOURCE_DIR}/web/node_modules/numcodecs/LICENSE
+               ${TESSERA_WEB_SITE}/numcodecs/LICENSE COPYONLY)
 file(GLOB TESSERA_WEB_STATIC CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/web/*.html
      ${CMAKE_SOURCE_DIR}/web/*.js ${CMAKE_SOURCE_DIR}/web/*.css)
 foreach(f ${TESSERA_WEB_STATIC} ${TESSERA_PAKO})

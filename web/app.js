@@ -65,6 +65,7 @@
   let renderWaiters = [];
   let refineNotBefore = 0;  // performance.now() before which no strip is rendered
   let slices = null;        // web/slices.js, once the module is up
+  let zarr = null;  // an open OME-Zarr store (web/zarr-url.js)
 
   function showError(message) {
     const e = $('error');
@@ -159,7 +160,21 @@
   // of the pending full-quality one; render() promises resolve once the
   // frame is complete.
   function loop() {
-    if (api) {
+    if (api && zarr && zarr.active()) {
+      // An OME-Zarr store (web/zarr-url.js): frames while bricks arrive.
+      let ms = -1;
+      if (needsRender || zarr.wantsFrame()) {
+        needsRender = false;
+        fitCanvas();
+        ms = zarr.frame(canvas.width, canvas.height);
+        frames++;
+      }
+      if (!needsRender && renderWaiters.length) {
+        const waiters = renderWaiters;
+        renderWaiters = [];
+        waiters.forEach((w) => w(ms));
+      }
+    } else if (api) {
       let ms = -1;
       if (needsRender) {
         needsRender = false;
@@ -255,6 +270,7 @@
       showError(explain(api.lastError()) + keeps());
       return false;
     }
+    if (zarr) zarr.close();  // the files' volume replaces the store
     clearError();
     volumeChanged();
     await requestRender();
@@ -678,7 +694,12 @@
     new ResizeObserver(() => { if (fitCanvas()) requestRender(); }).observe(canvas);
     window.addEventListener('resize', () => { if (fitCanvas()) requestRender(); });
     requestAnimationFrame(loop);
-    if (volumeUrls.length) {
+    if (volumeUrls.length === 1 && window.TesseraZarr && TesseraZarr.isStoreUrl(volumeUrls[0])) {
+      zarr = TesseraZarr.create(M, { showError, clearError, status: (t) => { $('status').textContent = t; },
+        progress: (v, max) => { $('progress').hidden = !(max > 0); if (max > 0) { $('progress').max = max; $('progress').value = v; } } });
+      await zarr.open(volumeUrls[0]);
+      volumeChanged();
+    } else if (volumeUrls.length) {
       if (!(await openUrls(volumeUrls))) volumeChanged();
     } else {
       if (!api.loadGenerated(defaultVolume)) showError(api.lastError());
@@ -699,6 +720,7 @@
     openFile: (file) => openFiles([file]),
     openUrls,
     lastLoad: () => lastLoad,
+    zarr: () => (zarr ? zarr.stats() : null),
     setProgressive: (on) => { api.setProgressive(on ? 1 : 0, frameBudgetMs); },
     setCamera: (az, el, zoom) => { api.setCamera(az, el, zoom); return requestRender(); },
     setTfJson: (json) => { const ok = api.tfSetJson(json); tfEdited(); return ok; },

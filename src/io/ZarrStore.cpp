@@ -459,12 +459,48 @@ Volume ZarrStore::readBox(int l, glm::ivec3 begin, glm::ivec3 end, const Progres
   if (threads <= 1) {
     work();
   } else {
-    std::vector<std::jthread> pool;
-    for (int t = 0; t < threads; ++t) pool.emplace_back(work);
+    // std::thread, joined by hand: the browser build's libc++ has no jthread.
+    std::vector<std::thread> pool;
+    const auto joinAll = [&] {
+      for (std::thread& t : pool) t.join();
+    };
+    try {
+      for (int t = 0; t < threads; ++t) pool.emplace_back(work);
+    } catch (...) {
+      next = chunks.size();
+      joinAll();
+      throw;
+    }
+    joinAll();
   }
   if (failure) std::rethrow_exception(failure);
   out.invalidateRange();
   return out;
+}
+
+std::string ZarrStore::chunkKeyAt(int l, const std::vector<std::int64_t>& spatial) const {
+  const ZarrLevel& lv = levels_[std::size_t(l)];
+  const ZarrArrayMeta& m = lv.array;
+  std::vector<std::int64_t> index(std::size_t(m.rank()), 0);
+  for (int r = 0; r < 3; ++r) index[std::size_t(axis_[r])] = spatial[std::size_t(r)];
+  const int sel[2] = {selection_.time, selection_.channel};
+  for (int r = kT; r <= kC; ++r) {
+    if (axis_[r] >= 0) index[std::size_t(axis_[r])] = sel[r - kT] / m.chunks[std::size_t(axis_[r])];
+  }
+  return (lv.path.empty() ? "" : lv.path + "/") + m.chunkKey(index);
+}
+
+std::vector<std::string> ZarrStore::chunkKeys(int l, glm::ivec3 begin, glm::ivec3 end) const {
+  const ZarrLevel& lv = level(l);
+  const glm::ivec3 c0 = glm::max(begin, glm::ivec3(0)) / lv.chunk;
+  const glm::ivec3 c1 = (glm::min(end, lv.dims) - 1) / lv.chunk + 1;
+  std::vector<std::string> keys;
+  for (int z = c0.z; z < c1.z; ++z) {
+    for (int y = c0.y; y < c1.y; ++y) {
+      for (int x = c0.x; x < c1.x; ++x) keys.push_back(chunkKeyAt(l, {x, y, z}));
+    }
+  }
+  return keys;
 }
 
 void ZarrStore::readChunkInto(int l, const std::vector<std::int64_t>& spatial, glm::ivec3 begin,
@@ -472,22 +508,18 @@ void ZarrStore::readChunkInto(int l, const std::vector<std::int64_t>& spatial, g
   const ZarrLevel& lv = levels_[std::size_t(l)];
   const ZarrArrayMeta& m = lv.array;
   const int rank = m.rank();
-  // The chunk's grid index over every array axis, and the element strides
-  // inside a chunk (C order).
-  std::vector<std::int64_t> index(std::size_t(rank), 0);
+  // The element strides inside a chunk (C order), and the selected time
+  // point's and channel's offset in it.
   std::vector<std::int64_t> stride(std::size_t(rank), 1);
   for (int a = rank - 2; a >= 0; --a)
     stride[std::size_t(a)] = stride[std::size_t(a) + 1] * m.chunks[std::size_t(a) + 1];
   std::int64_t base = 0;
-  for (int r = 0; r < 3; ++r) index[std::size_t(axis_[r])] = spatial[std::size_t(r)];
   const int sel[2] = {selection_.time, selection_.channel};
   for (int r = kT; r <= kC; ++r) {
     if (axis_[r] < 0) continue;
-    const std::int64_t ch = m.chunks[std::size_t(axis_[r])];
-    index[std::size_t(axis_[r])] = sel[r - kT] / ch;
-    base += (sel[r - kT] % ch) * stride[std::size_t(axis_[r])];
+    base += (sel[r - kT] % m.chunks[std::size_t(axis_[r])]) * stride[std::size_t(axis_[r])];
   }
-  const std::string key = (lv.path.empty() ? "" : lv.path + "/") + m.chunkKey(index);
+  const std::string key = chunkKeyAt(l, spatial);
   const glm::ivec3 origin =
       glm::ivec3(int(spatial[0]), int(spatial[1]), int(spatial[2])) * lv.chunk;
   const glm::ivec3 lo = glm::max(begin, origin);
@@ -497,7 +529,9 @@ void ZarrStore::readChunkInto(int l, const std::vector<std::int64_t>& spatial, g
     const auto stored = storage_->get(key, m.maxStoredChunkBytes());
     if (!stored) break;
     try {
-      raw = decodeZarrChunk(m, *stored, storage_->locate(key));
+      raw = storage_->decodesChunks(m.compressor)
+                ? decodedZarrChunk(m, std::move(*stored), storage_->locate(key))
+                : decodeZarrChunk(m, *stored, storage_->locate(key));
       break;
     } catch (const InputError&) {
       // A network may have damaged the body: fetch it again.

@@ -66,7 +66,8 @@ void BrickStreamer::request(const std::vector<BrickKey>& keys) {
 }
 
 void BrickStreamer::readQueuedInline(int count) {
-  for (int i = 0; i < count; ++i) {
+  int notReady = 0;
+  while (count > 0) {
     BrickKey key;
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -74,6 +75,13 @@ void BrickStreamer::readQueuedInline(int count) {
       key = queue_.front();
       queue_.pop_front();
     }
+    // A brick whose bytes are still on their way is asked for again next
+    // request; waiting here would block the (browser's only) thread.
+    if (!source_->prefetch(key.level, grid_.readBox(key))) {
+      if (++notReady >= options_.prefetchAhead) return;
+      continue;
+    }
+    --count;
     try {
       readNow(key);
     } catch (const std::exception&) {

@@ -7,6 +7,7 @@ namespace tessera::lod {
 ZarrMultiresSource::ZarrMultiresSource(std::shared_ptr<const ZarrStore> store)
     : store_(std::move(store)) {}
 
+#ifndef __EMSCRIPTEN__
 std::unique_ptr<ZarrMultiresSource> ZarrMultiresSource::open(const std::string& spec,
                                                              ZarrSelection selection) {
   // Bricks read with an apron touch their neighbours' chunks: keep the
@@ -17,6 +18,7 @@ std::unique_ptr<ZarrMultiresSource> ZarrMultiresSource::open(const std::string& 
   return std::make_unique<ZarrMultiresSource>(
       std::make_shared<const ZarrStore>(std::move(storage), selection));
 }
+#endif
 
 LevelInfo ZarrMultiresSource::levelInfo(int level) const {
   const ZarrLevel& l = store_->level(level);

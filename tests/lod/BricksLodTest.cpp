@@ -212,3 +212,60 @@ TEST(BricksLod, WithoutWorkerThreadsRequestReadsInline) {
   EXPECT_TRUE(streamer.find({0, {2, 0, 0}}));
   EXPECT_TRUE(streamer.idle());
 }
+
+namespace {
+
+// A source whose bytes arrive asynchronously (the browser's fetch()): boxes
+// starting in brick column 1 are not ready until `arrived`; it counts the
+// prefetches that asked for them and any read of a box that was not ready.
+class LateSource final : public lod::MultiresSource {
+ public:
+  LateSource(std::shared_ptr<const lod::MultiresSource> inner, int brick)
+      : inner_(std::move(inner)), brick_(brick) {}
+  const Volume& shape() const override { return inner_->shape(); }
+  int levelCount() const override { return inner_->levelCount(); }
+  lod::LevelInfo levelInfo(int level) const override { return inner_->levelInfo(level); }
+  Volume readBox(int level, const lod::VoxelBox& box) const override {
+    if (!prefetch(level, box)) ++readsNotReady;
+    return inner_->readBox(level, box);
+  }
+  bool prefetch(int, const lod::VoxelBox& box) const override {
+    if ((box.begin.x + 1) / brick_ != 1 || arrived) return true;
+    ++asked;
+    return false;
+  }
+  std::string describe() const override { return "late " + inner_->describe(); }
+  bool arrived = false;
+  mutable int asked = 0;
+  mutable int readsNotReady = 0;
+
+ private:
+  std::shared_ptr<const lod::MultiresSource> inner_;
+  int brick_;
+};
+
+}  // namespace
+
+TEST(BricksLod, InlineStreamerSkipsBricksWhoseBytesHaveNotArrivedWithoutCountingFailures) {
+  const auto v = hashVolume({48, 16, 16});
+  auto late = std::make_shared<LateSource>(std::make_shared<lod::InCoreMultiresSource>(v, 8), 16);
+  const lod::BrickGrid grid = lod::BrickGrid::of(*late, 16);
+  lod::BrickStreamerOptions o;
+  o.workers = 0;
+  lod::BrickStreamer streamer(late, grid, o);
+  const std::vector<lod::BrickKey> keys{{0, {0, 0, 0}}, {0, {1, 0, 0}}, {0, {2, 0, 0}}};
+  streamer.request(keys);
+  EXPECT_TRUE(streamer.find(keys[0]));
+  EXPECT_FALSE(streamer.find(keys[1])) << "its bytes are on their way: not read, not waited for";
+  EXPECT_TRUE(streamer.find(keys[2])) << "the brick behind it is read meanwhile";
+  EXPECT_EQ(late->asked, 1);
+  EXPECT_FALSE(streamer.failing(keys[1]));
+  EXPECT_EQ(streamer.stats().readErrors, 0u);
+  streamer.request(keys);
+  EXPECT_EQ(late->asked, 2) << "asked for again on the next request";
+  late->arrived = true;
+  streamer.request(keys);
+  EXPECT_TRUE(streamer.find(keys[1]));
+  EXPECT_EQ(late->readsNotReady, 0);
+  EXPECT_TRUE(streamer.idle());
+}

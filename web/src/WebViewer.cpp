@@ -18,7 +18,9 @@
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
+#include "ZarrStoreView.h"
 #include "tessera/core/Error.h"
+#include "tessera/core/Histogram.h"
 #include "tessera/core/PatientFrame.h"
 #include "tessera/core/SliceImage.h"
 #include "tessera/gpu/DeviceProfile.h"
@@ -620,6 +622,152 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_projection_json(int width, int height) 
   });
   scratch() = j.dump();
   return scratch().c_str();
+}
+
+}  // extern "C"
+
+// ---- OME-Zarr stores over fetch() (web/zarr-url.js drives these): the page
+// fetches the keys a step wants and hands them over, the store renders
+// through the bricks layout coarse to fine (ZarrStoreView.h) with the viewer
+// core's camera, transfer function and settings.
+namespace {
+
+std::unique_ptr<web::ZarrStoreView>& zarrView() {
+  static std::unique_ptr<web::ZarrStoreView> v;
+  return v;
+}
+
+web::ZarrStoreView& theZarrView() {
+  if (!zarrView()) throw Error("no OME-Zarr store is open");
+  return *zarrView();
+}
+
+}  // namespace
+
+extern "C" {
+
+// Starts opening the store at `url` (its root, e.g. http://host/ch2.ome.zarr).
+EMSCRIPTEN_KEEPALIVE int tessera_zarr_begin(const char* url) {
+  return guarded([&] {
+    viewer::Viewer& v = theViewer();
+    zarrView() = std::make_unique<web::ZarrStoreView>(v.context(), v.limits(), url);
+  });
+}
+
+// One step of opening: 1 open (the coarsest level is on the GPU), 0 keys
+// are wanted (tessera_zarr_wanted), -1 failed (tessera_last_error).
+EMSCRIPTEN_KEEPALIVE int tessera_zarr_open_step() {
+  int state = -1;
+  guarded([&] {
+    web::ZarrStoreView& z = theZarrView();
+    state = z.open() ? 1 : 0;
+    if (state == 1) {
+      viewer::Viewer& v = theViewer();
+      v.tfEditor().setHistogram(Histogram::compute(z.coarsest(), 256, z.store().shape().window()));
+      v.resetCamera();
+    }
+  });
+  return state;
+}
+
+// The keys wanted since the last call, most urgent first, as a JSON array.
+EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_wanted() {
+  nlohmann::json keys = nlohmann::json::array();
+  if (zarrView()) {
+    for (const std::string& k : zarrView()->storage().takeWanted()) keys.push_back(k);
+  }
+  scratch() = keys.dump();
+  return scratch().c_str();
+}
+
+// A fetched key: its bytes (malloc'ed by the page, freed here), a 404, or
+// the page's error after its retries (naming the URL).
+EMSCRIPTEN_KEEPALIVE void tessera_zarr_put(const char* key, std::uint8_t* bytes, int size) {
+  const std::unique_ptr<std::uint8_t, decltype(&std::free)> owned(bytes, &std::free);
+  if (!zarrView()) return;
+  const auto* b = reinterpret_cast<const std::byte*>(bytes);
+  zarrView()->storage().put(key, std::vector<std::byte>(b, b + std::max(0, size)));
+}
+EMSCRIPTEN_KEEPALIVE void tessera_zarr_put_missing(const char* key) {
+  if (zarrView()) zarrView()->storage().putMissing(key);
+}
+EMSCRIPTEN_KEEPALIVE void tessera_zarr_put_failed(const char* key, const char* message) {
+  if (zarrView()) zarrView()->storage().putFailed(key, message);
+}
+
+// The page decodes chunks of this compressor ("blosc", "zstd") itself
+// (numcodecs, web/zarr-url.js) before it hands them over.
+EMSCRIPTEN_KEEPALIVE int tessera_zarr_page_decodes(const char* compressor) {
+  return guarded([&] { theZarrView().storage().setPageDecodes(parseZarrCompressor(compressor)); });
+}
+
+// A frame of the open store on the canvas: JSON with the bricks' state
+// ("complete", "wanted", "missing", "failing", "uploaded", cells per level),
+// or "" on error (tessera_last_error).
+EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_frame(int width, int height) {
+  scratch().clear();
+  guarded([&] {
+    viewer::Viewer& v = theViewer();
+    web::ZarrStoreView& z = theZarrView();
+    const web::StoreFrame f = z.frame(
+        v.camera(), v.frameSettings(), v.tfEditor().transferFunction(), v.tfEditor().revision(),
+        v.showBoundingBox, v.showAxes, width, height, v.maxVolumePixels);
+    const lod::StreamerStats s = z.bricks().streamerStats();
+    const web::FetchStats fetched = z.storage().stats();
+    nlohmann::json j;
+    j["ms"] = f.ms;
+    j["render_size"] = {f.renderWidth, f.renderHeight};
+    j["complete"] = f.bricks.complete;
+    j["wanted"] = f.bricks.wanted;
+    j["missing"] = f.bricks.missing;
+    j["failing"] = f.bricks.failing;
+    j["uploaded"] = f.bricks.uploaded;
+    j["limited_by_budget"] = f.bricks.limitedByBudget;
+    j["wanted_per_level"] = f.bricks.wantedPerLevel;
+    j["cells_per_level"] = f.bricks.cellsPerLevel;  // last: transparent cells
+    j["bricks_read"] = s.bricksRead;
+    j["read_errors"] = s.readErrors;
+    j["last_error"] = s.lastError;
+    j["fetched_keys"] = fetched.keys;
+    j["fetched_bytes"] = fetched.bytes;
+    j["fetch_failures"] = fetched.failed;
+    j["held_bytes"] = fetched.heldBytes;
+    scratch() = j.dump();
+  });
+  return scratch().c_str();
+}
+
+// The open store: its description, levels and the bricks layout's plan.
+EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_info() {
+  scratch().clear();
+  guarded([&] {
+    const web::ZarrStoreView& z = theZarrView();
+    nlohmann::json j;
+    j["url"] = z.store().storage().describe();
+    j["description"] = z.store().describe();
+    j["open"] = z.isOpen();
+    j["levels"] = nlohmann::json::array();
+    for (int l = 0; l < z.store().levelCount(); ++l) {
+      const ZarrLevel& lv = z.store().level(l);
+      j["levels"].push_back({{"path", lv.path},
+                             {"dims", {lv.dims.x, lv.dims.y, lv.dims.z}},
+                             {"chunk", {lv.chunk.x, lv.chunk.y, lv.chunk.z}},
+                             {"compressor", lv.array.compressorText}});
+    }
+    if (z.isOpen()) {
+      j["layout_reason"] = z.bricks().plan().reason;
+      j["brick_size"] = z.bricks().grid().brickSize();
+      j["slots"] = z.bricks().slotCount();
+    }
+    j["notes"] = z.store().notes();
+    scratch() = j.dump();
+  });
+  return scratch().c_str();
+}
+
+// Closes the store (the viewer core's volume shows again).
+EMSCRIPTEN_KEEPALIVE void tessera_zarr_close() {
+  zarrView().reset();
 }
 
 }  // extern "C"

@@ -66,6 +66,11 @@ std::string zarrayJson(const std::vector<std::int64_t>& shape,
 std::vector<std::byte> decodeZarrChunk(const ZarrArrayMeta& meta, std::span<const std::byte> stored,
                                        const std::string& where);
 
+// A chunk its storage decoded already (ZarrStorage::decodesChunks): checked
+// to hold exactly meta.chunkBytes() bytes (InputError naming `where`).
+std::vector<std::byte> decodedZarrChunk(const ZarrArrayMeta& meta, std::vector<std::byte> raw,
+                                        const std::string& where);
+
 // Raw little-endian chunk bytes -> the stored form (blosc: lz4 + byte
 // shuffle of `itemSize`-byte elements; zstd level 3; zlib level 6).
 std::vector<std::byte> encodeZarrChunk(ZarrCompressor compressor, int itemSize,

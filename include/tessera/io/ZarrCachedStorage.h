@@ -25,6 +25,7 @@ class CachedStorage final : public ZarrStorage {
   void forget(const std::string& key) const override;
   std::string locate(const std::string& key) const override { return inner_->locate(key); }
   int refetches() const override { return inner_->refetches(); }
+  bool decodesChunks(ZarrCompressor c) const override { return inner_->decodesChunks(c); }
   int parallelism() const override { return inner_->parallelism(); }
   std::string describe() const override { return inner_->describe(); }
 

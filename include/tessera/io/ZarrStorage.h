@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "tessera/io/ZarrArray.h"
+
 namespace tessera {
 
 class ZarrStorage {
@@ -33,6 +35,15 @@ class ZarrStorage {
   // same bytes would come back (disk, memory); a network may have
   // delivered a damaged body.
   virtual int refetches() const { return 0; }
+  // True when get() hands over the chunks of arrays with this compressor
+  // decoded already: the browser's storage, whose page decodes each chunk
+  // once as it arrives (pako; numcodecs' WebAssembly blosc and zstd, as
+  // Debian's libblosc and libzstd are native only). ZarrStore then checks
+  // their size instead of decoding them.
+  virtual bool decodesChunks(ZarrCompressor compressor) const {
+    (void)compressor;
+    return false;
+  }
   // How many chunk reads are worth having in flight at once.
   virtual int parallelism() const { return 2; }
   // The store's root for `info`: a folder or a URL.

@@ -66,6 +66,11 @@ class ZarrStore {
     return readBox(l, glm::ivec3(0), level(l).dims, progress);
   }
 
+  // The storage keys of the chunks readBox(l, begin, end) reads, in its
+  // order: what an asynchronous storage (the browser's fetch()) must hold
+  // before the read.
+  std::vector<std::string> chunkKeys(int l, glm::ivec3 begin, glm::ivec3 end) const;
+
   // The finest level whose voxels (plus one chunk per reader) fit the host
   // budget; -1 if none does.
   int finestLevelWithin(std::uint64_t budgetBytes) const;
@@ -85,6 +90,7 @@ class ZarrStore {
   void addLevel(const std::string& path, glm::dvec3 scale, glm::dvec3 translation);
   void checkSelection();
   void makeShape(const std::string& attrsText);
+  std::string chunkKeyAt(int l, const std::vector<std::int64_t>& spatial) const;
   void readChunkInto(int l, const std::vector<std::int64_t>& chunkIndex, glm::ivec3 begin,
                      glm::ivec3 end, Volume& out) const;
 

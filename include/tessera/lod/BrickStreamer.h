@@ -32,6 +32,9 @@ struct BrickStreamerOptions {
   double firstRetryMs = 20.0;              // back-off: doubles per failure...
   double maxRetryMs = 2000.0;              // ...up to this
   int attemptsBeforeFailing = 3;           // then failing() is true (still retried)
+  // Without workers: queued bricks whose source is not ready yet
+  // (MultiresSource::prefetch) looked at per request before it gives up.
+  int prefetchAhead = 16;
 };
 
 struct BrickRange {

@@ -57,6 +57,17 @@ class MultiresSource {
   // coarser level on screen and retries later.
   virtual Volume readBox(int level, const VoxelBox& box) const = 0;
 
+  // Whether readBox(level, box) can return now without waiting on slow
+  // storage. Sources whose storage answers asynchronously (the browser's
+  // fetch(), which the single-threaded page must not block on) start the
+  // reads the box needs and say false until they have arrived; the
+  // streamer then reads other bricks and asks again next frame.
+  virtual bool prefetch(int level, const VoxelBox& box) const {
+    (void)level;
+    (void)box;
+    return true;
+  }
+
   // A short description for logs and `tessera info` (path or URL).
   virtual std::string describe() const = 0;
 };

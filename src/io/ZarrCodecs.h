@@ -1,0 +1,22 @@
+#pragma once
+// The chunk decoders behind decodeZarrChunk (io/ZarrArray.h), one set per
+// platform: natively Debian's zlib, libzstd and libblosc
+// (io/ZarrCodecs.cpp); in the browser the page's pako for zlib/gzip
+// (web/src/ZarrCodecsWeb.cpp). Each returns exactly `expected` bytes or
+// throws InputError naming `where` (the chunk's path or URL).
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace tessera::io_detail {
+
+std::vector<std::byte> inflateZarrChunk(std::span<const std::byte> in, std::uint64_t expected,
+                                        bool gzip, const std::string& where);
+std::vector<std::byte> zstdZarrChunk(std::span<const std::byte> in, std::uint64_t expected,
+                                     const std::string& where);
+std::vector<std::byte> bloscZarrChunk(std::span<const std::byte> in, std::uint64_t expected,
+                                      const std::string& where);
+
+}  // namespace tessera::io_detail

@@ -1,0 +1,344 @@
+// OME-Zarr stores in the page (?url=http://host/NAME.ome.zarr): the store is
+// read with fetch(), key by key, as the wasm side asks for keys
+// (web/src/ZarrFetchStorage.cpp), and rendered coarse to fine through the
+// bricks layout (web/src/ZarrStoreView.cpp): first the coarsest level, then
+// finer bricks as their chunks arrive, nearest first. Nothing here waits on
+// the network inside a frame: fetches run beside the animation frames, and
+// each frame uploads what has arrived.
+//
+// Fetching as the native HTTP storage does (io/HttpStorage.h): a few
+// requests at a time, up to 4 attempts with back-off (100 ms doubling, with
+// jitter) for network errors, timeouts, 5xx, 408 and 429, the body checked
+// against Content-Length; a 404 is a missing key (a chunk reads as
+// fill_value, as Zarr defines); a key that keeps failing is handed over as
+// an error naming its URL (the coarser level stays on screen; it is fetched
+// again later).
+'use strict';
+
+(function () {
+  const CONNECTIONS = 6;
+  const ATTEMPTS = 4;
+  const TIMEOUT_MS = 60000;
+
+  // A URL whose path ends in .zarr (NAME.zarr, NAME.ome.zarr, with or
+  // without a trailing slash).
+  function isStoreUrl(u) {
+    try {
+      return /\.zarr\/?$/i.test(new URL(u, location.href).pathname);
+    } catch {
+      return false;
+    }
+  }
+
+  const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
+  const retryable = (status) => status >= 500 || status === 408 || status === 429;
+
+  // {bytes} or {missing: true}; throws an Error naming the URL.
+  async function fetchKey(url) {
+    let why = '';
+    for (let attempt = 1; attempt <= ATTEMPTS; attempt++) {
+      if (attempt > 1) await sleep(100 * 2 ** (attempt - 2) * (0.75 + 0.5 * Math.random()));
+      const abort = new AbortController();
+      const timer = setTimeout(() => abort.abort(), TIMEOUT_MS);
+      try {
+        const r = await fetch(url, { signal: abort.signal });
+        if (r.status === 404) return { missing: true };
+        if (!r.ok) {
+          why = `HTTP ${r.status} ${r.statusText}`.trim();
+          if (retryable(r.status)) continue;
+          break;
+        }
+        const bytes = new Uint8Array(await r.arrayBuffer());
+        const declared = r.headers.get('Content-Length');
+        if (declared !== null && !r.headers.get('Content-Encoding') && parseInt(declared, 10) !== bytes.length) {
+          why = `truncated body (${bytes.length} of ${declared} bytes)`;
+          continue;
+        }
+        return { bytes };
+      } catch (e) {
+        why = e.name === 'AbortError' ? `no answer in ${TIMEOUT_MS / 1000} s`
+          : `cannot fetch it (${e.message}): the server is unreachable, or it does not let this page read it (CORS)`;
+      } finally {
+        clearTimeout(timer);
+      }
+    }
+    throw new Error(`${url}: ${why} (after at most ${ATTEMPTS} attempts)`);
+  }
+
+  // Chunks are decoded here as they arrive, once each (a brick read with
+  // its apron touches up to 27 chunks: decoding them in every read cost
+  // most of the refinement): zlib and gzip with the page's pako, blosc and
+  // zstd — Debian's libraries are native only — with numcodecs' WebAssembly
+  // builds of them (npm numcodecs, MIT, pinned in web/package-lock.json,
+  // copied into the site's numcodecs/), loaded when a store needs them. The
+  // wasm side checks each decoded chunk's size.
+  const PAGE_CODECS = new Set(['zlib', 'gzip', 'blosc', 'zstd']);
+  const codecModules = {};
+  const codecErrors = {};
+  const pakoCodec = { fromConfig: () => ({ decode: (bytes) => globalThis.pako.inflate(bytes) }) };
+  function loadCodec(id) {
+    if (id === 'zlib' || id === 'gzip') return Promise.resolve(globalThis.pako ? pakoCodec : null);
+    if (!codecModules[id]) {
+      codecModules[id] = import(`./numcodecs/${id}.js`).then((m) => m.default, (e) => {
+        codecErrors[id] = e.message;
+        return null;
+      });
+    }
+    return codecModules[id];
+  }
+
+  // Bytes per chunk of a .zarray (shape of a chunk x the dtype's size).
+  function chunkBytesOf(meta) {
+    const size = parseInt(String(meta.dtype).replace(/^[<>|=]?[a-zA-Z]/, ''), 10) || 1;
+    return meta.chunks.reduce((n, c) => n * c, size);
+  }
+
+  // The store view of one page: M is the emscripten module; ui has
+  // status(text), progress(value, max) (max 0 hides it), showError(text),
+  // clearError().
+  function create(M, ui) {
+    const c = (name, ret, args) => M.cwrap(name, ret, args);
+    const api = {
+      begin: c('tessera_zarr_begin', 'number', ['string']),
+      openStep: c('tessera_zarr_open_step', 'number', []),
+      wanted: c('tessera_zarr_wanted', 'string', []),
+      put: c('tessera_zarr_put', null, ['string', 'number', 'number']),
+      putMissing: c('tessera_zarr_put_missing', null, ['string']),
+      putFailed: c('tessera_zarr_put_failed', null, ['string', 'string']),
+      frame: c('tessera_zarr_frame', 'string', ['number', 'number']),
+      info: c('tessera_zarr_info', 'string', []),
+      close: c('tessera_zarr_close', null, []),
+      lastError: c('tessera_last_error', 'string', []),
+      pageDecodes: c('tessera_zarr_page_decodes', 'number', ['string']),
+    };
+
+    let base = '';
+    let name = '';
+    let open = false;
+    let t0 = 0;
+    let queue = [];          // keys wanted and not started, most urgent first
+    const inFlight = new Set();
+    let idleWaiters = [];
+    let arrived = false;     // a key arrived since the last frame
+    let last = null;         // the last frame's JSON
+    let lastFrameAt = 0;
+    let bricksRead = 0;
+    const arrays = new Map();  // array path ('' for a root array) -> {id, config, chunkBytes, codec}
+    const record = { url: '', requests: 0, bytes: 0, timeline: [], firstImageMs: null, completeMs: null,
+      openMs: null, info: null, errors: [] };
+
+    function put(key, r) {
+      if (r.missing) {
+        api.putMissing(key);
+        return;
+      }
+      const p = M._malloc(Math.max(1, r.bytes.length));
+      if (!p) {
+        api.putFailed(key, `${base}/${key}: cannot allocate ${r.bytes.length} bytes for it`);
+        return;
+      }
+      M.HEAPU8.set(r.bytes, p);
+      api.put(key, p, r.bytes.length);  // owned (and freed) by the module
+    }
+
+    async function start(key) {
+      inFlight.add(key);
+      const url = `${base}/${key}`;
+      try {
+        let r = await fetchKey(url);
+        record.requests++;
+        if (r.bytes) {
+          record.bytes += r.bytes.length;
+          if (key === '.zarray' || key.endsWith('/.zarray')) await noteArray(key, r.bytes);
+          else r = await decodeInPage(key, url, r);
+        }
+        if (base) put(key, r);
+      } catch (e) {
+        record.errors.push(e.message);
+        if (base) api.putFailed(key, e.message);
+      } finally {
+        inFlight.delete(key);
+        arrived = true;
+        pump();
+      }
+    }
+
+    // A .zarray's compressor: blosc and zstd chunks are decoded here when
+    // numcodecs loads (the wasm side is told so); otherwise its decoder
+    // says that it cannot decode them.
+    async function noteArray(key, bytes) {
+      let meta;
+      try {
+        meta = JSON.parse(new TextDecoder().decode(bytes));
+      } catch {
+        return;  // the store reader reports it
+      }
+      const path = key.slice(0, key.length - '.zarray'.length).replace(/\/$/, '');
+      const id = meta && meta.compressor && meta.compressor.id;
+      const Codec = PAGE_CODECS.has(id) && Array.isArray(meta.chunks) ? await loadCodec(id) : null;
+      arrays.set(path, { id, codec: Codec ? Codec.fromConfig(meta.compressor) : null,
+        chunkBytes: Codec ? chunkBytesOf(meta) : 0 });
+      if (Codec && base) api.pageDecodes(id);
+    }
+
+    // The array a chunk key belongs to: the longest array path before it.
+    function arrayOf(key) {
+      let best = null;
+      let bestLength = -1;
+      for (const [path, a] of arrays) {
+        if ((path === '' || key.startsWith(`${path}/`)) && path.length > bestLength) {
+          best = a;
+          bestLength = path.length;
+        }
+      }
+      return best;
+    }
+
+    async function decodeInPage(key, url, r) {
+      const array = arrayOf(key);
+      if (!array || !array.codec) return r;
+      let raw;
+      try {
+        raw = await array.codec.decode(r.bytes);
+      } catch (e) {
+        throw new Error(`${url}: corrupt ${array.id} chunk (${e.message})`);
+      }
+      if (raw.length !== array.chunkBytes) {
+        throw new Error(`${url}: ${array.id} chunk decoded to ${raw.length} bytes, expected ${array.chunkBytes}`);
+      }
+      return { bytes: raw };
+    }
+
+    function pump() {
+      while (inFlight.size < CONNECTIONS && queue.length) start(queue.shift());
+      if (inFlight.size === 0 && queue.length === 0) {
+        const w = idleWaiters;
+        idleWaiters = [];
+        w.forEach((f) => f());
+      }
+    }
+
+    // The wasm side's wanted keys replace the queue (the view changed what
+    // is urgent); keys being fetched stay in flight.
+    function takeWanted() {
+      const keys = JSON.parse(api.wanted());
+      queue = keys.filter((k) => !inFlight.has(k));
+      pump();
+      return keys.length;
+    }
+
+    const idle = () => (inFlight.size === 0 && queue.length === 0 ? Promise.resolve()
+      : new Promise((resolve) => idleWaiters.push(resolve)));
+
+    // Metadata, then the coarsest level; true when the store is open.
+    async function openStore(url) {
+      close();
+      const resolved = new URL(url, location.href).href.replace(/\/+$/, '');
+      base = resolved;
+      name = decodeURIComponent(resolved.split('/').pop() || 'store');
+      Object.assign(record, { url: resolved, requests: 0, bytes: 0, timeline: [], firstImageMs: null,
+        completeMs: null, openMs: null, info: null, errors: [] });
+      t0 = performance.now();
+      ui.progress(0, 0);
+      ui.status(`opening ${resolved}…`);
+      if (!api.begin(resolved)) {
+        ui.showError(`${resolved}: ${api.lastError()}`);
+        return false;
+      }
+      for (;;) {
+        const state = api.openStep();
+        if (state === 1) break;
+        if (state < 0 || takeWanted() === 0) {
+          const message = api.lastError() || 'the store could not be opened';
+          ui.showError(message.includes(resolved) ? message : `${resolved}: ${message}`);
+          close();
+          return false;
+        }
+        ui.status(`opening ${resolved}: ${record.requests} keys, ${(record.bytes / 1048576).toFixed(2)} MB`);
+        await idle();
+      }
+      open = true;
+      record.openMs = performance.now() - t0;
+      record.info = JSON.parse(api.info());
+      ui.clearError();
+      return true;
+    }
+
+    function close() {
+      arrays.clear();
+      if (base) api.close();
+      base = '';
+      open = false;
+      queue = [];
+      last = null;
+      bricksRead = 0;
+    }
+
+    // Whether a frame now would show something new: keys arrived, or bricks
+    // were read last frame (uploaded by the next), or a refinement waits on
+    // nothing in flight (bricks backing off after errors: every 250 ms). While
+    // fetches are under way a frame waits until they are done or twice the
+    // last frame's time has passed: fetches are answered only between frames,
+    // and a slow frame (SwiftShader: a second) would otherwise hold them up.
+    function wantsFrame() {
+      if (!open) return false;
+      if (!last) return true;
+      const since = performance.now() - lastFrameAt;
+      const fetching = inFlight.size > 0 || queue.length > 0;
+      const paced = !fetching || since >= 2 * last.ms;
+      if (last.complete) return arrived ? paced : last.failing > 0 && since > 3000;
+      if (arrived || last.uploaded > 0 || last.bricks_read !== bricksRead) return paced;
+      return !fetching && since > 250;
+    }
+
+    function levelsText(f) {
+      const cells = f.cells_per_level;
+      const parts = [];
+      cells.forEach((n, l) => {
+        if (n > 0) parts.push(l === cells.length - 1 ? `${n} empty` : `L${l}: ${n}`);
+      });
+      return parts.join(', ');
+    }
+
+    // One frame on the canvas; returns its ms, -1 on error.
+    function frame(width, height) {
+      arrived = false;
+      const text = api.frame(width, height);
+      lastFrameAt = performance.now();
+      if (!text) {
+        ui.showError(`${base}: ${api.lastError()}`);
+        return -1;
+      }
+      const f = JSON.parse(text);
+      const prevRead = last ? last.bricks_read : 0;
+      bricksRead = prevRead;
+      last = f;
+      takeWanted();
+      const t = lastFrameAt - t0;
+      if (record.firstImageMs === null) record.firstImageMs = t;
+      if (f.complete && record.completeMs === null) record.completeMs = t;
+      record.timeline.push({ t, ms: f.ms, complete: f.complete, missing: f.missing, wanted: f.wanted,
+        uploaded: f.uploaded, cells: f.cells_per_level, fetched: record.bytes });
+      if (record.timeline.length > 2000) record.timeline.splice(1, 1);
+      const mb = (record.bytes / 1048576).toFixed(2);
+      ui.status(`${name} (OME-Zarr, bricks) · cells ${levelsText(f)} · ` +
+        (f.complete ? 'refined' : `${f.missing} of ${f.wanted} bricks coming`) +
+        ` · ${record.requests} requests, ${mb} MB · frame ${f.ms.toFixed(0)} ms` +
+        (f.failing ? ` · ${f.failing} bricks failing: ${f.last_error}` : ''));
+      ui.progress(f.complete ? 0 : f.wanted - f.missing, f.complete ? 0 : f.wanted);
+      return f.ms;
+    }
+
+    return {
+      open: openStore,
+      close,
+      active: () => open,
+      wantsFrame,
+      frame,
+      // For tests: what was fetched and the frames' timeline.
+      stats: () => ({ ...record, last, inFlight: inFlight.size, queued: queue.length }),
+    };
+  }
+
+  window.TesseraZarr = { isStoreUrl, create };
+})();
