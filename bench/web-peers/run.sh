@@ -9,7 +9,6 @@
 # Writes images, table.md and results.json to build-web/web-peers/ (--out).
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
-cd "$here/../.."
 if [ ! -d "$here/node_modules/@kitware/vtk.js" ] || [ ! -d "$here/node_modules/@niivue/niivue" ] ||
    [ ! -d "$here/node_modules/esbuild" ] || [ ! -d "$here/node_modules/playwright-core" ]; then
   (cd "$here" && npm ci --no-audit --no-fund --loglevel=error)
@@ -19,6 +18,6 @@ if [ ! -f "$here/dist/vtk-peer.js" ] || [ "$here/pages/vtk-entry.js" -nt "$here/
      --outfile=dist/vtk-peer.js --log-level=warning)
 fi
 if [ -z "${TESSERA_SITE:-}" ]; then
-  scripts/web.sh
+  (cd "$here/../.." && scripts/web.sh)
 fi
 exec node "$here/bench.mjs" "$@"
