@@ -95,6 +95,7 @@
       wheel: c('tessera_wheel', null, ['number']),
       interacting: c('tessera_interacting', 'number', []),
       setCamera: c('tessera_set_camera', 'number', ['number', 'number', 'number']),
+      setProjection: c('tessera_set_projection', null, ['number']),
       tfJson: c('tessera_tf_json', 'string', []),
       tfSetJson: c('tessera_tf_set_json', 'number', ['string']),
       tfPreset: c('tessera_tf_preset', 'number', ['string']),
@@ -723,12 +724,26 @@
     zarr: () => (zarr ? zarr.stats() : null),
     setProgressive: (on) => { api.setProgressive(on ? 1 : 0, frameBudgetMs); },
     setCamera: (az, el, zoom) => { api.setCamera(az, el, zoom); return requestRender(); },
+    setProjection: (orthographic) => { api.setProjection(orthographic ? 1 : 0); return requestRender(); },
     setTfJson: (json) => { const ok = api.tfSetJson(json); tfEdited(); return ok; },
     error: () => ($('error').hidden ? '' : $('error').textContent),
     // The canvas's RGBA pixels, top row first.
     pixels: () => {
       const p = api.readPixels(canvas.width, canvas.height);
       return M.HEAPU8.slice(p, p + canvas.width * canvas.height * 4);
+    },
+    // n whole frames of the current view as the page renders them, each
+    // timed here up to its 1-pixel read-back (bench/web-peers).
+    timeFrames: (n) => {
+      const times = [];
+      api.setProgressive(0, 0);
+      for (let i = 0; i < n; i++) {
+        const t = performance.now();
+        renderNow();
+        times.push(performance.now() - t);
+      }
+      api.setProgressive(progressive ? 1 : 0, frameBudgetMs);
+      return times;
     },
     // Median frame time over n frames turning 10 degrees each (a frame ends
     // with a 1-pixel read-back, since glFinish does not wait in browsers).

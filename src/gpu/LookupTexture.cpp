@@ -27,7 +27,7 @@ std::vector<std::uint8_t> toBytes(const std::vector<float>& v) {
 }  // namespace
 
 void LookupTexture::upload(GlContext& context, const std::vector<float>& rgba,
-                           const std::string& label) {
+                           const std::string& label, Filter filter) {
   const int entries = static_cast<int>(rgba.size() / 4);
   ++uploads_;
   TexelFormat format = TexelFormat::Rgba8Unsized;
@@ -46,11 +46,16 @@ void LookupTexture::upload(GlContext& context, const std::vector<float>& rgba,
                                                            : static_cast<const void*>(rgba.data());
   if (texture_.id() != 0 && entries == entries_ && texture_.format() == format) {
     texture_.update(data);
+    texture_.setFilter(filter);
     return;
   }
   entries_ = entries;
   texture_ = Texture();  // release first: the ledger counts the new one alone
   texture_ = Texture::create2D(context.ledger(), label, format, entries, 1, data);
+  // Nearest for render/classify.glsl, which interpolates between two entries
+  // itself: an unfiltered fetch is much cheaper for a software rasteriser
+  // such as the browsers' SwiftShader (bench/web-peers).
+  texture_.setFilter(filter);
 }
 
 }  // namespace tessera::gpu

@@ -62,7 +62,7 @@ std::vector<float> rampTable() {
 
 gpu::LookupTexture rampLookup(gpu::GlContext& context) {
   gpu::LookupTexture lut;
-  lut.upload(context, rampTable(), "roofline transfer function");
+  lut.upload(context, rampTable(), "roofline transfer function", gpu::Filter::Linear);
   return lut;
 }
 

@@ -9,10 +9,23 @@ uniform float u_valueBias;
 float normalizedValue(float stored) { return clamp(stored * u_valueScale + u_valueBias, 0.0, 1.0); }
 
 vec4 classify(float n) {
-  float x = (n * (u_tfSize - 1.0) + 0.5) / u_tfSize;
 #if TESSERA_GLSL == 300
-  return texture(u_tf, vec2(x, 0.5));
+  // Linear between entries floor(x) and floor(x) + 1 from two texel fetches:
+  // the table's LINEAR filter computed in the shader, which software
+  // rasterisers (SwiftShader in browsers) run far faster than a filtered
+  // fetch of the half-float table (bench/web-peers).
+  float x = n * (u_tfSize - 1.0);
+  float x0 = min(floor(x), u_tfSize - 2.0);
+  vec4 a = texelFetch(u_tf, ivec2(int(x0), 0), 0);
+  vec4 b = texelFetch(u_tf, ivec2(int(x0) + 1, 0), 0);
+  return mix(a, b, x - x0);
 #else
-  return texture2D(u_tf, vec2(x, 0.5));
+  // The same from two unfiltered fetches at texel centres (the ray caster
+  // samples its table with NEAREST filtering).
+  float x = n * (u_tfSize - 1.0);
+  float x0 = min(floor(x), u_tfSize - 2.0);
+  vec4 a = texture2D(u_tf, vec2((x0 + 0.5) / u_tfSize, 0.5));
+  vec4 b = texture2D(u_tf, vec2((x0 + 1.5) / u_tfSize, 0.5));
+  return mix(a, b, x - x0);
 #endif
 }

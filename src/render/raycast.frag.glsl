@@ -76,26 +76,36 @@ void main() {
     k = max(0.0, floor((crop.x - t0) / u_step - j));
     t1 = min(t1, crop.y + 0.5 * u_step);
 #endif
+#ifdef EMPTY_SPACE_SKIPPING
+    // The block grid is read once per block the ray enters, not per sample:
+    // samples before tBlockExit lie in the occupied block read last (one
+    // that float rounding puts just past the face is taken too, harmlessly:
+    // a skippable block's samples add nothing).
+    float tBlockExit = -1.0;
+#endif
     for (int i = 0; i < MAX_STEPS; i++) {
       if (k >= u_maxSteps) break;
       float t = t0 + (k + j) * u_step;
       if (t >= t1) break;
       vec3 p = to + t * td;
 #ifdef EMPTY_SPACE_SKIPPING
-      vec3 cell = clamp(floor(p * u_blocksPerUnit), vec3(0.0), u_blockCount - 1.0);
-      vec4 block = blockAt(cell);
+      if (t >= tBlockExit) {
+        vec3 cell = clamp(floor(p * u_blocksPerUnit), vec3(0.0), u_blockCount - 1.0);
+        vec4 block = blockAt(cell);
 #ifdef MODE_MIP
-      bool empty = block.g <= maxValue;
+        bool empty = block.g <= maxValue;
 #else
-      bool empty = block.r < 0.5;
+        bool empty = block.r < 0.5;
 #endif
-      if (empty) {
-        // Jump to the first sample at or past the block's exit face.
         vec3 exitFace = (cell + step(0.0, td)) / u_blocksPerUnit;
         vec3 tb = (exitFace - to) * invTd;
         float tExit = min(min(tb.x, tb.y), tb.z);
-        k = max(ceil((tExit - t0) / u_step - j), k + 1.0);
-        continue;
+        if (empty) {
+          // Jump to the first sample at or past the block's exit face.
+          k = max(ceil((tExit - t0) / u_step - j), k + 1.0);
+          continue;
+        }
+        tBlockExit = tExit;
       }
 #endif
 #ifdef CLIPPING

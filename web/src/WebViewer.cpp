@@ -208,14 +208,25 @@ EMSCRIPTEN_KEEPALIVE int tessera_interacting() {
   return app().viewer && theViewer().controller().interacting() ? 1 : 0;
 }
 
+// Keeps the projection (tessera_set_projection).
 EMSCRIPTEN_KEEPALIVE int tessera_set_camera(double azimuth, double elevation, double zoom) {
   return guarded([&] {
     Camera& c = theViewer().camera();
+    const Projection projection = c.projection;
     theViewer().resetCamera();
+    c.projection = projection;
     c.azimuthDeg = azimuth;
     c.elevationDeg = elevation;
     c.zoom = zoom;
   });
+}
+
+// 1: orthographic (parallel rays; the view's half height is the framed
+// radius / zoom), 0: perspective (the default).
+EMSCRIPTEN_KEEPALIVE void tessera_set_projection(int orthographic) {
+  if (app().viewer)
+    theViewer().camera().projection =
+        orthographic ? Projection::Orthographic : Projection::Perspective;
 }
 
 // Transfer function: JSON in and out (the CLI's format), presets, editor gestures

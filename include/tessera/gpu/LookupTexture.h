@@ -16,8 +16,10 @@ namespace tessera::gpu {
 
 class LookupTexture {
  public:
-  // `rgba` holds 4 floats per entry.
-  void upload(GlContext& context, const std::vector<float>& rgba, const std::string& label);
+  // `rgba` holds 4 floats per entry. Nearest by default: render/classify.glsl
+  // reads two entries at texel centres and interpolates them itself.
+  void upload(GlContext& context, const std::vector<float>& rgba, const std::string& label,
+              Filter filter = Filter::Nearest);
   const Texture& texture() const { return texture_; }
   int entries() const { return entries_; }
   int uploads() const { return uploads_; }  // how often upload() ran (tests of TF update paths)
