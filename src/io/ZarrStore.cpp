@@ -194,6 +194,7 @@ void ZarrStore::readMultiscales(const std::string& attrsText) {
   const json& ms = all[0];
   version_ = ms.value("version", std::string("?"));
   name_ = ms.contains("name") && ms["name"].is_string() ? ms["name"].get<std::string>() : "";
+  reduction_ = ms.contains("type") && ms["type"].is_string() ? ms["type"].get<std::string>() : "";
   if (!ms.contains("datasets") || !ms["datasets"].is_array() || ms["datasets"].empty()) {
     throw InputError(where + ": multiscales[0] has no \"datasets\"");
   }

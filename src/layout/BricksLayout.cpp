@@ -340,11 +340,19 @@ ValueMapping BricksLayout::rawFromStored() const {
   return m.identity ? ValueMapping{255.0, 0.0} : ValueMapping{m.width, m.min};
 }
 
-std::optional<lod::BrickRange> BricksLayout::rangeOrEstimate(const lod::BrickKey& key) const {
-  // A brick not read yet: its parent's range (with the parent's apron),
-  // the estimate Schultz-style streaming decides with before the fetch.
+std::optional<lod::BrickRange> BricksLayout::subtreeBound(const lod::BrickKey& key) const {
+  // The nearest range read (the brick's own or an ancestor's, with its
+  // apron), widened down to level 0. Only a mean pyramid of identity-stored
+  // values bounds finer levels; otherwise nothing is known of the bricks
+  // under a read one until they are read themselves (a small bright finding
+  // averaged into a dim coarse brick must not vanish).
+  const bool mean = source_->meanPyramid() && streamer_->mapping().identity;
   for (lod::BrickKey k = key; k.level < grid_.levelCount(); k = grid_.parent(k)) {
-    if (auto r = streamer_->range(k)) return r;
+    if (auto r = streamer_->range(k)) {
+      if (k.level == 0) return r;
+      if (!mean) return std::nullopt;
+      return lod::meanPyramidBound(*r, k.level);
+    }
   }
   return std::nullopt;
 }
@@ -352,7 +360,7 @@ std::optional<lod::BrickRange> BricksLayout::rangeOrEstimate(const lod::BrickKey
 bool BricksLayout::transparent(const lod::BrickKey& key, const TransferFunction&, bool exactOnly,
                                std::uint8_t* value) const {
   if (opaquePrefix_.empty()) return false;
-  const std::optional<lod::BrickRange> r = exactOnly ? streamer_->range(key) : rangeOrEstimate(key);
+  const std::optional<lod::BrickRange> r = exactOnly ? streamer_->range(key) : subtreeBound(key);
   if (!r) return false;
   const int lo = 2 * r->min, hi = 2 * r->max;
   const bool any = opaquePrefix_[static_cast<std::size_t>(hi) + 1] -

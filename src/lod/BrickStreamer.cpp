@@ -98,6 +98,15 @@ std::shared_ptr<const StoredBrick> BrickStreamer::find(const BrickKey& key) {
   return it->second->second;
 }
 
+BrickRange meanPyramidBound(BrickRange ancestor, int levelsUp) {
+  double lo = ancestor.min, hi = ancestor.max;
+  for (int i = 0; i < levelsUp && (lo > 0.0 || hi < 255.0); ++i) {
+    lo = std::max(0.0, 8.0 * (lo - 1.0) - 7.0 * 255.0);
+    hi = std::min(255.0, 8.0 * (hi + 1.0));
+  }
+  return {static_cast<std::uint8_t>(lo), static_cast<std::uint8_t>(hi)};
+}
+
 std::optional<BrickRange> BrickStreamer::range(const BrickKey& key) const {
   std::lock_guard<std::mutex> lock(mutex_);
   const auto it = ranges_.find(key.id());

@@ -7,6 +7,8 @@
 #include <atomic>
 #include <memory>
 #include <set>
+#include <unordered_map>
+#include <vector>
 
 #include "tessera/core/Error.h"
 #include "tessera/lod/BrickGrid.h"
@@ -268,4 +270,56 @@ TEST(BricksLod, InlineStreamerSkipsBricksWhoseBytesHaveNotArrivedWithoutCounting
   EXPECT_TRUE(streamer.find(keys[1]));
   EXPECT_EQ(late->readsNotReady, 0);
   EXPECT_TRUE(streamer.idle());
+}
+
+// In a mean pyramid every brick's stored range lies within the bound each of
+// its ancestors gives (the bricks layout leaves unread bricks out by it),
+// also around lone bright voxels that the coarse levels average away.
+TEST(BricksLod, MeanPyramidBoundHoldsForEveryBrickUnderEveryAncestor) {
+  auto v = std::make_shared<Volume>(Volume::allocate({70, 45, 52}, ScalarType::U8));
+  for (std::size_t i = 0; i < v->voxelCount(); ++i) {
+    const std::size_t h = i * 2654435761u >> 9;
+    v->setValueAtIndex(i, h % 997 == 0 ? 255.0 : h % 5 == 0 ? static_cast<double>(h % 7) : 0.0);
+  }
+  v->invalidateRange();
+  const auto source = std::make_shared<lod::InCoreMultiresSource>(v, 8);
+  ASSERT_TRUE(source->meanPyramid());
+  const lod::BrickGrid grid = lod::BrickGrid::of(*source, 8);
+  const lod::StoredMapping identity = lod::StoredMapping::of(source->shape());
+  std::vector<std::unordered_map<std::uint64_t, lod::BrickRange>> ranges(grid.levelCount());
+  for (int l = 0; l < grid.levelCount(); ++l) {
+    const glm::ivec3 n = grid.bricks(l);
+    for (int z = 0; z < n.z; ++z)
+      for (int y = 0; y < n.y; ++y)
+        for (int x = 0; x < n.x; ++x) {
+          const lod::BrickKey k{l, {x, y, z}};
+          const lod::StoredBrick b = lod::readStoredBrick(*source, grid, k, identity);
+          ranges[l][k.id()] = {b.min, b.max};
+        }
+  }
+  int checked = 0, dimAncestorOfBright = 0;
+  for (int l = 0; l + 1 < grid.levelCount(); ++l) {
+    const glm::ivec3 n = grid.bricks(l);
+    for (int z = 0; z < n.z; ++z)
+      for (int y = 0; y < n.y; ++y)
+        for (int x = 0; x < n.x; ++x) {
+          const lod::BrickKey k{l, {x, y, z}};
+          const lod::BrickRange r = ranges[l][k.id()];
+          int up = 1;
+          for (lod::BrickKey a = grid.parent(k); a.level < grid.levelCount();
+               a = grid.parent(a), ++up) {
+            const lod::BrickRange ar = ranges[a.level][a.id()];
+            const lod::BrickRange bound = lod::meanPyramidBound(ar, up);
+            EXPECT_LE(bound.min, r.min) << "level " << l << " up " << up;
+            EXPECT_GE(bound.max, r.max) << "level " << l << " up " << up;
+            if (r.max == 255 && ar.max < 64) ++dimAncestorOfBright;
+            ++checked;
+          }
+        }
+  }
+  EXPECT_GT(checked, 100);
+  EXPECT_GT(dimAncestorOfBright, 0) << "the volume should hold bright voxels averaged away";
+  // Over empty space the bound stays tight: a coarse maximum of 0.
+  EXPECT_EQ(lod::meanPyramidBound({0, 0}, 1).max, 8);
+  EXPECT_EQ(lod::meanPyramidBound({0, 0}, 2).max, 72);
 }

@@ -78,6 +78,9 @@ class ZarrStore {
   // Things the user should know ("dtype <i4 is read as f32", "axes have no
   // unit: taken as mm").
   const std::vector<std::string>& notes() const { return notes_; }
+  // The multiscales "type": how the coarser levels were made ("mean",
+  // "gaussian", "nearest", ...; "" when the metadata does not say).
+  const std::string& reduction() const { return reduction_; }
   // "OME-NGFF 0.4 (multiscales 'name'), 3 levels, blosc lz4 shuffle".
   std::string describe() const;
   const ZarrStorage& storage() const { return *storage_; }
@@ -98,6 +101,7 @@ class ZarrStore {
   ZarrSelection selection_;
   std::string version_;
   std::string name_;
+  std::string reduction_;
   // Array axis of x, y, z, t, c (-1: the array has no such axis).
   int axis_[5] = {-1, -1, -1, -1, -1};
   double unitToMm_ = 1.0;

@@ -125,9 +125,13 @@ class BricksLayout final : public Layout {
   BricksLayout() = default;
   int slotFor(std::uint64_t id, std::uint64_t frame);
   void upload(int slot, const lod::StoredBrick& brick);
+  // Whether the TF makes the brick transparent: by its own range read
+  // (exactOnly, for the page table), or else the brick and every brick
+  // under it by subtreeBound() (for the level selection, which leaves such
+  // a brick's whole subtree out).
   bool transparent(const lod::BrickKey& key, const TransferFunction& tf, bool exactOnly,
                    std::uint8_t* value) const;
-  std::optional<lod::BrickRange> rangeOrEstimate(const lod::BrickKey& key) const;
+  std::optional<lod::BrickRange> subtreeBound(const lod::BrickKey& key) const;
   void rebuildPages(const TransferFunction& tf, BricksFrame& frame);
   glm::ivec3 slotOrigin(int slot) const;
 

@@ -42,6 +42,16 @@ struct BrickRange {
   std::uint8_t max = 0;
 };
 
+// What a brick `levelsUp` levels above tells of the stored values (0..255,
+// 0 = the smallest the source holds) of the bricks under it, in a mean
+// pyramid (MultiresSource::meanPyramid()): a coarse voxel m is the mean of
+// n <= 8 finer ones, none below 0 or above 255, so each of them lies in
+// [8m - 7*255, 8m]; rounding of the stored means adds one either way. The
+// bound widens eightfold a level; it is tight where it matters, over empty
+// space (a coarse maximum of 0 bounds every finer voxel at 8), and a lone
+// bright voxel averaged into a dim coarse one is never bounded away.
+BrickRange meanPyramidBound(BrickRange ancestor, int levelsUp);
+
 struct StreamerStats {
   std::uint64_t bricksRead = 0;
   std::uint64_t bytesRead = 0;  // stored bytes of the bricks read

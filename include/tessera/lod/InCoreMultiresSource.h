@@ -21,6 +21,7 @@ class InCoreMultiresSource final : public MultiresSource {
   LevelInfo levelInfo(int level) const override;
   Volume readBox(int level, const VoxelBox& box) const override;
   std::string describe() const override;
+  bool meanPyramid() const override { return true; }  // lod::downsample
 
   // The level's voxels (level 0 is the volume given).
   const Volume& level(int level) const;

@@ -68,6 +68,15 @@ class MultiresSource {
     return true;
   }
 
+  // Whether every coarser voxel is the mean of the (up to 8) finer voxels
+  // under it. Only then does a coarse brick's range bound the values of
+  // the bricks under it (see meanPyramidBound()), which lets the bricks
+  // layout leave unread bricks out when the TF makes the bound transparent.
+  // Other reductions (decimation, a Gaussian, an analytic field per level)
+  // say nothing of finer values: such bricks are read before they can be
+  // skipped. Default false.
+  virtual bool meanPyramid() const { return false; }
+
   // A short description for logs and `tessera info` (path or URL).
   virtual std::string describe() const = 0;
 };

@@ -25,6 +25,9 @@ class ZarrMultiresSource final : public MultiresSource {
   LevelInfo levelInfo(int level) const override;
   Volume readBox(int level, const VoxelBox& box) const override;
   std::string describe() const override { return store_->describe(); }
+  // As the store's multiscales metadata says ("type": "mean", which
+  // `tessera convert` writes); a store that does not say is not trusted.
+  bool meanPyramid() const override { return store_->reduction() == "mean"; }
 
   const ZarrStore& store() const { return *store_; }
 
