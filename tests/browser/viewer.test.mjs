@@ -844,11 +844,29 @@ async function gridView(context, url, tmp, run) {
         `3D view ${back.dims.join('x')}; block ${boxSpec(last.block)}; ${cyanBefore} cyan overlay pixels before, ${cyanAfter} after`);
   const errors = logs.filter((l) => l.startsWith('pageerror') || l.startsWith('error'));
   check('no script errors on the grid-view page', errors.length === 0, errors.join(' | '));
-  if (shots) {
-    await page.evaluate(async () => { await window.tessera.slices.grid.enter(); await window.tessera.setCamera(35, 15, 1); });
-    await page.screenshot({ path: path.join(shots, 'web-grid.jpg'), type: 'jpeg', quality: 85 });
-  }
   await page.close();
+  if (shots && fs.existsSync(CH2)) {
+    // The head: a grid block after one move forward, then the overview with
+    // the block's cyan box; and the move pad on a phone.
+    const { page: p2 } = await openPage(context, url, 'url=/templates/ch2.nii.gz');
+    await p2.setViewportSize({ width: 1280, height: 1220 });
+    await p2.evaluate(async () => {
+      window.tessera.slices.setCross(70, 120, 95);
+      await window.tessera.setCamera(35, 15, 1);
+      await window.tessera.slices.grid.enter();
+      await window.tessera.slices.grid.move(0);
+    });
+    await p2.screenshot({ path: path.join(shots, 'web-grid-block.jpg'), type: 'jpeg', quality: 85 });
+    await p2.evaluate(() => window.tessera.slices.grid.leave());
+    await p2.screenshot({ path: path.join(shots, 'web-grid-overview.jpg'), type: 'jpeg', quality: 85 });
+    const cdp2 = await context.newCDPSession(p2);
+    await cdp2.send('Emulation.setDeviceMetricsOverride', { width: 390, height: 844, deviceScaleFactor: 2, mobile: true });
+    await p2.evaluate(() => window.tessera.slices.grid.enter());
+    await p2.evaluate(() => window.tessera.render());
+    const phoneShot = await cdp2.send('Page.captureScreenshot', { format: 'jpeg', quality: 80 });
+    fs.writeFileSync(path.join(shots, 'web-phone-grid.jpg'), Buffer.from(phoneShot.data, 'base64'));
+    await p2.close();
+  }
   console.log(`     (grid view: ${((Date.now() - t) / 1000).toFixed(1)} s)`);
 }
 
