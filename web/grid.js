@@ -177,13 +177,13 @@ window.TesseraGrid = (function () {
     window.addEventListener('keydown', (e) => {
       const t = e.target;
       if (t && (t.tagName === 'INPUT' || t.tagName === 'SELECT' || t.tagName === 'TEXTAREA')) return;
-      if (t && t.classList && t.classList.contains('slice-overlay')) return;  // its own keys
       if (e.ctrlKey || e.metaKey || e.altKey) return;
       if (e.key === 'g' || e.key === 'G') {
         if (!grid.has_volume) return;
         refresh().active ? leave() : enter();
         e.preventDefault();
-      } else if (e.key in KEYS && refresh().active) {
+      } else if (e.key in KEYS && refresh().active && !(t && t.classList && t.classList.contains('slice-overlay'))) {
+        // (A focused slice view keeps the arrows for its slices.)
         move(KEYS[e.key]);
         e.preventDefault();
       }
