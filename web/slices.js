@@ -51,6 +51,7 @@ window.TesseraSlices = (function () {
     let picking = false;        // "Pick region" pressed
     let rubber = null;          // a box being dragged: {panel, a: [px, py], b: [px, py]} in image pixels
     const panels = {};          // by plane
+    let grid = null;            // web/grid.js, the grid view (attached below)
 
     // The three panels; which index axis each shows is decided per volume
     // from the slice frames the core reports (the plane nearest each axis).
@@ -188,6 +189,14 @@ window.TesseraSlices = (function () {
         ctx.strokeRect(x, y, w, h);
         ctx.setLineDash([]);
       }
+      // The grid view's block (web/grid.js), cyan, where this slice cuts it.
+      const block = grid && grid.block();
+      if (block && cross[p.axis] >= block.begin[p.axis] && cross[p.axis] < block.end[p.axis]) {
+        const [x, y, w, h] = boxRect(p, block);
+        ctx.lineWidth = 2 * px;
+        ctx.strokeStyle = '#3cd8f0';
+        ctx.strokeRect(x, y, w, h);
+      }
       if (rubber && rubber.panel === p) {
         const b = rubberBox(p);
         const [x, y, w, h] = boxRect(p, b);
@@ -302,13 +311,14 @@ window.TesseraSlices = (function () {
       const r = region;
       const text = r ? `region x ${r.begin[0]}:${r.end[0]}, y ${r.begin[1]}:${r.end[1]}, z ${r.begin[2]}:${r.end[2]} ` +
         `(${r.end.map((e, a) => e - r.begin[a]).join('×')} voxels, native resolution)` : 'no region picked';
-      $('regionInfo').textContent = explore.showing_region ? `3D view: ${text}` : text;
+      const gridShown = grid && grid.active();
+      $('regionInfo').textContent = explore.showing_region && !gridShown ? `3D view: ${text}` : text;
       $('overview').disabled = !explore.showing_region;
       $('showRegion').disabled = !region || explore.showing_region;
       $('pickRegion').setAttribute('aria-pressed', picking ? 'true' : 'false');
       $('pickRegion').classList.toggle('pressed', picking);
       views.classList.toggle('picking', picking);
-      views.classList.toggle('region-shown', !!explore.showing_region);
+      views.classList.toggle('region-shown', !!explore.showing_region && !gridShown);
     }
 
     function redrawOverlays() {
@@ -324,7 +334,7 @@ window.TesseraSlices = (function () {
     // marks follow the camera; in colour, a TF edit redraws them too.
     function frameShown(state) {
       explore = JSON.parse(api.explore());
-      if (!explore.has_volume) { redrawOverlays(); return; }
+      if (!explore.has_volume) { redrawOverlays(); if (grid) grid.frameShown(explore); return; }
       const key = `${explore.name}|${explore.dims.join('x')}`;
       let redraw = false;
       if (key !== volumeKey) {
@@ -342,6 +352,7 @@ window.TesseraSlices = (function () {
       if (wk !== windowKey) { windowKey = wk; redraw = true; }
       if (redraw) drawAllSlices();
       redrawOverlays();
+      if (grid) grid.frameShown(explore);
     }
 
     function setCross(v) {
@@ -539,6 +550,12 @@ window.TesseraSlices = (function () {
       showRegion,
       overview,
     };
+    // The grid view (web/grid.js) shares the 3D view, the crosshair and
+    // the overview's return with the region.
+    if (window.TesseraGrid) {
+      grid = window.TesseraGrid.attach({ M, canvas, requestRender, showError, clearError, slices: testApi });
+      testApi.grid = grid.testApi;
+    }
     return { frameShown, testApi };
   }
 

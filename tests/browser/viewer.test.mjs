@@ -489,6 +489,7 @@ async function main() {
     await responsiveCanvas(context, url);
     await loadFromUrl(context, url, tmp, run);
     await sliceViewsAndRegion(context, url, tmp, run);
+    await gridView(context, url, tmp, run);
     await dicomFolder(context, url, tmp, run);
     await zarrStoreFromUrl(context, url, tmp, run);
 
@@ -708,6 +709,165 @@ async function sliceViewsAndRegion(context, url, tmp, run) {
     await p2.close();
   }
   console.log(`     (slice views and region: ${((Date.now() - t) / 1000).toFixed(1)} s)`);
+}
+
+// Grid view in the page (issue 15 items 3 and 6; Schultz 2016 §7.3), with
+// the native lod::GridNavigator through tessera_grid_*: a PIL NIfTI of
+// 40x32x24 voxels (writePilNifti's, a bright cube added at high x) in cells
+// of 8 voxels (5x4x3 cells, grid points 0..5 x 0..4 x 0..3). Entering at
+// the crosshair (the centre voxel 20,16,12) stands on the nearest point
+// (3,2,2): its 2x2x2 block, voxels 16:32,8:24,8:24, renders like
+// `tessera render --region` of that box. From the front (azimuth 0,
+// elevation 0: looking posterior, and index x runs posterior in a PIL
+// file) Forward is +x: the block moves one cell (8 voxels) along x and
+// nothing else. At the +x face a further Forward is refused, the block and
+// the image stay and the page says why. On a phone the pad's buttons fit
+// the screen and a tap moves. Overview shows the block as a cyan box.
+async function gridView(context, url, tmp, run) {
+  const t = Date.now();
+  const file = path.join(tmp, 'grid.nii');
+  writePilNifti(file);
+  const bytes = fs.readFileSync(file);
+  const [nx, ny] = [40, 32];
+  for (let z = 10; z < 16; z++) for (let y = 12; y < 18; y++) for (let x = 30; x < 37; x++) bytes[352 + x + nx * (y + ny * z)] = 250;
+  fs.writeFileSync(file, bytes);
+  const { page, logs } = await openPage(context, url, `size=${SIZE}&url=/data/grid.nii`);
+  const grid = () => page.evaluate(() => window.tessera.slices.grid.state());
+  const cyanPixels = async () => page.evaluate(() => {
+    const p = window.tessera.slices.grid.overlayPixels();
+    let n = 0;
+    for (let i = 0; i < p.length; i += 4) if (p[i + 3] > 128 && p[i] < 110 && p[i + 1] > 170 && p[i + 2] > 190) n++;
+    return n;
+  });
+  const boxSpec = (b) => [0, 1, 2].map((a) => `${b.begin[a]}:${b.end[a]}`).join(',');
+  await withoutOverlays(page);
+  await page.evaluate(() => window.tessera.setCamera(0, 0, 1));
+  await page.evaluate(() => window.tessera.slices.setCross(20, 16, 12));
+  const cyanBefore = await cyanPixels();
+
+  // Enter (the button, after setting the cell side in its field).
+  await page.fill('#gridCell', '8');
+  await page.click('#gridEnter');
+  await page.waitForFunction(() => window.tessera.slices.grid.state().active || window.tessera.error() !== '', null, { timeout: 20000 });
+  const enterError = await page.evaluate(() => window.tessera.error());
+  if (enterError) throw new Error(`entering the grid view: ${enterError}`);
+  await page.evaluate(() => window.tessera.render());
+  let g = await grid();
+  let s3d = await page.evaluate(() => window.tessera.state());
+  const first = '16:32,8:24,8:24';
+  const refPng = path.join(tmp, 'grid-block.png');
+  run('render', file, '--region', first, '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', '--out', refPng);
+  let m = await psnrAgainst(page, refPng);
+  const padShown = await page.locator('#grid-pad').isVisible();
+  check('G enters the grid view: the 2x2x2 block around the point nearest the crosshair renders like `tessera render --region` of it (PSNR >= 35 dB)',
+        g.active && g.point.join() === '3,2,2' && g.cells.join() === '5,4,3' && boxSpec(g.block) === first &&
+        s3d.dims.join('x') === '16x16x16' && m.psnr >= 35 && padShown,
+        m.error || `point (${g.point.join(', ')}) ${g.point_class}, block ${boxSpec(g.block)} (3D view ${s3d.dims.join('x')}): ${m.psnr.toFixed(2)} dB; pad ${padShown ? 'shown' : 'HIDDEN'}`);
+
+  // Forward from the front: +x, one cell. The other labels follow from the
+  // PIL axes too: the screen's right is the patient's left (+z), up is
+  // superior (-y).
+  const labels = await page.evaluate(() => Array.from(document.querySelectorAll('#grid-pad button[data-move]'))
+    .map((b) => `${b.dataset.move}:${b.textContent.trim().replace(/\s+/g, ' ')}`));
+  const forwardLabel = labels.find((l) => l.startsWith('0:'));
+  const before = await snapshot(page);
+  await page.click('#grid-pad button[data-move="0"]');
+  await page.evaluate(() => window.tessera.render());
+  const g2 = await grid();
+  const after = await snapshot(page);
+  const db = [0, 1, 2].map((a) => g2.block.begin[a] - g.block.begin[a]);
+  const de = [0, 1, 2].map((a) => g2.block.end[a] - g.block.end[a]);
+  const movedRef = path.join(tmp, 'grid-moved.png');
+  run('render', file, '--region', boxSpec(g2.block), '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', '--out', movedRef);
+  const m2 = await psnrAgainst(page, movedRef);
+  check('from the front the buttons read Forward +x, Right +z (patient left), Up -y (superior); Forward moves the block one cell (8 voxels) along x only, rendered like the CLI (>= 35 dB)',
+        forwardLabel === '0:Forward +x' && labels.join() === '4:Up -y,0:Forward +x,5:Down +y,2:Left -z,1:Back -x,3:Right +z' && g2.point.join() === '4,2,2' && db.join() === '8,0,0' && de.join() === '8,0,0' &&
+        m2.psnr >= 35 && changedFraction(before.pixels, after.pixels) > 0.01,
+        m2.error || `buttons ${labels.join(', ')}; block ${boxSpec(g.block)} -> ${boxSpec(g2.block)}: ${m2.psnr.toFixed(2)} dB, ` +
+        `${(100 * changedFraction(before.pixels, after.pixels)).toFixed(1)} % of the view changed`);
+
+  // The arrow key to the +x face (point x 5), then once more: refused.
+  await page.keyboard.press('ArrowUp');
+  await page.waitForFunction(() => window.tessera.slices.grid.state().point[0] === 5, null, { timeout: 20000 });
+  await page.evaluate(() => window.tessera.render());
+  const atFace = await grid();
+  const faceShot = await snapshot(page);
+  await page.keyboard.press('ArrowUp');
+  await page.evaluate(() => window.tessera.render());
+  const refused = await grid();
+  const stillShot = await snapshot(page);
+  const note = (await page.locator('#gridNote').textContent()).trim();
+  const noteVisible = await page.locator('#gridNote').isVisible();
+  const forwardMarked = await page.evaluate(() => document.querySelector('#grid-pad button[data-move="0"]').classList.contains('illegal'));
+  check('at the +x face Forward (ArrowUp) is refused: the block and the image stay, the reason shows in the page',
+        atFace.point.join() === '5,2,2' && boxSpec(atFace.block) === '32:40,8:24,8:24' && refused.point.join() === '5,2,2' &&
+        boxSpec(refused.block) === boxSpec(atFace.block) && refused.refused && noteVisible && /\+x face/.test(note) &&
+        forwardMarked && meanAbsDiff(faceShot.pixels, stillShot.pixels) < 0.01,
+        `${atFace.describe}; "${note}"; forward button ${forwardMarked ? 'marked illegal' : 'NOT marked'}`);
+
+  // A phone (390x844): the pad's six buttons fit the screen, at least 44 px
+  // tall, under the 3D view; a tap on Back moves the block back.
+  const cdp = await context.newCDPSession(page);
+  await cdp.send('Emulation.setDeviceMetricsOverride', { width: 390, height: 844, deviceScaleFactor: 3, mobile: true });
+  await cdp.send('Emulation.setTouchEmulationEnabled', { enabled: true, maxTouchPoints: 5 });
+  await page.click('#view-tabs button[data-tab="3d"]');
+  await page.locator('#grid-pad').scrollIntoViewIfNeeded();
+  const phone = await page.evaluate(() => {
+    const r = (e) => e.getBoundingClientRect();
+    const buttons = Array.from(document.querySelectorAll('#grid-pad button[data-move]')).map(r);
+    return { buttons: buttons.map((b) => [b.left, b.right, b.height]), view: r(document.getElementById('view')).bottom,
+      pad: r(document.getElementById('grid-pad')).top, page: document.documentElement.scrollWidth };
+  });
+  const backBox = await page.locator('#grid-pad button[data-move="1"]').boundingBox();
+  const tap = [Math.round(backBox.x + backBox.width / 2), Math.round(backBox.y + backBox.height / 2)];
+  await cdp.send('Input.dispatchTouchEvent', { type: 'touchStart', touchPoints: [{ x: tap[0], y: tap[1], id: 5 }] });
+  await cdp.send('Input.dispatchTouchEvent', { type: 'touchEnd', touchPoints: [] });
+  await page.waitForFunction(() => window.tessera.slices.grid.state().point[0] === 4, null, { timeout: 5000 }).catch(() => {});
+  const tapped = await grid();
+  await cdp.send('Emulation.setTouchEmulationEnabled', { enabled: false });
+  await cdp.send('Emulation.clearDeviceMetricsOverride');
+  const fits = phone.buttons.every(([l, r, h]) => l >= 0 && r <= 390 && h >= 44) && phone.page <= 390 && phone.pad >= phone.view - 1;
+  check('phone (390x844): the six move buttons fit the screen under the 3D view (>= 44 px tall) and a tap on Back moves back (-x)',
+        fits && tapped.point.join() === '4,2,2',
+        `buttons x ${phone.buttons.map(([l, r, h]) => `${l.toFixed(0)}-${r.toFixed(0)}/${h.toFixed(0)}px`).join(' ')}, page ${phone.page} px; ` +
+        `tap -> point (${tapped.point.join(', ')}), "${tapped.note}"`);
+
+  // One action back: the overview, with the block as a cyan box.
+  await page.click('#gridLeave');
+  await page.waitForFunction(() => !window.tessera.slices.grid.state().active, null, { timeout: 20000 });
+  await page.evaluate(() => window.tessera.render());
+  const back = await page.evaluate(() => window.tessera.state());
+  const cyanAfter = await cyanPixels();
+  const last = await grid();
+  check('Overview returns to the whole volume and shows the last block as a cyan box',
+        back.dims.join('x') === '40x32x24' && cyanBefore === 0 && cyanAfter > SIZE / 2 && boxSpec(last.block) === '24:40,8:24,8:24',
+        `3D view ${back.dims.join('x')}; block ${boxSpec(last.block)}; ${cyanBefore} cyan overlay pixels before, ${cyanAfter} after`);
+  const errors = logs.filter((l) => l.startsWith('pageerror') || l.startsWith('error'));
+  check('no script errors on the grid-view page', errors.length === 0, errors.join(' | '));
+  await page.close();
+  if (shots && fs.existsSync(CH2)) {
+    // The head: a grid block after one move forward, then the overview with
+    // the block's cyan box; and the move pad on a phone.
+    const { page: p2 } = await openPage(context, url, 'url=/templates/ch2.nii.gz');
+    await p2.setViewportSize({ width: 1280, height: 1220 });
+    await p2.evaluate(async () => {
+      window.tessera.slices.setCross(70, 120, 95);
+      await window.tessera.setCamera(35, 15, 1);
+      await window.tessera.slices.grid.enter();
+      await window.tessera.slices.grid.move(0);
+    });
+    await p2.screenshot({ path: path.join(shots, 'web-grid-block.jpg'), type: 'jpeg', quality: 85 });
+    await p2.evaluate(() => window.tessera.slices.grid.leave());
+    await p2.screenshot({ path: path.join(shots, 'web-grid-overview.jpg'), type: 'jpeg', quality: 85 });
+    const cdp2 = await context.newCDPSession(p2);
+    await cdp2.send('Emulation.setDeviceMetricsOverride', { width: 390, height: 844, deviceScaleFactor: 2, mobile: true });
+    await p2.evaluate(() => window.tessera.slices.grid.enter());
+    await p2.evaluate(() => window.tessera.render());
+    const phoneShot = await cdp2.send('Page.captureScreenshot', { format: 'jpeg', quality: 80 });
+    fs.writeFileSync(path.join(shots, 'web-phone-grid.jpg'), Buffer.from(phoneShot.data, 'base64'));
+    await p2.close();
+  }
+  console.log(`     (grid view: ${((Date.now() - t) / 1000).toFixed(1)} s)`);
 }
 
 function psnrOf(a, b) {

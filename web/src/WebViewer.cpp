@@ -10,11 +10,13 @@
 #include <cstdint>
 #include <cstdlib>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
@@ -30,6 +32,7 @@
 #include "tessera/io/ByteSource.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/io/VolumeReader.h"
+#include "tessera/lod/GridNavigator.h"
 #include "tessera/lod/InCoreMultiresSource.h"
 #include "tessera/render/OverlayRenderer.h"
 #include "tessera/render/TechniqueRegistry.h"
@@ -779,6 +782,215 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_info() {
 // Closes the store (the viewer core's volume shows again).
 EMSCRIPTEN_KEEPALIVE void tessera_zarr_close() {
   zarrView().reset();
+}
+
+}  // extern "C"
+
+// ---------------------------------------------------------------- grid view
+// Issue 15 items 3 and 6 (web/grid.js): Schultz 2016 §7.3's grid view over
+// the loaded volume, with the native core's lod::GridNavigator (the grid
+// points, their classes, the legal moves and the moves chosen by the view
+// direction are all its own; the page only shows them). The 2x2x2 block of
+// cells around the current grid point is shown as the 3D view at native
+// resolution the way the bread-slice region is (tessera_region_show:
+// lod::copyBox of the loaded volume), so "Overview" / Esc
+// (tessera_region_overview) returns from either.
+
+namespace {
+
+struct GridView {
+  std::optional<lod::GridNavigator> nav;
+  std::string volumeKey;               // the overview it was made for: name and dims
+  int askedCell = 0;                   // the cell side asked for (0: the default)
+  std::string shownName;               // the viewer's volume name while its block is shown
+  std::optional<lod::VoxelBox> block;  // the last block shown
+  std::string note;                    // the last move, or why it was refused
+  bool refused = false;
+};
+
+GridView& gridView() {
+  static GridView g;
+  return g;
+}
+
+std::string overviewKey(const Volume& v) {
+  const glm::ivec3 d = v.dims();
+  const std::string name = regionShown() ? sliceViews().overviewName : theViewer().volumeName();
+  return name + "|" + std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
+}
+
+// True while the 3D view shows the block this block put in (not a region
+// picked since, nor the overview, nor another file).
+bool gridShown() {
+  const GridView& g = gridView();
+  return !g.shownName.empty() && regionShown() && sliceViews().shownName == g.shownName;
+}
+
+// The default cell: cubic, a multiple of 16 voxels, as large as possible
+// while the 2x2x2 block fits the region's default side cubed (what the
+// profile's texture size and budget allow, at most 256³), and no larger
+// than a quarter of the longest axis (Schultz's 4x4x4 split), so that a
+// volume that fits the budget whole still has a grid to move on.
+lod::GridNavigator defaultGrid(const Volume& volume) {
+  const int side = defaultRegionSide(volume).first;
+  const glm::ivec3 d = volume.dims();
+  const int budgetCell =
+      lod::GridNavigator::forBudget(d, std::uint64_t(side) * side * side, 16).cellSize().x;
+  const int quarter = (std::max({d.x, d.y, d.z}) + 3) / 4;
+  const int splitCell = std::max(16, (quarter + 15) / 16 * 16);
+  return lod::GridNavigator(d, glm::ivec3(std::min(budgetCell, splitCell)));
+}
+
+// The navigator for the overview volume now (made anew for another volume
+// or another cell side; `cellSide` < 0 keeps the current one).
+lod::GridNavigator& gridFor(const Volume& volume, int cellSide) {
+  GridView& g = gridView();
+  const std::string key = overviewKey(volume);
+  const int asked = cellSide < 0 ? g.askedCell : cellSide;
+  if (!g.nav || g.volumeKey != key || g.askedCell != asked) {
+    g.nav = asked > 0 ? lod::GridNavigator(volume.dims(), glm::ivec3(asked)) : defaultGrid(volume);
+    g.volumeKey = key;
+    g.askedCell = asked;
+    g.block.reset();
+    g.shownName.clear();
+    g.note.clear();
+    g.refused = false;
+  }
+  return *g.nav;
+}
+
+std::string boxText(const lod::VoxelBox& b) {
+  return std::to_string(b.begin.x) + ":" + std::to_string(b.end.x) + "," +
+         std::to_string(b.begin.y) + ":" + std::to_string(b.end.y) + "," +
+         std::to_string(b.begin.z) + ":" + std::to_string(b.end.z);
+}
+
+// Shows `box` of the overview as the 3D view. The view direction and the
+// projection stay (the moves are chosen from it); the zoom too on a move,
+// 1 on entering (the block fills the view).
+void showGridBlock(const lod::VoxelBox& box, bool keepZoom) {
+  viewer::Viewer& v = theViewer();
+  const Camera before = v.camera();
+  if (!tessera_region_show(box.begin.x, box.end.x, box.begin.y, box.end.y, box.begin.z,
+                           box.end.z)) {
+    throw InputError("grid view: " + std::string(lastError()));
+  }
+  Camera& c = v.camera();
+  c.projection = before.projection;
+  c.azimuthDeg = before.azimuthDeg;
+  c.elevationDeg = before.elevationDeg;
+  c.zoom = keepZoom ? before.zoom : 1.0;
+  GridView& g = gridView();
+  g.shownName = sliceViews().shownName;
+  g.block = box;
+}
+
+const lod::ViewMove kViewMoves[6] = {lod::ViewMove::Forward, lod::ViewMove::Back,
+                                     lod::ViewMove::Left,    lod::ViewMove::Right,
+                                     lod::ViewMove::Up,      lod::ViewMove::Down};
+
+}  // namespace
+
+extern "C" {
+
+// Enters the grid view (or starts it again) at the grid point nearest the
+// centre of voxel (x, y, z) of the overview (the crosshair), with cubic
+// cells of `cellSide` voxels (0: the default for the profile, -1: as
+// before), and shows that point's block.
+EMSCRIPTEN_KEEPALIVE int tessera_grid_enter(int cellSide, int x, int y, int z) {
+  return guarded([&] {
+    const Volume& volume = overviewVolume();
+    lod::GridNavigator& nav = gridFor(volume, cellSide);
+    const glm::dvec3 c = (glm::dvec3(x, y, z) + 0.5) / glm::dvec3(nav.cellSize());
+    nav.moveTo(glm::clamp(glm::ivec3(glm::round(c)), glm::ivec3(0), nav.cells()));
+    showGridBlock(nav.blockBox(nav.point()), false);
+    GridView& g = gridView();
+    g.note = "grid point " + nav.describe(nav.point());
+    g.refused = false;
+  });
+}
+
+// One of the six moves relative to the view (0 forward, 1 back, 2 left,
+// 3 right, 4 up, 5 down; lod::viewMoveToGridMove with the 3D view's camera):
+// 1 moved (the new block is shown), 0 refused at the grid's boundary (the
+// reason in tessera_grid_json's note; nothing changes), -1 error.
+EMSCRIPTEN_KEEPALIVE int tessera_grid_move(int viewMove) {
+  int result = -1;
+  guarded([&] {
+    if (viewMove < 0 || viewMove > 5) throw InputError("grid view: moves are 0..5");
+    if (!gridShown()) throw InputError("grid view: not in the grid view (press G)");
+    viewer::Viewer& v = theViewer();
+    lod::GridNavigator& nav = gridFor(overviewVolume(), -1);
+    const lod::ViewMove vm = kViewMoves[viewMove];
+    const lod::GridMove m = lod::viewMoveToGridMove(v.camera().basis(), vm);
+    const std::string what = std::string(lod::viewMoveName(vm)) + " = " + m.name();
+    GridView& g = gridView();
+    const glm::ivec3 from = nav.point();
+    const lod::MoveResult r = nav.apply(m);
+    if (!r.moved) {
+      g.note = what + " refused: " + r.reason;
+      g.refused = true;
+      result = 0;
+      return;
+    }
+    try {
+      showGridBlock(nav.blockBox(nav.point()), true);
+    } catch (...) {
+      nav.moveTo(from);
+      throw;
+    }
+    g.note = what + ": grid point " + nav.describe(nav.point());
+    g.refused = false;
+    result = 1;
+  });
+  return result;
+}
+
+// The grid view: JSON {has_volume, active (its block is the 3D view),
+// cell_size, cells, point, point_class, describe, block (the last block
+// shown, overview voxels, end exclusive; null before the first),
+// block_text, moves (per view move: its name, the grid move, legal and why
+// not), note, refused, default_cell}.
+EMSCRIPTEN_KEEPALIVE const char* tessera_grid_json() {
+  nlohmann::json j;
+  j["has_volume"] = false;
+  guarded([&] {
+    if (!app().viewer || !theViewer().hasVolume()) return;
+    const Volume& volume = overviewVolume();
+    lod::GridNavigator& nav = gridFor(volume, -1);
+    const GridView& g = gridView();
+    const glm::ivec3 cs = nav.cellSize(), cells = nav.cells(), p = nav.point();
+    j["has_volume"] = true;
+    j["active"] = gridShown();
+    j["cell_size"] = {cs.x, cs.y, cs.z};
+    j["cells"] = {cells.x, cells.y, cells.z};
+    j["point"] = {p.x, p.y, p.z};
+    j["point_class"] = lod::gridPointClassName(nav.pointClass());
+    j["describe"] = nav.describe(p);
+    if (g.block) {
+      const lod::VoxelBox& b = *g.block;
+      j["block"] = {{"begin", {b.begin.x, b.begin.y, b.begin.z}},
+                    {"end", {b.end.x, b.end.y, b.end.z}}};
+      j["block_text"] = boxText(b);
+    } else {
+      j["block"] = nullptr;
+    }
+    j["moves"] = nlohmann::json::array();
+    const glm::dmat3 basis = theViewer().camera().basis();
+    for (const lod::ViewMove vm : kViewMoves) {
+      const lod::GridMove m = lod::viewMoveToGridMove(basis, vm);
+      const lod::MoveResult r = nav.check(p, m);
+      j["moves"].push_back({{"view", lod::viewMoveName(vm)},
+                            {"move", m.name()},
+                            {"legal", r.moved},
+                            {"reason", r.reason}});
+    }
+    j["note"] = g.note;
+    j["refused"] = g.refused;
+    j["default_cell"] = defaultGrid(volume).cellSize().x;
+  });
+  scratch() = j.dump();
+  return scratch().c_str();
 }
 
 }  // extern "C"
