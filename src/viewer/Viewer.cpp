@@ -5,6 +5,10 @@
 #include <cmath>
 #include <sstream>
 
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+#include <glm/gtc/constants.hpp>
+
 #include "tessera/core/Error.h"
 #include "tessera/core/Histogram.h"
 #include "tessera/core/HostBudget.h"
@@ -23,6 +27,50 @@ constexpr int kHistogramBins = 256;
 // Render-target size the plan reserves memory for (the largest frame we expect).
 constexpr int kPlanImageSize = 1024;
 constexpr int kSkipBlock = 8;
+
+glm::vec4 fullView() {
+  return {0.0f, 0.0f, 1.0f, 1.0f};
+}
+
+// The part of a view that the volume box (centred at the origin, `extent`
+// wide) covers, as fractions (x0, y0, x1, y1) of the view, padded by `pad`
+// pixels: the bounding rectangle of the box's projected corners, with the
+// rays of render/camera_ray.glsl. Rays outside it miss the box, so a pass
+// scissored to it draws the same image. The whole view when a corner is not
+// in front of a perspective eye.
+glm::vec4 volumeScreenRegion(const Camera& camera, glm::dvec3 extent, int width, int height,
+                             double pad) {
+  const glm::dmat3 b = camera.basis();
+  const glm::dvec3 eye = camera.eye();
+  const double aspect = static_cast<double>(width) / height;
+  const double tanHalfFov = std::tan(0.5 * camera.fovYDeg * glm::pi<double>() / 180.0);
+  glm::dvec2 lo(1e300), hi(-1e300);
+  for (int i = 0; i < 8; ++i) {
+    const glm::dvec3 corner =
+        0.5 * extent * glm::dvec3(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1);
+    const glm::dvec3 v = corner - eye;
+    glm::dvec2 ndc(glm::dot(v, b[0]), glm::dot(v, b[1]));
+    if (camera.projection == Projection::Orthographic) {
+      ndc /= glm::dvec2(camera.orthoHalfHeight() * aspect, camera.orthoHalfHeight());
+    } else {
+      const double depth = -glm::dot(v, b[2]);
+      if (!(depth > 1e-6 * glm::length(extent))) return fullView();
+      ndc /= glm::dvec2(depth * tanHalfFov * aspect, depth * tanHalfFov);
+    }
+    lo = glm::min(lo, ndc);
+    hi = glm::max(hi, ndc);
+  }
+  const glm::dvec2 margin(pad / width, pad / height);
+  const glm::dvec2 a = glm::clamp(0.5 * lo + 0.5 - margin, 0.0, 1.0);
+  const glm::dvec2 c = glm::clamp(0.5 * hi + 0.5 + margin, 0.0, 1.0);
+  if (!std::isfinite(a.x + a.y + c.x + c.y)) return fullView();
+  return {static_cast<float>(a.x), static_cast<float>(a.y), static_cast<float>(c.x),
+          static_cast<float>(c.y)};
+}
+
+glm::vec4 regionUnion(glm::vec4 a, glm::vec4 b) {
+  return {std::min(a.x, b.x), std::min(a.y, b.y), std::max(a.z, b.z), std::max(a.w, b.w)};
+}
 
 }  // namespace
 
@@ -68,6 +116,7 @@ void Viewer::setVolume(Volume volume, const std::string& name) {
   // Everything worked: swap in.
   active_ = std::move(next);
   pending_ = {};
+  drawn_ = {};
   frameMsPerPixel_ = stripMsPerPixel_ = 0.0;
   volume_ = source.level(glm::ivec3(1));
   volumeName_ = name;
@@ -128,6 +177,7 @@ void Viewer::setTechnique(const std::string& name) {
     uploadedTfRevision_ = tfEditor_.revision();
   }
   pending_ = {};
+  drawn_ = {};
   frameMsPerPixel_ = stripMsPerPixel_ = 0.0;
   techniqueName_ = name;
 }
@@ -188,21 +238,60 @@ Viewer::VolumePass Viewer::volumePass(int width, int height,
 
 void Viewer::compose(const gpu::Texture& image, int width, int height, unsigned framebuffer,
                      glm::ivec2 origin) {
-  gpu_->compositor.setOverlayLines(overlayLines());
-  gpu_->compositor.composeInto(image, camera_, glm::vec4(settings_.background), volume_->extent(),
-                               framebuffer, glm::ivec4(origin, width, height));
+  const std::vector<render::OverlayLine> lines = overlayLines();
+  gpu_->compositor.setOverlayLines(lines);
+  const glm::ivec4 box(origin, width, height);
+  if (lines.empty()) {
+    // Without lines, what lies outside the volume's part of the view is the
+    // background: a clear, and the composite pass only where the volume is
+    // (padded by the upscaled layer's bilinear footprint).
+    gpu::bindFramebuffer(framebuffer, box);
+    gpu::apply({.scissor = true, .scissorBox = box});
+    gpu::clearColor(glm::vec4(settings_.background));
+    gpu::apply({});
+    const double upscale = std::max(static_cast<double>(width) / image.width(),
+                                    static_cast<double>(height) / image.height());
+    const gpu::RegionScope region(volumeScreenRegion(camera_, volume_->extent(), width, height,
+                                                     2.0 + 2.0 * std::ceil(upscale)));
+    gpu_->compositor.composeInto(image, camera_, glm::vec4(settings_.background), volume_->extent(),
+                                 framebuffer, box);
+  } else {
+    gpu_->compositor.composeInto(image, camera_, glm::vec4(settings_.background), volume_->extent(),
+                                 framebuffer, box);
+  }
   // glFinish does not wait in browsers: a read-back of one pixel does.
   std::uint8_t pixel[4];
   gpu::readPixelsRgba8({origin, 1, 1}, pixel);
   gpu::checkErrors("viewer frame");
 }
 
+// The ray caster's rays outside the volume's part of the view miss the box
+// and write transparent black, so a frame scissored to that part draws the
+// same image, provided the target holds nothing outside it from before: the
+// part drawn is the union of this frame's and the last one's, and the whole
+// target when it was not this technique's last frame at this size.
+const gpu::Texture& Viewer::renderVolume(const VolumePass& pass) {
+  render::Technique* technique = active_.technique.get();
+  if (techniqueName_ != "raycast") {
+    drawn_ = {};
+    return technique->render(camera_, pass.settings, pass.width, pass.height, 0.0);
+  }
+  const glm::vec4 region =
+      volumeScreenRegion(camera_, volume_->extent(), pass.width, pass.height, 2.0);
+  const bool sameTarget =
+      drawn_.technique == technique && drawn_.width == pass.width && drawn_.height == pass.height;
+  const gpu::RegionScope scope(sameTarget ? regionUnion(region, drawn_.region) : fullView());
+  const gpu::Texture& image =
+      technique->render(camera_, pass.settings, pass.width, pass.height, 0.0);
+  drawn_ = {.technique = technique, .width = pass.width, .height = pass.height, .region = region};
+  return image;
+}
+
 FrameStats Viewer::presentFrame(int width, int height, unsigned framebuffer, glm::ivec2 origin,
                                 const render::QualityLevel& level) {
   const auto t0 = std::chrono::steady_clock::now();
   const VolumePass pass = volumePass(width, height, level);
-  const gpu::Texture& image =
-      active_.technique->render(camera_, pass.settings, pass.width, pass.height, 0.0);
+  const gpu::Texture& image = renderVolume(pass);
   compose(image, width, height, framebuffer, origin);
   FrameStats stats;
   stats.ms = msSince(t0);
@@ -300,6 +389,7 @@ FrameStats Viewer::refine() {
   const double minStrip = 1.0 / p.pass.height;
   const gpu::Texture* image = nullptr;
   gpu::clearErrors();
+  drawn_ = {};  // the strips write the whole target
   // One strip per call, as many rows as the budget affords at the cost per
   // pixel of the strips before (a single draw keeps the per-call overhead
   // of multi-pass techniques, such as the slicers' hundreds of slices, once).

@@ -91,6 +91,33 @@ TEST_F(ViewerFixture, FrameShowsWhatTheRayCasterRenders) {
   EXPECT_GE(psnr(shown, direct), 60.0);
 }
 
+// The ray cast and the composite are scissored to the part of the view the
+// volume box covers (the ray cast also to the last frame's part, which its
+// target still holds): as the box moves across the view, shrinks and grows,
+// every frame equals a whole frame of the ray caster.
+TEST_F(ViewerFixture, FramesScissoredToTheVolumeEqualWholeFrames) {
+  Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
+  v.setVolume(makeSheppLogan({48, 48, 48}), "phantom");
+  v.showBoundingBox = v.showAxes = false;
+  v.quality = Quality::Full;
+  for (Projection projection : {Projection::Orthographic, Projection::Perspective}) {
+    v.camera().projection = projection;
+    for (const glm::dvec3 view : {glm::dvec3(0.5, -0.25, 0.1), glm::dvec3(0.5, 0.3, -0.2),
+                                  glm::dvec3(0.3, 0.0, 0.0), glm::dvec3(1.0, 0.0, 0.0)}) {
+      v.camera().zoom = view.x;
+      v.camera().target = glm::dvec3(0.0);
+      v.camera().pan(view.y, view.z);
+      v.camera().azimuthDeg += 25.0;
+      v.render(kSize, kSize, fb.id());
+      EXPECT_GE(
+          psnr(readFramebuffer(fb), directRender(ctx, v.volume(), v.tfEditor().transferFunction(),
+                                                 v.camera(), v.settings())),
+          60.0)
+          << "zoom " << view.x << ", pan " << view.y << " " << view.z;
+    }
+  }
+}
+
 TEST_F(ViewerFixture, SlicingTechniquesShowWhatTheSlicersRender) {
   Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
   v.setVolume(makeSheppLogan({40, 40, 40}), "phantom");

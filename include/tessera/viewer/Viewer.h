@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <glm/vec2.hpp>
+#include <glm/vec4.hpp>
 
 #include "tessera/core/Camera.h"
 #include "tessera/core/RenderSettings.h"
@@ -151,6 +152,16 @@ class Viewer {
   };
   VolumePass volumePass(int width, int height, const render::QualityLevel& level) const;
   void syncTransferFunction();
+  // The technique's image of `pass`, ray casts scissored to the volume.
+  const gpu::Texture& renderVolume(const VolumePass& pass);
+  // The technique's last whole frame: its target, size and the part of the
+  // view that can hold the volume (render/camera_ray.glsl's rays).
+  struct DrawnRegion {
+    const render::Technique* technique = nullptr;
+    int width = 0, height = 0;
+    glm::vec4 region{0.0f};
+  };
+  DrawnRegion drawn_;
   // Renders the volume at `level` and composes it into the framebuffer.
   FrameStats presentFrame(int width, int height, unsigned framebuffer, glm::ivec2 origin,
                           const render::QualityLevel& level);
