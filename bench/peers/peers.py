@@ -138,10 +138,11 @@ class Tessera:
         ).stdout
         return json.loads(out)
 
-    def frames(self, cfg, first_azimuth, count, png):
+    def frames(self, cfg, first_azimuth, count, png, variant_args=()):
         """Renders `count` frames rotating from first_azimuth; returns the
         per-frame milliseconds Tessera measured (render + glFinish, after
-        shader compile and upload, no PNG writing) and its JSON report."""
+        shader compile and upload, no PNG writing) and its JSON report.
+        `variant_args`: the ablation's sampling options (docs/sampling.md)."""
         cmd = [
             self.binary, "render", self.volume_path,
             "--tf", self.tf,
@@ -151,12 +152,30 @@ class Tessera:
             "--repeat", str(count),
             "--rotate", str(cfg["rotate"]),
             "--json", "--out", png,
-        ] + (["--shade"] if cfg["shade"] else []) + self.extra
+        ] + (["--shade"] if cfg["shade"] else []) + self.extra + list(variant_args)
         run = subprocess.run(cmd, capture_output=True, text=True)
         if run.returncode != 0:
             raise SystemExit(f"tessera failed: {' '.join(cmd)}\n{run.stderr}")
         report = json.loads(run.stdout)
         return [float(ms) for ms in report["frame_ms"]], report
+
+    def fine_reference(self, cfg, fine_step, png):
+        """Tessera's CPU reference at azimuth 0 with every sample at
+        `fine_step` voxels, post-classified (--reference-step): what each
+        Tessera image is judged against. Untimed."""
+        ref_png = png.replace(".png", "-fine.png")
+        cmd = [
+            self.binary, "render", self.volume_path,
+            "--tf", self.tf,
+            "--size", f"{cfg['width']}x{cfg['height']}",
+            "--step", str(cfg["step"]),
+            "--reference-step", str(fine_step), "--reference-out", ref_png,
+            "--json", "--out", png,
+        ] + (["--shade"] if cfg["shade"] else []) + self.extra
+        run = subprocess.run(cmd, capture_output=True, text=True)
+        if run.returncode != 0:
+            raise SystemExit(f"tessera failed: {' '.join(cmd)}\n{run.stderr}")
+        return read_png_rgb(ref_png), json.loads(run.stdout)
 
 
 # --------------------------------------------------------------------------
@@ -336,16 +355,32 @@ def configurations(args):
                        "frames": args.frames, "rounds": args.rounds, "rotate": args.rotate}
 
 
-def run_configuration(cfg, tessera, vtks, workdir, log):
+# The ablation (--ablation): Tessera's sampling levers one at a time, in the
+# same alternation. "tessera" itself runs with tessera render's defaults.
+ABLATION = {
+    "baseline": ["--preintegrate", "off", "--adaptive", "off"],
+    "+preint": ["--preintegrate", "on", "--adaptive", "off"],
+    "+adaptive": ["--preintegrate", "off", "--adaptive", "on"],
+    "+preint +adaptive": ["--preintegrate", "on", "--adaptive", "on"],
+}
+
+
+def run_configuration(cfg, tessera, vtks, workdir, log, variants=None, fine_step=0.0):
     label = (f"{cfg['width']}x{cfg['height']} step {cfg['step']:g} "
              f"{'shaded' if cfg['shade'] else 'unshaded'}")
+    variants = variants or {}
     for r in vtks.values():
         r.configure(cfg)
+    fine = None
+    if fine_step > 0:
+        fine, _ = tessera.fine_reference(cfg, fine_step, os.path.join(workdir, "fine.png"))
     # Warm-up (not timed): VTK's first Render compiles shaders and uploads the
     # volume, what Tessera does in prepare() before its frames. It also
     # gives the frame at azimuth 0 for the PSNR.
     images = {k: r.image(0.0) for k, r in vtks.items()}
     ms = {k: [] for k in RENDERERS}
+    variant_ms = {k: [] for k in variants}
+    variant_images = {}
     per_round = [cfg["frames"] // cfg["rounds"]] * cfg["rounds"]
     per_round[-1] += cfg["frames"] - sum(per_round)
     first = 0
@@ -358,6 +393,12 @@ def run_configuration(cfg, tessera, vtks, workdir, log):
         if rnd == 0:
             images["tessera"] = read_png_rgb(png)
             tessera_report = report
+        for name, args in variants.items():
+            vpng = os.path.join(workdir, f"variant-{rnd}.png")
+            vtimes, _ = tessera.frames(cfg, azimuths[0], count, vpng, args)
+            variant_ms[name] += vtimes
+            if rnd == 0:
+                variant_images[name] = read_png_rgb(vpng)
         for k, r in vtks.items():
             ms[k] += [r.frame_ms(a) for a in azimuths]
         first += count
@@ -375,6 +416,19 @@ def run_configuration(cfg, tessera, vtks, workdir, log):
         row[f"psnr_vs_{k}"] = psnr(images["tessera"], images[k])
         row[f"footprint_iou_vs_{k}"] = footprint_iou(images["tessera"], images[k])
     row["psnr_vtk_cpu_vs_vtk_gpu"] = psnr(images["vtk-cpu"], images["vtk-gpu"])
+    row["fine_step"] = fine_step
+    row["psnr_vs_fine"] = psnr(images["tessera"], fine) if fine is not None else None
+    row["sampling"] = {k: tessera_report.get(k) for k in (
+        "step_voxels", "preintegrate", "adaptive", "adaptive_tolerance", "adaptive_max")}
+    row["variants"] = {}
+    for name in variants:
+        med = statistics.median(variant_ms[name])
+        row["variants"][name] = {
+            "ms_median": med, "frame_ms": variant_ms[name],
+            "speedup_vs_vtk_cpu": row["vtk-cpu_ms_median"] / med,
+            "speedup_vs_vtk_gpu": row["vtk-gpu_ms_median"] / med,
+            "psnr_vs_fine": psnr(variant_images[name], fine) if fine is not None else None,
+        }
     row["tessera_layout"] = tessera_report.get("layout")
     row["gl_renderer"] = tessera_report.get("gl_renderer")
     row["images"] = images
@@ -382,20 +436,28 @@ def run_configuration(cfg, tessera, vtks, workdir, log):
 
 
 def db(v):
+    if v is None:
+        return "—"
     return "∞" if math.isinf(v) else f"{v:.1f} dB"
 
 
 def markdown(rows, meta):
+    fine = meta.get("fine_step") or 0
     lines = [
         f"Tessera vs VTK {meta['vtk_version']}: {meta['volume']} "
         f"({'x'.join(str(d) for d in meta['dims'])}), TF `{meta['tf']}`, "
         f"{meta['frames']} frames rotating {meta['rotate']:g} deg per renderer in "
         f"{meta['rounds']} alternating rounds; Tessera GL: {meta['gl_renderer']}. "
-        "Frame = render + glFinish, medians in ms; speed-up = VTK median / Tessera median.",
+        "Frame = render + glFinish, medians in ms; speed-up = VTK median / Tessera median. "
+        "Tessera runs with `tessera render`'s defaults at the same nominal step as VTK "
+        "(docs/sampling.md)"
+        + (f"; its image is also judged against the {fine:g}-voxel reference "
+           "(every sample, post-classified)." if fine else "."),
         "",
         "| image | step (voxel) | shading | Tessera ms | VTK CPU ms | VTK GPU ms "
-        "| × vs VTK CPU | × vs VTK GPU | PSNR vs CPU | PSNR vs GPU | VTK CPU vs GPU | footprint IoU CPU/GPU |",
-        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "| × vs VTK CPU | × vs VTK GPU | PSNR vs CPU | PSNR vs GPU | VTK CPU vs GPU | footprint IoU CPU/GPU "
+        + (f"| Tessera vs {fine:g}-step ref " if fine else "") + "|",
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|" + ("---:|" if fine else ""),
     ]
     for r in rows:
         lines.append(
@@ -405,7 +467,27 @@ def markdown(rows, meta):
             f"| {r['speedup_vs_vtk_gpu']:.2f} | {db(r['psnr_vs_vtk-cpu'])} "
             f"| {db(r['psnr_vs_vtk-gpu'])} | {db(r['psnr_vtk_cpu_vs_vtk_gpu'])} "
             f"| {r['footprint_iou_vs_vtk-cpu']:.3f} / "
-            f"{r['footprint_iou_vs_vtk-gpu']:.3f} |")
+            f"{r['footprint_iou_vs_vtk-gpu']:.3f} |"
+            + (f" {db(r['psnr_vs_fine'])} |" if fine else ""))
+    if any(r.get("variants") for r in rows):
+        lines += [
+            "",
+            "Ablation, in the same alternation: Tessera with each sampling lever on its own "
+            "(baseline: post-classification, every sample of the nominal step, the old "
+            "behaviour; +preint: pre-integrated classification; +adaptive: adaptive steps; "
+            "both: the defaults).",
+            "",
+            "| image | step | shading | variant | Tessera ms | × vs VTK CPU | × vs VTK GPU "
+            + (f"| vs {fine:g}-step ref " if fine else "") + "|",
+            "|---|---:|---|---|---:|---:|---:|" + ("---:|" if fine else ""),
+        ]
+        for r in rows:
+            for name, v in r["variants"].items():
+                lines.append(
+                    f"| {r['width']}×{r['height']} | {r['step']:g} "
+                    f"| {'on' if r['shade'] else 'off'} | {name} | {v['ms_median']:.1f} "
+                    f"| {v['speedup_vs_vtk_cpu']:.2f} | {v['speedup_vs_vtk_gpu']:.2f} |"
+                    + (f" {db(v['psnr_vs_fine'])} |" if fine else ""))
     for note in meta["notes"]:
         lines += ["", note]
     return "\n".join(lines) + "\n"
@@ -431,7 +513,7 @@ def write_outputs(rows, meta, out):
     fields = ["width", "height", "step", "shade"] + [
         f"{k}_ms_median" for k in RENDERERS] + [
         "speedup_vs_vtk_cpu", "speedup_vs_vtk_gpu", "psnr_vs_vtk-cpu", "psnr_vs_vtk-gpu",
-        "footprint_iou_vs_vtk-cpu", "footprint_iou_vs_vtk-gpu"]
+        "footprint_iou_vs_vtk-cpu", "footprint_iou_vs_vtk-gpu", "psnr_vs_fine"]
     with open(os.path.join(out, "peers.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
         w.writeheader()
@@ -502,6 +584,12 @@ def main():
     ap.add_argument("--shininess", type=float, default=10.0)
     ap.add_argument("--tessera-args", default="",
                     help="extra arguments for tessera render (space-separated)")
+    ap.add_argument("--ablation", action="store_true",
+                    help="also run Tessera with each sampling lever alone (baseline / +preint / "
+                         "+adaptive / both) in the same alternation")
+    ap.add_argument("--fine-step", type=float, default=0.25,
+                    help="judge Tessera's frame at azimuth 0 against its CPU reference at this "
+                         "step (every sample, post-classified); 0: skip")
     ap.add_argument("--out", default=os.path.join(REPO, "out", "peers"),
                     help="folder for peers.md/.json/.csv/.png and the compared frames")
     ap.add_argument("--smoke", action="store_true",
@@ -541,7 +629,9 @@ def main():
             notes.append("Shaded rows skipped: this tessera has no --shade.")
             cfgs = [c for c in cfgs if not c["shade"]]
         vtks = {k: VtkRenderer(k, volume, image_data, tf, lighting) for k in RENDERERS[1:]}
-        rows = [run_configuration(cfg, tessera, vtks, workdir, log) for cfg in cfgs]
+        variants = ABLATION if args.ablation else {}
+        rows = [run_configuration(cfg, tessera, vtks, workdir, log, variants, args.fine_step)
+                for cfg in cfgs]
         for r in vtks.values():
             r.close()
         meta = {
@@ -551,7 +641,8 @@ def main():
             "frames": args.frames, "rounds": args.rounds, "rotate": args.rotate,
             "lighting": lighting, "vtk_version": vtk.vtkVersion.GetVTKVersion(),
             "gl_renderer": rows[0]["gl_renderer"] if rows else None,
-            "tessera": args.tessera, "notes": notes,
+            "tessera": args.tessera, "notes": notes, "fine_step": args.fine_step,
+            "ablation": list(ABLATION) if args.ablation else [],
             "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()),
         }
         md = write_outputs(rows, meta, args.out)

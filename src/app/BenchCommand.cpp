@@ -11,6 +11,7 @@
 #include "app/BenchFcc.h"
 #include "app/BenchHybrid.h"
 #include "app/BenchRoofline.h"
+#include "app/BenchSampling.h"
 #include "app/BenchSlicing.h"
 #include "app/Commands.h"
 #include "app/RenderJob.h"
@@ -56,6 +57,19 @@ struct BenchOptions {
   bool roofline = false;
   int fetches = 128;
   ShadingOptions shading;
+  // --sampling / --sampling-sweep (BenchSampling.h).
+  bool sampling = false;
+  bool samplingSweep = false;
+  std::vector<std::string> samplingVolumes;
+  std::vector<std::string> samplingTfs;
+  std::vector<double> samplingSteps{0.5, 1.0};
+  std::vector<std::string> samplingShading;
+  double samplingTolerance = 0.1;
+  std::vector<double> samplingTolerances{0.25, 0.5, 1.0};
+  int samplingMax = 16;
+  int preintEntries = 256;
+  double referenceStep = 0.25;
+  int views = 2;
 };
 
 struct Variant {
@@ -371,9 +385,67 @@ void addBenchCommand(CLI::App& app) {
                   "With --roofline: fetches per fragment in the peak "
                   "passes")
       ->capture_default_str();
+  cmd->add_flag("--sampling", o->sampling,
+                "Fewer samples for the same image: baseline / +pre-integration / +adaptive / "
+                "both at each --sampling-steps, interleaved; ms, samples per ray, PSNR vs the "
+                "--reference-step reference (default 8 frames)");
+  cmd->add_flag("--sampling-sweep", o->samplingSweep,
+                "Candidate sampling settings (fixed steps, pre-integration, adaptive "
+                "tolerances) per volume x TF x shading: how tessera render's defaults were "
+                "chosen (docs/sampling.md)");
+  cmd->add_option("--sampling-volumes", o->samplingVolumes,
+                  "With --sampling(-sweep): volumes (default: FILE or ch2)");
+  cmd->add_option("--sampling-tfs", o->samplingTfs,
+                  "With --sampling(-sweep): transfer functions (default: --tf)");
+  cmd->add_option("--sampling-steps", o->samplingSteps, "With --sampling(-sweep): base steps")
+      ->capture_default_str();
+  cmd->add_option("--sampling-shading", o->samplingShading,
+                  "With --sampling(-sweep): off, on or both (default: --shade)");
+  cmd->add_option("--adaptive-tolerance", o->samplingTolerance,
+                  "With --sampling: the adaptive variants' tolerance")
+      ->capture_default_str();
+  cmd->add_option("--sampling-tolerances", o->samplingTolerances,
+                  "With --sampling-sweep: the adaptive tolerances tried")
+      ->capture_default_str();
+  cmd->add_option("--adaptive-max", o->samplingMax,
+                  "With --sampling(-sweep): the largest step multiple")
+      ->capture_default_str();
+  cmd->add_option("--preint-size", o->preintEntries,
+                  "With --sampling(-sweep): pre-integration table entries per axis")
+      ->capture_default_str();
+  cmd->add_option("--reference-step", o->referenceStep,
+                  "With --sampling(-sweep): the fine reference's step in voxels")
+      ->capture_default_str();
+  cmd->add_option("--views", o->views, "With --sampling(-sweep): views whose worst PSNR counts")
+      ->capture_default_str();
   addExploreBenchOptions(cmd);
   cmd->callback([o] {
     if (runExploreBenchIfAsked()) return;
+    if (o->sampling || o->samplingSweep) {
+      SamplingBenchOptions s;
+      s.volumes = o->samplingVolumes;
+      if (s.volumes.empty() && !o->file.empty()) s.volumes.push_back(o->file);
+      s.tfs = o->samplingTfs.empty() ? std::vector<std::string>{o->tf} : o->samplingTfs;
+      s.steps = o->samplingSteps;
+      s.size = o->size;
+      s.frames = o->frames == 36 ? 8 : o->frames;
+      s.rotate = o->rotate;
+      s.referenceStep = o->referenceStep;
+      s.views = o->views;
+      s.shadingOptions = o->shading;
+      s.shading = o->samplingShading.empty()
+                      ? std::vector<std::string>{o->shading.shade ? "on" : "off"}
+                      : o->samplingShading;
+      if (s.shading.size() == 1 && s.shading[0] == "both") s.shading = {"off", "on"};
+      s.tolerance = o->samplingTolerance;
+      s.tolerances = o->samplingTolerances;
+      s.maxMultiplier = o->samplingMax;
+      s.preintEntries = o->preintEntries;
+      s.sweep = o->samplingSweep;
+      s.json = o->json;
+      runSamplingBench(s);
+      return;
+    }
     if (o->roofline) {
       runRooflineBench({.file = o->file,
                         .size = o->size,

@@ -11,6 +11,7 @@
 #include "app/Commands.h"
 #include "app/HybridJob.h"
 #include "app/RenderJob.h"
+#include "app/SamplingOptions.h"
 #include "app/ShadingOptions.h"
 #include "app/VolumePyramid.h"
 #include "tessera/core/Error.h"
@@ -47,7 +48,7 @@ struct RenderOptions {
   double fov = 30.0;
   bool ortho = false;
   std::string mode = "composite";
-  double step = 0.5;
+  SamplingOptions sampling;
   int maxSteps = 4096;
   double opacityScale = 1.0;
   double ert = 0.99;
@@ -57,6 +58,7 @@ struct RenderOptions {
   std::string out = "render.png";
   bool reference = false;
   std::string referenceOut;
+  double referenceStep = 0.0;
   int repeat = 1;
   double rotate = 10.0;
   int skipBlock = 8;
@@ -84,6 +86,12 @@ struct RenderOptions {
   CLI::Option* labelsOption = nullptr;
   bool labelVolume() const { return labelsOption != nullptr && labelsOption->count() > 0; }
 };
+
+std::string describeStep(double step) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", step);
+  return buf;
+}
 
 nlohmann::json numberOrNull(std::optional<double> v) {
   if (!v) return nullptr;
@@ -146,7 +154,7 @@ RenderRequest requestFrom(const RenderOptions& o) {
     req.settings.mode = RenderMode::Average;
   else
     throw InputError("--mode '" + o.mode + "': expected composite, mip, minip or average");
-  req.settings.stepVoxels = o.step;
+  applySampling(o.sampling, req.settings);
   req.settings.maxSteps = o.maxSteps;
   req.settings.opacityScale = o.opacityScale;
   req.settings.ertThreshold = o.ert;
@@ -161,7 +169,11 @@ RenderRequest requestFrom(const RenderOptions& o) {
   req.settings.background = glm::dvec4(o.background[0], o.background[1], o.background[2], 1.0);
   req.repeat = o.repeat;
   req.rotateDeg = o.repeat > 1 ? o.rotate : 0.0;
-  req.reference = o.reference || !o.referenceOut.empty();
+  if (o.referenceStep < 0.0 || !std::isfinite(o.referenceStep)) {
+    throw InputError("--reference-step must be a positive number of voxels");
+  }
+  req.referenceStep = o.referenceStep;
+  req.reference = o.reference || !o.referenceOut.empty() || o.referenceStep > 0.0;
   // Checked before the volume is read, so that a typo fails at once.
   if (!render::TechniqueRegistry::global().contains(o.technique)) {
     throw InputError("--technique '" + o.technique + "': expected " +
@@ -182,7 +194,8 @@ RenderRequest requestFrom(const RenderOptions& o) {
 // fits the host budget.
 bool needsInCore(const RenderOptions& o) {
   return o.labelVolume() || !o.window.empty() || !o.overlays.empty() || !o.offscreen.empty() ||
-         !o.roi.empty() || o.reference || !o.referenceOut.empty() || o.lattice != "cartesian";
+         !o.roi.empty() || o.reference || !o.referenceOut.empty() || o.referenceStep > 0.0 ||
+         o.lattice != "cartesian";
 }
 
 // With --layout auto a store streams when the planner, given its finest
@@ -366,7 +379,22 @@ void printRenderJson(const RenderOptions& o, const RenderRequest& req, const Ren
   }
   j["mode"] = o.mode;
   j["technique"] = o.technique;
-  j["step_voxels"] = o.step;
+  j["step_voxels"] = req.settings.stepVoxels;
+  j["preintegrate"] = r.preintegrated;
+  j["adaptive"] = r.adaptive;
+  if (r.adaptive) {
+    j["adaptive_tolerance"] = req.settings.sampling.tolerance;
+    j["adaptive_max"] = req.settings.sampling.maxMultiplier;
+  }
+  if (r.preintegrated) {
+    j["preintegration_build_ms"] = r.preintegrationBuildMs;
+    j["preintegration_upload_ms"] = r.preintegrationUploadMs;
+  }
+  if (r.referenceImage) {
+    j["reference_step"] = r.referenceStep;
+    j["reference_is_twin"] = req.referenceStep <= 0.0;
+  }
+  if (r.samplesPerRay > 0.0) j["samples_per_ray"] = r.samplesPerRay;
   j["shade"] = o.shading.shade;
   j["tf"] = tf.name;
   std::printf("%s\n", j.dump(2).c_str());
@@ -387,6 +415,20 @@ void printRenderText(const RenderOptions& o, const RenderRequest& req, const Ren
               device.limits.api == gpu::ApiLevel::Gles2 ? "1.00" : "3.00");
   std::printf("profile  %s (%s)\n", device.profile.name.c_str(), device.profile.note.c_str());
   std::printf("layout   %s: %s\n", r.layout.c_str(), r.layoutReason.c_str());
+  if (o.technique == "raycast") {
+    RenderSettings effective = req.settings;
+    effective.sampling.preintegrate = r.preintegrated;
+    effective.sampling.adaptive = r.adaptive;
+    std::string line = describeSampling(effective);
+    if (r.preintegrated) {
+      char buf[96];
+      std::snprintf(buf, sizeof buf, " (table rebuilt in %.2f ms + %.2f ms upload)",
+                    r.preintegrationBuildMs, r.preintegrationUploadMs);
+      line += buf;
+    }
+    std::printf("sampling %s%s\n", line.c_str(),
+                o.sampling.stepGiven() ? "" : "; the default (docs/sampling.md)");
+  }
   if (!r.planNote.empty()) std::printf("note     %s\n", r.planNote.c_str());
   std::printf("textures %s on the GPU (%llu bytes)%s\n", formatBytes(r.textureBytes).c_str(),
               static_cast<unsigned long long>(r.textureBytes),
@@ -428,8 +470,15 @@ void printRenderText(const RenderOptions& o, const RenderRequest& req, const Ren
                 static_cast<unsigned long long>(fetch->retries));
   }
   if (r.psnrDb) {
-    std::printf("reference %.0f ms on the CPU; PSNR %.2f dB, SSIM %.5f\n", r.referenceMs, *r.psnrDb,
-                *r.ssim);
+    const std::string what =
+        req.referenceStep > 0.0
+            ? "fine reference (step " + describeStep(r.referenceStep) + " voxel, every sample)"
+            : "reference (the render's own samples)";
+    std::printf("reference %s: %.0f ms on the CPU; PSNR %.2f dB, SSIM %.5f\n", what.c_str(),
+                r.referenceMs, *r.psnrDb, *r.ssim);
+    if (r.samplesPerRay > 0.0) {
+      std::printf("samples  %.1f per ray that meets the volume\n", r.samplesPerRay);
+    }
   }
 }
 
@@ -523,8 +572,7 @@ void addRenderCommand(CLI::App& app) {
                   "samples): the projections show the TF colour of their value; minip and "
                   "average by raycast only")
       ->capture_default_str();
-  cmd->add_option("--step", o->step, "Sample distance in voxels (of the smallest spacing)")
-      ->capture_default_str();
+  addSamplingOptions(cmd, o->sampling);
   cmd->add_option("--max-steps", o->maxSteps, "Maximum samples per ray")->capture_default_str();
   cmd->add_option("--opacity-scale", o->opacityScale, "Global opacity scale")
       ->capture_default_str();
@@ -551,6 +599,10 @@ void addRenderCommand(CLI::App& app) {
                 "Also render with the CPU reference and print PSNR/SSIM");
   cmd->add_option("--reference-out", o->referenceOut,
                   "Write the reference image to this PNG (implies --reference)");
+  cmd->add_option("--reference-step", o->referenceStep,
+                  "Judge quality against a fine reference instead: the CPU reference at this "
+                  "step in voxels (e.g. 0.25), every sample, post-classified (implies "
+                  "--reference; without it the reference takes the render's own samples)");
   cmd->add_option("--repeat", o->repeat, "Render N frames, rotating the camera, and report timings")
       ->capture_default_str();
   cmd->add_option("--rotate", o->rotate, "Azimuth step in degrees between repeated frames")

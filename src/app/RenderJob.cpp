@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
 #include "tessera/core/Error.h"
@@ -11,6 +12,7 @@
 #include "tessera/layout/FccLayout.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
+#include "tessera/render/Raycaster.h"
 #include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::app {
@@ -101,25 +103,52 @@ void describeStorage(const render::TechniqueOnVolume& t, RenderResult& result) {
 
 // Frame 0 against the CPU reference of the volume the GPU rendered: its
 // voxels through trilinear interpolation, or an FCC layout's lattice through
-// the box spline.
-void compareWithReference(const Volume& volume, const layout::Layout* layout,
-                          const TransferFunction& tf, const RenderRequest& req,
-                          RenderResult& result) {
+// the box spline. The twin (no --reference-step) takes the render's own
+// samples: the ray caster's block grid when it steps adaptively. With
+// --reference-step the reference is the fine truth: that step, every sample,
+// post-classified.
+void compareWithReference(const Volume& volume, const render::Technique& technique,
+                          const layout::Layout* layout, const TransferFunction& tf,
+                          const RenderRequest& req, RenderResult& result) {
+  const auto* caster = dynamic_cast<const render::Raycaster*>(&technique);
+  const StepGrid* grid =
+      caster != nullptr && caster->stepGrid().valid() && usesAdaptiveSampling(req.settings)
+          ? &caster->stepGrid()
+          : nullptr;
+  const bool fine = req.referenceStep > 0.0;
+  RenderSettings settings = req.settings;
+  if (fine) {
+    settings.stepVoxels = req.referenceStep;
+    settings.sampling = Sampling();
+    // Enough steps for the whole ray at the fine step.
+    settings.maxSteps =
+        std::max(settings.maxSteps,
+                 static_cast<int>(std::ceil(req.settings.maxSteps * req.settings.stepVoxels /
+                                            req.referenceStep)));
+  }
+  const auto render = [&](const RenderSettings& s, const StepGrid* g, ReferenceStats* stats,
+                          int width, int height) {
+    if (const auto* fcc = dynamic_cast<const layout::FccLayout*>(layout)) {
+      return renderReference(fcc->lattice().box(), lattice::BoxSplineReconstruction(fcc->lattice()),
+                             tf, req.camera, s, width, height, 0, stats, nullptr, g);
+    }
+    return renderReference(volume, tf, req.camera, s, width, height, 0, stats, nullptr, g);
+  };
   const auto t0 = std::chrono::steady_clock::now();
   ReferenceStats stats;
-  if (const auto* fcc = dynamic_cast<const layout::FccLayout*>(layout)) {
-    result.referenceImage =
-        renderReference(fcc->lattice().box(), lattice::BoxSplineReconstruction(fcc->lattice()), tf,
-                        req.camera, req.settings, req.width, req.height, 0, &stats);
-  } else {
-    result.referenceImage =
-        renderReference(volume, tf, req.camera, req.settings, req.width, req.height, 0, &stats);
-  }
+  result.referenceImage = render(settings, fine ? nullptr : grid, &stats, req.width, req.height);
+  result.referenceMs = msSince(t0);
   result.referenceSamples = stats.samples;
   result.referenceRays = stats.raysHittingVolume;
-  result.referenceMs = msSince(t0);
+  result.referenceStep = settings.stepVoxels;
   result.psnrDb = psnr(result.first, *result.referenceImage);
   result.ssim = ssim(result.first, *result.referenceImage);
+  if (!fine) {
+    result.samplesPerRay =
+        stats.raysHittingVolume
+            ? static_cast<double>(stats.samples) / static_cast<double>(stats.raysHittingVolume)
+            : 0.0;
+  }
 }
 
 }  // namespace
@@ -169,6 +198,10 @@ RenderResult runRender(DeviceSession& device, const lod::VolumeSource& source,
   RenderResult result;
   t.technique->setTransferFunction(tf);
   req.camera.frame(volume);
+  // Pre-integration and adaptive steps are the ray caster's; the slicers draw
+  // planes, and their reference must not assume either.
+  auto* caster = dynamic_cast<render::Raycaster*>(t.technique.get());
+  if (caster == nullptr) req.settings.sampling = Sampling();
   const auto tPrepare = std::chrono::steady_clock::now();
   t.technique->prepare(req.camera, req.settings);
   result.prepareMs = msSince(tPrepare);
@@ -179,6 +212,13 @@ RenderResult runRender(DeviceSession& device, const lod::VolumeSource& source,
   }
   renderFrames(*t.technique, bricks, tf, req, result);
   result.textureBytes = device.context->ledger().totalBytes();  // while the technique holds its own
+  result.preintegrated = caster != nullptr && usesPreintegration(req.settings);
+  result.adaptive =
+      caster != nullptr && usesAdaptiveSampling(req.settings) && caster->stepGrid().valid();
+  if (result.preintegrated) {
+    result.preintegrationBuildMs = caster->preintegrationTable().lastBuildMs();
+    result.preintegrationUploadMs = caster->preintegrationTable().lastUploadMs();
+  }
   describeStorage(t, result);
   if (bricks) {
     const lod::StreamerStats s = bricks->streamerStats();
@@ -194,7 +234,7 @@ RenderResult runRender(DeviceSession& device, const lod::VolumeSource& source,
       throw InputError("--reference needs the volume in host memory; " + result.layout +
                        " streams it");
     }
-    compareWithReference(volume, t.upload.layout.get(), tf, req, result);
+    compareWithReference(volume, *t.technique, t.upload.layout.get(), tf, req, result);
   }
   return result;
 }

@@ -29,6 +29,10 @@ struct RenderRequest {
   int repeat = 1;
   double rotateDeg = 0.0;
   bool reference = false;
+  // > 0: judge quality against a fine reference instead of the render's twin:
+  // the CPU reference at this step (voxels), post-classified, every sample
+  // (no pre-integration, no adaptive steps), the render's other settings.
+  double referenceStep = 0.0;
   // A technique of render::TechniqueRegistry and its options.
   std::string technique = "raycast";
   int skipBlock = 8;
@@ -70,6 +74,16 @@ struct RenderResult {
   double referenceMs = 0.0;
   std::uint64_t referenceSamples = 0;  // samples the reference took for frame 0
   std::uint64_t referenceRays = 0;     // rays of frame 0 that meet the volume
+  double referenceStep = 0.0;          // the reference's step (voxels)
+  // What the render took (the twin reference walks its samples, see
+  // ReferenceRaycaster.h): samples per ray hitting the volume, frame 0; set
+  // with the twin reference only (not with --reference-step).
+  double samplesPerRay = 0.0;
+  // Sampling in effect (settings.sampling after the technique's support).
+  bool preintegrated = false;
+  bool adaptive = false;
+  double preintegrationBuildMs = 0.0;  // the last table rebuild, CPU side
+  double preintegrationUploadMs = 0.0;
   std::optional<double> psnrDb;
   std::optional<double> ssim;
   std::uint64_t textureBytes = 0;  // every GPU texture/buffer alive, from the ledger

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include <glm/geometric.hpp>
 
 #include "tessera/core/Error.h"
+#include "tessera/reference/PreIntegration.h"
 
 namespace tessera {
 
@@ -41,18 +43,19 @@ double sampleTrilinear(const Volume& volume, glm::dvec3 p) {
 
 Image renderReference(const Volume& volume, const TransferFunction& tf, const Camera& camera,
                       const RenderSettings& settings, int width, int height, int threads,
-                      ReferenceStats* stats, const ReferenceStops* stops) {
+                      ReferenceStats* stats, const ReferenceStops* stops, const StepGrid* steps) {
   if (settings.nearest) {
     return renderReference(volume, NearestReconstruction(volume), tf, camera, settings, width,
-                           height, threads, stats, stops);
+                           height, threads, stats, stops, steps);
   }
   return renderReference(volume, TrilinearReconstruction(volume), tf, camera, settings, width,
-                         height, threads, stats, stops);
+                         height, threads, stats, stops, steps);
 }
 
 Image renderReference(const Volume& volume, const Reconstruction& field, const TransferFunction& tf,
                       const Camera& camera, const RenderSettings& settings, int width, int height,
-                      int threads, ReferenceStats* stats, const ReferenceStops* stops) {
+                      int threads, ReferenceStats* stats, const ReferenceStops* stops,
+                      const StepGrid* steps) {
   if (width <= 0 || height <= 0) throw InputError("reference: image size must be positive");
   if (!(settings.stepVoxels > 0.0)) throw InputError("reference: step must be > 0");
   const glm::dvec3 extent = volume.extent();
@@ -69,12 +72,26 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
   const std::vector<glm::dvec4> clipPlanes =
       clipHalfSpaces(settings.clipping, camera.modelFromWorld, extent);
   const glm::dvec3 gradientScale = std::min({spacing.x, spacing.y, spacing.z}) / (ww * extent);
+  // Pre-integration and the block walk (docs/sampling.md): segments between
+  // consecutive samples classified by their two values; with a grid, the
+  // GPU's walk over it (empty blocks left at once, adaptive steps).
+  const bool pre = usesPreintegration(settings);
+  const std::optional<PreIntegral> integral =
+      pre ? std::optional<PreIntegral>(std::in_place, tf, settings.opacityScale) : std::nullopt;
+  const bool walk = steps != nullptr && steps->valid() && settings.mode == RenderMode::Composite &&
+                    !settings.nearest;
+  if (walk && steps->dims != volume.dims()) {
+    throw Error("reference: the step grid was made for another volume");
+  }
+  const bool clipped = settings.clipping.active();
+  const bool adaptive = walk && settings.sampling.adaptive;
+  const bool grow = adaptive && settings.sampling.opacityGrowth;
 
   Image image(width, height);
   std::atomic<int> nextRow{0};
-  std::atomic<std::uint64_t> totalSamples{0}, totalHits{0};
+  std::atomic<std::uint64_t> totalSamples{0}, totalHits{0}, totalSteps{0};
   auto worker = [&] {
-    std::uint64_t samples = 0, hits = 0;
+    std::uint64_t samples = 0, hits = 0, visits = 0;
     for (int py = nextRow++; py < height; py = nextRow++) {
       for (int px = 0; px < width; ++px) {
         // An opaque stop (overlay line) ends the ray and replaces the background.
@@ -107,31 +124,115 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
         std::uint64_t kept = 0;
         if (t0 < tEnd) {
           ++hits;
-          const double j = settings.jitter
-                               ? jitterOffset(static_cast<unsigned>(px), static_cast<unsigned>(py))
-                               : 0.5;
-          for (int k = 0; k < settings.maxSteps; ++k) {
+          // Pre-integrated samples sit half a step earlier, one more of them
+          // (raycast.frag.glsl): segment k-1..k covers what post-classified
+          // sample k - 1 stands for.
+          const double j =
+              (settings.jitter ? jitterOffset(static_cast<unsigned>(px), static_cast<unsigned>(py))
+                               : 0.5) -
+              (pre ? 0.5 : 0.0);
+          const double tLast = pre ? std::min(tFar + 0.5 * ds, tStop) : tEnd;
+          const auto normalised = [&](glm::dvec3 p) {
+            return std::clamp((field.value(p) - win.min) / ww, 0.0, 1.0);
+          };
+          const auto keeps = [&](glm::dvec3 p) {
+            return clipKeeps(settings.clipping, clipPlanes, p);
+          };
+          // The twin of the GPU's segment: straight colour lit at the
+          // segment's middle, opacity for its length.
+          const auto composite = [&](double nf, double nb, double kf, double kb) {
+            const glm::dvec4 s = integral->segment(nf, nb, (kb - kf) * ds);
+            glm::dvec3 c(s);
+            if (shade && s.a > 0.0) {
+              const glm::dvec3 mid = to + (t0 + (0.5 * (kf + kb) + j) * ds) * td;
+              c = shadeBlinnPhong(c, field.gradient(mid) * gradientScale, settings.shading, light);
+            }
+            acc += (1.0 - acc.a) * glm::dvec4(c * s.a, s.a);
+          };
+          double k = 0.0;
+          if (clipped) {
+            // As the GPU: start at the box-aligned sample at or before the
+            // crop box's entry (samples before it are dropped either way).
+            double cropEnter = -std::numeric_limits<double>::infinity();
+            for (int a = 0; a < 3; ++a) {
+              const double inv = (td[a] >= 0.0 ? 1.0 : -1.0) / std::max(std::abs(td[a]), 1e-20);
+              const double ta = (settings.clipping.cropMin[a] - to[a]) * inv;
+              const double tb = (settings.clipping.cropMax[a] - to[a]) * inv;
+              cropEnter = std::max(cropEnter, std::min(ta, tb));
+            }
+            k = std::max(0.0, std::floor((cropEnter - t0) / ds - j));
+          }
+          double frontN = 0.0, frontK = -1.0;  // pre-integration: the segment's front sample
+          bool lazyFront = false;              // after an empty block: front at k - 1
+          while (k < settings.maxSteps) {
             const double t = t0 + (k + j) * ds;
-            if (t >= tEnd) break;
-            ++samples;
+            if (t >= tLast) break;
             const glm::dvec3 p = to + t * td;
-            if (!clipKeeps(settings.clipping, clipPlanes, p)) continue;  // dropped, not moved
-            const double raw = field.value(p);
-            const double n = std::clamp((raw - win.min) / ww, 0.0, 1.0);
+            double kNext = k + 1.0;
+            ++visits;
+            if (walk) {
+              const glm::ivec3 cell = steps->cellAt(p);
+              const std::uint8_t code = steps->code(cell);
+              const double m =
+                  code == 0 || !adaptive
+                      ? 1.0
+                      : stepMultiplier(code, grow ? acc.a : 0.0, settings.sampling.maxMultiplier);
+              if (code == 0 || m > 1.0) {
+                const double kExit = exitSample(steps->exitT(cell, to, td), t0, ds, j, k);
+                if (code == 0) {
+                  if (pre && frontK >= 0.0 && keeps(p)) {
+                    ++samples;
+                    composite(frontN, normalised(p), frontK, k);
+                  }
+                  frontK = -1.0;
+                  lazyFront = pre;
+                  k = kExit;
+                  if (acc.a >= settings.ertThreshold) break;
+                  continue;
+                }
+                kNext = nextAdaptiveSample(k, m, kExit, pre);
+              }
+            }
+            ++samples;
+            if (clipped && !keeps(p)) {  // dropped, not moved
+              frontK = -1.0;
+              lazyFront = false;
+              k = kNext;
+              continue;
+            }
+            const double n = normalised(p);
             if (isProjection(settings.mode)) {
               maxValue = std::max(maxValue, n);
               minValue = std::min(minValue, n);
               sumValue += n;
               ++kept;
+              k = kNext;
               continue;
             }
-            glm::dvec3 c = tf.color(n);
-            const double a = tf.correctedOpacity(n, ds, settings.opacityScale);
-            if (shade && a > 0.0) {
-              c = shadeBlinnPhong(c, field.gradient(p) * gradientScale, settings.shading, light);
+            if (pre) {
+              if (frontK < 0.0 && lazyFront) {
+                const glm::dvec3 p1 = to + (t - ds) * td;
+                if (!clipped || keeps(p1)) {
+                  ++samples;
+                  frontN = normalised(p1);
+                  frontK = k - 1.0;
+                }
+              }
+              if (frontK >= 0.0) composite(frontN, n, frontK, k);
+              frontN = n;
+              frontK = k;
+              lazyFront = false;
+            } else {
+              glm::dvec3 c = tf.color(n);
+              // A sample stands for the stretch to the next one.
+              const double a = tf.correctedOpacity(n, ds * (kNext - k), settings.opacityScale);
+              if (shade && a > 0.0) {
+                c = shadeBlinnPhong(c, field.gradient(p) * gradientScale, settings.shading, light);
+              }
+              acc += (1.0 - acc.a) * glm::dvec4(c * a, a);
             }
-            acc += (1.0 - acc.a) * glm::dvec4(c * a, a);
             if (acc.a >= settings.ertThreshold) break;
+            k = kNext;
           }
         }
         if (isProjection(settings.mode) && kept > 0) {
@@ -152,6 +253,7 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
     }
     totalSamples += samples;
     totalHits += hits;
+    totalSteps += visits;
   };
   const int n =
       threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -161,6 +263,7 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
   if (stats) {
     stats->samples = totalSamples;
     stats->raysHittingVolume = totalHits;
+    stats->steps = totalSteps;
   }
   return image;
 }

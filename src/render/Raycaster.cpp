@@ -49,51 +49,65 @@ void Raycaster::setLutSize(int entries) {
 }
 
 std::uint64_t Raycaster::ownTextureBytes() const {
-  return lut_.bytes() + blockTexture_.bytes() + target_.color().bytes();
+  return lut_.bytes() + preint_.bytes() + blockTexture_.bytes() + target_.color().bytes();
+}
+
+void Raycaster::setPreintegrationEntries(int entries) {
+  if (entries < 16 || entries > 1024) {
+    throw InputError("pre-integration table size must be 16..1024 entries per axis, got " +
+                     std::to_string(entries));
+  }
+  preintEntries_ = entries;
+  lookupKey_.clear();
 }
 
 void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistance) {
   const ValueRange w = volume_.window();
+  const bool pre = usesPreintegration(settings);
+  const bool adaptive = blockSize_ > 0 && usesAdaptiveSampling(settings);
   std::ostringstream key;
   key.precision(17);
   key << sampleDistance << '|' << settings.opacityScale << '|' << w.min << '|' << w.max << '|'
-      << lutSize_ << '|' << blockSize_ << '|' << tf_.toJson();
+      << lutSize_ << '|' << blockSize_ << '|' << pre << '|' << preintEntries_ << '|' << adaptive
+      << '|' << settings.sampling.tolerance << '|' << settings.sampling.maxMultiplier << '|'
+      << tf_.toJson();
   if (key.str() == lookupKey_) return;
   lookupKey_ = key.str();
 
-  lutValues_ = tf_.bake(lutSize_, sampleDistance, settings.opacityScale);
-  uploadLut();
+  // Composite with pre-integration classifies segments through the 2D table
+  // and needs no 1D one; everything else samples the 1D table.
+  if (pre) {
+    preint_.update(context_, tf_, settings.opacityScale, sampleDistance, preintEntries_);
+  } else {
+    lutValues_ = tf_.bake(lutSize_, sampleDistance, settings.opacityScale);
+    uploadLut();
+  }
 
   occupiedFraction_ = 1.0;
+  stepGrid_ = StepGrid();
   if (blockSize_ == 0) return;
-  // A block is empty when no LUT entry its samples can reach has opacity:
-  // normalised values of its samples lie in [n(min), n(max)], and the GPU's
-  // linear LUT lookup mixes the entries floor/ceil of n * (N - 1).
-  std::vector<int> opaquePrefix(static_cast<std::size_t>(lutSize_) + 1, 0);
-  for (int i = 0; i < lutSize_; ++i) {
-    opaquePrefix[static_cast<std::size_t>(i) + 1] =
-        opaquePrefix[static_cast<std::size_t>(i)] +
-        (lutValues_[static_cast<std::size_t>(i) * 4 + 3] > 0.0f ? 1 : 0);
-  }
+  // Per block: visible at all (and with adaptive sampling its step
+  // multiplier) for the table the ray caster samples (AdaptiveSteps.h), and
+  // the largest normalised value for MIP.
+  const std::vector<std::uint8_t> codes = classifyStepBlocks(
+      blocks_.mins(), blocks_.maxs(), w, tf_, settings.opacityScale, sampleDistance,
+      pre ? preintEntries_ : lutSize_, settings.sampling, adaptive);
   const double ww = w.max - w.min;
-  const glm::ivec3 c = blocks_.blockCount();
-  std::vector<std::uint8_t> cells(static_cast<std::size_t>(c.x) * c.y * c.z * 2);
+  std::vector<std::uint8_t> cells(codes.size() * 4, 0);
   std::size_t occupiedCount = 0;
-  for (std::size_t b = 0; b < blocks_.mins().size(); ++b) {
-    const double nlo = std::clamp((blocks_.mins()[b] - w.min) / ww, 0.0, 1.0);
+  for (std::size_t b = 0; b < codes.size(); ++b) {
     const double nhi = std::clamp((blocks_.maxs()[b] - w.min) / ww, 0.0, 1.0);
-    const int i0 = static_cast<int>(std::floor(nlo * (lutSize_ - 1)));
-    const int i1 = std::min(lutSize_ - 1, static_cast<int>(std::ceil(nhi * (lutSize_ - 1))));
-    const bool occupied = opaquePrefix[static_cast<std::size_t>(i1) + 1] -
-                              opaquePrefix[static_cast<std::size_t>(i0)] >
-                          0;
-    cells[b * 2] = occupied ? 255 : 0;
-    occupiedCount += occupied ? 1 : 0;
+    cells[b * 4] = codes[b] > 0 ? 255 : 0;
+    occupiedCount += codes[b] > 0 ? 1 : 0;
     // Rounded up so that "block max <= current max" never skips a larger sample.
-    cells[b * 2 + 1] = static_cast<std::uint8_t>(std::min(255.0, std::ceil(nhi * 255.0)));
+    cells[b * 4 + 1] = static_cast<std::uint8_t>(std::min(255.0, std::ceil(nhi * 255.0)));
+    cells[b * 4 + 2] = codes[b];  // the step allowance (AdaptiveSteps.h)
   }
-  occupiedFraction_ =
-      static_cast<double>(occupiedCount) / static_cast<double>(blocks_.mins().size());
+  occupiedFraction_ = static_cast<double>(occupiedCount) / static_cast<double>(codes.size());
+  stepGrid_ = {.dims = volume_.dims(),
+               .blockSize = blockSize_,
+               .count = blocks_.blockCount(),
+               .codes = codes};
   uploadBlocks(cells);
 }
 
@@ -108,7 +122,7 @@ void Raycaster::uploadBlocks(const std::vector<std::uint8_t>& cells) {
     // mosaic's address arithmetic (see README, Benchmark).
     if (blockTexture_.id() == 0) {
       blockTexture_ = gpu::Texture::create3D(context_.ledger(), "empty-space blocks",
-                                             gpu::TexelFormat::RG8, c.x, c.y, c.z, cells.data());
+                                             gpu::TexelFormat::RGBA8, c.x, c.y, c.z, cells.data());
       blockTexture_.setFilter(gpu::Filter::Nearest);
     } else {
       blockTexture_.update(cells.data());
@@ -134,8 +148,7 @@ void Raycaster::uploadBlocks(const std::vector<std::uint8_t>& cells) {
       for (int x = 0; x < c.x; ++x) {
         const std::size_t b = blocks_.index(x, y, z);
         const std::size_t t = (static_cast<std::size_t>(oy + y) * blockTexSize_.x + ox + x) * 4;
-        texels[t] = cells[b * 2];
-        texels[t + 1] = cells[b * 2 + 1];
+        for (int ch = 0; ch < 4; ++ch) texels[t + ch] = cells[b * 4 + ch];
       }
     }
   }
@@ -158,6 +171,13 @@ std::vector<std::string> Raycaster::definesFor(const RenderSettings& settings) c
   // serves composite and MIP; MinIP and the average need every sample.
   const bool skippable = settings.mode == RenderMode::Composite || settings.mode == RenderMode::Mip;
   if (blockSize_ > 0 && skippable) defines.push_back("EMPTY_SPACE_SKIPPING 1");
+  // Fewer samples (docs/sampling.md): both for composite only; adaptive steps
+  // live in the block grid.
+  if (usesPreintegration(settings)) defines.push_back("PREINTEGRATED 1");
+  if (blockSize_ > 0 && usesAdaptiveSampling(settings)) {
+    defines.push_back("ADAPTIVE_SAMPLING 1");
+    if (settings.sampling.opacityGrowth) defines.push_back("OPACITY_GROWTH 1");
+  }
   addShadingDefines(settings, defines);
   addClippingDefines(settings, defines);
   if (settings.nearest) defines.push_back("NEAREST 1");
@@ -262,15 +282,23 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
   if (settings.nearest) prog.set("u_sampleDims", glm::vec3(volume_.dims()));
 
   int unit = layout_.bindSeam(prog, 0);
-  lut_.texture().bind(unit);
-  prog.set("u_tf", unit++);
-  prog.set("u_tfSize", static_cast<float>(lutSize_));
+  if (usesPreintegration(settings)) {
+    preint_.texture().bind(unit);
+    prog.set("u_preint", unit++);
+    prog.set("u_preintSize", static_cast<float>(preint_.entries()));
+  } else {
+    lut_.texture().bind(unit);
+    prog.set("u_tf", unit++);
+    prog.set("u_tfSize", static_cast<float>(lutSize_));
+  }
   if (blockSize_ > 0) {
     blockTexture_.bind(unit);
     prog.set("u_blocks", unit++);
     prog.set("u_blocksPerUnit",
              glm::vec3(glm::dvec3(volume_.dims()) / static_cast<double>(blockSize_)));
     prog.set("u_blockCount", glm::vec3(blocks_.blockCount()));
+    prog.set("u_log2MaxMultiplier",
+             static_cast<float>(std::log2(std::max(1, settings.sampling.maxMultiplier))));
     if (context_.caps().api == gpu::ApiLevel::Gles2) {
       prog.set("u_blockTilesX", static_cast<float>(blockTilesX_));
       prog.set("u_blockTexSize", glm::vec2(blockTexSize_));
@@ -331,7 +359,11 @@ TechniqueRequirements Raycaster::requirements(const gpu::DeviceLimits& limits,
   r.textureUnits = skipBlock > 0 ? kOwnTextureUnits : 1;
   const std::uint64_t target = static_cast<std::uint64_t>(options.imageSize.x) *
                                static_cast<std::uint64_t>(options.imageSize.y) * 4;
-  const std::uint64_t lut = 4096 * 8;
+  // The 1D TF table or the pre-integration table (at most 1024^2 RGBA16F),
+  // counted at the default size.
+  const std::uint64_t lut = std::max<std::uint64_t>(
+      4096 * 8, static_cast<std::uint64_t>(PreIntegrationTable::kDefaultEntries) *
+                    PreIntegrationTable::kDefaultEntries * 8);
   std::uint64_t blocks = 0;
   if (skipBlock > 0) {
     const glm::u64vec3 c =

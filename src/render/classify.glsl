@@ -29,3 +29,22 @@ vec4 classify(float n) {
   return mix(a, b, x - x0);
 #endif
 }
+
+// A sample or segment that stands for m base steps (adaptive sampling): its
+// opacity for the longer stretch, a' = 1 - (1 - a)^m (AdaptiveSteps.h).
+vec4 stretchOpacity(vec4 c, float m) {
+  return m == 1.0 ? c : vec4(c.rgb, 1.0 - pow(max(1.0 - c.a, 0.0), m));
+}
+
+#ifdef PREINTEGRATED
+// Pre-integrated classification (reference/PreIntegration.h): straight colour
+// and the opacity of one base step for the segment on which the normalised
+// value runs from nf (front) to nb (back); u_preint holds u_preintSize^2
+// entries, front along x (render/PreIntegrationTable.h).
+uniform sampler2D u_preint;
+uniform float u_preintSize;
+
+vec4 classifySegment(float nf, float nb) {
+  return TEX2D(u_preint, (vec2(nf, nb) * (u_preintSize - 1.0) + 0.5) / u_preintSize);
+}
+#endif

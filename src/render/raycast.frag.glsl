@@ -10,6 +10,11 @@
 // With EMPTY_SPACE_SKIPPING, blocks whose every possible sample is
 // transparent (or cannot raise the maximum) are jumped over without changing
 // which samples are taken, so the image is the same as without skipping.
+// With PREINTEGRATED the composite mode classifies each segment between two
+// samples by its front and back values (classifiedSegment); with
+// ADAPTIVE_SAMPLING the block grid also holds a step multiplier m per block
+// and the ray takes every m-th sample of its lattice there (the walk of
+// reference/AdaptiveSteps.h, which the CPU reference follows too).
 
 uniform float u_step;       // world units
 uniform float u_maxSteps;   // the user's cap, <= MAX_STEPS
@@ -41,7 +46,52 @@ vec4 blockAt(vec3 cell) {
   return TEX2D(u_blocks, texel / u_blockTexSize);
 }
 #endif
+
+// The first base sample at or past the ray's exit from block `cell`
+// (AdaptiveSteps.h: exitSample).
+float exitSample(vec3 cell, vec3 to, vec3 td, vec3 invTd, float t0, float j, float k) {
+  vec3 exitFace = (cell + step(0.0, td)) / u_blocksPerUnit;
+  vec3 tb = (exitFace - to) * invTd;
+  float tExit = min(min(tb.x, tb.y), tb.z);
+  return max(ceil((tExit - t0) / u_step - j), k + 1.0);
+}
+
+#ifdef ADAPTIVE_SAMPLING
+uniform float u_log2MaxMultiplier;
+
+// The multiplier of a block whose code (AdaptiveSteps.h: 64 + floor(8 log2 s),
+// s the block's step allowance) is stored in `b`, behind opacity `alpha`:
+// 2^floor(log2(s / (1 - alpha))), 1..2^u_log2MaxMultiplier. Integer maths on
+// floats, rounded, so that the lattice arithmetic stays exact.
+float stepMultiplier(float b, float alpha) {
+  float code = floor(b * 255.0 + 0.5);
+  float e = floor((code - 64.0) / 8.0 - log2(max(1.0 - alpha, 1e-6)));
+  return floor(exp2(clamp(e, 0.0, u_log2MaxMultiplier)) + 0.5);
+}
+
+// The next sample after k in a block with multiplier m whose exit sample is
+// kExit (AdaptiveSteps.h: nextAdaptiveSample): the next multiple of m, and a
+// pre-integrated ray stops at kExit - 1 so that it crosses the face in one
+// base step.
+float nextSample(float k, float m, float kExit) {
+  float aligned = (floor(k / m) + 1.0) * m;
+#ifdef PREINTEGRATED
+  return k >= kExit - 1.0 ? k + 1.0 : min(aligned, kExit - 1.0);
+#else
+  return min(aligned, kExit);
 #endif
+}
+#endif
+#endif
+
+// Whether clipping keeps the sample at p.
+bool sampleKept(vec3 p) {
+#ifdef CLIPPING
+  return clipKeeps(p);
+#else
+  return true;
+#endif
+}
 
 void main() {
   vec2 ndc = gl_FragCoord.xy / u_viewport * 2.0 - 1.0;
@@ -66,6 +116,14 @@ void main() {
       j = jitterOffset(floor(gl_FragCoord.x), u_viewport.y - 1.0 - floor(gl_FragCoord.y));
     }
     float k = 0.0;  // sample index; a float so GLSL ES 1.00 needs no integer maths
+#ifdef PREINTEGRATED
+    // Segments run between samples: on the lattice shifted back half a step,
+    // one sample more, segment k-1..k covers exactly the stretch
+    // [t0 + (k + j - 1) ds, t0 + (k + j) ds] that post-classified sample k - 1
+    // stands for, from the ray's entry to past its exit.
+    j -= 0.5;
+    t1 += 0.5 * u_step;
+#endif
 #ifdef CLIPPING
     // March only through the crop box, from the box-aligned sample at or just
     // before its entry (clipKeeps drops any sample outside): no sample moves.
@@ -76,41 +134,88 @@ void main() {
     k = max(0.0, floor((crop.x - t0) / u_step - j));
     t1 = min(t1, crop.y + 0.5 * u_step);
 #endif
+#ifdef PREINTEGRATED
+    float frontN = 0.0;      // the segment's front sample: value and index
+    float frontK = -1.0;     // < 0: none (the ray starts a new segment)
+    bool lazyFront = false;  // after an empty block: the front is sample k - 1
+#endif
 #ifdef EMPTY_SPACE_SKIPPING
-    // The block grid is read once per block the ray enters, not per sample:
-    // samples before tBlockExit lie in the occupied block read last (one
-    // that float rounding puts just past the face is taken too, harmlessly:
-    // a skippable block's samples add nothing).
-    float tBlockExit = -1.0;
+    // The block grid is read once per block the ray enters, not per sample
+    // (SwiftShader, in browsers, pays for every fetch): samples before
+    // blockExit lie in the block read last.
+    float blockExit = -1.0;
+    vec4 block = vec4(0.0);
 #endif
     for (int i = 0; i < MAX_STEPS; i++) {
       if (k >= u_maxSteps) break;
       float t = t0 + (k + j) * u_step;
       if (t >= t1) break;
       vec3 p = to + t * td;
+      float kNext = k + 1.0;
+      bool empty = false;
 #ifdef EMPTY_SPACE_SKIPPING
-      if (t >= tBlockExit) {
+      if (k >= blockExit) {
         vec3 cell = clamp(floor(p * u_blocksPerUnit), vec3(0.0), u_blockCount - 1.0);
-        vec4 block = blockAt(cell);
+        block = blockAt(cell);
+        // The first sample at or past the block's exit face: where an empty
+        // block is left for, and where adaptive steps end.
+        blockExit = exitSample(cell, to, td, invTd, t0, j, k);
+      }
 #ifdef MODE_MIP
-        bool empty = block.g <= maxValue;
+      empty = block.g <= maxValue;
 #else
-        bool empty = block.r < 0.5;
+      empty = block.r < 0.5;
 #endif
-        vec3 exitFace = (cell + step(0.0, td)) / u_blocksPerUnit;
-        vec3 tb = (exitFace - to) * invTd;
-        float tExit = min(min(tb.x, tb.y), tb.z);
-        if (empty) {
-          // Jump to the first sample at or past the block's exit face.
-          k = max(ceil((tExit - t0) / u_step - j), k + 1.0);
-          continue;
-        }
-        tBlockExit = tExit;
+      float kExit = blockExit;
+#ifdef ADAPTIVE_SAMPLING
+#ifdef OPACITY_GROWTH
+      float m = stepMultiplier(block.b, acc.a);
+#else
+      float m = stepMultiplier(block.b, 0.0);
+#endif
+      if (m > 1.0) kNext = nextSample(k, m, kExit);
+#endif
+      if (empty) kNext = kExit;
+#ifdef PREINTEGRATED
+      // An empty block still ends the segment that enters it (below); with
+      // no segment open there is nothing to read.
+      if (empty && frontK < 0.0) {
+        lazyFront = true;
+        k = kNext;
+        continue;
+      }
+#else
+      if (empty) {
+        k = kNext;
+        continue;
       }
 #endif
+#endif
+#if defined(PREINTEGRATED) && !defined(MODE_MIP) && !defined(MODE_MINIP) && !defined(MODE_AVERAGE)
+      // One volume and one table fetch per iteration, whatever happens (a
+      // SIMD rasteriser such as llvmpipe runs every branch of the body for
+      // the whole group): after an empty block, an iteration reads the front
+      // at k - 1 and stays at k; clipping drops the segments it touches.
+      bool frontOnly = lazyFront && frontK < 0.0 && sampleKept(p);
+      vec3 q = frontOnly ? p - u_step * td : p;
+      bool keepQ = sampleKept(q);
+      float n = normalizedValue(fieldValue(q));
+      float tMid = t0 + (0.5 * (frontK + k) + j) * u_step;
+      vec4 c = classifiedSegment(frontN, n, k - frontK, to + tMid * td);
+      if (!frontOnly && keepQ && frontK >= 0.0) compositeFrontToBack(acc, c);
+      frontN = n;
+      if (frontOnly) {
+        frontK = keepQ ? k - 1.0 : -1.0;
+        kNext = k;
+      } else {
+        frontK = keepQ && !empty ? k : -1.0;
+      }
+      lazyFront = !frontOnly && empty;
+      if (acc.a >= u_ert) break;
+#else
 #ifdef CLIPPING
       if (!clipKeeps(p)) {
-        k += 1.0;
+        k = kNext;
         continue;
       }
 #endif
@@ -123,10 +228,16 @@ void main() {
       sumValue += normalizedValue(fieldValue(p));
       kept += 1.0;
 #else
+#ifdef ADAPTIVE_SAMPLING
+      // A sample stands for the stretch to the next one.
+      compositeFrontToBack(acc, stretchOpacity(classifiedSample(p), kNext - k));
+#else
       compositeFrontToBack(acc, classifiedSample(p));
+#endif
       if (acc.a >= u_ert) break;
 #endif
-      k += 1.0;
+#endif
+      k = kNext;
     }
   }
 #ifdef MODE_MIP

@@ -34,3 +34,19 @@ vec4 classifiedSample(vec3 p) {
 #endif
   return c;
 }
+
+#ifdef PREINTEGRATED
+// The pre-integrated segment from normalised value nf to nb standing for m
+// base steps (m > 1 only with ADAPTIVE_SAMPLING), with SHADING lit by the gradient at pMid, the segment's middle.
+vec4 classifiedSegment(float nf, float nb, float m, vec3 pMid) {
+#ifdef ADAPTIVE_SAMPLING
+  vec4 c = stretchOpacity(classifySegment(nf, nb), m);
+#else
+  vec4 c = classifySegment(nf, nb);  // m = 1: consecutive samples
+#endif
+#ifdef SHADING
+  c = shadeSample(c, pMid);
+#endif
+  return c;
+}
+#endif

@@ -53,9 +53,13 @@ TEST(Cli, RenderPhantomJsonReportsRequiredFieldsAndWritesPng) {
   EXPECT_LE(j["ms_min"].get<double>(), j["ms_median"].get<double>());
   EXPECT_LE(j["ms_median"].get<double>(), j["ms_max"].get<double>());
   EXPECT_GE(j["psnr_db"].get<double>(), 40.0);
-  // 48^3 u8 volume + 4096-entry RGBA16F table + 6^3 RG8 blocks + 64x48 RGBA8 target + VBO.
+  // 48^3 u8 volume + 256^2 RGBA16F pre-integration table (the default) + 6^3
+  // RGBA8 blocks + 64x48 RGBA8 target + VBO.
   EXPECT_EQ(j["texture_bytes"].get<std::uint64_t>(),
-            48u * 48 * 48 + 4096u * 8 + 6u * 6 * 6 * 2 + 64u * 48 * 4 + 24u);
+            48u * 48 * 48 + 256u * 256 * 8 + 6u * 6 * 6 * 4 + 64u * 48 * 4 + 24u);
+  EXPECT_EQ(j["preintegrate"], true);
+  EXPECT_EQ(j["adaptive"], true);
+  EXPECT_GT(j["samples_per_ray"].get<double>(), 0.0);
   const tessera::Image img = tessera::Image::readPng(png);
   EXPECT_EQ(img.width(), 64);
   EXPECT_EQ(img.height(), 48);

@@ -114,14 +114,21 @@ void expectConformant(gpu::GlContext& c, const Volume& v, const layout::Layout& 
     for (int skip : {0, 8}) {
       caster.setSkipBlockSize(skip);
       for (bool shade : {false, true}) {
-        RenderSettings s;
-        s.mode = mode;
-        s.shading.enabled = shade;
-        if (shade) s.clipping.planes.push_back({});  // render/clipping.glsl too
-        const Validation frag = validate(gpu::assembleShader(caster.fragmentParts(s)), "frag");
-        EXPECT_EQ(frag.exitCode, 0)
-            << layout.name() << " skip " << skip << " shade " << shade << ":\n"
-            << frag.log;
+        // Composite also pre-integrated and with adaptive steps (the other
+        // modes ignore both, docs/sampling.md).
+        const int samplings = mode == RenderMode::Composite ? 4 : 1;
+        for (int sampling = 0; sampling < samplings; ++sampling) {
+          RenderSettings s;
+          s.mode = mode;
+          s.shading.enabled = shade;
+          s.sampling.preintegrate = (sampling & 1) != 0;
+          s.sampling.adaptive = (sampling & 2) != 0;
+          if (shade) s.clipping.planes.push_back({});  // render/clipping.glsl too
+          const Validation frag = validate(gpu::assembleShader(caster.fragmentParts(s)), "frag");
+          EXPECT_EQ(frag.exitCode, 0) << layout.name() << " skip " << skip << " shade " << shade
+                                      << " sampling " << sampling << ":\n"
+                                      << frag.log;
+        }
       }
     }
   }

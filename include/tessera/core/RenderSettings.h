@@ -64,6 +64,38 @@ struct Clipping {
   bool active() const { return !planes.empty() || cropped(); }
 };
 
+// Fewer samples for the same image (docs/sampling.md). Both apply to the
+// composite mode of the ray caster and its CPU reference only (the projections
+// need every sample, labels are not interpolated, the slicers draw planes).
+//
+// Pre-integrated classification (Engel et al. 2001): each segment between two
+// consecutive samples is classified by its front and back values, the TF
+// integrated over the values in between as if the field ran linearly from one
+// to the other (reference/PreIntegration.h), instead of by one value per
+// sample (post-classification); large steps then miss no thin TF feature.
+//
+// Adaptive sampling: inside blocks of the empty-space grid where the TF varies
+// little over the block's value range, samples are taken every m-th step of
+// the base lattice t0 + (k + j) ds (m = 2, 4, ... up to maxMultiplier; m k
+// still on the lattice, so samples never move), with opacity corrected for
+// the longer segment: a' = 1 - (1 - a)^m (reference/AdaptiveSteps.h).
+struct Sampling {
+  bool preintegrate = false;
+  bool adaptive = false;
+  // A block gets the largest m with m * ds * V <= tolerance, where V is the
+  // TF's variation over the block's value range (extinction per world unit
+  // plus extinction-weighted colour, max minus min): the bound on what a
+  // segment of length m ds can get wrong there.
+  double tolerance = 0.1;
+  int maxMultiplier = 16;  // a power of two, 1..64
+  // Behind accumulated opacity A a stretch's error reaches the pixel (1 - A)
+  // times weaker, so steps grow by 2^floor(-log2(1 - A)) (Danskin & Hanrahan
+  // 1992's opacity-based acceleration): the transmittance-weighted error of a
+  // step never exceeds what the block's multiplier allows at full
+  // transmittance. Still on the lattice, still capped by maxMultiplier.
+  bool opacityGrowth = true;
+};
+
 struct RenderSettings {
   RenderMode mode = RenderMode::Composite;
   Shading shading;
@@ -71,6 +103,7 @@ struct RenderSettings {
   // Nearest-neighbour reconstruction: a sample takes the value of the voxel
   // whose cell holds it (label volumes: no interpolation across labels).
   bool nearest = false;
+  Sampling sampling;
   // Sample distance in voxels of the smallest spacing: ds = stepVoxels * min(spacing).
   double stepVoxels = 0.5;
   // Upper bound on samples per ray (Schultz 2016, 7.2.3).
@@ -86,6 +119,15 @@ struct RenderSettings {
   // Composited behind the volume: out = C + (1 - A) * background.
   glm::dvec4 background{0.0, 0.0, 0.0, 1.0};
 };
+
+// Whether a render with these settings pre-integrates / samples adaptively
+// (both: composite mode, interpolated values).
+inline bool usesPreintegration(const RenderSettings& s) {
+  return s.sampling.preintegrate && s.mode == RenderMode::Composite && !s.nearest;
+}
+inline bool usesAdaptiveSampling(const RenderSettings& s) {
+  return s.sampling.adaptive && s.mode == RenderMode::Composite && !s.nearest;
+}
 
 // Jitter offset of pixel (x, y) (y from the top row): an 8x8 ordered-dither
 // (Bayer) pattern, (M(x mod 8, y mod 8) + 0.5) / 64, where the base-4 digit i

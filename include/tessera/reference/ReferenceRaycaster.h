@@ -15,6 +15,7 @@
 #include "tessera/core/RenderSettings.h"
 #include "tessera/core/TransferFunction.h"
 #include "tessera/core/Volume.h"
+#include "tessera/reference/AdaptiveSteps.h"
 #include "tessera/reference/Reconstruction.h"
 
 namespace tessera {
@@ -28,6 +29,10 @@ double sampleTrilinear(const Volume& volume, glm::dvec3 p);
 struct ReferenceStats {
   std::uint64_t raysHittingVolume = 0;
   std::uint64_t samples = 0;
+  // Positions the ray visited, samples plus those where a walked grid
+  // (AdaptiveSteps.h) found an empty block and left it: the GPU loop's
+  // iterations.
+  std::uint64_t steps = 0;
 };
 
 // Opaque things in the scene besides the volume (overlay lines), per pixel:
@@ -40,10 +45,15 @@ struct ReferenceStops {
 };
 
 // Renders width x height pixels of the volume's trilinear field; threads = 0
-// uses every hardware thread.
+// uses every hardware thread. With settings.sampling.preintegrate the
+// composite mode classifies segments (PreIntegration.h). `steps`: the block
+// grid the GPU ray caster walks (AdaptiveSteps.h); given, the reference takes
+// exactly its samples (adaptive steps, and empty blocks left as it leaves
+// them); without it every sample of the lattice, as with skipping off.
 Image renderReference(const Volume& volume, const TransferFunction& tf, const Camera& camera,
                       const RenderSettings& settings, int width, int height, int threads = 0,
-                      ReferenceStats* stats = nullptr, const ReferenceStops* stops = nullptr);
+                      ReferenceStats* stats = nullptr, const ReferenceStops* stops = nullptr,
+                      const StepGrid* steps = nullptr);
 
 // The same with another reconstruction of the field: `volume` gives the box
 // (extent, spacing for the sample distance) and the value window, `field`
@@ -51,6 +61,6 @@ Image renderReference(const Volume& volume, const TransferFunction& tf, const Ca
 Image renderReference(const Volume& volume, const Reconstruction& field, const TransferFunction& tf,
                       const Camera& camera, const RenderSettings& settings, int width, int height,
                       int threads = 0, ReferenceStats* stats = nullptr,
-                      const ReferenceStops* stops = nullptr);
+                      const ReferenceStops* stops = nullptr, const StepGrid* steps = nullptr);
 
 }  // namespace tessera

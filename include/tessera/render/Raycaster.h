@@ -2,7 +2,9 @@
 // The single-pass GPU ray caster, in OpenGL ES 2.0 and 3.0 contexts alike.
 // Works on any Layout (it only calls sampleVolume()), with composite and MIP
 // modes, early ray termination, jitter and empty-space skipping over a block
-// min/max grid. Besides the layout's units it uses two: the TF and the grid.
+// min/max grid, pre-integrated classification and adaptive steps over that
+// grid (docs/sampling.md). Besides the layout's units it uses two: the TF (or
+// the pre-integration table) and the grid.
 // The "raycast" technique of the registry (render/TechniqueRegistry.h).
 #include <glm/vec2.hpp>
 #include <map>
@@ -21,6 +23,8 @@
 #include "tessera/gpu/ProgramCache.h"
 #include "tessera/layout/Layout.h"
 #include "tessera/layout/ValueBlocks.h"
+#include "tessera/reference/AdaptiveSteps.h"
+#include "tessera/render/PreIntegrationTable.h"
 #include "tessera/render/Technique.h"
 #include "tessera/render/TechniqueRegistry.h"
 
@@ -38,6 +42,13 @@ class Raycaster final : public Technique {
   void setSkipBlockSize(int voxels);
   // TF lookup-table entries (256 or 4096).
   void setLutSize(int entries);
+  // Entries per axis of the pre-integration table (default 256).
+  void setPreintegrationEntries(int entries);
+  // The pre-integration table in RGBA8 even where half floats filter.
+  void setPreintegrationEightBit(bool eightBit) {
+    preint_.setEightBit(eightBit);
+    lookupKey_.clear();
+  }
 
   // Compiles the program and builds the lookup tables the settings need, so
   // that a timed frame measures rendering only.
@@ -62,6 +73,12 @@ class Raycaster final : public Technique {
   // Fraction of empty-space blocks the current TF and window leave
   // occupied (1 when skipping is off); valid after prepare()/renderFrame().
   double occupiedBlockFraction() const { return occupiedFraction_; }
+  // The block grid as the last frame walked it (codes: 0 empty, else the
+  // step allowance, AdaptiveSteps.h), for the CPU reference to take the same
+  // samples; not valid() without a grid.
+  const StepGrid& stepGrid() const { return stepGrid_; }
+  // The pre-integration table (built when a frame pre-integrates).
+  const PreIntegrationTable& preintegrationTable() const { return preint_; }
 
   static constexpr int kOwnTextureUnits = 2;
 
@@ -107,6 +124,9 @@ class Raycaster final : public Technique {
   std::uint64_t blocksVersion_ = 0;  // layout_.contentVersion() the blocks were made for
   std::vector<float> lutValues_;     // the baked TF, 4 floats per entry
   gpu::LookupTexture lut_;
+  PreIntegrationTable preint_;
+  int preintEntries_ = PreIntegrationTable::kDefaultEntries;
+  StepGrid stepGrid_;
   gpu::Texture blockTexture_;
   gpu::Framebuffer target_;
   gpu::FullscreenTriangle triangle_;

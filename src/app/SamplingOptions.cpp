@@ -1,0 +1,80 @@
+#include "app/SamplingOptions.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "tessera/core/Error.h"
+
+namespace tessera::app {
+
+bool parseOnOff(const std::string& text, const std::string& option) {
+  if (text == "on" || text == "true" || text == "1" || text == "yes") return true;
+  if (text == "off" || text == "false" || text == "0" || text == "no") return false;
+  throw InputError(option + " '" + text + "': expected on or off");
+}
+
+void addSamplingOptions(CLI::App* cmd, SamplingOptions& o) {
+  o.stepOption =
+      cmd->add_option("--step", o.step,
+                      "Base sample distance in voxels of the smallest spacing; adaptive steps "
+                      "take every m-th sample of it where the TF allows (add --adaptive off for "
+                      "exactly this step everywhere)")
+          ->capture_default_str();
+  cmd->add_option("--preintegrate", o.preintegrate,
+                  "Pre-integrated classification of the segments between samples (composite "
+                  "ray casting): on or off (post-classification of each sample)")
+      ->capture_default_str();
+  cmd->add_option("--adaptive", o.adaptive,
+                  "Adaptive sampling: larger steps inside empty-space blocks where the TF varies "
+                  "little over the block's values (composite ray casting; needs --skip-block > "
+                  "0): on or off")
+      ->capture_default_str();
+  cmd->add_option("--adaptive-tolerance", o.tolerance,
+                  "With --adaptive: a block takes m base steps at once while m * step * (TF "
+                  "variation over its values, per mm) <= this")
+      ->capture_default_str();
+  cmd->add_option("--adaptive-max", o.maxMultiplier,
+                  "With --adaptive: the largest multiple of the base step (1, 2, 4, ... 64)")
+      ->capture_default_str();
+  cmd->add_option("--adaptive-growth", o.growth,
+                  "With --adaptive: steps also grow behind accumulated opacity A, by "
+                  "2^floor(-log2(1 - A)) (its error reaches the pixel 1 - A times weaker): on "
+                  "or off")
+      ->capture_default_str();
+}
+
+void applySampling(const SamplingOptions& o, RenderSettings& settings) {
+  if (!(o.step > 0.0) || !std::isfinite(o.step)) {
+    throw InputError("--step must be a positive number of voxels");
+  }
+  settings.stepVoxels = o.step;
+  settings.sampling.preintegrate = parseOnOff(o.preintegrate, "--preintegrate");
+  settings.sampling.adaptive = parseOnOff(o.adaptive, "--adaptive");
+  if (!(o.tolerance >= 0.0) || !std::isfinite(o.tolerance)) {
+    throw InputError("--adaptive-tolerance must be a finite number >= 0");
+  }
+  const int m = o.maxMultiplier;
+  if (m < 1 || m > 64 || (m & (m - 1)) != 0) {
+    throw InputError("--adaptive-max must be a power of two in 1..64, got " + std::to_string(m));
+  }
+  settings.sampling.tolerance = o.tolerance;
+  settings.sampling.maxMultiplier = m;
+  settings.sampling.opacityGrowth = parseOnOff(o.growth, "--adaptive-growth");
+}
+
+std::string describeSampling(const RenderSettings& s) {
+  char buf[160];
+  std::string out;
+  std::snprintf(buf, sizeof buf, "step %g voxel", s.stepVoxels);
+  out = buf;
+  out += usesPreintegration(s) ? ", pre-integrated" : ", post-classified";
+  if (usesAdaptiveSampling(s)) {
+    std::snprintf(buf, sizeof buf, ", adaptive steps up to %dx (tolerance %g%s)",
+                  s.sampling.maxMultiplier, s.sampling.tolerance,
+                  s.sampling.opacityGrowth ? ", growing behind opacity" : "");
+    out += buf;
+  }
+  return out;
+}
+
+}  // namespace tessera::app
