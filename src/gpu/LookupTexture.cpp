@@ -4,27 +4,10 @@
 #include <cmath>
 #include <cstdint>
 
-#include <glm/gtc/packing.hpp>
-
 #include "tessera/gpu/DeviceProfile.h"
+#include "tessera/gpu/TexelFormat.h"
 
 namespace tessera::gpu {
-
-namespace {
-std::vector<std::uint16_t> toHalves(const std::vector<float>& v) {
-  std::vector<std::uint16_t> out(v.size());
-  std::transform(v.begin(), v.end(), out.begin(), [](float x) { return glm::packHalf1x16(x); });
-  return out;
-}
-
-std::vector<std::uint8_t> toBytes(const std::vector<float>& v) {
-  std::vector<std::uint8_t> out(v.size());
-  std::transform(v.begin(), v.end(), out.begin(), [](float x) {
-    return static_cast<std::uint8_t>(std::lround(std::clamp(x, 0.0f, 1.0f) * 255.0f));
-  });
-  return out;
-}
-}  // namespace
 
 void LookupTexture::upload(GlContext& context, const std::vector<float>& rgba,
                            const std::string& label, Filter filter) {
@@ -37,9 +20,9 @@ void LookupTexture::upload(GlContext& context, const std::vector<float>& rgba,
     format = TexelFormat::RgbaHalfUnsized;
   }
   const std::vector<std::uint16_t> halves =
-      format == TexelFormat::RgbaHalfUnsized ? toHalves(rgba) : std::vector<std::uint16_t>();
+      format == TexelFormat::RgbaHalfUnsized ? packHalves(rgba) : std::vector<std::uint16_t>();
   const std::vector<std::uint8_t> bytes =
-      format == TexelFormat::Rgba8Unsized ? toBytes(rgba) : std::vector<std::uint8_t>();
+      format == TexelFormat::Rgba8Unsized ? packUnorm8(rgba) : std::vector<std::uint8_t>();
   const void* data = format == TexelFormat::RgbaHalfUnsized
                          ? static_cast<const void*>(halves.data())
                      : format == TexelFormat::Rgba8Unsized ? static_cast<const void*>(bytes.data())

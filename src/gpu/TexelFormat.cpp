@@ -1,5 +1,10 @@
 #include "tessera/gpu/TexelFormat.h"
 
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/packing.hpp>
+
 #include "gpu/GlFormats.h"
 
 namespace tessera::gpu {
@@ -74,6 +79,21 @@ const char* texelFormatName(TexelFormat f) {
       return "RGBA16F (ES 2 half float)";
   }
   return "?";
+}
+
+std::vector<std::uint16_t> packHalves(const std::vector<float>& values) {
+  std::vector<std::uint16_t> out(values.size());
+  std::transform(values.begin(), values.end(), out.begin(),
+                 [](float x) { return glm::packHalf1x16(x); });
+  return out;
+}
+
+std::vector<std::uint8_t> packUnorm8(const std::vector<float>& values) {
+  std::vector<std::uint8_t> out(values.size());
+  std::transform(values.begin(), values.end(), out.begin(), [](float x) {
+    return static_cast<std::uint8_t>(std::lround(std::clamp(x, 0.0f, 1.0f) * 255.0f));
+  });
+  return out;
 }
 
 }  // namespace tessera::gpu

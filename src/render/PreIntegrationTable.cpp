@@ -6,29 +6,12 @@
 #include <cstdint>
 #include <sstream>
 
-#include <glm/gtc/packing.hpp>
-
 #include "tessera/core/Timing.h"
 #include "tessera/gpu/DeviceProfile.h"
+#include "tessera/gpu/TexelFormat.h"
 #include "tessera/reference/PreIntegration.h"
 
 namespace tessera::render {
-
-namespace {
-std::vector<std::uint16_t> toHalves(const std::vector<float>& v) {
-  std::vector<std::uint16_t> out(v.size());
-  std::transform(v.begin(), v.end(), out.begin(), [](float x) { return glm::packHalf1x16(x); });
-  return out;
-}
-
-std::vector<std::uint8_t> toBytes(const std::vector<float>& v) {
-  std::vector<std::uint8_t> out(v.size());
-  std::transform(v.begin(), v.end(), out.begin(), [](float x) {
-    return static_cast<std::uint8_t>(std::lround(std::clamp(x, 0.0f, 1.0f) * 255.0f));
-  });
-  return out;
-}
-}  // namespace
 
 bool PreIntegrationTable::update(gpu::GlContext& context, const TransferFunction& tf,
                                  double opacityScale, double length, int entries) {
@@ -51,11 +34,11 @@ bool PreIntegrationTable::update(gpu::GlContext& context, const TransferFunction
     format = gpu::TexelFormat::RgbaHalfUnsized;
   }
   const std::vector<std::uint16_t> halves = format == gpu::TexelFormat::RgbaHalfUnsized
-                                                ? toHalves(values_)
+                                                ? gpu::packHalves(values_)
                                                 : std::vector<std::uint16_t>();
   const std::vector<std::uint8_t> bytes =
       format == gpu::TexelFormat::Rgba8Unsized || format == gpu::TexelFormat::RGBA8
-          ? toBytes(values_)
+          ? gpu::packUnorm8(values_)
           : std::vector<std::uint8_t>();
   const void* data = format == gpu::TexelFormat::RgbaHalfUnsized
                          ? static_cast<const void*>(halves.data())

@@ -4,6 +4,7 @@
 // formats are ES 3.0 (R16 with EXT_texture_norm16), the unsized ones ES 2.0.
 // The format fixes what an upload passes (`data` layout per texel).
 #include <cstdint>
+#include <vector>
 
 #include "tessera/gpu/DeviceCaps.h"
 
@@ -37,5 +38,10 @@ std::uint64_t bytesPerTexel(TexelFormat format);
 std::uint64_t uploadBytesPerTexel(TexelFormat format);
 // "R8", "RGBA16F", "L8" ... for labels and plans.
 const char* texelFormatName(TexelFormat format);
+
+// Float texel components as uploaded for the half-float and 8-bit formats:
+// IEEE half floats, and unsigned normalised bytes (clamped to [0, 1], rounded).
+std::vector<std::uint16_t> packHalves(const std::vector<float>& values);
+std::vector<std::uint8_t> packUnorm8(const std::vector<float>& values);
 
 }  // namespace tessera::gpu
