@@ -37,6 +37,7 @@
 #include "tessera/viewer/RecentFiles.h"
 #include "tessera/viewer/SliceView.h"
 #include "tessera/viewer/Viewer.h"
+#include "tessera/viewer/ZoomSwap.h"
 #endif
 
 namespace tessera::app {
@@ -59,7 +60,7 @@ struct ViewOptions {
   bool pick = false;            // pick the region around the crosshair
   int regionSide = 0;           // 0: 256 or what the profile allows
   double zoom = 1.0;
-  bool zoomGrid = false;          // the zoom policy switches overview <-> grid view
+  bool zoomGrid = false;          // the zoom swaps coarse / medium / native block (ZoomSwap)
   std::string mode = "overview";  // overview, region, grid
   ShadingOptions shading;
   ClippingOptions clipping;
@@ -228,13 +229,13 @@ struct DesktopSession {
   std::string exploreNote;                 // e.g. why a grid move was refused
   bool fourUp = true;
   bool sliceColour = false;       // slices in the TF's colour instead of grey
-  bool zoomSwitchesGrid = false;  // lod::ZoomLevelPolicy enters / leaves the grid view
+  bool zoomSwitchesGrid = false;  // the zoom swaps coarse / medium level / native grid block
   double viewPixels = 0.0;        // the 3D view's height in pixels (the policy's view)
-  std::optional<lod::ZoomLevelPolicy> zoomPolicy;
-  std::string zoomPolicyKey;  // the stages it was made for
+  // While it exists, the zoom decides what the 3D view shows (viewer/ZoomSwap.h);
+  // a manual mode change (region, grid, overview) ends it.
+  std::unique_ptr<viewer::ZoomSwap> zoomSwap;
+  std::string zoomSwapKey;  // the stages it was made for
   double lastFrameMs = 0.0;
-  gpu::Framebuffer fadeFrom;  // the 3D view before a zoom-driven swap
-  double fadeOld = 0.0;       // its weight still on screen (1 -> 0 over the fade)
   // The three slice views: axial, coronal, sagittal.
   struct SliceTile {
     std::string plane;
@@ -409,6 +410,7 @@ std::string boxText(const lod::VoxelBox& b) {
 
 void showOverview(DesktopSession& ds, Follow follow = Follow::Fill) {
   if (!ds.overview) return;
+  ds.zoomSwap.reset();  // made again from the overview (panelExplore)
   try {
     showIn3D(ds, *ds.overview,
              ds.volumeLabel +
@@ -426,6 +428,7 @@ void showOverview(DesktopSession& ds, Follow follow = Follow::Fill) {
 // Reads `box` at native resolution (one bounded read) into the 3D view.
 void showNative(DesktopSession& ds, const lod::VoxelBox& box, DesktopSession::Mode mode,
                 Follow follow) {
+  ds.zoomSwap.reset();  // the keys decide now
   try {
     showIn3D(ds, ds.explorer->readRegion(box), ds.volumeLabel + " " + boxText(box) + " (native)",
              box, follow);
@@ -996,19 +999,6 @@ void panelShading(viewer::Viewer& v) {
   slider("shininess", s.shininess, 1.0f, 128.0f);
 }
 
-// Keeps the 3D view's last frame for the cross-fade of a zoom-driven swap
-// (ES 3: the frame cache; ES 2 redraws every frame and has no copy to fade).
-void captureFade(DesktopSession& ds) {
-  if (!ds.es3 || ds.cache.width() == 0) return;
-  if (ds.fadeFrom.width() != ds.cache.width() || ds.fadeFrom.height() != ds.cache.height()) {
-    ds.fadeFrom = gpu::Framebuffer();
-    ds.fadeFrom = gpu::Framebuffer::create(ds.context->ledger(), "zoom fade", ds.cache.width(),
-                                           ds.cache.height());
-  }
-  const glm::ivec4 box(0, 0, ds.cache.width(), ds.cache.height());
-  gpu::blitFramebuffer(ds.cache.id(), box, ds.fadeFrom.id(), box);
-}
-
 // The exploring controls (issue 15): mode, crosshair, region size, the
 // grid view's moves as buttons (touch-style controls beside the keys), and
 // the zoom policy's stages (lod/ZoomLevelPolicy.h), which can switch the
@@ -1048,49 +1038,39 @@ void panelExplore(DesktopSession& ds) {
   ImGui::Checkbox("four views (L)", &ds.fourUp);
   ImGui::SameLine();
   ImGui::Checkbox("slices in TF colour (C)", &ds.sliceColour);
-  // The zoom policy's stages for this volume and view.
-  const lod::GridNavigator& g = ex.grid();
-  const glm::dvec3 sp = ex.source().shape().spacing();
-  const double volumeRadius = 0.5 * glm::length(glm::dvec3(d) * sp);
-  const double blockRadius = 0.5 * glm::length(glm::dvec3(glm::min(2 * g.cellSize(), d)) * sp);
-  const int coarse = std::min(ds.overviewLevel + 1, ex.source().levelCount() - 1);
-  const double pxPerVoxel = std::max(1.0, ds.viewPixels) / glm::length(glm::dvec3(d));
-  const lod::ZoomLevelPolicy policy(lod::ZoomLevelPolicy::overviewStages(
-      coarse, ds.overviewLevel, pxPerVoxel, volumeRadius, blockRadius));
-  std::string stages;
-  for (const lod::ZoomStage& st : policy.stages()) {
+  // The zoom swap's stages for this volume and view (viewer/ZoomSwap.h).
+  const std::vector<lod::ZoomStage> stages =
+      viewer::zoomStagesFor(ex, ds.overviewLevel, ds.viewPixels);
+  std::string text;
+  for (const lod::ZoomStage& st : stages) {
     char t[80];
-    std::snprintf(t, sizeof t, "%s%s L%d from zoom %.2f", stages.empty() ? "" : "; ",
-                  st.name.c_str(), st.level, st.enterZoom);
-    stages += t;
+    std::snprintf(t, sizeof t, "%s%s L%d from zoom %.2f", text.empty() ? "" : "; ", st.name.c_str(),
+                  st.level, st.enterZoom);
+    text += t;
   }
-  ImGui::TextWrapped("zoom stages: %s", stages.c_str());
-  if (ImGui::Checkbox("zoom into the grid view", &ds.zoomSwitchesGrid)) ds.zoomPolicy.reset();
-  if (!ds.zoomSwitchesGrid || !policy.stages().back().subVolume) {
-    ds.fadeOld = 0.0;
+  ImGui::TextWrapped("zoom stages: %s", text.c_str());
+  if (ImGui::Checkbox("zoom swaps levels and the grid view", &ds.zoomSwitchesGrid) &&
+      !ds.zoomSwitchesGrid && ds.zoomSwap) {
+    showOverview(ds, Follow::Keep);
+  }
+  if (!ds.zoomSwitchesGrid || stages.size() < 2) {
+    ds.zoomSwap.reset();
     return;
   }
-  // The policy lives across frames (its hysteresis and fade are state);
-  // new stages (another volume or view size) start it afresh.
-  if (!ds.zoomPolicy || ds.zoomPolicyKey != stages) {
-    ds.zoomPolicy.emplace(policy.stages());
-    ds.zoomPolicyKey = stages;
+  if (ds.zoomSwap) {
+    ImGui::Text("zoom %.2f: %s%s", ds.zoomSwap->overviewZoom(ds.viewer->camera()),
+                ds.viewer->volumeName().c_str(), ds.zoomSwap->fading() ? " (fading)" : "");
   }
-  const bool native = ds.mode == DesktopSession::Mode::Grid;
-  const double zoom = ds.viewer->camera().zoom;
-  // In the grid view the camera frames the block: its zoom in overview terms.
-  const double overviewZoom = native ? zoom * volumeRadius / blockRadius : zoom;
-  const double now = 1000.0 * glfwGetTime();
-  const lod::ZoomFrame f = ds.zoomPolicy->update(overviewZoom, now - ds.lastFrameMs);
-  ds.lastFrameMs = now;
-  const bool wantNative = policy.stages()[static_cast<std::size_t>(f.stage)].subVolume;
-  if (wantNative != native && ds.mode != DesktopSession::Mode::Region) {
-    captureFade(ds);
-    wantNative ? enterGrid(ds, Follow::Keep) : showOverview(ds, Follow::Keep);
+  // Made from the overview (after a manual mode change: once back there);
+  // new stages (another volume or view size) make it again.
+  if (ds.mode != DesktopSession::Mode::Overview || (ds.zoomSwap && ds.zoomSwapKey == text)) return;
+  try {
+    ds.zoomSwap = std::make_unique<viewer::ZoomSwap>(*ds.context, ex, stages);
+    ds.zoomSwap->keepLevel(ds.overviewLevel, ds.overview);
+    ds.zoomSwapKey = text;
+  } catch (const Error& e) {
+    ds.error = e.what();
   }
-  // The image from before the swap fades out over the policy's fade time.
-  const bool nativeSwap = policy.stages()[static_cast<std::size_t>(f.from)].subVolume != wantNative;
-  ds.fadeOld = f.from != f.stage && nativeSwap ? 1.0 - f.mix : 0.0;
 }
 
 // The control panel at the window's left edge.
@@ -1140,12 +1120,53 @@ std::string viewKey(viewer::Viewer& v, int viewW, int viewH) {
   return key.str();
 }
 
+// The 3D view while the zoom decides what it shows: every frame on ES 2,
+// on ES 3 when the view changed, a fade runs or the zoom asks for another
+// stage (the cached frame blitted otherwise). The session's mode follows
+// the stage shown (the native stage is the grid view's block).
+void drawZoomSwapView(DesktopSession& ds, glm::ivec2 origin, int viewW, int viewH) {
+  viewer::Viewer& v = *ds.viewer;
+  viewer::ZoomSwap& zs = *ds.zoomSwap;
+  const double now = 1000.0 * glfwGetTime();
+  const double dtMs = ds.lastFrameMs > 0.0 ? now - ds.lastFrameMs : 0.0;
+  ds.lastFrameMs = now;
+  if (ds.es3) {
+    if (ds.cache.width() != viewW || ds.cache.height() != viewH) {
+      ds.cache = gpu::Framebuffer();
+      ds.cache = gpu::Framebuffer::create(ds.context->ledger(), "view cache", viewW, viewH);
+      ds.cacheKey.clear();
+    }
+    const int shown = zs.shownStage();
+    const bool swapAsked =
+        shown < 0 || zs.policy().stageFor(shown, zs.overviewZoom(v.camera())) != shown;
+    if (swapAsked || zs.fading() || viewKey(v, viewW, viewH) != ds.cacheKey) {
+      zs.frame(v, dtMs, viewW, viewH, ds.cache.id());
+      ds.cacheKey = viewKey(v, viewW, viewH);
+    } else if (v.refining()) {
+      v.refine();  // a strip of the full-quality frame per window frame (no fade runs)
+    }
+    gpu::blitFramebuffer(ds.cache.id(), {0, 0, viewW, viewH}, 0,
+                         {origin.x, origin.y, viewW, viewH});
+  } else {
+    zs.frame(v, dtMs, viewW, viewH, 0, origin);
+  }
+  if (zs.shownBox()) {
+    ds.mode = DesktopSession::Mode::Grid;
+    ds.shown = ds.gridBlock = zs.shownBox();
+  } else {
+    ds.mode = DesktopSession::Mode::Overview;
+    ds.shown.reset();
+  }
+}
+
 // The volume right of the panel: re-rendered only when something it shows
 // changed (ES 3 blits the cached frame), every frame on ES 2 (no blit).
 void drawVolumeView(DesktopSession& ds, glm::ivec2 origin, int viewW, int viewH) {
   viewer::Viewer& v = *ds.viewer;
   try {
-    if (ds.es3) {
+    if (ds.zoomSwap) {
+      drawZoomSwapView(ds, origin, viewW, viewH);
+    } else if (ds.es3) {
       const std::string key = viewKey(v, viewW, viewH);
       if (key != ds.cacheKey || ds.cache.width() != viewW || ds.cache.height() != viewH) {
         if (ds.cache.width() != viewW || ds.cache.height() != viewH) {
@@ -1219,13 +1240,6 @@ void runFrame(DesktopSession& ds) {
   updateOverlay(ds);
   drawPanel(ds, wh);
   for (int t = 0; t < 3 && ds.fourUp; ++t) drawSliceTile(ds, ds.slices[t], tiles.slice[t]);
-  if (ds.fadeOld > 0.0 && ds.fadeFrom.width() > 0) {
-    // GL textures start at the bottom row: flipped texture coordinates.
-    ImGui::GetBackgroundDrawList()->AddImage(
-        reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(ds.fadeFrom.color().id())),
-        tiles.view3d.p0, tiles.view3d.p1, ImVec2(0.0f, 1.0f), ImVec2(1.0f, 0.0f),
-        IM_COL32(255, 255, 255, static_cast<int>(std::lround(255.0 * ds.fadeOld))));
-  }
   drawHelpOverlay(ds, kPanelWidth, static_cast<float>(ww), static_cast<float>(wh));
   const EdgeLabels labels = ds.viewer->orientationLabels();
   drawEdgeLetters(labels.left, labels.right, labels.top, labels.bottom, tiles.view3d.p0,
@@ -1333,7 +1347,7 @@ void runView(const ViewOptions& o) {
   ImGui::DestroyContext();
   ds.cache = gpu::Framebuffer();
   for (auto& tile : ds.slices) tile.texture = gpu::Texture();  // before the context's ledger goes
-  ds.fadeFrom = gpu::Framebuffer();
+  ds.zoomSwap.reset();
   ds.viewer.reset();
   ds.context.reset();
   glfwDestroyWindow(ds.window);
@@ -1380,8 +1394,9 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--zoom", o->zoom, "Initial camera zoom (1: the volume fills the view)")
       ->capture_default_str();
   cmd->add_flag("--zoom-grid", o->zoomGrid,
-                "Let the zoom switch between the overview and the grid view (lod/ZoomLevelPolicy: "
-                "thresholds with hysteresis, cross-fade)");
+                "Let the zoom swap the 3D view between a coarse level, the overview level and the "
+                "native grid block around the view's centre (viewer/ZoomSwap: thresholds with "
+                "hysteresis, a cross-fade on ES 2 and ES 3)");
   cmd->add_option("--region-side", o->regionSide,
                   "Side of the picked region in voxels (16 .. 256 or what the profile allows)");
   cmd->add_option("--mode", o->mode,

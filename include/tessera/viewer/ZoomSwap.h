@@ -50,6 +50,12 @@ class ZoomSwap {
   lod::ZoomFrame frame(Viewer& viewer, double dtMs, int width, int height, unsigned framebuffer = 0,
                        glm::ivec2 origin = {0, 0});
 
+  // A whole level the front end has already read (its overview): used
+  // instead of reading it again.
+  void keepLevel(int level, std::shared_ptr<const Volume> volume) {
+    levels_[level] = std::move(volume);
+  }
+
   const lod::ZoomLevelPolicy& policy() const { return policy_; }
   // The stage in the viewer (-1 before the first frame).
   int shownStage() const { return shown_; }
