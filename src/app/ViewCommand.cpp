@@ -1185,6 +1185,13 @@ void drawVolumeView(DesktopSession& ds, glm::ivec2 origin, int viewW, int viewH)
     }
   } catch (const Error& e) {
     ds.error = e.what();
+    if (ds.zoomSwap) {
+      // A stage that cannot be read or uploaded: the zoom stops swapping
+      // (instead of trying again every frame); the last volume stays.
+      ds.zoomSwap.reset();
+      ds.zoomSwitchesGrid = false;
+      ds.error += " (zoom swap turned off)";
+    }
   }
   const viewer::FrameStats& fs = v.lastFrame();
   char line[160];
