@@ -37,10 +37,22 @@ window.TesseraGrid = (function () {
       json: c('tessera_grid_json', 'string', []),
       overview: c('tessera_region_overview', 'number', []),
       projection: c('tessera_projection_json', 'string', ['number', 'number']),
+      markBox: c('tessera_set_mark_box', 'number', ['number', 'number', 'number', 'number', 'number', 'number', 'number']),
       lastError: c('tessera_last_error', 'string', []),
     };
+    // The last block's cyan box in the overview is drawn by the viewer
+    // (slot 1), as lines composed with the volume by depth like the
+    // bounding box; sent when it changes.
+    let sentMark = '';
+    function syncMark(box) {
+      const key = box ? `${box.begin.join(',')}:${box.end.join(',')}` : '';
+      if (key === sentMark) return false;
+      sentMark = key;
+      if (box) api.markBox(1, box.begin[0], box.end[0], box.begin[1], box.end[1], box.begin[2], box.end[2]);
+      else api.markBox(1, 0, 0, 0, 0, 0, 0);
+      return true;
+    }
     const pad = $('grid-pad');
-    const overlay = $('overlayGrid');
     const moveButtons = Array.from(pad.querySelectorAll('button[data-move]'));
     let grid = { has_volume: false };
     let volumeKey = '';
@@ -74,53 +86,11 @@ window.TesseraGrid = (function () {
       note.classList.toggle('refused', !!grid.refused);
     }
 
-    // The last block as a box over the 3D view while the overview shows.
+    // The last block as a box in the 3D view while the overview shows
+    // (drawn by the viewer; the 2D overlay canvas stays clear).
     function drawOverlay() {
-      const dpr = window.devicePixelRatio || 1;
-      const W = canvas.clientWidth, H = canvas.clientHeight;
-      Object.assign(overlay.style, {
-        left: `${canvas.offsetLeft + canvas.clientLeft}px`, top: `${canvas.offsetTop + canvas.clientTop}px`,
-        width: `${W}px`, height: `${H}px`,
-      });
-      const bw = Math.max(1, Math.round(W * dpr)), bh = Math.max(1, Math.round(H * dpr));
-      if (overlay.width !== bw || overlay.height !== bh) { overlay.width = bw; overlay.height = bh; }
-      const ctx = overlay.getContext('2d');
-      ctx.setTransform(1, 0, 0, 1, 0, 0);
-      ctx.clearRect(0, 0, bw, bh);
-      if (!grid.has_volume || !grid.block || grid.active) return;
-      if (explore.showing_region) return;  // a region is shown: its own view
-      const pj = JSON.parse(api.projection(canvas.width, canvas.height) || '{}');
-      if (!pj.mvp) return;
-      const m = pj.mvp;
-      const project = (v) => {
-        const p = v.map((x, a) => x * pj.spacing[a] + pj.offset[a]);
-        const cx = m[0] * p[0] + m[4] * p[1] + m[8] * p[2] + m[12];
-        const cy = m[1] * p[0] + m[5] * p[1] + m[9] * p[2] + m[13];
-        const cw = m[3] * p[0] + m[7] * p[1] + m[11] * p[2] + m[15];
-        if (!(cw > 1e-9)) return null;
-        return [(cx / cw + 1) / 2 * bw, (1 - cy / cw) / 2 * bh];
-      };
-      const b = grid.block.begin, e = grid.block.end;
-      ctx.beginPath();
-      for (let axis = 0; axis < 3; axis++) {
-        const u = (axis + 1) % 3, w = (axis + 2) % 3;
-        for (let i = 0; i < 4; i++) {
-          const a = [0, 0, 0];
-          a[u] = i & 1 ? e[u] : b[u];
-          a[w] = i & 2 ? e[w] : b[w];
-          const z = a.slice();
-          a[axis] = b[axis];
-          z[axis] = e[axis];
-          const pa = project(a), pb = project(z);
-          if (!pa || !pb) continue;
-          ctx.moveTo(pa[0], pa[1]);
-          ctx.lineTo(pb[0], pb[1]);
-        }
-      }
-      ctx.strokeStyle = COLOR;
-      ctx.lineWidth = 2.5 * dpr;
-      ctx.setLineDash([8 * dpr, 5 * dpr]);
-      ctx.stroke();
+      const want = grid.has_volume && grid.block && !grid.active && !explore.showing_region ? grid.block : null;
+      if (syncMark(want)) requestRender();
     }
 
     // After every frame (slices.js): a new volume forgets the block.
@@ -154,6 +124,7 @@ window.TesseraGrid = (function () {
 
     async function leave() {
       if (!api.overview()) { showError(api.lastError()); return false; }
+      syncMark(refresh().block);  // in the very frame that shows the overview
       await requestRender();
       return true;
     }
@@ -188,15 +159,14 @@ window.TesseraGrid = (function () {
         e.preventDefault();
       }
     });
-    new ResizeObserver(() => drawOverlay()).observe(canvas);
 
     const testApi = {
       state: () => refresh(),
       enter: async (cell) => { if (cell !== undefined) $('gridCell').value = cell; return enter(); },
       move,
       leave,
-      // RGBA pixels of the grid's overlay over the 3D view (the block's box).
-      overlayPixels: () => Array.from(overlay.getContext('2d').getImageData(0, 0, overlay.width, overlay.height).data),
+      // RGBA pixels of the 3D view's frame (the block's box, drawn by depth).
+      framePixels: () => Array.from(window.tessera.pixels()),
     };
     return {
       frameShown,

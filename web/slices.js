@@ -37,8 +37,21 @@ window.TesseraSlices = (function () {
       regionShow: c('tessera_region_show', 'number', ['number', 'number', 'number', 'number', 'number', 'number']),
       regionOverview: c('tessera_region_overview', 'number', []),
       projection: c('tessera_projection_json', 'string', ['number', 'number']),
+      markBox: c('tessera_set_mark_box', 'number', ['number', 'number', 'number', 'number', 'number', 'number', 'number']),
       lastError: c('tessera_last_error', 'string', []),
     };
+    // The region's box in the overview is drawn by the viewer (slot 0), as
+    // lines composed with the volume by depth like the bounding box; sent
+    // when it changes, and a frame asked for.
+    let sentMark = '';
+    function syncMark(box) {
+      const key = box ? `${box.begin.join(',')}:${box.end.join(',')}` : '';
+      if (key === sentMark) return false;
+      sentMark = key;
+      if (box) api.markBox(0, box.begin[0], box.end[0], box.begin[1], box.end[1], box.begin[2], box.end[2]);
+      else api.markBox(0, 0, 0, 0, 0, 0, 0);
+      return true;
+    }
 
     const views = $('views');
     views.classList.add('quad');
@@ -227,8 +240,8 @@ window.TesseraSlices = (function () {
     }
 
     // The 3D view's marks, over its canvas: the crosshair as a small 3D
-    // cross (x red, y green, z blue, as the axes), and in the overview the
-    // picked region as a red box.
+    // cross (x red, y green, z blue, as the axes). The picked region's red
+    // box in the overview is drawn by the viewer (syncMark), by depth.
     function draw3dOverlay() {
       const dpr = window.devicePixelRatio || 1;
       const W = canvas.clientWidth, H = canvas.clientHeight;
@@ -264,25 +277,7 @@ window.TesseraSlices = (function () {
         ctx.lineTo(pb[0], pb[1]);
       };
       const showing = explore.showing_region ? explore.region : null;
-      if (region && !showing) {
-        const b = region.begin, e = region.end;
-        ctx.beginPath();
-        for (let axis = 0; axis < 3; axis++) {
-          const u = (axis + 1) % 3, w = (axis + 2) % 3;
-          for (let i = 0; i < 4; i++) {
-            const a = [0, 0, 0];
-            a[u] = i & 1 ? e[u] : b[u];
-            a[w] = i & 2 ? e[w] : b[w];
-            const z = a.slice();
-            a[axis] = b[axis];
-            z[axis] = e[axis];
-            line(a, z);
-          }
-        }
-        ctx.strokeStyle = '#ff3b3b';
-        ctx.lineWidth = 2.5 * dpr;
-        ctx.stroke();
-      }
+      if (syncMark(region && !showing ? region : null)) requestRender();
       const inside = $('crosshair3d').checked && (!showing || [0, 1, 2].every((a) => cross[a] >= showing.begin[a] && cross[a] < showing.end[a]));
       if (inside) {
         const dims = showing ? [0, 1, 2].map((a) => showing.end[a] - showing.begin[a]) : explore.dims;
@@ -418,6 +413,7 @@ window.TesseraSlices = (function () {
 
     async function overview() {
       if (!api.regionOverview()) { showError(api.lastError()); return false; }
+      syncMark(region);  // in the very frame that shows the overview
       await requestRender();
       return true;
     }
@@ -542,8 +538,10 @@ window.TesseraSlices = (function () {
         const img = panels[plane].image;
         return Array.from(img.getContext('2d').getImageData(0, 0, img.width, img.height).data);
       },
-      // RGBA pixels of the 3D view's overlay (crosshair marker, region box).
+      // RGBA pixels of the 3D view's overlay (the crosshair marker) and, as
+      // frameRegionPixels, of the frame (the region's box, drawn by depth).
       overlayPixels: () => Array.from(overlay3d.getContext('2d').getImageData(0, 0, overlay3d.width, overlay3d.height).data),
+      framePixels: () => Array.from(window.tessera.pixels()),
       setCross: (x, y, z) => setCross([x, y, z]),
       setPicking: (on) => { picking = !!on; updateInfo(); },
       setRegionSide: (side) => { $('regionSide').value = side; },

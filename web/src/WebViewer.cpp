@@ -36,6 +36,7 @@
 #include "tessera/lod/InCoreMultiresSource.h"
 #include "tessera/render/OverlayRenderer.h"
 #include "tessera/render/TechniqueRegistry.h"
+#include "tessera/viewer/Explorer.h"
 #include "tessera/viewer/Viewer.h"
 
 using namespace tessera;
@@ -94,6 +95,12 @@ glm::dvec3 toRgb(double r, double g, double b) {
   return {r, g, b};
 }
 
+}  // namespace
+
+namespace {
+// The region / grid block boxes as lines of the viewer (slices.js, grid.js:
+// tessera_set_mark_box), set before each frame.
+void applyMarkBoxes();
 }  // namespace
 
 extern "C" {
@@ -171,7 +178,10 @@ EMSCRIPTEN_KEEPALIVE int tessera_load_files() {
 // Renders a frame on the canvas; returns its time in ms (-1 on error).
 EMSCRIPTEN_KEEPALIVE double tessera_render(int width, int height) {
   double ms = -1.0;
-  guarded([&] { ms = theViewer().render(width, height).ms; });
+  guarded([&] {
+    applyMarkBoxes();
+    ms = theViewer().render(width, height).ms;
+  });
   return ms;
 }
 
@@ -607,6 +617,62 @@ EMSCRIPTEN_KEEPALIVE int tessera_region_overview() {
     v.camera() = s.overviewCamera;
     s.overview.reset();
     s.shown = nullptr;
+  });
+}
+
+}  // extern "C"
+
+namespace {
+
+// Boxes marked in the overview (0: the picked region, red; 1: the grid
+// view's last block, cyan), drawn by the viewer as lines composed with the
+// volume by depth, like the bounding box and axes (render/HybridCompositor):
+// hidden behind opaque tissue, faded behind translucent. Each is kept with
+// the dims of the overview it was given for, so that another file never
+// shows a stale box.
+struct MarkBox {
+  std::optional<lod::VoxelBox> box;
+  glm::ivec3 dims{0};
+};
+MarkBox& markBox(int slot) {
+  static MarkBox boxes[2];
+  return boxes[std::clamp(slot, 0, 1)];
+}
+
+void applyMarkBoxes() {
+  viewer::Viewer& v = theViewer();
+  v.extraLines.clear();
+  if (!v.hasVolume() || regionShown()) return;  // the region or block is the view itself
+  const glm::ivec3 dims = v.volume().dims();
+  const glm::vec4 colours[2] = {{1.0f, 0.25f, 0.2f, 1.0f}, {0.25f, 0.85f, 0.95f, 1.0f}};
+  for (int slot = 0; slot < 2; ++slot) {
+    const MarkBox& m = markBox(slot);
+    if (!m.box || m.dims != dims) continue;
+    const auto lines = viewer::boxLines(*m.box, dims, v.volume().extent(), colours[slot]);
+    v.extraLines.insert(v.extraLines.end(), lines.begin(), lines.end());
+  }
+}
+
+}  // namespace
+
+extern "C" {
+
+// Marks box [x0,x1) x [y0,y1) x [z0,z1) of the overview in slot 0 (the
+// region, red) or 1 (the grid block, cyan) for the next frames; an empty
+// box clears the slot. Clamped to the overview.
+EMSCRIPTEN_KEEPALIVE int tessera_set_mark_box(int slot, int x0, int x1, int y0, int y1, int z0,
+                                              int z1) {
+  return guarded([&] {
+    if (slot < 0 || slot > 1) throw InputError("mark box: slot must be 0 or 1");
+    MarkBox& m = markBox(slot);
+    const lod::VoxelBox box{{x0, y0, z0}, {x1, y1, z1}};
+    if (glm::any(glm::lessThanEqual(box.end, box.begin)) || !theViewer().hasVolume()) {
+      m.box.reset();
+      return;
+    }
+    m.dims = overviewVolume().dims();
+    m.box = lod::VoxelBox{glm::clamp(box.begin, glm::ivec3(0), m.dims),
+                          glm::clamp(box.end, glm::ivec3(0), m.dims)};
   });
 }
 
