@@ -605,7 +605,7 @@ async function sliceViewsAndRegion(context, url, tmp, run) {
   // A region dragged in the axial view: at most 16 voxels each way (the
   // side), 16 deep around its slice.
   const regionPixels = async () => page.evaluate(() => {
-    const p = window.tessera.slices.overlayPixels();
+    const p = window.tessera.slices.framePixels();  // the box is drawn by depth in the frame
     let n = 0;
     for (let i = 0; i < p.length; i += 4) if (p[i + 3] > 128 && p[i] > 200 && p[i + 1] < 70 && p[i + 2] < 70) n++;
     return n;
@@ -651,6 +651,21 @@ async function sliceViewsAndRegion(context, url, tmp, run) {
   check('Overview returns to the whole volume and shows the region as a red box',
         back.dims.join('x') === '40x32x24' && redBefore === 0 && redAfter > SIZE / 2,
         `3D view ${back.dims.join('x')}; ${redBefore} red overlay pixels before the pick, ${redAfter} after`);
+  // The box is composed with the volume by depth (the viewer's lines, not a
+  // 2D overlay): inside an opaque volume most of it is hidden, inside a
+  // clear one it shows whole.
+  const tfKept = await page.evaluate(() => JSON.stringify(window.tessera.tf()));
+  const redWith = async (alpha) => {
+    await page.evaluate((tf) => window.tessera.setTfJson(tf), JSON.stringify({ name: 'uniform', opacity_unit_length: 1,
+      color: [{ x: 0, rgb: [0.2, 0.3, 0.9] }, { x: 1, rgb: [0.9, 0.9, 0.2] }], opacity: [{ x: 0, alpha }, { x: 1, alpha }] }));
+    await page.evaluate(() => window.tessera.render());
+    return regionPixels();
+  };
+  const redOpaque = await redWith(1), redClear = await redWith(0);
+  await page.evaluate((tf) => window.tessera.setTfJson(tf), tfKept);
+  check('the region box in the 3D view is composed by depth: hidden inside an opaque volume, whole in a clear one',
+        redClear > SIZE / 2 && redOpaque < 0.5 * redClear,
+        `${redOpaque} red pixels in an opaque volume, ${redClear} in a clear one`);
   // On a phone (390x844): one view at a time under tabs; the axial tab
   // shows the axial slice across the screen, and a tap moves the crosshair
   // to the voxel under the finger.
@@ -734,7 +749,7 @@ async function gridView(context, url, tmp, run) {
   const { page, logs } = await openPage(context, url, `size=${SIZE}&url=/data/grid.nii`);
   const grid = () => page.evaluate(() => window.tessera.slices.grid.state());
   const cyanPixels = async () => page.evaluate(() => {
-    const p = window.tessera.slices.grid.overlayPixels();
+    const p = window.tessera.slices.grid.framePixels();  // the box is drawn by depth in the frame
     let n = 0;
     for (let i = 0; i < p.length; i += 4) if (p[i + 3] > 128 && p[i] < 110 && p[i + 1] > 170 && p[i + 2] > 190) n++;
     return n;
