@@ -282,6 +282,13 @@ EMSCRIPTEN_KEEPALIVE int tessera_set_step(double voxels) {
     theViewer().settings().stepVoxels = voxels;
   });
 }
+// `tessera render`'s fast path (defaultSampling(), the viewer's default):
+// pre-integrated classification and adaptive steps, each on (1) or off (0).
+EMSCRIPTEN_KEEPALIVE void tessera_set_sampling(int preintegrate, int adaptive) {
+  if (!app().viewer) return;
+  theViewer().settings().sampling.preintegrate = preintegrate != 0;
+  theViewer().settings().sampling.adaptive = adaptive != 0;
+}
 // Blinn-Phong shading with a headlight and the default terms (RenderSettings::shading).
 EMSCRIPTEN_KEEPALIVE void tessera_set_shading(int on) {
   if (app().viewer) theViewer().settings().shading.enabled = on != 0;
@@ -349,6 +356,12 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_state_json(int logHistogram) {
                                {"bottom", labels.bottom}};
     const Camera& c = v.camera();
     j["camera"] = {{"azimuth", c.azimuthDeg}, {"elevation", c.elevationDeg}, {"zoom", c.zoom}};
+    const RenderSettings& rs = v.settings();
+    j["sampling"] = {{"step", rs.stepVoxels},
+                     {"preintegrate", rs.sampling.preintegrate},
+                     {"adaptive", rs.sampling.adaptive},
+                     {"tolerance", rs.sampling.tolerance},
+                     {"max_multiplier", rs.sampling.maxMultiplier}};
     j["frame_ms"] = v.lastFrame().ms;
     j["refining"] = v.refining();
     j["render_size"] = {v.lastFrame().renderWidth, v.lastFrame().renderHeight};
