@@ -198,6 +198,9 @@ async function main() {
       '--out', path.join(tmp, 'native-webgl2.png'));
   run('render', VOLUME, '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl1',
       '--out', path.join(tmp, 'native-webgl1.png'));
+  // The same without `tessera render`'s fast path (pre-integration, adaptive steps).
+  run('render', VOLUME, '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2',
+      '--preintegrate', 'off', '--adaptive', 'off', '--out', path.join(tmp, 'native-webgl2-plain.png'));
   run('convert', 'gen:shepp-logan:64', path.join(tmp, 'phantom64.nrrd'));
   run('convert', 'gen:sphere:48', path.join(tmp, 'sphere48.nii.gz'));
   const goodNii = path.join(tmp, 'sphere40.nii');
@@ -264,9 +267,31 @@ async function main() {
     check('default volume renders (non-black pixels)', shot.lit > 0.1, `${(100 * shot.lit).toFixed(1)} % lit`);
 
     await withoutOverlays(page);
+    // The page starts with `tessera render`'s sampling (defaultSampling()),
+    // so its image is the CLI's default image.
     const m2 = await psnrAgainst(page, path.join(tmp, 'native-webgl2.png'));
-    check('canvas matches the native renderer (PSNR >= 35 dB)', m2.psnr >= 35,
-          m2.error || `${m2.psnr.toFixed(2)} dB`);
+    check('canvas matches the native renderer with the same default sampling (PSNR >= 50 dB)',
+          m2.psnr >= 50 && s.sampling.preintegrate && s.sampling.adaptive,
+          m2.error || `${m2.psnr.toFixed(2)} dB; page ${JSON.stringify(s.sampling)}`);
+    // The page's sampling controls off: plain post-classified samples at the
+    // step, as `--preintegrate off --adaptive off` renders them, and no longer
+    // the fast path's image.
+    const setSampling = (preint, adaptive) => page.evaluate(async ([p, a]) => {
+      document.getElementById('preint').checked = p;
+      document.getElementById('adaptive').checked = a;
+      document.getElementById('adaptive').dispatchEvent(new Event('change'));
+      await window.tessera.render();
+    }, [preint, adaptive]);
+    await setSampling(false, false);
+    const plainOwn = await psnrAgainst(page, path.join(tmp, 'native-webgl2-plain.png'));
+    const plainFast = await psnrAgainst(page, path.join(tmp, 'native-webgl2.png'));
+    const plainState = (await page.evaluate(() => window.tessera.state())).sampling;
+    check('sampling controls off: the canvas matches `--preintegrate off --adaptive off` (PSNR >= 50 dB), ' +
+          'at least 3 dB closer than to the fast path\'s image',
+          plainOwn.psnr >= 50 && plainOwn.psnr >= plainFast.psnr + 3 && !plainState.preintegrate && !plainState.adaptive,
+          plainOwn.error || plainFast.error ||
+          `${plainOwn.psnr.toFixed(2)} dB vs plain native, ${plainFast.psnr.toFixed(2)} dB vs default native`);
+    await setSampling(true, true);
 
     // Lines composed with the volume by depth: an opaque volume seen from
     // the (+x, +y, +z) corner (azimuth 45, elevation 30) hides the axes,
