@@ -694,6 +694,8 @@
       o.textContent = n;
       $('technique').appendChild(o);
     });
+    $('preint').checked = state.sampling.preintegrate;  // webDefaultSampling()
+    $('adaptive').checked = state.sampling.adaptive;
     api.setMaxVolumePixels(maxVolumePixels);
     api.setProgressive(progressive ? 1 : 0, frameBudgetMs);
     new ResizeObserver(() => { if (fitCanvas()) requestRender(); }).observe(canvas);

@@ -18,9 +18,10 @@
 // fix, built with scripts/web.sh and copied) as two more viewers in the
 // same rounds, so that a fix's gain is measured alternating too.
 // --variants adds Tessera WebGL 2 tabs with the page's sampling controls set
-// otherwise (default: pre-integrated and adaptive, as `tessera render`):
-// `post` (adaptive, post-classified), `fixed` (pre-integrated, every step),
-// `plain` (neither: post-classified samples at exactly the step).
+// otherwise than its default (adaptive steps, post-classified):
+// `preint` (pre-integrated and adaptive: `tessera render`'s default), `fixed`
+// (pre-integrated, every step), `plain` (post-classified samples at exactly
+// the step).
 //
 // run.sh installs the pinned packages (npm ci), bundles the vtk.js page and
 // builds the web page first. Environment: TESSERA_SITE (default
@@ -53,7 +54,7 @@ const only = arg('only', '') ? arg('only', '').split(',') : null;
 const extraQuery = arg('query', '');
 const baselineSite = arg('baseline', '') ? path.resolve(arg('baseline', '')) : '';
 const SAMPLING_VARIANTS = {
-  post: { preint: false, adaptive: true, label: 'adaptive, post-classified' },
+  preint: { preint: true, adaptive: true, label: 'pre-integrated, adaptive' },
   fixed: { preint: true, adaptive: false, label: 'pre-integrated, fixed step' },
   plain: { preint: false, adaptive: false, label: 'post-classified, fixed step' },
 };
@@ -175,7 +176,7 @@ async function openTab(context, url, readyExpr) {
 }
 
 function tesseraViewer(webgl, baseline = false, variant = null) {
-  const sampling = variant ? SAMPLING_VARIANTS[variant] : { preint: true, adaptive: true };
+  const sampling = variant ? SAMPLING_VARIANTS[variant] : null;  // null: the page's default
   return {
     key: `tessera${webgl}${baseline ? '-baseline' : ''}${variant ? `-${variant}` : ''}`,
     label: `Tessera WebGL ${webgl}${baseline ? ' (baseline build)' : ''}${variant ? ` (${sampling.label})` : ''}`,
@@ -195,7 +196,7 @@ function tesseraViewer(webgl, baseline = false, variant = null) {
         // The page's sampling controls (a baseline build may predate them).
         const preint = document.getElementById('preint');
         const adaptive = document.getElementById('adaptive');
-        if (preint && adaptive) {
+        if (sampling && preint && adaptive) {
           preint.checked = sampling.preint;
           adaptive.checked = sampling.adaptive;
           adaptive.dispatchEvent(new Event('change'));
@@ -210,7 +211,7 @@ function tesseraViewer(webgl, baseline = false, variant = null) {
       const stepNow = await this.page.evaluate(() => +document.getElementById('step').value);
       if (Math.abs(stepNow - step) > 1e-9) throw new Error(`Tessera page: step ${step} not accepted (${stepNow})`);
       const sm = st.sampling;
-      if (sm && (sm.preintegrate !== sampling.preint || sm.adaptive !== sampling.adaptive)) {
+      if (sm && sampling && (sm.preintegrate !== sampling.preint || sm.adaptive !== sampling.adaptive)) {
         throw new Error(`Tessera page: sampling ${JSON.stringify(sm)}, asked for ${JSON.stringify(sampling)}`);
       }
       return `${st.render_size.join('x')} volume pixels` + (sm ? `, step ${sm.step}, ${sm.preintegrate ? 'pre-integrated' : 'post-classified'}` +

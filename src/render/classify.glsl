@@ -45,20 +45,6 @@ uniform sampler2D u_preint;
 uniform float u_preintSize;
 
 vec4 classifySegment(float nf, float nb) {
-#if TESSERA_GLSL == 300
-  // Bilinear between the four entries around (nf, nb) from unfiltered
-  // fetches, as classify() does: SwiftShader filters the half-float table in
-  // software, far slower (bench/web-peers).
-  vec2 x = vec2(nf, nb) * (u_preintSize - 1.0);
-  vec2 x0 = min(floor(x), vec2(u_preintSize - 2.0));
-  vec2 f = x - x0;
-  ivec2 i = ivec2(x0);
-  vec4 front = mix(texelFetch(u_preint, i, 0), texelFetch(u_preint, i + ivec2(1, 0), 0), f.x);
-  vec4 back =
-      mix(texelFetch(u_preint, i + ivec2(0, 1), 0), texelFetch(u_preint, i + ivec2(1, 1), 0), f.x);
-  return mix(front, back, f.y);
-#else
   return TEX2D(u_preint, (vec2(nf, nb) * (u_preintSize - 1.0) + 0.5) / u_preintSize);
-#endif
 }
 #endif

@@ -85,6 +85,19 @@ int guarded(F&& f) {
   }
 }
 
+// The page's default sampling: `tessera render`'s (defaultSampling()) without
+// pre-integration. In browsers without a GPU (SwiftShader) the
+// pre-integration table's filtered half-float fetch costs more than the
+// fewer samples save: on ch2 at 512^2 the page took 1.4-2.0x longer per frame
+// pre-integrated than with the adaptive steps alone, which keep 45-48 dB
+// against the 0.25-voxel reference (docs/web-peers.md, "Sampling in the
+// browser"). The page's "pre-integrated" control switches it on.
+constexpr Sampling webDefaultSampling() {
+  Sampling s = defaultSampling();
+  s.preintegrate = false;
+  return s;
+}
+
 viewer::Viewer& theViewer() {
   if (!app().viewer) throw GpuError("the viewer has no WebGL context yet");
   return *app().viewer;
@@ -124,6 +137,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_init(int webglVersion) {
     app().context = gpu::GlContext::adoptCurrent(api, profile);
     app().viewer =
         std::make_unique<viewer::Viewer>(*app().context, gpu::DeviceProfile::find(profile));
+    app().viewer->settings().sampling = webDefaultSampling();
     app().handle = h;
     app().webglVersion = attrs.majorVersion;
   });
@@ -282,8 +296,8 @@ EMSCRIPTEN_KEEPALIVE int tessera_set_step(double voxels) {
     theViewer().settings().stepVoxels = voxels;
   });
 }
-// `tessera render`'s fast path (defaultSampling(), the viewer's default):
-// pre-integrated classification and adaptive steps, each on (1) or off (0).
+// Pre-integrated classification and adaptive steps (RenderSettings.h: the
+// page starts with webDefaultSampling()), each on (1) or off (0).
 EMSCRIPTEN_KEEPALIVE void tessera_set_sampling(int preintegrate, int adaptive) {
   if (!app().viewer) return;
   theViewer().settings().sampling.preintegrate = preintegrate != 0;
