@@ -110,6 +110,7 @@
       setStep: c('tessera_set_step', 'number', ['number']),
       setOpacityScale: c('tessera_set_opacity_scale', null, ['number']),
       setShading: c('tessera_set_shading', null, ['number']),
+      setSampling: c('tessera_set_sampling', null, ['number', 'number']),
       setOverlays: c('tessera_set_overlays', null, ['number', 'number']),
       setQuality: c('tessera_set_quality', null, ['number']),
       setMaxVolumePixels: c('tessera_set_max_volume_pixels', null, ['number']),
@@ -656,6 +657,9 @@
       if (!api.setStep(+e.target.value)) showError(api.lastError());
       requestRender();
     });
+    const sampling = () => { api.setSampling($('preint').checked ? 1 : 0, $('adaptive').checked ? 1 : 0); requestRender(); };
+    $('preint').addEventListener('change', sampling);
+    $('adaptive').addEventListener('change', sampling);
     $('opacity').addEventListener('input', (e) => { api.setOpacityScale(+e.target.value); requestRender(); });
     $('shade').addEventListener('change', (e) => { api.setShading(e.target.checked ? 1 : 0); requestRender(); });
     const overlays = () => { api.setOverlays($('box').checked ? 1 : 0, $('axes').checked ? 1 : 0); requestRender(); };
@@ -690,6 +694,8 @@
       o.textContent = n;
       $('technique').appendChild(o);
     });
+    $('preint').checked = state.sampling.preintegrate;  // webDefaultSampling()
+    $('adaptive').checked = state.sampling.adaptive;
     api.setMaxVolumePixels(maxVolumePixels);
     api.setProgressive(progressive ? 1 : 0, frameBudgetMs);
     new ResizeObserver(() => { if (fitCanvas()) requestRender(); }).observe(canvas);

@@ -12,10 +12,16 @@
 //
 //   node bench.mjs [--rounds N] [--frames N] [--steps 0.5,1] [--out DIR]
 //                  [--only tessera2,vtk,...] [--query EXTRA] [--baseline SITE]
+//                  [--variants post,fixed,...]
 //
 // --baseline SITE adds another build of the page (e.g. the commit before a
 // fix, built with scripts/web.sh and copied) as two more viewers in the
 // same rounds, so that a fix's gain is measured alternating too.
+// --variants adds Tessera WebGL 2 tabs with the page's sampling controls set
+// otherwise than its default (adaptive steps, post-classified):
+// `preint` (pre-integrated and adaptive: `tessera render`'s default), `fixed`
+// (pre-integrated, every step), `plain` (post-classified samples at exactly
+// the step).
 //
 // run.sh installs the pinned packages (npm ci), bundles the vtk.js page and
 // builds the web page first. Environment: TESSERA_SITE (default
@@ -47,6 +53,13 @@ const outDir = path.resolve(arg('out', path.join(root, 'build-web/web-peers')));
 const only = arg('only', '') ? arg('only', '').split(',') : null;
 const extraQuery = arg('query', '');
 const baselineSite = arg('baseline', '') ? path.resolve(arg('baseline', '')) : '';
+const SAMPLING_VARIANTS = {
+  preint: { preint: true, adaptive: true, label: 'pre-integrated, adaptive' },
+  fixed: { preint: true, adaptive: false, label: 'pre-integrated, fixed step' },
+  plain: { preint: false, adaptive: false, label: 'post-classified, fixed step' },
+};
+const variants = arg('variants', '') ? arg('variants', '').split(',') : [];
+for (const v of variants) if (!SAMPLING_VARIANTS[v]) throw new Error(`--variants ${v}: one of ${Object.keys(SAMPLING_VARIANTS).join(', ')}`);
 
 // ---- The volume: NIfTI-1 header parsed here for vtk.js's raw voxels.
 function readNifti(file) {
@@ -162,10 +175,11 @@ async function openTab(context, url, readyExpr) {
   return { page, logs };
 }
 
-function tesseraViewer(webgl, baseline = false) {
+function tesseraViewer(webgl, baseline = false, variant = null) {
+  const sampling = variant ? SAMPLING_VARIANTS[variant] : null;  // null: the page's default
   return {
-    key: `tessera${webgl}${baseline ? '-baseline' : ''}`,
-    label: `Tessera WebGL ${webgl}${baseline ? ' (baseline build)' : ''}`,
+    key: `tessera${webgl}${baseline ? '-baseline' : ''}${variant ? `-${variant}` : ''}`,
+    label: `Tessera WebGL ${webgl}${baseline ? ' (baseline build)' : ''}${variant ? ` (${sampling.label})` : ''}`,
     async open(context, base) {
       const q = `size=${SIZE}&url=/data/volume.nii.gz${webgl === 1 ? '&webgl=1' : ''}${extraQuery ? `&${extraQuery}` : ''}`;
       const dir = baseline ? 'tessera-baseline' : 'tessera';
@@ -176,19 +190,32 @@ function tesseraViewer(webgl, baseline = false) {
       return { tf: await this.page.evaluate(() => window.tessera.tf()), window: s.window, dims: s.dims };
     },
     async setup({ step, camera }) {
-      await this.page.evaluate(async ({ step, camera }) => {
+      await this.page.evaluate(async ({ step, camera, sampling }) => {
         for (const id of ['box', 'axes']) document.getElementById(id).checked = false;
         document.getElementById('axes').dispatchEvent(new Event('change'));
+        // The page's sampling controls (a baseline build may predate them).
+        const preint = document.getElementById('preint');
+        const adaptive = document.getElementById('adaptive');
+        if (sampling && preint && adaptive) {
+          preint.checked = sampling.preint;
+          adaptive.checked = sampling.adaptive;
+          adaptive.dispatchEvent(new Event('change'));
+        }
         const s = document.getElementById('step');
         s.value = String(step);
         s.dispatchEvent(new Event('input'));
         await window.tessera.setProjection(true);
         await window.tessera.setCamera(camera.azimuth, camera.elevation, camera.zoom);
-      }, { step, camera });
+      }, { step, camera, sampling });
       const st = await this.page.evaluate(() => window.tessera.state());
       const stepNow = await this.page.evaluate(() => +document.getElementById('step').value);
       if (Math.abs(stepNow - step) > 1e-9) throw new Error(`Tessera page: step ${step} not accepted (${stepNow})`);
-      return `${st.render_size.join('x')} volume pixels`;
+      const sm = st.sampling;
+      if (sm && sampling && (sm.preintegrate !== sampling.preint || sm.adaptive !== sampling.adaptive)) {
+        throw new Error(`Tessera page: sampling ${JSON.stringify(sm)}, asked for ${JSON.stringify(sampling)}`);
+      }
+      return `${st.render_size.join('x')} volume pixels` + (sm ? `, step ${sm.step}, ${sm.preintegrate ? 'pre-integrated' : 'post-classified'}` +
+        (sm.adaptive ? `, adaptive up to ${sm.max_multiplier}x (tolerance ${sm.tolerance})` : ', fixed step') : '');
     },
     frames(n) { return this.page.evaluate((n) => window.tessera.timeFrames(n), n); },
     async pixels() {
@@ -262,6 +289,7 @@ async function main() {
       if (!fs.existsSync(path.join(baselineSite, 'tessera.wasm'))) throw new Error(`--baseline ${baselineSite}: no tessera.wasm there`);
       viewers.push(tesseraViewer(2, true), tesseraViewer(1, true));
     }
+    for (const v of variants) viewers.push(tesseraViewer(2, false, v));
     if (only) viewers = viewers.filter((v) => v.key === 'tessera2' || only.includes(v.key));
     const opened = {};
     for (const v of viewers) opened[v.key] = await v.open(context, url);

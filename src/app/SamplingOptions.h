@@ -14,22 +14,15 @@
 
 namespace tessera::app {
 
-struct SamplingDefaults {
-  static constexpr double kStep = 0.5;
-  static constexpr bool kPreintegrate = true;
-  static constexpr bool kAdaptive = true;
-  static constexpr double kTolerance = 0.5;
-  static constexpr int kMaxMultiplier = 16;
-  static constexpr bool kOpacityGrowth = true;
-};
-
+// Defaults: defaultSampling() and kDefaultStepVoxels (core/RenderSettings.h),
+// which the viewers start with too.
 struct SamplingOptions {
-  double step = SamplingDefaults::kStep;
-  std::string preintegrate = SamplingDefaults::kPreintegrate ? "on" : "off";
-  std::string adaptive = SamplingDefaults::kAdaptive ? "on" : "off";
-  double tolerance = SamplingDefaults::kTolerance;
-  int maxMultiplier = SamplingDefaults::kMaxMultiplier;
-  std::string growth = SamplingDefaults::kOpacityGrowth ? "on" : "off";
+  double step = kDefaultStepVoxels;
+  std::string preintegrate = defaultSampling().preintegrate ? "on" : "off";
+  std::string adaptive = defaultSampling().adaptive ? "on" : "off";
+  double tolerance = defaultSampling().tolerance;
+  int maxMultiplier = defaultSampling().maxMultiplier;
+  std::string growth = defaultSampling().opacityGrowth ? "on" : "off";
   CLI::Option* stepOption = nullptr;
   bool stepGiven() const { return stepOption != nullptr && stepOption->count() > 0; }
 };

@@ -942,6 +942,12 @@ void panelRendering(DesktopSession& ds) {
   }
   float step = static_cast<float>(v.settings().stepVoxels);
   if (ImGui::SliderFloat("step (voxels)", &step, 0.25f, 2.0f)) v.settings().stepVoxels = step;
+  // `tessera render`'s fast path (docs/sampling.md), on by default; off:
+  // post-classified samples at exactly the step above.
+  Sampling& sampling = v.settings().sampling;
+  ImGui::Checkbox("pre-integrated", &sampling.preintegrate);
+  ImGui::SameLine();
+  ImGui::Checkbox("adaptive steps", &sampling.adaptive);
   float opacity = static_cast<float>(v.settings().opacityScale);
   if (ImGui::SliderFloat("opacity x", &opacity, 0.0f, 4.0f)) v.settings().opacityScale = opacity;
   ImGui::Checkbox("bounding box", &v.showBoundingBox);
@@ -1100,6 +1106,7 @@ std::string viewKey(viewer::Viewer& v, int viewW, int viewH) {
   key << v.volumeName() << '|' << c.azimuthDeg << '|' << c.elevationDeg << '|' << c.zoom << '|'
       << c.target.x << c.target.y << c.target.z << '|' << v.tfEditor().revision() << '|'
       << static_cast<int>(v.settings().mode) << '|' << v.settings().stepVoxels << '|'
+      << v.settings().sampling.preintegrate << v.settings().sampling.adaptive << '|'
       << v.settings().opacityScale << '|' << v.window().min << v.window().max << '|'
       << v.technique() << static_cast<int>(v.quality) << v.controller().interacting() << '|'
       << v.showBoundingBox << v.showAxes << '|' << viewW << 'x' << viewH;

@@ -86,6 +86,19 @@ int guarded(F&& f) {
   }
 }
 
+// The page's default sampling: `tessera render`'s (defaultSampling()) without
+// pre-integration. In browsers without a GPU (SwiftShader) the
+// pre-integration table's filtered half-float fetch costs more than the
+// fewer samples save: on ch2 at 512^2 the page took 1.4-2.0x longer per frame
+// pre-integrated than with the adaptive steps alone, which keep 45-48 dB
+// against the 0.25-voxel reference (docs/web-peers.md, "Sampling in the
+// browser"). The page's "pre-integrated" control switches it on.
+constexpr Sampling webDefaultSampling() {
+  Sampling s = defaultSampling();
+  s.preintegrate = false;
+  return s;
+}
+
 viewer::Viewer& theViewer() {
   if (!app().viewer) throw GpuError("the viewer has no WebGL context yet");
   return *app().viewer;
@@ -131,6 +144,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_init(int webglVersion) {
     app().context = gpu::GlContext::adoptCurrent(api, profile);
     app().viewer =
         std::make_unique<viewer::Viewer>(*app().context, gpu::DeviceProfile::find(profile));
+    app().viewer->settings().sampling = webDefaultSampling();
     app().handle = h;
     app().webglVersion = attrs.majorVersion;
   });
@@ -292,6 +306,13 @@ EMSCRIPTEN_KEEPALIVE int tessera_set_step(double voxels) {
     theViewer().settings().stepVoxels = voxels;
   });
 }
+// Pre-integrated classification and adaptive steps (RenderSettings.h: the
+// page starts with webDefaultSampling()), each on (1) or off (0).
+EMSCRIPTEN_KEEPALIVE void tessera_set_sampling(int preintegrate, int adaptive) {
+  if (!app().viewer) return;
+  theViewer().settings().sampling.preintegrate = preintegrate != 0;
+  theViewer().settings().sampling.adaptive = adaptive != 0;
+}
 // Blinn-Phong shading with a headlight and the default terms (RenderSettings::shading).
 EMSCRIPTEN_KEEPALIVE void tessera_set_shading(int on) {
   if (app().viewer) theViewer().settings().shading.enabled = on != 0;
@@ -359,6 +380,12 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_state_json(int logHistogram) {
                                {"bottom", labels.bottom}};
     const Camera& c = v.camera();
     j["camera"] = {{"azimuth", c.azimuthDeg}, {"elevation", c.elevationDeg}, {"zoom", c.zoom}};
+    const RenderSettings& rs = v.settings();
+    j["sampling"] = {{"step", rs.stepVoxels},
+                     {"preintegrate", rs.sampling.preintegrate},
+                     {"adaptive", rs.sampling.adaptive},
+                     {"tolerance", rs.sampling.tolerance},
+                     {"max_multiplier", rs.sampling.maxMultiplier}};
     j["frame_ms"] = v.lastFrame().ms;
     j["refining"] = v.refining();
     j["render_size"] = {v.lastFrame().renderWidth, v.lastFrame().renderHeight};

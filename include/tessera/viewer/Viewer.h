@@ -187,7 +187,7 @@ class Viewer {
   Camera camera_;
   CameraController controller_{camera_};
   TransferFunctionEditor tfEditor_;
-  RenderSettings settings_;
+  RenderSettings settings_ = defaultRenderSettings();  // what `tessera render` uses
   std::string techniqueName_ = "raycast";
   std::uint64_t uploadedTfRevision_ = 0;
   FrameStats last_;
