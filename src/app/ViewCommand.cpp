@@ -33,6 +33,7 @@
 #include "tessera/io/VolumeReader.h"
 #include "tessera/lod/ZoomLevelPolicy.h"
 #include "tessera/render/TechniqueRegistry.h"
+#include "tessera/viewer/CropHandles.h"
 #include "tessera/viewer/Explorer.h"
 #include "tessera/viewer/RecentFiles.h"
 #include "tessera/viewer/SliceView.h"
@@ -248,6 +249,9 @@ struct DesktopSession {
   int dragTile = -1;          // a slice view being dragged in (-1: none)
   bool dragRegion = false;    // right button: drawing a region box
   glm::dvec2 dragStart{0.0};  // window units
+  // The crop box drawn with a handle on each face (viewer/CropHandles.h).
+  bool showCropBox = false;
+  viewer::CropHandles crop;
 };
 
 // A rectangle of the window in ImGui (window) units, top-left origin.
@@ -421,6 +425,11 @@ void showOverview(DesktopSession& ds, Follow follow = Follow::Fill) {
     ds.error = e.what();
   }
   updateOverlay(ds);
+  if (ds.showCropBox && ds.viewer->hasVolume()) {
+    const auto lines = viewer::CropHandles::lines(ds.viewer->settings().clipping,
+                                                  ds.viewer->volume().extent(), ds.crop.dragging());
+    ds.viewer->extraLines.insert(ds.viewer->extraLines.end(), lines.begin(), lines.end());
+  }
 }
 
 // Reads `box` at native resolution (one bounded read) into the 3D view.
@@ -811,11 +820,29 @@ void handleShortcuts(DesktopSession& ds) {
   }
 }
 
-// The 3D view: mouse drags orbit (right button or shift: pan), wheel zooms.
-void handleViewInput(viewer::Viewer& v, const Rect& view, double scale) {
+// The 3D view: mouse drags orbit (right button or shift: pan), wheel zooms;
+// a left drag that starts on a crop box handle moves that face instead.
+void handleViewInput(DesktopSession& ds, const Rect& view, double scale) {
+  viewer::Viewer& v = *ds.viewer;
   ImGuiIO& io = ImGui::GetIO();
   const glm::dvec2 pos((io.MousePos.x - view.p0.x) * scale, (io.MousePos.y - view.p0.y) * scale);
+  const int viewW = std::max(1, static_cast<int>(std::lround((view.p1.x - view.p0.x) * scale)));
+  const int viewH = std::max(1, static_cast<int>(std::lround((view.p1.y - view.p0.y) * scale)));
+  Clipping& clipping = v.settings().clipping;
+  if (ds.crop.dragging()) {
+    ds.crop.move(pos, clipping);
+    if (ImGui::IsMouseReleased(0)) ds.crop.end();
+    return;
+  }
   if (!io.WantCaptureMouse && view.contains(io.MousePos)) {
+    if (ds.showCropBox && v.hasVolume() && ImGui::IsMouseClicked(0) && !io.KeyShift) {
+      const glm::dvec3 extent = v.volume().extent();
+      if (const auto face =
+              viewer::CropHandles::hit(v.camera(), clipping, extent, pos, viewW, viewH)) {
+        ds.crop.begin(v.camera(), clipping, extent, *face, pos, viewW, viewH);
+        return;
+      }
+    }
     for (int b = 0; b < 2; ++b) {
       if (ImGui::IsMouseClicked(b)) {
         v.controller().pointerDown(
@@ -947,9 +974,12 @@ void panelRendering(DesktopSession& ds) {
   if (ImGui::Button("Reset view")) v.resetCamera();
 }
 
-// The crop box (fractions of each axis) and a clip plane that follows the camera.
-void panelClipping(viewer::Viewer& v) {
+// The crop box (fractions of each axis; handles to drag in the 3D view) and a
+// clip plane that follows the camera.
+void panelClipping(DesktopSession& ds) {
+  viewer::Viewer& v = *ds.viewer;
   section("Clipping");
+  ImGui::Checkbox("crop box handles (drag in 3D)", &ds.showCropBox);
   Clipping& c = v.settings().clipping;
   for (int a = 0; a < 3; ++a) {
     float range[2] = {static_cast<float>(c.cropMin[a]), static_cast<float>(c.cropMax[a])};
@@ -1105,7 +1135,7 @@ void drawPanel(DesktopSession& ds, int windowHeight) {
   panelWindowLevel(*ds.viewer);
   panelRendering(ds);
   panelShading(*ds.viewer);
-  panelClipping(*ds.viewer);
+  panelClipping(ds);
   ImGui::Separator();
   ImGui::TextWrapped("%s", ds.status.c_str());
   ImGui::End();
@@ -1212,7 +1242,7 @@ void runFrame(DesktopSession& ds) {
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
-  handleViewInput(*ds.viewer, tiles.view3d, scale);
+  handleViewInput(ds, tiles.view3d, scale);
   handleSliceInput(ds, tiles);
   handleShortcuts(ds);
   handleExploreKeys(ds, tiles);
@@ -1319,6 +1349,7 @@ void runView(const ViewOptions& o) {
   ds.viewer->camera().elevationDeg = o.elevation;
   ds.viewer->settings().shading = shadingFrom(o.shading);
   ds.viewer->settings().clipping = clippingFrom(o.clipping);
+  ds.showCropBox = ds.viewer->settings().clipping.cropped();
   startExploring(ds, o);
 
   IMGUI_CHECKVERSION();
