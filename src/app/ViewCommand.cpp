@@ -349,7 +349,7 @@ std::uint64_t regionBudget(const gpu::DeviceLimits& limits) {
 }
 
 // The lines the overview shows: the region or grid block and the crosshair.
-void updateOverlay(DesktopSession& ds) {
+void addExploreLines(DesktopSession& ds) {
   viewer::Viewer& v = *ds.viewer;
   v.extraLines.clear();
   if (!ds.explorer || !v.hasVolume()) return;
@@ -375,6 +375,17 @@ void updateOverlay(DesktopSession& ds) {
         glm::all(glm::lessThan(c, ds.shown->size()))) {
       v.extraLines = viewer::crosshairLines(c, ds.shown->size(), extent, cross);
     }
+  }
+}
+
+// The 3D view's extra lines: exploring's, then the crop box with its handles.
+void updateOverlay(DesktopSession& ds) {
+  addExploreLines(ds);
+  viewer::Viewer& v = *ds.viewer;
+  if (ds.showCropBox && v.hasVolume()) {
+    const auto lines =
+        viewer::CropHandles::lines(v.settings().clipping, v.volume().extent(), ds.crop.dragging());
+    v.extraLines.insert(v.extraLines.end(), lines.begin(), lines.end());
   }
 }
 
@@ -425,11 +436,6 @@ void showOverview(DesktopSession& ds, Follow follow = Follow::Fill) {
     ds.error = e.what();
   }
   updateOverlay(ds);
-  if (ds.showCropBox && ds.viewer->hasVolume()) {
-    const auto lines = viewer::CropHandles::lines(ds.viewer->settings().clipping,
-                                                  ds.viewer->volume().extent(), ds.crop.dragging());
-    ds.viewer->extraLines.insert(ds.viewer->extraLines.end(), lines.begin(), lines.end());
-  }
 }
 
 // Reads `box` at native resolution (one bounded read) into the 3D view.
