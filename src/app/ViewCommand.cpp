@@ -64,6 +64,7 @@ struct ViewOptions {
   std::string mode = "overview";  // overview, region, grid
   ShadingOptions shading;
   ClippingOptions clipping;
+  std::string projection = "composite";  // composite, mip, minip, average (RenderMode)
 };
 
 #ifdef TESSERA_DESKTOP_VIEWER
@@ -1356,6 +1357,10 @@ void runView(const ViewOptions& o) {
   ds.viewer->settings().shading = shadingFrom(o.shading);
   ds.viewer->settings().clipping = clippingFrom(o.clipping);
   ds.showCropBox = ds.viewer->settings().clipping.cropped();
+  const std::string modes[] = {"composite", "mip", "minip", "average"};  // RenderMode's order
+  for (int m = 0; m < 4; ++m) {
+    if (o.projection == modes[m]) ds.viewer->settings().mode = static_cast<RenderMode>(m);
+  }
   startExploring(ds, o);
 
   IMGUI_CHECKVERSION();
@@ -1424,6 +1429,11 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--mode", o->mode,
                   "Start in: overview, region (the picked region at native resolution) or grid "
                   "(the grid view's block nearest the crosshair)")
+      ->capture_default_str();
+  cmd->add_option("--render-mode", o->projection,
+                  "The 3D view's mode: composite, mip, minip or average (the Rendering panel's "
+                  "mode)")
+      ->check(CLI::IsMember({"composite", "mip", "minip", "average"}))
       ->capture_default_str();
   addShadingOptions(cmd, o->shading);
   addClippingOptions(cmd, o->clipping);

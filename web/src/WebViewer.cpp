@@ -1075,7 +1075,7 @@ EMSCRIPTEN_KEEPALIVE void tessera_show_crop_box(int on) {
 EMSCRIPTEN_KEEPALIVE const char* tessera_crop_json(int width, int height) {
   nlohmann::json j;
   if (app().viewer) {
-    const viewer::Viewer& v = theViewer();
+    viewer::Viewer& v = theViewer();
     const Clipping& c = v.settings().clipping;
     if (v.hasVolume() && width > 0 && height > 0) {
       j["handles"] = nlohmann::json::array();
