@@ -1200,6 +1200,7 @@ async function shadingAndCrop(context, url, tmp, run) {
   await page.evaluate(() => window.tessera.render());
   const before = await page.evaluate(() => window.tessera.crop());
   const top = before.handles[5];  // +z: superior, at the top of the front view
+  await page.locator('#canvas').scrollIntoViewIfNeeded();  // the controls scrolled the page
   const box = await page.locator('#canvas').boundingBox();
   const css = box.width / SIZE;
   await page.mouse.move(box.x + top[0] * css, box.y + top[1] * css);
