@@ -1232,8 +1232,19 @@ async function shadingAndCrop(context, url, tmp, run) {
 // docs/viewers.md's web screenshots (TESSERA_SHOTS only): ch2 shaded, cropped
 // with the handles shown, MinIP and average, with the controls beside.
 async function viewerControlShots(context, url) {
-  const { page } = await openPage(context, url, 'size=512');
-  await page.setViewportSize({ width: 1280, height: 900 });
+  const { page } = await openPage(context, url, 'size=420');
+  await page.setViewportSize({ width: 1600, height: 1000 });
+  // Controls set from script: in the 2x2 layout the slice views may cover them.
+  const setBox = (id, on) => page.evaluate(([id, on]) => {
+    const e = document.getElementById(id);
+    e.checked = on;
+    e.dispatchEvent(new Event('change'));
+  }, [id, on]);
+  const setSelect = (id, v) => page.evaluate(([id, v]) => {
+    const e = document.getElementById(id);
+    e.value = v;
+    e.dispatchEvent(new Event('change'));
+  }, [id, v]);
   await page.setInputFiles('#file', CH2);
   await page.waitForFunction(() => window.tessera.state().name === 'ch2.nii.gz', null, { timeout: 60000 });
   const setRange = (id, v) => page.evaluate(([id, v]) => {
@@ -1245,27 +1256,27 @@ async function viewerControlShots(context, url) {
     await page.evaluate(() => window.tessera.render());
     await page.screenshot({ path: path.join(shots, name), type: 'jpeg', quality: 80 });
   };
-  await page.check('#shade');
+  await setBox('shade', true);
   await page.evaluate(() => window.tessera.setCamera(30, 10, 1));
   await shot('web-shaded.jpg');
-  await page.check('#cropShow');
+  await setBox('cropShow', true);
   await setRange('cropZ1', 0.62);
   await setRange('cropY1', 0.7);
   await page.evaluate(() => window.tessera.setCamera(-60, 30, 1));
   await shot('web-crop-handles.jpg');
-  await page.uncheck('#cropShow');
-  await page.click('#resetCrop');
-  await page.uncheck('#shade');
-  await page.selectOption('#preset', 'grey');
-  await page.selectOption('#mode', '2');  // MinIP inside a box around the ventricles
+  await setBox('cropShow', false);
+  await page.evaluate(() => document.getElementById('resetCrop').click());
+  await setBox('shade', false);
+  await setSelect('preset', 'grey');
+  await setSelect('mode', '2');  // MinIP inside a box around the ventricles
   for (const [id, v] of [['cropX0', 0.25], ['cropX1', 0.75], ['cropY0', 0.25], ['cropY1', 0.75], ['cropZ0', 0.3], ['cropZ1', 0.8]]) {
     await setRange(id, v);
   }
   await page.evaluate(() => window.tessera.setCamera(0, 0, 2));
   await shot('web-minip.jpg');
-  await page.click('#resetCrop');
+  await page.evaluate(() => document.getElementById('resetCrop').click());
   await page.evaluate(() => window.tessera.setCamera(0, 0, 1));
-  await page.selectOption('#mode', '3');
+  await setSelect('mode', '3');
   await shot('web-average.jpg');
   await page.close();
 }
