@@ -120,7 +120,25 @@
       setTechnique: c('tessera_set_technique', 'number', ['string']),
       stateJson: c('tessera_state_json', 'string', ['number']),
       readPixels: c('tessera_read_pixels', 'number', ['number', 'number']),
+      setLight: c('tessera_set_light', 'number', ['number', 'number', 'number', 'number', 'number', 'number', 'number', 'number']),
+      setCrop: c('tessera_set_crop', 'number', ['number', 'number', 'number', 'number', 'number', 'number']),
+      showCropBox: c('tessera_show_crop_box', null, ['number']),
+      cropJson: c('tessera_crop_json', 'string', ['number', 'number']),
+      cropDown: c('tessera_crop_pointer_down', 'number', ['number', 'number', 'number', 'number', 'number']),
+      cropMove: c('tessera_crop_pointer_move', 'number', ['number', 'number']),
+      cropUp: c('tessera_crop_pointer_up', null, []),
+      setFollowingPlane: c('tessera_set_following_plane', null, ['number', 'number']),
     };
+  }
+
+  // The crop sliders follow the box (dragged handles, reset).
+  function syncCropControls() {
+    const c = JSON.parse(api.cropJson(canvas.width, canvas.height));
+    if (!c.min) return;
+    ['X', 'Y', 'Z'].forEach((a, i) => {
+      $('crop' + a + '0').value = c.min[i];
+      $('crop' + a + '1').value = c.max[i];
+    });
   }
 
   function refreshState() {
@@ -548,9 +566,20 @@
     return [(e.clientX - r.left) * canvas.width / r.width, (e.clientY - r.top) * canvas.height / r.height];
   }
   canvas.addEventListener('contextmenu', (e) => e.preventDefault());
+  // A left press on a crop box handle drags that face instead of the camera.
+  let cropPointer = null;
   canvas.addEventListener('pointerdown', (e) => {
     if (!api) return;
     const [x, y] = canvasPos(e);
+    const handleRadius = (e.pointerType === 'touch' ? 24 : 12) * canvas.width / canvas.getBoundingClientRect().width;
+    if (cropPointer === null && e.button === 0 && !e.shiftKey &&
+        api.cropDown(x, y, canvas.width, canvas.height, handleRadius)) {
+      cropPointer = e.pointerId;
+      canvas.setPointerCapture(e.pointerId);
+      e.preventDefault();
+      requestRender();
+      return;
+    }
     api.pointerDown(e.pointerId, x, y, e.button === 2 || e.shiftKey ? 1 : 0);
     canvas.setPointerCapture(e.pointerId);
     e.preventDefault();
@@ -558,11 +587,21 @@
   canvas.addEventListener('pointermove', (e) => {
     if (!api) return;
     const [x, y] = canvasPos(e);
+    if (e.pointerId === cropPointer) {
+      if (api.cropMove(x, y)) { syncCropControls(); requestRender(); }
+      return;
+    }
     api.pointerMove(e.pointerId, x, y);
     if (api.interacting()) requestRender();
   });
   const viewEnd = (e) => {
     if (!api) return;
+    if (e.pointerId === cropPointer) {
+      cropPointer = null;
+      api.cropUp();
+      requestRender();
+      return;
+    }
     api.pointerUp(e.pointerId);
     requestRender();  // full quality once released
   };
@@ -666,6 +705,40 @@
     $('box').addEventListener('change', overlays);
     $('axes').addEventListener('change', overlays);
     $('resetView').addEventListener('click', () => { api.setCamera(0, 0, 1); requestRender(); });
+    // Light: a headlight or a fixed light (patient frame), and the Blinn-Phong terms.
+    const applyLight = () => {
+      const dir = $('lightDir').value.split(',').map(Number);
+      if (!api.setLight($('headlight').checked ? 1 : 0, +$('ambient').value, +$('diffuse').value,
+        +$('specular').value, +$('shininess').value, dir[0], dir[1], dir[2])) showError(api.lastError());
+      $('lightDir').disabled = $('headlight').checked;
+      requestRender();
+    };
+    ['headlight', 'lightDir'].forEach((id) => $(id).addEventListener('change', applyLight));
+    ['ambient', 'diffuse', 'specular', 'shininess'].forEach((id) => $(id).addEventListener('input', applyLight));
+    // Clipping: the crop box (sliders and handles) and the camera-facing plane.
+    const applyCrop = (e) => {
+      const v = (id) => +$(id).value;
+      // Keep min below max: the slider being moved pushes its partner.
+      for (const a of ['X', 'Y', 'Z']) {
+        const lo = $('crop' + a + '0'), hi = $('crop' + a + '1');
+        if (+lo.value > +hi.value - 0.02) {
+          if (e && e.target === lo) lo.value = Math.max(0, +hi.value - 0.02);
+          else hi.value = Math.min(1, +lo.value + 0.02);
+        }
+      }
+      if (!api.setCrop(v('cropX0'), v('cropX1'), v('cropY0'), v('cropY1'), v('cropZ0'), v('cropZ1'))) showError(api.lastError());
+      requestRender();
+    };
+    ['X', 'Y', 'Z'].forEach((a) => ['0', '1'].forEach((k) => $('crop' + a + k).addEventListener('input', applyCrop)));
+    $('cropShow').addEventListener('change', (e) => { api.showCropBox(e.target.checked ? 1 : 0); requestRender(); });
+    $('resetCrop').addEventListener('click', () => { api.setCrop(0, 1, 0, 1, 0, 1); syncCropControls(); requestRender(); });
+    const applyPlane = () => {
+      // Depth: a fraction of half the volume's diagonal, towards the viewer.
+      api.setFollowingPlane($('followPlane').checked ? 1 : 0, +$('planeDepth').value);
+      requestRender();
+    };
+    $('followPlane').addEventListener('change', applyPlane);
+    $('planeDepth').addEventListener('input', applyPlane);
     window.addEventListener('resize', drawTf);
   }
 
@@ -730,6 +803,7 @@
     zarr: () => (zarr ? zarr.stats() : null),
     setProgressive: (on) => { api.setProgressive(on ? 1 : 0, frameBudgetMs); },
     setCamera: (az, el, zoom) => { api.setCamera(az, el, zoom); return requestRender(); },
+    crop: () => JSON.parse(api.cropJson(canvas.width, canvas.height)),
     setProjection: (orthographic) => { api.setProjection(orthographic ? 1 : 0); return requestRender(); },
     setTfJson: (json) => { const ok = api.tfSetJson(json); tfEdited(); return ok; },
     error: () => ($('error').hidden ? '' : $('error').textContent),

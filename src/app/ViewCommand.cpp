@@ -33,6 +33,7 @@
 #include "tessera/io/VolumeReader.h"
 #include "tessera/lod/ZoomLevelPolicy.h"
 #include "tessera/render/TechniqueRegistry.h"
+#include "tessera/viewer/CropHandles.h"
 #include "tessera/viewer/Explorer.h"
 #include "tessera/viewer/RecentFiles.h"
 #include "tessera/viewer/SliceView.h"
@@ -64,6 +65,7 @@ struct ViewOptions {
   std::string mode = "overview";  // overview, region, grid
   ShadingOptions shading;
   ClippingOptions clipping;
+  std::string projection = "composite";  // composite, mip, minip, average (RenderMode)
 };
 
 #ifdef TESSERA_DESKTOP_VIEWER
@@ -249,6 +251,9 @@ struct DesktopSession {
   int dragTile = -1;          // a slice view being dragged in (-1: none)
   bool dragRegion = false;    // right button: drawing a region box
   glm::dvec2 dragStart{0.0};  // window units
+  // The crop box drawn with a handle on each face (viewer/CropHandles.h).
+  bool showCropBox = false;
+  viewer::CropHandles crop;
 };
 
 // A rectangle of the window in ImGui (window) units, top-left origin.
@@ -346,7 +351,7 @@ std::uint64_t regionBudget(const gpu::DeviceLimits& limits) {
 }
 
 // The lines the overview shows: the region or grid block and the crosshair.
-void updateOverlay(DesktopSession& ds) {
+void addExploreLines(DesktopSession& ds) {
   viewer::Viewer& v = *ds.viewer;
   v.extraLines.clear();
   if (!ds.explorer || !v.hasVolume()) return;
@@ -372,6 +377,17 @@ void updateOverlay(DesktopSession& ds) {
         glm::all(glm::lessThan(c, ds.shown->size()))) {
       v.extraLines = viewer::crosshairLines(c, ds.shown->size(), extent, cross);
     }
+  }
+}
+
+// The 3D view's extra lines: exploring's, then the crop box with its handles.
+void updateOverlay(DesktopSession& ds) {
+  addExploreLines(ds);
+  viewer::Viewer& v = *ds.viewer;
+  if (ds.showCropBox && v.hasVolume()) {
+    const auto lines =
+        viewer::CropHandles::lines(v.settings().clipping, v.volume().extent(), ds.crop.dragging());
+    v.extraLines.insert(v.extraLines.end(), lines.begin(), lines.end());
   }
 }
 
@@ -814,11 +830,29 @@ void handleShortcuts(DesktopSession& ds) {
   }
 }
 
-// The 3D view: mouse drags orbit (right button or shift: pan), wheel zooms.
-void handleViewInput(viewer::Viewer& v, const Rect& view, double scale) {
+// The 3D view: mouse drags orbit (right button or shift: pan), wheel zooms;
+// a left drag that starts on a crop box handle moves that face instead.
+void handleViewInput(DesktopSession& ds, const Rect& view, double scale) {
+  viewer::Viewer& v = *ds.viewer;
   ImGuiIO& io = ImGui::GetIO();
   const glm::dvec2 pos((io.MousePos.x - view.p0.x) * scale, (io.MousePos.y - view.p0.y) * scale);
+  const int viewW = std::max(1, static_cast<int>(std::lround((view.p1.x - view.p0.x) * scale)));
+  const int viewH = std::max(1, static_cast<int>(std::lround((view.p1.y - view.p0.y) * scale)));
+  Clipping& clipping = v.settings().clipping;
+  if (ds.crop.dragging()) {
+    ds.crop.move(pos, clipping);
+    if (ImGui::IsMouseReleased(0)) ds.crop.end();
+    return;
+  }
   if (!io.WantCaptureMouse && view.contains(io.MousePos)) {
+    if (ds.showCropBox && v.hasVolume() && ImGui::IsMouseClicked(0) && !io.KeyShift) {
+      const glm::dvec3 extent = v.volume().extent();
+      if (const auto face =
+              viewer::CropHandles::hit(v.camera(), clipping, extent, pos, viewW, viewH)) {
+        ds.crop.begin(v.camera(), clipping, extent, *face, pos, viewW, viewH);
+        return;
+      }
+    }
     for (int b = 0; b < 2; ++b) {
       if (ImGui::IsMouseClicked(b)) {
         v.controller().pointerDown(
@@ -956,9 +990,12 @@ void panelRendering(DesktopSession& ds) {
   if (ImGui::Button("Reset view")) v.resetCamera();
 }
 
-// The crop box (fractions of each axis) and a clip plane that follows the camera.
-void panelClipping(viewer::Viewer& v) {
+// The crop box (fractions of each axis; handles to drag in the 3D view) and a
+// clip plane that follows the camera.
+void panelClipping(DesktopSession& ds) {
+  viewer::Viewer& v = *ds.viewer;
   section("Clipping");
+  ImGui::Checkbox("crop box handles (drag in 3D)", &ds.showCropBox);
   Clipping& c = v.settings().clipping;
   for (int a = 0; a < 3; ++a) {
     float range[2] = {static_cast<float>(c.cropMin[a]), static_cast<float>(c.cropMax[a])};
@@ -1091,7 +1128,7 @@ void drawPanel(DesktopSession& ds, int windowHeight) {
   panelWindowLevel(*ds.viewer);
   panelRendering(ds);
   panelShading(*ds.viewer);
-  panelClipping(*ds.viewer);
+  panelClipping(ds);
   ImGui::Separator();
   ImGui::TextWrapped("%s", ds.status.c_str());
   ImGui::End();
@@ -1247,7 +1284,7 @@ void runFrame(DesktopSession& ds) {
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
-  handleViewInput(*ds.viewer, tiles.view3d, scale);
+  handleViewInput(ds, tiles.view3d, scale);
   handleSliceInput(ds, tiles);
   handleShortcuts(ds);
   handleExploreKeys(ds, tiles);
@@ -1347,6 +1384,11 @@ void runView(const ViewOptions& o) {
   ds.viewer->camera().elevationDeg = o.elevation;
   ds.viewer->settings().shading = shadingFrom(o.shading);
   ds.viewer->settings().clipping = clippingFrom(o.clipping);
+  ds.showCropBox = ds.viewer->settings().clipping.cropped();
+  const std::string modes[] = {"composite", "mip", "minip", "average"};  // RenderMode's order
+  for (int m = 0; m < 4; ++m) {
+    if (o.projection == modes[m]) ds.viewer->settings().mode = static_cast<RenderMode>(m);
+  }
   startExploring(ds, o);
 
   IMGUI_CHECKVERSION();
@@ -1416,6 +1458,11 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--mode", o->mode,
                   "Start in: overview, region (the picked region at native resolution) or grid "
                   "(the grid view's block nearest the crosshair)")
+      ->capture_default_str();
+  cmd->add_option("--render-mode", o->projection,
+                  "The 3D view's mode: composite, mip, minip or average (the Rendering panel's "
+                  "mode)")
+      ->check(CLI::IsMember({"composite", "mip", "minip", "average"}))
       ->capture_default_str();
   addShadingOptions(cmd, o->shading);
   addClippingOptions(cmd, o->clipping);

@@ -18,6 +18,7 @@
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/lod/InCoreVolumeSource.h"
 #include "tessera/render/HybridCompositor.h"
+#include "tessera/viewer/CropHandles.h"
 
 namespace tessera::viewer {
 
@@ -207,8 +208,7 @@ RenderSettings Viewer::frameSettings() const {
   RenderSettings settings = settings_;
   if (clipPlaneFollowsCamera &&
       settings.clipping.planes.size() < static_cast<std::size_t>(kMaxClipPlanes)) {
-    // The camera's back vector in the patient frame: towards the viewer.
-    settings.clipping.planes.push_back({camera_.worldBasis()[2], followingPlaneDistance});
+    settings.clipping.planes.push_back(cameraFacingPlane(camera_, followingPlaneDistance));
   }
   return settings;
 }

@@ -515,6 +515,7 @@ async function main() {
     await gridView(context, url, tmp, run);
     await dicomFolder(context, url, tmp, run);
     await zarrStoreFromUrl(context, url, tmp, run);
+    await shadingAndCrop(context, url, tmp, run);
 
     if (bench) await benchmark(context, url);
   } finally {
@@ -1212,6 +1213,110 @@ async function zarrStoreFromUrl(context, url, tmp, run) {
           error || mc.error || `${mc.psnr.toFixed(2)} dB, refined in ${zc.completeMs.toFixed(0)} ms, ${zc.requests} requests`);
     await p.page.close();
   }
+}
+
+// Light and clip controls (issue 16): shade on matches `tessera render
+// --shade`; dragging the crop box's superior handle down with the mouse
+// lowers the top face (the slider follows), and the cropped image matches
+// `tessera render --crop` of the box the page reports.
+async function shadingAndCrop(context, url, tmp, run) {
+  const { page } = await openPage(context, url, `size=${SIZE}`);
+  await withoutOverlays(page);
+  const plain = await snapshot(page);
+  await page.check('#shade');
+  await page.evaluate(() => window.tessera.render());
+  const shadedPng = path.join(tmp, 'native-shaded.png');
+  run('render', VOLUME, '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', '--shade',
+      '--out', shadedPng);
+  const ms = await psnrAgainst(page, shadedPng);
+  const shaded = await snapshot(page);
+  check('shade on in the page matches `tessera render --shade` (PSNR >= 35 dB) and changes the image',
+        ms.psnr >= 35 && changedFraction(plain.pixels, shaded.pixels) > 0.05,
+        ms.error || `${ms.psnr.toFixed(2)} dB, ${(100 * changedFraction(plain.pixels, shaded.pixels)).toFixed(1)} % of pixels changed`);
+
+  await page.check('#cropShow');
+  await page.evaluate(() => window.tessera.render());
+  const before = await page.evaluate(() => window.tessera.crop());
+  const top = before.handles[5];  // +z: superior, at the top of the front view
+  await page.locator('#canvas').scrollIntoViewIfNeeded();  // the controls scrolled the page
+  const box = await page.locator('#canvas').boundingBox();
+  const css = box.width / SIZE;
+  await page.mouse.move(box.x + top[0] * css, box.y + top[1] * css);
+  await page.mouse.down();
+  for (let k = 1; k <= 4; k++) await page.mouse.move(box.x + top[0] * css, box.y + (top[1] + 20 * k) * css);
+  await page.mouse.up();
+  await page.uncheck('#cropShow');  // the image without the box's lines
+  await page.evaluate(() => window.tessera.render());
+  const after = await page.evaluate(() => window.tessera.crop());
+  const slider = +(await page.locator('#cropZ1').inputValue());
+  const cam = await page.evaluate(() => window.tessera.state().camera);
+  check('dragging the superior crop handle down lowers the top face only; the slider follows; the camera stays',
+        top[1] < SIZE / 2 && after.max[2] < before.max[2] - 0.1 && after.max[0] === 1 && after.max[1] === 1 &&
+        after.min.every((v) => v === 0) && Math.abs(slider - after.max[2]) <= 0.006 &&
+        cam.azimuth === 0 && cam.elevation === 0,
+        `handle at ${top.map((v) => v.toFixed(1))}, z max ${before.max[2]} -> ${after.max[2].toFixed(4)}, slider ${slider}`);
+  const cropPng = path.join(tmp, 'native-crop.png');
+  run('render', VOLUME, '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', '--shade',
+      '--crop', `0:1,0:1,0:${after.max[2].toPrecision(17)}`, '--out', cropPng);
+  const mc = await psnrAgainst(page, cropPng);
+  const cropped = await snapshot(page);
+  check('the dragged crop box matches `tessera render --crop` (PSNR >= 35 dB) and removes part of the image',
+        mc.psnr >= 35 && cropped.lit < shaded.lit - 0.02,
+        mc.error || `${mc.psnr.toFixed(2)} dB, lit ${(100 * shaded.lit).toFixed(1)} % -> ${(100 * cropped.lit).toFixed(1)} %`);
+  await page.close();
+  if (shots && fs.existsSync(CH2)) await viewerControlShots(context, url);
+}
+
+// docs/viewers.md's web screenshots (TESSERA_SHOTS only): ch2 shaded, cropped
+// with the handles shown, MinIP and average, with the controls beside.
+async function viewerControlShots(context, url) {
+  const { page } = await openPage(context, url, 'size=420');
+  await page.setViewportSize({ width: 1600, height: 1000 });
+  // Controls set from script: in the 2x2 layout the slice views may cover them.
+  const setBox = (id, on) => page.evaluate(([id, on]) => {
+    const e = document.getElementById(id);
+    e.checked = on;
+    e.dispatchEvent(new Event('change'));
+  }, [id, on]);
+  const setSelect = (id, v) => page.evaluate(([id, v]) => {
+    const e = document.getElementById(id);
+    e.value = v;
+    e.dispatchEvent(new Event('change'));
+  }, [id, v]);
+  await page.setInputFiles('#file', CH2);
+  await page.waitForFunction(() => window.tessera.state().name === 'ch2.nii.gz', null, { timeout: 60000 });
+  const setRange = (id, v) => page.evaluate(([id, v]) => {
+    const e = document.getElementById(id);
+    e.value = v;
+    e.dispatchEvent(new Event('input'));
+  }, [id, v]);
+  const shot = async (name) => {
+    await page.evaluate(() => window.tessera.render());
+    await page.screenshot({ path: path.join(shots, name), type: 'jpeg', quality: 80 });
+  };
+  await setBox('shade', true);
+  await page.evaluate(() => window.tessera.setCamera(30, 10, 1));
+  await shot('web-shaded.jpg');
+  await setBox('cropShow', true);
+  await setRange('cropZ1', 0.62);
+  await setRange('cropY1', 0.7);
+  await page.evaluate(() => window.tessera.setCamera(-60, 30, 1));
+  await shot('web-crop-handles.jpg');
+  await setBox('cropShow', false);
+  await page.evaluate(() => document.getElementById('resetCrop').click());
+  await setBox('shade', false);
+  await setSelect('preset', 'grey');
+  await setSelect('mode', '2');  // MinIP inside a box around the ventricles
+  for (const [id, v] of [['cropX0', 0.25], ['cropX1', 0.75], ['cropY0', 0.25], ['cropY1', 0.75], ['cropZ0', 0.3], ['cropZ1', 0.8]]) {
+    await setRange(id, v);
+  }
+  await page.evaluate(() => window.tessera.setCamera(0, 0, 2));
+  await shot('web-minip.jpg');
+  await page.evaluate(() => document.getElementById('resetCrop').click());
+  await page.evaluate(() => window.tessera.setCamera(0, 0, 1));
+  await setSelect('mode', '3');
+  await shot('web-average.jpg');
+  await page.close();
 }
 
 // ch2 through the picker at 512x512, WebGL 2 and WebGL 1: median of 7 frames.

@@ -36,6 +36,7 @@
 #include "tessera/lod/InCoreMultiresSource.h"
 #include "tessera/render/OverlayRenderer.h"
 #include "tessera/render/TechniqueRegistry.h"
+#include "tessera/viewer/CropHandles.h"
 #include "tessera/viewer/Explorer.h"
 #include "tessera/viewer/Viewer.h"
 
@@ -103,6 +104,8 @@ viewer::Viewer& theViewer() {
   if (!app().viewer) throw GpuError("the viewer has no WebGL context yet");
   return *app().viewer;
 }
+
+void refreshExtraLines();  // region / grid boxes and the crop box (below)
 
 glm::dvec3 toRgb(double r, double g, double b) {
   return {r, g, b};
@@ -193,7 +196,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_load_files() {
 EMSCRIPTEN_KEEPALIVE double tessera_render(int width, int height) {
   double ms = -1.0;
   guarded([&] {
-    applyMarkBoxes();
+    refreshExtraLines();
     ms = theViewer().render(width, height).ms;
   });
   return ms;
@@ -1084,6 +1087,141 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_grid_json() {
   });
   scratch() = j.dump();
   return scratch().c_str();
+}
+
+}  // extern "C"
+
+// ---- Light, clipping and the crop box's handles (issue 16) ----
+
+namespace {
+
+struct CropState {
+  bool show = false;  // the crop box and its handles in the 3D view
+  viewer::CropHandles handles;
+};
+
+CropState& cropState() {
+  static CropState s;
+  return s;
+}
+
+// The crop box's lines go into the viewer's extra lines (the page draws its
+// other marks on a 2D canvas), composed by depth like the bounding box.
+// The viewer's extra lines: the region / grid boxes (applyMarkBoxes()), then
+// the crop box's.
+void refreshExtraLines() {
+  if (!app().viewer) return;
+  applyMarkBoxes();
+  viewer::Viewer& v = theViewer();
+  if (cropState().show && v.hasVolume()) {
+    const auto lines = viewer::CropHandles::lines(v.settings().clipping, v.volume().extent(),
+                                                  cropState().handles.dragging());
+    v.extraLines.insert(v.extraLines.end(), lines.begin(), lines.end());
+  }
+}
+
+}  // namespace
+
+extern "C" {
+
+// Blinn-Phong terms and the light: a headlight, or a fixed light from
+// (lx, ly, lz) in the patient frame (RAS+, towards the light).
+EMSCRIPTEN_KEEPALIVE int tessera_set_light(int headlight, double ambient, double diffuse,
+                                           double specular, double shininess, double lx, double ly,
+                                           double lz) {
+  return guarded([&] {
+    const glm::dvec3 dir(lx, ly, lz);
+    if (!headlight && glm::length(dir) < 1e-6)
+      throw InputError("the fixed light needs a direction");
+    Shading& s = theViewer().settings().shading;
+    s.headlight = headlight != 0;
+    s.ambient = std::clamp(ambient, 0.0, 1.0);
+    s.diffuse = std::clamp(diffuse, 0.0, 1.0);
+    s.specular = std::clamp(specular, 0.0, 1.0);
+    s.shininess = std::clamp(shininess, 1.0, 256.0);
+    if (!s.headlight) s.lightDirection = dir;
+  });
+}
+
+// The crop box in fractions of each index axis (0..1, min < max).
+EMSCRIPTEN_KEEPALIVE int tessera_set_crop(double x0, double x1, double y0, double y1, double z0,
+                                          double z1) {
+  return guarded([&] {
+    const glm::dvec3 lo(x0, y0, z0), hi(x1, y1, z1);
+    for (int a = 0; a < 3; ++a) {
+      if (!(lo[a] >= 0.0 && hi[a] <= 1.0 && lo[a] < hi[a])) {
+        throw InputError(std::string("crop box: ") + "xyz"[a] +
+                         " must satisfy 0 <= min < max <= 1");
+      }
+    }
+    theViewer().settings().clipping.cropMin = lo;
+    theViewer().settings().clipping.cropMax = hi;
+    refreshExtraLines();
+  });
+}
+EMSCRIPTEN_KEEPALIVE void tessera_show_crop_box(int on) {
+  cropState().show = on != 0;
+  refreshExtraLines();
+}
+// The crop box as JSON {"min": [x, y, z], "max": [...], "handles": [[px,
+// py] per face (-x, +x, -y, +y, -z, +z) on a width x height canvas]}.
+EMSCRIPTEN_KEEPALIVE const char* tessera_crop_json(int width, int height) {
+  nlohmann::json j;
+  if (app().viewer) {
+    viewer::Viewer& v = theViewer();
+    const Clipping& c = v.settings().clipping;
+    if (v.hasVolume() && width > 0 && height > 0) {
+      j["handles"] = nlohmann::json::array();
+      for (int f = 0; f < viewer::kCropFaces; ++f) {
+        const auto p = viewer::projectToScreen(
+            v.camera(), viewer::CropHandles::faceCentre(c, v.volume().extent(), f), width, height);
+        j["handles"].push_back(p ? nlohmann::json{p->pixel.x, p->pixel.y} : nlohmann::json());
+      }
+    }
+    j["min"] = {c.cropMin.x, c.cropMin.y, c.cropMin.z};
+    j["max"] = {c.cropMax.x, c.cropMax.y, c.cropMax.z};
+    j["show"] = cropState().show;
+    j["dragging"] = cropState().handles.dragging() ? *cropState().handles.dragging() : -1;
+  }
+  scratch() = j.dump();
+  return scratch().c_str();
+}
+// A pointer pressed at canvas pixel (x, y) of a width x height canvas: 1 when
+// it grabbed a crop box handle (the page then sends moves here, not to the
+// camera), else 0.
+EMSCRIPTEN_KEEPALIVE int tessera_crop_pointer_down(double x, double y, int width, int height,
+                                                   double radiusPx) {
+  if (!app().viewer || !cropState().show || !theViewer().hasVolume()) return 0;
+  viewer::Viewer& v = theViewer();
+  const glm::dvec3 extent = v.volume().extent();
+  const auto face = viewer::CropHandles::hit(v.camera(), v.settings().clipping, extent, {x, y},
+                                             width, height, radiusPx);
+  if (!face) return 0;
+  cropState().handles.begin(v.camera(), v.settings().clipping, extent, *face, {x, y}, width,
+                            height);
+  refreshExtraLines();
+  return 1;
+}
+// 1 when the box changed.
+EMSCRIPTEN_KEEPALIVE int tessera_crop_pointer_move(double x, double y) {
+  if (!app().viewer) return 0;
+  const bool changed = cropState().handles.move({x, y}, theViewer().settings().clipping);
+  if (changed) refreshExtraLines();
+  return changed ? 1 : 0;
+}
+EMSCRIPTEN_KEEPALIVE void tessera_crop_pointer_up() {
+  cropState().handles.end();
+  refreshExtraLines();
+}
+// The clip plane that follows the camera (viewer::cameraFacingPlane), at
+// `depth` x half the volume's diagonal from its centre towards the viewer
+// (-1..1: the whole volume).
+EMSCRIPTEN_KEEPALIVE void tessera_set_following_plane(int on, double depth) {
+  if (!app().viewer) return;
+  viewer::Viewer& v = theViewer();
+  v.clipPlaneFollowsCamera = on != 0;
+  const double reach = v.hasVolume() ? 0.5 * glm::length(v.volume().extent()) : 0.0;
+  v.followingPlaneDistance = std::clamp(depth, -1.0, 1.0) * reach;
 }
 
 }  // extern "C"
