@@ -21,6 +21,7 @@
 #include "tessera/gpu/LookupTexture.h"
 #include "tessera/gpu/Program.h"
 #include "tessera/gpu/ProgramCache.h"
+#include "tessera/layout/GradientTexture.h"
 #include "tessera/layout/Layout.h"
 #include "tessera/layout/ValueBlocks.h"
 #include "tessera/reference/AdaptiveSteps.h"
@@ -49,6 +50,17 @@ class Raycaster final : public Technique {
     preint_.setEightBit(eightBit);
     lookupKey_.clear();
   }
+
+  // Where shaded frames take the gradient (layout/GradientTexture.h): the
+  // plan's choice by default. Throws InputError for Precomputed where it
+  // cannot be had.
+  void setGradient(layout::GradientWish wish);
+  const layout::GradientPlan& gradientPlan() const { return gradientPlan_; }
+  // The precomputed gradient the last shaded frame used; not valid() when it
+  // took central differences on the fly.
+  const layout::GradientTexture& gradientTexture() const { return gradient_; }
+  // Whether frames with these settings shade from the precomputed gradient.
+  bool precomputedGradient(const RenderSettings& settings) const;
 
   // Compiles the program and builds the lookup tables the settings need, so
   // that a timed frame measures rendering only.
@@ -113,6 +125,8 @@ class Raycaster final : public Technique {
   void updateLookup(const RenderSettings& settings, double sampleDistance);
   void uploadLut();
   void uploadBlocks(const std::vector<std::uint8_t>& cells);
+  // Builds the precomputed gradient texture when these settings shade from it.
+  void updateGradient(const RenderSettings& settings);
 
   gpu::GlContext& context_;
   const Volume& volume_;
@@ -127,6 +141,8 @@ class Raycaster final : public Technique {
   PreIntegrationTable preint_;
   int preintEntries_ = PreIntegrationTable::kDefaultEntries;
   StepGrid stepGrid_;
+  layout::GradientPlan gradientPlan_;
+  layout::GradientTexture gradient_;
   gpu::Texture blockTexture_;
   gpu::Framebuffer target_;
   gpu::FullscreenTriangle triangle_;
