@@ -16,10 +16,13 @@
 namespace tessera::render {
 
 Raycaster::Raycaster(gpu::GlContext& context, const Volume& volume, const layout::Layout& layout)
-    : context_(context), volume_(volume), layout_(layout), tf_(TransferFunction::preset("grey")) {
+    : context_(context),
+      volume_(volume),
+      layout_(layout),
+      tf_(TransferFunction::preset("grey")),
+      gradient_(context, volume, layout, kOwnTextureUnits) {
   triangle_ = gpu::FullscreenTriangle(context.ledger());
   setSkipBlockSize(blockSize_);
-  setGradient(layout::GradientWish::Auto);
 }
 
 Raycaster::~Raycaster() = default;
@@ -181,7 +184,7 @@ std::vector<std::string> Raycaster::definesFor(const RenderSettings& settings) c
     if (settings.sampling.opacityGrowth) defines.push_back("OPACITY_GROWTH 1");
   }
   addShadingDefines(settings, defines);
-  if (precomputedGradient(settings)) defines.push_back("PRECOMPUTED_GRADIENT 1");
+  gradient_.addDefines(settings, defines);
   addClippingDefines(settings, defines);
   if (settings.nearest) defines.push_back("NEAREST 1");
   defines.push_back("MAX_STEPS " + std::to_string(settings.maxSteps));
@@ -201,7 +204,7 @@ std::vector<gpu::ShaderPart> Raycaster::fragmentParts(const RenderSettings& sett
       gpu::shaderPreamble(context_.caps().api, true, definesFor(settings)),
       gpu::embeddedShaderPart("render/camera_ray.glsl")};
   // The precomputed gradient (when defined) stands in for the seam's own.
-  if (context_.caps().api == gpu::ApiLevel::Gles3) parts.push_back(layout::GradientTexture::glsl());
+  gradient_.addParts(parts);
   for (gpu::ShaderPart& part : layout_.seamParts()) parts.push_back(std::move(part));
   for (const char* file :
        {"render/classify.glsl", "render/shading.glsl", "render/clipping.glsl", "render/sample.glsl",
@@ -223,37 +226,8 @@ void Raycaster::prepare(const RenderSettings& settings) {
   const glm::dvec3 spacing = volume_.spacing();
   const double ds = settings.stepVoxels * std::min({spacing.x, spacing.y, spacing.z});
   updateLookup(settings, isProjection(settings.mode) ? tf_.opacityUnitLength : ds);
-  updateGradient(settings);
+  gradient_.prepare(settings);
   programFor(settings);
-}
-
-void Raycaster::setGradient(layout::GradientWish wish) {
-  const gpu::DeviceCaps& caps = context_.caps();
-  // One unit more than the ray caster's own, next to the layout's.
-  if (layout_.textureUnits() + kOwnTextureUnits + 1 > caps.maxTextureUnits) {
-    if (wish == layout::GradientWish::Precomputed) {
-      throw InputError("--gradient precomputed: no texture unit left for a gradient texture");
-    }
-    gradientPlan_ = layout::GradientPlan();
-    gradientPlan_.reason =
-        "on the fly (central differences, 6 fetches per lit sample): no "
-        "texture unit left for a gradient texture";
-  } else {
-    gradientPlan_ = layout::planGradient(wish, layout_.volumeDims(), layout_.name(), caps.api,
-                                         caps.max3DTextureSize, context_.ledger().budget(),
-                                         context_.ledger().totalBytes() - gradient_.bytes());
-  }
-  if (!gradientPlan_.precomputed) gradient_ = layout::GradientTexture();
-}
-
-bool Raycaster::precomputedGradient(const RenderSettings& settings) const {
-  return gradientPlan_.precomputed && shadingActive(settings) && !settings.nearest;
-}
-
-void Raycaster::updateGradient(const RenderSettings& settings) {
-  if (precomputedGradient(settings) && !gradient_.valid()) {
-    gradient_ = layout::GradientTexture::create(context_.ledger(), volume_);
-  }
 }
 
 void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings, int width,
@@ -277,7 +251,7 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
   // MIP shows one classified sample, so its table is not distance-corrected
   // (correcting for one unit length leaves opacity as it is).
   updateLookup(settings, isProjection(settings.mode) ? tf_.opacityUnitLength : ds);
-  updateGradient(settings);
+  gradient_.prepare(settings);
 
   if (target_.id() == 0 || target_.width() != width || target_.height() != height) {
     target_ = gpu::Framebuffer();
@@ -318,7 +292,7 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
   if (settings.nearest) prog.set("u_sampleDims", glm::vec3(volume_.dims()));
 
   int unit = layout_.bindSeam(prog, 0);
-  if (precomputedGradient(settings)) unit += gradient_.bind(prog, unit, m.scale);
+  unit += gradient_.bind(prog, unit, settings);
   if (usesPreintegration(settings)) {
     preint_.texture().bind(unit);
     prog.set("u_preint", unit++);
@@ -377,7 +351,7 @@ const gpu::Texture& Raycaster::render(const Camera& camera, const RenderSettings
 TechniqueReport Raycaster::report() const {
   TechniqueReport r;
   r.occupiedBlockFraction = occupiedFraction_;
-  r.gradient = gradientPlan_.reason;
+  r.gradient = gradient_.plan().reason;
   return r;
 }
 

@@ -21,11 +21,11 @@
 #include "tessera/gpu/LookupTexture.h"
 #include "tessera/gpu/Program.h"
 #include "tessera/gpu/ProgramCache.h"
-#include "tessera/layout/GradientTexture.h"
 #include "tessera/layout/Layout.h"
 #include "tessera/layout/ValueBlocks.h"
 #include "tessera/reference/AdaptiveSteps.h"
 #include "tessera/render/PreIntegrationTable.h"
+#include "tessera/render/ShadingGradient.h"
 #include "tessera/render/Technique.h"
 #include "tessera/render/TechniqueRegistry.h"
 
@@ -54,13 +54,15 @@ class Raycaster final : public Technique {
   // Where shaded frames take the gradient (layout/GradientTexture.h): the
   // plan's choice by default. Throws InputError for Precomputed where it
   // cannot be had.
-  void setGradient(layout::GradientWish wish);
-  const layout::GradientPlan& gradientPlan() const { return gradientPlan_; }
+  void setGradient(layout::GradientWish wish) { gradient_.setWish(wish); }
+  const layout::GradientPlan& gradientPlan() const { return gradient_.plan(); }
   // The precomputed gradient the last shaded frame used; not valid() when it
   // took central differences on the fly.
-  const layout::GradientTexture& gradientTexture() const { return gradient_; }
+  const layout::GradientTexture& gradientTexture() const { return gradient_.texture(); }
   // Whether frames with these settings shade from the precomputed gradient.
-  bool precomputedGradient(const RenderSettings& settings) const;
+  bool precomputedGradient(const RenderSettings& settings) const {
+    return gradient_.precomputed(settings);
+  }
 
   // Compiles the program and builds the lookup tables the settings need, so
   // that a timed frame measures rendering only.
@@ -125,8 +127,6 @@ class Raycaster final : public Technique {
   void updateLookup(const RenderSettings& settings, double sampleDistance);
   void uploadLut();
   void uploadBlocks(const std::vector<std::uint8_t>& cells);
-  // Builds the precomputed gradient texture when these settings shade from it.
-  void updateGradient(const RenderSettings& settings);
 
   gpu::GlContext& context_;
   const Volume& volume_;
@@ -141,8 +141,7 @@ class Raycaster final : public Technique {
   PreIntegrationTable preint_;
   int preintEntries_ = PreIntegrationTable::kDefaultEntries;
   StepGrid stepGrid_;
-  layout::GradientPlan gradientPlan_;
-  layout::GradientTexture gradient_;
+  ShadingGradient gradient_;
   gpu::Texture blockTexture_;
   gpu::Framebuffer target_;
   gpu::FullscreenTriangle triangle_;
