@@ -68,7 +68,8 @@ void runPlan(const PlanOptions& o) {
   // With --shade: where the ray caster's gradient would come from (next to
   // the volume and the ray caster's own bytes; units as Raycaster::setGradient).
   const bool unitForGradient =
-      plan.volumeUnits + render::Raycaster::kOwnTextureUnits + 1 <= l.textureUnits;
+      static_cast<int>(plan.layout.textures.size()) + render::Raycaster::kOwnTextureUnits + 1 <=
+      l.textureUnits;
   const layout::GradientPlan gradient =
       layout::planGradient(layout::GradientWish::Auto, plan.volumeDims, plan.layout.layout, l.api,
                            unitForGradient ? l.max3DTextureSize : 0, l.textureBudget,
