@@ -21,41 +21,59 @@ VoxelGradients computeVoxelGradients(const Volume& volume) {
   g.dims = volume.dims();
   const glm::ivec3 d = g.dims;
   const std::size_t n = static_cast<std::size_t>(volume.voxelCount());
-  HostBudget::global().check(n * 16, "precomputed gradient");
-  std::vector<float> diff(3 * n);
-  auto value = [&](int x, int y, int z) {
-    x = std::clamp(x, 0, d.x - 1);
-    y = std::clamp(y, 0, d.y - 1);
-    z = std::clamp(z, 0, d.z - 1);
-    return volume.finiteValueAtIndex(volume.index(x, y, z));
-  };
-  glm::dvec3 largest(0.0);
-  std::size_t i = 0;
-  for (int z = 0; z < d.z; ++z) {
-    for (int y = 0; y < d.y; ++y) {
-      for (int x = 0; x < d.x; ++x, ++i) {
-        const glm::dvec3 c(0.5 * (value(x + 1, y, z) - value(x - 1, y, z)),
-                           0.5 * (value(x, y + 1, z) - value(x, y - 1, z)),
-                           0.5 * (value(x, y, z + 1) - value(x, y, z - 1)));
-        for (int a = 0; a < 3; ++a) {
-          diff[3 * i + a] = static_cast<float>(c[a]);
-          largest[a] = std::max(largest[a], std::abs(c[a]));
+  HostBudget::global().check(n * 8, "precomputed gradient");
+  // The values once as floats (exact for 8- and 16-bit voxels), then
+  // neighbours by index arithmetic.
+  std::vector<float> values(n);
+  if (volume.type() == ScalarType::U8) {
+    const auto* bytes = reinterpret_cast<const std::uint8_t*>(volume.bytes().data());
+    for (std::size_t i = 0; i < n; ++i) values[i] = bytes[i];
+  } else {
+    for (std::size_t i = 0; i < n; ++i)
+      values[i] = static_cast<float>(volume.finiteValueAtIndex(i));
+  }
+  const std::size_t sx = 1;
+  const std::size_t sy = static_cast<std::size_t>(d.x);
+  const std::size_t sz = sy * static_cast<std::size_t>(d.y);
+  // Two passes (the scale, then the codes): no copy of the gradients next
+  // to the 4 bytes per voxel that are kept.
+  auto forEachVoxel = [&](auto visit) {
+    std::size_t i = 0;
+    for (int z = 0; z < d.z; ++z) {
+      const std::size_t zm = z > 0 ? sz : 0, zp = z + 1 < d.z ? sz : 0;
+      for (int y = 0; y < d.y; ++y) {
+        const std::size_t ym = y > 0 ? sy : 0, yp = y + 1 < d.y ? sy : 0;
+        for (int x = 0; x < d.x; ++x, ++i) {
+          const std::size_t xm = x > 0 ? sx : 0, xp = x + 1 < d.x ? sx : 0;
+          visit(i, 0.5f * (values[i + xp] - values[i - xm]),
+                0.5f * (values[i + yp] - values[i - ym]), 0.5f * (values[i + zp] - values[i - zm]));
         }
       }
     }
-  }
+  };
+  float largest[3] = {0.0f, 0.0f, 0.0f};
+  forEachVoxel([&](std::size_t, float gx, float gy, float gz) {
+    largest[0] = std::max(largest[0], std::abs(gx));
+    largest[1] = std::max(largest[1], std::abs(gy));
+    largest[2] = std::max(largest[2], std::abs(gz));
+  });
+  float perCode[3];
   for (int a = 0; a < 3; ++a) {
-    g.step[a] = largest[a] > 0.0 ? largest[a] / VoxelGradients::kCodeRange : 1.0;
+    g.step[a] = largest[a] > 0.0f ? largest[a] / VoxelGradients::kCodeRange : 1.0;
+    perCode[a] = static_cast<float>(1.0 / g.step[a]);
   }
   g.texels.assign(4 * n, 255);
-  for (std::size_t v = 0; v < n; ++v) {
-    for (int a = 0; a < 3; ++a) {
-      const double code = std::round(diff[3 * v + a] / g.step[a]);
-      g.texels[4 * v + a] = static_cast<std::uint8_t>(
-          VoxelGradients::kZeroCode +
-          std::clamp(code, -VoxelGradients::kCodeRange, VoxelGradients::kCodeRange));
-    }
-  }
+  constexpr float kRange = static_cast<float>(VoxelGradients::kCodeRange);
+  auto code = [&](float c, int a) {
+    const float q = std::clamp(std::nearbyint(c * perCode[a]), -kRange, kRange);
+    return static_cast<std::uint8_t>(VoxelGradients::kZeroCode + static_cast<int>(q));
+  };
+  forEachVoxel([&](std::size_t i, float gx, float gy, float gz) {
+    std::uint8_t* t = &g.texels[4 * i];
+    t[0] = code(gx, 0);
+    t[1] = code(gy, 1);
+    t[2] = code(gz, 2);
+  });
   return g;
 }
 
