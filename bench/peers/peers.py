@@ -363,12 +363,19 @@ ABLATION = {
     "+adaptive": ["--preintegrate", "off", "--adaptive", "on"],
     "+preint +adaptive": ["--preintegrate", "on", "--adaptive", "on"],
 }
+# Shaded rows only: the defaults with the gradient taken on the fly (6 fetches
+# per lit sample) instead of the precomputed texture (docs/shading.md).
+SHADED_ABLATION = {
+    "defaults, gradient on the fly": ["--gradient", "on-the-fly"],
+}
 
 
 def run_configuration(cfg, tessera, vtks, workdir, log, variants=None, fine_step=0.0):
     label = (f"{cfg['width']}x{cfg['height']} step {cfg['step']:g} "
              f"{'shaded' if cfg['shade'] else 'unshaded'}")
-    variants = variants or {}
+    variants = dict(variants or {})
+    if cfg["shade"] and variants:
+        variants.update(SHADED_ABLATION)
     for r in vtks.values():
         r.configure(cfg)
     fine = None
@@ -475,7 +482,9 @@ def markdown(rows, meta):
             "Ablation, in the same alternation: Tessera with each sampling lever on its own "
             "(baseline: post-classification, every sample of the nominal step, the old "
             "behaviour; +preint: pre-integrated classification; +adaptive: adaptive steps; "
-            "both: the defaults).",
+            "both: the defaults; shaded rows: every variant takes the precomputed gradient "
+            "texture, the defaults' choice on ES 3, and 'defaults, gradient on the fly' takes "
+            "central differences instead, 6 fetches per lit sample).",
             "",
             "| image | step | shading | variant | Tessera ms | × vs VTK CPU | × vs VTK GPU "
             + (f"| vs {fine:g}-step ref " if fine else "") + "|",
@@ -642,7 +651,7 @@ def main():
             "lighting": lighting, "vtk_version": vtk.vtkVersion.GetVTKVersion(),
             "gl_renderer": rows[0]["gl_renderer"] if rows else None,
             "tessera": args.tessera, "notes": notes, "fine_step": args.fine_step,
-            "ablation": list(ABLATION) if args.ablation else [],
+            "ablation": list(ABLATION) + list(SHADED_ABLATION) if args.ablation else [],
             "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()),
         }
         md = write_outputs(rows, meta, args.out)

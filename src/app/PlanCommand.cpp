@@ -65,6 +65,15 @@ void runPlan(const PlanOptions& o) {
   request.streamed = streamed;
   const layout::Plan plan = layout::planLayout(volume, device.limits, request);
   const gpu::DeviceLimits& l = device.limits;
+  // With --shade: where the ray caster's gradient would come from (next to
+  // the volume and the ray caster's own bytes; units as Raycaster::setGradient).
+  const bool unitForGradient =
+      static_cast<int>(plan.layout.textures.size()) + render::Raycaster::kOwnTextureUnits + 1 <=
+      l.textureUnits;
+  const layout::GradientPlan gradient =
+      layout::planGradient(layout::GradientWish::Auto, plan.volumeDims, plan.layout.layout, l.api,
+                           unitForGradient ? l.max3DTextureSize : 0, l.textureBudget,
+                           plan.layout.totalBytes + needs.bytes);
   if (o.json) {
     nlohmann::json j;
     j["file"] = spec;
@@ -85,6 +94,9 @@ void runPlan(const PlanOptions& o) {
     j["renderer_reserved_bytes"] = needs.bytes;
     j["empty_space_skipping"] = skipping;
     j["reason"] = plan.reason;
+    j["shaded_gradient"] = {{"precomputed", gradient.precomputed},
+                            {"bytes", gradient.precomputed ? gradient.texture.bytes : 0},
+                            {"reason", gradient.reason}};
     if (!needs.note.empty()) j["note"] = needs.note;
     nlohmann::json rejected = nlohmann::json::array();
     for (const auto& r : plan.rejected) rejected.push_back(planJson(r));
@@ -121,6 +133,7 @@ void runPlan(const PlanOptions& o) {
   }
   if (!needs.note.empty()) std::printf("note     %s\n", needs.note.c_str());
   std::printf("reason   %s\n", plan.reason.c_str());
+  std::printf("gradient with --shade: %s\n", gradient.reason.c_str());
 }
 
 }  // namespace

@@ -181,6 +181,7 @@ RenderRequest requestFrom(const RenderOptions& o) {
   }
   req.technique = o.technique;
   req.skipBlock = o.skipBlock;
+  req.gradient = o.shading.gradient;
   req.lutSize = o.labelVolume() ? 256 : o.lut;
   req.slices = o.slices;
   req.classify = o.classify;
@@ -428,6 +429,9 @@ void printRenderText(const RenderOptions& o, const RenderRequest& req, const Ren
     }
     std::printf("sampling %s%s\n", line.c_str(),
                 o.sampling.stepGiven() ? "" : "; the default (docs/sampling.md)");
+  }
+  if (req.settings.shading.enabled && !r.gradient.empty()) {
+    std::printf("gradient %s\n", r.gradient.c_str());
   }
   if (!r.planNote.empty()) std::printf("note     %s\n", r.planNote.c_str());
   std::printf("textures %s on the GPU (%llu bytes)%s\n", formatBytes(r.textureBytes).c_str(),

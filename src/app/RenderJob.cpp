@@ -12,6 +12,7 @@
 #include "tessera/layout/FccLayout.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
+#include "tessera/reference/VoxelGradients.h"
 #include "tessera/render/Raycaster.h"
 #include "tessera/render/TechniqueRegistry.h"
 
@@ -99,6 +100,7 @@ void describeStorage(const render::TechniqueOnVolume& t, RenderResult& result) {
   result.planNote = t.requirements.note;
   if (!report.note.empty()) result.planNote += (result.planNote.empty() ? "" : "; ") + report.note;
   result.occupiedBlockFraction = report.occupiedBlockFraction;
+  result.gradient = report.gradient;
 }
 
 // Frame 0 against the CPU reference of the volume the GPU rendered: its
@@ -132,6 +134,15 @@ void compareWithReference(const Volume& volume, const render::Technique& techniq
       return renderReference(fcc->lattice().box(), lattice::BoxSplineReconstruction(fcc->lattice()),
                              tf, req.camera, s, width, height, 0, stats, nullptr, g);
     }
+    // The twin shades the field the GPU shaded: with a precomputed gradient
+    // texture its quantised per-voxel differences; the fine reference keeps
+    // the exact central differences (the truth the texture is judged by).
+    if (!fine && caster != nullptr && caster->precomputedGradient(req.settings)) {
+      const TrilinearReconstruction values(volume);
+      return renderReference(
+          volume, VoxelGradientReconstruction(values, caster->gradientTexture().gradients()), tf,
+          req.camera, s, width, height, 0, stats, nullptr, g);
+    }
     return renderReference(volume, tf, req.camera, s, width, height, 0, stats, nullptr, g);
   };
   const auto t0 = std::chrono::steady_clock::now();
@@ -158,7 +169,8 @@ render::TechniqueOptions RenderRequest::techniqueOptions() const {
           .skipBlock = skipBlock,
           .lutSize = lutSize,
           .slices = slices,
-          .classify = classify};
+          .classify = classify,
+          .gradient = gradient};
 }
 
 double RenderResult::median() const {

@@ -39,6 +39,7 @@ struct RenderRequest {
   int lutSize = 4096;
   int slices = 0;                 // 0 = from the step (slice3d) or every slice (slice2d)
   std::string classify = "post";  // slice2d: pre, palette or post
+  std::string gradient = "auto";  // raycast, shaded: auto, on-the-fly or precomputed
   // bricks: stop refining frame 0 after this many frames or seconds.
   int maxRefineFrames = 10000;
   double maxRefineSeconds = 600.0;
@@ -69,6 +70,7 @@ struct BricksRun {
 struct RenderResult {
   std::vector<double> frameMs;
   double prepareMs = 0.0;  // shader compile + lookup tables, before the first frame
+  std::string gradient;    // shaded ray casting: where the gradient came from and why
   Image first;             // the frame at the requested view
   std::optional<Image> referenceImage;
   double referenceMs = 0.0;

@@ -38,8 +38,15 @@ glm::dvec3 parseLightDirection(const std::string& text) {
 
 void addShadingOptions(CLI::App* cmd, ShadingOptions& o) {
   cmd->add_flag("--shade", o.shade,
-                "Blinn-Phong shading from the gradient of the reconstructed field (central "
-                "differences, 6 extra fetches per visible sample); composite mode only");
+                "Blinn-Phong shading from the gradient of the reconstructed field; composite "
+                "mode only");
+  cmd->add_option("--gradient", o.gradient,
+                  "With --shade (raycast): 'precomputed' (per-voxel central differences in an "
+                  "RGBA8 3D texture: 1 fetch per lit sample, 4 bytes per voxel), 'on-the-fly' "
+                  "(central differences through the layout: 6 fetches, no memory) or 'auto' "
+                  "(precomputed where the device has 3D textures and the budget holds it)")
+      ->check(CLI::IsMember({"auto", "on-the-fly", "precomputed"}))
+      ->capture_default_str();
   cmd->add_option("--light", o.light,
                   "With --shade: 'headlight' (light from the viewer) or a fixed direction "
                   "towards the light X,Y,Z in the patient frame (RAS+: x right, y anterior, "

@@ -13,7 +13,8 @@ namespace tessera::app {
 struct ShadingOptions {
   bool shade = false;
   std::string light = "headlight";
-  Shading coefficients;  // ambient, diffuse, specular, shininess and their defaults
+  Shading coefficients;           // ambient, diffuse, specular, shininess and their defaults
+  std::string gradient = "auto";  // auto, on-the-fly or precomputed (layout/GradientTexture.h)
 };
 
 void addShadingOptions(CLI::App* cmd, ShadingOptions& o);

@@ -16,7 +16,11 @@
 namespace tessera::render {
 
 Raycaster::Raycaster(gpu::GlContext& context, const Volume& volume, const layout::Layout& layout)
-    : context_(context), volume_(volume), layout_(layout), tf_(TransferFunction::preset("grey")) {
+    : context_(context),
+      volume_(volume),
+      layout_(layout),
+      tf_(TransferFunction::preset("grey")),
+      gradient_(context, volume, layout, kOwnTextureUnits) {
   triangle_ = gpu::FullscreenTriangle(context.ledger());
   setSkipBlockSize(blockSize_);
 }
@@ -49,7 +53,8 @@ void Raycaster::setLutSize(int entries) {
 }
 
 std::uint64_t Raycaster::ownTextureBytes() const {
-  return lut_.bytes() + preint_.bytes() + blockTexture_.bytes() + target_.color().bytes();
+  return lut_.bytes() + preint_.bytes() + blockTexture_.bytes() + target_.color().bytes() +
+         gradient_.bytes();
 }
 
 void Raycaster::setPreintegrationEntries(int entries) {
@@ -179,6 +184,7 @@ std::vector<std::string> Raycaster::definesFor(const RenderSettings& settings) c
     if (settings.sampling.opacityGrowth) defines.push_back("OPACITY_GROWTH 1");
   }
   addShadingDefines(settings, defines);
+  gradient_.addDefines(settings, defines);
   addClippingDefines(settings, defines);
   if (settings.nearest) defines.push_back("NEAREST 1");
   defines.push_back("MAX_STEPS " + std::to_string(settings.maxSteps));
@@ -197,6 +203,8 @@ std::vector<gpu::ShaderPart> Raycaster::fragmentParts(const RenderSettings& sett
   std::vector<gpu::ShaderPart> parts = {
       gpu::shaderPreamble(context_.caps().api, true, definesFor(settings)),
       gpu::embeddedShaderPart("render/camera_ray.glsl")};
+  // The precomputed gradient (when defined) stands in for the seam's own.
+  gradient_.addParts(parts);
   for (gpu::ShaderPart& part : layout_.seamParts()) parts.push_back(std::move(part));
   for (const char* file :
        {"render/classify.glsl", "render/shading.glsl", "render/clipping.glsl", "render/sample.glsl",
@@ -218,6 +226,7 @@ void Raycaster::prepare(const RenderSettings& settings) {
   const glm::dvec3 spacing = volume_.spacing();
   const double ds = settings.stepVoxels * std::min({spacing.x, spacing.y, spacing.z});
   updateLookup(settings, isProjection(settings.mode) ? tf_.opacityUnitLength : ds);
+  gradient_.prepare(settings);
   programFor(settings);
 }
 
@@ -242,6 +251,7 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
   // MIP shows one classified sample, so its table is not distance-corrected
   // (correcting for one unit length leaves opacity as it is).
   updateLookup(settings, isProjection(settings.mode) ? tf_.opacityUnitLength : ds);
+  gradient_.prepare(settings);
 
   if (target_.id() == 0 || target_.width() != width || target_.height() != height) {
     target_ = gpu::Framebuffer();
@@ -282,6 +292,7 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
   if (settings.nearest) prog.set("u_sampleDims", glm::vec3(volume_.dims()));
 
   int unit = layout_.bindSeam(prog, 0);
+  unit += gradient_.bind(prog, unit, settings);
   if (usesPreintegration(settings)) {
     preint_.texture().bind(unit);
     prog.set("u_preint", unit++);
@@ -340,6 +351,7 @@ const gpu::Texture& Raycaster::render(const Camera& camera, const RenderSettings
 TechniqueReport Raycaster::report() const {
   TechniqueReport r;
   r.occupiedBlockFraction = occupiedFraction_;
+  r.gradient = gradient_.plan().reason;
   return r;
 }
 
@@ -384,6 +396,7 @@ TechniqueEntry Raycaster::registration() {
             auto caster = std::make_unique<Raycaster>(s.context, s.volume, *s.layout);
             caster->setSkipBlockSize(skipBlockFor(s.limits, s.options.skipBlock));
             caster->setLutSize(s.options.lutSize);
+            caster->setGradient(layout::parseGradientWish(s.options.gradient));
             return caster;
           }};
 }

@@ -21,7 +21,8 @@ Slice3DRenderer::Slice3DRenderer(gpu::GlContext& context, const Volume& volume,
       volume_(volume),
       layout_(layout),
       tf_(TransferFunction::preset("grey")),
-      accumulator_(context) {}
+      accumulator_(context),
+      gradient_(context, volume, layout, kOwnTextureUnits) {}
 
 void Slice3DRenderer::setTransferFunction(const TransferFunction& tf) {
   tf_ = tf;
@@ -58,7 +59,8 @@ double Slice3DRenderer::sliceSpacingFor(const RenderSettings& settings) const {
 }
 
 std::uint64_t Slice3DRenderer::ownTextureBytes() const {
-  return lut_.texture().bytes() + accumulator_.ownTextureBytes() + vertices_.bytes();
+  return lut_.texture().bytes() + accumulator_.ownTextureBytes() + vertices_.bytes() +
+         gradient_.bytes();
 }
 
 void Slice3DRenderer::buildGeometry(int slices) {
@@ -107,9 +109,11 @@ std::vector<gpu::ShaderPart> Slice3DRenderer::fragmentParts(const RenderSettings
   std::vector<std::string> defines;
   if (settings.mode == RenderMode::Mip) defines.push_back("MODE_MIP 1");
   addShadingDefines(settings, defines);
+  gradient_.addDefines(settings, defines);
   addClippingDefines(settings, defines);
   if (settings.nearest) defines.push_back("NEAREST 1");
   std::vector<gpu::ShaderPart> parts = {gpu::shaderPreamble(context_.caps().api, true, defines)};
+  gradient_.addParts(parts);
   for (gpu::ShaderPart& part : layout_.seamParts()) parts.push_back(std::move(part));
   for (const char* file :
        {"render/classify.glsl", "render/shading.glsl", "render/clipping.glsl", "render/sample.glsl",
@@ -122,6 +126,7 @@ std::vector<gpu::ShaderPart> Slice3DRenderer::fragmentParts(const RenderSettings
 const gpu::Program& Slice3DRenderer::programFor(const RenderSettings& settings) {
   const std::string key = layout_.name() + (settings.mode == RenderMode::Mip ? "|mip" : "") +
                           (shadingActive(settings) ? "|shade" : "") +
+                          (gradient_.precomputed(settings) ? "|gradient-texture" : "") +
                           (settings.clipping.active() ? "|clip" : "") +
                           (settings.nearest ? "|nearest" : "");
   return programs_.get(key, [&] {
@@ -139,6 +144,7 @@ void Slice3DRenderer::prepare(const RenderSettings& settings) {
   if (n != builtSlices_) buildGeometry(n);
   updateLookup(settings, settings.mode == RenderMode::Mip ? tf_.opacityUnitLength
                                                           : sliceSpacingFor(settings));
+  gradient_.prepare(settings);
   programFor(settings);
 }
 
@@ -178,6 +184,7 @@ void Slice3DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
   setClippingUniforms(prog, settings, camera, extent);
   if (settings.nearest) prog.set("u_sampleDims", glm::vec3(volume_.dims()));
   int unit = layout_.bindSeam(prog, 0);
+  unit += gradient_.bind(prog, unit, settings);
   lut_.texture().bind(unit);
   prog.set("u_tf", unit);
   prog.set("u_tfSize", static_cast<float>(lut_.entries()));
@@ -203,6 +210,7 @@ TechniqueReport Slice3DRenderer::report() const {
   TechniqueReport r;
   r.note = "slice3d: " + std::to_string(builtSlices_) + " view-aligned slices, accumulation " +
            accumulationFormat() + ", no early termination";
+  r.gradient = gradient_.plan().reason;
   return r;
 }
 
@@ -226,6 +234,7 @@ TechniqueEntry Slice3DRenderer::registration() {
             if (!s.layout) throw Error("slice3d samples a layout, and none was made");
             auto slicer = std::make_unique<Slice3DRenderer>(s.context, s.volume, *s.layout);
             slicer->setSliceCount(s.options.slices);
+            slicer->setGradient(layout::parseGradientWish(s.options.gradient));
             return slicer;
           }};
 }

@@ -19,6 +19,7 @@
 #include "tessera/layout/Texture3DLayout.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
+#include "tessera/reference/VoxelGradients.h"
 #include "tessera/render/Raycaster.h"
 #include "tessera/render/Slice2DRenderer.h"
 #include "tessera/render/Slice3DRenderer.h"
@@ -62,16 +63,20 @@ std::vector<std::unique_ptr<layout::Layout>> layoutsFor(gpu::GlContext& c, const
 }
 
 Image raycastWith(gpu::GlContext& c, const Volume& v, const layout::Layout& l, const Camera& cam,
-                  const RenderSettings& s, int size) {
+                  const RenderSettings& s, int size,
+                  layout::GradientWish gradient = layout::GradientWish::OnTheFly) {
   render::Raycaster caster(c, v, l);
   caster.setTransferFunction(visibleTf());
+  caster.setGradient(gradient);
   return caster.render(cam, s, size, size);
 }
 
 Image sliceWith(gpu::GlContext& c, const Volume& v, const layout::Layout& l, const Camera& cam,
-                const RenderSettings& s, int size) {
+                const RenderSettings& s, int size,
+                layout::GradientWish gradient = layout::GradientWish::OnTheFly) {
   render::Slice3DRenderer slicer(c, v, l);
   slicer.setTransferFunction(visibleTf());
+  slicer.setGradient(gradient);
   return slicer.render(cam, s, size, size);
 }
 
@@ -102,14 +107,35 @@ void expectShadedLayoutsMatchReference(gpu::ApiLevel api, const Volume& v, doubl
     const Image ref = renderReference(v, visibleTf(), cam, s, 96, 96);
     const Image refUnshaded = renderReference(v, visibleTf(), cam, unshaded, 96, 96);
     ASSERT_LT(psnr(ref, refUnshaded), 30.0) << "shading must change the image";
+    // The precomputed gradient (ES 3: an RGBA8 3D texture) against the
+    // reference of the same quantised field, and against the exact one.
+    const VoxelGradients gradients = computeVoxelGradients(v);
+    const TrilinearReconstruction values(v);
+    const Image refPre = renderReference(v, VoxelGradientReconstruction(values, gradients),
+                                         visibleTf(), cam, s, 96, 96);
+    const char* name = v.dims().x == 37 ? "sphere" : "phantom";
     for (const auto& l : layoutsFor(c, v)) {
       const double cast = psnr(raycastWith(c, v, *l, cam, s, 96), ref);
       const double slice = psnr(sliceWith(c, v, *l, cam, s, 96), ref);
       std::printf(
-          "  [measured] shaded %-7s %s %-13s raycast %.2f dB, slice3d %.2f dB vs reference\n",
-          v.dims().x == 37 ? "sphere" : "phantom", apiName(api), l->name().c_str(), cast, slice);
+          "  [measured] shaded %-7s %s %-13s raycast %.2f dB, slice3d %.2f dB vs reference\n", name,
+          apiName(api), l->name().c_str(), cast, slice);
       EXPECT_GE(cast, 40.0) << l->name();
       EXPECT_GE(slice, sliceBar) << l->name();
+      if (api != gpu::ApiLevel::Gles3) continue;
+      const Image pre = raycastWith(c, v, *l, cam, s, 96, layout::GradientWish::Precomputed);
+      const double same = psnr(pre, refPre);
+      const double exact = psnr(pre, ref);
+      const double slicePre =
+          psnr(sliceWith(c, v, *l, cam, s, 96, layout::GradientWish::Precomputed), refPre);
+      std::printf(
+          "  [measured] shaded %-7s %s %-13s precomputed gradient: raycast %.2f dB vs its "
+          "reference, %.2f dB vs the exact-gradient reference (quantisation: %.2f dB); "
+          "slice3d %.2f dB vs its reference\n",
+          name, apiName(api), l->name().c_str(), same, exact, psnr(refPre, ref), slicePre);
+      EXPECT_GE(same, 40.0) << l->name();
+      EXPECT_GE(exact, 40.0) << l->name();
+      EXPECT_GE(slicePre, sliceBar) << l->name();
     }
   });
 }
@@ -197,8 +223,14 @@ TEST(Shading, LinearRampIsLitByItsAnalyticNormal) {
       for (const auto& l : layoutsFor(c, v)) {
         render::Raycaster caster(c, v, *l);
         caster.setTransferFunction(opaqueGrey);
+        caster.setGradient(layout::GradientWish::OnTheFly);
         const std::string what = std::string("raycast ") + apiName(api) + " " + l->name();
         expectRampLitByAnalyticNormal(caster.render(cam, s, 96, 96), v, cam, s, what.c_str());
+        if (api != gpu::ApiLevel::Gles3) continue;
+        // The ramp's differences (8, 5, 0) quantise exactly (codes 127, 127, 0).
+        caster.setGradient(layout::GradientWish::Precomputed);
+        expectRampLitByAnalyticNormal(caster.render(cam, s, 96, 96), v, cam, s,
+                                      (what + ", precomputed gradient").c_str());
       }
     });
   }

@@ -25,6 +25,7 @@
 #include "tessera/layout/ValueBlocks.h"
 #include "tessera/reference/AdaptiveSteps.h"
 #include "tessera/render/PreIntegrationTable.h"
+#include "tessera/render/ShadingGradient.h"
 #include "tessera/render/Technique.h"
 #include "tessera/render/TechniqueRegistry.h"
 
@@ -48,6 +49,19 @@ class Raycaster final : public Technique {
   void setPreintegrationEightBit(bool eightBit) {
     preint_.setEightBit(eightBit);
     lookupKey_.clear();
+  }
+
+  // Where shaded frames take the gradient (layout/GradientTexture.h): the
+  // plan's choice by default. Throws InputError for Precomputed where it
+  // cannot be had.
+  void setGradient(layout::GradientWish wish) { gradient_.setWish(wish); }
+  const layout::GradientPlan& gradientPlan() const { return gradient_.plan(); }
+  // The precomputed gradient the last shaded frame used; not valid() when it
+  // took central differences on the fly.
+  const layout::GradientTexture& gradientTexture() const { return gradient_.texture(); }
+  // Whether frames with these settings shade from the precomputed gradient.
+  bool precomputedGradient(const RenderSettings& settings) const {
+    return gradient_.precomputed(settings);
   }
 
   // Compiles the program and builds the lookup tables the settings need, so
@@ -127,6 +141,7 @@ class Raycaster final : public Technique {
   PreIntegrationTable preint_;
   int preintEntries_ = PreIntegrationTable::kDefaultEntries;
   StepGrid stepGrid_;
+  ShadingGradient gradient_;
   gpu::Texture blockTexture_;
   gpu::Framebuffer target_;
   gpu::FullscreenTriangle triangle_;

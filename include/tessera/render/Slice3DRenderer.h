@@ -29,6 +29,7 @@
 #include "tessera/gpu/Program.h"
 #include "tessera/gpu/ProgramCache.h"
 #include "tessera/layout/Layout.h"
+#include "tessera/render/ShadingGradient.h"
 #include "tessera/render/SliceAccumulator.h"
 #include "tessera/render/Technique.h"
 #include "tessera/render/TechniqueRegistry.h"
@@ -48,6 +49,13 @@ class Slice3DRenderer final : public Technique {
   int sliceCountFor(const RenderSettings& settings) const;
   // World distance between slices for these settings.
   double sliceSpacingFor(const RenderSettings& settings) const;
+
+  // Where shaded frames take the gradient (render/ShadingGradient.h).
+  void setGradient(layout::GradientWish wish) { gradient_.setWish(wish); }
+  const layout::GradientTexture& gradientTexture() const { return gradient_.texture(); }
+  bool precomputedGradient(const RenderSettings& settings) const {
+    return gradient_.precomputed(settings);
+  }
 
   void prepare(const RenderSettings& settings);
   void renderFrame(const Camera& camera, const RenderSettings& settings, int width, int height);
@@ -102,6 +110,7 @@ class Slice3DRenderer final : public Technique {
   gpu::LookupTexture lut_;
   std::string lookupKey_;
   SliceAccumulator accumulator_;
+  ShadingGradient gradient_;
   gpu::ProgramCache programs_;
 };
 

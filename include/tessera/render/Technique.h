@@ -29,6 +29,7 @@ struct TechniqueOptions {
   int slices = 0;                  // slice3d: over the diagonal; slice2d: per stack (0 = auto)
   std::string classify = "post";   // slice2d: pre, palette or post
   bool currentStackOnly = false;   // slice2d: only the stack being drawn on the GPU
+  std::string gradient = "auto";   // raycast, shaded: auto, on-the-fly or precomputed
 };
 
 // What a technique needs of a device besides the volume's textures.
@@ -49,6 +50,7 @@ struct TechniqueReport {
   std::string storageReason;
   std::uint64_t storageBytes = 0;
   double occupiedBlockFraction = 1.0;  // empty-space skipping: blocks the TF leaves occupied
+  std::string gradient;  // shading: where the gradient comes from and why (empty: n/a)
 };
 
 class Technique {
