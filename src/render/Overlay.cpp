@@ -8,10 +8,7 @@
 
 namespace tessera::render {
 
-namespace {
-
-// The 12 edges of the box [lo, hi].
-void addBox(std::vector<OverlayLine>& out, glm::dvec3 lo, glm::dvec3 hi, glm::vec4 color) {
+void addBoxEdges(std::vector<OverlayLine>& out, glm::dvec3 lo, glm::dvec3 hi, glm::vec4 color) {
   auto corner = [&](int i) {
     return glm::dvec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
   };
@@ -23,8 +20,6 @@ void addBox(std::vector<OverlayLine>& out, glm::dvec3 lo, glm::dvec3 hi, glm::ve
     }
   }
 }
-
-}  // namespace
 
 OverlayOptions OverlayOptions::parse(const std::string& list) {
   OverlayOptions o;
@@ -77,7 +72,7 @@ std::string OverlayOptions::describe() const {
 std::vector<OverlayLine> overlayLines(const Volume& volume, const OverlayOptions& options) {
   std::vector<OverlayLine> lines;
   const glm::dvec3 half = 0.5 * volume.extent();
-  if (options.box) addBox(lines, -half, half, glm::vec4(1.0f, 1.0f, 1.0f, 1.0f));
+  if (options.box) addBoxEdges(lines, -half, half, glm::vec4(1.0f, 1.0f, 1.0f, 1.0f));
   if (options.axes) {
     // From the centre outwards, so that each axis runs inside the volume and
     // leaves it: the case of a line through the volume, which an opacity
@@ -93,8 +88,8 @@ std::vector<OverlayLine> overlayLines(const Volume& volume, const OverlayOptions
   }
   if (options.roi) {
     const glm::dvec3 extent = volume.extent();
-    addBox(lines, (options.roiMin - 0.5) * extent, (options.roiMax - 0.5) * extent,
-           glm::vec4(1.0f, 0.85f, 0.1f, 1.0f));
+    addBoxEdges(lines, (options.roiMin - 0.5) * extent, (options.roiMax - 0.5) * extent,
+                glm::vec4(1.0f, 0.85f, 0.1f, 1.0f));
   }
   return lines;
 }

@@ -48,18 +48,7 @@ std::vector<render::OverlayLine> CropHandles::lines(const Clipping& clipping, gl
   const glm::vec4 edge(1.0f, 0.75f, 0.2f, 1.0f);  // orange: the crop box
   const glm::dvec3 lo = (clipping.cropMin - 0.5) * extent;
   const glm::dvec3 hi = (clipping.cropMax - 0.5) * extent;
-  for (int axis = 0; axis < 3; ++axis) {
-    const int u = (axis + 1) % 3, w = (axis + 2) % 3;
-    for (int i = 0; i < 4; ++i) {
-      glm::dvec3 a(0.0);
-      a[u] = (i & 1) ? hi[u] : lo[u];
-      a[w] = (i & 2) ? hi[w] : lo[w];
-      glm::dvec3 b = a;
-      a[axis] = lo[axis];
-      b[axis] = hi[axis];
-      out.push_back({a, b, edge});
-    }
-  }
+  render::addBoxEdges(out, lo, hi, edge);
   // A cross in the face's plane, 6% of the box's smallest side.
   const double size = 0.06 * std::max(1e-9, std::min({extent.x, extent.y, extent.z}));
   for (int f = 0; f < kCropFaces; ++f) {

@@ -43,18 +43,7 @@ std::vector<render::OverlayLine> boxLines(const lod::VoxelBox& box, glm::ivec3 d
   const glm::dvec3 lo = toModel(glm::dvec3(box.begin), dims, extent);
   const glm::dvec3 hi = toModel(glm::dvec3(box.end), dims, extent);
   std::vector<render::OverlayLine> lines;
-  for (int axis = 0; axis < 3; ++axis) {
-    const int u = (axis + 1) % 3, w = (axis + 2) % 3;
-    for (int i = 0; i < 4; ++i) {
-      glm::dvec3 a(0.0);
-      a[u] = (i & 1) ? hi[u] : lo[u];
-      a[w] = (i & 2) ? hi[w] : lo[w];
-      glm::dvec3 b = a;
-      a[axis] = lo[axis];
-      b[axis] = hi[axis];
-      lines.push_back({a, b, colour});
-    }
-  }
+  render::addBoxEdges(lines, lo, hi, colour);
   return lines;
 }
 

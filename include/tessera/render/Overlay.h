@@ -38,6 +38,9 @@ struct OverlayOptions {
   std::string describe() const;  // "box,axes" / "none"
 };
 
+// Appends the 12 edges of the axis-aligned box [lo, hi] (world coordinates).
+void addBoxEdges(std::vector<OverlayLine>& out, glm::dvec3 lo, glm::dvec3 hi, glm::vec4 color);
+
 // The line segments of the chosen overlays for `volume`.
 std::vector<OverlayLine> overlayLines(const Volume& volume, const OverlayOptions& options);
 
