@@ -722,6 +722,21 @@
     openUrls,
     lastLoad: () => lastLoad,
     zarr: () => (zarr ? zarr.stats() : null),
+    // The bread-slice region [begin, end) of an open store's level 0 at
+    // native resolution (bounded reads: only its chunks are fetched); the
+    // keys fetched for it. zarrOverview() returns to the store.
+    zarrRegion: async (begin, end) => {
+      if (!zarr) throw new Error('no OME-Zarr store is open');
+      const keys = await zarr.showRegion(begin, end);
+      volumeChanged();
+      await requestRender();
+      return keys;
+    },
+    zarrOverview: () => {
+      if (zarr) zarr.overview();
+      volumeChanged();
+      return requestRender();
+    },
     setProgressive: (on) => { api.setProgressive(on ? 1 : 0, frameBudgetMs); },
     setCamera: (az, el, zoom) => { api.setCamera(az, el, zoom); return requestRender(); },
     setProjection: (orthographic) => { api.setProjection(orthographic ? 1 : 0); return requestRender(); },

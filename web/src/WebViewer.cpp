@@ -845,6 +845,81 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_info() {
   return scratch().c_str();
 }
 
+}  // extern "C"
+
+namespace {
+
+// The bread-slice region of a store (issue 15): voxels [x0,x1) x [y0,y1) x
+// [z0,z1) of level 0, read with bounded reads: only the chunks overlapping
+// the box are fetched (asynchronously, by the page), then one readBox, never
+// the level whole. Ends past the level are clamped; an empty box or one
+// that starts outside is an error naming the store.
+lod::VoxelBox storeRegionBox(web::ZarrStoreView& z, int x0, int x1, int y0, int y1, int z0,
+                             int z1) {
+  const glm::ivec3 d = z.source().levelInfo(0).dims;
+  lod::VoxelBox box{{x0, y0, z0}, {x1, y1, z1}};
+  const char* names = "xyz";
+  for (int a = 0; a < 3; ++a) {
+    if (box.begin[a] < 0 || box.begin[a] >= d[a] || box.end[a] <= box.begin[a]) {
+      throw InputError(z.storage().describe() + ": region: " + names[a] + " range " +
+                       std::to_string(box.begin[a]) + ":" + std::to_string(box.end[a]) +
+                       " is empty or starts outside 0:" + std::to_string(d[a]) + " of level 0");
+    }
+    box.end[a] = std::min(box.end[a], d[a]);
+  }
+  return box;
+}
+
+}  // namespace
+
+extern "C" {
+
+// 1 when every level-0 chunk of the box has arrived, 0 when some are wanted
+// (tessera_zarr_wanted lists them: the page fetches them and asks again),
+// -1 on error (tessera_last_error).
+EMSCRIPTEN_KEEPALIVE int tessera_zarr_region_prefetch(int x0, int x1, int y0, int y1, int z0,
+                                                      int z1) {
+  int state = -1;
+  guarded([&] {
+    web::ZarrStoreView& z = theZarrView();
+    if (!z.isOpen()) throw Error(z.storage().describe() + ": the store is not open yet");
+    state = z.source().prefetch(0, storeRegionBox(z, x0, x1, y0, y1, z0, z1)) ? 1 : 0;
+  });
+  return state;
+}
+
+// Reads the box (its chunks fetched: tessera_zarr_region_prefetch) at level
+// 0 and makes it the viewer's volume, placed and windowed as in the store
+// (what `tessera render STORE --region` reads); the page then draws the
+// viewer instead of the store until it goes back to the store's overview.
+EMSCRIPTEN_KEEPALIVE int tessera_zarr_region_show(int x0, int x1, int y0, int y1, int z0, int z1) {
+  return guarded([&] {
+    web::ZarrStoreView& z = theZarrView();
+    const lod::VoxelBox box = storeRegionBox(z, x0, x1, y0, y1, z0, z1);
+    if (!z.source().prefetch(0, box)) {
+      throw Error(z.storage().describe() + ": region: its chunks have not all arrived");
+    }
+    Volume region = z.source().readBox(0, box);
+    region.setWindow(z.store().shape().window());
+    const ValueRange window = region.window();
+    viewer::Viewer& v = theViewer();
+    const Camera camera = v.camera();
+    const auto text = [&](int a) {
+      return std::to_string(box.begin[a]) + ":" + std::to_string(box.end[a]);
+    };
+    v.setVolume(std::move(region),
+                z.storage().describe() + " region " + text(0) + "," + text(1) + "," + text(2));
+    v.setWindow(window);
+    // Framed on the region (setVolume), seen from the store view's
+    // direction, projection and zoom.
+    Camera& c = v.camera();
+    c.projection = camera.projection;
+    c.azimuthDeg = camera.azimuthDeg;
+    c.elevationDeg = camera.elevationDeg;
+    c.zoom = camera.zoom;
+  });
+}
+
 // Closes the store (the viewer core's volume shows again).
 EMSCRIPTEN_KEEPALIVE void tessera_zarr_close() {
   zarrView().reset();

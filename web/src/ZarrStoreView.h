@@ -61,6 +61,9 @@ class ZarrStoreView {
   bool isOpen() const { return active_.technique != nullptr; }
   const ZarrStore& store() const { return *store_; }
   const layout::BricksLayout& bricks() const { return *bricks_; }
+  // The store's levels; readBox of a box whose chunks have arrived
+  // (prefetch true) reads without the network.
+  const FetchedZarrSource& source() const { return *source_; }
   // The coarsest level, read once at open (for the page's histogram).
   const Volume& coarsest() const { return coarsest_; }
 
