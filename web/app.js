@@ -169,6 +169,7 @@
         fitCanvas();
         ms = zarr.frame(canvas.width, canvas.height);
         frames++;
+        if (slices) slices.frameShown(refreshState());  // the store's slice views
       }
       if (!needsRender && renderWaiters.length) {
         const waiters = renderWaiters;
@@ -678,7 +679,8 @@
     }
     bindControls();
     if (withSlices) {
-      slices = window.TesseraSlices.attach({ M, canvas, requestRender, showError, clearError });
+      slices = window.TesseraSlices.attach({ M, canvas, requestRender, showError, clearError,
+        storeRegion: zarrRegion, storeOverview: zarrOverview });
       window.tessera.slices = slices.testApi;
     } else {
       $('slice-controls').hidden = true;
@@ -710,6 +712,23 @@
     return state;
   })();
 
+  // The bread-slice region [begin, end) of an open store's level 0 at
+  // native resolution (bounded reads: only its chunks are fetched), shown
+  // by the viewer; resolves to the keys fetched for it. zarrOverview()
+  // returns to the store.
+  async function zarrRegion(begin, end) {
+    if (!zarr) throw new Error('no OME-Zarr store is open');
+    const keys = await zarr.showRegion(begin, end);
+    volumeChanged();
+    await requestRender();
+    return keys;
+  }
+  function zarrOverview() {
+    if (zarr) zarr.overview();
+    volumeChanged();
+    return requestRender();
+  }
+
   // For tests and the console.
   window.tessera = {
     ready,
@@ -725,18 +744,8 @@
     // The bread-slice region [begin, end) of an open store's level 0 at
     // native resolution (bounded reads: only its chunks are fetched); the
     // keys fetched for it. zarrOverview() returns to the store.
-    zarrRegion: async (begin, end) => {
-      if (!zarr) throw new Error('no OME-Zarr store is open');
-      const keys = await zarr.showRegion(begin, end);
-      volumeChanged();
-      await requestRender();
-      return keys;
-    },
-    zarrOverview: () => {
-      if (zarr) zarr.overview();
-      volumeChanged();
-      return requestRender();
-    },
+    zarrRegion,
+    zarrOverview,
     setProgressive: (on) => { api.setProgressive(on ? 1 : 0, frameBudgetMs); },
     setCamera: (az, el, zoom) => { api.setCamera(az, el, zoom); return requestRender(); },
     setProjection: (orthographic) => { api.setProjection(orthographic ? 1 : 0); return requestRender(); },

@@ -110,6 +110,7 @@
       close: c('tessera_zarr_close', null, []),
       regionPrefetch: c('tessera_zarr_region_prefetch', 'number', Array(6).fill('number')),
       regionShow: c('tessera_zarr_region_show', 'number', Array(6).fill('number')),
+      regionOverview: c('tessera_zarr_region_overview', null, []),
       lastError: c('tessera_last_error', 'string', []),
       pageDecodes: c('tessera_zarr_page_decodes', 'number', ['string']),
     };
@@ -379,7 +380,10 @@
       // The store is drawn (not a region read from it, which the viewer draws).
       active: () => open && !regionShown,
       showRegion,
-      overview: () => { regionShown = false; },
+      overview: () => {
+        regionShown = false;
+        if (base) api.regionOverview();
+      },
       showingRegion: () => regionShown,
       wantsFrame,
       frame,

@@ -1193,8 +1193,10 @@ async function zarrStoreFromUrl(context, url, tmp, run) {
   }
 }
 
-// The bread-slice region of a served store (issue 15): a box straddling
-// chunk boundaries, read at level 0 with bounded reads. At 64 px the page
+// The bread-slice region of a served store (issue 15): the slice views show
+// the store's coarsest level; a box picked there (slices.js's showRegion,
+// what a drag calls) straddles chunk boundaries at level 0 and is read there
+// with bounded reads. At 64 px the page
 // refines the store only to level 2, so every level-0 request comes from the
 // region: the requests while it is picked are exactly the level-0 chunks
 // overlapping it (a 404 for an all-zero chunk counts), and its render
@@ -1206,8 +1208,12 @@ async function zarrRegionFromUrl(context, url, tmp, run) {
   const { page, logs } = await openPage(context, url, 'size=64&url=/data/ch2.ome.zarr');
   await page.waitForFunction(() => window.tessera.zarr().completeMs !== null, null, { timeout: 60000 });
   await withoutOverlays(page);
-  const begin = [40, 100, 50];
-  const end = [100, 150, 80];
+  const level0Before = served.paths.filter((p) => /^\/data\/ch2\.ome\.zarr\/0\/\d/.test(p)).length;
+  const from = served.paths.length;
+  const picked = await page.evaluate(() => window.tessera.slices.showRegion({ begin: [10, 25, 13], end: [25, 38, 20] }));
+  const ex = await page.evaluate(() => window.tessera.slices.state().explore);
+  if (!picked || !ex.region_level0) throw new Error(`picking a region of the store: ${await page.evaluate(() => window.tessera.error())}`);
+  const { begin, end } = ex.region_level0;
   const meta = JSON.parse(fs.readFileSync(path.join(store, '0', '.zarray'), 'utf8'));
   const chunk = [...meta.chunks].reverse();  // x, y, z
   const expected = [];
@@ -1218,9 +1224,7 @@ async function zarrRegionFromUrl(context, url, tmp, run) {
       }
     }
   }
-  const level0Before = served.paths.filter((p) => /^\/data\/ch2\.ome\.zarr\/0\/\d/.test(p)).length;
-  const from = served.paths.length;
-  const keys = await page.evaluate(([b, e]) => window.tessera.zarrRegion(b, e), [begin, end]);
+  const keys = (await page.evaluate(() => window.tessera.zarr())).region.keys;
   const requested = served.paths.slice(from).filter((p) => p.startsWith('/data/ch2.ome.zarr/'));
   const s = await page.evaluate(() => window.tessera.state());
   const same = (a, b) => JSON.stringify([...new Set(a)].sort()) === JSON.stringify([...new Set(b)].sort());
@@ -1229,7 +1233,8 @@ async function zarrRegionFromUrl(context, url, tmp, run) {
         s.dims.join('x') === [0, 1, 2].map((a) => end[a] - begin[a]).join('x'),
         `${requested.length} requests (${requested.map((p) => p.slice(19)).join(' ')}), expected ` +
         `${expected.length} (${expected.map((p) => p.slice(19)).join(' ')}); ${keys.length} keys asked; ` +
-        `level-0 requests before: ${level0Before}; 3D view ${s.dims.join('x')}`);
+        `level-0 requests before: ${level0Before}; slices of the ${ex.dims.join('x')} overview level, ` +
+        `picked ${JSON.stringify(ex.region)} -> level 0 ${JSON.stringify(ex.region_level0)}; 3D view ${s.dims.join('x')}`);
   const spec = [0, 1, 2].map((a) => `${begin[a]}:${end[a]}`).join(',');
   const refPng = path.join(tmp, 'native-zarr-region.png');
   // Oblique: from the front (elevation 0) the top face is seen edge-on and
@@ -1240,11 +1245,14 @@ async function zarrRegionFromUrl(context, url, tmp, run) {
   const m = await psnrAgainst(page, refPng);
   check(`OME-Zarr region: renders like \`tessera render STORE --region ${spec}\` (PSNR >= 45 dB)`, m.psnr >= 45,
         m.error || `${m.psnr.toFixed(2)} dB`);
-  await page.evaluate(() => window.tessera.zarrOverview());
+  await page.evaluate(() => window.tessera.slices.overview());
+  await page.evaluate(() => window.tessera.render());
   const back = await page.evaluate(() => window.tessera.zarr());
   const errors = logs.filter((l) => (l.startsWith('pageerror') || l.startsWith('error')) && !/status of 404/.test(l));
-  check('OME-Zarr region: back to the store, no script errors', back.last && back.last.complete && errors.length === 0,
-        errors.join(' | '));
+  const after = await page.evaluate(() => window.tessera.slices.state());
+  check('OME-Zarr region: Overview returns to the store, the region stays picked; no script errors',
+        back.last && back.last.complete && !after.showing_region && after.region && errors.length === 0,
+        errors.join(' | ') || `region ${JSON.stringify(after.region)}`);
   await page.close();
   console.log(`     (OME-Zarr region: ${((Date.now() - t) / 1000).toFixed(1)} s)`);
 }
