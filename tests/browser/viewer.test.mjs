@@ -1205,10 +1205,11 @@ async function zarrRegionFromUrl(context, url, tmp, run) {
   const store = path.join(tmp, 'ch2.ome.zarr');
   if (!fs.existsSync(store)) return;  // zarrStoreFromUrl said why
   const t = Date.now();
+  const opened = served.paths.length;  // this page's requests from here
   const { page, logs } = await openPage(context, url, 'size=64&url=/data/ch2.ome.zarr');
   await page.waitForFunction(() => window.tessera.zarr().completeMs !== null, null, { timeout: 60000 });
   await withoutOverlays(page);
-  const level0Before = served.paths.filter((p) => /^\/data\/ch2\.ome\.zarr\/0\/\d/.test(p)).length;
+  const level0Before = served.paths.slice(opened).filter((p) => /^\/data\/ch2\.ome\.zarr\/0\/\d/.test(p)).length;
   const from = served.paths.length;
   const picked = await page.evaluate(() => window.tessera.slices.showRegion({ begin: [10, 25, 13], end: [25, 38, 20] }));
   const ex = await page.evaluate(() => window.tessera.slices.state().explore);
@@ -1250,9 +1251,19 @@ async function zarrRegionFromUrl(context, url, tmp, run) {
   const back = await page.evaluate(() => window.tessera.zarr());
   const errors = logs.filter((l) => (l.startsWith('pageerror') || l.startsWith('error')) && !/status of 404/.test(l));
   const after = await page.evaluate(() => window.tessera.slices.state());
-  check('OME-Zarr region: Overview returns to the store, the region stays picked; no script errors',
-        back.last && back.last.complete && !after.showing_region && after.region && errors.length === 0,
-        errors.join(' | ') || `region ${JSON.stringify(after.region)}`);
+  // The region's red box over the store, by depth: seen through a clear TF.
+  await page.evaluate(() => window.tessera.setTfJson(JSON.stringify({ name: 'clear', opacity_unit_length: 1,
+    color: [{ x: 0, rgb: [0.2, 0.3, 0.9] }, { x: 1, rgb: [0.9, 0.9, 0.2] }], opacity: [{ x: 0, alpha: 0 }, { x: 1, alpha: 0 }] })));
+  await page.evaluate(() => window.tessera.render());
+  const red = await page.evaluate(() => {
+    const p = window.tessera.pixels();
+    let n = 0;
+    for (let i = 0; i < p.length; i += 4) if (p[i] > 200 && p[i + 1] < 70 && p[i + 2] < 70) n++;
+    return n;
+  });
+  check('OME-Zarr region: Overview returns to the store with the region as a red box, still picked in the slices; no script errors',
+        back.last && back.last.complete && !after.showing_region && after.region && red > 20 && errors.length === 0,
+        errors.join(' | ') || `region ${JSON.stringify(after.region)}, ${red} red pixels over the store (clear TF)`);
   await page.close();
   console.log(`     (OME-Zarr region: ${((Date.now() - t) / 1000).toFixed(1)} s)`);
 }

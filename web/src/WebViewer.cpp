@@ -842,9 +842,17 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_frame(int width, int height) {
   guarded([&] {
     viewer::Viewer& v = theViewer();
     web::ZarrStoreView& z = theZarrView();
+    // The picked region as a red box over the store, as over a file's
+    // overview (applyMarkBoxes), composed by depth.
+    std::vector<render::OverlayLine> marks;
+    const StoreRegion& r = storeRegion();
+    if (glm::all(glm::lessThan(r.box.begin, r.box.end))) {
+      const Volume& shape = z.store().shape();
+      marks = viewer::boxLines(r.box, shape.dims(), shape.extent(), {1.0f, 0.25f, 0.2f, 1.0f});
+    }
     const web::StoreFrame f = z.frame(
         v.camera(), v.frameSettings(), v.tfEditor().transferFunction(), v.tfEditor().revision(),
-        v.showBoundingBox, v.showAxes, width, height, v.maxVolumePixels);
+        v.showBoundingBox, v.showAxes, width, height, v.maxVolumePixels, marks);
     const lod::StreamerStats s = z.bricks().streamerStats();
     const web::FetchStats fetched = z.storage().stats();
     nlohmann::json j;
