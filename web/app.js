@@ -188,6 +188,7 @@
         fitCanvas();
         ms = zarr.frame(canvas.width, canvas.height);
         frames++;
+        if (slices) slices.frameShown(refreshState());  // the store's slice views
       }
       if (!needsRender && renderWaiters.length) {
         const waiters = renderWaiters;
@@ -755,7 +756,8 @@
     }
     bindControls();
     if (withSlices) {
-      slices = window.TesseraSlices.attach({ M, canvas, requestRender, showError, clearError });
+      slices = window.TesseraSlices.attach({ M, canvas, requestRender, showError, clearError,
+        storeRegion: zarrRegion, storeOverview: zarrOverview });
       window.tessera.slices = slices.testApi;
     } else {
       $('slice-controls').hidden = true;
@@ -789,6 +791,23 @@
     return state;
   })();
 
+  // The bread-slice region [begin, end) of an open store's level 0 at
+  // native resolution (bounded reads: only its chunks are fetched), shown
+  // by the viewer; resolves to the keys fetched for it. zarrOverview()
+  // returns to the store.
+  async function zarrRegion(begin, end) {
+    if (!zarr) throw new Error('no OME-Zarr store is open');
+    const keys = await zarr.showRegion(begin, end);
+    volumeChanged();
+    await requestRender();
+    return keys;
+  }
+  function zarrOverview() {
+    if (zarr) zarr.overview();
+    volumeChanged();
+    return requestRender();
+  }
+
   // For tests and the console.
   window.tessera = {
     ready,
@@ -801,6 +820,11 @@
     openUrls,
     lastLoad: () => lastLoad,
     zarr: () => (zarr ? zarr.stats() : null),
+    // The bread-slice region [begin, end) of an open store's level 0 at
+    // native resolution (bounded reads: only its chunks are fetched); the
+    // keys fetched for it. zarrOverview() returns to the store.
+    zarrRegion,
+    zarrOverview,
     setProgressive: (on) => { api.setProgressive(on ? 1 : 0, frameBudgetMs); },
     setCamera: (az, el, zoom) => { api.setCamera(az, el, zoom); return requestRender(); },
     crop: () => JSON.parse(api.cropJson(canvas.width, canvas.height)),

@@ -259,7 +259,7 @@ window.TesseraSlices = (function () {
       ctx.setTransform(1, 0, 0, 1, 0, 0);
       ctx.clearRect(0, 0, bw, bh);
       if (!explore.has_volume) return;
-      const pj = JSON.parse(api.projection(canvas.width, canvas.height) || '{}');
+      const pj = JSON.parse(api.projection(canvas.width, canvas.height) || '{}') || {};
       if (!pj.mvp) return;
       const m = pj.mvp;
       const project = (v) => {
@@ -401,6 +401,23 @@ window.TesseraSlices = (function () {
     }
 
     async function showRegion(box) {
+      if (explore.store) {
+        // An OME-Zarr store: the slices show its overview level; the box
+        // is read at level 0 with bounded reads (only its chunks fetched).
+        const s = explore.store_scale, d0 = explore.level0_dims;
+        const begin = box.begin.map((v, a) => Math.floor(v * s[a]));
+        const end = box.end.map((v, a) => Math.min(d0[a], Math.ceil(v * s[a])));
+        try {
+          await opts.storeRegion(begin, end);
+        } catch (e) {
+          showError(`region: ${e.message}`);
+          return false;
+        }
+        clearError();
+        explore = JSON.parse(api.explore());
+        region = explore.region;
+        return true;
+      }
       if (!api.regionShow(box.begin[0], box.end[0], box.begin[1], box.end[1], box.begin[2], box.end[2])) {
         showError(`region: ${api.lastError()}`);
         return false;
@@ -412,6 +429,10 @@ window.TesseraSlices = (function () {
     }
 
     async function overview() {
+      if (explore.store) {
+        await opts.storeOverview();
+        return true;
+      }
       if (!api.regionOverview()) { showError(api.lastError()); return false; }
       syncMark(region);  // in the very frame that shows the overview
       await requestRender();

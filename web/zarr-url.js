@@ -108,6 +108,9 @@
       frame: c('tessera_zarr_frame', 'string', ['number', 'number']),
       info: c('tessera_zarr_info', 'string', []),
       close: c('tessera_zarr_close', null, []),
+      regionPrefetch: c('tessera_zarr_region_prefetch', 'number', Array(6).fill('number')),
+      regionShow: c('tessera_zarr_region_show', 'number', Array(6).fill('number')),
+      regionOverview: c('tessera_zarr_region_overview', null, []),
       lastError: c('tessera_last_error', 'string', []),
       pageDecodes: c('tessera_zarr_page_decodes', 'number', ['string']),
     };
@@ -123,6 +126,8 @@
     let last = null;         // the last frame's JSON
     let lastFrameAt = 0;
     let bricksRead = 0;
+    let regionShown = false;  // the viewer shows a region read from the store
+    let pinned = [];          // a region's chunk keys not arrived yet: fetched first
     const arrays = new Map();  // array path ('' for a root array) -> {id, config, chunkBytes, codec}
     const record = { url: '', requests: 0, bytes: 0, timeline: [], firstImageMs: null, completeMs: null,
       openMs: null, info: null, errors: [] };
@@ -158,6 +163,7 @@
         if (base) api.putFailed(key, e.message);
       } finally {
         inFlight.delete(key);
+        pinned = pinned.filter((k) => k !== key);
         arrived = true;
         pump();
       }
@@ -222,7 +228,7 @@
     // is urgent); keys being fetched stay in flight.
     function takeWanted() {
       const keys = JSON.parse(api.wanted());
-      queue = keys.filter((k) => !inFlight.has(k));
+      queue = [...new Set([...pinned, ...keys])].filter((k) => !inFlight.has(k));
       pump();
       return keys.length;
     }
@@ -264,7 +270,46 @@
       return true;
     }
 
+    // The bread-slice region [begin, end) of level 0 (voxels x, y, z) at
+    // native resolution with bounded reads: the chunks overlapping it are
+    // fetched (ahead of the bricks' refinement; frames go on meanwhile),
+    // then read as one box and shown by the viewer in place of the store.
+    // Resolves to the keys fetched for it; throws an Error naming the store.
+    async function showRegion(begin, end) {
+      if (!open) throw new Error('no OME-Zarr store is open');
+      const box = [begin[0], end[0], begin[1], end[1], begin[2], end[2]];
+      const fetched = [];
+      for (;;) {
+        const state = api.regionPrefetch(...box);
+        if (state === 1) break;
+        const keys = state < 0 ? [] : JSON.parse(api.wanted());
+        if (keys.length === 0) {
+          const message = api.lastError() || 'the region could not be read';
+          throw new Error(message.includes(base) ? message : `${base}: ${message}`);
+        }
+        const region = keys.filter((k) => !pinned.includes(k));
+        pinned.push(...region);
+        fetched.push(...region);
+        queue = [...new Set([...pinned, ...queue])].filter((k) => !inFlight.has(k));
+        pump();
+        ui.status(`${name}: region ${box.join(',')}: fetching ${keys.length} chunks of level 0`);
+        await new Promise((resolve) => {
+          const wait = () => (pinned.length === 0 ? resolve() : setTimeout(wait, 20));
+          wait();
+        });
+      }
+      if (!api.regionShow(...box)) {
+        const message = api.lastError();
+        throw new Error(message.includes(base) ? message : `${base}: ${message}`);
+      }
+      regionShown = true;
+      record.region = { box, keys: fetched };
+      return fetched;
+    }
+
     function close() {
+      regionShown = false;
+      pinned = [];
       arrays.clear();
       if (base) api.close();
       base = '';
@@ -332,7 +377,14 @@
     return {
       open: openStore,
       close,
-      active: () => open,
+      // The store is drawn (not a region read from it, which the viewer draws).
+      active: () => open && !regionShown,
+      showRegion,
+      overview: () => {
+        regionShown = false;
+        if (base) api.regionOverview();
+      },
+      showingRegion: () => regionShown,
       wantsFrame,
       frame,
       // For tests: what was fetched and the frames' timeline.

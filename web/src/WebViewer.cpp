@@ -428,6 +428,21 @@ EMSCRIPTEN_KEEPALIVE const std::uint8_t* tessera_read_pixels(int width, int heig
 
 namespace {
 
+// An open OME-Zarr store (defined with the store's exports below): its
+// coarsest level is the slice views' overview (null when no store is
+// open), and its region, level-0 voxels, while the viewer shows it.
+const Volume* storeOverview();
+glm::ivec3 theZarrViewDims0();
+web::ZarrStoreView& theZarrView();
+struct StoreRegion {
+  lod::VoxelBox box;
+  bool shown = false;
+};
+StoreRegion& storeRegion() {
+  static StoreRegion r;
+  return r;
+}
+
 struct SliceViews {
   // The overview's volume while a region is shown (the viewer holds the
   // region then), its name and camera; null when the overview is shown.
@@ -459,6 +474,7 @@ bool regionShown() {
 
 // The volume the slices show: the overview's, also while a region is shown.
 const Volume& overviewVolume() {
+  if (const Volume* store = storeOverview()) return *store;
   viewer::Viewer& v = theViewer();
   if (regionShown()) return *sliceViews().overview;
   if (!v.hasVolume()) throw InputError("no volume is loaded");
@@ -512,8 +528,10 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_slice(int axis, int index, int colour) 
     const SliceRaster r = sliceRaster(f, d, volume.spacing());
     Image& image = sliceViews().images[axis];
     viewer::Viewer& v = theViewer();
-    image = sliceImage(volume, f, index, v.window(),
-                       colour ? &v.tfEditor().transferFunction() : nullptr);
+    // A store's window until a region of it is shown (the viewer's then).
+    const ValueRange window = storeOverview() && !v.hasVolume() ? volume.window() : v.window();
+    image =
+        sliceImage(volume, f, index, window, colour ? &v.tfEditor().transferFunction() : nullptr);
     nlohmann::json j;
     j["axis"] = axis;
     j["index"] = index;
@@ -556,25 +574,51 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_explore_json() {
   nlohmann::json j;
   j["has_volume"] = false;
   guarded([&] {
-    if (!app().viewer || !theViewer().hasVolume()) return;
-    const bool inRegion = regionShown();
+    const Volume* store = app().viewer ? storeOverview() : nullptr;
+    if (!app().viewer || (!theViewer().hasVolume() && !store)) return;
+    const bool inRegion = store ? storeRegion().shown : regionShown();
     const Volume& volume = overviewVolume();
     const glm::ivec3 d = volume.dims();
     const glm::dvec3 sp = volume.spacing();
     j["has_volume"] = true;
     j["tf_revision"] = theViewer().tfEditor().revision();
-    j["name"] = inRegion ? sliceViews().overviewName : theViewer().volumeName();
+    j["name"] = store      ? theZarrView().storage().describe()
+                : inRegion ? sliceViews().overviewName
+                           : theViewer().volumeName();
     j["dims"] = {d.x, d.y, d.z};
     j["spacing"] = {sp.x, sp.y, sp.z};
     j["showing_region"] = inRegion;
-    if (inRegion) {
+    // A store: the slices show its coarsest level (these dims); regions
+    // are read at level 0 (level0_dims), store_scale level-0 voxels per
+    // overview voxel along each axis.
+    j["store"] = store != nullptr;
+    glm::dvec3 scale(1.0);
+    if (store) {
+      const glm::ivec3 d0 = theZarrViewDims0();
+      scale = glm::dvec3(d0) / glm::dvec3(d);
+      j["level0_dims"] = {d0.x, d0.y, d0.z};
+      j["store_scale"] = {scale.x, scale.y, scale.z};
+    }
+    if (store && inRegion) {
+      const lod::VoxelBox& b = storeRegion().box;
+      const glm::ivec3 lo = glm::ivec3(glm::floor(glm::dvec3(b.begin) / scale));
+      const glm::ivec3 hi = glm::min(d, glm::ivec3(glm::ceil(glm::dvec3(b.end) / scale)));
+      j["region"] = {{"begin", {lo.x, lo.y, lo.z}}, {"end", {hi.x, hi.y, hi.z}}};
+      j["region_level0"] = {{"begin", {b.begin.x, b.begin.y, b.begin.z}},
+                            {"end", {b.end.x, b.end.y, b.end.z}}};
+    } else if (inRegion) {
       const lod::VoxelBox& b = sliceViews().region;
       j["region"] = {{"begin", {b.begin.x, b.begin.y, b.begin.z}},
                      {"end", {b.end.x, b.end.y, b.end.z}}};
     } else {
       j["region"] = nullptr;
     }
-    const auto [side, why] = defaultRegionSide(volume);
+    auto [side, why] = defaultRegionSide(volume);
+    if (store) {
+      // The side is of level-0 voxels; the slices pick in overview voxels.
+      side = std::max(1, static_cast<int>(side / std::max({scale.x, scale.y, scale.z})));
+      why += ", " + std::to_string(side) + " voxels of the overview level";
+    }
     j["region_side"] = side;
     j["region_side_reason"] = why;
   });
@@ -715,7 +759,8 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_projection_json(int width, int height) 
   nlohmann::json j;
   guarded([&] {
     viewer::Viewer& v = theViewer();
-    if (!v.hasVolume() || width <= 0 || height <= 0) return;
+    // A store's frames are drawn by its bricks view: no 3D marks on them yet.
+    if (storeOverview() || !v.hasVolume() || width <= 0 || height <= 0) return;
     const Volume& shownVolume = v.volume();
     const glm::dvec3 spacing = shownVolume.spacing();
     glm::dvec3 offset = -0.5 * shownVolume.extent();
@@ -750,6 +795,14 @@ std::unique_ptr<web::ZarrStoreView>& zarrView() {
 web::ZarrStoreView& theZarrView() {
   if (!zarrView()) throw Error("no OME-Zarr store is open");
   return *zarrView();
+}
+
+const Volume* storeOverview() {
+  return zarrView() && zarrView()->isOpen() ? &zarrView()->coarsest() : nullptr;
+}
+
+glm::ivec3 theZarrViewDims0() {
+  return theZarrView().source().levelInfo(0).dims;
 }
 
 }  // namespace
@@ -819,9 +872,17 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_frame(int width, int height) {
   guarded([&] {
     viewer::Viewer& v = theViewer();
     web::ZarrStoreView& z = theZarrView();
+    // The picked region as a red box over the store, as over a file's
+    // overview (applyMarkBoxes), composed by depth.
+    std::vector<render::OverlayLine> marks;
+    const StoreRegion& r = storeRegion();
+    if (glm::all(glm::lessThan(r.box.begin, r.box.end))) {
+      const Volume& shape = z.store().shape();
+      marks = viewer::boxLines(r.box, shape.dims(), shape.extent(), {1.0f, 0.25f, 0.2f, 1.0f});
+    }
     const web::StoreFrame f = z.frame(
         v.camera(), v.frameSettings(), v.tfEditor().transferFunction(), v.tfEditor().revision(),
-        v.showBoundingBox, v.showAxes, width, height, v.maxVolumePixels);
+        v.showBoundingBox, v.showAxes, width, height, v.maxVolumePixels, marks);
     const lod::StreamerStats s = z.bricks().streamerStats();
     const web::FetchStats fetched = z.storage().stats();
     nlohmann::json j;
@@ -875,9 +936,92 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_info() {
   return scratch().c_str();
 }
 
+}  // extern "C"
+
+namespace {
+
+// The bread-slice region of a store (issue 15): voxels [x0,x1) x [y0,y1) x
+// [z0,z1) of level 0, read with bounded reads: only the chunks overlapping
+// the box are fetched (asynchronously, by the page), then one readBox, never
+// the level whole. Ends past the level are clamped; an empty box or one
+// that starts outside is an error naming the store.
+lod::VoxelBox storeRegionBox(web::ZarrStoreView& z, int x0, int x1, int y0, int y1, int z0,
+                             int z1) {
+  const glm::ivec3 d = z.source().levelInfo(0).dims;
+  lod::VoxelBox box{{x0, y0, z0}, {x1, y1, z1}};
+  const char* names = "xyz";
+  for (int a = 0; a < 3; ++a) {
+    if (box.begin[a] < 0 || box.begin[a] >= d[a] || box.end[a] <= box.begin[a]) {
+      throw InputError(z.storage().describe() + ": region: " + names[a] + " range " +
+                       std::to_string(box.begin[a]) + ":" + std::to_string(box.end[a]) +
+                       " is empty or starts outside 0:" + std::to_string(d[a]) + " of level 0");
+    }
+    box.end[a] = std::min(box.end[a], d[a]);
+  }
+  return box;
+}
+
+}  // namespace
+
+extern "C" {
+
+// 1 when every level-0 chunk of the box has arrived, 0 when some are wanted
+// (tessera_zarr_wanted lists them: the page fetches them and asks again),
+// -1 on error (tessera_last_error).
+EMSCRIPTEN_KEEPALIVE int tessera_zarr_region_prefetch(int x0, int x1, int y0, int y1, int z0,
+                                                      int z1) {
+  int state = -1;
+  guarded([&] {
+    web::ZarrStoreView& z = theZarrView();
+    if (!z.isOpen()) throw Error(z.storage().describe() + ": the store is not open yet");
+    state = z.source().prefetch(0, storeRegionBox(z, x0, x1, y0, y1, z0, z1)) ? 1 : 0;
+  });
+  return state;
+}
+
+// Reads the box (its chunks fetched: tessera_zarr_region_prefetch) at level
+// 0 and makes it the viewer's volume, placed and windowed as in the store
+// (what `tessera render STORE --region` reads); the page then draws the
+// viewer instead of the store until it goes back to the store's overview.
+EMSCRIPTEN_KEEPALIVE int tessera_zarr_region_show(int x0, int x1, int y0, int y1, int z0, int z1) {
+  return guarded([&] {
+    web::ZarrStoreView& z = theZarrView();
+    const lod::VoxelBox box = storeRegionBox(z, x0, x1, y0, y1, z0, z1);
+    if (!z.source().prefetch(0, box)) {
+      throw Error(z.storage().describe() + ": region: its chunks have not all arrived");
+    }
+    Volume region = z.source().readBox(0, box);
+    region.setWindow(z.store().shape().window());
+    const ValueRange window = region.window();
+    viewer::Viewer& v = theViewer();
+    const Camera camera = v.camera();
+    const auto text = [&](int a) {
+      return std::to_string(box.begin[a]) + ":" + std::to_string(box.end[a]);
+    };
+    storeRegion() = {box, true};
+    v.setVolume(std::move(region),
+                z.storage().describe() + " region " + text(0) + "," + text(1) + "," + text(2));
+    v.setWindow(window);
+    // Framed on the region (setVolume), seen from the store view's
+    // direction, projection and zoom.
+    Camera& c = v.camera();
+    c.projection = camera.projection;
+    c.azimuthDeg = camera.azimuthDeg;
+    c.elevationDeg = camera.elevationDeg;
+    c.zoom = camera.zoom;
+  });
+}
+
+// Back to the store's overview from its region (the page draws the store
+// again; the region stays known, for its outline in the slice views).
+EMSCRIPTEN_KEEPALIVE void tessera_zarr_region_overview() {
+  storeRegion().shown = false;
+}
+
 // Closes the store (the viewer core's volume shows again).
 EMSCRIPTEN_KEEPALIVE void tessera_zarr_close() {
   zarrView().reset();
+  storeRegion() = {};
 }
 
 }  // extern "C"
@@ -995,6 +1139,11 @@ extern "C" {
 // before), and shows that point's block.
 EMSCRIPTEN_KEEPALIVE int tessera_grid_enter(int cellSide, int x, int y, int z) {
   return guarded([&] {
+    if (storeOverview()) {
+      throw InputError(theZarrView().storage().describe() +
+                       ": the grid view of an OME-Zarr store is not built yet (a region "
+                       "picked in a slice view is read at native resolution)");
+    }
     const Volume& volume = overviewVolume();
     lod::GridNavigator& nav = gridFor(volume, cellSide);
     const glm::dvec3 c = (glm::dvec3(x, y, z) + 0.5) / glm::dvec3(nav.cellSize());
@@ -1051,7 +1200,8 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_grid_json() {
   nlohmann::json j;
   j["has_volume"] = false;
   guarded([&] {
-    if (!app().viewer || !theViewer().hasVolume()) return;
+    // Not on a store yet (tessera_grid_enter says so).
+    if (!app().viewer || !theViewer().hasVolume() || storeOverview()) return;
     const Volume& volume = overviewVolume();
     lod::GridNavigator& nav = gridFor(volume, -1);
     const GridView& g = gridView();

@@ -69,7 +69,8 @@ bool ZarrStoreView::open() {
 
 StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings& settings,
                                 const TransferFunction& tf, std::uint64_t tfRevision, bool box,
-                                bool axes, int width, int height, int maxVolumePixels) {
+                                bool axes, int width, int height, int maxVolumePixels,
+                                const std::vector<render::OverlayLine>& marks) {
   const auto t0 = std::chrono::steady_clock::now();
   StoreFrame f;
   if (tfRevision != tfRevision_) {
@@ -108,7 +109,9 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
   render::OverlayOptions overlays;
   overlays.box = box;
   overlays.axes = axes;
-  compositor_->setOverlayLines(render::overlayLines(shape, overlays));
+  std::vector<render::OverlayLine> lines = render::overlayLines(shape, overlays);
+  lines.insert(lines.end(), marks.begin(), marks.end());
+  compositor_->setOverlayLines(std::move(lines));
   compositor_->composeInto(image, camera, glm::vec4(settings.background), shape.extent(), 0,
                            glm::ivec4(0, 0, width, height));
   std::uint8_t pixel[4];

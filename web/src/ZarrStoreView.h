@@ -8,6 +8,7 @@
 // function and render settings drive it, so the page's controls work on it.
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "ZarrFetchStorage.h"
 #include "tessera/core/Camera.h"
@@ -18,6 +19,7 @@
 #include "tessera/layout/BricksLayout.h"
 #include "tessera/lod/ZarrMultiresSource.h"
 #include "tessera/render/HybridCompositor.h"
+#include "tessera/render/Overlay.h"
 #include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::web {
@@ -61,6 +63,9 @@ class ZarrStoreView {
   bool isOpen() const { return active_.technique != nullptr; }
   const ZarrStore& store() const { return *store_; }
   const layout::BricksLayout& bricks() const { return *bricks_; }
+  // The store's levels; readBox of a box whose chunks have arrived
+  // (prefetch true) reads without the network.
+  const FetchedZarrSource& source() const { return *source_; }
   // The coarsest level, read once at open (for the page's histogram).
   const Volume& coarsest() const { return coarsest_; }
 
@@ -68,9 +73,11 @@ class ZarrStoreView {
   // the missing ones (storage().takeWanted()), and draws into the canvas
   // (width x height), the volume at most maxVolumePixels (0: all) and
   // upscaled with the overlay lines as the viewer core draws them.
+  // `marks`: more lines (level-0 model frame), composed by depth like the box.
   StoreFrame frame(const Camera& viewerCamera, const RenderSettings& settings,
                    const TransferFunction& tf, std::uint64_t tfRevision, bool box, bool axes,
-                   int width, int height, int maxVolumePixels);
+                   int width, int height, int maxVolumePixels,
+                   const std::vector<render::OverlayLine>& marks = {});
 
  private:
   gpu::GlContext& context_;
