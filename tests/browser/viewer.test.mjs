@@ -1225,6 +1225,35 @@ async function shadingAndCrop(context, url, tmp, run) {
   check('the dragged crop box matches `tessera render --crop` (PSNR >= 35 dB) and removes part of the image',
         mc.psnr >= 35 && cropped.lit < shaded.lit - 0.02,
         mc.error || `${mc.psnr.toFixed(2)} dB, lit ${(100 * shaded.lit).toFixed(1)} % -> ${(100 * cropped.lit).toFixed(1)} %`);
+
+  // Labels: the phantom's integer values as a label volume (default palette),
+  // then a label text file that hides all but two labels.
+  await page.uncheck('#shade');
+  await page.evaluate(() => document.getElementById('resetCrop').click());
+  await page.check('#labels');
+  await page.evaluate(() => window.tessera.render());
+  const labelsPng = path.join(tmp, 'native-labels.png');
+  run('render', VOLUME, '--labels', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', '--out', labelsPng);
+  const ml = await psnrAgainst(page, labelsPng);
+  const rows = await page.locator('#labelList input').count();
+  check('labels on in the page match `tessera render --labels` (PSNR >= 40 dB), one row per label',
+        ml.psnr >= 40 && rows > 2, ml.error || `${ml.psnr.toFixed(2)} dB, ${rows} labels listed`);
+  const tablePath = path.join(tmp, 'labels.txt');
+  fs.writeFileSync(tablePath, '# ITK-SNAP\n1 255 0 0 1 1 1 "one"\n2 0 0 255 1 1 1 "two"\n');
+  await page.setInputFiles('#labelFile', tablePath);
+  await page.evaluate(() => window.tessera.render());
+  const tablePng = path.join(tmp, 'native-labels-table.png');
+  run('render', VOLUME, '--labels', tablePath, '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', '--out', tablePng);
+  const mt = await psnrAgainst(page, tablePng);
+  const rowsT = await page.locator('#labelList input').count();
+  const withTable = await snapshot(page);
+  await page.locator('#labelList input').first().uncheck();
+  await page.evaluate(() => window.tessera.render());
+  const hidden = await snapshot(page);
+  const changed = changedFraction(withTable.pixels, hidden.pixels);
+  check('a label table file loads through the same parser (PSNR >= 40 dB vs the CLI); hiding a label changes the image',
+        mt.psnr >= 40 && rowsT === 2 && changed > 0.001,
+        mt.error || `${mt.psnr.toFixed(2)} dB, ${rowsT} labels listed, hiding one changed ${(100 * changed).toFixed(2)} % of pixels`);
   await page.close();
   if (shots && fs.existsSync(CH2)) await viewerControlShots(context, url);
 }
@@ -1278,6 +1307,17 @@ async function viewerControlShots(context, url) {
   await page.evaluate(() => window.tessera.setCamera(0, 0, 1));
   await setSelect('mode', '3');
   await shot('web-average.jpg');
+  // The aal atlas as labels with mricron's names (only where mricron-data has it).
+  const aal = '/usr/share/mricron/templates/aal.nii.gz';
+  if (fs.existsSync(aal)) {
+    await setSelect('mode', '0');
+    await page.setInputFiles('#file', aal);
+    await page.waitForFunction(() => window.tessera.state().name === 'aal.nii.gz', null, { timeout: 60000 });
+    await page.setInputFiles('#labelFile', '/usr/share/mricron/templates/aal.nii.txt');
+    await page.evaluate(() => window.tessera.setCamera(40, 20, 1));
+    await page.locator('#label-controls').scrollIntoViewIfNeeded();
+    await shot('web-labels-aal.jpg');
+  }
   await page.close();
 }
 
