@@ -1236,10 +1236,14 @@ async function shadingAndCrop(context, url, tmp, run) {
   run('render', VOLUME, '--labels', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', '--out', labelsPng);
   const ml = await psnrAgainst(page, labelsPng);
   const rows = await page.locator('#labelList input').count();
+  const labelsShot = await snapshot(page);
   check('labels on in the page match `tessera render --labels` (PSNR >= 40 dB), one row per label',
-        ml.psnr >= 40 && rows > 2, ml.error || `${ml.psnr.toFixed(2)} dB, ${rows} labels listed`);
+        ml.psnr >= 40 && rows > 2 && labelsShot.lit > 0.02,
+        ml.error || `${ml.psnr.toFixed(2)} dB, ${rows} labels listed, ${(100 * labelsShot.lit).toFixed(1)} % lit`);
+  // The phantom's values (multiples of 25.5, rounded) as the default list shows them.
+  const values = await page.$$eval('#labelList input', (boxes) => boxes.map((b) => +b.dataset.value));
   const tablePath = path.join(tmp, 'labels.txt');
-  fs.writeFileSync(tablePath, '# ITK-SNAP\n1 255 0 0 1 1 1 "one"\n2 0 0 255 1 1 1 "two"\n');
+  fs.writeFileSync(tablePath, `# ITK-SNAP\n${values[0]} 255 0 0 1 1 1 "first"\n${values[1]} 0 0 255 1 1 1 "second"\n`);
   await page.setInputFiles('#labelFile', tablePath);
   await page.evaluate(() => window.tessera.render());
   const tablePng = path.join(tmp, 'native-labels-table.png');
@@ -1247,13 +1251,13 @@ async function shadingAndCrop(context, url, tmp, run) {
   const mt = await psnrAgainst(page, tablePng);
   const rowsT = await page.locator('#labelList input').count();
   const withTable = await snapshot(page);
-  await page.locator('#labelList input').first().uncheck();
+  await page.locator('#labelList input').nth(1).uncheck();  // the larger value: the outer region
   await page.evaluate(() => window.tessera.render());
   const hidden = await snapshot(page);
   const changed = changedFraction(withTable.pixels, hidden.pixels);
   check('a label table file loads through the same parser (PSNR >= 40 dB vs the CLI); hiding a label changes the image',
-        mt.psnr >= 40 && rowsT === 2 && changed > 0.001,
-        mt.error || `${mt.psnr.toFixed(2)} dB, ${rowsT} labels listed, hiding one changed ${(100 * changed).toFixed(2)} % of pixels`);
+        mt.psnr >= 40 && rowsT === 2 && withTable.lit > 0.02 && changed > 0.001,
+        mt.error || `${mt.psnr.toFixed(2)} dB, ${rowsT} labels (${values[0]}, ${values[1]}), ${(100 * withTable.lit).toFixed(1)} % lit, hiding one changed ${(100 * changed).toFixed(2)} % of pixels`);
   await page.close();
   if (shots && fs.existsSync(CH2)) await viewerControlShots(context, url);
 }
@@ -1315,8 +1319,10 @@ async function viewerControlShots(context, url) {
     await page.waitForFunction(() => window.tessera.state().name === 'aal.nii.gz', null, { timeout: 60000 });
     await page.setInputFiles('#labelFile', '/usr/share/mricron/templates/aal.nii.txt');
     await page.evaluate(() => window.tessera.setCamera(40, 20, 1));
-    await page.locator('#label-controls').scrollIntoViewIfNeeded();
-    await shot('web-labels-aal.jpg');
+    // The whole page: the view at the top, the Labels list further down.
+    await page.evaluate(() => window.tessera.render());
+    await page.evaluate(() => window.scrollTo(0, 0));
+    await page.screenshot({ path: path.join(shots, 'web-labels-aal.jpg'), type: 'jpeg', quality: 75, fullPage: true });
   }
   await page.close();
 }
