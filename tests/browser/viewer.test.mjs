@@ -1251,13 +1251,14 @@ async function shadingAndCrop(context, url, tmp, run) {
   const mt = await psnrAgainst(page, tablePng);
   const rowsT = await page.locator('#labelList input').count();
   const withTable = await snapshot(page);
-  await page.locator('#labelList input').nth(1).uncheck();  // the larger value: the outer region
+  // One label inside the other may be hidden by it: unchecking both boxes leaves the background.
+  for (let k = 0; k < rowsT; k++) await page.locator('#labelList input').nth(k).uncheck();
   await page.evaluate(() => window.tessera.render());
   const hidden = await snapshot(page);
   const changed = changedFraction(withTable.pixels, hidden.pixels);
-  check('a label table file loads through the same parser (PSNR >= 40 dB vs the CLI); hiding a label changes the image',
-        mt.psnr >= 40 && rowsT === 2 && withTable.lit > 0.02 && changed > 0.001,
-        mt.error || `${mt.psnr.toFixed(2)} dB, ${rowsT} labels (${values[0]}, ${values[1]}), ${(100 * withTable.lit).toFixed(1)} % lit, hiding one changed ${(100 * changed).toFixed(2)} % of pixels`);
+  check('a label table file loads through the same parser (PSNR >= 40 dB vs the CLI); unchecking its labels leaves the background',
+        mt.psnr >= 40 && rowsT === 2 && withTable.lit > 0.02 && changed > 0.02 && hidden.lit < 0.001,
+        mt.error || `${mt.psnr.toFixed(2)} dB, ${rowsT} labels (${values[0]}, ${values[1]}), ${(100 * withTable.lit).toFixed(1)} % lit, unchecked: ${(100 * changed).toFixed(2)} % of pixels changed, ${(100 * hidden.lit).toFixed(2)} % lit`);
   await page.close();
   if (shots && fs.existsSync(CH2)) await viewerControlShots(context, url);
 }
