@@ -128,6 +128,9 @@
       cropMove: c('tessera_crop_pointer_move', 'number', ['number', 'number']),
       cropUp: c('tessera_crop_pointer_up', null, []),
       setFollowingPlane: c('tessera_set_following_plane', null, ['number', 'number']),
+      setLabels: c('tessera_set_labels', 'number', ['number', 'string', 'string']),
+      labelsJson: c('tessera_labels_json', 'string', []),
+      setLabelVisible: c('tessera_set_label_visible', null, ['number', 'number']),
     };
   }
 
@@ -141,9 +144,40 @@
     });
   }
 
+  // One row per label: swatch, visibility box, value and name.
+  function drawLabelList() {
+    const t = JSON.parse(api.labelsJson());
+    const list = $('labelList');
+    list.replaceChildren();
+    $('labelsAll').hidden = !t.on;
+    for (const l of t.labels) {
+      const row = document.createElement('label');
+      const swatch = document.createElement('span');
+      swatch.className = 'swatch';
+      swatch.style.background = `rgb(${l.color.map((c) => Math.round(255 * c)).join(',')})`;
+      const box = document.createElement('input');
+      box.type = 'checkbox';
+      box.checked = l.visible;
+      box.dataset.value = l.value;
+      box.addEventListener('change', () => { api.setLabelVisible(l.value, box.checked ? 1 : 0); requestRender(); });
+      row.append(box, swatch, ` ${l.value} ${l.name}`);
+      list.append(row);
+    }
+  }
+
+  function showAllLabels(on) {
+    api.setLabelVisible(-1, on ? 1 : 0);
+    drawLabelList();
+    requestRender();
+  }
+
   function refreshState() {
     state = JSON.parse(api.stateJson($('logHist').checked ? 1 : 0));
     tf = JSON.parse(api.tfJson());
+    if ($('labels').checked !== !!state.labels) {  // a new volume leaves label mode
+      $('labels').checked = !!state.labels;
+      drawLabelList();
+    }
     return state;
   }
 
@@ -739,7 +773,27 @@
       requestRender();
     };
     $('followPlane').addEventListener('change', applyPlane);
+    // Labels: the volume as a label volume, a table file, visibility per label.
+    let labelTable = { text: '', name: '' };
+    const applyLabels = () => {
+      if (!api.setLabels($('labels').checked ? 1 : 0, labelTable.text, labelTable.name)) {
+        showError(api.lastError());
+        $('labels').checked = false;
+      }
+      drawLabelList();
+      requestRender();
+    };
+    $('labels').addEventListener('change', applyLabels);
+    $('labelFile').addEventListener('change', async (e) => {
+      const f = e.target.files[0];
+      if (!f) return;
+      labelTable = { text: await f.text(), name: f.name };
+      $('labels').checked = true;
+      applyLabels();
+    });
     $('planeDepth').addEventListener('input', applyPlane);
+    $('labelsShow').addEventListener('click', () => showAllLabels(true));
+    $('labelsHide').addEventListener('click', () => showAllLabels(false));
     window.addEventListener('resize', drawTf);
   }
 

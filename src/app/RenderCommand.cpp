@@ -162,8 +162,8 @@ RenderRequest requestFrom(const RenderOptions& o) {
   req.settings.shading = shadingFrom(o.shading);
   req.settings.clipping = clippingFrom(o.clipping);
   if (o.labelVolume()) {
-    req.settings.nearest = true;  // no interpolation across labels
-    req.lutSize = 256;            // one table entry per label value
+    render::applyLabelSettings(req.settings);
+    req.lutSize = render::kLabelLutSize;
   }
   if (o.background.size() != 3) throw InputError("--background takes three numbers R G B in [0,1]");
   req.settings.background = glm::dvec4(o.background[0], o.background[1], o.background[2], 1.0);
@@ -182,7 +182,7 @@ RenderRequest requestFrom(const RenderOptions& o) {
   req.technique = o.technique;
   req.skipBlock = o.skipBlock;
   req.gradient = o.shading.gradient;
-  req.lutSize = o.labelVolume() ? 256 : o.lut;
+  req.lutSize = o.labelVolume() ? render::kLabelLutSize : o.lut;
   req.slices = o.slices;
   req.classify = o.classify;
   req.layout = latticeLayout(o);

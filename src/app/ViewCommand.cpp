@@ -32,6 +32,7 @@
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/io/VolumeReader.h"
 #include "tessera/lod/ZoomLevelPolicy.h"
+#include "tessera/render/LabelTable.h"
 #include "tessera/render/TechniqueRegistry.h"
 #include "tessera/viewer/CropHandles.h"
 #include "tessera/viewer/Explorer.h"
@@ -66,6 +67,10 @@ struct ViewOptions {
   ShadingOptions shading;
   ClippingOptions clipping;
   std::string projection = "composite";  // composite, mip, minip, average (RenderMode)
+  // --labels [TABLE]: a label volume, as `tessera render --labels` shows it.
+  std::string labels;
+  CLI::Option* labelsOption = nullptr;
+  bool labelVolume() const { return labelsOption != nullptr && labelsOption->count() > 0; }
 };
 
 #ifdef TESSERA_DESKTOP_VIEWER
@@ -213,6 +218,7 @@ struct DesktopSession {
   std::string cacheKey;
   char pathBuf[512] = "";
   char tfPathBuf[512] = "transfer-function.json";
+  char labelPathBuf[512] = "labels.txt";
   bool logHistogram = true;
   int frame = 0;
   bool showHelp = false;
@@ -403,7 +409,10 @@ void showIn3D(DesktopSession& ds, Volume volume, const std::string& name,
               const std::optional<lod::VoxelBox>& box, Follow follow) {
   const Camera before = ds.viewer->camera();
   const std::optional<lod::VoxelBox> from = ds.shown;
+  std::optional<render::LabelTable> labels;
+  if (ds.viewer->labelsOn()) labels = ds.viewer->labelTable();
   ds.viewer->setVolume(std::move(volume), name);
+  if (labels) ds.viewer->setLabels(std::move(*labels));  // the same table on the region
   Camera& c = ds.viewer->camera();
   if (follow == Follow::Keep) {
     const Camera kept = viewer::cameraAcrossSwap(before, from, box, ds.explorer->dims(),
@@ -1018,6 +1027,58 @@ void panelClipping(DesktopSession& ds) {
 }
 
 // Blinn-Phong shading (RenderSettings::shading): on/off, the light, the terms.
+// Label volumes: on/off (the default palette), a table file, and every
+// label with its colour and a visibility box (aal has 116: scrollable).
+void panelLabels(DesktopSession& ds) {
+  viewer::Viewer& v = *ds.viewer;
+  section("Labels");
+  bool on = v.labelsOn();
+  if (ImGui::Checkbox("label volume (atlas)", &on)) {
+    try {
+      if (on) {
+        v.setLabelsDefault();
+      } else {
+        v.clearLabels();
+        v.tfEditor().setTransferFunction(TransferFunction::fromPresetOrFile(ds.options.tf));
+      }
+      ds.error.clear();
+    } catch (const Error& e) {
+      ds.error = e.what();
+    }
+  }
+  ImGui::InputText("##labeltable", ds.labelPathBuf, sizeof ds.labelPathBuf);
+  ImGui::SameLine();
+  if (ImGui::Button("load table")) {
+    try {
+      v.setLabels(render::LabelTable::load(ds.labelPathBuf));
+      ds.error.clear();
+    } catch (const Error& e) {
+      ds.error = e.what();
+    }
+  }
+  if (!v.labelsOn()) return;
+  if (ImGui::Button("show all")) v.setAllLabelsVisible(true);
+  ImGui::SameLine();
+  if (ImGui::Button("hide all")) v.setAllLabelsVisible(false);
+  ImGui::SameLine();
+  ImGui::Text("%zu labels", v.labelTable().labels.size());
+  ImGui::BeginChild("labels", ImVec2(0.0f, 220.0f), true);
+  std::vector<std::pair<int, bool>> changes;
+  for (const auto& [value, label] : v.labelTable().labels) {
+    ImGui::PushID(value);
+    const ImVec4 c(static_cast<float>(label.color.r), static_cast<float>(label.color.g),
+                   static_cast<float>(label.color.b), 1.0f);
+    ImGui::ColorButton("##swatch", c, ImGuiColorEditFlags_NoTooltip, ImVec2(14.0f, 14.0f));
+    ImGui::SameLine();
+    bool visible = label.visible;
+    const std::string text = std::to_string(value) + " " + label.name;
+    if (ImGui::Checkbox(text.c_str(), &visible)) changes.emplace_back(value, visible);
+    ImGui::PopID();
+  }
+  ImGui::EndChild();
+  for (const auto& [value, visible] : changes) v.setLabelVisible(value, visible);
+}
+
 void panelShading(viewer::Viewer& v) {
   section("Shading");
   Shading& s = v.settings().shading;
@@ -1124,11 +1185,14 @@ void drawPanel(DesktopSession& ds, int windowHeight) {
                ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
   panelFile(ds);
   panelExplore(ds);
+  const bool labelsFirst = ds.viewer->labelsOn();  // the list before the TF it drives
+  if (labelsFirst) panelLabels(ds);
   panelTransferFunction(ds);
   panelWindowLevel(*ds.viewer);
   panelRendering(ds);
   panelShading(*ds.viewer);
   panelClipping(ds);
+  if (!labelsFirst) panelLabels(ds);
   ImGui::Separator();
   ImGui::TextWrapped("%s", ds.status.c_str());
   ImGui::End();
@@ -1146,7 +1210,8 @@ std::string viewKey(viewer::Viewer& v, int viewW, int viewH) {
       << v.settings().sampling.preintegrate << v.settings().sampling.adaptive << '|'
       << v.settings().opacityScale << '|' << v.window().min << v.window().max << '|'
       << v.technique() << static_cast<int>(v.quality) << v.controller().interacting() << '|'
-      << v.showBoundingBox << v.showAxes << '|' << viewW << 'x' << viewH;
+      << v.showBoundingBox << v.showAxes << '|' << v.settings().nearest << '|' << viewW << 'x'
+      << viewH;
   for (const render::OverlayLine& l : v.extraLines) {
     key << "|l" << l.a.x << ',' << l.a.y << ',' << l.a.z << ',' << l.b.x << ',' << l.b.y << ','
         << l.b.z;
@@ -1390,6 +1455,11 @@ void runView(const ViewOptions& o) {
     if (o.projection == modes[m]) ds.viewer->settings().mode = static_cast<RenderMode>(m);
   }
   startExploring(ds, o);
+  if (o.labelVolume()) {
+    ds.viewer->setLabels(o.labels.empty() ? render::LabelTable::defaultFor(ds.viewer->volume())
+                                          : render::LabelTable::load(o.labels));
+    std::snprintf(ds.labelPathBuf, sizeof ds.labelPathBuf, "%s", o.labels.c_str());
+  }
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -1429,6 +1499,13 @@ void addViewCommand(CLI::App& app) {
   addSeriesOption(cmd, o->series);
   cmd->add_option("--tf", o->tf, "Transfer function: preset or FILE.json")->capture_default_str();
   cmd->add_option("--size", o->size, "Window size WIDTHxHEIGHT")->capture_default_str();
+  o->labelsOption = cmd->add_option("--labels", o->labels,
+                                    "Show a label volume (atlas) as `tessera render --labels` "
+                                    "does: nearest-neighbour sampling and a categorical colour "
+                                    "table instead of --tf. TABLE (optional): JSON or a label text "
+                                    "file (ITK-SNAP, FreeSurfer LUT, mricron); without it a "
+                                    "default palette. The Labels panel shows and hides labels")
+                        ->expected(0, 1);
   cmd->add_option("--profile", o->profile,
                   "Device profile (gles3, gles2, webgl1, ...; its API level picks the context)")
       ->capture_default_str();

@@ -90,6 +90,10 @@ void prepareLabelVolume(Volume& volume) {
   volume.setWindow({0.0, 255.0});
 }
 
+void applyLabelSettings(RenderSettings& settings) {
+  settings.nearest = true;
+}
+
 LabelTable LabelTable::defaultFor(const Volume& volume) {
   Volume copy = volume;  // checks only
   prepareLabelVolume(copy);

@@ -96,9 +96,11 @@ Viewer::~Viewer() {
 
 render::TechniqueOnVolume Viewer::createActive(const std::string& technique,
                                                const lod::VolumeSource& source) const {
-  render::TechniqueOnVolume t = render::createTechnique(
-      technique, context_, limits_, source,
-      {.imageSize = {kPlanImageSize, kPlanImageSize}, .skipBlock = kSkipBlock});
+  render::TechniqueOnVolume t =
+      render::createTechnique(technique, context_, limits_, source,
+                              {.imageSize = {kPlanImageSize, kPlanImageSize},
+                               .skipBlock = kSkipBlock,
+                               .lutSize = lutSize_});
   t.technique->setTransferFunction(tfEditor_.transferFunction());
   return t;
 }
@@ -107,12 +109,24 @@ void Viewer::setVolume(Volume volume, const std::string& name) {
   if (!volume.hasData()) throw InputError(name + ": the volume has no voxels");
   const lod::InCoreVolumeSource source(std::make_shared<Volume>(std::move(volume)));
   render::TechniqueOnVolume next;
+  const bool wasLabels = labels_.has_value();
+  if (wasLabels) lutSize_ = 4096;  // a new volume is not a label volume until setLabels
   try {
     next = createActive(techniqueName_, source);
   } catch (const BudgetError& e) {
     if (!hasVolume()) throw;
+    if (wasLabels) lutSize_ = render::kLabelLutSize;
     throw BudgetError(name + ": does not fit the GPU budget next to the current volume (" +
                       formatBytes(context_.ledger().budget()) + "): " + e.what());
+  } catch (...) {
+    if (wasLabels) lutSize_ = render::kLabelLutSize;
+    throw;
+  }
+  if (wasLabels) {
+    labels_.reset();
+    settings_.nearest = false;
+    tfEditor_.loadPreset("mr-default");
+    next.technique->setTransferFunction(tfEditor_.transferFunction());
   }
   // Everything worked: swap in.
   active_ = std::move(next);
@@ -181,6 +195,59 @@ void Viewer::setTechnique(const std::string& name) {
   drawn_ = {};
   frameMsPerPixel_ = stripMsPerPixel_ = 0.0;
   techniqueName_ = name;
+}
+
+void Viewer::recreateActive() {
+  const lod::InCoreVolumeSource source(volume_);
+  active_ = {};  // the old upload goes first: both may not fit the budget
+  active_ = createActive(techniqueName_, source);
+  uploadedTfRevision_ = tfEditor_.revision();
+  pending_ = {};
+  drawn_ = {};
+  frameMsPerPixel_ = stripMsPerPixel_ = 0.0;
+}
+
+void Viewer::setLabels(render::LabelTable table) {
+  if (!hasVolume()) throw InputError("labels: no volume loaded");
+  if (!labels_) {
+    Volume check = *volume_;  // InputError before anything changes
+    render::prepareLabelVolume(check);
+    volume_->setWindow(check.window());
+    if (active_.upload.volume != volume_) active_.upload.volume->setWindow(check.window());
+    render::applyLabelSettings(settings_);
+    lutSize_ = render::kLabelLutSize;
+    labels_ = std::move(table);
+    tfEditor_.setTransferFunction(labels_->toTransferFunction());
+    recreateActive();
+    updateHistogram();
+    return;
+  }
+  labels_ = std::move(table);
+  tfEditor_.setTransferFunction(labels_->toTransferFunction());
+}
+
+void Viewer::clearLabels(const std::string& tf) {
+  if (!labels_) return;
+  labels_.reset();
+  settings_.nearest = false;
+  lutSize_ = 4096;
+  tfEditor_.loadPreset(tf);
+  recreateActive();
+  resetWindow();
+}
+
+void Viewer::setLabelVisible(int value, bool visible) {
+  if (!labels_) return;
+  const auto it = labels_->labels.find(value);
+  if (it == labels_->labels.end() || it->second.visible == visible) return;
+  it->second.visible = visible;
+  tfEditor_.setTransferFunction(labels_->toTransferFunction());
+}
+
+void Viewer::setAllLabelsVisible(bool visible) {
+  if (!labels_) return;
+  for (auto& [value, label] : labels_->labels) label.visible = visible;
+  tfEditor_.setTransferFunction(labels_->toTransferFunction());
 }
 
 std::string Viewer::storageName() const {

@@ -1265,6 +1265,40 @@ async function shadingAndCrop(context, url, tmp, run) {
   check('the dragged crop box matches `tessera render --crop` (PSNR >= 35 dB) and removes part of the image',
         mc.psnr >= 35 && cropped.lit < shaded.lit - 0.02,
         mc.error || `${mc.psnr.toFixed(2)} dB, lit ${(100 * shaded.lit).toFixed(1)} % -> ${(100 * cropped.lit).toFixed(1)} %`);
+
+  // Labels: the phantom's integer values as a label volume (default palette),
+  // then a label text file that hides all but two labels.
+  await page.uncheck('#shade');
+  await page.evaluate(() => document.getElementById('resetCrop').click());
+  await page.check('#labels');
+  await page.evaluate(() => window.tessera.render());
+  const labelsPng = path.join(tmp, 'native-labels.png');
+  run('render', VOLUME, '--labels', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', '--out', labelsPng);
+  const ml = await psnrAgainst(page, labelsPng);
+  const rows = await page.locator('#labelList input').count();
+  const labelsShot = await snapshot(page);
+  check('labels on in the page match `tessera render --labels` (PSNR >= 40 dB), one row per label',
+        ml.psnr >= 40 && rows > 2 && labelsShot.lit > 0.02,
+        ml.error || `${ml.psnr.toFixed(2)} dB, ${rows} labels listed, ${(100 * labelsShot.lit).toFixed(1)} % lit`);
+  // The phantom's values (multiples of 25.5, rounded) as the default list shows them.
+  const values = await page.$$eval('#labelList input', (boxes) => boxes.map((b) => +b.dataset.value));
+  const tablePath = path.join(tmp, 'labels.txt');
+  fs.writeFileSync(tablePath, `# ITK-SNAP\n${values[0]} 255 0 0 1 1 1 "first"\n${values[1]} 0 0 255 1 1 1 "second"\n`);
+  await page.setInputFiles('#labelFile', tablePath);
+  await page.evaluate(() => window.tessera.render());
+  const tablePng = path.join(tmp, 'native-labels-table.png');
+  run('render', VOLUME, '--labels', tablePath, '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', '--out', tablePng);
+  const mt = await psnrAgainst(page, tablePng);
+  const rowsT = await page.locator('#labelList input').count();
+  const withTable = await snapshot(page);
+  // One label inside the other may be hidden by it: unchecking both boxes leaves the background.
+  for (let k = 0; k < rowsT; k++) await page.locator('#labelList input').nth(k).uncheck();
+  await page.evaluate(() => window.tessera.render());
+  const hidden = await snapshot(page);
+  const changed = changedFraction(withTable.pixels, hidden.pixels);
+  check('a label table file loads through the same parser (PSNR >= 40 dB vs the CLI); unchecking its labels leaves the background',
+        mt.psnr >= 40 && rowsT === 2 && withTable.lit > 0.02 && changed > 0.02 && hidden.lit < 0.001,
+        mt.error || `${mt.psnr.toFixed(2)} dB, ${rowsT} labels (${values[0]}, ${values[1]}), ${(100 * withTable.lit).toFixed(1)} % lit, unchecked: ${(100 * changed).toFixed(2)} % of pixels changed, ${(100 * hidden.lit).toFixed(2)} % lit`);
   await page.close();
   if (shots && fs.existsSync(CH2)) await viewerControlShots(context, url);
 }
@@ -1318,6 +1352,19 @@ async function viewerControlShots(context, url) {
   await page.evaluate(() => window.tessera.setCamera(0, 0, 1));
   await setSelect('mode', '3');
   await shot('web-average.jpg');
+  // The aal atlas as labels with mricron's names (only where mricron-data has it).
+  const aal = '/usr/share/mricron/templates/aal.nii.gz';
+  if (fs.existsSync(aal)) {
+    await setSelect('mode', '0');
+    await page.setInputFiles('#file', aal);
+    await page.waitForFunction(() => window.tessera.state().name === 'aal.nii.gz', null, { timeout: 60000 });
+    await page.setInputFiles('#labelFile', '/usr/share/mricron/templates/aal.nii.txt');
+    await page.evaluate(() => window.tessera.setCamera(40, 20, 1));
+    // The whole page: the view at the top, the Labels list further down.
+    await page.evaluate(() => window.tessera.render());
+    await page.evaluate(() => window.scrollTo(0, 0));
+    await page.screenshot({ path: path.join(shots, 'web-labels-aal.jpg'), type: 'jpeg', quality: 75, fullPage: true });
+  }
   await page.close();
 }
 

@@ -3,6 +3,7 @@
 // a display.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -10,9 +11,12 @@
 #include <sstream>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "support/TestSupport.h"
 #include "tessera/core/Image.h"
+#include "tessera/io/Procedural.h"
+#include "tessera/render/LabelTable.h"
 
 namespace tessera::viewer {
 namespace {
@@ -152,6 +156,58 @@ TEST(DesktopViewer, FourUpShowsSlicesWithThePickedRegion) {
   const CommandRun bad = run(base + "--crosshair 48 0 0 --screenshot " + (dir / "x.png").string());
   EXPECT_NE(bad.status, 0);
   EXPECT_NE(bad.output.find("outside the volume"), std::string::npos) << bad.output;
+}
+
+// --labels: the 3D view shows the volume's labels in the table's colours
+// (the Shepp-Logan phantom's few integer values: the default palette's
+// colours, which the ordinary TF does not show), a label file sets names and colours, and a
+// bad label file is refused naming the file and line.
+TEST(DesktopViewer, LabelsShowTheTablesColours) {
+  if (run("command -v xvfb-run").status != 0) GTEST_SKIP() << "xvfb-run not installed";
+  if (!desktopViewerBuilt()) GTEST_SKIP() << "tessera built without GLFW/ImGui";
+  test::TempDir dir;
+  const std::string base = "xvfb-run -a -s '-screen 0 1024x640x24' " +
+                           std::string(TESSERA_CLI_PATH) +
+                           " view gen:shepp-logan:48 --size 960x600 --layout single --frames 2 ";
+  // Pixels of the view (right of the panel) in one of the default palette's colours.
+  std::vector<glm::ivec3> palette;
+  for (const auto& [value, label] :
+       render::LabelTable::defaultFor(makeSheppLogan({48, 48, 48})).labels) {
+    palette.push_back(glm::ivec3(glm::round(label.color * 255.0)));
+  }
+  auto inPalette = [&](const Image& img) {
+    int n = 0;
+    for (int y = 0; y < img.height(); ++y) {
+      for (int x = 400; x < img.width(); ++x) {
+        const std::uint8_t* p = img.pixel(x, y);
+        for (const glm::ivec3& c : palette) {
+          if (std::abs(p[0] - c.r) <= 1 && std::abs(p[1] - c.g) <= 1 && std::abs(p[2] - c.b) <= 1) {
+            ++n;
+            break;
+          }
+        }
+      }
+    }
+    return n;
+  };
+  const CommandRun plain = run(base + "--screenshot " + (dir / "plain.png").string());
+  ASSERT_EQ(plain.status, 0) << plain.output;
+  const CommandRun labels = run(base + "--labels --screenshot " + (dir / "labels.png").string());
+  ASSERT_EQ(labels.status, 0) << labels.output;
+  const int before = inPalette(Image::readPng(dir / "plain.png"));
+  const int after = inPalette(Image::readPng(dir / "labels.png"));
+  std::printf("  [measured] view pixels in the palette: %d plain, %d as labels\n", before, after);
+  EXPECT_GT(after, 5000);
+  EXPECT_GT(after, 5 * before + 1000);
+
+  {
+    std::ofstream table(dir / "table.txt");
+    table << "# value name\n1 outer\nnot-a-number here\n";
+  }
+  const CommandRun bad = run(base + "--labels " + (dir / "table.txt").string() + " --screenshot " +
+                             (dir / "bad.png").string());
+  EXPECT_NE(bad.status, 0);
+  EXPECT_NE(bad.output.find("table.txt:3"), std::string::npos) << bad.output;
 }
 
 TEST(DesktopViewer, WithoutADisplayItSaysWhatToDo) {

@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -15,6 +17,7 @@
 #include "tessera/io/Procedural.h"
 #include "tessera/layout/Planner.h"
 #include "tessera/reference/ImageMetrics.h"
+#include "tessera/render/LabelTable.h"
 #include "tessera/render/Raycaster.h"
 #include "tessera/render/Slice2DRenderer.h"
 #include "tessera/render/Slice3DRenderer.h"
@@ -89,6 +92,119 @@ TEST_F(ViewerFixture, FrameShowsWhatTheRayCasterRenders) {
   const Image direct =
       directRender(ctx, v.volume(), v.tfEditor().transferFunction(), v.camera(), v.settings());
   EXPECT_GE(psnr(shown, direct), 60.0);
+}
+
+// A label volume in the viewer renders as `tessera render --labels` does
+// (the same preparation, settings and 256-entry categorical table: the ray
+// caster with render::applyLabelSettings and render::kLabelLutSize), and
+// with opaque labels no colour outside the table appears. Hiding a label
+// removes its colour; clearLabels goes back to an interpolated volume.
+TEST_F(ViewerFixture, LabelVolumesRenderAsTheRenderCommandsLabels) {
+  Volume labels = Volume::allocate({20, 18, 16}, ScalarType::U8, "labels");
+  std::mt19937 rng(7);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(labels.voxelCount()); ++i) {
+    labels.setValueAtIndex(i, static_cast<double>(rng() % 31));  // 0: background
+  }
+  labels.invalidateRange();
+  Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
+  v.setVolume(labels, "labels");
+  v.showBoundingBox = v.showAxes = false;
+  v.quality = Quality::Full;
+  v.camera().azimuthDeg = 33;
+  v.camera().elevationDeg = 21;
+  v.setLabelsDefault();
+  ASSERT_TRUE(v.labelsOn());
+  EXPECT_TRUE(v.settings().nearest);
+  ASSERT_EQ(v.labelTable().labels.size(), 30u);
+
+  // `tessera render --labels` without a table: the same steps on the file's volume.
+  Volume prepared = labels;
+  render::prepareLabelVolume(prepared);
+  const render::LabelTable table = render::LabelTable::defaultFor(prepared);
+  const TransferFunction tf = table.toTransferFunction();
+  RenderSettings s = v.frameSettings();
+  render::applyLabelSettings(s);
+  auto renderCommand = [&](const TransferFunction& t) {
+    const gpu::DeviceLimits limits = gpu::DeviceLimits::of(ctx.caps());
+    const layout::Plan plan = layout::planLayout(prepared, limits, {});
+    auto layout = layout::createLayout(plan, prepared, limits, ctx.ledger());
+    render::Raycaster caster(ctx, prepared, *layout);
+    caster.setLutSize(render::kLabelLutSize);
+    caster.setTransferFunction(t);
+    return caster.render(v.camera(), s, kSize, kSize);
+  };
+  v.render(kSize, kSize, fb.id());
+  const Image shown = readFramebuffer(fb);
+  const double p = psnr(shown, renderCommand(tf));
+  std::printf("  [measured] viewer labels vs render --labels: %.1f dB\n", p);
+  EXPECT_GE(p, 50.0);
+
+  std::vector<glm::ivec3> allowed{glm::ivec3(0)};  // the black background
+  for (const auto& [value, label] : table.labels) {
+    allowed.push_back(glm::ivec3(glm::round(label.color * 255.0)));
+  }
+  auto outsideTable = [&](const Image& img, int& drawn) {
+    int outside = 0;
+    drawn = 0;
+    for (int py = 0; py < img.height(); ++py) {
+      for (int px = 0; px < img.width(); ++px) {
+        const std::uint8_t* q = img.pixel(px, py);
+        const glm::ivec3 c(q[0], q[1], q[2]);
+        bool found = false;
+        for (const glm::ivec3& a : allowed) {
+          const glm::ivec3 d = glm::abs(c - a);
+          found = found || (d.x <= 1 && d.y <= 1 && d.z <= 1);
+        }
+        outside += found ? 0 : 1;
+        drawn += c != glm::ivec3(0) ? 1 : 0;
+      }
+    }
+    return outside;
+  };
+  int drawn = 0;
+  EXPECT_EQ(outsideTable(shown, drawn), 0);
+  EXPECT_GT(drawn, 1000);
+
+  // Hiding label 5 in the viewer equals the table with label 5 hidden.
+  v.setLabelVisible(5, false);
+  render::LabelTable hidden = table;
+  hidden.labels.at(5).visible = false;
+  v.render(kSize, kSize, fb.id());
+  const Image withoutFive = readFramebuffer(fb);
+  EXPECT_GE(psnr(withoutFive, renderCommand(hidden.toTransferFunction())), 50.0);
+  EXPECT_LT(psnr(withoutFive, shown), 50.0) << "hiding a label must change the frame";
+  v.setAllLabelsVisible(false);
+  v.render(kSize, kSize, fb.id());
+  EXPECT_EQ(outsideTable(readFramebuffer(fb), drawn), 0);
+  EXPECT_EQ(drawn, 0) << "all labels hidden: only the background";
+
+  v.clearLabels();
+  EXPECT_FALSE(v.labelsOn());
+  EXPECT_FALSE(v.settings().nearest);
+  v.render(kSize, kSize, fb.id());
+  EXPECT_GE(psnr(readFramebuffer(fb), directRender(ctx, v.volume(), v.tfEditor().transferFunction(),
+                                                   v.camera(), v.frameSettings())),
+            60.0);
+}
+
+// A volume that is not a label volume is refused with a clear error, and
+// the viewer keeps rendering it as before.
+TEST_F(ViewerFixture, NonLabelVolumesAreRefusedAsLabels) {
+  Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
+  Volume ramp = Volume::allocate({8, 8, 8}, ScalarType::F32, "ramp");
+  for (std::size_t i = 0; i < static_cast<std::size_t>(ramp.voxelCount()); ++i) {
+    ramp.setValueAtIndex(i, 0.5 * static_cast<double>(i % 7));
+  }
+  ramp.invalidateRange();
+  v.setVolume(ramp, "ramp");
+  try {
+    v.setLabelsDefault();
+    ADD_FAILURE() << "a ramp of halves is not a label volume";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("labels must be integers"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(v.labelsOn());
+  EXPECT_FALSE(v.settings().nearest);
 }
 
 // The ray cast and the composite are scissored to the part of the view the

@@ -34,6 +34,7 @@
 #include "tessera/io/VolumeReader.h"
 #include "tessera/lod/GridNavigator.h"
 #include "tessera/lod/InCoreMultiresSource.h"
+#include "tessera/render/LabelTable.h"
 #include "tessera/render/OverlayRenderer.h"
 #include "tessera/render/TechniqueRegistry.h"
 #include "tessera/viewer/CropHandles.h"
@@ -355,6 +356,7 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_state_json(int logHistogram) {
     j["description"] = v.description();
     j["techniques"] = render::TechniqueRegistry::global().names();
     j["technique"] = v.technique();
+    j["labels"] = v.labelsOn();
     if (v.hasVolume()) {
       const glm::ivec3 d = v.volume().dims();
       j["name"] = v.volumeName();
@@ -1372,6 +1374,62 @@ EMSCRIPTEN_KEEPALIVE void tessera_set_following_plane(int on, double depth) {
   v.clipPlaneFollowsCamera = on != 0;
   const double reach = v.hasVolume() ? 0.5 * glm::length(v.volume().extent()) : 0.0;
   v.followingPlaneDistance = std::clamp(depth, -1.0, 1.0) * reach;
+}
+
+}  // extern "C"
+
+// ---- Label volumes (atlases), as `tessera render --labels` shows them
+// (viewer::Viewer::setLabels). The page's label table file goes through
+// render::LabelTable's parsers: JSON when it starts with '{', else a label
+// text file (ITK-SNAP, FreeSurfer, mricron); errors name the file and line.
+extern "C" {
+
+// on = 0: an ordinary volume again (the TF preset `mr-default`). on = 1:
+// labels, with `table` (the file's text, named `name`) or, when empty, the
+// default palette. 0 on error (tessera_last_error), the state unchanged.
+EMSCRIPTEN_KEEPALIVE int tessera_set_labels(int on, const char* table, const char* name) {
+  return guarded([&] {
+    viewer::Viewer& v = theViewer();
+    if (on == 0) {
+      v.clearLabels();
+      return;
+    }
+    const std::string text = table;
+    if (text.empty()) {
+      v.setLabelsDefault();
+      return;
+    }
+    const auto first = text.find_first_not_of(" \t\r\n");
+    const bool json = first != std::string::npos && text[first] == '{';
+    v.setLabels(json ? render::LabelTable::fromJson(text, name)
+                     : render::LabelTable::fromText(text, name));
+  });
+}
+// {"on": bool, "labels": [{"value", "name", "color": [r, g, b] 0..1, "visible"}]}
+EMSCRIPTEN_KEEPALIVE const char* tessera_labels_json() {
+  nlohmann::json j;
+  const bool on = app().viewer && theViewer().labelsOn();
+  j["on"] = on;
+  j["labels"] = nlohmann::json::array();
+  if (on) {
+    for (const auto& [value, label] : theViewer().labelTable().labels) {
+      j["labels"].push_back({{"value", value},
+                             {"name", label.name},
+                             {"color", {label.color.r, label.color.g, label.color.b}},
+                             {"visible", label.visible}});
+    }
+  }
+  scratch() = j.dump();
+  return scratch().c_str();
+}
+// value < 0: every label.
+EMSCRIPTEN_KEEPALIVE void tessera_set_label_visible(int value, int visible) {
+  if (!app().viewer) return;
+  if (value < 0) {
+    theViewer().setAllLabelsVisible(visible != 0);
+  } else {
+    theViewer().setLabelVisible(value, visible != 0);
+  }
 }
 
 }  // extern "C"

@@ -11,6 +11,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "tessera/core/RenderSettings.h"
 #include "tessera/core/TransferFunction.h"
 #include "tessera/core/Volume.h"
 
@@ -51,5 +52,11 @@ class LabelTable {
 // Prepares a label volume for rendering: checks it (u8-representable
 // integers), sets its window to 0..255. InputError otherwise.
 void prepareLabelVolume(Volume& volume);
+
+// What a label render changes besides the volume and the TF, shared by
+// `tessera render --labels` and the viewers: no interpolation across labels
+// (RenderSettings::nearest) and one TF table entry per label value.
+constexpr int kLabelLutSize = 256;
+void applyLabelSettings(RenderSettings& settings);
 
 }  // namespace tessera::render

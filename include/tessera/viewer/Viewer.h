@@ -5,6 +5,7 @@
 // bounding box and axes, and times every frame. A front end only turns its
 // input events into calls here and shows the frame.
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,7 @@
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/layout/Planner.h"
+#include "tessera/render/LabelTable.h"
 #include "tessera/render/Overlay.h"
 #include "tessera/render/QualityController.h"
 #include "tessera/render/TechniqueRegistry.h"
@@ -53,7 +55,8 @@ class Viewer {
   // Uploads the volume for the technique (render::createTechnique) and
   // frames it. On any error (InputError, BudgetError, GpuError) the previous
   // volume stays and the error propagates with its message. Keeps the TF;
-  // resets window and camera.
+  // resets window and camera; leaves label mode (the TF editor back to
+  // its mr-default preset).
   void setVolume(Volume volume, const std::string& name);
   bool hasVolume() const { return active_.technique != nullptr; }
   const Volume& volume() const { return *volume_; }  // empty before the first setVolume
@@ -86,6 +89,22 @@ class Viewer {
   // for its requirements. InputError if unknown; on any error the old stays.
   void setTechnique(const std::string& name);
   const std::string& technique() const { return techniqueName_; }
+
+  // Label volumes (atlases), rendered as `tessera render --labels` renders
+  // them (render::prepareLabelVolume, render::applyLabelSettings, the
+  // table's categorical TF in a render::kLabelLutSize-entry table).
+  // setLabels checks the current volume (InputError if it is not one; the
+  // previous state stays), re-uploads it for the label table once, and sets
+  // the TF editor to the table's TF; called again it only updates the TF
+  // (visibility, colours). clearLabels goes back to an ordinary volume
+  // (window reset, linear interpolation, the TF editor's preset `tf`).
+  void setLabels(render::LabelTable table);
+  void setLabelsDefault() { setLabels(render::LabelTable::defaultFor(*volume_)); }
+  void clearLabels(const std::string& tf = "mr-default");
+  bool labelsOn() const { return labels_.has_value(); }
+  const render::LabelTable& labelTable() const { return *labels_; }  // only when labelsOn()
+  void setLabelVisible(int value, bool visible);
+  void setAllLabelsVisible(bool visible);
   Quality quality = Quality::Adaptive;
   // At most this many pixels of volume per frame (0: no cap): on a HiDPI
   // screen the frame (lines, compositing) has the screen's pixels while the
@@ -189,6 +208,9 @@ class Viewer {
   TransferFunctionEditor tfEditor_;
   RenderSettings settings_ = defaultRenderSettings();  // what `tessera render` uses
   std::string techniqueName_ = "raycast";
+  int lutSize_ = 4096;  // render::TechniqueOptions::lutSize
+  std::optional<render::LabelTable> labels_;
+  void recreateActive();  // the volume uploaded again for techniqueName_ and lutSize_
   std::uint64_t uploadedTfRevision_ = 0;
   FrameStats last_;
   render::QualityController qualityController_{{.goalMs = 66.0}};  // 15 frames/s
