@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "support/GpuTestContext.h"
+#include "support/LabelPalette.h"
 #include "support/TestSupport.h"
 #include "tessera/core/Error.h"
 #include "tessera/layout/MosaicLayout.h"
@@ -27,9 +28,7 @@ using namespace tessera;
 
 namespace {
 
-glm::ivec3 rgb8(glm::dvec3 c) {
-  return glm::ivec3(glm::round(c * 255.0));
-}
+using test::rgb8;
 
 // Every technique on every layout of a context, rendering `v` with `tf`.
 template <class Check>
@@ -138,28 +137,13 @@ TEST(Labels, NoColourOutsideTheTableAppears) {
   render::prepareLabelVolume(v);
   const render::LabelTable table = render::LabelTable::defaultFor(v);
   const TransferFunction tf = table.toTransferFunction();
-  std::vector<glm::ivec3> allowed{glm::ivec3(0)};  // the black background
-  for (const auto& [value, label] : table.labels) allowed.push_back(rgb8(label.color));
   Camera cam;
   cam.azimuthDeg = 33;
   cam.elevationDeg = 21;
   cam.frame(v.extent());
   const RenderSettings s = labelSettings();
   auto check = [&](const Image& img, const std::string& what) {
-    int outside = 0, drawn = 0;
-    for (int py = 0; py < img.height(); ++py) {
-      for (int px = 0; px < img.width(); ++px) {
-        const std::uint8_t* p = img.pixel(px, py);
-        const glm::ivec3 c(p[0], p[1], p[2]);
-        bool found = false;
-        for (const glm::ivec3& a : allowed) {
-          const glm::ivec3 d = glm::abs(c - a);
-          found = found || (d.x <= 1 && d.y <= 1 && d.z <= 1);
-        }
-        outside += found ? 0 : 1;
-        drawn += c != glm::ivec3(0) ? 1 : 0;
-      }
-    }
+    const auto [drawn, outside] = test::countAgainstPalette(img, table);
     std::printf("  [measured] labels %-28s %d label pixels, %d not in the table\n", what.c_str(),
                 drawn, outside);
     EXPECT_GT(drawn, 1000) << what;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "support/GpuTestContext.h"
+#include "support/LabelPalette.h"
 #include "support/TestSupport.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
@@ -139,27 +140,10 @@ TEST_F(ViewerFixture, LabelVolumesRenderAsTheRenderCommandsLabels) {
   std::printf("  [measured] viewer labels vs render --labels: %.1f dB\n", p);
   EXPECT_GE(p, 50.0);
 
-  std::vector<glm::ivec3> allowed{glm::ivec3(0)};  // the black background
-  for (const auto& [value, label] : table.labels) {
-    allowed.push_back(glm::ivec3(glm::round(label.color * 255.0)));
-  }
   auto outsideTable = [&](const Image& img, int& drawn) {
-    int outside = 0;
-    drawn = 0;
-    for (int py = 0; py < img.height(); ++py) {
-      for (int px = 0; px < img.width(); ++px) {
-        const std::uint8_t* q = img.pixel(px, py);
-        const glm::ivec3 c(q[0], q[1], q[2]);
-        bool found = false;
-        for (const glm::ivec3& a : allowed) {
-          const glm::ivec3 d = glm::abs(c - a);
-          found = found || (d.x <= 1 && d.y <= 1 && d.z <= 1);
-        }
-        outside += found ? 0 : 1;
-        drawn += c != glm::ivec3(0) ? 1 : 0;
-      }
-    }
-    return outside;
+    const test::PaletteCount n = test::countAgainstPalette(img, table);
+    drawn = n.drawn;
+    return n.outside;
   };
   int drawn = 0;
   EXPECT_EQ(outsideTable(shown, drawn), 0);
