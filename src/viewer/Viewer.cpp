@@ -28,6 +28,8 @@ constexpr int kHistogramBins = 256;
 // Render-target size the plan reserves memory for (the largest frame we expect).
 constexpr int kPlanImageSize = 1024;
 constexpr int kSkipBlock = 8;
+// The TF table size of a volume that is not shown as labels.
+const int kValueLutSize = render::TechniqueOptions{}.lutSize;
 
 glm::vec4 fullView() {
   return {0.0f, 0.0f, 1.0f, 1.0f};
@@ -110,7 +112,7 @@ void Viewer::setVolume(Volume volume, const std::string& name) {
   const lod::InCoreVolumeSource source(std::make_shared<Volume>(std::move(volume)));
   render::TechniqueOnVolume next;
   const bool wasLabels = labels_.has_value();
-  if (wasLabels) lutSize_ = 4096;  // a new volume is not a label volume until setLabels
+  if (wasLabels) lutSize_ = kValueLutSize;  // a new volume is not a label volume until setLabels
   try {
     next = createActive(techniqueName_, source);
   } catch (const BudgetError& e) {
@@ -230,7 +232,7 @@ void Viewer::clearLabels(const std::string& tf) {
   if (!labels_) return;
   labels_.reset();
   settings_.nearest = false;
-  lutSize_ = 4096;
+  lutSize_ = kValueLutSize;
   tfEditor_.loadPreset(tf);
   recreateActive();
   resetWindow();

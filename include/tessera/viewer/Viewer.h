@@ -208,7 +208,7 @@ class Viewer {
   TransferFunctionEditor tfEditor_;
   RenderSettings settings_ = defaultRenderSettings();  // what `tessera render` uses
   std::string techniqueName_ = "raycast";
-  int lutSize_ = 4096;  // render::TechniqueOptions::lutSize
+  int lutSize_ = render::TechniqueOptions{}.lutSize;  // kLabelLutSize while labels are shown
   std::optional<render::LabelTable> labels_;
   void recreateActive();  // the volume uploaded again for techniqueName_ and lutSize_
   std::uint64_t uploadedTfRevision_ = 0;
