@@ -61,15 +61,42 @@ glm::ivec3 StepGrid::cellAt(glm::dvec3 p) const {
   return glm::clamp(glm::ivec3(c), glm::ivec3(0), count - 1);
 }
 
-double StepGrid::exitT(glm::ivec3 cell, glm::dvec3 to, glm::dvec3 td) const {
-  double t = std::numeric_limits<double>::infinity();
+StepGrid::Exit StepGrid::exit(glm::ivec3 cell, glm::dvec3 to, glm::dvec3 td) const {
+  const auto faceT = [&](glm::ivec3 c, int a) {
+    const double face =
+        (c[a] + (td[a] > 0.0 ? 1.0 : 0.0)) * blockSize / static_cast<double>(dims[a]);
+    return (face - to[a]) / td[a];
+  };
+  Exit e{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  int axis = -1;
   for (int a = 0; a < 3; ++a) {
     if (td[a] == 0.0) continue;
-    const double face =
-        (cell[a] + (td[a] > 0.0 ? 1.0 : 0.0)) * blockSize / static_cast<double>(dims[a]);
-    t = std::min(t, (face - to[a]) / td[a]);
+    const double t = faceT(cell, a);
+    if (t < e.t) {
+      e.t = t;
+      axis = a;
+    }
   }
-  return t;
+  if (axis < 0) return e;
+  glm::ivec3 next = cell;
+  next[axis] += td[axis] > 0.0 ? 1 : -1;
+  for (int a = 0; a < 3; ++a) {
+    if (td[a] != 0.0) e.tNext = std::min(e.tNext, faceT(next, a));
+  }
+  return e;
+}
+
+std::uint8_t StepGrid::aheadCode(glm::ivec3 cell) const {
+  std::uint8_t lowest = 255;
+  for (int a = 0; a < 3; ++a) {
+    for (int side : {-1, 1}) {
+      glm::ivec3 n = cell;
+      n[a] += side;
+      lowest = contains(n) ? std::min(lowest, code(n)) : std::uint8_t{0};
+      if (lowest == 0) return 0;
+    }
+  }
+  return lowest;
 }
 
 std::vector<std::uint8_t> classifyStepBlocks(const std::vector<float>& mins,

@@ -178,7 +178,8 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
                       ? 1.0
                       : stepMultiplier(code, grow ? acc.a : 0.0, settings.sampling.maxMultiplier);
               if (code == 0 || m > 1.0) {
-                const double kExit = exitSample(steps->exitT(cell, to, td), t0, ds, j, k);
+                const StepGrid::Exit exit = steps->exit(cell, to, td);
+                const double kExit = exitSample(exit.t, t0, ds, j, k);
                 if (code == 0) {
                   if (pre && frontK >= 0.0 && keeps(p)) {
                     ++samples;
@@ -190,7 +191,13 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
                   if (acc.a >= settings.ertThreshold) break;
                   continue;
                 }
-                kNext = nextAdaptiveSample(k, m, kExit, pre);
+                // The block ahead, bounded as the GPU reads it (AdaptiveSteps.h).
+                StepsAhead ahead;
+                if (const std::uint8_t a = steps->aheadCode(cell); a != 0) {
+                  ahead.m = stepMultiplier(a, grow ? acc.a : 0.0, settings.sampling.maxMultiplier);
+                  ahead.kExit = exitSample(exit.tNext, t0, ds, j, k);
+                }
+                kNext = nextAdaptiveSample(k, m, kExit, ahead, pre);
               }
             }
             ++samples;

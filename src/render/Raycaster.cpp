@@ -108,11 +108,19 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
     cells[b * 4 + 1] = static_cast<std::uint8_t>(std::min(255.0, std::ceil(nhi * 255.0)));
     cells[b * 4 + 2] = codes[b];  // the step allowance (AdaptiveSteps.h)
   }
-  occupiedFraction_ = static_cast<double>(occupiedCount) / static_cast<double>(codes.size());
   stepGrid_ = {.dims = volume_.dims(),
                .blockSize = blockSize_,
                .count = blocks_.blockCount(),
                .codes = codes};
+  const glm::ivec3 count = stepGrid_.count;
+  for (int z = 0, b = 0; z < count.z; ++z) {
+    for (int y = 0; y < count.y; ++y) {
+      for (int x = 0; x < count.x; ++x, ++b) {
+        cells[static_cast<std::size_t>(b) * 4 + 3] = stepGrid_.aheadCode({x, y, z});
+      }
+    }
+  }
+  occupiedFraction_ = static_cast<double>(occupiedCount) / static_cast<double>(codes.size());
   uploadBlocks(cells);
 }
 

@@ -24,7 +24,9 @@ uniform vec4 u_background;  // premultiplied
 
 #ifdef EMPTY_SPACE_SKIPPING
 // The block grid: r = 1 where the TF gives some sample in the block opacity,
-// g = the largest normalised value in the block, rounded up.
+// g = the largest normalised value in the block, rounded up; with
+// ADAPTIVE_SAMPLING b = the block's step code and a = the smallest code of
+// its six face neighbours (AdaptiveSteps.h).
 uniform vec3 u_blocksPerUnit;  // blocks per texture-space unit = dims / blockSize
 uniform vec3 u_blockCount;
 #if TESSERA_GLSL == 300
@@ -47,12 +49,22 @@ vec4 blockAt(vec3 cell) {
 }
 #endif
 
-// The first base sample at or past the ray's exit from block `cell`
-// (AdaptiveSteps.h: exitSample).
-float exitSample(vec3 cell, vec3 to, vec3 td, vec3 invTd, float t0, float j, float k) {
+// The ray parameter where it leaves block `cell`, and where it leaves the
+// block it enters there (across the face it leaves by, the first axis on a
+// tie, as AdaptiveSteps.cpp's StepGrid::exit): x and y of the result.
+vec2 exitT(vec3 cell, vec3 to, vec3 td, vec3 invTd) {
   vec3 exitFace = (cell + step(0.0, td)) / u_blocksPerUnit;
   vec3 tb = (exitFace - to) * invTd;
   float tExit = min(min(tb.x, tb.y), tb.z);
+  vec3 axis = tExit == tb.x ? vec3(1.0, 0.0, 0.0)
+                            : (tExit == tb.y ? vec3(0.0, 1.0, 0.0) : vec3(0.0, 0.0, 1.0));
+  vec3 tAhead = tb + axis * abs(invTd) / u_blocksPerUnit;
+  return vec2(tExit, min(min(tAhead.x, tAhead.y), tAhead.z));
+}
+
+// The first base sample at or past parameter tExit (AdaptiveSteps.h:
+// exitSample).
+float exitSample(float tExit, float t0, float j, float k) {
   return max(ceil((tExit - t0) / u_step - j), k + 1.0);
 }
 
@@ -69,17 +81,28 @@ float stepMultiplier(float b, float alpha) {
   return floor(exp2(clamp(e, 0.0, u_log2MaxMultiplier)) + 0.5);
 }
 
+float nextMultiple(float k, float m) {
+  return (floor(k / m) + 1.0) * m;
+}
+
 // The next sample after k in a block with multiplier m whose exit sample is
-// kExit (AdaptiveSteps.h: nextAdaptiveSample): the next multiple of m, and a
-// pre-integrated ray stops at kExit - 1 so that it crosses the face in one
-// base step.
-float nextSample(float k, float m, float kExit) {
-  float aligned = (floor(k / m) + 1.0) * m;
+// kExit, with the block ahead's multiplier mAhead (0: none or empty) and exit
+// sample kExitAhead (AdaptiveSteps.h: nextAdaptiveSample): the next multiple
+// of m inside the block; across its face on the lattice of min(m, mAhead),
+// ending inside the block ahead; without one, a pre-integrated ray crosses
+// the face in one base step from kExit - 1.
+float nextSample(float k, float m, float kExit, float mAhead, float kExitAhead) {
 #ifdef PREINTEGRATED
-  return k >= kExit - 1.0 ? k + 1.0 : min(aligned, kExit - 1.0);
+  float last = kExit - 1.0;
+  float end = kExitAhead - 1.0;
 #else
-  return min(aligned, kExit);
+  float last = kExit;
+  float end = kExitAhead;
 #endif
+  float aligned = nextMultiple(k, m);
+  if (aligned <= last) return aligned;
+  if (mAhead <= 0.0) return max(k + 1.0, last);
+  return max(k + 1.0, min(nextMultiple(k, min(m, mAhead)), end));
 }
 #endif
 #endif
@@ -145,6 +168,9 @@ void main() {
     // blockExit lie in the block read last.
     float blockExit = -1.0;
     vec4 block = vec4(0.0);
+#ifdef ADAPTIVE_SAMPLING
+    float aheadExit = -1.0;  // the exit sample of the next block along the ray
+#endif
 #endif
     for (int i = 0; i < MAX_STEPS; i++) {
       if (k >= u_maxSteps) break;
@@ -158,8 +184,13 @@ void main() {
         vec3 cell = clamp(floor(p * u_blocksPerUnit), vec3(0.0), u_blockCount - 1.0);
         block = blockAt(cell);
         // The first sample at or past the block's exit face: where an empty
-        // block is left for, and where adaptive steps end.
-        blockExit = exitSample(cell, to, td, invTd, t0, j, k);
+        // block is left for, and where adaptive steps end unless the block
+        // ahead lets them cross.
+        vec2 exits = exitT(cell, to, td, invTd);
+        blockExit = exitSample(exits.x, t0, j, k);
+#ifdef ADAPTIVE_SAMPLING
+        aheadExit = exitSample(exits.y, t0, j, k);
+#endif
       }
 #ifdef MODE_MIP
       empty = block.g <= maxValue;
@@ -169,11 +200,15 @@ void main() {
       float kExit = blockExit;
 #ifdef ADAPTIVE_SAMPLING
 #ifdef OPACITY_GROWTH
-      float m = stepMultiplier(block.b, acc.a);
+      float grownBy = acc.a;
 #else
-      float m = stepMultiplier(block.b, 0.0);
+      float grownBy = 0.0;
 #endif
-      if (m > 1.0) kNext = nextSample(k, m, kExit);
+      float m = stepMultiplier(block.b, grownBy);
+      // Whichever face neighbour the ray enters, its code is at least the
+      // smallest of the six (a; 0 when one is empty or outside the grid).
+      float mAhead = block.a < 0.5 / 255.0 ? 0.0 : stepMultiplier(block.a, grownBy);
+      if (m > 1.0) kNext = nextSample(k, m, kExit, mAhead, aheadExit);
 #endif
       if (empty) kNext = kExit;
 #ifdef PREINTEGRATED

@@ -151,13 +151,12 @@ TEST(AdaptiveSteps, BlocksGetCodesFromTheTfOverTheirRange) {
                InputError);
 }
 
-TEST(AdaptiveSteps, TheWalkStaysOnTheLatticeAndCrossesFacesInOneStep) {
+TEST(AdaptiveSteps, WithoutABlockAheadTheWalkStaysOnTheLatticeAndCrossesFacesInOneStep) {
   for (double m : {2.0, 4.0, 8.0}) {
-    for (double k = 0; k < 40; ++k) {
+    for (double k = 0; k < 37; ++k) {
       const double kExit = 37;
-      if (k >= kExit) break;
-      const double post = nextAdaptiveSample(k, m, kExit, false);
-      const double pre = nextAdaptiveSample(k, m, kExit, true);
+      const double post = nextAdaptiveSample(k, m, kExit, {}, false);
+      const double pre = nextAdaptiveSample(k, m, kExit, {}, true);
       EXPECT_GT(post, k);
       EXPECT_TRUE(std::fmod(post, m) == 0.0 || post == kExit) << k << " " << m;
       EXPECT_LE(post, kExit);
@@ -166,6 +165,41 @@ TEST(AdaptiveSteps, TheWalkStaysOnTheLatticeAndCrossesFacesInOneStep) {
       EXPECT_LE(pre, kExit);
       if (pre == kExit) {
         EXPECT_EQ(k, kExit - 1) << "a face is crossed by one base step";
+      }
+    }
+  }
+}
+
+// With a visible block ahead a stretch or segment crosses the face on the
+// lattice of the smaller multiplier and ends inside that block: it spans two
+// blocks at most, each of which allows its length.
+TEST(AdaptiveSteps, ABlockAheadLetsTheWalkCrossTheFaceWithTheSmallerMultiplier) {
+  const double kExit = 37, kExitAhead = 53;
+  for (double m : {1.0, 2.0, 4.0, 8.0, 16.0}) {
+    for (double mAhead : {1.0, 2.0, 4.0, 8.0, 16.0}) {
+      for (bool pre : {false, true}) {
+        const double last = pre ? kExit - 1 : kExit;
+        const double end = pre ? kExitAhead - 1 : kExitAhead;
+        for (double k = 0; k < kExit; ++k) {
+          const double next = nextAdaptiveSample(k, m, kExit, {mAhead, kExitAhead}, pre);
+          EXPECT_GT(next, k);
+          EXPECT_LE(next, end) << "ends inside the block ahead";
+          if (nextMultiple(k, m) <= last) {
+            EXPECT_EQ(next, nextMultiple(k, m)) << "inside the block: its own lattice";
+          } else {  // toward the face: within what both blocks allow
+            const double mc = std::min(m, mAhead);
+            EXPECT_LE(next - k, mc) << k << " " << m << " " << mAhead;
+            EXPECT_TRUE(std::fmod(next, mc) == 0.0 || next == end || next == k + 1)
+                << k << " " << m << " " << mAhead;
+          }
+        }
+        // The face costs no extra sample when the block ahead allows the
+        // same multiplier: the walk keeps the lattice it had inside.
+        const double k0 = std::floor((kExit - 1) / m) * m;
+        if (m == mAhead && k0 + m <= end) {
+          EXPECT_EQ(nextAdaptiveSample(k0, m, kExit, {m, kExitAhead}, pre), k0 + m)
+              << m << " " << pre;
+        }
       }
     }
   }

@@ -45,7 +45,22 @@ struct StepGrid {
     return codes[(static_cast<std::size_t>(cell.z) * count.y + cell.y) * count.x + cell.x];
   }
   // Ray parameter t where the ray to + t td leaves `cell`.
-  double exitT(glm::ivec3 cell, glm::dvec3 to, glm::dvec3 td) const;
+  double exitT(glm::ivec3 cell, glm::dvec3 to, glm::dvec3 td) const { return exit(cell, to, td).t; }
+  // That t, and where the ray leaves the block it enters there (across the
+  // face it leaves by; the first axis on a tie, as the shader).
+  struct Exit {
+    double t;
+    double tNext;
+  };
+  Exit exit(glm::ivec3 cell, glm::dvec3 to, glm::dvec3 td) const;
+  // The smallest code of the six face neighbours of `cell`, 0 when one is
+  // empty or outside the grid: a bound on the code of whichever block a ray
+  // enters next (the GPU reads it with the block, channel a).
+  std::uint8_t aheadCode(glm::ivec3 cell) const;
+  bool contains(glm::ivec3 cell) const {
+    return cell.x >= 0 && cell.y >= 0 && cell.z >= 0 && cell.x < count.x && cell.y < count.y &&
+           cell.z < count.z;
+  }
 };
 
 // The code of a visible block without adaptive steps (s = 1: m = 1).
@@ -71,20 +86,40 @@ std::vector<std::uint8_t> classifyStepBlocks(const std::vector<float>& mins,
                                              const Sampling& sampling, bool adaptive);
 
 // The walk. At base sample k in a block with multiplier m whose exit is
-// first passed by sample kExit (> k), the next sample is
-//   post-classification: min(next multiple of m after k, kExit)
-//   pre-integration:     k + 1 when k >= kExit - 1, else
-//                        min(next multiple of m after k, kExit - 1)
-// so pre-integrated segments that cross a block face are one base step long
-// (the blocks on either side may differ completely). Empty blocks (code 0)
-// are left for kExit; a pre-integrated ray then composites the segment from
-// the last sample before the block to its first sample inside it, and starts
-// again with the segment (kExit - 1, kExit): every segment it leaves out lies
-// in values the TF makes transparent.
-inline double nextAdaptiveSample(double k, double m, double kExit, bool preintegrated) {
-  const double aligned = (std::floor(k / m) + 1.0) * m;
-  if (!preintegrated) return std::min(aligned, kExit);
-  return k >= kExit - 1.0 ? k + 1.0 : std::min(aligned, kExit - 1.0);
+// first passed by sample kExit (> k), the next sample is the next multiple
+// of m after k while that stays inside the block: at most kExit
+// (post-classification: the sample stands for the stretch up to the next
+// one) or kExit - 1 (pre-integration: the segment ends before the face).
+// Past that, the walk looks one block ahead: the block the ray enters across
+// the face it leaves by (`ahead`, its multiplier mAhead and exit sample
+// kExitAhead; mAhead = 0 when there is none or it is empty). A stretch or
+// segment may cross the face with min(m, mAhead), up to kExitAhead
+// (post-classification) or kExitAhead - 1 (pre-integration), so that it lies
+// in the two blocks whose allowances it keeps, and never shorter than one
+// base step. Without a block ahead it stops at kExit (post) or crosses the
+// face in one base step from kExit - 1 (pre), since the blocks on either side
+// may differ completely. Empty blocks (code 0) are left for kExit; a
+// pre-integrated ray then composites the segment from the last sample before
+// the block to its first sample inside it, and starts again with the segment
+// (kExit - 1, kExit): every segment it leaves out lies in values the TF makes
+// transparent.
+struct StepsAhead {
+  double m = 0.0;      // the next block's multiplier; 0: no block ahead, or an empty one
+  double kExit = 0.0;  // its exit sample
+};
+
+inline double nextMultiple(double k, double m) {
+  return (std::floor(k / m) + 1.0) * m;
+}
+
+inline double nextAdaptiveSample(double k, double m, double kExit, StepsAhead ahead,
+                                 bool preintegrated) {
+  const double last = preintegrated ? kExit - 1.0 : kExit;
+  const double aligned = nextMultiple(k, m);
+  if (aligned <= last) return aligned;
+  if (ahead.m <= 0.0) return std::max(k + 1.0, last);
+  const double end = preintegrated ? ahead.kExit - 1.0 : ahead.kExit;
+  return std::max(k + 1.0, std::min(nextMultiple(k, std::min(m, ahead.m)), end));
 }
 
 // The first base sample at or past parameter tExit: max(ceil((tExit - t0)/ds - j), k + 1).
