@@ -61,10 +61,10 @@ glm::ivec3 StepGrid::cellAt(glm::dvec3 p) const {
   return glm::clamp(glm::ivec3(c), glm::ivec3(0), count - 1);
 }
 
-StepGrid::Exit StepGrid::exit(glm::ivec3 cell, glm::dvec3 to, glm::dvec3 td) const {
+StepGrid::Exit StepGrid::exit(glm::ivec3 cell, glm::dvec3 to, glm::dvec3 td, int radius) const {
   const auto faceT = [&](glm::ivec3 c, int a) {
     const double face =
-        (c[a] + (td[a] > 0.0 ? 1.0 : 0.0)) * blockSize / static_cast<double>(dims[a]);
+        (c[a] + (td[a] > 0.0 ? 1.0 + radius : -radius)) * blockSize / static_cast<double>(dims[a]);
     return (face - to[a]) / td[a];
   };
   Exit e{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
@@ -84,6 +84,45 @@ StepGrid::Exit StepGrid::exit(glm::ivec3 cell, glm::dvec3 to, glm::dvec3 td) con
     if (td[a] != 0.0) e.tNext = std::min(e.tNext, faceT(next, a));
   }
   return e;
+}
+
+void StepGrid::measureEmptySpace() {
+  constexpr int kFar = 1 << 20;
+  std::vector<int> d(codes.size());
+  for (std::size_t b = 0; b < codes.size(); ++b) d[b] = codes[b] != 0 ? 0 : kFar;
+  const auto at = [&](int x, int y, int z) -> int& {
+    return d[(static_cast<std::size_t>(z) * count.y + y) * count.x + x];
+  };
+  // Forward over the 13 neighbours before a cell in raster order, then
+  // backward over the 13 after it.
+  for (int pass : {1, -1}) {
+    const int z0 = pass > 0 ? 0 : count.z - 1, y0 = pass > 0 ? 0 : count.y - 1,
+              x0 = pass > 0 ? 0 : count.x - 1;
+    for (int z = z0; z >= 0 && z < count.z; z += pass) {
+      for (int y = y0; y >= 0 && y < count.y; y += pass) {
+        for (int x = x0; x >= 0 && x < count.x; x += pass) {
+          int& here = at(x, y, z);
+          for (int dz = -1; dz <= 0; ++dz) {
+            for (int dy = -1; dy <= 1; ++dy) {
+              for (int dx = -1; dx <= 1; ++dx) {
+                // Raster-earlier neighbours only (for this pass's direction).
+                if (dz == 0 && (dy > 0 || (dy == 0 && dx >= 0))) continue;
+                const int nx = x + pass * dx, ny = y + pass * dy, nz = z + pass * dz;
+                if (nx < 0 || ny < 0 || nz < 0 || nx >= count.x || ny >= count.y || nz >= count.z) {
+                  continue;
+                }
+                here = std::min(here, at(nx, ny, nz) + 1);
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+  emptyDistance.resize(codes.size());
+  for (std::size_t b = 0; b < d.size(); ++b) {
+    emptyDistance[b] = static_cast<std::uint8_t>(std::min(d[b], 255));
+  }
 }
 
 std::uint8_t StepGrid::aheadCode(glm::ivec3 cell) const {

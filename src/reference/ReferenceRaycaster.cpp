@@ -178,7 +178,10 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
                       ? 1.0
                       : stepMultiplier(code, grow ? acc.a : 0.0, settings.sampling.maxMultiplier);
               if (code == 0 || m > 1.0) {
-                const StepGrid::Exit exit = steps->exit(cell, to, td);
+                // An empty block is left with the cube of empty blocks
+                // around it.
+                const int radius = code == 0 ? std::max(steps->distance(cell) - 1, 0) : 0;
+                const StepGrid::Exit exit = steps->exit(cell, to, td, radius);
                 const double kExit = exitSample(exit.t, t0, ds, j, k);
                 if (code == 0) {
                   if (pre && frontK >= 0.0 && keeps(p)) {

@@ -102,7 +102,6 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
   std::size_t occupiedCount = 0;
   for (std::size_t b = 0; b < codes.size(); ++b) {
     const double nhi = std::clamp((blocks_.maxs()[b] - w.min) / ww, 0.0, 1.0);
-    cells[b * 4] = codes[b] > 0 ? 255 : 0;
     occupiedCount += codes[b] > 0 ? 1 : 0;
     // Rounded up so that "block max <= current max" never skips a larger sample.
     cells[b * 4 + 1] = static_cast<std::uint8_t>(std::min(255.0, std::ceil(nhi * 255.0)));
@@ -111,12 +110,16 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
   stepGrid_ = {.dims = volume_.dims(),
                .blockSize = blockSize_,
                .count = blocks_.blockCount(),
-               .codes = codes};
+               .codes = codes,
+               .emptyDistance = {}};
+  stepGrid_.measureEmptySpace();
   const glm::ivec3 count = stepGrid_.count;
   for (int z = 0, b = 0; z < count.z; ++z) {
     for (int y = 0; y < count.y; ++y) {
       for (int x = 0; x < count.x; ++x, ++b) {
-        cells[static_cast<std::size_t>(b) * 4 + 3] = stepGrid_.aheadCode({x, y, z});
+        const auto i = static_cast<std::size_t>(b) * 4;
+        cells[i] = stepGrid_.distance({x, y, z});
+        cells[i + 3] = stepGrid_.aheadCode({x, y, z});
       }
     }
   }

@@ -23,8 +23,10 @@ uniform float u_jitter;     // 1.0: dithered first sample
 uniform vec4 u_background;  // premultiplied
 
 #ifdef EMPTY_SPACE_SKIPPING
-// The block grid: r = 1 where the TF gives some sample in the block opacity,
-// g = the largest normalised value in the block, rounded up; with
+// The block grid: r = 0 where the TF gives some sample in the block opacity,
+// otherwise the chessboard distance d to the nearest such block (/255; the
+// cube of blocks d - 1 around it is empty too), g = the largest normalised
+// value in the block, rounded up; with
 // ADAPTIVE_SAMPLING b = the block's step code and a = the smallest code of
 // its six face neighbours (AdaptiveSteps.h).
 uniform vec3 u_blocksPerUnit;  // blocks per texture-space unit = dims / blockSize
@@ -49,11 +51,12 @@ vec4 blockAt(vec3 cell) {
 }
 #endif
 
-// The ray parameter where it leaves block `cell`, and where it leaves the
-// block it enters there (across the face it leaves by, the first axis on a
-// tie, as AdaptiveSteps.cpp's StepGrid::exit): x and y of the result.
-vec2 exitT(vec3 cell, vec3 to, vec3 td, vec3 invTd) {
-  vec3 exitFace = (cell + step(0.0, td)) / u_blocksPerUnit;
+// The ray parameter where it leaves the cube of blocks within chessboard
+// distance `radius` of block `cell`, and where it leaves the block it enters
+// there (across the face it leaves by, the first axis on a tie, as
+// AdaptiveSteps.cpp's StepGrid::exit): x and y of the result.
+vec2 exitT(vec3 cell, float radius, vec3 to, vec3 td, vec3 invTd) {
+  vec3 exitFace = (cell + step(0.0, td) + sign(td) * radius) / u_blocksPerUnit;
   vec3 tb = (exitFace - to) * invTd;
   float tExit = min(min(tb.x, tb.y), tb.z);
   vec3 axis = tExit == tb.x ? vec3(1.0, 0.0, 0.0)
@@ -186,7 +189,13 @@ void main() {
         // The first sample at or past the block's exit face: where an empty
         // block is left for, and where adaptive steps end unless the block
         // ahead lets them cross.
-        vec2 exits = exitT(cell, to, td, invTd);
+#ifdef MODE_MIP
+        float radius = 0.0;
+#else
+        // An empty block is left with the cube of empty blocks around it.
+        float radius = max(floor(block.r * 255.0 + 0.5) - 1.0, 0.0);
+#endif
+        vec2 exits = exitT(cell, radius, to, td, invTd);
         blockExit = exitSample(exits.x, t0, j, k);
 #ifdef ADAPTIVE_SAMPLING
         aheadExit = exitSample(exits.y, t0, j, k);
@@ -195,7 +204,7 @@ void main() {
 #ifdef MODE_MIP
       empty = block.g <= maxValue;
 #else
-      empty = block.r < 0.5;
+      empty = block.r > 0.5 / 255.0;
 #endif
       float kExit = blockExit;
 #ifdef ADAPTIVE_SAMPLING

@@ -2,6 +2,7 @@
 // walk of adaptive sampling (reference/AdaptiveSteps.h), on the CPU.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -200,6 +201,32 @@ TEST(AdaptiveSteps, ABlockAheadLetsTheWalkCrossTheFaceWithTheSmallerMultiplier) 
           EXPECT_EQ(nextAdaptiveSample(k0, m, kExit, {m, kExitAhead}, pre), k0 + m)
               << m << " " << pre;
         }
+      }
+    }
+  }
+}
+
+// Distance-based skipping: every empty block's distance is the chessboard
+// distance to the nearest visible block, computed directly; a grid with no
+// visible block is 255 everywhere.
+TEST(AdaptiveSteps, EmptyDistanceIsTheChessboardDistanceToTheNearestVisibleBlock) {
+  StepGrid grid;
+  grid.count = {9, 6, 7};
+  grid.codes.assign(9 * 6 * 7, 0);
+  grid.measureEmptySpace();
+  for (std::uint8_t d : grid.emptyDistance) EXPECT_EQ(d, 255);
+  std::vector<glm::ivec3> visible = {{0, 0, 0}, {8, 5, 6}, {4, 2, 3}, {7, 0, 1}};
+  for (glm::ivec3 v : visible) grid.codes[(v.z * 6 + v.y) * 9 + v.x] = 70;
+  grid.measureEmptySpace();
+  for (int z = 0; z < 7; ++z) {
+    for (int y = 0; y < 6; ++y) {
+      for (int x = 0; x < 9; ++x) {
+        int direct = 1 << 20;
+        for (glm::ivec3 v : visible) {
+          direct =
+              std::min(direct, std::max({std::abs(x - v.x), std::abs(y - v.y), std::abs(z - v.z)}));
+        }
+        EXPECT_EQ(grid.distance({x, y, z}), direct) << x << " " << y << " " << z;
       }
     }
   }

@@ -36,6 +36,19 @@ struct StepGrid {
   int blockSize = 0;
   glm::ivec3 count{0};
   std::vector<std::uint8_t> codes;  // x fastest
+  // Per block, the chessboard distance in blocks to the nearest visible one
+  // (0: visible; at most 255): an empty block at distance d lies in a cube of
+  // empty blocks d - 1 blocks around it, which a ray leaves in one step
+  // (distance-based empty-space skipping). Filled by measureEmptySpace().
+  std::vector<std::uint8_t> emptyDistance;
+
+  // Fills emptyDistance from codes (two raster passes, exact for the
+  // chessboard metric).
+  void measureEmptySpace();
+  std::uint8_t distance(glm::ivec3 cell) const {
+    if (emptyDistance.empty()) return code(cell) != 0 ? 0 : 1;
+    return emptyDistance[(static_cast<std::size_t>(cell.z) * count.y + cell.y) * count.x + cell.x];
+  }
 
   bool valid() const { return blockSize > 0 && !codes.empty(); }
   // The cell holding texture-space point p (clamped to the grid), as the
@@ -52,7 +65,9 @@ struct StepGrid {
     double t;
     double tNext;
   };
-  Exit exit(glm::ivec3 cell, glm::dvec3 to, glm::dvec3 td) const;
+  // With `radius` > 0, t is where the ray leaves the cube of blocks within
+  // that chessboard distance of `cell`.
+  Exit exit(glm::ivec3 cell, glm::dvec3 to, glm::dvec3 td, int radius = 0) const;
   // The smallest code of the six face neighbours of `cell`, 0 when one is
   // empty or outside the grid: a bound on the code of whichever block a ray
   // enters next (the GPU reads it with the block, channel a).
