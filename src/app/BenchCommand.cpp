@@ -10,6 +10,7 @@
 #include "app/BenchExplore.h"
 #include "app/BenchFcc.h"
 #include "app/BenchHybrid.h"
+#include "app/BenchPeers.h"
 #include "app/BenchRoofline.h"
 #include "app/BenchSampling.h"
 #include "app/BenchSlicing.h"
@@ -419,8 +420,10 @@ void addBenchCommand(CLI::App& app) {
   cmd->add_option("--views", o->views, "With --sampling(-sweep): views whose worst PSNR counts")
       ->capture_default_str();
   addExploreBenchOptions(cmd);
+  addPeersBenchOptions(cmd);
   cmd->callback([o] {
     if (runExploreBenchIfAsked()) return;
+    if (runPeersBenchIfAsked()) return;
     if (o->sampling || o->samplingSweep) {
       SamplingBenchOptions s;
       s.volumes = o->samplingVolumes;

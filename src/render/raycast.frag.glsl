@@ -74,14 +74,21 @@ float exitSample(float tExit, float t0, float j, float k) {
 #ifdef ADAPTIVE_SAMPLING
 uniform float u_log2MaxMultiplier;
 
-// The multiplier of a block whose code (AdaptiveSteps.h: 64 + floor(8 log2 s),
-// s the block's step allowance) is stored in `b`, behind opacity `alpha`:
-// 2^floor(log2(s / (1 - alpha))), 1..2^u_log2MaxMultiplier. Integer maths on
-// floats, rounded, so that the lattice arithmetic stays exact.
-float stepMultiplier(float b, float alpha) {
-  float code = floor(b * 255.0 + 0.5);
-  float e = floor((code - 64.0) / 8.0 - log2(max(1.0 - alpha, 1e-6)));
-  return floor(exp2(clamp(e, 0.0, u_log2MaxMultiplier)) + 0.5);
+// The multipliers for the step codes in `codes` (AdaptiveSteps.h: 64 +
+// floor(8 log2 s), s a step allowance; x the block's own, y the bound on its
+// neighbours') behind opacity `alpha`: 2^floor(log2(s / (1 - alpha))),
+// 1..2^u_log2MaxMultiplier. Integer maths on floats, rounded, so that the
+// lattice arithmetic stays exact; one log2 for both, and on ES 3 the power
+// of two as an integer shift (software rasterisers pay for every exp2).
+vec2 stepMultipliers(vec2 codes, float alpha) {
+  vec2 code = floor(codes * 255.0 + 0.5);
+  vec2 e = clamp(floor((code - 64.0) / 8.0 - log2(max(1.0 - alpha, 1e-6))), 0.0,
+                 u_log2MaxMultiplier);
+#if TESSERA_GLSL == 300
+  return vec2(float(1 << int(e.x)), float(1 << int(e.y)));
+#else
+  return floor(exp2(e) + 0.5);
+#endif
 }
 
 float nextMultiple(float k, float m) {
@@ -213,10 +220,11 @@ void main() {
 #else
       float grownBy = 0.0;
 #endif
-      float m = stepMultiplier(block.b, grownBy);
+      vec2 ms = stepMultipliers(block.ba, grownBy);
+      float m = ms.x;
       // Whichever face neighbour the ray enters, its code is at least the
       // smallest of the six (a; 0 when one is empty or outside the grid).
-      float mAhead = block.a < 0.5 / 255.0 ? 0.0 : stepMultiplier(block.a, grownBy);
+      float mAhead = block.a < 0.5 / 255.0 ? 0.0 : ms.y;
       if (m > 1.0) kNext = nextSample(k, m, kExit, mAhead, aheadExit);
 #endif
       if (empty) kNext = kExit;

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/CliRunner.h"
 #include "support/TestSupport.h"
 
 namespace {
@@ -55,4 +56,35 @@ TEST(PeersBench, SmokeRunFailsWhenTheFramingDiffers) {
   if (!haveVtk()) GTEST_SKIP() << "python3-vtk9 / xvfb not installed (scripts/setup.sh)";
   tessera::test::TempDir dir;
   EXPECT_NE(runSmoke(dir, "--zoom 1.15"), 0) << std::ifstream(dir / "log.txt").rdbuf();
+}
+
+// `tessera bench --peers` runs the same script with this binary as Tessera.
+TEST(PeersBench, TheCliRunsTheScriptWithItself) {
+  if (!haveVtk()) GTEST_SKIP() << "python3-vtk9 / xvfb not installed (scripts/setup.sh)";
+  tessera::test::TempDir dir;
+  const auto run = tessera::test::runCli("bench --peers --peers-args=\"--smoke --out " +
+                                         dir.path().string() + "\"");
+  ASSERT_EQ(run.exitCode, 0) << (run.out + run.err);
+  EXPECT_NE((run.out + run.err).find(std::string("--tessera ") + TESSERA_CLI_PATH),
+            std::string::npos)
+      << (run.out + run.err);
+  std::ifstream in(dir / "peers.json");
+  ASSERT_TRUE(in.good()) << (run.out + run.err);
+  EXPECT_FALSE(nlohmann::json::parse(in)["rows"].empty());
+}
+
+// Without the source tree (or with a wrong one) the error names the path.
+TEST(PeersBench, TheCliNamesAMissingScript) {
+  tessera::test::TempDir dir;
+  for (const std::string flag : {"--peers", "--web-peers"}) {
+    const auto run =
+        tessera::test::runCli("bench " + flag + " --source-dir " + dir.path().string());
+    EXPECT_EQ(run.exitCode, 1) << (run.out + run.err);
+    EXPECT_NE((run.out + run.err).find(dir.path().string() + "/bench/"), std::string::npos)
+        << (run.out + run.err);
+    EXPECT_NE((run.out + run.err).find("not found"), std::string::npos) << (run.out + run.err);
+  }
+  const auto both = tessera::test::runCli("bench --peers --web-peers");
+  EXPECT_EQ(both.exitCode, 1);
+  EXPECT_NE(both.err.find("one at a time"), std::string::npos) << both.err;
 }

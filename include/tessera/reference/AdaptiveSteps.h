@@ -83,7 +83,7 @@ constexpr std::uint8_t kUnitStepCode = 64;
 
 // The multiplier for a visible block's code behind accumulated opacity
 // `alpha` (0 without opacity growth); `maxMultiplier` a power of two. The GLSL
-// twin is raycast.frag.glsl's stepMultiplier().
+// twin is raycast.frag.glsl's stepMultipliers().
 inline double stepMultiplier(std::uint8_t code, double alpha, int maxMultiplier) {
   const double e = std::floor((code - 64.0) / 8.0 - std::log2(std::max(1.0 - alpha, 1e-6)));
   return std::exp2(std::clamp(e, 0.0, std::log2(static_cast<double>(maxMultiplier))));
