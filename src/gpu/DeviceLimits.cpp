@@ -14,10 +14,13 @@ DeviceLimits DeviceLimits::of(const DeviceCaps& caps) {
   l.textureUnits = caps.maxTextureUnits;
   if (caps.api == ApiLevel::Gles3) {
     l.floatRenderTargets = caps.has("GL_EXT_color_buffer_float");
+    l.halfFloatRenderTargets = l.floatRenderTargets || caps.has("GL_EXT_color_buffer_half_float");
     l.norm16Textures = caps.has("GL_EXT_texture_norm16");
     l.halfFloatTextures = true;  // RGBA16F is filterable in ES 3.0
   } else {
     l.floatRenderTargets = false;
+    l.halfFloatRenderTargets =
+        caps.has("GL_EXT_color_buffer_half_float") && caps.has("GL_OES_texture_half_float");
     l.norm16Textures = false;
     l.halfFloatTextures =
         caps.has("GL_OES_texture_half_float") && caps.has("GL_OES_texture_half_float_linear");
@@ -42,6 +45,7 @@ DeviceLimits effectiveLimits(const DeviceProfile& profile, const DeviceCaps& cap
   l.textureBudget = profile.textureBudget;
   l.hostBudget = profile.hostBudget;
   l.floatRenderTargets = l.floatRenderTargets && profile.floatRenderTargets;
+  l.halfFloatRenderTargets = l.halfFloatRenderTargets && profile.floatRenderTargets;
   return l;
 }
 

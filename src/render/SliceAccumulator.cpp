@@ -8,7 +8,13 @@ namespace tessera::render {
 
 SliceAccumulator::SliceAccumulator(gpu::GlContext& context) : context_(context) {
   const gpu::DeviceLimits limits = gpu::DeviceLimits::of(context.caps());
-  floatTarget_ = context.caps().api == gpu::ApiLevel::Gles3 && limits.floatRenderTargets;
+  // Half floats where the context renders to them (ES 3: RGBA16F; ES 2:
+  // EXT_color_buffer_half_float), so that thin slices' small premultiplied
+  // contributions are not rounded to 8 bits one by one; RGBA8 otherwise.
+  if (limits.halfFloatRenderTargets) {
+    floatTarget_ = context.caps().api == gpu::ApiLevel::Gles3 ? gpu::TexelFormat::RGBA16F
+                                                              : gpu::TexelFormat::RgbaHalfUnsized;
+  }
   triangle_ = gpu::FullscreenTriangle(context.ledger());
 }
 
@@ -51,7 +57,10 @@ void SliceAccumulator::begin(int width, int height, RenderMode mode) {
     image_ = gpu::Framebuffer();
     const gpu::TexelFormat rgba8 = gpu::rgba8For(context_.caps().api);
     accumulation_ = gpu::Framebuffer::create(context_.ledger(), "slice accumulation", width, height,
-                                             floatTarget_ ? gpu::TexelFormat::RGBA16F : rgba8);
+                                             floatTarget_.value_or(rgba8));
+    // Read at texel centres anyway; NEAREST also keeps an ES 2 half-float
+    // target complete where half floats do not filter.
+    accumulation_.color().setFilter(gpu::Filter::Nearest);
     // Read back at texel centres (gl_FragCoord / size), where linear
     // filtering returns the texel itself.
     image_ = gpu::Framebuffer::create(context_.ledger(), "slice image", width, height, rgba8);

@@ -3,6 +3,7 @@
 // gradient of a linear ramp lights the analytic normal.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -13,6 +14,7 @@
 #include "support/GpuTestContext.h"
 #include "support/TestTransferFunctions.h"
 #include "tessera/core/Error.h"
+#include "tessera/gpu/DeviceProfile.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/layout/MosaicLayout.h"
 #include "tessera/layout/PackedMosaicLayout.h"
@@ -96,10 +98,16 @@ void withContext(gpu::ApiLevel api, Body body) {
 }
 
 // `sliceBar`: view-aligned slices sample other positions than rays, which
-// shows at the phantom's ideal steps (where normals turn within a voxel), and
-// ES 2 accumulates them in RGBA8 (unshaded slice3d ES 2 on the phantom: 43.7 dB).
+// shows at the phantom's ideal steps (where normals turn within a voxel).
+// slice3d accumulates in half floats where the context renders to them (ES 2:
+// EXT_color_buffer_half_float, which Mesa has); in RGBA8 the phantom fell to
+// 38.7 dB, so a context without them is held to 35 dB.
 void expectShadedLayoutsMatchReference(gpu::ApiLevel api, const Volume& v, double sliceBar) {
   withContext(api, [&](gpu::GlContext& c) {
+    if (!gpu::DeviceLimits::of(c.caps()).halfFloatRenderTargets) {
+      std::printf("  [note] no half-float render target: slice3d accumulates in RGBA8\n");
+      sliceBar = std::min(sliceBar, 35.0);
+    }
     const Camera cam = obliqueCamera(v);
     const RenderSettings s = shadedSettings();
     RenderSettings unshaded = s;
@@ -115,6 +123,11 @@ void expectShadedLayoutsMatchReference(gpu::ApiLevel api, const Volume& v, doubl
                                          visibleTf(), cam, s, 96, 96);
     const char* name = v.dims().x == 37 ? "sphere" : "phantom";
     for (const auto& l : layoutsFor(c, v)) {
+      if (gpu::DeviceLimits::of(c.caps()).halfFloatRenderTargets) {
+        render::Slice3DRenderer slicer(c, v, *l);
+        EXPECT_NE(slicer.accumulationFormat().find("RGBA16F"), std::string::npos)
+            << slicer.accumulationFormat();
+      }
       const double cast = psnr(raycastWith(c, v, *l, cam, s, 96), ref);
       const double slice = psnr(sliceWith(c, v, *l, cam, s, 96), ref);
       std::printf(
@@ -150,7 +163,7 @@ TEST(Shading, EveryLayoutMatchesShadedReferenceOnEs3) {
 
 TEST(Shading, EveryLayoutMatchesShadedReferenceOnEs2) {
   expectShadedLayoutsMatchReference(gpu::ApiLevel::Gles2, makeSphere({37, 53, 29}), 40.0);
-  expectShadedLayoutsMatchReference(gpu::ApiLevel::Gles2, makeSheppLogan({38, 53, 29}), 35.0);
+  expectShadedLayoutsMatchReference(gpu::ApiLevel::Gles2, makeSheppLogan({38, 53, 29}), 40.0);
 }
 
 namespace {

@@ -11,6 +11,7 @@
 #include "support/GpuTestContext.h"
 #include "support/TestTransferFunctions.h"
 #include "tessera/core/Error.h"
+#include "tessera/gpu/TexelFormat.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/layout/MosaicLayout.h"
 #include "tessera/layout/PackedMosaicLayout.h"
@@ -98,7 +99,9 @@ TEST(Slice3D, Es2ContextRendersMosaicAndPackedLayouts) {
     auto mosaic = layout::MosaicLayout::create(v, limits, c->ledger());
     limits.max2DTextureSize = 128;
     auto packed = layout::PackedMosaicLayout::create(v, limits, c->ledger(), 6);
-    // ES 2 accumulates in RGBA8; fewer, thicker slices round less often.
+    // ES 2 accumulates in half floats where the context renders to them
+    // (EXT_color_buffer_half_float), RGBA8 otherwise; a 1-voxel step keeps
+    // the RGBA8 case's rounding small too.
     RenderSettings s = halfVoxel();
     s.stepVoxels = 1.0;
     const Camera cam = obliqueCamera(v);
@@ -106,7 +109,10 @@ TEST(Slice3D, Es2ContextRendersMosaicAndPackedLayouts) {
     for (const layout::Layout* l : {static_cast<const layout::Layout*>(mosaic.get()),
                                     static_cast<const layout::Layout*>(packed.get())}) {
       render::Slice3DRenderer r(*c, v, *l);
-      EXPECT_EQ(r.accumulationFormat(), "RGBA8");
+      EXPECT_EQ(r.accumulationFormat(),
+                limits.halfFloatRenderTargets
+                    ? gpu::texelFormatName(gpu::TexelFormat::RgbaHalfUnsized)
+                    : std::string("RGBA8"));
       r.setTransferFunction(visibleTf());
       const Image img = r.render(cam, s, 96, 96);
       const double db = psnr(img, ref);

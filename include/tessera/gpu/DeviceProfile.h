@@ -61,6 +61,12 @@ struct DeviceLimits {
   std::uint64_t textureBudget = 0;  // 0 = unlimited
   std::uint64_t hostBudget = 0;     // 0 = unlimited
   bool floatRenderTargets = false;
+  // Half floats as a render target: RGBA16F on gles3 (EXT_color_buffer_float
+  // or EXT_color_buffer_half_float), RGBA + HALF_FLOAT_OES on gles2
+  // (EXT_color_buffer_half_float with OES_texture_half_float, as most WebGL 1
+  // browsers and many ES 2 GPUs offer). A profile without float render
+  // targets has neither.
+  bool halfFloatRenderTargets = false;
   bool norm16Textures = false;  // EXT_texture_norm16 (gles3 only)
   bool halfFloatTextures =
       false;  // RGBA16F textures filterable (gles3, or OES_texture_half_float(_linear))

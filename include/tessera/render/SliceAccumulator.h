@@ -14,6 +14,7 @@
 // would drift. ES 2 devices accumulate in RGBA8, as the papers' devices did.
 // MIP blends with GL_MAX (ES 3, or ES 2 with EXT_blend_minmax): slices write
 // (n * inside, 0, 0, inside) and the resolve pass classifies the maximum.
+#include <optional>
 #include <string>
 
 #include "tessera/core/Image.h"
@@ -41,14 +42,16 @@ class SliceAccumulator {
   const gpu::Texture& colorTexture() const { return image_.color(); }
 
   // "RGBA16F" or "RGBA8".
-  std::string accumulationFormat() const { return floatTarget_ ? "RGBA16F" : "RGBA8"; }
+  std::string accumulationFormat() const {
+    return floatTarget_ ? gpu::texelFormatName(*floatTarget_) : "RGBA8";
+  }
   std::uint64_t ownTextureBytes() const;
 
  private:
   const gpu::Program& resolveProgram(RenderMode mode);
 
   gpu::GlContext& context_;
-  bool floatTarget_ = false;
+  std::optional<gpu::TexelFormat> floatTarget_;  // the half-float target, if any
   gpu::Framebuffer accumulation_;
   gpu::Framebuffer image_;
   gpu::FullscreenTriangle triangle_;
