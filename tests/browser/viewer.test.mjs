@@ -666,11 +666,11 @@ async function sliceViewsAndRegion(context, url, tmp, run) {
   const spec = [0, 1, 2].map((a) => `${r.begin[a]}:${r.end[a]}`).join(',');
   const s3d = await page.evaluate(() => window.tessera.state());
   const refPng = path.join(tmp, 'native-region.png');
-  run('render', file, '--region', spec, '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', '--out', refPng);
+  run('render', file, '--region', spec, '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', ...PAGE_SAMPLING, '--out', refPng);
   const m = await psnrAgainst(page, refPng);
   const size = [0, 1, 2].map((a) => r.end[a] - r.begin[a]);
-  check('a box dragged in the axial view renders like `tessera render --region` of it (PSNR >= 35 dB)',
-        m.psnr >= 35 && s3d.dims.join('x') === size.join('x') && size[ax.axis] === 16 && size.every((d) => d > 1 && d <= 16),
+  check('a box dragged in the axial view renders like `tessera render --region` of it (PSNR >= 50 dB)',
+        m.psnr >= 50 && s3d.dims.join('x') === size.join('x') && size[ax.axis] === 16 && size.every((d) => d > 1 && d <= 16),
         m.error || `region ${spec} (${size.join('x')} voxels, 3D view ${s3d.dims.join('x')}): ${m.psnr.toFixed(2)} dB`);
 
   await page.click('#overview');
@@ -801,12 +801,12 @@ async function gridView(context, url, tmp, run) {
   let s3d = await page.evaluate(() => window.tessera.state());
   const first = '16:32,8:24,8:24';
   const refPng = path.join(tmp, 'grid-block.png');
-  run('render', file, '--region', first, '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', '--out', refPng);
+  run('render', file, '--region', first, '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', ...PAGE_SAMPLING, '--out', refPng);
   let m = await psnrAgainst(page, refPng);
   const padShown = await page.locator('#grid-pad').isVisible();
-  check('G enters the grid view: the 2x2x2 block around the point nearest the crosshair renders like `tessera render --region` of it (PSNR >= 35 dB)',
+  check('G enters the grid view: the 2x2x2 block around the point nearest the crosshair renders like `tessera render --region` of it (PSNR >= 50 dB)',
         g.active && g.point.join() === '3,2,2' && g.cells.join() === '5,4,3' && boxSpec(g.block) === first &&
-        s3d.dims.join('x') === '16x16x16' && m.psnr >= 35 && padShown,
+        s3d.dims.join('x') === '16x16x16' && m.psnr >= 50 && padShown,
         m.error || `point (${g.point.join(', ')}) ${g.point_class}, block ${boxSpec(g.block)} (3D view ${s3d.dims.join('x')}): ${m.psnr.toFixed(2)} dB; pad ${padShown ? 'shown' : 'HIDDEN'}`);
 
   // Forward from the front: +x, one cell. The other labels follow from the
@@ -823,11 +823,11 @@ async function gridView(context, url, tmp, run) {
   const db = [0, 1, 2].map((a) => g2.block.begin[a] - g.block.begin[a]);
   const de = [0, 1, 2].map((a) => g2.block.end[a] - g.block.end[a]);
   const movedRef = path.join(tmp, 'grid-moved.png');
-  run('render', file, '--region', boxSpec(g2.block), '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', '--out', movedRef);
+  run('render', file, '--region', boxSpec(g2.block), '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', ...PAGE_SAMPLING, '--out', movedRef);
   const m2 = await psnrAgainst(page, movedRef);
-  check('from the front the buttons read Forward +x, Right +z (patient left), Up -y (superior); Forward moves the block one cell (8 voxels) along x only, rendered like the CLI (>= 35 dB)',
+  check('from the front the buttons read Forward +x, Right +z (patient left), Up -y (superior); Forward moves the block one cell (8 voxels) along x only, rendered like the CLI (>= 50 dB)',
         forwardLabel === '0:Forward +x' && labels.join() === '4:Up -y,0:Forward +x,5:Down +y,2:Left -z,1:Back -x,3:Right +z' && g2.point.join() === '4,2,2' && db.join() === '8,0,0' && de.join() === '8,0,0' &&
-        m2.psnr >= 35 && changedFraction(before.pixels, after.pixels) > 0.01,
+        m2.psnr >= 50 && changedFraction(before.pixels, after.pixels) > 0.01,
         m2.error || `buttons ${labels.join(', ')}; block ${boxSpec(g.block)} -> ${boxSpec(g2.block)}: ${m2.psnr.toFixed(2)} dB, ` +
         `${(100 * changedFraction(before.pixels, after.pixels)).toFixed(1)} % of the view changed`);
 
@@ -1013,7 +1013,7 @@ async function responsiveCanvas(context, url) {
 async function loadFromUrl(context, url, tmp, run) {
   if (!fs.existsSync(CH2)) { check(`?url= test needs ${CH2} (mricron-data)`, false); return; }
   run('render', CH2, '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2',
-      '--out', path.join(tmp, 'native-ch2.png'));
+      ...PAGE_SAMPLING, '--out', path.join(tmp, 'native-ch2.png'));
   const { page, logs } = await openPage(context, url, `size=${SIZE}&url=/templates/ch2.nii.gz`);
   const s = await page.evaluate(() => window.tessera.state());
   const load = await page.evaluate(() => window.tessera.lastLoad());
@@ -1141,7 +1141,7 @@ async function zarrStoreFromUrl(context, url, tmp, run) {
   run('convert', CH2, store, '--compressor', 'zlib');
   const nativePng = path.join(tmp, 'native-ch2-zarr.png');
   const native = JSON.parse(run('render', store, '--layout', 'bricks', '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`,
-                                '--profile', 'webgl2', '--json', '--out', nativePng));
+                                '--profile', 'webgl2', ...PAGE_SAMPLING, '--json', '--out', nativePng));
   const bytesUnder = (dir) => fs.readdirSync(dir, { recursive: true }).map((f) => path.join(dir, f))
     .filter((f) => fs.statSync(f).isFile() && !path.basename(f).startsWith('.')).reduce((n, f) => n + fs.statSync(f).size, 0);
   const finestBytes = bytesUnder(path.join(store, '0'));
@@ -1167,7 +1167,7 @@ async function zarrStoreFromUrl(context, url, tmp, run) {
         `complete after ${z.completeMs.toFixed(0)} ms in ${z.timeline.length} frames; cells ${JSON.stringify(lastCells)} ` +
         `(native ${JSON.stringify(nativeCells)}); ${(100 * changedFraction(coarse.pixels, fine.pixels)).toFixed(1)} % of pixels changed`);
   const m = await psnrAgainst(page, nativePng);
-  check('OME-Zarr ?url=: the refined image matches the native render of the store (PSNR >= 35 dB)', m.psnr >= 35,
+  check('OME-Zarr ?url=: the refined image matches the native render of the store (PSNR >= 50 dB)', m.psnr >= 50,
         m.error || `${m.psnr.toFixed(2)} dB`);
   const metadata = fs.readdirSync(store, { recursive: true }).filter((f) => path.basename(f).startsWith('.'))
     .reduce((n, f) => n + fs.statSync(path.join(store, f)).size, 0);
@@ -1214,8 +1214,8 @@ async function zarrStoreFromUrl(context, url, tmp, run) {
     const zc = await p.page.evaluate(() => window.tessera.zarr());
     const mc = await psnrAgainst(p.page, nativePng);
     const error = await p.page.evaluate(() => window.tessera.error());
-    check(`OME-Zarr ?url= of a ${codec} store (decoded by numcodecs in the page) matches the native render (PSNR >= 35 dB)`,
-          !error && zc.last && zc.last.complete && mc.psnr >= 35,
+    check(`OME-Zarr ?url= of a ${codec} store (decoded by numcodecs in the page) matches the native render (PSNR >= 50 dB)`,
+          !error && zc.last && zc.last.complete && mc.psnr >= 50,
           error || mc.error || `${mc.psnr.toFixed(2)} dB, refined in ${zc.completeMs.toFixed(0)} ms, ${zc.requests} requests`);
     await p.page.close();
   }
