@@ -52,6 +52,14 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& o) {
                   "towards the light X,Y,Z in the patient frame (RAS+: x right, y anterior, "
                   "z superior), e.g. 0,1,1 from the front and above")
       ->capture_default_str();
+  cmd->add_option("--gradient-opacity", o.gradientOpacity,
+                  "Gradient-magnitude opacity modulation, LOW,HIGH (or 'on' for " +
+                      std::to_string(Shading{}.gradientLow).substr(0, 4) + "," +
+                      std::to_string(Shading{}.gradientHigh).substr(0, 4) +
+                      "): a sample's opacity is scaled by clamp((|gradient| - LOW) / (HIGH - "
+                      "LOW), 0, 1), |gradient| in normalised value per voxel, so homogeneous "
+                      "regions fade and boundaries stay; with or without --shade; composite "
+                      "mode only");
   cmd->add_option("--ambient", o.coefficients.ambient, "With --shade: ambient term")
       ->capture_default_str();
   cmd->add_option("--diffuse", o.coefficients.diffuse, "With --shade: diffuse term")
@@ -67,6 +75,20 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& o) {
 Shading shadingFrom(const ShadingOptions& o) {
   Shading s = o.coefficients;
   s.enabled = o.shade;
+  if (!o.gradientOpacity.empty() && o.gradientOpacity != "off") {
+    s.gradientOpacity = true;
+    if (o.gradientOpacity != "on") {
+      double low = 0.0, high = 0.0;
+      char comma = 0, extra = 0;
+      std::istringstream in(o.gradientOpacity);
+      if (!(in >> low >> comma >> high) || comma != ',' || (in >> extra)) {
+        throw InputError("--gradient-opacity '" + o.gradientOpacity +
+                         "': expected on, off or LOW,HIGH (e.g. 0.01,0.06)");
+      }
+      s.gradientLow = low;
+      s.gradientHigh = high;
+    }
+  }
   s.headlight = o.light == "headlight";
   if (!s.headlight) s.lightDirection = parseLightDirection(o.light);
   render::checkShading(s);

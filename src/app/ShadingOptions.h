@@ -15,6 +15,7 @@ struct ShadingOptions {
   std::string light = "headlight";
   Shading coefficients;           // ambient, diffuse, specular, shininess and their defaults
   std::string gradient = "auto";  // auto, on-the-fly or precomputed (layout/GradientTexture.h)
+  std::string gradientOpacity;    // --gradient-opacity: empty/off, on or LOW,HIGH
 };
 
 void addShadingOptions(CLI::App* cmd, ShadingOptions& o);

@@ -1082,7 +1082,18 @@ void panelLabels(DesktopSession& ds) {
 void panelShading(viewer::Viewer& v) {
   section("Shading");
   Shading& s = v.settings().shading;
+  auto slider = [](const char* label, double& value, float lo, float hi) {
+    float f = static_cast<float>(value);
+    if (ImGui::SliderFloat(label, &f, lo, hi)) value = f;
+  };
   ImGui::Checkbox("shade (gradient lighting)", &s.enabled);
+  // Gradient-magnitude opacity modulation, with or without the light.
+  ImGui::Checkbox("gradient opacity", &s.gradientOpacity);
+  if (s.gradientOpacity) {
+    slider("|gradient| from", s.gradientLow, 0.0f, 0.3f);
+    slider("|gradient| full", s.gradientHigh, 0.001f, 0.6f);
+    s.gradientHigh = std::max(s.gradientHigh, s.gradientLow + 0.001);
+  }
   if (!s.enabled) return;
   ImGui::Checkbox("headlight", &s.headlight);
   if (!s.headlight) {
@@ -1093,10 +1104,6 @@ void panelShading(viewer::Viewer& v) {
       s.lightDirection = {dir[0], dir[1], dir[2]};
     }
   }
-  auto slider = [](const char* label, double& value, float lo, float hi) {
-    float f = static_cast<float>(value);
-    if (ImGui::SliderFloat(label, &f, lo, hi)) value = f;
-  };
   slider("ambient", s.ambient, 0.0f, 1.0f);
   slider("diffuse", s.diffuse, 0.0f, 1.0f);
   slider("specular", s.specular, 0.0f, 1.0f);
@@ -1225,7 +1232,8 @@ std::string viewKey(viewer::Viewer& v, int viewW, int viewH) {
   const Shading& sh = v.settings().shading;
   key << '|' << sh.enabled << sh.headlight << sh.lightDirection.x << ',' << sh.lightDirection.y
       << ',' << sh.lightDirection.z << '|' << sh.ambient << ',' << sh.diffuse << ',' << sh.specular
-      << ',' << sh.shininess;
+      << ',' << sh.shininess << '|' << sh.gradientOpacity << sh.gradientLow << ','
+      << sh.gradientHigh;
   return key.str();
 }
 

@@ -66,7 +66,11 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
   const glm::dvec4 bg = settings.background;
   // Shading (core/RenderSettings.h): the field's gradient per texture unit ->
   // normalised value per model length, times the smallest voxel.
-  const bool shade = settings.shading.enabled && settings.mode == RenderMode::Composite;
+  // With gradient-opacity modulation the gradient is needed without the
+  // light too (lightSample leaves the colour then).
+  const bool shade = (settings.shading.enabled || settings.shading.gradientOpacity) &&
+                     settings.mode == RenderMode::Composite;
+  const bool modulate = shade && settings.shading.gradientOpacity;
   const ShadingLight light =
       shadingLight(settings.shading, camera.basis()[2], camera.modelFromWorld);
   const std::vector<glm::dvec4> clipPlanes =
@@ -141,11 +145,15 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
           // The twin of the GPU's segment: straight colour lit at the
           // segment's middle, opacity for its length.
           const auto composite = [&](double nf, double nb, double kf, double kb) {
-            const glm::dvec4 s = integral->segment(nf, nb, (kb - kf) * ds);
+            glm::dvec4 s = integral->segment(nf, nb, (kb - kf) * ds);
             glm::dvec3 c(s);
             if (shade && s.a > 0.0) {
+              // As the GPU: the segment's opacity for its length, then lit
+              // and modulated at its middle.
               const glm::dvec3 mid = to + (t0 + (0.5 * (kf + kb) + j) * ds) * td;
-              c = shadeBlinnPhong(c, field.gradient(mid) * gradientScale, settings.shading, light);
+              const glm::dvec3 g = field.gradient(mid) * gradientScale;
+              c = lightSample(c, g, settings.shading, light);
+              if (modulate) s.a *= gradientOpacityFactor(g, settings.shading);
             }
             acc += (1.0 - acc.a) * glm::dvec4(c * s.a, s.a);
           };
@@ -235,9 +243,17 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
             } else {
               glm::dvec3 c = tf.color(n);
               // A sample stands for the stretch to the next one.
-              const double a = tf.correctedOpacity(n, ds * (kNext - k), settings.opacityScale);
+              double a = tf.correctedOpacity(n, ds * (kNext - k), settings.opacityScale);
               if (shade && a > 0.0) {
-                c = shadeBlinnPhong(c, field.gradient(p) * gradientScale, settings.shading, light);
+                const glm::dvec3 g = field.gradient(p) * gradientScale;
+                c = lightSample(c, g, settings.shading, light);
+                if (modulate) {
+                  // As the GPU: the base step's opacity modulated, then
+                  // corrected for the stretch the sample stands for.
+                  const double a1 = tf.correctedOpacity(n, ds, settings.opacityScale) *
+                                    gradientOpacityFactor(g, settings.shading);
+                  a = 1.0 - std::pow(1.0 - a1, kNext - k);
+                }
               }
               acc += (1.0 - acc.a) * glm::dvec4(c * a, a);
             }

@@ -11,11 +11,15 @@
 namespace tessera::render {
 
 bool shadingActive(const RenderSettings& settings) {
-  return settings.shading.enabled && settings.mode == RenderMode::Composite;
+  return (settings.shading.enabled || settings.shading.gradientOpacity) &&
+         settings.mode == RenderMode::Composite;
 }
 
 void addShadingDefines(const RenderSettings& settings, std::vector<std::string>& defines) {
-  if (shadingActive(settings)) defines.push_back("SHADING 1");
+  if (!shadingActive(settings)) return;
+  defines.push_back("SHADING 1");  // the gradient
+  if (settings.shading.enabled) defines.push_back("LIGHTING 1");
+  if (settings.shading.gradientOpacity) defines.push_back("GRADIENT_OPACITY 1");
 }
 
 void checkShading(const Shading& shading) {
@@ -27,6 +31,14 @@ void checkShading(const Shading& shading) {
   }
   if (!(shading.shininess >= 1.0 && shading.shininess <= 512.0)) {
     throw InputError("shading: shininess must be 1..512, got " + std::to_string(shading.shininess));
+  }
+  if (shading.gradientOpacity &&
+      !(shading.gradientLow >= 0.0 && shading.gradientHigh > shading.gradientLow &&
+        std::isfinite(shading.gradientHigh))) {
+    throw InputError(
+        "gradient opacity: expected 0 <= low < high (gradient magnitude in "
+        "normalised value per voxel), got " +
+        std::to_string(shading.gradientLow) + ", " + std::to_string(shading.gradientHigh));
   }
   if (!shading.headlight && !(glm::length(shading.lightDirection) > 1e-9)) {
     throw InputError("shading: the light direction must not be zero");
@@ -48,6 +60,10 @@ void setShadingUniforms(const gpu::Program& program, const RenderSettings& setti
   program.set("u_shadeCoefficients",
               glm::vec4(static_cast<float>(s.ambient), static_cast<float>(s.diffuse),
                         static_cast<float>(s.specular), static_cast<float>(s.shininess)));
+  if (s.gradientOpacity) {
+    program.set("u_gradientOpacity",
+                glm::vec2(static_cast<float>(s.gradientLow), static_cast<float>(s.gradientHigh)));
+  }
 }
 
 }  // namespace tessera::render

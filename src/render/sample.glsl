@@ -23,7 +23,7 @@ float fieldValue(vec3 p) {
 // gradient's fetches.
 vec4 shadeSample(vec4 c, vec3 p) {
   if (c.a <= 0.0) return c;
-  return vec4(shadeBlinnPhong(c.rgb, sampleVolumeGradient(p) * u_shadeGradientScale), c.a);
+  return shadeClassified(c, sampleVolumeGradient(p) * u_shadeGradientScale);
 }
 #endif
 

@@ -25,4 +25,28 @@ vec3 shadeBlinnPhong(vec3 rgb, vec3 g) {
              vec3(u_shadeCoefficients.z * specular);
   return min(lit, vec3(1.0));
 }
+
+#ifdef GRADIENT_OPACITY
+uniform vec2 u_gradientOpacity;  // low, high: |gradient| where opacity starts and is full
+
+// Gradient-magnitude opacity modulation (core/RenderSettings.h:
+// gradientOpacityFactor): homogeneous regions fade, boundaries stay.
+float gradientOpacity(vec3 g) {
+  return clamp((length(g) - u_gradientOpacity.x) / (u_gradientOpacity.y - u_gradientOpacity.x),
+               0.0, 1.0);
+}
+#endif
+
+// A classified straight-colour sample with gradient g: lit (LIGHTING; without
+// it SHADING only brings the gradient for the modulation) and with
+// GRADIENT_OPACITY its opacity scaled. Every technique calls this.
+vec4 shadeClassified(vec4 c, vec3 g) {
+#ifdef LIGHTING
+  c.rgb = shadeBlinnPhong(c.rgb, g);
+#endif
+#ifdef GRADIENT_OPACITY
+  c.a *= gradientOpacity(g);
+#endif
+  return c;
+}
 #endif

@@ -81,7 +81,7 @@ void main() {
 #ifndef MODE_MIP
   vec4 c = classify(n);
 #ifdef SHADING
-  if (c.a > 0.0) c.rgb = shadeBlinnPhong(c.rgb, sliceGradient(texel, here) * u_shadeGradientScale);
+  if (c.a > 0.0) c = shadeClassified(c, sliceGradient(texel, here) * u_shadeGradientScale);
 #endif
   c.rgb *= c.a;
 #endif

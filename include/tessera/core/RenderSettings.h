@@ -39,6 +39,14 @@ struct Shading {
   // which turns with the volume.
   bool headlight = true;
   glm::dvec3 lightDirection{0.0, 1.0, 1.0};
+  // Gradient-magnitude opacity modulation (Levoy 1988's idea in its simplest
+  // form): a sample's opacity is scaled by clamp((|g| - low) / (high - low),
+  // 0, 1), g the same gradient the light uses (normalised value per voxel of
+  // the smallest spacing), so homogeneous regions fade and boundaries stay.
+  // It works with or without the light (`enabled`).
+  bool gradientOpacity = false;
+  double gradientLow = 0.01;
+  double gradientHigh = 0.06;
 };
 
 // A clip plane: keeps the points x (world units from the volume box's
@@ -206,6 +214,23 @@ inline glm::dvec3 shadeBlinnPhong(glm::dvec3 rgb, glm::dvec3 g, const Shading& s
   const glm::dvec3 lit =
       rgb * (shading.ambient + shading.diffuse * diffuse) + glm::dvec3(shading.specular * specular);
   return glm::min(lit, glm::dvec3(1.0));
+}
+
+// The opacity factor of gradient-magnitude modulation for gradient `g`
+// (Shading::gradientOpacity). The GLSL twin is render/shading.glsl's
+// gradientOpacity().
+inline double gradientOpacityFactor(glm::dvec3 g, const Shading& shading) {
+  return std::clamp(
+      (glm::length(g) - shading.gradientLow) / (shading.gradientHigh - shading.gradientLow), 0.0,
+      1.0);
+}
+
+// What a sample's light does with its colour: Blinn-Phong where the light is
+// on, the colour unchanged where only the gradient's opacity modulation
+// needs the gradient (Shading::gradientOpacity without `enabled`).
+inline glm::dvec3 lightSample(glm::dvec3 rgb, glm::dvec3 g, const Shading& shading,
+                              const ShadingLight& light) {
+  return shading.enabled ? shadeBlinnPhong(rgb, g, shading, light) : rgb;
 }
 
 // The clip planes as half-spaces of texture space (p in [0,1]^3, the volume
