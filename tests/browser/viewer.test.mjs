@@ -1024,7 +1024,7 @@ async function loadFromUrl(context, url, tmp, run) {
   await withoutOverlays(page);
   const plain = (await snapshot(page)).pixels;
   const m = await psnrAgainst(page, path.join(tmp, 'native-ch2.png'));
-  check('?url= volume renders like the native image (PSNR >= 35 dB)', m.psnr >= 35, m.error || `${m.psnr.toFixed(2)} dB`);
+  check('?url= volume renders like the native image (PSNR >= 50 dB)', m.psnr >= 50, m.error || `${m.psnr.toFixed(2)} dB`);
   await page.check('#box');
   await page.check('#axes');
   await page.evaluate(() => window.tessera.render());
