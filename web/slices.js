@@ -572,7 +572,10 @@ window.TesseraSlices = (function () {
     // The grid view (web/grid.js) shares the 3D view, the crosshair and
     // the overview's return with the region.
     if (window.TesseraGrid) {
-      grid = window.TesseraGrid.attach({ M, canvas, requestRender, showError, clearError, slices: testApi });
+      grid = window.TesseraGrid.attach({
+        M, canvas, requestRender, showError, clearError, slices: testApi,
+        storeRegion: opts.storeRegion, storeOverview: opts.storeOverview,
+      });
       testApi.grid = grid.testApi;
     }
     return { frameShown, testApi };
