@@ -28,7 +28,7 @@ window.TesseraGrid = (function () {
   const KEYS = { ArrowUp: 0, ArrowDown: 1, ArrowLeft: 2, ArrowRight: 3, PageUp: 4, PageDown: 5 };
 
   function attach(opts) {
-    const { M, canvas, requestRender, showError, clearError, slices } = opts;
+    const { M, canvas, requestRender, showError, clearError, slices, storeRegion, storeOverview } = opts;
     const $ = (id) => document.getElementById(id);
     const c = (name, ret, args) => M.cwrap(name, ret, args);
     const api = {
@@ -39,7 +39,22 @@ window.TesseraGrid = (function () {
       projection: c('tessera_projection_json', 'string', ['number', 'number']),
       markBox: c('tessera_set_mark_box', 'number', ['number', 'number', 'number', 'number', 'number', 'number', 'number']),
       lastError: c('tessera_last_error', 'string', []),
+      storeShown: c('tessera_grid_store_shown', 'number', []),
     };
+    // An OME-Zarr store's block is read like its region (web/zarr-url.js:
+    // only the level-0 chunks it overlaps are fetched, then one box read).
+    async function readStoreBlock() {
+      if (!grid.store_wanted) return true;
+      try {
+        await storeRegion(grid.block.begin, grid.block.end);
+      } catch (e) {
+        showError(`grid view: ${e.message}`);
+        return false;
+      }
+      if (!api.storeShown()) { showError(api.lastError()); return false; }
+      refresh();
+      return true;
+    }
     // The last block's cyan box in the overview is drawn by the viewer
     // (slot 1), as lines composed with the volume by depth like the
     // bounding box; sent when it changes.
@@ -117,13 +132,15 @@ window.TesseraGrid = (function () {
       }
       clearError();
       refresh();
+      if (!(await readStoreBlock())) return false;
       updatePad();
       await requestRender();
       return true;
     }
 
     async function leave() {
-      if (!api.overview()) { showError(api.lastError()); return false; }
+      if (refresh().store) await storeOverview();
+      else if (!api.overview()) { showError(api.lastError()); return false; }
       syncMark(refresh().block);  // in the very frame that shows the overview
       await requestRender();
       return true;
@@ -136,6 +153,7 @@ window.TesseraGrid = (function () {
       if (r < 0) { showError(api.lastError()); return r; }
       clearError();
       refresh();
+      if (r === 1 && !(await readStoreBlock())) return -1;
       updatePad();
       await requestRender();
       return r;

@@ -203,7 +203,13 @@ window.TesseraSlices = (function () {
         ctx.setLineDash([]);
       }
       // The grid view's block (web/grid.js), cyan, where this slice cuts it.
-      const block = grid && grid.block();
+      // A store's block is in level-0 voxels: scaled to the overview's.
+      const level0Block = grid && grid.block();
+      const sc = explore.store ? explore.store_scale : [1, 1, 1];
+      const block = level0Block && {
+        begin: level0Block.begin.map((v, a) => Math.floor(v / sc[a])),
+        end: level0Block.end.map((v, a) => Math.ceil(v / sc[a])),
+      };
       if (block && cross[p.axis] >= block.begin[p.axis] && cross[p.axis] < block.end[p.axis]) {
         const [x, y, w, h] = boxRect(p, block);
         ctx.lineWidth = 2 * px;
@@ -572,7 +578,10 @@ window.TesseraSlices = (function () {
     // The grid view (web/grid.js) shares the 3D view, the crosshair and
     // the overview's return with the region.
     if (window.TesseraGrid) {
-      grid = window.TesseraGrid.attach({ M, canvas, requestRender, showError, clearError, slices: testApi });
+      grid = window.TesseraGrid.attach({
+        M, canvas, requestRender, showError, clearError, slices: testApi,
+        storeRegion: opts.storeRegion, storeOverview: opts.storeOverview,
+      });
       testApi.grid = grid.testApi;
     }
     return { frameShown, testApi };

@@ -1048,6 +1048,7 @@ struct GridView {
   std::optional<lod::VoxelBox> block;  // the last block shown
   std::string note;                    // the last move, or why it was refused
   bool refused = false;
+  bool storeWanted = false;  // a store's block is to be read (the page fetches its chunks)
 };
 
 GridView& gridView() {
@@ -1055,8 +1056,18 @@ GridView& gridView() {
   return g;
 }
 
+// A store's grid is over level 0 (its blocks are read there, like its
+// regions); a file's over the overview volume.
+glm::ivec3 gridDims(const Volume& v) {
+  return storeOverview() ? theZarrView().source().levelInfo(0).dims : v.dims();
+}
+
 std::string overviewKey(const Volume& v) {
-  const glm::ivec3 d = v.dims();
+  const glm::ivec3 d = gridDims(v);
+  if (storeOverview()) {
+    return "store:" + theZarrView().storage().describe() + "|" + std::to_string(d.x) + "x" +
+           std::to_string(d.y) + "x" + std::to_string(d.z);
+  }
   const std::string name = regionShown() ? sliceViews().overviewName : theViewer().volumeName();
   return name + "|" + std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
 }
@@ -1065,6 +1076,11 @@ std::string overviewKey(const Volume& v) {
 // picked since, nor the overview, nor another file).
 bool gridShown() {
   const GridView& g = gridView();
+  if (storeOverview()) {
+    const StoreRegion& r = storeRegion();
+    return !g.shownName.empty() && r.shown && g.block && r.box.begin == g.block->begin &&
+           r.box.end == g.block->end && theViewer().volumeName() == g.shownName;
+  }
   return !g.shownName.empty() && regionShown() && sliceViews().shownName == g.shownName;
 }
 
@@ -1075,7 +1091,7 @@ bool gridShown() {
 // volume that fits the budget whole still has a grid to move on.
 lod::GridNavigator defaultGrid(const Volume& volume) {
   const int side = defaultRegionSide(volume).first;
-  const glm::ivec3 d = volume.dims();
+  const glm::ivec3 d = gridDims(volume);
   const int budgetCell =
       lod::GridNavigator::forBudget(d, std::uint64_t(side) * side * side, 16).cellSize().x;
   const int quarter = (std::max({d.x, d.y, d.z}) + 3) / 4;
@@ -1090,7 +1106,8 @@ lod::GridNavigator& gridFor(const Volume& volume, int cellSide) {
   const std::string key = overviewKey(volume);
   const int asked = cellSide < 0 ? g.askedCell : cellSide;
   if (!g.nav || g.volumeKey != key || g.askedCell != asked) {
-    g.nav = asked > 0 ? lod::GridNavigator(volume.dims(), glm::ivec3(asked)) : defaultGrid(volume);
+    g.nav =
+        asked > 0 ? lod::GridNavigator(gridDims(volume), glm::ivec3(asked)) : defaultGrid(volume);
     g.volumeKey = key;
     g.askedCell = asked;
     g.block.reset();
@@ -1111,6 +1128,16 @@ std::string boxText(const lod::VoxelBox& b) {
 // projection stay (the moves are chosen from it); the zoom too on a move,
 // 1 on entering (the block fills the view).
 void showGridBlock(const lod::VoxelBox& box, bool keepZoom) {
+  GridView& g = gridView();
+  if (storeOverview()) {
+    // A store's block is read like its region (tessera_zarr_region_prefetch
+    // / _show): the page fetches exactly its level-0 chunks, then calls
+    // tessera_grid_store_shown.
+    g.block = box;
+    g.storeWanted = true;
+    g.shownName.clear();
+    return;
+  }
   viewer::Viewer& v = theViewer();
   const Camera before = v.camera();
   if (!tessera_region_show(box.begin.x, box.end.x, box.begin.y, box.end.y, box.begin.z,
@@ -1122,7 +1149,6 @@ void showGridBlock(const lod::VoxelBox& box, bool keepZoom) {
   c.azimuthDeg = before.azimuthDeg;
   c.elevationDeg = before.elevationDeg;
   c.zoom = keepZoom ? before.zoom : 1.0;
-  GridView& g = gridView();
   g.shownName = sliceViews().shownName;
   g.block = box;
 }
@@ -1141,14 +1167,11 @@ extern "C" {
 // before), and shows that point's block.
 EMSCRIPTEN_KEEPALIVE int tessera_grid_enter(int cellSide, int x, int y, int z) {
   return guarded([&] {
-    if (storeOverview()) {
-      throw InputError(theZarrView().storage().describe() +
-                       ": the grid view of an OME-Zarr store is not built yet (a region "
-                       "picked in a slice view is read at native resolution)");
-    }
     const Volume& volume = overviewVolume();
     lod::GridNavigator& nav = gridFor(volume, cellSide);
-    const glm::dvec3 c = (glm::dvec3(x, y, z) + 0.5) / glm::dvec3(nav.cellSize());
+    // The crosshair is in overview voxels; a store's grid is over level 0.
+    const glm::dvec3 scale = glm::dvec3(gridDims(volume)) / glm::dvec3(volume.dims());
+    const glm::dvec3 c = (glm::dvec3(x, y, z) + 0.5) * scale / glm::dvec3(nav.cellSize());
     nav.moveTo(glm::clamp(glm::ivec3(glm::round(c)), glm::ivec3(0), nav.cells()));
     showGridBlock(nav.blockBox(nav.point()), false);
     GridView& g = gridView();
@@ -1165,7 +1188,9 @@ EMSCRIPTEN_KEEPALIVE int tessera_grid_move(int viewMove) {
   int result = -1;
   guarded([&] {
     if (viewMove < 0 || viewMove > 5) throw InputError("grid view: moves are 0..5");
-    if (!gridShown()) throw InputError("grid view: not in the grid view (press G)");
+    if (!gridShown() && !gridView().storeWanted) {
+      throw InputError("grid view: not in the grid view (press G)");
+    }
     viewer::Viewer& v = theViewer();
     lod::GridNavigator& nav = gridFor(overviewVolume(), -1);
     const lod::ViewMove vm = kViewMoves[viewMove];
@@ -1202,8 +1227,8 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_grid_json() {
   nlohmann::json j;
   j["has_volume"] = false;
   guarded([&] {
-    // Not on a store yet (tessera_grid_enter says so).
-    if (!app().viewer || !theViewer().hasVolume() || storeOverview()) return;
+    if (!app().viewer || (!theViewer().hasVolume() && !storeOverview())) return;
+    if (storeOverview() && !theZarrView().isOpen()) return;
     const Volume& volume = overviewVolume();
     lod::GridNavigator& nav = gridFor(volume, -1);
     const GridView& g = gridView();
@@ -1236,9 +1261,28 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_grid_json() {
     j["note"] = g.note;
     j["refused"] = g.refused;
     j["default_cell"] = defaultGrid(volume).cellSize().x;
+    // A store: the block (level-0 voxels) the page is to fetch and show
+    // (tessera_zarr_region_prefetch / _show, then tessera_grid_store_shown).
+    j["store"] = storeOverview() != nullptr;
+    j["store_wanted"] = g.storeWanted;
   });
   scratch() = j.dump();
   return scratch().c_str();
+}
+
+// A store's block (tessera_grid_json's block) has been read and shown by
+// tessera_zarr_region_show: it is now the grid view's.
+EMSCRIPTEN_KEEPALIVE int tessera_grid_store_shown() {
+  return guarded([&] {
+    GridView& g = gridView();
+    const StoreRegion& r = storeRegion();
+    if (!g.storeWanted || !g.block || !r.shown || r.box.begin != g.block->begin ||
+        r.box.end != g.block->end) {
+      throw InputError("grid view: the store's block has not been read");
+    }
+    g.storeWanted = false;
+    g.shownName = theViewer().volumeName();
+  });
 }
 
 }  // extern "C"
