@@ -120,6 +120,7 @@
       setTechnique: c('tessera_set_technique', 'number', ['string']),
       stateJson: c('tessera_state_json', 'string', ['number']),
       readPixels: c('tessera_read_pixels', 'number', ['number', 'number']),
+      setGradientOpacity: c('tessera_set_gradient_opacity', 'number', ['number', 'number', 'number']),
       setLight: c('tessera_set_light', 'number', ['number', 'number', 'number', 'number', 'number', 'number', 'number', 'number']),
       setCrop: c('tessera_set_crop', 'number', ['number', 'number', 'number', 'number', 'number', 'number']),
       showCropBox: c('tessera_show_crop_box', null, ['number']),
@@ -749,6 +750,19 @@
       requestRender();
     };
     ['headlight', 'lightDir'].forEach((id) => $(id).addEventListener('change', applyLight));
+    // Gradient-magnitude opacity (with or without the light): the sliders
+    // keep low below high.
+    const applyGradientOpacity = (e) => {
+      const lo = $('gradLow'), hi = $('gradHigh');
+      if (+lo.value >= +hi.value) {
+        if (e && e.target === lo) hi.value = Math.min(+hi.max, +lo.value + 0.005);
+        else lo.value = Math.max(0, +hi.value - 0.005);
+      }
+      if (!api.setGradientOpacity($('gradOpacity').checked ? 1 : 0, +lo.value, +hi.value)) showError(api.lastError());
+      requestRender();
+    };
+    $('gradOpacity').addEventListener('change', applyGradientOpacity);
+    ['gradLow', 'gradHigh'].forEach((id) => $(id).addEventListener('input', applyGradientOpacity));
     ['ambient', 'diffuse', 'specular', 'shininess'].forEach((id) => $(id).addEventListener('input', applyLight));
     // Clipping: the crop box (sliders and handles) and the camera-facing plane.
     const applyCrop = (e) => {

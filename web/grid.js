@@ -20,6 +20,11 @@
 // - The overview draws the last block as a cyan box (the region is red),
 //   and the slice views outline it where they cut it.
 //
+// - "Zoom swaps levels and the native block" (or Z): viewer::ZoomSwap drives
+//   the 3D view of a loaded file (coarse level, medium level, the native
+//   block around the view's centre, chosen by the zoom, cross-faded;
+//   docs/explore.md); its stages are shown under the checkbox.
+//
 // slices.js calls TesseraGrid.attach() and frameShown() after every frame.
 'use strict';
 
@@ -40,6 +45,9 @@ window.TesseraGrid = (function () {
       markBox: c('tessera_set_mark_box', 'number', ['number', 'number', 'number', 'number', 'number', 'number', 'number']),
       lastError: c('tessera_last_error', 'string', []),
       storeShown: c('tessera_grid_store_shown', 'number', []),
+      storeFailed: c('tessera_grid_store_failed', 'number', []),
+      zoomSwap: c('tessera_zoom_swap', 'number', ['number', 'number', 'number', 'number']),
+      zoomJson: c('tessera_zoom_json', 'string', []),
     };
     // An OME-Zarr store's block is read like its region (web/zarr-url.js:
     // only the level-0 chunks it overlaps are fetched, then one box read).
@@ -48,6 +56,9 @@ window.TesseraGrid = (function () {
       try {
         await storeRegion(grid.block.begin, grid.block.end);
       } catch (e) {
+        // Back to the grid point and block shown before (or none).
+        api.storeFailed();
+        refresh();
         showError(`grid view: ${e.message}`);
         return false;
       }
@@ -108,6 +119,39 @@ window.TesseraGrid = (function () {
       if (syncMark(want)) requestRender();
     }
 
+    // ------------------------------------------------------------ zoom swap
+    // The zoom-driven level swap (viewer::ZoomSwap through tessera_zoom_*):
+    // after a frame that starts or runs a cross-fade, or whose zoom asks for
+    // another stage, the next frame is asked for at once.
+    let zoom = { active: false };
+    let zoomOpts = { overviewVoxels: 0, blockVoxels: 0 };
+    function syncZoom() {
+      zoom = JSON.parse(api.zoomJson());
+      $('zoomSwap').checked = !!zoom.active;
+      const info = $('zoomInfo');
+      if (!zoom.active) { info.textContent = ''; return; }
+      const stages = zoom.stages.map((st, i) => {
+        const what = st.native ? 'native block' : `${st.name} L${st.level}`;
+        const text = `${what} from zoom ${st.enter_zoom.toFixed(2)}`;
+        return i === zoom.shown_stage ? `[${text}]` : text;
+      });
+      info.textContent = `zoom ${zoom.zoom.toFixed(2)}: ${stages.join(' · ')}${zoom.fading ? ' (fading)' : ''}`;
+      if (zoom.fading || zoom.target !== zoom.shown_stage) requestRender();
+    }
+    async function setZoomSwap(on, opts) {
+      if (opts) zoomOpts = { overviewVoxels: opts.overviewVoxels || 0, blockVoxels: opts.blockVoxels || 0 };
+      if (!api.zoomSwap(on ? 1 : 0, canvas.height, zoomOpts.overviewVoxels, zoomOpts.blockVoxels)) {
+        showError(api.lastError());
+        syncZoom();
+        return false;
+      }
+      clearError();
+      syncZoom();
+      await requestRender();
+      return true;
+    }
+    $('zoomSwap').addEventListener('change', (e) => setZoomSwap(e.target.checked));
+
     // After every frame (slices.js): a new volume forgets the block.
     function frameShown(exploreNow) {
       explore = exploreNow;
@@ -119,6 +163,7 @@ window.TesseraGrid = (function () {
       }
       updatePad();
       drawOverlay();
+      syncZoom();
     }
 
     // ------------------------------------------------------------ actions
@@ -167,7 +212,10 @@ window.TesseraGrid = (function () {
       const t = e.target;
       if (t && (t.tagName === 'INPUT' || t.tagName === 'SELECT' || t.tagName === 'TEXTAREA')) return;
       if (e.ctrlKey || e.metaKey || e.altKey) return;
-      if (e.key === 'g' || e.key === 'G') {
+      if ((e.key === 'z' || e.key === 'Z') && grid.has_volume && !refresh().store) {
+        setZoomSwap(!zoom.active);
+        e.preventDefault();
+      } else if (e.key === 'g' || e.key === 'G') {
         if (!grid.has_volume) return;
         refresh().active ? leave() : enter();
         e.preventDefault();
@@ -183,6 +231,10 @@ window.TesseraGrid = (function () {
       enter: async (cell) => { if (cell !== undefined) $('gridCell').value = cell; return enter(); },
       move,
       leave,
+      // The zoom swap: on/off (options: overviewVoxels, blockVoxels replace
+      // the profile's budgets), and its state (tessera_zoom_json).
+      zoomSwap: setZoomSwap,
+      zoomState: () => JSON.parse(api.zoomJson()),
       // RGBA pixels of the 3D view's frame (the block's box, drawn by depth).
       framePixels: () => Array.from(window.tessera.pixels()),
     };

@@ -336,26 +336,6 @@ GLFWwindow* openWindow(int width, int height, bool es3) {
   return window;
 }
 
-// The overview (the 3D view's whole volume): the finest level of the
-// pyramid with at most this many voxels, so that a store is never read whole
-// at native resolution; in-core files are shown as loaded.
-std::uint64_t overviewVoxels(const gpu::DeviceLimits& limits) {
-  const std::uint64_t budget = limits.textureBudget ? limits.textureBudget / 2 : (1ull << 30);
-  return std::min<std::uint64_t>(budget, 64ull << 20);
-}
-
-// What a native region or grid block may take: a quarter of the texture
-// budget, and no more than one 3D texture of the profile holds (so that it
-// is shown at native resolution, not reduced by the planner).
-std::uint64_t regionBudget(const gpu::DeviceLimits& limits) {
-  std::uint64_t budget = limits.textureBudget ? limits.textureBudget / 4 : (1ull << 30);
-  if (limits.max3DTextureSize > 0) {
-    const auto side = static_cast<std::uint64_t>(limits.max3DTextureSize);
-    budget = std::min(budget, side * side * side);
-  }
-  return budget;
-}
-
 // The lines the overview shows: the region or grid block and the crosshair.
 void addExploreLines(DesktopSession& ds) {
   viewer::Viewer& v = *ds.viewer;
@@ -512,8 +492,9 @@ void openVolume(DesktopSession& ds, const std::string& spec) {
   try {
     const VolumePyramid pyramid = openVolumePyramid(spec, {.series = ds.options.series});
     const gpu::DeviceLimits& limits = ds.viewer->limits();
-    auto explorer = std::make_unique<viewer::Explorer>(pyramid.source, regionBudget(limits));
-    const int level = explorer->overviewLevel(overviewVoxels(limits));
+    auto explorer =
+        std::make_unique<viewer::Explorer>(pyramid.source, viewer::regionBudgetBytes(limits));
+    const int level = explorer->overviewLevel(viewer::overviewVoxelBudget(limits));
     auto overview = std::make_shared<const Volume>(explorer->readLevel(level));
     const std::string label = fileName(spec);
     ds.viewer->setVolume(*overview,
@@ -1178,6 +1159,7 @@ void panelExplore(DesktopSession& ds) {
   try {
     ds.zoomSwap = std::make_unique<viewer::ZoomSwap>(*ds.context, ex, stages);
     ds.zoomSwap->keepLevel(ds.overviewLevel, ds.overview);
+    ds.zoomSwap->setLabel(ds.volumeLabel);
     ds.zoomSwapKey = text;
   } catch (const Error& e) {
     ds.error = e.what();

@@ -21,6 +21,20 @@ glm::dvec3 toModel(glm::dvec3 voxel, glm::ivec3 dims, glm::dvec3 extent) {
 
 }  // namespace
 
+std::uint64_t overviewVoxelBudget(const gpu::DeviceLimits& limits) {
+  const std::uint64_t budget = limits.textureBudget ? limits.textureBudget / 2 : (1ull << 30);
+  return std::min<std::uint64_t>(budget, 64ull << 20);
+}
+
+std::uint64_t regionBudgetBytes(const gpu::DeviceLimits& limits) {
+  std::uint64_t budget = limits.textureBudget ? limits.textureBudget / 4 : (1ull << 30);
+  if (limits.max3DTextureSize > 0) {
+    const auto side = static_cast<std::uint64_t>(limits.max3DTextureSize);
+    budget = std::min(budget, side * side * side);
+  }
+  return budget;
+}
+
 int defaultRegionSide(std::uint64_t budgetBytes, int bytesPerVoxel) {
   int side = kPaperRegionSide;
   const std::uint64_t per = static_cast<std::uint64_t>(std::max(1, bytesPerVoxel));

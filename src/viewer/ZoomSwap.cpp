@@ -78,8 +78,13 @@ void ZoomSwap::show(Viewer& viewer, int stage) {
     volume = kept;
     name += " level " + std::to_string(st.level);
   }
+  if (!label_.empty()) name = label_ + " (" + name + ")";
+  // The camera and the window (a user's window/level) stay across the swap.
   const Camera before = viewer.camera();
+  const std::optional<ValueRange> window =
+      viewer.hasVolume() ? std::optional<ValueRange>(viewer.window()) : std::nullopt;
   viewer.setVolume(*volume, name);
+  if (window) viewer.setWindow(*window);
   const Camera kept = cameraAcrossSwap(before, box_, box, dims, spacing);
   viewer.camera() = kept;
   box_ = box;

@@ -522,6 +522,7 @@ async function main() {
     await zarrStoreFromUrl(context, url, tmp, run);
     await zarrRegionFromUrl(context, url, tmp, run);
     await zarrGridFromUrl(context, url, tmp, run);
+    await zoomSwapView(context, url);
     await shadingAndCrop(context, url, tmp, run);
 
     if (bench) await benchmark(context, url);
@@ -1241,6 +1242,26 @@ async function shadingAndCrop(context, url, tmp, run) {
         ms.psnr >= 50 && changedFraction(plain.pixels, shaded.pixels) > 0.05,
         ms.error || `${ms.psnr.toFixed(2)} dB, ${(100 * changedFraction(plain.pixels, shaded.pixels)).toFixed(1)} % of pixels changed`);
 
+  // Gradient opacity on (and the light still on), as the CLI's
+  // --gradient-opacity 0.02,0.08; then off again.
+  await page.check('#gradOpacity');
+  await page.evaluate(() => {
+    document.getElementById('gradLow').value = 0.02;
+    document.getElementById('gradHigh').value = 0.08;
+    document.getElementById('gradHigh').dispatchEvent(new Event('input'));
+  });
+  await page.evaluate(() => window.tessera.render());
+  const gradPng = path.join(tmp, 'native-gradient-opacity.png');
+  run('render', VOLUME, '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', '--shade',
+      '--gradient-opacity', '0.02,0.08', ...PAGE_SAMPLING, '--out', gradPng);
+  const mg = await psnrAgainst(page, gradPng);
+  const graded = await snapshot(page);
+  await page.uncheck('#gradOpacity');
+  await page.evaluate(() => window.tessera.render());
+  check('gradient opacity in the page matches `tessera render --gradient-opacity 0.02,0.08` (PSNR >= 50 dB) and fades interiors',
+        mg.psnr >= 50 && changedFraction(shaded.pixels, graded.pixels) > 0.02,
+        mg.error || `${mg.psnr.toFixed(2)} dB, ${(100 * changedFraction(shaded.pixels, graded.pixels)).toFixed(1)} % of pixels changed`);
+
   await page.check('#cropShow');
   await page.evaluate(() => window.tessera.render());
   const before = await page.evaluate(() => window.tessera.crop());
@@ -1473,6 +1494,26 @@ async function zarrGridFromUrl(context, url, tmp, run) {
   await page.waitForFunction(() => window.tessera.zarr().completeMs !== null, null, { timeout: 60000 });
   await withoutOverlays(page);
   await page.evaluate(() => window.tessera.setCamera(30, 20, 1));
+  // A frame of the store once its bricks for this view are all in, with
+  // the volume transparent (opacity x 0): only lines drawn by depth show.
+  const opacity = (x) => page.evaluate((v) => {
+    const e = document.getElementById('opacity');
+    e.value = v;
+    e.dispatchEvent(new Event('input'));
+  }, x);
+  const settledStoreFrame = async () => {
+    await page.waitForFunction(() => {
+      const z = window.tessera.zarr();
+      return z.last && z.last.complete && z.inFlight === 0 && z.queued === 0;
+    }, null, { timeout: 30000 });
+    await opacity(0);
+    await page.evaluate(() => window.tessera.render());
+    const pixels = await page.evaluate(() => window.tessera.slices.grid.framePixels());
+    await opacity(1);
+    await page.evaluate(() => window.tessera.render());
+    return pixels;
+  };
+  const storeFrame = await settledStoreFrame();  // no block yet
   const same = (a, b) => JSON.stringify([...new Set(a)].sort()) === JSON.stringify([...new Set(b)].sort());
   const blockCheck = async (what, act) => {
     const from = served.paths.length;
@@ -1503,11 +1544,149 @@ async function zarrGridFromUrl(context, url, tmp, run) {
     const i = g.moves.findIndex((mv) => mv.legal);
     return i >= 0 && (await window.tessera.slices.grid.move(i)) === 1;
   });
+  // A move whose chunks keep failing (500 on every new level-0 request)
+  // leaves the grid point and the block where they were. Moves that need no
+  // new chunk (already fetched) succeed; the first that does fail is checked.
+  served.fails = (p) => /^\/data\/ch2\.ome\.zarr\/0\/\d/.test(p);
+  let failed = null;
+  for (let attempt = 0; attempt < 6 && !failed; attempt++) {
+    const before = await page.evaluate(() => window.tessera.slices.grid.state());
+    const from = served.paths.length;
+    const i = before.moves.findIndex((mv, k) => mv.legal && k !== 1);  // not Back: that block is fetched
+    if (i < 0) break;
+    const r = await page.evaluate((k) => window.tessera.slices.grid.move(k), i);
+    const after = await page.evaluate(() => window.tessera.slices.grid.state());
+    const tried = served.paths.slice(from).filter((p) => served.fails(p)).length;
+    if (r !== 1) failed = { r, before, after, tried, error: await page.evaluate(() => window.tessera.error()) };
+  }
+  served.fails = () => false;
+  const boxText = (b) => (b ? [0, 1, 2].map((a) => `${b.begin[a]}:${b.end[a]}`).join(',') : 'none');
+  check('OME-Zarr grid view: a move whose chunks keep failing is undone: the grid point and block stay, the error names the chunk\'s URL',
+        !!failed && failed.r === -1 && failed.tried > 0 && failed.after.active && failed.after.point.join() === failed.before.point.join() &&
+        boxText(failed.after.block) === boxText(failed.before.block) && !failed.after.store_wanted &&
+        /could not be read/.test(failed.after.note) && /ch2\.ome\.zarr\/0\//.test(failed.error),
+        failed ? `${failed.tried} failing requests; point (${failed.before.point.join(', ')}) -> (${failed.after.point.join(', ')}), ` +
+          `block ${boxText(failed.before.block)} -> ${boxText(failed.after.block)}; "${failed.after.note}"; error "${failed.error.slice(0, 120)}"`
+          : 'no move needed a new chunk');
+
+  // Back at the store's overview: the block's cyan box and the crosshair
+  // are drawn over the store's frames too.
   await page.evaluate(() => window.tessera.slices.grid.leave());
-  const errors = logs.filter((l) => (l.startsWith('pageerror') || l.startsWith('error')) && !/status of 404/.test(l));
+  await page.evaluate(() => window.tessera.render());
+  const frameBack = await settledStoreFrame();
+  const overStore = await page.evaluate(() => {
+    const o = window.tessera.slices.overlayPixels();  // the crosshair marker's canvas
+    let marked = 0;
+    for (let i = 3; i < o.length; i += 4) if (o[i] > 0) marked++;
+    return { marked, active: window.tessera.slices.grid.state().active, camera: window.tessera.state().camera };
+  });
+  // The same view as before entering (the store's camera is restored), so
+  // the frames differ by the block's lines only.
+  const boxed = differingPixels(storeFrame, frameBack, 8);
+  let cyan = 0;
+  for (let i = 0; i < frameBack.length; i += 4) if (frameBack[i] < 110 && frameBack[i + 1] > 170 && frameBack[i + 2] > 190) cyan++;
+  const cam = overStore.camera;
+  check('OME-Zarr grid view: back over the store at its own camera, the last block is a cyan box in its frames and the crosshair is projected into them',
+        !overStore.active && cam.azimuth === 30 && cam.elevation === 20 && cam.zoom === 1 && boxed > 32 && cyan > 32 && overStore.marked > 8,
+        `camera ${cam.azimuth}/${cam.elevation}/${cam.zoom}; ${boxed} pixels drawn by the block's box (${cyan} cyan), ${overStore.marked} crosshair pixels over the frame`);
+  const errors = logs.filter((l) => (l.startsWith('pageerror') || l.startsWith('error')) && !/status of (404|500)/.test(l));
   check('OME-Zarr grid view: leaving returns to the store; no script errors', errors.length === 0, errors.join(' | '));
   await page.close();
   console.log(`     (OME-Zarr grid view: ${((Date.now() - t) / 1000).toFixed(1)} s)`);
+}
+
+// The zoom-driven level swap (issue 15 item 4) on the head, with budgets
+// small enough for all three stages (overview 1 Mi voxels: medium level 1,
+// coarse level 2; native blocks of 64³): zooming in goes coarse -> medium ->
+// native block, each swap cross-faded over several frames (no frame changes
+// the picture by more than a fraction of the swap's jump), the reads are
+// bounded (never level 0 whole), the slice views keep the whole volume, and
+// turning it off restores the whole volume's image at the same camera.
+async function zoomSwapView(context, url) {
+  if (!fs.existsSync(CH2)) return;
+  const t = Date.now();
+  const { page, logs } = await openPage(context, url, `size=${SIZE}&url=/templates/ch2.nii.gz`);
+  await withoutOverlays(page);
+  const zoomState = () => page.evaluate(() => window.tessera.slices.grid.zoomState());
+  const on = await page.evaluate(() => window.tessera.slices.grid.zoomSwap(true, { overviewVoxels: 1 << 20, blockVoxels: 1 << 18 }));
+  let z = await zoomState();
+  if (!on || !z.active || z.stages.length !== 3) {
+    check('zoom swap: three stages on the head', false, `${await page.evaluate(() => window.tessera.error())} ${JSON.stringify(z)}`);
+    await page.close();
+    return;
+  }
+  const stagesText = z.stages.map((st) => `${st.native ? 'native' : `${st.name} L${st.level}`} from ${st.enter_zoom.toFixed(2)}`).join(', ');
+  // Zooms to `zoom` and renders frame after frame (in one task: the page's
+  // own loop cannot interleave) until the fade ends: per frame the stage, the
+  // mix and the PSNR against the frame before; and the PSNR of the first
+  // frame (mix 0: the old stage) against the last (the swap's whole jump).
+  const zoomTo = (zoom) => page.evaluate((zm) => {
+    const psnr = (a, b) => {
+      let sum = 0;
+      for (let i = 0; i < a.length; i += 4) for (let k = 0; k < 3; k++) sum += (a[i + k] - b[i + k]) ** 2;
+      const mse = sum / (a.length / 4 * 3);
+      return mse === 0 ? 999 : 10 * Math.log10(255 * 255 / mse);
+    };
+    window.tessera.setCamera(30, 15, zm);  // not awaited: the frames below are the swap's
+    const out = [];
+    let first = null;
+    let last = null;
+    for (let i = 0; i < 60; i++) {
+      window.tessera.timeFrames(1);
+      const st = window.tessera.slices.grid.zoomState();
+      const px = window.tessera.pixels();
+      out.push({ stage: st.shown_stage, mix: st.mix, step: last ? psnr(last, px) : 999 });
+      if (!first) first = px;
+      last = px;
+      if (i >= 1 && !st.fading && st.target === st.shown_stage) break;
+    }
+    return { frames: out, jump: psnr(first, last) };
+  }, zoom);
+  const [z0, z1, z2] = [0.5 * z.stages[1].enter_zoom, Math.sqrt(z.stages[1].enter_zoom * z.stages[2].enter_zoom), 1.25 * z.stages[2].enter_zoom];
+  // The whole volume at zoom z0 (the swap off), then on again at z0.
+  await page.evaluate(() => window.tessera.slices.grid.zoomSwap(false));
+  await page.evaluate((zm) => window.tessera.setCamera(30, 15, zm), z0);
+  const before = { state: await page.evaluate(() => window.tessera.state()), shot: await snapshot(page) };
+  await page.evaluate(() => window.tessera.slices.grid.zoomSwap(true, { overviewVoxels: 1 << 20, blockVoxels: 1 << 18 }));
+  await zoomTo(z0);
+  const atStart = await zoomState();
+  const fadeCheck = (what, swap, want) => {
+    const seq = swap.frames;
+    const fading = seq.filter((f) => f.mix > 0 && f.mix < 1).length;
+    const end = seq[seq.length - 1];
+    const worst = Math.min(...seq.slice(1).map((f) => f.step));
+    check(`zoom swap: ${what}: cross-faded over ${fading} frames, no frame changes the view as much as the swap (each step >= the jump + 6 dB)`,
+          seq[0].stage === want && seq[0].mix === 0 && end.stage === want && end.mix === 1 && fading >= 2 && worst >= swap.jump + 6,
+          `stage@mix ${seq.map((f) => `${f.stage}@${f.mix.toFixed(2)}`).join(' ')}; smallest frame-to-frame PSNR ${worst.toFixed(1)} dB, whole swap ${swap.jump.toFixed(1)} dB`);
+  };
+  const toMedium = await zoomTo(z1);
+  fadeCheck(`coarse L2 -> medium L1 at zoom ${z1.toFixed(2)}`, toMedium, 1);
+  const toNative = await zoomTo(z2);
+  fadeCheck(`medium L1 -> the native 64³ block at zoom ${z2.toFixed(2)}`, toNative, 2);
+  z = await zoomState();
+  const s3d = await page.evaluate(() => window.tessera.state());
+  const ex = await page.evaluate(() => window.tessera.slices.state().explore);
+  const blockVoxels = z.block ? [0, 1, 2].reduce((n, a) => n * (z.block.end[a] - z.block.begin[a]), 1) : 0;
+  const levels = [[91, 109, 91], [46, 55, 46]].reduce((n, d) => n + d[0] * d[1] * d[2], 0);
+  check('zoom swap: the native stage is a 2x2x2 block of level 0 (bounded reads: the two levels and the block, never level 0 whole); the slices keep the whole head',
+        atStart.shown_stage === 0 && z.shown_stage === 2 && blockVoxels === 64 ** 3 && s3d.dims.join('x') === '64x64x64' &&
+        z.voxels_read === levels + blockVoxels && z.voxels_read < z.whole_voxels / 2 && ex.dims.join('x') === '181x217x181',
+        `stages ${stagesText}; block ${z.block ? [0, 1, 2].map((a) => `${z.block.begin[a]}:${z.block.end[a]}`).join(',') : 'none'}, ` +
+        `${z.voxels_read} voxels read of ${z.whole_voxels}; 3D view ${s3d.dims.join('x')}, slices ${ex.dims.join('x')}`);
+  // Back out and off: the whole volume at the same camera, as before.
+  await zoomTo(z0);
+  await page.evaluate(() => window.tessera.slices.grid.zoomSwap(false));
+  await page.evaluate((zm) => window.tessera.setCamera(30, 15, zm), z0);
+  const after = { state: await page.evaluate(() => window.tessera.state()), shot: await snapshot(page) };
+  const unchecked = await page.evaluate(() => !document.getElementById('zoomSwap').checked);
+  const db = psnrOf(before.shot.pixels, after.shot.pixels);
+  check('zoom swap: off gives the whole volume back (its name, and the image before the zoom swap at the same camera, >= 50 dB)',
+        after.state.dims.join('x') === '181x217x181' && after.state.name === before.state.name && unchecked && db >= 50,
+        `3D view ${after.state.dims.join('x')} "${after.state.name}", ${db.toFixed(1)} dB`);
+  const errors = logs.filter((l) => l.startsWith('pageerror') || l.startsWith('error'));
+  check('zoom swap: no script errors', errors.length === 0, errors.join(' | '));
+  await page.close();
+  console.log(`     (zoom swap: ${((Date.now() - t) / 1000).toFixed(1)} s)`);
 }
 
 // ch2 through the picker at 512x512, WebGL 2 and WebGL 1: median of 7 frames.

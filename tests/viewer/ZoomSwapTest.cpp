@@ -184,6 +184,36 @@ void checkFadeAndInstant(gpu::GlContext& ctx, const std::string& profile) {
   }
 }
 
+// A user's window/level stays across every swap (each stage is a new
+// volume in the viewer, whose own window would otherwise come back), and
+// the viewer's volume is named after the front end's label.
+TEST(ZoomSwap, TheWindowAndTheLabelStayAcrossSwaps) {
+  gpu::GlContext& ctx = test::gpuContext();
+  auto volume = detailedVolume(128);
+  auto source = std::make_shared<lod::InCoreMultiresSource>(volume);
+  Explorer explorer(source, 64ull * 64 * 64);
+  Viewer viewer(ctx, gpu::DeviceProfile::find("gles3"));
+  viewer.setVolume(explorer.readLevel(1), "head");
+  const ValueRange window{40.0, 180.0};
+  viewer.setWindow(window);
+  const lod::ZoomPolicyOptions options{.fadeMs = 0.0};
+  ZoomSwap swap(ctx, explorer, zoomStagesFor(explorer, 1, kSize, options), options);
+  swap.setLabel("head");
+  gpu::Framebuffer fb = gpu::Framebuffer::create(ctx.ledger(), "zoom view", kSize, kSize,
+                                                 gpu::rgba8For(ctx.caps().api));
+  std::vector<std::string> names;
+  for (const double zoom : {0.3, 0.5, 2.2}) {
+    const double scale = swap.overviewZoom(viewer.camera()) / viewer.camera().zoom;
+    viewer.camera().zoom = zoom / scale;
+    swap.frame(viewer, kDtMs, kSize, kSize, fb.id());
+    names.push_back(viewer.volumeName());
+    EXPECT_EQ(viewer.window().min, window.min) << viewer.volumeName();
+    EXPECT_EQ(viewer.window().max, window.max) << viewer.volumeName();
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"head (coarse level 2)", "head (medium level 1)",
+                                             "head (native block)"}));
+}
+
 TEST(ZoomSwap, ThresholdsSwapLevelsAndTheFadeHasNoPopEs3) {
   checkFadeAndInstant(test::gpuContext(), "gles3");
 }

@@ -40,6 +40,7 @@
 #include "tessera/viewer/CropHandles.h"
 #include "tessera/viewer/Explorer.h"
 #include "tessera/viewer/Viewer.h"
+#include "tessera/viewer/ZoomSwap.h"
 
 using namespace tessera;
 
@@ -107,6 +108,16 @@ viewer::Viewer& theViewer() {
 }
 
 void refreshExtraLines();  // region / grid boxes and the crop box (below)
+// The zoom swap (below): the whole loaded volume while the zoom drives the
+// 3D view (null otherwise); forgetting it (another volume is loaded);
+// handing the view back to the whole volume.
+const Volume* zoomOverview();
+void zoomForget();
+void zoomStop();
+double zoomFrame(int width, int height);  // a frame of the zoom swap: ms
+std::string zoomName();                   // the whole volume's name
+// The native block the zoom swap shows (level-0 voxels), nullopt for a level.
+std::optional<lod::VoxelBox> zoomBox();
 
 glm::dvec3 toRgb(double r, double g, double b) {
   return {r, g, b};
@@ -160,7 +171,10 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_last_error() {
 
 // "gen:shepp-logan:96" and the other procedural specs of `tessera render`.
 EMSCRIPTEN_KEEPALIVE int tessera_load_generated(const char* spec) {
-  return guarded([&] { theViewer().setVolume(makeProcedural(spec), spec); });
+  return guarded([&] {
+    zoomForget();
+    theViewer().setVolume(makeProcedural(spec), spec);
+  });
 }
 
 // Files picked or dropped together: each is added (`bytes` malloc'ed by the
@@ -187,6 +201,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_load_files() {
                             reinterpret_cast<const std::byte*>(f.bytes.get()), f.size));
     }
     const std::string name = volumeFileAmong(files.names());
+    zoomForget();
     theViewer().setVolume(readVolume(*files.open(name), files), name);
   });
   app().picked.clear();
@@ -198,7 +213,7 @@ EMSCRIPTEN_KEEPALIVE double tessera_render(int width, int height) {
   double ms = -1.0;
   guarded([&] {
     refreshExtraLines();
-    ms = theViewer().render(width, height).ms;
+    ms = zoomOverview() ? zoomFrame(width, height) : theViewer().render(width, height).ms;
   });
   return ms;
 }
@@ -439,6 +454,8 @@ web::ZarrStoreView& theZarrView();
 struct StoreRegion {
   lod::VoxelBox box;
   bool shown = false;
+  Camera overviewCamera;   // the store view's camera, restored on the way back
+  bool gridBlock = false;  // read for the grid view (outlined cyan), not picked (red)
 };
 StoreRegion& storeRegion() {
   static StoreRegion r;
@@ -477,6 +494,7 @@ bool regionShown() {
 // The volume the slices show: the overview's, also while a region is shown.
 const Volume& overviewVolume() {
   if (const Volume* store = storeOverview()) return *store;
+  if (const Volume* whole = zoomOverview()) return *whole;
   viewer::Viewer& v = theViewer();
   if (regionShown()) return *sliceViews().overview;
   if (!v.hasVolume()) throw InputError("no volume is loaded");
@@ -584,9 +602,10 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_explore_json() {
     const glm::dvec3 sp = volume.spacing();
     j["has_volume"] = true;
     j["tf_revision"] = theViewer().tfEditor().revision();
-    j["name"] = store      ? theZarrView().storage().describe()
-                : inRegion ? sliceViews().overviewName
-                           : theViewer().volumeName();
+    j["name"] = store            ? theZarrView().storage().describe()
+                : inRegion       ? sliceViews().overviewName
+                : zoomOverview() ? zoomName()
+                                 : theViewer().volumeName();
     j["dims"] = {d.x, d.y, d.z};
     j["spacing"] = {sp.x, sp.y, sp.z};
     j["showing_region"] = inRegion;
@@ -634,6 +653,7 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_explore_json() {
 // the overview stay; tessera_region_overview goes back.
 EMSCRIPTEN_KEEPALIVE int tessera_region_show(int x0, int x1, int y0, int y1, int z0, int z1) {
   return guarded([&] {
+    zoomStop();  // the region replaces the whole volume, not a level of it
     viewer::Viewer& v = theViewer();
     SliceViews& s = sliceViews();
     const bool inRegion = regionShown();
@@ -719,7 +739,10 @@ void applyMarkBoxes() {
   viewer::Viewer& v = theViewer();
   v.extraLines.clear();
   if (!v.hasVolume() || regionShown()) return;  // the region or block is the view itself
-  const glm::ivec3 dims = v.volume().dims();
+  // The zoom swap's levels span the whole volume (its block is the view).
+  const Volume* whole = zoomOverview();
+  if (whole && zoomBox()) return;
+  const glm::ivec3 dims = whole ? whole->dims() : v.volume().dims();
   const glm::vec4 colours[2] = {{1.0f, 0.25f, 0.2f, 1.0f}, {0.25f, 0.85f, 0.95f, 1.0f}};
   for (int slot = 0; slot < 2; ++slot) {
     const MarkBox& m = markBox(slot);
@@ -761,12 +784,46 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_projection_json(int width, int height) 
   nlohmann::json j;
   guarded([&] {
     viewer::Viewer& v = theViewer();
-    // A store's frames are drawn by its bricks view: no 3D marks on them yet.
-    if (storeOverview() || !v.hasVolume() || width <= 0 || height <= 0) return;
+    if (width <= 0 || height <= 0) return;
+    if (const Volume* store = storeOverview()) {
+      // The slices show the store's coarsest level; its frames are drawn in
+      // level 0's model frame (ZarrStoreView::frame), a region of it by the
+      // viewer (a box of level 0 placed where it lies).
+      const Volume& shape = theZarrView().store().shape();
+      const glm::dvec3 scale = glm::dvec3(shape.dims()) / glm::dvec3(store->dims());
+      const StoreRegion& r = storeRegion();
+      const bool inRegion = r.shown && v.hasVolume();
+      const glm::dvec3 spacing = scale * shape.spacing();
+      const glm::dvec3 extent = inRegion ? v.volume().extent() : shape.extent();
+      const glm::dvec3 offset =
+          -0.5 * extent - (inRegion ? glm::dvec3(r.box.begin) * shape.spacing() : glm::dvec3(0.0));
+      // The store's frames frame the viewer's camera on the store's shape.
+      Camera c = v.camera();
+      if (!inRegion) c.frame(shape);
+      const glm::dmat4 m =
+          render::viewProjection(c, double(width) / height, 0.5 * glm::length(extent));
+      j["mvp"] = nlohmann::json::array();
+      for (int col = 0; col < 4; ++col) {
+        for (int row = 0; row < 4; ++row) j["mvp"].push_back(m[col][row]);
+      }
+      j["spacing"] = {spacing.x, spacing.y, spacing.z};
+      j["offset"] = {offset.x, offset.y, offset.z};
+      return;
+    }
+    if (!v.hasVolume()) return;
     const Volume& shownVolume = v.volume();
-    const glm::dvec3 spacing = shownVolume.spacing();
+    glm::dvec3 spacing = shownVolume.spacing();
     glm::dvec3 offset = -0.5 * shownVolume.extent();
     if (regionShown()) offset -= glm::dvec3(sliceViews().region.begin) * spacing;
+    if (const Volume* whole = zoomOverview()) {
+      // A level spans the whole volume's box; the native block is a box of
+      // level 0.
+      if (const auto box = zoomBox()) {
+        offset -= glm::dvec3(box->begin) * spacing;
+      } else {
+        spacing = shownVolume.extent() / glm::dvec3(whole->dims());
+      }
+    }
     const Camera& c = v.camera();
     const double radius = 0.5 * glm::length(shownVolume.extent());
     const glm::dmat4 m = render::viewProjection(c, double(width) / height, radius);
@@ -807,6 +864,10 @@ glm::ivec3 theZarrViewDims0() {
   return theZarrView().source().levelInfo(0).dims;
 }
 
+// The grid view's last block over a store (level-0 voxels), while the
+// store's overview is drawn (defined with the grid view below).
+std::optional<lod::VoxelBox> storeGridBlock();
+
 }  // namespace
 
 extern "C" {
@@ -815,6 +876,7 @@ extern "C" {
 EMSCRIPTEN_KEEPALIVE int tessera_zarr_begin(const char* url) {
   return guarded([&] {
     viewer::Viewer& v = theViewer();
+    zoomStop();
     zarrView() = std::make_unique<web::ZarrStoreView>(v.context(), v.limits(), url);
   });
 }
@@ -878,9 +940,15 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_frame(int width, int height) {
     // overview (applyMarkBoxes), composed by depth.
     std::vector<render::OverlayLine> marks;
     const StoreRegion& r = storeRegion();
-    if (glm::all(glm::lessThan(r.box.begin, r.box.end))) {
-      const Volume& shape = z.store().shape();
+    const Volume& shape = z.store().shape();
+    if (!r.gridBlock && glm::all(glm::lessThan(r.box.begin, r.box.end))) {
       marks = viewer::boxLines(r.box, shape.dims(), shape.extent(), {1.0f, 0.25f, 0.2f, 1.0f});
+    }
+    // The grid view's last block, cyan (level-0 voxels, as the region).
+    if (const std::optional<lod::VoxelBox> block = storeGridBlock()) {
+      const auto cyan =
+          viewer::boxLines(*block, shape.dims(), shape.extent(), {0.25f, 0.85f, 0.95f, 1.0f});
+      marks.insert(marks.end(), cyan.begin(), cyan.end());
     }
     const web::StoreFrame f = z.frame(
         v.camera(), v.frameSettings(), v.tfEditor().transferFunction(), v.tfEditor().revision(),
@@ -1000,7 +1068,12 @@ EMSCRIPTEN_KEEPALIVE int tessera_zarr_region_show(int x0, int x1, int y0, int y1
     const auto text = [&](int a) {
       return std::to_string(box.begin[a]) + ":" + std::to_string(box.end[a]);
     };
-    storeRegion() = {box, true};
+    StoreRegion& r = storeRegion();
+    // From the store view (not from another region of it): its camera.
+    if (!r.shown) r.overviewCamera = camera;
+    r.box = box;
+    r.shown = true;
+    r.gridBlock = false;  // tessera_grid_store_shown says when it is the grid's
     v.setVolume(std::move(region),
                 z.storage().describe() + " region " + text(0) + "," + text(1) + "," + text(2));
     v.setWindow(window);
@@ -1017,7 +1090,9 @@ EMSCRIPTEN_KEEPALIVE int tessera_zarr_region_show(int x0, int x1, int y0, int y1
 // Back to the store's overview from its region (the page draws the store
 // again; the region stays known, for its outline in the slice views).
 EMSCRIPTEN_KEEPALIVE void tessera_zarr_region_overview() {
-  storeRegion().shown = false;
+  StoreRegion& r = storeRegion();
+  if (r.shown && app().viewer) theViewer().camera() = r.overviewCamera;
+  r.shown = false;
 }
 
 // Closes the store (the viewer core's volume shows again).
@@ -1049,6 +1124,10 @@ struct GridView {
   std::string note;                    // the last move, or why it was refused
   bool refused = false;
   bool storeWanted = false;  // a store's block is to be read (the page fetches its chunks)
+  // Where a store's pending block came from: restored when its read fails.
+  glm::ivec3 fromPoint{0};
+  std::optional<lod::VoxelBox> fromBlock;
+  std::string fromShownName;
 };
 
 GridView& gridView() {
@@ -1082,6 +1161,12 @@ bool gridShown() {
            r.box.end == g.block->end && theViewer().volumeName() == g.shownName;
   }
   return !g.shownName.empty() && regionShown() && sliceViews().shownName == g.shownName;
+}
+
+std::optional<lod::VoxelBox> storeGridBlock() {
+  const GridView& g = gridView();
+  if (!g.block || g.storeWanted || !storeOverview() || storeRegion().shown) return std::nullopt;
+  return g.block;
 }
 
 // The default cell: cubic, a multiple of 16 voxels, as large as possible
@@ -1133,6 +1218,10 @@ void showGridBlock(const lod::VoxelBox& box, bool keepZoom) {
     // A store's block is read like its region (tessera_zarr_region_prefetch
     // / _show): the page fetches exactly its level-0 chunks, then calls
     // tessera_grid_store_shown.
+    if (!g.storeWanted) {
+      g.fromBlock = g.block;
+      g.fromShownName = g.shownName;
+    }
     g.block = box;
     g.storeWanted = true;
     g.shownName.clear();
@@ -1167,11 +1256,13 @@ extern "C" {
 // before), and shows that point's block.
 EMSCRIPTEN_KEEPALIVE int tessera_grid_enter(int cellSide, int x, int y, int z) {
   return guarded([&] {
+    zoomStop();  // the grid view's block replaces the whole volume
     const Volume& volume = overviewVolume();
     lod::GridNavigator& nav = gridFor(volume, cellSide);
     // The crosshair is in overview voxels; a store's grid is over level 0.
     const glm::dvec3 scale = glm::dvec3(gridDims(volume)) / glm::dvec3(volume.dims());
     const glm::dvec3 c = (glm::dvec3(x, y, z) + 0.5) * scale / glm::dvec3(nav.cellSize());
+    if (!gridView().storeWanted) gridView().fromPoint = nav.point();
     nav.moveTo(glm::clamp(glm::ivec3(glm::round(c)), glm::ivec3(0), nav.cells()));
     showGridBlock(nav.blockBox(nav.point()), false);
     GridView& g = gridView();
@@ -1198,6 +1289,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_grid_move(int viewMove) {
     const std::string what = std::string(lod::viewMoveName(vm)) + " = " + m.name();
     GridView& g = gridView();
     const glm::ivec3 from = nav.point();
+    if (!g.storeWanted) g.fromPoint = from;
     const lod::MoveResult r = nav.apply(m);
     if (!r.moved) {
       g.note = what + " refused: " + r.reason;
@@ -1270,6 +1362,23 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_grid_json() {
   return scratch().c_str();
 }
 
+// A store's block could not be read (its chunks kept failing): the grid
+// point and block go back to where they were before the enter or move that
+// asked for it (the 3D view still shows that block, or the store), with a
+// note saying so.
+EMSCRIPTEN_KEEPALIVE int tessera_grid_store_failed() {
+  return guarded([&] {
+    GridView& g = gridView();
+    if (!g.storeWanted || !g.nav) return;
+    g.nav->moveTo(g.fromPoint);
+    g.block = g.fromBlock;
+    g.shownName = g.fromShownName;
+    g.storeWanted = false;
+    g.note = "the block could not be read; back at grid point " + g.nav->describe(g.fromPoint);
+    g.refused = true;
+  });
+}
+
 // A store's block (tessera_grid_json's block) has been read and shown by
 // tessera_zarr_region_show: it is now the grid view's.
 EMSCRIPTEN_KEEPALIVE int tessera_grid_store_shown() {
@@ -1282,6 +1391,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_grid_store_shown() {
     }
     g.storeWanted = false;
     g.shownName = theViewer().volumeName();
+    storeRegion().gridBlock = true;
   });
 }
 
@@ -1336,6 +1446,22 @@ EMSCRIPTEN_KEEPALIVE int tessera_set_light(int headlight, double ambient, double
     s.specular = std::clamp(specular, 0.0, 1.0);
     s.shininess = std::clamp(shininess, 1.0, 256.0);
     if (!s.headlight) s.lightDirection = dir;
+  });
+}
+
+// Gradient-magnitude opacity modulation (Shading::gradientOpacity): opacity
+// times clamp((|g| - low) / (high - low), 0, 1), with or without the light
+// (`tessera render --gradient-opacity on|LOW,HIGH`).
+EMSCRIPTEN_KEEPALIVE int tessera_set_gradient_opacity(int on, double low, double high) {
+  return guarded([&] {
+    if (!(low >= 0.0 && high > low)) {
+      throw InputError("gradient opacity: needs 0 <= low < high (got " + std::to_string(low) +
+                       ", " + std::to_string(high) + ")");
+    }
+    Shading& s = theViewer().settings().shading;
+    s.gradientOpacity = on != 0;
+    s.gradientLow = low;
+    s.gradientHigh = high;
   });
 }
 
@@ -1433,6 +1559,7 @@ extern "C" {
 // default palette. 0 on error (tessera_last_error), the state unchanged.
 EMSCRIPTEN_KEEPALIVE int tessera_set_labels(int on, const char* table, const char* name) {
   return guarded([&] {
+    if (on != 0) zoomStop();  // labels are not averaged into coarser levels
     viewer::Viewer& v = theViewer();
     if (on == 0) {
       v.clearLabels();
@@ -1474,6 +1601,195 @@ EMSCRIPTEN_KEEPALIVE void tessera_set_label_visible(int value, int visible) {
   } else {
     theViewer().setLabelVisible(value, visible != 0);
   }
+}
+
+}  // extern "C"
+
+// ---- Zoom-driven level swap (issue 15 item 4; Schultz 2016 §7.3.1), the
+// desktop viewer's viewer::ZoomSwap on the page: zoomed out the 3D view
+// shows a coarse level of the loaded volume, then the medium level (the
+// finest that fits the profile's overview budget), then, zoomed in far
+// enough, the native 2x2x2 grid block around the view's centre; each swap
+// keeps the camera (every patient point stays on screen) and cross-fades.
+// The page's slice views, crosshair, region and grid keep working on the
+// whole loaded volume (held here while the zoom drives the view); picking
+// a region, entering the grid view, labels or another volume hand the view
+// back to the whole volume first.
+namespace {
+
+struct ZoomView {
+  std::shared_ptr<const Volume> whole;  // the loaded volume (level 0 of the pyramid)
+  std::string name;                     // its name
+  std::unique_ptr<viewer::Explorer> explorer;
+  std::unique_ptr<viewer::ZoomSwap> swap;  // after the explorer: it holds a reference
+  int mediumLevel = 0;
+  double lastFrameMs = -1.0;
+  std::string shownName;  // the viewer's volume after the last frame
+};
+
+ZoomView& zoomView() {
+  static ZoomView z;
+  return z;
+}
+
+// A frame's time step for the fade, at most this: a fade spans at least
+// 250 / 100 + 1 frames however slow a frame is (a software rasteriser's
+// 300 ms frame would otherwise end it in one: a pop).
+constexpr double kMaxFadeStepMs = 100.0;
+
+}  // namespace
+
+namespace {
+
+// True while the zoom swap drives the viewer (a volume loaded since ends it).
+bool zoomActive() {
+  ZoomView& z = zoomView();
+  if (!z.swap || !app().viewer) return false;
+  const viewer::Viewer& v = theViewer();
+  if (v.hasVolume() && v.volumeName() == z.shownName) return true;
+  z = ZoomView();
+  return false;
+}
+
+const Volume* zoomOverview() {
+  return zoomActive() ? zoomView().whole.get() : nullptr;
+}
+
+std::string zoomName() {
+  return zoomView().name;
+}
+
+std::optional<lod::VoxelBox> zoomBox() {
+  return zoomActive() ? zoomView().swap->shownBox() : std::nullopt;
+}
+
+void zoomForget() {
+  zoomView() = ZoomView();
+}
+
+void zoomStop() {
+  if (!zoomActive()) {
+    zoomForget();
+    return;
+  }
+  ZoomView& z = zoomView();
+  viewer::Viewer& v = theViewer();
+  const Camera before = v.camera();
+  const ValueRange window = v.window();
+  const std::optional<lod::VoxelBox> box = z.swap->shownBox();
+  std::shared_ptr<const Volume> whole = z.whole;
+  const std::string name = z.name;
+  zoomForget();
+  v.setVolume(Volume(*whole), name);
+  v.setWindow(window);
+  v.camera() = viewer::cameraAcrossSwap(before, box, std::nullopt, whole->dims(), whole->spacing());
+}
+
+double zoomFrame(int width, int height) {
+  ZoomView& z = zoomView();
+  viewer::Viewer& v = theViewer();
+  const double now = emscripten_get_now();
+  const double dt = z.lastFrameMs < 0.0 ? 0.0 : std::min(now - z.lastFrameMs, kMaxFadeStepMs);
+  z.lastFrameMs = now;
+  z.swap->frame(v, dt, width, height);
+  z.shownName = v.volumeName();
+  return emscripten_get_now() - now;
+}
+
+}  // namespace
+
+extern "C" {
+
+// on = 1: the zoom drives the 3D view of the loaded file (stages for a view
+// `viewPixels` high; `overviewVoxels` > 0 replaces the profile's overview
+// budget and `blockVoxels` > 0 its native block budget, e.g. to see all
+// three stages on a small volume). on = 0: the whole volume again, with the
+// camera kept. 0 on error (tessera_last_error), nothing changed.
+EMSCRIPTEN_KEEPALIVE int tessera_zoom_swap(int on, int viewPixels, double overviewVoxels,
+                                           double blockVoxels) {
+  return guarded([&] {
+    if (on == 0) {
+      zoomStop();
+      return;
+    }
+    viewer::Viewer& v = theViewer();
+    if (storeOverview()) {
+      throw InputError(
+          "zoom swap: an OME-Zarr store already refines with the zoom (its bricks' level "
+          "selection); the zoom swap is for files");
+    }
+    if (v.labelsOn()) {
+      throw InputError("zoom swap: not for a label volume (coarser levels would average labels)");
+    }
+    tessera_region_overview();
+    zoomStop();
+    if (!v.hasVolume()) throw InputError("zoom swap: no volume is loaded");
+    ZoomView z;
+    z.whole = std::make_shared<const Volume>(v.volume());
+    z.name = v.volumeName();
+    auto source = std::make_shared<const lod::InCoreMultiresSource>(z.whole);
+    const gpu::DeviceLimits& limits = v.limits();
+    const std::uint64_t bpv = bytesPerVoxel(z.whole->type());
+    const std::uint64_t blockBytes = blockVoxels > 0.0
+                                         ? static_cast<std::uint64_t>(blockVoxels) * bpv
+                                         : viewer::regionBudgetBytes(limits);
+    z.explorer = std::make_unique<viewer::Explorer>(source, blockBytes);
+    z.mediumLevel =
+        z.explorer->overviewLevel(overviewVoxels > 0.0 ? static_cast<std::uint64_t>(overviewVoxels)
+                                                       : viewer::overviewVoxelBudget(limits));
+    const std::vector<lod::ZoomStage> stages =
+        viewer::zoomStagesFor(*z.explorer, z.mediumLevel, std::max(1, viewPixels));
+    if (stages.size() < 2) {
+      throw InputError("zoom swap: " + z.name + " is too small to have coarser levels");
+    }
+    z.swap = std::make_unique<viewer::ZoomSwap>(*app().context, *z.explorer, stages);
+    z.swap->keepLevel(0, z.whole);
+    z.swap->setLabel(z.name);
+    z.shownName = v.volumeName();
+    zoomView() = std::move(z);
+  });
+}
+
+// The zoom swap: JSON {active, name, stages: [{name, level, native,
+// enter_zoom}], shown_stage, shown (the viewer's volume), zoom (in the whole
+// volume's terms), fading, mix, target, block (level-0 voxels, end
+// exclusive, or null), voxels_read (by the swaps: bounded reads),
+// whole_voxels, medium_level}.
+EMSCRIPTEN_KEEPALIVE const char* tessera_zoom_json() {
+  nlohmann::json j;
+  j["active"] = false;
+  guarded([&] {
+    if (!zoomActive()) return;
+    const ZoomView& z = zoomView();
+    const viewer::ZoomSwap& zs = *z.swap;
+    viewer::Viewer& v = theViewer();
+    j["active"] = true;
+    j["name"] = z.name;
+    j["stages"] = nlohmann::json::array();
+    for (const lod::ZoomStage& st : zs.policy().stages()) {
+      j["stages"].push_back({{"name", st.name},
+                             {"level", st.level},
+                             {"native", st.subVolume},
+                             {"enter_zoom", st.enterZoom}});
+    }
+    j["shown_stage"] = zs.shownStage();
+    j["shown"] = v.volumeName();
+    j["zoom"] = zs.overviewZoom(v.camera());
+    j["fading"] = zs.fading();
+    j["mix"] = zs.policy().frame().mix;
+    j["target"] = zs.policy().stageFor(std::max(0, zs.shownStage()), zs.overviewZoom(v.camera()));
+    if (const auto& b = zs.shownBox()) {
+      j["block"] = {{"begin", {b->begin.x, b->begin.y, b->begin.z}},
+                    {"end", {b->end.x, b->end.y, b->end.z}}};
+    } else {
+      j["block"] = nullptr;
+    }
+    j["voxels_read"] = zs.voxelsRead();
+    j["whole_voxels"] = z.whole->voxelCount();
+    j["medium_level"] = z.mediumLevel;
+  });
+  scratch() = j.dump();
+  return scratch().c_str();
 }
 
 }  // extern "C"

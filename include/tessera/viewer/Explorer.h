@@ -17,6 +17,7 @@
 
 #include "tessera/core/Camera.h"
 #include "tessera/core/Volume.h"
+#include "tessera/gpu/DeviceProfile.h"
 #include "tessera/lod/GridNavigator.h"
 #include "tessera/lod/MultiresSource.h"
 #include "tessera/render/Overlay.h"
@@ -27,6 +28,15 @@ namespace tessera::viewer {
 // The region's default side: 256 voxels (the paper's custom sub-volume), or
 // less so that side^3 voxels of `bytesPerVoxel` fit `budgetBytes`; at least 16.
 int defaultRegionSide(std::uint64_t budgetBytes, int bytesPerVoxel);
+
+// The overview (the 3D view's whole volume): the finest level of the
+// pyramid with at most this many voxels (half the profile's texture budget,
+// at most 64 Mi), so that a store is never read whole at native resolution.
+std::uint64_t overviewVoxelBudget(const gpu::DeviceLimits& limits);
+// What a native region or grid block may take: a quarter of the texture
+// budget, and no more than one 3D texture of the profile holds (so that it
+// is shown at native resolution, not reduced by the planner).
+std::uint64_t regionBudgetBytes(const gpu::DeviceLimits& limits);
 
 // A box of `side` voxels per axis centred on `centre`, shifted to lie inside
 // `dims` and clamped to it where the volume is smaller.

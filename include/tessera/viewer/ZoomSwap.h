@@ -17,6 +17,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include <glm/vec2.hpp>
 
@@ -56,6 +57,10 @@ class ZoomSwap {
     levels_[level] = std::move(volume);
   }
 
+  // The viewer's volume is named "LABEL (medium level 1)" and so on (without
+  // a label: "medium level 1").
+  void setLabel(std::string label) { label_ = std::move(label); }
+
   const lod::ZoomLevelPolicy& policy() const { return policy_; }
   // The stage in the viewer (-1 before the first frame).
   int shownStage() const { return shown_; }
@@ -79,6 +84,7 @@ class ZoomSwap {
   std::optional<lod::VoxelBox> box_;
   std::map<int, std::shared_ptr<const Volume>> levels_;  // whole levels read so far
   std::uint64_t voxelsRead_ = 0;
+  std::string label_;
   gpu::Framebuffer old_;  // the previous stage's image during a fade
   gpu::Program blend_;
   gpu::FullscreenTriangle triangle_;
