@@ -825,7 +825,9 @@
     bindControls();
     if (withSlices) {
       slices = window.TesseraSlices.attach({ M, canvas, requestRender, showError, clearError,
-        storeRegion: zarrRegion, storeOverview: zarrOverview });
+        storeRegion: zarrRegion, storeOverview: zarrOverview,
+        storeFetch: () => (zarr ? zarr.fetchWanted() : Promise.resolve([])),
+        storeDropWanted: () => { if (zarr) zarr.dropWanted(); } });
       window.tessera.slices = slices.testApi;
     } else {
       $('slice-controls').hidden = true;

@@ -16,6 +16,10 @@
 //   (tessera_region_show); "Overview" (or Esc) returns, and the overview
 //   shows the region as a red box.
 //
+// - An OME-Zarr store (?url=): everything above is in level-0 voxels; each
+//   slice is read at the finest level its panel can show, the coarsest
+//   level standing in until that slab's chunks arrive (refinePending).
+//
 // The page (app.js) calls TesseraSlices.attach() once the module is up and
 // frameShown() after every frame; window.tessera.slices is for tests.
 'use strict';
@@ -31,7 +35,7 @@ window.TesseraSlices = (function () {
     const $ = (id) => document.getElementById(id);
     const c = (name, ret, args) => M.cwrap(name, ret, args);
     const api = {
-      slice: c('tessera_slice', 'string', ['number', 'number', 'number']),
+      slice: c('tessera_slice', 'string', ['number', 'number', 'number', 'number']),
       value: c('tessera_voxel_value', 'number', ['number', 'number', 'number']),
       explore: c('tessera_explore_json', 'string', []),
       regionShow: c('tessera_region_show', 'number', ['number', 'number', 'number', 'number', 'number', 'number']),
@@ -129,9 +133,21 @@ window.TesseraSlices = (function () {
 
     // ------------------------------------------------------------ drawing
 
+    // The panel's backing pixels: an OME-Zarr store's slice is read at the
+    // finest level with no more pixels than that (finer would not show).
+    let pixelsOverride = 0;  // tests: as if every panel had this many pixels
+    function panelPixels(p) {
+      if (pixelsOverride > 0) return pixelsOverride;
+      const dpr = window.devicePixelRatio || 1;
+      return p ? Math.max(1, p.el.clientWidth * dpr) * Math.max(1, p.el.clientHeight * dpr) : 0;
+    }
+    function sliceJson(axis, p) {
+      return api.slice(axis, cross[axis], colour(), panelPixels(p));
+    }
+
     function assignAxes() {
       // Each index axis's plane, from the core's slice frames.
-      const frames = [0, 1, 2].map((a) => JSON.parse(api.slice(a, cross[a], colour()) || 'null'));
+      const frames = [0, 1, 2].map((a) => JSON.parse(sliceJson(a, null) || 'null'));
       if (frames.some((f) => !f)) { showError(api.lastError()); return false; }
       const byPlane = {};
       frames.forEach((f) => { byPlane[f.plane] = f.axis; });
@@ -147,27 +163,60 @@ window.TesseraSlices = (function () {
     }
 
     function drawSlice(p) {
-      const json = api.slice(p.axis, cross[p.axis], colour());
+      const json = sliceJson(p.axis, p);
       if (!json) { showError(api.lastError()); return; }
       const f = JSON.parse(json);
       p.frame = f;
-      const n = f.width * f.height * 4;
-      const pixels = new Uint8ClampedArray(M.HEAPU8.slice(f.pixels, f.pixels + n).buffer);
-      if (p.image.width !== f.width || p.image.height !== f.height) {
-        p.image.width = f.width;
-        p.image.height = f.height;
+      // The image's own pixels (a store's slice at the level read, or the
+      // coarsest while that level's chunks arrive), shown stretched over
+      // the frame's width x height.
+      const iw = f.image_width, ih = f.image_height;
+      const pixels = new Uint8ClampedArray(M.HEAPU8.slice(f.pixels, f.pixels + iw * ih * 4).buffer);
+      if (p.image.width !== iw || p.image.height !== ih) {
+        p.image.width = iw;
+        p.image.height = ih;
       }
-      p.image.getContext('2d').putImageData(new ImageData(pixels, f.width, f.height), 0, 0);
+      p.image.getContext('2d').putImageData(new ImageData(pixels, iw, ih), 0, 0);
+      p.el.classList.toggle('pending', !!f.pending);
+      p.image.title = f.note || (f.pending ? 'a coarser level while the slice is fetched' : '');
+      if (f.pending) refinePending();
       for (const edge of ['left', 'right', 'top', 'bottom']) {
         p.el.querySelector(`.orient-${edge}`).textContent = f.oriented ? f.edges[edge] : '';
       }
-      p.label.textContent = `${f.plane} ${f.index}`;
+      p.label.textContent = `${f.plane} ${f.index}${f.pending ? ' · loading…' : ''}`;
       p.label.title = `index ${f.index} of 0–${f.count - 1} along the volume's ${'xyz'[f.axis]} axis`;
       fitPanel(p);
     }
 
     function drawAllSlices() {
       for (const plane of PLANES) drawSlice(panels[plane]);
+    }
+
+    // An OME-Zarr store's slices shown from a coarser level: their chunks
+    // are fetched (ahead of the 3D view's refinement) and the slices drawn
+    // again, refined in place; a few rounds at most per call (a slice moved
+    // meanwhile asks for its own chunks).
+    let refining = null;
+    function refinePending() {
+      if (refining || !opts.storeFetch) return refining;
+      refining = (async () => {
+        try {
+          for (let round = 0; round < 4; round++) {
+            const keys = await opts.storeFetch();
+            const pending = PLANES.map((q) => panels[q]).filter((q) => q.frame && q.frame.pending);
+            if (keys.length === 0 || pending.length === 0) break;
+            // What was listed while those keys were in flight may have
+            // arrived since: drawn again, the slices list only what they
+            // still lack (no chunk fetched twice).
+            if (opts.storeDropWanted) opts.storeDropWanted();
+            for (const q of pending) drawSlice(q);
+            redrawOverlays();
+          }
+        } finally {
+          refining = null;
+        }
+      })();
+      return refining;
     }
 
     // In-plane rectangle (image pixels) of a voxel box, or null.
@@ -349,7 +398,8 @@ window.TesseraSlices = (function () {
         if (!assignAxes()) return;
         redraw = true;
       }
-      const wk = `${(state.window || []).join(',')}|${colour() ? explore.tf_revision : 'grey'}`;
+      // (A label volume's slices are always in its label colours.)
+      const wk = `${(state.window || []).join(',')}|${colour() || explore.labels ? explore.tf_revision : 'grey'}`;
       if (wk !== windowKey) { windowKey = wk; redraw = true; }
       if (redraw) drawAllSlices();
       redrawOverlays();
@@ -570,6 +620,9 @@ window.TesseraSlices = (function () {
       overlayPixels: () => Array.from(overlay3d.getContext('2d').getImageData(0, 0, overlay3d.width, overlay3d.height).data),
       framePixels: () => Array.from(window.tessera.pixels()),
       setCross: (x, y, z) => setCross([x, y, z]),
+      // As if each panel had `n` backing pixels (0: their own): the level a
+      // store's slices are read at.
+      setPanelPixels: (n) => { pixelsOverride = n; drawAllSlices(); redrawOverlays(); },
       setPicking: (on) => { picking = !!on; updateInfo(); },
       setRegionSide: (side) => { $('regionSide').value = side; },
       showRegion,

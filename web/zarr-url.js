@@ -102,6 +102,7 @@
       begin: c('tessera_zarr_begin', 'number', ['string']),
       openStep: c('tessera_zarr_open_step', 'number', []),
       wanted: c('tessera_zarr_wanted', 'string', []),
+      holds: c('tessera_zarr_holds', 'number', ['string']),
       put: c('tessera_zarr_put', null, ['string', 'number', 'number']),
       putMissing: c('tessera_zarr_put_missing', null, ['string']),
       putFailed: c('tessera_zarr_put_failed', null, ['string', 'string']),
@@ -216,7 +217,16 @@
     }
 
     function pump() {
-      while (inFlight.size < CONNECTIONS && queue.length) start(queue.shift());
+      while (inFlight.size < CONNECTIONS && queue.length) {
+        const key = queue.shift();
+        if (base && api.holds(key)) {
+          // Arrived since it was asked for (listed again while in flight):
+          // never fetched twice.
+          pinned = pinned.filter((k) => k !== key);
+          continue;
+        }
+        start(key);
+      }
       if (inFlight.size === 0 && queue.length === 0) {
         const w = idleWaiters;
         idleWaiters = [];
@@ -307,6 +317,24 @@
       return fetched;
     }
 
+    // The keys the module wants now (a slice view's slab: tessera_slice
+    // asked for them), fetched ahead of the bricks' refinement like a
+    // region's. Resolves to those keys once they have arrived or failed
+    // (a failure reaches the module, which reports it on the next read).
+    async function fetchWanted() {
+      if (!open) return [];
+      const keys = JSON.parse(api.wanted());
+      if (keys.length === 0) return keys;
+      pinned.push(...keys.filter((k) => !pinned.includes(k)));
+      queue = [...new Set([...pinned, ...queue])].filter((k) => !inFlight.has(k));
+      pump();
+      await new Promise((resolve) => {
+        const wait = () => (keys.every((k) => !pinned.includes(k)) ? resolve() : setTimeout(wait, 20));
+        wait();
+      });
+      return keys;
+    }
+
     function close() {
       regionShown = false;
       pinned = [];
@@ -380,6 +408,10 @@
       // The store is drawn (not a region read from it, which the viewer draws).
       active: () => open && !regionShown,
       showRegion,
+      fetchWanted,
+      // Forgets what the module has asked for so far (listed while those
+      // keys were in flight: it asks again for what it still lacks).
+      dropWanted: () => { if (open) api.wanted(); },
       overview: () => {
         regionShown = false;
         if (base) api.regionOverview();

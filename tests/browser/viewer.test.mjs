@@ -76,10 +76,8 @@ async function serve(dir, dataDirs) {
   return { server, url: `http://127.0.0.1:${server.address().port}` };
 }
 
-// PSNR (dB) over R, G, B of the canvas against a PNG, computed in the page
-// (the browser decodes the PNG), as reference::psnr does.
-async function psnrAgainst(page, pngPath) {
-  const b64 = fs.readFileSync(pngPath).toString('base64');
+// A PNG decoded by the browser: {width, height, data (RGBA)}.
+function decodePng(page, pngPath) {
   return page.evaluate(async (b64) => {
     const img = new Image();
     img.src = `data:image/png;base64,${b64}`;
@@ -89,7 +87,15 @@ async function psnrAgainst(page, pngPath) {
     c.height = img.height;
     const ctx = c.getContext('2d');
     ctx.drawImage(img, 0, 0);
-    const ref = ctx.getImageData(0, 0, c.width, c.height).data;
+    return { width: c.width, height: c.height, data: Array.from(ctx.getImageData(0, 0, c.width, c.height).data) };
+  }, fs.readFileSync(pngPath).toString('base64'));
+}
+
+// PSNR (dB) over R, G, B of the canvas against a PNG, computed in the page
+// (the browser decodes the PNG), as reference::psnr does.
+async function psnrAgainst(page, pngPath) {
+  const { data } = await decodePng(page, pngPath);
+  return page.evaluate((ref) => {
     const px = window.tessera.pixels();
     if (px.length !== ref.length) return { error: `sizes differ: ${px.length} vs ${ref.length}` };
     let sum = 0;
@@ -98,7 +104,7 @@ async function psnrAgainst(page, pngPath) {
     }
     const mse = sum / (px.length / 4 * 3);
     return { psnr: mse === 0 ? 999 : 10 * Math.log10(255 * 255 / mse), mse };
-  }, b64);
+  }, data);
 }
 
 // Mean absolute difference of the canvas now against `before` (0..255),
@@ -522,6 +528,7 @@ async function main() {
     await zarrStoreFromUrl(context, url, tmp, run);
     await zarrRegionFromUrl(context, url, tmp, run);
     await zarrGridFromUrl(context, url, tmp, run);
+    await zarrSlicesFromUrl(context, url, tmp, run);
     await zoomSwapView(context, url);
     await shadingAndCrop(context, url, tmp, run);
 
@@ -553,18 +560,7 @@ async function sliceViewsAndRegion(context, url, tmp, run) {
   fs.writeFileSync(file, bytes);
   const { page, logs } = await openPage(context, url, `size=${SIZE}&url=/data/marked.nii`);
   const slices = () => page.evaluate(() => window.tessera.slices.state());
-  // Decodes a PNG in the page: {width, height, data}.
-  const decode = (png) => page.evaluate(async (b64) => {
-    const img = new Image();
-    img.src = `data:image/png;base64,${b64}`;
-    await img.decode();
-    const c = document.createElement('canvas');
-    c.width = img.width;
-    c.height = img.height;
-    const ctx = c.getContext('2d');
-    ctx.drawImage(img, 0, 0);
-    return { width: c.width, height: c.height, data: Array.from(ctx.getImageData(0, 0, c.width, c.height).data) };
-  }, fs.readFileSync(png).toString('base64'));
+  const decode = (png) => decodePng(page, png);
 
   const cross = [33, 25, 19];  // through the cube
   await page.evaluate((v) => window.tessera.slices.setCross(...v), cross);
@@ -1296,8 +1292,22 @@ async function shadingAndCrop(context, url, tmp, run) {
   // then a label text file that hides all but two labels.
   await page.uncheck('#shade');
   await page.evaluate(() => document.getElementById('resetCrop').click());
+  // Slice views: grey before, the label colours with labels on.
+  const colouredSlicePixels = () => page.evaluate(() => {
+    const planes = ['axial', 'coronal', 'sagittal'];
+    let n = 0;
+    for (const q of planes) {
+      const p = window.tessera.slices.imagePixels(q);
+      for (let i = 0; i < p.length; i += 4) if (Math.max(p[i], p[i + 1], p[i + 2]) - Math.min(p[i], p[i + 1], p[i + 2]) > 40) n++;
+    }
+    return n;
+  });
+  const greySlices = await colouredSlicePixels();
   await page.check('#labels');
   await page.evaluate(() => window.tessera.render());
+  const labelSlices = await colouredSlicePixels();
+  check('the slice views show a label volume in its label colours (grey before)', greySlices === 0 && labelSlices > 100,
+        `${greySlices} coloured slice pixels before, ${labelSlices} with labels on`);
   const labelsPng = path.join(tmp, 'native-labels.png');
   run('render', VOLUME, '--labels', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', '--out', labelsPng);
   const ml = await psnrAgainst(page, labelsPng);
@@ -1410,9 +1420,13 @@ async function zarrRegionFromUrl(context, url, tmp, run) {
   const { page, logs } = await openPage(context, url, 'size=64&url=/data/ch2.ome.zarr');
   await page.waitForFunction(() => window.tessera.zarr().completeMs !== null, null, { timeout: 60000 });
   await withoutOverlays(page);
-  const level0Before = served.paths.slice(opened).filter((p) => /^\/data\/ch2\.ome\.zarr\/0\/\d/.test(p)).length;
+  // The slice views read level-0 slabs too (their chunks fetched before).
+  await page.waitForFunction(() => Object.values(window.tessera.slices.state().panels).every((p) => p.frame && !p.frame.pending),
+                             null, { timeout: 30000 }).catch(() => {});
+  const fetchedBefore = new Set(served.paths.slice(opened).filter((p) => /^\/data\/ch2\.ome\.zarr\/0\/\d/.test(p)));
+  const level0Before = fetchedBefore.size;
   const from = served.paths.length;
-  const picked = await page.evaluate(() => window.tessera.slices.showRegion({ begin: [10, 25, 13], end: [25, 38, 20] }));
+  const picked = await page.evaluate(() => window.tessera.slices.showRegion({ begin: [39, 98, 51], end: [99, 150, 79] }));
   const ex = await page.evaluate(() => window.tessera.slices.state().explore);
   if (!picked || !ex.region_level0) throw new Error(`picking a region of the store: ${await page.evaluate(() => window.tessera.error())}`);
   const { begin, end } = ex.region_level0;
@@ -1430,12 +1444,13 @@ async function zarrRegionFromUrl(context, url, tmp, run) {
   const requested = served.paths.slice(from).filter((p) => p.startsWith('/data/ch2.ome.zarr/'));
   const s = await page.evaluate(() => window.tessera.state());
   const same = (a, b) => JSON.stringify([...new Set(a)].sort()) === JSON.stringify([...new Set(b)].sort());
-  check('OME-Zarr region: only the level-0 chunks overlapping the box are fetched, each once',
-        same(requested, expected) && requested.length === expected.length && level0Before === 0 &&
+  const missing = expected.filter((p) => !fetchedBefore.has(p));
+  check('OME-Zarr region: only the level-0 chunks overlapping the box are fetched (those the slices had not), each once',
+        same(requested, missing) && requested.length === missing.length &&
         s.dims.join('x') === [0, 1, 2].map((a) => end[a] - begin[a]).join('x'),
         `${requested.length} requests (${requested.map((p) => p.slice(19)).join(' ')}), expected ` +
         `${expected.length} (${expected.map((p) => p.slice(19)).join(' ')}); ${keys.length} keys asked; ` +
-        `level-0 requests before: ${level0Before}; slices of the ${ex.dims.join('x')} overview level, ` +
+        `${level0Before} level-0 chunks fetched before (slices), ${missing.length} of the box's not; slices in the ${ex.dims.join('x')} voxels of level 0, ` +
         `picked ${JSON.stringify(ex.region)} -> level 0 ${JSON.stringify(ex.region_level0)}; 3D view ${s.dims.join('x')}`);
   const spec = [0, 1, 2].map((a) => `${begin[a]}:${end[a]}`).join(',');
   const refPng = path.join(tmp, 'native-zarr-region.png');
@@ -1593,6 +1608,76 @@ async function zarrGridFromUrl(context, url, tmp, run) {
   check('OME-Zarr grid view: leaving returns to the store; no script errors', errors.length === 0, errors.join(' | '));
   await page.close();
   console.log(`     (OME-Zarr grid view: ${((Date.now() - t) / 1000).toFixed(1)} s)`);
+}
+
+// An OME-Zarr store's slice views at native resolution: with panels large
+// enough for level 0 the three slices through the crosshair are read as
+// level-0 slabs (only the chunks they cut are fetched; the coarsest level
+// stands in meanwhile) and equal `tessera slice STORE`; moving the
+// crosshair reads the new slab.
+async function zarrSlicesFromUrl(context, url, tmp, run) {
+  const store = path.join(tmp, 'ch2.ome.zarr');
+  if (!fs.existsSync(store)) return;
+  const t = Date.now();
+  const opened = served.paths.length;
+  // A 64 px 3D view refines only to level 2: every level-0 request is the
+  // slices', read at level 0 as for panels of 512² pixels.
+  const { page, logs } = await openPage(context, url, 'size=64&url=/data/ch2.ome.zarr');
+  await page.waitForFunction(() => window.tessera.zarr().completeMs !== null, null, { timeout: 60000 });
+  await page.evaluate(() => window.tessera.slices.setPanelPixels(512 * 512));
+  const meta = JSON.parse(fs.readFileSync(path.join(store, '0', '.zarray'), 'utf8'));
+  const chunk = [...meta.chunks].reverse();  // x, y, z
+  const dims = [...meta.shape].reverse();
+  const slabChunks = (axis, index) => {
+    const keys = [];
+    const n = dims.map((d, a) => Math.ceil(d / chunk[a]));
+    for (let cz = 0; cz < n[2]; cz++) for (let cy = 0; cy < n[1]; cy++) for (let cx = 0; cx < n[0]; cx++) {
+      if ([cx, cy, cz][axis] === Math.floor(index / chunk[axis])) keys.push(`/data/ch2.ome.zarr/0/${cz}/${cy}/${cx}`);
+    }
+    return keys;
+  };
+  const decode = (png) => decodePng(page, png);
+  const compare = async (what) => {
+    await page.waitForFunction(() => Object.values(window.tessera.slices.state().panels).every((p) => p.frame && !p.frame.pending),
+                               null, { timeout: 30000 }).catch(() => {});
+    const st = await page.evaluate(() => window.tessera.slices.state());
+    const rows = [];
+    let ok = true;
+    for (const [plane, p] of Object.entries(st.panels)) {
+      const png = path.join(tmp, `zarr-slice-${plane}.png`);
+      run('slice', store, '--axis', 'xyz'[p.axis], '--index', String(p.index), '--out', png);
+      const ref = await decode(png);
+      const shown = await page.evaluate((q) => window.tessera.slices.imagePixels(q), plane);
+      const f = p.frame;
+      const same = f.image_width === ref.width && f.image_height === ref.height && shown.length === ref.data.length;
+      const differing = same ? differingPixels(shown, ref.data, 0) : -1;
+      ok = ok && f.level === 0 && !f.pending && differing === 0;
+      rows.push(`${plane} ${'xyz'[p.axis]}=${p.index}: level ${f.level}${f.pending ? ' (pending)' : ''}, ${f.image_width}x${f.image_height}, ${differing} pixels differ`);
+    }
+    return { ok, text: rows.join('; '), st };
+  };
+  const first = await compare('open');
+  const level0 = served.paths.slice(opened).filter((p) => /^\/data\/ch2\.ome\.zarr\/0\/\d/.test(p));
+  const cross = first.st.cross;
+  const allowed = new Set([0, 1, 2].flatMap((a) => slabChunks(a, cross[a])));
+  check('OME-Zarr slices: the three slices through the crosshair are level-0 slabs, identical to `tessera slice STORE`; only the chunks they cut are fetched, each once',
+        first.ok && level0.length > 0 && level0.every((p) => allowed.has(p)) && new Set(level0).size === level0.length,
+        `${first.text}; ${level0.length} level-0 requests (${new Set(level0).size} distinct), all among the ${allowed.size} chunks the slabs cut: ${level0.every((p) => allowed.has(p))}`);
+  // Another axial slice, in another chunk layer: its slab is read.
+  const z = Math.min(dims[2] - 1, cross[2] + chunk[2]);
+  const from = served.paths.length;
+  await page.evaluate((v) => window.tessera.slices.setCross(...v), [cross[0], cross[1], z]);
+  const moved = await compare('moved');
+  const asked = served.paths.slice(from).filter((p) => /^\/data\/ch2\.ome\.zarr\/0\/\d/.test(p));
+  const axialAxis = 2;
+  check('OME-Zarr slices: moving the crosshair to another chunk layer reads that slab (only its chunks), identical to `tessera slice STORE`',
+        moved.ok && asked.length > 0 && asked.every((p) => slabChunks(axialAxis, z).includes(p) && !level0.includes(p)),
+        `${moved.text}; ${asked.length} new level-0 requests, none fetched before`);
+  const value = await page.evaluate(() => document.getElementById('crosshairInfo').textContent);
+  const errors = logs.filter((l) => (l.startsWith('pageerror') || l.startsWith('error')) && !/status of 404/.test(l));
+  check('OME-Zarr slices: no script errors', errors.length === 0, errors.join(' | ') || value);
+  await page.close();
+  console.log(`     (OME-Zarr slices: ${((Date.now() - t) / 1000).toFixed(1)} s)`);
 }
 
 // The zoom-driven level swap (issue 15 item 4) on the head, with budgets

@@ -492,6 +492,17 @@ bool regionShown() {
 }
 
 // The volume the slices show: the overview's, also while a region is shown.
+const Volume& overviewVolume();
+
+// The voxel space of the slice views, the crosshair, the region and the
+// grid: the overview volume's, or an OME-Zarr store's level 0 (its shape:
+// dims, spacing, direction and type, no voxels; slices read at the level
+// the panel can show, tessera_slice).
+const Volume& sliceShape() {
+  if (storeOverview()) return theZarrView().store().shape();
+  return overviewVolume();
+}
+
 const Volume& overviewVolume() {
   if (const Volume* store = storeOverview()) return *store;
   if (const Volume* whole = zoomOverview()) return *whole;
@@ -532,26 +543,81 @@ std::pair<int, std::string> defaultRegionSide(const Volume& volume) {
 
 extern "C" {
 
-// Slice `index` along index axis `axis` (0 x, 1 y, 2 z) of the overview
-// volume through the viewer's window, nearest voxel at voxel centres, grey
-// or (colour != 0) in the colours of the viewer's TF (`tessera slice --tf`):
-// JSON with the image (`pixels`: RGBA, top row first, width x height, valid
-// until the next call for this axis), its frame (plane, the index axes of
-// columns and rows and whether they run reversed, pixel_mm) and the patient
+// Slice `index` along index axis `axis` (0 x, 1 y, 2 z) of the slice views'
+// volume (sliceShape) through the viewer's window, nearest voxel at voxel
+// centres, grey or (colour != 0) in the colours of the viewer's TF
+// (`tessera slice --tf`): JSON with the image (`pixels`: RGBA, top row
+// first, image_width x image_height, valid until the next call for this
+// axis), its frame (plane, the index axes of columns and rows and whether
+// they run reversed; width x height pixels of pixel_mm in the volume's
+// voxel space: the image is shown stretched to that) and the patient
 // directions of its edges; "" on error (tessera_last_error).
-EMSCRIPTEN_KEEPALIVE const char* tessera_slice(int axis, int index, int colour) {
+//
+// An OME-Zarr store's slice (indices of level 0) is read at the finest level
+// whose slice has at most `maxPixels` pixels (the panel's: finer would not
+// show; <= 0: level 0), as one slab with bounded reads; until that slab's
+// chunks have arrived the coarsest level (in memory) stands in and
+// `pending` is true: the page fetches the chunks (tessera_zarr_wanted) and
+// asks again. A chunk that keeps failing leaves the coarse slice, with
+// `note` naming it.
+EMSCRIPTEN_KEEPALIVE const char* tessera_slice(int axis, int index, int colour, double maxPixels) {
   scratch().clear();
   guarded([&] {
-    const Volume& volume = overviewVolume();
+    if (axis < 0 || axis > 2) throw InputError("slice: the axis must be 0, 1 or 2");
+    const Volume& volume = sliceShape();
     const SliceFrame f = sliceFrame(volume.direction(), axis);
     const glm::ivec3 d = volume.dims();
+    if (index < 0 || index >= d[axis]) {
+      throw InputError("slice: index " + std::to_string(index) +
+                       " is outside 0:" + std::to_string(d[axis]));
+    }
     const SliceRaster r = sliceRaster(f, d, volume.spacing());
     Image& image = sliceViews().images[axis];
     viewer::Viewer& v = theViewer();
+    const Volume* store = storeOverview();
     // A store's window until a region of it is shown (the viewer's then).
-    const ValueRange window = storeOverview() && !v.hasVolume() ? volume.window() : v.window();
-    image =
-        sliceImage(volume, f, index, window, colour ? &v.tfEditor().transferFunction() : nullptr);
+    const ValueRange window = store && !v.hasVolume() ? volume.window() : v.window();
+    // A label volume's slices in its label colours (its TF), always.
+    const TransferFunction* tf =
+        colour || v.labelsOn() ? &v.tfEditor().transferFunction() : nullptr;
+    int level = 0;
+    bool pending = false;
+    std::string note;
+    if (store) {
+      const web::FetchedZarrSource& src = theZarrView().source();
+      const int coarsest = src.levelCount() - 1;
+      while (level < coarsest && maxPixels > 0.0) {
+        const lod::LevelInfo li = src.levelInfo(level);
+        const SliceRaster rl = sliceRaster(f, li.dims, li.spacing);
+        if (double(rl.width) * rl.height <= maxPixels) break;
+        ++level;
+      }
+      // Level l's slice through level-0 slice `index` (levels need not halve).
+      const auto indexAt = [&](int l) {
+        const int n = src.levelInfo(l).dims[axis];
+        return std::clamp(static_cast<int>((index + 0.5) * n / d[axis]), 0, n - 1);
+      };
+      const lod::LevelInfo li = src.levelInfo(level);
+      lod::VoxelBox slab{{0, 0, 0}, li.dims};
+      slab.begin[axis] = indexAt(level);
+      slab.end[axis] = slab.begin[axis] + 1;
+      bool ready = false;
+      try {
+        ready = level == coarsest || src.prefetch(level, slab);
+      } catch (const Error& e) {
+        note = e.what();
+      }
+      if (ready && level < coarsest) {
+        const viewer::SliceGeometry g(li.dims, li.spacing, volume.direction(), axis);
+        image = g.render(src, level, slab.begin[axis], window, tf);
+      } else {
+        pending = note.empty() && level < coarsest;
+        level = coarsest;
+        image = sliceImage(*store, f, indexAt(coarsest), window, tf);
+      }
+    } else {
+      image = sliceImage(volume, f, index, window, tf);
+    }
     nlohmann::json j;
     j["axis"] = axis;
     j["index"] = index;
@@ -567,6 +633,11 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_slice(int axis, int index, int colour) 
     j["width"] = r.width;
     j["height"] = r.height;
     j["pixel_mm"] = r.pixelMm;
+    j["image_width"] = image.width();
+    j["image_height"] = image.height();
+    j["level"] = level;
+    j["pending"] = pending;
+    j["note"] = note;
     j["tf_revision"] = v.tfEditor().revision();
     j["pixels"] = reinterpret_cast<std::uintptr_t>(image.rgba().data());
     scratch() = j.dump();
@@ -574,15 +645,30 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_slice(int axis, int index, int colour) 
   return scratch().c_str();
 }
 
-// Raw value of voxel (x, y, z) of the overview volume (NaN outside it).
+// Raw value of voxel (x, y, z) of the slice views' volume (NaN outside
+// it). A store's level-0 voxel once its chunk has arrived (the slices fetch
+// it when they show level 0; the readout asks for nothing), the coarsest
+// level's otherwise.
 EMSCRIPTEN_KEEPALIVE double tessera_voxel_value(int x, int y, int z) {
   double value = std::nan("");
   guarded([&] {
-    const Volume& volume = overviewVolume();
-    const glm::ivec3 d = volume.dims();
-    if (x >= 0 && y >= 0 && z >= 0 && x < d.x && y < d.y && z < d.z) {
-      value = volume.valueAt(x, y, z);
+    const glm::ivec3 d = sliceShape().dims();
+    if (!(x >= 0 && y >= 0 && z >= 0 && x < d.x && y < d.y && z < d.z)) return;
+    const Volume* store = storeOverview();
+    if (!store) {
+      value = overviewVolume().valueAt(x, y, z);
+      return;
     }
+    const web::FetchedZarrSource& src = theZarrView().source();
+    const lod::VoxelBox voxel{{x, y, z}, {x + 1, y + 1, z + 1}};
+    if (src.resident(0, voxel)) {
+      value = src.readBox(0, voxel).valueAt(0, 0, 0);
+      return;
+    }
+    const glm::ivec3 c = glm::clamp(
+        glm::ivec3((glm::dvec3(x, y, z) + 0.5) * glm::dvec3(store->dims()) / glm::dvec3(d)),
+        glm::ivec3(0), store->dims() - 1);
+    value = store->valueAt(c.x, c.y, c.z);
   });
   return value;
 }
@@ -597,11 +683,12 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_explore_json() {
     const Volume* store = app().viewer ? storeOverview() : nullptr;
     if (!app().viewer || (!theViewer().hasVolume() && !store)) return;
     const bool inRegion = store ? storeRegion().shown : regionShown();
-    const Volume& volume = overviewVolume();
+    const Volume& volume = sliceShape();
     const glm::ivec3 d = volume.dims();
     const glm::dvec3 sp = volume.spacing();
     j["has_volume"] = true;
     j["tf_revision"] = theViewer().tfEditor().revision();
+    j["labels"] = theViewer().labelsOn();  // slices in the label colours
     j["name"] = store            ? theZarrView().storage().describe()
                 : inRegion       ? sliceViews().overviewName
                 : zoomOverview() ? zoomName()
@@ -609,9 +696,9 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_explore_json() {
     j["dims"] = {d.x, d.y, d.z};
     j["spacing"] = {sp.x, sp.y, sp.z};
     j["showing_region"] = inRegion;
-    // A store: the slices show its coarsest level (these dims); regions
-    // are read at level 0 (level0_dims), store_scale level-0 voxels per
-    // overview voxel along each axis.
+    // A store: the slices, crosshair and regions are in level-0 voxels
+    // (these dims; level0_dims the same, store_scale 1), the slices read at
+    // the level their panel shows (tessera_slice).
     j["store"] = store != nullptr;
     glm::dvec3 scale(1.0);
     if (store) {
@@ -635,11 +722,6 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_explore_json() {
       j["region"] = nullptr;
     }
     auto [side, why] = defaultRegionSide(volume);
-    if (store) {
-      // The side is of level-0 voxels; the slices pick in overview voxels.
-      side = std::max(1, static_cast<int>(side / std::max({scale.x, scale.y, scale.z})));
-      why += ", " + std::to_string(side) + " voxels of the overview level";
-    }
     j["region_side"] = side;
     j["region_side_reason"] = why;
   });
@@ -769,7 +851,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_set_mark_box(int slot, int x0, int x1, int y0, 
       m.box.reset();
       return;
     }
-    m.dims = overviewVolume().dims();
+    m.dims = sliceShape().dims();
     m.box = lod::VoxelBox{glm::clamp(box.begin, glm::ivec3(0), m.dims),
                           glm::clamp(box.end, glm::ivec3(0), m.dims)};
   });
@@ -785,15 +867,14 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_projection_json(int width, int height) 
   guarded([&] {
     viewer::Viewer& v = theViewer();
     if (width <= 0 || height <= 0) return;
-    if (const Volume* store = storeOverview()) {
-      // The slices show the store's coarsest level; its frames are drawn in
-      // level 0's model frame (ZarrStoreView::frame), a region of it by the
-      // viewer (a box of level 0 placed where it lies).
+    if (storeOverview()) {
+      // The slices' voxels are the store's level-0 voxels (sliceShape); its
+      // frames are drawn in level 0's model frame (ZarrStoreView::frame), a
+      // region of it by the viewer (a box of level 0 placed where it lies).
       const Volume& shape = theZarrView().store().shape();
-      const glm::dvec3 scale = glm::dvec3(shape.dims()) / glm::dvec3(store->dims());
       const StoreRegion& r = storeRegion();
       const bool inRegion = r.shown && v.hasVolume();
-      const glm::dvec3 spacing = scale * shape.spacing();
+      const glm::dvec3 spacing = shape.spacing();
       const glm::dvec3 extent = inRegion ? v.volume().extent() : shape.extent();
       const glm::dvec3 offset =
           -0.5 * extent - (inRegion ? glm::dvec3(r.box.begin) * shape.spacing() : glm::dvec3(0.0));
@@ -905,6 +986,12 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_wanted() {
   }
   scratch() = keys.dump();
   return scratch().c_str();
+}
+
+// 1 when the key has arrived (or is known missing, or failed moments ago):
+// the page does not fetch it again when it is listed twice.
+EMSCRIPTEN_KEEPALIVE int tessera_zarr_holds(const char* key) {
+  return zarrView() && zarrView()->storage().holds(key) ? 1 : 0;
 }
 
 // A fetched key: its bytes (malloc'ed by the page, freed here), a 404, or
@@ -1147,7 +1234,9 @@ std::string overviewKey(const Volume& v) {
     return "store:" + theZarrView().storage().describe() + "|" + std::to_string(d.x) + "x" +
            std::to_string(d.y) + "x" + std::to_string(d.z);
   }
-  const std::string name = regionShown() ? sliceViews().overviewName : theViewer().volumeName();
+  const std::string name = regionShown()    ? sliceViews().overviewName
+                           : zoomOverview() ? zoomName()
+                                            : theViewer().volumeName();
   return name + "|" + std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
 }
 
@@ -1257,9 +1346,9 @@ extern "C" {
 EMSCRIPTEN_KEEPALIVE int tessera_grid_enter(int cellSide, int x, int y, int z) {
   return guarded([&] {
     zoomStop();  // the grid view's block replaces the whole volume
-    const Volume& volume = overviewVolume();
+    const Volume& volume = sliceShape();
     lod::GridNavigator& nav = gridFor(volume, cellSide);
-    // The crosshair is in overview voxels; a store's grid is over level 0.
+    // The crosshair is in the slices' voxels (a store's: level 0, as its grid).
     const glm::dvec3 scale = glm::dvec3(gridDims(volume)) / glm::dvec3(volume.dims());
     const glm::dvec3 c = (glm::dvec3(x, y, z) + 0.5) * scale / glm::dvec3(nav.cellSize());
     if (!gridView().storeWanted) gridView().fromPoint = nav.point();
@@ -1283,7 +1372,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_grid_move(int viewMove) {
       throw InputError("grid view: not in the grid view (press G)");
     }
     viewer::Viewer& v = theViewer();
-    lod::GridNavigator& nav = gridFor(overviewVolume(), -1);
+    lod::GridNavigator& nav = gridFor(sliceShape(), -1);
     const lod::ViewMove vm = kViewMoves[viewMove];
     const lod::GridMove m = lod::viewMoveToGridMove(v.camera().basis(), vm);
     const std::string what = std::string(lod::viewMoveName(vm)) + " = " + m.name();
@@ -1321,7 +1410,7 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_grid_json() {
   guarded([&] {
     if (!app().viewer || (!theViewer().hasVolume() && !storeOverview())) return;
     if (storeOverview() && !theZarrView().isOpen()) return;
-    const Volume& volume = overviewVolume();
+    const Volume& volume = sliceShape();
     lod::GridNavigator& nav = gridFor(volume, -1);
     const GridView& g = gridView();
     const glm::ivec3 cs = nav.cellSize(), cells = nav.cells(), p = nav.point();

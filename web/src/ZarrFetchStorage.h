@@ -55,6 +55,8 @@ class FetchStorage final : public ZarrStorage {
   // True when `key` has arrived (bytes, a 404 or an error); otherwise
   // records it as wanted.
   bool ready(const std::string& key) const;
+  // Whether the key has arrived (or is known missing), without asking for it.
+  bool holds(const std::string& key) const { return entries_.count(key) != 0; }
   // The keys wanted since the last call, in the order they were first
   // wanted (most urgent first), and forgets them.
   std::vector<std::string> takeWanted() const;

@@ -36,6 +36,13 @@ bool FetchedZarrSource::prefetch(int level, const lod::VoxelBox& box) const {
   return ready;
 }
 
+bool FetchedZarrSource::resident(int level, const lod::VoxelBox& box) const {
+  for (const std::string& key : store_->chunkKeys(level, box.begin, box.end)) {
+    if (!storage_->holds(key)) return false;
+  }
+  return true;
+}
+
 ZarrStoreView::ZarrStoreView(gpu::GlContext& context, const gpu::DeviceLimits& limits,
                              const std::string& url)
     : context_(context),

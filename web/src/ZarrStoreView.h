@@ -37,6 +37,8 @@ class FetchedZarrSource final : public lod::MultiresSource {
     return zarr_.readBox(level, box);
   }
   bool prefetch(int level, const lod::VoxelBox& box) const override;
+  // Whether every chunk of the box has arrived, asking for none.
+  bool resident(int level, const lod::VoxelBox& box) const;
   std::string describe() const override { return zarr_.describe(); }
 
  private:
