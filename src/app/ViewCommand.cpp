@@ -453,22 +453,16 @@ void viewPickedRegion(DesktopSession& ds) {
   showNative(ds, *ds.picked, DesktopSession::Mode::Region, Follow::Fill);
 }
 
-// The grid view starts at the grid point nearest the crosshair, or, when
-// the zoom switches to it (Follow::Keep), nearest the point the 3D view is
-// centred on, so that the block holds what the user zoomed into.
-void enterGrid(DesktopSession& ds, Follow follow = Follow::Fill) {
+// The grid view starts at the grid point nearest the crosshair (the zoom
+// swap, viewer/ZoomSwap.h, picks the point the view is centred on itself).
+void enterGrid(DesktopSession& ds) {
   if (!ds.explorer) return;
   lod::GridNavigator& g = ds.explorer->grid();
-  glm::dvec3 voxel = glm::dvec3(ds.explorer->crosshair()) + 0.5;
-  if (follow == Follow::Keep && ds.mode == DesktopSession::Mode::Overview) {
-    // The camera's target in the overview's model frame (mm from its centre).
-    const glm::dvec3 spacing = ds.explorer->source().shape().spacing();
-    voxel = ds.viewer->camera().target / spacing + 0.5 * glm::dvec3(ds.explorer->dims());
-  }
+  const glm::dvec3 voxel = glm::dvec3(ds.explorer->crosshair()) + 0.5;
   const glm::dvec3 c = voxel / glm::dvec3(g.cellSize());
   g.moveTo(glm::clamp(glm::ivec3(glm::round(c)), glm::ivec3(0), g.cells()));
   ds.exploreNote = g.describe(g.point());
-  showNative(ds, g.blockBox(g.point()), DesktopSession::Mode::Grid, follow);
+  showNative(ds, g.blockBox(g.point()), DesktopSession::Mode::Grid, Follow::Fill);
 }
 
 void gridMove(DesktopSession& ds, lod::ViewMove move) {

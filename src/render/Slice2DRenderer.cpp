@@ -48,7 +48,7 @@ Slice2DRenderer::Slice2DRenderer(gpu::GlContext& context, const Volume& volume,
       options_(options),
       stacks_(volume),
       tf_(TransferFunction::preset("grey")),
-      accumulator_(context) {
+      accumulator_(context, options.halfFloatAccumulation) {
   const int maxSize = options.maxTextureSize > 0
                           ? std::min(options.maxTextureSize, context.caps().max2DTextureSize)
                           : context.caps().max2DTextureSize;
@@ -413,6 +413,7 @@ TechniqueEntry Slice2DRenderer::registration() {
             options.classification = parseSliceClassification(s.options.classify);
             options.currentStackOnly = s.options.currentStackOnly;
             options.maxTextureSize = s.limits.max2DTextureSize;
+            options.halfFloatAccumulation = s.limits.halfFloatRenderTargets;
             auto slicer = std::make_unique<Slice2DRenderer>(s.context, s.volume, options);
             slicer->setSliceCount(s.options.slices);
             return slicer;

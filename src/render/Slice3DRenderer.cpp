@@ -16,12 +16,13 @@
 namespace tessera::render {
 
 Slice3DRenderer::Slice3DRenderer(gpu::GlContext& context, const Volume& volume,
-                                 const layout::Layout& layout)
+                                 const layout::Layout& layout,
+                                 std::optional<bool> halfFloatAccumulation)
     : context_(context),
       volume_(volume),
       layout_(layout),
       tf_(TransferFunction::preset("grey")),
-      accumulator_(context),
+      accumulator_(context, halfFloatAccumulation),
       gradient_(context, volume, layout, kOwnTextureUnits) {}
 
 void Slice3DRenderer::setTransferFunction(const TransferFunction& tf) {
@@ -232,7 +233,8 @@ TechniqueEntry Slice3DRenderer::registration() {
           .requirements = &Slice3DRenderer::requirements,
           .create = [](const TechniqueSetup& s) -> std::unique_ptr<Technique> {
             if (!s.layout) throw Error("slice3d samples a layout, and none was made");
-            auto slicer = std::make_unique<Slice3DRenderer>(s.context, s.volume, *s.layout);
+            auto slicer = std::make_unique<Slice3DRenderer>(s.context, s.volume, *s.layout,
+                                                            s.limits.halfFloatRenderTargets);
             slicer->setSliceCount(s.options.slices);
             slicer->setGradient(layout::parseGradientWish(s.options.gradient));
             return slicer;

@@ -6,12 +6,14 @@
 
 namespace tessera::render {
 
-SliceAccumulator::SliceAccumulator(gpu::GlContext& context) : context_(context) {
+SliceAccumulator::SliceAccumulator(gpu::GlContext& context, std::optional<bool> halfFloat)
+    : context_(context) {
   const gpu::DeviceLimits limits = gpu::DeviceLimits::of(context.caps());
   // Half floats where the context renders to them (ES 3: RGBA16F; ES 2:
-  // EXT_color_buffer_half_float), so that thin slices' small premultiplied
-  // contributions are not rounded to 8 bits one by one; RGBA8 otherwise.
-  if (limits.halfFloatRenderTargets) {
+  // EXT_color_buffer_half_float) and the device allows them, so that thin
+  // slices' small premultiplied contributions are not rounded to 8 bits one
+  // by one; RGBA8 otherwise.
+  if (limits.halfFloatRenderTargets && halfFloat.value_or(true)) {
     floatTarget_ = context.caps().api == gpu::ApiLevel::Gles3 ? gpu::TexelFormat::RGBA16F
                                                               : gpu::TexelFormat::RgbaHalfUnsized;
   }

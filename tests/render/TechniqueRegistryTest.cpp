@@ -20,6 +20,8 @@
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
 #include "tessera/render/CameraRay.h"
+#include "tessera/render/Slice2DRenderer.h"
+#include "tessera/render/Slice3DRenderer.h"
 #include "tessera/render/TechniqueRegistry.h"
 
 using namespace tessera;
@@ -264,6 +266,26 @@ TEST(TechniqueRegistry, LayoutWishesDoNotApplyToATechniqueWithItsOwnStorage) {
       render::createTechnique("slice2d", c, gpu::DeviceLimits::of(c.caps()), source, {});
   EXPECT_EQ(t.upload.layout, nullptr);
   EXPECT_EQ(t.upload.volume.get(), &source.volume());  // its own copy comes from the source
+}
+
+// The slicers accumulate in half floats only where the device's limits
+// allow them (a profile without float render targets gets RGBA8 on a
+// context that has them), so that profile emulation shows the device's
+// rounding, not the host's.
+TEST(TechniqueRegistry, SliceAccumulationFollowsTheDeviceLimitsNotJustTheContext) {
+  gpu::GlContext& c = test::gpuContext();
+  const lod::InCoreVolumeSource source(makeSphere({16, 16, 16}));
+  gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());
+  ASSERT_TRUE(limits.halfFloatRenderTargets) << "llvmpipe renders to RGBA16F";
+  const auto formats = [&](const gpu::DeviceLimits& l) {
+    const render::TechniqueOnVolume s3 = render::createTechnique("slice3d", c, l, source, {});
+    const render::TechniqueOnVolume s2 = render::createTechnique("slice2d", c, l, source, {});
+    return dynamic_cast<const render::Slice3DRenderer&>(*s3.technique).accumulationFormat() + " " +
+           dynamic_cast<const render::Slice2DRenderer&>(*s2.technique).accumulationFormat();
+  };
+  EXPECT_EQ(formats(limits), "RGBA16F RGBA16F");
+  limits.halfFloatRenderTargets = false;
+  EXPECT_EQ(formats(limits), "RGBA8 RGBA8");
 }
 
 TEST(TechniqueRegistry, AnXRayTechniqueRegisteredFromATestRendersLikeTheCpu) {

@@ -233,15 +233,18 @@ TEST_F(ViewerFixture, SlicingTechniquesShowWhatTheSlicersRender) {
     const Image shown = readFramebuffer(fb);
     const TransferFunction& tf = v.tfEditor().transferFunction();
     Image direct;
-    const gpu::DeviceLimits limits = gpu::DeviceLimits::of(ctx.caps());
+    // The viewer's device (its profile's limits: RGBA8 accumulation where
+    // the profile has no float render targets).
+    const gpu::DeviceLimits& limits = v.limits();
     const layout::Plan plan = layout::planLayout(v.volume(), limits, {});
     auto layout = layout::createLayout(plan, v.volume(), limits, ctx.ledger());
     if (std::string(name) == "slice3d") {
-      render::Slice3DRenderer slicer(ctx, v.volume(), *layout);
+      render::Slice3DRenderer slicer(ctx, v.volume(), *layout, limits.halfFloatRenderTargets);
       slicer.setTransferFunction(tf);
       direct = slicer.render(v.camera(), v.settings(), kSize, kSize);
     } else {
-      render::Slice2DRenderer slicer(ctx, v.volume(), render::Slice2DOptions{});
+      render::Slice2DRenderer slicer(ctx, v.volume(),
+                                     {.halfFloatAccumulation = limits.halfFloatRenderTargets});
       slicer.setTransferFunction(tf);
       direct = slicer.render(v.camera(), v.settings(), kSize, kSize);
     }

@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,9 @@ struct Slice2DOptions {
   bool currentStackOnly = false;
   bool powerOfTwoAtlases = false;
   int maxTextureSize = 0;  // 0: the context's limit
+  // Half-float accumulation (SliceAccumulator): nullopt where the context
+  // renders to half floats; the device's limits decide through the registry.
+  std::optional<bool> halfFloatAccumulation = std::nullopt;
 };
 
 class Slice2DRenderer final : public Technique {

@@ -15,6 +15,7 @@
 // The "slice3d" technique of the registry (render/TechniqueRegistry.h).
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,7 +40,10 @@ namespace tessera::render {
 class Slice3DRenderer final : public Technique {
  public:
   // `volume` and `layout` must outlive the renderer.
-  Slice3DRenderer(gpu::GlContext& context, const Volume& volume, const layout::Layout& layout);
+  // `halfFloatAccumulation` as SliceAccumulator's (the registry passes the
+  // device limits' halfFloatRenderTargets).
+  Slice3DRenderer(gpu::GlContext& context, const Volume& volume, const layout::Layout& layout,
+                  std::optional<bool> halfFloatAccumulation = std::nullopt);
 
   void setTransferFunction(const TransferFunction& tf) override;
   // Number of slices over the cube's side; 0 (the default) derives it from

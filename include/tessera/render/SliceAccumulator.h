@@ -27,7 +27,10 @@ namespace tessera::render {
 
 class SliceAccumulator {
  public:
-  explicit SliceAccumulator(gpu::GlContext& context);
+  // `halfFloat`: accumulate in half floats where the context renders to
+  // them (nullopt: whenever it does; false: RGBA8, as a device profile
+  // without float render targets has it).
+  explicit SliceAccumulator(gpu::GlContext& context, std::optional<bool> halfFloat = std::nullopt);
 
   // (Re)allocates the targets for the size, binds and clears the
   // accumulation target and sets the blending for `mode`. GpuError for MIP
