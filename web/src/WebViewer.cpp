@@ -1768,8 +1768,8 @@ void zoomStop() {
   const std::optional<lod::VoxelBox> box = z.swap->shownBox();
   std::shared_ptr<const Volume> whole = z.whole;
   const std::string name = z.name;
+  v.setVolume(Volume(*whole), name);  // throws with the zoom swap still on
   zoomForget();
-  v.setVolume(Volume(*whole), name);
   v.setWindow(window);
   v.camera() = viewer::cameraAcrossSwap(before, box, std::nullopt, whole->dims(), whole->spacing());
 }
