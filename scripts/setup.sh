@@ -16,7 +16,7 @@ PACKAGES=(
   python3-nibabel python3-pydicom python3-numpy          # independent NIfTI/DICOM readers in geometry tests
   libblosc-dev libzstd-dev libcurl4-openssl-dev          # OME-Zarr chunks (blosc, zstd) and HTTP(S) stores
   python3-zarr python3-numcodecs nginx-light             # zarr-python interop tests; nginx serves stores in HTTP tests
-  python3-vtk9                                           # bench/peers: VTK side-by-side benchmark (not a test)
+  python3-vtk9 python3-matplotlib                        # bench/peers: VTK side by side (PNGs, plots) and its smoke tests
 )
 
 # playwright-core for the browser test, pinned by tests/browser/package-lock.json;
