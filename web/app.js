@@ -826,8 +826,7 @@
     if (withSlices) {
       slices = window.TesseraSlices.attach({ M, canvas, requestRender, showError, clearError,
         storeRegion: zarrRegion, storeOverview: zarrOverview,
-        storeFetch: () => (zarr ? zarr.fetchWanted() : Promise.resolve([])),
-        storeDropWanted: () => { if (zarr) zarr.dropWanted(); } });
+        storeFetch: () => (zarr ? zarr.fetchWanted() : Promise.resolve([])) });
       window.tessera.slices = slices.testApi;
     } else {
       $('slice-controls').hidden = true;

@@ -63,8 +63,8 @@ window.TesseraSlices = (function () {
     let explore = { has_volume: false };
     let volumeKey = '';
     let windowKey = '';
-    let cross = [0, 0, 0];      // the crosshair voxel (overview voxels)
-    let region = null;          // the picked box {begin, end} (overview voxels, end exclusive)
+    let cross = [0, 0, 0];      // the crosshair voxel (the slices' voxels: a store's level 0)
+    let region = null;          // the picked box {begin, end} (the slices' voxels, end exclusive)
     let picking = false;        // "Pick region" pressed
     let rubber = null;          // a box being dragged: {panel, a: [px, py], b: [px, py]} in image pixels
     const panels = {};          // by plane
@@ -134,12 +134,14 @@ window.TesseraSlices = (function () {
     // ------------------------------------------------------------ drawing
 
     // The panel's backing pixels: an OME-Zarr store's slice is read at the
-    // finest level with no more pixels than that (finer would not show).
+    // finest level with no more pixels than that (finer would not show). No
+    // panel (the frames only, assignAxes): 1, the coarsest level in memory.
     let pixelsOverride = 0;  // tests: as if every panel had this many pixels
     function panelPixels(p) {
+      if (!p) return 1;
       if (pixelsOverride > 0) return pixelsOverride;
       const dpr = window.devicePixelRatio || 1;
-      return p ? Math.max(1, p.el.clientWidth * dpr) * Math.max(1, p.el.clientHeight * dpr) : 0;
+      return Math.max(1, p.el.clientWidth * dpr) * Math.max(1, p.el.clientHeight * dpr);
     }
     function sliceJson(axis, p) {
       return api.slice(axis, cross[axis], colour(), panelPixels(p));
@@ -205,10 +207,8 @@ window.TesseraSlices = (function () {
             const keys = await opts.storeFetch();
             const pending = PLANES.map((q) => panels[q]).filter((q) => q.frame && q.frame.pending);
             if (keys.length === 0 || pending.length === 0) break;
-            // What was listed while those keys were in flight may have
-            // arrived since: drawn again, the slices list only what they
-            // still lack (no chunk fetched twice).
-            if (opts.storeDropWanted) opts.storeDropWanted();
+            // Drawn again, they list only what they still lack (zarr-url.js
+            // never fetches a key twice).
             for (const q of pending) drawSlice(q);
             redrawOverlays();
           }
@@ -252,13 +252,7 @@ window.TesseraSlices = (function () {
         ctx.setLineDash([]);
       }
       // The grid view's block (web/grid.js), cyan, where this slice cuts it.
-      // A store's block is in level-0 voxels: scaled to the overview's.
-      const level0Block = grid && grid.block();
-      const sc = explore.store ? explore.store_scale : [1, 1, 1];
-      const block = level0Block && {
-        begin: level0Block.begin.map((v, a) => Math.floor(v / sc[a])),
-        end: level0Block.end.map((v, a) => Math.ceil(v / sc[a])),
-      };
+      const block = grid && grid.block();
       if (block && cross[p.axis] >= block.begin[p.axis] && cross[p.axis] < block.end[p.axis]) {
         const [x, y, w, h] = boxRect(p, block);
         ctx.lineWidth = 2 * px;
@@ -458,13 +452,10 @@ window.TesseraSlices = (function () {
 
     async function showRegion(box) {
       if (explore.store) {
-        // An OME-Zarr store: the slices show its overview level; the box
-        // is read at level 0 with bounded reads (only its chunks fetched).
-        const s = explore.store_scale, d0 = explore.level0_dims;
-        const begin = box.begin.map((v, a) => Math.floor(v * s[a]));
-        const end = box.end.map((v, a) => Math.min(d0[a], Math.ceil(v * s[a])));
+        // An OME-Zarr store: the box (level-0 voxels, as the slices) is read
+        // with bounded reads (only its chunks fetched).
         try {
-          await opts.storeRegion(begin, end);
+          await opts.storeRegion(box.begin, box.end);
         } catch (e) {
           showError(`region: ${e.message}`);
           return false;

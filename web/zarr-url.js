@@ -297,16 +297,8 @@
           const message = api.lastError() || 'the region could not be read';
           throw new Error(message.includes(base) ? message : `${base}: ${message}`);
         }
-        const region = keys.filter((k) => !pinned.includes(k));
-        pinned.push(...region);
-        fetched.push(...region);
-        queue = [...new Set([...pinned, ...queue])].filter((k) => !inFlight.has(k));
-        pump();
         ui.status(`${name}: region ${box.join(',')}: fetching ${keys.length} chunks of level 0`);
-        await new Promise((resolve) => {
-          const wait = () => (pinned.length === 0 ? resolve() : setTimeout(wait, 20));
-          wait();
-        });
+        fetched.push(...(await fetchPinned(keys)));
       }
       if (!api.regionShow(...box)) {
         const message = api.lastError();
@@ -317,21 +309,28 @@
       return fetched;
     }
 
-    // The keys the module wants now (a slice view's slab: tessera_slice
-    // asked for them), fetched ahead of the bricks' refinement like a
-    // region's. Resolves to those keys once they have arrived or failed
-    // (a failure reaches the module, which reports it on the next read).
-    async function fetchWanted() {
-      if (!open) return [];
-      const keys = JSON.parse(api.wanted());
-      if (keys.length === 0) return keys;
-      pinned.push(...keys.filter((k) => !pinned.includes(k)));
+    // Fetches `keys` ahead of the bricks' refinement (pinned at the head of
+    // the queue; frames go on meanwhile). Resolves, to the keys it pinned,
+    // once all of them have arrived or failed (a failure reaches the
+    // module, which reports it on the next read).
+    async function fetchPinned(keys) {
+      const fresh = keys.filter((k) => !pinned.includes(k));
+      pinned.push(...fresh);
       queue = [...new Set([...pinned, ...queue])].filter((k) => !inFlight.has(k));
       pump();
       await new Promise((resolve) => {
         const wait = () => (keys.every((k) => !pinned.includes(k)) ? resolve() : setTimeout(wait, 20));
         wait();
       });
+      return fresh;
+    }
+
+    // The keys the module wants now (a slice view's slab: tessera_slice
+    // asked for them), fetched like a region's; resolves to them.
+    async function fetchWanted() {
+      if (!open) return [];
+      const keys = JSON.parse(api.wanted());
+      if (keys.length > 0) await fetchPinned(keys);
       return keys;
     }
 
@@ -409,9 +408,6 @@
       active: () => open && !regionShown,
       showRegion,
       fetchWanted,
-      // Forgets what the module has asked for so far (listed while those
-      // keys were in flight: it asks again for what it still lacks).
-      dropWanted: () => { if (open) api.wanted(); },
       overview: () => {
         regionShown = false;
         if (base) api.regionOverview();

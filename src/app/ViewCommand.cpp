@@ -551,14 +551,12 @@ void drawSliceTile(DesktopSession& ds, DesktopSession::SliceTile& tile, const Re
   const ValueRange w = v.window();
   std::ostringstream key;
   key.precision(17);
-  // A label volume's slices are always in its label colours (its TF).
-  const bool colour = ds.sliceColour || v.labelsOn();
-  key << index << '|' << w.min << '|' << w.max << '|' << colour << '|'
-      << (colour ? v.tfEditor().revision() : 0);
+  const TransferFunction* colours = v.sliceColours(ds.sliceColour);
+  key << index << '|' << w.min << '|' << w.max << '|' << (colours != nullptr) << '|'
+      << (colours ? v.tfEditor().revision() : 0);
   if (key.str() != tile.key) {
     try {
-      const TransferFunction& tf = v.tfEditor().transferFunction();
-      const Image img = g.render(src, 0, index, w, colour ? &tf : nullptr);
+      const Image img = g.render(src, 0, index, w, colours);
       tile.texture = gpu::Texture();
       tile.texture = gpu::Texture::create2D(
           ds.context->ledger(), "slice view",

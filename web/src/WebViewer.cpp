@@ -446,10 +446,9 @@ EMSCRIPTEN_KEEPALIVE const std::uint8_t* tessera_read_pixels(int width, int heig
 namespace {
 
 // An open OME-Zarr store (defined with the store's exports below): its
-// coarsest level is the slice views' overview (null when no store is
-// open), and its region, level-0 voxels, while the viewer shows it.
+// coarsest level, in memory since open (null when no store is open), and
+// its region, level-0 voxels, while the viewer shows it.
 const Volume* storeOverview();
-glm::ivec3 theZarrViewDims0();
 web::ZarrStoreView& theZarrView();
 struct StoreRegion {
   lod::VoxelBox box;
@@ -577,9 +576,7 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_slice(int axis, int index, int colour, 
     const Volume* store = storeOverview();
     // A store's window until a region of it is shown (the viewer's then).
     const ValueRange window = store && !v.hasVolume() ? volume.window() : v.window();
-    // A label volume's slices in its label colours (its TF), always.
-    const TransferFunction* tf =
-        colour || v.labelsOn() ? &v.tfEditor().transferFunction() : nullptr;
+    const TransferFunction* tf = v.sliceColours(colour != 0);
     int level = 0;
     bool pending = false;
     std::string note;
@@ -696,24 +693,15 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_explore_json() {
     j["dims"] = {d.x, d.y, d.z};
     j["spacing"] = {sp.x, sp.y, sp.z};
     j["showing_region"] = inRegion;
-    // A store: the slices, crosshair and regions are in level-0 voxels
-    // (these dims; level0_dims the same, store_scale 1), the slices read at
-    // the level their panel shows (tessera_slice).
+    // A store: the slices, crosshair and regions are in level-0 voxels (these
+    // dims), the slices read at the level their panel shows (tessera_slice);
+    // its region is the box read at level 0 (also as region_level0).
     j["store"] = store != nullptr;
-    glm::dvec3 scale(1.0);
-    if (store) {
-      const glm::ivec3 d0 = theZarrViewDims0();
-      scale = glm::dvec3(d0) / glm::dvec3(d);
-      j["level0_dims"] = {d0.x, d0.y, d0.z};
-      j["store_scale"] = {scale.x, scale.y, scale.z};
-    }
     if (store && inRegion) {
       const lod::VoxelBox& b = storeRegion().box;
-      const glm::ivec3 lo = glm::ivec3(glm::floor(glm::dvec3(b.begin) / scale));
-      const glm::ivec3 hi = glm::min(d, glm::ivec3(glm::ceil(glm::dvec3(b.end) / scale)));
-      j["region"] = {{"begin", {lo.x, lo.y, lo.z}}, {"end", {hi.x, hi.y, hi.z}}};
-      j["region_level0"] = {{"begin", {b.begin.x, b.begin.y, b.begin.z}},
-                            {"end", {b.end.x, b.end.y, b.end.z}}};
+      j["region"] = {{"begin", {b.begin.x, b.begin.y, b.begin.z}},
+                     {"end", {b.end.x, b.end.y, b.end.z}}};
+      j["region_level0"] = j["region"];
     } else if (inRegion) {
       const lod::VoxelBox& b = sliceViews().region;
       j["region"] = {{"begin", {b.begin.x, b.begin.y, b.begin.z}},
@@ -939,10 +927,6 @@ web::ZarrStoreView& theZarrView() {
 
 const Volume* storeOverview() {
   return zarrView() && zarrView()->isOpen() ? &zarrView()->coarsest() : nullptr;
-}
-
-glm::ivec3 theZarrViewDims0() {
-  return theZarrView().source().levelInfo(0).dims;
 }
 
 // The grid view's last block over a store (level-0 voxels), while the
@@ -1222,14 +1206,10 @@ GridView& gridView() {
   return g;
 }
 
-// A store's grid is over level 0 (its blocks are read there, like its
-// regions); a file's over the overview volume.
-glm::ivec3 gridDims(const Volume& v) {
-  return storeOverview() ? theZarrView().source().levelInfo(0).dims : v.dims();
-}
-
+// The grid is over the slices' voxels (sliceShape: a store's level 0, where
+// its blocks are read like its regions; a file's overview volume).
 std::string overviewKey(const Volume& v) {
-  const glm::ivec3 d = gridDims(v);
+  const glm::ivec3 d = v.dims();
   if (storeOverview()) {
     return "store:" + theZarrView().storage().describe() + "|" + std::to_string(d.x) + "x" +
            std::to_string(d.y) + "x" + std::to_string(d.z);
@@ -1265,7 +1245,7 @@ std::optional<lod::VoxelBox> storeGridBlock() {
 // volume that fits the budget whole still has a grid to move on.
 lod::GridNavigator defaultGrid(const Volume& volume) {
   const int side = defaultRegionSide(volume).first;
-  const glm::ivec3 d = gridDims(volume);
+  const glm::ivec3 d = volume.dims();
   const int budgetCell =
       lod::GridNavigator::forBudget(d, std::uint64_t(side) * side * side, 16).cellSize().x;
   const int quarter = (std::max({d.x, d.y, d.z}) + 3) / 4;
@@ -1280,8 +1260,7 @@ lod::GridNavigator& gridFor(const Volume& volume, int cellSide) {
   const std::string key = overviewKey(volume);
   const int asked = cellSide < 0 ? g.askedCell : cellSide;
   if (!g.nav || g.volumeKey != key || g.askedCell != asked) {
-    g.nav =
-        asked > 0 ? lod::GridNavigator(gridDims(volume), glm::ivec3(asked)) : defaultGrid(volume);
+    g.nav = asked > 0 ? lod::GridNavigator(volume.dims(), glm::ivec3(asked)) : defaultGrid(volume);
     g.volumeKey = key;
     g.askedCell = asked;
     g.block.reset();
@@ -1348,9 +1327,8 @@ EMSCRIPTEN_KEEPALIVE int tessera_grid_enter(int cellSide, int x, int y, int z) {
     zoomStop();  // the grid view's block replaces the whole volume
     const Volume& volume = sliceShape();
     lod::GridNavigator& nav = gridFor(volume, cellSide);
-    // The crosshair is in the slices' voxels (a store's: level 0, as its grid).
-    const glm::dvec3 scale = glm::dvec3(gridDims(volume)) / glm::dvec3(volume.dims());
-    const glm::dvec3 c = (glm::dvec3(x, y, z) + 0.5) * scale / glm::dvec3(nav.cellSize());
+    // The crosshair is in the slices' voxels, as the grid.
+    const glm::dvec3 c = (glm::dvec3(x, y, z) + 0.5) / glm::dvec3(nav.cellSize());
     if (!gridView().storeWanted) gridView().fromPoint = nav.point();
     nav.moveTo(glm::clamp(glm::ivec3(glm::round(c)), glm::ivec3(0), nav.cells()));
     showGridBlock(nav.blockBox(nav.point()), false);
@@ -1401,7 +1379,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_grid_move(int viewMove) {
 
 // The grid view: JSON {has_volume, active (its block is the 3D view),
 // cell_size, cells, point, point_class, describe, block (the last block
-// shown, overview voxels, end exclusive; null before the first),
+// shown, the slices' voxels, end exclusive; null before the first),
 // block_text, moves (per view move: its name, the grid move, legal and why
 // not), note, refused, default_cell}.
 EMSCRIPTEN_KEEPALIVE const char* tessera_grid_json() {
@@ -1725,10 +1703,6 @@ ZoomView& zoomView() {
 // 250 / 100 + 1 frames however slow a frame is (a software rasteriser's
 // 300 ms frame would otherwise end it in one: a pop).
 constexpr double kMaxFadeStepMs = 100.0;
-
-}  // namespace
-
-namespace {
 
 // True while the zoom swap drives the viewer (a volume loaded since ends it).
 bool zoomActive() {

@@ -102,6 +102,11 @@ class Viewer {
   void setLabelsDefault() { setLabels(render::LabelTable::defaultFor(*volume_)); }
   void clearLabels(const std::string& tf = "mr-default");
   bool labelsOn() const { return labels_.has_value(); }
+  // The colours of the 2D slice views: the TF's when `asked`, and always for
+  // a label volume (its label colours); null: grey.
+  const TransferFunction* sliceColours(bool asked) const {
+    return asked || labelsOn() ? &tfEditor_.transferFunction() : nullptr;
+  }
   const render::LabelTable& labelTable() const { return *labels_; }  // only when labelsOn()
   void setLabelVisible(int value, bool visible);
   void setAllLabelsVisible(bool visible);
