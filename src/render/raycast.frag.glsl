@@ -51,24 +51,48 @@ vec4 blockAt(vec3 cell) {
 }
 #endif
 
+// The ray's block-face geometry, fixed per ray so that the march divides by
+// nothing (a SIMD rasteriser runs the block code on every iteration): the
+// parameter of face plane f (in blocks) along each axis is f * faceScale +
+// faceBias; the far faces of a block lie at cell + faceSide; base sample
+// index = t * invStep - sampleBias.
+struct RayBlocks {
+  vec3 faceScale;
+  vec3 faceBias;
+  vec3 faceSide;
+  vec3 outward;  // sign(td): which way a radius widens the exit face
+  float invStep;
+  float sampleBias;
+};
+
+RayBlocks rayBlocks(vec3 to, vec3 td, vec3 invTd, float t0, float j) {
+  RayBlocks r;
+  r.faceScale = invTd / u_blocksPerUnit;
+  r.faceBias = -to * invTd;
+  r.faceSide = step(0.0, td);
+  r.outward = sign(td);
+  r.invStep = 1.0 / u_step;
+  r.sampleBias = t0 * r.invStep + j;
+  return r;
+}
+
 // The ray parameter where it leaves the cube of blocks within chessboard
 // distance `radius` of block `cell`, and where it leaves the block it enters
 // there (across the face it leaves by, the first axis on a tie, as
 // AdaptiveSteps.cpp's StepGrid::exit): x and y of the result.
-vec2 exitT(vec3 cell, float radius, vec3 to, vec3 td, vec3 invTd) {
-  vec3 exitFace = (cell + step(0.0, td) + sign(td) * radius) / u_blocksPerUnit;
-  vec3 tb = (exitFace - to) * invTd;
+vec2 exitT(vec3 cell, float radius, RayBlocks r) {
+  vec3 tb = (cell + r.faceSide + r.outward * radius) * r.faceScale + r.faceBias;
   float tExit = min(min(tb.x, tb.y), tb.z);
   vec3 axis = tExit == tb.x ? vec3(1.0, 0.0, 0.0)
                             : (tExit == tb.y ? vec3(0.0, 1.0, 0.0) : vec3(0.0, 0.0, 1.0));
-  vec3 tAhead = tb + axis * abs(invTd) / u_blocksPerUnit;
+  vec3 tAhead = tb + axis * abs(r.faceScale);
   return vec2(tExit, min(min(tAhead.x, tAhead.y), tAhead.z));
 }
 
 // The first base sample at or past parameter tExit (AdaptiveSteps.h:
 // exitSample).
-float exitSample(float tExit, float t0, float j, float k) {
-  return max(ceil((tExit - t0) / u_step - j), k + 1.0);
+float exitSample(float tExit, RayBlocks r, float k) {
+  return max(ceil(tExit * r.invStep - r.sampleBias), k + 1.0);
 }
 
 #ifdef ADAPTIVE_SAMPLING
@@ -82,7 +106,7 @@ uniform float u_log2MaxMultiplier;
 // of two as an integer shift (software rasterisers pay for every exp2).
 vec2 stepMultipliers(vec2 codes, float alpha) {
   vec2 code = floor(codes * 255.0 + 0.5);
-  vec2 e = clamp(floor((code - 64.0) / 8.0 - log2(max(1.0 - alpha, 1e-6))), 0.0,
+  vec2 e = clamp(floor((code - 64.0) * 0.125 - log2(max(1.0 - alpha, 1e-6))), 0.0,
                  u_log2MaxMultiplier);
 #if TESSERA_GLSL == 300
   return vec2(float(1 << int(e.x)), float(1 << int(e.y)));
@@ -178,6 +202,7 @@ void main() {
     // blockExit lie in the block read last.
     float blockExit = -1.0;
     vec4 block = vec4(0.0);
+    RayBlocks rb = rayBlocks(to, td, invTd, t0, j);
 #ifdef ADAPTIVE_SAMPLING
     float aheadExit = -1.0;  // the exit sample of the next block along the ray
 #endif
@@ -202,10 +227,10 @@ void main() {
         // An empty block is left with the cube of empty blocks around it.
         float radius = max(floor(block.r * 255.0 + 0.5) - 1.0, 0.0);
 #endif
-        vec2 exits = exitT(cell, radius, to, td, invTd);
-        blockExit = exitSample(exits.x, t0, j, k);
+        vec2 exits = exitT(cell, radius, rb);
+        blockExit = exitSample(exits.x, rb, k);
 #ifdef ADAPTIVE_SAMPLING
-        aheadExit = exitSample(exits.y, t0, j, k);
+        aheadExit = exitSample(exits.y, rb, k);
 #endif
       }
 #ifdef MODE_MIP
