@@ -198,6 +198,9 @@ std::vector<std::string> Raycaster::definesFor(const RenderSettings& settings) c
   gradient_.addDefines(settings, defines);
   addClippingDefines(settings, defines);
   if (settings.nearest) defines.push_back("NEAREST 1");
+  // The 4096-entry table is read at its nearest entry (render/classify.glsl);
+  // a 256-entry one keeps the linear lookup.
+  if (lutSize_ >= 4096) defines.push_back("TF_NEAREST_ENTRY 1");
   defines.push_back("MAX_STEPS " + std::to_string(settings.maxSteps));
   return defines;
 }

@@ -9,7 +9,18 @@ uniform float u_valueBias;
 float normalizedValue(float stored) { return clamp(stored * u_valueScale + u_valueBias, 0.0, 1.0); }
 
 vec4 classify(float n) {
+#ifdef TF_NEAREST_ENTRY
+  // A fine table (4096 entries): the nearest entry, one unfiltered fetch,
+  // within 1/8190 of the value the linear lookup below reads at (far below an
+  // 8-bit voxel's step); a software rasteriser pays for every fetch (the web
+  // page's frame at step 1: 1.10x faster under SwiftShader, bench/web-peers).
+  float i = floor(n * (u_tfSize - 1.0) + 0.5);
 #if TESSERA_GLSL == 300
+  return texelFetch(u_tf, ivec2(int(i), 0), 0);
+#else
+  return texture2D(u_tf, vec2((i + 0.5) / u_tfSize, 0.5));
+#endif
+#elif TESSERA_GLSL == 300
   // Linear between entries floor(x) and floor(x) + 1 from two texel fetches:
   // the table's LINEAR filter computed in the shader, which software
   // rasterisers (SwiftShader in browsers) run far faster than a filtered
