@@ -12,4 +12,15 @@ uniform vec3 u_gradientDecode;
 vec3 sampleVolumeGradient(vec3 p) {
   return (texture(u_gradientTexture, p).rgb * 255.0 - 128.0) * u_gradientDecode;
 }
+
+#ifdef GRADIENT_HOLDS_VALUES
+// With 8-bit voxels in alpha (VoxelGradients::valuesInAlpha), where the
+// layout stores raw / 255 on the same grid: the stored value (w) and the
+// gradient (xyz) at p from one trilinear fetch.
+#define LAYOUT_HAS_VALUE_AND_GRADIENT 1
+vec4 sampleVolumeAndGradient(vec3 p) {
+  vec4 t = texture(u_gradientTexture, p);
+  return vec4((t.rgb * 255.0 - 128.0) * u_gradientDecode, t.a);
+}
+#endif
 #endif

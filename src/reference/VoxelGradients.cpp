@@ -63,6 +63,7 @@ VoxelGradients computeVoxelGradients(const Volume& volume) {
     perCode[a] = static_cast<float>(1.0 / g.step[a]);
   }
   g.texels.assign(4 * n, 255);
+  g.valuesInAlpha = volume.type() == ScalarType::U8;
   constexpr float kRange = static_cast<float>(VoxelGradients::kCodeRange);
   auto code = [&](float c, int a) {
     const float q = std::clamp(std::nearbyint(c * perCode[a]), -kRange, kRange);
@@ -73,6 +74,7 @@ VoxelGradients computeVoxelGradients(const Volume& volume) {
     t[0] = code(gx, 0);
     t[1] = code(gy, 1);
     t[2] = code(gz, 2);
+    if (g.valuesInAlpha) t[3] = static_cast<std::uint8_t>(values[i]);
   });
   return g;
 }

@@ -43,6 +43,15 @@ void ShadingGradient::prepare(const RenderSettings& settings) {
 void ShadingGradient::addDefines(const RenderSettings& settings,
                                  std::vector<std::string>& defines) const {
   if (precomputed(settings)) defines.push_back("PRECOMPUTED_GRADIENT 1");
+  if (valuesFromGradient(settings)) defines.push_back("GRADIENT_HOLDS_VALUES 1");
+}
+
+bool ShadingGradient::valuesFromGradient(const RenderSettings& settings) const {
+  // The texture holds exactly what the layout's sampleVolume() reads: 8-bit
+  // voxels stored as raw / 255 over the same grid.
+  const layout::ValueMapping m = layout_.rawFromStored();
+  return precomputed(settings) && texture_.holdsValues() && m.scale == 255.0 && m.offset == 0.0 &&
+         texture_.gradients().dims == layout_.volumeDims();
 }
 
 void ShadingGradient::addParts(std::vector<gpu::ShaderPart>& parts) const {

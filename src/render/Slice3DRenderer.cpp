@@ -128,6 +128,7 @@ const gpu::Program& Slice3DRenderer::programFor(const RenderSettings& settings) 
   const std::string key = layout_.name() + (settings.mode == RenderMode::Mip ? "|mip" : "") +
                           (shadingActive(settings) ? "|shade" : "") +
                           (gradient_.precomputed(settings) ? "|gradient-texture" : "") +
+                          (gradient_.valuesFromGradient(settings) ? "|values" : "") +
                           (settings.clipping.active() ? "|clip" : "") +
                           (settings.nearest ? "|nearest" : "");
   return programs_.get(key, [&] {

@@ -18,6 +18,13 @@ float fieldValue(vec3 p) {
 }
 #endif
 
+// A lit sample's value and gradient from one fetch where the layout's seam
+// offers both (the precomputed gradient holding 8-bit voxels,
+// layout/gradient_texture.glsl): the same field, half the fetches.
+#if defined(SHADING) && defined(LAYOUT_HAS_VALUE_AND_GRADIENT) && !defined(NEAREST)
+#define FUSED_VALUE_GRADIENT 1
+#endif
+
 #ifdef SHADING
 // Straight colour c classified at p, lit; transparent samples skip the
 // gradient's fetches.
@@ -28,16 +35,25 @@ vec4 shadeSample(vec4 c, vec3 p) {
 #endif
 
 vec4 classifiedSample(vec3 p) {
+#ifdef FUSED_VALUE_GRADIENT
+  vec4 vg = sampleVolumeAndGradient(p);
+  return shadeClassified(classify(normalizedValue(vg.w)), vg.xyz * u_shadeGradientScale);
+#else
   vec4 c = classify(normalizedValue(fieldValue(p)));
 #ifdef SHADING
   c = shadeSample(c, p);
 #endif
   return c;
+#endif
 }
 
 #ifdef PREINTEGRATED
 // The pre-integrated segment from normalised value nf to nb standing for m
-// base steps (m > 1 only with ADAPTIVE_SAMPLING), with SHADING lit by the gradient at pMid, the segment's middle.
+// base steps (m > 1 only with ADAPTIVE_SAMPLING), with SHADING lit by the
+// gradient at pMid, the segment's middle. Its ends' values come from the
+// layout: the middle is another position (lighting an adaptive segment of up
+// to 16 base steps at its ends cost up to 7 dB, docs/shading.md), so a fused
+// fetch would save nothing here.
 vec4 classifiedSegment(float nf, float nb, float m, vec3 pMid) {
 #ifdef ADAPTIVE_SAMPLING
   vec4 c = stretchOpacity(classifySegment(nf, nb), m);

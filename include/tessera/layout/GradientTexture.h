@@ -53,6 +53,10 @@ class GradientTexture {
   // rawFromStored().scale. Returns the units used (1).
   int bind(const gpu::Program& program, int unit, double rawPerStored) const;
   std::uint64_t bytes() const { return valid() ? gradients_.texels.size() : 0; }
+  // Whether the texture's alpha holds the voxels' raw values (8-bit volumes):
+  // sampleVolumeAndGradient() may stand in for a layout that stores raw / 255
+  // at the same voxel centres.
+  bool holdsValues() const { return valid() && gradients_.valuesInAlpha; }
   // The GLSL part that defines LAYOUT_HAS_GRADIENT and sampleVolumeGradient()
   // from the texture; it goes before the layout's seam parts.
   static gpu::ShaderPart glsl();

@@ -22,8 +22,12 @@ namespace tessera {
 struct VoxelGradients {
   glm::ivec3 dims{0};
   // RGBA8 texels, x fastest: code c per axis, difference = (c - 128) * step
-  // (raw value per voxel); alpha unused (255).
+  // (raw value per voxel); alpha the voxel's own raw value where
+  // valuesInAlpha (8-bit volumes), 255 otherwise.
   std::vector<std::uint8_t> texels;
+  // Whether alpha holds the voxels: one trilinear fetch then gives a lit
+  // sample's value (raw / 255) and gradient (layout/gradient_texture.glsl).
+  bool valuesInAlpha = false;
   glm::dvec3 step{0.0};  // raw value per voxel per code unit: max |difference| / 127
 
   static constexpr int kZeroCode = 128;

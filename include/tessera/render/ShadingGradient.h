@@ -31,6 +31,11 @@ class ShadingGradient {
   // Whether frames with these settings shade from the precomputed texture.
   bool precomputed(const RenderSettings& settings) const;
 
+  // Whether lit samples take their value from the texture too (its alpha:
+  // one fetch per lit sample instead of two; render/sample.glsl). Known once
+  // prepare() built the texture.
+  bool valuesFromGradient(const RenderSettings& settings) const;
+
   // Builds the texture when these settings need it.
   void prepare(const RenderSettings& settings);
   void addDefines(const RenderSettings& settings, std::vector<std::string>& defines) const;
