@@ -56,6 +56,7 @@ RenderSettings variantSettings(const RenderSettings& base, double step, bool pre
   RenderSettings s = base;
   s.stepVoxels = step;
   s.sampling.preintegrate = pre;
+  s.sampling.preintegrateLitOnly = false;  // a variant says which it measures
   s.sampling.adaptive = adaptive;
   s.sampling.tolerance = tolerance;
   s.sampling.maxMultiplier = maxMultiplier;

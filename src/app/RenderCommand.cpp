@@ -419,6 +419,7 @@ void printRenderText(const RenderOptions& o, const RenderRequest& req, const Ren
   if (o.technique == "raycast") {
     RenderSettings effective = req.settings;
     effective.sampling.preintegrate = r.preintegrated;
+    effective.sampling.preintegrateLitOnly = false;
     effective.sampling.adaptive = r.adaptive;
     std::string line = describeSampling(effective);
     if (r.preintegrated) {

@@ -8,9 +8,14 @@
 namespace tessera::app {
 
 bool parseOnOff(const std::string& text, const std::string& option) {
+  return parseOnOffOr(text, option, "");
+}
+
+bool parseOnOffOr(const std::string& text, const std::string& option, const std::string& other) {
   if (text == "on" || text == "true" || text == "1" || text == "yes") return true;
   if (text == "off" || text == "false" || text == "0" || text == "no") return false;
-  throw InputError(option + " '" + text + "': expected on or off");
+  throw InputError(option + " '" + text + "': expected " +
+                   (other.empty() ? "on or off" : "on, off or " + other));
 }
 
 void addSamplingOptions(CLI::App* cmd, SamplingOptions& o) {
@@ -22,7 +27,9 @@ void addSamplingOptions(CLI::App* cmd, SamplingOptions& o) {
           ->capture_default_str();
   cmd->add_option("--preintegrate", o.preintegrate,
                   "Pre-integrated classification of the segments between samples (composite "
-                  "ray casting): on or off (post-classification of each sample)")
+                  "ray casting): on, off (post-classification of each sample) or lit (only "
+                  "frames with --shade or --gradient-opacity: the fastest that keeps 40 dB, "
+                  "docs/sampling.md)")
       ->capture_default_str();
   cmd->add_option("--adaptive", o.adaptive,
                   "Adaptive sampling: larger steps inside empty-space blocks where the TF varies "
@@ -48,7 +55,9 @@ void applySampling(const SamplingOptions& o, RenderSettings& settings) {
     throw InputError("--step must be a positive number of voxels");
   }
   settings.stepVoxels = o.step;
-  settings.sampling.preintegrate = parseOnOff(o.preintegrate, "--preintegrate");
+  settings.sampling.preintegrateLitOnly = o.preintegrate == "lit";
+  settings.sampling.preintegrate = settings.sampling.preintegrateLitOnly ||
+                                   parseOnOffOr(o.preintegrate, "--preintegrate", "lit");
   settings.sampling.adaptive = parseOnOff(o.adaptive, "--adaptive");
   if (!(o.tolerance >= 0.0) || !std::isfinite(o.tolerance)) {
     throw InputError("--adaptive-tolerance must be a finite number >= 0");

@@ -18,7 +18,9 @@ namespace tessera::app {
 // which the viewers start with too.
 struct SamplingOptions {
   double step = kDefaultStepVoxels;
-  std::string preintegrate = defaultSampling().preintegrate ? "on" : "off";
+  std::string preintegrate = !defaultSampling().preintegrate         ? "off"
+                             : defaultSampling().preintegrateLitOnly ? "lit"
+                                                                     : "on";
   std::string adaptive = defaultSampling().adaptive ? "on" : "off";
   double tolerance = defaultSampling().tolerance;
   int maxMultiplier = defaultSampling().maxMultiplier;
@@ -34,6 +36,8 @@ void addSamplingOptions(CLI::App* cmd, SamplingOptions& o);
 void applySampling(const SamplingOptions& o, RenderSettings& settings);
 // "on"/"off" (also true/false, 1/0, yes/no) as a bool; InputError names the option.
 bool parseOnOff(const std::string& text, const std::string& option);
+// The same where a third word `other` is handled by the caller (named in the error).
+bool parseOnOffOr(const std::string& text, const std::string& option, const std::string& other);
 // A line for reports: "step 0.5 voxel, pre-integrated, adaptive x8 (tolerance 0.1)".
 std::string describeSampling(const RenderSettings& settings);
 

@@ -961,10 +961,16 @@ void panelRendering(DesktopSession& ds) {
   float step = static_cast<float>(v.settings().stepVoxels);
   if (ImGui::SliderFloat("step (voxels)", &step, 0.25f, 2.0f)) v.settings().stepVoxels = step;
   // `tessera render`'s fast path (docs/sampling.md), on by default; off:
-  // post-classified samples at exactly the step above.
+  // post-classified samples at exactly the step above. Pre-integration by
+  // default only in lit frames (shading or gradient opacity), as the CLI's
+  // --preintegrate lit.
   Sampling& sampling = v.settings().sampling;
-  ImGui::Checkbox("pre-integrated", &sampling.preintegrate);
-  ImGui::SameLine();
+  int classification = !sampling.preintegrate ? 0 : sampling.preintegrateLitOnly ? 2 : 1;
+  if (ImGui::Combo("classification", &classification,
+                   "post-classified\0pre-integrated\0pre-integrated when lit\0")) {
+    sampling.preintegrate = classification != 0;
+    sampling.preintegrateLitOnly = classification == 2;
+  }
   ImGui::Checkbox("adaptive steps", &sampling.adaptive);
   float opacity = static_cast<float>(v.settings().opacityScale);
   if (ImGui::SliderFloat("opacity x", &opacity, 0.0f, 4.0f)) v.settings().opacityScale = opacity;
@@ -1190,11 +1196,11 @@ std::string viewKey(viewer::Viewer& v, int viewW, int viewH) {
   key << v.volumeName() << '|' << c.azimuthDeg << '|' << c.elevationDeg << '|' << c.zoom << '|'
       << c.target.x << c.target.y << c.target.z << '|' << v.tfEditor().revision() << '|'
       << static_cast<int>(v.settings().mode) << '|' << v.settings().stepVoxels << '|'
-      << v.settings().sampling.preintegrate << v.settings().sampling.adaptive << '|'
-      << v.settings().opacityScale << '|' << v.window().min << v.window().max << '|'
-      << v.technique() << static_cast<int>(v.quality) << v.controller().interacting() << '|'
-      << v.showBoundingBox << v.showAxes << '|' << v.settings().nearest << '|' << viewW << 'x'
-      << viewH;
+      << v.settings().sampling.preintegrate << v.settings().sampling.preintegrateLitOnly
+      << v.settings().sampling.adaptive << '|' << v.settings().opacityScale << '|' << v.window().min
+      << v.window().max << '|' << v.technique() << static_cast<int>(v.quality)
+      << v.controller().interacting() << '|' << v.showBoundingBox << v.showAxes << '|'
+      << v.settings().nearest << '|' << viewW << 'x' << viewH;
   for (const render::OverlayLine& l : v.extraLines) {
     key << "|l" << l.a.x << ',' << l.a.y << ',' << l.a.z << ',' << l.b.x << ',' << l.b.y << ','
         << l.b.z;

@@ -11,8 +11,7 @@
 namespace tessera::render {
 
 bool shadingActive(const RenderSettings& settings) {
-  return (settings.shading.enabled || settings.shading.gradientOpacity) &&
-         settings.mode == RenderMode::Composite;
+  return litSamples(settings);
 }
 
 void addShadingDefines(const RenderSettings& settings, std::vector<std::string>& defines) {

@@ -34,6 +34,28 @@ CliRun run(const std::string& args) {
 
 }  // namespace
 
+// The default classification: pre-integrated where samples are lit, post-classified
+// otherwise (docs/sampling.md, "Defaults"); on and off force it.
+TEST(Cli, RenderPreintegratesLitFramesByDefault) {
+  const tessera::test::TempDir tmp;
+  const std::string out = " --out " + (tmp / "p.png").string();
+  const auto preintegrated = [&](const std::string& extra) {
+    const CliRun r = run("render gen:shepp-logan:32 --size 32x32 --json --tf bench " + extra + out);
+    EXPECT_EQ(r.exitCode, 0) << r.out;
+    return nlohmann::json::parse(r.out)["preintegrate"].get<bool>();
+  };
+  EXPECT_FALSE(preintegrated(""));
+  EXPECT_TRUE(preintegrated("--shade"));
+  EXPECT_TRUE(preintegrated("--gradient-opacity on"));
+  EXPECT_TRUE(preintegrated("--preintegrate on"));
+  EXPECT_FALSE(preintegrated("--shade --preintegrate off"));
+  EXPECT_TRUE(preintegrated("--shade --preintegrate lit"));
+  const CliRun bad = run("render gen:shepp-logan:32 --size 32x32 --preintegrate maybe" + out);
+  EXPECT_NE(bad.exitCode, 0);
+  EXPECT_NE(bad.out.find("--preintegrate 'maybe': expected on, off or lit"), std::string::npos)
+      << bad.out;
+}
+
 TEST(Cli, RenderPhantomJsonReportsRequiredFieldsAndWritesPng) {
   const tessera::test::TempDir tmp;
   const fs::path png = tmp / "phantom.png";
@@ -53,11 +75,11 @@ TEST(Cli, RenderPhantomJsonReportsRequiredFieldsAndWritesPng) {
   EXPECT_LE(j["ms_min"].get<double>(), j["ms_median"].get<double>());
   EXPECT_LE(j["ms_median"].get<double>(), j["ms_max"].get<double>());
   EXPECT_GE(j["psnr_db"].get<double>(), 40.0);
-  // 48^3 u8 volume + 256^2 RGBA16F pre-integration table (the default) + 6^3
-  // RGBA8 blocks + 64x48 RGBA8 target + VBO.
+  // 48^3 u8 volume + the 4096-entry RGBA16F TF table (unlit frames are
+  // post-classified by default) + 6^3 RGBA8 blocks + 64x48 RGBA8 target + VBO.
   EXPECT_EQ(j["texture_bytes"].get<std::uint64_t>(),
-            48u * 48 * 48 + 256u * 256 * 8 + 6u * 6 * 6 * 4 + 64u * 48 * 4 + 24u);
-  EXPECT_EQ(j["preintegrate"], true);
+            48u * 48 * 48 + 4096u * 8 + 6u * 6 * 6 * 4 + 64u * 48 * 4 + 24u);
+  EXPECT_EQ(j["preintegrate"], false);
   EXPECT_EQ(j["adaptive"], true);
   EXPECT_GT(j["samples_per_ray"].get<double>(), 0.0);
   const tessera::Image img = tessera::Image::readPng(png);

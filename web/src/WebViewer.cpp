@@ -330,6 +330,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_set_step(double voxels) {
 EMSCRIPTEN_KEEPALIVE void tessera_set_sampling(int preintegrate, int adaptive) {
   if (!app().viewer) return;
   theViewer().settings().sampling.preintegrate = preintegrate != 0;
+  theViewer().settings().sampling.preintegrateLitOnly = false;
   theViewer().settings().sampling.adaptive = adaptive != 0;
 }
 // Blinn-Phong shading with a headlight and the default terms (RenderSettings::shading).
