@@ -66,16 +66,28 @@ void Raycaster::setPreintegrationEntries(int entries) {
   lookupKey_.clear();
 }
 
+bool Raycaster::logTransmittance(const RenderSettings& settings) const {
+  // Unlit post-classified adaptive composite frames (the default's unlit
+  // case): a stretch of m base steps then costs one exp2 instead of a pow,
+  // and the accumulated transmittance's log2, which the steps grow by, is a
+  // running sum instead of a log2 per iteration. Lit samples keep opacity
+  // (gradient opacity scales it); the 256-entry table keeps the linear
+  // lookup of opacity the reference takes.
+  return blockSize_ > 0 && usesAdaptiveSampling(settings) && !usesPreintegration(settings) &&
+         !litSamples(settings) && settings.mode == RenderMode::Composite && lutSize_ >= 4096;
+}
+
 void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistance) {
   const ValueRange w = volume_.window();
   const bool pre = usesPreintegration(settings);
   const bool adaptive = blockSize_ > 0 && usesAdaptiveSampling(settings);
+  const bool logT = logTransmittance(settings);
   std::ostringstream key;
   key.precision(17);
   key << sampleDistance << '|' << settings.opacityScale << '|' << w.min << '|' << w.max << '|'
       << lutSize_ << '|' << blockSize_ << '|' << pre << '|' << preintEntries_ << '|' << adaptive
-      << '|' << settings.sampling.tolerance << '|' << settings.sampling.maxMultiplier << '|'
-      << tf_.toJson();
+      << '|' << settings.sampling.tolerance << '|' << settings.sampling.maxMultiplier << '|' << logT
+      << '|' << tf_.toJson();
   if (key.str() == lookupKey_) return;
   lookupKey_ = key.str();
 
@@ -85,6 +97,13 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
     preint_.update(context_, tf_, settings.opacityScale, sampleDistance, preintEntries_);
   } else {
     lutValues_ = tf_.bake(lutSize_, sampleDistance, settings.opacityScale);
+    if (logT) {
+      // log2(1 - a), at least -24 (a = 1 - 2^-24: opaque for 8-bit output).
+      for (std::size_t i = 3; i < lutValues_.size(); i += 4) {
+        lutValues_[i] = static_cast<float>(
+            std::log2(std::max(1.0 - static_cast<double>(lutValues_[i]), std::exp2(-24.0))));
+      }
+    }
     uploadLut();
   }
 
@@ -201,6 +220,7 @@ std::vector<std::string> Raycaster::definesFor(const RenderSettings& settings) c
   // The 4096-entry table is read at its nearest entry (render/classify.glsl);
   // a 256-entry one keeps the linear lookup.
   if (lutSize_ >= 4096) defines.push_back("TF_NEAREST_ENTRY 1");
+  if (logTransmittance(settings)) defines.push_back("LOG_TRANSMITTANCE 1");
   defines.push_back("MAX_STEPS " + std::to_string(settings.maxSteps));
   return defines;
 }

@@ -100,13 +100,14 @@ uniform float u_log2MaxMultiplier;
 
 // The multipliers for the step codes in `codes` (AdaptiveSteps.h: 64 +
 // floor(8 log2 s), s a step allowance; x the block's own, y the bound on its
-// neighbours') behind opacity `alpha`: 2^floor(log2(s / (1 - alpha))),
-// 1..2^u_log2MaxMultiplier. Integer maths on floats, rounded, so that the
-// lattice arithmetic stays exact; one log2 for both, and on ES 3 the power
-// of two as an integer shift (software rasterisers pay for every exp2).
-vec2 stepMultipliers(vec2 codes, float alpha) {
+// neighbours') behind accumulated opacity alpha, given as log2T = log2(1 -
+// alpha): 2^floor(log2(s / (1 - alpha))), 1..2^u_log2MaxMultiplier, with 1 -
+// alpha at least 1e-6 (log2: -19.93). Integer maths on floats, rounded, so
+// that the lattice arithmetic stays exact; on ES 3 the power of two as an
+// integer shift (software rasterisers pay for every exp2).
+vec2 stepMultipliers(vec2 codes, float log2T) {
   vec2 code = floor(codes * 255.0 + 0.5);
-  vec2 e = clamp(floor((code - 64.0) * 0.125 - log2(max(1.0 - alpha, 1e-6))), 0.0,
+  vec2 e = clamp(floor((code - 64.0) * 0.125 - max(log2T, -19.931569)), 0.0,
                  u_log2MaxMultiplier);
 #if TESSERA_GLSL == 300
   return vec2(float(1 << int(e.x)), float(1 << int(e.y)));
@@ -163,6 +164,9 @@ void main() {
   float t1 = range.y;
 
   vec4 acc = vec4(0.0);
+#ifdef LOG_TRANSMITTANCE
+  float logT = 0.0;  // log2(1 - acc.a)
+#endif
   float maxValue = -1.0;
   float minValue = 2.0;  // MinIP
   float sumValue = 0.0;  // average
@@ -240,8 +244,10 @@ void main() {
 #endif
       float kExit = blockExit;
 #ifdef ADAPTIVE_SAMPLING
-#ifdef OPACITY_GROWTH
-      float grownBy = acc.a;
+#if defined(OPACITY_GROWTH) && defined(LOG_TRANSMITTANCE)
+      float grownBy = logT;  // log2(1 - acc.a), summed as the ray composites
+#elif defined(OPACITY_GROWTH)
+      float grownBy = log2(max(1.0 - acc.a, 1e-6));
 #else
       float grownBy = 0.0;
 #endif
@@ -305,7 +311,15 @@ void main() {
       sumValue += normalizedValue(fieldValue(p));
       kept += 1.0;
 #else
-#ifdef ADAPTIVE_SAMPLING
+#if defined(LOG_TRANSMITTANCE)
+      // A sample stands for the stretch to the next one; the table's .a is
+      // log2 of one base step's transmittance, so the stretch's is m times
+      // it, and so is what it adds to the ray's.
+      vec4 c = classifiedSample(p);
+      float stretchLog2T = (kNext - k) * c.a;
+      compositeFrontToBack(acc, vec4(c.rgb, 1.0 - exp2(stretchLog2T)));
+      logT += stretchLog2T;
+#elif defined(ADAPTIVE_SAMPLING)
       // A sample stands for the stretch to the next one.
       compositeFrontToBack(acc, stretchOpacity(classifiedSample(p), kNext - k));
 #else

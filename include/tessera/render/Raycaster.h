@@ -125,6 +125,9 @@ class Raycaster final : public Technique {
   const gpu::Program& programFor(const RenderSettings& settings);
   std::vector<std::string> definesFor(const RenderSettings& settings) const;
   void updateLookup(const RenderSettings& settings, double sampleDistance);
+  // Whether frames with these settings read the table's opacity as log2 of a
+  // base step's transmittance (raycast.frag.glsl, LOG_TRANSMITTANCE).
+  bool logTransmittance(const RenderSettings& settings) const;
   void uploadLut();
   void uploadBlocks(const std::vector<std::uint8_t>& cells);
 
