@@ -6,12 +6,18 @@
 #include <cstdint>
 #include <sstream>
 
+#include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/TexelFormat.h"
 #include "tessera/reference/PreIntegration.h"
 
 namespace tessera::render {
+
+bool PreIntegrationTable::floatTexels(const gpu::GlContext& context) const {
+  return !eightBit_ && (context.caps().api == gpu::ApiLevel::Gles3 ||
+                        gpu::DeviceLimits::of(context.caps()).halfFloatTextures);
+}
 
 bool PreIntegrationTable::update(gpu::GlContext& context, const TransferFunction& tf,
                                  double opacityScale, double length, int entries) {
@@ -33,17 +39,29 @@ bool PreIntegrationTable::update(gpu::GlContext& context, const TransferFunction
   } else if (!eightBit_ && gpu::DeviceLimits::of(context.caps()).halfFloatTextures) {
     format = gpu::TexelFormat::RgbaHalfUnsized;
   }
+  if (logTransmittance_ && !floatTexels(context)) {
+    throw Error("pre-integration table: log transmittance needs float texels");
+  }
+  std::vector<float> logValues;
+  if (logTransmittance_) {
+    logValues = values_;
+    for (std::size_t i = 3; i < logValues.size(); i += 4) {
+      logValues[i] = static_cast<float>(
+          std::log2(std::max(1.0 - static_cast<double>(logValues[i]), std::exp2(-24.0))));
+    }
+  }
+  const std::vector<float>& uploaded = logTransmittance_ ? logValues : values_;
   const std::vector<std::uint16_t> halves = format == gpu::TexelFormat::RgbaHalfUnsized
-                                                ? gpu::packHalves(values_)
+                                                ? gpu::packHalves(uploaded)
                                                 : std::vector<std::uint16_t>();
   const std::vector<std::uint8_t> bytes =
       format == gpu::TexelFormat::Rgba8Unsized || format == gpu::TexelFormat::RGBA8
-          ? gpu::packUnorm8(values_)
+          ? gpu::packUnorm8(uploaded)
           : std::vector<std::uint8_t>();
   const void* data = format == gpu::TexelFormat::RgbaHalfUnsized
                          ? static_cast<const void*>(halves.data())
                      : !bytes.empty() ? static_cast<const void*>(bytes.data())
-                                      : static_cast<const void*>(values_.data());
+                                      : static_cast<const void*>(uploaded.data());
   if (texture_.id() != 0 && entries == entries_ && texture_.format() == format) {
     texture_.update(data);
   } else {

@@ -67,14 +67,19 @@ void Raycaster::setPreintegrationEntries(int entries) {
 }
 
 bool Raycaster::logTransmittance(const RenderSettings& settings) const {
-  // Unlit post-classified adaptive composite frames (the default's unlit
-  // case): a stretch of m base steps then costs one exp2 instead of a pow,
-  // and the accumulated transmittance's log2, which the steps grow by, is a
-  // running sum instead of a log2 per iteration. Lit samples keep opacity
-  // (gradient opacity scales it); the 256-entry table keeps the linear
-  // lookup of opacity the reference takes.
-  return blockSize_ > 0 && usesAdaptiveSampling(settings) && !usesPreintegration(settings) &&
-         !litSamples(settings) && settings.mode == RenderMode::Composite && lutSize_ >= 4096;
+  // Unlit adaptive composite frames: a stretch of m base steps then costs
+  // one exp2 instead of a pow, and the accumulated transmittance's log2,
+  // which the steps grow by, is a running sum instead of a log2 per
+  // iteration (1.12x post-classified, 1.09x pre-integrated at step 1 on
+  // llvmpipe). Lit frames gained nothing (post-classified) or lost 6 %
+  // (pre-integrated), and gradient opacity scales opacity itself. The
+  // 256-entry table keeps the linear lookup of opacity the reference takes;
+  // an RGBA8 pre-integration table cannot hold negative numbers.
+  if (blockSize_ == 0 || !usesAdaptiveSampling(settings) ||
+      settings.mode != RenderMode::Composite || litSamples(settings)) {
+    return false;
+  }
+  return usesPreintegration(settings) ? preint_.floatTexels(context_) : lutSize_ >= 4096;
 }
 
 void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistance) {
@@ -94,6 +99,7 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
   // Composite with pre-integration classifies segments through the 2D table
   // and needs no 1D one; everything else samples the 1D table.
   if (pre) {
+    preint_.setLogTransmittance(logT);
     preint_.update(context_, tf_, settings.opacityScale, sampleDistance, preintEntries_);
   } else {
     lutValues_ = tf_.bake(lutSize_, sampleDistance, settings.opacityScale);

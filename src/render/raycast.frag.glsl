@@ -285,7 +285,15 @@ void main() {
       float n = normalizedValue(fieldValue(q));
       float tMid = t0 + (0.5 * (frontK + k) + j) * u_step;
       vec4 c = classifiedSegment(frontN, n, k - frontK, to + tMid * td);
-      if (!frontOnly && keepQ && frontK >= 0.0) compositeFrontToBack(acc, c);
+      bool composites = !frontOnly && keepQ && frontK >= 0.0;
+#ifdef LOG_TRANSMITTANCE
+      // The segment stands for k - frontK base steps (see the post-classified
+      // case below).
+      float stretchLog2T = (k - frontK) * c.a;
+      c.a = 1.0 - exp2(stretchLog2T);
+      if (composites) logT += stretchLog2T;
+#endif
+      if (composites) compositeFrontToBack(acc, c);
       frontN = n;
       if (frontOnly) {
         frontK = keepQ ? k - 1.0 : -1.0;

@@ -27,7 +27,8 @@ float fieldValue(vec3 p) {
 
 #ifdef SHADING
 // Straight colour c classified at p, lit; transparent samples skip the
-// gradient's fetches.
+// gradient's fetches. (Never with LOG_TRANSMITTANCE: only unlit frames read
+// opacity as log2 of the transmittance.)
 vec4 shadeSample(vec4 c, vec3 p) {
   if (c.a <= 0.0) return c;
   return shadeClassified(c, sampleVolumeGradient(p) * u_shadeGradientScale);
@@ -55,7 +56,9 @@ vec4 classifiedSample(vec3 p) {
 // to 16 base steps at its ends cost up to 7 dB, docs/shading.md), so a fused
 // fetch would save nothing here.
 vec4 classifiedSegment(float nf, float nb, float m, vec3 pMid) {
-#ifdef ADAPTIVE_SAMPLING
+#ifdef LOG_TRANSMITTANCE
+  vec4 c = classifySegment(nf, nb);  // .a: log2 of one base step's transmittance
+#elif defined(ADAPTIVE_SAMPLING)
   vec4 c = stretchOpacity(classifySegment(nf, nb), m);
 #else
   vec4 c = classifySegment(nf, nb);  // m = 1: consecutive samples

@@ -30,6 +30,16 @@ class PreIntegrationTable {
     if (eightBit != eightBit_) key_.clear();
     eightBit_ = eightBit;
   }
+  // Whether the texels are (half) floats in `context`: they can hold an
+  // opacity as log2 of the transmittance (negative).
+  bool floatTexels(const gpu::GlContext& context) const;
+  // Upload opacity as log2(1 - a) (at least -24) instead of a, for
+  // raycast.frag.glsl's LOG_TRANSMITTANCE; only with floatTexels(). values()
+  // keeps a.
+  void setLogTransmittance(bool on) {
+    if (on != logTransmittance_) key_.clear();
+    logTransmittance_ = on;
+  }
 
   const gpu::Texture& texture() const { return texture_; }
   int entries() const { return entries_; }
@@ -47,6 +57,7 @@ class PreIntegrationTable {
   int entries_ = 0;
   int builds_ = 0;
   bool eightBit_ = false;
+  bool logTransmittance_ = false;
   double buildMs_ = 0.0;
   double uploadMs_ = 0.0;
   std::vector<float> values_;
