@@ -282,7 +282,7 @@ void main() {
       bool frontOnly = lazyFront && frontK < 0.0 && sampleKept(p);
       vec3 q = frontOnly ? p - u_step * td : p;
       bool keepQ = sampleKept(q);
-      float n = normalizedValue(fieldValue(q));
+      float n = normalizedValue(segmentValue(q));
       float tMid = t0 + (0.5 * (frontK + k) + j) * u_step;
       vec4 c = classifiedSegment(frontN, n, k - frontK, to + tMid * td);
       bool composites = !frontOnly && keepQ && frontK >= 0.0;

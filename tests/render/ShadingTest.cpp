@@ -216,8 +216,9 @@ void expectRampLitByAnalyticNormal(const Image& img, const Volume& v, const Came
 
 // 8-bit voxels ride in the precomputed gradient's alpha: a lit sample's value
 // and gradient come from one fetch (render/sample.glsl: post-classified and
-// slice3d samples) where the layout stores raw / 255; 16-bit volumes keep two.
-// Pre-integrated segments (lit at their middle) still match their reference.
+// slice3d samples) where the layout stores raw / 255, and a pre-integrated
+// segment's end values come from that texture too; 16-bit volumes read the
+// layout.
 TEST(Shading, EightBitLitSamplesTakeTheirValueFromTheGradientFetch) {
   withContext(gpu::ApiLevel::Gles3, [](gpu::GlContext& c) {
     const Volume v8 = makeSphere({37, 53, 29});
