@@ -59,6 +59,7 @@ RenderSettings variantSettings(const RenderSettings& base, double step, bool pre
   s.sampling.preintegrateLitOnly = false;  // a variant says which it measures
   s.sampling.adaptive = adaptive;
   s.sampling.tolerance = tolerance;
+  s.sampling.litTolerance = -1.0;  // lit variants too
   s.sampling.maxMultiplier = maxMultiplier;
   return s;
 }

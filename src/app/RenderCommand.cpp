@@ -384,7 +384,7 @@ void printRenderJson(const RenderOptions& o, const RenderRequest& req, const Ren
   j["preintegrate"] = r.preintegrated;
   j["adaptive"] = r.adaptive;
   if (r.adaptive) {
-    j["adaptive_tolerance"] = req.settings.sampling.tolerance;
+    j["adaptive_tolerance"] = adaptiveTolerance(req.settings);
     j["adaptive_max"] = req.settings.sampling.maxMultiplier;
   }
   if (r.preintegrated) {

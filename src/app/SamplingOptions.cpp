@@ -27,19 +27,21 @@ void addSamplingOptions(CLI::App* cmd, SamplingOptions& o) {
           ->capture_default_str();
   cmd->add_option("--preintegrate", o.preintegrate,
                   "Pre-integrated classification of the segments between samples (composite "
-                  "ray casting): on, off (post-classification of each sample) or lit (only "
-                  "frames with --shade or --gradient-opacity: the fastest that keeps 40 dB, "
-                  "docs/sampling.md)")
+                  "ray casting): on, off (post-classification of each sample; with adaptive "
+                  "steps the fastest that keeps 40 dB, docs/sampling.md) or lit (only frames "
+                  "with --shade or --gradient-opacity)")
       ->capture_default_str();
   cmd->add_option("--adaptive", o.adaptive,
                   "Adaptive sampling: larger steps inside empty-space blocks where the TF varies "
                   "little over the block's values (composite ray casting; needs --skip-block > "
                   "0): on or off")
       ->capture_default_str();
-  cmd->add_option("--adaptive-tolerance", o.tolerance,
-                  "With --adaptive: a block takes m base steps at once while m * step * (TF "
-                  "variation over its values, per mm) <= this")
-      ->capture_default_str();
+  o.toleranceOption =
+      cmd->add_option("--adaptive-tolerance", o.tolerance,
+                      "With --adaptive: a block takes m base steps at once while m * step * (TF "
+                      "variation over its values, per mm) <= this; by default this in unlit "
+                      "frames and half of it with --shade or --gradient-opacity")
+          ->capture_default_str();
   cmd->add_option("--adaptive-max", o.maxMultiplier,
                   "With --adaptive: the largest multiple of the base step (1, 2, 4, ... 64)")
       ->capture_default_str();
@@ -67,6 +69,9 @@ void applySampling(const SamplingOptions& o, RenderSettings& settings) {
     throw InputError("--adaptive-max must be a power of two in 1..64, got " + std::to_string(m));
   }
   settings.sampling.tolerance = o.tolerance;
+  // Given, the tolerance holds for lit frames too; otherwise theirs is the default's.
+  const bool given = o.toleranceOption != nullptr && o.toleranceOption->count() > 0;
+  settings.sampling.litTolerance = given ? -1.0 : defaultSampling().litTolerance;
   settings.sampling.maxMultiplier = m;
   settings.sampling.opacityGrowth = parseOnOff(o.growth, "--adaptive-growth");
 }
@@ -79,7 +84,7 @@ std::string describeSampling(const RenderSettings& s) {
   out += usesPreintegration(s) ? ", pre-integrated" : ", post-classified";
   if (usesAdaptiveSampling(s)) {
     std::snprintf(buf, sizeof buf, ", adaptive steps up to %dx (tolerance %g%s)",
-                  s.sampling.maxMultiplier, s.sampling.tolerance,
+                  s.sampling.maxMultiplier, adaptiveTolerance(s),
                   s.sampling.opacityGrowth ? ", growing behind opacity" : "");
     out += buf;
   }

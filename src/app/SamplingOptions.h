@@ -23,6 +23,7 @@ struct SamplingOptions {
                                                                      : "on";
   std::string adaptive = defaultSampling().adaptive ? "on" : "off";
   double tolerance = defaultSampling().tolerance;
+  CLI::Option* toleranceOption = nullptr;  // given: lit frames take it too
   int maxMultiplier = defaultSampling().maxMultiplier;
   std::string growth = defaultSampling().opacityGrowth ? "on" : "off";
   CLI::Option* stepOption = nullptr;

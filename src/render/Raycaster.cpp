@@ -91,7 +91,7 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
   key.precision(17);
   key << sampleDistance << '|' << settings.opacityScale << '|' << w.min << '|' << w.max << '|'
       << lutSize_ << '|' << blockSize_ << '|' << pre << '|' << preintEntries_ << '|' << adaptive
-      << '|' << settings.sampling.tolerance << '|' << settings.sampling.maxMultiplier << '|' << logT
+      << '|' << adaptiveTolerance(settings) << '|' << settings.sampling.maxMultiplier << '|' << logT
       << '|' << tf_.toJson();
   if (key.str() == lookupKey_) return;
   lookupKey_ = key.str();
@@ -119,9 +119,12 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
   // Per block: visible at all (and with adaptive sampling its step
   // multiplier) for the table the ray caster samples (AdaptiveSteps.h), and
   // the largest normalised value for MIP.
-  const std::vector<std::uint8_t> codes = classifyStepBlocks(
-      blocks_.mins(), blocks_.maxs(), w, tf_, settings.opacityScale, sampleDistance,
-      pre ? preintEntries_ : lutSize_, settings.sampling, adaptive);
+  // The tolerance this frame uses (lit frames have their own).
+  Sampling sampling = settings.sampling;
+  sampling.tolerance = adaptiveTolerance(settings);
+  const std::vector<std::uint8_t> codes =
+      classifyStepBlocks(blocks_.mins(), blocks_.maxs(), w, tf_, settings.opacityScale,
+                         sampleDistance, pre ? preintEntries_ : lutSize_, sampling, adaptive);
   const double ww = w.max - w.min;
   std::vector<std::uint8_t> cells(codes.size() * 4, 0);
   std::size_t occupiedCount = 0;

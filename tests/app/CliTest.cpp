@@ -34,22 +34,29 @@ CliRun run(const std::string& args) {
 
 }  // namespace
 
-// The default classification: pre-integrated where samples are lit, post-classified
-// otherwise (docs/sampling.md, "Defaults"); on and off force it.
-TEST(Cli, RenderPreintegratesLitFramesByDefault) {
+// The default sampling (docs/sampling.md, "Defaults"): post-classified
+// adaptive steps, tolerance 0.5 unlit and 0.25 lit; --preintegrate on, lit
+// (only lit frames) and off; a given --adaptive-tolerance holds for both.
+TEST(Cli, RenderSamplesPostClassifiedByDefaultWithAHalvedToleranceWhenLit) {
   const tessera::test::TempDir tmp;
   const std::string out = " --out " + (tmp / "p.png").string();
-  const auto preintegrated = [&](const std::string& extra) {
+  const auto report = [&](const std::string& extra) {
     const CliRun r = run("render gen:shepp-logan:32 --size 32x32 --json --tf bench " + extra + out);
     EXPECT_EQ(r.exitCode, 0) << r.out;
-    return nlohmann::json::parse(r.out)["preintegrate"].get<bool>();
+    return nlohmann::json::parse(r.out);
   };
-  EXPECT_FALSE(preintegrated(""));
-  EXPECT_TRUE(preintegrated("--shade"));
-  EXPECT_TRUE(preintegrated("--gradient-opacity on"));
-  EXPECT_TRUE(preintegrated("--preintegrate on"));
-  EXPECT_FALSE(preintegrated("--shade --preintegrate off"));
-  EXPECT_TRUE(preintegrated("--shade --preintegrate lit"));
+  auto j = report("");
+  EXPECT_FALSE(j["preintegrate"].get<bool>());
+  EXPECT_DOUBLE_EQ(j["adaptive_tolerance"].get<double>(), 0.5);
+  j = report("--shade");
+  EXPECT_FALSE(j["preintegrate"].get<bool>());
+  EXPECT_DOUBLE_EQ(j["adaptive_tolerance"].get<double>(), 0.25);
+  EXPECT_DOUBLE_EQ(report("--gradient-opacity on")["adaptive_tolerance"].get<double>(), 0.25);
+  EXPECT_DOUBLE_EQ(report("--shade --adaptive-tolerance 0.4")["adaptive_tolerance"].get<double>(),
+                   0.4);
+  EXPECT_TRUE(report("--preintegrate on")["preintegrate"].get<bool>());
+  EXPECT_FALSE(report("--preintegrate lit")["preintegrate"].get<bool>());
+  EXPECT_TRUE(report("--shade --preintegrate lit")["preintegrate"].get<bool>());
   const CliRun bad = run("render gen:shepp-logan:32 --size 32x32 --preintegrate maybe" + out);
   EXPECT_NE(bad.exitCode, 0);
   EXPECT_NE(bad.out.find("--preintegrate 'maybe': expected on, off or lit"), std::string::npos)
