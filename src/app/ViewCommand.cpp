@@ -960,10 +960,10 @@ void panelRendering(DesktopSession& ds) {
   }
   float step = static_cast<float>(v.settings().stepVoxels);
   if (ImGui::SliderFloat("step (voxels)", &step, 0.25f, 2.0f)) v.settings().stepVoxels = step;
-  // `tessera render`'s fast path (docs/sampling.md), on by default; off:
-  // post-classified samples at exactly the step above. Pre-integration by
-  // default only in lit frames (shading or gradient opacity), as the CLI's
-  // --preintegrate lit.
+  // `tessera render`'s fast path (docs/sampling.md): adaptive steps, on by
+  // default (off: samples at exactly the step above), post-classified by
+  // default; pre-integration for every frame or, as the CLI's --preintegrate
+  // lit, for shaded or gradient-opacity frames only.
   Sampling& sampling = v.settings().sampling;
   int classification = !sampling.preintegrate ? 0 : sampling.preintegrateLitOnly ? 2 : 1;
   if (ImGui::Combo("classification", &classification,

@@ -14,6 +14,13 @@
 
 namespace tessera::render {
 
+void toLog2Transmittance(std::vector<float>& rgba) {
+  for (std::size_t i = 3; i < rgba.size(); i += 4) {
+    rgba[i] = static_cast<float>(
+        std::log2(std::max(1.0 - static_cast<double>(rgba[i]), std::exp2(-24.0))));
+  }
+}
+
 bool PreIntegrationTable::floatTexels(const gpu::GlContext& context) const {
   return !eightBit_ && (context.caps().api == gpu::ApiLevel::Gles3 ||
                         gpu::DeviceLimits::of(context.caps()).halfFloatTextures);
@@ -34,10 +41,9 @@ bool PreIntegrationTable::update(gpu::GlContext& context, const TransferFunction
   // 8 bits where nothing better filters (or when asked); half floats hold
   // the small opacities of short steps.
   gpu::TexelFormat format = gpu::rgba8For(context.caps().api);
-  if (!eightBit_ && context.caps().api == gpu::ApiLevel::Gles3) {
-    format = gpu::TexelFormat::RGBA16F;
-  } else if (!eightBit_ && gpu::DeviceLimits::of(context.caps()).halfFloatTextures) {
-    format = gpu::TexelFormat::RgbaHalfUnsized;
+  if (floatTexels(context)) {
+    format = context.caps().api == gpu::ApiLevel::Gles3 ? gpu::TexelFormat::RGBA16F
+                                                        : gpu::TexelFormat::RgbaHalfUnsized;
   }
   if (logTransmittance_ && !floatTexels(context)) {
     throw Error("pre-integration table: log transmittance needs float texels");
@@ -45,10 +51,7 @@ bool PreIntegrationTable::update(gpu::GlContext& context, const TransferFunction
   std::vector<float> logValues;
   if (logTransmittance_) {
     logValues = values_;
-    for (std::size_t i = 3; i < logValues.size(); i += 4) {
-      logValues[i] = static_cast<float>(
-          std::log2(std::max(1.0 - static_cast<double>(logValues[i]), std::exp2(-24.0))));
-    }
+    toLog2Transmittance(logValues);
   }
   const std::vector<float>& uploaded = logTransmittance_ ? logValues : values_;
   const std::vector<std::uint16_t> halves = format == gpu::TexelFormat::RgbaHalfUnsized

@@ -103,13 +103,7 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
     preint_.update(context_, tf_, settings.opacityScale, sampleDistance, preintEntries_);
   } else {
     lutValues_ = tf_.bake(lutSize_, sampleDistance, settings.opacityScale);
-    if (logT) {
-      // log2(1 - a), at least -24 (a = 1 - 2^-24: opaque for 8-bit output).
-      for (std::size_t i = 3; i < lutValues_.size(); i += 4) {
-        lutValues_[i] = static_cast<float>(
-            std::log2(std::max(1.0 - static_cast<double>(lutValues_[i]), std::exp2(-24.0))));
-      }
-    }
+    if (logT) toLog2Transmittance(lutValues_);
     uploadLut();
   }
 

@@ -16,6 +16,12 @@
 
 namespace tessera::render {
 
+// Replaces each entry's opacity a (every 4th float of straight RGBA) by
+// log2(1 - a), at least -24 (a = 1 - 2^-24: opaque for 8-bit output): the
+// tables raycast.frag.glsl reads with LOG_TRANSMITTANCE (this 2D one and the
+// 1D TF table).
+void toLog2Transmittance(std::vector<float>& rgba);
+
 class PreIntegrationTable {
  public:
   static constexpr int kDefaultEntries = 256;
