@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <memory>
 #include <set>
 #include <unordered_map>
@@ -150,7 +151,11 @@ TEST(BricksLod, StreamerRetriesFailingReadsWithBackOffAndKeepsTheCacheInBudget) 
   for (int x = 0; x < 4; ++x)
     for (int y = 0; y < 2; ++y)
       for (int z = 0; z < 2; ++z) keys.push_back({0, {x, y, z}});
-  for (int round = 0; round < 400; ++round) {
+  // Bounded by time, not by rounds: evicted good bricks are read again on
+  // every request, so progress can wake hundreds of rounds within the few
+  // milliseconds the failing bricks' back-off takes.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (std::chrono::steady_clock::now() < deadline) {
     streamer.request(keys);
     streamer.waitForProgress(5.0);
     bool settled = true;
