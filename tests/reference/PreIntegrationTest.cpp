@@ -4,12 +4,10 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 
 #include "tessera/core/Error.h"
-#include "tessera/core/Timing.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/reference/AdaptiveSteps.h"
 #include "tessera/reference/ImageMetrics.h"
@@ -91,13 +89,10 @@ TEST(PreIntegration, ALongerSegmentIsTheOpacityCorrectedShortOne) {
   }
 }
 
-TEST(PreIntegration, TableHoldsTheSegmentsAndRebuildsFast) {
-  const TransferFunction tf = rampTf();
-  const auto t0 = std::chrono::steady_clock::now();
-  const PreIntegral integral(tf);
+// Its build time is a benchmark figure (`tessera bench --sampling`), not a test.
+TEST(PreIntegration, TableHoldsTheSegments) {
+  const PreIntegral integral(rampTf());
   const std::vector<float> table = bakePreIntegrationTable(integral, 256, 0.5);
-  const double ms = msSince(t0);
-  std::printf("  [measured] 256^2 table from the TF in %.2f ms\n", ms);
   ASSERT_EQ(table.size(), 256u * 256u * 4u);
   for (int j : {0, 17, 128, 255}) {
     for (int i : {0, 3, 128, 200, 255}) {
@@ -107,7 +102,6 @@ TEST(PreIntegration, TableHoldsTheSegmentsAndRebuildsFast) {
       }
     }
   }
-  EXPECT_LT(ms, 500.0);  // about a millisecond on a quiet machine; sanitizers are slower
   EXPECT_THROW(bakePreIntegrationTable(integral, 1, 0.5), InputError);
 }
 
