@@ -75,10 +75,7 @@ bool Raycaster::logTransmittance(const RenderSettings& settings) const {
   // (pre-integrated), and gradient opacity scales opacity itself. The
   // 256-entry table keeps the linear lookup of opacity the reference takes;
   // an RGBA8 pre-integration table cannot hold negative numbers.
-  if (blockSize_ == 0 || !usesAdaptiveSampling(settings) ||
-      settings.mode != RenderMode::Composite || litSamples(settings)) {
-    return false;
-  }
+  if (blockSize_ == 0 || !usesAdaptiveSampling(settings) || litSamples(settings)) return false;
   return usesPreintegration(settings) ? preint_.floatTexels(context_) : lutSize_ >= 4096;
 }
 

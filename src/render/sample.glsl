@@ -64,10 +64,10 @@ float segmentValue(vec3 p) {
 
 // The pre-integrated segment from normalised value nf to nb standing for m
 // base steps (m > 1 only with ADAPTIVE_SAMPLING), with SHADING lit by the
-// gradient at pMid, the segment's middle. Its ends' values come from the
-// layout: the middle is another position (lighting an adaptive segment of up
-// to 16 base steps at its ends cost up to 7 dB, docs/shading.md), so a fused
-// fetch would save nothing here.
+// gradient at pMid, the segment's middle: the gradient is fetched at
+// another position than the ends' values (segmentValue()), because lighting
+// an adaptive segment of up to 16 base steps by its ends' gradients cost up
+// to 7 dB (docs/shading.md).
 vec4 classifiedSegment(float nf, float nb, float m, vec3 pMid) {
 #ifdef LOG_TRANSMITTANCE
   vec4 c = classifySegment(nf, nb);  // .a: log2 of one base step's transmittance
