@@ -5,12 +5,13 @@
 #include <cstdio>
 #include <memory>
 
-#include "app/RenderJob.h"
+#include "app/Commands.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"
 #include "tessera/layout/Planner.h"
 #include "tessera/lod/MultiresVolumeSource.h"
 #include "tessera/lod/ProceduralMultiresSource.h"
+#include "tessera/session/RenderRun.h"
 
 namespace tessera::app {
 
@@ -33,10 +34,13 @@ std::string levels(const std::vector<int>& perLevel) {
   return s;
 }
 
-RenderRequest requestFor(const BricksBenchOptions& o, const std::string& layout) {
+RenderRequest requestFor(const BricksBenchOptions& o, const TransferFunction& tf,
+                         const std::string& layout) {
   RenderRequest req;
   parseSize(o.size, req.width, req.height);
-  req.layout = layout;
+  req.settings.render = RenderSettings();  // plain sampling, as the runs were measured
+  req.settings.tf = tf;
+  req.settings.layout = layout;
   req.repeat = o.frames + 1;
   req.rotateDeg = o.rotate;
   return req;
@@ -59,7 +63,7 @@ void runBricksBench(const BricksBenchOptions& o) {
       std::fprintf(stderr, "bench: %s on %s...\n", spec.c_str(), profile.c_str());
       DeviceSession device = openDevice(profile);
       const lod::MultiresVolumeSource source(std::make_shared<lod::ProceduralMultiresSource>(spec));
-      const RenderResult r = runRender(device, source, tf, requestFor(o, "bricks"));
+      const RenderResult r = runRender(device, source, requestFor(o, tf, "bricks"));
       std::vector<double> rotating(r.frameMs.begin() + 1, r.frameMs.end());
       const double rotatingMs = median(rotating);
       // The baseline: the same volume in core, where the profile holds it.
@@ -70,7 +74,7 @@ void runBricksBench(const BricksBenchOptions& o) {
         const layout::Plan p = layout::planLayout(source.shape(), device.limits, pr);
         const std::uint64_t voxels = source.shape().voxelCount();
         if (!p.downsampled() && voxels <= HostBudget::global().limitBytes()) {
-          const RenderResult b = runRender(device, source, tf, requestFor(o, p.layout.layout));
+          const RenderResult b = runRender(device, source, requestFor(o, tf, p.layout.layout));
           const double baseMs = median(std::vector<double>(b.frameMs.begin() + 1, b.frameMs.end()));
           char text[32];
           std::snprintf(text, sizeof text, "%.0f (%s)", baseMs, b.layout.c_str());

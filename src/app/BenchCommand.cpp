@@ -15,7 +15,6 @@
 #include "app/BenchSampling.h"
 #include "app/BenchSlicing.h"
 #include "app/Commands.h"
-#include "app/RenderJob.h"
 #include "app/ShadingOptions.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
@@ -29,6 +28,7 @@
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
 #include "tessera/render/TechniqueRegistry.h"
+#include "tessera/session/RenderRun.h"
 
 namespace tessera::app {
 

@@ -10,7 +10,7 @@
 #include <sstream>
 #include <thread>
 
-#include "app/RenderJob.h"
+#include "app/Commands.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"
@@ -18,6 +18,7 @@
 #include "tessera/lod/GridNavigator.h"
 #include "tessera/lod/InCoreVolumeSource.h"
 #include "tessera/lod/ProceduralMultiresSource.h"
+#include "tessera/session/RenderRun.h"
 
 namespace tessera::app {
 
@@ -130,9 +131,10 @@ RenderRequest requestFor(const ExploreBenchOptions& o, const Volume& v, double a
                          int repeat, double rotate) {
   RenderRequest req;
   parseSize(o.size, req.width, req.height);
-  req.layout = "texture3d";
-  req.camera.azimuthDeg = azimuth;
-  req.camera.zoom = zoom;
+  req.settings.render = RenderSettings();  // plain sampling, as the paper's runs
+  req.settings.layout = "texture3d";
+  req.settings.camera.azimuthDeg = azimuth;
+  req.settings.camera.zoom = zoom;
   req.repeat = repeat;
   req.rotateDeg = rotate;
   // The paper steps 1/stepsAcross of the texture cube: the same number of
@@ -141,8 +143,8 @@ RenderRequest requestFor(const ExploreBenchOptions& o, const Volume& v, double a
   const double longest = std::max({extent.x, extent.y, extent.z});
   const glm::dvec3 sp = v.spacing();
   const double minSpacing = std::min({sp.x, sp.y, sp.z});
-  req.settings.stepVoxels = longest / o.stepsAcross / minSpacing;
-  req.settings.maxSteps = o.maxSteps;
+  req.settings.render.stepVoxels = longest / o.stepsAcross / minSpacing;
+  req.settings.render.maxSteps = o.maxSteps;
   return req;
 }
 
@@ -159,9 +161,9 @@ void benchCell(DeviceSession& device, const ExploreBenchOptions& o, const Subjec
   RenderRequest req = requestFor(o, *s.volume, azimuth, cell.zoom,
                                  spin ? spinFrames + 1 : o.frames + 1, spin ? o.spinDeg : 0.0);
   const glm::dvec3 sp = s.volume->spacing();
-  const TransferFunction tf =
-      paperTf(o.alpha, cell.minValue, req.settings.stepVoxels * std::min({sp.x, sp.y, sp.z}));
-  const RenderResult rr = runRender(device, source, tf, req);
+  req.settings.tf = paperTf(o.alpha, cell.minValue,
+                            req.settings.render.stepVoxels * std::min({sp.x, sp.y, sp.z}));
+  const RenderResult rr = runRender(device, source, req);
   // Frame 0 pays for the first use of the texture: it is left out.
   const std::vector<double> frames(rr.frameMs.begin() + 1, rr.frameMs.end());
   Cell done = cell;

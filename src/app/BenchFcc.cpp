@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/RenderJob.h"
+#include "app/Commands.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"
@@ -21,6 +21,7 @@
 #include "tessera/layout/Texture3DLayout.h"
 #include "tessera/lod/Downsample.h"
 #include "tessera/render/TechniqueRegistry.h"
+#include "tessera/session/RenderRun.h"
 
 namespace tessera::app {
 

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "app/BenchFcc.h"
-#include "app/RenderJob.h"
+#include "app/Commands.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/io/Procedural.h"
@@ -27,6 +27,7 @@
 #include "tessera/reference/Reconstruction.h"
 #include "tessera/reference/ReferenceRaycaster.h"
 #include "tessera/render/TechniqueRegistry.h"
+#include "tessera/session/RenderRun.h"
 
 namespace tessera::app {
 

@@ -11,7 +11,6 @@
 #include <nlohmann/json.hpp>
 
 #include "app/Commands.h"
-#include "app/RenderJob.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
 #include "tessera/io/VolumeReader.h"
@@ -21,6 +20,7 @@
 #include "tessera/reference/ReferenceOverlay.h"
 #include "tessera/render/HybridCompositor.h"
 #include "tessera/render/TechniqueRegistry.h"
+#include "tessera/session/RenderRun.h"
 
 namespace tessera::app {
 

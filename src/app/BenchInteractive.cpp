@@ -7,7 +7,6 @@
 
 #include "app/BenchHybrid.h"
 #include "app/Commands.h"
-#include "app/RenderJob.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
 #include "tessera/io/VolumeReader.h"
@@ -17,6 +16,7 @@
 #include "tessera/render/HybridCompositor.h"
 #include "tessera/render/QualityController.h"
 #include "tessera/render/TechniqueRegistry.h"
+#include "tessera/session/RenderRun.h"
 
 namespace tessera::app {
 

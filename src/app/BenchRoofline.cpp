@@ -7,7 +7,6 @@
 #include <nlohmann/json.hpp>
 
 #include "app/Commands.h"
-#include "app/RenderJob.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
 #include "tessera/io/VolumeReader.h"
@@ -15,6 +14,7 @@
 #include "tessera/reference/ReferenceRaycaster.h"
 #include "tessera/render/Roofline.h"
 #include "tessera/render/TechniqueRegistry.h"
+#include "tessera/session/RenderRun.h"
 
 namespace tessera::app {
 
@@ -39,15 +39,16 @@ struct SampleCounts {
 };
 
 SampleCounts countSamples(const Volume& volume, const TransferFunction& tf, RenderRequest req) {
-  req.camera.frame(volume);
+  Camera& camera = req.settings.camera;
+  camera.frame(volume);
   SampleCounts counts;
   ReferenceStats stats;
-  renderReference(volume, tf, req.camera, req.settings, req.width, req.height, 0, &stats);
+  renderReference(volume, tf, camera, req.settings.render, req.width, req.height, 0, &stats);
   counts.withErt = static_cast<double>(stats.samples);
-  RenderSettings noErt = req.settings;
+  RenderSettings noErt = req.settings.render;
   noErt.ertThreshold = 2.0;
   stats = {};
-  renderReference(volume, tf, req.camera, noErt, req.width, req.height, 0, &stats);
+  renderReference(volume, tf, camera, noErt, req.width, req.height, 0, &stats);
   counts.nominal = static_cast<double>(stats.samples);
   return counts;
 }
@@ -83,7 +84,8 @@ void runRooflineBench(const RooflineBenchOptions& o) {
   RenderRequest base;
   parseSize(o.size, base.width, base.height);
   if (o.frames < 1) throw InputError("--frames must be >= 1");
-  base.settings.stepVoxels = o.step;
+  base.settings.render = RenderSettings();  // plain sampling: the counted samples
+  base.settings.render.stepVoxels = o.step;
   Camera camera;
   camera.frame(volume);
 
@@ -100,24 +102,23 @@ void runRooflineBench(const RooflineBenchOptions& o) {
   struct Setup {
     std::string technique, layout;
     int skipBlock;
+    std::string label;
   };
-  for (const Setup& setup : std::vector<Setup>{{"raycast", "texture3d", 0},
-                                               {"raycast", "texture3d", 8},
-                                               {"raycast", "mosaic", 8},
-                                               {"raycast", "packed-mosaic", 8},
-                                               {"slice3d", "auto", 8},
-                                               {"slice2d", "auto", 8}}) {
-    TechniqueRow row{setup.technique, setup.layout, {}, {}, {}};
+  for (const Setup& setup :
+       std::vector<Setup>{{"raycast", "texture3d", 0, "raycast, no skipping"},
+                          {"raycast", "texture3d", 8, "raycast, 8^3 skipping"},
+                          {"raycast", "mosaic", 8, "raycast, 8^3 skipping"},
+                          {"raycast", "packed-mosaic", 8, "raycast, 8^3 skipping"},
+                          {"slice3d", "auto", 8, "slice3d"},
+                          {"slice2d", "auto", 8, "slice2d"}}) {
+    TechniqueRow row{setup.label, setup.layout, {}, {}, {}};
     RenderRequest req = base;
-    req.skipBlock = setup.skipBlock;
+    req.settings.skipBlock = setup.skipBlock;
     row.onVolume = render::createTechnique(setup.technique, *device.context, device.limits, source,
                                            req.techniqueOptions(), setup.layout);
     row.layout = row.onVolume.storageName();
-    if (setup.technique == "raycast") {
-      row.technique += setup.skipBlock ? ", 8^3 skipping" : ", no skipping";
-    }
     row.onVolume.technique->setTransferFunction(tf);
-    row.onVolume.technique->prepare(camera, base.settings);
+    row.onVolume.technique->prepare(camera, base.settings.render);
     rows.push_back(std::move(row));
   }
   // Peak passes and technique frames interleaved, so that a shared machine's
@@ -126,7 +127,7 @@ void runRooflineBench(const RooflineBenchOptions& o) {
     probe.measurePass();
     for (TechniqueRow& row : rows) {
       const auto t0 = std::chrono::steady_clock::now();
-      row.onVolume.technique->render(camera, base.settings, base.width, base.height, 0.0);
+      row.onVolume.technique->render(camera, base.settings.render, base.width, base.height, 0.0);
       row.ms.push_back(msSince(t0));
     }
     if (!o.json) std::fprintf(stderr, "\rround %d/%d", f + 1, o.frames);

@@ -9,7 +9,6 @@
 #include <nlohmann/json.hpp>
 
 #include "app/Commands.h"
-#include "app/RenderJob.h"
 #include "app/SamplingOptions.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
@@ -20,6 +19,7 @@
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
 #include "tessera/render/Raycaster.h"
+#include "tessera/session/RenderRun.h"
 
 namespace tessera::app {
 

@@ -218,6 +218,22 @@ std::unique_ptr<render::Technique> makeTechnique(gpu::GlContext& context,
   return t;
 }
 
+// slice2d with its own interface (stack re-creation, upload timing), as the
+// registry makes it.
+std::unique_ptr<render::Slice2DRenderer> makeSlice2D(gpu::GlContext& context,
+                                                     const gpu::DeviceLimits& limits,
+                                                     const Volume& volume,
+                                                     const render::TechniqueOptions& options,
+                                                     const TransferFunction& tf) {
+  auto t = render::Slice2DRenderer::create({.context = context,
+                                            .limits = limits,
+                                            .volume = volume,
+                                            .layout = nullptr,
+                                            .options = options});
+  t->setTransferFunction(tf);
+  return t;
+}
+
 // ch2 and its GRAPP 2012-sized resampling, each uploaded once.
 std::vector<Scene> loadScenes(gpu::GlContext& context, const gpu::DeviceLimits& limits,
                               const std::string& spec) {
@@ -341,8 +357,8 @@ std::vector<TfRow> measureTfUpdates(gpu::GlContext& context, const gpu::DeviceLi
     cam.elevationDeg = 10;
     const RenderSettings s;
     for (const Path& p : paths) {
-      const auto t = makeTechnique(context, limits, "slice2d", v, nullptr, p.options, tf);
-      auto& r = dynamic_cast<render::Slice2DRenderer&>(*t);
+      const auto t = makeSlice2D(context, limits, v, p.options, tf);
+      render::Slice2DRenderer& r = *t;
       r.renderFrame(cam, s, 480, 320);
       // The update alone (classification + uploads, waited for), then the
       // frame it makes ready; summed, they are "TF changed -> frame ready".
@@ -369,9 +385,8 @@ std::vector<TfRow> measureTfUpdates(gpu::GlContext& context, const gpu::DeviceLi
 // The hitch of the one-stack mode when the view changes stack (ms).
 double measureStackHitch(gpu::GlContext& context, const gpu::DeviceLimits& limits,
                          const Scene& scene, const TransferFunction& tf) {
-  const auto t = makeTechnique(context, limits, "slice2d", scene.volume(), nullptr,
-                               {.currentStackOnly = true}, tf);
-  auto& r = dynamic_cast<render::Slice2DRenderer&>(*t);
+  const auto t = makeSlice2D(context, limits, scene.volume(), {.currentStackOnly = true}, tf);
+  render::Slice2DRenderer& r = *t;
   Camera cam = benchCamera(scene.volume());
   cam.azimuthDeg = 10;
   r.renderFrame(cam, {}, 480, 320);
@@ -523,12 +538,17 @@ void runSlicingBench(const SlicingBenchOptions& o) {
   const double hitchMs = measureStackHitch(*context, limits, scenes.front(), tf);
 
   std::ostringstream md;
-  const auto slice3d = makeTechnique(*context, limits, "slice3d", scenes.front().volume(),
-                                     scenes.front().upload.layout.get(), {}, tf);
+  const render::TechniqueOptions defaults;
+  const auto slice3d =
+      render::Slice3DRenderer::create({.context = *context,
+                                       .limits = limits,
+                                       .volume = scenes.front().volume(),
+                                       .layout = scenes.front().upload.layout.get(),
+                                       .options = defaults});
   md << "GL: " << context->caps().renderer << " (" << context->caps().version << "); TF `" << o.tf
      << "`; camera azimuth 30, elevation 20; median of " << o.frames
-     << " frames rotating 10 deg; texture3d layout; accumulation "
-     << dynamic_cast<const render::Slice3DRenderer&>(*slice3d).accumulationFormat() << ".\n\n";
+     << " frames rotating 10 deg; texture3d layout; accumulation " << slice3d->accumulationFormat()
+     << ".\n\n";
   for (const Scene& scene : scenes) reportSpeed(md, scene, grid, speed);
   reportQuality(md, scenes.back(), grid, quality);
   reportTfUpdates(md, tfRows, scenes.front().name, hitchMs);

@@ -2,10 +2,29 @@
 // The `tessera` subcommands; each registers itself on the CLI11 app and
 // returns a callback run after parsing.
 #include <functional>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
+#include "tessera/gpu/DeviceSession.h"
+#include "tessera/session/RenderRun.h"
+#include "tessera/session/VolumePyramid.h"
+
 namespace tessera::app {
+
+// The session types every command uses.
+using gpu::DeviceSession;
+using gpu::openDevice;
+using session::BricksRun;
+using session::chunksTouched;
+using session::CountingStorage;
+using session::openVolumePyramid;
+using session::parseLevel;
+using session::parseRegion;
+using session::RenderRequest;
+using session::RenderResult;
+using session::runRender;
+using session::VolumePyramid;
 
 void addInfoCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);
@@ -40,6 +59,9 @@ inline void addTimeChannelOptions(CLI::App* cmd, int& time, int& channel) {
   cmd->add_option("--channel", channel, "OME-Zarr: channel to read from a c axis (default 0)")
       ->check(CLI::NonNegativeNumber);
 }
+
+// Parses --size "512x512" (InputError otherwise).
+void parseSize(const std::string& text, int& width, int& height);
 
 // ch2 from mricron-data when installed, else a generated Shepp–Logan phantom.
 std::string defaultVolumeSpec();

@@ -26,13 +26,13 @@ void compareWithGroundTruth(const Volume& volume, const TransferFunction& tf,
                             const RenderRequest& req, const render::HybridCompositor& compositor,
                             HybridResult& result) {
   const auto tRef = std::chrono::steady_clock::now();
-  if (req.settings.mode == RenderMode::Composite) {
-    result.groundTruth = renderReferenceWithLines(volume, tf, req.camera, req.settings, req.width,
-                                                  req.height, compositor.overlays().readColor(),
-                                                  compositor.overlays().readDistance());
+  if (req.settings.render.mode == RenderMode::Composite) {
+    result.groundTruth = renderReferenceWithLines(
+        volume, tf, req.settings.camera, req.settings.render, req.width, req.height,
+        compositor.overlays().readColor(), compositor.overlays().readDistance());
   } else {
-    result.groundTruth =
-        renderReference(volume, tf, req.camera, req.settings, req.width, req.height);
+    result.groundTruth = renderReference(volume, tf, req.settings.camera, req.settings.render,
+                                         req.width, req.height);
   }
   result.groundTruthMs = msSince(tRef);
   result.psnrDb = psnr(result.image, *result.groundTruth);
@@ -42,33 +42,35 @@ void compareWithGroundTruth(const Volume& volume, const TransferFunction& tf,
 }  // namespace
 
 HybridResult runHybridRender(DeviceSession& device, const lod::VolumeSource& source,
-                             const TransferFunction& tf, RenderRequest req,
-                             const HybridRequest& hybrid) {
+                             RenderRequest req, const HybridRequest& hybrid) {
   if (req.repeat < 1) throw InputError("--repeat must be >= 1");
-  if (req.settings.mode != RenderMode::Composite && hybrid.overlays.any() &&
+  req.settings.validate();
+  const TransferFunction& tf = req.settings.tf;
+  if (req.settings.render.mode != RenderMode::Composite && hybrid.overlays.any() &&
       hybrid.hybrid.opacity != render::OverlayOpacity::Alpha) {
     throw InputError("--overlay-opacity " + render::overlayOpacityName(hybrid.hybrid.opacity) +
                      " needs --mode composite");
   }
   gpu::GlContext& context = *device.context;
-  render::TechniqueOnVolume t = render::createTechnique(req.technique, context, device.limits,
-                                                        source, req.techniqueOptions(), req.layout);
+  render::TechniqueOnVolume t =
+      render::createTechnique(req.settings.technique, context, device.limits, source,
+                              req.techniqueOptions(), req.settings.layout);
   const Volume& volume = *t.upload.volume;
   render::Technique& technique = *t.technique;
   technique.setTransferFunction(tf);
-  req.camera.frame(volume);
-  technique.prepare(req.camera, req.settings);
+  req.settings.camera.frame(volume);
+  technique.prepare(req.settings.camera, req.settings.render);
   render::HybridCompositor compositor(context);
   compositor.setOverlayLines(render::overlayLines(volume, hybrid.overlays));
 
   HybridResult result;
   result.layout = t.storageName();
-  result.technique = req.technique;
+  result.technique = req.settings.technique;
   for (int i = 0; i < req.repeat; ++i) {
-    Camera cam = req.camera;
+    Camera cam = req.settings.camera;
     cam.azimuthDeg += i * req.rotateDeg;
     const auto t0 = std::chrono::steady_clock::now();
-    compositor.render(technique, cam, req.settings, volume.extent(), req.width, req.height,
+    compositor.render(technique, cam, req.settings.render, volume.extent(), req.width, req.height,
                       hybrid.hybrid);
     result.frameMs.push_back(msSince(t0));
     if (i == 0) {

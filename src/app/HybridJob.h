@@ -6,11 +6,15 @@
 #include <optional>
 #include <string>
 
-#include "app/RenderJob.h"
+#include "tessera/gpu/DeviceSession.h"
 #include "tessera/render/HybridCompositor.h"
 #include "tessera/render/Overlay.h"
+#include "tessera/session/RenderRun.h"
 
 namespace tessera::app {
+
+using gpu::DeviceSession;
+using session::RenderRequest;
 
 struct HybridRequest {
   render::OverlayOptions overlays;
@@ -31,8 +35,7 @@ struct HybridResult {
 };
 
 HybridResult runHybridRender(DeviceSession& device, const lod::VolumeSource& source,
-                             const TransferFunction& tf, RenderRequest request,
-                             const HybridRequest& hybrid);
+                             RenderRequest request, const HybridRequest& hybrid);
 
 // The render command's output for a hybrid run (text or JSON).
 void printHybridResult(const HybridResult& r, const RenderRequest& request,

@@ -4,12 +4,12 @@
 #include <nlohmann/json.hpp>
 
 #include "app/Commands.h"
-#include "app/RenderJob.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/io/VolumeReader.h"
 #include "tessera/layout/LayoutRegistry.h"
 #include "tessera/lod/ProceduralMultiresSource.h"
 #include "tessera/render/Raycaster.h"
+#include "tessera/session/RenderRun.h"
 
 namespace tessera::app {
 

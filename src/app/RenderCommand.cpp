@@ -10,28 +10,30 @@
 #include "app/ClippingOptions.h"
 #include "app/Commands.h"
 #include "app/HybridJob.h"
-#include "app/RenderJob.h"
 #include "app/SamplingOptions.h"
 #include "app/ShadingOptions.h"
-#include "app/VolumePyramid.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"
 #include "tessera/io/HttpStorage.h"
-#include "tessera/io/VolumeReader.h"
 #include "tessera/io/ZarrCachedStorage.h"
 #include "tessera/io/ZarrStore.h"
 #include "tessera/layout/FccLayout.h"
 #include "tessera/layout/LayoutRegistry.h"
-#include "tessera/layout/Planner.h"
-#include "tessera/lod/InCoreVolumeSource.h"
-#include "tessera/lod/MultiresVolumeSource.h"
-#include "tessera/lod/ProceduralMultiresSource.h"
 #include "tessera/lod/ZarrMultiresSource.h"
 #include "tessera/render/LabelTable.h"
 #include "tessera/render/TechniqueRegistry.h"
+#include "tessera/session/Session.h"
 
 namespace tessera::app {
+
+using gpu::DeviceSession;
+using session::BricksRun;
+using session::parseRenderMode;
+using session::RenderRequest;
+using session::RenderResult;
+using session::Session;
+using session::Settings;
 
 namespace {
 
@@ -120,11 +122,11 @@ std::string latticeLayout(const RenderOptions& o) {
 
 // The FCC lattice lives in a layout: a technique with its own storage
 // (slice2d's slice stacks) cannot render it.
-void checkSamplesLayout(const RenderOptions& o, const DeviceSession& device,
-                        const lod::InCoreVolumeSource& source, const RenderRequest& req) {
+void checkSamplesLayout(const RenderOptions& o, const DeviceSession& device, const Volume& volume,
+                        const RenderRequest& req) {
   const render::TechniqueEntry& entry = render::TechniqueRegistry::global().find(o.technique);
   const render::TechniqueRequirements r =
-      entry.requirements(device.limits, source.volume().dims(), req.techniqueOptions());
+      entry.requirements(device.limits, volume.dims(), req.techniqueOptions());
   if (!r.ownStorage.empty()) {
     throw InputError(
         "--lattice fcc needs a technique that samples the layout (e.g. raycast or "
@@ -133,171 +135,74 @@ void checkSamplesLayout(const RenderOptions& o, const DeviceSession& device,
   }
 }
 
-// The camera, settings and technique the options ask for.
+// The camera, settings and technique the options ask for, checked by the
+// session's one settings type before the volume is read, so that a typo
+// fails at once.
 RenderRequest requestFrom(const RenderOptions& o) {
   RenderRequest req;
   parseSize(o.size, req.width, req.height);
-  req.camera.azimuthDeg = o.azimuth;
-  req.camera.elevationDeg = o.elevation;
-  if (!(o.zoom > 0.0)) throw InputError("--zoom must be > 0");
-  req.camera.zoom = o.zoom;
-  if (!(o.fov > 0.0 && o.fov < 180.0)) throw InputError("--fov must be in (0, 180) degrees");
-  req.camera.fovYDeg = o.fov;
-  req.camera.projection = o.ortho ? Projection::Orthographic : Projection::Perspective;
-  if (o.mode == "composite")
-    req.settings.mode = RenderMode::Composite;
-  else if (o.mode == "mip")
-    req.settings.mode = RenderMode::Mip;
-  else if (o.mode == "minip")
-    req.settings.mode = RenderMode::MinIp;
-  else if (o.mode == "average")
-    req.settings.mode = RenderMode::Average;
-  else
-    throw InputError("--mode '" + o.mode + "': expected composite, mip, minip or average");
-  applySampling(o.sampling, req.settings);
-  req.settings.maxSteps = o.maxSteps;
-  req.settings.opacityScale = o.opacityScale;
-  req.settings.ertThreshold = o.ert;
-  req.settings.jitter = o.jitter;
-  req.settings.shading = shadingFrom(o.shading);
-  req.settings.clipping = clippingFrom(o.clipping);
-  if (o.labelVolume()) {
-    render::applyLabelSettings(req.settings);
-    req.lutSize = render::kLabelLutSize;
-  }
+  Settings& s = req.settings;
+  s.camera.azimuthDeg = o.azimuth;
+  s.camera.elevationDeg = o.elevation;
+  s.camera.zoom = o.zoom;
+  s.camera.fovYDeg = o.fov;
+  s.camera.projection = o.ortho ? Projection::Orthographic : Projection::Perspective;
+  s.render.mode = parseRenderMode(o.mode);
+  applySampling(o.sampling, s.render);
+  s.render.maxSteps = o.maxSteps;
+  s.render.opacityScale = o.opacityScale;
+  s.render.ertThreshold = o.ert;
+  s.render.jitter = o.jitter;
+  s.render.shading = shadingFrom(o.shading);
+  s.render.clipping = clippingFrom(o.clipping);
   if (o.background.size() != 3) throw InputError("--background takes three numbers R G B in [0,1]");
-  req.settings.background = glm::dvec4(o.background[0], o.background[1], o.background[2], 1.0);
+  s.render.background = glm::dvec4(o.background[0], o.background[1], o.background[2], 1.0);
+  if (!o.window.empty()) {
+    if (o.window.size() != 2) throw InputError("--window takes two numbers MIN MAX");
+    s.window = ValueRange{o.window[0], o.window[1]};
+  }
+  s.labels = o.labelVolume();
+  s.technique = o.technique;
+  s.skipBlock = o.skipBlock;
+  s.gradient = o.shading.gradient;
+  s.lutSize = o.labelVolume() ? render::kLabelLutSize : o.lut;
+  s.slices = o.slices;
+  s.classify = o.classify;
+  s.layout = latticeLayout(o);
+  if (s.labels) render::applyLabelSettings(s.render);
+  if (!s.labels) s.tf = TransferFunction::fromPresetOrFile(o.tf);
+  s.validate();
   req.repeat = o.repeat;
+  if (req.repeat < 1) throw InputError("--repeat must be >= 1");
   req.rotateDeg = o.repeat > 1 ? o.rotate : 0.0;
   if (o.referenceStep < 0.0 || !std::isfinite(o.referenceStep)) {
     throw InputError("--reference-step must be a positive number of voxels");
   }
   req.referenceStep = o.referenceStep;
   req.reference = o.reference || !o.referenceOut.empty() || o.referenceStep > 0.0;
-  // Checked before the volume is read, so that a typo fails at once.
-  if (!render::TechniqueRegistry::global().contains(o.technique)) {
-    throw InputError("--technique '" + o.technique + "': expected " +
-                     render::TechniqueRegistry::global().choices());
-  }
-  req.technique = o.technique;
-  req.skipBlock = o.skipBlock;
-  req.gradient = o.shading.gradient;
-  req.lutSize = o.labelVolume() ? render::kLabelLutSize : o.lut;
-  req.slices = o.slices;
-  req.classify = o.classify;
-  req.layout = latticeLayout(o);
   return req;
 }
 
-// Options that need the voxels in host memory (a window or label table
-// applied to them, the hybrid compositor, the CPU reference, the FCC
-// resampling): with these a store is read in core, at the finest level that
-// fits the host budget.
-bool needsInCore(const RenderOptions& o) {
-  return o.labelVolume() || !o.window.empty() || !o.overlays.empty() || !o.offscreen.empty() ||
-         !o.roi.empty() || o.reference || !o.referenceOut.empty() || o.referenceStep > 0.0 ||
-         o.lattice != "cartesian";
-}
-
-// With --layout auto a store streams when the planner, given its finest
-// level as a streamed shape and the technique's own units and bytes (what
-// uploadVolume will ask it), rejects every in-core layout under the profile
-// (its textures or its host budget; the plan's reason says which) and picks
-// bricks; a store that fits keeps the in-core path, and so does a technique
-// with its own storage.
-bool plannerStreams(const RenderRequest& req, const DeviceSession& device,
-                    const lod::MultiresSource& store) {
-  const render::TechniqueEntry& entry = render::TechniqueRegistry::global().find(req.technique);
-  const render::TechniqueRequirements r =
-      entry.requirements(device.limits, store.shape().dims(), req.techniqueOptions());
-  if (!r.ownStorage.empty()) return false;
-  layout::PlanRequest request;
-  request.reservedUnits = r.textureUnits;
-  request.reservedBytes = r.bytes;
-  request.streamed = true;
-  return layout::planLayout(store.shape(), device.limits, request).layout.layout == "bricks";
-}
-
-// A volume read brick by brick instead of whole: a generated head:WxHxD, an
-// OME-Zarr store (folder or URL) with --layout bricks, or with --layout auto
-// when its finest level does not fit in core. Null otherwise.
-std::shared_ptr<const lod::MultiresSource> streamedSource(const RenderOptions& o,
-                                                          const RenderRequest& req,
-                                                          const DeviceSession& device,
-                                                          const std::string& spec) {
-  if (lod::ProceduralMultiresSource::isSpec(spec)) {
-    return std::make_shared<lod::ProceduralMultiresSource>(spec);
-  }
-  if (!isZarrStore(spec)) return nullptr;
-  if (o.layout == "bricks") {
-    return lod::ZarrMultiresSource::open(spec, {.time = o.time, .channel = o.channel});
-  }
-  if (o.layout != "auto" || needsInCore(o)) return nullptr;
-  auto store = lod::ZarrMultiresSource::open(spec, {.time = o.time, .channel = o.channel});
-  if (!plannerStreams(req, device, *store)) return nullptr;
-  return store;
-}
-
-// --region: the box of the level, read with readBox (a store reads only the
-// chunks it touches), placed where it lies in the full volume; its window is
-// the full volume's so that it is coloured as in the overview.
-Volume readRegion(const RenderOptions& o, const std::string& spec, nlohmann::json& report) {
-  const VolumePyramid pyramid =
-      openVolumePyramid(spec, {.series = o.series, .time = o.time, .channel = o.channel});
-  const lod::MultiresSource& source = *pyramid.source;
-  const int level = parseLevel(o.level, source.levelCount(), spec);
-  const lod::LevelInfo info = source.levelInfo(level);
-  std::string clamped;
-  const lod::VoxelBox box = parseRegion(o.region, info.dims, &clamped);
-  if (!clamped.empty()) std::fprintf(stderr, "tessera: note: --region %s\n", clamped.c_str());
-  Volume region = source.readBox(level, box);
-  region.setWindow(source.shape().window());
-  report = {{"level", level},
-            {"level_dims", {info.dims.x, info.dims.y, info.dims.z}},
-            {"begin", {box.begin.x, box.begin.y, box.begin.z}},
-            {"end", {box.end.x, box.end.y, box.end.z}},
-            {"voxels_read", box.count()},
-            {"level_voxels", lod::VoxelBox{glm::ivec3(0), info.dims}.count()}};
-  if (!clamped.empty()) report["clamped"] = clamped;
-  if (pyramid.storage) {
-    report["chunks_read"] = pyramid.storage->chunksRead();
-    report["chunk_bytes_read"] = pyramid.storage->chunkBytesRead();
-    report["chunks_touched"] = chunksTouched(box, info.chunk, info.dims);
-    report["chunks_in_level"] =
-        chunksTouched(lod::VoxelBox{glm::ivec3(0), info.dims}, info.chunk, info.dims);
-  }
-  return region;
-}
-
-// The volume (or its --region), with the window the options ask for.
-lod::InCoreVolumeSource loadVolume(const RenderOptions& o, const std::string& spec,
-                                   nlohmann::json& regionReport) {
-  Volume volume =
-      o.region.empty()
-          ? readVolume(spec, {.dicomSeries = o.series, .time = o.time, .channel = o.channel})
-          : readRegion(o, spec, regionReport);
-  if (!o.window.empty()) {
-    if (o.window.size() != 2) throw InputError("--window takes two numbers MIN MAX");
-    volume.setWindow({o.window[0], o.window[1]});
-  }
-  if (o.labelVolume()) render::prepareLabelVolume(volume);
-  return lod::InCoreVolumeSource(std::move(volume));
+// Options that need the voxels in host memory (the hybrid compositor, the
+// CPU reference, the FCC resampling): with these a store is read in core,
+// at the finest level that fits the host budget.
+bool needsHostVoxels(const RenderOptions& o) {
+  return !o.overlays.empty() || !o.offscreen.empty() || !o.roi.empty() || o.reference ||
+         !o.referenceOut.empty() || o.referenceStep > 0.0 || o.lattice != "cartesian";
 }
 
 // --overlays, --offscreen or --roi: the hybrid compositor's run.
-void runHybridCommand(const RenderOptions& o, DeviceSession& device,
-                      const lod::InCoreVolumeSource& source, const TransferFunction& tf,
-                      const RenderRequest& req, const std::string& spec,
-                      render::OverlayOpacity overlayOpacity) {
+void runHybridCommand(const RenderOptions& o, Session& session, const RenderRequest& req,
+                      const std::string& spec, render::OverlayOpacity overlayOpacity) {
   HybridRequest h;
   h.overlays = render::OverlayOptions::parse(o.overlays);
-  if (!o.roi.empty()) h.overlays.setRoiVoxels(o.roi, source.volume());
+  if (!o.roi.empty()) h.overlays.setRoiVoxels(o.roi, session.volume());
   h.hybrid.offscreen = render::OffscreenSize::parse(o.offscreen.empty() ? "full" : o.offscreen);
   h.hybrid.opacity = overlayOpacity;
-  const HybridResult hr = runHybridRender(device, source, tf, req, h);
+  const HybridResult hr = runHybridRender(session.device(), session.source(), req, h);
   hr.image.writePng(o.out);
   if (hr.groundTruth && !o.referenceOut.empty()) hr.groundTruth->writePng(o.referenceOut);
-  printHybridResult(hr, req, h, device, spec, o.out, o.json);
+  printHybridResult(hr, req, h, session.device(), spec, o.out, o.json);
 }
 
 struct RenderTimes {
@@ -322,9 +227,8 @@ std::optional<HttpFetch> httpFetch(const lod::MultiresSource& source) {
 }
 
 void printRenderJson(const RenderOptions& o, const RenderRequest& req, const RenderResult& r,
-                     const DeviceSession& device, const TransferFunction& tf,
-                     const std::string& spec, RenderTimes times, const nlohmann::json& region,
-                     std::optional<HttpFetch> fetch = std::nullopt) {
+                     const DeviceSession& device, const std::string& spec, RenderTimes times,
+                     const nlohmann::json& region, std::optional<HttpFetch> fetch = std::nullopt) {
   const gpu::GlContext& context = *device.context;
   nlohmann::json j;
   if (!region.is_null()) j["region"] = region;
@@ -380,12 +284,12 @@ void printRenderJson(const RenderOptions& o, const RenderRequest& req, const Ren
   }
   j["mode"] = o.mode;
   j["technique"] = o.technique;
-  j["step_voxels"] = req.settings.stepVoxels;
+  j["step_voxels"] = req.settings.render.stepVoxels;
   j["preintegrate"] = r.preintegrated;
   j["adaptive"] = r.adaptive;
   if (r.adaptive) {
-    j["adaptive_tolerance"] = adaptiveTolerance(req.settings);
-    j["adaptive_max"] = req.settings.sampling.maxMultiplier;
+    j["adaptive_tolerance"] = adaptiveTolerance(req.settings.render);
+    j["adaptive_max"] = req.settings.render.sampling.maxMultiplier;
   }
   if (r.preintegrated) {
     j["preintegration_build_ms"] = r.preintegrationBuildMs;
@@ -397,7 +301,7 @@ void printRenderJson(const RenderOptions& o, const RenderRequest& req, const Ren
   }
   if (r.samplesPerRay > 0.0) j["samples_per_ray"] = r.samplesPerRay;
   j["shade"] = o.shading.shade;
-  j["tf"] = tf.name;
+  j["tf"] = req.settings.tf.name;
   std::printf("%s\n", j.dump(2).c_str());
 }
 
@@ -416,8 +320,8 @@ void printRenderText(const RenderOptions& o, const RenderRequest& req, const Ren
               device.limits.api == gpu::ApiLevel::Gles2 ? "1.00" : "3.00");
   std::printf("profile  %s (%s)\n", device.profile.name.c_str(), device.profile.note.c_str());
   std::printf("layout   %s: %s\n", r.layout.c_str(), r.layoutReason.c_str());
-  if (o.technique == "raycast") {
-    RenderSettings effective = req.settings;
+  if (render::TechniqueRegistry::global().find(o.technique).honoursSampling) {
+    RenderSettings effective = req.settings.render;
     effective.sampling.preintegrate = r.preintegrated;
     effective.sampling.preintegrateLitOnly = false;
     effective.sampling.adaptive = r.adaptive;
@@ -431,7 +335,7 @@ void printRenderText(const RenderOptions& o, const RenderRequest& req, const Ren
     std::printf("sampling %s%s\n", line.c_str(),
                 o.sampling.stepGiven() ? "" : "; the default (docs/sampling.md)");
   }
-  if (req.settings.shading.enabled && !r.gradient.empty()) {
+  if (req.settings.render.shading.enabled && !r.gradient.empty()) {
     std::printf("gradient %s\n", r.gradient.c_str());
   }
   if (!r.planNote.empty()) std::printf("note     %s\n", r.planNote.c_str());
@@ -489,65 +393,78 @@ void printRenderText(const RenderOptions& o, const RenderRequest& req, const Ren
 
 void runRenderCommand(const RenderOptions& o) {
   const auto tStart = std::chrono::steady_clock::now();
-  const RenderRequest req = requestFrom(o);
+  RenderRequest req = requestFrom(o);
   const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
-  TransferFunction tf =
-      o.labelVolume() ? TransferFunction() : TransferFunction::fromPresetOrFile(o.tf);
   // The profile first: it sets the host budget the reader must respect.
-  DeviceSession device = openDevice(o.profile);
-  // The planner weighs a streamed source's in-core read against the budget
-  // the reader obeys: the profile's, or lower (TESSERA_HOST_BUDGET_MB, half
-  // the physical memory).
-  device.limits.hostBudget = HostBudget::global().limitBytes();
+  Session session(o.profile);
+  session.settings() = req.settings;
   RenderTimes times;
   const auto tLoad = std::chrono::steady_clock::now();
-  // --region reads its one box in core instead.
-  if (auto pyramid = o.region.empty() ? streamedSource(o, req, device, spec) : nullptr) {
-    const lod::MultiresVolumeSource streamed(pyramid);  // read brick by brick, never whole
-    times.loadMs = msSince(tLoad);
-    const RenderResult r = runRender(device, streamed, tf, req);
+  session.open(spec, {.series = o.series,
+                      .time = o.time,
+                      .channel = o.channel,
+                      .region = o.region,
+                      .level = o.level,
+                      .hostVoxels = needsHostVoxels(o)});
+  if (o.labelVolume()) {
+    const render::LabelTable table = o.labels.empty()
+                                         ? render::LabelTable::defaultFor(session.volume())
+                                         : render::LabelTable::load(o.labels);
+    req.settings.tf = table.toTransferFunction();
+    session.settings().tf = req.settings.tf;
+  }
+  times.loadMs = msSince(tLoad);
+  const DeviceSession& device = session.device();
+  if (session.streamed()) {
+    const RenderResult r = session.run(req);
     r.first.writePng(o.out);
     times.totalMs = msSince(tStart);
     if (o.json) {
-      printRenderJson(o, req, r, device, tf, spec, times, nullptr, httpFetch(*pyramid));
+      printRenderJson(o, req, r, device, spec, times, nullptr, httpFetch(*session.pyramid()));
     } else {
-      printRenderText(o, req, r, device, streamed.shape(), spec, times, httpFetch(*pyramid));
+      printRenderText(o, req, r, device, session.shape(), spec, times,
+                      httpFetch(*session.pyramid()));
     }
     return;
   }
-  if (o.region.empty() && o.level != "native") {
-    throw InputError("--level " + o.level + " applies to --region (and to `tessera slice`)");
-  }
-  nlohmann::json regionReport;
-  const lod::InCoreVolumeSource source = loadVolume(o, spec, regionReport);
-  if (o.labelVolume()) {
-    const render::LabelTable table = o.labels.empty()
-                                         ? render::LabelTable::defaultFor(source.volume())
-                                         : render::LabelTable::load(o.labels);
-    tf = table.toTransferFunction();
-  }
-  times.loadMs = msSince(tLoad);
-
-  if (o.lattice == "fcc") checkSamplesLayout(o, device, source, req);
+  if (o.lattice != "cartesian") checkSamplesLayout(o, device, session.volume(), req);
   // Checked even when nothing uses it, so that a typo is not silently ignored.
   const render::OverlayOpacity overlayOpacity = render::parseOverlayOpacity(o.overlayOpacity);
   if (!o.overlays.empty() || !o.offscreen.empty() || !o.roi.empty()) {
-    runHybridCommand(o, device, source, tf, req, spec, overlayOpacity);
+    runHybridCommand(o, session, req, spec, overlayOpacity);
     return;
   }
-  const RenderResult r = runRender(device, source, tf, req);
+  const RenderResult r = session.run(req);
   r.first.writePng(o.out);
   if (r.referenceImage && !o.referenceOut.empty()) r.referenceImage->writePng(o.referenceOut);
   times.totalMs = msSince(tStart);
+  const nlohmann::json& regionReport = session.regionReport();
   if (o.json) {
-    printRenderJson(o, req, r, device, tf, spec, times, regionReport);
+    printRenderJson(o, req, r, device, spec, times, regionReport);
   } else {
-    printRenderText(o, req, r, device, source.volume(), spec, times);
+    printRenderText(o, req, r, device, session.volume(), spec, times);
     if (!regionReport.is_null()) std::printf("region   %s\n", regionReport.dump().c_str());
   }
 }
 
 }  // namespace
+
+void parseSize(const std::string& text, int& width, int& height) {
+  const auto x = text.find('x');
+  try {
+    if (x == std::string::npos) throw std::invalid_argument("no x");
+    std::size_t used = 0;
+    width = std::stoi(text.substr(0, x), &used);
+    if (used != x) throw std::invalid_argument("junk");
+    height = std::stoi(text.substr(x + 1), &used);
+    if (used != text.size() - x - 1) throw std::invalid_argument("junk");
+  } catch (const std::exception&) {
+    throw InputError("--size '" + text + "': expected WIDTHxHEIGHT, e.g. 512x512");
+  }
+  if (width <= 0 || height <= 0 || width > 16384 || height > 16384) {
+    throw InputError("--size '" + text + "': width and height must be 1..16384");
+  }
+}
 
 void addRenderCommand(CLI::App& app) {
   auto o = std::make_shared<RenderOptions>();

@@ -53,21 +53,12 @@ void addSamplingOptions(CLI::App* cmd, SamplingOptions& o) {
 }
 
 void applySampling(const SamplingOptions& o, RenderSettings& settings) {
-  if (!(o.step > 0.0) || !std::isfinite(o.step)) {
-    throw InputError("--step must be a positive number of voxels");
-  }
   settings.stepVoxels = o.step;
   settings.sampling.preintegrateLitOnly = o.preintegrate == "lit";
   settings.sampling.preintegrate = settings.sampling.preintegrateLitOnly ||
                                    parseOnOffOr(o.preintegrate, "--preintegrate", "lit");
   settings.sampling.adaptive = parseOnOff(o.adaptive, "--adaptive");
-  if (!(o.tolerance >= 0.0) || !std::isfinite(o.tolerance)) {
-    throw InputError("--adaptive-tolerance must be a finite number >= 0");
-  }
   const int m = o.maxMultiplier;
-  if (m < 1 || m > 64 || (m & (m - 1)) != 0) {
-    throw InputError("--adaptive-max must be a power of two in 1..64, got " + std::to_string(m));
-  }
   settings.sampling.tolerance = o.tolerance;
   // Given, the tolerance holds for lit frames too; otherwise theirs is the default's.
   const bool given = o.toleranceOption != nullptr && o.toleranceOption->count() > 0;

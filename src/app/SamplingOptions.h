@@ -33,7 +33,8 @@ struct SamplingOptions {
 // --step, --preintegrate, --adaptive, --adaptive-tolerance, --adaptive-max,
 // --adaptive-growth.
 void addSamplingOptions(CLI::App* cmd, SamplingOptions& o);
-// Into settings.stepVoxels and settings.sampling; InputError for bad values.
+// Into settings.stepVoxels and settings.sampling (checked by session::Settings::validate);
+// InputError for words that are not on/off.
 void applySampling(const SamplingOptions& o, RenderSettings& settings);
 // "on"/"off" (also true/false, 1/0, yes/no) as a bool; InputError names the option.
 bool parseOnOff(const std::string& text, const std::string& option);

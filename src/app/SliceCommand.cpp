@@ -7,12 +7,12 @@
 #include <nlohmann/json.hpp>
 
 #include "app/Commands.h"
-#include "app/VolumePyramid.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/Image.h"
 #include "tessera/core/PatientFrame.h"
 #include "tessera/core/SliceImage.h"
 #include "tessera/core/TransferFunction.h"
+#include "tessera/session/VolumePyramid.h"
 
 namespace tessera::app {
 

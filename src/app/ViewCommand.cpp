@@ -13,10 +13,10 @@
 
 #include "app/ClippingOptions.h"
 #include "app/Commands.h"
-#include "app/RenderJob.h"
 #include "app/ShadingOptions.h"
-#include "app/VolumePyramid.h"
 #include "tessera/core/Error.h"
+#include "tessera/session/RenderRun.h"
+#include "tessera/session/VolumePyramid.h"
 
 #ifdef TESSERA_DESKTOP_VIEWER
 #define GLFW_INCLUDE_NONE

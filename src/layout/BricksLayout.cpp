@@ -616,6 +616,8 @@ int BricksLayout::bind(const gpu::Program& program, int firstUnit) const {
 
 LayoutEntry BricksLayout::registration() {
   return {.name = "bricks",
+          .streamsBricks = true,
+          .holdsVoxelGrid = false,
           .plan =
               [](const Volume& shape, const gpu::DeviceLimits& limits, int units) {
                 gpu::DeviceLimits l = limits;
@@ -627,6 +629,11 @@ LayoutEntry BricksLayout::registration() {
             // The caller keeps `volume` alive for as long as the layout.
             std::shared_ptr<const Volume> borrowed(&volume, [](const Volume*) {});
             return create(std::make_shared<lod::InCoreMultiresSource>(borrowed), limits, ledger);
+          },
+          .stream = [](std::shared_ptr<const lod::MultiresSource> source,
+                       const gpu::DeviceLimits& limits,
+                       gpu::MemoryLedger& ledger) -> std::unique_ptr<Layout> {
+            return create(std::move(source), limits, ledger);
           }};
 }
 

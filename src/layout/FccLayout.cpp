@@ -1,5 +1,7 @@
 #include "tessera/layout/FccLayout.h"
 
+#include "tessera/lattice/BoxSplineReconstruction.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -282,12 +284,17 @@ ValueBlocks FccLayout::valueBlocks(int blockSize) const {
   return ValueBlocks(count, blockSize, supportVoxels(), std::move(mins), std::move(maxs));
 }
 
+ReferenceField FccLayout::referenceField() const {
+  return {.box = &fcc_.box(), .field = std::make_shared<lattice::BoxSplineReconstruction>(fcc_)};
+}
+
 LayoutEntry FccLayout::registration(lattice::FccDensity density) {
   return {.name = layoutName(density),
           .minApi = gpu::ApiLevel::Gles3,
           .needs3DTextures = true,
           .automatic = false,
           .needsText = "OpenGL ES 3 (3D textures, texelFetch and integer maths for the box spline)",
+          .holdsVoxelGrid = false,
           .plan =
               [density](const Volume& shape, const gpu::DeviceLimits& limits, int) {
                 return planFor(lattice::fccGridDims(shape.dims(), density), shape.type(), limits,

@@ -1,5 +1,7 @@
 #include "tessera/layout/GradientTexture.h"
 
+#include "tessera/layout/LayoutRegistry.h"
+
 #include <algorithm>
 
 #include "tessera/core/Error.h"
@@ -30,8 +32,7 @@ GradientPlan planGradient(GradientWish wish, glm::ivec3 dims, const std::string&
     plan.reason = "on the fly (asked for): central differences, 6 fetches per lit sample";
     return plan;
   }
-  const bool cartesian =
-      layoutName == "texture3d" || layoutName == "mosaic" || layoutName == "packed-mosaic";
+  const bool cartesian = LayoutRegistry::global().find(layoutName).holdsVoxelGrid;
   if (api != gpu::ApiLevel::Gles3 || max3DTextureSize == 0) {
     refusal = "no 3D textures in this context";
   } else if (!cartesian) {

@@ -70,7 +70,7 @@ Plan planLayout(const Volume& volume, const gpu::DeviceLimits& limits, const Pla
     // is downsampled, because only a front end that drives the bricks'
     // per-frame streaming (tessera render, bench) refines them (--layout bricks).
     for (const LayoutEntry& e : LayoutRegistry::global().entries()) {
-      if (e.automatic && (e.name != "bricks" || request.streamed)) candidates.push_back(&e);
+      if (e.automatic && (!e.streamsBricks || request.streamed)) candidates.push_back(&e);
     }
   } else {
     const LayoutEntry& wished = LayoutRegistry::global().find(request.layout);
@@ -102,7 +102,7 @@ Plan planLayout(const Volume& volume, const gpu::DeviceLimits& limits, const Pla
     for (const LayoutEntry* candidate : candidates) {
       LayoutPlan p = candidate->plan(shape, volumeLimits, units);
       const std::uint64_t hostBytes = shape.voxelCount() * bytesPerVoxel(shape.type());
-      if (p.fits && request.streamed && candidate->name != "bricks" && limits.hostBudget != 0 &&
+      if (p.fits && request.streamed && !candidate->streamsBricks && limits.hostBudget != 0 &&
           hostBytes > limits.hostBudget) {
         p.fits = false;
         p.reason = dimsText(dims) + " needs " + formatBytes(hostBytes) +

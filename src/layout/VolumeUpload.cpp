@@ -1,6 +1,7 @@
 #include "tessera/layout/VolumeUpload.h"
 
-#include "tessera/layout/BricksLayout.h"
+#include "tessera/core/Error.h"
+#include "tessera/layout/LayoutRegistry.h"
 #include "tessera/lod/InCoreMultiresSource.h"
 
 namespace tessera::layout {
@@ -20,7 +21,8 @@ VolumeUpload uploadVolume(gpu::GlContext& context, const gpu::DeviceLimits& limi
   request.reservedBytes = technique.bytes;
   request.streamed = source.multires() != nullptr;
   upload.plan = planLayout(source.shape(), limits, request);
-  if (upload.plan.layout.layout == "bricks") {
+  const LayoutEntry& entry = LayoutRegistry::global().find(upload.plan.layout.layout);
+  if (entry.streamsBricks) {
     // Streamed: the technique sees the shape only; in core: the volume
     // itself (for references), bricked from a pyramid built here.
     std::shared_ptr<const lod::MultiresSource> pyramid = source.multires();
@@ -33,7 +35,8 @@ VolumeUpload uploadVolume(gpu::GlContext& context, const gpu::DeviceLimits& limi
     gpu::DeviceLimits volumeLimits = limits;
     volumeLimits.textureUnits = upload.plan.volumeUnits;
     if (limits.textureBudget != 0) volumeLimits.textureBudget -= technique.bytes;
-    upload.layout = BricksLayout::create(pyramid, volumeLimits, context.ledger());
+    if (!entry.stream) throw Error("layout " + entry.name + " streams bricks but cannot stream");
+    upload.layout = entry.stream(pyramid, volumeLimits, context.ledger());
     // The plan made from the shape alone did not know the source's chunks
     // (which set the brick size) nor its levels: report what was built.
     const std::string planned = upload.plan.layout.reason;

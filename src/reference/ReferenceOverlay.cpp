@@ -10,7 +10,7 @@ Image renderReferenceWithLines(const Volume& volume, const TransferFunction& tf,
                                int height, const Image& lineColor,
                                const std::vector<float>& lineDistance, int threads) {
   if (width <= 0 || height <= 0) throw InputError("reference: image size must be positive");
-  if (!(settings.stepVoxels > 0.0)) throw InputError("reference: step must be > 0");
+  sampleDistance(settings, volume.spacing());  // the step's invariant
   if (lineColor.width() != width || lineColor.height() != height ||
       lineDistance.size() != static_cast<std::size_t>(width) * height) {
     throw InputError("reference overlay: line layer is " + std::to_string(lineColor.width()) + "x" +

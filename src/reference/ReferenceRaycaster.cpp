@@ -57,10 +57,9 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
                       int threads, ReferenceStats* stats, const ReferenceStops* stops,
                       const StepGrid* steps) {
   if (width <= 0 || height <= 0) throw InputError("reference: image size must be positive");
-  if (!(settings.stepVoxels > 0.0)) throw InputError("reference: step must be > 0");
   const glm::dvec3 extent = volume.extent();
   const glm::dvec3 spacing = volume.spacing();
-  const double ds = settings.stepVoxels * std::min({spacing.x, spacing.y, spacing.z});
+  const double ds = sampleDistance(settings, spacing);
   const ValueRange win = volume.window();
   const double ww = win.max - win.min;
   const glm::dvec4 bg = settings.background;

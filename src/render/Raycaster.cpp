@@ -258,7 +258,7 @@ const gpu::Program& Raycaster::programFor(const RenderSettings& settings) {
 
 void Raycaster::prepare(const RenderSettings& settings) {
   const glm::dvec3 spacing = volume_.spacing();
-  const double ds = settings.stepVoxels * std::min({spacing.x, spacing.y, spacing.z});
+  const double ds = sampleDistance(settings, spacing);
   updateLookup(settings, isProjection(settings.mode) ? tf_.opacityUnitLength : ds);
   gradient_.prepare(settings);
   programFor(settings);
@@ -273,15 +273,11 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
     throw InputError("image size " + std::to_string(width) + "x" + std::to_string(height) +
                      " is outside 1.." + std::to_string(context_.caps().maxRenderbufferSize));
   }
-  if (!(settings.stepVoxels > 0.0) || !std::isfinite(settings.stepVoxels)) {
-    throw InputError("step must be a positive number of voxels, got " +
-                     std::to_string(settings.stepVoxels));
-  }
   if (settings.maxSteps <= 0 || settings.maxSteps > 65536) {
     throw InputError("max steps must be 1..65536, got " + std::to_string(settings.maxSteps));
   }
   const glm::dvec3 spacing = volume_.spacing();
-  const double ds = settings.stepVoxels * std::min({spacing.x, spacing.y, spacing.z});
+  const double ds = sampleDistance(settings, spacing);
   // MIP shows one classified sample, so its table is not distance-corrected
   // (correcting for one unit length leaves opacity as it is).
   updateLookup(settings, isProjection(settings.mode) ? tf_.opacityUnitLength : ds);
@@ -421,9 +417,23 @@ TechniqueRequirements Raycaster::requirements(const gpu::DeviceLimits& limits,
   return r;
 }
 
+SamplingTwin Raycaster::samplingTwin(const RenderSettings& settings) const {
+  SamplingTwin twin;
+  if (stepGrid_.valid() && usesAdaptiveSampling(settings)) twin.steps = &stepGrid_;
+  if (precomputedGradient(settings)) twin.gradients = &gradientTexture().gradients();
+  twin.preintegrated = usesPreintegration(settings);
+  if (twin.preintegrated) {
+    twin.preintegrationBuildMs = preint_.lastBuildMs();
+    twin.preintegrationUploadMs = preint_.lastUploadMs();
+  }
+  return twin;
+}
+
 TechniqueEntry Raycaster::registration() {
   return {.name = "raycast",
           .summary = "single-pass ray casting",
+          .honoursSampling = true,
+          .scissorsToVolume = true,
           .requirements = &Raycaster::requirements,
           .create = [](const TechniqueSetup& s) -> std::unique_ptr<Technique> {
             if (!s.layout) throw Error("raycast samples a layout, and none was made");

@@ -404,20 +404,23 @@ TechniqueRequirements Slice2DRenderer::requirements(const gpu::DeviceLimits&, gl
   return r;
 }
 
+std::unique_ptr<Slice2DRenderer> Slice2DRenderer::create(const TechniqueSetup& s) {
+  Slice2DOptions options;
+  options.classification = parseSliceClassification(s.options.classify);
+  options.currentStackOnly = s.options.currentStackOnly;
+  options.maxTextureSize = s.limits.max2DTextureSize;
+  options.halfFloatAccumulation = s.limits.halfFloatRenderTargets;
+  auto slicer = std::make_unique<Slice2DRenderer>(s.context, s.volume, options);
+  slicer->setSliceCount(s.options.slices);
+  return slicer;
+}
+
 TechniqueEntry Slice2DRenderer::registration() {
-  return {.name = "slice2d",
-          .summary = "axis-aligned slice stacks",
-          .requirements = &Slice2DRenderer::requirements,
-          .create = [](const TechniqueSetup& s) -> std::unique_ptr<Technique> {
-            Slice2DOptions options;
-            options.classification = parseSliceClassification(s.options.classify);
-            options.currentStackOnly = s.options.currentStackOnly;
-            options.maxTextureSize = s.limits.max2DTextureSize;
-            options.halfFloatAccumulation = s.limits.halfFloatRenderTargets;
-            auto slicer = std::make_unique<Slice2DRenderer>(s.context, s.volume, options);
-            slicer->setSliceCount(s.options.slices);
-            return slicer;
-          }};
+  return {
+      .name = "slice2d",
+      .summary = "axis-aligned slice stacks",
+      .requirements = &Slice2DRenderer::requirements,
+      .create = [](const TechniqueSetup& s) -> std::unique_ptr<Technique> { return create(s); }};
 }
 
 }  // namespace tessera::render

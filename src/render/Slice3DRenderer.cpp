@@ -40,12 +40,7 @@ void Slice3DRenderer::setSliceCount(int slices) {
 
 int Slice3DRenderer::sliceCountFor(const RenderSettings& settings) const {
   if (requestedSlices_ > 0) return requestedSlices_;
-  if (!(settings.stepVoxels > 0.0) || !std::isfinite(settings.stepVoxels)) {
-    throw InputError("step must be a positive number of voxels, got " +
-                     std::to_string(settings.stepVoxels));
-  }
-  const glm::dvec3 s = volume_.spacing();
-  const double ds = settings.stepVoxels * std::min({s.x, s.y, s.z});
+  const double ds = sampleDistance(settings, volume_.spacing());
   const double n = std::ceil(glm::length(volume_.extent()) / ds - 1e-9);
   if (n > kMaxSlices) {
     throw InputError("a step of " + std::to_string(settings.stepVoxels) + " voxels needs " +
@@ -228,18 +223,21 @@ TechniqueRequirements Slice3DRenderer::requirements(const gpu::DeviceLimits&, gl
   return r;
 }
 
+std::unique_ptr<Slice3DRenderer> Slice3DRenderer::create(const TechniqueSetup& s) {
+  if (!s.layout) throw Error("slice3d samples a layout, and none was made");
+  auto slicer = std::make_unique<Slice3DRenderer>(s.context, s.volume, *s.layout,
+                                                  s.limits.halfFloatRenderTargets);
+  slicer->setSliceCount(s.options.slices);
+  slicer->setGradient(layout::parseGradientWish(s.options.gradient));
+  return slicer;
+}
+
 TechniqueEntry Slice3DRenderer::registration() {
-  return {.name = "slice3d",
-          .summary = "view-aligned slicing",
-          .requirements = &Slice3DRenderer::requirements,
-          .create = [](const TechniqueSetup& s) -> std::unique_ptr<Technique> {
-            if (!s.layout) throw Error("slice3d samples a layout, and none was made");
-            auto slicer = std::make_unique<Slice3DRenderer>(s.context, s.volume, *s.layout,
-                                                            s.limits.halfFloatRenderTargets);
-            slicer->setSliceCount(s.options.slices);
-            slicer->setGradient(layout::parseGradientWish(s.options.gradient));
-            return slicer;
-          }};
+  return {
+      .name = "slice3d",
+      .summary = "view-aligned slicing",
+      .requirements = &Slice3DRenderer::requirements,
+      .create = [](const TechniqueSetup& s) -> std::unique_ptr<Technique> { return create(s); }};
 }
 
 }  // namespace tessera::render

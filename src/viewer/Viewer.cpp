@@ -341,7 +341,7 @@ void Viewer::compose(const gpu::Texture& image, int width, int height, unsigned 
 // target when it was not this technique's last frame at this size.
 const gpu::Texture& Viewer::renderVolume(const VolumePass& pass) {
   render::Technique* technique = active_.technique.get();
-  if (techniqueName_ != "raycast") {
+  if (!render::TechniqueRegistry::global().find(techniqueName_).scissorsToVolume) {
     drawn_ = {};
     return technique->render(camera_, pass.settings, pass.width, pass.height, 0.0);
   }

@@ -8,6 +8,7 @@
 #include "tessera/gpu/Draw.h"
 #include "tessera/lod/MultiresVolumeSource.h"
 #include "tessera/render/Overlay.h"
+#include "tessera/session/BrickRefinement.h"
 
 namespace tessera::web {
 
@@ -68,7 +69,7 @@ bool ZarrStoreView::open() {
     if (storage_->hasWanted()) return false;
     throw;
   }
-  bricks_ = dynamic_cast<layout::BricksLayout*>(active_.upload.layout.get());
+  bricks_ = active_.upload.layout ? active_.upload.layout->streaming() : nullptr;
   if (!bricks_) throw Error(storage_->describe() + ": the bricks layout was not created");
   compositor_ = std::make_unique<render::HybridCompositor>(context_);
   return true;
@@ -94,20 +95,11 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
   f.renderWidth = std::max(1, static_cast<int>(std::lround(width * scale)));
   f.renderHeight = std::max(1, static_cast<int>(std::lround(height * scale)));
   gpu::clearErrors();
-  f.bricks = bricks_->update(camera, f.renderWidth, f.renderHeight, tf);
-  // Each update reads a few bricks whose chunks have arrived and uploads
-  // what the last one read; a ray march costs far more (SwiftShader: most of
-  // a second), so stream on for up to kStreamMs before drawing, and a frame
-  // shows everything that has arrived.
-  const auto tStream = std::chrono::steady_clock::now();
-  int uploaded = f.bricks.uploaded;
-  while (!f.bricks.complete && msSince(tStream) < kStreamMs) {
-    const std::uint64_t read = bricks_->streamerStats().bricksRead;
-    f.bricks = bricks_->update(camera, f.renderWidth, f.renderHeight, tf);
-    uploaded += f.bricks.uploaded;
-    if (f.bricks.uploaded == 0 && bricks_->streamerStats().bricksRead == read) break;
-  }
-  f.bricks.uploaded = uploaded;
+  // A ray march costs far more than an update (SwiftShader: most of a
+  // second), so stream for up to kStreamMs before drawing, and a frame
+  // shows everything that has arrived; the page fetches between frames.
+  f.bricks = session::BrickRefinement(*bricks_).step(camera, f.renderWidth, f.renderHeight, tf,
+                                                     {.streamMs = kStreamMs, .idleWaitMs = 0.0});
   // Over transparent black; the compositor adds the background and lines.
   RenderSettings pass = settings;
   pass.background = glm::dvec4(0.0);

@@ -16,7 +16,7 @@
 #include "tessera/core/TransferFunction.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/io/ZarrStore.h"
-#include "tessera/layout/BricksLayout.h"
+#include "tessera/layout/StreamingLayout.h"
 #include "tessera/lod/ZarrMultiresSource.h"
 #include "tessera/render/HybridCompositor.h"
 #include "tessera/render/Overlay.h"
@@ -64,7 +64,7 @@ class ZarrStoreView {
   bool open();
   bool isOpen() const { return active_.technique != nullptr; }
   const ZarrStore& store() const { return *store_; }
-  const layout::BricksLayout& bricks() const { return *bricks_; }
+  const layout::StreamingLayout& bricks() const { return *bricks_; }
   // The store's levels; readBox of a box whose chunks have arrived
   // (prefetch true) reads without the network.
   const FetchedZarrSource& source() const { return *source_; }
@@ -89,7 +89,7 @@ class ZarrStoreView {
   std::shared_ptr<const FetchedZarrSource> source_;
   Volume coarsest_;
   render::TechniqueOnVolume active_;
-  layout::BricksLayout* bricks_ = nullptr;
+  layout::StreamingLayout* bricks_ = nullptr;
   std::unique_ptr<render::HybridCompositor> compositor_;
   std::uint64_t tfRevision_ = 0;
 };

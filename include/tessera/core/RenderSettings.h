@@ -164,6 +164,13 @@ inline RenderSettings defaultRenderSettings() {
   return s;
 }
 
+// The sample distance in world units, ds = stepVoxels * min(spacing): the
+// one place every renderer (GPU techniques and the reference) computes it.
+// InputError unless the step is a positive finite number (the engine's
+// invariant; the user's range is session::kStepRange, checked once by
+// session::Settings).
+double sampleDistance(const RenderSettings& settings, glm::dvec3 spacing);
+
 // Whether the samples of a render with these settings take the gradient
 // (shading or gradient-opacity modulation; composite mode).
 inline bool litSamples(const RenderSettings& s) {

@@ -34,6 +34,7 @@
 #include "tessera/layout/Layout.h"
 #include "tessera/layout/LayoutRegistry.h"
 #include "tessera/layout/MosaicLayout.h"
+#include "tessera/layout/StreamingLayout.h"
 #include "tessera/lod/BrickStreamer.h"
 #include "tessera/lod/LevelSelection.h"
 
@@ -53,19 +54,7 @@ struct BricksOptions {
   int workers = 2;                 // reader threads
 };
 
-// What one update() did and what the page table now holds.
-struct BricksFrame {
-  bool complete = false;  // every brick the view wants is resident (or its read keeps failing)
-  int wanted = 0;         // bricks in the view's cut
-  int uploaded = 0;       // bricks uploaded this frame
-  int missing = 0;        // wanted, not resident
-  int failing = 0;        // missing because their reads keep failing
-  bool limitedByBudget = false;     // some brick stayed coarser because the atlas is full
-  std::vector<int> wantedPerLevel;  // the cut, bricks per level
-  std::vector<int> cellsPerLevel;   // page-table cells drawn from each level (last: transparent)
-};
-
-class BricksLayout final : public Layout {
+class BricksLayout final : public Layout, public StreamingLayout {
  public:
   // The atlas and page table for a volume of `shape` within `limits`.
   // `levels`: the source's level dims (empty: a factor-2 pyramid down to 16).
@@ -84,9 +73,12 @@ class BricksLayout final : public Layout {
 
   // One frame's level selection, requests, uploads and page table. The
   // camera must be framed on shape() (Camera::frame).
-  BricksFrame update(const Camera& camera, int width, int height, const TransferFunction& tf);
+  BricksFrame update(const Camera& camera, int width, int height,
+                     const TransferFunction& tf) override;
   // Waits (up to ms) for a brick read to finish: the render loop's idle.
-  void waitForBricks(double ms);
+  void waitForBricks(double ms) override;
+  StreamingLayout* streaming() override { return this; }
+  const StreamingLayout* streaming() const override { return this; }
 
   std::string name() const override { return "bricks"; }
   const LayoutPlan& plan() const override { return plan_; }
@@ -99,10 +91,10 @@ class BricksLayout final : public Layout {
   ValueBlocks valueBlocks(int blockSize) const override;
   std::uint64_t contentVersion() const override { return contentVersion_; }
 
-  const lod::BrickGrid& grid() const { return grid_; }
+  const lod::BrickGrid& grid() const override { return grid_; }
   const lod::MultiresSource& source() const { return *source_; }
-  int slotCount() const { return static_cast<int>(slotKey_.size()); }
-  lod::StreamerStats streamerStats() const { return streamer_->stats(); }
+  int slotCount() const override { return static_cast<int>(slotKey_.size()); }
+  lod::StreamerStats streamerStats() const override { return streamer_->stats(); }
   // The page table as uploaded (RGBA per level-0 cell, x fastest): the CPU
   // twin of the lookup in bricks.glsl reads it.
   const std::vector<std::uint8_t>& pageTable() const { return pages_host_; }

@@ -83,6 +83,8 @@ class FccLayout final : public Layout {
   ValueBlocks valueBlocks(int blockSize) const override;
 
   const lattice::FccVolume& lattice() const { return fcc_; }
+  // The box spline over the lattice, the field the GLSL evaluates.
+  ReferenceField referenceField() const override;
   Storage storage() const { return storage_; }
 
   // For `tessera bench --fcc`'s split of the cost: the 16 fetches without

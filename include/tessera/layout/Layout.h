@@ -8,6 +8,7 @@
 // returning a "stored value" s that relates to raw voxel values by the affine
 // map rawFromStored(). Techniques never see textures, only that function.
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,7 @@
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/Program.h"
 #include "tessera/layout/ValueBlocks.h"
+#include "tessera/reference/Reconstruction.h"
 
 namespace tessera::layout {
 
@@ -33,6 +35,18 @@ struct PlannedTexture {
   bool is3D = false;
   std::string format;  // "R8", "R16", "R16F", "RGBA8", ...
   std::uint64_t bytes = 0;
+};
+
+class StreamingLayout;
+
+// The field sampleVolume() reconstructs, as the CPU reference renders it:
+// `field` over the box of `box` (extent, spacing, window). Empty (both
+// null): the trilinear (or, with RenderSettings::nearest, nearest) field of
+// the voxels the layout was made from.
+struct ReferenceField {
+  const Volume* box = nullptr;
+  std::shared_ptr<const Reconstruction> field;
+  bool ownField() const { return field != nullptr; }
 };
 
 struct LayoutPlan {
@@ -77,6 +91,14 @@ class Layout {
   // Changes whenever what sampleVolume() returns may have changed (a
   // streamed layout's page table), so techniques rebuild their value blocks.
   virtual std::uint64_t contentVersion() const { return 0; }
+
+  // Non-null for a layout that streams its volume (bricks): the front end
+  // drives its per-frame refinement through it.
+  virtual StreamingLayout* streaming() { return nullptr; }
+  virtual const StreamingLayout* streaming() const { return nullptr; }
+  // What the CPU reference renders as this layout's twin (fcc: the box
+  // spline over its lattice); default: the voxels it was made from.
+  virtual ReferenceField referenceField() const { return {}; }
 
   // The seam's GLSL as a technique includes it: the layout's glslParts() and then
   // the shared gradient part (layout/gradient.glsl: sampleVolumeGradient() by

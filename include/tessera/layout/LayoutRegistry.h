@@ -15,6 +15,7 @@
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/MemoryLedger.h"
 #include "tessera/layout/Layout.h"
+#include "tessera/lod/MultiresSource.h"
 
 namespace tessera::layout {
 
@@ -30,6 +31,16 @@ struct LayoutEntry {
   // What it needs, in words, for the refusal (default: "3D textures" or
   // "OpenGL ES 3" from the two fields above).
   std::string needsText = {};
+  // What callers ask of a layout, instead of comparing its name:
+  // streamsBricks: it reads the volume brick by brick from a multiresolution
+  // source within a budget (a streamed source plans only onto it, and a
+  // front end must drive its per-frame refinement: Layout::streaming()).
+  bool streamsBricks = false;
+  // holdsVoxelGrid: sampleVolume() is the trilinear field of the volume's own
+  // voxels, all resident at the planned resolution, so per-voxel data
+  // precomputed from them (a gradient texture) matches what it samples. False
+  // for a layout that reconstructs another field (fcc) or mixes levels (bricks).
+  bool holdsVoxelGrid = true;
   // What it costs: the textures it would allocate for a volume of `shape`
   // within `limits` using at most `units` texture units; fits = false and a
   // reason when it cannot.
@@ -38,6 +49,11 @@ struct LayoutEntry {
   std::function<std::unique_ptr<Layout>(const Volume& volume, const gpu::DeviceLimits& limits,
                                         gpu::MemoryLedger& ledger, int units)>
       create;
+  // A layout with streamsBricks: creates it over a multiresolution source
+  // (planned within `limits`), reading only what the views ask for.
+  std::function<std::unique_ptr<Layout>(std::shared_ptr<const lod::MultiresSource> source,
+                                        const gpu::DeviceLimits& limits, gpu::MemoryLedger& ledger)>
+      stream = {};
 
   // Whether the device has what the layout needs.
   bool runsOn(const gpu::DeviceLimits& limits) const;

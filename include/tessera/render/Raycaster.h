@@ -93,6 +93,7 @@ class Raycaster final : public Technique {
   const StepGrid& stepGrid() const { return stepGrid_; }
   // The pre-integration table (built when a frame pre-integrates).
   const PreIntegrationTable& preintegrationTable() const { return preint_; }
+  SamplingTwin samplingTwin(const RenderSettings& settings) const override;
 
   static constexpr int kOwnTextureUnits = 2;
 

@@ -117,6 +117,9 @@ class Slice2DRenderer final : public Technique {
   TechniqueReport report() const override;
 
   // The registry's entry: its own stacks (no layout), the atlas and TF units.
+  // As the registry makes it (TechniqueRegistry::create), for callers that
+  // need its own interface (the slicing benchmark).
+  static std::unique_ptr<Slice2DRenderer> create(const TechniqueSetup& setup);
   static TechniqueEntry registration();
   static TechniqueRequirements requirements(const gpu::DeviceLimits& limits, glm::ivec3 volumeDims,
                                             const TechniqueOptions& options);

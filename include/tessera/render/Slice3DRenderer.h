@@ -15,6 +15,7 @@
 // The "slice3d" technique of the registry (render/TechniqueRegistry.h).
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -94,6 +95,9 @@ class Slice3DRenderer final : public Technique {
 
   // The registry's entry: one unit for the TF table; the bytes of a frame
   // target and the table.
+  // As the registry makes it (TechniqueRegistry::create), for callers that
+  // need its own interface (the slicing benchmark).
+  static std::unique_ptr<Slice3DRenderer> create(const TechniqueSetup& setup);
   static TechniqueEntry registration();
   static TechniqueRequirements requirements(const gpu::DeviceLimits& limits, glm::ivec3 volumeDims,
                                             const TechniqueOptions& options);

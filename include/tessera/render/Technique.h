@@ -18,6 +18,8 @@
 #include "tessera/core/RenderSettings.h"
 #include "tessera/core/TransferFunction.h"
 #include "tessera/gpu/GlObjects.h"
+#include "tessera/reference/AdaptiveSteps.h"
+#include "tessera/reference/VoxelGradients.h"
 
 namespace tessera::render {
 
@@ -53,6 +55,16 @@ struct TechniqueReport {
   std::string gradient;  // shading: where the gradient comes from and why (empty: n/a)
 };
 
+// What the CPU reference needs to take the samples a technique's frames with
+// some settings take (its twin, ReferenceRaycaster.h), and how it sampled.
+struct SamplingTwin {
+  const StepGrid* steps = nullptr;            // adaptive steps' block grid, when walked
+  const VoxelGradients* gradients = nullptr;  // the precomputed gradient it shades from
+  bool preintegrated = false;                 // segments classified by pre-integration
+  double preintegrationBuildMs = 0.0;         // its table's last rebuild, CPU side
+  double preintegrationUploadMs = 0.0;
+};
+
 class Technique {
  public:
   virtual ~Technique() = default;
@@ -80,6 +92,12 @@ class Technique {
   // GPU bytes of its own resources, alive now.
   virtual std::uint64_t ownTextureBytes() const = 0;
   virtual TechniqueReport report() const { return {}; }
+  // A technique that honours RenderSettings::sampling says what its frames
+  // with `settings` did; the default: every sample, post-classified.
+  virtual SamplingTwin samplingTwin(const RenderSettings& settings) const {
+    (void)settings;
+    return {};
+  }
 
   // A width x height frame for a screen of that shape, read back.
   Image renderImage(const Camera& camera, const RenderSettings& settings, int width, int height) {

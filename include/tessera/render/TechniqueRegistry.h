@@ -40,6 +40,15 @@ struct TechniqueSetup {
 struct TechniqueEntry {
   std::string name;
   std::string summary;  // a few words for --help and the viewers' menus
+  // What callers ask of a technique, instead of comparing its name:
+  // honoursSampling: it takes RenderSettings::sampling (pre-integration,
+  // adaptive steps); the others take every sample post-classified, and
+  // their reference must assume neither.
+  bool honoursSampling = false;
+  // scissorsToVolume: pixels outside the volume's projection come out
+  // transparent black (its rays miss the box), so a frame scissored to that
+  // part of the view draws the same image.
+  bool scissorsToVolume = false;
   std::function<TechniqueRequirements(const gpu::DeviceLimits& limits, glm::ivec3 volumeDims,
                                       const TechniqueOptions& options)>
       requirements;

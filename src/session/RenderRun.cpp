@@ -1,4 +1,4 @@
-#include "app/RenderJob.h"
+#include "tessera/session/RenderRun.h"
 
 #include <algorithm>
 #include <chrono>
@@ -7,16 +7,13 @@
 
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
-#include "tessera/lattice/BoxSplineReconstruction.h"
-#include "tessera/layout/BricksLayout.h"
-#include "tessera/layout/FccLayout.h"
+#include "tessera/layout/StreamingLayout.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
 #include "tessera/reference/VoxelGradients.h"
-#include "tessera/render/Raycaster.h"
 #include "tessera/render/TechniqueRegistry.h"
 
-namespace tessera::app {
+namespace tessera::session {
 
 namespace {
 
@@ -36,53 +33,46 @@ std::string levelsText(const std::vector<int>& perLevel, bool lastIsTransparent)
   return s;
 }
 
-// Frame 0 of a bricked volume: draw, stream, upload, draw again until every
-// brick the view wants is resident (progressive refinement while the view
-// stays still), so the image written is the refined one.
-void refineBricks(layout::BricksLayout& bricks, render::Technique& technique,
-                  const TransferFunction& tf, const RenderRequest& req, BricksRun& run) {
-  const auto t0 = std::chrono::steady_clock::now();
-  layout::BricksFrame f;
-  double lastReportMs = 0.0;
+// Frame 0 of a streamed volume: draw, stream, upload, draw again until
+// every brick the view wants is resident (progressive refinement while the
+// view stays still), so the image written is the refined one.
+void refineFirstFrame(layout::StreamingLayout& bricks, render::Technique& technique,
+                      const TransferFunction& tf, const RenderRequest& req, BricksRun& run) {
+  const Camera& camera = req.settings.camera;
   bool reported = false;
-  while (true) {
-    f = bricks.update(req.camera, req.width, req.height, tf);
-    technique.render(req.camera, req.settings, req.width, req.height, 0.0);
-    if (++run.refineFrames == 1) run.firstFrameMs = msSince(t0);
-    if (f.complete || run.refineFrames >= req.maxRefineFrames ||
-        msSince(t0) > 1000.0 * req.maxRefineSeconds) {
-      break;
-    }
-    if (f.uploaded == 0) bricks.waitForBricks(50.0);
-    if (msSince(t0) - lastReportMs > 1000.0) {  // progress, once a second
-      lastReportMs = msSince(t0);
-      reported = true;
-      std::fprintf(stderr, "\rbricks: frame %d, %.0f s, %d of %d bricks missing   ",
-                   run.refineFrames, lastReportMs / 1000.0, f.missing, f.wanted);
-    }
-  }
+  const RefineRun r = BrickRefinement(bricks).refine(
+      camera, req.width, req.height, tf,
+      [&] { technique.render(camera, req.settings.render, req.width, req.height, 0.0); },
+      req.refine,
+      [&](const RefineRun& now, double ms) {
+        reported = true;
+        std::fprintf(stderr, "\rbricks: frame %d, %.0f s, %d of %d bricks missing   ", now.frames,
+                     ms / 1000.0, now.last.missing, now.last.wanted);
+      });
   if (reported) std::fprintf(stderr, "\n");
-  run.completeMs = msSince(t0);
-  run.complete = f.complete;
-  run.failing = f.failing;
-  run.wantedPerLevel = f.wantedPerLevel;
-  run.cellsPerLevel = f.cellsPerLevel;
+  run.refineFrames = r.frames;
+  run.firstFrameMs = r.firstFrameMs;
+  run.completeMs = r.completeMs;
+  run.complete = r.last.complete;
+  run.failing = r.last.failing;
+  run.wantedPerLevel = r.last.wantedPerLevel;
+  run.cellsPerLevel = r.last.cellsPerLevel;
 }
 
 // The frames, rotating from the requested view; the first is kept. A
 // bricked volume streams during the rotation: each frame selects, requests
 // and uploads within the layout's per-frame budget, and that time counts.
-void renderFrames(render::Technique& technique, layout::BricksLayout* bricks,
+void renderFrames(render::Technique& technique, layout::StreamingLayout* bricks,
                   const TransferFunction& tf, const RenderRequest& req, RenderResult& result) {
   for (int i = 0; i < req.repeat; ++i) {
-    Camera cam = req.camera;
+    Camera cam = req.settings.camera;
     cam.azimuthDeg += i * req.rotateDeg;
     const auto t0 = std::chrono::steady_clock::now();
     if (bricks && i > 0) {
       const layout::BricksFrame f = bricks->update(cam, req.width, req.height, tf);
       result.bricks->rotatingLevels.push_back(levelsText(f.cellsPerLevel, true));
     }
-    technique.render(cam, req.settings, req.width, req.height, 0.0);
+    technique.render(cam, req.settings.render, req.width, req.height, 0.0);
     result.frameMs.push_back(msSince(t0));
     if (i == 0) result.first = technique.readImage();
   }
@@ -112,42 +102,40 @@ void describeStorage(const render::TechniqueOnVolume& t, RenderResult& result) {
 void compareWithReference(const Volume& volume, const render::Technique& technique,
                           const layout::Layout* layout, const TransferFunction& tf,
                           const RenderRequest& req, RenderResult& result) {
-  const auto* caster = dynamic_cast<const render::Raycaster*>(&technique);
-  const StepGrid* grid =
-      caster != nullptr && caster->stepGrid().valid() && usesAdaptiveSampling(req.settings)
-          ? &caster->stepGrid()
-          : nullptr;
+  const render::SamplingTwin twin = technique.samplingTwin(req.settings.render);
   const bool fine = req.referenceStep > 0.0;
-  RenderSettings settings = req.settings;
+  const Camera& camera = req.settings.camera;
+  RenderSettings settings = req.settings.render;
   if (fine) {
     settings.stepVoxels = req.referenceStep;
     settings.sampling = Sampling();
     // Enough steps for the whole ray at the fine step.
     settings.maxSteps =
         std::max(settings.maxSteps,
-                 static_cast<int>(std::ceil(req.settings.maxSteps * req.settings.stepVoxels /
-                                            req.referenceStep)));
+                 static_cast<int>(std::ceil(req.settings.render.maxSteps *
+                                            req.settings.render.stepVoxels / req.referenceStep)));
   }
+  const layout::ReferenceField own = layout ? layout->referenceField() : layout::ReferenceField{};
   const auto render = [&](const RenderSettings& s, const StepGrid* g, ReferenceStats* stats,
                           int width, int height) {
-    if (const auto* fcc = dynamic_cast<const layout::FccLayout*>(layout)) {
-      return renderReference(fcc->lattice().box(), lattice::BoxSplineReconstruction(fcc->lattice()),
-                             tf, req.camera, s, width, height, 0, stats, nullptr, g);
+    if (own.ownField()) {
+      return renderReference(*own.box, *own.field, tf, camera, s, width, height, 0, stats, nullptr,
+                             g);
     }
     // The twin shades the field the GPU shaded: with a precomputed gradient
     // texture its quantised per-voxel differences; the fine reference keeps
     // the exact central differences (the truth the texture is judged by).
-    if (!fine && caster != nullptr && caster->precomputedGradient(req.settings)) {
+    if (!fine && twin.gradients != nullptr) {
       const TrilinearReconstruction values(volume);
-      return renderReference(
-          volume, VoxelGradientReconstruction(values, caster->gradientTexture().gradients()), tf,
-          req.camera, s, width, height, 0, stats, nullptr, g);
+      return renderReference(volume, VoxelGradientReconstruction(values, *twin.gradients), tf,
+                             camera, s, width, height, 0, stats, nullptr, g);
     }
-    return renderReference(volume, tf, req.camera, s, width, height, 0, stats, nullptr, g);
+    return renderReference(volume, tf, camera, s, width, height, 0, stats, nullptr, g);
   };
   const auto t0 = std::chrono::steady_clock::now();
   ReferenceStats stats;
-  result.referenceImage = render(settings, fine ? nullptr : grid, &stats, req.width, req.height);
+  result.referenceImage =
+      render(settings, fine ? nullptr : twin.steps, &stats, req.width, req.height);
   result.referenceMs = msSince(t0);
   result.referenceSamples = stats.samples;
   result.referenceRays = stats.raysHittingVolume;
@@ -164,15 +152,6 @@ void compareWithReference(const Volume& volume, const render::Technique& techniq
 
 }  // namespace
 
-render::TechniqueOptions RenderRequest::techniqueOptions() const {
-  return {.imageSize = {width, height},
-          .skipBlock = skipBlock,
-          .lutSize = lutSize,
-          .slices = slices,
-          .classify = classify,
-          .gradient = gradient};
-}
-
 double RenderResult::median() const {
   return tessera::median(frameMs);
 }
@@ -183,67 +162,50 @@ double RenderResult::max() const {
   return frameMs.empty() ? 0.0 : *std::max_element(frameMs.begin(), frameMs.end());
 }
 
-void parseSize(const std::string& text, int& width, int& height) {
-  const auto x = text.find('x');
-  try {
-    if (x == std::string::npos) throw std::invalid_argument("no x");
-    std::size_t used = 0;
-    width = std::stoi(text.substr(0, x), &used);
-    if (used != x) throw std::invalid_argument("junk");
-    height = std::stoi(text.substr(x + 1), &used);
-    if (used != text.size() - x - 1) throw std::invalid_argument("junk");
-  } catch (const std::exception&) {
-    throw InputError("--size '" + text + "': expected WIDTHxHEIGHT, e.g. 512x512");
-  }
-  if (width <= 0 || height <= 0 || width > 16384 || height > 16384) {
-    throw InputError("--size '" + text + "': width and height must be 1..16384");
-  }
-}
-
-RenderResult runRender(DeviceSession& device, const lod::VolumeSource& source,
-                       const TransferFunction& tf, RenderRequest req) {
-  if (req.repeat < 1) throw InputError("--repeat must be >= 1");
-  if (req.slices < 0) throw InputError("--slices must be >= 1 (0 = automatic)");
-  render::TechniqueOnVolume t = render::createTechnique(
-      req.technique, *device.context, device.limits, source, req.techniqueOptions(), req.layout);
+RenderResult runRender(gpu::DeviceSession& device, const lod::VolumeSource& source,
+                       RenderRequest req) {
+  req.settings.validate();
+  if (req.repeat < 1) throw InputError("repeat " + std::to_string(req.repeat) + ": expected >= 1");
+  const Settings& s = req.settings;
+  render::TechniqueOnVolume t = render::createTechnique(s.technique, *device.context, device.limits,
+                                                        source, req.techniqueOptions(), s.layout);
   const Volume& volume = *t.upload.volume;
+  const TransferFunction& tf = s.tf;
   RenderResult result;
   t.technique->setTransferFunction(tf);
-  req.camera.frame(volume);
+  req.settings.camera.frame(volume);
   // Pre-integration and adaptive steps are the ray caster's; the slicers draw
   // planes, and their reference must not assume either.
-  auto* caster = dynamic_cast<render::Raycaster*>(t.technique.get());
-  if (caster == nullptr) req.settings.sampling = Sampling();
+  const render::TechniqueEntry& entry = render::TechniqueRegistry::global().find(s.technique);
+  if (!entry.honoursSampling) req.settings.render.sampling = Sampling();
   const auto tPrepare = std::chrono::steady_clock::now();
-  t.technique->prepare(req.camera, req.settings);
+  t.technique->prepare(req.settings.camera, req.settings.render);
   result.prepareMs = msSince(tPrepare);
-  auto* bricks = dynamic_cast<layout::BricksLayout*>(t.upload.layout.get());
+  layout::StreamingLayout* bricks = t.upload.layout ? t.upload.layout->streaming() : nullptr;
   if (bricks) {
     result.bricks.emplace();
-    refineBricks(*bricks, *t.technique, tf, req, *result.bricks);
+    refineFirstFrame(*bricks, *t.technique, tf, req, *result.bricks);
   }
   renderFrames(*t.technique, bricks, tf, req, result);
   result.textureBytes = device.context->ledger().totalBytes();  // while the technique holds its own
-  result.preintegrated = caster != nullptr && usesPreintegration(req.settings);
-  result.adaptive =
-      caster != nullptr && usesAdaptiveSampling(req.settings) && caster->stepGrid().valid();
-  if (result.preintegrated) {
-    result.preintegrationBuildMs = caster->preintegrationTable().lastBuildMs();
-    result.preintegrationUploadMs = caster->preintegrationTable().lastUploadMs();
-  }
+  const render::SamplingTwin twin = t.technique->samplingTwin(req.settings.render);
+  result.preintegrated = twin.preintegrated;
+  result.adaptive = twin.steps != nullptr;
+  result.preintegrationBuildMs = twin.preintegrationBuildMs;
+  result.preintegrationUploadMs = twin.preintegrationUploadMs;
   describeStorage(t, result);
   if (bricks) {
-    const lod::StreamerStats s = bricks->streamerStats();
+    const lod::StreamerStats stats = bricks->streamerStats();
     result.bricks->slots = bricks->slotCount();
-    result.bricks->bytesRead = s.bytesRead;
-    result.bricks->bricksRead = s.bricksRead;
-    result.bricks->readErrors = s.readErrors;
-    result.bricks->cachePeakBytes = s.cachePeakBytes;
-    result.bricks->lastError = s.lastError;
+    result.bricks->bytesRead = stats.bytesRead;
+    result.bricks->bricksRead = stats.bricksRead;
+    result.bricks->readErrors = stats.readErrors;
+    result.bricks->cachePeakBytes = stats.cachePeakBytes;
+    result.bricks->lastError = stats.lastError;
   }
   if (req.reference) {
     if (!volume.hasData()) {
-      throw InputError("--reference needs the volume in host memory; " + result.layout +
+      throw InputError("the reference needs the volume in host memory; " + result.layout +
                        " streams it");
     }
     compareWithReference(volume, *t.technique, t.upload.layout.get(), tf, req, result);
@@ -251,4 +213,4 @@ RenderResult runRender(DeviceSession& device, const lod::VolumeSource& source,
   return result;
 }
 
-}  // namespace tessera::app
+}  // namespace tessera::session

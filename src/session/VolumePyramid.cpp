@@ -1,4 +1,4 @@
-#include "app/VolumePyramid.h"
+#include "tessera/session/VolumePyramid.h"
 
 #include <sstream>
 
@@ -9,7 +9,7 @@
 #include "tessera/lod/ProceduralMultiresSource.h"
 #include "tessera/lod/ZarrMultiresSource.h"
 
-namespace tessera::app {
+namespace tessera::session {
 
 std::optional<std::vector<std::byte>> CountingStorage::get(const std::string& key,
                                                            std::uint64_t maxBytes) const {
@@ -87,4 +87,4 @@ std::uint64_t chunksTouched(const lod::VoxelBox& box, glm::ivec3 chunk, glm::ive
   return n;
 }
 
-}  // namespace tessera::app
+}  // namespace tessera::session

@@ -1,31 +1,27 @@
 #pragma once
-// One render run shared by `tessera render` and `tessera bench`: upload the
-// volume for the technique (render::createTechnique), render N frames
-// (rotating), optionally compare with the reference.
+// One render run of a session (session/Session.h), and of the benchmarks
+// that time one: upload the volume for the technique
+// (render::createTechnique), refine a streamed volume's first frame
+// (session/BrickRefinement.h), render N frames (rotating), optionally compare
+// with the CPU reference.
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "tessera/core/Camera.h"
 #include "tessera/core/Image.h"
-#include "tessera/core/RenderSettings.h"
-#include "tessera/core/TransferFunction.h"
 #include "tessera/gpu/DeviceSession.h"
 #include "tessera/layout/Planner.h"
 #include "tessera/lod/VolumeSource.h"
 #include "tessera/render/Technique.h"
+#include "tessera/session/BrickRefinement.h"
+#include "tessera/session/Settings.h"
 
-namespace tessera::app {
-
-using gpu::DeviceSession;
-using gpu::openDevice;
+namespace tessera::session {
 
 struct RenderRequest {
-  std::string layout = "auto";
+  Settings settings;  // validated by runRender
   int width = 512;
   int height = 512;
-  Camera camera;  // radius is set from the volume
-  RenderSettings settings;
   int repeat = 1;
   double rotateDeg = 0.0;
   bool reference = false;
@@ -33,18 +29,12 @@ struct RenderRequest {
   // the CPU reference at this step (voxels), post-classified, every sample
   // (no pre-integration, no adaptive steps), the render's other settings.
   double referenceStep = 0.0;
-  // A technique of render::TechniqueRegistry and its options.
-  std::string technique = "raycast";
-  int skipBlock = 8;
-  int lutSize = 4096;
-  int slices = 0;                 // 0 = from the step (slice3d) or every slice (slice2d)
-  std::string classify = "post";  // slice2d: pre, palette or post
-  std::string gradient = "auto";  // raycast, shaded: auto, on-the-fly or precomputed
-  // bricks: stop refining frame 0 after this many frames or seconds.
-  int maxRefineFrames = 10000;
-  double maxRefineSeconds = 600.0;
+  // A streamed volume: where refining frame 0 stops.
+  RefineLimits refine;
 
-  render::TechniqueOptions techniqueOptions() const;
+  render::TechniqueOptions techniqueOptions() const {
+    return settings.techniqueOptions({width, height});
+  }
 };
 
 // The bricks layout's streaming (layout/BricksLayout.h): how frame 0 was
@@ -103,10 +93,8 @@ struct RenderResult {
   double max() const;
 };
 
-RenderResult runRender(DeviceSession& device, const lod::VolumeSource& source,
-                       const TransferFunction& tf, RenderRequest request);
+// The TF is request.settings.tf; a label volume's is its table's.
+RenderResult runRender(gpu::DeviceSession& device, const lod::VolumeSource& source,
+                       RenderRequest request);
 
-// Parses "512x512".
-void parseSize(const std::string& text, int& width, int& height);
-
-}  // namespace tessera::app
+}  // namespace tessera::session

@@ -13,7 +13,7 @@
 #include "tessera/io/ZarrStorage.h"
 #include "tessera/lod/MultiresSource.h"
 
-namespace tessera::app {
+namespace tessera::session {
 
 // A ZarrStorage that forwards to another and counts chunk fetches (keys
 // whose last part is not metadata such as .zarray) and their bytes.
@@ -65,4 +65,4 @@ lod::VoxelBox parseRegion(const std::string& text, glm::ivec3 dims, std::string*
 // Chunks of `chunk` voxels (0: the whole level is one) that `box` touches.
 std::uint64_t chunksTouched(const lod::VoxelBox& box, glm::ivec3 chunk, glm::ivec3 dims);
 
-}  // namespace tessera::app
+}  // namespace tessera::session

@@ -1,0 +1,44 @@
+#pragma once
+// What a front end drives of a layout that streams its volume (bricks of a
+// multiresolution source, layout/BricksLayout.h) instead of holding it: each
+// frame it selects what the view wants, requests and uploads it, and says how
+// far the refinement has come. A caller asks Layout::streaming() for it
+// rather than knowing the layout's class or name.
+#include <vector>
+
+#include "tessera/core/Camera.h"
+#include "tessera/core/TransferFunction.h"
+#include "tessera/layout/Layout.h"
+#include "tessera/lod/BrickGrid.h"
+#include "tessera/lod/BrickStreamer.h"
+
+namespace tessera::layout {
+
+// What one update() did and what the page table now holds.
+struct BricksFrame {
+  bool complete = false;  // every brick the view wants is resident (or its read keeps failing)
+  int wanted = 0;         // bricks in the view's cut
+  int uploaded = 0;       // bricks uploaded this frame
+  int missing = 0;        // wanted, not resident
+  int failing = 0;        // missing because their reads keep failing
+  bool limitedByBudget = false;     // some brick stayed coarser because the atlas is full
+  std::vector<int> wantedPerLevel;  // the cut, bricks per level
+  std::vector<int> cellsPerLevel;   // page-table cells drawn from each level (last: transparent)
+};
+
+class StreamingLayout {
+ public:
+  virtual ~StreamingLayout() = default;
+  // One frame's level selection, requests, uploads and page table. The
+  // camera must be framed on the source's shape (Camera::frame).
+  virtual BricksFrame update(const Camera& camera, int width, int height,
+                             const TransferFunction& tf) = 0;
+  // Waits (up to ms) for a read to finish: the render loop's idle.
+  virtual void waitForBricks(double ms) = 0;
+  virtual lod::StreamerStats streamerStats() const = 0;
+  virtual int slotCount() const = 0;               // atlas slots
+  virtual const lod::BrickGrid& grid() const = 0;  // the bricks and levels it streams
+  virtual const LayoutPlan& plan() const = 0;      // what it allocated (Layout::plan)
+};
+
+}  // namespace tessera::layout

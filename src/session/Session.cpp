@@ -1,0 +1,233 @@
+#include "tessera/session/Session.h"
+
+#include <cstdio>
+
+#include <nlohmann/json.hpp>
+
+#include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
+#include "tessera/io/VolumeReader.h"
+#include "tessera/io/ZarrStore.h"
+#include "tessera/layout/LayoutRegistry.h"
+#include "tessera/layout/Planner.h"
+#include "tessera/lod/MultiresVolumeSource.h"
+#include "tessera/lod/ProceduralMultiresSource.h"
+#include "tessera/lod/ZarrMultiresSource.h"
+#include "tessera/reference/ReferenceRaycaster.h"
+#include "tessera/render/LabelTable.h"
+#include "tessera/render/TechniqueRegistry.h"
+
+namespace tessera::session {
+
+namespace {
+
+const nlohmann::json kNoRegion;
+
+bool streamsBricks(const std::string& layoutWish) {
+  return layoutWish != "auto" && layout::LayoutRegistry::global().find(layoutWish).streamsBricks;
+}
+
+// With layout auto a store streams when the planner, given its finest level
+// as a streamed shape and the technique's own units and bytes (what
+// uploadVolume will ask it), rejects every in-core layout under the profile
+// (its textures or its host budget; the plan's reason says which) and picks
+// one that streams; a store that fits keeps the in-core path, and so does a
+// technique with its own storage.
+bool plannerStreams(const Settings& s, const gpu::DeviceSession& device,
+                    const lod::MultiresSource& store) {
+  const render::TechniqueEntry& entry = render::TechniqueRegistry::global().find(s.technique);
+  const render::TechniqueRequirements r =
+      entry.requirements(device.limits, store.shape().dims(), s.techniqueOptions({512, 512}));
+  if (!r.ownStorage.empty()) return false;
+  layout::PlanRequest request;
+  request.reservedUnits = r.textureUnits;
+  request.reservedBytes = r.bytes;
+  request.streamed = true;
+  const std::string chosen =
+      layout::planLayout(store.shape(), device.limits, request).layout.layout;
+  return layout::LayoutRegistry::global().find(chosen).streamsBricks;
+}
+
+// A volume read brick by brick instead of whole: a generated head:WxHxD, or
+// an OME-Zarr store (folder or URL) with a streaming layout asked for, or
+// with layout auto when its finest level does not fit in core. Null
+// otherwise.
+std::shared_ptr<const lod::MultiresSource> streamedSource(const std::string& spec,
+                                                          const OpenOptions& o, const Settings& s,
+                                                          const gpu::DeviceSession& device) {
+  if (lod::ProceduralMultiresSource::isSpec(spec)) {
+    return std::make_shared<lod::ProceduralMultiresSource>(spec);
+  }
+  if (!isZarrStore(spec)) return nullptr;
+  const ZarrSelection zarr{.time = o.time, .channel = o.channel};
+  if (streamsBricks(s.layout)) return lod::ZarrMultiresSource::open(spec, zarr);
+  if (s.layout != "auto" || o.hostVoxels || s.window || s.labels) return nullptr;
+  auto store = lod::ZarrMultiresSource::open(spec, zarr);
+  if (!plannerStreams(s, device, *store)) return nullptr;
+  return store;
+}
+
+// The region's box of its level, read with readBox (a store reads only the
+// chunks it touches), placed where it lies in the full volume; its window
+// is the full volume's so that it is coloured as in the overview.
+Volume readRegion(const std::string& spec, const OpenOptions& o, nlohmann::json& report) {
+  const VolumePyramid pyramid =
+      openVolumePyramid(spec, {.series = o.series, .time = o.time, .channel = o.channel});
+  const lod::MultiresSource& source = *pyramid.source;
+  const int level = parseLevel(o.level, source.levelCount(), spec);
+  const lod::LevelInfo info = source.levelInfo(level);
+  std::string clamped;
+  const lod::VoxelBox box = parseRegion(o.region, info.dims, &clamped);
+  if (!clamped.empty()) std::fprintf(stderr, "tessera: note: --region %s\n", clamped.c_str());
+  Volume region = source.readBox(level, box);
+  region.setWindow(source.shape().window());
+  report = {{"level", level},
+            {"level_dims", {info.dims.x, info.dims.y, info.dims.z}},
+            {"begin", {box.begin.x, box.begin.y, box.begin.z}},
+            {"end", {box.end.x, box.end.y, box.end.z}},
+            {"voxels_read", box.count()},
+            {"level_voxels", lod::VoxelBox{glm::ivec3(0), info.dims}.count()}};
+  if (!clamped.empty()) report["clamped"] = clamped;
+  if (pyramid.storage) {
+    report["chunks_read"] = pyramid.storage->chunksRead();
+    report["chunk_bytes_read"] = pyramid.storage->chunkBytesRead();
+    report["chunks_touched"] = chunksTouched(box, info.chunk, info.dims);
+    report["chunks_in_level"] =
+        chunksTouched(lod::VoxelBox{glm::ivec3(0), info.dims}, info.chunk, info.dims);
+  }
+  return region;
+}
+
+}  // namespace
+
+Session::Session(const std::string& profile) : device_(gpu::openDevice(profile)) {
+  // The planner weighs a streamed source's in-core read against the budget
+  // the reader obeys: the profile's, or lower (TESSERA_HOST_BUDGET_MB, half
+  // the physical memory).
+  device_.limits.hostBudget = HostBudget::global().limitBytes();
+}
+
+Session::Session(gpu::DeviceSession device) : device_(std::move(device)) {}
+
+Session::~Session() = default;
+
+void Session::open(const std::string& spec, const OpenOptions& options) {
+  settings_.validate();
+  if (!options.region.empty()) {
+    auto report = std::make_unique<nlohmann::json>();
+    Volume region = readRegion(spec, options, *report);
+    setVolume(std::move(region), spec);
+    region_ = std::move(report);
+    return;
+  }
+  if (options.level != "native") {
+    throw InputError("--level " + options.level + " applies to --region (and to `tessera slice`)");
+  }
+  if (auto pyramid = streamedSource(spec, options, settings_, device_)) {
+    inCore_.reset();
+    region_.reset();
+    streamed_ = std::move(pyramid);
+    streamedView_ = std::make_unique<lod::MultiresVolumeSource>(streamed_);
+    name_ = spec;
+    return;
+  }
+  setVolume(
+      readVolume(spec,
+                 {.dicomSeries = options.series, .time = options.time, .channel = options.channel}),
+      spec);
+}
+
+void Session::setVolume(Volume volume, const std::string& name) {
+  setVolume(std::make_shared<Volume>(std::move(volume)), name);
+}
+
+void Session::setVolume(std::shared_ptr<Volume> volume, const std::string& name) {
+  if (!volume) throw InputError("setVolume: no volume");
+  streamed_.reset();
+  streamedView_.reset();
+  region_.reset();
+  inCore_ = std::make_shared<lod::InCoreVolumeSource>(std::move(volume));
+  name_ = name;
+  applyVolumeSettings();
+}
+
+// The settings that change the in-core voxels' meaning: the window (raw
+// values mapped to the TF) and a label volume's preparation.
+void Session::applyVolumeSettings() {
+  if (!inCore_) return;
+  Volume& v = inCore_->volume();
+  if (settings_.window) v.setWindow(*settings_.window);
+  if (settings_.labels) render::prepareLabelVolume(v);
+}
+
+const Volume& Session::shape() const {
+  if (!hasVolume()) throw InputError("the session has no volume: open one first");
+  return source().shape();
+}
+
+const Volume& Session::volume() const {
+  if (!inCore_) {
+    throw InputError(hasVolume() ? name_ + " is streamed, not held in memory"
+                                 : "the session has no volume: open one first");
+  }
+  return inCore_->volume();
+}
+
+const nlohmann::json& Session::regionReport() const {
+  return region_ ? *region_ : kNoRegion;
+}
+
+const lod::VolumeSource& Session::source() const {
+  if (streamedView_) return *streamedView_;
+  if (!inCore_) throw InputError("the session has no volume: open one first");
+  return *inCore_;
+}
+
+void Session::setSettings(Settings settings) {
+  settings.validate();
+  settings_ = std::move(settings);
+  applyVolumeSettings();
+}
+
+RenderRequest Session::request(int width, int height) const {
+  RenderRequest r;
+  r.settings = settings_;
+  r.width = width;
+  r.height = height;
+  return r;
+}
+
+RenderResult Session::run(const RenderRequest& request) {
+  return runRender(device_, source(), request);
+}
+
+Image Session::render(int width, int height) {
+  return run(request(width, height)).first;
+}
+
+Image Session::renderReference(int width, int height) {
+  settings_.validate();
+  Camera camera = settings_.camera;
+  const Volume& v = volume();
+  camera.frame(v);
+  return tessera::renderReference(v, settings_.tf, camera, settings_.render, width, height);
+}
+
+nlohmann::json Session::state() const {
+  nlohmann::json volume = nullptr;
+  if (hasVolume()) {
+    const Volume& s = shape();
+    volume = {
+        {"name", name_}, {"dims", {s.dims().x, s.dims().y, s.dims().z}}, {"streamed", streamed()}};
+  }
+  return {{"version", kSettingsVersion}, {"volume", volume}, {"settings", settings_.toJson()}};
+}
+
+void Session::restore(const nlohmann::json& state) {
+  if (!state.is_object() || !state.contains("settings")) {
+    throw InputError("session state: expected {\"version\", \"volume\", \"settings\"}");
+  }
+  setSettings(Settings::fromJson(state["settings"]));
+}
+
+}  // namespace tessera::session

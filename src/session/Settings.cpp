@@ -1,0 +1,293 @@
+#include "tessera/session/Settings.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include <nlohmann/json.hpp>
+
+#include "tessera/core/Error.h"
+#include "tessera/layout/LayoutRegistry.h"
+#include "tessera/render/ClippingUniforms.h"
+#include "tessera/render/ShadingUniforms.h"
+#include "tessera/render/TechniqueRegistry.h"
+
+namespace tessera::session {
+
+namespace {
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+void checkOneOf(const std::string& name, const std::string& value,
+                std::initializer_list<const char*> choices) {
+  std::string list;
+  for (const char* c : choices) {
+    if (value == c) return;
+    list += (list.empty() ? "" : ", ") + std::string(c);
+  }
+  throw InputError(name + " '" + value + "': expected one of " + list);
+}
+
+nlohmann::json vec(glm::dvec3 v) {
+  return {v.x, v.y, v.z};
+}
+
+glm::dvec3 vec3From(const nlohmann::json& j, const std::string& name) {
+  if (!j.is_array() || j.size() != 3) throw InputError(name + ": expected [x, y, z]");
+  return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+}
+
+const char* preintegrateText(const Sampling& s) {
+  return !s.preintegrate ? "off" : s.preintegrateLitOnly ? "lit" : "on";
+}
+
+}  // namespace
+
+bool Range::contains(double v) const {
+  if (!std::isfinite(v)) return false;
+  const bool aboveMin = minOpen ? v > min : v >= min;
+  const bool belowMax = maxOpen ? v < max : v <= max;
+  return aboveMin && belowMax;
+}
+
+std::string Range::text() const {
+  return std::string(minOpen ? "(" : "[") + number(min) + ", " + number(max) +
+         (maxOpen ? ")" : "]");
+}
+
+void checkRange(const std::string& name, double value, const Range& range,
+                const std::string& unit) {
+  if (range.contains(value)) return;
+  throw InputError(name + " " + number(value) + ": expected " + (unit.empty() ? "" : unit + " ") +
+                   "in " + range.text());
+}
+
+RenderMode parseRenderMode(const std::string& text) {
+  if (text == "composite") return RenderMode::Composite;
+  if (text == "mip") return RenderMode::Mip;
+  if (text == "minip") return RenderMode::MinIp;
+  if (text == "average") return RenderMode::Average;
+  throw InputError("mode '" + text + "': expected composite, mip, minip or average");
+}
+
+std::string renderModeName(RenderMode mode) {
+  switch (mode) {
+    case RenderMode::Composite:
+      return "composite";
+    case RenderMode::Mip:
+      return "mip";
+    case RenderMode::MinIp:
+      return "minip";
+    case RenderMode::Average:
+      return "average";
+  }
+  return "composite";
+}
+
+void Settings::validate() const {
+  if (!render::TechniqueRegistry::global().contains(technique)) {
+    throw InputError("technique '" + technique + "': expected " +
+                     render::TechniqueRegistry::global().choices());
+  }
+  if (layout != "auto") layout::LayoutRegistry::global().find(layout);  // names the choices
+  checkRange("zoom", camera.zoom, kZoomRange);
+  checkRange("fov", camera.fovYDeg, kFovRange, "degrees");
+  checkRange("step", render.stepVoxels, kStepRange, "voxels");
+  checkRange("max-steps", render.maxSteps, kMaxStepsRange, "samples per ray");
+  checkRange("opacity-scale", render.opacityScale, kOpacityScaleRange);
+  checkRange("ert", render.ertThreshold, kErtRange);
+  checkRange("adaptive-tolerance", render.sampling.tolerance, kToleranceRange);
+  if (render.sampling.litTolerance >= 0.0) {
+    checkRange("adaptive-tolerance (lit)", render.sampling.litTolerance, kToleranceRange);
+  }
+  const int m = render.sampling.maxMultiplier;
+  if (m < 1 || m > 64 || (m & (m - 1)) != 0) {
+    throw InputError("adaptive-max " + std::to_string(m) + ": expected a power of two in 1..64");
+  }
+  for (int c = 0; c < 3; ++c) checkRange("background", render.background[c], kBackgroundRange);
+  if (window &&
+      !(std::isfinite(window->min) && std::isfinite(window->max) && window->max > window->min)) {
+    throw InputError("window " + number(window->min) + " " + number(window->max) +
+                     ": expected MIN < MAX, both finite (raw values)");
+  }
+  checkRange("skip-block", skipBlock, kSkipBlockRange, "voxels");
+  if (lutSize != 256 && lutSize != 4096) {
+    throw InputError("lut " + std::to_string(lutSize) + ": expected 256 or 4096 entries");
+  }
+  checkRange("slices", slices, kSlicesRange);
+  checkOneOf("classify", classify, {"pre", "palette", "post"});
+  checkOneOf("gradient", gradient, {"auto", "on-the-fly", "precomputed"});
+  render::checkShading(render.shading);
+  render::checkClipping(render.clipping);
+}
+
+render::TechniqueOptions Settings::techniqueOptions(glm::ivec2 imageSize) const {
+  return {.imageSize = imageSize,
+          .skipBlock = skipBlock,
+          .lutSize = lutSize,
+          .slices = slices,
+          .classify = classify,
+          .gradient = gradient};
+}
+
+nlohmann::json Settings::toJson() const {
+  const Shading& sh = render.shading;
+  const Sampling& sa = render.sampling;
+  nlohmann::json planes = nlohmann::json::array();
+  for (const ClipPlane& p : render.clipping.planes) {
+    planes.push_back({p.normal.x, p.normal.y, p.normal.z, p.distance});
+  }
+  nlohmann::json j = {
+      {"version", kSettingsVersion},
+      {"technique", technique},
+      {"layout", layout},
+      {"camera",
+       {{"azimuth", camera.azimuthDeg},
+        {"elevation", camera.elevationDeg},
+        {"zoom", camera.zoom},
+        {"fov", camera.fovYDeg},
+        {"projection",
+         camera.projection == Projection::Orthographic ? "orthographic" : "perspective"},
+        {"target", vec(camera.target)}}},
+      {"tf", nlohmann::json::parse(tf.toJson())},
+      {"window", window ? nlohmann::json{window->min, window->max} : nlohmann::json(nullptr)},
+      {"mode", renderModeName(render.mode)},
+      {"step", render.stepVoxels},
+      {"max_steps", render.maxSteps},
+      {"opacity_scale", render.opacityScale},
+      {"ert", render.ertThreshold},
+      {"jitter", render.jitter},
+      {"nearest", render.nearest},
+      {"background", {render.background.r, render.background.g, render.background.b}},
+      {"sampling",
+       {{"preintegrate", preintegrateText(sa)},
+        {"adaptive", sa.adaptive},
+        {"tolerance", sa.tolerance},
+        {"lit_tolerance", sa.litTolerance},
+        {"max_multiplier", sa.maxMultiplier},
+        {"opacity_growth", sa.opacityGrowth}}},
+      {"shading",
+       {{"enabled", sh.enabled},
+        {"ambient", sh.ambient},
+        {"diffuse", sh.diffuse},
+        {"specular", sh.specular},
+        {"shininess", sh.shininess},
+        {"headlight", sh.headlight},
+        {"light_direction", vec(sh.lightDirection)},
+        {"gradient_opacity", sh.gradientOpacity},
+        {"gradient_low", sh.gradientLow},
+        {"gradient_high", sh.gradientHigh}}},
+      {"clipping",
+       {{"planes", planes},
+        {"crop_min", vec(render.clipping.cropMin)},
+        {"crop_max", vec(render.clipping.cropMax)}}},
+      {"skip_block", skipBlock},
+      {"lut", lutSize},
+      {"slices", slices},
+      {"classify", classify},
+      {"gradient", gradient},
+      {"labels", labels}};
+  return j;
+}
+
+Settings Settings::fromJson(const nlohmann::json& state) {
+  if (!state.is_object()) throw InputError("session state: expected a JSON object");
+  const int version = state.value("version", 0);
+  if (version != kSettingsVersion) {
+    throw InputError("session state version " + std::to_string(version) + ": this Tessera reads " +
+                     std::to_string(kSettingsVersion));
+  }
+  Settings s;
+  try {
+    s.technique = state.value("technique", s.technique);
+    s.layout = state.value("layout", s.layout);
+    if (state.contains("camera")) {
+      const nlohmann::json& c = state["camera"];
+      s.camera.azimuthDeg = c.value("azimuth", s.camera.azimuthDeg);
+      s.camera.elevationDeg = c.value("elevation", s.camera.elevationDeg);
+      s.camera.zoom = c.value("zoom", s.camera.zoom);
+      s.camera.fovYDeg = c.value("fov", s.camera.fovYDeg);
+      const std::string projection = c.value("projection", std::string("perspective"));
+      checkOneOf("camera projection", projection, {"perspective", "orthographic"});
+      s.camera.projection =
+          projection == "orthographic" ? Projection::Orthographic : Projection::Perspective;
+      if (c.contains("target")) s.camera.target = vec3From(c["target"], "camera target");
+    }
+    if (state.contains("tf")) {
+      const nlohmann::json& tf = state["tf"];
+      s.tf = tf.is_string() ? TransferFunction::fromPresetOrFile(tf.get<std::string>())
+                            : TransferFunction::fromJson(tf.dump(), "session state tf");
+    }
+    if (state.contains("window") && !state["window"].is_null()) {
+      const nlohmann::json& w = state["window"];
+      if (!w.is_array() || w.size() != 2) throw InputError("window: expected [min, max]");
+      s.window = ValueRange{w[0].get<double>(), w[1].get<double>()};
+    }
+    RenderSettings& r = s.render;
+    r.mode = parseRenderMode(state.value("mode", std::string("composite")));
+    r.stepVoxels = state.value("step", r.stepVoxels);
+    r.maxSteps = state.value("max_steps", r.maxSteps);
+    r.opacityScale = state.value("opacity_scale", r.opacityScale);
+    r.ertThreshold = state.value("ert", r.ertThreshold);
+    r.jitter = state.value("jitter", r.jitter);
+    r.nearest = state.value("nearest", r.nearest);
+    if (state.contains("background")) {
+      const glm::dvec3 b = vec3From(state["background"], "background");
+      r.background = glm::dvec4(b, 1.0);
+    }
+    if (state.contains("sampling")) {
+      const nlohmann::json& sa = state["sampling"];
+      const std::string pre = sa.value("preintegrate", std::string(preintegrateText(r.sampling)));
+      checkOneOf("sampling preintegrate", pre, {"off", "on", "lit"});
+      r.sampling.preintegrate = pre != "off";
+      r.sampling.preintegrateLitOnly = pre == "lit";
+      r.sampling.adaptive = sa.value("adaptive", r.sampling.adaptive);
+      r.sampling.tolerance = sa.value("tolerance", r.sampling.tolerance);
+      r.sampling.litTolerance = sa.value("lit_tolerance", r.sampling.litTolerance);
+      r.sampling.maxMultiplier = sa.value("max_multiplier", r.sampling.maxMultiplier);
+      r.sampling.opacityGrowth = sa.value("opacity_growth", r.sampling.opacityGrowth);
+    }
+    if (state.contains("shading")) {
+      const nlohmann::json& sh = state["shading"];
+      Shading& d = r.shading;
+      d.enabled = sh.value("enabled", d.enabled);
+      d.ambient = sh.value("ambient", d.ambient);
+      d.diffuse = sh.value("diffuse", d.diffuse);
+      d.specular = sh.value("specular", d.specular);
+      d.shininess = sh.value("shininess", d.shininess);
+      d.headlight = sh.value("headlight", d.headlight);
+      if (sh.contains("light_direction")) {
+        d.lightDirection = vec3From(sh["light_direction"], "shading light_direction");
+      }
+      d.gradientOpacity = sh.value("gradient_opacity", d.gradientOpacity);
+      d.gradientLow = sh.value("gradient_low", d.gradientLow);
+      d.gradientHigh = sh.value("gradient_high", d.gradientHigh);
+    }
+    if (state.contains("clipping")) {
+      const nlohmann::json& c = state["clipping"];
+      for (const nlohmann::json& p : c.value("planes", nlohmann::json::array())) {
+        if (!p.is_array() || p.size() != 4)
+          throw InputError("clipping plane: expected [nx, ny, nz, d]");
+        r.clipping.planes.push_back(
+            {{p[0].get<double>(), p[1].get<double>(), p[2].get<double>()}, p[3].get<double>()});
+      }
+      if (c.contains("crop_min")) r.clipping.cropMin = vec3From(c["crop_min"], "crop_min");
+      if (c.contains("crop_max")) r.clipping.cropMax = vec3From(c["crop_max"], "crop_max");
+    }
+    s.skipBlock = state.value("skip_block", s.skipBlock);
+    s.lutSize = state.value("lut", s.lutSize);
+    s.slices = state.value("slices", s.slices);
+    s.classify = state.value("classify", s.classify);
+    s.gradient = state.value("gradient", s.gradient);
+    s.labels = state.value("labels", s.labels);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(std::string("session state: ") + e.what());
+  }
+  s.validate();
+  return s;
+}
+
+}  // namespace tessera::session
