@@ -7,6 +7,7 @@
 #include <fstream>
 #include <memory>
 #include <numeric>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -23,6 +24,9 @@
 namespace tessera::app {
 
 namespace {
+
+// The paper's storage: the volume in one 3D texture.
+constexpr const char* kPaperLayout = "texture3d";
 
 struct ExploreBenchOptions {
   bool run = false;
@@ -132,7 +136,7 @@ RenderRequest requestFor(const ExploreBenchOptions& o, const Volume& v, double a
   RenderRequest req;
   parseSize(o.size, req.width, req.height);
   req.settings.render = RenderSettings();  // plain sampling, as the paper's runs
-  req.settings.layout = "texture3d";
+  req.settings.layout = kPaperLayout;
   req.settings.camera.azimuthDeg = azimuth;
   req.settings.camera.zoom = zoom;
   req.repeat = repeat;
@@ -267,10 +271,18 @@ void runExploreBench(const ExploreBenchOptions& o) {
     Subject full{"full", dimsText(dims) + " (level 0)", nullptr, ""};
     layout::PlanRequest pr;
     pr.streamed = false;
-    const layout::Plan plan = layout::planLayout(source.shape(), device.limits, pr);
+    pr.layout = kPaperLayout;
+    std::optional<layout::Plan> plan;
+    std::string refusal;
+    try {
+      plan = layout::planLayout(source.shape(), device.limits, pr);
+    } catch (const InputError& e) {
+      refusal = e.what();
+    }
     const std::uint64_t bytes = source.shape().voxelCount();
-    if (plan.downsampled() || plan.layout.layout != "texture3d") {
-      full.skipped = "does not fit " + o.profile + " in one 3D texture: " + plan.reason;
+    if (!plan || plan->downsampled()) {
+      full.skipped =
+          "does not fit " + o.profile + " in one 3D texture: " + (plan ? plan->reason : refusal);
     } else if (bytes > HostBudget::global().limitBytes()) {
       full.skipped = "over the host budget of " + o.profile;
     } else {

@@ -104,11 +104,12 @@ nlohmann::json numberOrNull(std::optional<double> v) {
 // --lattice and --density as a layout wish: the FCC lattice is a layout
 // (layout/FccLayout.h: "fcc" at the same sample count, "fcc-half").
 std::string latticeLayout(const RenderOptions& o) {
-  if (o.lattice == "cartesian") {
+  const std::string lattices[] = {"cartesian", "fcc"};  // the option's words
+  if (o.lattice == lattices[0]) {
     if (!o.density.empty()) throw InputError("--density applies to --lattice fcc only");
     return o.layout;
   }
-  if (o.lattice != "fcc") {
+  if (o.lattice != lattices[1]) {
     throw InputError("--lattice '" + o.lattice + "': expected cartesian or fcc");
   }
   if (o.layout != "auto") {
