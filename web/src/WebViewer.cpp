@@ -94,7 +94,7 @@ int guarded(F&& f) {
 // pre-integration table's filtered half-float fetch costs more than the
 // fewer samples save: on ch2 at 512^2 the page took 1.4-2.0x longer per frame
 // pre-integrated than with the adaptive steps alone, which keep 45-48 dB
-// against the 0.25-voxel reference (docs/web-peers.md, "Sampling in the
+// against the 0.25-voxel reference (docs/benchmarks.md, "Sampling in the
 // browser"). The page's "pre-integrated" control switches it on.
 constexpr Sampling webDefaultSampling() {
   Sampling s = defaultSampling();
