@@ -1,4 +1,4 @@
-// Grid view (issue 15 items 3 and 6; Schultz 2016 §7.3) beside the slice
+// Grid view (Schultz 2016 §7.3) beside the slice
 // views of web/slices.js: the loaded volume split into cubic cells, the
 // user on a grid point (a cell corner), the 2x2x2 block of cells around it
 // shown as the 3D view at native resolution, six moves relative to the view.

@@ -1,4 +1,4 @@
-// Slice views and the bread-slice region (issue 15 item 6; Schultz 2016
+// Slice views and the bread-slice region (Schultz 2016
 // §7.4), beside the 3D view of web/app.js:
 //
 // - Axial, coronal and sagittal slices of the loaded volume, drawn by the

@@ -1,4 +1,4 @@
-// Side-by-side browser benchmark (issue 18, item 5): Tessera's web page
+// Side-by-side browser benchmark: Tessera's web page
 // (build-web/site, WebGL 2 and WebGL 1), vtk.js 37.4 (vtkVolumeMapper,
 // WebGL 2) and NiiVue 0.69 (WebGL 2) in ONE headless Chromium (Debian's,
 // SwiftShader through ANGLE), each in its own tab, showing the same volume

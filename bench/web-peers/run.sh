@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Side-by-side browser benchmark of the web page against NiiVue and vtk.js
-# (bench/web-peers/bench.mjs; issue 18). Installs the pinned npm packages
+# (bench/web-peers/bench.mjs). Installs the pinned npm packages
 # (package-lock.json: @niivue/niivue, @kitware/vtk.js, esbuild,
 # playwright-core) with `npm ci` when missing, bundles the vtk.js page with
 # esbuild, builds the web page (scripts/web.sh), then runs the bench in

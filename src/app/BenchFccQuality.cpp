@@ -1,4 +1,4 @@
-// `tessera bench --fcc-out DIR`: issue 17's quality figures. Marschner-Lobb
+// `tessera bench --fcc-out DIR`: the FCC lattice's quality figures. Marschner-Lobb
 // (fM = 6, alpha = 0.25) on the Cartesian grid (trilinear) and on the FCC
 // lattice (box spline, same and half sample count), at 41^3 and 64^3: RMS
 // error of the reconstructed signal along the rays and at random points

@@ -123,7 +123,7 @@ void addPeersBenchOptions(CLI::App* bench) {
   bench->add_flag("--web-peers", o.web,
                   "The web page (WebGL 2 and 1) vs NiiVue and vtk.js in headless Chromium, "
                   "alternating: runs bench/web-peers/run.sh (needs node, npm, chromium, "
-                  "emscripten; docs/web-peers.md)");
+                  "emscripten; docs/benchmarks.md)");
   bench
       ->add_option("--source-dir", o.sourceDir,
                    "With --peers/--web-peers: the source tree holding bench/")

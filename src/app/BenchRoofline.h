@@ -1,5 +1,5 @@
 #pragma once
-// `tessera bench --roofline` (issue 16, item 6): the context's peak trilinear
+// `tessera bench --roofline`: the context's peak trilinear
 // 3D fetch and TF lookup rates (render/Roofline.h), then each technique's
 // effective samples per second on a real volume as a fraction of them.
 #include <string>

@@ -1,5 +1,5 @@
 #pragma once
-// `tessera bench --sampling` (issue 16, item 4: fewer samples for the same
+// `tessera bench --sampling` (fewer samples for the same
 // image). The ablation: the ray caster as it was (post-classification, every
 // sample), + pre-integration, + adaptive steps, and both, at each base step,
 // frames interleaved; per variant the median frame time, the samples per ray

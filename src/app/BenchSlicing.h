@@ -1,5 +1,5 @@
 #pragma once
-// `tessera bench --slicing`: the texture-slicing benchmarks of issue 4 —
+// `tessera bench --slicing`: the texture-slicing benchmarks —
 // GRAPP 2012 Tables 1-2 (ms/frame and fps of ray casting by steps and
 // view-aligned slicing by slices, plus axis-aligned slicing), the
 // TF-update times in the shape of Moser & Weiskopf 2008 Figure 6, and the

@@ -1,6 +1,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -57,7 +58,7 @@ struct RenderOptions {
   bool jitter = false;
   std::vector<double> window;
   std::vector<double> background{0.0, 0.0, 0.0};
-  std::string out = "render.png";
+  std::string out = "out/render.png";
   bool reference = false;
   std::string referenceOut;
   double referenceStep = 0.0;
@@ -392,8 +393,23 @@ void printRenderText(const RenderOptions& o, const RenderRequest& req, const Ren
   }
 }
 
+// The default output lies in out/, which a fresh checkout lacks: the folders an
+// output path names are created before the frame is rendered, so a path that
+// cannot be written fails before the render's work instead of after it.
+void createParentFolders(const std::string& path) {
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (parent.empty()) return;
+  std::error_code ec;
+  std::filesystem::create_directories(parent, ec);
+  if (ec) {
+    throw InputError(path + ": cannot create its folder " + parent.string() + ": " + ec.message());
+  }
+}
+
 void runRenderCommand(const RenderOptions& o) {
   const auto tStart = std::chrono::steady_clock::now();
+  createParentFolders(o.out);
+  if (!o.referenceOut.empty()) createParentFolders(o.referenceOut);
   RenderRequest req = requestFrom(o);
   const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
   // The profile first: it sets the host budget the reader must respect.

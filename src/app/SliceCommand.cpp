@@ -1,4 +1,4 @@
-// tessera slice FILE|STORE --axis x|y|z --index K --out PNG (issue 15 item 5):
+// tessera slice FILE|STORE --axis x|y|z --index K --out PNG:
 // one index-axis slice at native voxel resolution (nearest voxel, no
 // interpolation), read as a one-voxel-thick box of one pyramid level, shown
 // in the radiological convention with the patient directions of its edges.

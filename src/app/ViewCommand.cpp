@@ -224,7 +224,7 @@ struct DesktopSession {
   bool showHelp = false;
   viewer::RecentFiles recent{viewer::RecentFiles::defaultPath()};
 
-  // Exploring at native resolution (issue 15; viewer/Explorer.h).
+  // Exploring at native resolution (viewer/Explorer.h).
   enum class Mode { Overview, Region, Grid };
   Mode mode = Mode::Overview;
   std::unique_ptr<viewer::Explorer> explorer;
@@ -1091,7 +1091,7 @@ void panelShading(viewer::Viewer& v) {
   slider("shininess", s.shininess, 1.0f, 128.0f);
 }
 
-// The exploring controls (issue 15): mode, crosshair, region size, the
+// The exploring controls: mode, crosshair, region size, the
 // grid view's moves as buttons (touch-style controls beside the keys), and
 // the zoom policy's stages (lod/ZoomLevelPolicy.h), which can switch the
 // overview to the grid view and back by zoom alone.

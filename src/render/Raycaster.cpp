@@ -154,7 +154,7 @@ void Raycaster::uploadBlocks(const std::vector<std::uint8_t>& cells) {
   const glm::ivec3 c = blocks_.blockCount();
   if (context_.caps().api == gpu::ApiLevel::Gles3) {
     // One texelFetch per lookup: measurably cheaper per sample than the
-    // mosaic's address arithmetic (see README, Benchmark).
+    // mosaic's address arithmetic (docs/benchmarks.md, Ray casting).
     if (blockTexture_.id() == 0) {
       blockTexture_ = gpu::Texture::create3D(context_.ledger(), "empty-space blocks",
                                              gpu::TexelFormat::RGBA8, c.x, c.y, c.z, cells.data());

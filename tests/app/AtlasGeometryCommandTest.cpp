@@ -1,5 +1,5 @@
 // `tessera info --json` on the mricron-data atlases (MNI space, LAS storage,
-// sform != qform) prints nibabel's img.affine: issue 12's acceptance.
+// sform != qform) prints nibabel's img.affine: the geometry's acceptance.
 // Skipped when mricron-data is not installed.
 #include <gtest/gtest.h>
 

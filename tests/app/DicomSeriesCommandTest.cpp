@@ -1,7 +1,7 @@
 // A DICOM folder as scanners leave it: slice files with meaningless names,
 // a second series and a stray text file beside them. `tessera info` must
 // find the right volume and `tessera render` must draw what the same volume
-// as NIfTI draws (issue 7's acceptance, on ch2 when mricron-data is there).
+// as NIfTI draws (the DICOM reader's acceptance, on ch2 when mricron-data is there).
 #include <gtest/gtest.h>
 
 #include <filesystem>

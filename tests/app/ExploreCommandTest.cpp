@@ -1,4 +1,4 @@
-// `tessera slice` and `tessera render --region` (issue 15 item 5): slice
+// `tessera slice` and `tessera render --region`: slice
 // pixels are the voxels they claim (direct indexing), the same anatomy
 // gives the same image whatever the storage order (radiological
 // convention), stores read only the chunks a slice or region touches, and a

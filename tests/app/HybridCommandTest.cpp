@@ -1,4 +1,4 @@
-// `tessera render --overlays ... --offscreen ...` (issue 5): the hybrid
+// `tessera render --overlays ... --offscreen ...`: the hybrid
 // compositor from the command line, with every technique, against the CPU
 // ground truth (volume and lines at full resolution, rays stopped at lines).
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Issue 12's acceptance: one marked head (bright block on the patient's
+// The patient geometry's acceptance: one marked head (bright block on the patient's
 // right-anterior-superior side) stored as RAS and LAS NIfTI, LPS NRRD,
 // MetaImage with a TransformMatrix, DICOM axial (both slice orders),
 // sagittal, coronal and oblique -- written by nibabel, pydicom and

@@ -1,4 +1,4 @@
-// bench/peers (issue 16, item 5) is a benchmark, never timed here; its
+// bench/peers is a benchmark, never timed here; its
 // --smoke mode checks in seconds that the script draws the same picture as
 // VTK's two mappers (a 40^3 LAS volume with an off-centre block, 96x80) and
 // writes its table, and that a framing mistake is caught by the PSNR.

@@ -1,4 +1,4 @@
-// `tessera render --technique slice3d|slice2d` (issue 4): the CLI reaches
+// `tessera render --technique slice3d|slice2d`: the CLI reaches
 // the slicing techniques, reports them, and their images match the reference.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Browser test of the web viewer (issue 6): playwright-core drives Debian's
+// Browser test of the web viewer: playwright-core drives Debian's
 // headless Chromium (SwiftShader WebGL) against build-web/site served on
 // localhost. Every check measures something; any failure exits 1.
 //
@@ -544,7 +544,7 @@ async function main() {
   process.exit(failures ? 1 : 0);
 }
 
-// Slice views and the bread-slice region (issue 15 item 6). A PIL NIfTI
+// Slice views and the bread-slice region. A PIL NIfTI
 // (writePilNifti's, anisotropic voxels) with a bright cube near its
 // (+x, +y, +z) index corner: the page's axial, coronal and sagittal images
 // through the cube equal `tessera slice` PNGs of the same file and index
@@ -755,7 +755,7 @@ async function sliceViewsAndRegion(context, url, tmp, run) {
   console.log(`     (slice views and region: ${((Date.now() - t) / 1000).toFixed(1)} s)`);
 }
 
-// Grid view in the page (issue 15 items 3 and 6; Schultz 2016 §7.3), with
+// Grid view in the page (Schultz 2016 §7.3), with
 // the native lod::GridNavigator through tessera_grid_*: a PIL NIfTI of
 // 40x32x24 voxels (writePilNifti's, a bright cube added at high x) in cells
 // of 8 voxels (5x4x3 cells, grid points 0..5 x 0..4 x 0..3). Entering at
@@ -1055,7 +1055,7 @@ async function loadFromUrl(context, url, tmp, run) {
   }
 }
 
-// A DICOM series in the browser (issue 18): ch2 written as a folder by
+// A DICOM series in the browser: ch2 written as a folder by
 // `tessera convert`, dropped on the view as a folder (a drop event whose
 // item is a directory entry, walked like a real one: webkitGetAsEntry,
 // createReader, readEntries) and picked through the folder picker
@@ -1127,7 +1127,7 @@ async function dicomFolder(context, url, tmp, run) {
   await page.close();
 }
 
-// ?url= of an OME-Zarr store (issue 14): ch2 written by `tessera convert
+// ?url= of an OME-Zarr store: ch2 written by `tessera convert
 // --compressor zlib`, served as a folder tree and read key by key with
 // fetch(). The finest level's chunks are served 0.75 s late, so the page must
 // show the coarser levels first; it then refines to what the native CLI
@@ -1220,7 +1220,7 @@ async function zarrStoreFromUrl(context, url, tmp, run) {
   }
 }
 
-// Light and clip controls (issue 16): shade on matches `tessera render
+// Light and clip controls: shade on matches `tessera render
 // --shade`; dragging the crop box's superior handle down with the mouse
 // lowers the top face (the slider follows), and the cropped image matches
 // `tessera render --crop` of the box the page reports.
@@ -1405,7 +1405,7 @@ async function viewerControlShots(context, url) {
   await page.close();
 }
 
-// The bread-slice region of a served store (issue 15): the slice views show
+// The bread-slice region of a served store: the slice views show
 // the store's coarsest level; a box picked there (slices.js's showRegion,
 // what a drag calls) straddles chunk boundaries at level 0 and is read there
 // with bounded reads. At 64 px the page
@@ -1500,7 +1500,7 @@ function chunkKeys(store, begin, end) {
   return keys;
 }
 
-// Grid view on a store (issue 15): each 2x2x2 block is read at level 0 with
+// Grid view on a store: each 2x2x2 block is read at level 0 with
 // only its chunks fetched, and renders like `tessera render STORE --region`.
 async function zarrGridFromUrl(context, url, tmp, run) {
   const store = path.join(tmp, 'ch2.ome.zarr');
@@ -1681,7 +1681,7 @@ async function zarrSlicesFromUrl(context, url, tmp, run) {
   console.log(`     (OME-Zarr slices: ${((Date.now() - t) / 1000).toFixed(1)} s)`);
 }
 
-// The zoom-driven level swap (issue 15 item 4) on the head, with budgets
+// The zoom-driven level swap on the head, with budgets
 // small enough for all three stages (overview 1 Mi voxels: medium level 1,
 // coarse level 2; native blocks of 64³): zooming in goes coarse -> medium ->
 // native block, each swap cross-faded over several frames (no frame changes

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The marked head of issue 12, stored every way a user meets it.
+"""The marked head of the patient-geometry tests, stored every way a user meets it.
 
     marked_head.py make OUTDIR     writes the storages and OUTDIR/truth.json
     marked_head.py marker FILE...  prints {file: marker centre (RAS mm)} as JSON

@@ -1,4 +1,4 @@
-// DICOM geometry (issue 12: IPP/IOP -> RAS affine, and back) and the defects
+// DICOM geometry (IPP/IOP -> RAS affine, and back) and the defects
 // found on pydicom's and nibabel's test files, each reproduced by a file
 // that pydicom writes at test time (Debian's /usr/bin/python3 with
 // python3-pydicom; the tests skip, saying why, when it is missing).

@@ -1,4 +1,4 @@
-// Interoperability is the acceptance (issue 14): stores zarr-python writes
+// Interoperability is the acceptance: stores zarr-python writes
 // (blosc lz4/zstd with shuffle/bitshuffle, zlib, gzip, zstd, none; "/" and
 // "." separators; u1, <u2, >i2, <f4, <i4; missing chunks; chunks that do
 // not divide the shape; 5D t,c,z,y,x) are read voxel-exact, and stores

@@ -145,7 +145,7 @@ TEST(BoxSplineReconstruction, MarschnerLobbOnFccRendersCloserToTheSignalThanTril
   }
 }
 
-// Real data (issue 17's acceptance, CPU side): the ch2 MRI head on the FCC
+// Real data (the FCC acceptance, CPU side): the ch2 MRI head on the FCC
 // lattice at half and same density, rendered through the box spline, against
 // the trilinear reference of the original. Skipped without mricron-data.
 TEST(BoxSplineReconstruction, Ch2OnFccRendersLikeTheOriginal) {

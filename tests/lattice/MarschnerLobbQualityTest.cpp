@@ -60,7 +60,7 @@ class Quality {
 
 }  // namespace
 
-// The acceptance table of issue 17: at the same sample count the box spline on
+// The FCC acceptance table: at the same sample count the box spline on
 // FCC beats trilinear on the Cartesian grid, once its samples are
 // quasi-interpolated (Kim 2013); raw samples as coefficients blur too much.
 TEST(MarschnerLobbQuality, FccBoxSplineBeatsCartesianTrilinearAtTheSameSampleCount) {

@@ -1,4 +1,4 @@
-// The bricks layout end to end (issue 14): bricked renders equal the in-core
+// The bricks layout end to end: bricked renders equal the in-core
 // texture3d/mosaic renders and the CPU reference (brick faces crossed by many
 // rays, a brick size that does not divide the volume), on ES 3 (3D atlas)
 // and ES 2 (mosaic atlas); the page table's address maths against direct

@@ -1,4 +1,4 @@
-// Clip planes and the crop box (issue 16, item 2): every technique on every
+// Clip planes and the crop box: every technique on every
 // layout, ES 3.0 and ES 2.0, against the clipped reference; moving a plane
 // by less than a sample step changes no sample on the kept side.
 #include <gtest/gtest.h>

@@ -72,7 +72,7 @@ bool haveValidator() {
   return std::system("command -v glslangValidator >/dev/null 2>&1") == 0;
 }
 
-// The slicing techniques (issue 4): slice3d on this layout, slice2d with
+// The slicing techniques: slice3d on this layout, slice2d with
 // every classification, composite and MIP.
 void expectSlicingConformant(gpu::GlContext& c, const Volume& v, const layout::Layout& layout) {
   render::Slice3DRenderer slice3d(c, v, layout);
@@ -183,7 +183,7 @@ TEST(GlslConformance, Es3ShadersPassTheReferenceCompiler) {
   expectConformant(c, v, *bricks);
 }
 
-// The overlay and hybrid-compositor programs (issue 5), assembled as
+// The overlay and hybrid-compositor programs, assembled as
 // OverlayRenderer and HybridCompositor assemble them, for both API levels.
 TEST(GlslConformance, OverlayAndHybridShadersPassTheReferenceCompiler) {
   if (!haveValidator())

@@ -1,4 +1,4 @@
-// Label volumes (issue 16, item 3): nearest-neighbour sampling and a
+// Label volumes: nearest-neighbour sampling and a
 // categorical table, on every technique and layout; label table files.
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // The ray caster on every layout, in ES 2.0 and ES 3.0 contexts: against
-// texture3d and against the CPU reference (issue 3's image tests).
+// texture3d and against the CPU reference (the layouts' image tests).
 #include <gtest/gtest.h>
 
 #include <cstdio>

@@ -1,5 +1,5 @@
 // The same anatomy renders the same image whatever its storage order
-// (issue 12): a marked phantom stored RAS, mirrored (LAS), LPS, sagittal and
+// (patient geometry): a marked phantom stored RAS, mirrored (LAS), LPS, sagittal and
 // coronal stacks and a scrambled order, each with the direction cosines that
 // say so, against the RAS render from three views. Storage changes are exact
 // permutations of voxels, so every technique must agree with itself to far

@@ -1,4 +1,4 @@
-// MinIP and average-intensity projection (issue 16, item 3): the ray caster
+// MinIP and average-intensity projection: the ray caster
 // on every layout, ES 3.0 and ES 2.0, against the reference; the slicers say
 // they cannot.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The platform roofline (issue 16, item 6): every kernel compiles, runs and
+// The platform roofline: every kernel compiles, runs and
 // is timed, and bad options are refused. The rates themselves are
 // benchmarks (`tessera bench --roofline`), never asserted.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Fewer samples for the same image (issue 16, item 4): pre-integrated
+// Fewer samples for the same image: pre-integrated
 // classification and adaptive steps in the GPU ray caster, against the CPU
 // reference that takes the same samples (>= 40 dB) and against a fine
 // reference (every sample at 0.25 voxel): the quality they buy or cost.

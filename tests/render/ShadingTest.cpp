@@ -1,4 +1,4 @@
-// Blinn-Phong shading (issue 16, item 1): every technique on every layout,
+// Blinn-Phong shading: every technique on every layout,
 // in ES 3.0 and ES 2.0 contexts, against the shaded CPU reference; the
 // gradient of a linear ramp lights the analytic normal.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Axis-aligned slicing (issue 4): each stack against the CPU reference when
+// Axis-aligned slicing: each stack against the CPU reference when
 // the view looks along it, for every classification; atlases; the
 // one-stack-resident mode; what a TF change re-uploads.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// View-aligned slicing (issue 4): against the CPU reference, across layouts
+// View-aligned slicing: against the CPU reference, across layouts
 // and API levels, and the static proxy geometry.
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // The slice views, crosshair, bread-slice region and grid block of the
-// viewers (issue 15): slice images against direct indexing, patient letters
+// viewers: slice images against direct indexing, patient letters
 // and an asymmetric marker for two storage orders, exact pixel <-> voxel
 // mappings, and bounded region reads counted at the source.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The zoom-driven level swap (issue 15 item 4; viewer/ZoomSwap.h) end to
+// The zoom-driven level swap (viewer/ZoomSwap.h) end to
 // end on ES 3 and ES 2: zooming through the documented thresholds shows
 // coarse -> medium -> native block -> medium -> coarse; during each swap
 // consecutive frames stay close (the cross-fade spreads the change), where

@@ -94,7 +94,7 @@ int guarded(F&& f) {
 // pre-integration table's filtered half-float fetch costs more than the
 // fewer samples save: on ch2 at 512^2 the page took 1.4-2.0x longer per frame
 // pre-integrated than with the adaptive steps alone, which keep 45-48 dB
-// against the 0.25-voxel reference (docs/web-peers.md, "Sampling in the
+// against the 0.25-voxel reference (docs/benchmarks.md, "Sampling in the
 // browser"). The page's "pre-integrated" control switches it on.
 constexpr Sampling webDefaultSampling() {
   Sampling s = defaultSampling();
@@ -437,7 +437,7 @@ EMSCRIPTEN_KEEPALIVE const std::uint8_t* tessera_read_pixels(int width, int heig
 }  // extern "C"
 
 // ---------------------------------------------------------------- slice views and region
-// Issue 15 item 6 (web/slices.js): axial, coronal and sagittal slices of the
+// The slice views (web/slices.js): axial, coronal and sagittal slices of the
 // loaded volume drawn on the CPU with core/SliceImage (the same pixels and
 // patient-direction letters as `tessera slice`), and the bread-slice region
 // (Schultz 2016 §7.4): a box of the volume at native resolution shown as the
@@ -1082,7 +1082,7 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_info() {
 
 namespace {
 
-// The bread-slice region of a store (issue 15): voxels [x0,x1) x [y0,y1) x
+// The bread-slice region of a store: voxels [x0,x1) x [y0,y1) x
 // [z0,z1) of level 0, read with bounded reads: only the chunks overlapping
 // the box are fetched (asynchronously, by the page), then one readBox, never
 // the level whole. Ends past the level are clamped; an empty box or one
@@ -1176,7 +1176,7 @@ EMSCRIPTEN_KEEPALIVE void tessera_zarr_close() {
 }  // extern "C"
 
 // ---------------------------------------------------------------- grid view
-// Issue 15 items 3 and 6 (web/grid.js): Schultz 2016 §7.3's grid view over
+// The grid view (web/grid.js): Schultz 2016 §7.3's grid view over
 // the loaded volume, with the native core's lod::GridNavigator (the grid
 // points, their classes, the legal moves and the moves chosen by the view
 // direction are all its own; the page only shows them). The 2x2x2 block of
@@ -1465,7 +1465,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_grid_store_shown() {
 
 }  // extern "C"
 
-// ---- Light, clipping and the crop box's handles (issue 16) ----
+// ---- Light, clipping and the crop box's handles ----
 
 namespace {
 
@@ -1673,7 +1673,7 @@ EMSCRIPTEN_KEEPALIVE void tessera_set_label_visible(int value, int visible) {
 
 }  // extern "C"
 
-// ---- Zoom-driven level swap (issue 15 item 4; Schultz 2016 §7.3.1), the
+// ---- Zoom-driven level swap (Schultz 2016 §7.3.1), the
 // desktop viewer's viewer::ZoomSwap on the page: zoomed out the 3D view
 // shows a coarse level of the loaded volume, then the medium level (the
 // finest that fits the profile's overview budget), then, zoomed in far

@@ -1,5 +1,5 @@
 #pragma once
-// One index-axis slice of a volume as a 2D image (issue 15): nearest voxel
+// One index-axis slice of a volume as a 2D image: nearest voxel
 // at voxel centres, no interpolation, in the radiological convention with
 // the patient directions of its four edges. `tessera slice` and the web
 // page's slice views both draw slices with this, so they show the same

@@ -7,7 +7,7 @@
 //
 // The choice is a feedback loop on the measured frame time. Rendering cost is
 // nearly linear in pixels x samples (Moser & Weiskopf 2008, Figures 3 and 4;
-// README, Benchmark), so a level is summarised by its work fraction
+// docs/benchmarks.md), so a level is summarised by its work fraction
 //   w = resolutionScale^2 / stepScale   (1 = full quality),
 // and after each frame w is multiplied by (goal / measured)^gain. With a
 // fixed per-frame overhead a (compositing, lines) and t(w) = a + b w, the

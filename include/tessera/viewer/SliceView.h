@@ -1,5 +1,5 @@
 #pragma once
-// The 2D slice views next to the 3D view (issue 15; Schultz 2016 §7.4's
+// The 2D slice views next to the 3D view (Schultz 2016 §7.4's
 // "bread slice" flipping): an index-axis slice of a volume at native voxel
 // resolution (nearest voxel), in the radiological convention of
 // core/SliceImage.h, the one `tessera slice` and the web page draw with

@@ -1,6 +1,6 @@
 #pragma once
-// The zoom-driven level swap of the overview (Schultz 2016 §7.3.1; issue 15
-// item 4), the part both front ends share: lod::ZoomLevelPolicy decides from
+// The zoom-driven level swap of the overview (Schultz 2016 §7.3.1), the
+// part both front ends share: lod::ZoomLevelPolicy decides from
 // the camera's zoom which stage to show (coarse level, medium level, the
 // native 2x2x2 grid block around the view's centre), this class reads that
 // stage with bounded reads of the Explorer's source (a whole coarse level,
