@@ -25,7 +25,7 @@ PREFIX=$TMP/prefix
 cmake --install build --prefix "$PREFIX" >/dev/null
 
 fail() { echo "embed-test: $*" >&2; exit 1; }
-leaks=$(grep -rl "$ROOT" "$PREFIX/lib/cmake" || true)
+leaks=$(grep -rlF "$ROOT" "$PREFIX/lib/cmake" || true)
 [[ -z "$leaks" ]] || fail "installed package files name the source/build tree $ROOT: $leaks"
 
 # A copy of the example outside the tree: its quoted includes cannot reach
@@ -33,11 +33,11 @@ leaks=$(grep -rl "$ROOT" "$PREFIX/lib/cmake" || true)
 cp -r examples/embed "$TMP/src"
 cmake -S "$TMP/src" -B "$TMP/build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$PREFIX" \
   -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF -DCMAKE_CXX_FLAGS="-Wall -Wextra -Werror" >/dev/null
-grep -q "^Tessera_DIR:PATH=$PREFIX/lib/cmake/Tessera$" "$TMP/build/CMakeCache.txt" ||
+grep -qxF "Tessera_DIR:PATH=$PREFIX/lib/cmake/Tessera" "$TMP/build/CMakeCache.txt" ||
   fail "find_package(Tessera) did not resolve to $PREFIX: $(grep '^Tessera_DIR' "$TMP/build/CMakeCache.txt")"
 cmake --build "$TMP/build" -j"$(nproc)" >/dev/null
 # The compiler's dependency files list every header the example used.
-leaks=$(grep -rl "$ROOT" "$TMP/build" || true)
+leaks=$(grep -rlF "$ROOT" "$TMP/build" || true)
 [[ -z "$leaks" ]] || fail "the example's build used files of $ROOT: $leaks"
 
 rc=0
