@@ -25,11 +25,15 @@ if(TESSERA_DESKTOP_FOUND)
   target_compile_options(tessera_gpu_glfw PRIVATE ${TESSERA_WARNINGS})
   target_link_libraries(tessera_gpu_glfw PUBLIC tessera_gpu PRIVATE PkgConfig::GLFW3)
 
-  target_compile_definitions(tessera_cli PRIVATE TESSERA_DESKTOP_VIEWER=1)
+  file(GLOB TESSERA_DESKTOP_SOURCES CONFIGURE_DEPENDS ${TESSERA_DESKTOP_DIR}/*.cpp)
+  list(REMOVE_ITEM TESSERA_DESKTOP_SOURCES ${TESSERA_DESKTOP_DIR}/ViewCommand.cpp
+       ${TESSERA_DESKTOP_DIR}/ViewUnavailable.cpp)
+  target_sources(tessera_cli PRIVATE ${TESSERA_DESKTOP_SOURCES})
   # SYSTEM: ImGui's and GLFW's headers are not ours to keep free of warnings.
   target_include_directories(tessera_cli SYSTEM PRIVATE ${IMGUI_INCLUDE_DIRS} ${GLFW3_INCLUDE_DIRS})
   target_link_libraries(tessera_cli PRIVATE tessera_gpu_glfw PkgConfig::GLFW3 PkgConfig::IMGUI
                                             ${CMAKE_DL_LIBS})
 else()
   message(STATUS "tessera view: off (needs libglfw3-dev and libimgui-dev)")
+  target_sources(tessera_cli PRIVATE ${TESSERA_DESKTOP_DIR}/ViewUnavailable.cpp)
 endif()

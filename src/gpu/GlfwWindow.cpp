@@ -46,10 +46,12 @@ GlfwWindow::GlfwWindow(const Options& options) {
   glfwWindowHint(GLFW_CONTEXT_CREATION_API, GLFW_EGL_CONTEXT_API);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, es3 ? 3 : 2);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 0);
-  window_ = glfwCreateWindow(options.width, options.height, options.title.c_str(), nullptr, nullptr);
+  window_ =
+      glfwCreateWindow(options.width, options.height, options.title.c_str(), nullptr, nullptr);
   if (!window_) {
-    const std::string message = withGlfwError(std::string("cannot open a window with an OpenGL ES ") +
-                                              (es3 ? "3.0" : "2.0") + " context through EGL");
+    const std::string message =
+        withGlfwError(std::string("cannot open a window with an OpenGL ES ") +
+                      (es3 ? "3.0" : "2.0") + " context through EGL");
     glfwTerminate();
     throw GpuError(message);
   }
@@ -71,13 +73,21 @@ GlfwWindow::~GlfwWindow() {
   glfwTerminate();
 }
 
-bool GlfwWindow::shouldClose() const { return glfwWindowShouldClose(window_) != 0; }
+bool GlfwWindow::shouldClose() const {
+  return glfwWindowShouldClose(window_) != 0;
+}
 
-void GlfwWindow::requestClose() { glfwSetWindowShouldClose(window_, 1); }
+void GlfwWindow::requestClose() {
+  glfwSetWindowShouldClose(window_, 1);
+}
 
-void GlfwWindow::pollEvents() { glfwPollEvents(); }
+void GlfwWindow::pollEvents() {
+  glfwPollEvents();
+}
 
-void GlfwWindow::swapBuffers() { glfwSwapBuffers(window_); }
+void GlfwWindow::swapBuffers() {
+  glfwSwapBuffers(window_);
+}
 
 glm::ivec2 GlfwWindow::framebufferSize() const {
   glm::ivec2 size(0);
@@ -91,7 +101,9 @@ glm::ivec2 GlfwWindow::windowSize() const {
   return size;
 }
 
-double GlfwWindow::seconds() const { return glfwGetTime(); }
+double GlfwWindow::seconds() const {
+  return glfwGetTime();
+}
 
 void GlfwWindow::onDrop(std::function<void(const std::string& path)> handler) {
   drop_ = std::move(handler);
