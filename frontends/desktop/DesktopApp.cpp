@@ -110,7 +110,7 @@ void runFrame(DesktopApp& ds) {
   handleViewInput(ds, tiles.view3d, scale);
   handleSliceInput(ds, tiles);
   handleShortcuts(ds);
-  handleExploreKeys(ds, tiles);
+  handleArrowKeys(ds, tiles);
   updateOverlay(ds);
   drawPanel(ds, win.y);
   for (int t = 0; t < 3 && ds.fourUp; ++t) drawSliceTile(ds, ds.slices[t], tiles.slice[t]);

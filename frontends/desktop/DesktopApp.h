@@ -14,6 +14,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <imgui.h>
@@ -165,7 +166,7 @@ void drawSliceTile(DesktopApp& ds, DesktopApp::SliceTile& tile, const Rect& r);
 void handleViewInput(DesktopApp& ds, const Rect& view, double scale);
 void handleSliceInput(DesktopApp& ds, const Tiles& tiles);
 void handleShortcuts(DesktopApp& ds);
-void handleExploreKeys(DesktopApp& ds, const Tiles& tiles);
+void handleArrowKeys(DesktopApp& ds, const Tiles& tiles);
 void drawHelpOverlay(DesktopApp& ds, float x0, float x1, float height);
 
 // VolumeView.cpp

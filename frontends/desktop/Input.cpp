@@ -89,9 +89,43 @@ void nextTechnique(DesktopApp& ds) {
   reportErrors(ds, [&] { ds.viewer->setTechnique(names[next]); });
 }
 
+// The typed-letter shortcuts of kShortcuts, either case; `exploring`: only
+// with a volume to explore.
+struct LetterKey {
+  char letter;
+  bool exploring;
+  void (*act)(DesktopApp&);
+};
+constexpr LetterKey kLetterKeys[] = {
+    {'?', false, [](DesktopApp& ds) { ds.showHelp = !ds.showHelp; }},
+    {'r', false, [](DesktopApp& ds) { ds.viewer->resetCamera(); }},
+    {'b', false, [](DesktopApp& ds) { ds.viewer->showBoundingBox = !ds.viewer->showBoundingBox; }},
+    {'a', false, [](DesktopApp& ds) { ds.viewer->showAxes = !ds.viewer->showAxes; }},
+    {'m', false,
+     [](DesktopApp& ds) {
+       RenderMode& mode = ds.viewer->settings().mode;
+       mode = mode == RenderMode::Mip ? RenderMode::Composite : RenderMode::Mip;
+     }},
+    {'q', false,
+     [](DesktopApp& ds) {
+       viewer::Quality& q = ds.viewer->quality;
+       q = q == viewer::Quality::Adaptive ? viewer::Quality::Full : viewer::Quality::Adaptive;
+     }},
+    {'t', false, nextTechnique},
+    {'v', true, viewPickedRegion},
+    {'g', true,
+     [](DesktopApp& ds) { ds.mode == DesktopApp::Mode::Grid ? showOverview(ds) : enterGrid(ds); }},
+    {'o', true, [](DesktopApp& ds) { showOverview(ds); }},
+    {'l', true, [](DesktopApp& ds) { ds.fourUp = !ds.fourUp; }},
+    {'c', true, [](DesktopApp& ds) { ds.sliceColour = !ds.sliceColour; }},
+    {'[', true, [](DesktopApp& ds) { ds.explorer->setRegionSide(ds.explorer->regionSide() - 16); }},
+    {']', true, [](DesktopApp& ds) { ds.explorer->setRegionSide(ds.explorer->regionSide() + 16); }},
+};
+
 }  // namespace
 
-// The keys of kShortcuts (GLFW key codes and typed characters, ImGui 1.86).
+// The keys of kShortcuts but the arrows (GLFW key codes and typed
+// characters, ImGui 1.86).
 void handleShortcuts(DesktopApp& ds) {
   ImGuiIO& io = ImGui::GetIO();
   if (ImGui::IsKeyPressed(GLFW_KEY_F1, false)) ds.showHelp = !ds.showHelp;
@@ -106,34 +140,9 @@ void handleShortcuts(DesktopApp& ds) {
       }
     }
   }
-  viewer::Viewer& v = *ds.viewer;
   for (const ImWchar c : io.InputQueueCharacters) {
-    switch (lowerAscii(c)) {
-      case '?':
-        ds.showHelp = !ds.showHelp;
-        break;
-      case 'r':
-        v.resetCamera();
-        break;
-      case 'b':
-        v.showBoundingBox = !v.showBoundingBox;
-        break;
-      case 'a':
-        v.showAxes = !v.showAxes;
-        break;
-      case 'm':
-        v.settings().mode =
-            v.settings().mode == RenderMode::Mip ? RenderMode::Composite : RenderMode::Mip;
-        break;
-      case 'q':
-        v.quality = v.quality == viewer::Quality::Adaptive ? viewer::Quality::Full
-                                                           : viewer::Quality::Adaptive;
-        break;
-      case 't':
-        nextTechnique(ds);
-        break;
-      default:
-        break;
+    for (const LetterKey& k : kLetterKeys) {
+      if (lowerAscii(c) == k.letter && (!k.exploring || ds.explorer)) k.act(ds);
     }
   }
 }
@@ -236,13 +245,12 @@ void handleSliceInput(DesktopApp& ds, const Tiles& tiles) {
   }
 }
 
-// The keys of the exploring modes (kShortcuts).
-void handleExploreKeys(DesktopApp& ds, const Tiles& tiles) {
+// The arrow keys: grid moves in the grid view, else slices (kShortcuts).
+void handleArrowKeys(DesktopApp& ds, const Tiles& tiles) {
   ImGuiIO& io = ImGui::GetIO();
   if (io.WantTextInput || !ds.explorer) return;
-  const bool grid = ds.mode == DesktopApp::Mode::Grid;
   auto pressed = [](int key) { return ImGui::IsKeyPressed(key, true); };
-  if (grid) {
+  if (ds.mode == DesktopApp::Mode::Grid) {
     if (pressed(GLFW_KEY_UP)) gridMove(ds, lod::ViewMove::Forward);
     if (pressed(GLFW_KEY_DOWN)) gridMove(ds, lod::ViewMove::Back);
     if (pressed(GLFW_KEY_LEFT)) gridMove(ds, lod::ViewMove::Left);
@@ -252,33 +260,6 @@ void handleExploreKeys(DesktopApp& ds, const Tiles& tiles) {
   } else {
     if (pressed(GLFW_KEY_UP)) stepSlice(ds, tileUnderPointer(ds, tiles), 1);
     if (pressed(GLFW_KEY_DOWN)) stepSlice(ds, tileUnderPointer(ds, tiles), -1);
-  }
-  for (const ImWchar c : io.InputQueueCharacters) {
-    switch (lowerAscii(c)) {
-      case 'v':
-        viewPickedRegion(ds);
-        break;
-      case 'g':
-        grid ? showOverview(ds) : enterGrid(ds);
-        break;
-      case 'o':
-        showOverview(ds);
-        break;
-      case 'l':
-        ds.fourUp = !ds.fourUp;
-        break;
-      case 'c':
-        ds.sliceColour = !ds.sliceColour;
-        break;
-      case '[':
-        ds.explorer->setRegionSide(ds.explorer->regionSide() - 16);
-        break;
-      case ']':
-        ds.explorer->setRegionSide(ds.explorer->regionSide() + 16);
-        break;
-      default:
-        break;
-    }
   }
 }
 
