@@ -4,6 +4,8 @@
 // layer (gpu::GlfwWindow); this front end turns input into viewer calls and
 // draws the panels with Dear ImGui.
 //
+//   ViewCommand.cpp    the subcommand's options (ViewOptions.h); without
+//                      GLFW or ImGui, ViewUnavailable.cpp says what to install
 //   DesktopApp.cpp     start-up, the frame loop, the window's layout
 //   VolumeView.cpp     the 3D view: render when it changed, else blit the cache
 //   Input.cpp          keys and mouse on the 3D and slice views, the help overlay
