@@ -1,20 +1,39 @@
-# `tessera view` (src/app/ViewCommand.cpp): a GLFW window with an OpenGL ES
+# `tessera view` (frontends/desktop/): a GLFW window with an OpenGL ES
 # context through EGL and Dear ImGui controls. On by default when Debian's
 # libglfw3-dev and libimgui-dev are installed; without them the command
-# exists and says what to install.
+# exists and says what to install (frontends/desktop/ViewUnavailable.cpp).
 option(TESSERA_DESKTOP_VIEWER "Build the desktop viewer (tessera view) when GLFW and ImGui are found"
        ON)
+set(TESSERA_DESKTOP_DIR ${CMAKE_SOURCE_DIR}/frontends/desktop)
+# The subcommand's options are parsed whether or not the window can be built.
+target_sources(tessera_cli PRIVATE ${TESSERA_DESKTOP_DIR}/ViewCommand.cpp)
+set(TESSERA_DESKTOP_FOUND OFF)
 if(TESSERA_DESKTOP_VIEWER)
   pkg_check_modules(GLFW3 IMPORTED_TARGET glfw3)
   # Debian's imgui.pc requires stb (ImGui's font rasteriser and rect packer).
   pkg_check_modules(IMGUI IMPORTED_TARGET imgui)
   if(GLFW3_FOUND AND IMGUI_FOUND)
-    message(STATUS "tessera view: GLFW ${GLFW3_VERSION} + Dear ImGui ${IMGUI_VERSION}")
-    target_compile_definitions(tessera_cli PRIVATE TESSERA_DESKTOP_VIEWER=1)
-    # SYSTEM: ImGui's headers are not ours to keep free of warnings.
-    target_include_directories(tessera_cli SYSTEM PRIVATE ${IMGUI_INCLUDE_DIRS})
-    target_link_libraries(tessera_cli PRIVATE PkgConfig::GLFW3 PkgConfig::IMGUI ${CMAKE_DL_LIBS})
-  else()
-    message(STATUS "tessera view: off (needs libglfw3-dev and libimgui-dev)")
+    set(TESSERA_DESKTOP_FOUND ON)
   endif()
+endif()
+
+if(TESSERA_DESKTOP_FOUND)
+  message(STATUS "tessera view: GLFW ${GLFW3_VERSION} + Dear ImGui ${IMGUI_VERSION}")
+  # The gpu layer's GLFW window (include/tessera/gpu/GlfwWindow.h), apart
+  # from tessera_gpu so that the layer never needs GLFW.
+  add_library(tessera_gpu_glfw STATIC ${CMAKE_SOURCE_DIR}/src/gpu/GlfwWindow.cpp)
+  target_compile_options(tessera_gpu_glfw PRIVATE ${TESSERA_WARNINGS})
+  target_link_libraries(tessera_gpu_glfw PUBLIC tessera_gpu PRIVATE PkgConfig::GLFW3)
+
+  file(GLOB TESSERA_DESKTOP_SOURCES CONFIGURE_DEPENDS ${TESSERA_DESKTOP_DIR}/*.cpp)
+  list(REMOVE_ITEM TESSERA_DESKTOP_SOURCES ${TESSERA_DESKTOP_DIR}/ViewCommand.cpp
+       ${TESSERA_DESKTOP_DIR}/ViewUnavailable.cpp)
+  target_sources(tessera_cli PRIVATE ${TESSERA_DESKTOP_SOURCES})
+  # SYSTEM: ImGui's and GLFW's headers are not ours to keep free of warnings.
+  target_include_directories(tessera_cli SYSTEM PRIVATE ${IMGUI_INCLUDE_DIRS} ${GLFW3_INCLUDE_DIRS})
+  target_link_libraries(tessera_cli PRIVATE tessera_gpu_glfw PkgConfig::GLFW3 PkgConfig::IMGUI
+                                            ${CMAKE_DL_LIBS})
+else()
+  message(STATUS "tessera view: off (needs libglfw3-dev and libimgui-dev)")
+  target_sources(tessera_cli PRIVATE ${TESSERA_DESKTOP_DIR}/ViewUnavailable.cpp)
 endif()

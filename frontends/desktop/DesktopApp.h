@@ -1,0 +1,179 @@
+#pragma once
+// The desktop viewer's state between frames and the functions each of its
+// files offers the others. The window and its context come from the gpu
+// layer (gpu::GlfwWindow); this front end turns input into viewer calls and
+// draws the panels with Dear ImGui.
+//
+//   ViewCommand.cpp    the subcommand's options (ViewOptions.h); without
+//                      GLFW or ImGui, ViewUnavailable.cpp says what to install
+//   DesktopApp.cpp     start-up, the frame loop, the window's layout
+//   VolumeView.cpp     the 3D view: render when it changed, else blit the cache
+//   Input.cpp          keys and mouse on the 3D and slice views, the help overlay
+//   Exploring.cpp      overview / region / grid through viewer::Explorer
+//   PanelsFile.cpp     open, recent and dropped volumes
+//   PanelsStyle.cpp    TF editor, window/level, rendering, shading, clipping, labels
+//   PanelsExplore.cpp  the slice views and the exploring panel (zoom stages)
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <imgui.h>
+#include <glm/vec2.hpp>
+
+#include "ViewOptions.h"
+#include "tessera/core/Error.h"
+#include "tessera/gpu/GlObjects.h"
+#include "tessera/gpu/GlfwWindow.h"
+#include "tessera/lod/GridNavigator.h"
+#include "tessera/lod/MultiresSource.h"
+#include "tessera/lod/ZoomLevelPolicy.h"
+#include "tessera/viewer/CropHandles.h"
+#include "tessera/viewer/Explorer.h"
+#include "tessera/viewer/RecentFiles.h"
+#include "tessera/viewer/SliceView.h"
+#include "tessera/viewer/Viewer.h"
+#include "tessera/viewer/ZoomSwap.h"
+
+namespace tessera::desktop {
+
+constexpr float kPanelWidth = 390.0f;
+
+// Everything the desktop viewer holds between frames. The window is the
+// first member: destroyed last, after every GL object of its context.
+struct DesktopApp {
+  DesktopApp(const ViewOptions& o, std::unique_ptr<gpu::GlfwWindow> w, bool gles3)
+      : window(std::move(w)), options(o), es3(gles3) {}
+  std::unique_ptr<gpu::GlfwWindow> window;
+  const ViewOptions& options;
+  bool es3;
+  gpu::GlContext& context() { return window->context(); }
+  std::unique_ptr<viewer::Viewer> viewer;
+  std::string pendingDrop;  // a file dropped on the window, opened after the events
+  std::string error;
+  std::string status;
+  gpu::Framebuffer cache;  // ES 3: the last volume frame, blitted while nothing changes
+  std::string cacheKey;
+  char pathBuf[512] = "";
+  char tfPathBuf[512] = "transfer-function.json";
+  char labelPathBuf[512] = "labels.txt";
+  bool logHistogram = true;
+  int frame = 0;
+  bool showHelp = false;
+  viewer::RecentFiles recent{viewer::RecentFiles::defaultPath()};
+
+  // Exploring at native resolution (viewer/Explorer.h).
+  enum class Mode { Overview, Region, Grid };
+  Mode mode = Mode::Overview;
+  std::unique_ptr<viewer::Explorer> explorer;
+  std::string volumeLabel;
+  int overviewLevel = 0;
+  std::shared_ptr<const Volume> overview;  // what the 3D view returns to
+  std::optional<lod::VoxelBox> picked;     // the bread-slice region (slice views, overview)
+  std::optional<lod::VoxelBox> shown;      // the region or grid block the 3D view shows
+  std::optional<lod::VoxelBox> gridBlock;  // the grid view's last block (slices, overview)
+  std::string exploreNote;                 // e.g. why a grid move was refused
+  bool fourUp = true;
+  bool sliceColour = false;       // slices in the TF's colour instead of grey
+  bool zoomSwitchesGrid = false;  // the zoom swaps coarse / medium level / native grid block
+  double viewPixels = 0.0;        // the 3D view's height in pixels (the policy's view)
+  // While it exists, the zoom decides what the 3D view shows (viewer/ZoomSwap.h);
+  // a manual mode change (region, grid, overview) ends it.
+  std::unique_ptr<viewer::ZoomSwap> zoomSwap;
+  std::string zoomSwapKey;  // the stages it was made for
+  double lastFrameMs = 0.0;
+  // The three slice views: axial, coronal, sagittal.
+  struct SliceTile {
+    std::string plane;
+    std::unique_ptr<viewer::SliceGeometry> geometry;
+    gpu::Texture texture;
+    std::string key;
+    viewer::SliceViewport viewport;
+  };
+  SliceTile slices[3] = {
+      {"axial", {}, {}, "", {}}, {"coronal", {}, {}, "", {}}, {"sagittal", {}, {}, "", {}}};
+  int dragTile = -1;          // a slice view being dragged in (-1: none)
+  bool dragRegion = false;    // right button: drawing a region box
+  glm::dvec2 dragStart{0.0};  // window units
+  // The crop box drawn with a handle on each face (viewer/CropHandles.h).
+  bool showCropBox = false;
+  viewer::CropHandles crop;
+};
+
+// Runs `action`; its Error goes to the panel's error line (and true means
+// it succeeded, the line cleared).
+template <class Action>
+bool reportErrors(DesktopApp& ds, Action&& action) {
+  try {
+    action();
+    ds.error.clear();
+    return true;
+  } catch (const Error& e) {
+    ds.error = e.what();
+    return false;
+  }
+}
+
+// A rectangle of the window in ImGui (window) units, top-left origin.
+struct Rect {
+  ImVec2 p0, p1;
+  bool contains(ImVec2 p) const { return p.x >= p0.x && p.y >= p0.y && p.x < p1.x && p.y < p1.y; }
+};
+// Where the views go right of the panel: one 3D view, or four up (axial
+// top-left, 3D top-right, sagittal bottom-left, coronal bottom-right, as
+// 3D Slicer's four-up layout).
+struct Tiles {
+  Rect view3d;
+  Rect slice[3];  // axial, coronal, sagittal (empty when not four-up)
+};
+
+// How the camera follows a swap of the 3D view's volume (its direction
+// always stays). Keep: the same point of the patient stays at the view's
+// centre at the same scale (the zoom policy's swaps change the data, not
+// the view: no jump). Centre: the new volume's centre, the zoom kept (a grid
+// move). Fill: the new volume's centre at zoom 1 (a key or button).
+enum class Follow { Keep, Centre, Fill };
+
+// Exploring.cpp: what a session will own (volume pyramid, region, grid).
+void loadVolume(DesktopApp& ds, const std::string& spec);
+void startExploring(DesktopApp& ds, const ViewOptions& o);
+void showOverview(DesktopApp& ds, Follow follow = Follow::Fill);
+void viewPickedRegion(DesktopApp& ds);
+void enterGrid(DesktopApp& ds);
+void gridMove(DesktopApp& ds, lod::ViewMove move);
+void keepZoomSwap(DesktopApp& ds, const std::vector<lod::ZoomStage>& stages,
+                  const std::string& stagesKey);
+void updateOverlay(DesktopApp& ds);
+std::string boxText(const lod::VoxelBox& b);
+
+// PanelsFile.cpp
+void openVolume(DesktopApp& ds, const std::string& spec);
+void panelFile(DesktopApp& ds);
+
+// PanelsStyle.cpp
+void section(const char* title);
+void panelTransferFunction(DesktopApp& ds);
+void panelWindowLevel(viewer::Viewer& v);
+void panelRendering(DesktopApp& ds);
+void panelShading(viewer::Viewer& v);
+void panelClipping(DesktopApp& ds);
+void panelLabels(DesktopApp& ds);
+
+// PanelsExplore.cpp
+void panelExplore(DesktopApp& ds);
+void drawSliceTile(DesktopApp& ds, DesktopApp::SliceTile& tile, const Rect& r);
+
+// Input.cpp
+void handleViewInput(DesktopApp& ds, const Rect& view, double scale);
+void handleSliceInput(DesktopApp& ds, const Tiles& tiles);
+void handleShortcuts(DesktopApp& ds);
+void handleArrowKeys(DesktopApp& ds, const Tiles& tiles);
+void drawHelpOverlay(DesktopApp& ds, float x0, float x1, float height);
+
+// VolumeView.cpp
+void drawVolumeView(DesktopApp& ds, glm::ivec2 origin, int viewW, int viewH);
+void drawEdgeLetters(const std::string& left, const std::string& right, const std::string& top,
+                     const std::string& bottom, ImVec2 p0, ImVec2 p1);
+
+}  // namespace tessera::desktop

@@ -1,0 +1,78 @@
+// The file panel: a path to open, the recent volumes (Ctrl+1..9 in
+// Input.cpp), files dropped on the window, and the panel's error line.
+#include <filesystem>
+#include <string>
+
+#include "DesktopApp.h"
+
+namespace tessera::desktop {
+
+namespace {
+
+bool generated(const std::string& spec) {
+  return spec.rfind("gen:", 0) == 0 || spec.rfind("head:", 0) == 0;
+}
+
+// Files and folders (not generated volumes) go to the recent list, by their
+// absolute path; one that cannot be opened because it is gone leaves it.
+void rememberOpened(DesktopApp& ds, const std::string& spec) {
+  if (generated(spec)) return;
+  reportErrors(ds, [&] {
+    std::error_code ec;
+    const std::filesystem::path full = std::filesystem::absolute(spec, ec);
+    ds.recent.add(ec ? spec : full.lexically_normal().string());
+  });
+}
+
+void forgetIfGone(DesktopApp& ds, const std::string& spec) {
+  std::error_code ec;
+  if (std::filesystem::exists(spec, ec)) return;
+  try {
+    ds.recent.remove(spec);
+  } catch (const Error&) {
+    // The list could not be rewritten: the open error already says more.
+  }
+}
+
+}  // namespace
+
+// Shows the volume's overview (Exploring.cpp); an error is shown in the
+// panel and the previous volume stays.
+void openVolume(DesktopApp& ds, const std::string& spec) {
+  try {
+    loadVolume(ds, spec);
+    ds.error.clear();
+  } catch (const Error& e) {
+    ds.error = std::string(e.what()) + " (the previous volume stays)";
+    forgetIfGone(ds, spec);
+    return;
+  }
+  rememberOpened(ds, spec);
+}
+
+void panelFile(DesktopApp& ds) {
+  ImGui::TextWrapped("%s", ds.viewer->description().c_str());
+  ImGui::InputText("##path", ds.pathBuf, sizeof ds.pathBuf);
+  ImGui::SameLine();
+  if (ImGui::Button("Open") && ds.pathBuf[0]) openVolume(ds, ds.pathBuf);
+  ImGui::TextDisabled("or drop a file on the window; F1: keyboard shortcuts");
+  if (!ds.recent.entries().empty() && ImGui::BeginCombo("recent", "open a recent volume")) {
+    std::string chosen;
+    for (std::size_t i = 0; i < ds.recent.entries().size(); ++i) {
+      const std::string& path = ds.recent.entries()[i];
+      const std::string label = std::to_string(i + 1) + "  " +
+                                std::filesystem::path(path).filename().string() + "##" + path;
+      if (ImGui::Selectable(label.c_str())) chosen = path;
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", path.c_str());
+    }
+    ImGui::EndCombo();
+    if (!chosen.empty()) openVolume(ds, chosen);
+  }
+  if (!ds.error.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1.0f));
+    ImGui::TextWrapped("%s", ds.error.c_str());
+    ImGui::PopStyleColor();
+  }
+}
+
+}  // namespace tessera::desktop

@@ -1,0 +1,45 @@
+#pragma once
+// `tessera view`'s options as the command line gives them (ViewCommand.cpp)
+// and the entry that runs the window with them (DesktopApp.cpp, or
+// ViewUnavailable.cpp where the build has no GLFW or Dear ImGui).
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "app/ClippingOptions.h"
+#include "app/ShadingOptions.h"
+
+namespace tessera::desktop {
+
+struct ViewOptions {
+  std::string file;
+  std::string series;
+  std::string tf = "mr-default";
+  std::string size = "1280x800";
+  std::string profile = "gles3";
+  double azimuth = 0.0;
+  double elevation = 0.0;
+  std::string screenshot;
+  int frames = 3;
+  bool helpOverlay = false;
+  std::string layout = "four";  // four: axial, 3D, sagittal, coronal; single: 3D only
+  std::vector<int> crosshair;   // X Y Z (level-0 voxel)
+  bool pick = false;            // pick the region around the crosshair
+  int regionSide = 0;           // 0: 256 or what the profile allows
+  double zoom = 1.0;
+  bool zoomGrid = false;          // the zoom swaps coarse / medium / native block (ZoomSwap)
+  std::string mode = "overview";  // overview, region, grid
+  app::ShadingOptions shading;
+  app::ClippingOptions clipping;
+  std::string projection = "composite";  // composite, mip, minip, average (RenderMode)
+  // --labels [TABLE]: a label volume, as `tessera render --labels` shows it.
+  std::string labels;
+  CLI::Option* labelsOption = nullptr;
+  bool labelVolume() const { return labelsOption != nullptr && labelsOption->count() > 0; }
+};
+
+// Opens the window and runs it until it is closed (or --screenshot is written).
+void runView(const ViewOptions& options);
+
+}  // namespace tessera::desktop
