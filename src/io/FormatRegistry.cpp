@@ -517,24 +517,32 @@ const VolumeFormat& chooseReadFormat(const ByteSource& file) {
 }
 
 std::string readExtensionsText() {
-  std::vector<std::string> items;
+  std::vector<std::string> extensions;
+  std::vector<std::string> others;
   for (const VolumeFormat& f : volumeFormats()) {
     switch (f.container) {
       case FormatContainer::File:
         for (const std::string& e : f.extensions) {
-          if (e != "/") items.push_back(e);
+          if (e != "/") extensions.push_back(e);
         }
-        if (f.id == "dicom") items.push_back("a DICOM file or folder");
+        if (f.sniff &&
+            std::find(f.extensions.begin(), f.extensions.end(), "/") != f.extensions.end()) {
+          others.push_back("a " + f.name + " file of any name or a folder of them");
+        }
         break;
       case FormatContainer::Folder:
-        items.push_back("an " + f.name + " store (folder or http(s):// URL)");
+        others.push_back("an " + f.name + " store (folder or http(s):// URL)");
         break;
       case FormatContainer::Spec:
-        items.push_back("gen:sphere|shepp-logan|marschner-lobb[:N]");
+        others.push_back("gen:sphere|shepp-logan|marschner-lobb[:N]");
         break;
     }
   }
-  return joined(items, " ");
+  std::string text = joined(extensions, " ");
+  for (std::size_t i = 0; i < others.size(); ++i) {
+    text += (i + 1 == others.size() ? ", or " : ", ") + others[i];
+  }
+  return text;
 }
 
 std::string writeExtensionsText() {
