@@ -15,7 +15,7 @@
 
 #include "DesktopApp.h"
 #include "app/Commands.h"
-#include "tessera/session/RenderRun.h"
+#include "app/Commands.h"
 #include "tessera/core/Image.h"
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/Draw.h"

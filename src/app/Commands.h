@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "tessera/gpu/DeviceSession.h"
+#include "tessera/io/FormatRegistry.h"
 #include "tessera/session/RenderRun.h"
 #include "tessera/session/VolumePyramid.h"
 
@@ -34,17 +35,18 @@ void addPlanCommand(CLI::App& app);      // PlanCommand.cpp
 void addConvertCommand(CLI::App& app);   // ConvertCommand.cpp
 void addViewCommand(CLI::App& app);      // ViewCommand.cpp (desktop viewer)
 void addSliceCommand(CLI::App& app);     // SliceCommand.cpp
+void addFormatsCommand(CLI::App& app);   // FormatsCommand.cpp
 
-// The volume argument's help, and the --series option every command that
-// reads a volume offers.
-inline constexpr const char* kVolumeHelp =
-    "Volume: .nii .nii.gz .hdr .nrrd .nhdr .mha .mhd .vti .pvm .raw/.json, a DICOM file or "
-    "folder, an OME-Zarr store (folder or http(s):// URL; render streams it through bricks "
-    "when its finest level does not fit in core or with --layout bricks, otherwise the finest "
-    "level that fits the host budget), or gen:sphere|shepp-logan|marschner-lobb[:N]; "
-    "default: ch2 (mricron-data) or a Shepp-Logan phantom. render and plan: head:WxHxD (or "
-    "head:N) is a generated u8 head of any size computed brick by brick, never held whole "
-    "(streamed through the bricks layout when it does not fit in core)";
+// The volume argument's help (its formats from io/FormatRegistry.h), and the
+// --series option every command that reads a volume offers.
+inline const std::string kVolumeHelp =
+    "Volume: " + readExtensionsText() +
+    ". An OME-Zarr store: render streams it through bricks when its finest level does not fit "
+    "in core or with --layout bricks, otherwise the finest level that fits the host budget is "
+    "read. Default: ch2 (mricron-data) or a Shepp-Logan phantom. render and plan: "
+    "head:WxHxD (or head:N) is a generated u8 head of any size computed brick by brick, never "
+    "held whole (streamed through the bricks layout when it does not fit in core). "
+    "`tessera formats` lists the formats";
 inline void addSeriesOption(CLI::App* cmd, std::string& series) {
   cmd->add_option("--series", series,
                   "DICOM: Series Instance UID to read when a folder holds several (default: the "

@@ -10,6 +10,7 @@
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/PatientFrame.h"
+#include "tessera/io/FormatRegistry.h"
 #include "tessera/io/VolumeReader.h"
 #include "tessera/io/VolumeWriter.h"
 #include "tessera/io/ZarrStore.h"
@@ -232,12 +233,13 @@ void addConvertCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "convert",
       "Convert between volume formats (by extension), optionally cropping and downsampling.\n"
-      "Output: .nrrd .nii .nii.gz .mha .vti .pvm .raw(+.json), FOLDER/ (DICOM series) or\n"
-      "NAME.ome.zarr (OME-Zarr, NGFF 0.4: a factor-2 pyramid of 2x2x2 means down to one chunk,\n"
-      "written slab by slab; OME-Zarr input is streamed too, other inputs are read whole).\n"
-      "The output appears only when complete (temporary file or folder + rename).");
-  cmd->add_option("in", o->in, "Input volume (any format tessera info reads, or gen:...)")
-      ->required();
+      "Output: " +
+          writeExtensionsText() +
+          "\n(OME-Zarr: NGFF 0.4, a factor-2 pyramid of 2x2x2 means down to one chunk,\n"
+          "written slab by slab; OME-Zarr input is streamed too, other inputs are read whole).\n"
+          "The output appears only when complete (temporary file or folder + rename).\n"
+          "`tessera formats` lists what each format keeps and loses.");
+  cmd->add_option("in", o->in, "Input volume: " + readExtensionsText())->required();
   cmd->add_option("out", o->out, "Output file (format from its extension)")->required();
   addSeriesOption(cmd, o->series);
   cmd->add_option("--crop", o->crop, "Keep voxels x0:x1,y0:y1,z0:z1 (end exclusive)");

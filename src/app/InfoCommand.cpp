@@ -167,7 +167,8 @@ void addInfoCommand(CLI::App& app) {
   CLI::App* cmd =
       app.add_subcommand("info",
                          "Print a volume's dims, spacing, orientation and index-to-world affine "
-                         "(RAS+ mm), type, value range, histogram summary and bytes");
+                         "(RAS+ mm), type, value range, histogram summary and bytes. Reads: " +
+                             readExtensionsText());
   cmd->add_option("file", opts->file, kVolumeHelp);
   addSeriesOption(cmd, opts->series);
   addTimeChannelOptions(cmd, opts->time, opts->channel);

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   tessera::app::addConvertCommand(app);
   tessera::app::addViewCommand(app);
   tessera::app::addSliceCommand(app);
+  tessera::app::addFormatsCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <optional>
@@ -20,6 +21,7 @@
 
 #include "io/DicomSeries.h"
 #include "tessera/core/Error.h"
+#include "tessera/io/DicomDecoder.h"
 
 namespace tessera {
 
@@ -650,6 +652,35 @@ std::vector<DicomSeriesInfo> listDicomSeriesBasic(const fs::path& folder) {
   const fs::path dir = fs::is_directory(folder, ec) ? folder : folderOf(folder);
   if (!fs::is_directory(dir, ec)) throw InputError(folder.string() + ": no such directory");
   return io_detail::listSeries(scanFolder(dir));
+}
+
+namespace {
+// The reader without DCMTK behind the DicomDecoder interface: the syntaxes
+// marked readable in kSyntaxes, from files on disk or in memory.
+class BasicDicomDecoder final : public DicomDecoder {
+ public:
+  std::string name() const override { return "basic"; }
+  bool canDecode(std::string_view uid) const override {
+    return std::any_of(std::begin(kSyntaxes), std::end(kSyntaxes),
+                       [&](const TransferSyntax& ts) { return ts.readable && uid == ts.uid; });
+  }
+  bool canRead(const FileSet&) const override { return true; }
+  std::string decodes() const override {
+    return "implicit/explicit VR little endian, RLE lossless";
+  }
+  Volume read(const ByteSource& named, const FileSet& files,
+              const std::string& seriesUid) const override {
+    return readDicomSeriesBasic(named, files, seriesUid);
+  }
+  Volume readFolder(const fs::path& folderOrFile, const std::string& seriesUid) const override {
+    return readDicomSeriesBasic(folderOrFile, seriesUid);
+  }
+};
+}  // namespace
+
+const DicomDecoder& basicDicomDecoder() {
+  static const BasicDicomDecoder decoder;
+  return decoder;
 }
 
 }  // namespace tessera

@@ -12,6 +12,8 @@
 #include <dcmtk/oflog/oflog.h>
 
 #include "tessera/core/Error.h"
+#include "tessera/io/DicomDecoder.h"
+#include "tessera/io/DicomSeriesReader.h"
 
 namespace tessera::io_detail {
 
@@ -73,3 +75,42 @@ std::string conditionText(const OFCondition& cond) {
 }
 
 }  // namespace tessera::io_detail
+
+namespace tessera {
+
+namespace {
+// DCMTK's series reader behind the DicomDecoder interface: every syntax its
+// registered codecs decode, from files on disk (it opens them itself).
+class DcmtkDicomDecoder final : public DicomDecoder {
+ public:
+  std::string name() const override { return "DCMTK"; }
+  bool canDecode(std::string_view uid) const override {
+    const DcmXfer x(std::string(uid).c_str());
+    if (x.getXfer() == EXS_Unknown) return false;
+    io_detail::initDicomToolkit();
+    return io_detail::canDecodePixels(x.getXfer());
+  }
+  bool canRead(const FileSet& files) const override { return files.onDisk(); }
+  std::string decodes() const override {
+    return "uncompressed, deflate, JPEG baseline/extended/lossless, JPEG-LS, RLE";
+  }
+  Volume read(const ByteSource& named, const FileSet& files,
+              const std::string& seriesUid) const override {
+    if (!files.onDisk()) {
+      throw InputError(named.name() + ": DCMTK reads DICOM files on disk only");
+    }
+    return readDicomSeries(named.name(), seriesUid);
+  }
+  Volume readFolder(const std::filesystem::path& folderOrFile,
+                    const std::string& seriesUid) const override {
+    return readDicomSeries(folderOrFile, seriesUid);
+  }
+};
+}  // namespace
+
+const DicomDecoder& dcmtkDicomDecoder() {
+  static const DcmtkDicomDecoder decoder;
+  return decoder;
+}
+
+}  // namespace tessera

@@ -1,20 +1,12 @@
 #include "tessera/io/VolumeReader.h"
 
-#include <array>
 #include <cstdio>
-#include <cstring>
 
 #include "io/HeaderText.h"
 #include "tessera/core/Error.h"
-#include "tessera/io/DicomBasicReader.h"
-#include "tessera/io/DicomSeriesReader.h"
-#include "tessera/io/MetaImageReader.h"
-#include "tessera/io/NiftiReader.h"
-#include "tessera/io/NrrdReader.h"
+#include "tessera/io/DicomDecoder.h"
+#include "tessera/io/FormatRegistry.h"
 #include "tessera/io/Procedural.h"
-#include "tessera/io/PvmReader.h"
-#include "tessera/io/RawSidecarReader.h"
-#include "tessera/io/VtiReader.h"
 #include "tessera/io/ZarrStore.h"
 
 namespace tessera {
@@ -28,17 +20,6 @@ bool endsWith(const std::string& s, const std::string& suffix) {
 
 std::string lowerFileName(const std::string& name) {
   return io_detail::lower(std::filesystem::path(name).filename().string());
-}
-
-bool isDicomName(const std::string& lower) {
-  return endsWith(lower, ".dcm") || endsWith(lower, ".ima");
-}
-
-// DICOM files often have no extension: a Part-10 file has "DICM" at byte 128.
-bool hasDicomMarker(const ByteSource& file) {
-  std::array<char, 4> marker{};
-  return file.read(128, reinterpret_cast<std::byte*>(marker.data()), marker.size()) == 4 &&
-         std::memcmp(marker.data(), "DICM", 4) == 0;
 }
 
 }  // namespace
@@ -71,33 +52,23 @@ Volume readVolume(const std::string& spec, const ReadOptions& options) {
     throw InputError(spec +
                      ": no such file (or use gen:sphere, gen:shepp-logan, gen:marschner-lobb)");
   }
-  // A folder is a DICOM series (the only format that is a folder).
-  if (std::filesystem::is_directory(path, ec)) return readDicomSeries(path, options.dicomSeries);
+  // A folder is a DICOM series (the only file format that is a folder; an
+  // OME-Zarr store was recognised above by its metadata files).
+  if (std::filesystem::is_directory(path, ec)) return readDicomFolder(path, options.dicomSeries);
   const FileSource file(path);
-  if (isDicomName(lowerFileName(spec)) || hasDicomMarker(file)) {
-    return readDicomSeries(path, options.dicomSeries);
-  }
+  const VolumeFormat& format = chooseReadFormat(file);
+  // DICOM from disk: the decoder that reads every syntax of the series
+  // (DCMTK in the native build), from the files beside it.
+  if (format.id == "dicom") return readDicomFolder(path, options.dicomSeries);
   notDicom();
-  return readVolume(file, FolderFiles());
+  return format.read(file, FolderFiles());
 }
 
 Volume readVolume(const ByteSource& file, const FileSet& files) {
-  const std::string lower = lowerFileName(file.name());
-  // The reader without DCMTK (the browser has none): the file's series from
-  // the files beside it.
-  if (isDicomName(lower) || hasDicomMarker(file)) return readDicomSeriesBasic(file, files);
-  if (endsWith(lower, ".nii") || endsWith(lower, ".nii.gz") || endsWith(lower, ".hdr") ||
-      endsWith(lower, ".hdr.gz")) {
-    return readNifti(file, files);
-  }
-  if (endsWith(lower, ".nrrd") || endsWith(lower, ".nhdr")) return readNrrd(file, files);
-  if (endsWith(lower, ".mha") || endsWith(lower, ".mhd")) return readMetaImage(file, files);
-  if (endsWith(lower, ".vti")) return readVti(file);
-  if (endsWith(lower, ".pvm")) return readPvm(file);
-  if (endsWith(lower, ".raw") || endsWith(lower, ".json")) return readRawWithSidecar(file, files);
-  throw InputError(file.name() +
-                   ": unknown volume format (supported: .nii, .nii.gz, .hdr/.img, .nrrd, .nhdr, "
-                   ".mha, .mhd, .vti, .pvm, .raw + .json sidecar, DICOM files or a DICOM folder)");
+  // By extension, the content deciding when the extension is unknown or
+  // contradicts it (FormatRegistry.h); DICOM through the decoder that
+  // decodes the series and reads where its files are (DicomDecoder.h).
+  return chooseReadFormat(file).read(file, files);
 }
 
 std::string volumeFileAmong(const std::vector<std::string>& names) {

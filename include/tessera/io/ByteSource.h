@@ -80,6 +80,9 @@ class FileSet {
   // not searched recursively; all files held in memory), as names `open`
   // takes, in a stable order: a DICOM series is read from them.
   virtual std::vector<std::string> filesBeside(const ByteSource& from) const = 0;
+  // True when the names are paths of files on disk (readers that open
+  // files themselves, such as DCMTK's, can read them).
+  virtual bool onDisk() const { return false; }
 };
 
 // Files on disk.
@@ -89,6 +92,7 @@ class FolderFiles final : public FileSet {
   bool contains(const std::string& resolved) const override;
   std::unique_ptr<ByteSource> open(const std::string& resolved) const override;
   std::vector<std::string> filesBeside(const ByteSource& from) const override;
+  bool onDisk() const override { return true; }
 };
 
 // Files held in memory and found by their whole name, else by file name

@@ -10,15 +10,16 @@
 
 namespace tessera {
 
-// Picks the reader by name: `.nii`, `.nii.gz`, `.hdr`/`.img` (NIfTI-1/2),
-// `.nrrd`, `.nhdr` (NRRD), `.mha`, `.mhd` (MetaImage), `.vti` (VTK XML
-// ImageData), `.pvm` (PVM), `.raw` or its `.json` sidecar (raw), a folder,
-// `.dcm`/`.ima` or any file with the DICM marker (DICOM series), an
-// OME-Zarr store (a folder with .zgroup/.zattrs/.zarray, or an http(s)://
-// URL: the finest level that fits the host budget, see io/ZarrStore.h); or
-// generates a procedural volume when `spec` starts with "gen:" (see
-// io/Procedural.h). Throws InputError naming the file and the problem; never
-// allocates more than the file can justify or the host budget allows.
+// Picks the reader from the format registry (FormatRegistry.h, listed by
+// `tessera formats`): by extension, the content deciding when the extension
+// is unknown or contradicts it (`scan.dat` holding a NIfTI opens as NIfTI);
+// a folder is an OME-Zarr store (.zgroup/.zattrs/.zarray) or a DICOM series,
+// an http(s):// URL an OME-Zarr store (the finest level that fits the host
+// budget, see io/ZarrStore.h); "gen:" specs are generated (io/Procedural.h).
+// DICOM is read by the preferred decoder that decodes the series
+// (DicomDecoder.h: DCMTK natively). Throws InputError naming the file and
+// the problem; never allocates more than the file can justify or the host
+// budget allows.
 struct ReadOptions {
   // DICOM: the Series Instance UID to read from a folder holding several
   // (empty: the series with the most slices). An InputError for other formats.
@@ -31,10 +32,11 @@ struct ReadOptions {
 
 Volume readVolume(const std::string& spec, const ReadOptions& options = {});
 
-// The same readers on a byte source, the other files it names found in
-// `files`: what the browser reads picked or dropped files with. DICOM is read
-// by the reader without DCMTK (DicomBasicReader.h: uncompressed and RLE
-// Part-10 files), the series of `file` from the files beside it.
+// The same choice and readers on a byte source, the other files it names
+// found in `files`: what the browser reads picked or dropped files with.
+// DICOM: the series of `file` from the files beside it, by the first decoder
+// that decodes it and reads where the files are (files in memory: the
+// reader without DCMTK, DicomBasicReader.h).
 Volume readVolume(const ByteSource& file, const FileSet& files);
 
 // Of several files opened together (the browser's picker or a drop), the

@@ -8,14 +8,17 @@
 
 namespace tessera {
 
-// Writes by extension: .nrrd, .nii, .nii.gz, .mha, .vti, .pvm, .raw (+ .json
-// sidecar), or a directory name ending in "/" or ".dcm.d" for a DICOM series.
+// Writes by extension, through the format registry (FormatRegistry.h,
+// formatForWriteName): .nrrd, .nii, .nii.gz, .mha, .vti, .pvm, .raw (+ .json
+// sidecar), a folder name ending in .zarr (OME-Zarr), or one ending in "/"
+// or ".dcm.d" for a DICOM series.
 // The file appears under its final name only when complete: the writer
 // writes a temporary file in the same directory and renames it, so an
 // interrupted write never leaves a half-written file under the final name.
 void writeVolume(const Volume& volume, const std::filesystem::path& path);
 
-// What writing `volume` to `out` (chosen by extension, as writeVolume)
+// What writing `volume` to `out` (chosen by extension, as writeVolume; the
+// registry entry's lossNotes)
 // would lose, as sentences for the user: geometry ("PVM stores spacing only:
 // orientation LAS ... is lost") and values (f32 into DICOM's 16-bit
 // integers: "... quantised, max error 0.0035"). Empty when the format holds
