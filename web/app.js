@@ -659,8 +659,12 @@ import { TesseraViewer } from './tessera.js';
       const f = e.target.files[0];
       e.target.value = '';
       if (!f) return;
-      try { viewer.setTransferFunction(await f.text()); } catch (err) { showError(`${f.name}: ${err.message}`); }
-      else clearError();
+      try {
+        viewer.setTransferFunction(await f.text());
+        clearError();
+      } catch (err) {
+        showError(`${f.name}: ${err.message}`);
+      }
       tfEdited();
     });
     $('winWidth').addEventListener('input', applyWindow);

@@ -26,7 +26,7 @@ test('benchmark: ch2 at 512x512 (TESSERA_BENCH=1 or scripts/browser-test.sh --be
 async function webglPages(context, url, tmp, run) {
   // Reference images of the page's default view, and files to open.
   // The page samples as `tessera render` does by default, post-classified
-  // (WebViewer.cpp: webDefaultSampling()); the CLI pre-integrates lit frames
+  // (WebSession.cpp: webDefaultSampling()); the CLI pre-integrates lit frames
   // by default, and every frame with --preintegrate on.
   run('render', VOLUME, '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2',
       '--preintegrate', 'off', '--out', path.join(tmp, 'native-webgl2.png'));
