@@ -1,7 +1,9 @@
 # The browser build of the viewer (included from CMakeLists.txt under
 # emcmake; scripts/web.sh runs it). Compiles the layers the viewer needs —
 # core, gpu, lod, reference, lattice, layout, render, viewer and io's readers — with Debian's
-# emscripten into web/site's tessera.js + tessera.wasm. nifticlib, zlib,
+# emscripten into the site's tessera-core.js + tessera-core.wasm, an ES
+# module factory (-sMODULARIZE -sEXPORT_ES6: every instance has its own
+# memory and WebGL context) that web/tessera.js wraps for pages. nifticlib, zlib,
 # DCMTK and libpng are not available to emscripten here. The io readers
 # need none of them to read (they parse every header themselves, on byte
 # sources): files picked or dropped in the page are read by the same
@@ -11,8 +13,9 @@
 # io/DicomBasicReader.cpp instead of DCMTK (web/src/DicomBasicSeries.cpp
 # routes the path entry points to it), and PNG I/O reports that it is not
 # built in (web/src/PngUnavailable.cpp). The gpu layer's EGL platform
-# (GlContext.cpp) is replaced by the browser's (web/src/GlContextWebGL.cpp:
-# the page's canvas owns the WebGL context).
+# (GlContext.cpp) is replaced by the browser's (src/gpu/GlContextWebGL.cpp,
+# which makes the WebGL context on the page's canvas; the native build
+# compiles it empty).
 # No pthreads: SharedArrayBuffer needs cross-origin isolation a static page
 # cannot count on; code that sizes thread pools sees one core.
 cmake_minimum_required(VERSION 3.25)
@@ -56,11 +59,15 @@ file(GLOB TESSERA_WEB_IO CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/io/*.cpp)
 list(FILTER TESSERA_WEB_IO EXCLUDE REGEX
      "/(.*Writer|DicomSeriesReader|DicomToolkit|InflaterZlib|OutputFile|ZarrVolume|ZarrCodecs|Http.*)\\.cpp$")
 set(TESSERA_WEB_SOURCES ${TESSERA_GLSL_CPP} ${TESSERA_WEB_IO})
-foreach(layer core gpu lod reference lattice layout render viewer)
+foreach(layer core gpu lod reference lattice layout render viewer session)
   file(GLOB_RECURSE srcs CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/${layer}/*.cpp)
   list(APPEND TESSERA_WEB_SOURCES ${srcs})
 endforeach()
-# The EGL platform; web/src/GlContextWebGL.cpp is the browser's.
+# The session's settings, run and refinement loop; not its headless device
+# (EGL) nor its store opening (the page fetches stores itself).
+list(REMOVE_ITEM TESSERA_WEB_SOURCES ${CMAKE_SOURCE_DIR}/src/session/Session.cpp
+     ${CMAKE_SOURCE_DIR}/src/session/VolumePyramid.cpp)
+# The EGL platform; src/gpu/GlContextWebGL.cpp is the browser's.
 list(REMOVE_ITEM TESSERA_WEB_SOURCES ${CMAKE_SOURCE_DIR}/src/gpu/GlContext.cpp)
 file(GLOB TESSERA_WEB_FRONT CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/web/src/*.cpp)
 
@@ -73,7 +80,7 @@ set_source_files_properties(${TESSERA_WEB_IO} PROPERTIES
 
 set(TESSERA_WEB_SITE ${CMAKE_BINARY_DIR}/site)
 add_executable(tessera_web ${TESSERA_WEB_SOURCES} ${TESSERA_WEB_FRONT})
-set_target_properties(tessera_web PROPERTIES OUTPUT_NAME tessera SUFFIX ".js"
+set_target_properties(tessera_web PROPERTIES OUTPUT_NAME tessera-core SUFFIX ".js"
                                              RUNTIME_OUTPUT_DIRECTORY ${TESSERA_WEB_SITE})
 target_include_directories(tessera_web PRIVATE ${CMAKE_SOURCE_DIR}/include ${CMAKE_SOURCE_DIR}/src)
 target_include_directories(tessera_web SYSTEM PRIVATE ${TESSERA_HOST_INC})
@@ -85,7 +92,7 @@ target_compile_options(tessera_web PRIVATE ${TESSERA_WEB_FLAGS} -Wall -Wextra)
 target_link_options(tessera_web PRIVATE ${TESSERA_WEB_FLAGS}
   -sMIN_WEBGL_VERSION=1 -sMAX_WEBGL_VERSION=2 -sALLOW_MEMORY_GROWTH=1 -sINITIAL_MEMORY=64MB
   --js-library ${CMAKE_SOURCE_DIR}/web/src/InflaterPako.js
-  -sMODULARIZE=1 -sEXPORT_NAME=createTesseraModule -sENVIRONMENT=web
+  -sMODULARIZE=1 -sEXPORT_ES6=1 -sEXPORT_NAME=createTesseraModule -sENVIRONMENT=web
   "-sEXPORTED_FUNCTIONS=_malloc,_free"
   "-sEXPORTED_RUNTIME_METHODS=ccall,cwrap,UTF8ToString,HEAPU8,HEAPF32")
 
@@ -118,4 +125,11 @@ file(GLOB TESSERA_WEB_STATIC CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/web/*.html
 foreach(f ${TESSERA_WEB_STATIC} ${TESSERA_PAKO})
   get_filename_component(n ${f} NAME)
   configure_file(${f} ${TESSERA_WEB_SITE}/${n} COPYONLY)
+endforeach()
+# The embedding example (examples/embed-web), served from the site so that
+# its import of ../../tessera.js finds the module.
+file(GLOB TESSERA_EMBED_EXAMPLE CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/examples/embed-web/*)
+foreach(f ${TESSERA_EMBED_EXAMPLE})
+  get_filename_component(n ${f} NAME)
+  configure_file(${f} ${TESSERA_WEB_SITE}/examples/embed-web/${n} COPYONLY)
 endforeach()

@@ -19,7 +19,7 @@ if [ ! -f "$BUILD/build.ninja" ] && [ ! -f "$BUILD/Makefile" ]; then
   emcmake cmake -S . -B "$BUILD" "${gen[@]}" -DCMAKE_BUILD_TYPE=Release >/dev/null
 fi
 cmake --build "$BUILD" -j"$(nproc)"
-echo "web.sh: built $BUILD/site (index.html, tessera.js, tessera.wasm)"
+echo "web.sh: built $BUILD/site (index.html, tessera.js, tessera-core.js, tessera-core.wasm, examples/embed-web/)"
 if [ "${1:-}" = "--serve" ]; then
   port=${2:-8080}
   echo "web.sh: serving http://127.0.0.1:$port/ (Ctrl-C stops)"

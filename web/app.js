@@ -1,9 +1,11 @@
-// The page around the WebAssembly viewer core (web/src/WebViewer.cpp): input
-// events, the transfer-function editor canvas, file opening (read here,
-// never uploaded: the bytes go to the same io readers as the CLI's, whose
-// gzip/zlib the page's pako inflates) and error messages. window.tessera
-// exposes the same operations to tests.
-'use strict';
+// The page around the WebAssembly viewer core: a TesseraViewer (tessera.js,
+// the module other pages embed) for the context, volumes, frames, camera
+// and transfer function, and the rest of the C API (web/src/WebExports*.cpp)
+// for the page's controls; input events, the transfer-function editor
+// canvas, file opening (read here, never uploaded: the bytes go to the same
+// io readers as the CLI's, whose gzip/zlib the page's pako inflates) and
+// error messages. window.tessera exposes the same operations to tests.
+import { TesseraViewer } from './tessera.js';
 
 (function () {
   const params = new URLSearchParams(location.search);
@@ -56,8 +58,9 @@
   }
   fitCanvas();
 
-  let M = null;     // the emscripten module
-  let api = null;   // cwrapped functions
+  let viewer = null;  // the TesseraViewer (tessera.js)
+  let M = null;       // its emscripten module
+  let api = null;     // cwrapped functions the viewer does not cover
   let state = {};   // last tessera_state_json
   let tf = null;    // parsed TF JSON
   let needsRender = true;
@@ -82,23 +85,14 @@
   function wrap(M) {
     const c = (name, ret, args) => M.cwrap(name, ret, args);
     return {
-      init: c('tessera_init', 'number', ['number']),
       lastError: c('tessera_last_error', 'string', []),
-      loadGenerated: c('tessera_load_generated', 'number', ['string']),
-      addFile: c('tessera_add_file', null, ['string', 'number', 'number']),
-      loadFiles: c('tessera_load_files', 'number', []),
-      clearFiles: c('tessera_clear_files', null, []),
-      render: c('tessera_render', 'number', ['number', 'number']),
       pointerDown: c('tessera_pointer_down', null, ['number', 'number', 'number', 'number']),
       pointerMove: c('tessera_pointer_move', null, ['number', 'number', 'number']),
       pointerUp: c('tessera_pointer_up', null, ['number']),
       wheel: c('tessera_wheel', null, ['number']),
       interacting: c('tessera_interacting', 'number', []),
-      setCamera: c('tessera_set_camera', 'number', ['number', 'number', 'number']),
       setProjection: c('tessera_set_projection', null, ['number']),
       tfJson: c('tessera_tf_json', 'string', []),
-      tfSetJson: c('tessera_tf_set_json', 'number', ['string']),
-      tfPreset: c('tessera_tf_preset', 'number', ['string']),
       tfDown: c('tessera_tf_pointer_down', null, ['number', 'number', 'number', 'number', 'number']),
       tfMove: c('tessera_tf_pointer_move', null, ['number', 'number']),
       tfUp: c('tessera_tf_pointer_up', null, ['number', 'number']),
@@ -119,7 +113,6 @@
       refine: c('tessera_refine', 'number', []),
       setTechnique: c('tessera_set_technique', 'number', ['string']),
       stateJson: c('tessera_state_json', 'string', ['number']),
-      readPixels: c('tessera_read_pixels', 'number', ['number', 'number']),
       setGradientOpacity: c('tessera_set_gradient_opacity', 'number', ['number', 'number', 'number']),
       setLight: c('tessera_set_light', 'number', ['number', 'number', 'number', 'number', 'number', 'number', 'number', 'number']),
       setCrop: c('tessera_set_crop', 'number', ['number', 'number', 'number', 'number', 'number', 'number']),
@@ -189,8 +182,12 @@
 
   function renderNow() {
     fitCanvas();
-    const ms = api.render(canvas.width, canvas.height);
-    if (ms < 0) showError(api.lastError());
+    let ms = -1;
+    try {
+      ms = viewer.render();
+    } catch (e) {
+      showError(e.message);
+    }
     frames++;
     refreshState();
     updateStatus();
@@ -312,18 +309,10 @@
   // Hands {name, bytes} entries to the io readers; `explain` turns a
   // failure's message into what the page shows.
   async function openEntries(entries, explain) {
-    for (const { name, bytes } of entries) {
-      const p = M._malloc(Math.max(1, bytes.length));
-      if (!p) {
-        showError(explain(`${name}: cannot allocate ${bytes.length} bytes for the file`) + keeps());
-        api.clearFiles();  // drops the files handed over so far
-        return false;
-      }
-      M.HEAPU8.set(bytes, p);
-      api.addFile(name, p, bytes.length);  // owned by the module from here on
-    }
-    if (!api.loadFiles()) {
-      showError(explain(api.lastError()) + keeps());
+    try {
+      await viewer.openFiles(entries, { explain });
+    } catch (e) {
+      showError(e.message + keeps());
       return false;
     }
     if (zarr) zarr.close();  // the files' volume replaces the store
@@ -335,83 +324,44 @@
 
   function megabytes(n) { return (n / 1048576).toFixed(1); }
 
-  // GET `url` with progress (ReadableStream, Content-Length); throws an
-  // Error whose message names the URL and what went wrong.
-  async function fetchBytes(url, onProgress) {
-    let response;
-    try {
-      response = await fetch(url);
-    } catch (e) {
-      throw new Error(`${url}: cannot fetch it (${e.message}): the server is unreachable, ` +
-                      'or it does not let this page read the file (CORS)');
-    }
-    if (!response.ok) throw new Error(`${url}: HTTP ${response.status} ${response.statusText}`.trim());
-    const total = parseInt(response.headers.get('Content-Length') || '0', 10) || 0;
-    if (!response.body) {
-      const all = new Uint8Array(await response.arrayBuffer());
-      onProgress(all.length, total);
-      return all;
-    }
-    const reader = response.body.getReader();
-    const chunks = [];
-    let received = 0;
-    for (;;) {
-      const { done, value } = await reader.read();
-      if (done) break;
-      chunks.push(value);
-      received += value.length;
-      onProgress(received, total);
-    }
-    const all = new Uint8Array(received);
-    let at = 0;
-    for (const c of chunks) { all.set(c, at); at += c.length; }
-    return all;
-  }
-
   // ?url=… (repeat it for a header and its data file): fetched with a
-  // progress bar, then read like picked files.
+  // progress bar (TesseraViewer.openUrl), then read like picked files;
+  // errors name the URL.
   let lastLoad = null;  // for tests: what the last ?url= load fetched
   async function openUrls(urls) {
     const progress = $('progress');
-    const entries = [];
     lastLoad = { urls, bytes: 0, total: 0, updates: 0 };
+    const sizes = new Map();  // per URL: [received, total]
+    progress.hidden = false;
+    progress.removeAttribute('value');
     try {
-      for (const u of urls) {
-        let resolved;
-        try {
-          resolved = new URL(u, location.href);
-        } catch {
-          throw new Error(`${u}: not a valid URL`);
+      await viewer.openUrl(urls, { onProgress: ({ url, received, total }) => {
+        lastLoad.updates++;
+        sizes.set(url, [received, total]);
+        if (total > 0) {
+          progress.max = total;
+          progress.value = Math.min(received, total);
         }
-        const name = decodeURIComponent(resolved.pathname.split('/').pop() || '') || 'volume';
-        progress.hidden = false;
-        progress.removeAttribute('value');
-        const bytes = await fetchBytes(resolved.href, (got, total) => {
-          lastLoad.updates++;
-          if (total > 0) {
-            progress.max = total;
-            progress.value = Math.min(got, total);
-          }
-          $('status').textContent = `loading ${resolved.href}: ${megabytes(got)}` +
-            (total > 0 ? ` of ${megabytes(total)} MB (${Math.round(100 * Math.min(1, got / total))} %)` : ' MB');
-        });
-        entries.push({ name, bytes, url: resolved.href });
-        lastLoad.bytes += bytes.length;
-        lastLoad.total += parseInt(progress.max, 10) || 0;
-      }
+        $('status').textContent = `loading ${url}: ${megabytes(received)}` +
+          (total > 0 ? ` of ${megabytes(total)} MB (${Math.round(100 * Math.min(1, received / total))} %)` : ' MB');
+      } });
     } catch (e) {
       progress.hidden = true;
       showError(e.message + keeps());
       updateStatus();
       return false;
+    } finally {
+      for (const [received, total] of sizes.values()) {
+        lastLoad.bytes += received;
+        lastLoad.total += total;
+      }
     }
     progress.hidden = true;
-    const byName = new Map(entries.map((e) => [e.name, e.url]));
-    return openEntries(entries, (message) => {
-      // Name the URL of the file the reader complains about (or all of them).
-      for (const [name, url] of byName) if (message.startsWith(name)) return `${url}: ${message}`;
-      return `${entries.map((e) => e.url).join(', ')}: ${message}`;
-    });
+    if (zarr) zarr.close();  // the files' volume replaces the store
+    clearError();
+    volumeChanged();
+    await requestRender();
+    return true;
   }
 
   function volumeChanged() {
@@ -688,7 +638,7 @@
     });
     $('preset').value = 'mr-default';
     $('preset').addEventListener('change', (e) => {
-      if (!api.tfPreset(e.target.value)) showError(api.lastError());
+      try { viewer.setTransferFunction(e.target.value); } catch (err) { showError(err.message); }
       tfEdited();
     });
     $('logHist').addEventListener('change', () => { refreshState(); drawTf(); });
@@ -709,8 +659,12 @@
       const f = e.target.files[0];
       e.target.value = '';
       if (!f) return;
-      if (!api.tfSetJson(await f.text())) showError(`${f.name}: ${api.lastError()}`);
-      else clearError();
+      try {
+        viewer.setTransferFunction(await f.text());
+        clearError();
+      } catch (err) {
+        showError(`${f.name}: ${err.message}`);
+      }
       tfEdited();
     });
     $('winWidth').addEventListener('input', applyWindow);
@@ -740,7 +694,7 @@
     const overlays = () => { api.setOverlays($('box').checked ? 1 : 0, $('axes').checked ? 1 : 0); requestRender(); };
     $('box').addEventListener('change', overlays);
     $('axes').addEventListener('change', overlays);
-    $('resetView').addEventListener('click', () => { api.setCamera(0, 0, 1); requestRender(); });
+    $('resetView').addEventListener('click', () => { viewer.setCamera({ azimuth: 0, elevation: 0, zoom: 1 }); requestRender(); });
     // Light: a headlight or a fixed light (patient frame), and the Blinn-Phong terms.
     const applyLight = () => {
       const dir = $('lightDir').value.split(',').map(Number);
@@ -814,14 +768,14 @@
   // ---------------------------------------------------------------- start
 
   const ready = (async () => {
-    M = await createTesseraModule({ canvas });
-    api = wrap(M);
-    let ok = forceWebgl1 ? 0 : api.init(2);
-    if (!ok) ok = api.init(1);  // the ES 2.0 path
-    if (!ok) {
-      showError(api.lastError());
-      throw new Error(api.lastError());
+    try {
+      viewer = await TesseraViewer.create(canvas, { profile: forceWebgl1 ? 'webgl1' : 'auto' });
+    } catch (e) {
+      showError(e.message);
+      throw e;
     }
+    M = viewer.module;
+    api = wrap(M);
     bindControls();
     if (withSlices) {
       slices = window.TesseraSlices.attach({ M, canvas, requestRender, showError, clearError,
@@ -853,7 +807,7 @@
     } else if (volumeUrls.length) {
       if (!(await openUrls(volumeUrls))) volumeChanged();
     } else {
-      if (!api.loadGenerated(defaultVolume)) showError(api.lastError());
+      try { viewer.loadGenerated(defaultVolume); } catch (e) { showError(e.message); }
       volumeChanged();
     }
     await requestRender();
@@ -895,16 +849,19 @@
     zarrRegion,
     zarrOverview,
     setProgressive: (on) => { api.setProgressive(on ? 1 : 0, frameBudgetMs); },
-    setCamera: (az, el, zoom) => { api.setCamera(az, el, zoom); return requestRender(); },
+    setCamera: (az, el, zoom) => { viewer.setCamera({ azimuth: az, elevation: el, zoom }); return requestRender(); },
     crop: () => JSON.parse(api.cropJson(canvas.width, canvas.height)),
     setProjection: (orthographic) => { api.setProjection(orthographic ? 1 : 0); return requestRender(); },
-    setTfJson: (json) => { const ok = api.tfSetJson(json); tfEdited(); return ok; },
+    setTfJson: (json) => {
+      let ok = 1;
+      try { viewer.setTransferFunction(json); } catch { ok = 0; }  // tessera_last_error says why
+      tfEdited();
+      return ok;
+    },
     error: () => ($('error').hidden ? '' : $('error').textContent),
     // The canvas's RGBA pixels, top row first.
-    pixels: () => {
-      const p = api.readPixels(canvas.width, canvas.height);
-      return M.HEAPU8.slice(p, p + canvas.width * canvas.height * 4);
-    },
+    pixels: () => viewer.pixels(),
+    viewer: () => viewer,
     // n whole frames of the current view as the page renders them, each
     // timed here up to its 1-pixel read-back (bench/web-peers).
     timeFrames: (n) => {
@@ -924,7 +881,7 @@
       const times = [];
       api.setProgressive(0, 0);  // whole frames, timed one by one
       for (let i = 0; i < n; i++) {
-        api.setCamera(i * 10, 0, 1);
+        viewer.setCamera({ azimuth: i * 10, elevation: 0, zoom: 1 });
         times.push(renderNow());
       }
       api.setProgressive(progressive ? 1 : 0, frameBudgetMs);

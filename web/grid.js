@@ -4,7 +4,7 @@
 // shown as the 3D view at native resolution, six moves relative to the view.
 //
 // Everything about the grid is the native core's lod::GridNavigator, through
-// the tessera_grid_* exports of web/src/WebViewer.cpp: the grid points and
+// the tessera_grid_* exports of web/src/WebExportsExplore.cpp: the grid points and
 // their class (corner/edge/face/interior), which index axis each of the six
 // moves means for the current camera (the dominant axis of the view
 // direction; of the screen's right and up for the others) and whether it is

@@ -258,7 +258,7 @@ function peerViewer(key, label, pageUrl) {
 }
 
 async function main() {
-  if (!fs.existsSync(path.join(site, 'tessera.wasm'))) throw new Error(`no web build in ${site} (scripts/web.sh)`);
+  if (!fs.existsSync(path.join(site, 'tessera-core.wasm'))) throw new Error(`no web build in ${site} (scripts/web.sh)`);
   const vtkBundle = path.join(here, 'dist/vtk-peer.js');
   if (!fs.existsSync(vtkBundle)) throw new Error(`${vtkBundle} missing: run bench/web-peers/run.sh (it bundles the vtk.js page)`);
   const vol = readNifti(volumeFile);

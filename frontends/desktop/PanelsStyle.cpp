@@ -11,6 +11,7 @@
 #include "DesktopApp.h"
 #include "tessera/render/LabelTable.h"
 #include "tessera/render/TechniqueRegistry.h"
+#include "tessera/session/Settings.h"
 
 namespace tessera::desktop {
 
@@ -113,9 +114,14 @@ void transferFunctionEditor(viewer::TransferFunctionEditor& ed, bool logHistogra
 // The ray step in voxels, 0.25 to 2 as on the web page: the one place the
 // desktop sets and bounds it, to hand over to a session that checks the step
 // for every front end.
+// The slider spans the useful part of session::kStepRange; a value typed
+// into it (ctrl+click) outside the range is not taken.
 void stepSlider(RenderSettings& settings) {
   float step = static_cast<float>(settings.stepVoxels);
-  if (ImGui::SliderFloat("step (voxels)", &step, 0.25f, 2.0f)) settings.stepVoxels = step;
+  if (ImGui::SliderFloat("step (voxels)", &step, 0.25f, 2.0f) &&
+      session::kStepRange.contains(step)) {
+    settings.stepVoxels = step;
+  }
 }
 
 }  // namespace

@@ -82,9 +82,9 @@ std::vector<fs::path> sources(const std::vector<std::string>& folders) {
 
 bool allowed(const fs::path& p) {
   const std::string rel = fs::relative(p, kRoot).generic_string();
-  // The gpu layer, and the browser's context creation (the web twin of
-  // src/gpu/GlContext.cpp).
-  return rel.rfind("src/gpu/", 0) == 0 || rel == "web/src/GlContextWebGL.cpp";
+  // The gpu layer, which also creates every context (EGL's in
+  // GlContext.cpp, the browser's WebGL one in GlContextWebGL.cpp).
+  return rel.rfind("src/gpu/", 0) == 0;
 }
 
 }  // namespace
@@ -103,6 +103,27 @@ TEST(GlBoundary, NoRawGlOutsideTheGpuLayer) {
     std::smatch m;
     if (std::regex_search(code, m, call) || std::regex_search(code, m, name) ||
         std::regex_search(raw, m, header)) {
+      offenders.push_back(fs::relative(p, kRoot).string() + ": " + m.str());
+    }
+  }
+  EXPECT_GT(checked, 100);
+  for (const auto& o : offenders) ADD_FAILURE() << o;
+}
+
+// Contexts are created in the gpu layer only: the front ends (the CLI's
+// EGL, the desktop viewer's window, the page's canvas) go through
+// gpu::GlContext. The desktop viewer's GLFW window makes its own context
+// (glfwCreateWindow), which it then adopts; that call is not matched here.
+TEST(GlBoundary, ContextsAreCreatedOnlyInTheGpuLayer) {
+  const std::regex create(R"(\b(eglCreateContext|emscripten_webgl_create_context)\s*\()");
+  int checked = 0;
+  std::vector<std::string> offenders;
+  for (const fs::path& p : sources({"src", "include", "web/src"})) {
+    if (allowed(p)) continue;
+    ++checked;
+    std::smatch m;
+    const std::string code = codeOnly(readFile(p));
+    if (std::regex_search(code, m, create)) {
       offenders.push_back(fs::relative(p, kRoot).string() + ": " + m.str());
     }
   }

@@ -1,0 +1,180 @@
+// The C API of OME-Zarr stores over fetch() (web/zarr-url.js drives it): the
+// page fetches the keys a step wants and hands them over. Each export
+// marshals its arguments to the session's store (WebSessionStore.cpp,
+// ZarrStoreView.h) and its results back.
+#include <algorithm>
+#include <cstdint>
+#include <cstdlib>
+#include <memory>
+#include <vector>
+
+#include "WebExports.h"
+#include "tessera/core/Error.h"
+
+using namespace tessera;
+using web::guarded;
+using web::session;
+
+namespace {
+
+// The open store, or null (no session, or no store): the calls that hand
+// fetched keys over do nothing then.
+web::ZarrStoreView* storeIfAny() {
+  web::WebSession* s = web::sessionIfAny();
+  return s ? s->store() : nullptr;
+}
+
+lod::VoxelBox boxOf(int x0, int x1, int y0, int y1, int z0, int z1) {
+  return {{x0, y0, z0}, {x1, y1, z1}};
+}
+
+}  // namespace
+
+extern "C" {
+
+// Starts opening the store at `url` (its root, e.g. http://host/ch2.ome.zarr).
+EMSCRIPTEN_KEEPALIVE int tessera_zarr_begin(const char* url) {
+  return guarded([&] { session().beginStore(url); });
+}
+
+// One step of opening: 1 open (the coarsest level is on the GPU), 0 keys
+// are wanted (tessera_zarr_wanted), -1 failed (tessera_last_error).
+EMSCRIPTEN_KEEPALIVE int tessera_zarr_open_step() {
+  int state = -1;
+  guarded([&] { state = session().storeOpenStep() ? 1 : 0; });
+  return state;
+}
+
+// The keys wanted since the last call, most urgent first, as a JSON array.
+EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_wanted() {
+  nlohmann::json keys = nlohmann::json::array();
+  if (web::ZarrStoreView* z = storeIfAny()) {
+    for (const std::string& k : z->storage().takeWanted()) keys.push_back(k);
+  }
+  return web::jsonOut(keys);
+}
+
+// 1 when the key has arrived (or is known missing, or failed moments ago):
+// the page does not fetch it again when it is listed twice.
+EMSCRIPTEN_KEEPALIVE int tessera_zarr_holds(const char* key) {
+  web::ZarrStoreView* z = storeIfAny();
+  return z && z->storage().holds(key) ? 1 : 0;
+}
+
+// A fetched key: its bytes (malloc'ed by the page, freed here), a 404, or
+// the page's error after its retries (naming the URL).
+EMSCRIPTEN_KEEPALIVE void tessera_zarr_put(const char* key, std::uint8_t* bytes, int size) {
+  const std::unique_ptr<std::uint8_t, decltype(&std::free)> owned(bytes, &std::free);
+  web::ZarrStoreView* z = storeIfAny();
+  if (!z) return;
+  const auto* b = reinterpret_cast<const std::byte*>(bytes);
+  z->storage().put(key, std::vector<std::byte>(b, b + std::max(0, size)));
+}
+EMSCRIPTEN_KEEPALIVE void tessera_zarr_put_missing(const char* key) {
+  if (web::ZarrStoreView* z = storeIfAny()) z->storage().putMissing(key);
+}
+EMSCRIPTEN_KEEPALIVE void tessera_zarr_put_failed(const char* key, const char* message) {
+  if (web::ZarrStoreView* z = storeIfAny()) z->storage().putFailed(key, message);
+}
+
+// The page decodes chunks of this compressor ("blosc", "zstd") itself
+// (numcodecs, web/zarr-url.js) before it hands them over.
+EMSCRIPTEN_KEEPALIVE int tessera_zarr_page_decodes(const char* compressor) {
+  return guarded(
+      [&] { session().theStore().storage().setPageDecodes(parseZarrCompressor(compressor)); });
+}
+
+// A frame of the open store on the canvas, with the picked region (red) and
+// the grid view's last block (cyan) composed by depth: JSON with the bricks'
+// state ("complete", "wanted", "missing", "failing", "uploaded", cells per
+// level), or "" on error (tessera_last_error).
+EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_frame(int width, int height) {
+  web::scratch().clear();
+  guarded([&] {
+    web::WebSession& s = session();
+    const web::StoreFrame f = s.storeFrame(width, height);
+    web::ZarrStoreView& z = s.theStore();
+    const lod::StreamerStats st = z.bricks().streamerStats();
+    const web::FetchStats fetched = z.storage().stats();
+    nlohmann::json j;
+    j["ms"] = f.ms;
+    j["render_size"] = {f.renderWidth, f.renderHeight};
+    j["complete"] = f.bricks.complete;
+    j["wanted"] = f.bricks.wanted;
+    j["missing"] = f.bricks.missing;
+    j["failing"] = f.bricks.failing;
+    j["uploaded"] = f.bricks.uploaded;
+    j["limited_by_budget"] = f.bricks.limitedByBudget;
+    j["wanted_per_level"] = f.bricks.wantedPerLevel;
+    j["cells_per_level"] = f.bricks.cellsPerLevel;  // last: transparent cells
+    j["bricks_read"] = st.bricksRead;
+    j["read_errors"] = st.readErrors;
+    j["last_error"] = st.lastError;
+    j["fetched_keys"] = fetched.keys;
+    j["fetched_bytes"] = fetched.bytes;
+    j["fetch_failures"] = fetched.failed;
+    j["held_bytes"] = fetched.heldBytes;
+    web::scratch() = j.dump();
+  });
+  return web::scratch().c_str();
+}
+
+// The open store: its description, levels and the bricks layout's plan.
+EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_info() {
+  web::scratch().clear();
+  guarded([&] {
+    const web::ZarrStoreView& z = session().theStore();
+    nlohmann::json j;
+    j["url"] = z.store().storage().describe();
+    j["description"] = z.store().describe();
+    j["open"] = z.isOpen();
+    j["levels"] = nlohmann::json::array();
+    for (int l = 0; l < z.store().levelCount(); ++l) {
+      const ZarrLevel& lv = z.store().level(l);
+      j["levels"].push_back({{"path", lv.path},
+                             {"dims", {lv.dims.x, lv.dims.y, lv.dims.z}},
+                             {"chunk", {lv.chunk.x, lv.chunk.y, lv.chunk.z}},
+                             {"compressor", lv.array.compressorText}});
+    }
+    if (z.isOpen()) {
+      j["layout_reason"] = z.bricks().plan().reason;
+      j["brick_size"] = z.bricks().grid().brickSize();
+      j["slots"] = z.bricks().slotCount();
+    }
+    j["notes"] = z.store().notes();
+    web::scratch() = j.dump();
+  });
+  return web::scratch().c_str();
+}
+
+// The bread-slice region of a store: voxels [x0,x1) x [y0,y1) x [z0,z1) of
+// level 0, read with bounded reads. 1 when every level-0 chunk of the box
+// has arrived, 0 when some are wanted (tessera_zarr_wanted lists them: the
+// page fetches them and asks again), -1 on error (tessera_last_error).
+EMSCRIPTEN_KEEPALIVE int tessera_zarr_region_prefetch(int x0, int x1, int y0, int y1, int z0,
+                                                      int z1) {
+  int state = -1;
+  guarded([&] { state = session().storeRegionPrefetch(boxOf(x0, x1, y0, y1, z0, z1)) ? 1 : 0; });
+  return state;
+}
+
+// Reads the box (its chunks fetched: tessera_zarr_region_prefetch) at level
+// 0 and makes it the viewer's volume, placed and windowed as in the store
+// (what `tessera render STORE --region` reads); the page then draws the
+// viewer instead of the store until it goes back to the store's overview.
+EMSCRIPTEN_KEEPALIVE int tessera_zarr_region_show(int x0, int x1, int y0, int y1, int z0, int z1) {
+  return guarded([&] { session().showStoreRegion(boxOf(x0, x1, y0, y1, z0, z1)); });
+}
+
+// Back to the store's overview from its region (the page draws the store
+// again; the region stays known, for its outline in the slice views).
+EMSCRIPTEN_KEEPALIVE void tessera_zarr_region_overview() {
+  if (web::WebSession* s = web::sessionIfAny()) s->storeRegionOverview();
+}
+
+// Closes the store (the viewer core's volume shows again).
+EMSCRIPTEN_KEEPALIVE void tessera_zarr_close() {
+  if (web::WebSession* s = web::sessionIfAny()) s->closeStore();
+}
+
+}  // extern "C"

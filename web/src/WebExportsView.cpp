@@ -1,0 +1,205 @@
+// The C API of the 3D view (web/tessera.js, web/app.js): the session's
+// start and end, volumes, frames, pointer input, the camera and the state.
+// Each export marshals its arguments to the session (WebSession.h) and its
+// results back: numbers, or JSON strings valid until the next call.
+#include <algorithm>
+#include <cstdint>
+#include <string>
+
+#include "WebExports.h"
+#include "tessera/core/Error.h"
+#include "tessera/core/PatientFrame.h"
+#include "tessera/render/TechniqueRegistry.h"
+
+using namespace tessera;
+using web::guarded;
+using web::session;
+using web::viewerIfAny;
+
+namespace tessera::web {
+
+namespace {
+std::string gLastError;
+std::string gScratch;
+}  // namespace
+
+std::string& lastError() {
+  return gLastError;
+}
+
+std::string& scratch() {
+  return gScratch;
+}
+
+}  // namespace tessera::web
+
+extern "C" {
+
+// Creates the WebGL 2 (version 2) or WebGL 1 (version 1) context on the
+// canvas named by `canvasSelector` ("#canvas"), the viewer on it (device
+// profile webgl2 / webgl1) and the session; a session made before is ended.
+EMSCRIPTEN_KEEPALIVE int tessera_init(const char* canvasSelector, int webglVersion) {
+  return guarded([&] { web::startSession(canvasSelector, webglVersion); });
+}
+
+// Ends the session: the viewer's GPU objects, the WebGL context and every
+// volume, region, grid, zoom swap and store go.
+EMSCRIPTEN_KEEPALIVE void tessera_dispose() {
+  web::endSession();
+}
+
+EMSCRIPTEN_KEEPALIVE const char* tessera_last_error() {
+  return web::lastError().c_str();
+}
+
+// "gen:shepp-logan:96" and the other procedural specs of `tessera render`.
+EMSCRIPTEN_KEEPALIVE int tessera_load_generated(const char* spec) {
+  return guarded([&] { session().loadGenerated(spec); });
+}
+
+// Files picked or dropped together: each is added (`bytes` malloc'ed by the
+// page and owned from here on), then tessera_load_files reads the one that
+// names the others (io/VolumeReader.h, volumeFileAmong) with the same io
+// readers as the CLI, and drops them all.
+EMSCRIPTEN_KEEPALIVE void tessera_add_file(const char* name, std::uint8_t* bytes, int size) {
+  web::PickedFile f;
+  f.name = name;
+  f.bytes.reset(bytes);
+  f.size = static_cast<std::size_t>(std::max(0, size));
+  if (web::WebSession* s = web::sessionIfAny()) s->addFile(std::move(f));
+}
+
+EMSCRIPTEN_KEEPALIVE void tessera_clear_files() {
+  if (web::WebSession* s = web::sessionIfAny()) s->clearFiles();
+}
+
+EMSCRIPTEN_KEEPALIVE int tessera_load_files() {
+  return guarded([&] { session().loadPickedFiles(); });
+}
+
+// Renders a frame on the canvas; returns its time in ms (-1 on error).
+EMSCRIPTEN_KEEPALIVE double tessera_render(int width, int height) {
+  double ms = -1.0;
+  guarded([&] { ms = session().renderFrame(width, height); });
+  return ms;
+}
+
+// Progressive full-quality frames (viewer::Viewer::progressive): the page
+// calls tessera_refine once per animation frame while tessera_refining says
+// a frame is pending; each call costs about `budgetMs`.
+EMSCRIPTEN_KEEPALIVE void tessera_set_progressive(int on, double budgetMs) {
+  viewer::Viewer* v = viewerIfAny();
+  if (!v) return;
+  v->progressive = on != 0;
+  if (budgetMs > 0.0) v->frameBudgetMs = budgetMs;
+}
+EMSCRIPTEN_KEEPALIVE int tessera_refining() {
+  const viewer::Viewer* v = viewerIfAny();
+  return v && v->refining() ? 1 : 0;
+}
+EMSCRIPTEN_KEEPALIVE double tessera_refine() {
+  double ms = -1.0;
+  guarded([&] { ms = session().viewer().refine().ms; });
+  return ms;
+}
+
+// Pointer input in canvas pixels; action 0 orbit, 1 pan.
+EMSCRIPTEN_KEEPALIVE void tessera_pointer_down(int id, double x, double y, int action) {
+  if (viewer::Viewer* v = viewerIfAny()) {
+    v->controller().pointerDown(
+        id, {x, y}, action == 1 ? viewer::PointerAction::Pan : viewer::PointerAction::Orbit);
+  }
+}
+EMSCRIPTEN_KEEPALIVE void tessera_pointer_move(int id, double x, double y) {
+  if (viewer::Viewer* v = viewerIfAny()) v->controller().pointerMove(id, {x, y});
+}
+EMSCRIPTEN_KEEPALIVE void tessera_pointer_up(int id) {
+  if (viewer::Viewer* v = viewerIfAny()) v->controller().pointerUp(id);
+}
+EMSCRIPTEN_KEEPALIVE void tessera_wheel(double notches) {
+  if (viewer::Viewer* v = viewerIfAny()) v->controller().wheel(notches);
+}
+EMSCRIPTEN_KEEPALIVE int tessera_interacting() {
+  viewer::Viewer* v = viewerIfAny();
+  return v && v->controller().interacting() ? 1 : 0;
+}
+
+// Keeps the projection (tessera_set_projection).
+EMSCRIPTEN_KEEPALIVE int tessera_set_camera(double azimuth, double elevation, double zoom) {
+  return guarded([&] { session().setCamera(azimuth, elevation, zoom); });
+}
+
+// 1: orthographic (parallel rays; the view's half height is the framed
+// radius / zoom), 0: perspective (the default).
+EMSCRIPTEN_KEEPALIVE void tessera_set_projection(int orthographic) {
+  if (viewer::Viewer* v = viewerIfAny()) {
+    v->camera().projection = orthographic ? Projection::Orthographic : Projection::Perspective;
+  }
+}
+
+// Everything the page shows about the state, as JSON (null before tessera_init).
+EMSCRIPTEN_KEEPALIVE const char* tessera_state_json(int logHistogram) {
+  nlohmann::json j;
+  web::WebSession* session = web::sessionIfAny();
+  if (!session) return web::jsonOut(j);
+  viewer::Viewer& v = session->viewer();
+  const gpu::DeviceCaps& caps = v.context().caps();
+  j["webgl"] = session->webglVersion();
+  j["api"] = gpu::apiLevelName(v.limits().api);
+  j["renderer"] = caps.renderer;
+  j["gl_version"] = caps.version;
+  j["has_volume"] = v.hasVolume();
+  j["description"] = v.description();
+  j["techniques"] = render::TechniqueRegistry::global().names();
+  j["technique"] = v.technique();
+  j["labels"] = v.labelsOn();
+  if (v.hasVolume()) {
+    const glm::ivec3 d = v.volume().dims();
+    j["name"] = v.volumeName();
+    j["dims"] = {d.x, d.y, d.z};
+    j["type"] = std::string(scalarTypeName(v.volume().type()));
+    // Its geometry, as `tessera info --json` prints it.
+    const Orientation orient = orientationOf(v.volume().direction());
+    j["orientation"] = orient.code;
+    j["orientation_text"] = orient.describe();
+    j["geometry_source"] = v.volume().geometrySource();
+    const glm::dmat4 a = v.volume().indexToWorld();
+    j["affine"] = nlohmann::json::array();
+    for (int row = 0; row < 4; ++row) {
+      j["affine"].push_back({a[0][row], a[1][row], a[2][row], a[3][row]});
+    }
+    j["layout"] = v.storageName();
+    j["plan_reason"] = v.plan().reason;
+    j["range"] = {v.valueRange().min, v.valueRange().max};
+    j["window"] = {v.window().min, v.window().max};
+    j["histogram"] = v.tfEditor().histogramHeights(logHistogram != 0);
+  }
+  const EdgeLabels labels = v.orientationLabels();
+  j["orientation_labels"] = {{"left", labels.left},
+                             {"right", labels.right},
+                             {"top", labels.top},
+                             {"bottom", labels.bottom}};
+  const Camera& c = v.camera();
+  j["camera"] = {{"azimuth", c.azimuthDeg}, {"elevation", c.elevationDeg}, {"zoom", c.zoom}};
+  const RenderSettings& rs = v.settings();
+  j["sampling"] = {{"step", rs.stepVoxels},
+                   {"preintegrate", rs.sampling.preintegrate},
+                   {"adaptive", rs.sampling.adaptive},
+                   {"tolerance", rs.sampling.tolerance},
+                   {"max_multiplier", rs.sampling.maxMultiplier}};
+  j["frame_ms"] = v.lastFrame().ms;
+  j["refining"] = v.refining();
+  j["render_size"] = {v.lastFrame().renderWidth, v.lastFrame().renderHeight};
+  const viewer::TransferFunctionEditor::Selection& s = v.tfEditor().selection();
+  j["selection"] = {{"channel", s.channel == viewer::TfChannel::Color ? 1 : 0}, {"index", s.index}};
+  return web::jsonOut(j);
+}
+
+// The canvas's pixels (RGBA, top row first), for tests and "save image";
+// valid until the next call (null before tessera_init).
+EMSCRIPTEN_KEEPALIVE const std::uint8_t* tessera_read_pixels(int width, int height) {
+  web::WebSession* s = web::sessionIfAny();
+  return s ? s->readPixels(width, height) : nullptr;
+}
+
+}  // extern "C"

@@ -1,0 +1,252 @@
+#pragma once
+// Everything one page (or one embedded viewer, web/tessera.js) holds between
+// calls of the C API (web/src/WebExports*.cpp): the WebGL context, the
+// viewer core, the files handed over, the slice views' region, the grid
+// view, the zoom swap, an open OME-Zarr store and the crop box's handles.
+// One object, made by tessera_init and destroyed by tessera_dispose; the
+// exports only marshal arguments to it and its results back.
+//
+// The member functions below are the session logic (what to show when a
+// region is picked, a grid move made, the zoom swaps; which settings are
+// valid); they are grouped by feature over WebSession.cpp (the view and
+// settings), WebSessionExplore.cpp (slices, region, grid), WebSessionStore.cpp
+// (OME-Zarr) and WebSessionZoom.cpp (the zoom swap).
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "ZarrStoreView.h"
+#include "tessera/core/Camera.h"
+#include "tessera/core/SliceImage.h"
+#include "tessera/gpu/WebGlContext.h"
+#include "tessera/lod/GridNavigator.h"
+#include "tessera/viewer/CropHandles.h"
+#include "tessera/viewer/Explorer.h"
+#include "tessera/viewer/Viewer.h"
+#include "tessera/viewer/ZoomSwap.h"
+
+namespace tessera::web {
+
+// A file the page handed over (malloc'ed by it, freed here).
+struct PickedFile {
+  std::string name;
+  std::unique_ptr<std::uint8_t, decltype(&std::free)> bytes{nullptr, &std::free};
+  std::size_t size = 0;
+};
+
+// The bread-slice region of a file (Schultz 2016 §7.4): the overview kept
+// while the viewer shows the region, to return to.
+struct SliceViews {
+  // The overview's volume while a region is shown (the viewer holds the
+  // region then), its name and camera; null when the overview is shown.
+  std::unique_ptr<Volume> overview;
+  std::string overviewName;
+  Camera overviewCamera;
+  lod::VoxelBox region;           // of the overview, voxels (end exclusive)
+  const Volume* shown = nullptr;  // the viewer's volume when the region went in
+  std::string shownName;
+  Image images[3];  // the last slice per axis (tessera_slice's pixels)
+};
+
+// A store's region, level-0 voxels, while the viewer shows it.
+struct StoreRegion {
+  lod::VoxelBox box;
+  bool shown = false;
+  Camera overviewCamera;   // the store view's camera, restored on the way back
+  bool gridBlock = false;  // read for the grid view (outlined cyan), not picked (red)
+};
+
+// Boxes marked in the overview (0: the picked region, red; 1: the grid
+// view's last block, cyan), each with the dims of the overview it was given
+// for, so that another file never shows a stale box.
+struct MarkBox {
+  std::optional<lod::VoxelBox> box;
+  glm::ivec3 dims{0};
+};
+
+struct GridView {
+  std::optional<lod::GridNavigator> nav;
+  std::string volumeKey;               // the overview it was made for: name and dims
+  int askedCell = 0;                   // the cell side asked for (0: the default)
+  std::string shownName;               // the viewer's volume name while its block is shown
+  std::optional<lod::VoxelBox> block;  // the last block shown
+  std::string note;                    // the last move, or why it was refused
+  bool refused = false;
+  bool storeWanted = false;  // a store's block is to be read (the page fetches its chunks)
+  // Where a store's pending block came from: restored when its read fails.
+  glm::ivec3 fromPoint{0};
+  std::optional<lod::VoxelBox> fromBlock;
+  std::string fromShownName;
+};
+
+struct ZoomView {
+  std::shared_ptr<const Volume> whole;  // the loaded volume (level 0 of the pyramid)
+  std::string name;                     // its name
+  std::unique_ptr<viewer::Explorer> explorer;
+  std::unique_ptr<viewer::ZoomSwap> swap;  // after the explorer: it holds a reference
+  int mediumLevel = 0;
+  double lastFrameMs = -1.0;
+  std::string shownName;  // the viewer's volume after the last frame
+};
+
+struct CropState {
+  bool show = false;  // the crop box and its handles in the 3D view
+  viewer::CropHandles handles;
+};
+
+// A slice of the slice views (tessera_slice): its frame, raster and image.
+struct SliceResult {
+  SliceFrame frame;
+  SliceRaster raster;
+  const Image* image = nullptr;
+  int count = 0;  // slices along the axis
+  bool oriented = false;
+  int level = 0;
+  bool pending = false;
+  std::string note;
+};
+
+// How the 3D view projects the overview's voxels (tessera_projection_json).
+struct VoxelProjection {
+  glm::dmat4 mvp{1.0};
+  glm::dvec3 spacing{1.0};
+  glm::dvec3 offset{0.0};
+};
+
+// The grid view's six moves relative to the view, in the C API's order
+// (0 forward, 1 back, 2 left, 3 right, 4 up, 5 down).
+inline constexpr lod::ViewMove kViewMoves[6] = {lod::ViewMove::Forward, lod::ViewMove::Back,
+                                                lod::ViewMove::Left,    lod::ViewMove::Right,
+                                                lod::ViewMove::Up,      lod::ViewMove::Down};
+
+class WebSession {
+ public:
+  // A WebGL context on the canvas named by `canvasSelector` (WebGL 2 for
+  // version 2, else 1) and the viewer on it (profile webgl2 / webgl1).
+  WebSession(const std::string& canvasSelector, int webglVersion);
+  ~WebSession();
+  WebSession(const WebSession&) = delete;
+  WebSession& operator=(const WebSession&) = delete;
+
+  viewer::Viewer& viewer() { return *viewer_; }
+  gpu::GlContext& context() { return context_.gl(); }
+  int webglVersion() const { return context_.webglVersion(); }
+
+  // ---- volumes and frames (WebSession.cpp)
+  void loadGenerated(const std::string& spec);
+  void addFile(PickedFile file) { picked_.push_back(std::move(file)); }
+  void clearFiles() { picked_.clear(); }
+  // Reads the picked file that names the others; drops them all.
+  void loadPickedFiles();
+  double renderFrame(int width, int height);  // ms
+  void setCamera(double azimuth, double elevation, double zoom);
+  // Settings checks: the step range, light, gradient opacity, crop box.
+  void setStep(double voxels);
+  void setLight(bool headlight, double ambient, double diffuse, double specular, double shininess,
+                const glm::dvec3& direction);
+  void setGradientOpacity(bool on, double low, double high);
+  void setCrop(const glm::dvec3& lo, const glm::dvec3& hi);
+  void setFollowingPlane(bool on, double depth);
+  void setLabels(bool on, const std::string& table, const std::string& name);
+  CropState& crop() { return crop_; }
+  // The viewer's extra lines: the region / grid boxes, then the crop box's.
+  void refreshExtraLines();
+  // The canvas's pixels (RGBA, top row first), valid until the next call.
+  const std::uint8_t* readPixels(int width, int height);
+
+  // ---- slice views, region and grid (WebSessionExplore.cpp)
+  // True while the viewer still shows the region put in by showRegion; a
+  // volume loaded since then (another file) ends region mode.
+  bool regionShown();
+  const SliceViews& sliceViews() const { return slices_; }
+  // The volume the slices show: the overview's, also while a region is shown.
+  const Volume& overviewVolume();
+  // The voxel space of the slice views, the crosshair, the region and the
+  // grid: the overview volume's, or an open store's level 0 (its shape).
+  const Volume& sliceShape();
+  // The largest cube side (<= 256) whose voxels fit the profile, and why.
+  std::pair<int, std::string> defaultRegionSide(const Volume& volume);
+  SliceResult slice(int axis, int index, bool colour, double maxPixels);
+  double voxelValue(int x, int y, int z);
+  // The name shown for the overview (a store's URL, the file's name).
+  std::string overviewName();
+  // Shows `box` of the overview at native resolution as the 3D view; back
+  // with returnToOverview().
+  void showRegion(lod::VoxelBox box);
+  void returnToOverview();
+  void setMarkBox(int slot, const lod::VoxelBox& box);
+  std::optional<VoxelProjection> projection(int width, int height);
+  // The grid view (Schultz 2016 §7.3; lod::GridNavigator).
+  void gridEnter(int cellSide, const glm::ivec3& voxel);
+  // 1 moved, 0 refused at the grid's boundary (the note says why).
+  int gridMove(int viewMove);
+  void gridStoreFailed();
+  void gridStoreShown();
+  bool gridShown();
+  lod::GridNavigator& gridFor(const Volume& volume, int cellSide);
+  lod::GridNavigator defaultGrid(const Volume& volume);
+  const GridView& grid() const { return grid_; }
+
+  // ---- OME-Zarr stores over fetch() (WebSessionStore.cpp)
+  ZarrStoreView* store() { return zarr_.get(); }
+  ZarrStoreView& theStore();
+  // The open store's coarsest level (null when no store is open).
+  const Volume* storeOverview();
+  void beginStore(const std::string& url);
+  bool storeOpenStep();
+  void closeStore();
+  const StoreRegion& storeRegion() const { return storeRegion_; }
+  // The store's level-0 box of these ranges (clamped; errors name the store).
+  lod::VoxelBox storeRegionBox(const lod::VoxelBox& asked);
+  bool storeRegionPrefetch(const lod::VoxelBox& asked);
+  void showStoreRegion(const lod::VoxelBox& asked);
+  void storeRegionOverview();
+  // The store's frame with the region and grid block marked.
+  StoreFrame storeFrame(int width, int height);
+  // The grid view's last block over a store, while the store is drawn.
+  std::optional<lod::VoxelBox> storeGridBlock();
+
+  // ---- the zoom-driven level swap (WebSessionZoom.cpp)
+  bool zoomActive();
+  const Volume* zoomOverview();
+  const ZoomView& zoom() const { return zoom_; }
+  std::optional<lod::VoxelBox> zoomBox();
+  void zoomStart(int viewPixels, double overviewVoxels, double blockVoxels);
+  void zoomForget() { zoom_ = ZoomView(); }
+  // Hands the view back to the whole volume, the camera kept.
+  void zoomStop();
+  double zoomFrame(int width, int height);
+
+ private:
+  void applyMarkBoxes();
+  std::string overviewKey(const Volume& v);
+  void showGridBlock(const lod::VoxelBox& box, bool keepZoom);
+
+  // Declared in destruction order's reverse: the viewer's GPU objects go
+  // before the context.
+  gpu::WebGlContext context_;
+  std::unique_ptr<ZarrStoreView> zarr_;
+  ZoomView zoom_;
+  std::unique_ptr<viewer::Viewer> viewer_;
+  std::vector<PickedFile> picked_;
+  SliceViews slices_;
+  StoreRegion storeRegion_;
+  MarkBox marks_[2];
+  GridView grid_;
+  CropState crop_;
+  std::vector<std::uint8_t> pixels_;
+};
+
+// The session tessera_init made (GpuError when there is none yet).
+WebSession& session();
+// Null before tessera_init and after tessera_dispose.
+WebSession* sessionIfAny();
+void startSession(const std::string& canvasSelector, int webglVersion);
+void endSession();
+
+}  // namespace tessera::web
