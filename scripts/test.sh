@@ -20,6 +20,7 @@ timed setup scripts/setup.sh
 timed build scripts/build.sh
 timed ctest ctest_build
 timed embed scripts/embed-test.sh  # examples/embed against an installed Tessera
+timed readme scripts/readme-commands.sh  # every command the README shows
 timed browser scripts/browser-test.sh  # web viewer in headless Chromium vs build/tessera
 timed sanitize scripts/sanitize.sh
 timed fuzz scripts/fuzz.sh "$FUZZ_SECONDS"

@@ -7,11 +7,8 @@
 #include <exception>
 #include <numbers>
 
-#include "tessera/gpu/DeviceSession.h"
-#include "tessera/lod/InCoreVolumeSource.h"
 #include "tessera/reference/ImageMetrics.h"
-#include "tessera/reference/ReferenceRaycaster.h"
-#include "tessera/render/TechniqueRegistry.h"
+#include "tessera/session/Session.h"
 
 using namespace tessera;
 
@@ -38,24 +35,19 @@ struct Frames {
   Image gpu, reference;
 };
 
-// The one place that talks to the renderer: device, upload, technique, frame.
-static Frames renderBoth(const Volume& volume, const TransferFunction& tf, int width, int height) {
-  gpu::DeviceSession device = gpu::openDevice("native");
-  const lod::InCoreVolumeSource source(volume);
-  render::TechniqueOnVolume t =
-      render::createTechnique("raycast", *device.context, device.limits, source,
-                              {.imageSize = {width, height}, .gradient = "on-the-fly"});
-  Camera camera;
-  camera.azimuthDeg = 30.0;
-  camera.elevationDeg = 35.0;
-  camera.frame(*t.upload.volume);
-  RenderSettings settings;          // plain post-classified sampling, half-voxel steps
-  settings.shading.enabled = true;  // gradients on the fly: the reference's central differences
-  t.technique->setTransferFunction(tf);
-  t.technique->prepare(camera, settings);
-  t.technique->render(camera, settings, width, height, 0.0);
-  return {t.technique->readImage(),
-          renderReference(*t.upload.volume, tf, camera, settings, width, height)};
+// The one place that talks to the renderer: a session on a headless device,
+// the array moved in (not copied), its settings, a frame and its reference.
+static Frames renderBoth(Volume volume, const TransferFunction& tf, int width, int height) {
+  session::Session s("native");
+  s.setVolume(std::move(volume), "Marschner-Lobb");
+  session::Settings& settings = s.settings();
+  settings.tf = tf;
+  settings.camera.azimuthDeg = 30.0;
+  settings.camera.elevationDeg = 35.0;
+  settings.gradient = "on-the-fly";    // the reference's central differences
+  settings.render = RenderSettings();  // plain post-classified sampling, half-voxel steps
+  settings.render.shading.enabled = true;
+  return {s.render(width, height), s.renderReference(width, height)};
 }
 
 int main(int argc, char** argv) try {

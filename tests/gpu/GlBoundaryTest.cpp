@@ -110,27 +110,6 @@ TEST(GlBoundary, NoRawGlOutsideTheGpuLayer) {
   for (const auto& o : offenders) ADD_FAILURE() << o;
 }
 
-// Contexts are created in the gpu layer only: the front ends (the CLI's
-// EGL, the desktop viewer's window, the page's canvas) go through
-// gpu::GlContext. The desktop viewer's GLFW window makes its own context
-// (glfwCreateWindow), which it then adopts; that call is not matched here.
-TEST(GlBoundary, ContextsAreCreatedOnlyInTheGpuLayer) {
-  const std::regex create(R"(\b(eglCreateContext|emscripten_webgl_create_context)\s*\()");
-  int checked = 0;
-  std::vector<std::string> offenders;
-  for (const fs::path& p : sources({"src", "include", "web/src"})) {
-    if (allowed(p)) continue;
-    ++checked;
-    std::smatch m;
-    const std::string code = codeOnly(readFile(p));
-    if (std::regex_search(code, m, create)) {
-      offenders.push_back(fs::relative(p, kRoot).string() + ": " + m.str());
-    }
-  }
-  EXPECT_GT(checked, 100);
-  for (const auto& o : offenders) ADD_FAILURE() << o;
-}
-
 TEST(GlBoundary, PublicHeadersNeverReachTheGlHeaders) {
   const std::regex header(R"(#\s*include\s*[<"](GLES\d?/|EGL/|gpu/gl\.h))");
   int checked = 0;
@@ -155,14 +134,11 @@ TEST(GlBoundary, TheCheckSeesACallAndIgnoresCommentsAndStrings) {
 TEST(GlBoundary, OnlyTheGpuLayerCreatesContexts) {
   const std::regex create(
       R"(\b(glfwCreateWindow|eglCreateContext|emscripten_webgl_create_context)\s*\()");
-  // The web page's context is made in its entry file until it moves into
-  // src/gpu beside GlContext.cpp; then this exemption goes.
-  const std::string webEntry = "web/src/WebViewer.cpp";
   int checked = 0;
   std::vector<std::string> offenders;
   for (const fs::path& p : sources({"src", "include", "frontends", "web/src"})) {
     const std::string rel = fs::relative(p, kRoot).generic_string();
-    if (rel.rfind("src/gpu/", 0) == 0 || rel == webEntry) continue;
+    if (rel.rfind("src/gpu/", 0) == 0) continue;
     ++checked;
     std::smatch m;
     const std::string code = codeOnly(readFile(p));
