@@ -124,14 +124,25 @@ TEST(RegistryExtension, TheFlippedMosaicIsRegisteredByNameOnly) {
 }
 
 // The shared layoutsFor() (tests/support/TestLayouts.h) picks it up, so the
-// shading and clipping tests render through it too.
+// shading and clipping tests render through it too; on the volume those
+// tests use, a layout that can (packed-mosaic) is squeezed across several
+// textures, as their own lists did.
 TEST(RegistryExtension, SharedLayoutsForIncludesTheFlippedMosaic) {
   gpu::GlContext& c = test::gpuContext();
-  const Volume v = makeSphere({17, 19, 13});
+  const Volume v = makeSphere({37, 53, 29});
   const auto layouts = test::layoutsFor(c, v);
-  EXPECT_TRUE(std::any_of(layouts.begin(), layouts.end(), [](const auto& l) {
-    return l->name() == kName;
-  })) << test::layoutNames(layouts);
+  const auto any = [&](auto predicate) {
+    return std::any_of(layouts.begin(), layouts.end(), predicate);
+  };
+  EXPECT_TRUE(any([](const auto& l) { return l->name() == kName; })) << test::layoutNames(layouts);
+  EXPECT_TRUE(any([](const auto& l) { return l->textureUnits() >= 2; }))
+      << test::layoutNames(layouts);
+  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());
+  std::size_t expected = 0;
+  for (const layout::LayoutEntry& e : layout::LayoutRegistry::global().entries()) {
+    expected += e.holdsVoxelGrid && !e.streamsBricks && e.runsOn(limits) ? 1 : 0;
+  }
+  EXPECT_EQ(layouts.size(), expected) << test::layoutNames(layouts);
 }
 
 // Stored reversed, sampled straight: at every voxel centre it returns the
