@@ -247,7 +247,8 @@ TEST_P(RegistrySuite, MatchesItsCpuTwin) {
   }
   ASSERT_TRUE(r.referenceImage);
   // The reference shows the volume (not an empty frame that any empty
-  // frame would match): the clipped sphere lights about 6% of the pixels.
+  // frame would match): the smallest, the clipped sphere, lights a few
+  // percent of the pixels.
   int lit = 0;
   const Image& ref = *r.referenceImage;
   for (int y = 0; y < ref.height(); ++y) {
