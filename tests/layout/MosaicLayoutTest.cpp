@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "support/GpuTestContext.h"
+#include "support/ProbePositions.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/io/Procedural.h"
@@ -23,6 +24,8 @@ using namespace tessera;
 using layout::MosaicLayout;
 
 namespace {
+
+using test::probePositions;
 
 // A volume whose every voxel differs from its neighbours, so an addressing
 // slip of one voxel along any axis shows.
@@ -47,41 +50,6 @@ std::unique_ptr<gpu::GlContext> es2Context() {
   gpu::GlContext::Options options;
   options.api = gpu::ApiLevel::Gles2;
   return gpu::GlContext::createHeadless(options);
-}
-
-// A deterministic scatter over the whole box, plus positions that test the
-// tile borders: the edge texel centres, just inside and outside them, and
-// the box faces, where the in-tile clamp must reproduce clamp-to-edge.
-std::vector<glm::vec3> probePositions(glm::ivec3 d) {
-  std::vector<glm::vec3> p;
-  for (int i = 0; i < 4000; ++i) {
-    p.emplace_back(std::fmod(i * 0.6180339887f, 1.0f), std::fmod(i * 0.7548776662f, 1.0f),
-                   std::fmod(i * 0.5698402910f, 1.0f));
-  }
-  const auto edges = [](int n) {
-    const float t = 1.0f / static_cast<float>(n);
-    return std::vector<float>{0.0f,
-                              0.25f * t,
-                              0.5f * t,
-                              0.5f * t + 1e-4f,
-                              0.75f * t,
-                              1.0f - 0.75f * t,
-                              1.0f - 0.5f * t - 1e-4f,
-                              1.0f - 0.5f * t,
-                              1.0f - 0.25f * t,
-                              1.0f};
-  };
-  int k = 0;
-  for (float x : edges(d.x)) {
-    for (float y : edges(d.y)) {
-      const float z = std::fmod(0.37f + 0.2357f * static_cast<float>(k++), 1.0f);
-      p.emplace_back(x, y, z);
-    }
-  }
-  for (float z : edges(d.z)) {
-    for (int i = 0; i < 20; ++i) p.emplace_back(0.05f * i, 1.0f - 0.05f * i, z);
-  }
-  return p;
 }
 
 gpu::DeviceLimits limitsWithMax2D(const gpu::DeviceCaps& caps, int max2D) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "support/GpuTestContext.h"
+#include "support/ProbePositions.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/gpu/Program.h"
@@ -30,6 +31,8 @@ using layout::PackedMosaicLayout;
 using Packing = PackedMosaicLayout::Packing;
 
 namespace {
+
+using test::probePositions;
 
 constexpr Packing kPackings[] = {Packing::Dense, Packing::Overlapped};
 
@@ -101,53 +104,6 @@ gpu::DeviceLimits limitsFor(const gpu::DeviceCaps& caps, const Spill& p) {
   gpu::DeviceLimits l = gpu::DeviceLimits::of(caps);
   if (p.max2D != 0) l.max2DTextureSize = p.max2D;
   return l;
-}
-
-// A deterministic scatter over the whole box, plus positions at the tile
-// borders in x and y (edge texel centres, just inside and outside them, the
-// box faces) and, in z, between every pair of neighbouring slices: those
-// include every seam of both packings (dense: channel 3 -> channel 0 of the
-// next tile, possibly in the next texture; overlapped: the pairs in
-// channels B, A and the next tile's R, G, which repeats A).
-std::vector<glm::vec3> probePositions(glm::ivec3 d) {
-  std::vector<glm::vec3> p;
-  for (int i = 0; i < 4000; ++i) {
-    p.emplace_back(std::fmod(i * 0.6180339887f, 1.0f), std::fmod(i * 0.7548776662f, 1.0f),
-                   std::fmod(i * 0.5698402910f, 1.0f));
-  }
-  const auto edges = [](int n) {
-    const float t = 1.0f / static_cast<float>(n);
-    return std::vector<float>{0.0f,
-                              0.25f * t,
-                              0.5f * t,
-                              0.5f * t + 1e-4f,
-                              0.75f * t,
-                              1.0f - 0.75f * t,
-                              1.0f - 0.5f * t - 1e-4f,
-                              1.0f - 0.5f * t,
-                              1.0f - 0.25f * t,
-                              1.0f};
-  };
-  int k = 0;
-  for (float x : edges(d.x)) {
-    for (float y : edges(d.y)) {
-      const float z = std::fmod(0.37f + 0.2357f * static_cast<float>(k++), 1.0f);
-      p.emplace_back(x, y, z);
-    }
-  }
-  for (float z : edges(d.z)) {
-    for (int i = 0; i < 20; ++i) p.emplace_back(0.05f * i, 1.0f - 0.05f * i, z);
-  }
-  for (int s = 0; s + 1 < d.z; ++s) {
-    for (float f : {0.0f, 0.1f, 0.3f, 0.5f, 0.7f, 0.9f, 1.0f}) {
-      const float z = (static_cast<float>(s) + 0.5f + f) / static_cast<float>(d.z);
-      for (int i = 0; i < 12; ++i) {
-        p.emplace_back(std::fmod(0.03f + i * 0.4142f, 1.0f), std::fmod(0.07f + i * 0.7321f, 1.0f),
-                       z);
-      }
-    }
-  }
-  return p;
 }
 
 double worstTrilinearError(const Volume& v, const layout::Layout& l,

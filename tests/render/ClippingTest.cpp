@@ -9,11 +9,10 @@
 #include <vector>
 
 #include "support/GpuTestContext.h"
+#include "support/TestLayouts.h"
 #include "support/TestTransferFunctions.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/Procedural.h"
-#include "tessera/layout/MosaicLayout.h"
-#include "tessera/layout/PackedMosaicLayout.h"
 #include "tessera/layout/Texture3DLayout.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
@@ -25,6 +24,7 @@ using namespace tessera;
 
 namespace {
 
+using test::layoutsFor;
 using test::visibleTf;
 
 // Two planes and a crop box that cut into the sphere's inside.
@@ -37,19 +37,6 @@ RenderSettings clippedSettings() {
   s.clipping.cropMin = {0.1, 0.0, 0.15};
   s.clipping.cropMax = {0.85, 1.0, 1.0};
   return s;
-}
-
-std::vector<std::unique_ptr<layout::Layout>> layoutsFor(gpu::GlContext& c, const Volume& v) {
-  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());
-  gpu::DeviceLimits packedLimits = limits;
-  packedLimits.max2DTextureSize = 128;
-  std::vector<std::unique_ptr<layout::Layout>> layouts;
-  if (c.caps().api == gpu::ApiLevel::Gles3) {
-    layouts.push_back(layout::Texture3DLayout::create(v, limits, c.ledger()));
-  }
-  layouts.push_back(layout::MosaicLayout::create(v, limits, c.ledger()));
-  layouts.push_back(layout::PackedMosaicLayout::create(v, packedLimits, c.ledger(), 6));
-  return layouts;
 }
 
 const char* apiName(gpu::ApiLevel api) {

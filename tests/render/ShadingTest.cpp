@@ -12,12 +12,11 @@
 #include <glm/geometric.hpp>
 
 #include "support/GpuTestContext.h"
+#include "support/TestLayouts.h"
 #include "support/TestTransferFunctions.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/io/Procedural.h"
-#include "tessera/layout/MosaicLayout.h"
-#include "tessera/layout/PackedMosaicLayout.h"
 #include "tessera/layout/Texture3DLayout.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
@@ -31,6 +30,7 @@ using namespace tessera;
 
 namespace {
 
+using test::layoutsFor;
 using test::visibleTf;
 
 // Slicing cannot stop early; the ray caster and the reference are told the same.
@@ -48,21 +48,6 @@ Camera obliqueCamera(const Volume& v) {
   cam.elevationDeg = 25;
   cam.frame(v.extent());
   return cam;
-}
-
-// The three Cartesian layouts a context offers (texture3d on ES 3.0 only);
-// small textures force packed-mosaic across channels and textures.
-std::vector<std::unique_ptr<layout::Layout>> layoutsFor(gpu::GlContext& c, const Volume& v) {
-  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());
-  gpu::DeviceLimits packedLimits = limits;
-  packedLimits.max2DTextureSize = 128;
-  std::vector<std::unique_ptr<layout::Layout>> layouts;
-  if (c.caps().api == gpu::ApiLevel::Gles3) {
-    layouts.push_back(layout::Texture3DLayout::create(v, limits, c.ledger()));
-  }
-  layouts.push_back(layout::MosaicLayout::create(v, limits, c.ledger()));
-  layouts.push_back(layout::PackedMosaicLayout::create(v, packedLimits, c.ledger(), 6));
-  return layouts;
 }
 
 Image raycastWith(gpu::GlContext& c, const Volume& v, const layout::Layout& l, const Camera& cam,
