@@ -351,14 +351,24 @@ std::vector<int> basesOf(const std::vector<FileSpec>& files) {
 
 // Reads a generated stack and checks affine and voxels against `inZOrder`
 // (the files in the z order expected).
-void expectStackReads(const test::TempDir& dir, const std::vector<FileSpec>& inZOrder) {
-  const Volume v = readDicomSeries(dir.path());
+Volume expectStackReads(const test::TempDir& dir, const std::vector<FileSpec>& inZOrder) {
+  Volume v = readDicomSeries(dir.path());
   const FileSpec& f = inZOrder.front();
   EXPECT_EQ(v.dims(), glm::ivec3(f.cols, f.rows, static_cast<int>(inZOrder.size())));
   expectAffineNear(v.indexToWorld(), expectedAffine(*f.iop, f.ps, positions(inZOrder)), 1e-6);
   expectVoxelsOf(v, basesOf(inZOrder), f.cols);
   EXPECT_NE(v.geometrySource().find("DICOM IPP/IOP (LPS -> RAS)"), std::string::npos)
       << v.geometrySource();
+  return v;
+}
+
+// Generates the stack `files` (in z order) into a folder of its own, checks
+// it reads back (expectStackReads) and gives the orientation code read.
+std::string stackOrientation(const test::TempDir& work, const std::vector<FileSpec>& files) {
+  const test::TempDir dir;
+  generate(work, dir, files);
+  if (::testing::Test::HasFatalFailure()) return "(not generated)";
+  return orientationOf(expectStackReads(dir, files).direction()).code;
 }
 
 TEST(DicomGeometry, AxialSeriesInEitherSliceOrderGivesTheAffineOfItsPositions) {
@@ -366,21 +376,13 @@ TEST(DicomGeometry, AxialSeriesInEitherSliceOrderGivesTheAffineOfItsPositions) {
   test::TempDir work;
   {
     SCOPED_TRACE("feet to head");
-    test::TempDir dir;
-    const auto files = stack(kAxial, {-40.5, 22.25, -10}, {0, 0, 2.5}, 8);
-    ASSERT_NO_FATAL_FAILURE(generate(work, dir, files));
-    expectStackReads(dir, files);
-    EXPECT_EQ(orientationOf(readDicomSeries(dir.path()).direction()).code, "LPS");
+    EXPECT_EQ(stackOrientation(work, stack(kAxial, {-40.5, 22.25, -10}, {0, 0, 2.5}, 8)), "LPS");
   }
   {
     // A scanner going head to foot: Instance Number grows downwards, and z
     // follows it (an LPI volume, nothing flipped).
     SCOPED_TRACE("head to feet");
-    test::TempDir dir;
-    const auto files = stack(kAxial, {-40.5, 22.25, 60}, {0, 0, -2.5}, 8);
-    ASSERT_NO_FATAL_FAILURE(generate(work, dir, files));
-    expectStackReads(dir, files);
-    EXPECT_EQ(orientationOf(readDicomSeries(dir.path()).direction()).code, "LPI");
+    EXPECT_EQ(stackOrientation(work, stack(kAxial, {-40.5, 22.25, 60}, {0, 0, -2.5}, 8)), "LPI");
   }
   {
     // Without Instance Numbers, z grows along the normal (row x column).
@@ -398,22 +400,14 @@ TEST(DicomGeometry, SagittalAndCoronalSeriesGiveTheirRasAffine) {
   test::TempDir work;
   {
     SCOPED_TRACE("sagittal");
-    test::TempDir dir;
     // IOP 0\1\0\0\0\-1: rows run posterior, columns inferior, the normal
     // (row x column) points right; the slices are numbered right to left.
-    const auto files = stack(kSagittal, {-30, -100, 80}, {3, 0, 0}, 8);
-    ASSERT_NO_FATAL_FAILURE(generate(work, dir, files));
-    expectStackReads(dir, files);
-    EXPECT_EQ(orientationOf(readDicomSeries(dir.path()).direction()).code, "PIL");
+    EXPECT_EQ(stackOrientation(work, stack(kSagittal, {-30, -100, 80}, {3, 0, 0}, 8)), "PIL");
   }
   {
     SCOPED_TRACE("coronal");
-    test::TempDir dir;
     // IOP 1\0\0\0\0\-1: normal = (1,0,0) x (0,0,-1) = (0,1,0), posterior.
-    const auto files = stack(kCoronal, {-90, -20, 70}, {0, 1.5, 0}, 8);
-    ASSERT_NO_FATAL_FAILURE(generate(work, dir, files));
-    expectStackReads(dir, files);
-    EXPECT_EQ(orientationOf(readDicomSeries(dir.path()).direction()).code, "LIP");
+    EXPECT_EQ(stackOrientation(work, stack(kCoronal, {-90, -20, 70}, {0, 1.5, 0}, 8)), "LIP");
   }
 }
 

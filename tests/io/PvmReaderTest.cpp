@@ -21,23 +21,16 @@ namespace {
 using namespace std::string_literals;
 using io_detail::DdsVersion;
 using test::BudgetOverride;
+using test::expectCh2RoundTrips;
 using test::expectRejected;
 using test::expectSameVolume;
+using test::fileBytes;
 using test::TempDir;
 using test::writeFile;
 
 Volume randomVolume(glm::ivec3 dims, ScalarType type, unsigned seed) {
   return test::randomVolume(dims, type, seed,
                             {.spacing = {0.5, 1.25, 3.0}, .origin = {-90.5, 12.25, 0.1}});
-}
-
-const std::filesystem::path kCh2 = "/usr/share/mricron/templates/ch2.nii.gz";
-
-std::string fileBytes(const std::filesystem::path& path) {
-  std::string bytes(static_cast<std::size_t>(std::filesystem::file_size(path)), '\0');
-  std::ifstream in(path, std::ios::binary);
-  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  return bytes;
 }
 
 std::span<const std::uint8_t> asBytes(const std::string& s) {
@@ -144,11 +137,9 @@ TEST(PvmReader, KeepsThePvm3StringsInTheDescription) {
 }
 
 TEST(PvmReader, Ch2RoundTripsExactly) {
-  if (!std::filesystem::exists(kCh2)) GTEST_SKIP() << kCh2 << " is not installed (mricron-data)";
-  TempDir dir;
-  const Volume ch2 = readNifti(kCh2);
-  writePvm(ch2, dir / "ch2.pvm");
-  expectSameVolume(readPvm(dir / "ch2.pvm"), ch2);
+  expectCh2RoundTrips(
+      {"ch2.pvm"}, [](const Volume& v, const auto& path) { writePvm(v, path); },
+      [](const auto& path) { return readPvm(path); });
 }
 
 // ---- DDS-compressed PVM ----
@@ -322,12 +313,11 @@ TEST(PvmReader, ReadsDdsCompressedU8AndU16Volumes) {
 }
 
 TEST(PvmReader, Ch2RoundTripsThroughDdsCompression) {
-  if (!std::filesystem::exists(kCh2)) GTEST_SKIP() << kCh2 << " is not installed (mricron-data)";
-  TempDir dir;
-  const Volume ch2 = readNifti(kCh2);
-  writeDdsPvm(ch2, dir / "ch2.pvm", DdsVersion::V3d);
-  EXPECT_LT(std::filesystem::file_size(dir / "ch2.pvm"), ch2.byteSize() / 2);
-  expectSameVolume(readPvm(dir / "ch2.pvm"), ch2);
+  const auto writeDds = [](const Volume& v, const std::filesystem::path& path) {
+    writeDdsPvm(v, path, DdsVersion::V3d);
+    EXPECT_LT(std::filesystem::file_size(path), v.byteSize() / 2);
+  };
+  expectCh2RoundTrips({"ch2.pvm"}, writeDds, [](const auto& path) { return readPvm(path); });
 }
 
 // ---- writing ----
