@@ -6,6 +6,7 @@
 // NIfTI-1 vox_offset float is cast to int unchecked) where Tessera names the
 // problem. It remains the NIfTI writer and the test oracle for the affines.
 #include "tessera/io/NiftiReader.h"
+#include "io/HeaderText.h"
 
 #include <algorithm>
 #include <array>
@@ -82,11 +83,7 @@ std::string quoteMagic(const char* m, std::size_t n) {
   return "'" + s + "'";
 }
 
-std::string numberString(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
+using io_detail::numberString;
 
 bool endsWith(const std::string& name, const std::string& suffix) {
   return name.size() >= suffix.size() &&

@@ -14,6 +14,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -299,6 +300,15 @@ void expectAffineNear(const glm::dmat4& got, const glm::dmat4& want, double tole
   }
 }
 
+// A slice `name` of orientation `iop` at `ipp`, the rest as FileSpec says.
+FileSpec placedSlice(std::string name, const Iop& iop, glm::dvec3 ipp) {
+  FileSpec f;
+  f.name = std::move(name);
+  f.iop = iop;
+  f.ipp = ipp;
+  return f;
+}
+
 // A stack of `n` slices: positions first + k * step, files named so that
 // name order is not slice order; Instance Number k + 1 unless `numbered` is
 // false; pixel base 1000 k.
@@ -306,10 +316,8 @@ std::vector<FileSpec> stack(const Iop& iop, glm::dvec3 first, glm::dvec3 step, i
                             bool numbered = true) {
   std::vector<FileSpec> files;
   for (int k = 0; k < n; ++k) {
-    FileSpec f;
-    f.name = "IM" + std::to_string((k * 5 + 3) % n) + ".dcm";
-    f.iop = iop;
-    f.ipp = first + static_cast<double>(k) * step;
+    FileSpec f = placedSlice("IM" + std::to_string((k * 5 + 3) % n) + ".dcm", iop,
+                             first + static_cast<double>(k) * step);
     if (numbered) f.instance = k + 1;
     f.base = 1000 * k;
     f.rows = 12;
@@ -468,10 +476,7 @@ TEST(DicomGeometry, SingleSliceAndMissingOrientationFallBackAsDocumented) {
   {
     SCOPED_TRACE("one coronal slice with Slice Thickness");
     test::TempDir dir;
-    FileSpec f;
-    f.name = "one.dcm";
-    f.iop = kCoronal;
-    f.ipp = glm::dvec3(-90, 14, 70);
+    FileSpec f = placedSlice("one.dcm", kCoronal, glm::dvec3(-90, 14, 70));
     f.more = "'thickness': 3.5";
     ASSERT_NO_FATAL_FAILURE(generate(work, dir, {f}));
     const Volume v = readDicomSeries(dir / "one.dcm");
@@ -691,10 +696,7 @@ TEST(DicomDefects, UnreadableCopiesBesideAReadableFileAreSkippedAndCounted) {
   {
     SCOPED_TRACE("MR_small beside MR_truncated");
     test::TempDir dir;
-    FileSpec small;
-    small.name = "MR_small.dcm";
-    small.iop = kAxial;
-    small.ipp = glm::dvec3(-83.9063, -91.2, 6.6406);
+    FileSpec small = placedSlice("MR_small.dcm", kAxial, glm::dvec3(-83.9063, -91.2, 6.6406));
     FileSpec truncated = small;
     truncated.name = "MR_truncated.dcm";
     truncated.more = "'truncate': 62";  // ends inside its pixel data
@@ -778,10 +780,7 @@ TEST(DicomDefects, AttributesStoredAsUnAreReadForTheRealReason) {
   const std::string un = "'un': ['ImagePositionPatient', 'ImageOrientationPatient', 'PixelSpacing'";
   {
     test::TempDir dir;
-    FileSpec f;
-    f.name = "rtdose.dcm";
-    f.iop = kAxial;
-    f.ipp = glm::dvec3(189.43125, 199.43125, -761.87);
+    FileSpec f = placedSlice("rtdose.dcm", kAxial, glm::dvec3(189.43125, 199.43125, -761.87));
     f.more = "'frames': 3, " + un + "]";
     ASSERT_NO_FATAL_FAILURE(generate(work, dir, {f}));
     try {

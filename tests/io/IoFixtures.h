@@ -23,6 +23,7 @@
 #include <unistd.h>
 
 #include "support/TestSupport.h"
+#include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Volume.h"
 #include "tessera/io/NiftiReader.h"
@@ -246,6 +247,16 @@ void expectRejected(F&& f, const std::vector<std::string>& fragments) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_LT(seconds, 2.0) << "rejecting bad input took " << seconds << " s";
+}
+
+// Expects write(volume, path) into a folder that does not exist to throw an
+// Error naming the path, and to leave nothing behind in `dir`.
+template <class Write>
+void expectWriteIntoMissingFolderFails(const TempDir& dir, const std::filesystem::path& path,
+                                       Write&& write) {
+  const Volume v = randomVolume({2, 2, 2}, ScalarType::U8, 1);
+  expectRejected<Error>([&] { write(v, path); }, {path.string(), "does not exist"});
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
 }
 
 }  // namespace tessera::test
