@@ -579,50 +579,19 @@ void addFile(const ByteSource& source, bool mustBeImage, FolderScan& scan) {
   scan.slices.push_back(sliceOf(f));
 }
 
-FolderScan scanFolder(const fs::path& folder) {
-  FolderScan scan;
-  scan.where = "folder " + folder.string();
-  std::vector<fs::path> files;
-  std::error_code ec;
-  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
-    std::error_code tec;
-    if (it->is_directory(tec)) {
-      ++scan.subfolders;
-    } else if (it->is_regular_file(tec)) {
-      files.push_back(it->path());
-    }
-  }
-  if (ec) throw InputError(folder.string() + ": cannot list the folder: " + ec.message());
-  std::sort(files.begin(), files.end());
-  for (const auto& f : files) addFile(FileSource(f), false, scan);
-  return scan;
-}
-
 std::unique_ptr<ByteSource> openFile(const fs::path& p) {
   return std::make_unique<FileSource>(p);
 }
 
-fs::path folderOf(const fs::path& p) {
-  fs::path f = p.parent_path();
-  return f.empty() ? fs::path(".") : f;
+void addFileOnDisk(const fs::path& file, bool mustBeImage, FolderScan& scan) {
+  addFile(FileSource(file), mustBeImage, scan);
 }
 
 }  // namespace
 
 Volume readDicomSeriesBasic(const fs::path& folderOrFile, const std::string& seriesUid) {
-  const std::string p = folderOrFile.string();
-  std::error_code ec;
-  const fs::file_status st = fs::status(folderOrFile, ec);
-  if (ec || !fs::exists(st)) throw InputError(p + ": no such file or directory");
-  if (fs::is_directory(st)) {
-    return io_detail::readSeries(scanFolder(folderOrFile), seriesUid, p, pixelDecoder(openFile));
-  }
-  if (!fs::is_regular_file(st)) throw InputError(p + ": not a regular file or a directory");
-  FolderScan own;
-  addFile(FileSource(folderOrFile), true, own);
-  const fs::path folder = folderOf(folderOrFile);
-  return io_detail::readSeries(scanFolder(folder), seriesUid, p, pixelDecoder(openFile),
-                               folder / folderOrFile.filename());
+  return io_detail::readFolderOrFile(folderOrFile, seriesUid, addFileOnDisk,
+                                     pixelDecoder(openFile));
 }
 
 Volume readDicomFilesBasic(const std::vector<fs::path>& files, const std::string& seriesUid) {
@@ -648,10 +617,7 @@ Volume readDicomSeriesBasic(const ByteSource& named, const FileSet& files,
 }
 
 std::vector<DicomSeriesInfo> listDicomSeriesBasic(const fs::path& folder) {
-  std::error_code ec;
-  const fs::path dir = fs::is_directory(folder, ec) ? folder : folderOf(folder);
-  if (!fs::is_directory(dir, ec)) throw InputError(folder.string() + ": no such directory");
-  return io_detail::listSeries(scanFolder(dir));
+  return io_detail::listFolderSeries(folder, addFileOnDisk);
 }
 
 namespace {

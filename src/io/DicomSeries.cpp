@@ -872,4 +872,57 @@ std::vector<DicomSeriesInfo> listSeries(FolderScan scan) {
   return out;
 }
 
+namespace {
+fs::path folderOf(const fs::path& p) {
+  fs::path f = p.parent_path();
+  return f.empty() ? fs::path(".") : f;
+}
+}  // namespace
+
+FolderScan scanFolder(const fs::path& folder, const FileAdder& add) {
+  FolderScan scan;
+  scan.where = "folder " + folder.string();
+  std::vector<fs::path> files;
+  std::error_code ec;
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    std::error_code tec;
+    if (it->is_directory(tec)) {
+      ++scan.subfolders;
+    } else if (it->is_regular_file(tec)) {
+      files.push_back(it->path());
+    }
+  }
+  if (ec) throw InputError(folder.string() + ": cannot list the folder: " + ec.message());
+  // Sorted only so that messages are the same from run to run; slice order
+  // comes from positions.
+  std::sort(files.begin(), files.end());
+  for (const auto& f : files) add(f, false, scan);
+  return scan;
+}
+
+Volume readFolderOrFile(const fs::path& folderOrFile, const std::string& seriesUid,
+                        const FileAdder& add, const PixelDecoder& decode) {
+  const std::string p = folderOrFile.string();
+  std::error_code ec;
+  const fs::file_status st = fs::status(folderOrFile, ec);
+  if (ec || !fs::exists(st)) throw InputError(p + ": no such file or directory");
+  if (fs::is_directory(st)) return readSeries(scanFolder(folderOrFile, add), seriesUid, p, decode);
+  if (!fs::is_regular_file(st)) throw InputError(p + ": not a regular file or a directory");
+
+  // One file: its own errors first, then its series (and stack) from the
+  // files beside it.
+  FolderScan own;
+  add(folderOrFile, true, own);
+  const fs::path folder = folderOf(folderOrFile);
+  return readSeries(scanFolder(folder, add), seriesUid, p, decode,
+                    folder / folderOrFile.filename());
+}
+
+std::vector<DicomSeriesInfo> listFolderSeries(const fs::path& folder, const FileAdder& add) {
+  std::error_code ec;
+  const fs::path dir = fs::is_directory(folder, ec) ? folder : folderOf(folder);
+  if (!fs::is_directory(dir, ec)) throw InputError(folder.string() + ": no such directory");
+  return listSeries(scanFolder(dir, add));
+}
+
 }  // namespace tessera::io_detail

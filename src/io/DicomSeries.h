@@ -156,4 +156,23 @@ Volume readSeries(FolderScan scan, const std::string& seriesUid, const std::stri
 // The series of a scan, the largest first.
 std::vector<DicomSeriesInfo> listSeries(FolderScan scan);
 
+// How a parser adds one file to a scan; with `mustBeImage`, a file that is
+// not a readable image is an InputError instead of a count in the scan.
+using FileAdder =
+    std::function<void(const std::filesystem::path& file, bool mustBeImage, FolderScan& scan)>;
+
+// Every regular file of `folder` given to `add`; subfolders are counted, not
+// entered.
+FolderScan scanFolder(const std::filesystem::path& folder, const FileAdder& add);
+
+// The series of a folder, or the series of the one file named (read from the
+// files beside it, that file's own errors first): what the readers'
+// path entry points share.
+Volume readFolderOrFile(const std::filesystem::path& folderOrFile, const std::string& seriesUid,
+                        const FileAdder& add, const PixelDecoder& decode);
+
+// The series of `folder`, or of the folder holding the file named.
+std::vector<DicomSeriesInfo> listFolderSeries(const std::filesystem::path& folder,
+                                              const FileAdder& add);
+
 }  // namespace tessera::io_detail

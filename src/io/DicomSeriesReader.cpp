@@ -232,27 +232,6 @@ void addFile(const fs::path& file, bool mustBeImage, FolderScan& scan) {
   scan.slices.push_back(sliceHeader(file, ff));
 }
 
-FolderScan scanFolder(const fs::path& folder) {
-  FolderScan scan;
-  scan.where = "folder " + folder.string();
-  std::vector<fs::path> files;
-  std::error_code ec;
-  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
-    std::error_code tec;
-    if (it->is_directory(tec)) {
-      ++scan.subfolders;
-    } else if (it->is_regular_file(tec)) {
-      files.push_back(it->path());
-    }
-  }
-  if (ec) throw InputError(folder.string() + ": cannot list the folder: " + ec.message());
-  // Sorted only so that messages are the same from run to run; slice order
-  // comes from positions.
-  std::sort(files.begin(), files.end());
-  for (const auto& f : files) addFile(f, false, scan);
-  return scan;
-}
-
 // Decodes one slice's pixels into z-plane `z` of `stored`.
 StoredRange readPixels(const Slice& s, Volume& stored, int z) {
   const std::string f = s.file.string();
@@ -292,30 +271,11 @@ StoredRange readPixels(const Slice& s, Volume& stored, int z) {
   return io_detail::storePixels(s, p, length, stored, z);
 }
 
-fs::path folderOf(const fs::path& p) {
-  fs::path f = p.parent_path();
-  return f.empty() ? fs::path(".") : f;
-}
-
 }  // namespace
 
 Volume readDicomSeries(const fs::path& folderOrFile, const std::string& seriesUid) {
   io_detail::initDicomToolkit();
-  const std::string p = folderOrFile.string();
-  std::error_code ec;
-  const fs::file_status st = fs::status(folderOrFile, ec);
-  if (ec || !fs::exists(st)) throw InputError(p + ": no such file or directory");
-  if (fs::is_directory(st))
-    return io_detail::readSeries(scanFolder(folderOrFile), seriesUid, p, readPixels);
-  if (!fs::is_regular_file(st)) throw InputError(p + ": not a regular file or a directory");
-
-  // One file: its own errors first, then its series (and stack) from the
-  // files beside it.
-  FolderScan own;
-  addFile(folderOrFile, true, own);
-  const fs::path folder = folderOf(folderOrFile);
-  return io_detail::readSeries(scanFolder(folder), seriesUid, p, readPixels,
-                               folder / folderOrFile.filename());
+  return io_detail::readFolderOrFile(folderOrFile, seriesUid, addFile, readPixels);
 }
 
 Volume readDicomFiles(const std::vector<fs::path>& files, const std::string& seriesUid) {
@@ -333,10 +293,7 @@ Volume readDicomFiles(const std::vector<fs::path>& files, const std::string& ser
 
 std::vector<DicomSeriesInfo> listDicomSeries(const fs::path& folder) {
   io_detail::initDicomToolkit();
-  std::error_code ec;
-  const fs::path dir = fs::is_directory(folder, ec) ? folder : folderOf(folder);
-  if (!fs::is_directory(dir, ec)) throw InputError(folder.string() + ": no such directory");
-  return io_detail::listSeries(scanFolder(dir));
+  return io_detail::listFolderSeries(folder, addFile);
 }
 
 }  // namespace tessera

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 
 #include "tessera/core/Error.h"
 
@@ -39,6 +40,18 @@ std::string lower(std::string_view s) {
   std::transform(out.begin(), out.end(), out.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return out;
+}
+
+void requireField(bool present, const std::string& file, const char* format, const char* key) {
+  if (!present) {
+    throw InputError(file + ": " + format + " header has no '" + std::string(key) + "' field");
+  }
+}
+
+std::string numberString(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
 }
 
 std::string printable(std::string_view s, std::size_t max) {

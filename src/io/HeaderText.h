@@ -18,6 +18,10 @@ std::string trim(std::string_view s);
 std::vector<std::string> words(std::string_view s);
 // ASCII lower case.
 std::string lower(std::string_view s);
+// InputError "<file>: <format> header has no '<key>' field" unless `present`.
+void requireField(bool present, const std::string& file, const char* format, const char* key);
+// `v` as printf's "%g" writes it (six significant digits), for messages.
+std::string numberString(double v);
 // At most `max` characters of `s`, non-printable ones shown as '?'.
 std::string printable(std::string_view s, std::size_t max);
 

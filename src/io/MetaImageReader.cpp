@@ -61,11 +61,7 @@ struct MetaHeader {
   std::uint64_t headerEnd = 0;  // offset of the first byte after the header
 };
 
-std::string numberString(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
+using io_detail::numberString;
 
 class LineParser {
  public:
@@ -359,13 +355,10 @@ Volume readMetaImage(const ByteSource& header, const FileSet& files) {
   const std::string& p = header.name();
   const MetaHeader h = parseHeader(header);
 
-  auto require = [&](bool ok, const char* key) {
-    if (!ok) throw InputError(p + ": MetaImage header has no '" + std::string(key) + "' field");
-  };
-  require(h.nDims.has_value(), "NDims");
-  require(!h.dimSize.empty(), "DimSize");
-  require(h.elementType.has_value(), "ElementType");
-  require(h.dataFile.has_value(), "ElementDataFile");
+  io_detail::requireField(h.nDims.has_value(), p, "MetaImage", "NDims");
+  io_detail::requireField(!h.dimSize.empty(), p, "MetaImage", "DimSize");
+  io_detail::requireField(h.elementType.has_value(), p, "MetaImage", "ElementType");
+  io_detail::requireField(h.dataFile.has_value(), p, "MetaImage", "ElementDataFile");
   if (h.objectType && *h.objectType != "Image") {
     throw InputError(p + ": ObjectType is '" + *h.objectType + "'; Tessera reads Image objects");
   }

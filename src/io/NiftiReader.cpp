@@ -6,6 +6,7 @@
 // NIfTI-1 vox_offset float is cast to int unchecked) where Tessera names the
 // problem. It remains the NIfTI writer and the test oracle for the affines.
 #include "tessera/io/NiftiReader.h"
+#include "io/HeaderText.h"
 
 #include <algorithm>
 #include <array>
@@ -82,11 +83,7 @@ std::string quoteMagic(const char* m, std::size_t n) {
   return "'" + s + "'";
 }
 
-std::string numberString(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
+using io_detail::numberString;
 
 bool endsWith(const std::string& name, const std::string& suffix) {
   return name.size() >= suffix.size() &&
@@ -99,54 +96,41 @@ bool isAnalyzePairName(const std::string& name) {
   return endsWith(name, ".hdr") || endsWith(name, ".hdr.gz") || endsWith(name, ".HDR");
 }
 
-// NIfTI-1 field offsets (nifti1.h, struct nifti_1_header).
-Header nifti1(const Fields& f) {
-  Header h;
-  h.version = 1;
-  for (std::size_t i = 0; i < 8; ++i) {
-    h.dim[i] = f.at<std::int16_t>(40 + 2 * i);
-    h.pixdim[i] = f.at<float>(76 + 4 * i);
-  }
-  h.datatype = f.at<std::int16_t>(70);
-  h.voxOffset = f.at<float>(108);
-  h.sclSlope = f.at<float>(112);
-  h.sclInter = f.at<float>(116);
-  NiftiGeometryFields& g = h.geometry;
-  g.qformCode = f.at<std::int16_t>(252);
-  g.sformCode = f.at<std::int16_t>(254);
-  g.quaternB = f.at<float>(256);
-  g.quaternC = f.at<float>(260);
-  g.quaternD = f.at<float>(264);
-  g.qoffset = glm::dvec3(f.at<float>(268), f.at<float>(272), f.at<float>(276));
-  for (std::size_t row = 0; row < 3; ++row) {
-    for (std::size_t col = 0; col < 4; ++col)
-      g.srow[row][col] = f.at<float>(280 + 16 * row + 4 * col);
-  }
-  return h;
-}
+// Where a header version keeps the fields read here. The fields that follow
+// one another (scl_slope/scl_inter, qform_code/sform_code, quatern_b/c/d
+// then qoffset_x/y/z, the srow_* rows) are adjacent in both versions.
+struct FieldOffsets {
+  std::size_t dim, pixdim, datatype, voxOffset, sclSlope, qformCode, quatern, srow;
+};
+constexpr FieldOffsets kNifti1Offsets{40, 76, 70, 108, 112, 252, 256, 280};   // nifti_1_header
+constexpr FieldOffsets kNifti2Offsets{16, 104, 12, 168, 176, 344, 352, 400};  // nifti_2_header
 
-// NIfTI-2 field offsets (nifti2.h, struct nifti_2_header).
-Header nifti2(const Fields& f) {
+// Decodes the fields at `o` in the widths of a header version: Int for dim,
+// Real for pixdim, the scaling and the geometry, Code for qform_code and
+// sform_code, VoxOffset for vox_offset (a float in NIfTI-1).
+template <class Int, class Real, class Code, class VoxOffset>
+Header decodeFields(const Fields& f, const FieldOffsets& o) {
   Header h;
-  h.version = 2;
   for (std::size_t i = 0; i < 8; ++i) {
-    h.dim[i] = f.at<std::int64_t>(16 + 8 * i);
-    h.pixdim[i] = f.at<double>(104 + 8 * i);
+    h.dim[i] = f.at<Int>(o.dim + sizeof(Int) * i);
+    h.pixdim[i] = f.at<Real>(o.pixdim + sizeof(Real) * i);
   }
-  h.datatype = f.at<std::int16_t>(12);
-  h.voxOffset = static_cast<double>(f.at<std::int64_t>(168));
-  h.sclSlope = f.at<double>(176);
-  h.sclInter = f.at<double>(184);
+  h.datatype = f.at<std::int16_t>(o.datatype);
+  h.voxOffset = static_cast<double>(f.at<VoxOffset>(o.voxOffset));
+  h.sclSlope = f.at<Real>(o.sclSlope);
+  h.sclInter = f.at<Real>(o.sclSlope + sizeof(Real));
   NiftiGeometryFields& g = h.geometry;
-  g.qformCode = f.at<std::int32_t>(344);
-  g.sformCode = f.at<std::int32_t>(348);
-  g.quaternB = f.at<double>(352);
-  g.quaternC = f.at<double>(360);
-  g.quaternD = f.at<double>(368);
-  g.qoffset = glm::dvec3(f.at<double>(376), f.at<double>(384), f.at<double>(392));
+  g.qformCode = f.at<Code>(o.qformCode);
+  g.sformCode = f.at<Code>(o.qformCode + sizeof(Code));
+  const auto real = [&](std::size_t base, std::size_t k) {
+    return f.at<Real>(base + sizeof(Real) * k);
+  };
+  g.quaternB = real(o.quatern, 0);
+  g.quaternC = real(o.quatern, 1);
+  g.quaternD = real(o.quatern, 2);
+  g.qoffset = glm::dvec3(real(o.quatern, 3), real(o.quatern, 4), real(o.quatern, 5));
   for (std::size_t row = 0; row < 3; ++row) {
-    for (std::size_t col = 0; col < 4; ++col)
-      g.srow[row][col] = f.at<double>(400 + 32 * row + 8 * col);
+    for (std::size_t col = 0; col < 4; ++col) g.srow[row][col] = real(o.srow, 4 * row + col);
   }
   return h;
 }
@@ -189,7 +173,11 @@ Header readHeader(const ByteSource& file) {
                      " header");
   }
   const Fields f(buf.data(), swapped);
-  Header h = version == 1 ? nifti1(f) : nifti2(f);
+  Header h =
+      version == 1
+          ? decodeFields<std::int16_t, float, std::int16_t, float>(f, kNifti1Offsets)
+          : decodeFields<std::int64_t, double, std::int32_t, std::int64_t>(f, kNifti2Offsets);
+  h.version = version;
   h.swapped = swapped;
   if (version == 1) {
     const char* magic = f.text(344);

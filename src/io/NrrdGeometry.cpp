@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 #include <glm/matrix.hpp>
 
+#include "io/HeaderText.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/PatientFrame.h"
 
@@ -21,11 +22,7 @@ std::string lower(std::string s) {
   return s;
 }
 
-std::string numberString(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
+using io_detail::numberString;
 
 std::string vectorString(const std::vector<double>& v) {
   std::string s = "(";

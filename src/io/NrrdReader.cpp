@@ -334,13 +334,10 @@ Volume readNrrd(const ByteSource& file, const FileSet& files) {
   const std::string& p = file.name();
   NrrdHeader h = parseHeader(file);
 
-  auto require = [&](bool ok, const std::string& field) {
-    if (!ok) throw InputError(p + ": NRRD header has no '" + field + "' field");
-  };
-  require(h.dimension > 0, "dimension");
-  require(!h.sizes.empty(), "sizes");
-  require(h.type.has_value(), "type");
-  require(!h.encoding.empty(), "encoding");
+  io_detail::requireField(h.dimension > 0, p, "NRRD", "dimension");
+  io_detail::requireField(!h.sizes.empty(), p, "NRRD", "sizes");
+  io_detail::requireField(h.type.has_value(), p, "NRRD", "type");
+  io_detail::requireField(!h.encoding.empty(), p, "NRRD", "encoding");
   if (h.sizes.size() != static_cast<std::size_t>(h.dimension)) {
     throw InputError(p + ": 'sizes' has " + std::to_string(h.sizes.size()) +
                      " values, but dimension is " + std::to_string(h.dimension));

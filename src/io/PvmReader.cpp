@@ -59,11 +59,7 @@ std::string printable(std::string_view s, std::size_t limit) {
   return out;
 }
 
-std::string numberString(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
+using io_detail::numberString;
 
 std::vector<std::string_view> words(std::string_view line) {
   std::vector<std::string_view> out;

@@ -11,6 +11,7 @@
 // directions" without the spacing), so world = origin + sum over a of
 // direction[a] * spacing[a] * index[a]. Without "direction": identity.
 #include "tessera/io/RawSidecarReader.h"
+#include "io/HeaderText.h"
 
 #include <array>
 #include <cmath>
@@ -53,11 +54,7 @@ bool endsWith(const std::string& s, const std::string& suffix) {
          s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-std::string numberString(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
+using io_detail::numberString;
 
 class SidecarParser {
  public:

@@ -77,11 +77,7 @@ struct VtiDocument {
   std::uint64_t appendedStart = 0;  // file offset just after the '_'
 };
 
-std::string numberString(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
+using io_detail::numberString;
 
 class AttributeReader {
  public:
@@ -94,23 +90,11 @@ class AttributeReader {
   const std::string* get(const char* name) const { return ev_.attribute(name); }
 
   std::int64_t integer(const std::string& s, const char* attr) const {
-    std::int64_t v = 0;
-    const char* b = s.data();
-    const char* e = s.data() + s.size();
-    if (b != e && *b == '+') ++b;
-    const auto [ptr, ec] = std::from_chars(b, e, v);
-    if (ec != std::errc() || ptr != e) fail(std::string(attr) + ": '" + s + "' is not an integer");
-    return v;
+    return parsed<std::int64_t>(s, attr, "an integer");
   }
 
   double real(const std::string& s, const char* attr) const {
-    double v = 0.0;
-    const char* b = s.data();
-    const char* e = s.data() + s.size();
-    if (b != e && *b == '+') ++b;
-    const auto [ptr, ec] = std::from_chars(b, e, v);
-    if (ec != std::errc() || ptr != e) fail(std::string(attr) + ": '" + s + "' is not a number");
-    return v;
+    return parsed<double>(s, attr, "a number");
   }
 
   std::vector<double> reals(const char* attr, std::size_t n) const {
@@ -143,6 +127,19 @@ class AttributeReader {
   }
 
  private:
+  // The whole of `s` as a T (a leading '+' allowed, as VTK writes it), or a
+  // failure saying it is not `kind`.
+  template <class T>
+  T parsed(const std::string& s, const char* attr, const char* kind) const {
+    T v{};
+    const char* b = s.data();
+    const char* e = s.data() + s.size();
+    if (b != e && *b == '+') ++b;
+    const auto [ptr, ec] = std::from_chars(b, e, v);
+    if (ec != std::errc() || ptr != e) fail(std::string(attr) + ": '" + s + "' is not " + kind);
+    return v;
+  }
+
   const std::string& what_;
   const XmlEvent& ev_;
 };

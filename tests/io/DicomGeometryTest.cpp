@@ -14,6 +14,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -299,6 +300,15 @@ void expectAffineNear(const glm::dmat4& got, const glm::dmat4& want, double tole
   }
 }
 
+// A slice `name` of orientation `iop` at `ipp`, the rest as FileSpec says.
+FileSpec placedSlice(std::string name, const Iop& iop, glm::dvec3 ipp) {
+  FileSpec f;
+  f.name = std::move(name);
+  f.iop = iop;
+  f.ipp = ipp;
+  return f;
+}
+
 // A stack of `n` slices: positions first + k * step, files named so that
 // name order is not slice order; Instance Number k + 1 unless `numbered` is
 // false; pixel base 1000 k.
@@ -306,10 +316,8 @@ std::vector<FileSpec> stack(const Iop& iop, glm::dvec3 first, glm::dvec3 step, i
                             bool numbered = true) {
   std::vector<FileSpec> files;
   for (int k = 0; k < n; ++k) {
-    FileSpec f;
-    f.name = "IM" + std::to_string((k * 5 + 3) % n) + ".dcm";
-    f.iop = iop;
-    f.ipp = first + static_cast<double>(k) * step;
+    FileSpec f = placedSlice("IM" + std::to_string((k * 5 + 3) % n) + ".dcm", iop,
+                             first + static_cast<double>(k) * step);
     if (numbered) f.instance = k + 1;
     f.base = 1000 * k;
     f.rows = 12;
@@ -351,14 +359,24 @@ std::vector<int> basesOf(const std::vector<FileSpec>& files) {
 
 // Reads a generated stack and checks affine and voxels against `inZOrder`
 // (the files in the z order expected).
-void expectStackReads(const test::TempDir& dir, const std::vector<FileSpec>& inZOrder) {
-  const Volume v = readDicomSeries(dir.path());
+Volume expectStackReads(const test::TempDir& dir, const std::vector<FileSpec>& inZOrder) {
+  Volume v = readDicomSeries(dir.path());
   const FileSpec& f = inZOrder.front();
   EXPECT_EQ(v.dims(), glm::ivec3(f.cols, f.rows, static_cast<int>(inZOrder.size())));
   expectAffineNear(v.indexToWorld(), expectedAffine(*f.iop, f.ps, positions(inZOrder)), 1e-6);
   expectVoxelsOf(v, basesOf(inZOrder), f.cols);
   EXPECT_NE(v.geometrySource().find("DICOM IPP/IOP (LPS -> RAS)"), std::string::npos)
       << v.geometrySource();
+  return v;
+}
+
+// Generates the stack `files` (in z order) into a folder of its own, checks
+// it reads back (expectStackReads) and gives the orientation code read.
+std::string stackOrientation(const test::TempDir& work, const std::vector<FileSpec>& files) {
+  const test::TempDir dir;
+  generate(work, dir, files);
+  if (::testing::Test::HasFatalFailure()) return "(not generated)";
+  return orientationOf(expectStackReads(dir, files).direction()).code;
 }
 
 TEST(DicomGeometry, AxialSeriesInEitherSliceOrderGivesTheAffineOfItsPositions) {
@@ -366,21 +384,13 @@ TEST(DicomGeometry, AxialSeriesInEitherSliceOrderGivesTheAffineOfItsPositions) {
   test::TempDir work;
   {
     SCOPED_TRACE("feet to head");
-    test::TempDir dir;
-    const auto files = stack(kAxial, {-40.5, 22.25, -10}, {0, 0, 2.5}, 8);
-    ASSERT_NO_FATAL_FAILURE(generate(work, dir, files));
-    expectStackReads(dir, files);
-    EXPECT_EQ(orientationOf(readDicomSeries(dir.path()).direction()).code, "LPS");
+    EXPECT_EQ(stackOrientation(work, stack(kAxial, {-40.5, 22.25, -10}, {0, 0, 2.5}, 8)), "LPS");
   }
   {
     // A scanner going head to foot: Instance Number grows downwards, and z
     // follows it (an LPI volume, nothing flipped).
     SCOPED_TRACE("head to feet");
-    test::TempDir dir;
-    const auto files = stack(kAxial, {-40.5, 22.25, 60}, {0, 0, -2.5}, 8);
-    ASSERT_NO_FATAL_FAILURE(generate(work, dir, files));
-    expectStackReads(dir, files);
-    EXPECT_EQ(orientationOf(readDicomSeries(dir.path()).direction()).code, "LPI");
+    EXPECT_EQ(stackOrientation(work, stack(kAxial, {-40.5, 22.25, 60}, {0, 0, -2.5}, 8)), "LPI");
   }
   {
     // Without Instance Numbers, z grows along the normal (row x column).
@@ -398,22 +408,14 @@ TEST(DicomGeometry, SagittalAndCoronalSeriesGiveTheirRasAffine) {
   test::TempDir work;
   {
     SCOPED_TRACE("sagittal");
-    test::TempDir dir;
     // IOP 0\1\0\0\0\-1: rows run posterior, columns inferior, the normal
     // (row x column) points right; the slices are numbered right to left.
-    const auto files = stack(kSagittal, {-30, -100, 80}, {3, 0, 0}, 8);
-    ASSERT_NO_FATAL_FAILURE(generate(work, dir, files));
-    expectStackReads(dir, files);
-    EXPECT_EQ(orientationOf(readDicomSeries(dir.path()).direction()).code, "PIL");
+    EXPECT_EQ(stackOrientation(work, stack(kSagittal, {-30, -100, 80}, {3, 0, 0}, 8)), "PIL");
   }
   {
     SCOPED_TRACE("coronal");
-    test::TempDir dir;
     // IOP 1\0\0\0\0\-1: normal = (1,0,0) x (0,0,-1) = (0,1,0), posterior.
-    const auto files = stack(kCoronal, {-90, -20, 70}, {0, 1.5, 0}, 8);
-    ASSERT_NO_FATAL_FAILURE(generate(work, dir, files));
-    expectStackReads(dir, files);
-    EXPECT_EQ(orientationOf(readDicomSeries(dir.path()).direction()).code, "LIP");
+    EXPECT_EQ(stackOrientation(work, stack(kCoronal, {-90, -20, 70}, {0, 1.5, 0}, 8)), "LIP");
   }
 }
 
@@ -474,10 +476,7 @@ TEST(DicomGeometry, SingleSliceAndMissingOrientationFallBackAsDocumented) {
   {
     SCOPED_TRACE("one coronal slice with Slice Thickness");
     test::TempDir dir;
-    FileSpec f;
-    f.name = "one.dcm";
-    f.iop = kCoronal;
-    f.ipp = glm::dvec3(-90, 14, 70);
+    FileSpec f = placedSlice("one.dcm", kCoronal, glm::dvec3(-90, 14, 70));
     f.more = "'thickness': 3.5";
     ASSERT_NO_FATAL_FAILURE(generate(work, dir, {f}));
     const Volume v = readDicomSeries(dir / "one.dcm");
@@ -697,10 +696,7 @@ TEST(DicomDefects, UnreadableCopiesBesideAReadableFileAreSkippedAndCounted) {
   {
     SCOPED_TRACE("MR_small beside MR_truncated");
     test::TempDir dir;
-    FileSpec small;
-    small.name = "MR_small.dcm";
-    small.iop = kAxial;
-    small.ipp = glm::dvec3(-83.9063, -91.2, 6.6406);
+    FileSpec small = placedSlice("MR_small.dcm", kAxial, glm::dvec3(-83.9063, -91.2, 6.6406));
     FileSpec truncated = small;
     truncated.name = "MR_truncated.dcm";
     truncated.more = "'truncate': 62";  // ends inside its pixel data
@@ -784,10 +780,7 @@ TEST(DicomDefects, AttributesStoredAsUnAreReadForTheRealReason) {
   const std::string un = "'un': ['ImagePositionPatient', 'ImageOrientationPatient', 'PixelSpacing'";
   {
     test::TempDir dir;
-    FileSpec f;
-    f.name = "rtdose.dcm";
-    f.iop = kAxial;
-    f.ipp = glm::dvec3(189.43125, 199.43125, -761.87);
+    FileSpec f = placedSlice("rtdose.dcm", kAxial, glm::dvec3(189.43125, 199.43125, -761.87));
     f.more = "'frames': 3, " + un + "]";
     ASSERT_NO_FATAL_FAILURE(generate(work, dir, {f}));
     try {

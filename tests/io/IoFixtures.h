@@ -23,8 +23,10 @@
 #include <unistd.h>
 
 #include "support/TestSupport.h"
+#include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Volume.h"
+#include "tessera/io/NiftiReader.h"
 
 namespace tessera::test {
 
@@ -32,6 +34,14 @@ inline void writeFile(const std::filesystem::path& path, std::string_view bytes)
   std::ofstream out(path, std::ios::binary);
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   if (!out) throw std::runtime_error("cannot write fixture " + path.string());
+}
+
+// The whole file.
+inline std::string fileBytes(const std::filesystem::path& path) {
+  std::string bytes(static_cast<std::size_t>(std::filesystem::file_size(path)), '\0');
+  std::ifstream in(path, std::ios::binary);
+  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  return bytes;
 }
 
 // What randomVolume() gives its volume besides the voxels.
@@ -79,6 +89,24 @@ inline void expectSameVolume(const Volume& a, const Volume& b) {
   ASSERT_EQ(a.byteSize(), b.byteSize());
   EXPECT_EQ(std::memcmp(a.bytes().data(), b.bytes().data(), a.byteSize()), 0)
       << "voxel bytes differ";
+}
+
+// The MNI ch2 head (mricron-data): real data for the writers' round trips.
+inline const std::filesystem::path kCh2 = "/usr/share/mricron/templates/ch2.nii.gz";
+
+// Writes ch2 as each of `names` with write(volume, path) and expects
+// read(path) to give it back exactly; skips the test where ch2 is not
+// installed.
+template <class Write, class Read>
+void expectCh2RoundTrips(const std::vector<std::string>& names, Write&& write, Read&& read) {
+  if (!std::filesystem::exists(kCh2)) GTEST_SKIP() << kCh2 << " is not installed (mricron-data)";
+  TempDir dir;
+  const Volume ch2 = readNifti(kCh2);
+  for (const auto& name : names) {
+    SCOPED_TRACE(name);
+    write(ch2, dir / name);
+    expectSameVolume(read(dir / name), ch2);
+  }
 }
 
 inline std::string gzipBytes(std::string_view data) {
@@ -219,6 +247,16 @@ void expectRejected(F&& f, const std::vector<std::string>& fragments) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_LT(seconds, 2.0) << "rejecting bad input took " << seconds << " s";
+}
+
+// Expects write(volume, path) into a folder that does not exist to throw an
+// Error naming the path, and to leave nothing behind in `dir`.
+template <class Write>
+void expectWriteIntoMissingFolderFails(const TempDir& dir, const std::filesystem::path& path,
+                                       Write&& write) {
+  const Volume v = randomVolume({2, 2, 2}, ScalarType::U8, 1);
+  expectRejected<Error>([&] { write(v, path); }, {path.string(), "does not exist"});
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
 }
 
 }  // namespace tessera::test

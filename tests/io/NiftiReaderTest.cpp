@@ -39,6 +39,16 @@ std::filesystem::path writeNifti(const TempDir& dir, const std::string& name, co
   return path;
 }
 
+// Writes `values` as the voxels of a file with header `f` (in its byte
+// order), reads it and expects every value back as it was.
+template <class T>
+Volume readBackValues(const TempDir& dir, const std::string& name, const NiftiFields& f,
+                      const std::vector<T>& values, bool gzip = false) {
+  const Volume v = readNifti(writeNifti(dir, name, f, voxelBytes(values, f.bigEndian), gzip));
+  for (std::size_t i = 0; i < values.size(); ++i) EXPECT_EQ(v.valueAtIndex(i), values[i]) << i;
+  return v;
+}
+
 std::vector<std::uint8_t> ramp(std::size_t n) {
   std::vector<std::uint8_t> v(n);
   for (std::size_t i = 0; i < n; ++i) v[i] = static_cast<std::uint8_t>((i * 37 + 11) % 256);
@@ -52,13 +62,10 @@ TEST(NiftiReader, ReadsUncompressedU8VoxelsDimsAndSpacingExactly) {
   f.pixdim[2] = 1.25;
   f.pixdim[3] = 3.0;
   const auto values = ramp(4 * 3 * 2);
-  const auto path = writeNifti(dir, "a.nii", f, voxelBytes(values, false));
-
-  const Volume v = readNifti(path);
+  const Volume v = readBackValues(dir, "a.nii", f, values);
   EXPECT_EQ(v.dims(), glm::ivec3(4, 3, 2));
   EXPECT_EQ(v.type(), ScalarType::U8);
   EXPECT_EQ(v.spacing(), glm::dvec3(0.5, 1.25, 3.0));
-  for (std::size_t i = 0; i < values.size(); ++i) EXPECT_EQ(v.valueAtIndex(i), values[i]) << i;
   EXPECT_NE(v.description().find("NIfTI-1"), std::string::npos) << v.description();
 }
 
@@ -73,12 +80,9 @@ TEST(NiftiReader, ReadsGzipInt16Exactly) {
   std::vector<std::int16_t> values(60);
   for (std::size_t i = 0; i < values.size(); ++i)
     values[i] = static_cast<std::int16_t>(i * 1000 - 30000);
-  const auto path = writeNifti(dir, "a.nii.gz", f, voxelBytes(values, false), true);
-
-  const Volume v = readNifti(path);
+  const Volume v = readBackValues(dir, "a.nii.gz", f, values, true);
   EXPECT_EQ(v.dims(), glm::ivec3(5, 4, 3));
   EXPECT_EQ(v.type(), ScalarType::I16);
-  for (std::size_t i = 0; i < values.size(); ++i) EXPECT_EQ(v.valueAtIndex(i), values[i]) << i;
 }
 
 TEST(NiftiReader, SwapsBigEndianHeaderAndVoxels) {
@@ -91,13 +95,10 @@ TEST(NiftiReader, SwapsBigEndianHeaderAndVoxels) {
   std::vector<std::uint16_t> values(24);
   for (std::size_t i = 0; i < values.size(); ++i)
     values[i] = static_cast<std::uint16_t>(i * 2731 + 1);
-  const auto path = writeNifti(dir, "be.nii", f, voxelBytes(values, true));
-
-  const Volume v = readNifti(path);
+  const Volume v = readBackValues(dir, "be.nii", f, values);
   EXPECT_EQ(v.dims(), glm::ivec3(4, 3, 2));
   EXPECT_EQ(v.type(), ScalarType::U16);
   EXPECT_EQ(v.spacing().x, 2.0);
-  for (std::size_t i = 0; i < values.size(); ++i) EXPECT_EQ(v.valueAtIndex(i), values[i]) << i;
 }
 
 TEST(NiftiReader, ReadsNifti2Float32BigAndLittleEndian) {
@@ -112,52 +113,44 @@ TEST(NiftiReader, ReadsNifti2Float32BigAndLittleEndian) {
     std::vector<float> values(24);
     for (std::size_t i = 0; i < values.size(); ++i)
       values[i] = -3.5f + 0.25f * static_cast<float>(i);
-    const auto path = writeNifti(dir, "n2.nii.gz", f, voxelBytes(values, big), true);
-
-    const Volume v = readNifti(path);
+    const Volume v = readBackValues(dir, "n2.nii.gz", f, values, true);
     EXPECT_EQ(v.dims(), glm::ivec3(4, 3, 2));
     EXPECT_EQ(v.type(), ScalarType::F32);
     EXPECT_EQ(v.spacing().z, 0.7);
-    for (std::size_t i = 0; i < values.size(); ++i) EXPECT_EQ(v.valueAtIndex(i), values[i]) << i;
     EXPECT_NE(v.description().find("NIfTI-2"), std::string::npos) << v.description();
   }
 }
 
+// 24 values of T: first, first + step, ...
+template <class T>
+std::vector<T> arithmetic(double first, double step) {
+  std::vector<T> v(24);
+  for (std::size_t i = 0; i < v.size(); ++i)
+    v[i] = static_cast<T>(first + step * static_cast<double>(i));
+  return v;
+}
+
+NiftiFields typed(int datatype, int bitpix, bool bigEndian = false) {
+  NiftiFields f;
+  f.datatype = datatype;
+  f.bitpix = bitpix;
+  f.bigEndian = bigEndian;
+  return f;
+}
+
 TEST(NiftiReader, WidensInt8AndConvertsInt32AndFloat64ToF32) {
   TempDir dir;
-  {
-    NiftiFields f;
-    f.datatype = kDtInt8;
-    std::vector<std::int8_t> values(24);
-    for (std::size_t i = 0; i < values.size(); ++i)
-      values[i] = static_cast<std::int8_t>(i * 11 - 128);
-    const Volume v = readNifti(writeNifti(dir, "i8.nii", f, voxelBytes(values, false)));
-    EXPECT_EQ(v.type(), ScalarType::I16);
-    for (std::size_t i = 0; i < values.size(); ++i) EXPECT_EQ(v.valueAtIndex(i), values[i]);
-  }
-  {
-    NiftiFields f;
-    f.datatype = kDtInt32;
-    f.bitpix = 32;
-    std::vector<std::int32_t> values(24);
-    for (std::size_t i = 0; i < values.size(); ++i)
-      values[i] = static_cast<std::int32_t>(i) * 100000 - 1000000;
-    const Volume v = readNifti(writeNifti(dir, "i32.nii", f, voxelBytes(values, false)));
-    EXPECT_EQ(v.type(), ScalarType::F32);
-    for (std::size_t i = 0; i < values.size(); ++i) EXPECT_EQ(v.valueAtIndex(i), values[i]);
-  }
-  {
-    NiftiFields f;
-    f.datatype = kDtFloat64;
-    f.bitpix = 64;
-    f.bigEndian = true;
-    std::vector<double> values(24);
-    for (std::size_t i = 0; i < values.size(); ++i) values[i] = 0.5 * static_cast<double>(i) - 4.0;
-    const Volume v = readNifti(writeNifti(dir, "f64.nii", f, voxelBytes(values, true)));
-    EXPECT_EQ(v.type(), ScalarType::F32);
-    for (std::size_t i = 0; i < values.size(); ++i) EXPECT_EQ(v.valueAtIndex(i), values[i]);
-    EXPECT_NE(v.description().find("converted to f32"), std::string::npos) << v.description();
-  }
+  EXPECT_EQ(
+      readBackValues(dir, "i8.nii", typed(kDtInt8, 8), arithmetic<std::int8_t>(-128, 11)).type(),
+      ScalarType::I16);
+  EXPECT_EQ(readBackValues(dir, "i32.nii", typed(kDtInt32, 32),
+                           arithmetic<std::int32_t>(-1000000, 100000))
+                .type(),
+            ScalarType::F32);
+  const Volume v =
+      readBackValues(dir, "f64.nii", typed(kDtFloat64, 64, true), arithmetic<double>(-4.0, 0.5));
+  EXPECT_EQ(v.type(), ScalarType::F32);
+  EXPECT_NE(v.description().find("converted to f32"), std::string::npos) << v.description();
 }
 
 TEST(NiftiReader, AppliesSlopeAndInterceptAsF32) {

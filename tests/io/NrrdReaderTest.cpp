@@ -18,12 +18,8 @@
 namespace tessera {
 namespace {
 
-using test::expectRejected;
-using test::expectSameVolume;
-using test::randomVolume;
-using test::TempDir;
-using test::voxelBytes;
-using test::writeFile;
+// The io fixtures are this suite's vocabulary.
+using namespace test;
 
 class NrrdRoundTrip : public ::testing::TestWithParam<std::tuple<ScalarType, bool>> {};
 
