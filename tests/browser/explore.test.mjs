@@ -1,20 +1,16 @@
 // Browser test: the slice views and the bread-slice region, the grid view
 // and the zoom-driven level swap (fixture.mjs serves the site and launches
 // Chromium).
-import { test, before, after } from 'node:test';
+import { test } from 'node:test';
 import fs from 'node:fs';
 import path from 'node:path';
 import {
-  SIZE, VOLUME, PAGE_SAMPLING, CH2, shots, bench, check, checksPassed, startBrowser, served,
-  decodePng, psnrAgainst, snapshot, changedFraction, differingPixels, meanAbsDiff, openPage,
-  writePilNifti, openThroughPicker, withoutOverlays, psnrOf, chunkKeys,
+  SIZE, PAGE_SAMPLING, CH2, shots, check, decodePng, psnrAgainst, snapshot, changedFraction,
+  differingPixels, meanAbsDiff, openPage, writePilNifti, withoutOverlays, psnrOf, browserSuite,
 } from './fixture.mjs';
 
-let browser;
-before(async () => { browser = await startBrowser(); });
-after(async () => { if (browser) await browser.close(); });
-// Runs one of the functions below (context, url, tmp, run) as a test.
-const checks = (f) => () => checksPassed(() => f(browser.context, browser.url, browser.tmp, browser.run));
+// One Chromium for the file; checks(f) runs f (context, url, tmp, run) as a test.
+const checks = browserSuite();
 
 test('slice views equal `tessera slice`; a region renders like `tessera render --region`', checks(sliceViewsAndRegion));
 test('grid view: blocks, moves and refusals', checks(gridView));

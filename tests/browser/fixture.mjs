@@ -15,6 +15,7 @@ import { execFileSync } from 'node:child_process';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
+import { before, after } from 'node:test';
 import http from 'node:http';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
@@ -49,6 +50,16 @@ export async function checksPassed(body) {
 
 // The native CLI (stdout as a string).
 export const run = (...args) => execFileSync(cli, args, { stdio: ['ignore', 'pipe', 'pipe'] }).toString();
+
+// One Chromium for the whole test file: registers the file's before/after
+// hooks and returns the wrapper that runs a function (context, url, tmp, run)
+// as a node test whose checks must all pass.
+export function browserSuite() {
+  let browser;
+  before(async () => { browser = await startBrowser(); });
+  after(async () => { if (browser) await browser.close(); });
+  return (f) => () => checksPassed(() => f(browser.context, browser.url, browser.tmp, browser.run));
+}
 
 // A temporary folder for the test's files, the site served with it under
 // /data/ (and the mricron templates under /templates/), and Chromium.

@@ -1,20 +1,16 @@
 // Browser test: the page's 3D view on WebGL 2 and WebGL 1 (render.test.mjs
 // of tests/browser; fixture.mjs serves the site and launches Chromium).
-import { test, before, after } from 'node:test';
+import { test } from 'node:test';
 import fs from 'node:fs';
 import path from 'node:path';
 import zlib from 'node:zlib';
 import {
-  SIZE, VOLUME, PAGE_SAMPLING, CH2, shots, bench, check, checksPassed, startBrowser, served,
-  decodePng, psnrAgainst, snapshot, changedFraction, differingPixels, meanAbsDiff, openPage,
-  writePilNifti, openThroughPicker, withoutOverlays, psnrOf, chunkKeys,
+  SIZE, VOLUME, CH2, shots, bench, check, psnrAgainst, snapshot, changedFraction, differingPixels,
+  meanAbsDiff, openPage, writePilNifti, openThroughPicker, withoutOverlays, browserSuite,
 } from './fixture.mjs';
 
-let browser;
-before(async () => { browser = await startBrowser(); });
-after(async () => { if (browser) await browser.close(); });
-// Runs one of the functions below (context, url, tmp, run) as a test.
-const checks = (f) => () => checksPassed(() => f(browser.context, browser.url, browser.tmp, browser.run));
+// One Chromium for the file; checks(f) runs f (context, url, tmp, run) as a test.
+const checks = browserSuite();
 
 test('WebGL 2 and WebGL 1 pages match the native renderer; controls, formats and errors', checks(webglPages));
 test('benchmark: ch2 at 512x512 (TESSERA_BENCH=1 or scripts/browser-test.sh --bench)', { skip: !bench }, checks(benchmark));

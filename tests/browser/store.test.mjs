@@ -2,20 +2,16 @@
 // grid view and slices read with bounded reads (fixture.mjs serves the site
 // and launches Chromium). The tests run in order: the first writes the
 // store the others read.
-import { test, before, after } from 'node:test';
+import { test } from 'node:test';
 import fs from 'node:fs';
 import path from 'node:path';
 import {
-  SIZE, VOLUME, PAGE_SAMPLING, CH2, shots, bench, check, checksPassed, startBrowser, served,
-  decodePng, psnrAgainst, snapshot, changedFraction, differingPixels, meanAbsDiff, openPage,
-  writePilNifti, openThroughPicker, withoutOverlays, psnrOf, chunkKeys,
+  SIZE, PAGE_SAMPLING, CH2, check, served, decodePng, psnrAgainst, snapshot, changedFraction,
+  differingPixels, openPage, withoutOverlays, chunkKeys, browserSuite,
 } from './fixture.mjs';
 
-let browser;
-before(async () => { browser = await startBrowser(); });
-after(async () => { if (browser) await browser.close(); });
-// Runs one of the functions below (context, url, tmp, run) as a test.
-const checks = (f) => () => checksPassed(() => f(browser.context, browser.url, browser.tmp, browser.run));
+// One Chromium for the file; checks(f) runs f (context, url, tmp, run) as a test.
+const checks = browserSuite();
 
 test('OME-Zarr ?url=: coarse first, refined to the native render; errors name the URL', checks(zarrStoreFromUrl));
 test('OME-Zarr region: bounded reads, renders like `tessera render STORE --region`', checks(zarrRegionFromUrl));
