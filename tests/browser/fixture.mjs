@@ -259,6 +259,18 @@ export function psnrOf(a, b) {
   return mse === 0 ? 999 : 10 * Math.log10(255 * 255 / mse);
 }
 
+// Sets the page's checkboxes ({ id: checked, ... }), sends one 'change'
+// from the last of them (the page's handler reads the whole group) and
+// waits for the frame it renders.
+export function setCheckboxes(page, states) {
+  return page.evaluate(async (s) => {
+    const ids = Object.keys(s);
+    for (const id of ids) document.getElementById(id).checked = s[id];
+    document.getElementById(ids[ids.length - 1]).dispatchEvent(new Event('change'));
+    await window.tessera.render();
+  }, states);
+}
+
 // The level-0 chunk keys of a store's box [begin, end) (x, y, z).
 export function chunkKeys(store, begin, end) {
   const meta = JSON.parse(fs.readFileSync(path.join(store, '0', '.zarray'), 'utf8'));
