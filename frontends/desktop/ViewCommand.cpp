@@ -18,13 +18,12 @@ void addViewCommand(CLI::App& app) {
   addSeriesOption(cmd, o->series);
   cmd->add_option("--tf", o->tf, "Transfer function: preset or FILE.json")->capture_default_str();
   cmd->add_option("--size", o->size, "Window size WIDTHxHEIGHT")->capture_default_str();
-  o->labelsOption = cmd->add_option("--labels", o->labels,
-                                    "Show a label volume (atlas) as `tessera render --labels` "
-                                    "does: nearest-neighbour sampling and a categorical colour "
-                                    "table instead of --tf. TABLE (optional): JSON or a label text "
-                                    "file (ITK-SNAP, FreeSurfer LUT, mricron); without it a "
-                                    "default palette. The Labels panel shows and hides labels")
-                        ->expected(0, 1);
+  o->labelsOption = addLabelsOption(
+      cmd, o->labels,
+      "Show a label volume (atlas) as `tessera render --labels` does: nearest-neighbour sampling "
+      "and a categorical colour table instead of --tf. TABLE (optional): JSON or a label text file "
+      "(ITK-SNAP, FreeSurfer LUT, mricron); without it a default palette. The Labels panel shows "
+      "and hides labels");
   cmd->add_option("--profile", o->profile,
                   "Device profile (gles3, gles2, webgl1, ...; its API level picks the context)")
       ->capture_default_str();

@@ -10,6 +10,7 @@
 #include "app/BenchExplore.h"
 #include "app/BenchFcc.h"
 #include "app/BenchHybrid.h"
+#include "app/BenchJson.h"
 #include "app/BenchPeers.h"
 #include "app/BenchRoofline.h"
 #include "app/BenchSampling.h"
@@ -177,12 +178,8 @@ void runBench(const BenchOptions& o) {
                       {"shade", v.settings.shading.enabled},
                       {"occupied_block_fraction", v.caster->report().occupiedBlockFraction}});
     }
-    nlohmann::json j;
-    j["file"] = spec;
-    j["width"] = width;
-    j["height"] = height;
+    nlohmann::json j = benchJson(spec, width, height, context->caps().renderer);
     j["frames"] = o.frames;
-    j["gl_renderer"] = context->caps().renderer;
     j["rows"] = rows;
     std::printf("%s\n", j.dump(2).c_str());
     return;
@@ -312,12 +309,8 @@ void runLayoutBench(const BenchOptions& o) {
                     {"frame_ms", v.ms}});
   }
   if (o.json) {
-    nlohmann::json j;
-    j["file"] = spec;
-    j["width"] = width;
-    j["height"] = height;
+    nlohmann::json j = benchJson(spec, width, height, context->caps().renderer);
     j["frames"] = o.frames;
-    j["gl_renderer"] = context->caps().renderer;
     j["rows"] = rows;
     std::printf("%s\n", j.dump(2).c_str());
   }

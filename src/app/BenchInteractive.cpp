@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/BenchHybrid.h"
+#include "app/BenchJson.h"
 #include "app/Commands.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
@@ -115,10 +116,7 @@ void runInteractiveBench(const HybridBenchOptions& o) {
   const double settledMedian = median(settled);
 
   if (o.json) {
-    nlohmann::json j;
-    j["file"] = spec;
-    j["width"] = width;
-    j["height"] = height;
+    nlohmann::json j = benchJson(spec, width, height, context->caps().renderer);
     j["goal_ms"] = qo.goalMs;
     j["full_quality_ms"] = fullMs;
     nlohmann::json jr = nlohmann::json::array();
@@ -135,7 +133,6 @@ void runInteractiveBench(const HybridBenchOptions& o) {
     j["settled_frames"] = settled.size();
     j["idle_psnr_vs_ground_truth"] = idlePsnr;
     j["last_moving_psnr_vs_idle"] = movingPsnr;
-    j["gl_renderer"] = context->caps().renderer;
     std::printf("%s\n", j.dump(2).c_str());
     return;
   }

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/BenchJson.h"
 #include "app/Commands.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
@@ -139,12 +140,8 @@ void runRooflineBench(const RooflineBenchOptions& o) {
   const SampleCounts samples = countSamples(volume, tf, base);
 
   if (o.json) {
-    nlohmann::json j;
-    j["file"] = spec;
-    j["width"] = base.width;
-    j["height"] = base.height;
+    nlohmann::json j = benchJson(spec, base.width, base.height, device.context->caps().renderer);
     j["step_voxels"] = o.step;
-    j["gl_renderer"] = device.context->caps().renderer;
     j["samples_per_frame_ert"] = samples.withErt;
     j["samples_per_frame_nominal"] = samples.nominal;
     for (const render::RooflineRate& r : rates) {

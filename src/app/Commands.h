@@ -62,6 +62,12 @@ inline void addTimeChannelOptions(CLI::App* cmd, int& time, int& channel) {
       ->check(CLI::NonNegativeNumber);
 }
 
+// --labels [TABLE]: render and view show a label volume with or without a
+// colour table; the option's count() says whether it was given.
+inline CLI::Option* addLabelsOption(CLI::App* cmd, std::string& table, const std::string& help) {
+  return cmd->add_option("--labels", table, help)->expected(0, 1);
+}
+
 // Parses --size "512x512" (InputError otherwise).
 void parseSize(const std::string& text, int& width, int& height);
 

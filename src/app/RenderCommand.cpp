@@ -520,15 +520,13 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_flag("--jitter", o->jitter, "Jitter the first sample per pixel");
   addShadingOptions(cmd, o->shading);
   addClippingOptions(cmd, o->clipping);
-  o->labelsOption =
-      cmd->add_option("--labels", o->labels,
-                      "Render a label volume (atlas, 8-bit integer labels): nearest-neighbour "
-                      "sampling and a categorical colour table instead of --tf. TABLE (optional): "
-                      "JSON {\"labels\": [{\"value\", \"name\", \"color\": [r,g,b] 0..1, "
-                      "\"opacity\", \"visible\"}]} or a label text file (ITK-SNAP, FreeSurfer "
-                      "LUT, or mricron's IDX NAME); labels it does not name are hidden. Without "
-                      "TABLE: a default palette for every label present")
-          ->expected(0, 1);
+  o->labelsOption = addLabelsOption(
+      cmd, o->labels,
+      "Render a label volume (atlas, 8-bit integer labels): nearest-neighbour sampling and a "
+      "categorical colour table instead of --tf. TABLE (optional): JSON {\"labels\": "
+      "[{\"value\", \"name\", \"color\": [r,g,b] 0..1, \"opacity\", \"visible\"}]} or a label "
+      "text file (ITK-SNAP, FreeSurfer LUT, or mricron's IDX NAME); labels it does not name are "
+      "hidden. Without TABLE: a default palette for every label present");
   cmd->add_option("--window", o->window,
                   "Value window MIN MAX (raw values); default: the value range")
       ->expected(2);

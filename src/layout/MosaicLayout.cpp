@@ -5,6 +5,7 @@
 #include <cstring>
 #include <limits>
 
+#include "layout/NormalisedMapping.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/gpu/Draw.h"
@@ -196,12 +197,7 @@ std::unique_ptr<MosaicLayout> MosaicLayout::create(const Volume& volume,
   if (!l->plan_.fits) throw GpuError("mosaic layout: " + l->plan_.reason);
   l->geometry_ = geometryFor(volume.dims(), limits.max2DTextureSize);
   l->storage_ = storageFor(volume.type(), limits);
-  if (volume.type() == ScalarType::U8) {
-    l->mapping_ = {255.0, 0.0};
-  } else {
-    const ValueRange r = volume.valueRange();
-    l->mapping_ = {r.max > r.min ? r.max - r.min : 1.0, r.min};
-  }
+  l->mapping_ = normalisedMapping(volume);
   const Geometry& g = l->geometry_;
   const gpu::TexelFormat f = formatOf(l->storage_);
   l->texture_ =

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "layout/NormalisedMapping.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/gpu/Draw.h"
@@ -241,12 +242,7 @@ std::unique_ptr<PackedMosaicLayout> PackedMosaicLayout::create(const Volume& vol
   l->plan_ = std::move(chosen.plan);
   if (!l->plan_.fits) throw GpuError("packed-mosaic layout: " + l->plan_.reason);
   l->geometry_ = chosen.geometry;
-  if (volume.type() == ScalarType::U8) {
-    l->mapping_ = {255.0, 0.0};
-  } else {
-    const ValueRange r = volume.valueRange();
-    l->mapping_ = {r.max > r.min ? r.max - r.min : 1.0, r.min};
-  }
+  l->mapping_ = normalisedMapping(volume);
   const Geometry& g = l->geometry_;
   // ES 2.0 takes only unsized internal formats.
   const gpu::TexelFormat format = gpu::rgba8For(limits.api);

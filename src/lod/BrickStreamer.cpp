@@ -179,24 +179,30 @@ void BrickStreamer::work() {
       queue_.pop_front();
       if (cached_.count(key.id()) || !reading_.insert(key.id()).second) continue;
     }
-    std::shared_ptr<const StoredBrick> brick;
     std::string error;
-    try {
-      brick = readOne(key);
-    } catch (const std::exception& e) {
-      error = e.what();
-    }
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      reading_.erase(key.id());
-      if (brick) {
-        store(key, std::move(brick));
-      } else {
-        recordFailure(key, error);
-      }
-    }
-    progress_.notify_all();
+    readAndStore(key, error);
   }
+}
+
+std::shared_ptr<const StoredBrick> BrickStreamer::readAndStore(const BrickKey& key,
+                                                               std::string& error) {
+  std::shared_ptr<const StoredBrick> brick;
+  try {
+    brick = readOne(key);
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    reading_.erase(key.id());
+    if (brick) {
+      store(key, brick);
+    } else {
+      recordFailure(key, error);
+    }
+  }
+  progress_.notify_all();
+  return brick;
 }
 
 std::shared_ptr<const StoredBrick> BrickStreamer::readNow(const BrickKey& key) {
@@ -209,22 +215,7 @@ std::shared_ptr<const StoredBrick> BrickStreamer::readNow(const BrickKey& key) {
       if (it != cached_.end()) return it->second->second;
       reading_.insert(key.id());
     }
-    std::shared_ptr<const StoredBrick> brick;
-    try {
-      brick = readOne(key);
-    } catch (const std::exception& e) {
-      error = e.what();
-    }
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      reading_.erase(key.id());
-      if (brick)
-        store(key, brick);
-      else
-        recordFailure(key, error);
-    }
-    progress_.notify_all();
-    if (brick) return brick;
+    if (auto brick = readAndStore(key, error)) return brick;
   }
   throw Error("reading brick (level " + std::to_string(key.level) + ") failed " +
               std::to_string(options_.attemptsBeforeFailing) + " times: " + error);

@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/constants.hpp>
 
+#include "render/FramebufferImage.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
 #include "tessera/gpu/Draw.h"
@@ -266,17 +267,11 @@ void HybridCompositor::composeInto(const gpu::Texture& volumeLayer, const Camera
 }
 
 Image HybridCompositor::readImage() const {
-  Image img(image_.width(), image_.height());
-  image_.readRgba8(img.rgba().data());
-  img.flipVertically();
-  return img;
+  return render::readImage(image_);
 }
 
 Image HybridCompositor::readOpacityLayer() const {
-  Image img(resolved_.width(), resolved_.height());
-  resolved_.readRgba8(img.rgba().data());
-  img.flipVertically();
-  return img;
+  return render::readImage(resolved_);
 }
 
 }  // namespace tessera::render

@@ -7,6 +7,7 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/constants.hpp>
 
+#include "render/FramebufferImage.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/Draw.h"
 
@@ -131,16 +132,11 @@ void OverlayRenderer::draw(const std::vector<OverlayLine>& lines, const Camera& 
 }
 
 Image OverlayRenderer::readColor() const {
-  Image img(color_.width(), color_.height());
-  color_.readRgba8(img.rgba().data());
-  img.flipVertically();
-  return img;
+  return render::readImage(color_);
 }
 
 std::vector<float> OverlayRenderer::readDistance() const {
-  Image packed(distance_.width(), distance_.height());
-  distance_.readRgba8(packed.rgba().data());
-  packed.flipVertically();
+  const Image packed = render::readImage(distance_);
   std::vector<float> out(static_cast<std::size_t>(packed.width()) * packed.height(),
                          std::numeric_limits<float>::infinity());
   for (std::size_t i = 0; i < out.size(); ++i) {

@@ -7,6 +7,8 @@
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/packing.hpp>
 
+#include "render/FramebufferImage.h"
+#include "render/SampleParts.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/Draw.h"
@@ -237,14 +239,9 @@ std::vector<gpu::ShaderPart> Raycaster::fragmentParts(const RenderSettings& sett
   std::vector<gpu::ShaderPart> parts = {
       gpu::shaderPreamble(context_.caps().api, true, definesFor(settings)),
       gpu::embeddedShaderPart("render/camera_ray.glsl")};
-  // The precomputed gradient (when defined) stands in for the seam's own.
-  gradient_.addParts(parts);
-  for (gpu::ShaderPart& part : layout_.seamParts()) parts.push_back(std::move(part));
-  for (const char* file :
-       {"render/classify.glsl", "render/shading.glsl", "render/clipping.glsl", "render/sample.glsl",
-        "render/composite.glsl", "render/raycast.frag.glsl"}) {
-    parts.push_back(gpu::embeddedShaderPart(file));
-  }
+  addSampleParts(parts, gradient_, layout_);
+  parts.push_back(gpu::embeddedShaderPart("render/composite.glsl"));
+  parts.push_back(gpu::embeddedShaderPart("render/raycast.frag.glsl"));
   return parts;
 }
 
@@ -353,10 +350,7 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
 }
 
 Image Raycaster::readImage() const {
-  Image img(target_.width(), target_.height());
-  target_.readRgba8(img.rgba().data());
-  img.flipVertically();
-  return img;
+  return render::readImage(target_);
 }
 
 // ---- The Technique interface and the registry's entry.

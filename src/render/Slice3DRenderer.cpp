@@ -7,6 +7,7 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "render/SampleParts.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/Draw.h"
 #include "tessera/render/ClippingUniforms.h"
@@ -109,13 +110,9 @@ std::vector<gpu::ShaderPart> Slice3DRenderer::fragmentParts(const RenderSettings
   addClippingDefines(settings, defines);
   if (settings.nearest) defines.push_back("NEAREST 1");
   std::vector<gpu::ShaderPart> parts = {gpu::shaderPreamble(context_.caps().api, true, defines)};
-  gradient_.addParts(parts);
-  for (gpu::ShaderPart& part : layout_.seamParts()) parts.push_back(std::move(part));
-  for (const char* file :
-       {"render/classify.glsl", "render/shading.glsl", "render/clipping.glsl", "render/sample.glsl",
-        "render/slice_opacity.glsl", "render/slice3d.frag.glsl"}) {
-    parts.push_back(gpu::embeddedShaderPart(file));
-  }
+  addSampleParts(parts, gradient_, layout_);
+  parts.push_back(gpu::embeddedShaderPart("render/slice_opacity.glsl"));
+  parts.push_back(gpu::embeddedShaderPart("render/slice3d.frag.glsl"));
   return parts;
 }
 

@@ -1,5 +1,6 @@
 #include "tessera/render/SliceAccumulator.h"
 
+#include "render/FramebufferImage.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/Draw.h"
@@ -97,10 +98,7 @@ void SliceAccumulator::resolve(const RenderSettings& settings, const gpu::Textur
 }
 
 Image SliceAccumulator::readImage() const {
-  Image img(image_.width(), image_.height());
-  image_.readRgba8(img.rgba().data());
-  img.flipVertically();
-  return img;
+  return render::readImage(image_);
 }
 
 }  // namespace tessera::render

@@ -1,24 +1,30 @@
 // Browser test: the slice views and the bread-slice region, the grid view
 // and the zoom-driven level swap (fixture.mjs serves the site and launches
 // Chromium).
-import { test, before, after } from 'node:test';
+import { test } from 'node:test';
 import fs from 'node:fs';
 import path from 'node:path';
 import {
-  SIZE, VOLUME, PAGE_SAMPLING, CH2, shots, bench, check, checksPassed, startBrowser, served,
-  decodePng, psnrAgainst, snapshot, changedFraction, differingPixels, meanAbsDiff, openPage,
-  writePilNifti, openThroughPicker, withoutOverlays, psnrOf, chunkKeys,
+  SIZE, PAGE_SAMPLING, CH2, shots, check, decodePng, psnrAgainst, snapshot, changedFraction,
+  differingPixels, meanAbsDiff, openPage, writePilNifti, withoutOverlays, psnrOf, browserSuite,
 } from './fixture.mjs';
 
-let browser;
-before(async () => { browser = await startBrowser(); });
-after(async () => { if (browser) await browser.close(); });
-// Runs one of the functions below (context, url, tmp, run) as a test.
-const checks = (f) => () => checksPassed(() => f(browser.context, browser.url, browser.tmp, browser.run));
+// One Chromium for the file; checks(f) runs f (context, url, tmp, run) as a test.
+const checks = browserSuite();
 
 test('slice views equal `tessera slice`; a region renders like `tessera render --region`', checks(sliceViewsAndRegion));
 test('grid view: blocks, moves and refusals', checks(gridView));
 test('zoom swap: coarse, medium and native stages, cross-faded, bounded reads', checks(zoomSwapView));
+
+// writePilNifti's volume (40x32 voxels a slice, u8 after the 352-byte
+// header) with the voxels of the box [lo, hi) (x, y, z) set to `value`.
+function writeMarkedNifti(file, lo, hi, value) {
+  writePilNifti(file);
+  const bytes = fs.readFileSync(file);
+  const [nx, ny] = [40, 32];
+  for (let z = lo[2]; z < hi[2]; z++) for (let y = lo[1]; y < hi[1]; y++) for (let x = lo[0]; x < hi[0]; x++) bytes[352 + x + nx * (y + ny * z)] = value;
+  fs.writeFileSync(file, bytes);
+}
 
 // Slice views and the bread-slice region (issue 15 item 6). A PIL NIfTI
 // (writePilNifti's, anisotropic voxels) with a bright cube near its
@@ -30,11 +36,7 @@ test('zoom swap: coarse, medium and native stages, cross-faded, bounded reads', 
 async function sliceViewsAndRegion(context, url, tmp, run) {
   const t = Date.now();
   const file = path.join(tmp, 'marked.nii');
-  writePilNifti(file);
-  const bytes = fs.readFileSync(file);
-  const [nx, ny] = [40, 32];
-  for (let z = 18; z < 22; z++) for (let y = 24; y < 28; y++) for (let x = 32; x < 36; x++) bytes[352 + x + nx * (y + ny * z)] = 255;
-  fs.writeFileSync(file, bytes);
+  writeMarkedNifti(file, [32, 24, 18], [36, 28, 22], 255);
   const { page, logs } = await openPage(context, url, `size=${SIZE}&url=/data/marked.nii`);
   const slices = () => page.evaluate(() => window.tessera.slices.state());
   const decode = (png) => decodePng(page, png);
@@ -246,11 +248,7 @@ async function sliceViewsAndRegion(context, url, tmp, run) {
 async function gridView(context, url, tmp, run) {
   const t = Date.now();
   const file = path.join(tmp, 'grid.nii');
-  writePilNifti(file);
-  const bytes = fs.readFileSync(file);
-  const [nx, ny] = [40, 32];
-  for (let z = 10; z < 16; z++) for (let y = 12; y < 18; y++) for (let x = 30; x < 37; x++) bytes[352 + x + nx * (y + ny * z)] = 250;
-  fs.writeFileSync(file, bytes);
+  writeMarkedNifti(file, [30, 12, 10], [37, 18, 16], 250);
   const { page, logs } = await openPage(context, url, `size=${SIZE}&url=/data/grid.nii`);
   const grid = () => page.evaluate(() => window.tessera.slices.grid.state());
   const cyanPixels = async () => page.evaluate(() => {

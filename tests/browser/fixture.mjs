@@ -15,6 +15,7 @@ import { execFileSync } from 'node:child_process';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
+import { before, after } from 'node:test';
 import http from 'node:http';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
@@ -49,6 +50,16 @@ export async function checksPassed(body) {
 
 // The native CLI (stdout as a string).
 export const run = (...args) => execFileSync(cli, args, { stdio: ['ignore', 'pipe', 'pipe'] }).toString();
+
+// One Chromium for the whole test file: registers the file's before/after
+// hooks and returns the wrapper that runs a function (context, url, tmp, run)
+// as a node test whose checks must all pass.
+export function browserSuite() {
+  let browser;
+  before(async () => { browser = await startBrowser(); });
+  after(async () => { if (browser) await browser.close(); });
+  return (f) => () => checksPassed(() => f(browser.context, browser.url, browser.tmp, browser.run));
+}
 
 // A temporary folder for the test's files, the site served with it under
 // /data/ (and the mricron templates under /templates/), and Chromium.
@@ -246,6 +257,18 @@ export function psnrOf(a, b) {
   for (let i = 0; i < a.length; i += 4) for (let k = 0; k < 3; k++) sum += (a[i + k] - b[i + k]) ** 2;
   const mse = sum / (a.length / 4 * 3);
   return mse === 0 ? 999 : 10 * Math.log10(255 * 255 / mse);
+}
+
+// Sets the page's checkboxes ({ id: checked, ... }), sends one 'change'
+// from the last of them (the page's handler reads the whole group) and
+// waits for the frame it renders.
+export function setCheckboxes(page, states) {
+  return page.evaluate(async (s) => {
+    const ids = Object.keys(s);
+    for (const id of ids) document.getElementById(id).checked = s[id];
+    document.getElementById(ids[ids.length - 1]).dispatchEvent(new Event('change'));
+    await window.tessera.render();
+  }, states);
 }
 
 // The level-0 chunk keys of a store's box [begin, end) (x, y, z).

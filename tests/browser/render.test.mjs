@@ -1,20 +1,16 @@
 // Browser test: the page's 3D view on WebGL 2 and WebGL 1 (render.test.mjs
 // of tests/browser; fixture.mjs serves the site and launches Chromium).
-import { test, before, after } from 'node:test';
+import { test } from 'node:test';
 import fs from 'node:fs';
 import path from 'node:path';
 import zlib from 'node:zlib';
 import {
-  SIZE, VOLUME, PAGE_SAMPLING, CH2, shots, bench, check, checksPassed, startBrowser, served,
-  decodePng, psnrAgainst, snapshot, changedFraction, differingPixels, meanAbsDiff, openPage,
-  writePilNifti, openThroughPicker, withoutOverlays, psnrOf, chunkKeys,
+  SIZE, VOLUME, CH2, shots, bench, check, psnrAgainst, snapshot, changedFraction, differingPixels,
+  meanAbsDiff, openPage, writePilNifti, openThroughPicker, withoutOverlays, setCheckboxes, browserSuite,
 } from './fixture.mjs';
 
-let browser;
-before(async () => { browser = await startBrowser(); });
-after(async () => { if (browser) await browser.close(); });
-// Runs one of the functions below (context, url, tmp, run) as a test.
-const checks = (f) => () => checksPassed(() => f(browser.context, browser.url, browser.tmp, browser.run));
+// One Chromium for the file; checks(f) runs f (context, url, tmp, run) as a test.
+const checks = browserSuite();
 
 test('WebGL 2 and WebGL 1 pages match the native renderer; controls, formats and errors', checks(webglPages));
 test('benchmark: ch2 at 512x512 (TESSERA_BENCH=1 or scripts/browser-test.sh --bench)', { skip: !bench }, checks(benchmark));
@@ -94,12 +90,7 @@ async function webglPages(context, url, tmp, run) {
         m2.error || `${m2.psnr.toFixed(2)} dB; page ${JSON.stringify(s.sampling)}`);
   // The page's "pre-integrated" control on: `tessera render --preintegrate
   // on`'s image, and no longer the post-classified one.
-  const setSampling = (preint, adaptive) => page.evaluate(async ([p, a]) => {
-    document.getElementById('preint').checked = p;
-    document.getElementById('adaptive').checked = a;
-    document.getElementById('adaptive').dispatchEvent(new Event('change'));
-    await window.tessera.render();
-  }, [preint, adaptive]);
+  const setSampling = (preint, adaptive) => setCheckboxes(page, { preint, adaptive });
   await setSampling(true, true);
   const preOwn = await psnrAgainst(page, path.join(tmp, 'native-webgl2-preint.png'));
   const prePost = await psnrAgainst(page, path.join(tmp, 'native-webgl2.png'));
@@ -115,12 +106,7 @@ async function webglPages(context, url, tmp, run) {
   // the (+x, +y, +z) corner (azimuth 45, elevation 30) hides the axes,
   // which run along the edges at the far, minimum corner; the box's near
   // edges show. Compared with the same frame without lines.
-  const setLines = (box, axes) => page.evaluate(async ([b, a]) => {
-    document.getElementById('box').checked = b;
-    document.getElementById('axes').checked = a;
-    document.getElementById('axes').dispatchEvent(new Event('change'));
-    await window.tessera.render();
-  }, [box, axes]);
+  const setLines = (box, axes) => setCheckboxes(page, { box, axes });
   const uniformTf = (alpha) => JSON.stringify({ name: 'uniform', opacity_unit_length: 1,
     color: [{ x: 0, rgb: [0.2, 0.3, 0.9] }, { x: 1, rgb: [0.9, 0.9, 0.2] }],
     opacity: [{ x: 0, alpha }, { x: 1, alpha }] });

@@ -2,20 +2,16 @@
 // grid view and slices read with bounded reads (fixture.mjs serves the site
 // and launches Chromium). The tests run in order: the first writes the
 // store the others read.
-import { test, before, after } from 'node:test';
+import { test } from 'node:test';
 import fs from 'node:fs';
 import path from 'node:path';
 import {
-  SIZE, VOLUME, PAGE_SAMPLING, CH2, shots, bench, check, checksPassed, startBrowser, served,
-  decodePng, psnrAgainst, snapshot, changedFraction, differingPixels, meanAbsDiff, openPage,
-  writePilNifti, openThroughPicker, withoutOverlays, psnrOf, chunkKeys,
+  SIZE, PAGE_SAMPLING, CH2, check, served, decodePng, psnrAgainst, snapshot, changedFraction,
+  differingPixels, openPage, withoutOverlays, chunkKeys, browserSuite,
 } from './fixture.mjs';
 
-let browser;
-before(async () => { browser = await startBrowser(); });
-after(async () => { if (browser) await browser.close(); });
-// Runs one of the functions below (context, url, tmp, run) as a test.
-const checks = (f) => () => checksPassed(() => f(browser.context, browser.url, browser.tmp, browser.run));
+// One Chromium for the file; checks(f) runs f (context, url, tmp, run) as a test.
+const checks = browserSuite();
 
 test('OME-Zarr ?url=: coarse first, refined to the native render; errors name the URL', checks(zarrStoreFromUrl));
 test('OME-Zarr region: bounded reads, renders like `tessera render STORE --region`', checks(zarrRegionFromUrl));
@@ -141,16 +137,7 @@ async function zarrRegionFromUrl(context, url, tmp, run) {
   const ex = await page.evaluate(() => window.tessera.slices.state().explore);
   if (!picked || !ex.region_level0) throw new Error(`picking a region of the store: ${await page.evaluate(() => window.tessera.error())}`);
   const { begin, end } = ex.region_level0;
-  const meta = JSON.parse(fs.readFileSync(path.join(store, '0', '.zarray'), 'utf8'));
-  const chunk = [...meta.chunks].reverse();  // x, y, z
-  const expected = [];
-  for (let cz = Math.floor(begin[2] / chunk[2]); cz * chunk[2] < end[2]; cz++) {
-    for (let cy = Math.floor(begin[1] / chunk[1]); cy * chunk[1] < end[1]; cy++) {
-      for (let cx = Math.floor(begin[0] / chunk[0]); cx * chunk[0] < end[0]; cx++) {
-        expected.push(`/data/ch2.ome.zarr/0/${cz}/${cy}/${cx}`);
-      }
-    }
-  }
+  const expected = chunkKeys(store, begin, end);
   const keys = (await page.evaluate(() => window.tessera.zarr())).region.keys;
   const requested = served.paths.slice(from).filter((p) => p.startsWith('/data/ch2.ome.zarr/'));
   const s = await page.evaluate(() => window.tessera.state());

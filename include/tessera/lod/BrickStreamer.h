@@ -100,6 +100,10 @@ class BrickStreamer {
   std::shared_ptr<const StoredBrick> readOne(const BrickKey& key);            // no lock held
   void store(const BrickKey& key, std::shared_ptr<const StoredBrick> brick);  // lock held
   void recordFailure(const BrickKey& key, const std::string& what);           // lock held
+  // Reads `key` (its id already in reading_), then stores it or records the
+  // failure (its message in `error`) and wakes the waiters. No lock held;
+  // null on failure.
+  std::shared_ptr<const StoredBrick> readAndStore(const BrickKey& key, std::string& error);
   double nowMs() const;
 
   std::shared_ptr<const MultiresSource> source_;
