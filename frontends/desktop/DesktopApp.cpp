@@ -15,7 +15,6 @@
 
 #include "DesktopApp.h"
 #include "app/Commands.h"
-#include "app/Commands.h"
 #include "tessera/core/Image.h"
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/Draw.h"

@@ -7,8 +7,8 @@
 #include <utility>
 
 #include "DesktopApp.h"
-#include "tessera/session/VolumePyramid.h"
 #include "tessera/render/LabelTable.h"
+#include "tessera/session/VolumePyramid.h"
 
 namespace tessera::desktop {
 
@@ -106,7 +106,8 @@ std::string boxText(const lod::VoxelBox& b) {
 // from it; a store or head:WxHxD is read box by box) and shows its
 // overview. Throws, leaving the previous volume, when it cannot.
 void loadVolume(DesktopApp& ds, const std::string& spec) {
-  const session::VolumePyramid pyramid = session::openVolumePyramid(spec, {.series = ds.options.series});
+  const session::VolumePyramid pyramid =
+      session::openVolumePyramid(spec, {.series = ds.options.series});
   const gpu::DeviceLimits& limits = ds.viewer->limits();
   auto explorer =
       std::make_unique<viewer::Explorer>(pyramid.source, viewer::regionBudgetBytes(limits));
