@@ -14,7 +14,7 @@
 #include <backends/imgui_impl_opengl3.h>
 
 #include "DesktopApp.h"
-#include "app/Commands.h"
+#include "cli/Commands.h"
 #include "tessera/core/Image.h"
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/Draw.h"

@@ -6,7 +6,7 @@
 #include <memory>
 
 #include "ViewOptions.h"
-#include "app/Commands.h"
+#include "cli/Commands.h"
 
 namespace tessera::app {
 

@@ -7,8 +7,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "app/ClippingOptions.h"
-#include "app/ShadingOptions.h"
+#include "cli/ClippingOptions.h"
+#include "cli/ShadingOptions.h"
 
 namespace tessera::desktop {
 

@@ -128,7 +128,7 @@ TEST(GlBoundary, TheCheckSeesACallAndIgnoresCommentsAndStrings) {
   EXPECT_FALSE(std::regex_search(codeOnly("/* glFinish(); */ y();\n"), call));
 }
 
-// Contexts are made in one place too: the front ends (frontends/, src/app,
+// Contexts are made in one place too: the front ends (frontends/,
 // web/) adopt the context a gpu class made (GlContext, GlfwWindow) and never
 // create one themselves.
 TEST(GlBoundary, OnlyTheGpuLayerCreatesContexts) {

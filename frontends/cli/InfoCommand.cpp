@@ -4,7 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/Commands.h"
+#include "cli/Commands.h"
 #include "tessera/core/Histogram.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/PatientFrame.h"

@@ -5,9 +5,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/BenchHybrid.h"
-#include "app/BenchJson.h"
-#include "app/Commands.h"
+#include "bench/BenchHybrid.h"
+#include "bench/BenchJson.h"
+#include "cli/Commands.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
 #include "tessera/io/VolumeReader.h"

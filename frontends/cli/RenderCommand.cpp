@@ -8,11 +8,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/ClippingOptions.h"
-#include "app/Commands.h"
-#include "app/HybridJob.h"
-#include "app/SamplingOptions.h"
-#include "app/ShadingOptions.h"
+#include "cli/ClippingOptions.h"
+#include "cli/Commands.h"
+#include "cli/HybridJob.h"
+#include "cli/SamplingOptions.h"
+#include "cli/ShadingOptions.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"

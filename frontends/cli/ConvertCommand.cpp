@@ -6,7 +6,7 @@
 #include <memory>
 #include <sstream>
 
-#include "app/Commands.h"
+#include "cli/Commands.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/PatientFrame.h"

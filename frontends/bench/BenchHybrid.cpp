@@ -1,4 +1,4 @@
-#include "app/BenchHybrid.h"
+#include "bench/BenchHybrid.h"
 
 #include <algorithm>
 #include <chrono>
@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/Commands.h"
+#include "cli/Commands.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
 #include "tessera/io/VolumeReader.h"

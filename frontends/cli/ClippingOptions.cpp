@@ -1,4 +1,4 @@
-#include "app/ClippingOptions.h"
+#include "cli/ClippingOptions.h"
 
 #include <cmath>
 #include <sstream>

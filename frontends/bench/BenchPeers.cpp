@@ -1,4 +1,4 @@
-#include "app/BenchPeers.h"
+#include "bench/BenchPeers.h"
 
 #include <sys/wait.h>
 #include <unistd.h>

@@ -1,4 +1,4 @@
-#include "app/HybridJob.h"
+#include "cli/HybridJob.h"
 
 #include <algorithm>
 #include <chrono>

@@ -4,7 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "app/Commands.h"
+#include "cli/Commands.h"
 #include "tessera/core/Error.h"
 
 int main(int argc, char** argv) {

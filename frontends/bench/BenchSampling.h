@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "app/ShadingOptions.h"
+#include "cli/ShadingOptions.h"
 
 namespace tessera::app {
 

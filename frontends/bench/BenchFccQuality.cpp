@@ -12,8 +12,8 @@
 #include <random>
 #include <vector>
 
-#include "app/BenchFcc.h"
-#include "app/Commands.h"
+#include "bench/BenchFcc.h"
+#include "cli/Commands.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/io/Procedural.h"

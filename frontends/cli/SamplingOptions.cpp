@@ -1,4 +1,4 @@
-#include "app/SamplingOptions.h"
+#include "cli/SamplingOptions.h"
 
 #include <cmath>
 #include <cstdio>

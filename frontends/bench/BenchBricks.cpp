@@ -1,11 +1,11 @@
-#include "app/BenchBricks.h"
+#include "bench/BenchBricks.h"
 
 #include <sys/resource.h>
 
 #include <cstdio>
 #include <memory>
 
-#include "app/Commands.h"
+#include "cli/Commands.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"
 #include "tessera/layout/Planner.h"

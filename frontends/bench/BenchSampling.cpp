@@ -1,4 +1,4 @@
-#include "app/BenchSampling.h"
+#include "bench/BenchSampling.h"
 
 #include <algorithm>
 #include <chrono>
@@ -8,8 +8,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/Commands.h"
-#include "app/SamplingOptions.h"
+#include "cli/Commands.h"
+#include "cli/SamplingOptions.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
 #include "tessera/io/VolumeReader.h"

@@ -1,4 +1,4 @@
-#include "app/BenchRoofline.h"
+#include "bench/BenchRoofline.h"
 
 #include <chrono>
 #include <cstdio>
@@ -6,8 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/BenchJson.h"
-#include "app/Commands.h"
+#include "bench/BenchJson.h"
+#include "cli/Commands.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
 #include "tessera/io/VolumeReader.h"

@@ -1,4 +1,4 @@
-#include "app/BenchFcc.h"
+#include "bench/BenchFcc.h"
 
 #include <algorithm>
 #include <chrono>
@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/Commands.h"
+#include "cli/Commands.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"

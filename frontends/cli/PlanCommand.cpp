@@ -3,7 +3,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/Commands.h"
+#include "cli/Commands.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/io/VolumeReader.h"
 #include "tessera/layout/LayoutRegistry.h"

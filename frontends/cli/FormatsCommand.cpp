@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <memory>
 
-#include "app/Commands.h"
+#include "cli/Commands.h"
 #include "tessera/io/DicomDecoder.h"
 #include "tessera/io/FormatRegistry.h"
 

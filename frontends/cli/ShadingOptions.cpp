@@ -1,4 +1,4 @@
-#include "app/ShadingOptions.h"
+#include "cli/ShadingOptions.h"
 
 #include <cmath>
 #include <sstream>

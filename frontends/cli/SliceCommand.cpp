@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/Commands.h"
+#include "cli/Commands.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/Image.h"
 #include "tessera/core/PatientFrame.h"

@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/Commands.h"
+#include "cli/Commands.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/gpu/DeviceProfile.h"
 
