@@ -9,7 +9,7 @@
 //   DesktopApp.cpp     start-up, the frame loop, the window's layout
 //   VolumeView.cpp     the 3D view: render when it changed, else blit the cache
 //   Input.cpp          keys and mouse on the 3D and slice views, the help overlay
-//   Exploring.cpp      overview / region / grid through viewer::Explorer
+//   Exploring.cpp      overview / region / grid through session::Exploration
 //   PanelsFile.cpp     open, recent and dropped volumes
 //   PanelsStyle.cpp    TF editor, window/level, rendering, shading, clipping, labels
 //   PanelsExplore.cpp  the slice views and the exploring panel (zoom stages)
@@ -29,8 +29,8 @@
 #include "tessera/lod/GridNavigator.h"
 #include "tessera/lod/MultiresSource.h"
 #include "tessera/lod/ZoomLevelPolicy.h"
+#include "tessera/session/Exploration.h"
 #include "tessera/viewer/CropHandles.h"
-#include "tessera/viewer/Explorer.h"
 #include "tessera/viewer/RecentFiles.h"
 #include "tessera/viewer/SliceView.h"
 #include "tessera/viewer/Viewer.h"
@@ -63,17 +63,9 @@ struct DesktopApp {
   bool showHelp = false;
   viewer::RecentFiles recent{viewer::RecentFiles::defaultPath()};
 
-  // Exploring at native resolution (viewer/Explorer.h).
-  enum class Mode { Overview, Region, Grid };
-  Mode mode = Mode::Overview;
-  std::unique_ptr<viewer::Explorer> explorer;
-  std::string volumeLabel;
-  int overviewLevel = 0;
-  std::shared_ptr<const Volume> overview;  // what the 3D view returns to
-  std::optional<lod::VoxelBox> picked;     // the bread-slice region (slice views, overview)
-  std::optional<lod::VoxelBox> shown;      // the region or grid block the 3D view shows
-  std::optional<lod::VoxelBox> gridBlock;  // the grid view's last block (slices, overview)
-  std::string exploreNote;                 // e.g. why a grid move was refused
+  // Exploring at native resolution (session/Exploration.h): the overview,
+  // crosshair, picked region, grid view and what the 3D view shows.
+  std::unique_ptr<session::Exploration> explore;
   bool fourUp = true;
   bool sliceColour = false;       // slices in the TF's colour instead of grey
   bool zoomSwitchesGrid = false;  // the zoom swaps coarse / medium level / native grid block
@@ -128,14 +120,9 @@ struct Tiles {
   Rect slice[3];  // axial, coronal, sagittal (empty when not four-up)
 };
 
-// How the camera follows a swap of the 3D view's volume (its direction
-// always stays). Keep: the same point of the patient stays at the view's
-// centre at the same scale (the zoom policy's swaps change the data, not
-// the view: no jump). Centre: the new volume's centre, the zoom kept (a grid
-// move). Fill: the new volume's centre at zoom 1 (a key or button).
-enum class Follow { Keep, Centre, Fill };
+using session::Follow;  // how the camera follows a swap of the 3D view's volume
 
-// Exploring.cpp: what a session will own (volume pyramid, region, grid).
+// Exploring.cpp: the keys and panels' steps of session::Exploration.
 void loadVolume(DesktopApp& ds, const std::string& spec);
 void startExploring(DesktopApp& ds, const ViewOptions& o);
 void showOverview(DesktopApp& ds, Follow follow = Follow::Fill);
@@ -145,7 +132,6 @@ void gridMove(DesktopApp& ds, lod::ViewMove move);
 void keepZoomSwap(DesktopApp& ds, const std::vector<lod::ZoomStage>& stages,
                   const std::string& stagesKey);
 void updateOverlay(DesktopApp& ds);
-std::string boxText(const lod::VoxelBox& b);
 
 // PanelsFile.cpp
 void openVolume(DesktopApp& ds, const std::string& spec);

@@ -53,18 +53,18 @@ constexpr Shortcut kShortcuts[] = {
 // side across it, centred on the slice; clamped to the budget and volume.
 void pickRegion(DesktopApp& ds, const DesktopApp::SliceTile& tile, glm::dvec2 a, glm::dvec2 b) {
   const viewer::SliceGeometry& g = *tile.geometry;
-  const int index = ds.explorer->crosshair()[g.axis()];
+  const int index = ds.explore->explorer().crosshair()[g.axis()];
   const glm::ivec2 pa = tile.viewport.pixelAt(a);
   const glm::ivec2 pb = glm::length(b - a) < 4.0 ? pa : tile.viewport.pixelAt(b);
-  ds.picked = ds.explorer->regionFromSlice(g, pa, pb, index);
+  ds.explore->pick(ds.explore->explorer().regionFromSlice(g, pa, pb, index));
 }
 
 // The crosshair `step` slices along the slice view's axis (its slice).
 void stepSlice(DesktopApp& ds, const DesktopApp::SliceTile& tile, int step) {
   if (!tile.geometry) return;
-  glm::ivec3 c = ds.explorer->crosshair();
+  glm::ivec3 c = ds.explore->explorer().crosshair();
   c[tile.geometry->axis()] += step;
-  ds.explorer->setCrosshair(c);
+  ds.explore->explorer().setCrosshair(c);
 }
 
 // The slice view under the pointer (axial if none).
@@ -114,12 +114,20 @@ constexpr LetterKey kLetterKeys[] = {
     {'t', false, nextTechnique},
     {'v', true, viewPickedRegion},
     {'g', true,
-     [](DesktopApp& ds) { ds.mode == DesktopApp::Mode::Grid ? showOverview(ds) : enterGrid(ds); }},
+     [](DesktopApp& ds) {
+       ds.explore->mode() == session::ExploreMode::Grid ? showOverview(ds) : enterGrid(ds);
+     }},
     {'o', true, [](DesktopApp& ds) { showOverview(ds); }},
     {'l', true, [](DesktopApp& ds) { ds.fourUp = !ds.fourUp; }},
     {'c', true, [](DesktopApp& ds) { ds.sliceColour = !ds.sliceColour; }},
-    {'[', true, [](DesktopApp& ds) { ds.explorer->setRegionSide(ds.explorer->regionSide() - 16); }},
-    {']', true, [](DesktopApp& ds) { ds.explorer->setRegionSide(ds.explorer->regionSide() + 16); }},
+    {'[', true,
+     [](DesktopApp& ds) {
+       ds.explore->explorer().setRegionSide(ds.explore->explorer().regionSide() - 16);
+     }},
+    {']', true,
+     [](DesktopApp& ds) {
+       ds.explore->explorer().setRegionSide(ds.explore->explorer().regionSide() + 16);
+     }},
 };
 
 }  // namespace
@@ -142,7 +150,7 @@ void handleShortcuts(DesktopApp& ds) {
   }
   for (const ImWchar c : io.InputQueueCharacters) {
     for (const LetterKey& k : kLetterKeys) {
-      if (lowerAscii(c) == k.letter && (!k.exploring || ds.explorer)) k.act(ds);
+      if (lowerAscii(c) == k.letter && (!k.exploring || ds.explore)) k.act(ds);
     }
   }
 }
@@ -213,7 +221,7 @@ void handleViewInput(DesktopApp& ds, const Rect& view, double scale) {
 // Mouse input on the slice views: left click/drag moves the crosshair, right
 // drag picks a region, the wheel flips slices.
 void handleSliceInput(DesktopApp& ds, const Tiles& tiles) {
-  if (!ds.explorer || !ds.fourUp) return;
+  if (!ds.explore || !ds.fourUp) return;
   ImGuiIO& io = ImGui::GetIO();
   const glm::dvec2 m(io.MousePos.x, io.MousePos.y);
   if (!io.WantCaptureMouse) {
@@ -230,8 +238,8 @@ void handleSliceInput(DesktopApp& ds, const Tiles& tiles) {
   if (ds.dragTile < 0) return;
   DesktopApp::SliceTile& tile = ds.slices[ds.dragTile];
   if (!ds.dragRegion && ImGui::IsMouseDown(0)) {
-    const int index = ds.explorer->crosshair()[tile.geometry->axis()];
-    ds.explorer->setCrosshair(tile.geometry->voxelAt(tile.viewport.pixelAt(m), index));
+    const int index = ds.explore->explorer().crosshair()[tile.geometry->axis()];
+    ds.explore->explorer().setCrosshair(tile.geometry->voxelAt(tile.viewport.pixelAt(m), index));
   }
   if (ds.dragRegion) {
     const ImVec2 a(static_cast<float>(ds.dragStart.x), static_cast<float>(ds.dragStart.y));
@@ -248,9 +256,9 @@ void handleSliceInput(DesktopApp& ds, const Tiles& tiles) {
 // The arrow keys: grid moves in the grid view, else slices (kShortcuts).
 void handleArrowKeys(DesktopApp& ds, const Tiles& tiles) {
   ImGuiIO& io = ImGui::GetIO();
-  if (io.WantTextInput || !ds.explorer) return;
+  if (io.WantTextInput || !ds.explore) return;
   auto pressed = [](int key) { return ImGui::IsKeyPressed(key, true); };
-  if (ds.mode == DesktopApp::Mode::Grid) {
+  if (ds.explore->mode() == session::ExploreMode::Grid) {
     if (pressed(GLFW_KEY_UP)) gridMove(ds, lod::ViewMove::Forward);
     if (pressed(GLFW_KEY_DOWN)) gridMove(ds, lod::ViewMove::Back);
     if (pressed(GLFW_KEY_LEFT)) gridMove(ds, lod::ViewMove::Left);

@@ -81,13 +81,7 @@ void drawZoomSwapView(DesktopApp& ds, glm::ivec2 origin, int viewW, int viewH) {
   } else {
     zs.frame(v, dtMs, viewW, viewH, 0, origin);
   }
-  if (zs.shownBox()) {
-    ds.mode = DesktopApp::Mode::Grid;
-    ds.shown = ds.gridBlock = zs.shownBox();
-  } else {
-    ds.mode = DesktopApp::Mode::Overview;
-    ds.shown.reset();
-  }
+  ds.explore->shownBy(zs.shownBox(), session::ExploreMode::Grid);
 }
 
 }  // namespace
