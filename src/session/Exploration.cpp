@@ -102,7 +102,8 @@ lod::VoxelBox Exploration::clampBox(lod::VoxelBox box, const std::string& what) 
 ExploreStep Exploration::region(const lod::VoxelBox& box, Follow follow) {
   const lod::VoxelBox b = clampBox(box, "region");
   picked_ = b;
-  return {b, ExploreMode::Region, follow};
+  pending_ = ExploreStep{b, ExploreMode::Region, follow};
+  return *pending_;
 }
 
 ExploreStep Exploration::pickedRegion(Follow follow) {
@@ -117,7 +118,8 @@ ExploreStep Exploration::enterGrid(glm::ivec3 voxel) {
   g.moveTo(glm::clamp(glm::ivec3(glm::round(c)), glm::ivec3(0), g.cells()));
   note_ = "grid point " + g.describe(g.point());
   refused_ = false;
-  return {g.blockBox(g.point()), ExploreMode::Grid, Follow::Fill};
+  pending_ = ExploreStep{g.blockBox(g.point()), ExploreMode::Grid, Follow::Fill};
+  return *pending_;
 }
 
 std::optional<ExploreStep> Exploration::move(lod::ViewMove move, const glm::dmat3& basis) {
@@ -134,7 +136,8 @@ std::optional<ExploreStep> Exploration::move(lod::ViewMove move, const glm::dmat
   pendingFrom_ = from;
   note_ = what + ": grid point " + g.describe(g.point());
   refused_ = false;
-  return ExploreStep{g.blockBox(g.point()), ExploreMode::Grid, Follow::Centre};
+  pending_ = ExploreStep{g.blockBox(g.point()), ExploreMode::Grid, Follow::Centre};
+  return pending_;
 }
 
 void Exploration::setGrid(lod::GridNavigator grid) {

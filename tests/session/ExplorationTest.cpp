@@ -1,0 +1,162 @@
+// session::Exploration, the one home of the overview / region / grid steps
+// both viewers drive: a region's voxels against direct indexing, the camera
+// and window across a swap and back, grid moves, refusals and a failed read
+// that puts the grid point back, box checks, and the state as JSON.
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <nlohmann/json.hpp>
+
+#include "support/GpuTestContext.h"
+#include "tessera/core/Error.h"
+#include "tessera/gpu/DeviceProfile.h"
+#include "tessera/session/Exploration.h"
+#include "tessera/viewer/Viewer.h"
+
+namespace tessera::session {
+namespace {
+
+// Every voxel a different value (mod 251), along a rotated direction so that
+// placement in the patient frame is checked, not assumed.
+std::shared_ptr<const Volume> hashVolume(glm::ivec3 dims) {
+  auto v = std::make_shared<Volume>(Volume::allocate(dims, ScalarType::U8));
+  for (std::size_t i = 0; i < v->voxelCount(); ++i) {
+    v->setValueAtIndex(i, static_cast<double>((i * 2654435761u >> 7) % 251));
+  }
+  v->setSpacing({1.0, 1.5, 2.0});
+  v->setDirection(glm::dmat3(glm::rotate(glm::dmat4(1.0), 0.3, glm::dvec3(0.0, 0.0, 1.0))));
+  v->setOrigin({-10.0, 5.0, 2.0});
+  v->setGeometrySource("test");
+  v->setWindow({0.0, 250.0});
+  return v;
+}
+
+constexpr std::uint64_t kBudget = 32ull * 32 * 32;
+
+TEST(Exploration, RegionIsTheBoxOfTheVolumeWhereItLiesAndTheOverviewComesBack) {
+  gpu::GlContext& ctx = test::gpuContext();
+  const auto volume = hashVolume({40, 32, 24});
+  Exploration e(volume, kBudget, "hash");
+  viewer::Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
+  v.setVolume(Volume(*e.overview()), e.overviewName());
+  v.setWindow({20.0, 120.0});
+  v.camera().azimuthDeg = 37.0;
+  v.camera().zoom = 1.7;
+  const Camera overviewCamera = v.camera();
+
+  const lod::VoxelBox box{{6, 16, 4}, {22, 32, 19}};
+  e.show(v, e.region(box, Follow::Centre));
+  EXPECT_EQ(e.mode(), ExploreMode::Region);
+  ASSERT_TRUE(e.shown());
+  EXPECT_EQ(e.shown()->begin, box.begin);
+  EXPECT_EQ(v.volumeName(), "hash region 6:22,16:32,4:19");
+  const Volume& region = v.volume();
+  ASSERT_EQ(region.dims(), box.size());
+  for (int z = 0; z < box.size().z; ++z) {
+    for (int y = 0; y < box.size().y; ++y) {
+      for (int x = 0; x < box.size().x; ++x) {
+        ASSERT_EQ(region.valueAt(x, y, z),
+                  volume->valueAt(x + box.begin.x, y + box.begin.y, z + box.begin.z));
+      }
+    }
+  }
+  // Each region voxel sits where the volume's voxel of the same data sits.
+  const glm::dvec3 a = region.worldOf(glm::dvec3(3.0, 2.0, 1.0));
+  const glm::dvec3 b = volume->worldOf(glm::dvec3(box.begin) + glm::dvec3(3.0, 2.0, 1.0));
+  EXPECT_NEAR(glm::length(a - b), 0.0, 1e-9);
+  // The user's window and view direction stay; Centre keeps the zoom.
+  EXPECT_EQ(v.window().min, 20.0);
+  EXPECT_EQ(v.window().max, 120.0);
+  EXPECT_DOUBLE_EQ(v.camera().azimuthDeg, 37.0);
+  EXPECT_DOUBLE_EQ(v.camera().zoom, 1.7);
+
+  e.showOverview(v, Follow::Back);
+  EXPECT_EQ(e.mode(), ExploreMode::Overview);
+  EXPECT_FALSE(e.shown());
+  EXPECT_EQ(v.volumeName(), "hash");
+  EXPECT_EQ(v.volume().dims(), volume->dims());
+  EXPECT_EQ(v.camera().target, overviewCamera.target);
+  EXPECT_DOUBLE_EQ(v.camera().zoom, overviewCamera.zoom);
+  ASSERT_TRUE(e.picked());  // still marked in the overview, red
+  const auto lines = e.lines(volume->extent());
+  EXPECT_EQ(lines.size(), 12u + 3u);  // the picked box's edges, the crosshair
+  EXPECT_EQ(lines.front().color, kRegionColour);
+}
+
+TEST(Exploration, GridMovesOneCellRefusesAtTheEdgeAndAFailedReadGoesBack) {
+  gpu::GlContext& ctx = test::gpuContext();
+  const auto volume = hashVolume({64, 48, 32});
+  Exploration e(volume, kBudget, "hash");
+  e.setGrid(lod::GridNavigator(e.dims(), glm::ivec3(8)));
+  viewer::Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
+  v.setVolume(Volume(*e.overview()), e.overviewName());
+  const ExploreStep enter = e.enterGrid({30, 20, 14});  // nearest point (4, 3, 2)
+  EXPECT_EQ(enter.box.begin, glm::ivec3(24, 16, 8));
+  EXPECT_EQ(enter.box.end, glm::ivec3(40, 32, 24));
+  e.show(v, enter);
+  EXPECT_EQ(e.mode(), ExploreMode::Grid);
+  ASSERT_TRUE(e.gridBlock());
+  EXPECT_DOUBLE_EQ(v.camera().zoom, 1.0);  // the block fills the view
+
+  // From the front (azimuth 0) Right is -x (the patient's right is on the
+  // viewer's left): one cell.
+  const auto right = e.move(lod::ViewMove::Right, v.camera().basis());
+  ASSERT_TRUE(right);
+  EXPECT_EQ(right->box.begin - enter.box.begin, glm::ivec3(-8, 0, 0));
+  // Not shown (a store's chunks failed): the point goes back, the block stays.
+  e.failed("the block could not be read");
+  EXPECT_TRUE(e.refused());
+  EXPECT_EQ(e.explorer().grid().point(), glm::ivec3(4, 3, 2));
+  EXPECT_EQ(e.gridBlock()->begin, enter.box.begin);
+  EXPECT_NE(e.note().find("back at grid point"), std::string::npos) << e.note();
+
+  // At the -x face the next move right is refused with a reason.
+  e.explorer().grid().moveTo({0, 3, 2});
+  const glm::ivec3 before = e.explorer().grid().point();
+  EXPECT_FALSE(e.move(lod::ViewMove::Right, v.camera().basis()));
+  EXPECT_TRUE(e.refused());
+  EXPECT_EQ(e.explorer().grid().point(), before);
+  EXPECT_NE(e.note().find("refused"), std::string::npos) << e.note();
+}
+
+TEST(Exploration, BoxesAreClampedAndABadOneNamesTheAxis) {
+  Exploration e(hashVolume({40, 32, 24}), kBudget, "hash");
+  const lod::VoxelBox b = e.clampBox({{30, 0, 0}, {99, 32, 24}}, "region");
+  EXPECT_EQ(b.end, glm::ivec3(40, 32, 24));
+  try {
+    e.region({{0, 40, 0}, {10, 50, 5}}, Follow::Fill);
+    FAIL() << "a box starting outside y was accepted";
+  } catch (const InputError& err) {
+    EXPECT_STREQ(err.what(), "region: y range 40:50 is empty or starts outside 0:32");
+  }
+  EXPECT_FALSE(e.picked());
+}
+
+TEST(Exploration, StateRoundTripsAndRefusesAnotherVolumesState) {
+  const auto volume = hashVolume({40, 32, 24});
+  Exploration a(volume, kBudget, "hash");
+  a.explorer().setCrosshair({5, 6, 7});
+  a.explorer().setRegionSide(16);
+  a.setGrid(lod::GridNavigator(a.dims(), glm::ivec3(8)));
+  a.enterGrid({20, 20, 10});
+  a.region({{1, 2, 3}, {17, 18, 19}}, Follow::Fill);
+  const nlohmann::json state = a.state();
+
+  Exploration b(volume, kBudget, "hash");
+  b.restore(state);
+  EXPECT_EQ(b.state(), state);
+  EXPECT_EQ(b.explorer().crosshair(), glm::ivec3(5, 6, 7));
+  EXPECT_EQ(b.explorer().grid().cellSize(), glm::ivec3(8));
+  EXPECT_EQ(b.picked()->end, glm::ivec3(17, 18, 19));
+
+  Exploration other(hashVolume({16, 16, 16}), kBudget, "small");
+  EXPECT_THROW(other.restore(state), InputError);
+  nlohmann::json future = state;
+  future["version"] = 2;
+  EXPECT_THROW(b.restore(future), InputError);
+}
+
+}  // namespace
+}  // namespace tessera::session
