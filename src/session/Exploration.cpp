@@ -182,9 +182,10 @@ Camera Exploration::followed(const Camera& before, const Camera& framed, Follow 
 
 void Exploration::showIn(viewer::Viewer& view, Volume volume, const ExploreStep& step) {
   const Camera before = view.camera();
-  const ValueRange window = view.window();
+  const bool had = view.hasVolume();
+  const ValueRange window = had ? view.window() : volume.window();
   std::optional<render::LabelTable> labels;
-  if (view.labelsOn()) labels = view.labelTable();
+  if (had && view.labelsOn()) labels = view.labelTable();
   const std::string name = label_ + " region " + boxText(step.box);
   view.setVolume(std::move(volume), name);         // throws with the old volume kept
   if (labels) view.setLabels(std::move(*labels));  // the same table on the region

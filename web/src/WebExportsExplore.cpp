@@ -13,7 +13,6 @@
 using namespace tessera;
 using web::boxJson;
 using web::guarded;
-using web::session;
 
 namespace {
 
@@ -52,7 +51,7 @@ extern "C" {
 EMSCRIPTEN_KEEPALIVE const char* tessera_slice(int axis, int index, int colour, double maxPixels) {
   web::scratch().clear();
   guarded([&] {
-    web::WebSession& s = session();
+    web::WebSession& s = web::session();
     const web::SliceResult r = s.slice(axis, index, colour != 0, maxPixels);
     const SliceFrame& f = r.frame;
     nlohmann::json j;
@@ -87,7 +86,7 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_slice(int axis, int index, int colour, 
 // otherwise).
 EMSCRIPTEN_KEEPALIVE double tessera_voxel_value(int x, int y, int z) {
   double value = std::nan("");
-  guarded([&] { value = session().voxelValue(x, y, z); });
+  guarded([&] { value = web::session().voxelValue(x, y, z); });
   return value;
 }
 
@@ -101,7 +100,7 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_explore_json() {
     web::WebSession* s = web::sessionIfAny();
     const Volume* store = s ? s->storeOverview() : nullptr;
     if (!s || (!s->viewer().hasVolume() && !store)) return;
-    const bool inRegion = store ? s->storeRegion().shown : s->regionShown();
+    const bool inRegion = s->regionShown();
     const Volume& volume = s->sliceShape();
     const glm::ivec3 d = volume.dims();
     const glm::dvec3 sp = volume.spacing();
@@ -116,14 +115,8 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_explore_json() {
     // dims), the slices read at the level their panel shows (tessera_slice);
     // its region is the box read at level 0 (also as region_level0).
     j["store"] = store != nullptr;
-    if (store && inRegion) {
-      j["region"] = boxJson(s->storeRegion().box);
-      j["region_level0"] = j["region"];
-    } else if (inRegion) {
-      j["region"] = boxJson(s->sliceViews().region);
-    } else {
-      j["region"] = nullptr;
-    }
+    j["region"] = inRegion ? boxJson(*s->exploration().shown()) : nlohmann::json(nullptr);
+    if (store && inRegion) j["region_level0"] = j["region"];
     auto [side, why] = s->defaultRegionSide(volume);
     j["region_side"] = side;
     j["region_side_reason"] = why;
@@ -136,13 +129,13 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_explore_json() {
 // empty box or one that starts outside is an error). The window, the TF and
 // the overview stay; tessera_region_overview goes back.
 EMSCRIPTEN_KEEPALIVE int tessera_region_show(int x0, int x1, int y0, int y1, int z0, int z1) {
-  return guarded([&] { session().showRegion(boxOf(x0, x1, y0, y1, z0, z1)); });
+  return guarded([&] { web::session().showRegion(boxOf(x0, x1, y0, y1, z0, z1)); });
 }
 
 // Back to the overview (with its camera and the current window); the
 // region stays known to the page, which draws it as a highlighted box.
 EMSCRIPTEN_KEEPALIVE int tessera_region_overview() {
-  return guarded([&] { session().returnToOverview(); });
+  return guarded([&] { web::session().returnToOverview(); });
 }
 
 // Marks box [x0,x1) x [y0,y1) x [z0,z1) of the overview in slot 0 (the
@@ -151,7 +144,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_region_overview() {
 // Clamped to the overview.
 EMSCRIPTEN_KEEPALIVE int tessera_set_mark_box(int slot, int x0, int x1, int y0, int y1, int z0,
                                               int z1) {
-  return guarded([&] { session().setMarkBox(slot, boxOf(x0, x1, y0, y1, z0, z1)); });
+  return guarded([&] { web::session().setMarkBox(slot, boxOf(x0, x1, y0, y1, z0, z1)); });
 }
 
 // How the 3D view projects the overview's voxel coordinates onto a
@@ -162,7 +155,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_set_mark_box(int slot, int x0, int x1, int y0, 
 EMSCRIPTEN_KEEPALIVE const char* tessera_projection_json(int width, int height) {
   nlohmann::json j;
   guarded([&] {
-    const std::optional<web::VoxelProjection> p = session().projection(width, height);
+    const std::optional<web::VoxelProjection> p = web::session().projection(width, height);
     if (!p) return;
     j["mvp"] = matrixJson(p->mvp);
     j["spacing"] = {p->spacing.x, p->spacing.y, p->spacing.z};
@@ -180,7 +173,7 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_projection_json(int width, int height) 
 // cells of `cellSide` voxels (0: the default for the profile, -1: as
 // before), and shows that point's block.
 EMSCRIPTEN_KEEPALIVE int tessera_grid_enter(int cellSide, int x, int y, int z) {
-  return guarded([&] { session().gridEnter(cellSide, {x, y, z}); });
+  return guarded([&] { web::session().gridEnter(cellSide, {x, y, z}); });
 }
 
 // One of the six moves relative to the view (0 forward, 1 back, 2 left,
@@ -189,7 +182,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_grid_enter(int cellSide, int x, int y, int z) {
 // reason in tessera_grid_json's note; nothing changes), -1 error.
 EMSCRIPTEN_KEEPALIVE int tessera_grid_move(int viewMove) {
   int result = -1;
-  guarded([&] { result = session().gridMove(viewMove); });
+  guarded([&] { result = web::session().gridMove(viewMove); });
   return result;
 }
 
@@ -206,8 +199,11 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_grid_json() {
     if (!s || (!s->viewer().hasVolume() && !s->storeOverview())) return;
     if (s->storeOverview() && !s->theStore().isOpen()) return;
     const Volume& volume = s->sliceShape();
-    lod::GridNavigator& nav = s->gridFor(volume, -1);
-    const web::GridView& g = s->grid();
+    const tessera::session::Exploration& e = s->exploration();
+    const lod::GridNavigator& nav = e.explorer().grid();
+    const bool wanted = s->gridStoreWanted();
+    // The block shown last, or the one a store is fetching.
+    const std::optional<lod::VoxelBox> block = wanted ? e.pending()->box : e.gridBlock();
     const glm::ivec3 cs = nav.cellSize(), cells = nav.cells(), p = nav.point();
     j["has_volume"] = true;
     j["active"] = s->gridShown();
@@ -216,12 +212,9 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_grid_json() {
     j["point"] = {p.x, p.y, p.z};
     j["point_class"] = lod::gridPointClassName(nav.pointClass());
     j["describe"] = nav.describe(p);
-    if (g.block) {
-      const lod::VoxelBox& b = *g.block;
-      j["block"] = boxJson(b);
-      j["block_text"] = std::to_string(b.begin.x) + ":" + std::to_string(b.end.x) + "," +
-                        std::to_string(b.begin.y) + ":" + std::to_string(b.end.y) + "," +
-                        std::to_string(b.begin.z) + ":" + std::to_string(b.end.z);
+    if (block) {
+      j["block"] = boxJson(*block);
+      j["block_text"] = tessera::session::boxText(*block);
     } else {
       j["block"] = nullptr;
     }
@@ -235,13 +228,13 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_grid_json() {
                             {"legal", r.moved},
                             {"reason", r.reason}});
     }
-    j["note"] = g.note;
-    j["refused"] = g.refused;
+    j["note"] = e.note();
+    j["refused"] = e.refused();
     j["default_cell"] = s->defaultGrid(volume).cellSize().x;
     // A store: the block (level-0 voxels) the page is to fetch and show
     // (tessera_zarr_region_prefetch / _show, then tessera_grid_store_shown).
     j["store"] = s->storeOverview() != nullptr;
-    j["store_wanted"] = g.storeWanted;
+    j["store_wanted"] = wanted;
   });
   return web::jsonOut(j);
 }
@@ -251,13 +244,13 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_grid_json() {
 // asked for it (the 3D view still shows that block, or the store), with a
 // note saying so.
 EMSCRIPTEN_KEEPALIVE int tessera_grid_store_failed() {
-  return guarded([&] { session().gridStoreFailed(); });
+  return guarded([&] { web::session().gridStoreFailed(); });
 }
 
 // A store's block (tessera_grid_json's block) has been read and shown by
 // tessera_zarr_region_show: it is now the grid view's.
 EMSCRIPTEN_KEEPALIVE int tessera_grid_store_shown() {
-  return guarded([&] { session().gridStoreShown(); });
+  return guarded([&] { web::session().gridStoreShown(); });
 }
 
 // ---- the zoom-driven level swap (viewer::ZoomSwap; WebSessionZoom.cpp)
@@ -271,9 +264,9 @@ EMSCRIPTEN_KEEPALIVE int tessera_zoom_swap(int on, int viewPixels, double overvi
                                            double blockVoxels) {
   return guarded([&] {
     if (on == 0) {
-      session().zoomStop();
+      web::session().zoomStop();
     } else {
-      session().zoomStart(viewPixels, overviewVoxels, blockVoxels);
+      web::session().zoomStart(viewPixels, overviewVoxels, blockVoxels);
     }
   });
 }

@@ -13,7 +13,6 @@
 
 using namespace tessera;
 using web::guarded;
-using web::session;
 
 namespace {
 
@@ -34,14 +33,14 @@ extern "C" {
 
 // Starts opening the store at `url` (its root, e.g. http://host/ch2.ome.zarr).
 EMSCRIPTEN_KEEPALIVE int tessera_zarr_begin(const char* url) {
-  return guarded([&] { session().beginStore(url); });
+  return guarded([&] { web::session().beginStore(url); });
 }
 
 // One step of opening: 1 open (the coarsest level is on the GPU), 0 keys
 // are wanted (tessera_zarr_wanted), -1 failed (tessera_last_error).
 EMSCRIPTEN_KEEPALIVE int tessera_zarr_open_step() {
   int state = -1;
-  guarded([&] { state = session().storeOpenStep() ? 1 : 0; });
+  guarded([&] { state = web::session().storeOpenStep() ? 1 : 0; });
   return state;
 }
 
@@ -81,7 +80,7 @@ EMSCRIPTEN_KEEPALIVE void tessera_zarr_put_failed(const char* key, const char* m
 // (numcodecs, web/zarr-url.js) before it hands them over.
 EMSCRIPTEN_KEEPALIVE int tessera_zarr_page_decodes(const char* compressor) {
   return guarded(
-      [&] { session().theStore().storage().setPageDecodes(parseZarrCompressor(compressor)); });
+      [&] { web::session().theStore().storage().setPageDecodes(parseZarrCompressor(compressor)); });
 }
 
 // A frame of the open store on the canvas, with the picked region (red) and
@@ -91,7 +90,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_zarr_page_decodes(const char* compressor) {
 EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_frame(int width, int height) {
   web::scratch().clear();
   guarded([&] {
-    web::WebSession& s = session();
+    web::WebSession& s = web::session();
     const web::StoreFrame f = s.storeFrame(width, height);
     web::ZarrStoreView& z = s.theStore();
     const lod::StreamerStats st = z.bricks().streamerStats();
@@ -123,7 +122,7 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_frame(int width, int height) {
 EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_info() {
   web::scratch().clear();
   guarded([&] {
-    const web::ZarrStoreView& z = session().theStore();
+    const web::ZarrStoreView& z = web::session().theStore();
     nlohmann::json j;
     j["url"] = z.store().storage().describe();
     j["description"] = z.store().describe();
@@ -154,7 +153,8 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_info() {
 EMSCRIPTEN_KEEPALIVE int tessera_zarr_region_prefetch(int x0, int x1, int y0, int y1, int z0,
                                                       int z1) {
   int state = -1;
-  guarded([&] { state = session().storeRegionPrefetch(boxOf(x0, x1, y0, y1, z0, z1)) ? 1 : 0; });
+  guarded(
+      [&] { state = web::session().storeRegionPrefetch(boxOf(x0, x1, y0, y1, z0, z1)) ? 1 : 0; });
   return state;
 }
 
@@ -163,7 +163,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_zarr_region_prefetch(int x0, int x1, int y0, in
 // (what `tessera render STORE --region` reads); the page then draws the
 // viewer instead of the store until it goes back to the store's overview.
 EMSCRIPTEN_KEEPALIVE int tessera_zarr_region_show(int x0, int x1, int y0, int y1, int z0, int z1) {
-  return guarded([&] { session().showStoreRegion(boxOf(x0, x1, y0, y1, z0, z1)); });
+  return guarded([&] { web::session().showStoreRegion(boxOf(x0, x1, y0, y1, z0, z1)); });
 }
 
 // Back to the store's overview from its region (the page draws the store

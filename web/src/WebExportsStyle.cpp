@@ -10,7 +10,6 @@
 
 using namespace tessera;
 using web::guarded;
-using web::session;
 using web::viewerIfAny;
 
 extern "C" {
@@ -23,10 +22,10 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_tf_json() {
   return web::scratch().c_str();
 }
 EMSCRIPTEN_KEEPALIVE int tessera_tf_set_json(const char* json) {
-  return guarded([&] { session().viewer().tfEditor().loadJson(json); });
+  return guarded([&] { web::session().viewer().tfEditor().loadJson(json); });
 }
 EMSCRIPTEN_KEEPALIVE int tessera_tf_preset(const char* name) {
-  return guarded([&] { session().viewer().tfEditor().loadPreset(name); });
+  return guarded([&] { web::session().viewer().tfEditor().loadPreset(name); });
 }
 EMSCRIPTEN_KEEPALIVE void tessera_tf_pointer_down(int channel, double x, double y, double rx,
                                                   double ry) {
@@ -51,7 +50,7 @@ EMSCRIPTEN_KEEPALIVE void tessera_tf_set_selected_color(double r, double g, doub
 
 // Render settings.
 EMSCRIPTEN_KEEPALIVE int tessera_set_window(double min, double max) {
-  return guarded([&] { session().viewer().setWindow({min, max}); });
+  return guarded([&] { web::session().viewer().setWindow({min, max}); });
 }
 EMSCRIPTEN_KEEPALIVE void tessera_reset_window() {
   if (viewer::Viewer* v = viewerIfAny()) v->resetWindow();
@@ -62,7 +61,7 @@ EMSCRIPTEN_KEEPALIVE void tessera_set_mode(int mode) {
   if (v && mode >= 0 && mode <= 3) v->settings().mode = static_cast<RenderMode>(mode);
 }
 EMSCRIPTEN_KEEPALIVE int tessera_set_step(double voxels) {
-  return guarded([&] { session().setStep(voxels); });
+  return guarded([&] { web::session().setStep(voxels); });
 }
 // Pre-integrated classification and adaptive steps (RenderSettings.h: the
 // page starts with the session's default sampling), each on (1) or off (0).
@@ -98,7 +97,7 @@ EMSCRIPTEN_KEEPALIVE void tessera_set_quality(int adaptive) {
   }
 }
 EMSCRIPTEN_KEEPALIVE int tessera_set_technique(const char* name) {
-  return guarded([&] { session().viewer().setTechnique(name); });
+  return guarded([&] { web::session().viewer().setTechnique(name); });
 }
 
 // Blinn-Phong terms and the light: a headlight, or a fixed light from
@@ -107,7 +106,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_set_light(int headlight, double ambient, double
                                            double specular, double shininess, double lx, double ly,
                                            double lz) {
   return guarded([&] {
-    session().setLight(headlight != 0, ambient, diffuse, specular, shininess, {lx, ly, lz});
+    web::session().setLight(headlight != 0, ambient, diffuse, specular, shininess, {lx, ly, lz});
   });
 }
 
@@ -115,13 +114,13 @@ EMSCRIPTEN_KEEPALIVE int tessera_set_light(int headlight, double ambient, double
 // times clamp((|g| - low) / (high - low), 0, 1), with or without the light
 // (`tessera render --gradient-opacity on|LOW,HIGH`).
 EMSCRIPTEN_KEEPALIVE int tessera_set_gradient_opacity(int on, double low, double high) {
-  return guarded([&] { session().setGradientOpacity(on != 0, low, high); });
+  return guarded([&] { web::session().setGradientOpacity(on != 0, low, high); });
 }
 
 // The crop box in fractions of each index axis (0..1, min < max).
 EMSCRIPTEN_KEEPALIVE int tessera_set_crop(double x0, double x1, double y0, double y1, double z0,
                                           double z1) {
-  return guarded([&] { session().setCrop({x0, y0, z0}, {x1, y1, z1}); });
+  return guarded([&] { web::session().setCrop({x0, y0, z0}, {x1, y1, z1}); });
 }
 EMSCRIPTEN_KEEPALIVE void tessera_show_crop_box(int on) {
   web::WebSession* s = web::sessionIfAny();
@@ -195,7 +194,7 @@ EMSCRIPTEN_KEEPALIVE void tessera_set_following_plane(int on, double depth) {
 // `name`; errors name the file and line) or, when empty, the default
 // palette. 0 on error (tessera_last_error), the state unchanged.
 EMSCRIPTEN_KEEPALIVE int tessera_set_labels(int on, const char* table, const char* name) {
-  return guarded([&] { session().setLabels(on != 0, table, name); });
+  return guarded([&] { web::session().setLabels(on != 0, table, name); });
 }
 // {"on": bool, "labels": [{"value", "name", "color": [r, g, b] 0..1, "visible"}]}
 EMSCRIPTEN_KEEPALIVE const char* tessera_labels_json() {

@@ -13,7 +13,6 @@
 
 using namespace tessera;
 using web::guarded;
-using web::session;
 using web::viewerIfAny;
 
 namespace tessera::web {
@@ -54,7 +53,7 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_last_error() {
 
 // "gen:shepp-logan:96" and the other procedural specs of `tessera render`.
 EMSCRIPTEN_KEEPALIVE int tessera_load_generated(const char* spec) {
-  return guarded([&] { session().loadGenerated(spec); });
+  return guarded([&] { web::session().loadGenerated(spec); });
 }
 
 // Files picked or dropped together: each is added (`bytes` malloc'ed by the
@@ -74,13 +73,13 @@ EMSCRIPTEN_KEEPALIVE void tessera_clear_files() {
 }
 
 EMSCRIPTEN_KEEPALIVE int tessera_load_files() {
-  return guarded([&] { session().loadPickedFiles(); });
+  return guarded([&] { web::session().loadPickedFiles(); });
 }
 
 // Renders a frame on the canvas; returns its time in ms (-1 on error).
 EMSCRIPTEN_KEEPALIVE double tessera_render(int width, int height) {
   double ms = -1.0;
-  guarded([&] { ms = session().renderFrame(width, height); });
+  guarded([&] { ms = web::session().renderFrame(width, height); });
   return ms;
 }
 
@@ -99,7 +98,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_refining() {
 }
 EMSCRIPTEN_KEEPALIVE double tessera_refine() {
   double ms = -1.0;
-  guarded([&] { ms = session().viewer().refine().ms; });
+  guarded([&] { ms = web::session().viewer().refine().ms; });
   return ms;
 }
 
@@ -126,7 +125,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_interacting() {
 
 // Keeps the projection (tessera_set_projection).
 EMSCRIPTEN_KEEPALIVE int tessera_set_camera(double azimuth, double elevation, double zoom) {
-  return guarded([&] { session().setCamera(azimuth, elevation, zoom); });
+  return guarded([&] { web::session().setCamera(azimuth, elevation, zoom); });
 }
 
 // 1: orthographic (parallel rays; the view's half height is the framed

@@ -25,6 +25,7 @@
 #include "tessera/core/SliceImage.h"
 #include "tessera/gpu/WebGlContext.h"
 #include "tessera/lod/GridNavigator.h"
+#include "tessera/session/Exploration.h"
 #include "tessera/viewer/CropHandles.h"
 #include "tessera/viewer/Explorer.h"
 #include "tessera/viewer/Viewer.h"
@@ -39,26 +40,9 @@ struct PickedFile {
   std::size_t size = 0;
 };
 
-// The bread-slice region of a file (Schultz 2016 §7.4): the overview kept
-// while the viewer shows the region, to return to.
+// The last slice per axis (tessera_slice's pixels).
 struct SliceViews {
-  // The overview's volume while a region is shown (the viewer holds the
-  // region then), its name and camera; null when the overview is shown.
-  std::unique_ptr<Volume> overview;
-  std::string overviewName;
-  Camera overviewCamera;
-  lod::VoxelBox region;           // of the overview, voxels (end exclusive)
-  const Volume* shown = nullptr;  // the viewer's volume when the region went in
-  std::string shownName;
-  Image images[3];  // the last slice per axis (tessera_slice's pixels)
-};
-
-// A store's region, level-0 voxels, while the viewer shows it.
-struct StoreRegion {
-  lod::VoxelBox box;
-  bool shown = false;
-  Camera overviewCamera;   // the store view's camera, restored on the way back
-  bool gridBlock = false;  // read for the grid view (outlined cyan), not picked (red)
+  Image images[3];
 };
 
 // Boxes marked in the overview (0: the picked region, red; 1: the grid
@@ -67,21 +51,6 @@ struct StoreRegion {
 struct MarkBox {
   std::optional<lod::VoxelBox> box;
   glm::ivec3 dims{0};
-};
-
-struct GridView {
-  std::optional<lod::GridNavigator> nav;
-  std::string volumeKey;               // the overview it was made for: name and dims
-  int askedCell = 0;                   // the cell side asked for (0: the default)
-  std::string shownName;               // the viewer's volume name while its block is shown
-  std::optional<lod::VoxelBox> block;  // the last block shown
-  std::string note;                    // the last move, or why it was refused
-  bool refused = false;
-  bool storeWanted = false;  // a store's block is to be read (the page fetches its chunks)
-  // Where a store's pending block came from: restored when its read fails.
-  glm::ivec3 fromPoint{0};
-  std::optional<lod::VoxelBox> fromBlock;
-  std::string fromShownName;
 };
 
 struct ZoomView {
@@ -160,8 +129,13 @@ class WebSession {
   const std::uint8_t* readPixels(int width, int height);
 
   // ---- slice views, region and grid (WebSessionExplore.cpp)
-  // True while the viewer still shows the region put in by showRegion; a
-  // volume loaded since then (another file) ends region mode.
+  // The exploration (session/Exploration.h) of what the slices show: the
+  // open store's level 0, or the file in the viewer (made for it on first
+  // use, sharing its voxels; `cellSide` > 0 asks for cubic grid cells of that
+  // side, 0 for the default, -1 keeps the current grid).
+  session::Exploration& exploration(int cellSide = -1);
+  // True while the viewer shows the region or grid block the exploration
+  // put in; a volume loaded since then (another file) ends it.
   bool regionShown();
   const SliceViews& sliceViews() const { return slices_; }
   // The volume the slices show: the overview's, also while a region is shown.
@@ -188,9 +162,9 @@ class WebSession {
   void gridStoreFailed();
   void gridStoreShown();
   bool gridShown();
-  lod::GridNavigator& gridFor(const Volume& volume, int cellSide);
+  // A store's grid block asked for and not read yet (the page fetches it).
+  bool gridStoreWanted();
   lod::GridNavigator defaultGrid(const Volume& volume);
-  const GridView& grid() const { return grid_; }
 
   // ---- OME-Zarr stores over fetch() (WebSessionStore.cpp)
   ZarrStoreView* store() { return zarr_.get(); }
@@ -200,7 +174,6 @@ class WebSession {
   void beginStore(const std::string& url);
   bool storeOpenStep();
   void closeStore();
-  const StoreRegion& storeRegion() const { return storeRegion_; }
   // The store's level-0 box of these ranges (clamped; errors name the store).
   lod::VoxelBox storeRegionBox(const lod::VoxelBox& asked);
   bool storeRegionPrefetch(const lod::VoxelBox& asked);
@@ -225,7 +198,7 @@ class WebSession {
  private:
   void applyMarkBoxes();
   std::string overviewKey(const Volume& v);
-  void showGridBlock(const lod::VoxelBox& box, bool keepZoom);
+  void showGridBlock(const session::ExploreStep& step);
 
   // Declared in destruction order's reverse: the viewer's GPU objects go
   // before the context.
@@ -235,9 +208,10 @@ class WebSession {
   std::unique_ptr<viewer::Viewer> viewer_;
   std::vector<PickedFile> picked_;
   SliceViews slices_;
-  StoreRegion storeRegion_;
   MarkBox marks_[2];
-  GridView grid_;
+  std::unique_ptr<session::Exploration> explore_;
+  std::string exploreKey_;  // the overview it was made for: name and dims
+  int askedCell_ = 0;       // the grid cell side asked for (0: the default)
   CropState crop_;
   std::vector<std::uint8_t> pixels_;
 };

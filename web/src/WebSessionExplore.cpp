@@ -35,12 +35,10 @@ std::string rangeText(const lod::VoxelBox& box, int a) {
 }  // namespace
 
 bool WebSession::regionShown() {
-  SliceViews& s = slices_;
-  if (!s.overview) return false;
+  if (!explore_ || explore_->mode() == session::ExploreMode::Overview) return false;
   const viewer::Viewer& v = viewer();
-  if (v.hasVolume() && &v.volume() == s.shown && v.volumeName() == s.shownName) return true;
-  s.overview.reset();
-  s.shown = nullptr;
+  if (v.hasVolume() && v.volumeName() == explore_->shownName()) return true;
+  if (!storeOverview()) explore_.reset();  // another volume came in since
   return false;
 }
 
@@ -53,14 +51,14 @@ const Volume& WebSession::overviewVolume() {
   if (const Volume* store = storeOverview()) return *store;
   if (const Volume* whole = zoomOverview()) return *whole;
   viewer::Viewer& v = viewer();
-  if (regionShown()) return *slices_.overview;
+  if (!storeOverview() && regionShown()) return *explore_->overview();
   if (!v.hasVolume()) throw InputError("no volume is loaded");
   return v.volume();
 }
 
 std::string WebSession::overviewName() {
   if (storeOverview()) return theStore().storage().describe();
-  if (regionShown()) return slices_.overviewName;
+  if (regionShown()) return explore_->label();
   if (zoomOverview()) return zoom_.name;
   return viewer().volumeName();
 }
@@ -174,63 +172,46 @@ double WebSession::voxelValue(int x, int y, int z) {
   return store->valueAt(c.x, c.y, c.z);
 }
 
-// Ends past the volume are clamped; an empty box or one that starts outside
-// is an error. The window, the TF and the overview stay.
-void WebSession::showRegion(lod::VoxelBox box) {
-  zoomStop();  // the region replaces the whole volume, not a level of it
-  viewer::Viewer& v = viewer();
-  SliceViews& s = slices_;
-  const bool inRegion = regionShown();
-  const Volume& full = overviewVolume();
-  const glm::ivec3 d = full.dims();
-  const char* names = "xyz";
-  for (int a = 0; a < 3; ++a) {
-    if (box.begin[a] < 0 || box.begin[a] >= d[a] || box.end[a] <= box.begin[a]) {
-      throw InputError(std::string("region: ") + names[a] + " range " + rangeText(box, a) +
-                       " is empty or starts outside 0:" + std::to_string(d[a]));
+// The exploration of what the slices show, made anew for another overview
+// (a file's shares the viewer's voxels) or another grid cell asked for.
+session::Exploration& WebSession::exploration(int cellSide) {
+  const Volume& volume = sliceShape();
+  const std::string key = overviewKey(volume);
+  if (!explore_ || exploreKey_ != key) {
+    const std::uint64_t budget = viewer::regionBudgetBytes(viewer().limits());
+    if (storeOverview()) {
+      // The store draws its own overview: none is read here.
+      explore_ = std::make_unique<session::Exploration>(theStore().sharedSource(), budget, 0,
+                                                        theStore().storage().describe());
+    } else {
+      explore_ = std::make_unique<session::Exploration>(viewer().sharedVolume(), budget,
+                                                        viewer().volumeName());
     }
-    box.end[a] = std::min(box.end[a], d[a]);
+    exploreKey_ = key;
+    askedCell_ = -1;  // the grid below is set for it
   }
-  const ValueRange window = v.window();
-  Volume region = lod::copyBox(full, box);
-  region.setGeometrySource(full.geometrySource());
-  region.setWindow(window);
-  const std::string overviewName = inRegion ? s.overviewName : v.volumeName();
-  const std::string name = overviewName + " region " + rangeText(box, 0) + "," + rangeText(box, 1) +
-                           "," + rangeText(box, 2);
-  // The viewer takes its volume by value: the overview is copied out
-  // before the region replaces it (kept while the region is shown).
-  std::unique_ptr<Volume> overview =
-      inRegion ? std::move(s.overview) : std::make_unique<Volume>(full);
-  const Camera camera = inRegion ? s.overviewCamera : v.camera();
-  try {
-    v.setVolume(std::move(region), name);
-  } catch (...) {
-    if (inRegion) s.overview = std::move(overview);
-    throw;
+  const int asked = cellSide < 0 ? std::max(askedCell_, 0) : cellSide;
+  if (asked != askedCell_) {
+    explore_->setGrid(asked > 0 ? lod::GridNavigator(volume.dims(), glm::ivec3(asked))
+                                : defaultGrid(volume));
+    askedCell_ = asked;
   }
-  v.setWindow(window);
-  s.overview = std::move(overview);
-  s.overviewName = overviewName;
-  s.overviewCamera = camera;
-  s.region = box;
-  s.shown = &v.volume();
-  s.shownName = name;
+  return *explore_;
+}
+
+// Ends past the volume are clamped; an empty box or one that starts outside
+// is an error. The window, the TF, the zoom and the overview stay.
+void WebSession::showRegion(lod::VoxelBox box) {
+  zoomStop();     // the region replaces the whole volume, not a level of it
+  regionShown();  // forgets an exploration of a volume no longer shown
+  session::Exploration& e = exploration();
+  e.show(viewer(), e.region(box, session::Follow::Centre));
 }
 
 // With the overview's camera and the current window; the region stays
 // known to the page, which draws it as a highlighted box.
 void WebSession::returnToOverview() {
-  if (!regionShown()) return;
-  viewer::Viewer& v = viewer();
-  SliceViews& s = slices_;
-  const ValueRange window = v.window();
-  // A copy, so that the overview survives an upload that fails.
-  v.setVolume(Volume(*s.overview), s.overviewName);
-  v.setWindow(window);
-  v.camera() = s.overviewCamera;
-  s.overview.reset();
-  s.shown = nullptr;
+  if (regionShown()) explore_->showOverview(viewer(), session::Follow::Back);
 }
 
 // A point at continuous voxel coordinates p of the overview lies at model
@@ -244,12 +225,11 @@ std::optional<VoxelProjection> WebSession::projection(int width, int height) {
     // frames are drawn in level 0's model frame (ZarrStoreView::frame), a
     // region of it by the viewer (a box of level 0 placed where it lies).
     const Volume& shape = theStore().store().shape();
-    const StoreRegion& r = storeRegion_;
-    const bool inRegion = r.shown && v.hasVolume();
+    const bool inRegion = regionShown();
     const glm::dvec3 extent = inRegion ? v.volume().extent() : shape.extent();
     p.spacing = shape.spacing();
-    p.offset =
-        -0.5 * extent - (inRegion ? glm::dvec3(r.box.begin) * shape.spacing() : glm::dvec3(0.0));
+    p.offset = -0.5 * extent - (inRegion ? glm::dvec3(explore_->shown()->begin) * shape.spacing()
+                                         : glm::dvec3(0.0));
     // The store's frames frame the viewer's camera on the store's shape.
     Camera c = v.camera();
     if (!inRegion) c.frame(shape);
@@ -260,7 +240,7 @@ std::optional<VoxelProjection> WebSession::projection(int width, int height) {
   const Volume& shownVolume = v.volume();
   p.spacing = shownVolume.spacing();
   p.offset = -0.5 * shownVolume.extent();
-  if (regionShown()) p.offset -= glm::dvec3(slices_.region.begin) * p.spacing;
+  if (regionShown()) p.offset -= glm::dvec3(explore_->shown()->begin) * p.spacing;
   if (const Volume* whole = zoomOverview()) {
     // A level spans the whole volume's box; the native block is a box of
     // level 0.
@@ -288,13 +268,12 @@ std::string WebSession::overviewKey(const Volume& v) {
 // True while the 3D view shows the block the grid put in (not a region
 // picked since, nor the overview, nor another file).
 bool WebSession::gridShown() {
-  const GridView& g = grid_;
-  if (storeOverview()) {
-    const StoreRegion& r = storeRegion_;
-    return !g.shownName.empty() && r.shown && g.block && r.box.begin == g.block->begin &&
-           r.box.end == g.block->end && viewer().volumeName() == g.shownName;
-  }
-  return !g.shownName.empty() && regionShown() && slices_.shownName == g.shownName;
+  return regionShown() && explore_->mode() == session::ExploreMode::Grid;
+}
+
+bool WebSession::gridStoreWanted() {
+  return storeOverview() && explore_ && explore_->pending() &&
+         explore_->pending()->mode == session::ExploreMode::Grid;
 }
 
 // The default cell: cubic, a multiple of 16 voxels, as large as possible
@@ -312,123 +291,47 @@ lod::GridNavigator WebSession::defaultGrid(const Volume& volume) {
   return lod::GridNavigator(d, glm::ivec3(std::min(budgetCell, splitCell)));
 }
 
-// Made anew for another volume or another cell side; `cellSide` < 0 keeps
-// the current one.
-lod::GridNavigator& WebSession::gridFor(const Volume& volume, int cellSide) {
-  GridView& g = grid_;
-  const std::string key = overviewKey(volume);
-  const int asked = cellSide < 0 ? g.askedCell : cellSide;
-  if (!g.nav || g.volumeKey != key || g.askedCell != asked) {
-    g.nav = asked > 0 ? lod::GridNavigator(volume.dims(), glm::ivec3(asked)) : defaultGrid(volume);
-    g.volumeKey = key;
-    g.askedCell = asked;
-    g.block.reset();
-    g.shownName.clear();
-    g.note.clear();
-    g.refused = false;
-  }
-  return *g.nav;
-}
-
-// Shows `box` of the overview as the 3D view. The view direction and the
-// projection stay (the moves are chosen from it); the zoom too on a move,
-// 1 on entering (the block fills the view).
-void WebSession::showGridBlock(const lod::VoxelBox& box, bool keepZoom) {
-  GridView& g = grid_;
-  if (storeOverview()) {
-    // A store's block is read like its region: the page fetches exactly its
-    // level-0 chunks, then calls tessera_grid_store_shown.
-    if (!g.storeWanted) {
-      g.fromBlock = g.block;
-      g.fromShownName = g.shownName;
-    }
-    g.block = box;
-    g.storeWanted = true;
-    g.shownName.clear();
-    return;
-  }
-  viewer::Viewer& v = viewer();
-  const Camera before = v.camera();
+// Shows a grid step as the 3D view (a store's block is read like its
+// region: the page fetches exactly its level-0 chunks, then calls
+// tessera_zarr_region_show and tessera_grid_store_shown).
+void WebSession::showGridBlock(const session::ExploreStep& step) {
+  if (storeOverview()) return;
   try {
-    showRegion(box);
+    explore_->show(viewer(), step);
   } catch (const std::exception& e) {
     throw InputError("grid view: " + std::string(e.what()));
   }
-  Camera& c = v.camera();
-  c.projection = before.projection;
-  c.azimuthDeg = before.azimuthDeg;
-  c.elevationDeg = before.elevationDeg;
-  c.zoom = keepZoom ? before.zoom : 1.0;
-  g.shownName = slices_.shownName;
-  g.block = box;
 }
 
 // At the grid point nearest the centre of voxel `voxel` of the overview.
 void WebSession::gridEnter(int cellSide, const glm::ivec3& voxel) {
   zoomStop();  // the grid view's block replaces the whole volume
-  const Volume& volume = sliceShape();
-  lod::GridNavigator& nav = gridFor(volume, cellSide);
-  // The crosshair is in the slices' voxels, as the grid.
-  const glm::dvec3 c = (glm::dvec3(voxel) + 0.5) / glm::dvec3(nav.cellSize());
-  if (!grid_.storeWanted) grid_.fromPoint = nav.point();
-  nav.moveTo(glm::clamp(glm::ivec3(glm::round(c)), glm::ivec3(0), nav.cells()));
-  showGridBlock(nav.blockBox(nav.point()), false);
-  grid_.note = "grid point " + nav.describe(nav.point());
-  grid_.refused = false;
+  regionShown();
+  session::Exploration& e = exploration(cellSide);
+  showGridBlock(e.enterGrid(voxel));  // the crosshair is in the slices' voxels, as the grid
 }
 
 int WebSession::gridMove(int viewMove) {
   if (viewMove < 0 || viewMove > 5) throw InputError("grid view: moves are 0..5");
-  if (!gridShown() && !grid_.storeWanted) {
+  if (!gridShown() && !gridStoreWanted()) {
     throw InputError("grid view: not in the grid view (press G)");
   }
-  lod::GridNavigator& nav = gridFor(sliceShape(), -1);
-  const lod::ViewMove vm = kViewMoves[viewMove];
-  const lod::GridMove m = lod::viewMoveToGridMove(viewer().camera().basis(), vm);
-  const std::string what = std::string(lod::viewMoveName(vm)) + " = " + m.name();
-  GridView& g = grid_;
-  const glm::ivec3 from = nav.point();
-  if (!g.storeWanted) g.fromPoint = from;
-  const lod::MoveResult r = nav.apply(m);
-  if (!r.moved) {
-    g.note = what + " refused: " + r.reason;
-    g.refused = true;
-    return 0;
-  }
-  try {
-    showGridBlock(nav.blockBox(nav.point()), true);
-  } catch (...) {
-    nav.moveTo(from);
-    throw;
-  }
-  g.note = what + ": grid point " + nav.describe(nav.point());
-  g.refused = false;
+  const auto step = exploration().move(kViewMoves[viewMove], viewer().camera().basis());
+  if (!step) return 0;
+  showGridBlock(*step);
   return 1;
 }
 
-// The grid point and block go back to where they were before the enter or
-// move that asked for the store's block.
+// The grid point goes back to where it was before the enter or move that
+// asked for the store's block.
 void WebSession::gridStoreFailed() {
-  GridView& g = grid_;
-  if (!g.storeWanted || !g.nav) return;
-  g.nav->moveTo(g.fromPoint);
-  g.block = g.fromBlock;
-  g.shownName = g.fromShownName;
-  g.storeWanted = false;
-  g.note = "the block could not be read; back at grid point " + g.nav->describe(g.fromPoint);
-  g.refused = true;
+  if (gridStoreWanted()) explore_->failed("the block could not be read");
 }
 
 void WebSession::gridStoreShown() {
-  GridView& g = grid_;
-  const StoreRegion& r = storeRegion_;
-  if (!g.storeWanted || !g.block || !r.shown || r.box.begin != g.block->begin ||
-      r.box.end != g.block->end) {
+  if (!gridShown() || !storeOverview()) {
     throw InputError("grid view: the store's block has not been read");
   }
-  g.storeWanted = false;
-  g.shownName = viewer().volumeName();
-  storeRegion_.gridBlock = true;
 }
 
 }  // namespace tessera::web

@@ -68,6 +68,7 @@ class ZarrStoreView {
   // The store's levels; readBox of a box whose chunks have arrived
   // (prefetch true) reads without the network.
   const FetchedZarrSource& source() const { return *source_; }
+  std::shared_ptr<const FetchedZarrSource> sharedSource() const { return source_; }
   // The coarsest level, read once at open (for the page's histogram).
   const Volume& coarsest() const { return coarsest_; }
 

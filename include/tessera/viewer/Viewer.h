@@ -60,6 +60,8 @@ class Viewer {
   void setVolume(Volume volume, const std::string& name);
   bool hasVolume() const { return active_.technique != nullptr; }
   const Volume& volume() const { return *volume_; }  // empty before the first setVolume
+  // The same volume, shared (an exploration keeps it as its overview).
+  std::shared_ptr<const Volume> sharedVolume() const { return volume_; }
   const std::string& volumeName() const { return volumeName_; }
   // How the technique's upload stored the volume (empty for a technique with
   // its own storage: see storageName()).
