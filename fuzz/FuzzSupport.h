@@ -11,19 +11,17 @@
 // other exception escapes LLVMFuzzerTestOneInput, std::terminate aborts, and
 // libFuzzer reports the input as a crash: readers must turn library errors
 // (nlohmann::json, DCMTK, zlib) into InputError.
-#include <unistd.h>
-
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
-#include <system_error>
 
 #include <span>
 #include <vector>
 
+#include "../tests/support/TestSupport.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/io/ByteSource.h"
@@ -33,28 +31,10 @@ namespace tessera::fuzz {
 // 64 MiB: far above what the seeds need, far below -rss_limit_mb.
 constexpr std::uint64_t kFuzzHostBudget = 64ull << 20;
 
-// Removed when the process exits normally; crashes leave it for inspection.
-class ScratchDir {
- public:
-  ScratchDir()
-      : path_(std::filesystem::temp_directory_path() /
-              ("tessera-fuzz-" + std::to_string(::getpid()))) {
-    std::filesystem::create_directories(path_);
-  }
-  ~ScratchDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  ScratchDir(const ScratchDir&) = delete;
-  ScratchDir& operator=(const ScratchDir&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
-
+// The tests' temporary folder (tests/support/TestSupport.h), made once per
+// process: removed when it exits normally; crashes leave it for inspection.
 inline const std::filesystem::path& scratchDir() {
-  static const ScratchDir dir;
+  static const test::TempDir dir;
   return dir.path();
 }
 

@@ -7,23 +7,12 @@
 #include <string>
 #include <vector>
 
-#include "FuzzSupport.h"
-#include "tessera/core/Error.h"
+#include "FuzzTarget.h"
 #include "tessera/io/DicomBasicReader.h"
 
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  tessera::fuzz::initialize();
-  return 0;
-}
-
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  tessera::MemoryFiles files;
+void tessera::fuzz::fuzzOne(const std::uint8_t* data, std::size_t size) {
+  MemoryFiles files;
   files.add("drop/fuzzed.dcm",
             std::span<const std::byte>(reinterpret_cast<const std::byte*>(data), size));
-  try {
-    tessera::readDicomSeriesBasic(*files.open("drop/fuzzed.dcm"), files);
-  } catch (const tessera::Error& e) {
-    tessera::fuzz::rejected(e);
-  }
-  return 0;
+  readDicomSeriesBasic(*files.open("drop/fuzzed.dcm"), files);
 }

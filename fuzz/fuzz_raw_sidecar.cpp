@@ -4,22 +4,11 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "FuzzSupport.h"
-#include "tessera/core/Error.h"
+#include "FuzzTarget.h"
 #include "tessera/io/RawSidecarReader.h"
 
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  tessera::fuzz::initialize();
-  return 0;
-}
-
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  tessera::MemoryFiles files = tessera::fuzz::besideInput();
+void tessera::fuzz::fuzzOne(const std::uint8_t* data, std::size_t size) {
+  MemoryFiles files = besideInput();
   files.add("data.raw.json", std::span(reinterpret_cast<const std::byte*>(data), size));
-  try {
-    tessera::readRawWithSidecar(*files.open("data.raw"), files);
-  } catch (const tessera::Error& e) {
-    tessera::fuzz::rejected(e);
-  }
-  return 0;
+  readRawWithSidecar(*files.open("data.raw"), files);
 }

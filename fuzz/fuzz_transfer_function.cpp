@@ -8,29 +8,18 @@
 #include <string>
 #include <vector>
 
-#include "FuzzSupport.h"
-#include "tessera/core/Error.h"
+#include "FuzzTarget.h"
 #include "tessera/core/TransferFunction.h"
 
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  tessera::fuzz::initialize();
-  return 0;
-}
-
-extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+void tessera::fuzz::fuzzOne(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
-  try {
-    const tessera::TransferFunction tf = tessera::TransferFunction::fromJson(text, "fuzz");
-    const std::vector<float> table = tf.bake(256, 0.5, 1.0);
-    for (const float v : table) {
-      // fromJson promises colours and opacities in [0, 1].
-      if (!(v >= 0.0f && v <= 1.0f)) {
-        std::fprintf(stderr, "bake() produced %g from an accepted transfer function\n", v);
-        std::abort();
-      }
+  const TransferFunction tf = TransferFunction::fromJson(text, "fuzz");
+  const std::vector<float> table = tf.bake(256, 0.5, 1.0);
+  for (const float v : table) {
+    // fromJson promises colours and opacities in [0, 1].
+    if (!(v >= 0.0f && v <= 1.0f)) {
+      std::fprintf(stderr, "bake() produced %g from an accepted transfer function\n", v);
+      std::abort();
     }
-  } catch (const tessera::Error& e) {
-    tessera::fuzz::rejected(e);
   }
-  return 0;
 }

@@ -1,4 +1,5 @@
 #include "support/TestSupport.h"
+#include "support/TestTransferFunctions.h"
 #include "tessera/core/TransferFunction.h"
 
 #include <gtest/gtest.h>
@@ -54,12 +55,8 @@ void expectSameTf(const TransferFunction& a, const TransferFunction& b) {
 }
 
 TEST(TransferFunction, InterpolatesLinearlyBetweenControlPoints) {
-  TransferFunction tf;
-  tf.addColor(0.2, {1.0, 0.0, 0.0});
-  tf.addColor(0.6, {0.0, 0.0, 1.0});
-  tf.addOpacity(0.0, 0.0);
-  tf.addOpacity(0.5, 0.4);
-  tf.addOpacity(1.0, 0.1);
+  const TransferFunction tf = test::tfFromPoints({{0.2, {1.0, 0.0, 0.0}}, {0.6, {0.0, 0.0, 1.0}}},
+                                                 {{0.0, 0.0}, {0.5, 0.4}, {1.0, 0.1}});
 
   EXPECT_EQ(tf.color(0.2), glm::dvec3(1.0, 0.0, 0.0));
   EXPECT_EQ(tf.color(0.6), glm::dvec3(0.0, 0.0, 1.0));
@@ -81,11 +78,8 @@ TEST(TransferFunction, InterpolatesLinearlyBetweenControlPoints) {
 }
 
 TEST(TransferFunction, HoldsEndValuesOutsideTheControlPoints) {
-  TransferFunction tf;
-  tf.addColor(0.3, {0.1, 0.2, 0.3});
-  tf.addColor(0.7, {0.9, 0.8, 0.7});
-  tf.addOpacity(0.3, 0.05);
-  tf.addOpacity(0.7, 0.6);
+  const TransferFunction tf = test::tfFromPoints({{0.3, {0.1, 0.2, 0.3}}, {0.7, {0.9, 0.8, 0.7}}},
+                                                 {{0.3, 0.05}, {0.7, 0.6}});
   for (double x : {0.0, 0.1, 0.3, -2.0, std::numeric_limits<double>::quiet_NaN()}) {
     EXPECT_EQ(tf.color(x), glm::dvec3(0.1, 0.2, 0.3)) << x;
     EXPECT_EQ(tf.opacity(x), 0.05) << x;

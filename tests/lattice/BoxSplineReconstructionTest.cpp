@@ -8,6 +8,8 @@
 #include <random>
 #include <string>
 
+#include "lattice/Blobs.h"
+#include "support/TestCameras.h"
 #include "tessera/core/Camera.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/io/VolumeReader.h"
@@ -24,23 +26,9 @@ namespace {
 
 constexpr int kImage = 64;
 
-// Three overlapping Gaussian blobs in [0,1]: smooth at any resolution.
+// The blobs in [0,1] as floats.
 Volume blobs(glm::ivec3 dims) {
-  Volume v = Volume::allocate(dims, ScalarType::F32, "blobs");
-  const glm::dvec3 centres[3] = {{0.35, 0.4, 0.5}, {0.65, 0.55, 0.4}, {0.5, 0.6, 0.7}};
-  for (int z = 0; z < dims.z; ++z) {
-    for (int y = 0; y < dims.y; ++y) {
-      for (int x = 0; x < dims.x; ++x) {
-        const glm::dvec3 p = (glm::dvec3(x, y, z) + 0.5) / glm::dvec3(dims);
-        double f = 0.0;
-        for (const glm::dvec3& c : centres) {
-          const glm::dvec3 d = p - c;
-          f += 0.6 * std::exp(-glm::dot(d, d) / (2 * 0.12 * 0.12));
-        }
-        v.setValueAtIndex(v.index(x, y, z), std::min(f, 1.0));
-      }
-    }
-  }
+  Volume v = test::blobs(dims, ScalarType::F32);
   v.setWindow({0.0, 1.0});
   return v;
 }
@@ -60,11 +48,7 @@ class MarschnerLobbField final : public Reconstruction {
 };
 
 Camera obliqueCamera(const Volume& v) {
-  Camera cam;
-  cam.azimuthDeg = 30;
-  cam.elevationDeg = 20;
-  cam.frame(v);
-  return cam;
+  return test::orbitCamera(v, 30, 20);
 }
 
 }  // namespace
@@ -153,10 +137,7 @@ TEST(BoxSplineReconstruction, Ch2OnFccRendersLikeTheOriginal) {
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not installed (mricron-data)";
   const Volume ch2 = readVolume(path);
   const TransferFunction tf = TransferFunction::preset("mr-default");
-  Camera cam;
-  cam.azimuthDeg = 30;
-  cam.elevationDeg = 15;
-  cam.frame(ch2);
+  Camera cam = test::orbitCamera(ch2, 30, 15);
   const RenderSettings s;
   const Image original = renderReference(ch2, tf, cam, s, kImage, kImage);
   for (const FccDensity density : {FccDensity::Half, FccDensity::Same}) {

@@ -12,7 +12,9 @@
 #include <string>
 #include <utility>
 
+#include "lattice/Blobs.h"
 #include "support/GpuTestContext.h"
+#include "support/TestCameras.h"
 #include "support/TestTransferFunctions.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/Procedural.h"
@@ -100,29 +102,12 @@ std::unique_ptr<render::Raycaster> makeCaster(const Volume& box, const layout::L
 }
 
 Camera obliqueCamera(const Volume& v) {
-  Camera cam;
-  cam.azimuthDeg = 30;
-  cam.elevationDeg = 20;
-  cam.frame(v);
-  return cam;
+  return test::orbitCamera(v, 30, 20);
 }
 
-// Smooth blobs in [0,1] (u8 after scaling): a small real-looking volume.
+// The blobs as u8 (255 at 1): a small real-looking volume.
 Volume blobs(glm::ivec3 dims) {
-  Volume v = Volume::allocate(dims, ScalarType::U8, "blobs");
-  const glm::dvec3 centres[3] = {{0.35, 0.4, 0.5}, {0.65, 0.55, 0.4}, {0.5, 0.6, 0.7}};
-  for (int z = 0; z < dims.z; ++z)
-    for (int y = 0; y < dims.y; ++y)
-      for (int x = 0; x < dims.x; ++x) {
-        const glm::dvec3 p = (glm::dvec3(x, y, z) + 0.5) / glm::dvec3(dims);
-        double f = 0.0;
-        for (const glm::dvec3& c : centres) {
-          const glm::dvec3 d = p - c;
-          f += 0.6 * std::exp(-glm::dot(d, d) / (2 * 0.12 * 0.12));
-        }
-        v.setValueAtIndex(v.index(x, y, z), std::round(255.0 * std::min(f, 1.0)));
-      }
-  return v;
+  return test::blobs(dims, ScalarType::U8);
 }
 
 }  // namespace

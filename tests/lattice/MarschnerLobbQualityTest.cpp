@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "support/TestCameras.h"
 #include "tessera/core/Camera.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/lattice/BoxSplineReconstruction.h"
@@ -40,10 +41,7 @@ class Quality {
  public:
   explicit Quality(const Volume& cartesian)
       : dims_(cartesian.dims()), random_(randomSamples(40000)) {
-    Camera camera;
-    camera.azimuthDeg = 30;
-    camera.elevationDeg = 20;
-    camera.frame(cartesian);
+    Camera camera = test::orbitCamera(cartesian, 30, 20);
     rays_ = raySamplePositions(cartesian, camera, 48);
   }
   Row row(const std::string& name, std::uint64_t samples, const Reconstruction& field) const {

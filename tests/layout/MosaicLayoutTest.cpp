@@ -10,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "layout/LayoutFixtures.h"
 #include "support/GpuTestContext.h"
 #include "support/ProbePositions.h"
 #include "tessera/core/Error.h"
@@ -25,50 +26,15 @@ using layout::MosaicLayout;
 
 namespace {
 
+using test::addressPattern;
+using test::es2Context;
 using test::probePositions;
-
-// A volume whose every voxel differs from its neighbours, so an addressing
-// slip of one voxel along any axis shows.
-Volume addressPattern(glm::ivec3 d, ScalarType type) {
-  Volume v = Volume::allocate(d, type);
-  for (int z = 0; z < d.z; ++z) {
-    for (int y = 0; y < d.y; ++y) {
-      for (int x = 0; x < d.x; ++x) {
-        const double u8 = (x * 7 + y * 31 + z * 101) % 256;
-        double value = u8;
-        if (type == ScalarType::U16) value = u8 * 200.0 + x;
-        if (type == ScalarType::I16) value = u8 * 100.0 - 12000.0 + y;
-        if (type == ScalarType::F32) value = u8 / 255.0 - 0.5 + z * 1e-3;
-        v.setValueAtIndex(v.index(x, y, z), value);
-      }
-    }
-  }
-  return v;
-}
-
-std::unique_ptr<gpu::GlContext> es2Context() {
-  gpu::GlContext::Options options;
-  options.api = gpu::ApiLevel::Gles2;
-  return gpu::GlContext::createHeadless(options);
-}
+using test::worstTrilinearError;
 
 gpu::DeviceLimits limitsWithMax2D(const gpu::DeviceCaps& caps, int max2D) {
   gpu::DeviceLimits l = gpu::DeviceLimits::of(caps);
   l.max2DTextureSize = max2D;
   return l;
-}
-
-// Worst |GPU - CPU trilinear| in raw units.
-double worstTrilinearError(const Volume& v, const layout::Layout& l,
-                           const std::vector<glm::vec3>& positions,
-                           const std::vector<float>& stored) {
-  const layout::ValueMapping m = l.rawFromStored();
-  double worst = 0.0;
-  for (std::size_t i = 0; i < positions.size(); ++i) {
-    const double gpu = m.scale * stored[i] + m.offset;
-    worst = std::max(worst, std::abs(gpu - sampleTrilinear(v, glm::dvec3(positions[i]))));
-  }
-  return worst;
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "layout/LayoutFixtures.h"
 #include "support/GpuTestContext.h"
 #include "support/ProbePositions.h"
 #include "tessera/core/Error.h"
@@ -53,26 +54,9 @@ int sliceIn(Packing p, int depth, int g, int c) {
   return std::min(3 * g + c, depth - 1);
 }
 
-// A volume whose every voxel differs from its neighbours, so an addressing
-// slip of one voxel along any axis shows.
-Volume addressPattern(glm::ivec3 d, ScalarType type) {
-  Volume v = Volume::allocate(d, type);
-  for (int z = 0; z < d.z; ++z) {
-    for (int y = 0; y < d.y; ++y) {
-      for (int x = 0; x < d.x; ++x) {
-        const double u8 = (x * 7 + y * 31 + z * 101) % 256;
-        v.setValueAtIndex(v.index(x, y, z), type == ScalarType::U8 ? u8 : u8 * 200.0 + x);
-      }
-    }
-  }
-  return v;
-}
-
-std::unique_ptr<gpu::GlContext> es2Context() {
-  gpu::GlContext::Options options;
-  options.api = gpu::ApiLevel::Gles2;
-  return gpu::GlContext::createHeadless(options);
-}
+using test::addressPattern;
+using test::es2Context;
+using test::worstTrilinearError;
 
 // Layouts that spill slices across channels, tiles and textures: the max 2D
 // size forces the number of textures, for each packing (0: more than the
@@ -104,18 +88,6 @@ gpu::DeviceLimits limitsFor(const gpu::DeviceCaps& caps, const Spill& p) {
   gpu::DeviceLimits l = gpu::DeviceLimits::of(caps);
   if (p.max2D != 0) l.max2DTextureSize = p.max2D;
   return l;
-}
-
-double worstTrilinearError(const Volume& v, const layout::Layout& l,
-                           const std::vector<glm::vec3>& positions,
-                           const std::vector<float>& stored) {
-  const layout::ValueMapping m = l.rawFromStored();
-  double worst = 0.0;
-  for (std::size_t i = 0; i < positions.size(); ++i) {
-    const double gpu = m.scale * stored[i] + m.offset;
-    worst = std::max(worst, std::abs(gpu - sampleTrilinear(v, glm::dvec3(positions[i]))));
-  }
-  return worst;
 }
 
 }  // namespace

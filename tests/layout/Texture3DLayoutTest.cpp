@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "layout/LayoutFixtures.h"
 #include "support/GpuTestContext.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/GlContext.h"
@@ -18,24 +19,7 @@ gpu::GlContext& context() {
   return test::gpuContext();
 }
 
-// A volume whose every voxel differs from its neighbours, so an addressing
-// slip of one voxel along any axis shows.
-Volume addressPattern(glm::ivec3 d, ScalarType type) {
-  Volume v = Volume::allocate(d, type);
-  for (int z = 0; z < d.z; ++z) {
-    for (int y = 0; y < d.y; ++y) {
-      for (int x = 0; x < d.x; ++x) {
-        const double u8 = (x * 7 + y * 31 + z * 101) % 256;
-        double value = u8;
-        if (type == ScalarType::U16) value = u8 * 200.0 + x;
-        if (type == ScalarType::I16) value = u8 * 100.0 - 12000.0 + y;
-        if (type == ScalarType::F32) value = u8 / 255.0 - 0.5 + z * 1e-3;
-        v.setValueAtIndex(v.index(x, y, z), value);
-      }
-    }
-  }
-  return v;
-}
+using test::addressPattern;
 }  // namespace
 
 TEST(Texture3DLayout, SampleMatchesDirectIndexForEveryVoxel) {

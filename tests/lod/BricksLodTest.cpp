@@ -4,13 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <memory>
 #include <set>
 #include <unordered_map>
 #include <vector>
 
+#include "support/WrappedSources.h"
 #include "tessera/core/Error.h"
 #include "tessera/lod/BrickGrid.h"
 #include "tessera/lod/BrickStreamer.h"
@@ -31,29 +31,7 @@ std::shared_ptr<const Volume> hashVolume(glm::ivec3 dims) {
   return v;
 }
 
-// Throws for level-0 bricks whose box starts at an odd brick column.
-class FlakySource final : public lod::MultiresSource {
- public:
-  FlakySource(std::shared_ptr<const lod::MultiresSource> inner, int brick)
-      : inner_(std::move(inner)), brick_(brick) {}
-  const Volume& shape() const override { return inner_->shape(); }
-  int levelCount() const override { return inner_->levelCount(); }
-  lod::LevelInfo levelInfo(int level) const override { return inner_->levelInfo(level); }
-  Volume readBox(int level, const lod::VoxelBox& box) const override {
-    const int column = (box.begin.x + 1) / brick_;
-    if (level == 0 && column % 2 == 1) {
-      ++failures;
-      throw Error("flaky: chunk 0/" + std::to_string(column) + " unreachable");
-    }
-    return inner_->readBox(level, box);
-  }
-  std::string describe() const override { return "flaky " + inner_->describe(); }
-  mutable std::atomic<int> failures{0};
-
- private:
-  std::shared_ptr<const lod::MultiresSource> inner_;
-  int brick_;
-};
+using test::FlakySource;
 
 }  // namespace
 
@@ -225,30 +203,22 @@ namespace {
 // A source whose bytes arrive asynchronously (the browser's fetch()): boxes
 // starting in brick column 1 are not ready until `arrived`; it counts the
 // prefetches that asked for them and any read of a box that was not ready.
-class LateSource final : public lod::MultiresSource {
+class LateSource final : public test::WrappedSource {
  public:
-  LateSource(std::shared_ptr<const lod::MultiresSource> inner, int brick)
-      : inner_(std::move(inner)), brick_(brick) {}
-  const Volume& shape() const override { return inner_->shape(); }
-  int levelCount() const override { return inner_->levelCount(); }
-  lod::LevelInfo levelInfo(int level) const override { return inner_->levelInfo(level); }
+  using WrappedSource::WrappedSource;
   Volume readBox(int level, const lod::VoxelBox& box) const override {
     if (!prefetch(level, box)) ++readsNotReady;
-    return inner_->readBox(level, box);
+    return WrappedSource::readBox(level, box);
   }
   bool prefetch(int, const lod::VoxelBox& box) const override {
-    if ((box.begin.x + 1) / brick_ != 1 || arrived) return true;
+    if (column(box) != 1 || arrived) return true;
     ++asked;
     return false;
   }
-  std::string describe() const override { return "late " + inner_->describe(); }
+  std::string describe() const override { return "late " + WrappedSource::describe(); }
   bool arrived = false;
   mutable int asked = 0;
   mutable int readsNotReady = 0;
-
- private:
-  std::shared_ptr<const lod::MultiresSource> inner_;
-  int brick_;
 };
 
 }  // namespace

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "support/TestCameras.h"
+#include "support/TestTransferFunctions.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/reference/AdaptiveSteps.h"
@@ -33,14 +35,9 @@ glm::dvec4 bruteForceSegment(const TransferFunction& tf, double f, double b, dou
 }
 
 TransferFunction rampTf() {
-  TransferFunction tf;
-  tf.addColor(0.0, {0.0, 0.0, 0.0});
-  tf.addColor(0.5, {0.9, 0.5, 0.2});
-  tf.addColor(1.0, {1.0, 1.0, 1.0});
-  tf.addOpacity(0.2, 0.0);
-  tf.addOpacity(0.6, 0.3);
-  tf.addOpacity(1.0, 0.6);
-  return tf;
+  return test::tfFromPoints(
+      {{0.0, {0.0, 0.0, 0.0}}, {0.5, {0.9, 0.5, 0.2}}, {1.0, {1.0, 1.0, 1.0}}},
+      {{0.2, 0.0}, {0.6, 0.3}, {1.0, 0.6}});
 }
 
 }  // namespace
@@ -231,10 +228,7 @@ TEST(AdaptiveSteps, EmptyDistanceIsTheChessboardDistanceToTheNearestVisibleBlock
 TEST(AdaptiveSteps, AGridOfUnitStepsIsTheUnwalkedReference) {
   const Volume v = makeSheppLogan({32, 32, 32});
   const TransferFunction tf = rampTf();
-  Camera cam;
-  cam.azimuthDeg = 30;
-  cam.elevationDeg = 20;
-  cam.frame(v.extent());
+  Camera cam = test::orbitCamera(v.extent(), 30, 20);
   StepGrid grid;
   grid.dims = v.dims();
   grid.blockSize = 8;

@@ -5,6 +5,8 @@
 
 #include <cmath>
 
+#include "support/TestCameras.h"
+#include "support/TestTransferFunctions.h"
 #include "tessera/core/Camera.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/reference/ImageMetrics.h"
@@ -56,9 +58,7 @@ TEST(Reconstruction, TrilinearReproducesALinearFieldAndItsGradient) {
 
 TEST(Reconstruction, ReferenceWithTheTrilinearFieldIsTheDefaultReference) {
   const Volume v = makeSheppLogan({24, 24, 24});
-  Camera cam;
-  cam.azimuthDeg = 25;
-  cam.frame(v);
+  Camera cam = test::orbitCamera(v, 25, 0);
   const TransferFunction tf = TransferFunction::preset("mr-default");
   const RenderSettings s;
   const Image a = renderReference(v, tf, cam, s, 64, 64);
@@ -72,11 +72,7 @@ TEST(Reconstruction, ReferenceWithTheTrilinearFieldIsTheDefaultReference) {
 TEST(Reconstruction, AnalyticFieldRendersAsComputedByHand) {
   Volume box = Volume::shapeOnly({8, 8, 8}, ScalarType::U8);
   box.setWindow({0.0, 1.0});
-  TransferFunction tf;
-  tf.addColor(0.0, {1.0, 1.0, 1.0});
-  tf.addColor(1.0, {1.0, 1.0, 1.0});
-  tf.addOpacity(0.0, 0.1);
-  tf.addOpacity(1.0, 0.1);
+  const TransferFunction tf = test::oneColorTf({1.0, 1.0, 1.0}, {{0.0, 0.1}, {1.0, 0.1}});
   Camera cam;
   cam.projection = Projection::Orthographic;
   cam.frame(box);

@@ -6,12 +6,14 @@
 // within the ledger; a source that fails for some bricks.
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <cstdio>
 #include <memory>
 
+#include "support/EachApi.h"
 #include "support/GpuTestContext.h"
+#include "support/TestCameras.h"
 #include "support/TestTransferFunctions.h"
+#include "support/WrappedSources.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/DeviceSession.h"
 #include "tessera/io/Procedural.h"
@@ -39,11 +41,7 @@ std::shared_ptr<const Volume> seamVolume() {
 }
 
 Camera viewOf(const Volume& v, double azimuth, double elevation) {
-  Camera cam;
-  cam.azimuthDeg = azimuth;
-  cam.elevationDeg = elevation;
-  cam.frame(v.extent());
-  return cam;
+  return test::orbitCamera(v.extent(), azimuth, elevation);
 }
 
 // Streams until every brick the view wants is resident; returns the frames.
@@ -79,79 +77,54 @@ layout::BricksOptions smallBricks(int b) {
 }
 
 void compareWithInCore(gpu::ApiLevel api) {
-  gpu::GlContext::Options options;
-  options.api = api;
-  auto owned = api == gpu::ApiLevel::Gles2 ? gpu::GlContext::createHeadless(options) : nullptr;
-  gpu::GlContext& c = owned ? *owned : test::gpuContext();
+  test::ApiContext context(api);
+  gpu::GlContext& c = context.get();
   const gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());
   const auto v = seamVolume();
-  {
-    // B = 12: 37x53x29 is 4x5x3 bricks, the last ones partial. On ES 2,
-    // 256^2 textures hold 23 slots each: the atlas spans several textures.
-    gpu::DeviceLimits brickLimits = limits;
-    if (api == gpu::ApiLevel::Gles2) brickLimits.max2DTextureSize = 256;
-    auto bricks = layout::BricksLayout::create(std::make_shared<lod::InCoreMultiresSource>(v, 8),
-                                               brickLimits, c.ledger(), smallBricks(12));
-    if (api == gpu::ApiLevel::Gles2) {
-      EXPECT_GE(bricks->textureUnits(), 4) << bricks->plan().reason;
-    }
-    std::unique_ptr<layout::Layout> inCore;
-    if (api == gpu::ApiLevel::Gles3) {
-      inCore = layout::Texture3DLayout::create(*v, limits, c.ledger());
-    } else {
-      inCore = layout::MosaicLayout::create(*v, limits, c.ledger());
-    }
-    // Oblique views: rays cross brick faces along all three axes.
-    for (const auto& [az, el] : {std::pair{35.0, 25.0}, std::pair{-120.0, -40.0}}) {
-      const Camera cam = viewOf(*v, az, el);
-      layout::BricksFrame f;
-      refine(*bricks, cam, visibleTf(), &f);
-      EXPECT_EQ(f.cellsPerLevel[0] + f.cellsPerLevel.back(), 60) << "all at level 0 or empty";
-      const Image viaBricks = renderWith(c, *v, *bricks, cam);
-      const Image viaInCore = renderWith(c, *v, *inCore, cam);
-      const Image ref = renderReference(*v, visibleTf(), cam, RenderSettings(), kImage, kImage);
-      const double vsInCore = psnr(viaBricks, viaInCore);
-      const double vsRef = psnr(viaBricks, ref);
-      EXPECT_GE(vsInCore, 45.0);
-      EXPECT_GE(vsRef, 40.0);
-      std::printf("  [measured] %s az %g el %g: bricks vs %s %.2f dB, vs reference %.2f dB\n",
-                  api == gpu::ApiLevel::Gles2 ? "ES2 mosaic atlas" : "ES3 3D atlas", az, el,
-                  inCore->name().c_str(), vsInCore, vsRef);
-    }
+  // B = 12: 37x53x29 is 4x5x3 bricks, the last ones partial. On ES 2,
+  // 256^2 textures hold 23 slots each: the atlas spans several textures.
+  gpu::DeviceLimits brickLimits = limits;
+  if (api == gpu::ApiLevel::Gles2) brickLimits.max2DTextureSize = 256;
+  auto bricks = layout::BricksLayout::create(std::make_shared<lod::InCoreMultiresSource>(v, 8),
+                                             brickLimits, c.ledger(), smallBricks(12));
+  if (api == gpu::ApiLevel::Gles2) {
+    EXPECT_GE(bricks->textureUnits(), 4) << bricks->plan().reason;
   }
-  owned.reset();
-  test::gpuContext();
+  std::unique_ptr<layout::Layout> inCore;
+  if (api == gpu::ApiLevel::Gles3) {
+    inCore = layout::Texture3DLayout::create(*v, limits, c.ledger());
+  } else {
+    inCore = layout::MosaicLayout::create(*v, limits, c.ledger());
+  }
+  // Oblique views: rays cross brick faces along all three axes.
+  for (const auto& [az, el] : {std::pair{35.0, 25.0}, std::pair{-120.0, -40.0}}) {
+    const Camera cam = viewOf(*v, az, el);
+    layout::BricksFrame f;
+    refine(*bricks, cam, visibleTf(), &f);
+    EXPECT_EQ(f.cellsPerLevel[0] + f.cellsPerLevel.back(), 60) << "all at level 0 or empty";
+    const Image viaBricks = renderWith(c, *v, *bricks, cam);
+    const Image viaInCore = renderWith(c, *v, *inCore, cam);
+    const Image ref = renderReference(*v, visibleTf(), cam, RenderSettings(), kImage, kImage);
+    const double vsInCore = psnr(viaBricks, viaInCore);
+    const double vsRef = psnr(viaBricks, ref);
+    EXPECT_GE(vsInCore, 45.0);
+    EXPECT_GE(vsRef, 40.0);
+    std::printf("  [measured] %s az %g el %g: bricks vs %s %.2f dB, vs reference %.2f dB\n",
+                api == gpu::ApiLevel::Gles2 ? "ES2 mosaic atlas" : "ES3 3D atlas", az, el,
+                inCore->name().c_str(), vsInCore, vsRef);
+  }
 }
 
-// Fails for every level-0 read of a brick in an odd brick column.
-class FlakySource final : public lod::MultiresSource {
- public:
-  FlakySource(std::shared_ptr<const lod::MultiresSource> inner, int brick)
-      : inner_(std::move(inner)), brick_(brick) {}
-  const Volume& shape() const override { return inner_->shape(); }
-  int levelCount() const override { return inner_->levelCount(); }
-  lod::LevelInfo levelInfo(int level) const override { return inner_->levelInfo(level); }
-  Volume readBox(int level, const lod::VoxelBox& box) const override {
-    if (level == 0 && ((box.begin.x + 1) / brick_) % 2 == 1) {
-      throw Error("chunk 0/" + std::to_string((box.begin.x + 1) / brick_) + ": HTTP 500");
-    }
-    return inner_->readBox(level, box);
-  }
-  std::string describe() const override { return "flaky"; }
-
- private:
-  std::shared_ptr<const lod::MultiresSource> inner_;
-  int brick_;
-};
+using test::FlakySource;
 
 }  // namespace
 
-TEST(BricksRender, MatchesTexture3dAndReferenceOnEs3) {
-  compareWithInCore(gpu::ApiLevel::Gles3);
-}
+using BricksRenderOnEachApi = test::EachApi;
+INSTANTIATE_TEST_SUITE_P(Api, BricksRenderOnEachApi, test::kEveryApi, test::apiParamName);
 
-TEST(BricksRender, MatchesMosaicAndReferenceOnEs2) {
-  compareWithInCore(gpu::ApiLevel::Gles2);
+// The in-core layout: texture3d on ES 3, mosaic on ES 2.
+TEST_P(BricksRenderOnEachApi, MatchesInCoreLayoutAndReference) {
+  compareWithInCore(GetParam());
 }
 
 TEST(BricksRender, PageTableLookupMatchesDirectIndexingForEveryVoxel) {
@@ -305,12 +278,8 @@ TEST(BricksRender, ASmallBrightFindingUnderDimCoarseBricksIsReadAndShown) {
       for (int x = 37; x < 39; ++x) v->setValueAtIndex(v->index(x, y, z), 255.0);
   v->setValueAtIndex(v->index(0, 0, 0), 1.0);  // so the window is not of one value
   v->invalidateRange();
-  TransferFunction bright;
-  bright.addColor(0.0, {1.0, 1.0, 1.0});
-  bright.addColor(1.0, {1.0, 1.0, 1.0});
-  bright.addOpacity(0.0, 0.0);
-  bright.addOpacity(0.3, 0.0);
-  bright.addOpacity(0.5, 1.0);
+  const TransferFunction bright =
+      test::oneColorTf({1.0, 1.0, 1.0}, {{0.0, 0.0}, {0.3, 0.0}, {0.5, 1.0}});
   auto bricks = layout::BricksLayout::create(std::make_shared<lod::InCoreMultiresSource>(v, 8),
                                              limits, c.ledger(), smallBricks(8));
   const Camera cam = viewOf(*v, 20.0, 15.0);

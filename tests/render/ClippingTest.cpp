@@ -8,9 +8,13 @@
 #include <memory>
 #include <vector>
 
+#include "render/SubStepClip.h"
+#include "support/EachApi.h"
 #include "support/GpuTestContext.h"
+#include "support/TestCameras.h"
 #include "support/TestLayouts.h"
 #include "support/TestTransferFunctions.h"
+#include "support/Texture3DCaster.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/layout/Texture3DLayout.h"
@@ -39,27 +43,16 @@ RenderSettings clippedSettings() {
   return s;
 }
 
-const char* apiName(gpu::ApiLevel api) {
-  return api == gpu::ApiLevel::Gles2 ? "gles2" : "gles3";
-}
+}  // namespace
 
-template <class Body>
-void withContext(gpu::ApiLevel api, Body body) {
-  gpu::GlContext::Options o;
-  o.api = api;
-  auto owned = api == gpu::ApiLevel::Gles2 ? gpu::GlContext::createHeadless(o) : nullptr;
-  body(owned ? *owned : test::gpuContext());
-  owned.reset();
-  test::gpuContext();
-}
+using ClippingOnEachApi = test::EachApi;
+INSTANTIATE_TEST_SUITE_P(Api, ClippingOnEachApi, test::kEveryApi, test::apiParamName);
 
-void expectClippedMatchesReference(gpu::ApiLevel api) {
-  withContext(api, [&](gpu::GlContext& c) {
+TEST_P(ClippingOnEachApi, EveryTechniqueAndLayoutMatchesClippedReference) {
+  const gpu::ApiLevel api = GetParam();
+  test::withApi(api, [&](gpu::GlContext& c) {
     const Volume v = makeSphere({37, 53, 29});
-    Camera cam;
-    cam.azimuthDeg = 35;
-    cam.elevationDeg = 25;
-    cam.frame(v.extent());
+    Camera cam = test::orbitCamera(v.extent(), 35, 25);
     const RenderSettings s = clippedSettings();
     RenderSettings plain = s;
     plain.clipping = {};
@@ -74,7 +67,7 @@ void expectClippedMatchesReference(gpu::ApiLevel api) {
       const double cast = psnr(caster.render(cam, s, 96, 96), ref);
       const double slice = psnr(slicer.render(cam, s, 96, 96), ref);
       std::printf("  [measured] clipped %s %-13s raycast %.2f dB, slice3d %.2f dB vs reference\n",
-                  apiName(api), l->name().c_str(), cast, slice);
+                  test::apiName(api), l->name().c_str(), cast, slice);
       EXPECT_GE(cast, 40.0) << l->name();
       EXPECT_GE(slice, 40.0) << l->name();
     }
@@ -85,62 +78,29 @@ void expectClippedMatchesReference(gpu::ApiLevel api) {
     render::Slice2DRenderer slicer2d(c, v, {});
     slicer2d.setTransferFunction(visibleTf());
     for (int axis = 0; axis < 3; ++axis) {
-      Camera aligned;
-      aligned.projection = Projection::Orthographic;
-      if (axis == 0) aligned.azimuthDeg = 90;
-      if (axis == 2) aligned.elevationDeg = 90;
-      aligned.frame(v.extent());
+      const Camera aligned = test::axisCamera(v.extent(), axis, Projection::Orthographic);
       const double db = psnr(slicer2d.render(aligned, s1, 96, 96),
                              renderReference(v, visibleTf(), aligned, s1, 96, 96));
-      std::printf("  [measured] clipped %s slice2d stack %c %.2f dB vs reference\n", apiName(api),
-                  "xyz"[axis], db);
+      std::printf("  [measured] clipped %s slice2d stack %c %.2f dB vs reference\n",
+                  test::apiName(api), "xyz"[axis], db);
       EXPECT_GE(db, 40.0) << "axis " << axis;
     }
   });
 }
 
-}  // namespace
-
-TEST(Clipping, EveryTechniqueAndLayoutMatchesClippedReferenceOnEs3) {
-  expectClippedMatchesReference(gpu::ApiLevel::Gles3);
-}
-
-TEST(Clipping, EveryTechniqueAndLayoutMatchesClippedReferenceOnEs2) {
-  expectClippedMatchesReference(gpu::ApiLevel::Gles2);
-}
-
-// Looking down -z orthographically, samples sit at z = top - (k + 0.5) ds.
-// A plane cutting away z > d between samples 10 and 11, moved by 0.3 ds,
-// leaves every kept sample where it was: the image does not change at all.
-// A whole step does change it (the test has teeth).
+// A plane moved by 0.3 of a step (render/SubStepClip.h) leaves the image
+// as it was; a whole step does change it (the test has teeth).
 TEST(Clipping, MovingAPlaneBySubStepKeepsTheSamplesOnTheKeptSide) {
   gpu::GlContext& c = test::gpuContext();
   const Volume v = makeSheppLogan({40, 40, 40});
-  auto t3d = layout::Texture3DLayout::create(v, gpu::DeviceLimits::of(c.caps()), c.ledger());
-  render::Raycaster caster(c, v, *t3d);
-  caster.setTransferFunction(visibleTf());
-  Camera cam;
-  cam.projection = Projection::Orthographic;
-  cam.elevationDeg = 90;
-  cam.frame(v.extent());
-  RenderSettings s;
-  const double ds = s.stepVoxels * v.spacing().z;
-  const double top = v.extent().z / 2.0;
-  auto renderAt = [&](double d) {
-    RenderSettings clipped = s;
-    clipped.clipping.planes.push_back({{0.0, 0.0, 1.0}, d});
-    return caster.render(cam, clipped, 80, 80);
-  };
-  const double d = top - 10.6 * ds;
-  const Image a = renderAt(d);
-  const Image b = renderAt(d - 0.3 * ds);
-  const Image stepped = renderAt(d - ds);
-  EXPECT_EQ(psnr(a, b), std::numeric_limits<double>::infinity());
-  EXPECT_LT(psnr(a, stepped), 50.0) << "a whole step moves the cut";
-  EXPECT_LT(psnr(a, caster.render(cam, s, 80, 80)), 40.0) << "the plane must cut";
-  RenderSettings clipped = s;
-  clipped.clipping.planes.push_back({{0.0, 0.0, 1.0}, d});
-  const double db = psnr(a, renderReference(v, visibleTf(), cam, clipped, 80, 80));
+  test::Texture3DCaster t3d(c, v, visibleTf());
+  render::Raycaster& caster = t3d.caster;
+  const Camera cam = test::topDownOrthographic(v.extent());
+  const test::SubStepClip r = test::renderSubStepClip(caster, v, cam, RenderSettings(), 80);
+  EXPECT_EQ(psnr(r.cut, r.nudged), std::numeric_limits<double>::infinity());
+  EXPECT_LT(psnr(r.cut, r.stepped), 50.0) << "a whole step moves the cut";
+  EXPECT_LT(psnr(r.cut, r.uncut), 40.0) << "the plane must cut";
+  const double db = psnr(r.cut, renderReference(v, visibleTf(), cam, r.clipped, 80, 80));
   std::printf("  [measured] clipped ortho raycast vs reference %.2f dB\n", db);
   EXPECT_GE(db, 40.0);
 }

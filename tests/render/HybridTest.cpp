@@ -7,6 +7,7 @@
 #include <map>
 
 #include "support/GpuTestContext.h"
+#include "support/TestTransferFunctions.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/layout/MosaicLayout.h"
@@ -29,16 +30,11 @@ namespace {
 // Saturated hues, semi-transparent: the case where luminance says little
 // about opacity (dark blue is opaque, pale yellow less so).
 TransferFunction colouredTf() {
-  TransferFunction tf;
-  tf.addColor(0.0, {0.0, 0.0, 0.0});
-  tf.addColor(0.2, {0.1, 0.1, 0.8});
-  tf.addColor(0.5, {0.9, 0.2, 0.1});
-  tf.addColor(1.0, {1.0, 0.95, 0.4});
-  tf.addOpacity(0.02, 0.0);
-  tf.addOpacity(0.15, 0.06);
-  tf.addOpacity(0.5, 0.12);
-  tf.addOpacity(1.0, 0.35);
-  return tf;
+  return test::tfFromPoints({{0.0, {0.0, 0.0, 0.0}},
+                             {0.2, {0.1, 0.1, 0.8}},
+                             {0.5, {0.9, 0.2, 0.1}},
+                             {1.0, {1.0, 0.95, 0.4}}},
+                            {{0.02, 0.0}, {0.15, 0.06}, {0.5, 0.12}, {1.0, 0.35}});
 }
 
 struct Scene {

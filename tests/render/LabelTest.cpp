@@ -12,11 +12,10 @@
 
 #include "support/GpuTestContext.h"
 #include "support/LabelPalette.h"
+#include "support/TestCameras.h"
+#include "support/TestLayouts.h"
 #include "support/TestSupport.h"
 #include "tessera/core/Error.h"
-#include "tessera/layout/MosaicLayout.h"
-#include "tessera/layout/PackedMosaicLayout.h"
-#include "tessera/layout/Texture3DLayout.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
 #include "tessera/render/LabelTable.h"
@@ -34,36 +33,22 @@ using test::rgb8;
 template <class Check>
 void forEveryPath(gpu::ApiLevel api, const Volume& v, const TransferFunction& tf, const Camera& cam,
                   const RenderSettings& s, int size, Check check) {
-  gpu::GlContext::Options o;
-  o.api = api;
-  auto owned = api == gpu::ApiLevel::Gles2 ? gpu::GlContext::createHeadless(o) : nullptr;
-  gpu::GlContext& c = owned ? *owned : test::gpuContext();
-  {
-    const gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());
-    gpu::DeviceLimits packedLimits = limits;
-    packedLimits.max2DTextureSize = 64;
-    std::vector<std::unique_ptr<layout::Layout>> layouts;
-    if (api == gpu::ApiLevel::Gles3) {
-      layouts.push_back(layout::Texture3DLayout::create(v, limits, c.ledger()));
-    }
-    layouts.push_back(layout::MosaicLayout::create(v, limits, c.ledger()));
-    layouts.push_back(layout::PackedMosaicLayout::create(v, packedLimits, c.ledger(), 6));
-    const std::string a = api == gpu::ApiLevel::Gles2 ? "gles2 " : "gles3 ";
-    for (const auto& l : layouts) {
-      render::Raycaster caster(c, v, *l);
-      caster.setLutSize(256);
-      caster.setTransferFunction(tf);
-      check(caster.render(cam, s, size, size), a + "raycast " + l->name());
-      render::Slice3DRenderer slicer(c, v, *l);
-      slicer.setTransferFunction(tf);
-      check(slicer.render(cam, s, size, size), a + "slice3d " + l->name());
-    }
-    render::Slice2DRenderer slicer2d(c, v, {});
-    slicer2d.setTransferFunction(tf);
-    check(slicer2d.render(cam, s, size, size), a + "slice2d");
+  test::ApiContext context(api);
+  gpu::GlContext& c = context.get();
+  const auto layouts = test::gridLayouts(c, api, v, 64);
+  const std::string a = api == gpu::ApiLevel::Gles2 ? "gles2 " : "gles3 ";
+  for (const auto& l : layouts) {
+    render::Raycaster caster(c, v, *l);
+    caster.setLutSize(256);
+    caster.setTransferFunction(tf);
+    check(caster.render(cam, s, size, size), a + "raycast " + l->name());
+    render::Slice3DRenderer slicer(c, v, *l);
+    slicer.setTransferFunction(tf);
+    check(slicer.render(cam, s, size, size), a + "slice3d " + l->name());
   }
-  owned.reset();
-  test::gpuContext();
+  render::Slice2DRenderer slicer2d(c, v, {});
+  slicer2d.setTransferFunction(tf);
+  check(slicer2d.render(cam, s, size, size), a + "slice2d");
 }
 
 RenderSettings labelSettings() {
@@ -88,10 +73,7 @@ TEST(Labels, EveryVoxelsColourAppearsAtItsCentre) {
   const render::LabelTable table = render::LabelTable::defaultFor(v);
   ASSERT_EQ(table.labels.size(), 120u);
   const TransferFunction tf = table.toTransferFunction();
-  Camera cam;
-  cam.projection = Projection::Orthographic;
-  cam.elevationDeg = 90;
-  cam.frame(v.extent());
+  const Camera cam = test::topDownOrthographic(v.extent());
   const RenderSettings s = labelSettings();
   auto check = [&](const Image& img, const std::string& what) {
     std::set<int> covered;
@@ -137,10 +119,7 @@ TEST(Labels, NoColourOutsideTheTableAppears) {
   render::prepareLabelVolume(v);
   const render::LabelTable table = render::LabelTable::defaultFor(v);
   const TransferFunction tf = table.toTransferFunction();
-  Camera cam;
-  cam.azimuthDeg = 33;
-  cam.elevationDeg = 21;
-  cam.frame(v.extent());
+  Camera cam = test::orbitCamera(v.extent(), 33, 21);
   const RenderSettings s = labelSettings();
   auto check = [&](const Image& img, const std::string& what) {
     const auto [drawn, outside] = test::countAgainstPalette(img, table);

@@ -5,7 +5,9 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "support/EachApi.h"
 #include "support/GpuTestContext.h"
+#include "support/TestCameras.h"
 #include "support/TestSupport.h"
 #include "support/TestTransferFunctions.h"
 #include "tessera/gpu/DeviceSession.h"
@@ -42,11 +44,15 @@ Volume seamVolume() {
   return makeSheppLogan({37, 53, 29});
 }
 
-void compareLayouts(gpu::ApiLevel api) {
-  gpu::GlContext::Options o;
-  o.api = api;
-  auto owned = api == gpu::ApiLevel::Gles2 ? gpu::GlContext::createHeadless(o) : nullptr;
-  gpu::GlContext& c = owned ? *owned : test::gpuContext();
+}  // namespace
+
+using LayoutRenderOnEachApi = test::EachApi;
+INSTANTIATE_TEST_SUITE_P(Api, LayoutRenderOnEachApi, test::kEveryApi, test::apiParamName);
+
+// On ES 3 they also match texture3d.
+TEST_P(LayoutRenderOnEachApi, MosaicAndPackedMatchReference) {
+  const gpu::ApiLevel api = GetParam();
+  gpu::GlContext& c = context();
   const Volume v = seamVolume();
   gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());
   // Small textures force the packed layout across channels and textures:
@@ -57,10 +63,7 @@ void compareLayouts(gpu::ApiLevel api) {
   auto packed = layout::PackedMosaicLayout::create(v, packedLimits, c.ledger(), 6);
   std::printf("  [plan] %s\n", packed->plan().reason.c_str());
   EXPECT_GE(packed->textureUnits(), 2) << "the test must cross texture seams";
-  Camera cam;
-  cam.azimuthDeg = 35;
-  cam.elevationDeg = 25;
-  cam.frame(v.extent());
+  Camera cam = test::orbitCamera(v.extent(), 35, 25);
   RenderSettings s;
   const Image ref = renderReference(v, visibleTf(), cam, s, 96, 96);
   const Image viaMosaic = renderWith(c, v, *mosaic, visibleTf(), cam, s, 96);
@@ -78,29 +81,11 @@ void compareLayouts(gpu::ApiLevel api) {
     std::printf("  [measured] ES3: mosaic vs texture3d %.2f dB, packed vs texture3d %.2f dB\n",
                 psnr(viaMosaic, via3d), psnr(viaPacked, via3d));
   }
-  // GL objects go before the context that owns them (and its ledger).
-  mosaic.reset();
-  packed.reset();
-  owned.reset();
-  test::gpuContext();
-}
-
-}  // namespace
-
-TEST(LayoutRender, MosaicAndPackedMatchReferenceAndTexture3dOnEs3) {
-  compareLayouts(gpu::ApiLevel::Gles3);
-}
-
-TEST(LayoutRender, MosaicAndPackedMatchReferenceOnEs2) {
-  compareLayouts(gpu::ApiLevel::Gles2);
 }
 
 TEST(LayoutRender, Es2MatchesEs3ImageOfTheSameLayout) {
   const Volume v = seamVolume();
-  Camera cam;
-  cam.azimuthDeg = -50;
-  cam.elevationDeg = 10;
-  cam.frame(v.extent());
+  Camera cam = test::orbitCamera(v.extent(), -50, 10);
   RenderSettings s;
   s.jitter = true;
   gpu::GlContext& c3 = test::gpuContext();
@@ -136,9 +121,7 @@ void expectPaperCapacity(const char* profile, Volume volume, int textures, int s
     const layout::Layout& layout = *t.upload.layout;
     EXPECT_EQ(layout.textureUnits(), textures);
     EXPECT_EQ(layout.textureBytes(), static_cast<std::uint64_t>(textures) * side * side * 4);
-    Camera cam;
-    cam.azimuthDeg = 20;
-    cam.frame(v.extent());
+    Camera cam = test::orbitCamera(v.extent(), 20, 0);
     RenderSettings s;
     s.stepVoxels = 2.0;  // keep the test quick; the comparison is what matters
     t.technique->setTransferFunction(visibleTf());
@@ -179,9 +162,7 @@ TEST(LayoutRender, EveryBuiltinProfileRendersCh2WithinItsBudget) {
     if (plan.downsampled()) {
       EXPECT_NE(plan.reason.find("downsampled"), std::string::npos) << plan.reason;
     }
-    Camera cam;
-    cam.azimuthDeg = 30;
-    cam.frame(v.extent());
+    Camera cam = test::orbitCamera(v.extent(), 30, 0);
     RenderSettings s;
     t.technique->setTransferFunction(TransferFunction::preset("mr-default"));
     const Image img = t.technique->renderImage(cam, s, 96, 96);

@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 
 #include "support/GpuTestContext.h"
+#include "support/TestTransferFunctions.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/reference/ImageMetrics.h"
@@ -22,14 +23,9 @@ using namespace tessera;
 namespace {
 
 TransferFunction tintedTf() {
-  TransferFunction tf;
-  tf.addColor(0.0, {0.0, 0.0, 0.0});
-  tf.addColor(0.5, {0.2, 0.5, 0.9});
-  tf.addColor(1.0, {1.0, 0.8, 0.3});
-  tf.addOpacity(0.02, 0.0);
-  tf.addOpacity(0.3, 0.1);
-  tf.addOpacity(1.0, 0.3);
-  return tf;
+  return test::tfFromPoints(
+      {{0.0, {0.0, 0.0, 0.0}}, {0.5, {0.2, 0.5, 0.9}}, {1.0, {1.0, 0.8, 0.3}}},
+      {{0.02, 0.0}, {0.3, 0.1}, {1.0, 0.3}});
 }
 
 // Distance from point p to segment ab.

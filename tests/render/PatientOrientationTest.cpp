@@ -12,6 +12,7 @@
 #include <string>
 
 #include "support/GpuTestContext.h"
+#include "support/TestCameras.h"
 #include "support/TestTransferFunctions.h"
 #include "tessera/core/Camera.h"
 #include "tessera/core/PatientFrame.h"
@@ -105,11 +106,7 @@ struct View {
 constexpr std::array<View, 3> kViews{{{0.0, 0.0}, {90.0, 0.0}, {35.0, 40.0}}};
 
 Camera cameraFor(const Volume& v, View view) {
-  Camera cam;
-  cam.azimuthDeg = view.azimuth;
-  cam.elevationDeg = view.elevation;
-  cam.frame(v);
-  return cam;
+  return test::orbitCamera(v, view.azimuth, view.elevation);
 }
 
 RenderSettings settings() {

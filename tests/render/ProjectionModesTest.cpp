@@ -7,11 +7,13 @@
 #include <memory>
 #include <vector>
 
+#include "support/EachApi.h"
 #include "support/GpuTestContext.h"
+#include "support/TestCameras.h"
+#include "support/TestLayouts.h"
+#include "support/Texture3DCaster.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/Procedural.h"
-#include "tessera/layout/MosaicLayout.h"
-#include "tessera/layout/PackedMosaicLayout.h"
 #include "tessera/layout/Texture3DLayout.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
@@ -27,61 +29,39 @@ const char* modeName(RenderMode m) {
   return m == RenderMode::MinIp ? "minip" : m == RenderMode::Average ? "average" : "mip";
 }
 
-void expectProjectionsMatchReference(gpu::ApiLevel api) {
-  gpu::GlContext::Options o;
-  o.api = api;
-  auto owned = api == gpu::ApiLevel::Gles2 ? gpu::GlContext::createHeadless(o) : nullptr;
-  gpu::GlContext& c = owned ? *owned : test::gpuContext();
-  {
-    const Volume v = makeSheppLogan({37, 53, 29});
-    const gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());
-    gpu::DeviceLimits packedLimits = limits;
-    packedLimits.max2DTextureSize = 128;
-    std::vector<std::unique_ptr<layout::Layout>> layouts;
-    if (api == gpu::ApiLevel::Gles3) {
-      layouts.push_back(layout::Texture3DLayout::create(v, limits, c.ledger()));
-    }
-    layouts.push_back(layout::MosaicLayout::create(v, limits, c.ledger()));
-    layouts.push_back(layout::PackedMosaicLayout::create(v, packedLimits, c.ledger(), 6));
-    Camera cam;
-    cam.azimuthDeg = 35;
-    cam.elevationDeg = 25;
-    cam.frame(v.extent());
-    const TransferFunction grey = TransferFunction::preset("grey");
-    RenderSettings mip;
-    mip.mode = RenderMode::Mip;
-    const Image mipRef = renderReference(v, grey, cam, mip, 80, 80);
-    for (RenderMode mode : {RenderMode::MinIp, RenderMode::Average}) {
-      RenderSettings s;
-      s.mode = mode;
-      // A crop box, so that MinIP is not just the phantom's dark rim.
-      s.clipping.cropMin = {0.2, 0.2, 0.2};
-      s.clipping.cropMax = {0.8, 0.8, 0.8};
-      const Image ref = renderReference(v, grey, cam, s, 80, 80);
-      EXPECT_LT(psnr(ref, mipRef), 30.0) << modeName(mode) << " must differ from MIP";
-      for (const auto& l : layouts) {
-        render::Raycaster caster(c, v, *l);
-        caster.setTransferFunction(grey);
-        const double db = psnr(caster.render(cam, s, 80, 80), ref);
-        std::printf("  [measured] %s %-7s %-13s raycast %.2f dB vs reference\n",
-                    api == gpu::ApiLevel::Gles2 ? "gles2" : "gles3", modeName(mode),
-                    l->name().c_str(), db);
-        EXPECT_GE(db, 40.0) << modeName(mode) << " " << l->name();
-      }
-    }
-  }
-  owned.reset();
-  test::gpuContext();
-}
-
 }  // namespace
 
-TEST(ProjectionModes, MinIpAndAverageMatchReferenceOnEveryLayoutEs3) {
-  expectProjectionsMatchReference(gpu::ApiLevel::Gles3);
-}
+using ProjectionModesOnEachApi = test::EachApi;
+INSTANTIATE_TEST_SUITE_P(Api, ProjectionModesOnEachApi, test::kEveryApi, test::apiParamName);
 
-TEST(ProjectionModes, MinIpAndAverageMatchReferenceOnEveryLayoutEs2) {
-  expectProjectionsMatchReference(gpu::ApiLevel::Gles2);
+TEST_P(ProjectionModesOnEachApi, MinIpAndAverageMatchReferenceOnEveryLayout) {
+  const gpu::ApiLevel api = GetParam();
+  gpu::GlContext& c = context();
+  const Volume v = makeSheppLogan({37, 53, 29});
+  const auto layouts = test::gridLayouts(c, api, v, 128);
+  Camera cam = test::orbitCamera(v.extent(), 35, 25);
+  const TransferFunction grey = TransferFunction::preset("grey");
+  RenderSettings mip;
+  mip.mode = RenderMode::Mip;
+  const Image mipRef = renderReference(v, grey, cam, mip, 80, 80);
+  for (RenderMode mode : {RenderMode::MinIp, RenderMode::Average}) {
+    RenderSettings s;
+    s.mode = mode;
+    // A crop box, so that MinIP is not just the phantom's dark rim.
+    s.clipping.cropMin = {0.2, 0.2, 0.2};
+    s.clipping.cropMax = {0.8, 0.8, 0.8};
+    const Image ref = renderReference(v, grey, cam, s, 80, 80);
+    EXPECT_LT(psnr(ref, mipRef), 30.0) << modeName(mode) << " must differ from MIP";
+    for (const auto& l : layouts) {
+      render::Raycaster caster(c, v, *l);
+      caster.setTransferFunction(grey);
+      const double db = psnr(caster.render(cam, s, 80, 80), ref);
+      std::printf("  [measured] %s %-7s %-13s raycast %.2f dB vs reference\n",
+                  api == gpu::ApiLevel::Gles2 ? "gles2" : "gles3", modeName(mode),
+                  l->name().c_str(), db);
+      EXPECT_GE(db, 40.0) << modeName(mode) << " " << l->name();
+    }
+  }
 }
 
 // The average of a volume whose every voxel is 100 (window 0..200) is 0.5.
@@ -93,12 +73,9 @@ TEST(ProjectionModes, AverageOfAConstantVolumeIsItsValue) {
   v.invalidateRange();
   v.setWindow({0.0, 200.0});
   gpu::GlContext& c = test::gpuContext();
-  auto t3d = layout::Texture3DLayout::create(v, gpu::DeviceLimits::of(c.caps()), c.ledger());
-  render::Raycaster caster(c, v, *t3d);
-  caster.setTransferFunction(TransferFunction::preset("grey"));
-  Camera cam;
-  cam.azimuthDeg = 20;
-  cam.frame(v.extent());
+  test::Texture3DCaster t3d(c, v, TransferFunction::preset("grey"));
+  render::Raycaster& caster = t3d.caster;
+  Camera cam = test::orbitCamera(v.extent(), 20, 0);
   RenderSettings s;
   s.mode = RenderMode::Average;
   const Image img = caster.render(cam, s, 32, 32);

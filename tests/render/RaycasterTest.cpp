@@ -7,7 +7,9 @@
 #include <random>
 
 #include "support/GpuTestContext.h"
+#include "support/TestCameras.h"
 #include "support/TestTransferFunctions.h"
+#include "support/Texture3DCaster.h"
 #include "tessera/core/Camera.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/io/Procedural.h"
@@ -96,12 +98,9 @@ TEST(Raycaster, OrthographicJitteredMatchesReference) {
 TEST(Raycaster, EmptySpaceSkippingDoesNotChangeTheImage) {
   const Volume v = makeSheppLogan({64, 64, 64});
   gpu::GlContext& c = context();
-  auto layout = layout::Texture3DLayout::create(v, gpu::DeviceLimits::of(c.caps()), c.ledger());
-  render::Raycaster caster(c, v, *layout);
-  caster.setTransferFunction(TransferFunction::preset("bench"));
-  Camera cam;
-  cam.azimuthDeg = 20;
-  cam.frame(v.extent());
+  test::Texture3DCaster t3d(c, v, TransferFunction::preset("bench"));
+  render::Raycaster& caster = t3d.caster;
+  Camera cam = test::orbitCamera(v.extent(), 20, 0);
   for (RenderMode mode : {RenderMode::Composite, RenderMode::Mip}) {
     RenderSettings s;
     s.mode = mode;
@@ -158,12 +157,9 @@ TEST(Raycaster, ComparisonDetectsASmallCameraError) {
   // degrees off, or with opacities 30 % off, falls below it.
   const Volume v = makeSheppLogan({64, 64, 64});
   gpu::GlContext& c = context();
-  auto layout = layout::Texture3DLayout::create(v, gpu::DeviceLimits::of(c.caps()), c.ledger());
-  render::Raycaster caster(c, v, *layout);
-  caster.setTransferFunction(visibleTf());
-  Camera cam;
-  cam.azimuthDeg = 30;
-  cam.frame(v.extent());
+  test::Texture3DCaster t3d(c, v, visibleTf());
+  render::Raycaster& caster = t3d.caster;
+  Camera cam = test::orbitCamera(v.extent(), 30, 0);
   RenderSettings s;
   const Image gpuImage = caster.render(cam, s, 128, 128);
   Camera off = cam;

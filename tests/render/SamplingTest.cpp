@@ -10,8 +10,11 @@
 #include <limits>
 #include <memory>
 
+#include "render/SubStepClip.h"
 #include "support/GpuTestContext.h"
+#include "support/TestCameras.h"
 #include "support/TestTransferFunctions.h"
+#include "support/Texture3DCaster.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/io/VolumeReader.h"
 #include "tessera/layout/MosaicLayout.h"
@@ -91,21 +94,7 @@ Image fineReference(const Volume& v, const TransferFunction& tf, const Camera& c
 }
 
 Camera oblique(const Volume& v) {
-  Camera cam;
-  cam.azimuthDeg = 35;
-  cam.elevationDeg = 25;
-  cam.frame(v);
-  return cam;
-}
-
-template <class Body>
-void withEs2(Body body) {
-  gpu::GlContext::Options o;
-  o.api = gpu::ApiLevel::Gles2;
-  auto owned = gpu::GlContext::createHeadless(o);
-  body(*owned);
-  owned.reset();
-  test::gpuContext();
+  return test::orbitCamera(v, 35, 25);
 }
 
 }  // namespace
@@ -113,9 +102,8 @@ void withEs2(Body body) {
 TEST(Sampling, GpuMatchesTheReferenceTakingTheSameSamplesOnEs3) {
   gpu::GlContext& c = test::gpuContext();
   const Volume v = makeSheppLogan({48, 48, 48});
-  auto layout = layout::Texture3DLayout::create(v, gpu::DeviceLimits::of(c.caps()), c.ledger());
-  render::Raycaster caster(c, v, *layout);
-  caster.setTransferFunction(visibleTf());
+  test::Texture3DCaster t3d(c, v, visibleTf());
+  render::Raycaster& caster = t3d.caster;
   const Camera cam = oblique(v);
   for (bool shade : {false, true}) {
     for (auto [pre, adaptive] : {std::pair{true, false}, {false, true}, {true, true}}) {
@@ -132,7 +120,7 @@ TEST(Sampling, GpuMatchesTheReferenceTakingTheSameSamplesOnEs3) {
 
 TEST(Sampling, GpuMatchesTheReferenceOnEs2WithHalfAndEightBitTables) {
   const Volume v = makeSheppLogan({48, 48, 48});
-  withEs2([&](gpu::GlContext& c) {
+  test::withApi(gpu::ApiLevel::Gles2, [&](gpu::GlContext& c) {
     auto layout = layout::MosaicLayout::create(v, gpu::DeviceLimits::of(c.caps()), c.ledger());
     render::Raycaster caster(c, v, *layout);
     caster.setTransferFunction(visibleTf());
@@ -182,10 +170,9 @@ TEST(Sampling, PreintegrationBeatsPostClassificationAtStepOneOnCh2) {
   if (!std::filesystem::exists(kCh2)) GTEST_SKIP() << "mricron-data not installed";
   gpu::GlContext& c = test::gpuContext();
   const Volume v = readVolume(kCh2);
-  auto layout = layout::Texture3DLayout::create(v, gpu::DeviceLimits::of(c.caps()), c.ledger());
-  render::Raycaster caster(c, v, *layout);
   const TransferFunction tf = spikyTf();
-  caster.setTransferFunction(tf);
+  test::Texture3DCaster t3d(c, v, tf);
+  render::Raycaster& caster = t3d.caster;
   Camera cam;
   cam.frame(v);
   const int size = 160;
@@ -206,10 +193,9 @@ TEST(Sampling, AdaptiveStepsTakeFewerSamplesOnCh2AndKeepTheImage) {
   if (!std::filesystem::exists(kCh2)) GTEST_SKIP() << "mricron-data not installed";
   gpu::GlContext& c = test::gpuContext();
   const Volume v = readVolume(kCh2);
-  auto layout = layout::Texture3DLayout::create(v, gpu::DeviceLimits::of(c.caps()), c.ledger());
-  render::Raycaster caster(c, v, *layout);
   const TransferFunction tf = TransferFunction::preset("mr-default");
-  caster.setTransferFunction(tf);
+  test::Texture3DCaster t3d(c, v, tf);
+  render::Raycaster& caster = t3d.caster;
   const Camera cam = oblique(v);
   const int size = 128;
   const Image fine = fineReference(v, tf, cam, RenderSettings(), size);
@@ -236,28 +222,15 @@ TEST(Sampling, AdaptiveStepsTakeFewerSamplesOnCh2AndKeepTheImage) {
 TEST(Sampling, MovingAClipPlaneBySubStepKeepsTheSamples) {
   gpu::GlContext& c = test::gpuContext();
   const Volume v = makeSheppLogan({40, 40, 40});
-  auto t3d = layout::Texture3DLayout::create(v, gpu::DeviceLimits::of(c.caps()), c.ledger());
-  render::Raycaster caster(c, v, *t3d);
-  caster.setTransferFunction(visibleTf());
-  Camera cam;
-  cam.projection = Projection::Orthographic;
-  cam.elevationDeg = 90;
-  cam.frame(v.extent());
+  test::Texture3DCaster t3d(c, v, visibleTf());
+  render::Raycaster& caster = t3d.caster;
+  const Camera cam = test::topDownOrthographic(v.extent());
   for (bool pre : {false, true}) {
     const RenderSettings s = sampling(pre, true);
-    const double ds = s.stepVoxels * v.spacing().z;
-    const double top = v.extent().z / 2.0;
-    auto renderAt = [&](double d) {
-      RenderSettings clipped = s;
-      clipped.clipping.planes.push_back({{0.0, 0.0, 1.0}, d});
-      return caster.render(cam, clipped, 80, 80);
-    };
-    const double d = top - 10.6 * ds;
-    const Image a = renderAt(d);
-    EXPECT_EQ(psnr(a, renderAt(d - 0.3 * ds)), std::numeric_limits<double>::infinity()) << pre;
-    EXPECT_LT(psnr(a, caster.render(cam, s, 80, 80)), 40.0) << "the plane must cut";
-    RenderSettings clipped = s;
-    clipped.clipping.planes.push_back({{0.0, 0.0, 1.0}, d});
+    const test::SubStepClip r = test::renderSubStepClip(caster, v, cam, s, 80);
+    EXPECT_EQ(psnr(r.cut, r.nudged), std::numeric_limits<double>::infinity()) << pre;
+    EXPECT_LT(psnr(r.cut, r.uncut), 40.0) << "the plane must cut";
+    RenderSettings clipped = r.clipped;
     clipped.clipping.cropMin = {0.1, 0.0, 0.0};
     const Twin t = renderTwin(caster, v, visibleTf(), cam, clipped, 80);
     const double db = psnr(t.gpu, t.cpu);
@@ -269,9 +242,8 @@ TEST(Sampling, MovingAClipPlaneBySubStepKeepsTheSamples) {
 TEST(Sampling, TheTableIsRebuiltWhenTheTfChangesOnly) {
   gpu::GlContext& c = test::gpuContext();
   const Volume v = makeSphere({24, 24, 24});
-  auto layout = layout::Texture3DLayout::create(v, gpu::DeviceLimits::of(c.caps()), c.ledger());
-  render::Raycaster caster(c, v, *layout);
-  caster.setTransferFunction(visibleTf());
+  test::Texture3DCaster t3d(c, v, visibleTf());
+  render::Raycaster& caster = t3d.caster;
   Camera cam;
   cam.frame(v.extent());
   const RenderSettings s = sampling(true, true);

@@ -11,7 +11,9 @@
 
 #include <glm/geometric.hpp>
 
+#include "support/EachApi.h"
 #include "support/GpuTestContext.h"
+#include "support/TestCameras.h"
 #include "support/TestLayouts.h"
 #include "support/TestTransferFunctions.h"
 #include "tessera/core/Error.h"
@@ -43,11 +45,7 @@ RenderSettings shadedSettings() {
 }
 
 Camera obliqueCamera(const Volume& v) {
-  Camera cam;
-  cam.azimuthDeg = 35;
-  cam.elevationDeg = 25;
-  cam.frame(v.extent());
-  return cam;
+  return test::orbitCamera(v.extent(), 35, 25);
 }
 
 Image raycastWith(gpu::GlContext& c, const Volume& v, const layout::Layout& l, const Camera& cam,
@@ -68,28 +66,13 @@ Image sliceWith(gpu::GlContext& c, const Volume& v, const layout::Layout& l, con
   return slicer.render(cam, s, size, size);
 }
 
-const char* apiName(gpu::ApiLevel api) {
-  return api == gpu::ApiLevel::Gles2 ? "gles2" : "gles3";
-}
-
-// Runs `body` with a context of `api` (the shared ES 3.0 one or a fresh ES 2.0 one).
-template <class Body>
-void withContext(gpu::ApiLevel api, Body body) {
-  gpu::GlContext::Options o;
-  o.api = api;
-  auto owned = api == gpu::ApiLevel::Gles2 ? gpu::GlContext::createHeadless(o) : nullptr;
-  body(owned ? *owned : test::gpuContext());
-  owned.reset();
-  test::gpuContext();
-}
-
 // `sliceBar`: view-aligned slices sample other positions than rays, which
 // shows at the phantom's ideal steps (where normals turn within a voxel).
 // slice3d accumulates in half floats where the context renders to them (ES 2:
 // EXT_color_buffer_half_float, which Mesa has); in RGBA8 the phantom fell to
 // 38.7 dB, so a context without them is held to 35 dB.
 void expectShadedLayoutsMatchReference(gpu::ApiLevel api, const Volume& v, double sliceBar) {
-  withContext(api, [&](gpu::GlContext& c) {
+  test::withApi(api, [&](gpu::GlContext& c) {
     if (!gpu::DeviceLimits::of(c.caps()).halfFloatRenderTargets) {
       std::printf("  [note] no half-float render target: slice3d accumulates in RGBA8\n");
       sliceBar = std::min(sliceBar, 35.0);
@@ -118,7 +101,7 @@ void expectShadedLayoutsMatchReference(gpu::ApiLevel api, const Volume& v, doubl
       const double slice = psnr(sliceWith(c, v, *l, cam, s, 96), ref);
       std::printf(
           "  [measured] shaded %-7s %s %-13s raycast %.2f dB, slice3d %.2f dB vs reference\n", name,
-          apiName(api), l->name().c_str(), cast, slice);
+          test::apiName(api), l->name().c_str(), cast, slice);
       EXPECT_GE(cast, 40.0) << l->name();
       EXPECT_GE(slice, sliceBar) << l->name();
       if (api != gpu::ApiLevel::Gles3) continue;
@@ -131,7 +114,7 @@ void expectShadedLayoutsMatchReference(gpu::ApiLevel api, const Volume& v, doubl
           "  [measured] shaded %-7s %s %-13s precomputed gradient: raycast %.2f dB vs its "
           "reference, %.2f dB vs the exact-gradient reference (quantisation: %.2f dB); "
           "slice3d %.2f dB vs its reference\n",
-          name, apiName(api), l->name().c_str(), same, exact, psnr(refPre, ref), slicePre);
+          name, test::apiName(api), l->name().c_str(), same, exact, psnr(refPre, ref), slicePre);
       EXPECT_GE(same, 40.0) << l->name();
       EXPECT_GE(exact, 40.0) << l->name();
       EXPECT_GE(slicePre, sliceBar) << l->name();
@@ -141,15 +124,13 @@ void expectShadedLayoutsMatchReference(gpu::ApiLevel api, const Volume& v, doubl
 
 }  // namespace
 
-// A smooth field (the sphere's radial ramp) and sharp steps (the phantom).
-TEST(Shading, EveryLayoutMatchesShadedReferenceOnEs3) {
-  expectShadedLayoutsMatchReference(gpu::ApiLevel::Gles3, makeSphere({37, 53, 29}), 40.0);
-  expectShadedLayoutsMatchReference(gpu::ApiLevel::Gles3, makeSheppLogan({38, 53, 29}), 40.0);
-}
+using ShadingOnEachApi = test::EachApi;
+INSTANTIATE_TEST_SUITE_P(Api, ShadingOnEachApi, test::kEveryApi, test::apiParamName);
 
-TEST(Shading, EveryLayoutMatchesShadedReferenceOnEs2) {
-  expectShadedLayoutsMatchReference(gpu::ApiLevel::Gles2, makeSphere({37, 53, 29}), 40.0);
-  expectShadedLayoutsMatchReference(gpu::ApiLevel::Gles2, makeSheppLogan({38, 53, 29}), 40.0);
+// A smooth field (the sphere's radial ramp) and sharp steps (the phantom).
+TEST_P(ShadingOnEachApi, EveryLayoutMatchesShadedReference) {
+  expectShadedLayoutsMatchReference(GetParam(), makeSphere({37, 53, 29}), 40.0);
+  expectShadedLayoutsMatchReference(GetParam(), makeSheppLogan({38, 53, 29}), 40.0);
 }
 
 namespace {
@@ -205,7 +186,7 @@ void expectRampLitByAnalyticNormal(const Image& img, const Volume& v, const Came
 // segment's end values come from that texture too; 16-bit volumes read the
 // layout.
 TEST(Shading, EightBitLitSamplesTakeTheirValueFromTheGradientFetch) {
-  withContext(gpu::ApiLevel::Gles3, [](gpu::GlContext& c) {
+  test::withApi(gpu::ApiLevel::Gles3, [](gpu::GlContext& c) {
     const Volume v8 = makeSphere({37, 53, 29});
     ASSERT_EQ(v8.type(), ScalarType::U8);
     Volume v16 = Volume::allocate(v8.dims(), ScalarType::U16);
@@ -251,15 +232,8 @@ TEST(Shading, EightBitLitSamplesTakeTheirValueFromTheGradientFetch) {
 
 TEST(Shading, LinearRampIsLitByItsAnalyticNormal) {
   const Volume v = rampVolume();
-  Camera cam;
-  cam.elevationDeg = 90;  // looking down -z
-  cam.projection = Projection::Orthographic;
-  cam.frame(v.extent());
-  TransferFunction opaqueGrey;
-  opaqueGrey.addColor(0.0, {0.5, 0.5, 0.5});
-  opaqueGrey.addColor(1.0, {0.5, 0.5, 0.5});
-  opaqueGrey.addOpacity(0.0, 1.0);
-  opaqueGrey.addOpacity(1.0, 1.0);
+  const Camera cam = test::topDownOrthographic(v.extent());  // looking down -z
+  const TransferFunction opaqueGrey = test::oneColorTf({0.5, 0.5, 0.5}, {{0.0, 1.0}, {1.0, 1.0}});
   RenderSettings s;
   s.shading.enabled = true;
   s.shading.headlight = false;
@@ -268,12 +242,12 @@ TEST(Shading, LinearRampIsLitByItsAnalyticNormal) {
   expectRampLitByAnalyticNormal(renderReference(v, opaqueGrey, cam, s, 96, 96), v, cam, s,
                                 "reference");
   for (gpu::ApiLevel api : {gpu::ApiLevel::Gles3, gpu::ApiLevel::Gles2}) {
-    withContext(api, [&](gpu::GlContext& c) {
+    test::withApi(api, [&](gpu::GlContext& c) {
       for (const auto& l : layoutsFor(c, v)) {
         render::Raycaster caster(c, v, *l);
         caster.setTransferFunction(opaqueGrey);
         caster.setGradient(layout::GradientWish::OnTheFly);
-        const std::string what = std::string("raycast ") + apiName(api) + " " + l->name();
+        const std::string what = std::string("raycast ") + test::apiName(api) + " " + l->name();
         expectRampLitByAnalyticNormal(caster.render(cam, s, 96, 96), v, cam, s, what.c_str());
         if (api != gpu::ApiLevel::Gles3) continue;
         // The ramp's differences (8, 5, 0) quantise exactly (codes 127, 127, 0).
@@ -296,21 +270,17 @@ TEST(Shading, Slice2DMatchesShadedReferenceAlongEachStackOnEs3AndEs2) {
   s.shading.headlight = false;
   s.shading.lightDirection = {1.0, 2.0, 3.0};
   for (gpu::ApiLevel api : {gpu::ApiLevel::Gles3, gpu::ApiLevel::Gles2}) {
-    withContext(api, [&](gpu::GlContext& c) {
+    test::withApi(api, [&](gpu::GlContext& c) {
       render::Slice2DRenderer slicer(c, v, {});
       slicer.setTransferFunction(visibleTf());
       for (int axis = 0; axis < 3; ++axis) {
-        Camera cam;
-        cam.projection = Projection::Orthographic;
-        if (axis == 0) cam.azimuthDeg = 90;
-        if (axis == 2) cam.elevationDeg = 90;
-        cam.frame(v.extent());
+        const Camera cam = test::axisCamera(v.extent(), axis, Projection::Orthographic);
         const Image img = slicer.render(cam, s, 96, 96);
         ASSERT_EQ(slicer.lastStackAxis(), axis);
         const double db = psnr(img, renderReference(v, visibleTf(), cam, s, 96, 96));
         std::printf("  [measured] shaded sphere  %s slice2d stack %c: %.2f dB vs reference\n",
-                    apiName(api), "xyz"[axis], db);
-        EXPECT_GE(db, 40.0) << apiName(api) << " axis " << axis;
+                    test::apiName(api), "xyz"[axis], db);
+        EXPECT_GE(db, 40.0) << test::apiName(api) << " axis " << axis;
       }
       RenderSettings unshaded = s;
       unshaded.shading.enabled = false;
@@ -344,7 +314,7 @@ TEST(Shading, Slice2DAsksForPostClassification) {
 TEST(Shading, GradientOpacityMatchesTheReferenceForEveryTechnique) {
   const Volume v = makeSheppLogan({38, 53, 29});
   for (gpu::ApiLevel api : {gpu::ApiLevel::Gles3, gpu::ApiLevel::Gles2}) {
-    withContext(api, [&](gpu::GlContext& c) {
+    test::withApi(api, [&](gpu::GlContext& c) {
       const Camera cam = obliqueCamera(v);
       for (bool lit : {true, false}) {
         RenderSettings s = shadedSettings();
@@ -362,7 +332,7 @@ TEST(Shading, GradientOpacityMatchesTheReferenceForEveryTechnique) {
           const double slice = psnr(sliceWith(c, v, *l, cam, s, 96), ref);
           std::printf(
               "  [measured] gradient opacity %s %s %-13s raycast %.2f dB, slice3d %.2f dB\n",
-              lit ? "lit  " : "unlit", apiName(api), l->name().c_str(), cast, slice);
+              lit ? "lit  " : "unlit", test::apiName(api), l->name().c_str(), cast, slice);
           EXPECT_GE(cast, 40.0) << l->name();
           EXPECT_GE(slice, 40.0) << l->name();
         }
@@ -377,7 +347,7 @@ TEST(Shading, GradientOpacityMatchesTheReferenceForEveryTechnique) {
         const double db = psnr(slicer.render(ortho, s1, 96, 96),
                                renderReference(v, visibleTf(), ortho, s1, 96, 96));
         std::printf("  [measured] gradient opacity %s %s slice2d %.2f dB\n",
-                    lit ? "lit  " : "unlit", apiName(api), db);
+                    lit ? "lit  " : "unlit", test::apiName(api), db);
         EXPECT_GE(db, 40.0);
       }
     });
@@ -399,12 +369,8 @@ TEST(Shading, GradientOpacityClearsHomogeneousInteriorsAndKeepsBoundaries) {
     }
   }
   v.setWindow({0.0, 255.0});
-  TransferFunction tf;
-  tf.addColor(0.0, {1.0, 1.0, 1.0});
-  tf.addColor(1.0, {1.0, 1.0, 1.0});
-  tf.addOpacity(0.0, 0.0);
-  tf.addOpacity(0.5, 0.15);
-  tf.addOpacity(1.0, 0.15);
+  const TransferFunction tf =
+      test::oneColorTf({1.0, 1.0, 1.0}, {{0.0, 0.0}, {0.5, 0.15}, {1.0, 0.15}});
   Camera cam;
   cam.projection = Projection::Orthographic;
   cam.frame(v.extent());
@@ -423,7 +389,7 @@ TEST(Shading, GradientOpacityClearsHomogeneousInteriorsAndKeepsBoundaries) {
   EXPECT_LT(modRef, 0.6 * plainRef) << "the interior fades";
   EXPECT_GT(modRef, 0.15) << "the faces keep their opacity";
   // A ray beside the cube sees nothing either way; the GPU agrees.
-  withContext(gpu::ApiLevel::Gles3, [&](gpu::GlContext& c) {
+  test::withApi(gpu::ApiLevel::Gles3, [&](gpu::GlContext& c) {
     const auto layouts = layoutsFor(c, v);
     render::Raycaster caster(c, v, *layouts.front());
     caster.setTransferFunction(tf);

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "support/GpuTestContext.h"
+#include "support/TestCameras.h"
 #include "support/TestTransferFunctions.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/Procedural.h"
@@ -38,11 +39,7 @@ Volume ch2Quarter() {
 
 // Looking along stack `axis`: az 90 looks along -x, az 0 along -y, el 90 along -z.
 Camera alignedCamera(const Volume& v, int axis) {
-  Camera cam;
-  if (axis == 0) cam.azimuthDeg = 90;
-  if (axis == 2) cam.elevationDeg = 90;
-  cam.frame(v.extent());
-  return cam;
+  return test::axisCamera(v.extent(), axis);
 }
 
 RenderSettings referenceSettings() {

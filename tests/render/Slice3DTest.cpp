@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 
 #include "support/GpuTestContext.h"
+#include "support/TestCameras.h"
 #include "support/TestTransferFunctions.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/TexelFormat.h"
@@ -35,11 +36,7 @@ RenderSettings halfVoxel() {
 }
 
 Camera obliqueCamera(const Volume& v) {
-  Camera cam;
-  cam.azimuthDeg = 35;
-  cam.elevationDeg = 25;
-  cam.frame(v.extent());
-  return cam;
+  return test::orbitCamera(v.extent(), 35, 25);
 }
 
 Image sliceWith(gpu::GlContext& c, const Volume& v, const layout::Layout& layout, const Camera& cam,

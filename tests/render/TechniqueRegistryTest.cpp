@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "support/GpuTestContext.h"
+#include "support/TestCameras.h"
 #include "support/TestSupport.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
@@ -184,10 +185,7 @@ void expectXRayMatchesTheCpu(const std::string& profile, const std::string& expe
                                                           source, {.imageSize = {width, height}});
     EXPECT_EQ(t.storageName(), expectedLayout);
     EXPECT_EQ(t.upload.plan.volumeUnits, device.limits.textureUnits);  // nothing reserved
-    Camera camera;
-    camera.azimuthDeg = 35;
-    camera.elevationDeg = 20;
-    camera.frame(*t.upload.volume);
+    Camera camera = test::orbitCamera(*t.upload.volume, 35, 20);
     t.technique->prepare(camera, {});
     const Image gpuImage = t.technique->renderImage(camera, {}, width, height);
     const Image cpuImage = cpuXRay(*t.upload.volume, camera, width, height);

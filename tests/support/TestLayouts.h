@@ -10,6 +10,9 @@
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/GlContext.h"
 #include "tessera/layout/LayoutRegistry.h"
+#include "tessera/layout/MosaicLayout.h"
+#include "tessera/layout/PackedMosaicLayout.h"
+#include "tessera/layout/Texture3DLayout.h"
 
 namespace tessera::test {
 
@@ -41,6 +44,24 @@ inline std::vector<std::unique_ptr<layout::Layout>> layoutsFor(gpu::GlContext& c
     const bool fitsSqueezed = e.plan(v, squeezed, choice.units).fits;
     layouts.push_back(e.create(v, fitsSqueezed ? squeezed : limits, c.ledger(), choice.units));
   }
+  return layouts;
+}
+
+// The three grid layouts by name, not from the registry: texture3d (ES 3
+// only), mosaic, and packed-mosaic with 6 units in 2D textures of at most
+// `packed2DSize`, so that its seams fall inside the image.
+inline std::vector<std::unique_ptr<layout::Layout>> gridLayouts(gpu::GlContext& c,
+                                                                gpu::ApiLevel api, const Volume& v,
+                                                                int packed2DSize) {
+  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());
+  gpu::DeviceLimits packedLimits = limits;
+  packedLimits.max2DTextureSize = packed2DSize;
+  std::vector<std::unique_ptr<layout::Layout>> layouts;
+  if (api == gpu::ApiLevel::Gles3) {
+    layouts.push_back(layout::Texture3DLayout::create(v, limits, c.ledger()));
+  }
+  layouts.push_back(layout::MosaicLayout::create(v, limits, c.ledger()));
+  layouts.push_back(layout::PackedMosaicLayout::create(v, packedLimits, c.ledger(), 6));
   return layouts;
 }
 

@@ -11,6 +11,7 @@
 #include "support/GpuTestContext.h"
 #include "support/LabelPalette.h"
 #include "support/TestSupport.h"
+#include "support/TestTransferFunctions.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/gpu/DeviceSession.h"
@@ -296,11 +297,8 @@ int differingPixels(const Image& a, const Image& b, int tolerance) {
 TEST_F(ViewerFixture, LinesBehindAnOpaqueVolumeAreHiddenAndLinesInFrontDrawn) {
   Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
   v.setVolume(makeSheppLogan({40, 40, 40}), "phantom");
-  TransferFunction opaque;
-  opaque.addColor(0.0, {0.2, 0.3, 0.9});
-  opaque.addColor(1.0, {0.9, 0.9, 0.2});
-  opaque.addOpacity(0.0, 1.0);
-  opaque.addOpacity(1.0, 1.0);
+  const TransferFunction opaque = test::tfFromPoints(
+      {{0.0, {0.2, 0.3, 0.9}}, {1.0, {0.9, 0.9, 0.2}}}, {{0.0, 1.0}, {1.0, 1.0}});
   v.tfEditor().setTransferFunction(opaque);
   v.quality = Quality::Full;
   bool cornerView = false;
