@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Sets up, builds everything (warnings as errors) and runs all tests; then
-# the browser test of the web viewer (scripts/browser-test.sh), the same
-# tests under ASan + UBSan (scripts/sanitize.sh) and a short fuzz
-# run of every parser (scripts/fuzz.sh, FUZZ_SECONDS each, default 30).
+# the browser tests of the web viewer (scripts/browser-test.sh), the CPU
+# layers' tests under ASan + UBSan (scripts/sanitize.sh; the GPU image tests
+# run once, above) and a short fuzz run of every parser under ASan
+# (scripts/fuzz.sh, FUZZ_SECONDS each, default 30).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 FUZZ_SECONDS=${FUZZ_SECONDS:-30}

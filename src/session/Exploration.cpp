@@ -46,15 +46,8 @@ std::shared_ptr<const lod::MultiresSource> levelZeroOnly(std::shared_ptr<const V
 }  // namespace
 
 const char* exploreModeName(ExploreMode mode) {
-  switch (mode) {
-    case ExploreMode::Overview:
-      return "overview";
-    case ExploreMode::Region:
-      return "region";
-    case ExploreMode::Grid:
-      return "grid";
-  }
-  return "overview";
+  static constexpr const char* kNames[] = {"overview", "region", "grid"};  // in enum order
+  return kNames[static_cast<int>(mode)];
 }
 
 std::string boxText(const lod::VoxelBox& b) {
