@@ -128,6 +128,7 @@ void Session::open(const std::string& spec, const OpenOptions& options) {
     region_.reset();
     streamed_ = std::move(pyramid);
     streamedView_ = std::make_unique<lod::MultiresVolumeSource>(streamed_);
+    exploration_.reset();
     name_ = spec;
     return;
   }
@@ -147,8 +148,21 @@ void Session::setVolume(std::shared_ptr<Volume> volume, const std::string& name)
   streamedView_.reset();
   region_.reset();
   inCore_ = std::make_shared<lod::InCoreVolumeSource>(std::move(volume));
+  exploration_.reset();
   name_ = name;
   applyVolumeSettings();
+}
+
+Exploration& Session::exploration() {
+  if (exploration_) return *exploration_;
+  if (!hasVolume()) throw InputError("exploring: no volume is open");
+  const gpu::DeviceLimits& limits = device_.limits;
+  const std::uint64_t regionBytes = viewer::regionBudgetBytes(limits);
+  exploration_ =
+      streamed_ ? std::make_unique<Exploration>(streamed_, regionBytes,
+                                                viewer::overviewVoxelBudget(limits), name_)
+                : std::make_unique<Exploration>(inCore_->level(glm::ivec3(1)), regionBytes, name_);
+  return *exploration_;
 }
 
 // The settings that change the in-core voxels' meaning: the window (raw
@@ -220,7 +234,10 @@ nlohmann::json Session::state() const {
     volume = {
         {"name", name_}, {"dims", {s.dims().x, s.dims().y, s.dims().z}}, {"streamed", streamed()}};
   }
-  return {{"version", kSettingsVersion}, {"volume", volume}, {"settings", settings_.toJson()}};
+  return {{"version", kSettingsVersion},
+          {"volume", volume},
+          {"settings", settings_.toJson()},
+          {"exploration", exploration_ ? exploration_->state() : nlohmann::json(nullptr)}};
 }
 
 void Session::restore(const nlohmann::json& state) {
@@ -228,6 +245,9 @@ void Session::restore(const nlohmann::json& state) {
     throw InputError("session state: expected {\"version\", \"volume\", \"settings\"}");
   }
   setSettings(Settings::fromJson(state["settings"]));
+  if (state.contains("exploration") && !state["exploration"].is_null()) {
+    exploration().restore(state["exploration"]);
+  }
 }
 
 }  // namespace tessera::session

@@ -13,6 +13,7 @@
 #include "tessera/core/Error.h"
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/session/Exploration.h"
+#include "tessera/session/Session.h"
 #include "tessera/viewer/Viewer.h"
 
 namespace tessera::session {
@@ -156,6 +157,26 @@ TEST(Exploration, StateRoundTripsAndRefusesAnotherVolumesState) {
   nlohmann::json future = state;
   future["version"] = 2;
   EXPECT_THROW(b.restore(future), InputError);
+}
+
+// A session saves what is being explored with its settings, and a session
+// with the same volume open takes it back.
+TEST(Exploration, SessionStateCarriesTheExploration) {
+  auto volume = std::make_shared<Volume>(*hashVolume({40, 32, 24}));
+  Session a("gles3");
+  a.setVolume(volume, "hash");
+  EXPECT_TRUE(a.state()["exploration"].is_null());
+  a.exploration().explorer().setCrosshair({7, 8, 9});
+  a.exploration().region({{2, 2, 2}, {18, 18, 18}}, Follow::Fill);
+  EXPECT_EQ(a.exploration().overview()->bytes().data(),
+            volume->bytes().data());  // shared, not copied
+  const nlohmann::json state = a.state();
+
+  Session b("gles3");
+  b.setVolume(volume, "hash");
+  b.restore(state);
+  EXPECT_EQ(b.exploration().explorer().crosshair(), glm::ivec3(7, 8, 9));
+  EXPECT_EQ(b.state()["exploration"], state["exploration"]);
 }
 
 }  // namespace

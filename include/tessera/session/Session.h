@@ -22,6 +22,7 @@
 #include "tessera/gpu/DeviceSession.h"
 #include "tessera/lod/InCoreVolumeSource.h"
 #include "tessera/lod/MultiresSource.h"
+#include "tessera/session/Exploration.h"
 #include "tessera/session/RenderRun.h"
 #include "tessera/session/Settings.h"
 #include "tessera/session/VolumePyramid.h"
@@ -91,9 +92,17 @@ class Session {
   // The CPU reference of the current settings' view (in core only).
   Image renderReference(int width, int height);
 
-  // The session's state as JSON: {"version", "volume": {...}, "settings"}.
+  // Exploring the volume at native resolution (session/Exploration.h):
+  // made on first use for the volume open now (an in-core volume is its own
+  // overview, shared; a streamed store's overview is the finest level the
+  // profile's overview budget allows), forgotten when another one opens.
+  Exploration& exploration();
+
+  // The session's state as JSON: {"version", "volume": {...}, "settings",
+  // "exploration" (null until exploration() was used)}.
   nlohmann::json state() const;
-  // Restores the settings of a state (the volume is the caller's to open).
+  // Restores the settings of a state and, where the state has one, the
+  // exploration of the volume open now (the volume is the caller's to open).
   void restore(const nlohmann::json& state);
 
  private:
@@ -107,6 +116,7 @@ class Session {
   std::shared_ptr<const lod::MultiresSource> streamed_;
   std::unique_ptr<lod::VolumeSource> streamedView_;
   std::unique_ptr<nlohmann::json> region_;
+  std::unique_ptr<Exploration> exploration_;
 };
 
 }  // namespace tessera::session
