@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli/Options.h"
 #include "tessera/gpu/DeviceSession.h"
 #include "tessera/io/FormatRegistry.h"
 #include "tessera/session/RenderRun.h"

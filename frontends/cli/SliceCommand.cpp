@@ -145,13 +145,11 @@ void addSliceCommand(CLI::App& app) {
   cmd->add_option("--window", o->window,
                   "Value window MIN MAX (raw values); default: the volume's window")
       ->expected(2);
-  cmd->add_option("--level", o->level, "Pyramid level: native (0, the finest) or N")
-      ->capture_default_str();
-  cmd->add_option("--tf", o->tf,
-                  "grey, or colour by a transfer function (preset or FILE.json; colour only)")
-      ->capture_default_str();
-  cmd->add_option("--out", o->out, "Output PNG (square pixels of the finer in-plane spacing)")
-      ->capture_default_str();
+  addDefaultedOption(cmd, "--level", o->level, "Pyramid level: native (0, the finest) or N");
+  addDefaultedOption(cmd, "--tf", o->tf,
+                     "grey, or colour by a transfer function (preset or FILE.json; colour only)");
+  addDefaultedOption(cmd, "--out", o->out,
+                     "Output PNG (square pixels of the finer in-plane spacing)");
   cmd->add_flag("--json", o->json, "Print one JSON object (edges, mapping, reads)");
   cmd->callback([o] { runSliceCommand(*o); });
 }
