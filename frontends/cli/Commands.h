@@ -54,6 +54,13 @@ inline void addSeriesOption(CLI::App* cmd, std::string& series) {
                   "series with the most slices; `tessera info FOLDER` lists them)");
 }
 
+// The volume argument and --series together, as info, render, plan, slice
+// and view take them.
+inline void addVolumeOptions(CLI::App* cmd, std::string& file, std::string& series) {
+  cmd->add_option("file", file, kVolumeHelp);
+  addSeriesOption(cmd, series);
+}
+
 // --time and --channel: which 3D volume of a 4D/5D (t, c, z, y, x) OME-Zarr
 // image the command reads.
 inline void addTimeChannelOptions(CLI::App* cmd, int& time, int& channel) {

@@ -142,8 +142,7 @@ void addPlanCommand(CLI::App& app) {
   auto o = std::make_shared<PlanOptions>();
   CLI::App* cmd = app.add_subcommand(
       "plan", "Show how a volume would be stored on a device: layout, textures, bytes and why");
-  cmd->add_option("file", o->file, kVolumeHelp);
-  addSeriesOption(cmd, o->series);
+  addVolumeOptions(cmd, o->file, o->series);
   addDefaultedOption(cmd, "--profile", o->profile,
                      "Device profile (tessera profiles) or FILE.json");
   addDefaultedOption(cmd, "--layout", o->layout, layout::LayoutRegistry::global().choices());

@@ -487,8 +487,7 @@ void addRenderCommand(CLI::App& app) {
   auto o = std::make_shared<RenderOptions>();
   CLI::App* cmd = app.add_subcommand(
       "render", "Render a volume headless to a PNG (GPU ray caster through EGL)");
-  cmd->add_option("file", o->file, kVolumeHelp);
-  addSeriesOption(cmd, o->series);
+  addVolumeOptions(cmd, o->file, o->series);
   addTimeChannelOptions(cmd, o->time, o->channel);
   addDefaultedOption(
       cmd, "--tf", o->tf,

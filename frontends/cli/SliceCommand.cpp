@@ -136,8 +136,7 @@ void addSliceCommand(CLI::App& app) {
       "Radiological convention: axial and coronal slices show the patient's left on the image's "
       "right, sagittal slices anterior on the left, superior (or anterior, axial) up; the "
       "patient directions of the four edges are printed");
-  cmd->add_option("file", o->file, kVolumeHelp);
-  addSeriesOption(cmd, o->series);
+  addVolumeOptions(cmd, o->file, o->series);
   addTimeChannelOptions(cmd, o->time, o->channel);
   cmd->add_option("--axis", o->axis, "Index axis the slice is normal to: x, y or z")->required();
   cmd->add_option("--index", o->index, "Slice index along --axis (0-based, in the level)")

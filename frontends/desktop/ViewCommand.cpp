@@ -14,8 +14,7 @@ void addViewCommand(CLI::App& app) {
   auto o = std::make_shared<desktop::ViewOptions>();
   CLI::App* cmd = app.add_subcommand(
       "view", "Interactive viewer: GLFW window with OpenGL ES (EGL) and the TF editor");
-  cmd->add_option("file", o->file, kVolumeHelp);
-  addSeriesOption(cmd, o->series);
+  addVolumeOptions(cmd, o->file, o->series);
   addDefaultedOption(cmd, "--tf", o->tf, "Transfer function: preset or FILE.json");
   addSizeOption(cmd, o->size, "Window");
   o->labelsOption = addLabelsOption(
