@@ -93,8 +93,8 @@ void marschnerLobb(gpu::GlContext& context, const gpu::DeviceLimits& limits,
     std::vector<Image> truths;
     for (const TransferFunction& tf :
          {lattice::marschnerLobbSoftTf(), lattice::marschnerLobbIsoTf()}) {
-      truths.push_back(renderReference(cartesian, lattice::MarschnerLobbField(cartesian.dims()), tf,
-                                       cam, {}, size, size));
+      truths.push_back(renderReference(cartesian, lattice::MarschnerLobbSignal(cartesian.dims()),
+                                       tf, cam, {}, size, size));
       truths.back().writePng(dir / ("fcc-ml" + std::to_string(n) + "-truth-" + tf.name + ".png"));
     }
     for (const Row& r : rows) {

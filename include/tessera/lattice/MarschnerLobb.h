@@ -25,9 +25,9 @@ glm::dvec3 marschnerLobbCoordinate(glm::ivec3 dims, glm::dvec3 p);
 
 // The signal itself as a reconstruction of the makeMarschnerLobb(dims) box:
 // the exact field that the measured reconstructions are compared with.
-class MarschnerLobbField final : public Reconstruction {
+class MarschnerLobbSignal final : public Reconstruction {
  public:
-  explicit MarschnerLobbField(glm::ivec3 dims) : dims_(dims) {}
+  explicit MarschnerLobbSignal(glm::ivec3 dims) : dims_(dims) {}
   double value(glm::dvec3 p) const override {
     return marschnerLobb(marschnerLobbCoordinate(dims_, p));
   }
