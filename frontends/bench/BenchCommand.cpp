@@ -325,12 +325,11 @@ void addBenchCommand(CLI::App& app) {
                                      "variant (interleaved), with PSNR vs "
                                      "the CPU reference");
   cmd->add_option("file", o->file, "Volume (default: ch2 or a phantom)");
-  cmd->add_option("--size", o->size, "Image size WIDTHxHEIGHT")->capture_default_str();
-  cmd->add_option("--frames", o->frames, "Frames per variant")->capture_default_str();
-  cmd->add_option("--rotate", o->rotate, "Azimuth step per frame in degrees")
-      ->capture_default_str();
-  cmd->add_option("--step", o->step, "Sample distance in voxels")->capture_default_str();
-  cmd->add_option("--tf", o->tf, "Transfer function preset or JSON file")->capture_default_str();
+  addSizeOption(cmd, o->size, "Image");
+  addDefaultedOption(cmd, "--frames", o->frames, "Frames per variant");
+  addDefaultedOption(cmd, "--rotate", o->rotate, "Azimuth step per frame in degrees");
+  addDefaultedOption(cmd, "--step", o->step, "Sample distance in voxels");
+  addDefaultedOption(cmd, "--tf", o->tf, "Transfer function preset or JSON file");
   addShadingOptions(cmd, o->shading);
   cmd->add_flag("--layouts", o->layouts,
                 "Compare layouts (texture3d, mosaic, packed-mosaic) instead of accelerations");
@@ -349,8 +348,7 @@ void addBenchCommand(CLI::App& app) {
       "head:512x512x894 head:1024); per profile the first and refined image, rotating "
       "frame time while streaming (default 8 frames), levels, texture bytes vs the "
       "budget, bricks read, peak RSS, and the in-core layout as baseline where it fits");
-  cmd->add_option("--bricks-profiles", o->bricksProfiles, "Profiles for --bricks")
-      ->capture_default_str();
+  addDefaultedOption(cmd, "--bricks-profiles", o->bricksProfiles, "Profiles for --bricks");
   cmd->add_flag("--slicing", o->slicing,
                 "Texture slicing vs ray casting (GRAPP 2012 Tables 1-2), TF-update times "
                 "(Moser & Weiskopf 2008 Fig. 6) and quality per count; --frames per cell");
@@ -375,10 +373,9 @@ void addBenchCommand(CLI::App& app) {
                 "Platform roofline: peak trilinear 3D fetch and TF lookup rates of this context, "
                 "and each technique's effective samples/s as a fraction of them (default 5 "
                 "frames per technique)");
-  cmd->add_option("--fetches", o->fetches,
-                  "With --roofline: fetches per fragment in the peak "
-                  "passes")
-      ->capture_default_str();
+  addDefaultedOption(cmd, "--fetches", o->fetches,
+                     "With --roofline: fetches per fragment in the peak "
+                     "passes");
   cmd->add_flag("--sampling", o->sampling,
                 "Fewer samples for the same image: baseline / +pre-integration / +adaptive / "
                 "both at each --sampling-steps, interleaved; ms, samples per ray, PSNR vs the "
@@ -391,27 +388,22 @@ void addBenchCommand(CLI::App& app) {
                   "With --sampling(-sweep): volumes (default: FILE or ch2)");
   cmd->add_option("--sampling-tfs", o->samplingTfs,
                   "With --sampling(-sweep): transfer functions (default: --tf)");
-  cmd->add_option("--sampling-steps", o->samplingSteps, "With --sampling(-sweep): base steps")
-      ->capture_default_str();
+  addDefaultedOption(cmd, "--sampling-steps", o->samplingSteps,
+                     "With --sampling(-sweep): base steps");
   cmd->add_option("--sampling-shading", o->samplingShading,
                   "With --sampling(-sweep): off, on or both (default: --shade)");
-  cmd->add_option("--adaptive-tolerance", o->samplingTolerance,
-                  "With --sampling: the adaptive variants' tolerance")
-      ->capture_default_str();
-  cmd->add_option("--sampling-tolerances", o->samplingTolerances,
-                  "With --sampling-sweep: the adaptive tolerances tried")
-      ->capture_default_str();
-  cmd->add_option("--adaptive-max", o->samplingMax,
-                  "With --sampling(-sweep): the largest step multiple")
-      ->capture_default_str();
-  cmd->add_option("--preint-size", o->preintEntries,
-                  "With --sampling(-sweep): pre-integration table entries per axis")
-      ->capture_default_str();
-  cmd->add_option("--reference-step", o->referenceStep,
-                  "With --sampling(-sweep): the fine reference's step in voxels")
-      ->capture_default_str();
-  cmd->add_option("--views", o->views, "With --sampling(-sweep): views whose worst PSNR counts")
-      ->capture_default_str();
+  addDefaultedOption(cmd, "--adaptive-tolerance", o->samplingTolerance,
+                     "With --sampling: the adaptive variants' tolerance");
+  addDefaultedOption(cmd, "--sampling-tolerances", o->samplingTolerances,
+                     "With --sampling-sweep: the adaptive tolerances tried");
+  addDefaultedOption(cmd, "--adaptive-max", o->samplingMax,
+                     "With --sampling(-sweep): the largest step multiple");
+  addDefaultedOption(cmd, "--preint-size", o->preintEntries,
+                     "With --sampling(-sweep): pre-integration table entries per axis");
+  addDefaultedOption(cmd, "--reference-step", o->referenceStep,
+                     "With --sampling(-sweep): the fine reference's step in voxels");
+  addDefaultedOption(cmd, "--views", o->views,
+                     "With --sampling(-sweep): views whose worst PSNR counts");
   addExploreBenchOptions(cmd);
   addPeersBenchOptions(cmd);
   cmd->callback([o] {

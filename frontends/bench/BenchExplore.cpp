@@ -333,15 +333,11 @@ void addExploreBenchOptions(CLI::App* cmd) {
                 "holds it), level-1 overview, grid view block (8 cells of a 4x4x4 split) and a "
                 "256^3 bread-slice region at native resolution; sagittal, frontal and spin at "
                 "zoom 1 and 1.5: ms per frame and texture bytes");
-  cmd->add_option("--explore-volume", o.volume, "With --explore: head:WxHxD")
-      ->capture_default_str();
-  cmd->add_option("--explore-profile", o.profile, "With --explore: device profile")
-      ->capture_default_str();
-  cmd->add_option("--explore-size", o.size, "With --explore: image size")->capture_default_str();
-  cmd->add_option("--explore-frames", o.frames, "With --explore: frames per fixed view")
-      ->capture_default_str();
-  cmd->add_option("--explore-spin", o.spinDeg, "With --explore: degrees per spin frame")
-      ->capture_default_str();
+  addDefaultedOption(cmd, "--explore-volume", o.volume, "With --explore: head:WxHxD");
+  addDefaultedOption(cmd, "--explore-profile", o.profile, "With --explore: device profile");
+  addDefaultedOption(cmd, "--explore-size", o.size, "With --explore: image size");
+  addDefaultedOption(cmd, "--explore-frames", o.frames, "With --explore: frames per fixed view");
+  addDefaultedOption(cmd, "--explore-spin", o.spinDeg, "With --explore: degrees per spin frame");
   cmd->add_option("--explore-out", o.out, "With --explore: also write the table to this file");
 }
 

@@ -33,25 +33,8 @@ namespace tessera::app {
 
 namespace {
 
-class MarschnerLobbField final : public Reconstruction {
- public:
-  explicit MarschnerLobbField(glm::ivec3 dims) : dims_(dims) {}
-  double value(glm::dvec3 p) const override {
-    return lattice::marschnerLobb(lattice::marschnerLobbCoordinate(dims_, p));
-  }
-  glm::ivec3 dims() const override { return dims_; }
-  int supportVoxels() const override { return 0; }
-
- private:
-  glm::ivec3 dims_;
-};
-
 Camera obliqueCamera(const Volume& v) {
-  Camera cam;
-  cam.azimuthDeg = 30;
-  cam.elevationDeg = 50;  // from above: the rings of the signal show
-  cam.frame(v);
-  return cam;
+  return Camera::framing(v, 30, 50);  // from above: the rings of the signal show
 }
 
 Image gpuImage(gpu::GlContext& context, const gpu::DeviceLimits& limits, const Volume& box,
@@ -110,8 +93,8 @@ void marschnerLobb(gpu::GlContext& context, const gpu::DeviceLimits& limits,
     std::vector<Image> truths;
     for (const TransferFunction& tf :
          {lattice::marschnerLobbSoftTf(), lattice::marschnerLobbIsoTf()}) {
-      truths.push_back(renderReference(cartesian, MarschnerLobbField(cartesian.dims()), tf, cam, {},
-                                       size, size));
+      truths.push_back(renderReference(cartesian, lattice::MarschnerLobbSignal(cartesian.dims()),
+                                       tf, cam, {}, size, size));
       truths.back().writePng(dir / ("fcc-ml" + std::to_string(n) + "-truth-" + tf.name + ".png"));
     }
     for (const Row& r : rows) {
@@ -141,10 +124,7 @@ void ch2(gpu::GlContext& context, const gpu::DeviceLimits& limits, const std::fi
   }
   const Volume original = readVolume(path);
   const TransferFunction tf = TransferFunction::preset("mr-default");
-  Camera cam;
-  cam.azimuthDeg = 30;
-  cam.elevationDeg = 15;
-  cam.frame(original);
+  const Camera cam = Camera::framing(original, 30, 15);
   const Image ref = renderReference(original, tf, cam, {}, size, size);
   ref.writePng(dir / "fcc-ch2-reference.png");
   std::printf(

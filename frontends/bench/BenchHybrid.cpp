@@ -29,19 +29,16 @@ namespace {
 // Saturated, semi-transparent hues over the MRI range: dark blue is the most
 // opaque, pale yellow the brightest, so luminance is a poor opacity guess.
 TransferFunction colouredTf() {
-  TransferFunction tf;
-  tf.name = "coloured";
-  tf.addColor(0.0, {0.0, 0.0, 0.0});
-  tf.addColor(0.15, {0.1, 0.15, 0.85});
-  tf.addColor(0.35, {0.85, 0.15, 0.1});
-  tf.addColor(0.6, {0.2, 0.8, 0.2});
-  tf.addColor(1.0, {1.0, 0.95, 0.5});
-  tf.addOpacity(0.0, 0.0);
-  tf.addOpacity(0.12, 0.0);
-  tf.addOpacity(0.2, 0.05);
-  tf.addOpacity(0.45, 0.02);
-  tf.addOpacity(1.0, 0.3);
-  return tf;
+  return TransferFunction::fromPoints(
+      "coloured",
+      {
+          {0.0, {0.0, 0.0, 0.0}},
+          {0.15, {0.1, 0.15, 0.85}},
+          {0.35, {0.85, 0.15, 0.1}},
+          {0.6, {0.2, 0.8, 0.2}},
+          {1.0, {1.0, 0.95, 0.5}},
+      },
+      {{0.0, 0.0}, {0.12, 0.0}, {0.2, 0.05}, {0.45, 0.02}, {1.0, 0.3}});
 }
 
 // The volume uploaded once as texture3d, which every technique shares.
@@ -92,10 +89,7 @@ nlohmann::json qualityTable(const Scene& scene, const HybridBenchOptions& o, boo
       {"mr-default, box+axes+roi", TransferFunction::preset("mr-default"), "box,axes,roi"},
       {"coloured, box", colouredTf(), "box"},
       {"coloured, box+axes+roi", colouredTf(), "box,axes,roi"}};
-  Camera camera;
-  camera.frame(volume);
-  camera.azimuthDeg = 35;
-  camera.elevationDeg = 20;
+  Camera camera = Camera::framing(volume, 35, 20);
   camera.zoom = 0.8;  // the whole box in the portrait screen
   RenderSettings settings;
   settings.stepVoxels = o.step;

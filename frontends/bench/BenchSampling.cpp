@@ -38,11 +38,7 @@ struct Variant {
 };
 
 Camera viewCamera(const Volume& volume, int view) {
-  Camera cam;
-  cam.azimuthDeg = 60.0 * view;
-  cam.elevationDeg = view == 0 ? 0.0 : 20.0;
-  cam.frame(volume);
-  return cam;
+  return Camera::framing(volume, 60.0 * view, view == 0 ? 0.0 : 20.0);
 }
 
 std::string stepName(double step) {

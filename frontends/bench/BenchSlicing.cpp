@@ -87,11 +87,7 @@ struct Grid {
 };
 
 Camera benchCamera(const Volume& v) {
-  Camera cam;
-  cam.azimuthDeg = 30;
-  cam.elevationDeg = 20;
-  cam.frame(v);
-  return cam;
+  return Camera::framing(v, 30, 20);
 }
 
 // Settings that make the ray caster take `steps` samples over the
@@ -352,9 +348,7 @@ std::vector<TfRow> measureTfUpdates(gpu::GlContext& context, const gpu::DeviceLi
   std::vector<TfRow> rows;
   for (const glm::ivec3 dims : dimsList) {
     const Volume v = resample(source, dims);
-    Camera cam = benchCamera(v);
-    cam.azimuthDeg = 10;  // the y stack
-    cam.elevationDeg = 10;
+    const Camera cam = Camera::framing(v, 10, 10);  // the y stack
     const RenderSettings s;
     for (const Path& p : paths) {
       const auto t = makeSlice2D(context, limits, v, p.options, tf);

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli/Options.h"
 #include "tessera/gpu/DeviceSession.h"
 #include "tessera/io/FormatRegistry.h"
 #include "tessera/session/RenderRun.h"
@@ -51,6 +52,13 @@ inline void addSeriesOption(CLI::App* cmd, std::string& series) {
   cmd->add_option("--series", series,
                   "DICOM: Series Instance UID to read when a folder holds several (default: the "
                   "series with the most slices; `tessera info FOLDER` lists them)");
+}
+
+// The volume argument and --series together, as info, render, plan, slice
+// and view take them.
+inline void addVolumeOptions(CLI::App* cmd, std::string& file, std::string& series) {
+  cmd->add_option("file", file, kVolumeHelp);
+  addSeriesOption(cmd, series);
 }
 
 // --time and --channel: which 3D volume of a 4D/5D (t, c, z, y, x) OME-Zarr

@@ -169,8 +169,7 @@ void addInfoCommand(CLI::App& app) {
                          "Print a volume's dims, spacing, orientation and index-to-world affine "
                          "(RAS+ mm), type, value range, histogram summary and bytes. Reads: " +
                              readExtensionsText());
-  cmd->add_option("file", opts->file, kVolumeHelp);
-  addSeriesOption(cmd, opts->series);
+  addVolumeOptions(cmd, opts->file, opts->series);
   addTimeChannelOptions(cmd, opts->time, opts->channel);
   cmd->add_flag("--json", opts->json, "Print one JSON object");
   cmd->callback([opts] { runInfo(*opts); });

@@ -142,16 +142,13 @@ void addPlanCommand(CLI::App& app) {
   auto o = std::make_shared<PlanOptions>();
   CLI::App* cmd = app.add_subcommand(
       "plan", "Show how a volume would be stored on a device: layout, textures, bytes and why");
-  cmd->add_option("file", o->file, kVolumeHelp);
-  addSeriesOption(cmd, o->series);
-  cmd->add_option("--profile", o->profile, "Device profile (tessera profiles) or FILE.json")
-      ->capture_default_str();
-  cmd->add_option("--layout", o->layout, layout::LayoutRegistry::global().choices())
-      ->capture_default_str();
-  cmd->add_option("--size", o->size, "Image size the renderer must also fit (WIDTHxHEIGHT)")
-      ->capture_default_str();
-  cmd->add_option("--skip-block", o->skipBlock, "Empty-space block size (0 = off)")
-      ->capture_default_str();
+  addVolumeOptions(cmd, o->file, o->series);
+  addDefaultedOption(cmd, "--profile", o->profile,
+                     "Device profile (tessera profiles) or FILE.json");
+  addDefaultedOption(cmd, "--layout", o->layout, layout::LayoutRegistry::global().choices());
+  addDefaultedOption(cmd, "--size", o->size,
+                     "Image size the renderer must also fit (WIDTHxHEIGHT)");
+  addDefaultedOption(cmd, "--skip-block", o->skipBlock, "Empty-space block size (0 = off)");
   cmd->add_flag("--json", o->json, "Print one JSON object");
   cmd->callback([o] { runPlan(*o); });
 }

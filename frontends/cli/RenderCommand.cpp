@@ -487,36 +487,29 @@ void addRenderCommand(CLI::App& app) {
   auto o = std::make_shared<RenderOptions>();
   CLI::App* cmd = app.add_subcommand(
       "render", "Render a volume headless to a PNG (GPU ray caster through EGL)");
-  cmd->add_option("file", o->file, kVolumeHelp);
-  addSeriesOption(cmd, o->series);
+  addVolumeOptions(cmd, o->file, o->series);
   addTimeChannelOptions(cmd, o->time, o->channel);
-  cmd->add_option(
-         "--tf", o->tf,
-         "Transfer function: preset (grey, mr-default, ct-bone, ct-muscle, bench) or FILE.json")
-      ->capture_default_str();
-  cmd->add_option("--size", o->size, "Image size WIDTHxHEIGHT")->capture_default_str();
-  cmd->add_option("--azimuth", o->azimuth,
-                  "Camera azimuth in degrees about the patient's superior axis (0: looking at the "
-                  "face from anterior, 90: from the patient's right), for every storage order")
-      ->capture_default_str();
-  cmd->add_option("--elevation", o->elevation,
-                  "Camera elevation in degrees (90: looking down from superior)")
-      ->capture_default_str();
-  cmd->add_option("--zoom", o->zoom, "Zoom factor (>1 magnifies)")->capture_default_str();
-  cmd->add_option("--fov", o->fov, "Vertical field of view in degrees (perspective)")
-      ->capture_default_str();
+  addDefaultedOption(
+      cmd, "--tf", o->tf,
+      "Transfer function: preset (grey, mr-default, ct-bone, ct-muscle, bench) or FILE.json");
+  addSizeOption(cmd, o->size, "Image");
+  addDefaultedOption(
+      cmd, "--azimuth", o->azimuth,
+      "Camera azimuth in degrees about the patient's superior axis (0: looking at the "
+      "face from anterior, 90: from the patient's right), for every storage order");
+  addDefaultedOption(cmd, "--elevation", o->elevation,
+                     "Camera elevation in degrees (90: looking down from superior)");
+  addDefaultedOption(cmd, "--zoom", o->zoom, "Zoom factor (>1 magnifies)");
+  addDefaultedOption(cmd, "--fov", o->fov, "Vertical field of view in degrees (perspective)");
   cmd->add_flag("--ortho", o->ortho, "Orthographic projection");
-  cmd->add_option("--mode", o->mode,
-                  "composite, mip (maximum), minip (minimum) or average (mean of the ray's "
-                  "samples): the projections show the TF colour of their value; minip and "
-                  "average by raycast only")
-      ->capture_default_str();
+  addDefaultedOption(cmd, "--mode", o->mode,
+                     "composite, mip (maximum), minip (minimum) or average (mean of the ray's "
+                     "samples): the projections show the TF colour of their value; minip and "
+                     "average by raycast only");
   addSamplingOptions(cmd, o->sampling);
-  cmd->add_option("--max-steps", o->maxSteps, "Maximum samples per ray")->capture_default_str();
-  cmd->add_option("--opacity-scale", o->opacityScale, "Global opacity scale")
-      ->capture_default_str();
-  cmd->add_option("--ert", o->ert, "Early ray termination threshold (>= 1 disables)")
-      ->capture_default_str();
+  addDefaultedOption(cmd, "--max-steps", o->maxSteps, "Maximum samples per ray");
+  addDefaultedOption(cmd, "--opacity-scale", o->opacityScale, "Global opacity scale");
+  addDefaultedOption(cmd, "--ert", o->ert, "Early ray termination threshold (>= 1 disables)");
   cmd->add_flag("--jitter", o->jitter, "Jitter the first sample per pixel");
   addShadingOptions(cmd, o->shading);
   addClippingOptions(cmd, o->clipping);
@@ -531,7 +524,7 @@ void addRenderCommand(CLI::App& app) {
                   "Value window MIN MAX (raw values); default: the value range")
       ->expected(2);
   cmd->add_option("--background", o->background, "Background colour R G B in [0,1]")->expected(3);
-  cmd->add_option("--out", o->out, "Output PNG")->capture_default_str();
+  addDefaultedOption(cmd, "--out", o->out, "Output PNG");
   cmd->add_flag("--reference", o->reference,
                 "Also render with the CPU reference and print PSNR/SSIM");
   cmd->add_option("--reference-out", o->referenceOut,
@@ -540,37 +533,30 @@ void addRenderCommand(CLI::App& app) {
                   "Judge quality against a fine reference instead: the CPU reference at this "
                   "step in voxels (e.g. 0.25), every sample, post-classified (implies "
                   "--reference; without it the reference takes the render's own samples)");
-  cmd->add_option("--repeat", o->repeat, "Render N frames, rotating the camera, and report timings")
-      ->capture_default_str();
-  cmd->add_option("--rotate", o->rotate, "Azimuth step in degrees between repeated frames")
-      ->capture_default_str();
-  cmd->add_option("--skip-block", o->skipBlock,
-                  "Empty-space skipping block size in voxels (0 = off)")
-      ->capture_default_str();
-  cmd->add_option("--lut", o->lut, "Transfer-function table entries (256 or 4096)")
-      ->capture_default_str();
-  cmd->add_option("--technique", o->technique, render::TechniqueRegistry::global().describe())
-      ->capture_default_str();
-  cmd->add_option("--slices", o->slices,
-                  "Slices: slice3d over the volume diagonal (0 = from --step), slice2d drawn "
-                  "per stack (0 = every voxel plane)")
-      ->capture_default_str();
-  cmd->add_option("--classify", o->classify,
-                  "slice2d classification: pre (CPU RGBA), palette (index + palette) or post (LUT)")
-      ->capture_default_str();
-  cmd->add_option("--profile", o->profile,
-                  "Device profile to obey (tessera profiles lists them) or FILE.json")
-      ->capture_default_str();
-  cmd->add_option("--layout", o->layout,
-                  "Volume storage: " + layout::LayoutRegistry::global().choices() +
-                      " (auto: the planner chooses)")
-      ->capture_default_str();
-  cmd->add_option("--lattice", o->lattice,
-                  "Sample lattice: cartesian (the volume's grid, trilinear) or fcc (resampled "
-                  "onto the face-centred cubic lattice with a cubic B-spline and "
-                  "quasi-interpolation, reconstructed with the six-direction box spline; needs "
-                  "an ES 3 profile; --reference then renders the box spline on the CPU)")
-      ->capture_default_str();
+  addDefaultedOption(cmd, "--repeat", o->repeat,
+                     "Render N frames, rotating the camera, and report timings");
+  addDefaultedOption(cmd, "--rotate", o->rotate, "Azimuth step in degrees between repeated frames");
+  addDefaultedOption(cmd, "--skip-block", o->skipBlock,
+                     "Empty-space skipping block size in voxels (0 = off)");
+  addDefaultedOption(cmd, "--lut", o->lut, "Transfer-function table entries (256 or 4096)");
+  addDefaultedOption(cmd, "--technique", o->technique,
+                     render::TechniqueRegistry::global().describe());
+  addDefaultedOption(cmd, "--slices", o->slices,
+                     "Slices: slice3d over the volume diagonal (0 = from --step), slice2d drawn "
+                     "per stack (0 = every voxel plane)");
+  addDefaultedOption(
+      cmd, "--classify", o->classify,
+      "slice2d classification: pre (CPU RGBA), palette (index + palette) or post (LUT)");
+  addDefaultedOption(cmd, "--profile", o->profile,
+                     "Device profile to obey (tessera profiles lists them) or FILE.json");
+  addDefaultedOption(cmd, "--layout", o->layout,
+                     "Volume storage: " + layout::LayoutRegistry::global().choices() +
+                         " (auto: the planner chooses)");
+  addDefaultedOption(cmd, "--lattice", o->lattice,
+                     "Sample lattice: cartesian (the volume's grid, trilinear) or fcc (resampled "
+                     "onto the face-centred cubic lattice with a cubic B-spline and "
+                     "quasi-interpolation, reconstructed with the six-direction box spline; needs "
+                     "an ES 3 profile; --reference then renders the box spline on the CPU)");
   cmd->add_option("--density", o->density,
                   "With --lattice fcc: same (as many lattice points as voxels, default) or half "
                   "(every voxel with an even index sum, no interpolation)");
@@ -578,10 +564,9 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--overlays", o->overlays,
                   "Lines drawn at full resolution with the volume: box,axes,roi (any subset); "
                   "with --reference the ground truth stops each ray at its line");
-  cmd->add_option("--overlay-opacity", o->overlayOpacity,
-                  "How lines behind/inside the volume are attenuated: alpha (target alpha), "
-                  "two-pass (renders over black and white), luma-avg, luma-601")
-      ->capture_default_str();
+  addDefaultedOption(cmd, "--overlay-opacity", o->overlayOpacity,
+                     "How lines behind/inside the volume are attenuated: alpha (target alpha), "
+                     "two-pass (renders over black and white), luma-avg, luma-601");
   cmd->add_option("--offscreen", o->offscreen,
                   "Render the volume at WxH (e.g. 128x128, 256x512) or a factor (e.g. 0.25) and "
                   "upscale it bilinearly (hybrid rendering; default with --overlays: full)");
@@ -593,8 +578,8 @@ void addRenderCommand(CLI::App& app) {
                   "one box (a store reads only the chunks it touches, never the whole level), "
                   "placed where it lies in the volume; the camera frames it. Ends past the "
                   "level are clamped (with a note)");
-  cmd->add_option("--level", o->level, "With --region: pyramid level, native (0, the finest) or N")
-      ->capture_default_str();
+  addDefaultedOption(cmd, "--level", o->level,
+                     "With --region: pyramid level, native (0, the finest) or N");
   cmd->callback([o] { runRenderCommand(*o); });
 }
 

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "cli/Options.h"
 #include "tessera/core/Error.h"
 
 namespace tessera::app {
@@ -20,36 +21,31 @@ bool parseOnOffOr(const std::string& text, const std::string& option, const std:
 
 void addSamplingOptions(CLI::App* cmd, SamplingOptions& o) {
   o.stepOption =
-      cmd->add_option("--step", o.step,
-                      "Base sample distance in voxels of the smallest spacing; adaptive steps "
-                      "take every m-th sample of it where the TF allows (add --adaptive off for "
-                      "exactly this step everywhere)")
-          ->capture_default_str();
-  cmd->add_option("--preintegrate", o.preintegrate,
-                  "Pre-integrated classification of the segments between samples (composite "
-                  "ray casting): on, off (post-classification of each sample; with adaptive "
-                  "steps the fastest that keeps 40 dB, docs/sampling.md) or lit (only frames "
-                  "with --shade or --gradient-opacity)")
-      ->capture_default_str();
-  cmd->add_option("--adaptive", o.adaptive,
-                  "Adaptive sampling: larger steps inside empty-space blocks where the TF varies "
-                  "little over the block's values (composite ray casting; needs --skip-block > "
-                  "0): on or off")
-      ->capture_default_str();
+      addDefaultedOption(cmd, "--step", o.step,
+                         "Base sample distance in voxels of the smallest spacing; adaptive steps "
+                         "take every m-th sample of it where the TF allows (add --adaptive off for "
+                         "exactly this step everywhere)");
+  addDefaultedOption(cmd, "--preintegrate", o.preintegrate,
+                     "Pre-integrated classification of the segments between samples (composite "
+                     "ray casting): on, off (post-classification of each sample; with adaptive "
+                     "steps the fastest that keeps 40 dB, docs/sampling.md) or lit (only frames "
+                     "with --shade or --gradient-opacity)");
+  addDefaultedOption(
+      cmd, "--adaptive", o.adaptive,
+      "Adaptive sampling: larger steps inside empty-space blocks where the TF varies "
+      "little over the block's values (composite ray casting; needs --skip-block > "
+      "0): on or off");
   o.toleranceOption =
-      cmd->add_option("--adaptive-tolerance", o.tolerance,
-                      "With --adaptive: a block takes m base steps at once while m * step * (TF "
-                      "variation over its values, per mm) <= this; by default this in unlit "
-                      "frames and half of it with --shade or --gradient-opacity")
-          ->capture_default_str();
-  cmd->add_option("--adaptive-max", o.maxMultiplier,
-                  "With --adaptive: the largest multiple of the base step (1, 2, 4, ... 64)")
-      ->capture_default_str();
-  cmd->add_option("--adaptive-growth", o.growth,
-                  "With --adaptive: steps also grow behind accumulated opacity A, by "
-                  "2^floor(-log2(1 - A)) (its error reaches the pixel 1 - A times weaker): on "
-                  "or off")
-      ->capture_default_str();
+      addDefaultedOption(cmd, "--adaptive-tolerance", o.tolerance,
+                         "With --adaptive: a block takes m base steps at once while m * step * (TF "
+                         "variation over its values, per mm) <= this; by default this in unlit "
+                         "frames and half of it with --shade or --gradient-opacity");
+  addDefaultedOption(cmd, "--adaptive-max", o.maxMultiplier,
+                     "With --adaptive: the largest multiple of the base step (1, 2, 4, ... 64)");
+  addDefaultedOption(cmd, "--adaptive-growth", o.growth,
+                     "With --adaptive: steps also grow behind accumulated opacity A, by "
+                     "2^floor(-log2(1 - A)) (its error reaches the pixel 1 - A times weaker): on "
+                     "or off");
 }
 
 void applySampling(const SamplingOptions& o, RenderSettings& settings) {

@@ -4,6 +4,7 @@
 #include <sstream>
 #include <vector>
 
+#include "cli/Options.h"
 #include "tessera/core/Error.h"
 #include "tessera/render/ShadingUniforms.h"
 
@@ -47,11 +48,10 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& o) {
                   "(precomputed where the device has 3D textures and the budget holds it)")
       ->check(CLI::IsMember({"auto", "on-the-fly", "precomputed"}))
       ->capture_default_str();
-  cmd->add_option("--light", o.light,
-                  "With --shade: 'headlight' (light from the viewer) or a fixed direction "
-                  "towards the light X,Y,Z in the patient frame (RAS+: x right, y anterior, "
-                  "z superior), e.g. 0,1,1 from the front and above")
-      ->capture_default_str();
+  addDefaultedOption(cmd, "--light", o.light,
+                     "With --shade: 'headlight' (light from the viewer) or a fixed direction "
+                     "towards the light X,Y,Z in the patient frame (RAS+: x right, y anterior, "
+                     "z superior), e.g. 0,1,1 from the front and above");
   cmd->add_option("--gradient-opacity", o.gradientOpacity,
                   "Gradient-magnitude opacity modulation, LOW,HIGH (or 'on' for " +
                       std::to_string(Shading{}.gradientLow).substr(0, 4) + "," +
@@ -60,16 +60,12 @@ void addShadingOptions(CLI::App* cmd, ShadingOptions& o) {
                       "LOW), 0, 1), |gradient| in normalised value per voxel, so homogeneous "
                       "regions fade and boundaries stay; with or without --shade; composite "
                       "mode only");
-  cmd->add_option("--ambient", o.coefficients.ambient, "With --shade: ambient term")
-      ->capture_default_str();
-  cmd->add_option("--diffuse", o.coefficients.diffuse, "With --shade: diffuse term")
-      ->capture_default_str();
-  cmd->add_option("--specular", o.coefficients.specular,
-                  "With --shade: specular term (white highlights)")
-      ->capture_default_str();
-  cmd->add_option("--shininess", o.coefficients.shininess,
-                  "With --shade: specular exponent, 1..512")
-      ->capture_default_str();
+  addDefaultedOption(cmd, "--ambient", o.coefficients.ambient, "With --shade: ambient term");
+  addDefaultedOption(cmd, "--diffuse", o.coefficients.diffuse, "With --shade: diffuse term");
+  addDefaultedOption(cmd, "--specular", o.coefficients.specular,
+                     "With --shade: specular term (white highlights)");
+  addDefaultedOption(cmd, "--shininess", o.coefficients.shininess,
+                     "With --shade: specular exponent, 1..512");
 }
 
 Shading shadingFrom(const ShadingOptions& o) {

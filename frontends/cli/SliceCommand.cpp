@@ -136,8 +136,7 @@ void addSliceCommand(CLI::App& app) {
       "Radiological convention: axial and coronal slices show the patient's left on the image's "
       "right, sagittal slices anterior on the left, superior (or anterior, axial) up; the "
       "patient directions of the four edges are printed");
-  cmd->add_option("file", o->file, kVolumeHelp);
-  addSeriesOption(cmd, o->series);
+  addVolumeOptions(cmd, o->file, o->series);
   addTimeChannelOptions(cmd, o->time, o->channel);
   cmd->add_option("--axis", o->axis, "Index axis the slice is normal to: x, y or z")->required();
   cmd->add_option("--index", o->index, "Slice index along --axis (0-based, in the level)")
@@ -145,13 +144,11 @@ void addSliceCommand(CLI::App& app) {
   cmd->add_option("--window", o->window,
                   "Value window MIN MAX (raw values); default: the volume's window")
       ->expected(2);
-  cmd->add_option("--level", o->level, "Pyramid level: native (0, the finest) or N")
-      ->capture_default_str();
-  cmd->add_option("--tf", o->tf,
-                  "grey, or colour by a transfer function (preset or FILE.json; colour only)")
-      ->capture_default_str();
-  cmd->add_option("--out", o->out, "Output PNG (square pixels of the finer in-plane spacing)")
-      ->capture_default_str();
+  addDefaultedOption(cmd, "--level", o->level, "Pyramid level: native (0, the finest) or N");
+  addDefaultedOption(cmd, "--tf", o->tf,
+                     "grey, or colour by a transfer function (preset or FILE.json; colour only)");
+  addDefaultedOption(cmd, "--out", o->out,
+                     "Output PNG (square pixels of the finer in-plane spacing)");
   cmd->add_flag("--json", o->json, "Print one JSON object (edges, mapping, reads)");
   cmd->callback([o] { runSliceCommand(*o); });
 }

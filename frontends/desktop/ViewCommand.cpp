@@ -14,46 +14,41 @@ void addViewCommand(CLI::App& app) {
   auto o = std::make_shared<desktop::ViewOptions>();
   CLI::App* cmd = app.add_subcommand(
       "view", "Interactive viewer: GLFW window with OpenGL ES (EGL) and the TF editor");
-  cmd->add_option("file", o->file, kVolumeHelp);
-  addSeriesOption(cmd, o->series);
-  cmd->add_option("--tf", o->tf, "Transfer function: preset or FILE.json")->capture_default_str();
-  cmd->add_option("--size", o->size, "Window size WIDTHxHEIGHT")->capture_default_str();
+  addVolumeOptions(cmd, o->file, o->series);
+  addDefaultedOption(cmd, "--tf", o->tf, "Transfer function: preset or FILE.json");
+  addSizeOption(cmd, o->size, "Window");
   o->labelsOption = addLabelsOption(
       cmd, o->labels,
       "Show a label volume (atlas) as `tessera render --labels` does: nearest-neighbour sampling "
       "and a categorical colour table instead of --tf. TABLE (optional): JSON or a label text file "
       "(ITK-SNAP, FreeSurfer LUT, mricron); without it a default palette. The Labels panel shows "
       "and hides labels");
-  cmd->add_option("--profile", o->profile,
-                  "Device profile (gles3, gles2, webgl1, ...; its API level picks the context)")
-      ->capture_default_str();
+  addDefaultedOption(cmd, "--profile", o->profile,
+                     "Device profile (gles3, gles2, webgl1, ...; its API level picks the context)");
   cmd->add_option("--azimuth", o->azimuth, "Initial camera azimuth in degrees");
   cmd->add_option("--elevation", o->elevation, "Initial camera elevation in degrees");
   cmd->add_option("--screenshot", o->screenshot,
                   "Write the window to this PNG after --frames frames and exit");
-  cmd->add_option("--frames", o->frames, "Frames before --screenshot")->capture_default_str();
+  addDefaultedOption(cmd, "--frames", o->frames, "Frames before --screenshot");
   cmd->add_flag("--help-overlay", o->helpOverlay,
                 "Start with the keyboard shortcuts shown (F1 or ? toggles them)");
-  cmd->add_option("--layout", o->layout,
-                  "four: axial, 3D, sagittal and coronal views (2x2); single: the 3D view only")
-      ->capture_default_str();
+  addDefaultedOption(cmd, "--layout", o->layout,
+                     "four: axial, 3D, sagittal and coronal views (2x2); single: the 3D view only");
   cmd->add_option("--crosshair", o->crosshair, "Start with the crosshair at voxel X Y Z (native)")
       ->expected(3);
   cmd->add_flag("--pick", o->pick,
                 "Start with the region (default side: 256 or what the profile allows) picked "
                 "around the crosshair");
-  cmd->add_option("--zoom", o->zoom, "Initial camera zoom (1: the volume fills the view)")
-      ->capture_default_str();
+  addDefaultedOption(cmd, "--zoom", o->zoom, "Initial camera zoom (1: the volume fills the view)");
   cmd->add_flag("--zoom-grid", o->zoomGrid,
                 "Let the zoom swap the 3D view between a coarse level, the overview level and the "
                 "native grid block around the view's centre (viewer/ZoomSwap: thresholds with "
                 "hysteresis, a cross-fade on ES 2 and ES 3)");
   cmd->add_option("--region-side", o->regionSide,
                   "Side of the picked region in voxels (16 .. 256 or what the profile allows)");
-  cmd->add_option("--mode", o->mode,
-                  "Start in: overview, region (the picked region at native resolution) or grid "
-                  "(the grid view's block nearest the crosshair)")
-      ->capture_default_str();
+  addDefaultedOption(cmd, "--mode", o->mode,
+                     "Start in: overview, region (the picked region at native resolution) or grid "
+                     "(the grid view's block nearest the crosshair)");
   cmd->add_option("--render-mode", o->projection,
                   "The 3D view's mode: composite, mip, minip or average (the Rendering panel's "
                   "mode)")

@@ -27,6 +27,14 @@ void Camera::frame(const Volume& volume) {
   modelFromWorld = glm::transpose(nearestOrthonormal(volume.direction()));
 }
 
+Camera Camera::framing(const Volume& volume, double azimuthDeg, double elevationDeg) {
+  Camera cam;
+  cam.azimuthDeg = azimuthDeg;
+  cam.elevationDeg = elevationDeg;
+  cam.frame(volume);
+  return cam;
+}
+
 glm::dmat3 Camera::basis() const {
   return modelFromWorld * worldBasis();
 }

@@ -80,40 +80,29 @@ void rejectUnknownKeys(const json& object, std::initializer_list<const char*> kn
   }
 }
 
-// A function called `name` with these points, added in order (the checks
-// and sorting of addColor and addOpacity).
-TransferFunction fromPoints(std::string name, std::initializer_list<ColorPoint> colors,
-                            std::initializer_list<OpacityPoint> opacities) {
-  TransferFunction tf;
-  tf.name = std::move(name);
-  for (const ColorPoint& p : colors) tf.addColor(p.x, p.rgb);
-  for (const OpacityPoint& p : opacities) tf.addOpacity(p.x, p.alpha);
-  return tf;
-}
-
 struct Preset {
   const char* name;
   TransferFunction (*make)();
 };
 
 TransferFunction makeGrey() {
-  return fromPoints("grey",
-                    {
-                        {0.0, {0.0, 0.0, 0.0}},
-                        {1.0, {1.0, 1.0, 1.0}},
-                    },
-                    {{0.0, 0.0}, {1.0, 0.05}});
+  return TransferFunction::fromPoints("grey",
+                                      {
+                                          {0.0, {0.0, 0.0, 0.0}},
+                                          {1.0, {1.0, 1.0, 1.0}},
+                                      },
+                                      {{0.0, 0.0}, {1.0, 0.05}});
 }
 
 // The benchmark TF: transparent up to 20 % of the range, then opacity rising
 // linearly to 0.2 per unit length (one voxel at spacing 1) at the maximum.
 TransferFunction makeBench() {
-  return fromPoints("bench",
-                    {
-                        {0.0, {0.0, 0.0, 0.0}},
-                        {1.0, {1.0, 1.0, 1.0}},
-                    },
-                    {{0.0, 0.0}, {0.2, 0.0}, {1.0, 0.2}});
+  return TransferFunction::fromPoints("bench",
+                                      {
+                                          {0.0, {0.0, 0.0, 0.0}},
+                                          {1.0, {1.0, 1.0, 1.0}},
+                                      },
+                                      {{0.0, 0.0}, {0.2, 0.0}, {1.0, 0.2}});
 }
 
 // For a T1 MRI head such as mricron's ch2 (u8, window 0..254): air and noise
@@ -122,36 +111,37 @@ TransferFunction makeBench() {
 // and reaches ~0.1 per mm within a few grey levels of it: with 0.5 mm steps a
 // few millimetres of scalp are nearly opaque, which gives a recognisable face.
 TransferFunction makeMrDefault() {
-  return fromPoints("mr-default",
-                    {
-                        {0.0, {0.0, 0.0, 0.0}},
-                        {0.12, {0.55, 0.30, 0.22}},
-                        {0.25, {0.85, 0.58, 0.46}},
-                        {0.45, {0.95, 0.76, 0.64}},
-                        {0.70, {1.00, 0.90, 0.82}},
-                        {1.0, {1.0, 1.0, 1.0}},
-                    },
-                    {{0.0, 0.0}, {0.12, 0.0}, {0.20, 0.12}, {0.45, 0.20}, {1.0, 0.30}});
+  return TransferFunction::fromPoints(
+      "mr-default",
+      {
+          {0.0, {0.0, 0.0, 0.0}},
+          {0.12, {0.55, 0.30, 0.22}},
+          {0.25, {0.85, 0.58, 0.46}},
+          {0.45, {0.95, 0.76, 0.64}},
+          {0.70, {1.00, 0.90, 0.82}},
+          {1.0, {1.0, 1.0, 1.0}},
+      },
+      {{0.0, 0.0}, {0.12, 0.0}, {0.20, 0.12}, {0.45, 0.20}, {1.0, 0.30}});
 }
 
 // Bone only: soft tissue (below ~0.45 of the window) is invisible; the
 // ivory-to-white ramp and the steep opacity ramp above 0.45 show the skull
 // as a surface.
 TransferFunction makeCtBone() {
-  return fromPoints("ct-bone",
-                    {
-                        {0.0, {0.0, 0.0, 0.0}},
-                        {0.45, {0.75, 0.62, 0.48}},
-                        {0.60, {0.95, 0.90, 0.80}},
-                        {1.0, {1.0, 1.0, 0.96}},
-                    },
-                    {{0.0, 0.0}, {0.45, 0.0}, {0.60, 0.5}, {1.0, 0.8}});
+  return TransferFunction::fromPoints("ct-bone",
+                                      {
+                                          {0.0, {0.0, 0.0, 0.0}},
+                                          {0.45, {0.75, 0.62, 0.48}},
+                                          {0.60, {0.95, 0.90, 0.80}},
+                                          {1.0, {1.0, 1.0, 0.96}},
+                                      },
+                                      {{0.0, 0.0}, {0.45, 0.0}, {0.60, 0.5}, {1.0, 0.8}});
 }
 
 // Soft tissue as a semi-transparent red/pink shell (0.3-0.5) in front of
 // opaque white bone (above ~0.6).
 TransferFunction makeCtMuscle() {
-  return fromPoints(
+  return TransferFunction::fromPoints(
       "ct-muscle",
       {
           {0.0, {0.0, 0.0, 0.0}},
@@ -184,6 +174,16 @@ bool endsWithJson(const std::string& s) {
 }
 
 }  // namespace
+
+TransferFunction TransferFunction::fromPoints(std::string name,
+                                              std::initializer_list<ColorPoint> colors,
+                                              std::initializer_list<OpacityPoint> opacities) {
+  TransferFunction tf;
+  tf.name = std::move(name);
+  for (const ColorPoint& p : colors) tf.addColor(p.x, p.rgb);
+  for (const OpacityPoint& p : opacities) tf.addOpacity(p.x, p.alpha);
+  return tf;
+}
 
 void TransferFunction::addColor(double x, glm::dvec3 rgb) {
   requireUnit(x, "addColor", "x");

@@ -69,27 +69,14 @@ double marschnerLobbRms(const Reconstruction& field, const std::vector<glm::dvec
 }
 
 TransferFunction marschnerLobbSoftTf() {
-  TransferFunction tf;
-  tf.name = "soft";
-  tf.addColor(0.0, {0.2, 0.4, 1.0});
-  tf.addColor(1.0, {1.0, 0.9, 0.6});
-  tf.addOpacity(0.0, 0.0);
-  tf.addOpacity(0.3, 0.0);
-  tf.addOpacity(1.0, 0.25);
-  return tf;
+  return TransferFunction::fromPoints("soft", {{0.0, {0.2, 0.4, 1.0}}, {1.0, {1.0, 0.9, 0.6}}},
+                                      {{0.0, 0.0}, {0.3, 0.0}, {1.0, 0.25}});
 }
 
 TransferFunction marschnerLobbIsoTf() {
-  TransferFunction tf;
-  tf.name = "iso";
-  tf.addColor(0.0, {1.0, 0.8, 0.5});
-  tf.addColor(1.0, {1.0, 0.8, 0.5});
-  tf.addOpacity(0.0, 0.0);
-  tf.addOpacity(0.46, 0.0);
-  tf.addOpacity(0.5, 1.0);
-  tf.addOpacity(0.54, 0.0);
-  tf.addOpacity(1.0, 0.0);
-  return tf;
+  return TransferFunction::fromPoints(
+      "iso", {{0.0, {1.0, 0.8, 0.5}}, {1.0, {1.0, 0.8, 0.5}}},
+      {{0.0, 0.0}, {0.46, 0.0}, {0.5, 1.0}, {0.54, 0.0}, {1.0, 0.0}});
 }
 
 }  // namespace tessera::lattice

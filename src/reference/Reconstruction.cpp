@@ -15,22 +15,19 @@ glm::dvec3 Reconstruction::gradient(glm::dvec3 p) const {
   return g;
 }
 
-TrilinearReconstruction::TrilinearReconstruction(const Volume& volume) : dims_(volume.dims()) {
+GridReconstruction::GridReconstruction(const Volume& volume) : dims_(volume.dims()) {
   data_.resize(static_cast<std::size_t>(volume.voxelCount()));
   for (std::size_t i = 0; i < data_.size(); ++i) data_[i] = volume.finiteValueAtIndex(i);
 }
 
 double TrilinearReconstruction::value(glm::dvec3 p) const {
-  const glm::ivec3 d = dims_;
+  const glm::ivec3 d = dims();
   // Continuous voxel coordinate with centres at integers.
   const glm::dvec3 u = p * glm::dvec3(d) - 0.5;
   const glm::dvec3 f = glm::floor(u);
   const glm::dvec3 w = u - f;
   const glm::ivec3 i0 = glm::clamp(glm::ivec3(f), glm::ivec3(0), d - 1);
   const glm::ivec3 i1 = glm::clamp(glm::ivec3(f) + 1, glm::ivec3(0), d - 1);
-  auto at = [&](int x, int y, int z) {
-    return data_[(static_cast<std::size_t>(z) * d.y + y) * d.x + x];
-  };
   const double c00 = at(i0.x, i0.y, i0.z) * (1 - w.x) + at(i1.x, i0.y, i0.z) * w.x;
   const double c10 = at(i0.x, i1.y, i0.z) * (1 - w.x) + at(i1.x, i1.y, i0.z) * w.x;
   const double c01 = at(i0.x, i0.y, i1.z) * (1 - w.x) + at(i1.x, i0.y, i1.z) * w.x;
@@ -40,15 +37,10 @@ double TrilinearReconstruction::value(glm::dvec3 p) const {
   return c0 * (1 - w.z) + c1 * w.z;
 }
 
-NearestReconstruction::NearestReconstruction(const Volume& volume) : dims_(volume.dims()) {
-  data_.resize(static_cast<std::size_t>(volume.voxelCount()));
-  for (std::size_t i = 0; i < data_.size(); ++i) data_[i] = volume.finiteValueAtIndex(i);
-}
-
 double NearestReconstruction::value(glm::dvec3 p) const {
-  const glm::ivec3 i =
-      glm::clamp(glm::ivec3(glm::floor(p * glm::dvec3(dims_))), glm::ivec3(0), dims_ - 1);
-  return data_[(static_cast<std::size_t>(i.z) * dims_.y + i.y) * dims_.x + i.x];
+  const glm::ivec3 d = dims();
+  const glm::ivec3 i = glm::clamp(glm::ivec3(glm::floor(p * glm::dvec3(d))), glm::ivec3(0), d - 1);
+  return at(i.x, i.y, i.z);
 }
 
 }  // namespace tessera

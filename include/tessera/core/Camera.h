@@ -43,6 +43,9 @@ class Camera {
   void frame(glm::dvec3 extent);
   // Frames the volume and orients the camera by its direction cosines.
   void frame(const Volume& volume);
+  // A camera at this azimuth and elevation that frames `volume` (frame()),
+  // the other settings their defaults.
+  static Camera framing(const Volume& volume, double azimuthDeg, double elevationDeg);
 
   // Camera basis in the model frame: columns right, up, back (forward =
   // -back). Orthonormal; left-handed when the volume's storage is mirrored.

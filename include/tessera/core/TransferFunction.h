@@ -5,6 +5,7 @@
 // opacity a slab of that thickness has; a sample that represents a length ds
 // gets a = 1 - (1 - a0)^(ds / unit) (DESIGN.md, Rendering semantics).
 #include <filesystem>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,10 @@ class TransferFunction {
 
   void addColor(double x, glm::dvec3 rgb);  // inserts sorted
   void addOpacity(double x, double alpha);  // inserts sorted
+  // A function called `name` with these points, added in order (the checks
+  // and sorting of addColor and addOpacity).
+  static TransferFunction fromPoints(std::string name, std::initializer_list<ColorPoint> colors,
+                                     std::initializer_list<OpacityPoint> opacities);
 
   glm::dvec3 color(double x) const;
   double opacity(double x) const;

@@ -23,6 +23,21 @@ double marschnerLobb(glm::dvec3 x);
 // (io/Procedural.h): its voxel i sits at -1 + 2 i / (n - 1).
 glm::dvec3 marschnerLobbCoordinate(glm::ivec3 dims, glm::dvec3 p);
 
+// The signal itself as a reconstruction of the makeMarschnerLobb(dims) box:
+// the exact field that the measured reconstructions are compared with.
+class MarschnerLobbSignal final : public Reconstruction {
+ public:
+  explicit MarschnerLobbSignal(glm::ivec3 dims) : dims_(dims) {}
+  double value(glm::dvec3 p) const override {
+    return marschnerLobb(marschnerLobbCoordinate(dims_, p));
+  }
+  glm::ivec3 dims() const override { return dims_; }
+  int supportVoxels() const override { return 0; }
+
+ private:
+  glm::ivec3 dims_;
+};
+
 // The signal sampled on the FCC lattice over the box of `cartesian`, a
 // makeMarschnerLobb() volume (or its shape with the same geometry), and
 // quasi-interpolated unless asked not to (FccResampling.h).

@@ -32,32 +32,38 @@ class Reconstruction {
   virtual int supportVoxels() const = 0;
 };
 
-// Trilinear interpolation of a Cartesian volume's raw values; NaN/Inf voxels
-// read as Volume::nonFiniteValue() (as the layouts upload them).
-class TrilinearReconstruction final : public Reconstruction {
+// A Cartesian volume's raw values, NaN/Inf voxels read as
+// Volume::nonFiniteValue() (as the layouts upload them): what the trilinear
+// and the nearest-neighbour reconstruction read.
+class GridReconstruction : public Reconstruction {
  public:
-  explicit TrilinearReconstruction(const Volume& volume);
-  double value(glm::dvec3 p) const override;
   glm::ivec3 dims() const override { return dims_; }
   int supportVoxels() const override { return 1; }
+
+ protected:
+  explicit GridReconstruction(const Volume& volume);
+  double at(int x, int y, int z) const {
+    return data_[(static_cast<std::size_t>(z) * dims_.y + y) * dims_.x + x];
+  }
 
  private:
   glm::ivec3 dims_;
   std::vector<double> data_;
 };
 
+// Trilinear interpolation of the volume's values.
+class TrilinearReconstruction final : public GridReconstruction {
+ public:
+  explicit TrilinearReconstruction(const Volume& volume) : GridReconstruction(volume) {}
+  double value(glm::dvec3 p) const override;
+};
+
 // Nearest neighbour: the value of the voxel whose cell holds p (label
 // volumes); the GLSL twin is fieldValue() with NEAREST (render/sample.glsl).
-class NearestReconstruction final : public Reconstruction {
+class NearestReconstruction final : public GridReconstruction {
  public:
-  explicit NearestReconstruction(const Volume& volume);
+  explicit NearestReconstruction(const Volume& volume) : GridReconstruction(volume) {}
   double value(glm::dvec3 p) const override;
-  glm::ivec3 dims() const override { return dims_; }
-  int supportVoxels() const override { return 1; }
-
- private:
-  glm::ivec3 dims_;
-  std::vector<double> data_;
 };
 
 }  // namespace tessera
