@@ -318,6 +318,48 @@ void runLayoutBench(const BenchOptions& o) {
 
 }  // namespace
 
+// The suites and switches of `tessera bench`, each a flag.
+struct BenchFlag {
+  const char* name;
+  bool BenchOptions::*member;
+  const char* help;
+};
+constexpr BenchFlag kBenchFlags[] = {
+    {"--layouts", &BenchOptions::layouts,
+     "Compare layouts (texture3d, mosaic, packed-mosaic) instead of accelerations"},
+    {"--fcc", &BenchOptions::fcc,
+     "FCC lattice + box spline vs Cartesian + trilinear (Sarfaraz & Shaban 2015 "
+     "Tables 1-2): 64^3-class volumes, FCC at the same and half the sample count, "
+     "and where the box spline's time goes; --frames per variant (default 12)"},
+    {"--json", &BenchOptions::json, "Print JSON instead of a Markdown table"},
+    {"--slicing", &BenchOptions::slicing,
+     "Texture slicing vs ray casting (GRAPP 2012 Tables 1-2), TF-update times "
+     "(Moser & Weiskopf 2008 Fig. 6) and quality per count; --frames per cell"},
+    {"--slicing-quick", &BenchOptions::slicingQuick, "With --slicing: a small smoke run"},
+    {"--hybrid", &BenchOptions::hybrid,
+     "Hybrid low/high-resolution rendering: each overlay-opacity method vs the ground "
+     "truth (Moser & Weiskopf 2008 Fig. 2) and full vs 128x128/256x256/256x512 "
+     "offscreen speed at 480x640 and 1024x768; --frames per cell"},
+    {"--interactive", &BenchOptions::interactive,
+     "Quality controller: --frames moving frames held near a frame-time goal, then one "
+     "full-quality idle frame (default size 480x640)"},
+    {"--print-tf", &BenchOptions::printTf,
+     "Print --tf as JSON (control points, opacity unit length) and exit: what "
+     "bench/peers translates into VTK's transfer functions"},
+    {"--roofline", &BenchOptions::roofline,
+     "Platform roofline: peak trilinear 3D fetch and TF lookup rates of this context, "
+     "and each technique's effective samples/s as a fraction of them (default 5 "
+     "frames per technique)"},
+    {"--sampling", &BenchOptions::sampling,
+     "Fewer samples for the same image: baseline / +pre-integration / +adaptive / "
+     "both at each --sampling-steps, interleaved; ms, samples per ray, PSNR vs the "
+     "--reference-step reference (default 8 frames)"},
+    {"--sampling-sweep", &BenchOptions::samplingSweep,
+     "Candidate sampling settings (fixed steps, pre-integration, adaptive "
+     "tolerances) per volume x TF x shading: how tessera render's defaults were "
+     "chosen (docs/sampling.md)"},
+};
+
 void addBenchCommand(CLI::App& app) {
   auto o = std::make_shared<BenchOptions>();
   CLI::App* cmd = app.add_subcommand("bench",
@@ -331,17 +373,11 @@ void addBenchCommand(CLI::App& app) {
   addDefaultedOption(cmd, "--step", o->step, "Sample distance in voxels");
   addDefaultedOption(cmd, "--tf", o->tf, "Transfer function preset or JSON file");
   addShadingOptions(cmd, o->shading);
-  cmd->add_flag("--layouts", o->layouts,
-                "Compare layouts (texture3d, mosaic, packed-mosaic) instead of accelerations");
-  cmd->add_flag("--fcc", o->fcc,
-                "FCC lattice + box spline vs Cartesian + trilinear (Sarfaraz & Shaban 2015 "
-                "Tables 1-2): 64^3-class volumes, FCC at the same and half the sample count, "
-                "and where the box spline's time goes; --frames per variant (default 12)");
+  for (const BenchFlag& f : kBenchFlags) cmd->add_flag(f.name, (*o).*f.member, f.help);
   cmd->add_option("--fcc-out", o->fccOut,
                   "FCC quality figures instead of speed: Marschner-Lobb RMS/PSNR at 41^3 and "
                   "64^3 (Cartesian trilinear vs FCC box spline, same and half density), ch2 on "
                   "FCC vs the original; tables on stdout, PNGs in this folder");
-  cmd->add_flag("--json", o->json, "Print JSON instead of a Markdown table");
   cmd->add_option(
       "--bricks", o->bricks,
       "Large volumes through the bricks layout: generated head:WxHxD specs (e.g. "
@@ -349,41 +385,15 @@ void addBenchCommand(CLI::App& app) {
       "frame time while streaming (default 8 frames), levels, texture bytes vs the "
       "budget, bricks read, peak RSS, and the in-core layout as baseline where it fits");
   addDefaultedOption(cmd, "--bricks-profiles", o->bricksProfiles, "Profiles for --bricks");
-  cmd->add_flag("--slicing", o->slicing,
-                "Texture slicing vs ray casting (GRAPP 2012 Tables 1-2), TF-update times "
-                "(Moser & Weiskopf 2008 Fig. 6) and quality per count; --frames per cell");
   cmd->add_option("--slicing-out", o->slicingOut,
                   "With --slicing: also write bench-slicing.md and SVG plots to this folder");
-  cmd->add_flag("--slicing-quick", o->slicingQuick, "With --slicing: a small smoke run");
-  cmd->add_flag("--hybrid", o->hybrid,
-                "Hybrid low/high-resolution rendering: each overlay-opacity method vs the ground "
-                "truth (Moser & Weiskopf 2008 Fig. 2) and full vs 128x128/256x256/256x512 "
-                "offscreen speed at 480x640 and 1024x768; --frames per cell");
   cmd->add_option("--hybrid-out", o->hybridOut,
                   "With --hybrid: write the pictures (ground truth, each method) to this folder");
-  cmd->add_flag("--interactive", o->interactive,
-                "Quality controller: --frames moving frames held near a frame-time goal, then one "
-                "full-quality idle frame (default size 480x640)");
   cmd->add_option("--goal-ms", o->goalMs,
                   "With --interactive: frame-time goal (default: a sixth of a full-quality frame)");
-  cmd->add_flag("--print-tf", o->printTf,
-                "Print --tf as JSON (control points, opacity unit length) and exit: what "
-                "bench/peers translates into VTK's transfer functions");
-  cmd->add_flag("--roofline", o->roofline,
-                "Platform roofline: peak trilinear 3D fetch and TF lookup rates of this context, "
-                "and each technique's effective samples/s as a fraction of them (default 5 "
-                "frames per technique)");
   addDefaultedOption(cmd, "--fetches", o->fetches,
                      "With --roofline: fetches per fragment in the peak "
                      "passes");
-  cmd->add_flag("--sampling", o->sampling,
-                "Fewer samples for the same image: baseline / +pre-integration / +adaptive / "
-                "both at each --sampling-steps, interleaved; ms, samples per ray, PSNR vs the "
-                "--reference-step reference (default 8 frames)");
-  cmd->add_flag("--sampling-sweep", o->samplingSweep,
-                "Candidate sampling settings (fixed steps, pre-integration, adaptive "
-                "tolerances) per volume x TF x shading: how tessera render's defaults were "
-                "chosen (docs/sampling.md)");
   cmd->add_option("--sampling-volumes", o->samplingVolumes,
                   "With --sampling(-sweep): volumes (default: FILE or ch2)");
   cmd->add_option("--sampling-tfs", o->samplingTfs,

@@ -19,6 +19,7 @@
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/Draw.h"
 #include "tessera/render/LabelTable.h"
+#include "tessera/session/Settings.h"
 
 namespace tessera::desktop {
 
@@ -154,10 +155,7 @@ void applyOptions(DesktopApp& ds, const ViewOptions& o) {
   ds.viewer->settings().shading = app::shadingFrom(o.shading);
   ds.viewer->settings().clipping = app::clippingFrom(o.clipping);
   ds.showCropBox = ds.viewer->settings().clipping.cropped();
-  const std::string modes[] = {"composite", "mip", "minip", "average"};  // RenderMode's order
-  for (int m = 0; m < 4; ++m) {
-    if (o.projection == modes[m]) ds.viewer->settings().mode = static_cast<RenderMode>(m);
-  }
+  ds.viewer->settings().mode = session::parseRenderMode(o.projection);
   startExploring(ds, o);
   if (o.labelVolume()) {
     ds.viewer->setLabels(o.labels.empty() ? render::LabelTable::defaultFor(ds.viewer->volume())

@@ -7,8 +7,30 @@
 
 #include "ViewOptions.h"
 #include "cli/Commands.h"
+#include "tessera/core/Error.h"
+#include "tessera/session/Settings.h"
 
 namespace tessera::app {
+
+namespace {
+
+// The switches of where exploring starts.
+struct StartFlag {
+  const char* name;
+  bool desktop::ViewOptions::*member;
+  const char* help;
+};
+constexpr StartFlag kStartFlags[] = {
+    {"--pick", &desktop::ViewOptions::pick,
+     "Start with the region (default side: 256 or what the profile allows) picked around the "
+     "crosshair"},
+    {"--zoom-grid", &desktop::ViewOptions::zoomGrid,
+     "Let the zoom swap the 3D view between a coarse level, the overview level and the native "
+     "grid block around the view's centre (viewer/ZoomSwap: thresholds with hysteresis, a "
+     "cross-fade on ES 2 and ES 3)"},
+};
+
+}  // namespace
 
 void addViewCommand(CLI::App& app) {
   auto o = std::make_shared<desktop::ViewOptions>();
@@ -36,24 +58,25 @@ void addViewCommand(CLI::App& app) {
                      "four: axial, 3D, sagittal and coronal views (2x2); single: the 3D view only");
   cmd->add_option("--crosshair", o->crosshair, "Start with the crosshair at voxel X Y Z (native)")
       ->expected(3);
-  cmd->add_flag("--pick", o->pick,
-                "Start with the region (default side: 256 or what the profile allows) picked "
-                "around the crosshair");
   addDefaultedOption(cmd, "--zoom", o->zoom, "Initial camera zoom (1: the volume fills the view)");
-  cmd->add_flag("--zoom-grid", o->zoomGrid,
-                "Let the zoom swap the 3D view between a coarse level, the overview level and the "
-                "native grid block around the view's centre (viewer/ZoomSwap: thresholds with "
-                "hysteresis, a cross-fade on ES 2 and ES 3)");
+  for (const StartFlag& f : kStartFlags) cmd->add_flag(f.name, (*o).*f.member, f.help);
   cmd->add_option("--region-side", o->regionSide,
                   "Side of the picked region in voxels (16 .. 256 or what the profile allows)");
   addDefaultedOption(cmd, "--mode", o->mode,
                      "Start in: overview, region (the picked region at native resolution) or grid "
                      "(the grid view's block nearest the crosshair)");
-  cmd->add_option("--render-mode", o->projection,
-                  "The 3D view's mode: composite, mip, minip or average (the Rendering panel's "
-                  "mode)")
-      ->check(CLI::IsMember({"composite", "mip", "minip", "average"}))
-      ->capture_default_str();
+  // The session's one list of render modes and its message for another.
+  addDefaultedOption(cmd, "--render-mode", o->projection,
+                     "The 3D view's mode: composite, mip, minip or average (the Rendering "
+                     "panel's mode)")
+      ->check([](const std::string& text) {
+        try {
+          session::parseRenderMode(text);
+          return std::string();
+        } catch (const Error& e) {
+          return std::string(e.what());
+        }
+      });
   addShadingOptions(cmd, o->shading);
   addClippingOptions(cmd, o->clipping);
   cmd->callback([o] { desktop::runView(*o); });

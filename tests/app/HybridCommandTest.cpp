@@ -9,6 +9,7 @@
 
 #include "support/CliRunner.h"
 
+using tessera::test::expectFailure;
 using tessera::test::runCli;
 
 namespace {
@@ -44,14 +45,10 @@ TEST(HybridCommand, EveryTechniqueMatchesTheGroundTruth) {
 }
 
 TEST(HybridCommand, BadOptionsFailWithOneLine) {
-  auto r = runCli("render gen:sphere:16 --overlay-opacity foggy --out /dev/null");
-  EXPECT_NE(r.exitCode, 0);
-  EXPECT_NE(r.err.find("--overlay-opacity 'foggy'"), std::string::npos) << r.err;
-  r = runCli("render gen:sphere:16 --overlays box --offscreen 0 --out /dev/null");
-  EXPECT_NE(r.exitCode, 0);
-  EXPECT_NE(r.err.find("offscreen"), std::string::npos) << r.err;
-  r = runCli(
-      "render gen:sphere:16 --technique slice2d --layout mosaic --overlays box --out /dev/null");
-  EXPECT_NE(r.exitCode, 0);
-  EXPECT_NE(r.err.find("--layout does not apply to slice2d"), std::string::npos) << r.err;
+  expectFailure("render gen:sphere:16 --overlay-opacity foggy --out /dev/null",
+                "--overlay-opacity 'foggy'");
+  expectFailure("render gen:sphere:16 --overlays box --offscreen 0 --out /dev/null", "offscreen");
+  expectFailure(
+      "render gen:sphere:16 --technique slice2d --layout mosaic --overlays box --out /dev/null",
+      "--layout does not apply to slice2d");
 }

@@ -7,11 +7,10 @@
 
 using tessera::test::countLines;
 using tessera::test::runCli;
+using tessera::test::runCliJson;
 
 TEST(PlanCommand, Ipad2PacksAndSaysWhyTheOthersDoNotFit) {
-  const auto r = runCli("plan gen:shepp-logan:181x217x181 --profile ipad2 --json");
-  ASSERT_EQ(r.exitCode, 0) << r.err;
-  const auto j = nlohmann::json::parse(r.out);
+  const auto j = runCliJson("plan gen:shepp-logan:181x217x181 --profile ipad2 --json");
   EXPECT_EQ(j["layout"], "packed-mosaic");
   EXPECT_EQ(j["profile"], "ipad2");
   EXPECT_EQ(j["limits"]["api"], "gles2");
@@ -26,9 +25,7 @@ TEST(PlanCommand, Ipad2PacksAndSaysWhyTheOthersDoNotFit) {
 }
 
 TEST(PlanCommand, Webgl2UsesA3dTexture) {
-  const auto r = runCli("plan gen:sphere:64x80x48 --profile webgl2 --json");
-  ASSERT_EQ(r.exitCode, 0) << r.err;
-  const auto j = nlohmann::json::parse(r.out);
+  const auto j = runCliJson("plan gen:sphere:64x80x48 --profile webgl2 --json");
   EXPECT_EQ(j["layout"], "texture3d");
   EXPECT_EQ(j["plan"]["total_bytes"], 64 * 80 * 48);
 }
@@ -45,11 +42,9 @@ TEST(PlanCommand, ImpossibleWishesFailWithOneLine) {
 }
 
 TEST(PlanCommand, RenderOnAnEs2ProfileMatchesTheReference) {
-  const auto r = runCli(
+  const auto j = runCliJson(
       "render gen:shepp-logan:48 --profile webgl1 --layout packed-mosaic --size 64x64 --tf bench "
       "--reference --json --out /dev/null");
-  ASSERT_EQ(r.exitCode, 0) << r.err;
-  const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["api"], "gles2");
   EXPECT_EQ(j["layout"], "packed-mosaic");
   EXPECT_GE(j["psnr_db"].get<double>(), 40.0);

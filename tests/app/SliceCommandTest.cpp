@@ -6,14 +6,14 @@
 
 #include "support/CliRunner.h"
 
+using tessera::test::expectFailure;
 using tessera::test::runCli;
+using tessera::test::runCliJson;
 
 TEST(SliceCommand, Slice3dOnAnEs2ProfileMatchesTheReference) {
-  const auto r = runCli(
+  const auto j = runCliJson(
       "render gen:shepp-logan:48 --technique slice3d --profile webgl1 --size 64x64 --tf bench "
       "--ert 1 --reference --json --out /dev/null");
-  ASSERT_EQ(r.exitCode, 0) << r.err;
-  const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["technique"], "slice3d");
   EXPECT_EQ(j["api"], "gles2");
   EXPECT_NE(j["layout"], "texture3d");
@@ -41,10 +41,8 @@ TEST(SliceCommand, Slice2dEveryClassificationMatchesTheReference) {
 }
 
 TEST(SliceCommand, BadTechniqueOrClassificationFailsWithOneLine) {
-  auto r = runCli("render gen:sphere:16 --technique splat --out /dev/null");
-  EXPECT_NE(r.exitCode, 0);
-  EXPECT_NE(r.err.find("technique 'splat': expected raycast"), std::string::npos) << r.err;
-  r = runCli("render gen:sphere:16 --technique slice2d --classify later --out /dev/null");
-  EXPECT_NE(r.exitCode, 0);
-  EXPECT_NE(r.err.find("classify 'later'"), std::string::npos) << r.err;
+  expectFailure("render gen:sphere:16 --technique splat --out /dev/null",
+                "technique 'splat': expected raycast");
+  expectFailure("render gen:sphere:16 --technique slice2d --classify later --out /dev/null",
+                "classify 'later'");
 }

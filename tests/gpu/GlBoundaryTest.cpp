@@ -5,79 +5,26 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
 #include <regex>
-#include <sstream>
 #include <string>
 #include <vector>
+
+#include "support/SourceScan.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-const fs::path kRoot = fs::path(TESSERA_TEST_DATA_DIR).parent_path().parent_path();
-
-std::string readFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+const fs::path& kRoot = tessera::test::repoRoot();
+using tessera::test::readText;
 
 // The code with comments and string/char literals blanked (lines kept).
 std::string codeOnly(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  enum { Code, Line, Block, String, Char } state = Code;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    const char next = i + 1 < text.size() ? text[i + 1] : '\0';
-    switch (state) {
-      case Code:
-        if (c == '/' && next == '/')
-          state = Line;
-        else if (c == '/' && next == '*')
-          state = Block;
-        else if (c == '"')
-          state = String;
-        else if (c == '\'')
-          state = Char;
-        out += state == Code ? c : ' ';
-        break;
-      case Line:
-        if (c == '\n') state = Code;
-        out += c == '\n' ? '\n' : ' ';
-        break;
-      case Block:
-        if (c == '*' && next == '/') {
-          state = Code;
-          ++i;
-        }
-        out += c == '\n' ? '\n' : ' ';
-        break;
-      case String:
-      case Char:
-        if (c == '\\') {
-          ++i;
-        } else if ((state == String && c == '"') || (state == Char && c == '\'')) {
-          state = Code;
-        }
-        out += c == '\n' ? '\n' : ' ';
-        break;
-    }
-  }
-  return out;
+  return tessera::test::blankComments(text, false);
 }
 
 std::vector<fs::path> sources(const std::vector<std::string>& folders) {
-  std::vector<fs::path> files;
-  for (const std::string& folder : folders) {
-    for (const auto& e : fs::recursive_directory_iterator(kRoot / folder)) {
-      const std::string ext = e.path().extension().string();
-      if (e.is_regular_file() && (ext == ".cpp" || ext == ".h")) files.push_back(e.path());
-    }
-  }
-  return files;
+  return tessera::test::cppSources(folders);
 }
 
 bool allowed(const fs::path& p) {
@@ -98,7 +45,7 @@ TEST(GlBoundary, NoRawGlOutsideTheGpuLayer) {
   for (const fs::path& p : sources({"src", "include", "frontends", "web/src"})) {
     if (allowed(p)) continue;
     ++checked;
-    const std::string raw = readFile(p);
+    const std::string raw = readText(p);
     const std::string code = codeOnly(raw);
     std::smatch m;
     if (std::regex_search(code, m, call) || std::regex_search(code, m, name) ||
@@ -115,7 +62,7 @@ TEST(GlBoundary, PublicHeadersNeverReachTheGlHeaders) {
   int checked = 0;
   for (const fs::path& p : sources({"include"})) {
     ++checked;
-    EXPECT_FALSE(std::regex_search(readFile(p), header)) << p;
+    EXPECT_FALSE(std::regex_search(readText(p), header)) << p;
   }
   EXPECT_GT(checked, 50);
 }
@@ -141,7 +88,7 @@ TEST(GlBoundary, OnlyTheGpuLayerCreatesContexts) {
     if (rel.rfind("src/gpu/", 0) == 0) continue;
     ++checked;
     std::smatch m;
-    const std::string code = codeOnly(readFile(p));
+    const std::string code = codeOnly(readText(p));
     if (std::regex_search(code, m, create)) offenders.push_back(rel + ": " + m.str());
   }
   EXPECT_GT(checked, 100);

@@ -33,20 +33,6 @@ Volume blobs(glm::ivec3 dims) {
   return v;
 }
 
-// The Marschner-Lobb signal itself as the reference's field.
-class MarschnerLobbField final : public Reconstruction {
- public:
-  explicit MarschnerLobbField(glm::ivec3 dims) : dims_(dims) {}
-  double value(glm::dvec3 p) const override {
-    return marschnerLobb(marschnerLobbCoordinate(dims_, p));
-  }
-  glm::ivec3 dims() const override { return dims_; }
-  int supportVoxels() const override { return 0; }
-
- private:
-  glm::ivec3 dims_;
-};
-
 Camera obliqueCamera(const Volume& v) {
   return test::orbitCamera(v, 30, 20);
 }
@@ -114,7 +100,7 @@ TEST(BoxSplineReconstruction, MarschnerLobbOnFccRendersCloserToTheSignalThanTril
     const FccVolume fcc = makeMarschnerLobbFcc(cartesian, FccDensity::Same);
     for (const auto& [tfName, tf] :
          {std::pair{"soft", marschnerLobbSoftTf()}, std::pair{"iso", marschnerLobbIsoTf()}}) {
-      const Image truth = renderReference(cartesian, MarschnerLobbField(cartesian.dims()), tf, cam,
+      const Image truth = renderReference(cartesian, MarschnerLobbSignal(cartesian.dims()), tf, cam,
                                           s, kImage, kImage);
       const double trilinear = psnr(renderReference(cartesian, tf, cam, s, kImage, kImage), truth);
       const double box =

@@ -11,12 +11,12 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
 #include <regex>
 #include <set>
-#include <sstream>
 #include <string>
 #include <vector>
+
+#include "support/SourceScan.h"
 
 #include "tessera/layout/LayoutRegistry.h"
 #include "tessera/render/TechniqueRegistry.h"
@@ -25,61 +25,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const fs::path kRoot = fs::path(TESSERA_TEST_DATA_DIR).parent_path().parent_path();
-
-std::string readFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+const fs::path& kRoot = tessera::test::repoRoot();
+using tessera::test::readText;
 
 // The code with comments blanked (string literals kept: they are what a
 // name compare compares with).
 std::string withoutComments(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  enum { Code, Line, Block, String } state = Code;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    const char next = i + 1 < text.size() ? text[i + 1] : '\0';
-    if (state == Code && c == '/' && (next == '/' || next == '*'))
-      state = next == '/' ? Line : Block;
-    if (state == Line && c == '\n') state = Code;
-    if (state == Block && c == '*' && next == '/') {
-      out += "  ";
-      ++i;
-      state = Code;
-      continue;
-    }
-    if (state == Code && c == '"') {
-      state = String;
-    } else if (state == String && c == '\\') {
-      out += c;
-      out += next;
-      ++i;
-      continue;
-    } else if (state == String && c == '"') {
-      state = Code;
-      out += c;
-      continue;
-    }
-    out += (state == Line || state == Block) && c != '\n' ? ' ' : c;
-  }
-  return out;
+  return tessera::test::blankComments(text, true);
 }
 
 // Production sources: the layers, the front ends and the examples.
 std::vector<fs::path> productionSources() {
-  std::vector<fs::path> files;
-  for (const char* dir : {"src", "include", "frontends", "web/src", "examples"}) {
-    if (!fs::exists(kRoot / dir)) continue;
-    for (const auto& e : fs::recursive_directory_iterator(kRoot / dir)) {
-      const std::string ext = e.path().extension().string();
-      if (e.is_regular_file() && (ext == ".cpp" || ext == ".h")) files.push_back(e.path());
-    }
-  }
-  return files;
+  return tessera::test::cppSources({"src", "include", "frontends", "web/src", "examples"});
 }
 
 std::string inRepo(const fs::path& p) {
@@ -127,7 +84,7 @@ std::set<std::string> concreteClasses() {
       R"(class\s+(\w+)\s+(?:final\s+)?:\s*public\s+(?:\w+::)?(Layout|Technique)\b)");
   for (const char* dir : {"include/tessera/layout", "include/tessera/render"}) {
     for (const auto& e : fs::directory_iterator(kRoot / dir)) {
-      const std::string text = readFile(e.path());
+      const std::string text = readText(e.path());
       for (std::sregex_iterator m(text.begin(), text.end(), derived), end; m != end; ++m) {
         classes.insert((*m)[1]);
       }
@@ -141,7 +98,7 @@ TEST(RegistryBoundary, NoSourceComparesARegistryNameOutsideItsDefinition) {
   ASSERT_GE(names.size(), 9u);  // 6 layouts, 3 techniques at least
   std::vector<std::string> leaks;
   for (const fs::path& file : productionSources()) {
-    const std::string code = withoutComments(readFile(file));
+    const std::string code = withoutComments(readText(file));
     for (const std::string& name : names) {
       const std::string quoted = quotedPattern(name);
       std::string pattern = "(==|!=)\\s*";
@@ -170,7 +127,7 @@ TEST(RegistryBoundary, NoSourceCastsToAConcreteLayoutOrTechniqueOutsideItsFiles)
   const std::regex cast(R"(dynamic_cast\s*<\s*(?:const\s+)?(?:\w+::)*(\w+)\s*[*&])");
   std::vector<std::string> leaks;
   for (const fs::path& file : productionSources()) {
-    const std::string code = withoutComments(readFile(file));
+    const std::string code = withoutComments(readText(file));
     const std::string stem = file.stem().string();
     for (std::sregex_iterator m(code.begin(), code.end(), cast), end; m != end; ++m) {
       const std::string target = (*m)[1];

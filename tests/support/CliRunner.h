@@ -8,7 +8,11 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "support/TestSupport.h"
 
@@ -35,6 +39,25 @@ inline CliRun runCli(const std::string& args) {
   std::ostringstream err;
   err << std::ifstream(errPath).rdbuf();
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out, err.str(), s};
+}
+
+// Runs `args`, which must succeed, and parses what it prints (--json);
+// a failure is thrown with the command's message.
+inline nlohmann::json runCliJson(const std::string& args) {
+  const CliRun r = runCli(args);
+  if (r.exitCode != 0) {
+    throw std::runtime_error("tessera " + args + ": exit " + std::to_string(r.exitCode) + ": " +
+                             r.err);
+  }
+  return nlohmann::json::parse(r.out);
+}
+
+// Runs `args`, which must fail with `needle` in its message (one line:
+// what a user sees).
+inline void expectFailure(const std::string& args, const std::string& needle) {
+  const CliRun r = runCli(args);
+  EXPECT_NE(r.exitCode, 0) << args;
+  EXPECT_NE(r.err.find(needle), std::string::npos) << args << ": " << r.err;
 }
 
 inline int countLines(const std::string& s) {
