@@ -133,6 +133,63 @@ render::TechniqueOptions Settings::techniqueOptions(glm::ivec2 imageSize) const 
           .gradient = gradient};
 }
 
+namespace {
+
+// The plain members of a settings struct with their JSON keys: written by
+// toJson and read back by fromJson from the same table, so that the two
+// cannot drift apart.
+template <class T, class V>
+struct Field {
+  const char* key;
+  V T::*member;
+};
+
+template <class T, class... V>
+void writeFields(nlohmann::json& j, const T& object, const Field<T, V>&... fields) {
+  ((j[fields.key] = object.*fields.member), ...);
+}
+
+template <class T, class... V>
+void readFields(const nlohmann::json& j, T& object, const Field<T, V>&... fields) {
+  ((object.*fields.member = j.value(fields.key, object.*fields.member)), ...);
+}
+
+// Each table applies `io` (writeFields or readFields) to its struct.
+template <class Json, class S, class Io>
+void shadingFields(Json& j, S& d, Io io) {
+  io(j, d, Field{"enabled", &Shading::enabled}, Field{"ambient", &Shading::ambient},
+     Field{"diffuse", &Shading::diffuse}, Field{"specular", &Shading::specular},
+     Field{"shininess", &Shading::shininess}, Field{"headlight", &Shading::headlight},
+     Field{"gradient_opacity", &Shading::gradientOpacity},
+     Field{"gradient_low", &Shading::gradientLow}, Field{"gradient_high", &Shading::gradientHigh});
+}
+
+template <class Json, class S, class Io>
+void samplingFields(Json& j, S& sa, Io io) {
+  io(j, sa, Field{"adaptive", &Sampling::adaptive}, Field{"tolerance", &Sampling::tolerance},
+     Field{"lit_tolerance", &Sampling::litTolerance},
+     Field{"max_multiplier", &Sampling::maxMultiplier},
+     Field{"opacity_growth", &Sampling::opacityGrowth});
+}
+
+template <class Json, class S, class Io>
+void renderFields(Json& j, S& r, Io io) {
+  io(j, r, Field{"step", &RenderSettings::stepVoxels},
+     Field{"max_steps", &RenderSettings::maxSteps},
+     Field{"opacity_scale", &RenderSettings::opacityScale},
+     Field{"ert", &RenderSettings::ertThreshold}, Field{"jitter", &RenderSettings::jitter},
+     Field{"nearest", &RenderSettings::nearest});
+}
+
+const auto kWrite = [](auto& j, const auto& object, const auto&... fields) {
+  writeFields(j, object, fields...);
+};
+const auto kRead = [](const auto& j, auto& object, const auto&... fields) {
+  readFields(j, object, fields...);
+};
+
+}  // namespace
+
 nlohmann::json Settings::toJson() const {
   const Shading& sh = render.shading;
   const Sampling& sa = render.sampling;
@@ -155,31 +212,9 @@ nlohmann::json Settings::toJson() const {
       {"tf", nlohmann::json::parse(tf.toJson())},
       {"window", window ? nlohmann::json{window->min, window->max} : nlohmann::json(nullptr)},
       {"mode", renderModeName(render.mode)},
-      {"step", render.stepVoxels},
-      {"max_steps", render.maxSteps},
-      {"opacity_scale", render.opacityScale},
-      {"ert", render.ertThreshold},
-      {"jitter", render.jitter},
-      {"nearest", render.nearest},
       {"background", {render.background.r, render.background.g, render.background.b}},
-      {"sampling",
-       {{"preintegrate", preintegrateText(sa)},
-        {"adaptive", sa.adaptive},
-        {"tolerance", sa.tolerance},
-        {"lit_tolerance", sa.litTolerance},
-        {"max_multiplier", sa.maxMultiplier},
-        {"opacity_growth", sa.opacityGrowth}}},
-      {"shading",
-       {{"enabled", sh.enabled},
-        {"ambient", sh.ambient},
-        {"diffuse", sh.diffuse},
-        {"specular", sh.specular},
-        {"shininess", sh.shininess},
-        {"headlight", sh.headlight},
-        {"light_direction", vec(sh.lightDirection)},
-        {"gradient_opacity", sh.gradientOpacity},
-        {"gradient_low", sh.gradientLow},
-        {"gradient_high", sh.gradientHigh}}},
+      {"sampling", {{"preintegrate", preintegrateText(sa)}}},
+      {"shading", {{"light_direction", vec(sh.lightDirection)}}},
       {"clipping",
        {{"planes", planes},
         {"crop_min", vec(render.clipping.cropMin)},
@@ -190,6 +225,9 @@ nlohmann::json Settings::toJson() const {
       {"classify", classify},
       {"gradient", gradient},
       {"labels", labels}};
+  renderFields(j, render, kWrite);
+  samplingFields(j["sampling"], sa, kWrite);
+  shadingFields(j["shading"], sh, kWrite);
   return j;
 }
 
@@ -228,12 +266,7 @@ Settings Settings::fromJson(const nlohmann::json& state) {
     }
     RenderSettings& r = s.render;
     r.mode = parseRenderMode(state.value("mode", std::string("composite")));
-    r.stepVoxels = state.value("step", r.stepVoxels);
-    r.maxSteps = state.value("max_steps", r.maxSteps);
-    r.opacityScale = state.value("opacity_scale", r.opacityScale);
-    r.ertThreshold = state.value("ert", r.ertThreshold);
-    r.jitter = state.value("jitter", r.jitter);
-    r.nearest = state.value("nearest", r.nearest);
+    renderFields(state, r, kRead);
     if (state.contains("background")) {
       const glm::dvec3 b = vec3From(state["background"], "background");
       r.background = glm::dvec4(b, 1.0);
@@ -244,27 +277,15 @@ Settings Settings::fromJson(const nlohmann::json& state) {
       checkOneOf("sampling preintegrate", pre, {"off", "on", "lit"});
       r.sampling.preintegrate = pre != "off";
       r.sampling.preintegrateLitOnly = pre == "lit";
-      r.sampling.adaptive = sa.value("adaptive", r.sampling.adaptive);
-      r.sampling.tolerance = sa.value("tolerance", r.sampling.tolerance);
-      r.sampling.litTolerance = sa.value("lit_tolerance", r.sampling.litTolerance);
-      r.sampling.maxMultiplier = sa.value("max_multiplier", r.sampling.maxMultiplier);
-      r.sampling.opacityGrowth = sa.value("opacity_growth", r.sampling.opacityGrowth);
+      samplingFields(sa, r.sampling, kRead);
     }
     if (state.contains("shading")) {
       const nlohmann::json& sh = state["shading"];
       Shading& d = r.shading;
-      d.enabled = sh.value("enabled", d.enabled);
-      d.ambient = sh.value("ambient", d.ambient);
-      d.diffuse = sh.value("diffuse", d.diffuse);
-      d.specular = sh.value("specular", d.specular);
-      d.shininess = sh.value("shininess", d.shininess);
-      d.headlight = sh.value("headlight", d.headlight);
+      shadingFields(sh, d, kRead);
       if (sh.contains("light_direction")) {
         d.lightDirection = vec3From(sh["light_direction"], "shading light_direction");
       }
-      d.gradientOpacity = sh.value("gradient_opacity", d.gradientOpacity);
-      d.gradientLow = sh.value("gradient_low", d.gradientLow);
-      d.gradientHigh = sh.value("gradient_high", d.gradientHigh);
     }
     if (state.contains("clipping")) {
       const nlohmann::json& c = state["clipping"];
