@@ -37,15 +37,7 @@ foreach(pair "glm;${TESSERA_HOST_GLM}/glm" "nlohmann;${TESSERA_HOST_JSON}/nlohma
   endif()
 endforeach()
 
-file(GLOB_RECURSE TESSERA_GLSL CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/*.glsl)
-string(REPLACE ";" "|" TESSERA_GLSL_ARG "${TESSERA_GLSL}")
-set(TESSERA_GLSL_CPP ${CMAKE_BINARY_DIR}/generated/EmbeddedShaders.cpp)
-add_custom_command(
-  OUTPUT ${TESSERA_GLSL_CPP}
-  COMMAND ${CMAKE_COMMAND} -DOUT=${TESSERA_GLSL_CPP} -DROOT=${CMAKE_SOURCE_DIR}/src
-          "-DFILES=${TESSERA_GLSL_ARG}" -P ${CMAKE_SOURCE_DIR}/cmake/EmbedGlsl.cmake
-  DEPENDS ${TESSERA_GLSL} ${CMAKE_SOURCE_DIR}/cmake/EmbedGlsl.cmake
-  COMMENT "Embedding GLSL shaders" VERBATIM)
+include(${CMAKE_SOURCE_DIR}/cmake/EmbeddedShaders.cmake)
 
 # From io: the readers and procedural sources; not the writers, DICOM, nor
 # the zlib inflater.

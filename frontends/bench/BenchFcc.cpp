@@ -148,29 +148,31 @@ void printTables(const std::vector<Dataset>& sets, const std::vector<Run>& runs)
       "| volume | Cartesian | trilinear | FCC same grid | box spline, cubes | box spline, packed "
       "| FCC half grid | box spline, cubes | box spline, packed |\n"
       "|---|---|---:|---|---:|---:|---|---:|---:|\n");
-  for (std::size_t i = 0; i < sets.size(); ++i) {
-    const auto& v = runs[i].variants;
-    const double base = v[0].median();
-    std::printf("| %s | %s %s | %.1f | %s | %s | %s | %s | %s | %s |\n", sets[i].name.c_str(),
-                dimsText(sets[i].cartesian.dims()).c_str(),
-                std::string(scalarTypeName(sets[i].cartesian.type())).c_str(), base,
+  // One row per volume, its variants and the trilinear median they are divided by.
+  const auto eachVolume = [&](const auto& row) {
+    for (std::size_t i = 0; i < sets.size(); ++i) {
+      row(sets[i], runs[i].variants, runs[i].variants[0].median());
+    }
+  };
+  eachVolume([](const Dataset& set, const auto& v, double base) {
+    std::printf("| %s | %s %s | %.1f | %s | %s | %s | %s | %s | %s |\n", set.name.c_str(),
+                dimsText(set.cartesian.dims()).c_str(),
+                std::string(scalarTypeName(set.cartesian.type())).c_str(), base,
                 gridOf(*v[1].layout).c_str(), cell(v[1], base).c_str(), cell(v[3], base).c_str(),
                 gridOf(*v[2].layout).c_str(), cell(v[2], base).c_str(), cell(v[4], base).c_str());
-  }
+  });
   std::printf(
       "\nWhere the box spline's time goes (same density, cubes; the split variants are not "
       "reconstructions), and the textures:\n\n| volume | trilinear | box spline | 5 fetches "
       "only | weights only | trilinear texture | cubes texture | packed texture |\n"
       "|---|---:|---:|---:|---:|---:|---:|---:|\n");
-  for (std::size_t i = 0; i < sets.size(); ++i) {
-    const auto& v = runs[i].variants;
-    const double base = v[0].median();
-    std::printf("| %s | %.1f | %s | %s | %s | %s | %s | %s |\n", sets[i].name.c_str(), base,
+  eachVolume([](const Dataset& set, const auto& v, double base) {
+    std::printf("| %s | %.1f | %s | %s | %s | %s | %s | %s |\n", set.name.c_str(), base,
                 cell(v[1], base).c_str(), cell(v[5], base).c_str(), cell(v[6], base).c_str(),
                 formatBytes(v[0].layout->textureBytes()).c_str(),
                 formatBytes(v[1].layout->textureBytes()).c_str(),
                 formatBytes(v[3].layout->textureBytes()).c_str());
-  }
+  });
 }
 
 void printJson(const std::vector<Dataset>& sets, const std::vector<Run>& runs,
