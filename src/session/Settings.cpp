@@ -143,6 +143,8 @@ struct Field {
   const char* key;
   V T::*member;
 };
+template <class T, class V>
+Field(const char*, V T::*) -> Field<T, V>;  // clang 14 (emscripten) lacks aggregate deduction
 
 template <class T, class... V>
 void writeFields(nlohmann::json& j, const T& object, const Field<T, V>&... fields) {
