@@ -592,7 +592,7 @@ def ds(*values):
 def dicom_slice(z, rows=8, cols=8, series=UID_ROOT + ".1", orientation=(1, 0, 0, 0, 1, 0),
                 spacing="0.5\\0.5", bits=16, samples=1, photometric="MONOCHROME2",
                 transfer_syntax=EXPLICIT_LE, pixel=None, claimed_pixel_len=None, magic=b"DICM",
-                position=None, instance=1, encapsulated=False):
+                position=None, instance=1, encapsulated=False, nested=0):
     sop = f"{UID_ROOT}.2.{instance}.{int(z * 10) & 0xFFFF}"
     meta = (dcm_el(0x0002, 0x0001, "OB", b"\0\1") +
             dcm_el(0x0002, 0x0002, "UI", CT_IMAGE_STORAGE) +
@@ -604,6 +604,7 @@ def dicom_slice(z, rows=8, cols=8, series=UID_ROOT + ".1", orientation=(1, 0, 0,
     body = (dcm_el(0x0008, 0x0016, "UI", CT_IMAGE_STORAGE) +
             dcm_el(0x0008, 0x0018, "UI", sop) +
             dcm_el(0x0008, 0x0060, "CS", "CT") +
+            (nested_sequences(nested) if nested else b"") +
             dcm_el(0x0020, 0x000D, "UI", UID_ROOT + ".3") +
             dcm_el(0x0020, 0x000E, "UI", series) +
             dcm_el(0x0020, 0x0013, "IS", str(instance)) +
@@ -631,6 +632,19 @@ def dicom_slice(z, rows=8, cols=8, series=UID_ROOT + ".1", orientation=(1, 0, 0,
         n = claimed_pixel_len if claimed_pixel_len is not None else len(pixel)
         body += struct.pack("<HH2sHI", 0x7FE0, 0x0010, b"OW", 0, n) + pixel
     return bytes(128) + magic + meta + body
+
+
+def nested_sequences(depth):
+    """`depth` Referenced Series Sequences (0008,1115) one inside another, each
+    of undefined length with one undefined-length item (PS3.5 7.5): 36 bytes a
+    level. DCMTK 3.6.7 reads them by recursion; thousands of levels overflow
+    its stack."""
+    seq = struct.pack("<HH2sHI", 0x0008, 0x1115, b"SQ", 0, 0xFFFFFFFF)
+    item = struct.pack("<HHI", 0xFFFE, 0xE000, 0xFFFFFFFF)
+    item_end = struct.pack("<HHI", 0xFFFE, 0xE00D, 0)
+    seq_end = struct.pack("<HHI", 0xFFFE, 0xE0DD, 0)
+    inner = dcm_el(0x0020, 0x000E, "UI", UID_ROOT + ".78")
+    return (seq + item) * depth + inner + (item_end + seq_end) * depth
 
 
 def make_dicom(c):
@@ -685,6 +699,8 @@ def make_dicom(c):
            ordinary([0, 1, 2], transfer_syntax="1.2.840.10008.1.2.4.90", encapsulated=True))
     series("no-dicom-files", "a folder holding only a text file", "DICOM",
            {"notes.txt": b"not a DICOM file\n"})
+    series("nested-sequences", "sequences nested 100 levels deep (the readers accept 64)",
+           "sequences nested deeper than 64 levels; refused", {"IM0001.dcm": dicom_slice(0, nested=100)})
     series("bad-magic", "128-byte preamble followed by 'DICX' and junk", "DICOM|magic|read|parse",
            {"IM0001.dcm": bytes(128) + b"DICX" + noise(200, 31)})
 
@@ -841,6 +857,7 @@ def fuzz_seeds(root):
     put("raw_sidecar", "f32.json", json.dumps({"dims": [2, 4, 16], "type": "f32"}))
     put("dicom", "slice.dcm", dicom_slice(0))
     put("dicom", "slice-u8.dcm", dicom_slice(3, bits=8, spacing="0.7\\0.7"))
+    put("dicom", "nested-10.dcm", dicom_slice(0, nested=10))
     put("transfer_function", "grey.json", json.dumps(
         {"name": "grey", "opacity_unit_length": 1.0,
          "color": [{"x": 0, "rgb": [0, 0, 0]}, {"x": 1, "rgb": [1, 1, 1]}],

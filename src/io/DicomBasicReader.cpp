@@ -34,8 +34,6 @@ using io_detail::StoredRange;
 namespace {
 
 constexpr std::uint32_t kUndefinedLength = 0xffffffffu;
-// Deeper nesting than this is no real file's (and would risk the stack).
-constexpr int kMaxNesting = 32;
 // PackBits never expands more than 64:1: a two-byte replicate run gives at
 // most 128 bytes (PS3.5 G.3.1). It bounds what an RLE frame can hold.
 constexpr std::uint64_t kMaxRleRatio = 64;
@@ -336,9 +334,9 @@ class Part10File final : public io_detail::DicomAttributes {
   }
 
   std::uint64_t skipSequence(const Header& seq, bool implicitVr, int depth, std::uint64_t end) {
-    if (depth > kMaxNesting) {
-      fail("sequences nested deeper than " + std::to_string(kMaxNesting) + " at offset " +
-           std::to_string(seq.valueOffset) + " (corrupt file)");
+    // The walk recurses once per level: bounded like DCMTK's reader.
+    if (depth > io_detail::kMaxSequenceNesting) {
+      throw InputError(io_detail::sequencesTooDeepMessage(name_));
     }
     std::uint64_t pos = seq.valueOffset;
     for (;;) {

@@ -31,6 +31,11 @@ std::string DicomTag::text() const {
   return buf;
 }
 
+std::string sequencesTooDeepMessage(const std::string& file) {
+  return file + ": sequences nested deeper than " + std::to_string(kMaxSequenceNesting) +
+         " levels; refused";
+}
+
 namespace {
 
 // Direction cosines of two slices agree when every component is within this.

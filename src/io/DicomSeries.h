@@ -49,6 +49,18 @@ inline constexpr DicomTag kTagImagePositionPatient{0x0020, 0x0032};
 inline constexpr DicomTag kTagImageOrientationPatient{0x0020, 0x0037};
 inline constexpr DicomTag kTagPixelData{0x7fe0, 0x0010};
 
+// Sequences within sequences (a sequence at the top level is level 1) a
+// reader accepts. Parsers that recurse per level (DCMTK's; the basic
+// reader's walk) would overflow the stack on a crafted file nested
+// thousands deep (6,000 levels fit in 216 KB); real objects nest a handful
+// (enhanced multi-frame functional groups 3, structured reports tens at
+// most).
+inline constexpr int kMaxSequenceNesting = 64;
+
+// The refusal of a file nested deeper: "<file>: sequences nested deeper
+// than 64 levels; refused".
+std::string sequencesTooDeepMessage(const std::string& file);
+
 // A parsed file's top-level attributes, as each parser provides them.
 class DicomAttributes {
  public:

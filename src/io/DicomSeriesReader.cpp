@@ -13,6 +13,7 @@
 #include <system_error>
 #include <utility>
 
+#include "io/DicomNesting.h"
 #include "io/DicomSeries.h"
 #include "io/DicomToolkit.h"
 #include "tessera/core/Error.h"
@@ -82,14 +83,17 @@ void checkDeclaredLengths(DcmItem& item, const fs::path& file, std::uintmax_t fi
 
 // Loads `file` (large values, i.e. the pixel data, stay on disk until used).
 // False when the file is not DICOM; InputError for a Part-10 file that DCMTK
-// cannot parse (truncated, corrupt, unknown transfer syntax) or whose
-// elements declare more bytes than the file holds.
+// cannot parse (truncated, corrupt, unknown transfer syntax), whose
+// elements declare more bytes than the file holds, or (any DICOM file) whose
+// sequences nest too deep for DCMTK's recursive parser.
 bool loadDicom(const fs::path& file, DcmFileFormat& ff) {
   const Probe probe = probeFile(file);
   if (probe == Probe::NotDicom) return false;
   std::error_code ec;
   const std::uintmax_t fileSize = fs::file_size(file, ec);
   if (ec) throw InputError(file.string() + ": cannot read: " + ec.message());
+  // DCMTK recurses once per nested sequence, without a limit.
+  io_detail::checkSequenceNesting(file, probe == Probe::Part10);
   const OFCondition c = ff.loadFile(file.c_str(), EXS_Unknown, EGL_noChange, DCM_MaxReadLength,
                                     probe == Probe::Part10 ? ERM_fileOnly : ERM_dataset);
   if (c.good()) {
