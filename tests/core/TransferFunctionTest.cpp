@@ -1,3 +1,4 @@
+#include "support/ExpectError.h"
 #include "support/TestSupport.h"
 #include "support/TestTransferFunctions.h"
 #include "tessera/core/TransferFunction.h"
@@ -26,17 +27,7 @@ void writeText(const fs::path& path, const std::string& text) {
   out << text;
 }
 
-// Message of the InputError `f` throws; fails the test if it throws nothing.
-template <class F>
-std::string inputErrorMessage(F f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected InputError";
-  return {};
-}
+using test::inputErrorMessage;
 
 void expectSameTf(const TransferFunction& a, const TransferFunction& b) {
   EXPECT_EQ(a.name, b.name);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "io/IoFixtures.h"
+#include "support/ExpectError.h"
 #include "support/NestedDicom.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/DicomBasicReader.h"
@@ -59,16 +60,7 @@ fs::path writeNested(const fs::path& file, const NestedDicomOptions& o) {
   return file;
 }
 
-// The InputError's message, or "" when `read` does not throw one.
-template <class Read>
-std::string inputErrorOf(Read read) {
-  try {
-    read();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::inputErrorMessage;
 
 void expectImage(const Volume& v, const std::string& what) {
   ASSERT_EQ(v.dims(), glm::ivec3(test::kNestedImageSide, test::kNestedImageSide, 1)) << what;
@@ -100,13 +92,13 @@ TEST(DicomNesting, RefusedInOneLineAtEveryDepthAndEncoding) {
     const fs::path f = writeNested(dir / "deep.dcm",
                                    {.depth = c.depth, .encoding = c.encoding, .part10 = c.part10});
     const auto t0 = std::chrono::steady_clock::now();
-    EXPECT_EQ(inputErrorOf([&] { readDicomSeries(f); }), refusal(f)) << what;
+    EXPECT_EQ(inputErrorMessage([&] { readDicomSeries(f); }), refusal(f)) << what;
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     // The walk reads headers only: a 3.6 MB file is refused in milliseconds.
     EXPECT_LT(s, 2.0) << what;
     if (c.part10) {
       // Through the format registry, as the CLI reads it.
-      EXPECT_EQ(inputErrorOf([&] { readVolume(f.string()); }), refusal(f)) << what;
+      EXPECT_EQ(inputErrorMessage([&] { readVolume(f.string()); }), refusal(f)) << what;
     }
   }
 }
@@ -126,7 +118,7 @@ TEST(DicomNesting, LegalDepthsStillRead) {
   const fs::path at = writeNested(atDir / "at.dcm", {.depth = 64});
   const fs::path over = writeNested(overDir / "over.dcm", {.depth = 65});
   EXPECT_NO_THROW(readDicomSeries(at));
-  EXPECT_EQ(inputErrorOf([&] { readDicomSeries(over); }), refusal(over));
+  EXPECT_EQ(inputErrorMessage([&] { readDicomSeries(over); }), refusal(over));
 }
 
 // The basic reader (browser, fuzzers) bounds its own walk the same way.
@@ -134,7 +126,7 @@ TEST(DicomNesting, BasicReaderRefusesTheSameFilesAndReadsTheLegalOnes) {
   const test::TempDir dir;
   for (const int depth : {65, 1000, 6000, 100000}) {
     const fs::path f = writeNested(dir / "deep.dcm", {.depth = depth});
-    EXPECT_EQ(inputErrorOf([&] { readDicomSeriesBasic(f); }), refusal(f)) << depth;
+    EXPECT_EQ(inputErrorMessage([&] { readDicomSeriesBasic(f); }), refusal(f)) << depth;
   }
   for (const NestedEncoding e : {NestedEncoding::ExplicitUndefined,
                                  NestedEncoding::ImplicitUndefined, NestedEncoding::UnknownVr}) {

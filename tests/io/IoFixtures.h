@@ -22,6 +22,7 @@
 
 #include <unistd.h>
 
+#include "support/Deflate.h"
 #include "support/TestSupport.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
@@ -110,20 +111,7 @@ void expectCh2RoundTrips(const std::vector<std::string>& names, Write&& write, R
 }
 
 inline std::string gzipBytes(std::string_view data) {
-  z_stream zs{};
-  if (deflateInit2(&zs, Z_BEST_SPEED, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) != Z_OK) {
-    throw std::runtime_error("deflateInit2 failed");
-  }
-  std::string out(deflateBound(&zs, static_cast<uLong>(data.size())) + 64, '\0');
-  zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
-  zs.avail_in = static_cast<uInt>(data.size());
-  zs.next_out = reinterpret_cast<Bytef*>(out.data());
-  zs.avail_out = static_cast<uInt>(out.size());
-  const int ret = deflate(&zs, Z_FINISH);
-  out.resize(zs.total_out);
-  deflateEnd(&zs);
-  if (ret != Z_STREAM_END) throw std::runtime_error("deflate failed");
-  return out;
+  return deflateBytes(data, 15 + 16, Z_BEST_SPEED);
 }
 
 // Bytes that deflate cannot shrink much, so truncating their gzip stream

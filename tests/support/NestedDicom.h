@@ -7,13 +7,14 @@
 // Sequences (0008,1115) in one another, the innermost item holding a Series
 // Instance UID. Every level costs 36 bytes in explicit VR with undefined
 // lengths: 6,000 levels are 216 KB, 100,000 levels 3.6 MB.
-#include <zlib.h>
 
 #include <cstdint>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "support/Deflate.h"
 
 namespace tessera::test {
 
@@ -103,20 +104,7 @@ class Encoder {
 };
 
 inline std::string deflateRaw(const std::string& in) {
-  z_stream zs{};
-  if (deflateInit2(&zs, 9, Z_DEFLATED, -MAX_WBITS, 8, Z_DEFAULT_STRATEGY) != Z_OK) {
-    throw std::runtime_error("deflateInit2 failed");
-  }
-  std::string out(deflateBound(&zs, static_cast<uLong>(in.size())), '\0');
-  zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(in.data()));
-  zs.avail_in = static_cast<uInt>(in.size());
-  zs.next_out = reinterpret_cast<Bytef*>(out.data());
-  zs.avail_out = static_cast<uInt>(out.size());
-  const int r = deflate(&zs, Z_FINISH);
-  out.resize(zs.total_out);
-  deflateEnd(&zs);
-  if (r != Z_STREAM_END) throw std::runtime_error("deflate failed");
-  return out;
+  return deflateBytes(in, -MAX_WBITS, 9);
 }
 
 // The nested sequences: `depth` Referenced Series Sequences, one item each.
