@@ -360,6 +360,23 @@ constexpr BenchFlag kBenchFlags[] = {
      "chosen (docs/sampling.md)"},
 };
 
+// The suites that write files, each with its folder option.
+struct BenchFolder {
+  const char* name;
+  std::string BenchOptions::*member;
+  const char* help;
+};
+constexpr BenchFolder kBenchFolders[] = {
+    {"--fcc-out", &BenchOptions::fccOut,
+     "FCC quality figures instead of speed: Marschner-Lobb RMS/PSNR at 41^3 and "
+     "64^3 (Cartesian trilinear vs FCC box spline, same and half density), ch2 on "
+     "FCC vs the original; tables on stdout, PNGs in this folder"},
+    {"--slicing-out", &BenchOptions::slicingOut,
+     "With --slicing: also write bench-slicing.md and SVG plots to this folder"},
+    {"--hybrid-out", &BenchOptions::hybridOut,
+     "With --hybrid: write the pictures (ground truth, each method) to this folder"},
+};
+
 void addBenchCommand(CLI::App& app) {
   auto o = std::make_shared<BenchOptions>();
   CLI::App* cmd = app.add_subcommand("bench",
@@ -374,10 +391,7 @@ void addBenchCommand(CLI::App& app) {
   addDefaultedOption(cmd, "--tf", o->tf, "Transfer function preset or JSON file");
   addShadingOptions(cmd, o->shading);
   for (const BenchFlag& f : kBenchFlags) cmd->add_flag(f.name, (*o).*f.member, f.help);
-  cmd->add_option("--fcc-out", o->fccOut,
-                  "FCC quality figures instead of speed: Marschner-Lobb RMS/PSNR at 41^3 and "
-                  "64^3 (Cartesian trilinear vs FCC box spline, same and half density), ch2 on "
-                  "FCC vs the original; tables on stdout, PNGs in this folder");
+  for (const BenchFolder& f : kBenchFolders) cmd->add_option(f.name, (*o).*f.member, f.help);
   cmd->add_option(
       "--bricks", o->bricks,
       "Large volumes through the bricks layout: generated head:WxHxD specs (e.g. "
@@ -385,10 +399,6 @@ void addBenchCommand(CLI::App& app) {
       "frame time while streaming (default 8 frames), levels, texture bytes vs the "
       "budget, bricks read, peak RSS, and the in-core layout as baseline where it fits");
   addDefaultedOption(cmd, "--bricks-profiles", o->bricksProfiles, "Profiles for --bricks");
-  cmd->add_option("--slicing-out", o->slicingOut,
-                  "With --slicing: also write bench-slicing.md and SVG plots to this folder");
-  cmd->add_option("--hybrid-out", o->hybridOut,
-                  "With --hybrid: write the pictures (ground truth, each method) to this folder");
   cmd->add_option("--goal-ms", o->goalMs,
                   "With --interactive: frame-time goal (default: a sixth of a full-quality frame)");
   addDefaultedOption(cmd, "--fetches", o->fetches,
