@@ -520,7 +520,8 @@ TEST(DicomBasicReader, SequencesAreSkippedAndMalformedOnesRefused) {
   for (int i = 0; i < 1000; ++i) {
     deep += element(0x0008, 0x1150, "SQ", "", true) + delimiter(0xe000, 0xffffffffu);
   }
-  expectInputError("deep.dcm", tinyImage(deep), {"sequences nested deeper than 64 levels; refused"});
+  expectInputError("deep.dcm", tinyImage(deep),
+                   {"sequences nested deeper than 64 levels; refused"});
   // A sequence without its delimiter: what follows is no item, or the file ends.
   const std::string open = element(0x0008, 0x1150, "SQ", definedItem, true);
   expectInputError("open.dcm", tinyImage(open), {"sequence (0008,1150) holds (0028,0010)"});
