@@ -43,6 +43,19 @@ std::shared_ptr<const lod::MultiresSource> levelZeroOnly(std::shared_ptr<const V
                                                            std::numeric_limits<int>::max());
 }
 
+// Swaps `volume` into the view with the user's window and label table kept
+// (a region or the overview is the same data, seen again); throws with the
+// old volume kept.
+void swapKeepingLook(viewer::Viewer& view, Volume volume, const std::string& name) {
+  const bool had = view.hasVolume();
+  const ValueRange window = had ? view.window() : volume.window();
+  std::optional<render::LabelTable> labels;
+  if (had && view.labelsOn()) labels = view.labelTable();
+  view.setVolume(std::move(volume), name);
+  if (labels) view.setLabels(std::move(*labels));
+  view.setWindow(window);
+}
+
 }  // namespace
 
 const char* exploreModeName(ExploreMode mode) {
@@ -175,14 +188,8 @@ Camera Exploration::followed(const Camera& before, const Camera& framed, Follow 
 
 void Exploration::showIn(viewer::Viewer& view, Volume volume, const ExploreStep& step) {
   const Camera before = view.camera();
-  const bool had = view.hasVolume();
-  const ValueRange window = had ? view.window() : volume.window();
-  std::optional<render::LabelTable> labels;
-  if (had && view.labelsOn()) labels = view.labelTable();
   const std::string name = label_ + " region " + boxText(step.box);
-  view.setVolume(std::move(volume), name);         // throws with the old volume kept
-  if (labels) view.setLabels(std::move(*labels));  // the same table on the region
-  view.setWindow(window);
+  swapKeepingLook(view, std::move(volume), name);
   if (mode_ == ExploreMode::Overview) overviewCamera_ = before;
   view.camera() = followed(before, view.camera(), step.follow, step.box);
   mode_ = step.mode;
@@ -208,12 +215,7 @@ void Exploration::showOverview(viewer::Viewer& view, Follow follow) {
     return;
   }
   const Camera before = view.camera();
-  const ValueRange window = view.window();
-  std::optional<render::LabelTable> labels;
-  if (view.labelsOn()) labels = view.labelTable();
-  view.setVolume(Volume(*overview_), overviewName());  // a copy: the overview stays here
-  if (labels) view.setLabels(std::move(*labels));
-  view.setWindow(window);
+  swapKeepingLook(view, Volume(*overview_), overviewName());  // a copy: the overview stays here
   // Back from the overview itself: nothing was left, the camera stays.
   if (follow != Follow::Back || mode_ != ExploreMode::Overview) {
     view.camera() = followed(before, view.camera(), follow, std::nullopt);
