@@ -3,16 +3,16 @@
 # core, gpu, lod, reference, lattice, layout, render, viewer and io's readers — with Debian's
 # emscripten into the site's tessera-core.js + tessera-core.wasm, an ES
 # module factory (-sMODULARIZE -sEXPORT_ES6: every instance has its own
-# memory and WebGL context) that web/tessera.js wraps for pages. nifticlib, zlib,
+# memory and WebGL context) that frontends/web/tessera.js wraps for pages. nifticlib, zlib,
 # DCMTK and libpng are not available to emscripten here. The io readers
 # need none of them to read (they parse every header themselves, on byte
 # sources): files picked or dropped in the page are read by the same
 # readers as the CLI's, their gzip/zlib inflated by the page's pako
-# (web/src/InflaterPako.cpp replaces io/InflaterZlib.cpp; web/package.json
+# (frontends/web/src/InflaterPako.cpp replaces io/InflaterZlib.cpp; frontends/web/package.json
 # pins pako). The writers (zlib, nifticlib) stay native; DICOM is read by
-# io/DicomBasicReader.cpp instead of DCMTK (web/src/DicomBasicSeries.cpp
+# io/DicomBasicReader.cpp instead of DCMTK (frontends/web/src/DicomBasicSeries.cpp
 # routes the path entry points to it), and PNG I/O reports that it is not
-# built in (web/src/PngUnavailable.cpp). The gpu layer's EGL platform
+# built in (frontends/web/src/PngUnavailable.cpp). The gpu layer's EGL platform
 # (GlContext.cpp) is replaced by the browser's (src/gpu/GlContextWebGL.cpp,
 # which makes the WebGL context on the page's canvas; the native build
 # compiles it empty).
@@ -43,8 +43,8 @@ include(${CMAKE_SOURCE_DIR}/cmake/EmbeddedShaders.cmake)
 # the zlib inflater.
 file(GLOB TESSERA_WEB_IO CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/io/*.cpp)
 # OME-Zarr: the store reader is shared; its storage is the page's fetch()
-# (web/src/ZarrFetchStorage.cpp) instead of folders and libcurl (Http*,
-# ZarrVolume), and its codecs web/src/ZarrCodecsWeb.cpp (pako) instead of
+# (frontends/web/src/ZarrFetchStorage.cpp) instead of folders and libcurl (Http*,
+# ZarrVolume), and its codecs frontends/web/src/ZarrCodecsWeb.cpp (pako) instead of
 # Debian's zlib, libzstd and libblosc (ZarrCodecs), which emscripten cannot
 # link here. DICOM: the reader without DCMTK (DicomBasicReader,
 # DicomSeries), not DCMTK's (DicomSeriesReader, DicomToolkit, DicomNesting).
@@ -61,14 +61,14 @@ list(REMOVE_ITEM TESSERA_WEB_SOURCES ${CMAKE_SOURCE_DIR}/src/session/Session.cpp
      ${CMAKE_SOURCE_DIR}/src/session/VolumePyramid.cpp)
 # The EGL platform; src/gpu/GlContextWebGL.cpp is the browser's.
 list(REMOVE_ITEM TESSERA_WEB_SOURCES ${CMAKE_SOURCE_DIR}/src/gpu/GlContext.cpp)
-file(GLOB TESSERA_WEB_FRONT CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/web/src/*.cpp)
+file(GLOB TESSERA_WEB_FRONT CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/frontends/web/src/*.cpp)
 
 set_source_files_properties(${CMAKE_SOURCE_DIR}/src/core/TransferFunction.cpp PROPERTIES
-  COMPILE_OPTIONS "-include;${CMAKE_SOURCE_DIR}/web/src/compat/FloatToChars.h")
+  COMPILE_OPTIONS "-include;${CMAKE_SOURCE_DIR}/frontends/web/src/compat/FloatToChars.h")
 # The io readers parse numbers with std::from_chars, which this libc++ lacks
 # for floating point.
 set_source_files_properties(${TESSERA_WEB_IO} PROPERTIES
-  COMPILE_OPTIONS "-include;${CMAKE_SOURCE_DIR}/web/src/compat/FloatFromChars.h")
+  COMPILE_OPTIONS "-include;${CMAKE_SOURCE_DIR}/frontends/web/src/compat/FloatFromChars.h")
 
 set(TESSERA_WEB_SITE ${CMAKE_BINARY_DIR}/site)
 add_executable(tessera_web ${TESSERA_WEB_SOURCES} ${TESSERA_WEB_FRONT})
@@ -83,26 +83,26 @@ set(TESSERA_WEB_FLAGS -O2 -fexceptions)
 target_compile_options(tessera_web PRIVATE ${TESSERA_WEB_FLAGS} -Wall -Wextra)
 target_link_options(tessera_web PRIVATE ${TESSERA_WEB_FLAGS}
   -sMIN_WEBGL_VERSION=1 -sMAX_WEBGL_VERSION=2 -sALLOW_MEMORY_GROWTH=1 -sINITIAL_MEMORY=64MB
-  --js-library ${CMAKE_SOURCE_DIR}/web/src/InflaterPako.js
+  --js-library ${CMAKE_SOURCE_DIR}/frontends/web/src/InflaterPako.js
   -sMODULARIZE=1 -sEXPORT_ES6=1 -sEXPORT_NAME=createTesseraModule -sENVIRONMENT=web
   "-sEXPORTED_FUNCTIONS=_malloc,_free"
   "-sEXPORTED_RUNTIME_METHODS=ccall,cwrap,UTF8ToString,HEAPU8,HEAPF32")
 
 set_property(TARGET tessera_web APPEND PROPERTY LINK_DEPENDS
-             ${CMAKE_SOURCE_DIR}/web/src/InflaterPako.js)
+             ${CMAKE_SOURCE_DIR}/frontends/web/src/InflaterPako.js)
 
-# The static page next to the module, and pako from web/node_modules
-# (`npm ci` in web/, which scripts/web.sh and scripts/setup.sh run).
-set(TESSERA_PAKO ${CMAKE_SOURCE_DIR}/web/node_modules/pako/dist/pako_inflate.min.js)
+# The static page next to the module, and pako from frontends/web/node_modules
+# (`npm ci` in frontends/web/, which scripts/web.sh and scripts/setup.sh run).
+set(TESSERA_PAKO ${CMAKE_SOURCE_DIR}/frontends/web/node_modules/pako/dist/pako_inflate.min.js)
 if(NOT EXISTS ${TESSERA_PAKO})
-  message(FATAL_ERROR "${TESSERA_PAKO} is missing: run `npm ci` in web/ (scripts/web.sh does)")
+  message(FATAL_ERROR "${TESSERA_PAKO} is missing: run `npm ci` in frontends/web/ (scripts/web.sh does)")
 endif()
 # numcodecs' blosc and zstd decoders (WebAssembly builds of c-blosc and
 # zstd; MIT), which the page loads for stores with those compressors
-# (web/zarr-url.js), into the site's numcodecs/.
-set(TESSERA_NUMCODECS ${CMAKE_SOURCE_DIR}/web/node_modules/numcodecs/dist)
+# (frontends/web/zarr-url.js), into the site's numcodecs/.
+set(TESSERA_NUMCODECS ${CMAKE_SOURCE_DIR}/frontends/web/node_modules/numcodecs/dist)
 if(NOT EXISTS ${TESSERA_NUMCODECS}/blosc.js)
-  message(FATAL_ERROR "${TESSERA_NUMCODECS} is missing: run `npm ci` in web/ (scripts/web.sh does)")
+  message(FATAL_ERROR "${TESSERA_NUMCODECS} is missing: run `npm ci` in frontends/web/ (scripts/web.sh does)")
 endif()
 file(GLOB TESSERA_NUMCODECS_JS ${TESSERA_NUMCODECS}/blosc.js ${TESSERA_NUMCODECS}/zstd.js
      ${TESSERA_NUMCODECS}/chunk-*.js)
@@ -110,10 +110,10 @@ foreach(f ${TESSERA_NUMCODECS_JS})
   get_filename_component(n ${f} NAME)
   configure_file(${f} ${TESSERA_WEB_SITE}/numcodecs/${n} COPYONLY)
 endforeach()
-configure_file(${CMAKE_SOURCE_DIR}/web/node_modules/numcodecs/LICENSE
+configure_file(${CMAKE_SOURCE_DIR}/frontends/web/node_modules/numcodecs/LICENSE
                ${TESSERA_WEB_SITE}/numcodecs/LICENSE COPYONLY)
-file(GLOB TESSERA_WEB_STATIC CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/web/*.html
-     ${CMAKE_SOURCE_DIR}/web/*.js ${CMAKE_SOURCE_DIR}/web/*.css)
+file(GLOB TESSERA_WEB_STATIC CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/frontends/web/*.html
+     ${CMAKE_SOURCE_DIR}/frontends/web/*.js ${CMAKE_SOURCE_DIR}/frontends/web/*.css)
 foreach(f ${TESSERA_WEB_STATIC} ${TESSERA_PAKO})
   get_filename_component(n ${f} NAME)
   configure_file(${f} ${TESSERA_WEB_SITE}/${n} COPYONLY)

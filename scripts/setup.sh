@@ -20,7 +20,7 @@ PACKAGES=(
 )
 
 # playwright-core for the browser test, pinned by tests/browser/package-lock.json;
-# pako for the web page (its inflater), pinned by web/package-lock.json.
+# pako for the web page (its inflater), pinned by frontends/web/package-lock.json.
 npm_deps() {
   local root
   root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -28,9 +28,9 @@ npm_deps() {
     echo "setup: npm ci in tests/browser (playwright-core)"
     (cd "$root/tests/browser" && npm ci --no-audit --no-fund --loglevel=error)
   fi
-  if [ ! -d "$root/web/node_modules/pako" ]; then
+  if [ ! -d "$root/frontends/web/node_modules/pako" ]; then
     echo "setup: npm ci in web (pako)"
-    (cd "$root/web" && npm ci --no-audit --no-fund --loglevel=error)
+    (cd "$root/frontends/web" && npm ci --no-audit --no-fund --loglevel=error)
   fi
 }
 

@@ -9,9 +9,9 @@ BUILD=${TESSERA_WEB_BUILD:-build-web}
 export NODE_PATH=${NODE_PATH:-/usr/share/nodejs}  # Debian's emscripten needs acorn from here
 command -v emcmake >/dev/null || { echo "web.sh: emscripten missing (scripts/setup.sh)" >&2; exit 1; }
 # pako (the page's inflater for the io readers) and numcodecs (blosc and zstd
-# for OME-Zarr stores), pinned by web/package-lock.json.
-if [ ! -f web/node_modules/pako/dist/pako_inflate.min.js ] || [ ! -f web/node_modules/numcodecs/dist/blosc.js ]; then
-  (cd web && npm ci --no-audit --no-fund --loglevel=error)
+# for OME-Zarr stores), pinned by frontends/web/package-lock.json.
+if [ ! -f frontends/web/node_modules/pako/dist/pako_inflate.min.js ] || [ ! -f frontends/web/node_modules/numcodecs/dist/blosc.js ]; then
+  (cd frontends/web && npm ci --no-audit --no-fund --loglevel=error)
 fi
 if [ ! -f "$BUILD/build.ninja" ] && [ ! -f "$BUILD/Makefile" ]; then
   gen=()

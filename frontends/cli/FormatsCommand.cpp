@@ -1,5 +1,5 @@
 // tessera formats [--markdown | --web-accept]: the format table of
-// io/FormatRegistry.h, which docs/formats.md and web/index.html's file
+// io/FormatRegistry.h, which docs/formats.md and frontends/web/index.html's file
 // picker are checked against (tests/app/FormatsCommandTest.cpp).
 #include <cstdio>
 #include <memory>

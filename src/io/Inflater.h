@@ -3,7 +3,7 @@
 // gzip (RFC 1952) stream, told apart by its header, inflated piece by piece
 // into the caller's buffer. Native builds use zlib (io/InflaterZlib.cpp);
 // the browser, which has no zlib, the page's pako through JavaScript
-// (web/src/InflaterPako.cpp). Both run behind the same readers, so their
+// (frontends/web/src/InflaterPako.cpp). Both run behind the same readers, so their
 // chunked, budget-checked decoding is the same everywhere.
 #include <cstddef>
 #include <memory>

@@ -1,6 +1,6 @@
 // Zarr chunk codecs of the native build (io/ZarrCodecs.h): numcodecs'
 // zlib, gzip, zstd and blosc through Debian's zlib, libzstd and libblosc.
-// The browser build has its own (web/src/ZarrCodecsWeb.cpp).
+// The browser build has its own (frontends/web/src/ZarrCodecsWeb.cpp).
 #include "io/ZarrCodecs.h"
 
 #include <blosc.h>

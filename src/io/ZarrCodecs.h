@@ -2,7 +2,7 @@
 // The chunk decoders behind decodeZarrChunk (io/ZarrArray.h), one set per
 // platform: natively Debian's zlib, libzstd and libblosc
 // (io/ZarrCodecs.cpp); in the browser the page's pako for zlib/gzip
-// (web/src/ZarrCodecsWeb.cpp). Each returns exactly `expected` bytes or
+// (frontends/web/src/ZarrCodecsWeb.cpp). Each returns exactly `expected` bytes or
 // throws InputError naming `where` (the chunk's path or URL).
 #include <cstddef>
 #include <cstdint>

@@ -41,7 +41,7 @@ std::string committedTable() {
 
 // The accept attribute of the page's "Open volume" picker (<input id="file">).
 std::string pageAcceptList() {
-  const std::string html = readText(sourceRoot() / "web" / "index.html");
+  const std::string html = readText(sourceRoot() / "frontends" / "web" / "index.html");
   const auto input = html.find("id=\"file\"");
   if (input == std::string::npos) return "(no id=\"file\" input)";
   const auto a = html.find("accept=\"", input);
@@ -69,7 +69,7 @@ TEST(FormatsCommand, WebPickerAcceptsExactlyTheBrowserReadableFiles) {
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_EQ(r.out, tessera::browserAcceptList() + "\n");
   EXPECT_EQ(pageAcceptList(), tessera::browserAcceptList())
-      << "web/index.html's accept list differs: set it to `tessera formats --web-accept`";
+      << "frontends/web/index.html's accept list differs: set it to `tessera formats --web-accept`";
 }
 
 TEST(FormatsCommand, TextTableNamesEveryFormatAndTheDicomDecoders) {

@@ -1,5 +1,5 @@
 // Browser test: examples/embed-web, a page that embeds the viewer through
-// web/tessera.js (served from the site's examples/embed-web/). It renders
+// frontends/web/tessera.js (served from the site's examples/embed-web/). It renders
 // the volume (pixels not background) and, without the overlays, matches the
 // native CLI's image; ?url= opens a served file; a second viewer on the same
 // page keeps its own volume, and disposing it leaves the first one working.

@@ -29,7 +29,7 @@ export const bench = process.env.TESSERA_BENCH === '1' || process.argv.includes(
 export const SIZE = 256;
 export const VOLUME = 'gen:shepp-logan:96';
 // The page samples adaptively but post-classified (webDefaultSampling() in
-// web/src/WebSession.cpp); CLI renders compared with the page's own frames
+// frontends/web/src/WebSession.cpp); CLI renders compared with the page's own frames
 // take the same sampling.
 export const PAGE_SAMPLING = ['--preintegrate', 'off'];
 export const CH2 = '/usr/share/mricron/templates/ch2.nii.gz';

@@ -1,4 +1,4 @@
-// What the browser's fetch() storage relies on (web/src/ZarrFetchStorage.h),
+// What the browser's fetch() storage relies on (frontends/web/src/ZarrFetchStorage.h),
 // with native stores: ZarrStore::chunkKeys names exactly the keys a readBox
 // reads, and a storage that hands over chunks decoded
 // (ZarrStorage::decodesChunks) reads the same voxels, its chunks' sizes

@@ -36,7 +36,7 @@ std::string withoutComments(const std::string& text) {
 
 // Production sources: the layers, the front ends and the examples.
 std::vector<fs::path> productionSources() {
-  return tessera::test::cppSources({"src", "include", "frontends", "web/src", "examples"});
+  return tessera::test::cppSources({"src", "include", "frontends", "examples"});
 }
 
 std::string inRepo(const fs::path& p) {

@@ -29,7 +29,14 @@ inline std::vector<std::filesystem::path> cppSources(const std::vector<std::stri
   std::vector<std::filesystem::path> files;
   for (const std::string& folder : folders) {
     if (!std::filesystem::exists(repoRoot() / folder)) continue;
-    for (const auto& e : std::filesystem::recursive_directory_iterator(repoRoot() / folder)) {
+    for (auto it = std::filesystem::recursive_directory_iterator(repoRoot() / folder);
+         it != std::filesystem::recursive_directory_iterator(); ++it) {
+      const auto& e = *it;
+      // The web front end's npm packages are not ours.
+      if (e.is_directory() && e.path().filename() == "node_modules") {
+        it.disable_recursion_pending();
+        continue;
+      }
       const std::string ext = e.path().extension().string();
       if (e.is_regular_file() && (ext == ".cpp" || ext == ".h")) files.push_back(e.path());
     }

@@ -16,7 +16,7 @@ class ZarrMultiresSource final : public MultiresSource {
   explicit ZarrMultiresSource(std::shared_ptr<const ZarrStore> store);
   // Opens a folder or URL (see io/ZarrStore.h), with a time point and channel.
   // Native only: the browser reads stores through the page's fetch()
-  // (web/src/ZarrFetchStorage.h).
+  // (frontends/web/src/ZarrFetchStorage.h).
   static std::unique_ptr<ZarrMultiresSource> open(const std::string& spec,
                                                   ZarrSelection selection = {});
 

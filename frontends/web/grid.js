@@ -1,10 +1,10 @@
 // Grid view (Schultz 2016 §7.3) beside the slice
-// views of web/slices.js: the loaded volume split into cubic cells, the
+// views of frontends/web/slices.js: the loaded volume split into cubic cells, the
 // user on a grid point (a cell corner), the 2x2x2 block of cells around it
 // shown as the 3D view at native resolution, six moves relative to the view.
 //
 // Everything about the grid is the native core's lod::GridNavigator, through
-// the tessera_grid_* exports of web/src/WebExportsExplore.cpp: the grid points and
+// the tessera_grid_* exports of frontends/web/src/WebExportsExplore.cpp: the grid points and
 // their class (corner/edge/face/interior), which index axis each of the six
 // moves means for the current camera (the dominant axis of the view
 // direction; of the screen's right and up for the others) and whether it is
@@ -49,7 +49,7 @@ window.TesseraGrid = (function () {
       zoomSwap: c('tessera_zoom_swap', 'number', ['number', 'number', 'number', 'number']),
       zoomJson: c('tessera_zoom_json', 'string', []),
     };
-    // An OME-Zarr store's block is read like its region (web/zarr-url.js:
+    // An OME-Zarr store's block is read like its region (frontends/web/zarr-url.js:
     // only the level-0 chunks it overlaps are fetched, then one box read).
     async function readStoreBlock() {
       if (!grid.store_wanted) return true;

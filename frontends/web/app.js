@@ -1,6 +1,6 @@
 // The page around the WebAssembly viewer core: a TesseraViewer (tessera.js,
 // the module other pages embed) for the context, volumes, frames, camera
-// and transfer function, and the rest of the C API (web/src/WebExports*.cpp)
+// and transfer function, and the rest of the C API (frontends/web/src/WebExports*.cpp)
 // for the page's controls; input events, the transfer-function editor
 // canvas, file opening (read here, never uploaded: the bytes go to the same
 // io readers as the CLI's, whose gzip/zlib the page's pako inflates) and
@@ -24,7 +24,7 @@ import { TesseraViewer } from './tessera.js';
   const progressive = params.get('progressive') !== '0';
   const frameBudgetMs = Math.max(1, parseFloat(params.get('budget') || '12') || 12);
   const volumeUrls = params.getAll('url').filter((u) => u.length);
-  // Axial, coronal and sagittal views beside the 3D view (web/slices.js;
+  // Axial, coronal and sagittal views beside the 3D view (frontends/web/slices.js;
   // ?slices=0: the 3D view alone).
   const withSlices = params.get('slices') !== '0' && !!window.TesseraSlices;
 
@@ -67,8 +67,8 @@ import { TesseraViewer } from './tessera.js';
   let frames = 0;
   let renderWaiters = [];
   let refineNotBefore = 0;  // performance.now() before which no strip is rendered
-  let slices = null;        // web/slices.js, once the module is up
-  let zarr = null;  // an open OME-Zarr store (web/zarr-url.js)
+  let slices = null;        // frontends/web/slices.js, once the module is up
+  let zarr = null;  // an open OME-Zarr store (frontends/web/zarr-url.js)
 
   function showError(message) {
     const e = $('error');
@@ -213,7 +213,7 @@ import { TesseraViewer } from './tessera.js';
   // frame is complete.
   function loop() {
     if (api && zarr && zarr.active()) {
-      // An OME-Zarr store (web/zarr-url.js): frames while bricks arrive.
+      // An OME-Zarr store (frontends/web/zarr-url.js): frames while bricks arrive.
       let ms = -1;
       if (needsRender || zarr.wantsFrame()) {
         needsRender = false;
@@ -277,7 +277,7 @@ import { TesseraViewer } from './tessera.js';
     return openEntries(entries, (message) => message);
   }
 
-  // A dropped or picked folder (a DICOM series; web/dicom-drop.js walks it):
+  // A dropped or picked folder (a DICOM series; frontends/web/dicom-drop.js walks it):
   // every file read with progress, then the series opened.
   async function openFolder(named) {
     const progress = $('progress');

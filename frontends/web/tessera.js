@@ -11,7 +11,7 @@
 //   viewer.render();
 import createTesseraModule from './tessera-core.js';
 
-// pako inflates gzip/zlib inside the io readers (web/src/InflaterPako.js);
+// pako inflates gzip/zlib inside the io readers (frontends/web/src/InflaterPako.js);
 // loaded once per page, next to this module.
 const PAKO_URL = new URL('./pako_inflate.min.js', import.meta.url).href;
 let pakoLoading = null;
@@ -91,7 +91,7 @@ export class TesseraViewer {
 
   #module;
   #canvas;
-  #c;  // the C API (web/src/WebExports*.cpp), cwrapped
+  #c;  // the C API (frontends/web/src/WebExports*.cpp), cwrapped
   #listeners = new Map();
 
   constructor(module, canvas) {
@@ -117,7 +117,7 @@ export class TesseraViewer {
     };
   }
 
-  // The emscripten module, for the page's own panels (web/slices.js,
+  // The emscripten module, for the page's own panels (frontends/web/slices.js,
   // grid.js, zarr-url.js call the rest of the C API through it).
   get module() { return this.#module; }
   get canvas() { return this.#canvas; }

@@ -1,6 +1,6 @@
-// JavaScript half of web/src/InflaterPako.cpp (an emscripten --js-library):
+// JavaScript half of frontends/web/src/InflaterPako.cpp (an emscripten --js-library):
 // gzip/zlib streams inflated by the page's pako (pako_inflate.min.js, from
-// web/package.json). pako's Inflate takes a push of input and hands out
+// frontends/web/package.json). pako's Inflate takes a push of input and hands out
 // whole output buffers; each stream queues what it produced and gives it
 // out in the caller's pieces. A push is at most 16 KiB of input, so no more
 // than 16.5 MiB of output (deflate's 1032:1) waits here at a time.

@@ -1,4 +1,4 @@
-// The session's OME-Zarr store over fetch() (web/zarr-url.js drives it): the
+// The session's OME-Zarr store over fetch() (frontends/web/zarr-url.js drives it): the
 // page fetches the keys a step wants and hands them over; the store renders
 // through the bricks layout coarse to fine (ZarrStoreView.h) with the viewer
 // core's camera, transfer function and settings. Its bread-slice region is

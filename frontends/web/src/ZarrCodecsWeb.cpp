@@ -1,8 +1,8 @@
 // The browser's Zarr chunk decoders (io/ZarrCodecs.h): zlib and gzip
-// through the page's pako (io/Inflater.h, web/src/InflaterPako.cpp), with
+// through the page's pako (io/Inflater.h, frontends/web/src/InflaterPako.cpp), with
 // the same checks as the native decoder's. Debian's libzstd and libblosc
 // cannot be linked by emscripten here: zstd and blosc chunks are decoded by
-// the page before they arrive (web/zarr-url.js, numcodecs' WebAssembly
+// the page before they arrive (frontends/web/zarr-url.js, numcodecs' WebAssembly
 // builds of the same libraries) when it can load them; a chunk that still
 // reaches these decoders is an error naming the chunk's URL and the codec.
 #include <algorithm>

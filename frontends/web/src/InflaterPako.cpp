@@ -1,5 +1,5 @@
 // The browser's Inflater (io/Inflater.h): the page loads pako
-// (web/package.json, copied into the site as pako_inflate.min.js), and each
+// (frontends/web/package.json, copied into the site as pako_inflate.min.js), and each
 // step runs it synchronously through JavaScript (InflaterPako.js), while
 // the readers' chunked, budget-checked decoding goes on as natively.
 #include <algorithm>
@@ -7,7 +7,7 @@
 
 #include "io/Inflater.h"
 
-// web/src/InflaterPako.js (linked with --js-library).
+// frontends/web/src/InflaterPako.js (linked with --js-library).
 extern "C" {
 int tessera_pako_open();
 int tessera_pako_step(int id, const void* in, int inSize, void* out, int outSize, int* info,

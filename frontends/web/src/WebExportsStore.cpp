@@ -1,4 +1,4 @@
-// The C API of OME-Zarr stores over fetch() (web/zarr-url.js drives it): the
+// The C API of OME-Zarr stores over fetch() (frontends/web/zarr-url.js drives it): the
 // page fetches the keys a step wants and hands them over. Each export
 // marshals its arguments to the session's store (WebSessionStore.cpp,
 // ZarrStoreView.h) and its results back.
@@ -77,7 +77,7 @@ EMSCRIPTEN_KEEPALIVE void tessera_zarr_put_failed(const char* key, const char* m
 }
 
 // The page decodes chunks of this compressor ("blosc", "zstd") itself
-// (numcodecs, web/zarr-url.js) before it hands them over.
+// (numcodecs, frontends/web/zarr-url.js) before it hands them over.
 EMSCRIPTEN_KEEPALIVE int tessera_zarr_page_decodes(const char* compressor) {
   return guarded(
       [&] { web::session().theStore().storage().setPageDecodes(parseZarrCompressor(compressor)); });

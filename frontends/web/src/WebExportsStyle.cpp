@@ -1,4 +1,4 @@
-// The C API of how the volume looks (web/app.js's controls): the transfer
+// The C API of how the volume looks (frontends/web/app.js's controls): the transfer
 // function and its editor, window, mode, sampling, shading and light, the
 // crop box and its handles, the clip plane and label volumes. Each export
 // marshals its arguments to the session (WebSession.h); the checks of the

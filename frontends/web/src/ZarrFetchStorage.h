@@ -1,6 +1,6 @@
 #pragma once
 // The browser's OME-Zarr storage (io/ZarrStorage.h): keys are read with
-// fetch() by the page (web/zarr-url.js), asynchronously, and handed over
+// fetch() by the page (frontends/web/zarr-url.js), asynchronously, and handed over
 // here; the single-threaded page never waits on the network. get() of a key
 // that has not arrived records it as wanted and throws KeyNotFetched; the
 // page fetches what is wanted (retries with back-off, errors naming the
@@ -45,9 +45,9 @@ class FetchStorage final : public ZarrStorage {
   std::string locate(const std::string& key) const override { return url_ + "/" + key; }
   std::string describe() const override { return url_; }
   int parallelism() const override { return 1; }  // no threads; the page fetches in parallel
-  // The page decodes chunks as they arrive, once each (web/zarr-url.js:
+  // The page decodes chunks as they arrive, once each (frontends/web/zarr-url.js:
   // zlib and gzip with pako, blosc and zstd with numcodecs) when it has the
-  // decoder (setPageDecodes); the io decoders (web/src/ZarrCodecsWeb.cpp)
+  // decoder (setPageDecodes); the io decoders (frontends/web/src/ZarrCodecsWeb.cpp)
   // are the fallback.
   bool decodesChunks(ZarrCompressor c) const override;
   void setPageDecodes(ZarrCompressor c) { pageDecodes_[static_cast<int>(c)] = true; }

@@ -1,5 +1,5 @@
 // Slice views and the bread-slice region (Schultz 2016
-// §7.4), beside the 3D view of web/app.js:
+// §7.4), beside the 3D view of frontends/web/app.js:
 //
 // - Axial, coronal and sagittal slices of the loaded volume, drawn by the
 //   wasm core (tessera_slice: core/SliceImage, the pixels and patient
@@ -68,7 +68,7 @@ window.TesseraSlices = (function () {
     let picking = false;        // "Pick region" pressed
     let rubber = null;          // a box being dragged: {panel, a: [px, py], b: [px, py]} in image pixels
     const panels = {};          // by plane
-    let grid = null;            // web/grid.js, the grid view (attached below)
+    let grid = null;            // frontends/web/grid.js, the grid view (attached below)
 
     // The three panels; which index axis each shows is decided per volume
     // from the slice frames the core reports (the plane nearest each axis).
@@ -251,7 +251,7 @@ window.TesseraSlices = (function () {
         ctx.strokeRect(x, y, w, h);
         ctx.setLineDash([]);
       }
-      // The grid view's block (web/grid.js), cyan, where this slice cuts it.
+      // The grid view's block (frontends/web/grid.js), cyan, where this slice cuts it.
       const block = grid && grid.block();
       if (block && cross[p.axis] >= block.begin[p.axis] && cross[p.axis] < block.end[p.axis]) {
         const [x, y, w, h] = boxRect(p, block);
@@ -619,7 +619,7 @@ window.TesseraSlices = (function () {
       showRegion,
       overview,
     };
-    // The grid view (web/grid.js) shares the 3D view, the crosshair and
+    // The grid view (frontends/web/grid.js) shares the 3D view, the crosshair and
     // the overview's return with the region.
     if (window.TesseraGrid) {
       grid = window.TesseraGrid.attach({

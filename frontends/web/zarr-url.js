@@ -1,7 +1,7 @@
 // OME-Zarr stores in the page (?url=http://host/NAME.ome.zarr): the store is
 // read with fetch(), key by key, as the wasm side asks for keys
-// (web/src/ZarrFetchStorage.cpp), and rendered coarse to fine through the
-// bricks layout (web/src/ZarrStoreView.cpp): first the coarsest level, then
+// (frontends/web/src/ZarrFetchStorage.cpp), and rendered coarse to fine through the
+// bricks layout (frontends/web/src/ZarrStoreView.cpp): first the coarsest level, then
 // finer bricks as their chunks arrive, nearest first. Nothing here waits on
 // the network inside a frame: fetches run beside the animation frames, and
 // each frame uploads what has arrived.
@@ -69,7 +69,7 @@
   // its apron touches up to 27 chunks: decoding them in every read cost
   // most of the refinement): zlib and gzip with the page's pako, blosc and
   // zstd — Debian's libraries are native only — with numcodecs' WebAssembly
-  // builds of them (npm numcodecs, MIT, pinned in web/package-lock.json,
+  // builds of them (npm numcodecs, MIT, pinned in frontends/web/package-lock.json,
   // copied into the site's numcodecs/), loaded when a store needs them. The
   // wasm side checks each decoded chunk's size.
   const PAGE_CODECS = new Set(['zlib', 'gzip', 'blosc', 'zstd']);

@@ -1,4 +1,4 @@
-// The C API of exploring a volume (web/slices.js, web/grid.js): the slice
+// The C API of exploring a volume (frontends/web/slices.js, frontends/web/grid.js): the slice
 // views, the bread-slice region, the boxes marked in the 3D view, the grid
 // view and the zoom-driven level swap. Each export marshals its arguments to
 // the session (WebSession.h, WebSessionExplore.cpp, WebSessionZoom.cpp) and

@@ -1,5 +1,5 @@
-// The session's slice views, bread-slice region and grid view (web/slices.js,
-// web/grid.js). Slices of the loaded volume are drawn on the CPU with
+// The session's slice views, bread-slice region and grid view (frontends/web/slices.js,
+// frontends/web/grid.js). Slices of the loaded volume are drawn on the CPU with
 // core/SliceImage (the same pixels and patient-direction letters as
 // `tessera slice`); the region (Schultz 2016 §7.4) is a box of the volume at
 // native resolution shown as the 3D view (lod::copyBox, what `tessera render

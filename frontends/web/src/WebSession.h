@@ -1,6 +1,6 @@
 #pragma once
-// Everything one page (or one embedded viewer, web/tessera.js) holds between
-// calls of the C API (web/src/WebExports*.cpp): the WebGL context, the
+// Everything one page (or one embedded viewer, frontends/web/tessera.js) holds between
+// calls of the C API (frontends/web/src/WebExports*.cpp): the WebGL context, the
 // viewer core, the files handed over, the slice views' region, the grid
 // view, the zoom swap, an open OME-Zarr store and the crop box's handles.
 // One object, made by tessera_init and destroyed by tessera_dispose; the

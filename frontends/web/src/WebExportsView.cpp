@@ -1,4 +1,4 @@
-// The C API of the 3D view (web/tessera.js, web/app.js): the session's
+// The C API of the 3D view (frontends/web/tessera.js, frontends/web/app.js): the session's
 // start and end, volumes, frames, pointer input, the camera and the state.
 // Each export marshals its arguments to the session (WebSession.h) and its
 // results back: numbers, or JSON strings valid until the next call.
