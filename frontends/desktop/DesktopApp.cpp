@@ -17,6 +17,7 @@
 #include "cli/Commands.h"
 #include "tessera/core/Image.h"
 #include "tessera/gpu/DeviceProfile.h"
+#include "tessera/gpu/DeviceSession.h"
 #include "tessera/gpu/Draw.h"
 #include "tessera/render/LabelTable.h"
 #include "tessera/session/Settings.h"
@@ -49,12 +50,12 @@ void drawPanel(DesktopApp& ds, int windowHeight) {
                ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
   panelFile(ds);
   panelExplore(ds);
-  const bool labelsFirst = ds.viewer->labelsOn();  // the list before the TF it drives
+  const bool labelsFirst = ds.view().labelsOn();  // the list before the TF it drives
   if (labelsFirst) panelLabels(ds);
   panelTransferFunction(ds);
-  panelWindowLevel(*ds.viewer);
+  panelWindowLevel(ds.view());
   panelRendering(ds);
-  panelShading(*ds.viewer);
+  panelShading(ds.view());
   panelClipping(ds);
   if (!labelsFirst) panelLabels(ds);
   ImGui::Separator();
@@ -71,7 +72,7 @@ void takeScreenshot(DesktopApp& ds, int fbw, int fbh) {
   shot.flipVertically();
   for (std::size_t i = 3; i < shot.rgba().size(); i += 4) shot.rgba()[i] = 255;
   shot.writePng(ds.options.screenshot);
-  const viewer::FrameStats& fs = ds.viewer->lastFrame();
+  const viewer::FrameStats& fs = ds.view().lastFrame();
   std::printf("wrote %s (%dx%d) after %d frames; last volume frame %.0f ms at %dx%d\n",
               ds.options.screenshot.c_str(), fbw, fbh, ds.frame, fs.ms, fs.renderWidth,
               fs.renderHeight);
@@ -115,7 +116,7 @@ void runFrame(DesktopApp& ds) {
   drawPanel(ds, win.y);
   for (int t = 0; t < 3 && ds.fourUp; ++t) drawSliceTile(ds, ds.slices[t], tiles.slice[t]);
   drawHelpOverlay(ds, kPanelWidth, static_cast<float>(win.x), static_cast<float>(win.y));
-  const EdgeLabels labels = ds.viewer->orientationLabels();
+  const EdgeLabels labels = ds.view().orientationLabels();
   drawEdgeLetters(labels.left, labels.right, labels.top, labels.bottom, tiles.view3d.p0,
                   tiles.view3d.p1);
   ImGui::Render();
@@ -126,7 +127,7 @@ void runFrame(DesktopApp& ds) {
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
   ++ds.frame;
-  if (!ds.options.screenshot.empty() && ds.frame >= ds.options.frames && !ds.viewer->refining()) {
+  if (!ds.options.screenshot.empty() && ds.frame >= ds.options.frames && !ds.view().refining()) {
     takeScreenshot(ds, fb.x, fb.y);
   }
   ds.window->swapBuffers();
@@ -143,25 +144,26 @@ void applyOptions(DesktopApp& ds, const ViewOptions& o) {
     std::fprintf(stderr, "tessera view: %s\n", e.what());
   }
   ds.showHelp = o.helpOverlay;
-  ds.viewer->tfEditor().setTransferFunction(TransferFunction::fromPresetOrFile(o.tf));
+  ds.view().tfEditor().setTransferFunction(TransferFunction::fromPresetOrFile(o.tf));
   openVolume(ds, o.file.empty() ? app::defaultVolumeSpec() : o.file);
-  if (!ds.error.empty() && !ds.viewer->hasVolume()) throw InputError(ds.error);
+  if (!ds.error.empty() && !ds.view().hasVolume()) throw InputError(ds.error);
   // What is left is the recent list's trouble (unreadable, or not written):
   // shown in the panel, while errors of the options below end the command.
   const std::string recentTrouble = ds.error.empty() ? recentError : ds.error;
   ds.error.clear();
-  ds.viewer->camera().azimuthDeg = o.azimuth;
-  ds.viewer->camera().elevationDeg = o.elevation;
-  ds.viewer->settings().shading = app::shadingFrom(o.shading);
-  ds.viewer->settings().clipping = app::clippingFrom(o.clipping);
-  ds.showCropBox = ds.viewer->settings().clipping.cropped();
-  ds.viewer->settings().mode = session::parseRenderMode(o.projection);
+  ds.view().camera().azimuthDeg = o.azimuth;
+  ds.view().camera().elevationDeg = o.elevation;
+  ds.view().settings().shading = app::shadingFrom(o.shading);
+  ds.view().settings().clipping = app::clippingFrom(o.clipping);
+  ds.showCropBox = ds.view().settings().clipping.cropped();
+  ds.view().settings().mode = session::parseRenderMode(o.projection);
   startExploring(ds, o);
   if (o.labelVolume()) {
-    ds.viewer->setLabels(o.labels.empty() ? render::LabelTable::defaultFor(ds.viewer->volume())
-                                          : render::LabelTable::load(o.labels));
+    ds.view().setLabels(o.labels.empty() ? render::LabelTable::defaultFor(ds.view().volume())
+                                         : render::LabelTable::load(o.labels));
     std::snprintf(ds.labelPathBuf, sizeof ds.labelPathBuf, "%s", o.labels.c_str());
   }
+  if (!o.state.empty()) loadState(ds, o.state);
   ds.error = recentTrouble;
 }
 
@@ -193,14 +195,18 @@ void runView(const ViewOptions& o) {
   const gpu::DeviceProfile profile = gpu::DeviceProfile::find(o.profile);
   window.api = profile.api;
   DesktopApp ds(o, std::make_unique<gpu::GlfwWindow>(window), profile.api == gpu::ApiLevel::Gles3);
-  ds.viewer = std::make_unique<viewer::Viewer>(ds.context(), profile);
+  ds.session = std::make_unique<session::Session>(gpu::borrowDevice(ds.context(), profile));
   // ES 3 keeps the frame in a cache between window frames, where a full-quality
   // frame can be refined strip by strip; ES 2 redraws every window frame.
-  ds.viewer->progressive = ds.es3;
+  ds.view().progressive = ds.es3;
   ds.window->onDrop([&ds](const std::string& path) { ds.pendingDrop = path; });
   applyOptions(ds, o);
   const ImGuiOnWindow imgui(*ds.window, ds.es3);
   while (!ds.window->shouldClose()) runFrame(ds);
+  if (!o.saveState.empty()) {
+    ds.session->saveState(o.saveState);
+    std::printf("wrote %s (the session's state)\n", o.saveState.c_str());
+  }
 }
 
 }  // namespace tessera::desktop

@@ -30,11 +30,11 @@
 #include "tessera/lod/MultiresSource.h"
 #include "tessera/lod/ZoomLevelPolicy.h"
 #include "tessera/session/Exploration.h"
+#include "tessera/session/Session.h"
 #include "tessera/viewer/CropHandles.h"
 #include "tessera/viewer/RecentFiles.h"
 #include "tessera/viewer/SliceView.h"
 #include "tessera/viewer/Viewer.h"
-#include "tessera/viewer/ZoomSwap.h"
 
 namespace tessera::desktop {
 
@@ -49,7 +49,13 @@ struct DesktopApp {
   const ViewOptions& options;
   bool es3;
   gpu::GlContext& context() { return window->context(); }
-  std::unique_ptr<viewer::Viewer> viewer;
+  // The rendering session on the window's context: its view is the 3D
+  // view, its exploration (once a volume is open) the slice views', region's
+  // and grid's, its state what "Save state" writes.
+  std::unique_ptr<session::Session> session;
+  viewer::Viewer& view() { return session->view(); }
+  bool exploring() const { return session && session->exploring(); }
+  session::Exploration& exploration() { return session->exploration(); }
   std::string pendingDrop;  // a file dropped on the window, opened after the events
   std::string error;
   std::string status;
@@ -58,22 +64,18 @@ struct DesktopApp {
   char pathBuf[512] = "";
   char tfPathBuf[512] = "transfer-function.json";
   char labelPathBuf[512] = "labels.txt";
+  char statePathBuf[512] = "tessera-state.json";
   bool logHistogram = true;
   int frame = 0;
   bool showHelp = false;
   viewer::RecentFiles recent{viewer::RecentFiles::defaultPath()};
 
-  // Exploring at native resolution (session/Exploration.h): the overview,
-  // crosshair, picked region, grid view and what the 3D view shows.
-  std::unique_ptr<session::Exploration> explore;
   bool fourUp = true;
-  bool sliceColour = false;       // slices in the TF's colour instead of grey
-  bool zoomSwitchesGrid = false;  // the zoom swaps coarse / medium level / native grid block
-  double viewPixels = 0.0;        // the 3D view's height in pixels (the policy's view)
-  // While it exists, the zoom decides what the 3D view shows (viewer/ZoomSwap.h);
-  // a manual mode change (region, grid, overview) ends it.
-  std::unique_ptr<viewer::ZoomSwap> zoomSwap;
-  std::string zoomSwapKey;  // the stages it was made for
+  bool sliceColour = false;  // slices in the TF's colour instead of grey
+  // The zoom swaps coarse / medium level / native grid block (the
+  // exploration's zoom swap, session::Exploration::keepZoom).
+  bool zoomSwitchesGrid = false;
+  double viewPixels = 0.0;  // the 3D view's height in pixels (the policy's view)
   double lastFrameMs = 0.0;
   // The three slice views: axial, coronal, sagittal.
   struct SliceTile {
@@ -135,6 +137,9 @@ void updateOverlay(DesktopApp& ds);
 
 // PanelsFile.cpp
 void openVolume(DesktopApp& ds, const std::string& spec);
+// Restores a saved session state (Session::loadState) and what the window
+// shows of it (the crop box, the slice views); throws on error.
+void loadState(DesktopApp& ds, const std::string& path);
 void panelFile(DesktopApp& ds);
 
 // PanelsStyle.cpp

@@ -53,18 +53,18 @@ constexpr Shortcut kShortcuts[] = {
 // side across it, centred on the slice; clamped to the budget and volume.
 void pickRegion(DesktopApp& ds, const DesktopApp::SliceTile& tile, glm::dvec2 a, glm::dvec2 b) {
   const viewer::SliceGeometry& g = *tile.geometry;
-  const int index = ds.explore->explorer().crosshair()[g.axis()];
+  const int index = ds.exploration().explorer().crosshair()[g.axis()];
   const glm::ivec2 pa = tile.viewport.pixelAt(a);
   const glm::ivec2 pb = glm::length(b - a) < 4.0 ? pa : tile.viewport.pixelAt(b);
-  ds.explore->pick(ds.explore->explorer().regionFromSlice(g, pa, pb, index));
+  ds.exploration().pick(ds.exploration().explorer().regionFromSlice(g, pa, pb, index));
 }
 
 // The crosshair `step` slices along the slice view's axis (its slice).
 void stepSlice(DesktopApp& ds, const DesktopApp::SliceTile& tile, int step) {
   if (!tile.geometry) return;
-  glm::ivec3 c = ds.explore->explorer().crosshair();
+  glm::ivec3 c = ds.exploration().explorer().crosshair();
   c[tile.geometry->axis()] += step;
-  ds.explore->explorer().setCrosshair(c);
+  ds.exploration().explorer().setCrosshair(c);
 }
 
 // The slice view under the pointer (axial if none).
@@ -84,9 +84,9 @@ ImWchar lowerAscii(ImWchar c) {
 
 void nextTechnique(DesktopApp& ds) {
   const std::vector<std::string> names = render::TechniqueRegistry::global().names();
-  const auto at = std::find(names.begin(), names.end(), ds.viewer->technique());
+  const auto at = std::find(names.begin(), names.end(), ds.view().technique());
   const std::size_t next = at == names.end() ? 0 : (at - names.begin() + 1) % names.size();
-  reportErrors(ds, [&] { ds.viewer->setTechnique(names[next]); });
+  reportErrors(ds, [&] { ds.view().setTechnique(names[next]); });
 }
 
 // The typed-letter shortcuts of kShortcuts, either case; `exploring`: only
@@ -98,35 +98,35 @@ struct LetterKey {
 };
 constexpr LetterKey kLetterKeys[] = {
     {'?', false, [](DesktopApp& ds) { ds.showHelp = !ds.showHelp; }},
-    {'r', false, [](DesktopApp& ds) { ds.viewer->resetCamera(); }},
-    {'b', false, [](DesktopApp& ds) { ds.viewer->showBoundingBox = !ds.viewer->showBoundingBox; }},
-    {'a', false, [](DesktopApp& ds) { ds.viewer->showAxes = !ds.viewer->showAxes; }},
+    {'r', false, [](DesktopApp& ds) { ds.view().resetCamera(); }},
+    {'b', false, [](DesktopApp& ds) { ds.view().showBoundingBox = !ds.view().showBoundingBox; }},
+    {'a', false, [](DesktopApp& ds) { ds.view().showAxes = !ds.view().showAxes; }},
     {'m', false,
      [](DesktopApp& ds) {
-       RenderMode& mode = ds.viewer->settings().mode;
+       RenderMode& mode = ds.view().settings().mode;
        mode = mode == RenderMode::Mip ? RenderMode::Composite : RenderMode::Mip;
      }},
     {'q', false,
      [](DesktopApp& ds) {
-       viewer::Quality& q = ds.viewer->quality;
+       viewer::Quality& q = ds.view().quality;
        q = q == viewer::Quality::Adaptive ? viewer::Quality::Full : viewer::Quality::Adaptive;
      }},
     {'t', false, nextTechnique},
     {'v', true, viewPickedRegion},
     {'g', true,
      [](DesktopApp& ds) {
-       ds.explore->mode() == session::ExploreMode::Grid ? showOverview(ds) : enterGrid(ds);
+       ds.exploration().mode() == session::ExploreMode::Grid ? showOverview(ds) : enterGrid(ds);
      }},
     {'o', true, [](DesktopApp& ds) { showOverview(ds); }},
     {'l', true, [](DesktopApp& ds) { ds.fourUp = !ds.fourUp; }},
     {'c', true, [](DesktopApp& ds) { ds.sliceColour = !ds.sliceColour; }},
     {'[', true,
      [](DesktopApp& ds) {
-       ds.explore->explorer().setRegionSide(ds.explore->explorer().regionSide() - 16);
+       ds.exploration().explorer().setRegionSide(ds.exploration().explorer().regionSide() - 16);
      }},
     {']', true,
      [](DesktopApp& ds) {
-       ds.explore->explorer().setRegionSide(ds.explore->explorer().regionSide() + 16);
+       ds.exploration().explorer().setRegionSide(ds.exploration().explorer().regionSide() + 16);
      }},
 };
 
@@ -150,7 +150,7 @@ void handleShortcuts(DesktopApp& ds) {
   }
   for (const ImWchar c : io.InputQueueCharacters) {
     for (const LetterKey& k : kLetterKeys) {
-      if (lowerAscii(c) == k.letter && (!k.exploring || ds.explore)) k.act(ds);
+      if (lowerAscii(c) == k.letter && (!k.exploring || ds.exploring())) k.act(ds);
     }
   }
 }
@@ -183,7 +183,7 @@ void drawHelpOverlay(DesktopApp& ds, float x0, float x1, float height) {
 // The 3D view: mouse drags orbit (right button or shift: pan), wheel zooms;
 // a left drag that starts on a crop box handle moves that face instead.
 void handleViewInput(DesktopApp& ds, const Rect& view, double scale) {
-  viewer::Viewer& v = *ds.viewer;
+  viewer::Viewer& v = ds.view();
   ImGuiIO& io = ImGui::GetIO();
   const glm::dvec2 pos((io.MousePos.x - view.p0.x) * scale, (io.MousePos.y - view.p0.y) * scale);
   const int viewW = std::max(1, static_cast<int>(std::lround((view.p1.x - view.p0.x) * scale)));
@@ -221,7 +221,7 @@ void handleViewInput(DesktopApp& ds, const Rect& view, double scale) {
 // Mouse input on the slice views: left click/drag moves the crosshair, right
 // drag picks a region, the wheel flips slices.
 void handleSliceInput(DesktopApp& ds, const Tiles& tiles) {
-  if (!ds.explore || !ds.fourUp) return;
+  if (!ds.exploring() || !ds.fourUp) return;
   ImGuiIO& io = ImGui::GetIO();
   const glm::dvec2 m(io.MousePos.x, io.MousePos.y);
   if (!io.WantCaptureMouse) {
@@ -238,8 +238,9 @@ void handleSliceInput(DesktopApp& ds, const Tiles& tiles) {
   if (ds.dragTile < 0) return;
   DesktopApp::SliceTile& tile = ds.slices[ds.dragTile];
   if (!ds.dragRegion && ImGui::IsMouseDown(0)) {
-    const int index = ds.explore->explorer().crosshair()[tile.geometry->axis()];
-    ds.explore->explorer().setCrosshair(tile.geometry->voxelAt(tile.viewport.pixelAt(m), index));
+    const int index = ds.exploration().explorer().crosshair()[tile.geometry->axis()];
+    ds.exploration().explorer().setCrosshair(
+        tile.geometry->voxelAt(tile.viewport.pixelAt(m), index));
   }
   if (ds.dragRegion) {
     const ImVec2 a(static_cast<float>(ds.dragStart.x), static_cast<float>(ds.dragStart.y));
@@ -256,9 +257,9 @@ void handleSliceInput(DesktopApp& ds, const Tiles& tiles) {
 // The arrow keys: grid moves in the grid view, else slices (kShortcuts).
 void handleArrowKeys(DesktopApp& ds, const Tiles& tiles) {
   ImGuiIO& io = ImGui::GetIO();
-  if (io.WantTextInput || !ds.explore) return;
+  if (io.WantTextInput || !ds.exploring()) return;
   auto pressed = [](int key) { return ImGui::IsKeyPressed(key, true); };
-  if (ds.explore->mode() == session::ExploreMode::Grid) {
+  if (ds.exploration().mode() == session::ExploreMode::Grid) {
     if (pressed(GLFW_KEY_UP)) gridMove(ds, lod::ViewMove::Forward);
     if (pressed(GLFW_KEY_DOWN)) gridMove(ds, lod::ViewMove::Back);
     if (pressed(GLFW_KEY_LEFT)) gridMove(ds, lod::ViewMove::Left);

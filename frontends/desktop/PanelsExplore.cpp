@@ -21,7 +21,7 @@ namespace {
 // slice, the window or its colours changed. False (the panel says why)
 // when it cannot be read.
 bool refreshSliceTexture(DesktopApp& ds, DesktopApp::SliceTile& tile) {
-  const viewer::Explorer& ex = ds.explore->explorer();
+  const viewer::Explorer& ex = ds.exploration().explorer();
   if (!tile.geometry) {
     const Volume& shape = ex.source().shape();
     tile.geometry = std::make_unique<viewer::SliceGeometry>(
@@ -30,7 +30,7 @@ bool refreshSliceTexture(DesktopApp& ds, DesktopApp::SliceTile& tile) {
   }
   const viewer::SliceGeometry& g = *tile.geometry;
   const int index = ex.crosshair()[g.axis()];
-  viewer::Viewer& v = *ds.viewer;
+  viewer::Viewer& v = ds.view();
   const ValueRange w = v.window();
   std::ostringstream key;
   key.precision(17);
@@ -57,11 +57,11 @@ bool refreshSliceTexture(DesktopApp& ds, DesktopApp::SliceTile& tile) {
 // The grid view's moves as buttons (touch-style controls beside the keys),
 // named in view terms and grid terms; a move off the grid is greyed out.
 void gridMoveButtons(DesktopApp& ds) {
-  const lod::GridNavigator& grid = ds.explore->explorer().grid();
+  const lod::GridNavigator& grid = ds.exploration().explorer().grid();
   const lod::ViewMove moves[6] = {lod::ViewMove::Forward, lod::ViewMove::Back, lod::ViewMove::Left,
                                   lod::ViewMove::Right,   lod::ViewMove::Up,   lod::ViewMove::Down};
   for (int i = 0; i < 6; ++i) {
-    const lod::GridMove m = lod::viewMoveToGridMove(ds.viewer->camera().basis(), moves[i]);
+    const lod::GridMove m = lod::viewMoveToGridMove(ds.view().camera().basis(), moves[i]);
     const std::string label = std::string(lod::viewMoveName(moves[i])) + " " + m.name();
     ImGui::BeginDisabled(!grid.check(grid.point(), m).moved);
     if (ImGui::Button(label.c_str(), ImVec2(110.0f, 0.0f))) gridMove(ds, moves[i]);
@@ -85,18 +85,18 @@ std::string stagesText(const std::vector<lod::ZoomStage>& stages) {
 // viewer/ZoomSwap.h), and the switch that lets the zoom alone swap the
 // overview for a coarser level or the grid view and back.
 void panelZoomStages(DesktopApp& ds) {
-  const std::vector<lod::ZoomStage> stages =
-      viewer::zoomStagesFor(ds.explore->explorer(), ds.explore->overviewLevel(), ds.viewPixels);
+  const std::vector<lod::ZoomStage> stages = viewer::zoomStagesFor(
+      ds.exploration().explorer(), ds.exploration().overviewLevel(), ds.viewPixels);
   const std::string text = stagesText(stages);
   ImGui::TextWrapped("zoom stages: %s", text.c_str());
   if (ImGui::Checkbox("zoom swaps levels and the grid view", &ds.zoomSwitchesGrid) &&
-      !ds.zoomSwitchesGrid && ds.zoomSwap) {
+      !ds.zoomSwitchesGrid && ds.exploration().zoom()) {
     showOverview(ds, Follow::Keep);
   }
   keepZoomSwap(ds, stages, text);
-  if (ds.zoomSwap) {
-    ImGui::Text("zoom %.2f: %s%s", ds.zoomSwap->overviewZoom(ds.viewer->camera()),
-                ds.viewer->volumeName().c_str(), ds.zoomSwap->fading() ? " (fading)" : "");
+  if (const viewer::ZoomSwap* zoom = ds.exploration().zoom()) {
+    ImGui::Text("zoom %.2f: %s%s", zoom->overviewZoom(ds.view().camera()),
+                ds.view().volumeName().c_str(), zoom->fading() ? " (fading)" : "");
   }
 }
 
@@ -109,8 +109,8 @@ void drawSliceTile(DesktopApp& ds, DesktopApp::SliceTile& tile, const Rect& r) {
   ImDrawList* dl = ImGui::GetBackgroundDrawList();
   dl->AddRectFilled(r.p0, r.p1, IM_COL32(0, 0, 0, 255));
   dl->AddRect(r.p0, r.p1, IM_COL32(60, 60, 60, 255));
-  if (!ds.explore || !refreshSliceTexture(ds, tile)) return;
-  const viewer::Explorer& ex = ds.explore->explorer();
+  if (!ds.exploring() || !refreshSliceTexture(ds, tile)) return;
+  const viewer::Explorer& ex = ds.exploration().explorer();
   const lod::MultiresSource& src = ex.source();
   const viewer::SliceGeometry& g = *tile.geometry;
   const int index = ex.crosshair()[g.axis()];
@@ -139,8 +139,8 @@ void drawSliceTile(DesktopApp& ds, DesktopApp::SliceTile& tile, const Rect& r) {
     if (fill) dl->AddRectFilled(screen(p0), screen(p1), fill);
     dl->AddRect(screen(p0), screen(p1), line, 0.0f, 0, 2.0f);
   };
-  if (const auto& b = ds.explore->gridBlock()) drawBox(*b, 0, IM_COL32(60, 220, 240, 255));
-  if (const auto& b = ds.explore->picked())
+  if (const auto& b = ds.exploration().gridBlock()) drawBox(*b, 0, IM_COL32(60, 220, 240, 255));
+  if (const auto& b = ds.exploration().picked())
     drawBox(*b, IM_COL32(255, 60, 40, 50), IM_COL32(255, 70, 50, 255));
   // The crosshair through the centre of its voxel.
   const glm::dvec2 c = g.pointOf(ex.crosshair());
@@ -159,24 +159,25 @@ void drawSliceTile(DesktopApp& ds, DesktopApp::SliceTile& tile, const Rect& r) {
 // The exploring controls: mode, crosshair, region size, the grid view's
 // moves and the zoom stages.
 void panelExplore(DesktopApp& ds) {
-  if (!ds.explore) return;
+  if (!ds.exploring()) return;
   section("Explore at native resolution");
-  viewer::Explorer& ex = ds.explore->explorer();
+  viewer::Explorer& ex = ds.exploration().explorer();
   const glm::ivec3 d = ex.dims(), c = ex.crosshair();
   ImGui::Text("native %dx%dx%d; overview level %d of %d", d.x, d.y, d.z,
-              ds.explore->overviewLevel(), ex.source().levelCount() - 1);
+              ds.exploration().overviewLevel(), ex.source().levelCount() - 1);
   const glm::dvec4 w = ex.source().shape().indexToWorld() * glm::dvec4(glm::dvec3(c), 1.0);
   ImGui::Text("crosshair (%d, %d, %d), RAS (%.0f, %.0f, %.0f) mm", c.x, c.y, c.z, w.x, w.y, w.z);
   int side = ex.regionSide();
   if (ImGui::SliderInt("region side", &side, 16, ex.maxRegionSide())) ex.setRegionSide(side);
-  if (const auto& b = ds.explore->picked()) ImGui::Text("region %s", session::boxText(*b).c_str());
+  if (const auto& b = ds.exploration().picked())
+    ImGui::Text("region %s", session::boxText(*b).c_str());
   if (ImGui::Button("View region (V)")) viewPickedRegion(ds);
   ImGui::SameLine();
   if (ImGui::Button("Grid view (G)")) enterGrid(ds);
   ImGui::SameLine();
   if (ImGui::Button("Overview (O)")) showOverview(ds);
-  if (ds.explore->mode() == session::ExploreMode::Grid) gridMoveButtons(ds);
-  if (!ds.explore->note().empty()) ImGui::TextWrapped("%s", ds.explore->note().c_str());
+  if (ds.exploration().mode() == session::ExploreMode::Grid) gridMoveButtons(ds);
+  if (!ds.exploration().note().empty()) ImGui::TextWrapped("%s", ds.exploration().note().c_str());
   ImGui::Checkbox("four views (L)", &ds.fourUp);
   ImGui::SameLine();
   ImGui::Checkbox("slices in TF colour (C)", &ds.sliceColour);

@@ -50,8 +50,15 @@ void openVolume(DesktopApp& ds, const std::string& spec) {
   rememberOpened(ds, spec);
 }
 
+void loadState(DesktopApp& ds, const std::string& path) {
+  ds.session->loadState(path);
+  ds.showCropBox = ds.view().settings().clipping.cropped();
+  for (auto& tile : ds.slices) tile.key.clear();
+  updateOverlay(ds);
+}
+
 void panelFile(DesktopApp& ds) {
-  ImGui::TextWrapped("%s", ds.viewer->description().c_str());
+  ImGui::TextWrapped("%s", ds.view().description().c_str());
   ImGui::InputText("##path", ds.pathBuf, sizeof ds.pathBuf);
   ImGui::SameLine();
   if (ImGui::Button("Open") && ds.pathBuf[0]) openVolume(ds, ds.pathBuf);
@@ -68,6 +75,14 @@ void panelFile(DesktopApp& ds) {
     ImGui::EndCombo();
     if (!chosen.empty()) openVolume(ds, chosen);
   }
+  // The session's state: camera, look, crosshair, region and grid.
+  ImGui::InputText("##state", ds.statePathBuf, sizeof ds.statePathBuf);
+  ImGui::SameLine();
+  if (ImGui::Button("Save state")) {
+    reportErrors(ds, [&] { ds.session->saveState(ds.statePathBuf); });
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("Load")) reportErrors(ds, [&] { loadState(ds, ds.statePathBuf); });
   if (!ds.error.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1.0f));
     ImGui::TextWrapped("%s", ds.error.c_str());

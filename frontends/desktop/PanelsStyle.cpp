@@ -128,7 +128,7 @@ void stepSlider(RenderSettings& settings) {
 
 void panelTransferFunction(DesktopApp& ds) {
   section("Transfer function");
-  viewer::TransferFunctionEditor& ed = ds.viewer->tfEditor();
+  viewer::TransferFunctionEditor& ed = ds.view().tfEditor();
   transferFunctionEditor(ed, ds.logHistogram);
   if (ImGui::BeginCombo("preset", ed.transferFunction().name.c_str())) {
     for (const std::string& name : TransferFunction::presetNames()) {
@@ -174,7 +174,7 @@ void panelWindowLevel(viewer::Viewer& v) {
 }
 
 void panelRendering(DesktopApp& ds) {
-  viewer::Viewer& v = *ds.viewer;
+  viewer::Viewer& v = ds.view();
   section("Rendering");
   int mode = static_cast<int>(v.settings().mode);
   if (ImGui::Combo("mode", &mode, "composite\0MIP\0MinIP\0average\0")) {
@@ -216,7 +216,7 @@ void panelRendering(DesktopApp& ds) {
 // The crop box (fractions of each axis; handles to drag in the 3D view) and a
 // clip plane that follows the camera.
 void panelClipping(DesktopApp& ds) {
-  viewer::Viewer& v = *ds.viewer;
+  viewer::Viewer& v = ds.view();
   section("Clipping");
   ImGui::Checkbox("crop box handles (drag in 3D)", &ds.showCropBox);
   Clipping& c = v.settings().clipping;
@@ -243,7 +243,7 @@ void panelClipping(DesktopApp& ds) {
 // Label volumes: on/off (the default palette), a table file, and every
 // label with its colour and a visibility box (aal has 116: scrollable).
 void panelLabels(DesktopApp& ds) {
-  viewer::Viewer& v = *ds.viewer;
+  viewer::Viewer& v = ds.view();
   section("Labels");
   bool on = v.labelsOn();
   if (ImGui::Checkbox("label volume (atlas)", &on)) {

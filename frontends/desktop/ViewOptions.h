@@ -21,6 +21,8 @@ struct ViewOptions {
   double azimuth = 0.0;
   double elevation = 0.0;
   std::string screenshot;
+  std::string state;      // a saved session state to start from
+  std::string saveState;  // where the session's state goes when the window closes
   int frames = 3;
   bool helpOverlay = false;
   std::string layout = "four";  // four: axial, 3D, sagittal, coronal; single: 3D only

@@ -61,8 +61,9 @@ void blitCache(DesktopApp& ds, glm::ivec2 origin, int viewW, int viewH) {
 // stage (the cached frame blitted otherwise). The session's mode follows
 // the stage shown (the native stage is the grid view's block).
 void drawZoomSwapView(DesktopApp& ds, glm::ivec2 origin, int viewW, int viewH) {
-  viewer::Viewer& v = *ds.viewer;
-  viewer::ZoomSwap& zs = *ds.zoomSwap;
+  viewer::Viewer& v = ds.view();
+  session::Exploration& e = ds.exploration();
+  const viewer::ZoomSwap& zs = *e.zoom();
   const double now = 1000.0 * ds.window->seconds();
   const double dtMs = ds.lastFrameMs > 0.0 ? now - ds.lastFrameMs : 0.0;
   ds.lastFrameMs = now;
@@ -72,16 +73,15 @@ void drawZoomSwapView(DesktopApp& ds, glm::ivec2 origin, int viewW, int viewH) {
     const bool swapAsked =
         shown < 0 || zs.policy().stageFor(shown, zs.overviewZoom(v.camera())) != shown;
     if (swapAsked || zs.fading() || viewKey(v, viewW, viewH) != ds.cacheKey) {
-      zs.frame(v, dtMs, viewW, viewH, ds.cache.id());
+      e.zoomFrame(v, dtMs, viewW, viewH, ds.cache.id());
       ds.cacheKey = viewKey(v, viewW, viewH);
     } else if (v.refining()) {
       v.refine();  // a strip of the full-quality frame per window frame (no fade runs)
     }
     blitCache(ds, origin, viewW, viewH);
   } else {
-    zs.frame(v, dtMs, viewW, viewH, 0, origin);
+    e.zoomFrame(v, dtMs, viewW, viewH, 0, origin);
   }
-  ds.explore->shownBy(zs.shownBox(), session::ExploreMode::Grid);
 }
 
 }  // namespace
@@ -110,9 +110,10 @@ void drawEdgeLetters(const std::string& left, const std::string& right, const st
 // The volume right of the panel: re-rendered only when something it shows
 // changed (ES 3 blits the cached frame), every frame on ES 2 (no blit).
 void drawVolumeView(DesktopApp& ds, glm::ivec2 origin, int viewW, int viewH) {
-  viewer::Viewer& v = *ds.viewer;
+  viewer::Viewer& v = ds.view();
+  const bool zooming = ds.exploring() && ds.exploration().zoom();
   try {
-    if (ds.zoomSwap) {
+    if (zooming) {
       drawZoomSwapView(ds, origin, viewW, viewH);
     } else if (ds.es3) {
       fitCache(ds, viewW, viewH);
@@ -129,10 +130,9 @@ void drawVolumeView(DesktopApp& ds, glm::ivec2 origin, int viewW, int viewH) {
     }
   } catch (const Error& e) {
     ds.error = e.what();
-    if (ds.zoomSwap) {
-      // A stage that cannot be read or uploaded: the zoom stops swapping
-      // (instead of trying again every frame); the last volume stays.
-      ds.zoomSwap.reset();
+    if (zooming) {
+      // A stage that cannot be read or uploaded: the exploration ended the
+      // swap (instead of trying again every frame); the last volume stays.
       ds.zoomSwitchesGrid = false;
       ds.error += " (zoom swap turned off)";
     }

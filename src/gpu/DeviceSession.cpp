@@ -23,4 +23,12 @@ DeviceSession openDevice(const std::string& profileNameOrFile) {
   return s;
 }
 
+DeviceSession borrowDevice(GlContext& context, const DeviceProfile& profile) {
+  DeviceSession s;
+  s.profile = profile;
+  s.context = std::shared_ptr<GlContext>(&context, [](GlContext*) {});  // not ours to destroy
+  s.limits = applyProfile(s.profile, context);
+  return s;
+}
+
 }  // namespace tessera::gpu

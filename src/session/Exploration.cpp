@@ -159,6 +159,7 @@ Volume Exploration::read(const ExploreStep& step) const {
 }
 
 void Exploration::show(viewer::Viewer& view, const ExploreStep& step) {
+  endZoom();  // the step decides now
   pending_ = step;
   try {
     showIn(view, read(step), step);
@@ -211,6 +212,7 @@ void Exploration::failed(const std::string& why) {
 
 void Exploration::showOverview(viewer::Viewer& view, Follow follow) {
   if (!overview_) throw InputError(label_ + ": no overview volume was read");
+  endZoom();  // made again from the overview when it is still wanted
   if (mode_ == ExploreMode::Overview && view.hasVolume() && view.volumeName() == overviewName()) {
     return;
   }
@@ -221,6 +223,38 @@ void Exploration::showOverview(viewer::Viewer& view, Follow follow) {
     view.camera() = followed(before, view.camera(), follow, std::nullopt);
   }
   overviewShown();
+}
+
+void Exploration::keepZoom(gpu::GlContext& context, bool wanted,
+                           const std::vector<lod::ZoomStage>& stages, const std::string& key) {
+  if (!wanted || stages.size() < 2) {
+    endZoom();
+    return;
+  }
+  if (mode_ != ExploreMode::Overview || (zoom_ && zoomKey_ == key)) return;
+  auto swap = std::make_unique<viewer::ZoomSwap>(context, *explorer_, stages);
+  if (overview_) swap->keepLevel(overviewLevel_, overview_);
+  swap->setLabel(label_);
+  zoom_ = std::move(swap);
+  zoomKey_ = key;
+}
+
+void Exploration::endZoom() {
+  zoom_.reset();
+  zoomKey_.clear();
+}
+
+lod::ZoomFrame Exploration::zoomFrame(viewer::Viewer& view, double dtMs, int width, int height,
+                                      unsigned framebuffer, glm::ivec2 origin) {
+  if (!zoom_) throw InputError(label_ + ": the zoom swap is not running");
+  try {
+    const lod::ZoomFrame frame = zoom_->frame(view, dtMs, width, height, framebuffer, origin);
+    shownBy(zoom_->shownBox(), ExploreMode::Grid);
+    return frame;
+  } catch (const Error&) {
+    endZoom();
+    throw;
+  }
 }
 
 void Exploration::overviewShown() {
@@ -270,7 +304,7 @@ nlohmann::json Exploration::state() const {
           {"grid", {{"cell", {cell.x, cell.y, cell.z}}, {"point", {p.x, p.y, p.z}}}}};
 }
 
-void Exploration::restore(const nlohmann::json& j) {
+std::optional<ExploreStep> Exploration::restore(const nlohmann::json& j) {
   try {
     if (j.at("version").get<int>() != kStateVersion) {
       throw InputError("exploration state version " + j.at("version").dump() + ": expected " +
@@ -287,6 +321,15 @@ void Exploration::restore(const nlohmann::json& j) {
     explorer_->setRegionSide(j.at("region_side").get<int>());
     const std::optional<lod::VoxelBox> picked = boxFrom(j.at("picked"));
     picked_ = picked ? std::optional(clampBox(*picked, "exploration state: picked")) : std::nullopt;
+    const std::string mode = j.at("mode").get<std::string>();
+    const std::optional<lod::VoxelBox> shown = boxFrom(j.at("shown"));
+    if (mode == exploreModeName(ExploreMode::Overview) || !shown) return std::nullopt;
+    const ExploreMode m =
+        mode == exploreModeName(ExploreMode::Grid) ? ExploreMode::Grid : ExploreMode::Region;
+    if (m == ExploreMode::Region && mode != exploreModeName(ExploreMode::Region)) {
+      throw InputError("exploration state: mode '" + mode + "': expected overview, region or grid");
+    }
+    return ExploreStep{clampBox(*shown, "exploration state: shown"), m, Follow::Fill};
   } catch (const nlohmann::json::exception& e) {
     throw InputError(std::string("exploration state: ") + e.what());
   }

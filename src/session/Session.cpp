@@ -1,6 +1,10 @@
 #include "tessera/session/Session.h"
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 
 #include <nlohmann/json.hpp>
 
@@ -111,6 +115,88 @@ Session::Session(gpu::DeviceSession device) : device_(std::move(device)) {}
 
 Session::~Session() = default;
 
+viewer::Viewer& Session::view() {
+  if (view_) return *view_;
+  view_ = std::make_unique<viewer::Viewer>(*device_.context, device_.profile);
+  if (inCore_) showInView();
+  applyToView();
+  return *view_;
+}
+
+// The in-core volume into the view, shared: the view's window and label
+// preparation are the session's volume's.
+void Session::showInView() {
+  view_->setVolume(inCore_->level(glm::ivec3(1)), name_);
+}
+
+// The settings into the view. Its camera keeps the radius and the frame it
+// got from framing the volume; the window applies to a volume it shows.
+void Session::applyToView() {
+  viewer::Viewer& v = *view_;
+  if (v.technique() != settings_.technique) v.setTechnique(settings_.technique);
+  v.settings() = settings_.render;
+  if (!v.hasVolume()) {
+    v.tfEditor().setTransferFunction(settings_.tf);
+    return;
+  }
+  if (settings_.labels) {
+    if (!v.labelsOn()) v.setLabelsDefault();
+  } else {
+    if (v.labelsOn()) v.clearLabels();
+    v.tfEditor().setTransferFunction(settings_.tf);
+  }
+  applyCameraToView();
+  if (settings_.window) v.setWindow(*settings_.window);
+}
+
+void Session::applyCameraToView() {
+  Camera& c = view_->camera();
+  c.azimuthDeg = settings_.camera.azimuthDeg;
+  c.elevationDeg = settings_.camera.elevationDeg;
+  c.zoom = settings_.camera.zoom;
+  c.fovYDeg = settings_.camera.fovYDeg;
+  c.projection = settings_.camera.projection;
+  c.target = settings_.camera.target;
+}
+
+Settings Session::currentSettings() const {
+  Settings s = settings_;
+  if (!view_) return s;
+  viewer::Viewer& v = *view_;
+  s.technique = v.technique();
+  s.render = v.settings();
+  s.labels = v.labelsOn();
+  if (!s.labels) s.tf = v.tfEditor().transferFunction();
+  const Camera& c = v.camera();
+  s.camera.azimuthDeg = c.azimuthDeg;
+  s.camera.elevationDeg = c.elevationDeg;
+  s.camera.zoom = c.zoom;
+  s.camera.fovYDeg = c.fovYDeg;
+  s.camera.projection = c.projection;
+  s.camera.target = c.target;
+  if (v.hasVolume()) s.window = v.window();
+  return s;
+}
+
+void Session::openInView(const std::string& spec, const OpenOptions& options) {
+  viewer::Viewer& v = view();
+  const VolumePyramid pyramid = openVolumePyramid(
+      spec, {.series = options.series, .time = options.time, .channel = options.channel});
+  auto explore = std::make_unique<Exploration>(
+      pyramid.source, viewer::regionBudgetBytes(v.limits()),
+      viewer::overviewVoxelBudget(v.limits()), std::filesystem::path(spec).filename().string());
+  // A copy: the exploration keeps its overview to come back to.
+  v.setVolume(Volume(*explore->overview()), explore->overviewName());
+  settings_ = currentSettings();  // the view's new window is the volume's own
+  settings_.window.reset();
+  inCore_.reset();
+  region_.reset();
+  streamed_ = pyramid.source;
+  streamedView_ = std::make_unique<lod::MultiresVolumeSource>(streamed_);
+  exploration_ = std::move(explore);
+  name_ = spec;
+}
+
 void Session::open(const std::string& spec, const OpenOptions& options) {
   settings_.validate();
   if (!options.region.empty()) {
@@ -144,10 +230,18 @@ void Session::setVolume(Volume volume, const std::string& name) {
 
 void Session::setVolume(std::shared_ptr<Volume> volume, const std::string& name) {
   if (!volume) throw InputError("setVolume: no volume");
+  auto next = std::make_shared<lod::InCoreVolumeSource>(std::move(volume));
+  if (view_) {
+    // The view's look carries over to the new volume, except its window and
+    // labels, which are the new volume's own (viewer::Viewer::setVolume).
+    view_->setVolume(next->level(glm::ivec3(1)), name);  // on error the old volume stays
+    settings_ = currentSettings();
+    settings_.window.reset();
+  }
   streamed_.reset();
   streamedView_.reset();
   region_.reset();
-  inCore_ = std::make_shared<lod::InCoreVolumeSource>(std::move(volume));
+  inCore_ = std::move(next);
   exploration_.reset();
   name_ = name;
   applyVolumeSettings();
@@ -187,6 +281,13 @@ const Volume& Session::volume() const {
   return inCore_->volume();
 }
 
+Exploration& Session::explore(std::shared_ptr<const lod::MultiresSource> source,
+                              std::uint64_t overviewVoxels, const std::string& label) {
+  exploration_ = std::make_unique<Exploration>(
+      std::move(source), viewer::regionBudgetBytes(device_.limits), overviewVoxels, label);
+  return *exploration_;
+}
+
 const nlohmann::json& Session::regionReport() const {
   return region_ ? *region_ : kNoRegion;
 }
@@ -201,6 +302,7 @@ void Session::setSettings(Settings settings) {
   settings.validate();
   settings_ = std::move(settings);
   applyVolumeSettings();
+  if (view_) applyToView();
 }
 
 RenderRequest Session::request(int width, int height) const {
@@ -236,7 +338,7 @@ nlohmann::json Session::state() const {
   }
   return {{"version", kSettingsVersion},
           {"volume", volume},
-          {"settings", settings_.toJson()},
+          {"settings", currentSettings().toJson()},
           {"exploration", exploration_ ? exploration_->state() : nlohmann::json(nullptr)}};
 }
 
@@ -245,8 +347,41 @@ void Session::restore(const nlohmann::json& state) {
     throw InputError("session state: expected {\"version\", \"volume\", \"settings\"}");
   }
   setSettings(Settings::fromJson(state["settings"]));
-  if (state.contains("exploration") && !state["exploration"].is_null()) {
-    exploration().restore(state["exploration"]);
+  if (!state.contains("exploration") || state["exploration"].is_null()) return;
+  Exploration& e = exploration();
+  const std::optional<ExploreStep> step = e.restore(state["exploration"]);
+  if (!view_) return;
+  if (step) {
+    e.show(*view_, *step);
+  } else if (e.overview() && e.mode() != ExploreMode::Overview) {
+    e.showOverview(*view_, Follow::Keep);
+  }
+  applyCameraToView();  // the camera the state was saved with, on what it showed
+}
+
+void Session::saveState(const std::string& path) const {
+  const std::filesystem::path p(path);
+  std::error_code ec;
+  if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path(), ec);
+  std::ofstream out(p);
+  out << state().dump(2) << "\n";
+  out.close();
+  if (!out) throw InputError(path + ": cannot write the session state: " + std::strerror(errno));
+}
+
+void Session::loadState(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot read the session state: " + std::strerror(errno));
+  nlohmann::json state;
+  try {
+    state = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path + ": not a session state (not JSON: " + e.what() + ")");
+  }
+  try {
+    restore(state);
+  } catch (const InputError& e) {
+    throw InputError(path + ": " + e.what());
   }
 }
 

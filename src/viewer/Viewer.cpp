@@ -108,8 +108,12 @@ render::TechniqueOnVolume Viewer::createActive(const std::string& technique,
 }
 
 void Viewer::setVolume(Volume volume, const std::string& name) {
-  if (!volume.hasData()) throw InputError(name + ": the volume has no voxels");
-  const lod::InCoreVolumeSource source(std::make_shared<Volume>(std::move(volume)));
+  setVolume(std::make_shared<Volume>(std::move(volume)), name);
+}
+
+void Viewer::setVolume(std::shared_ptr<Volume> volume, const std::string& name) {
+  if (!volume || !volume->hasData()) throw InputError(name + ": the volume has no voxels");
+  const lod::InCoreVolumeSource source(std::move(volume));
   render::TechniqueOnVolume next;
   const bool wasLabels = labels_.has_value();
   if (wasLabels) lutSize_ = kValueLutSize;  // a new volume is not a label volume until setLabels

@@ -12,6 +12,8 @@
 #include "support/GpuTestContext.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/DeviceProfile.h"
+#include "tessera/gpu/GlObjects.h"
+#include "tessera/lod/InCoreMultiresSource.h"
 #include "tessera/session/Exploration.h"
 #include "tessera/session/Session.h"
 #include "tessera/viewer/Viewer.h"
@@ -177,6 +179,96 @@ TEST(Exploration, SessionStateCarriesTheExploration) {
   b.restore(state);
   EXPECT_EQ(b.exploration().explorer().crosshair(), glm::ivec3(7, 8, 9));
   EXPECT_EQ(b.state()["exploration"], state["exploration"]);
+}
+
+// The interactive view is the session's: its volume is the session's
+// (shared), what the user sets in it is what state() saves, and another
+// session's view restored from that state shows the same region with the
+// same camera and look, pixel for pixel.
+TEST(Exploration, SessionViewStateRestoresTheSameFrame) {
+  auto volume = std::make_shared<Volume>(*hashVolume({40, 32, 24}));
+  const lod::VoxelBox box{{2, 2, 2}, {18, 18, 18}};
+  const int size = 64;
+  auto frame = [&](Session& s) {
+    viewer::Viewer& v = s.view();
+    v.quality = viewer::Quality::Full;
+    gpu::Framebuffer fb =
+        gpu::Framebuffer::create(s.device().context->ledger(), "state test", size, size);
+    v.render(size, size, fb.id());
+    Image img(size, size);
+    fb.readRgba8(img.rgba().data());
+    return img;
+  };
+
+  Session a("gles3");
+  a.setVolume(volume, "hash");
+  viewer::Viewer& va = a.view();
+  EXPECT_EQ(va.volume().bytes().data(), volume->bytes().data());  // shared, not copied
+  va.setWindow({10.0, 90.0});
+  va.settings().mode = RenderMode::Mip;
+  va.camera().azimuthDeg = 41.0;
+  a.exploration().show(va, a.exploration().region(box, Follow::Fill));
+  va.camera().elevationDeg = -12.0;
+  va.camera().zoom = 1.3;
+  const nlohmann::json state = a.state();
+  const Image shownA = frame(a);  // while a's context is the current one
+  EXPECT_EQ(state["settings"]["mode"], "mip");
+  EXPECT_EQ(state["exploration"]["mode"], "region");
+
+  Session b("gles3");
+  b.setVolume(volume, "hash");
+  viewer::Viewer& vb = b.view();
+  const Image before = frame(b);
+  b.restore(state);
+  EXPECT_EQ(vb.volumeName(), va.volumeName());
+  EXPECT_EQ(vb.volume().dims(), box.size());
+  EXPECT_EQ(vb.window().min, 10.0);
+  EXPECT_EQ(vb.window().max, 90.0);
+  EXPECT_DOUBLE_EQ(vb.camera().azimuthDeg, 41.0);
+  EXPECT_DOUBLE_EQ(vb.camera().elevationDeg, -12.0);
+  EXPECT_DOUBLE_EQ(vb.camera().zoom, 1.3);
+  EXPECT_EQ(b.currentSettings().toJson(), a.currentSettings().toJson());
+  const Image shownB = frame(b);
+  EXPECT_EQ(shownA.rgba(), shownB.rgba());
+  EXPECT_NE(before.rgba(), shownB.rgba());
+}
+
+// The zoom swap lives as long as the exploration says: made from the
+// overview when wanted with two stages or more, kept while the stages are the
+// same, ended by any other step and not made outside the overview.
+TEST(Exploration, ZoomSwapEndsWithAnyOtherStep) {
+  gpu::GlContext& ctx = test::gpuContext();
+  auto volume = std::make_shared<Volume>(*hashVolume({64, 64, 64}));
+  auto source = std::make_shared<const lod::InCoreMultiresSource>(volume);
+  Exploration e(source, 16ull * 16 * 16, 32ull * 32 * 32, "hash");
+  ASSERT_EQ(e.overviewLevel(), 1);
+  viewer::Viewer v(ctx, gpu::DeviceProfile::find("gles3"));
+  v.setVolume(Volume(*e.overview()), e.overviewName());
+  const std::vector<lod::ZoomStage> stages = viewer::zoomStagesFor(e.explorer(), 1, 400.0);
+  ASSERT_GE(stages.size(), 2u);
+  e.keepZoom(ctx, false, stages, "a");
+  EXPECT_EQ(e.zoom(), nullptr);
+  e.keepZoom(ctx, true, {stages.front()}, "one");
+  EXPECT_EQ(e.zoom(), nullptr);
+  e.keepZoom(ctx, true, stages, "a");
+  const viewer::ZoomSwap* made = e.zoom();
+  ASSERT_NE(made, nullptr);
+  e.keepZoom(ctx, true, stages, "a");
+  EXPECT_EQ(e.zoom(), made);  // the same stages: the same swap
+  gpu::Framebuffer fb = gpu::Framebuffer::create(ctx.ledger(), "zoom test", 32, 32);
+  e.zoomFrame(v, 0.0, 32, 32, fb.id());
+  EXPECT_EQ(e.zoom()->shownStage(), e.zoom()->policy().frame().stage);
+
+  e.show(v, e.region({{0, 0, 0}, {16, 16, 16}}, Follow::Fill));
+  EXPECT_EQ(e.zoom(), nullptr);
+  e.keepZoom(ctx, true, stages, "a");
+  EXPECT_EQ(e.zoom(), nullptr);  // not made while a region is shown
+  e.showOverview(v, Follow::Back);
+  e.keepZoom(ctx, true, stages, "a");
+  EXPECT_NE(e.zoom(), nullptr);
+  e.showOverview(v, Follow::Keep);
+  EXPECT_EQ(e.zoom(), nullptr);
+  EXPECT_THROW(e.zoomFrame(v, 0.0, 32, 32, fb.id()), InputError);
 }
 
 }  // namespace

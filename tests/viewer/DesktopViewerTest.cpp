@@ -158,6 +158,56 @@ TEST(DesktopViewer, FourUpShowsSlicesWithThePickedRegion) {
   EXPECT_NE(bad.output.find("outside the volume"), std::string::npos) << bad.output;
 }
 
+// The window's session state round-trips: a view saved with --save-state
+// (camera, TF, render mode, crosshair, the region shown) and started again
+// from it with --state shows the same 3D view, pixel for pixel, while the
+// same volume without it does not; a bad state file ends the command naming it.
+TEST(DesktopViewer, SavedStateRestoresTheSameView) {
+  if (run("command -v xvfb-run").status != 0) GTEST_SKIP() << "xvfb-run not installed";
+  if (!desktopViewerBuilt()) GTEST_SKIP() << "tessera built without GLFW/ImGui";
+  test::TempDir dir;
+  const std::string base = "xvfb-run -a -s '-screen 0 1024x640x24' " +
+                           std::string(TESSERA_CLI_PATH) +
+                           " view gen:shepp-logan:48 --size 960x600 --layout single --frames 3 ";
+  const auto state = dir / "state" / "view.json";
+  const CommandRun saved =
+      run(base +
+          "--azimuth 30 --elevation 10 --tf ct-bone --render-mode mip --crosshair 12 24 24 "
+          "--pick --region-side 16 --mode region --screenshot " +
+          (dir / "a.png").string() + " --save-state " + state.string());
+  ASSERT_EQ(saved.status, 0) << saved.output;
+  ASSERT_TRUE(std::filesystem::exists(state));
+  const CommandRun restored =
+      run(base + "--state " + state.string() + " --screenshot " + (dir / "b.png").string());
+  ASSERT_EQ(restored.status, 0) << restored.output;
+  const CommandRun plain = run(base + "--screenshot " + (dir / "c.png").string());
+  ASSERT_EQ(plain.status, 0) << plain.output;
+  const Image a = Image::readPng(dir / "a.png"), b = Image::readPng(dir / "b.png"),
+              c = Image::readPng(dir / "c.png");
+  // The 3D view right of the 390-px panel (the panel's status line has times).
+  auto differing = [](const Image& x, const Image& y) {
+    int n = 0;
+    for (int row = 0; row < x.height(); ++row) {
+      for (int col = 400; col < x.width(); ++col) {
+        const std::uint8_t *p = x.pixel(col, row), *q = y.pixel(col, row);
+        n += std::abs(p[0] - q[0]) + std::abs(p[1] - q[1]) + std::abs(p[2] - q[2]) > 6 ? 1 : 0;
+      }
+    }
+    return n;
+  };
+  EXPECT_EQ(differing(a, b), 0);
+  EXPECT_GT(differing(a, c), 5000);  // the state is what made the view differ
+  EXPECT_GT(litFraction(a, 400, a.width()), 0.02);
+
+  std::ofstream(dir / "bad.json")
+      << "{\"version\": 1, \"settings\": {\"version\": 1, \"mode\": \"loud\"}}";
+  const CommandRun bad = run(base + "--state " + (dir / "bad.json").string() + " --screenshot " +
+                             (dir / "x.png").string());
+  EXPECT_NE(bad.status, 0);
+  EXPECT_NE(bad.output.find((dir / "bad.json").string() + ": "), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("loud"), std::string::npos) << bad.output;
+}
+
 // --labels: the 3D view shows the volume's labels in the table's colours
 // (the Shepp-Logan phantom's few integer values: the default palette's
 // colours, which the ordinary TF does not show), a label file sets names and colours, and a

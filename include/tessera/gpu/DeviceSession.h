@@ -15,7 +15,9 @@ namespace tessera::gpu {
 
 struct DeviceSession {
   DeviceProfile profile;
-  std::unique_ptr<GlContext> context;
+  // Owned (openDevice), or the caller's (borrowDevice: a window's or a
+  // canvas's context, which outlives the session).
+  std::shared_ptr<GlContext> context;
   DeviceLimits limits;
 };
 
@@ -27,5 +29,9 @@ DeviceLimits applyProfile(const DeviceProfile& profile, GlContext& context);
 
 // A headless context of the profile's API level with the profile applied.
 DeviceSession openDevice(const std::string& profileNameOrFile);
+
+// The caller's current context (a window's, the page's WebGL) with `profile`
+// applied; the session refers to it and does not own it.
+DeviceSession borrowDevice(GlContext& context, const DeviceProfile& profile);
 
 }  // namespace tessera::gpu

@@ -27,10 +27,7 @@
 #include "tessera/lod/MultiresSource.h"
 #include "tessera/render/Overlay.h"
 #include "tessera/viewer/Explorer.h"
-
-namespace tessera::viewer {
-class Viewer;
-}
+#include "tessera/viewer/ZoomSwap.h"
 
 namespace tessera::session {
 
@@ -130,6 +127,28 @@ class Exploration {
   // The camera the overview had when it was left.
   const Camera& overviewCamera() const { return overviewCamera_; }
 
+  // The zoom swap (viewer/ZoomSwap.h, Schultz 2016 §7.3.1): while it runs,
+  // the camera's zoom alone decides what the 3D view shows (a coarse level,
+  // the overview level, the native grid block around the view's centre).
+  // Its lifetime is the exploration's: the front end only says whether it
+  // is wanted; any other step (show, showOverview) ends it.
+  //
+  // keepZoom: wanted with two stages or more, a swap for `stages` runs from
+  // here on (made from the overview only, so after another step once the
+  // view is back there; made again when `key`, naming the stages, changes);
+  // otherwise none runs. The overview level is handed over, not read again.
+  void keepZoom(gpu::GlContext& context, bool wanted, const std::vector<lod::ZoomStage>& stages,
+                const std::string& key);
+  // The running swap (null: none).
+  const viewer::ZoomSwap* zoom() const { return zoom_.get(); }
+  void endZoom();
+  // One frame of the running swap into `framebuffer` (ZoomSwap::frame); the
+  // mode follows the stage shown (the native stage is the grid's block). On
+  // error the swap ends (rather than failing every frame) and the error is
+  // rethrown; the last volume stays in the view.
+  lod::ZoomFrame zoomFrame(viewer::Viewer& view, double dtMs, int width, int height,
+                           unsigned framebuffer = 0, glm::ivec2 origin = {0, 0});
+
   // The 3D view's lines for a shown volume of `extent`: in the overview the
   // picked region, the grid block and the crosshair; in a region or block
   // the crosshair where it falls inside it.
@@ -138,8 +157,9 @@ class Exploration {
   // Mode, crosshair, region side, picked and shown boxes, grid cell and point.
   nlohmann::json state() const;
   // Restores the crosshair, region side, picked box, grid cell and point
-  // (InputError for a state of another volume); the caller shows the mode.
-  void restore(const nlohmann::json& state);
+  // (InputError for a state of another volume). Returns the step that shows
+  // the state's mode again (null for the overview): the caller shows it.
+  std::optional<ExploreStep> restore(const nlohmann::json& state);
 
  private:
   Camera followed(const Camera& before, const Camera& framed, Follow follow,
@@ -157,6 +177,9 @@ class Exploration {
   std::optional<ExploreStep> pending_;
   glm::ivec3 pendingFrom_{0};  // the grid point before the pending step
   Camera overviewCamera_;
+  // After explorer_, which it refers to.
+  std::unique_ptr<viewer::ZoomSwap> zoom_;
+  std::string zoomKey_;
 };
 
 // "x0:x1,y0:y1,z0:z1" (end exclusive), as --region takes it.

@@ -6,6 +6,10 @@
 // with a streamed source refined by the one refinement loop
 // (session/BrickRefinement.h). The CLI, the benchmarks, embedders
 // (examples/embed) and the Python module drive it; none re-implements it.
+// The interactive front ends (the desktop viewer, the web page) hold one
+// too, on their window's or canvas's context: its view() is what they draw,
+// its exploration() what the slice views, regions and grid show, and its
+// state() what they save and restore.
 //
 //   tessera::session::Session s("webgl1");
 //   s.open("/usr/share/mricron/templates/ch2.nii.gz");
@@ -26,6 +30,7 @@
 #include "tessera/session/RenderRun.h"
 #include "tessera/session/Settings.h"
 #include "tessera/session/VolumePyramid.h"
+#include "tessera/viewer/Viewer.h"
 
 namespace tessera::session {
 
@@ -48,7 +53,8 @@ class Session {
   // A headless device (EGL) obeying `profile` (a built-in name or a JSON
   // file; gpu::openDevice), with the host budget of this process.
   explicit Session(const std::string& profile = "native");
-  // A device opened by the caller (a window's context, the page's WebGL).
+  // A device opened by the caller (gpu::borrowDevice: a window's context,
+  // the page's WebGL), current while the session is used.
   explicit Session(gpu::DeviceSession device);
   ~Session();
   Session(const Session&) = delete;
@@ -66,7 +72,15 @@ class Session {
   void setVolume(Volume volume, const std::string& name = "array");
   void setVolume(std::shared_ptr<Volume> volume, const std::string& name = "array");
 
+  // Opens `spec` as a pyramid to explore it in the view (a store or
+  // head:WxHxD read box by box, a file read in core and downsampled): the
+  // view shows its overview, the finest level within the profile's overview
+  // budget, and exploration() works on the whole pyramid. On error the
+  // previous volume stays.
+  void openInView(const std::string& spec, const OpenOptions& options = {});
+
   bool hasVolume() const { return inCore_ != nullptr || streamed_ != nullptr; }
+  // Read from a pyramid level by level and box by box, not held whole.
   bool streamed() const { return streamed_ != nullptr; }
   const std::string& name() const { return name_; }
   // The volume's shape and geometry (its voxels when in core).
@@ -81,8 +95,20 @@ class Session {
 
   Settings& settings() { return settings_; }
   const Settings& settings() const { return settings_; }
-  // Validated first; the session keeps its old settings on error.
+  // Validated first; the session keeps its old settings on error. With a
+  // view, they are applied to it (technique, camera, TF, window, mode and
+  // the rest of the render settings, labels).
   void setSettings(Settings settings);
+  // The settings as they are now: with a view, what the user set there.
+  Settings currentSettings() const;
+
+  // The interactive view (viewer/Viewer.h) on the session's device: frames
+  // while the user moves (adaptive quality, progressive refinement), the TF
+  // editor, window/level, the bounding box and lines. Made on first use
+  // with the session's settings; the session's in-core volume is shown in it
+  // shared, not copied, and so is every volume opened later.
+  viewer::Viewer& view();
+  bool hasView() const { return view_ != nullptr; }
 
   // A frame of width x height at the current settings, refined to the end
   // when streamed.
@@ -97,16 +123,34 @@ class Session {
   // overview, shared; a streamed store's overview is the finest level the
   // profile's overview budget allows), forgotten when another one opens.
   Exploration& exploration();
+  bool exploring() const { return exploration_ != nullptr; }
+  // Explores another pyramid than the session's volume, one a front end
+  // draws itself (the page's OME-Zarr store over fetch): its overview level
+  // is read only when `overviewVoxels` > 0. Replaces the exploration.
+  Exploration& explore(std::shared_ptr<const lod::MultiresSource> source,
+                       std::uint64_t overviewVoxels, const std::string& label);
+  // Forgets the exploration (the next exploration() starts anew).
+  void endExploration() { exploration_.reset(); }
 
-  // The session's state as JSON: {"version", "volume": {...}, "settings",
-  // "exploration" (null until exploration() was used)}.
+  // The session's state as JSON: {"version", "volume": {...}, "settings"
+  // (currentSettings()), "exploration" (null until exploration() was used)}.
   nlohmann::json state() const;
   // Restores the settings of a state and, where the state has one, the
-  // exploration of the volume open now (the volume is the caller's to open).
+  // exploration of the volume open now (the volume is the caller's to open);
+  // with a view, the region or grid block the state showed is shown again
+  // and the camera is the state's.
   void restore(const nlohmann::json& state);
+  // state() as a JSON file (its folder made), and restore() from one;
+  // InputError naming the file when it cannot be read or written, is not
+  // JSON or is not a session state (with what is wrong in it).
+  void saveState(const std::string& path) const;
+  void loadState(const std::string& path);
 
  private:
   void applyVolumeSettings();
+  void applyToView();
+  void applyCameraToView();
+  void showInView();
   RenderRequest request(int width, int height) const;
 
   gpu::DeviceSession device_;
@@ -116,6 +160,9 @@ class Session {
   std::shared_ptr<const lod::MultiresSource> streamed_;
   std::unique_ptr<lod::VolumeSource> streamedView_;
   std::unique_ptr<nlohmann::json> region_;
+  // Both go before device_ (declared first), while its context lives: the
+  // view's GL objects and the exploration's zoom swap.
+  std::unique_ptr<viewer::Viewer> view_;
   std::unique_ptr<Exploration> exploration_;
 };
 

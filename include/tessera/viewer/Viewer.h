@@ -58,6 +58,8 @@ class Viewer {
   // resets window and camera; leaves label mode (the TF editor back to
   // its mr-default preset).
   void setVolume(Volume volume, const std::string& name);
+  // The same, sharing the caller's voxels (a session's volume): no copy.
+  void setVolume(std::shared_ptr<Volume> volume, const std::string& name);
   bool hasVolume() const { return active_.technique != nullptr; }
   const Volume& volume() const { return *volume_; }  // empty before the first setVolume
   // The same volume, shared (an exploration keeps it as its overview).
