@@ -55,9 +55,10 @@ foreach(layer core gpu lod reference lattice layout render viewer session)
   file(GLOB_RECURSE srcs CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/${layer}/*.cpp)
   list(APPEND TESSERA_WEB_SOURCES ${srcs})
 endforeach()
-# The session's settings, run and refinement loop; not its headless device
-# (EGL) nor its store opening (the page fetches stores itself).
-list(REMOVE_ITEM TESSERA_WEB_SOURCES ${CMAKE_SOURCE_DIR}/src/session/Session.cpp
+# The session, its settings, view, exploration, run and refinement loop;
+# not its headless device (EGL) nor its opening of named files and stores
+# (the page hands volumes over in memory and fetches stores itself).
+list(REMOVE_ITEM TESSERA_WEB_SOURCES ${CMAKE_SOURCE_DIR}/src/session/SessionOpen.cpp
      ${CMAKE_SOURCE_DIR}/src/session/VolumePyramid.cpp)
 # The EGL platform; src/gpu/GlContextWebGL.cpp is the browser's.
 list(REMOVE_ITEM TESSERA_WEB_SOURCES ${CMAKE_SOURCE_DIR}/src/gpu/GlContext.cpp)

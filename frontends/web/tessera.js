@@ -113,6 +113,8 @@ export class TesseraViewer {
       tfSetJson: c('tessera_tf_set_json', 'number', ['string']),
       tfPreset: c('tessera_tf_preset', 'number', ['string']),
       stateJson: c('tessera_state_json', 'string', ['number']),
+      sessionState: c('tessera_session_state', 'string', []),
+      sessionRestore: c('tessera_session_restore', 'number', ['string']),
       readPixels: c('tessera_read_pixels', 'number', ['number', 'number']),
     };
   }
@@ -153,6 +155,19 @@ export class TesseraViewer {
   // C API's tessera_state_json reports it.
   state({ logHistogram = false } = {}) {
     return JSON.parse(this.#c.stateJson(logHistogram ? 1 : 0));
+  }
+
+  // The session's state to save (settings, camera, transfer function,
+  // window, crosshair, region, grid): versioned JSON that restoreSession,
+  // `tessera render --state` and `tessera view --state` take.
+  sessionState() {
+    return JSON.parse(this.#c.sessionState());
+  }
+
+  // Restores a saved session state (an object or its JSON text) on the
+  // volume loaded now. Throws with what is wrong in it.
+  restoreSession(state) {
+    this.#check(this.#c.sessionRestore(typeof state === 'string' ? state : JSON.stringify(state)));
   }
 
   // A procedural volume of `tessera render` ("gen:shepp-logan:96").

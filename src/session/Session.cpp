@@ -9,17 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "tessera/core/Error.h"
-#include "tessera/core/HostBudget.h"
-#include "tessera/io/VolumeReader.h"
-#include "tessera/io/ZarrStore.h"
-#include "tessera/layout/LayoutRegistry.h"
-#include "tessera/layout/Planner.h"
-#include "tessera/lod/MultiresVolumeSource.h"
-#include "tessera/lod/ProceduralMultiresSource.h"
-#include "tessera/lod/ZarrMultiresSource.h"
 #include "tessera/reference/ReferenceRaycaster.h"
 #include "tessera/render/LabelTable.h"
-#include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::session {
 
@@ -27,89 +18,7 @@ namespace {
 
 const nlohmann::json kNoRegion;
 
-bool streamsBricks(const std::string& layoutWish) {
-  return layoutWish != "auto" && layout::LayoutRegistry::global().find(layoutWish).streamsBricks;
-}
-
-// With layout auto a store streams when the planner, given its finest level
-// as a streamed shape and the technique's own units and bytes (what
-// uploadVolume will ask it), rejects every in-core layout under the profile
-// (its textures or its host budget; the plan's reason says which) and picks
-// one that streams; a store that fits keeps the in-core path, and so does a
-// technique with its own storage.
-bool plannerStreams(const Settings& s, const gpu::DeviceSession& device,
-                    const lod::MultiresSource& store) {
-  const render::TechniqueEntry& entry = render::TechniqueRegistry::global().find(s.technique);
-  const render::TechniqueRequirements r =
-      entry.requirements(device.limits, store.shape().dims(), s.techniqueOptions({512, 512}));
-  if (!r.ownStorage.empty()) return false;
-  layout::PlanRequest request;
-  request.reservedUnits = r.textureUnits;
-  request.reservedBytes = r.bytes;
-  request.streamed = true;
-  const std::string chosen =
-      layout::planLayout(store.shape(), device.limits, request).layout.layout;
-  return layout::LayoutRegistry::global().find(chosen).streamsBricks;
-}
-
-// A volume read brick by brick instead of whole: a generated head:WxHxD, or
-// an OME-Zarr store (folder or URL) with a streaming layout asked for, or
-// with layout auto when its finest level does not fit in core. Null
-// otherwise.
-std::shared_ptr<const lod::MultiresSource> streamedSource(const std::string& spec,
-                                                          const OpenOptions& o, const Settings& s,
-                                                          const gpu::DeviceSession& device) {
-  if (lod::ProceduralMultiresSource::isSpec(spec)) {
-    return std::make_shared<lod::ProceduralMultiresSource>(spec);
-  }
-  if (!isZarrStore(spec)) return nullptr;
-  const ZarrSelection zarr{.time = o.time, .channel = o.channel};
-  if (streamsBricks(s.layout)) return lod::ZarrMultiresSource::open(spec, zarr);
-  if (s.layout != "auto" || o.hostVoxels || s.window || s.labels) return nullptr;
-  auto store = lod::ZarrMultiresSource::open(spec, zarr);
-  if (!plannerStreams(s, device, *store)) return nullptr;
-  return store;
-}
-
-// The region's box of its level, read with readBox (a store reads only the
-// chunks it touches), placed where it lies in the full volume; its window
-// is the full volume's so that it is coloured as in the overview.
-Volume readRegion(const std::string& spec, const OpenOptions& o, nlohmann::json& report) {
-  const VolumePyramid pyramid =
-      openVolumePyramid(spec, {.series = o.series, .time = o.time, .channel = o.channel});
-  const lod::MultiresSource& source = *pyramid.source;
-  const int level = parseLevel(o.level, source.levelCount(), spec);
-  const lod::LevelInfo info = source.levelInfo(level);
-  std::string clamped;
-  const lod::VoxelBox box = parseRegion(o.region, info.dims, &clamped);
-  if (!clamped.empty()) std::fprintf(stderr, "tessera: note: --region %s\n", clamped.c_str());
-  Volume region = source.readBox(level, box);
-  region.setWindow(source.shape().window());
-  report = {{"level", level},
-            {"level_dims", {info.dims.x, info.dims.y, info.dims.z}},
-            {"begin", {box.begin.x, box.begin.y, box.begin.z}},
-            {"end", {box.end.x, box.end.y, box.end.z}},
-            {"voxels_read", box.count()},
-            {"level_voxels", lod::VoxelBox{glm::ivec3(0), info.dims}.count()}};
-  if (!clamped.empty()) report["clamped"] = clamped;
-  if (pyramid.storage) {
-    report["chunks_read"] = pyramid.storage->chunksRead();
-    report["chunk_bytes_read"] = pyramid.storage->chunkBytesRead();
-    report["chunks_touched"] = chunksTouched(box, info.chunk, info.dims);
-    report["chunks_in_level"] =
-        chunksTouched(lod::VoxelBox{glm::ivec3(0), info.dims}, info.chunk, info.dims);
-  }
-  return region;
-}
-
 }  // namespace
-
-Session::Session(const std::string& profile) : device_(gpu::openDevice(profile)) {
-  // The planner weighs a streamed source's in-core read against the budget
-  // the reader obeys: the profile's, or lower (TESSERA_HOST_BUDGET_MB, half
-  // the physical memory).
-  device_.limits.hostBudget = HostBudget::global().limitBytes();
-}
 
 Session::Session(gpu::DeviceSession device) : device_(std::move(device)) {}
 
@@ -176,52 +85,6 @@ Settings Session::currentSettings() const {
   s.camera.target = c.target;
   if (v.hasVolume()) s.window = v.window();
   return s;
-}
-
-void Session::openInView(const std::string& spec, const OpenOptions& options) {
-  viewer::Viewer& v = view();
-  const VolumePyramid pyramid = openVolumePyramid(
-      spec, {.series = options.series, .time = options.time, .channel = options.channel});
-  auto explore = std::make_unique<Exploration>(
-      pyramid.source, viewer::regionBudgetBytes(v.limits()),
-      viewer::overviewVoxelBudget(v.limits()), std::filesystem::path(spec).filename().string());
-  // A copy: the exploration keeps its overview to come back to.
-  v.setVolume(Volume(*explore->overview()), explore->overviewName());
-  settings_ = currentSettings();  // the view's new window is the volume's own
-  settings_.window.reset();
-  inCore_.reset();
-  region_.reset();
-  streamed_ = pyramid.source;
-  streamedView_ = std::make_unique<lod::MultiresVolumeSource>(streamed_);
-  exploration_ = std::move(explore);
-  name_ = spec;
-}
-
-void Session::open(const std::string& spec, const OpenOptions& options) {
-  settings_.validate();
-  if (!options.region.empty()) {
-    auto report = std::make_unique<nlohmann::json>();
-    Volume region = readRegion(spec, options, *report);
-    setVolume(std::move(region), spec);
-    region_ = std::move(report);
-    return;
-  }
-  if (options.level != "native") {
-    throw InputError("--level " + options.level + " applies to --region (and to `tessera slice`)");
-  }
-  if (auto pyramid = streamedSource(spec, options, settings_, device_)) {
-    inCore_.reset();
-    region_.reset();
-    streamed_ = std::move(pyramid);
-    streamedView_ = std::make_unique<lod::MultiresVolumeSource>(streamed_);
-    exploration_.reset();
-    name_ = spec;
-    return;
-  }
-  setVolume(
-      readVolume(spec,
-                 {.dicomSeries = options.series, .time = options.time, .channel = options.channel}),
-      spec);
 }
 
 void Session::setVolume(Volume volume, const std::string& name) {

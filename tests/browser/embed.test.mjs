@@ -99,3 +99,45 @@ test('the embedding example opens ?url= and reports a failed one', () => checksP
         failed.includes('/data/missing.nii') && failed.includes('404') && still === 'sphere48.nii.gz', `"${failed}"`);
   await page.close();
 }));
+
+test('the page saves its session state and restores the same view from it', () => checksPassed(async () => {
+  const { page, logs } = await openExample('');
+  const r = await page.evaluate(() => {
+    const v = window.embedded;
+    v.setOverlays({ box: false, axes: false });
+    v.setTransferFunction('ct-bone');
+    v.setCamera({ azimuth: 40, elevation: 15, zoom: 1.2 });
+    v.render();
+    const saved = Array.from(v.pixels());
+    const state = v.sessionState();
+    v.setTransferFunction('mr-default');
+    v.setCamera({ azimuth: 0, elevation: 0, zoom: 1 });
+    v.render();
+    const moved = Array.from(v.pixels());
+    v.restoreSession(JSON.stringify(state));
+    v.render();
+    const restored = Array.from(v.pixels());
+    let refused = '';
+    try {
+      v.restoreSession({ version: 1, settings: { version: 1, mode: 'loud' } });
+    } catch (e) {
+      refused = e.message;
+    }
+    v.render();
+    const afterRefusal = Array.from(v.pixels());
+    return { state, saved, moved, restored, refused, afterRefusal };
+  });
+  const same = (a, b) => a.length === b.length && a.every((x, i) => x === b[i]);
+  check('state: the saved state holds the camera and look set on the page (versioned)',
+        r.state.version === 1 && r.state.settings.camera.azimuth === 40 &&
+        r.state.settings.camera.elevation === 15 && r.state.volume.name === VOLUME,
+        JSON.stringify(r.state.settings.camera));
+  check('state: restoring it shows the saved frame again, byte for byte (the moved view differed)',
+        same(r.restored, r.saved) && psnrOf(r.moved, r.saved) < 40,
+        `moved view ${psnrOf(r.moved, r.saved).toFixed(1)} dB from the saved one`);
+  check('state: a bad state is refused naming the setting, and the view stays as it was',
+        r.refused.includes('loud') && same(r.afterRefusal, r.restored), r.refused);
+  const errors = logs.filter((l) => l.startsWith('pageerror'));
+  check('state: no script errors', errors.length === 0, errors.join(' | '));
+  await page.close();
+}));

@@ -194,6 +194,24 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_state_json(int logHistogram) {
   return web::jsonOut(j);
 }
 
+// The session's state (session::Session::state: settings, camera, TF,
+// window, exploration) as versioned JSON, what `tessera render --state` and
+// `tessera view --state` read; "null" before tessera_init.
+EMSCRIPTEN_KEEPALIVE const char* tessera_session_state() {
+  web::WebSession* s = web::sessionIfAny();
+  if (!s) return web::jsonOut(nullptr);
+  nlohmann::json j;
+  if (!guarded([&] { j = s->rendering().state(); })) return web::jsonOut(nullptr);
+  return web::jsonOut(j);
+}
+
+// Restores a state of tessera_session_state (or of the CLI or the desktop
+// viewer) on the volume loaded now: the look, the camera and, for a file,
+// the crosshair, picked region, grid and the region or block it showed.
+EMSCRIPTEN_KEEPALIVE int tessera_session_restore(const char* json) {
+  return guarded([&] { web::session().restoreState(json); });
+}
+
 // The canvas's pixels (RGBA, top row first), for tests and "save image";
 // valid until the next call (null before tessera_init).
 EMSCRIPTEN_KEEPALIVE const std::uint8_t* tessera_read_pixels(int width, int height) {

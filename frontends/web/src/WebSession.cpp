@@ -6,9 +6,11 @@
 #include <span>
 
 #include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
 
 #include "tessera/core/Error.h"
 #include "tessera/gpu/DeviceProfile.h"
+#include "tessera/gpu/DeviceSession.h"
 #include "tessera/gpu/Draw.h"
 #include "tessera/io/ByteSource.h"
 #include "tessera/io/Procedural.h"
@@ -61,9 +63,12 @@ void endSession() {
 
 WebSession::WebSession(const std::string& canvasSelector, int webglVersion)
     : context_(canvasSelector, webglVersion) {
-  viewer_ =
-      std::make_unique<viewer::Viewer>(context(), gpu::DeviceProfile::find(context().platform()));
-  viewer_->settings().sampling = webDefaultSampling();
+  session_ = std::make_unique<session::Session>(
+      gpu::borrowDevice(context(), gpu::DeviceProfile::find(context().platform())));
+  session::Settings settings = session_->settings();
+  settings.render.sampling = webDefaultSampling();
+  session_->setSettings(std::move(settings));
+  session_->view();  // the 3D view from the start (its TF editor, camera)
 }
 
 WebSession::~WebSession() {
@@ -73,7 +78,7 @@ WebSession::~WebSession() {
 
 void WebSession::loadGenerated(const std::string& spec) {
   zoomForget();
-  viewer().setVolume(makeProcedural(spec), spec);
+  session_->setVolume(makeProcedural(spec), spec);
 }
 
 void WebSession::loadPickedFiles() {
@@ -86,7 +91,7 @@ void WebSession::loadPickedFiles() {
   }
   const std::string name = volumeFileAmong(files.names());
   zoomForget();
-  viewer().setVolume(readVolume(*files.open(name), files), name);
+  session_->setVolume(readVolume(*files.open(name), files), name);
 }
 
 double WebSession::renderFrame(int width, int height) {
@@ -214,6 +219,19 @@ void WebSession::setMarkBox(int slot, const lod::VoxelBox& box) {
   m.dims = sliceShape().dims();
   m.box = lod::VoxelBox{glm::clamp(box.begin, glm::ivec3(0), m.dims),
                         glm::clamp(box.end, glm::ivec3(0), m.dims)};
+}
+
+void WebSession::restoreState(const std::string& json) {
+  const nlohmann::json state = nlohmann::json::parse(json, nullptr, false);
+  if (state.is_discarded()) throw InputError("session state: not JSON");
+  if (storeOverview()) {
+    // A store's region and grid blocks are fetched by the page first.
+    throw InputError("session state: restoring is for a loaded file, not an open OME-Zarr store");
+  }
+  zoomStop();
+  if (session_->hasVolume()) exploration();  // the page's exploration, for the state to fill
+  session_->restore(state);
+  refreshExtraLines();
 }
 
 const std::uint8_t* WebSession::readPixels(int width, int height) {

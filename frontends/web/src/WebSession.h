@@ -26,6 +26,7 @@
 #include "tessera/gpu/WebGlContext.h"
 #include "tessera/lod/GridNavigator.h"
 #include "tessera/session/Exploration.h"
+#include "tessera/session/Session.h"
 #include "tessera/viewer/CropHandles.h"
 #include "tessera/viewer/Explorer.h"
 #include "tessera/viewer/Viewer.h"
@@ -102,7 +103,11 @@ class WebSession {
   WebSession(const WebSession&) = delete;
   WebSession& operator=(const WebSession&) = delete;
 
-  viewer::Viewer& viewer() { return *viewer_; }
+  // The rendering session on the canvas's context: its view is the 3D view,
+  // its exploration what the slice views, region and grid show, its state
+  // what tessera_state_json saves and tessera_state_restore restores.
+  session::Session& rendering() { return *session_; }
+  viewer::Viewer& viewer() { return session_->view(); }
   gpu::GlContext& context() { return context_.gl(); }
   int webglVersion() const { return context_.webglVersion(); }
 
@@ -125,6 +130,9 @@ class WebSession {
   CropState& crop() { return crop_; }
   // The viewer's extra lines: the region / grid boxes, then the crop box's.
   void refreshExtraLines();
+  // Session::restore of a state as JSON text; InputError naming what is
+  // wrong (the look stays as it was when the state is refused).
+  void restoreState(const std::string& json);
   // The canvas's pixels (RGBA, top row first), valid until the next call.
   const std::uint8_t* readPixels(int width, int height);
 
@@ -199,17 +207,20 @@ class WebSession {
   void applyMarkBoxes();
   std::string overviewKey(const Volume& v);
   void showGridBlock(const session::ExploreStep& step);
+  // The session's exploration, or null before one was made.
+  session::Exploration* explore() {
+    return session_->exploring() ? &session_->exploration() : nullptr;
+  }
 
   // Declared in destruction order's reverse: the viewer's GPU objects go
   // before the context.
   gpu::WebGlContext context_;
   std::unique_ptr<ZarrStoreView> zarr_;
   ZoomView zoom_;
-  std::unique_ptr<viewer::Viewer> viewer_;
+  std::unique_ptr<session::Session> session_;
   std::vector<PickedFile> picked_;
   SliceViews slices_;
   MarkBox marks_[2];
-  std::unique_ptr<session::Exploration> explore_;
   std::string exploreKey_;  // the overview it was made for: name and dims
   int askedCell_ = 0;       // the grid cell side asked for (0: the default)
   CropState crop_;

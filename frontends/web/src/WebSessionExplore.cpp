@@ -35,10 +35,10 @@ std::string rangeText(const lod::VoxelBox& box, int a) {
 }  // namespace
 
 bool WebSession::regionShown() {
-  if (!explore_ || explore_->mode() == session::ExploreMode::Overview) return false;
+  if (!explore() || explore()->mode() == session::ExploreMode::Overview) return false;
   const viewer::Viewer& v = viewer();
-  if (v.hasVolume() && v.volumeName() == explore_->shownName()) return true;
-  if (!storeOverview()) explore_.reset();  // another volume came in since
+  if (v.hasVolume() && v.volumeName() == explore()->shownName()) return true;
+  if (!storeOverview()) session_->endExploration();  // another volume came in since
   return false;
 }
 
@@ -51,14 +51,14 @@ const Volume& WebSession::overviewVolume() {
   if (const Volume* store = storeOverview()) return *store;
   if (const Volume* whole = zoomOverview()) return *whole;
   viewer::Viewer& v = viewer();
-  if (!storeOverview() && regionShown()) return *explore_->overview();
+  if (!storeOverview() && regionShown()) return *explore()->overview();
   if (!v.hasVolume()) throw InputError("no volume is loaded");
   return v.volume();
 }
 
 std::string WebSession::overviewName() {
   if (storeOverview()) return theStore().storage().describe();
-  if (regionShown()) return explore_->label();
+  if (regionShown()) return explore()->label();
   if (zoomOverview()) return zoom_.name;
   return viewer().volumeName();
 }
@@ -177,26 +177,25 @@ double WebSession::voxelValue(int x, int y, int z) {
 session::Exploration& WebSession::exploration(int cellSide) {
   const Volume& volume = sliceShape();
   const std::string key = overviewKey(volume);
-  if (!explore_ || exploreKey_ != key) {
-    const std::uint64_t budget = viewer::regionBudgetBytes(viewer().limits());
+  if (!explore() || exploreKey_ != key) {
     if (storeOverview()) {
       // The store draws its own overview: none is read here.
-      explore_ = std::make_unique<session::Exploration>(theStore().sharedSource(), budget, 0,
-                                                        theStore().storage().describe());
+      session_->explore(theStore().sharedSource(), 0, theStore().storage().describe());
     } else {
-      explore_ = std::make_unique<session::Exploration>(viewer().sharedVolume(), budget,
-                                                        viewer().volumeName());
+      // The file's: the session's volume, shared.
+      session_->endExploration();
+      session_->exploration();
     }
     exploreKey_ = key;
     askedCell_ = -1;  // the grid below is set for it
   }
   const int asked = cellSide < 0 ? std::max(askedCell_, 0) : cellSide;
   if (asked != askedCell_) {
-    explore_->setGrid(asked > 0 ? lod::GridNavigator(volume.dims(), glm::ivec3(asked))
-                                : defaultGrid(volume));
+    explore()->setGrid(asked > 0 ? lod::GridNavigator(volume.dims(), glm::ivec3(asked))
+                                 : defaultGrid(volume));
     askedCell_ = asked;
   }
-  return *explore_;
+  return *explore();
 }
 
 // Ends past the volume are clamped; an empty box or one that starts outside
@@ -211,7 +210,7 @@ void WebSession::showRegion(lod::VoxelBox box) {
 // With the overview's camera and the current window; the region stays
 // known to the page, which draws it as a highlighted box.
 void WebSession::returnToOverview() {
-  if (regionShown()) explore_->showOverview(viewer(), session::Follow::Back);
+  if (regionShown()) explore()->showOverview(viewer(), session::Follow::Back);
 }
 
 // A point at continuous voxel coordinates p of the overview lies at model
@@ -228,7 +227,7 @@ std::optional<VoxelProjection> WebSession::projection(int width, int height) {
     const bool inRegion = regionShown();
     const glm::dvec3 extent = inRegion ? v.volume().extent() : shape.extent();
     p.spacing = shape.spacing();
-    p.offset = -0.5 * extent - (inRegion ? glm::dvec3(explore_->shown()->begin) * shape.spacing()
+    p.offset = -0.5 * extent - (inRegion ? glm::dvec3(explore()->shown()->begin) * shape.spacing()
                                          : glm::dvec3(0.0));
     // The store's frames frame the viewer's camera on the store's shape.
     Camera c = v.camera();
@@ -240,7 +239,7 @@ std::optional<VoxelProjection> WebSession::projection(int width, int height) {
   const Volume& shownVolume = v.volume();
   p.spacing = shownVolume.spacing();
   p.offset = -0.5 * shownVolume.extent();
-  if (regionShown()) p.offset -= glm::dvec3(explore_->shown()->begin) * p.spacing;
+  if (regionShown()) p.offset -= glm::dvec3(explore()->shown()->begin) * p.spacing;
   if (const Volume* whole = zoomOverview()) {
     // A level spans the whole volume's box; the native block is a box of
     // level 0.
@@ -268,12 +267,12 @@ std::string WebSession::overviewKey(const Volume& v) {
 // True while the 3D view shows the block the grid put in (not a region
 // picked since, nor the overview, nor another file).
 bool WebSession::gridShown() {
-  return regionShown() && explore_->mode() == session::ExploreMode::Grid;
+  return regionShown() && explore()->mode() == session::ExploreMode::Grid;
 }
 
 bool WebSession::gridStoreWanted() {
-  return storeOverview() && explore_ && explore_->pending() &&
-         explore_->pending()->mode == session::ExploreMode::Grid;
+  return storeOverview() && explore() && explore()->pending() &&
+         explore()->pending()->mode == session::ExploreMode::Grid;
 }
 
 // The default cell: cubic, a multiple of 16 voxels, as large as possible
@@ -297,7 +296,7 @@ lod::GridNavigator WebSession::defaultGrid(const Volume& volume) {
 void WebSession::showGridBlock(const session::ExploreStep& step) {
   if (storeOverview()) return;
   try {
-    explore_->show(viewer(), step);
+    explore()->show(viewer(), step);
   } catch (const std::exception& e) {
     throw InputError("grid view: " + std::string(e.what()));
   }
@@ -325,7 +324,7 @@ int WebSession::gridMove(int viewMove) {
 // The grid point goes back to where it was before the enter or move that
 // asked for the store's block.
 void WebSession::gridStoreFailed() {
-  if (gridStoreWanted()) explore_->failed("the block could not be read");
+  if (gridStoreWanted()) explore()->failed("the block could not be read");
 }
 
 void WebSession::gridStoreShown() {

@@ -24,7 +24,7 @@ const Volume* WebSession::storeOverview() {
 
 void WebSession::beginStore(const std::string& url) {
   zoomStop();
-  explore_.reset();
+  session_->endExploration();
   zarr_ = std::make_unique<ZarrStoreView>(context(), viewer().limits(), url);
 }
 
@@ -42,7 +42,7 @@ bool WebSession::storeOpenStep() {
 // The viewer core's volume shows again.
 void WebSession::closeStore() {
   zarr_.reset();
-  explore_.reset();
+  session_->endExploration();
 }
 
 // Ends past the level are clamped; an empty box or one that starts outside
@@ -84,13 +84,13 @@ void WebSession::showStoreRegion(const lod::VoxelBox& asked) {
 // for its outline in the slice views).
 void WebSession::storeRegionOverview() {
   if (!regionShown()) return;
-  viewer().camera() = explore_->overviewCamera();
-  explore_->overviewShown();
+  viewer().camera() = explore()->overviewCamera();
+  explore()->overviewShown();
 }
 
 std::optional<lod::VoxelBox> WebSession::storeGridBlock() {
-  if (!storeOverview() || !explore_ || gridStoreWanted() || regionShown()) return std::nullopt;
-  return explore_->gridBlock();
+  if (!storeOverview() || !explore() || gridStoreWanted() || regionShown()) return std::nullopt;
+  return explore()->gridBlock();
 }
 
 StoreFrame WebSession::storeFrame(int width, int height) {
@@ -101,9 +101,9 @@ StoreFrame WebSession::storeFrame(int width, int height) {
   // composed by depth.
   std::vector<render::OverlayLine> marks;
   const Volume& shape = z.store().shape();
-  if (explore_ && explore_->picked()) {
-    marks =
-        viewer::boxLines(*explore_->picked(), shape.dims(), shape.extent(), session::kRegionColour);
+  if (explore() && explore()->picked()) {
+    marks = viewer::boxLines(*explore()->picked(), shape.dims(), shape.extent(),
+                             session::kRegionColour);
   }
   if (const std::optional<lod::VoxelBox> block = storeGridBlock()) {
     const auto cyan =
