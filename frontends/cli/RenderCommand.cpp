@@ -503,9 +503,10 @@ void addRenderCommand(CLI::App& app) {
   addDefaultedOption(cmd, "--fov", o->fov, "Vertical field of view in degrees (perspective)");
   cmd->add_flag("--ortho", o->ortho, "Orthographic projection");
   addDefaultedOption(cmd, "--mode", o->mode,
-                     "composite, mip (maximum), minip (minimum) or average (mean of the ray's "
-                     "samples): the projections show the TF colour of their value; minip and "
-                     "average by raycast only");
+                     renderModeChoices() +
+                         ": emission-absorption compositing, or a projection of each ray's "
+                         "maximum, minimum or mean sample, shown in the TF colour of that value; "
+                         "minip and average by raycast only");
   addSamplingOptions(cmd, o->sampling);
   addDefaultedOption(cmd, "--max-steps", o->maxSteps, "Maximum samples per ray");
   addDefaultedOption(cmd, "--opacity-scale", o->opacityScale, "Global opacity scale");
