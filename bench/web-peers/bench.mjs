@@ -286,7 +286,11 @@ async function main() {
       peerViewer('vtk', 'vtk.js 37.4 (WebGL 2)', 'vtk.html?raw=/data/volume.raw&meta=/data/volume.json'),
       peerViewer('niivue', 'NiiVue 0.69 (WebGL 2)', 'niivue.html?url=/data/volume.nii.gz')];
     if (baselineSite) {
-      if (!fs.existsSync(path.join(baselineSite, 'tessera.wasm'))) throw new Error(`--baseline ${baselineSite}: no tessera.wasm there`);
+      // Builds since the web adapter split write tessera-core.wasm; older ones tessera.wasm.
+      const wasmNames = ['tessera-core.wasm', 'tessera.wasm'];
+      if (!wasmNames.some((f) => fs.existsSync(path.join(baselineSite, f)))) {
+        throw new Error(`--baseline ${baselineSite}: neither ${wasmNames.join(' nor ')} there (not a web build)`);
+      }
       viewers.push(tesseraViewer(2, true), tesseraViewer(1, true));
     }
     for (const v of variants) viewers.push(tesseraViewer(2, false, v));

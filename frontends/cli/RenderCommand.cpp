@@ -1,10 +1,17 @@
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
+#include <set>
+#include <stdexcept>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -88,7 +95,95 @@ struct RenderOptions {
   std::string labels;
   CLI::Option* labelsOption = nullptr;
   bool labelVolume() const { return labelsOption != nullptr && labelsOption->count() > 0; }
+  // --state FILE: the settings to start from; --save-state FILE: where the
+  // render's own go. `command`: which options the command line gave.
+  std::string state;
+  std::string saveState;
+  const CLI::App* command = nullptr;
 };
+
+// Where each option that sets a setting lands in the settings' JSON
+// (session::Settings::toJson): with --state, an option given on the command
+// line replaces these keys of the file's settings, and the file keeps the
+// rest.
+const std::map<std::string, std::vector<std::string>>& settingKeys() {
+  static const std::map<std::string, std::vector<std::string>> keys = {
+      {"--tf", {"/tf"}},
+      {"--azimuth", {"/camera/azimuth"}},
+      {"--elevation", {"/camera/elevation"}},
+      {"--zoom", {"/camera/zoom"}},
+      {"--fov", {"/camera/fov"}},
+      {"--ortho", {"/camera/projection"}},
+      {"--mode", {"/mode"}},
+      {"--step", {"/step"}},
+      {"--preintegrate", {"/sampling/preintegrate"}},
+      {"--adaptive", {"/sampling/adaptive"}},
+      // Given, the tolerance holds for lit frames too (applySampling).
+      {"--adaptive-tolerance", {"/sampling/tolerance", "/sampling/lit_tolerance"}},
+      {"--adaptive-max", {"/sampling/max_multiplier"}},
+      {"--adaptive-growth", {"/sampling/opacity_growth"}},
+      {"--max-steps", {"/max_steps"}},
+      {"--opacity-scale", {"/opacity_scale"}},
+      {"--ert", {"/ert"}},
+      {"--jitter", {"/jitter"}},
+      {"--shade", {"/shading/enabled"}},
+      {"--gradient", {"/gradient"}},
+      {"--light", {"/shading/headlight", "/shading/light_direction"}},
+      {"--gradient-opacity",
+       {"/shading/gradient_opacity", "/shading/gradient_low", "/shading/gradient_high"}},
+      {"--ambient", {"/shading/ambient"}},
+      {"--diffuse", {"/shading/diffuse"}},
+      {"--specular", {"/shading/specular"}},
+      {"--shininess", {"/shading/shininess"}},
+      {"--crop", {"/clipping/crop_min", "/clipping/crop_max"}},
+      {"--clip", {"/clipping/planes"}},
+      // The table's TF replaces the file's once the volume is read.
+      {"--labels", {"/labels", "/lut", "/nearest"}},
+      {"--window", {"/window"}},
+      {"--background", {"/background"}},
+      {"--skip-block", {"/skip_block"}},
+      {"--lut", {"/lut"}},
+      {"--technique", {"/technique"}},
+      {"--slices", {"/slices"}},
+      {"--classify", {"/classify"}},
+      {"--layout", {"/layout"}},
+      {"--lattice", {"/layout"}},
+      {"--density", {"/layout"}},
+  };
+  return keys;
+}
+
+// The options that say what to read, how to run and what to write, not how
+// to draw: --state leaves them as the command line has them.
+const std::set<std::string>& runOptions() {
+  static const std::set<std::string> names = {
+      "file",        "--series",    "--time",          "--channel",        "--size",
+      "--out",       "--reference", "--reference-out", "--reference-step", "--repeat",
+      "--rotate",    "--profile",   "--json",          "--overlays",       "--overlay-opacity",
+      "--offscreen", "--roi",       "--region",        "--level",          "--state",
+      "--save-state"};
+  return names;
+}
+
+// Every option of `tessera render` is one or the other, so that --state
+// cannot silently drop a new setting's option: checked when the command is
+// built, which every run of the CLI does.
+void checkOptionsClassified(const CLI::App& cmd) {
+  for (const auto& [name, keys] : settingKeys()) {
+    if (cmd.get_option_no_throw(name) == nullptr) {
+      throw std::logic_error("tessera render: settingKeys() names " + name +
+                             ", which is no option of the command");
+    }
+  }
+  for (const CLI::Option* opt : cmd.get_options()) {
+    if (opt == cmd.get_help_ptr() || opt == cmd.get_help_all_ptr()) continue;
+    const std::string name = opt->get_name();
+    if (!settingKeys().contains(name) && !runOptions().contains(name)) {
+      throw std::logic_error("tessera render: option " + name +
+                             " is in neither settingKeys() nor runOptions() (RenderCommand.cpp)");
+    }
+  }
+}
 
 std::string describeStep(double step) {
   char buf[32];
@@ -137,13 +232,9 @@ void checkSamplesLayout(const RenderOptions& o, const DeviceSession& device, con
   }
 }
 
-// The camera, settings and technique the options ask for, checked by the
-// session's one settings type before the volume is read, so that a typo
-// fails at once.
-RenderRequest requestFrom(const RenderOptions& o) {
-  RenderRequest req;
-  parseSize(o.size, req.width, req.height);
-  Settings& s = req.settings;
+// The camera, settings and technique the options ask for.
+Settings settingsFrom(const RenderOptions& o) {
+  Settings s;
   s.camera.azimuthDeg = o.azimuth;
   s.camera.elevationDeg = o.elevation;
   s.camera.zoom = o.zoom;
@@ -174,6 +265,98 @@ RenderRequest requestFrom(const RenderOptions& o) {
   if (s.labels) render::applyLabelSettings(s.render);
   if (!s.labels) s.tf = TransferFunction::fromPresetOrFile(o.tf);
   s.validate();
+  return s;
+}
+
+// How a JSON value's kind reads in a message.
+std::string kindOf(const nlohmann::json& j) {
+  if (j.is_boolean()) return "true or false";
+  if (j.is_number()) return "a number";
+  if (j.is_string()) return "a string";
+  if (j.is_array()) return "an array";
+  if (j.is_object()) return "an object";
+  return "null";
+}
+
+// Settings::fromJson reads each key as the kind its default has; a key of
+// another kind is named here, found against the defaults' own JSON, so that
+// the message says which one.
+void checkKinds(const nlohmann::json& given, const nlohmann::json& defaults,
+                const std::string& where) {
+  const auto scalar = [](const nlohmann::json& j) { return j.is_primitive() && !j.is_null(); };
+  for (const auto& [key, value] : given.items()) {
+    if (!defaults.contains(key)) continue;  // as Settings::fromJson, which ignores it
+    const nlohmann::json& d = defaults[key];
+    const std::string at = where + "." + key;
+    if (d.is_object() && value.is_object()) checkKinds(value, d, at);
+    if (scalar(d) && kindOf(value) != kindOf(d)) {
+      throw InputError(at + " is " + kindOf(value) + ", expected " + kindOf(d));
+    }
+    if (!d.is_array() || d.empty() || !scalar(d[0]) || !value.is_array()) continue;
+    for (std::size_t i = 0; i < value.size(); ++i) {
+      if (kindOf(value[i]) != kindOf(d[0])) {
+        throw InputError(at + "[" + std::to_string(i) + "] is " + kindOf(value[i]) + ", expected " +
+                         kindOf(d[0]));
+      }
+    }
+  }
+}
+
+// The settings of a state file (what --save-state writes), as JSON, checked
+// by the one settings type. InputError names the file and the problem.
+nlohmann::json readStateSettings(const std::string& path) {
+  const std::string what = "--state " + path;
+  if (std::filesystem::is_directory(path)) throw InputError(what + ": a folder, not a file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(what + ": cannot open: " + std::strerror(errno));
+  nlohmann::json state;
+  try {
+    state = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(what + ": not JSON (syntax error at byte " + std::to_string(e.byte) + ")");
+  } catch (const nlohmann::json::exception& e) {  // out_of_range for 1e999
+    throw InputError(what + ": not JSON (" + e.what() + ")");
+  }
+  if (!state.is_object() || !state.contains("settings") || !state["settings"].is_object()) {
+    throw InputError(what +
+                     ": expected a session state {\"version\", \"settings\": {...}} as "
+                     "--save-state writes it");
+  }
+  const nlohmann::json version = state.value("version", nlohmann::json());
+  if (version != session::kSettingsVersion) {
+    throw InputError(what + ": state version " + version.dump() + ", this Tessera reads " +
+                     std::to_string(session::kSettingsVersion));
+  }
+  try {
+    checkKinds(state["settings"], Settings().toJson(), "settings");
+    return Settings::fromJson(state["settings"]).toJson();
+  } catch (const InputError& e) {
+    throw InputError(what + ": " + e.what());
+  }
+}
+
+// --state: the file's settings, with the keys that the options given on
+// the command line set replaced by the options' values.
+Settings stateWithOptions(const RenderOptions& o) {
+  nlohmann::json merged = readStateSettings(o.state);
+  const nlohmann::json given = settingsFrom(o).toJson();
+  for (const auto& [option, keys] : settingKeys()) {
+    if (o.command->get_option(option)->count() == 0) continue;
+    for (const std::string& key : keys) {
+      const nlohmann::json::json_pointer at(key);
+      merged[at] = given.at(at);
+    }
+  }
+  return Settings::fromJson(merged);
+}
+
+// The camera, settings and technique the options ask for (over the file of
+// --state), checked by the session's one settings type before the volume is
+// read, so that a typo fails at once.
+RenderRequest requestFrom(const RenderOptions& o) {
+  RenderRequest req;
+  parseSize(o.size, req.width, req.height);
+  req.settings = o.state.empty() ? settingsFrom(o) : stateWithOptions(o);
   req.repeat = o.repeat;
   if (req.repeat < 1) throw InputError("--repeat must be >= 1");
   req.rotateDeg = o.repeat > 1 ? o.rotate : 0.0;
@@ -284,8 +467,8 @@ void printRenderJson(const RenderOptions& o, const RenderRequest& req, const Ren
                  {"requests", fetch->requests},
                  {"retries", fetch->retries}};
   }
-  j["mode"] = o.mode;
-  j["technique"] = o.technique;
+  j["mode"] = std::string(renderModeToName(req.settings.render.mode));
+  j["technique"] = req.settings.technique;
   j["step_voxels"] = req.settings.render.stepVoxels;
   j["preintegrate"] = r.preintegrated;
   j["adaptive"] = r.adaptive;
@@ -302,7 +485,7 @@ void printRenderJson(const RenderOptions& o, const RenderRequest& req, const Ren
     j["reference_is_twin"] = req.referenceStep <= 0.0;
   }
   if (r.samplesPerRay > 0.0) j["samples_per_ray"] = r.samplesPerRay;
-  j["shade"] = o.shading.shade;
+  j["shade"] = req.settings.render.shading.enabled;
   j["tf"] = req.settings.tf.name;
   std::printf("%s\n", j.dump(2).c_str());
 }
@@ -322,7 +505,7 @@ void printRenderText(const RenderOptions& o, const RenderRequest& req, const Ren
               device.limits.api == gpu::ApiLevel::Gles2 ? "1.00" : "3.00");
   std::printf("profile  %s (%s)\n", device.profile.name.c_str(), device.profile.note.c_str());
   std::printf("layout   %s: %s\n", r.layout.c_str(), r.layoutReason.c_str());
-  if (render::TechniqueRegistry::global().find(o.technique).honoursSampling) {
+  if (render::TechniqueRegistry::global().find(req.settings.technique).honoursSampling) {
     RenderSettings effective = req.settings.render;
     effective.sampling.preintegrate = r.preintegrated;
     effective.sampling.preintegrateLitOnly = false;
@@ -334,8 +517,9 @@ void printRenderText(const RenderOptions& o, const RenderRequest& req, const Ren
                     r.preintegrationBuildMs, r.preintegrationUploadMs);
       line += buf;
     }
-    std::printf("sampling %s%s\n", line.c_str(),
-                o.sampling.stepGiven() ? "" : "; the default (docs/sampling.md)");
+    std::printf(
+        "sampling %s%s\n", line.c_str(),
+        o.sampling.stepGiven() || !o.state.empty() ? "" : "; the default (docs/sampling.md)");
   }
   if (req.settings.render.shading.enabled && !r.gradient.empty()) {
     std::printf("gradient %s\n", r.gradient.c_str());
@@ -406,10 +590,21 @@ void createParentFolders(const std::string& path) {
   }
 }
 
+// --save-state: the session's state after the render (version, volume,
+// settings), which --state reads back.
+void saveState(const RenderOptions& o, const Session& session) {
+  if (o.saveState.empty()) return;
+  std::ofstream out(o.saveState, std::ios::binary);
+  out << session.state().dump(2) << '\n';
+  out.close();
+  if (!out) throw Error(o.saveState + ": cannot write the state: " + std::strerror(errno));
+}
+
 void runRenderCommand(const RenderOptions& o) {
   const auto tStart = std::chrono::steady_clock::now();
   createParentFolders(o.out);
   if (!o.referenceOut.empty()) createParentFolders(o.referenceOut);
+  if (!o.saveState.empty()) createParentFolders(o.saveState);
   RenderRequest req = requestFrom(o);
   const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
   // The profile first: it sets the host budget the reader must respect.
@@ -435,6 +630,7 @@ void runRenderCommand(const RenderOptions& o) {
   if (session.streamed()) {
     const RenderResult r = session.run(req);
     r.first.writePng(o.out);
+    saveState(o, session);
     times.totalMs = msSince(tStart);
     if (o.json) {
       printRenderJson(o, req, r, device, spec, times, nullptr, httpFetch(*session.pyramid()));
@@ -449,11 +645,13 @@ void runRenderCommand(const RenderOptions& o) {
   const render::OverlayOpacity overlayOpacity = render::parseOverlayOpacity(o.overlayOpacity);
   if (!o.overlays.empty() || !o.offscreen.empty() || !o.roi.empty()) {
     runHybridCommand(o, session, req, spec, overlayOpacity);
+    saveState(o, session);
     return;
   }
   const RenderResult r = session.run(req);
   r.first.writePng(o.out);
   if (r.referenceImage && !o.referenceOut.empty()) r.referenceImage->writePng(o.referenceOut);
+  saveState(o, session);
   times.totalMs = msSince(tStart);
   const nlohmann::json& regionReport = session.regionReport();
   if (o.json) {
@@ -503,9 +701,10 @@ void addRenderCommand(CLI::App& app) {
   addDefaultedOption(cmd, "--fov", o->fov, "Vertical field of view in degrees (perspective)");
   cmd->add_flag("--ortho", o->ortho, "Orthographic projection");
   addDefaultedOption(cmd, "--mode", o->mode,
-                     "composite, mip (maximum), minip (minimum) or average (mean of the ray's "
-                     "samples): the projections show the TF colour of their value; minip and "
-                     "average by raycast only");
+                     renderModeChoices() +
+                         ": emission-absorption compositing, or a projection of each ray's "
+                         "maximum, minimum or mean sample, shown in the TF colour of that value; "
+                         "minip and average by raycast only");
   addSamplingOptions(cmd, o->sampling);
   addDefaultedOption(cmd, "--max-steps", o->maxSteps, "Maximum samples per ray");
   addDefaultedOption(cmd, "--opacity-scale", o->opacityScale, "Global opacity scale");
@@ -580,6 +779,19 @@ void addRenderCommand(CLI::App& app) {
                   "level are clamped (with a note)");
   addDefaultedOption(cmd, "--level", o->level,
                      "With --region: pyramid level, native (0, the finest) or N");
+  cmd->add_option("--state", o->state,
+                  "Start from the settings of FILE (written by --save-state): camera, TF, "
+                  "window, mode, sampling, shading, clipping, technique and layout. An option "
+                  "given with it replaces what it sets, the rest stays as saved; the volume, "
+                  "--size, --out and the other run options are this command's. A viewer's "
+                  "saved exploration is not replayed (render draws the whole volume or --region)")
+      ->type_name("FILE");
+  cmd->add_option("--save-state", o->saveState,
+                  "After the render, write its state (version, volume, settings; JSON) to FILE, "
+                  "creating its folder; --state reads it back")
+      ->type_name("FILE");
+  o->command = cmd;
+  checkOptionsClassified(*cmd);
   cmd->callback([o] { runRenderCommand(*o); });
 }
 

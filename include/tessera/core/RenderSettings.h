@@ -2,7 +2,12 @@
 // Parameters every renderer (GPU techniques and the CPU reference) honours
 // with identical meaning, so that their images can be compared pixel by pixel.
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -18,6 +23,28 @@ namespace tessera {
 // MinIp the smallest, Average the mean of the ray's samples (average
 // intensity projection, an X-ray-like view).
 enum class RenderMode { Composite, Mip, MinIp, Average };
+
+// The modes' names in the enum's order: the one list that option help,
+// parsers and saved settings take them from, so that a new mode is named
+// once.
+inline constexpr std::array<std::string_view, 4> renderModeNames() {
+  return {"composite", "mip", "minip", "average"};
+}
+static_assert(static_cast<std::size_t>(RenderMode::Average) + 1 == renderModeNames().size(),
+              "every RenderMode needs its name in renderModeNames()");
+
+inline constexpr std::string_view renderModeToName(RenderMode mode) {
+  return renderModeNames()[static_cast<std::size_t>(mode)];
+}
+// The mode of that name; none for a word that names no mode.
+inline constexpr std::optional<RenderMode> renderModeFromName(std::string_view name) {
+  for (std::size_t i = 0; i < renderModeNames().size(); ++i) {
+    if (renderModeNames()[i] == name) return static_cast<RenderMode>(i);
+  }
+  return std::nullopt;
+}
+// "composite, mip, minip or average": the list as help and errors write it.
+std::string renderModeChoices();
 
 inline bool isProjection(RenderMode mode) {
   return mode != RenderMode::Composite;
