@@ -1,10 +1,7 @@
-#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <memory>
@@ -268,70 +265,19 @@ Settings settingsFrom(const RenderOptions& o) {
   return s;
 }
 
-// How a JSON value's kind reads in a message.
-std::string kindOf(const nlohmann::json& j) {
-  if (j.is_boolean()) return "true or false";
-  if (j.is_number()) return "a number";
-  if (j.is_string()) return "a string";
-  if (j.is_array()) return "an array";
-  if (j.is_object()) return "an object";
-  return "null";
-}
-
-// Settings::fromJson reads each key as the kind its default has; a key of
-// another kind is named here, found against the defaults' own JSON, so that
-// the message says which one.
-void checkKinds(const nlohmann::json& given, const nlohmann::json& defaults,
-                const std::string& where) {
-  const auto scalar = [](const nlohmann::json& j) { return j.is_primitive() && !j.is_null(); };
-  for (const auto& [key, value] : given.items()) {
-    if (!defaults.contains(key)) continue;  // as Settings::fromJson, which ignores it
-    const nlohmann::json& d = defaults[key];
-    const std::string at = where + "." + key;
-    if (d.is_object() && value.is_object()) checkKinds(value, d, at);
-    if (scalar(d) && kindOf(value) != kindOf(d)) {
-      throw InputError(at + " is " + kindOf(value) + ", expected " + kindOf(d));
-    }
-    if (!d.is_array() || d.empty() || !scalar(d[0]) || !value.is_array()) continue;
-    for (std::size_t i = 0; i < value.size(); ++i) {
-      if (kindOf(value[i]) != kindOf(d[0])) {
-        throw InputError(at + "[" + std::to_string(i) + "] is " + kindOf(value[i]) + ", expected " +
-                         kindOf(d[0]));
-      }
-    }
-  }
-}
-
 // The settings of a state file (what --save-state writes), as JSON, checked
-// by the one settings type. InputError names the file and the problem.
+// by the one settings type. InputError names the option, the file and the
+// problem.
 nlohmann::json readStateSettings(const std::string& path) {
-  const std::string what = "--state " + path;
-  if (std::filesystem::is_directory(path)) throw InputError(what + ": a folder, not a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(what + ": cannot open: " + std::strerror(errno));
-  nlohmann::json state;
   try {
-    state = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(what + ": not JSON (syntax error at byte " + std::to_string(e.byte) + ")");
-  } catch (const nlohmann::json::exception& e) {  // out_of_range for 1e999
-    throw InputError(what + ": not JSON (" + e.what() + ")");
-  }
-  if (!state.is_object() || !state.contains("settings") || !state["settings"].is_object()) {
-    throw InputError(what +
-                     ": expected a session state {\"version\", \"settings\": {...}} as "
-                     "--save-state writes it");
-  }
-  const nlohmann::json version = state.value("version", nlohmann::json());
-  if (version != session::kSettingsVersion) {
-    throw InputError(what + ": state version " + version.dump() + ", this Tessera reads " +
-                     std::to_string(session::kSettingsVersion));
-  }
-  try {
-    checkKinds(state["settings"], Settings().toJson(), "settings");
-    return Settings::fromJson(state["settings"]).toJson();
+    const nlohmann::json state = session::readStateFile(path);
+    try {
+      return Settings::fromJson(state["settings"]).toJson();
+    } catch (const InputError& e) {
+      throw InputError(path + ": " + e.what());
+    }
   } catch (const InputError& e) {
-    throw InputError(what + ": " + e.what());
+    throw InputError("--state " + std::string(e.what()));
   }
 }
 
@@ -593,11 +539,7 @@ void createParentFolders(const std::string& path) {
 // --save-state: the session's state after the render (version, volume,
 // settings), which --state reads back.
 void saveState(const RenderOptions& o, const Session& session) {
-  if (o.saveState.empty()) return;
-  std::ofstream out(o.saveState, std::ios::binary);
-  out << session.state().dump(2) << '\n';
-  out.close();
-  if (!out) throw Error(o.saveState + ": cannot write the state: " + std::strerror(errno));
+  if (!o.saveState.empty()) session.saveState(o.saveState);
 }
 
 void runRenderCommand(const RenderOptions& o) {

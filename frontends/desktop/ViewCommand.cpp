@@ -8,6 +8,7 @@
 #include "ViewOptions.h"
 #include "cli/Commands.h"
 #include "tessera/core/Error.h"
+#include "tessera/core/RenderSettings.h"
 #include "tessera/session/Settings.h"
 
 namespace tessera::app {
@@ -74,8 +75,7 @@ void addViewCommand(CLI::App& app) {
                      "(the grid view's block nearest the crosshair)");
   // The session's one list of render modes and its message for another.
   addDefaultedOption(cmd, "--render-mode", o->projection,
-                     "The 3D view's mode: composite, mip, minip or average (the Rendering "
-                     "panel's mode)")
+                     "The 3D view's mode: " + renderModeChoices() + " (the Rendering panel's mode)")
       ->check([](const std::string& text) {
         try {
           session::parseRenderMode(text);

@@ -232,15 +232,31 @@ void Session::saveState(const std::string& path) const {
   if (!out) throw InputError(path + ": cannot write the session state: " + std::strerror(errno));
 }
 
-void Session::loadState(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot read the session state: " + std::strerror(errno));
+nlohmann::json readStateFile(const std::string& path) {
+  if (std::filesystem::is_directory(path)) throw InputError(path + ": a folder, not a file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open: " + std::strerror(errno));
   nlohmann::json state;
   try {
     state = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(path + ": not a session state (not JSON: " + e.what() + ")");
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(path + ": not JSON (syntax error at byte " + std::to_string(e.byte) + ")");
+  } catch (const nlohmann::json::exception& e) {  // out_of_range for 1e999
+    throw InputError(path + ": not JSON (" + e.what() + ")");
   }
+  if (!state.is_object() || !state.contains("settings") || !state["settings"].is_object()) {
+    throw InputError(path + ": expected a session state {\"version\", \"settings\": {...}}");
+  }
+  const nlohmann::json version = state.value("version", nlohmann::json());
+  if (version != kSettingsVersion) {
+    throw InputError(path + ": state version " + version.dump() + ", this Tessera reads " +
+                     std::to_string(kSettingsVersion));
+  }
+  return state;
+}
+
+void Session::loadState(const std::string& path) {
+  const nlohmann::json state = readStateFile(path);
   try {
     restore(state);
   } catch (const InputError& e) {

@@ -66,26 +66,52 @@ void checkRange(const std::string& name, double value, const Range& range,
 }
 
 RenderMode parseRenderMode(const std::string& text) {
-  if (text == "composite") return RenderMode::Composite;
-  if (text == "mip") return RenderMode::Mip;
-  if (text == "minip") return RenderMode::MinIp;
-  if (text == "average") return RenderMode::Average;
-  throw InputError("mode '" + text + "': expected composite, mip, minip or average");
+  if (const std::optional<RenderMode> mode = renderModeFromName(text)) return *mode;
+  throw InputError("mode '" + text + "': expected " + renderModeChoices());
 }
 
 std::string renderModeName(RenderMode mode) {
-  switch (mode) {
-    case RenderMode::Composite:
-      return "composite";
-    case RenderMode::Mip:
-      return "mip";
-    case RenderMode::MinIp:
-      return "minip";
-    case RenderMode::Average:
-      return "average";
-  }
-  return "composite";
+  return std::string(renderModeToName(mode));
 }
+
+namespace {
+
+// How a JSON value's kind reads in a message.
+std::string kindOf(const nlohmann::json& j) {
+  if (j.is_boolean()) return "true or false";
+  if (j.is_number()) return "a number";
+  if (j.is_string()) return "a string";
+  if (j.is_array()) return "an array";
+  if (j.is_object()) return "an object";
+  return "null";
+}
+
+// fromJson reads each key as the kind its default has; a key of another
+// kind is named here, found against the defaults' own JSON, so that the
+// message says which one ("settings.camera.azimuth is a string, expected a
+// number"). Keys the defaults lack are ignored, as fromJson ignores them.
+void checkKinds(const nlohmann::json& given, const nlohmann::json& defaults,
+                const std::string& where) {
+  const auto scalar = [](const nlohmann::json& j) { return j.is_primitive() && !j.is_null(); };
+  for (const auto& [key, value] : given.items()) {
+    if (!defaults.contains(key)) continue;
+    const nlohmann::json& d = defaults[key];
+    const std::string at = where + "." + key;
+    if (d.is_object() && value.is_object()) checkKinds(value, d, at);
+    if (scalar(d) && kindOf(value) != kindOf(d)) {
+      throw InputError(at + " is " + kindOf(value) + ", expected " + kindOf(d));
+    }
+    if (!d.is_array() || d.empty() || !scalar(d[0]) || !value.is_array()) continue;
+    for (std::size_t i = 0; i < value.size(); ++i) {
+      if (kindOf(value[i]) != kindOf(d[0])) {
+        throw InputError(at + "[" + std::to_string(i) + "] is " + kindOf(value[i]) + ", expected " +
+                         kindOf(d[0]));
+      }
+    }
+  }
+}
+
+}  // namespace
 
 void Settings::validate() const {
   if (!render::TechniqueRegistry::global().contains(technique)) {
@@ -241,6 +267,7 @@ Settings Settings::fromJson(const nlohmann::json& state) {
                      std::to_string(kSettingsVersion));
   }
   Settings s;
+  checkKinds(state, s.toJson(), "settings");
   try {
     s.technique = state.value("technique", s.technique);
     s.layout = state.value("layout", s.layout);

@@ -143,8 +143,7 @@ TEST(RenderState, JsonThatIsNoStateIsNamed) {
   const tessera::test::TempDir tmp;
   writeText(tmp / "tf.json", "{\"name\": \"grey\", \"color\": []}");
   expectStateError(tmp, tmp / "tf.json",
-                   "expected a session state {\"version\", \"settings\": {...}} as --save-state "
-                   "writes it");
+                   "expected a session state {\"version\", \"settings\": {...}}");
 }
 
 TEST(RenderState, AnotherVersionIsNamed) {

@@ -4,6 +4,7 @@
 // native CLI's image; ?url= opens a served file; a second viewer on the same
 // page keeps its own volume, and disposing it leaves the first one working.
 import { test, before, after } from 'node:test';
+import fs from 'node:fs';
 import path from 'node:path';
 import { SIZE, VOLUME, check, checksPassed, startBrowser, psnrOf, decodePng } from './fixture.mjs';
 
@@ -137,6 +138,17 @@ test('the page saves its session state and restores the same view from it', () =
         `moved view ${psnrOf(r.moved, r.saved).toFixed(1)} dB from the saved one`);
   check('state: a bad state is refused naming the setting, and the view stays as it was',
         r.refused.includes('loud') && same(r.afterRefusal, r.restored), r.refused);
+  // The CLI takes the page's state: `tessera render --state` draws the saved view.
+  const { tmp, run } = browser;
+  const statePath = path.join(tmp, 'page-state.json');
+  const cliPng = path.join(tmp, 'page-state.png');
+  fs.writeFileSync(statePath, JSON.stringify(r.state));
+  run('render', VOLUME, '--state', statePath, '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2',
+      '--out', cliPng);
+  const ref = await decodePng(page, cliPng);
+  const db = ref.data.length === r.saved.length ? psnrOf(r.saved, ref.data) : 0;
+  check('state: `tessera render --state` of the page\'s state draws the saved view (PSNR >= 50 dB)',
+        db >= 50, `${db.toFixed(2)} dB`);
   const errors = logs.filter((l) => l.startsWith('pageerror'));
   check('state: no script errors', errors.length === 0, errors.join(' | '));
   await page.close();

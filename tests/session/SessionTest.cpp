@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/ExpectError.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/reference/ImageMetrics.h"
@@ -87,6 +88,14 @@ TEST(SessionSettings, FromJsonRejectsOtherVersionsAndBadValuesByName) {
   }
   j["step"] = "half";
   EXPECT_THROW(Settings::fromJson(j), InputError);
+  j["step"] = 0.5;
+  j["camera"]["azimuth"] = "left";
+  EXPECT_EQ(test::inputErrorMessage([&] { Settings::fromJson(j); }),
+            "settings.camera.azimuth is a string, expected a number");
+  j["camera"]["azimuth"] = 10.0;
+  j["background"][1] = true;
+  EXPECT_EQ(test::inputErrorMessage([&] { Settings::fromJson(j); }),
+            "settings.background[1] is true or false, expected a number");
 }
 
 TEST(Session, RendersAnArrayItWasHandedWithoutCopyingItAgainstTheReference) {

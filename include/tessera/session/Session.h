@@ -48,6 +48,13 @@ struct OpenOptions {
   bool hostVoxels = false;
 };
 
+// A session state file (what Session::saveState, `tessera render
+// --save-state` and the viewers' Save state write), read and checked as far
+// as the file goes: InputError "PATH: ..." when it is a folder, cannot be
+// read, is not JSON, is not a state or is of another version. Its settings
+// are checked by Settings::fromJson, its exploration by Exploration::restore.
+nlohmann::json readStateFile(const std::string& path);
+
 class Session {
  public:
   // A headless device (EGL) obeying `profile` (a built-in name or a JSON
