@@ -74,6 +74,7 @@ Exploration::Exploration(std::shared_ptr<const lod::MultiresSource> source,
                          std::uint64_t regionBudgetBytes, std::uint64_t overviewVoxels,
                          std::string label)
     : explorer_(std::make_unique<viewer::Explorer>(std::move(source), regionBudgetBytes)),
+      regionBudgetBytes_(regionBudgetBytes),
       label_(std::move(label)) {
   if (overviewVoxels > 0) {
     overviewLevel_ = explorer_->overviewLevel(overviewVoxels);
@@ -84,6 +85,7 @@ Exploration::Exploration(std::shared_ptr<const lod::MultiresSource> source,
 Exploration::Exploration(std::shared_ptr<const Volume> volume, std::uint64_t regionBudgetBytes,
                          std::string label)
     : explorer_(std::make_unique<viewer::Explorer>(levelZeroOnly(volume), regionBudgetBytes)),
+      regionBudgetBytes_(regionBudgetBytes),
       label_(std::move(label)),
       overview_(std::move(volume)) {}
 
@@ -223,6 +225,18 @@ void Exploration::showOverview(viewer::Viewer& view, Follow follow) {
     view.camera() = followed(before, view.camera(), follow, std::nullopt);
   }
   overviewShown();
+}
+
+void Exploration::makeLevels() {
+  if (!overview_ || overviewLevel_ != 0 || explorer_->source().levelCount() > 1) return;
+  auto source = std::make_shared<const lod::InCoreMultiresSource>(overview_);
+  if (source->levelCount() < 2) return;  // too small to have coarser levels
+  endZoom();                             // it refers to the explorer replaced here
+  auto next = std::make_unique<viewer::Explorer>(std::move(source), regionBudgetBytes_);
+  next->setCrosshair(explorer_->crosshair());
+  next->setRegionSide(explorer_->regionSide());
+  next->grid() = explorer_->grid();
+  explorer_ = std::move(next);
 }
 
 void Exploration::keepZoom(gpu::GlContext& context, bool wanted,

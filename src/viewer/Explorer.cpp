@@ -102,9 +102,12 @@ Explorer::Explorer(std::shared_ptr<const lod::MultiresSource> source,
       maxRegionSide_(defaultRegionSide(regionBudgetBytes, bytesPerVoxel_)),
       regionSide_(maxRegionSide_),
       crosshair_(dims_ / 2),
-      grid_(lod::GridNavigator::forBudget(
-          dims_, regionBudgetBytes / static_cast<std::uint64_t>(std::max(1, bytesPerVoxel_)),
-          kBrickAlign)) {}
+      grid_(gridForBudget(
+          dims_, regionBudgetBytes / static_cast<std::uint64_t>(std::max(1, bytesPerVoxel_)))) {}
+
+lod::GridNavigator gridForBudget(glm::ivec3 dims, std::uint64_t blockVoxels) {
+  return lod::GridNavigator::forBudget(dims, blockVoxels, kBrickAlign);
+}
 
 void Explorer::setCrosshair(glm::ivec3 voxel) {
   crosshair_ = glm::clamp(voxel, glm::ivec3(0), dims_ - 1);

@@ -271,5 +271,30 @@ TEST(Exploration, ZoomSwapEndsWithAnyOtherStep) {
   EXPECT_THROW(e.zoomFrame(v, 0.0, 32, 32, fb.id()), InputError);
 }
 
+// A volume handed over in memory is explored as one level until the zoom
+// swap needs coarser ones: makeLevels makes them once and keeps what the
+// user set (crosshair, region side, grid cell and point, picked region).
+TEST(Exploration, LevelsAreMadeForTheZoomSwapKeepingTheUsersState) {
+  gpu::GlContext& ctx = test::gpuContext();
+  Exploration e(hashVolume({64, 48, 40}), 16ull * 16 * 16, "hash");
+  EXPECT_EQ(e.explorer().source().levelCount(), 1);
+  e.explorer().setCrosshair({9, 10, 11});
+  e.explorer().setRegionSide(12);
+  e.setGrid(lod::GridNavigator({64, 48, 40}, glm::ivec3(16)));
+  e.enterGrid({40, 30, 20});
+  e.pick(lod::VoxelBox{{1, 2, 3}, {11, 12, 13}});
+  const nlohmann::json before = e.state();
+  e.makeLevels();
+  EXPECT_GE(e.explorer().source().levelCount(), 3);
+  EXPECT_EQ(e.state(), before);
+  EXPECT_EQ(e.overview()->dims(), glm::ivec3(64, 48, 40));  // still the volume itself, level 0
+  const auto stages = viewer::zoomStagesFor(e.explorer(), 0, 400.0);
+  EXPECT_GE(stages.size(), 2u);
+  e.keepZoom(ctx, true, stages, "a");
+  ASSERT_NE(e.zoom(), nullptr);
+  e.makeLevels();  // a no-op now: the swap stays
+  EXPECT_NE(e.zoom(), nullptr);
+}
+
 }  // namespace
 }  // namespace tessera::session

@@ -282,11 +282,10 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_zoom_json() {
   guarded([&] {
     web::WebSession* s = web::sessionIfAny();
     if (!s || !s->zoomActive()) return;
-    const web::ZoomView& z = s->zoom();
-    const viewer::ZoomSwap& zs = *z.swap;
+    const viewer::ZoomSwap& zs = *s->zoomSwap();
     viewer::Viewer& v = s->viewer();
     j["active"] = true;
-    j["name"] = z.name;
+    j["name"] = s->zoomName();
     j["stages"] = nlohmann::json::array();
     for (const lod::ZoomStage& st : zs.policy().stages()) {
       j["stages"].push_back({{"name", st.name},
@@ -302,8 +301,8 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_zoom_json() {
     j["target"] = zs.policy().stageFor(std::max(0, zs.shownStage()), zs.overviewZoom(v.camera()));
     j["block"] = zs.shownBox() ? boxJson(*zs.shownBox()) : nlohmann::json(nullptr);
     j["voxels_read"] = zs.voxelsRead();
-    j["whole_voxels"] = z.whole->voxelCount();
-    j["medium_level"] = z.mediumLevel;
+    j["whole_voxels"] = s->zoomOverview()->voxelCount();
+    j["medium_level"] = s->zoomMediumLevel();
   });
   return web::jsonOut(j);
 }

@@ -54,16 +54,6 @@ struct MarkBox {
   glm::ivec3 dims{0};
 };
 
-struct ZoomView {
-  std::shared_ptr<const Volume> whole;  // the loaded volume (level 0 of the pyramid)
-  std::string name;                     // its name
-  std::unique_ptr<viewer::Explorer> explorer;
-  std::unique_ptr<viewer::ZoomSwap> swap;  // after the explorer: it holds a reference
-  int mediumLevel = 0;
-  double lastFrameMs = -1.0;
-  std::string shownName;  // the viewer's volume after the last frame
-};
-
 struct CropState {
   bool show = false;  // the crop box and its handles in the 3D view
   viewer::CropHandles handles;
@@ -192,13 +182,20 @@ class WebSession {
   // The grid view's last block over a store, while the store is drawn.
   std::optional<lod::VoxelBox> storeGridBlock();
 
-  // ---- the zoom-driven level swap (WebSessionZoom.cpp)
+  // ---- the zoom-driven level swap (WebSessionZoom.cpp): the exploration's
+  // (session::Exploration::keepZoom), over the loaded file.
   bool zoomActive();
+  const viewer::ZoomSwap* zoomSwap() { return zoomActive() ? explore()->zoom() : nullptr; }
+  // The whole loaded volume while the swap drives the view (null otherwise).
   const Volume* zoomOverview();
-  const ZoomView& zoom() const { return zoom_; }
+  const std::string& zoomName() { return explore()->label(); }
+  int zoomMediumLevel() const { return zoomMediumLevel_; }
   std::optional<lod::VoxelBox> zoomBox();
   void zoomStart(int viewPixels, double overviewVoxels, double blockVoxels);
-  void zoomForget() { zoom_ = ZoomView(); }
+  void zoomForget() {
+    if (explore()) explore()->endZoom();
+    zoomLastFrameMs_ = -1.0;
+  }
   // Hands the view back to the whole volume, the camera kept.
   void zoomStop();
   double zoomFrame(int width, int height);
@@ -216,13 +213,14 @@ class WebSession {
   // before the context.
   gpu::WebGlContext context_;
   std::unique_ptr<ZarrStoreView> zarr_;
-  ZoomView zoom_;
   std::unique_ptr<session::Session> session_;
   std::vector<PickedFile> picked_;
   SliceViews slices_;
   MarkBox marks_[2];
   std::string exploreKey_;  // the overview it was made for: name and dims
   int askedCell_ = 0;       // the grid cell side asked for (0: the default)
+  int zoomMediumLevel_ = 0;
+  double zoomLastFrameMs_ = -1.0;
   CropState crop_;
   std::vector<std::uint8_t> pixels_;
 };

@@ -35,6 +35,8 @@ std::string rangeText(const lod::VoxelBox& box, int a) {
 }  // namespace
 
 bool WebSession::regionShown() {
+  // The zoom swap's native stage is a block of the grid, shown by the swap.
+  if (zoomActive()) return false;
   if (!explore() || explore()->mode() == session::ExploreMode::Overview) return false;
   const viewer::Viewer& v = viewer();
   if (v.hasVolume() && v.volumeName() == explore()->shownName()) return true;
@@ -59,7 +61,7 @@ const Volume& WebSession::overviewVolume() {
 std::string WebSession::overviewName() {
   if (storeOverview()) return theStore().storage().describe();
   if (regionShown()) return explore()->label();
-  if (zoomOverview()) return zoom_.name;
+  if (zoomOverview()) return zoomName();
   return viewer().volumeName();
 }
 

@@ -14,7 +14,6 @@
 
 #include "WebSession.h"
 #include "tessera/core/Error.h"
-#include "tessera/lod/InCoreMultiresSource.h"
 
 namespace tessera::web {
 
@@ -27,54 +26,42 @@ constexpr double kMaxFadeStepMs = 100.0;
 
 }  // namespace
 
-// True while the zoom swap drives the viewer (a volume loaded since ends it).
+// True while the exploration's zoom swap drives the viewer (another volume
+// loaded since came with another exploration, without one).
 bool WebSession::zoomActive() {
-  if (!zoom_.swap) return false;
-  const viewer::Viewer& v = viewer();
-  if (v.hasVolume() && v.volumeName() == zoom_.shownName) return true;
-  zoom_ = ZoomView();
-  return false;
+  return explore() != nullptr && explore()->zoom() != nullptr;
 }
 
 const Volume* WebSession::zoomOverview() {
-  return zoomActive() ? zoom_.whole.get() : nullptr;
+  return zoomActive() ? explore()->overview().get() : nullptr;
 }
 
 std::optional<lod::VoxelBox> WebSession::zoomBox() {
-  return zoomActive() ? zoom_.swap->shownBox() : std::nullopt;
+  return zoomActive() ? explore()->zoom()->shownBox() : std::nullopt;
 }
 
+// The whole volume back in the view, the camera following so that every
+// point stays where it was on screen (session::Follow::Keep).
 void WebSession::zoomStop() {
   if (!zoomActive()) {
     zoomForget();
     return;
   }
-  viewer::Viewer& v = viewer();
-  const Camera before = v.camera();
-  const ValueRange window = v.window();
-  const std::optional<lod::VoxelBox> box = zoom_.swap->shownBox();
-  std::shared_ptr<const Volume> whole = zoom_.whole;
-  const std::string name = zoom_.name;
-  v.setVolume(Volume(*whole), name);  // throws with the zoom swap still on
-  zoomForget();
-  v.setWindow(window);
-  v.camera() = viewer::cameraAcrossSwap(before, box, std::nullopt, whole->dims(), whole->spacing());
+  explore()->showOverview(viewer(), session::Follow::Keep);  // ends the swap
+  zoomLastFrameMs_ = -1.0;
 }
 
 double WebSession::zoomFrame(int width, int height) {
-  viewer::Viewer& v = viewer();
   const double now = emscripten_get_now();
-  const double dt =
-      zoom_.lastFrameMs < 0.0 ? 0.0 : std::min(now - zoom_.lastFrameMs, kMaxFadeStepMs);
-  zoom_.lastFrameMs = now;
-  zoom_.swap->frame(v, dt, width, height);
-  zoom_.shownName = v.volumeName();
+  const double dt = zoomLastFrameMs_ < 0.0 ? 0.0 : std::min(now - zoomLastFrameMs_, kMaxFadeStepMs);
+  zoomLastFrameMs_ = now;
+  explore()->zoomFrame(viewer(), dt, width, height);
   return emscripten_get_now() - now;
 }
 
 // Stages for a view `viewPixels` high; `overviewVoxels` > 0 replaces the
 // profile's overview budget and `blockVoxels` > 0 its native block budget
-// (e.g. to see all three stages on a small volume).
+// (the grid's cells: e.g. to see all three stages on a small volume).
 void WebSession::zoomStart(int viewPixels, double overviewVoxels, double blockVoxels) {
   viewer::Viewer& v = viewer();
   if (storeOverview()) {
@@ -88,28 +75,23 @@ void WebSession::zoomStart(int viewPixels, double overviewVoxels, double blockVo
   returnToOverview();
   zoomStop();
   if (!v.hasVolume()) throw InputError("zoom swap: no volume is loaded");
-  ZoomView z;
-  z.whole = std::make_shared<const Volume>(v.volume());
-  z.name = v.volumeName();
-  auto source = std::make_shared<const lod::InCoreMultiresSource>(z.whole);
-  const gpu::DeviceLimits& limits = v.limits();
-  const std::uint64_t bpv = bytesPerVoxel(z.whole->type());
-  const std::uint64_t blockBytes = blockVoxels > 0.0 ? static_cast<std::uint64_t>(blockVoxels) * bpv
-                                                     : viewer::regionBudgetBytes(limits);
-  z.explorer = std::make_unique<viewer::Explorer>(source, blockBytes);
-  z.mediumLevel =
-      z.explorer->overviewLevel(overviewVoxels > 0.0 ? static_cast<std::uint64_t>(overviewVoxels)
-                                                     : viewer::overviewVoxelBudget(limits));
-  const std::vector<lod::ZoomStage> stages =
-      viewer::zoomStagesFor(*z.explorer, z.mediumLevel, std::max(1, viewPixels));
-  if (stages.size() < 2) {
-    throw InputError("zoom swap: " + z.name + " is too small to have coarser levels");
+  session::Exploration& e = exploration();
+  e.makeLevels();
+  if (blockVoxels > 0.0) {
+    e.setGrid(viewer::gridForBudget(e.dims(), static_cast<std::uint64_t>(blockVoxels)));
   }
-  z.swap = std::make_unique<viewer::ZoomSwap>(context(), *z.explorer, stages);
-  z.swap->keepLevel(0, z.whole);
-  z.swap->setLabel(z.name);
-  z.shownName = v.volumeName();
-  zoom_ = std::move(z);
+  const gpu::DeviceLimits& limits = v.limits();
+  const int medium =
+      e.explorer().overviewLevel(overviewVoxels > 0.0 ? static_cast<std::uint64_t>(overviewVoxels)
+                                                      : viewer::overviewVoxelBudget(limits));
+  const std::vector<lod::ZoomStage> stages =
+      viewer::zoomStagesFor(e.explorer(), medium, std::max(1, viewPixels));
+  if (stages.size() < 2) {
+    throw InputError("zoom swap: " + e.label() + " is too small to have coarser levels");
+  }
+  e.keepZoom(context(), true, stages, "page");
+  zoomMediumLevel_ = medium;
+  zoomLastFrameMs_ = -1.0;
 }
 
 }  // namespace tessera::web

@@ -133,6 +133,11 @@ class Exploration {
   // Its lifetime is the exploration's: the front end only says whether it
   // is wanted; any other step (show, showOverview) ends it.
   //
+  // makeLevels: a volume handed over in memory is explored as one level
+  // (no coarser level is made until needed); the zoom swap needs its coarser
+  // levels, made here once (lod::downsample). The crosshair, region side,
+  // grid and picked region stay; a running swap ends. No-op for a pyramid.
+  void makeLevels();
   // keepZoom: wanted with two stages or more, a swap for `stages` runs from
   // here on (made from the overview only, so after another step once the
   // view is back there; made again when `key`, naming the stages, changes);
@@ -166,6 +171,7 @@ class Exploration {
                   const std::optional<lod::VoxelBox>& to) const;
 
   std::unique_ptr<viewer::Explorer> explorer_;
+  std::uint64_t regionBudgetBytes_ = 0;
   std::string label_;
   std::shared_ptr<const Volume> overview_;
   int overviewLevel_ = 0;

@@ -71,6 +71,11 @@ Camera cameraAcrossSwap(const Camera& before, const std::optional<lod::VoxelBox>
                         const std::optional<lod::VoxelBox>& to, glm::ivec3 dims,
                         glm::dvec3 spacing);
 
+// The grid view's grid over `dims` whose 2x2x2 block has at most
+// `blockVoxels` voxels, its cells on brick boundaries (what an Explorer
+// makes from its region budget).
+lod::GridNavigator gridForBudget(glm::ivec3 dims, std::uint64_t blockVoxels);
+
 class Explorer {
  public:
   // `regionBudgetBytes`: what a native region or grid block may take (the
