@@ -1,7 +1,9 @@
 // The DICOM reader that needs no DCMTK (see DicomBasicReader.h): a Part-10
 // parser (PS3.10 7.1; data elements PS3.5 7.1, sequences 7.5, encapsulated
-// pixel data A.4) and an RLE Lossless decoder (PS3.5 Annex G) in front of
-// the series code the DCMTK reader uses (io/DicomSeries.cpp).
+// pixel data A.4), an RLE Lossless decoder (PS3.5 Annex G) and, natively,
+// JPEG 2000 and HTJ2K frames through OpenJPEG and OpenJPH
+// (io/Jpeg2000Frame.h), in front of the series code the DCMTK reader uses
+// (io/DicomSeries.cpp).
 #include "tessera/io/DicomBasicReader.h"
 
 #include <algorithm>
@@ -20,6 +22,9 @@
 #include <vector>
 
 #include "io/DicomSeries.h"
+#ifndef __EMSCRIPTEN__
+#include "io/Jpeg2000Frame.h"
+#endif
 #include "tessera/core/Error.h"
 #include "tessera/io/DicomDecoder.h"
 
@@ -37,6 +42,11 @@ constexpr std::uint32_t kUndefinedLength = 0xffffffffu;
 // PackBits never expands more than 64:1: a two-byte replicate run gives at
 // most 128 bytes (PS3.5 G.3.1). It bounds what an RLE frame can hold.
 constexpr std::uint64_t kMaxRleRatio = 64;
+// What a JPEG 2000 or HTJ2K frame is taken to expand to at most, so that a
+// small file cannot declare a huge image: lossy CT and MR stay under 1:200,
+// but a nearly uniform test image reaches 1:2100 (pydicom's JPEG2000.dcm:
+// 512 KiB of pixels in a 250-byte codestream); 4096 leaves room for both.
+constexpr std::uint64_t kMaxJpeg2000Ratio = 4096;
 // No attribute read here is longer (LT holds 10240 characters).
 constexpr std::uint32_t kLongestAttribute = 64 * 1024;
 
@@ -53,31 +63,52 @@ std::string tagText(std::uint32_t key) {
   return DicomTag{static_cast<std::uint16_t>(key >> 16), static_cast<std::uint16_t>(key)}.text();
 }
 
+// How a syntax's pixel data is stored.
+enum class Codec { None, Rle, Jpeg2000, Htj2k };
+
+#ifdef __EMSCRIPTEN__
+// The page has no OpenJPEG or OpenJPH (their WebAssembly builds are not
+// loaded yet): JPEG 2000 and HTJ2K are refused there with the reason.
+constexpr bool kJpeg2000Codecs = false;
+#else
+constexpr bool kJpeg2000Codecs = true;
+#endif
+
 struct TransferSyntax {
   const char* uid;
   const char* name;  // DCMTK's names, so both readers describe a file alike
   bool readable;
   bool implicitVr;
-  bool rle;
+  Codec codec;
 };
 
 // The syntaxes read here, and the usual others, named in the refusal.
 constexpr TransferSyntax kSyntaxes[] = {
-    {"1.2.840.10008.1.2", "Little Endian Implicit", true, true, false},
-    {"1.2.840.10008.1.2.1", "Little Endian Explicit", true, false, false},
-    {"1.2.840.10008.1.2.5", "RLE Lossless", true, false, true},
-    {"1.2.840.10008.1.2.2", "Big Endian Explicit", false, false, false},
-    {"1.2.840.10008.1.2.1.99", "Deflated Explicit VR Little Endian", false, false, false},
-    {"1.2.840.10008.1.2.4.50", "JPEG Baseline", false, false, false},
-    {"1.2.840.10008.1.2.4.51", "JPEG Extended", false, false, false},
-    {"1.2.840.10008.1.2.4.57", "JPEG Lossless, Non-hierarchical", false, false, false},
+    {"1.2.840.10008.1.2", "Little Endian Implicit", true, true, Codec::None},
+    {"1.2.840.10008.1.2.1", "Little Endian Explicit", true, false, Codec::None},
+    {"1.2.840.10008.1.2.5", "RLE Lossless", true, false, Codec::Rle},
+    {"1.2.840.10008.1.2.2", "Big Endian Explicit", false, false, Codec::None},
+    {"1.2.840.10008.1.2.1.99", "Deflated Explicit VR Little Endian", false, false, Codec::None},
+    {"1.2.840.10008.1.2.4.50", "JPEG Baseline", false, false, Codec::None},
+    {"1.2.840.10008.1.2.4.51", "JPEG Extended", false, false, Codec::None},
+    {"1.2.840.10008.1.2.4.57", "JPEG Lossless, Non-hierarchical", false, false, Codec::None},
     {"1.2.840.10008.1.2.4.70", "JPEG Lossless, Non-hierarchical, First-Order Prediction", false,
-     false, false},
-    {"1.2.840.10008.1.2.4.80", "JPEG-LS Lossless", false, false, false},
-    {"1.2.840.10008.1.2.4.81", "JPEG-LS Lossy (Near-lossless)", false, false, false},
-    {"1.2.840.10008.1.2.4.90", "JPEG 2000 (Lossless only)", false, false, false},
-    {"1.2.840.10008.1.2.4.91", "JPEG 2000", false, false, false},
+     false, Codec::None},
+    {"1.2.840.10008.1.2.4.80", "JPEG-LS Lossless", false, false, Codec::None},
+    {"1.2.840.10008.1.2.4.81", "JPEG-LS Lossy (Near-lossless)", false, false, Codec::None},
+    {"1.2.840.10008.1.2.4.90", "JPEG 2000 (Lossless only)", kJpeg2000Codecs, false,
+     Codec::Jpeg2000},
+    {"1.2.840.10008.1.2.4.91", "JPEG 2000", kJpeg2000Codecs, false, Codec::Jpeg2000},
+    {"1.2.840.10008.1.2.4.201", "HTJ2K (Lossless only)", kJpeg2000Codecs, false, Codec::Htj2k},
+    {"1.2.840.10008.1.2.4.202", "HTJ2K with RPCL Options (Lossless only)", kJpeg2000Codecs, false,
+     Codec::Htj2k},
+    {"1.2.840.10008.1.2.4.203", "HTJ2K", kJpeg2000Codecs, false, Codec::Htj2k},
 };
+
+// What this build reads, for messages and the decoder table.
+constexpr const char* kReadsText =
+    kJpeg2000Codecs ? "implicit and explicit VR little endian, RLE Lossless, JPEG 2000 and HTJ2K"
+                    : "implicit and explicit VR little endian and RLE Lossless";
 
 bool isLongVr(std::string_view vr) {
   static constexpr std::array<std::string_view, 13> kLong = {
@@ -155,7 +186,7 @@ class Part10File final : public io_detail::DicomAttributes {
       }
       throw InputError(unsupportedSyntaxMessage());
     }
-    encapsulated_ = ts->rle;
+    encapsulated_ = ts->codec != Codec::None;
     parseDataset(ts->implicitVr);
   }
 
@@ -164,6 +195,7 @@ class Part10File final : public io_detail::DicomAttributes {
     return std::string(syntax_ != nullptr ? syntax_->name : "unknown") + " (" + syntaxUid_ + ")";
   }
   bool encapsulated() const { return encapsulated_; }
+  Codec codec() const { return syntax_ != nullptr ? syntax_->codec : Codec::None; }
   bool hasPixelData() const { return pixelData_.has_value() || !fragments_.empty(); }
   const std::optional<Element>& pixelData() const { return pixelData_; }
   const std::vector<Element>& fragments() const { return fragments_; }
@@ -293,9 +325,9 @@ class Part10File final : public io_detail::DicomAttributes {
     const std::string what = syntax_ != nullptr
                                  ? std::string(syntax_->name) + " (" + syntaxUid_ + ")"
                                  : "'" + printable(syntaxUid_) + "' (unknown)";
-    return name_ + ": transfer syntax " + what +
-           " is not read by this DICOM reader (it reads implicit and explicit VR little endian "
-           "and RLE Lossless); open the folder with the native tessera (DCMTK), or convert it, "
+    return name_ + ": transfer syntax " + what + " is not read by this DICOM reader (it reads " +
+           kReadsText +
+           "); open the folder with the native tessera (DCMTK), or convert it, "
            "e.g. `gdcmconv --raw " +
            name_ + " out.dcm`";
   }
@@ -435,8 +467,9 @@ Slice sliceOf(const Part10File& f) {
   if (f.encapsulated()) {
     std::uint64_t compressed = 0;
     for (const Element& e : f.fragments()) compressed += e.length;
-    s.decodedBytesBound = compressed * kMaxRleRatio;
-    s.compression = "RLE Lossless";
+    const bool rle = f.codec() == Codec::Rle;
+    s.decodedBytesBound = compressed * (rle ? kMaxRleRatio : kMaxJpeg2000Ratio);
+    s.compression = rle ? "RLE Lossless" : f.syntaxText();
   }
   return s;
 }
@@ -518,6 +551,24 @@ std::vector<std::uint8_t> decodeRle(const Slice& s, const std::vector<std::uint8
   return out;
 }
 
+// One encapsulated frame's samples (8- or 16-bit, host order).
+std::vector<std::uint8_t> decodeFrame(const Slice& s, Codec codec,
+                                      const std::vector<std::uint8_t>& frame) {
+#ifndef __EMSCRIPTEN__
+  if (codec == Codec::Jpeg2000 || codec == Codec::Htj2k) {
+    const io_detail::FrameShape shape{.rows = s.rows,
+                                      .columns = s.columns,
+                                      .bitsAllocated = s.bitsAllocated,
+                                      .bitsStored = s.bitsStored,
+                                      .samplesPerPixel = s.samplesPerPixel};
+    return codec == Codec::Jpeg2000 ? io_detail::decodeJpeg2000Frame(frame, shape, s.file.string())
+                                    : io_detail::decodeHtj2kFrame(frame, shape, s.file.string());
+  }
+#endif
+  if (codec != Codec::Rle) throw InputError(s.file.string() + ": no decoder for its pixel data");
+  return decodeRle(s, frame);
+}
+
 using Opener = std::function<std::unique_ptr<ByteSource>(const fs::path&)>;
 
 // Decodes a slice's pixels (the file is parsed again: only the headers of
@@ -531,7 +582,7 @@ io_detail::PixelDecoder pixelDecoder(const Opener& open) {
       std::vector<std::uint8_t> frame;
       for (const Element& e : f.fragments())
         frame.insert(frame.end(), f.at(e.offset), f.at(e.offset) + e.length);
-      const std::vector<std::uint8_t> samples = decodeRle(s, frame);
+      const std::vector<std::uint8_t> samples = decodeFrame(s, f.codec(), frame);
       return io_detail::storePixels(s, samples.data(), samples.size(), stored, z);
     }
     const Element& e = *f.pixelData();
@@ -630,7 +681,8 @@ class BasicDicomDecoder final : public DicomDecoder {
   }
   bool canRead(const FileSet&) const override { return true; }
   std::string decodes() const override {
-    return "implicit/explicit VR little endian, RLE lossless";
+    return kJpeg2000Codecs ? "uncompressed little endian, RLE, JPEG 2000, HTJ2K"
+                           : "uncompressed little endian, RLE";
   }
   Volume read(const ByteSource& named, const FileSet& files,
               const std::string& seriesUid) const override {
