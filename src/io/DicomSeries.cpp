@@ -287,20 +287,22 @@ bool samePixelSpacing(const Slice& a, const Slice& b) {
 }
 
 // One Series Instance UID can hold several stacks (a localizer beside its
-// slices, reconstructions of other sizes or orientations). A named file
-// selects its own: the slices of its size, frame count, pixel type,
-// orientation and pixel spacing. Returns how many others were left out.
+// slices, reconstructions of other sizes or orientations): slices of one
+// stack share size, frame count, pixel type, orientation and pixel spacing.
+bool sameStack(const Slice& s, const Slice& r) {
+  return s.rows == r.rows && s.columns == r.columns && s.frames == r.frames &&
+         s.bitsAllocated == r.bitsAllocated && s.isSigned == r.isSigned && sameOrientation(s, r) &&
+         samePixelSpacing(s, r);
+}
+
+// A named file selects its own stack. Returns how many others were left out.
 std::size_t keepStackOf(std::vector<Slice>& slices, const fs::path& named) {
   const auto ref =
       std::find_if(slices.begin(), slices.end(), [&](const Slice& s) { return s.file == named; });
   if (ref == slices.end()) return 0;
   const Slice r = *ref;
   const std::size_t before = slices.size();
-  std::erase_if(slices, [&](const Slice& s) {
-    return s.rows != r.rows || s.columns != r.columns || s.frames != r.frames ||
-           s.bitsAllocated != r.bitsAllocated || s.isSigned != r.isSigned ||
-           !sameOrientation(s, r) || !samePixelSpacing(s, r);
-  });
+  std::erase_if(slices, [&](const Slice& s) { return !sameStack(s, r); });
   return before - slices.size();
 }
 
@@ -842,17 +844,19 @@ void addSkipNotes(const PickedSeries& p, const FolderScan& scan, const fs::path&
   }
 }
 
-}  // namespace
-
-Volume readSeries(FolderScan scan, const std::string& seriesUid, const std::string& what,
-                  const PixelDecoder& decode, const fs::path& named) {
+// The series picked from `scan`, checked, decoded and described; `lead`
+// notes come first in the description.
+Volume assembleSeries(FolderScan scan, const std::string& seriesUid, const std::string& what,
+                      const PixelDecoder& decode, const fs::path& named,
+                      std::vector<std::string> lead = {}) {
   refuseEmpty(scan, what);
   std::vector<SeriesGroup> groups = groupSeries(std::move(scan.slices));
   PickedSeries p = pickSeries(groups, std::move(scan.unreadable), seriesUid, named, what);
   for (const auto& s : p.slices) checkSlice(s);
   checkConsistent(p.slices);
   const Geometry g = geometryOf(p.slices);
-  std::vector<std::string> notes = g.notes;
+  std::vector<std::string> notes = std::move(lead);
+  notes.insert(notes.end(), g.notes.begin(), g.notes.end());
   Volume v = readVoxels(p.slices, what, decode, notes);
   applyGeometry(g, v);
   addSkipNotes(p, scan, named, notes);
@@ -864,6 +868,84 @@ Volume readSeries(FolderScan scan, const std::string& seriesUid, const std::stri
   for (const auto& n : notes) d += "; " + n;
   v.setDescription(d);
   return v;
+}
+
+// Why the named file `own` is read alone, for the note: the copies of it in
+// its stack when there are (what makes pydicom's test files, several
+// encodings of one slice sharing a Series Instance UID, unusable as a
+// series), else the error the series gave.
+std::string readAloneNote(const Slice& own, const std::vector<Slice>& neighbours,
+                          std::size_t unreadableNeighbours, const std::string& what,
+                          const std::string& error) {
+  std::vector<const Slice*> copies;
+  std::size_t stack = 0;
+  for (const Slice& s : neighbours) {
+    if (!sameStack(s, own)) continue;
+    ++stack;
+    if (own.position && s.position && glm::length(*s.position - *own.position) <= kSamePositionMm) {
+      copies.push_back(&s);
+    }
+  }
+  if (!own.position && stack > 0) {
+    return what + ": read alone: it has no Image Position (Patient) (0020,0032), so the " +
+           std::to_string(stack) + " other file" + (stack == 1 ? "" : "s") +
+           " of its series cannot be ordered with it";
+  }
+  if (!copies.empty()) {
+    return what + ": read alone: " + std::to_string(copies.size()) + " other file" +
+           (copies.size() == 1 ? " of its series is" : "s of its series are") +
+           " at its position (duplicate slices, e.g. " + copies.front()->file.string() +
+           "), so the series around it was not assembled";
+  }
+  const std::size_t others = neighbours.size() + unreadableNeighbours;
+  return what + ": read alone: the series around it (" + std::to_string(others) + " other file" +
+         (others == 1 ? "" : "s") + " of its series) was not assembled: " + error;
+}
+
+}  // namespace
+
+Volume readSeries(FolderScan scan, const std::string& seriesUid, const std::string& what,
+                  const PixelDecoder& decode, const fs::path& named) {
+  const auto own = std::find_if(scan.slices.begin(), scan.slices.end(),
+                                [&](const Slice& s) { return !named.empty() && s.file == named; });
+  // Files given as a folder or a list are one series or an error; so is a
+  // named file when another series is asked for.
+  if (own == scan.slices.end() || (!seriesUid.empty() && seriesUid != own->seriesUid)) {
+    return assembleSeries(std::move(scan), seriesUid, what, decode, named);
+  }
+  // A file named on its own is what the user wants to see. When the files
+  // of its series beside it cannot be assembled with it (copies of it,
+  // other encodings of the same slice, a broken or misplaced neighbour), it
+  // is read as if alone in its folder, with a note naming the reason; its
+  // own errors still refuse it. The series is never read short of a slice.
+  FolderScan alone;
+  alone.where = "file " + what + " (alone)";
+  alone.slices.push_back(*own);
+  std::vector<Slice> neighbours;
+  for (const Slice& s : scan.slices) {
+    if (s.seriesUid == own->seriesUid && s.file != named) neighbours.push_back(s);
+  }
+  const std::size_t unreadableNeighbours =
+      own->seriesUid.empty()
+          ? 0
+          : static_cast<std::size_t>(
+                std::count_if(scan.unreadable.begin(), scan.unreadable.end(),
+                              [&](const UnreadableFile& u) { return u.seriesUid == own->seriesUid; }));
+  if (neighbours.empty() && unreadableNeighbours == 0) {
+    return assembleSeries(std::move(scan), seriesUid, what, decode, named);
+  }
+  try {
+    return assembleSeries(std::move(scan), seriesUid, what, decode, named);
+  } catch (const InputError& e) {
+    const std::string note =
+        readAloneNote(alone.slices.front(), neighbours, unreadableNeighbours, what, e.what());
+    // Its own errors (the series failed on them too) refuse it here.
+    Volume v = assembleSeries(std::move(alone), "", what, decode, named, {note});
+    // Reading one slice instead of the series the user may expect is said
+    // where it is seen, not only in the description.
+    std::fprintf(stderr, "note: %s\n", note.c_str());
+    return v;
+  }
 }
 
 std::vector<DicomSeriesInfo> listSeries(FolderScan scan) {
