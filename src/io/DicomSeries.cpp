@@ -908,10 +908,20 @@ Volume readSeries(FolderScan scan, const std::string& seriesUid, const std::stri
                   const PixelDecoder& decode, const fs::path& named) {
   const auto own = std::find_if(scan.slices.begin(), scan.slices.end(),
                                 [&](const Slice& s) { return !named.empty() && s.file == named; });
-  // Files given as a folder or a list are one series or an error; so is a
-  // named file when another series is asked for.
-  if (own == scan.slices.end() || (!seriesUid.empty() && seriesUid != own->seriesUid)) {
+  // Files given as a folder or a list are one series or an error.
+  if (own == scan.slices.end()) {
     return assembleSeries(std::move(scan), seriesUid, what, decode, named);
+  }
+  // So is a series asked for by its UID beside a named file; its errors
+  // name that file too, the one the user gave.
+  if (!seriesUid.empty()) {
+    try {
+      return assembleSeries(std::move(scan), seriesUid, what, decode, named);
+    } catch (const InputError& e) {
+      const std::string m = e.what();
+      if (m.find(named.string()) != std::string::npos || m.find(what) != std::string::npos) throw;
+      throw InputError(what + ": series " + seriesUid + " beside it: " + m);
+    }
   }
   // A file named on its own is what the user wants to see. When the files
   // of its series beside it cannot be assembled with it (copies of it,
@@ -940,7 +950,7 @@ Volume readSeries(FolderScan scan, const std::string& seriesUid, const std::stri
     const std::string note =
         readAloneNote(alone.slices.front(), neighbours, unreadableNeighbours, what, e.what());
     // Its own errors (the series failed on them too) refuse it here.
-    Volume v = assembleSeries(std::move(alone), "", what, decode, named, {note});
+    Volume v = assembleSeries(std::move(alone), seriesUid, what, decode, named, {note});
     // Reading one slice instead of the series the user may expect is said
     // where it is seen, not only in the description.
     std::fprintf(stderr, "note: %s\n", note.c_str());
