@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <optional>
 #include <system_error>
 #include <utility>
 
@@ -870,36 +871,35 @@ Volume assembleSeries(FolderScan scan, const std::string& seriesUid, const std::
   return v;
 }
 
-// Why the named file `own` is read alone, for the note: the copies of it in
-// its stack when there are (what makes pydicom's test files, several
-// encodings of one slice sharing a Series Instance UID, unusable as a
-// series), else the error the series gave.
-std::string readAloneNote(const Slice& own, const std::vector<Slice>& neighbours,
-                          std::size_t unreadableNeighbours, const std::string& what,
-                          const std::string& error) {
-  std::vector<const Slice*> copies;
+// Why a named file cannot take a place in its series, for the note that
+// says it is read alone: other files of its stack at its position (copies,
+// other encodings of the same slice: pydicom's test files share a Series
+// Instance UID), or no Image Position (Patient) to order it among them.
+// nullopt when it can (the series is then read, or refused naming the file
+// at fault), or when nothing of its stack is beside it.
+std::optional<std::string> cannotHold(const Slice& own, const std::vector<Slice>& slices,
+                                      const std::string& what) {
   std::size_t stack = 0;
-  for (const Slice& s : neighbours) {
-    if (!sameStack(s, own)) continue;
+  const Slice* copy = nullptr;
+  std::size_t copies = 0;
+  for (const Slice& s : slices) {
+    if (s.file == own.file || s.seriesUid != own.seriesUid || !sameStack(s, own)) continue;
     ++stack;
     if (own.position && s.position && glm::length(*s.position - *own.position) <= kSamePositionMm) {
-      copies.push_back(&s);
+      if (copies++ == 0) copy = &s;
     }
   }
-  if (!own.position && stack > 0) {
+  if (stack == 0) return std::nullopt;
+  if (!own.position) {
     return what + ": read alone: it has no Image Position (Patient) (0020,0032), so the " +
            std::to_string(stack) + " other file" + (stack == 1 ? "" : "s") +
            " of its series cannot be ordered with it";
   }
-  if (!copies.empty()) {
-    return what + ": read alone: " + std::to_string(copies.size()) + " other file" +
-           (copies.size() == 1 ? " of its series is" : "s of its series are") +
-           " at its position (duplicate slices, e.g. " + copies.front()->file.string() +
-           "), so the series around it was not assembled";
-  }
-  const std::size_t others = neighbours.size() + unreadableNeighbours;
-  return what + ": read alone: the series around it (" + std::to_string(others) + " other file" +
-         (others == 1 ? "" : "s") + " of its series) was not assembled: " + error;
+  if (copies == 0) return std::nullopt;
+  return what + ": read alone: " + std::to_string(copies) + " other file" +
+         (copies == 1 ? " of its series is" : "s of its series are") +
+         " at its position (duplicate slices, e.g. " + copy->file.string() +
+         "), so the series around it was not assembled";
 }
 
 }  // namespace
@@ -912,49 +912,32 @@ Volume readSeries(FolderScan scan, const std::string& seriesUid, const std::stri
   if (own == scan.slices.end()) {
     return assembleSeries(std::move(scan), seriesUid, what, decode, named);
   }
-  // So is a series asked for by its UID beside a named file; its errors
-  // name that file too, the one the user gave.
-  if (!seriesUid.empty()) {
-    try {
-      return assembleSeries(std::move(scan), seriesUid, what, decode, named);
-    } catch (const InputError& e) {
-      const std::string m = e.what();
-      if (m.find(named.string()) != std::string::npos || m.find(what) != std::string::npos) throw;
-      throw InputError(what + ": series " + seriesUid + " beside it: " + m);
+  // A file named on its own that its series cannot hold is what the user
+  // wants to see: it is read as if alone in its folder, with a note, rather
+  // than refused for its neighbours; its own errors still refuse it. A
+  // series asked for by UID is that series or an error.
+  if (seriesUid.empty()) {
+    if (const auto note = cannotHold(*own, scan.slices, what)) {
+      FolderScan alone;
+      alone.where = "file " + what + " (alone)";
+      alone.slices.push_back(*own);
+      Volume v = assembleSeries(std::move(alone), "", what, decode, named, {*note});
+      // One slice instead of the series the user may expect is said where
+      // it is seen, not only in the description.
+      std::fprintf(stderr, "note: %s\n", note->c_str());
+      return v;
     }
   }
-  // A file named on its own is what the user wants to see. When the files
-  // of its series beside it cannot be assembled with it (copies of it,
-  // other encodings of the same slice, a broken or misplaced neighbour), it
-  // is read as if alone in its folder, with a note naming the reason; its
-  // own errors still refuse it. The series is never read short of a slice.
-  FolderScan alone;
-  alone.where = "file " + what + " (alone)";
-  alone.slices.push_back(*own);
-  std::vector<Slice> neighbours;
-  for (const Slice& s : scan.slices) {
-    if (s.seriesUid == own->seriesUid && s.file != named) neighbours.push_back(s);
-  }
-  const std::size_t unreadableNeighbours =
-      own->seriesUid.empty()
-          ? 0
-          : static_cast<std::size_t>(
-                std::count_if(scan.unreadable.begin(), scan.unreadable.end(),
-                              [&](const UnreadableFile& u) { return u.seriesUid == own->seriesUid; }));
-  if (neighbours.empty() && unreadableNeighbours == 0) {
-    return assembleSeries(std::move(scan), seriesUid, what, decode, named);
-  }
+  // Otherwise a series that cannot be read (a broken, missing or misplaced
+  // slice) is an error, never a volume short of a slice; it names the file
+  // at fault and, when that is another, the file the user gave.
   try {
     return assembleSeries(std::move(scan), seriesUid, what, decode, named);
   } catch (const InputError& e) {
-    const std::string note =
-        readAloneNote(alone.slices.front(), neighbours, unreadableNeighbours, what, e.what());
-    // Its own errors (the series failed on them too) refuse it here.
-    Volume v = assembleSeries(std::move(alone), seriesUid, what, decode, named, {note});
-    // Reading one slice instead of the series the user may expect is said
-    // where it is seen, not only in the description.
-    std::fprintf(stderr, "note: %s\n", note.c_str());
-    return v;
+    const std::string m = e.what();
+    if (m.find(named.string()) != std::string::npos || m.find(what) != std::string::npos) throw;
+    throw InputError(what + ": " + (seriesUid.empty() ? "its series" : "series " + seriesUid) +
+                     " cannot be read from the files beside it: " + m);
   }
 }
 
@@ -1007,7 +990,7 @@ Volume readFolderOrFile(const fs::path& folderOrFile, const std::string& seriesU
   if (!fs::is_regular_file(st)) throw InputError(p + ": not a regular file or a directory");
 
   // One file: its own errors first, then its series (and stack) from the
-  // files beside it.
+  // files beside it, or the file alone when its series cannot hold it.
   FolderScan own;
   add(folderOrFile, true, own);
   const fs::path folder = folderOf(folderOrFile);

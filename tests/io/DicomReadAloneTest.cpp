@@ -1,6 +1,7 @@
-// A DICOM file named on its own whose series cannot be assembled around it
-// (copies of it at its position, a broken neighbour) is read alone with a
-// note; a folder keeps the error; every message names the file given.
+// A DICOM file named on its own that its series cannot hold (copies of it
+// at its position, no position to order it by) is read alone with a note;
+// a broken neighbour is an error naming both files; a folder keeps the
+// error; every message names the file given.
 // Built from pydicom's test files (python3-pydicom), where several
 // encodings of one slice share a Series Instance UID, and from series
 // written here and damaged through DCMTK.
@@ -173,12 +174,15 @@ void seriesWithBrokenNeighbour(const fs::path& dir,
 }
 
 // A good 3-slice series and a broken fourth slice of it. The user who names
-// a good slice sees that slice, alone, and is told which neighbour spoiled
-// the series and how: the series is never read short of a slice (the
-// volume would be silently incomplete), and refusing the slice that was
-// asked for would blame it for its neighbour. Naming the broken file gives
-// its own error; naming the folder, the error naming the broken file.
-TEST(DicomReadAlone, GoodSliceBesideABrokenNeighbourIsReadAloneNamingBoth) {
+// a good slice is told which neighbour spoils the series, and how, in one
+// error naming both files: the series is never read short of a slice (the
+// volume would be silently incomplete), nor replaced by the one slice named
+// (a 300-slice CT shown as one slice because its slice 150 is damaged would
+// hide the damage behind a note). Read alone is for a file its series cannot
+// hold (copies at its position, no position), not for a broken neighbour.
+// Naming the broken file gives its own error; naming the folder, the error
+// naming the broken file.
+TEST(DicomReadAlone, GoodSliceBesideABrokenNeighbourIsRefusedNamingBoth) {
   struct Case {
     const char* what;
     std::function<void(const fs::path&)> damage;
@@ -204,26 +208,16 @@ TEST(DicomReadAlone, GoodSliceBesideABrokenNeighbourIsReadAloneNamingBoth) {
     seriesWithBrokenNeighbour(dir.path(), c.damage);
     const fs::path named = dir / "slice_0001.dcm";
     const std::string broken = (dir / "slice_0003.dcm").string();
-    test::TempDir alone;
-    fs::copy_file(named, alone / "slice_0001.dcm");
-    const Volume reference = readDicomSeries(alone.path());
-    ASSERT_EQ(reference.dims(), glm::ivec3(6, 5, 1));
-    EXPECT_NEAR(reference.origin().z, 32.0, 1e-9);
-
     for (const auto& read : std::vector<std::function<Volume()>>{
-             [&] { return readDicomSeries(named); }, [&] { return readDicomSeriesBasic(named); }}) {
-      const Read r = readCapturingStderr(read);
-      expectSameVolume(r.volume, reference);
-      EXPECT_EQ(r.stderrText.rfind("note: " + named.string() + ": read alone: the series around "
-                                   "it (3 other files of its series) was not assembled: " +
-                                   broken + ": ",
-                                   0),
-                0u)
-          << r.stderrText;
-      EXPECT_NE(r.stderrText.find(c.problem), std::string::npos) << r.stderrText;
+             [&] { return readDicomSeries(named); }, [&] { return readDicomSeriesBasic(named); },
+             [&] { return readVolume(named.string()); }}) {
+      test::expectRejected<InputError>(
+          [&] { readCapturingStderr(read); },
+          {named.string() + ": its series cannot be read from the files beside it: " + broken +
+               ": ",
+           c.problem});
     }
-    test::expectRejected<InputError>([&] { readDicomSeries(dir / "slice_0003.dcm"); },
-                                     {broken + ": ", c.problem});
+    test::expectRejected<InputError>([&] { readDicomSeries(broken); }, {broken + ": ", c.problem});
     test::expectRejected<InputError>([&] { readDicomSeries(dir.path()); }, {broken, c.problem});
   }
   // Without the broken file the series reads whole, with no note.
@@ -232,6 +226,34 @@ TEST(DicomReadAlone, GoodSliceBesideABrokenNeighbourIsReadAloneNamingBoth) {
   const Read whole = readCapturingStderr([&] { return readDicomSeries(dir / "slice_0001.dcm"); });
   EXPECT_EQ(whole.volume.dims(), glm::ivec3(6, 5, 3));
   EXPECT_EQ(whole.stderrText, "");
+}
+
+// A copy of a slice of a good series (another encoding of it, the same
+// position): named, the copy is read alone; a slice of the series without a
+// copy, named, still gets the series' error (the copy is at fault), naming
+// both.
+TEST(DicomReadAlone, CopyOfASliceIsReadAloneAndTheOthersAreRefused) {
+  test::TempDir dir;
+  seriesWithBrokenNeighbour(dir.path(), [](const fs::path& f) { fs::remove(f); });
+  fs::copy_file(dir / "slice_0001.dcm", dir / "copy_of_0001.dcm");
+  test::TempDir alone;
+  fs::copy_file(dir / "slice_0001.dcm", alone / "slice_0001.dcm");
+  const Volume reference = readDicomSeries(alone.path());
+  for (const char* name : {"copy_of_0001.dcm", "slice_0001.dcm"}) {
+    SCOPED_TRACE(name);
+    const Read r = readCapturingStderr([&] { return readDicomSeries(dir / name); });
+    expectSameVolume(r.volume, reference);
+    EXPECT_EQ(r.stderrText.rfind("note: " + (dir / name).string() +
+                                     ": read alone: 1 other file of its series is at its position",
+                                 0),
+              0u)
+        << r.stderrText;
+  }
+  const std::string other = (dir / "slice_0000.dcm").string();
+  test::expectRejected<InputError>(
+      [&] { readDicomSeries(other); },
+      {other + ": its series cannot be read from the files beside it: ",
+       (dir / "copy_of_0001.dcm").string(), (dir / "slice_0001.dcm").string(), "same position"});
 }
 
 // A file named with a Series Instance UID (--series) asks for that series:
@@ -246,12 +268,12 @@ TEST(DicomReadAlone, ASeriesAskedForIsReadOrRefusedNamingTheFileGiven) {
   o.shuffleFileNames = true;
   writeDicomSeries(test::randomVolume({4, 4, 2}, ScalarType::U8, 3), dir / "other", o);
   for (const auto& f : filesIn(dir / "other")) fs::rename(f, dir / f.filename());
-  const Volume other =
-      readDicomSeries(dir / "slice_0001.dcm", "1.2.826.0.1.3680043.9.7.301");
+  const Volume other = readDicomSeries(dir / "slice_0001.dcm", "1.2.826.0.1.3680043.9.7.301");
   EXPECT_EQ(other.dims(), glm::ivec3(4, 4, 2));
   test::expectRejected<InputError>(
       [&] { readDicomSeries(dir / "slice_0001.dcm", "1.2.826.0.1.3680043.9.7.300"); },
-      {(dir / "slice_0001.dcm").string() + ": series 1.2.826.0.1.3680043.9.7.300 beside it: " +
+      {(dir / "slice_0001.dcm").string() +
+           ": series 1.2.826.0.1.3680043.9.7.300 cannot be read from the files beside it: " +
            (dir / "slice_0003.dcm").string() + ": ",
        "truncated"});
 }
