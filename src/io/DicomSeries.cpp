@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <optional>
 #include <system_error>
 #include <utility>
 
@@ -287,20 +288,22 @@ bool samePixelSpacing(const Slice& a, const Slice& b) {
 }
 
 // One Series Instance UID can hold several stacks (a localizer beside its
-// slices, reconstructions of other sizes or orientations). A named file
-// selects its own: the slices of its size, frame count, pixel type,
-// orientation and pixel spacing. Returns how many others were left out.
+// slices, reconstructions of other sizes or orientations): slices of one
+// stack share size, frame count, pixel type, orientation and pixel spacing.
+bool sameStack(const Slice& s, const Slice& r) {
+  return s.rows == r.rows && s.columns == r.columns && s.frames == r.frames &&
+         s.bitsAllocated == r.bitsAllocated && s.isSigned == r.isSigned && sameOrientation(s, r) &&
+         samePixelSpacing(s, r);
+}
+
+// A named file selects its own stack. Returns how many others were left out.
 std::size_t keepStackOf(std::vector<Slice>& slices, const fs::path& named) {
   const auto ref =
       std::find_if(slices.begin(), slices.end(), [&](const Slice& s) { return s.file == named; });
   if (ref == slices.end()) return 0;
   const Slice r = *ref;
   const std::size_t before = slices.size();
-  std::erase_if(slices, [&](const Slice& s) {
-    return s.rows != r.rows || s.columns != r.columns || s.frames != r.frames ||
-           s.bitsAllocated != r.bitsAllocated || s.isSigned != r.isSigned ||
-           !sameOrientation(s, r) || !samePixelSpacing(s, r);
-  });
+  std::erase_if(slices, [&](const Slice& s) { return !sameStack(s, r); });
   return before - slices.size();
 }
 
@@ -842,17 +845,19 @@ void addSkipNotes(const PickedSeries& p, const FolderScan& scan, const fs::path&
   }
 }
 
-}  // namespace
-
-Volume readSeries(FolderScan scan, const std::string& seriesUid, const std::string& what,
-                  const PixelDecoder& decode, const fs::path& named) {
+// The series picked from `scan`, checked, decoded and described; `lead`
+// notes come first in the description.
+Volume assembleSeries(FolderScan scan, const std::string& seriesUid, const std::string& what,
+                      const PixelDecoder& decode, const fs::path& named,
+                      std::vector<std::string> lead = {}) {
   refuseEmpty(scan, what);
   std::vector<SeriesGroup> groups = groupSeries(std::move(scan.slices));
   PickedSeries p = pickSeries(groups, std::move(scan.unreadable), seriesUid, named, what);
   for (const auto& s : p.slices) checkSlice(s);
   checkConsistent(p.slices);
   const Geometry g = geometryOf(p.slices);
-  std::vector<std::string> notes = g.notes;
+  std::vector<std::string> notes = std::move(lead);
+  notes.insert(notes.end(), g.notes.begin(), g.notes.end());
   Volume v = readVoxels(p.slices, what, decode, notes);
   applyGeometry(g, v);
   addSkipNotes(p, scan, named, notes);
@@ -864,6 +869,76 @@ Volume readSeries(FolderScan scan, const std::string& seriesUid, const std::stri
   for (const auto& n : notes) d += "; " + n;
   v.setDescription(d);
   return v;
+}
+
+// Why a named file cannot take a place in its series, for the note that
+// says it is read alone: other files of its stack at its position (copies,
+// other encodings of the same slice: pydicom's test files share a Series
+// Instance UID), or no Image Position (Patient) to order it among them.
+// nullopt when it can (the series is then read, or refused naming the file
+// at fault), or when nothing of its stack is beside it.
+std::optional<std::string> cannotHold(const Slice& own, const std::vector<Slice>& slices,
+                                      const std::string& what) {
+  std::size_t stack = 0;
+  const Slice* copy = nullptr;
+  std::size_t copies = 0;
+  for (const Slice& s : slices) {
+    if (s.file == own.file || s.seriesUid != own.seriesUid || !sameStack(s, own)) continue;
+    ++stack;
+    if (own.position && s.position && glm::length(*s.position - *own.position) <= kSamePositionMm) {
+      if (copies++ == 0) copy = &s;
+    }
+  }
+  if (stack == 0) return std::nullopt;
+  if (!own.position) {
+    return what + ": read alone: it has no Image Position (Patient) (0020,0032), so the " +
+           std::to_string(stack) + " other file" + (stack == 1 ? "" : "s") +
+           " of its series cannot be ordered with it";
+  }
+  if (copies == 0) return std::nullopt;
+  return what + ": read alone: " + std::to_string(copies) + " other file" +
+         (copies == 1 ? " of its series is" : "s of its series are") +
+         " at its position (duplicate slices, e.g. " + copy->file.string() +
+         "), so the series around it was not assembled";
+}
+
+}  // namespace
+
+Volume readSeries(FolderScan scan, const std::string& seriesUid, const std::string& what,
+                  const PixelDecoder& decode, const fs::path& named) {
+  const auto own = std::find_if(scan.slices.begin(), scan.slices.end(),
+                                [&](const Slice& s) { return !named.empty() && s.file == named; });
+  // Files given as a folder or a list are one series or an error.
+  if (own == scan.slices.end()) {
+    return assembleSeries(std::move(scan), seriesUid, what, decode, named);
+  }
+  // A file named on its own that its series cannot hold is what the user
+  // wants to see: it is read as if alone in its folder, with a note, rather
+  // than refused for its neighbours; its own errors still refuse it. A
+  // series asked for by UID is that series or an error.
+  if (seriesUid.empty()) {
+    if (const auto note = cannotHold(*own, scan.slices, what)) {
+      FolderScan alone;
+      alone.where = "file " + what + " (alone)";
+      alone.slices.push_back(*own);
+      Volume v = assembleSeries(std::move(alone), "", what, decode, named, {*note});
+      // One slice instead of the series the user may expect is said where
+      // it is seen, not only in the description.
+      std::fprintf(stderr, "note: %s\n", note->c_str());
+      return v;
+    }
+  }
+  // Otherwise a series that cannot be read (a broken, missing or misplaced
+  // slice) is an error, never a volume short of a slice; it names the file
+  // at fault and, when that is another, the file the user gave.
+  try {
+    return assembleSeries(std::move(scan), seriesUid, what, decode, named);
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    if (m.find(named.string()) != std::string::npos || m.find(what) != std::string::npos) throw;
+    throw InputError(what + ": " + (seriesUid.empty() ? "its series" : "series " + seriesUid) +
+                     " cannot be read from the files beside it: " + m);
+  }
 }
 
 std::vector<DicomSeriesInfo> listSeries(FolderScan scan) {
@@ -915,7 +990,7 @@ Volume readFolderOrFile(const fs::path& folderOrFile, const std::string& seriesU
   if (!fs::is_regular_file(st)) throw InputError(p + ": not a regular file or a directory");
 
   // One file: its own errors first, then its series (and stack) from the
-  // files beside it.
+  // files beside it, or the file alone when its series cannot hold it.
   FolderScan own;
   add(folderOrFile, true, own);
   const fs::path folder = folderOf(folderOrFile);

@@ -161,7 +161,9 @@ using PixelDecoder = std::function<StoredRange(const Slice& slice, Volume& store
 void refuseEmpty(const FolderScan& scan, const std::string& what);
 
 // Reads the series `seriesUid` (empty: the one holding `named`, else the
-// largest) from what a folder scan found; see DicomSeriesReader.h.
+// largest) from what a folder scan found; see DicomSeriesReader.h. Without
+// `seriesUid`, a `named` file its series cannot hold is read alone, with a
+// note (stderr and the description); errors beside a named file name it.
 Volume readSeries(FolderScan scan, const std::string& seriesUid, const std::string& what,
                   const PixelDecoder& decode, const std::filesystem::path& named = {});
 
@@ -178,8 +180,8 @@ using FileAdder =
 FolderScan scanFolder(const std::filesystem::path& folder, const FileAdder& add);
 
 // The series of a folder, or the series of the one file named (read from the
-// files beside it, that file's own errors first): what the readers'
-// path entry points share.
+// files beside it, that file's own errors first; the file alone when its
+// series cannot hold it): what the readers' path entry points share.
 Volume readFolderOrFile(const std::filesystem::path& folderOrFile, const std::string& seriesUid,
                         const FileAdder& add, const PixelDecoder& decode);
 

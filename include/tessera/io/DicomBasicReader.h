@@ -48,7 +48,8 @@ Volume readDicomFilesBasic(const std::vector<std::filesystem::path>& files,
 // The series `named` belongs to (or `seriesUid`), from the files beside it
 // in `files` (FileSet::filesBeside): the browser's dropped or picked files,
 // or a folder on disk. Files beside it that are not DICOM are skipped with
-// a note.
+// a note; `named` is read alone, with a note, when its series cannot hold
+// it (as readDicomSeries).
 Volume readDicomSeriesBasic(const ByteSource& named, const FileSet& files,
                             const std::string& seriesUid = "");
 

@@ -26,7 +26,14 @@ struct DicomSeriesInfo {
 // within it its own stack (same size, frame count, pixel type, orientation
 // and pixel spacing; the others are left out with a note); else, for a
 // folder, the series with the most slices. The description names the
-// others found.
+// others found. A file named on its own (no `seriesUid`) that its series
+// cannot hold (other files of its stack at its position, or no Image
+// Position (Patient) to order it among them) is read as if alone in its
+// folder, with a note on stderr and in the description naming it and the
+// reason; its own errors still refuse it, and a folder keeps the error.
+// Any other series that cannot be read (a broken, missing or misplaced
+// slice) is an error, never a volume short of a slice; beside a named file
+// it names that file as well as the file at fault.
 //
 // Geometry (PS3.3 C.7.6.2), converted from DICOM's LPS+ to the volume's
 // RAS+ (x and y negated, core/PatientFrame.h): index x runs along Image
