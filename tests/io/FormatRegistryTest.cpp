@@ -202,6 +202,8 @@ TEST(DicomDecoder, ChosenByTransferSyntaxAndWhereTheFilesAre) {
   EXPECT_TRUE(basic.canDecode(kRle));
   EXPECT_FALSE(basic.canDecode(kJpegBaseline));
   EXPECT_FALSE(basic.canDecode(kJpegLs));
+  EXPECT_TRUE(basic.canDecode(kJpeg2000));                  // OpenJPEG
+  EXPECT_TRUE(basic.canDecode("1.2.840.10008.1.2.4.201"));  // HTJ2K lossless: OpenJPH
   EXPECT_TRUE(dcmtk.canDecode(kExplicitLe));
   EXPECT_TRUE(dcmtk.canDecode(kJpegBaseline));
   EXPECT_TRUE(dcmtk.canDecode(kJpegLs));
@@ -212,8 +214,10 @@ TEST(DicomDecoder, ChosenByTransferSyntaxAndWhereTheFilesAre) {
   EXPECT_EQ(chooseDicomDecoder(ranked, {kExplicitLe}, disk), &dcmtk);
   EXPECT_EQ(chooseDicomDecoder(ranked, {kJpegLs, kRle}, disk), &dcmtk);
   EXPECT_EQ(chooseDicomDecoder(ranked, {kExplicitLe, kRle}, memory), &basic);
-  // Nobody decodes JPEG 2000: the first that reads the files reports it.
-  EXPECT_EQ(chooseDicomDecoder(ranked, {kJpeg2000}, disk), &dcmtk);
+  // JPEG 2000 is the basic reader's (OpenJPEG), on disk too; with a syntax
+  // nobody decodes beside it, the first that reads the files reports it.
+  EXPECT_EQ(chooseDicomDecoder(ranked, {kJpeg2000}, disk), &basic);
+  EXPECT_EQ(chooseDicomDecoder(ranked, {kJpeg2000, kJpegLs}, disk), &dcmtk);
   // The browser's list: only the basic reader.
   EXPECT_EQ(chooseDicomDecoder({&basic}, {kRle}, disk), &basic);
   EXPECT_EQ(chooseDicomDecoder({&dcmtk}, {kRle}, memory), nullptr);
