@@ -21,4 +21,22 @@ inline void addSizeOption(CLI::App* cmd, std::string& size, const std::string& w
   addDefaultedOption(cmd, "--size", size, what + " size WIDTHxHEIGHT");
 }
 
+// --state FILE and --save-state FILE: the session state a command starts
+// from and writes (session::Session::state, one versioned JSON schema that
+// render, view and the web page share). `starts` and `writes` finish the two
+// help texts: what the command takes from the file, and when it writes one.
+inline void addStateOptions(CLI::App* cmd, std::string& state, std::string& saveState,
+                            const std::string& starts, const std::string& writes) {
+  cmd->add_option("--state", state,
+                  "Start from the session state in FILE (render --save-state, view --save-state "
+                  "or the viewers' Save state): " +
+                      starts)
+      ->type_name("FILE");
+  cmd->add_option("--save-state", saveState,
+                  "Write the session's state (version, volume, settings, exploration; JSON) to "
+                  "FILE " +
+                      writes)
+      ->type_name("FILE");
+}
+
 }  // namespace tessera::app

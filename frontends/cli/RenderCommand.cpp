@@ -721,17 +721,13 @@ void addRenderCommand(CLI::App& app) {
                   "level are clamped (with a note)");
   addDefaultedOption(cmd, "--level", o->level,
                      "With --region: pyramid level, native (0, the finest) or N");
-  cmd->add_option("--state", o->state,
-                  "Start from the settings of FILE (written by --save-state): camera, TF, "
-                  "window, mode, sampling, shading, clipping, technique and layout. An option "
-                  "given with it replaces what it sets, the rest stays as saved; the volume, "
-                  "--size, --out and the other run options are this command's. A viewer's "
-                  "saved exploration is not replayed (render draws the whole volume or --region)")
-      ->type_name("FILE");
-  cmd->add_option("--save-state", o->saveState,
-                  "After the render, write its state (version, volume, settings; JSON) to FILE, "
-                  "creating its folder; --state reads it back")
-      ->type_name("FILE");
+  addStateOptions(cmd, o->state, o->saveState,
+                  "camera, TF, window, mode, sampling, shading, clipping, technique and layout. "
+                  "An option given with it replaces what it sets, the rest stays as saved; the "
+                  "volume, --size, --out and the other run options are this command's. A "
+                  "viewer's saved exploration is not replayed (render draws the whole volume or "
+                  "--region)",
+                  "after the render, creating its folder; --state reads it back");
   o->command = cmd;
   checkOptionsClassified(*cmd);
   cmd->callback([o] { runRenderCommand(*o); });

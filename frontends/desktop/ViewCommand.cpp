@@ -53,13 +53,10 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--screenshot", o->screenshot,
                   "Write the window to this PNG after --frames frames and exit");
   addDefaultedOption(cmd, "--frames", o->frames, "Frames before --screenshot");
-  cmd->add_option("--state", o->state,
-                  "Start from a saved session state (--save-state, the panel's Save state, or "
-                  "`tessera render --save-state`): camera, transfer function, window, rendering "
-                  "settings, labels, crosshair, region and grid of the volume given; it is applied "
-                  "after the other options");
-  cmd->add_option("--save-state", o->saveState,
-                  "Write the session's state as JSON to FILE when the window closes");
+  addStateOptions(cmd, o->state, o->saveState,
+                  "camera, transfer function, window, rendering settings, labels, crosshair, "
+                  "region and grid of the volume given; applied after the other options",
+                  "when the window closes");
   cmd->add_flag("--help-overlay", o->helpOverlay,
                 "Start with the keyboard shortcuts shown (F1 or ? toggles them)");
   addDefaultedOption(cmd, "--layout", o->layout,
