@@ -57,6 +57,9 @@ FUZZ_REGRESSIONS = [
     ("fuzz-regressions/dicom/huge-element-length-oom", "dicom",
      "fuzz_dicom: a dataset element declaring gigabytes in a 717-byte file; reading it as a "
      "string makes DCMTK allocate them (OOM)", DICOM_HUGE_LENGTH),
+    ("fuzz-regressions/dicom/htj2k-zero-tile-size-fpe.dcm", "dicom",
+     "fuzz_dicom_basic: an HTJ2K frame whose SIZ marker declares a zero tile size; OpenJPH's "
+     "pre-allocation divided by it (SIGFPE)", "HTJ2K frame's header is invalid"),
     ("fuzz-regressions/device_profile/number-overflow-crash.json", "device_profile",
      "fuzz_device_profile: a number too large for a double made nlohmann::json throw "
      "out_of_range.406, which escaped DeviceProfile::fromJson", "device profile"),

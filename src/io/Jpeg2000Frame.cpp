@@ -163,7 +163,44 @@ void configureOpenJph() {
     static SilentWarning warning;
     ojph::configure_error(&error);
     ojph::configure_warning(&warning);
+    // OpenJPH 0.9 still prints through its own handlers: into a sink, so
+    // that stderr carries only our one line.
+    if (FILE* sink = std::fopen("/dev/null", "w")) {
+      ojph::set_error_stream(sink);
+      ojph::set_warning_stream(sink);
+      ojph::set_info_stream(sink);
+    }
   });
+}
+
+// The tiling and code-block layout OpenJPH sizes its buffers by, checked
+// as ISO 15444-1 A.5.1 and A.6.1 bound them before it divides by them (a
+// zero tile size made its pre-allocation divide by zero: found by
+// scripts/fuzz.sh).
+void checkHtj2kLayout(ojph::param_siz siz, ojph::param_cod cod, const std::string& what) {
+  const ojph::size tile = siz.get_tile_size();
+  const ojph::point tileAt = siz.get_tile_offset(), imageAt = siz.get_image_offset();
+  const ojph::point extent = siz.get_image_extent();
+  const auto bad = [&](const std::string& why) {
+    return InputError(what + ": the HTJ2K frame's header is invalid (" + why + ")");
+  };
+  if (tile.w == 0 || tile.h == 0) throw bad("tile size " + dims(tile.w, tile.h));
+  if (tileAt.x > imageAt.x || tileAt.y > imageAt.y ||
+      std::uint64_t(tileAt.x) + tile.w <= imageAt.x ||
+      std::uint64_t(tileAt.y) + tile.h <= imageAt.y || extent.x <= imageAt.x ||
+      extent.y <= imageAt.y) {
+    throw bad("tile or image offsets outside the image");
+  }
+  const ojph::ui32 levels = cod.get_num_decompositions();
+  if (levels > 32) throw bad(std::to_string(levels) + " decomposition levels");
+  const ojph::size block = cod.get_log_block_dims();
+  if (block.w < 2 || block.h < 2 || block.w > 10 || block.h > 10 || block.w + block.h > 12) {
+    throw bad("code-block size 2^" + std::to_string(block.w) + " x 2^" + std::to_string(block.h));
+  }
+  for (ojph::ui32 level = 0; level <= levels; ++level) {
+    const ojph::size precinct = cod.get_precinct_size(level);
+    if (precinct.w == 0 || precinct.h == 0) throw bad("an empty precinct");
+  }
 }
 
 }  // namespace
@@ -230,6 +267,7 @@ std::vector<std::uint8_t> decodeHtj2kFrame(std::span<const std::uint8_t> codestr
     checkHeader(shape, what, "HTJ2K", static_cast<long long>(extent.x) - offset.x,
                 static_cast<long long>(extent.y) - offset.y, components,
                 components > 0 ? siz.get_bit_depth(0) : 0, sub.x != 1 || sub.y != 1);
+    checkHtj2kLayout(siz, cs.access_cod(), what);
     cs.create();
     for (int y = 0; y < shape.rows; ++y) {
       ojph::ui32 comp = 0;
@@ -246,7 +284,10 @@ std::vector<std::uint8_t> decodeHtj2kFrame(std::span<const std::uint8_t> codestr
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
-    throw InputError(what + ": the HTJ2K frame cannot be decoded (" + e.what() +
+    const std::string why = e.what();
+    // OpenJPH's own handler throws its bare prefix; ours carries the reason.
+    throw InputError(what + ": the HTJ2K frame cannot be decoded (" +
+                     (why == "ojph error" ? std::string("OpenJPH") : why) +
                      "; corrupt or truncated?)");
   }
   return out;
