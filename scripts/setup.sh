@@ -15,8 +15,8 @@ PACKAGES=(
   emscripten nodejs chromium                             # web viewer (scripts/web.sh) and its browser test
   python3-nibabel python3-pydicom python3-numpy          # independent NIfTI/DICOM readers in geometry tests
   libblosc-dev libzstd-dev libcurl4-openssl-dev          # OME-Zarr chunks (blosc, zstd) and HTTP(S) stores
-  libopenjp2-7-dev libopenjph-dev                        # DICOM frames in JPEG 2000 and HTJ2K
-  libopenjp2-tools openjph-tools                         # their encoders, for the tests' data
+  libopenjp2-7-dev                                       # DICOM frames in JPEG 2000
+  libopenjp2-tools openjph-tools                         # JPEG 2000 and HTJ2K encoders, for the tests' data
   python3-zarr python3-numcodecs nginx-light             # zarr-python interop tests; nginx serves stores in HTTP tests
   python3-vtk9 python3-matplotlib                        # bench/peers: VTK side by side (PNGs, plots) and its smoke tests
 )

@@ -1,20 +1,11 @@
 #include "io/Jpeg2000Frame.h"
 
 #include <algorithm>
-#include <cstdarg>
 #include <cstdio>
 #include <cstring>
 #include <memory>
-#include <mutex>
-#include <stdexcept>
 
 #include <openjpeg.h>
-#include <openjph/ojph_arch.h>
-#include <openjph/ojph_codestream.h>
-#include <openjph/ojph_file.h>
-#include <openjph/ojph_mem.h>
-#include <openjph/ojph_message.h>
-#include <openjph/ojph_params.h>
 
 #include "tessera/core/Error.h"
 
@@ -133,76 +124,6 @@ bool isJp2(std::span<const std::uint8_t> d) {
          std::equal(std::begin(kJp2Signature), std::end(kJp2Signature), d.begin());
 }
 
-// ---- OpenJPH: its errors are thrown as runtime_error, without printing.
-// (Its message classes have no virtual destructor; these are never deleted
-// through a base pointer: they live as long as the process.)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wnon-virtual-dtor"
-class ThrowingError final : public ojph::message_error {
- public:
-  void operator()(int, const char*, int, const char* fmt, ...) override {
-    char buf[512];
-    va_list args;
-    va_start(args, fmt);
-    std::vsnprintf(buf, sizeof buf, fmt, args);
-    va_end(args);
-    throw std::runtime_error(buf);
-  }
-};
-
-class SilentWarning final : public ojph::message_warning {
- public:
-  void operator()(int, const char*, int, const char*, ...) override {}
-};
-#pragma GCC diagnostic pop
-
-void configureOpenJph() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    static ThrowingError error;
-    static SilentWarning warning;
-    ojph::configure_error(&error);
-    ojph::configure_warning(&warning);
-    // OpenJPH 0.9 still prints through its own handlers: into a sink, so
-    // that stderr carries only our one line.
-    if (FILE* sink = std::fopen("/dev/null", "w")) {
-      ojph::set_error_stream(sink);
-      ojph::set_warning_stream(sink);
-      ojph::set_info_stream(sink);
-    }
-  });
-}
-
-// The tiling and code-block layout OpenJPH sizes its buffers by, checked
-// as ISO 15444-1 A.5.1 and A.6.1 bound them before it divides by them (a
-// zero tile size made its pre-allocation divide by zero: found by
-// scripts/fuzz.sh).
-void checkHtj2kLayout(ojph::param_siz siz, ojph::param_cod cod, const std::string& what) {
-  const ojph::size tile = siz.get_tile_size();
-  const ojph::point tileAt = siz.get_tile_offset(), imageAt = siz.get_image_offset();
-  const ojph::point extent = siz.get_image_extent();
-  const auto bad = [&](const std::string& why) {
-    return InputError(what + ": the HTJ2K frame's header is invalid (" + why + ")");
-  };
-  if (tile.w == 0 || tile.h == 0) throw bad("tile size " + dims(tile.w, tile.h));
-  if (tileAt.x > imageAt.x || tileAt.y > imageAt.y ||
-      std::uint64_t(tileAt.x) + tile.w <= imageAt.x ||
-      std::uint64_t(tileAt.y) + tile.h <= imageAt.y || extent.x <= imageAt.x ||
-      extent.y <= imageAt.y) {
-    throw bad("tile or image offsets outside the image");
-  }
-  const ojph::ui32 levels = cod.get_num_decompositions();
-  if (levels > 32) throw bad(std::to_string(levels) + " decomposition levels");
-  const ojph::size block = cod.get_log_block_dims();
-  if (block.w < 2 || block.h < 2 || block.w > 10 || block.h > 10 || block.w + block.h > 12) {
-    throw bad("code-block size 2^" + std::to_string(block.w) + " x 2^" + std::to_string(block.h));
-  }
-  for (ojph::ui32 level = 0; level <= levels; ++level) {
-    const ojph::size precinct = cod.get_precinct_size(level);
-    if (precinct.w == 0 || precinct.h == 0) throw bad("an empty precinct");
-  }
-}
-
 }  // namespace
 
 std::vector<std::uint8_t> decodeJpeg2000Frame(std::span<const std::uint8_t> codestream,
@@ -248,48 +169,6 @@ std::vector<std::uint8_t> decodeJpeg2000Frame(std::span<const std::uint8_t> code
   }
   const std::size_t n = static_cast<std::size_t>(shape.rows) * shape.columns;
   for (std::size_t i = 0; i < n; ++i) putSample(out, i, comp.data[i], shape.bitsAllocated);
-  return out;
-}
-
-std::vector<std::uint8_t> decodeHtj2kFrame(std::span<const std::uint8_t> codestream,
-                                           const FrameShape& shape, const std::string& what) {
-  configureOpenJph();
-  std::vector<std::uint8_t> out = samplesFor(shape, what);
-  try {
-    ojph::mem_infile in;
-    in.open(codestream.data(), codestream.size());
-    ojph::codestream cs;
-    cs.read_headers(&in);
-    ojph::param_siz siz = cs.access_siz();
-    const ojph::point extent = siz.get_image_extent(), offset = siz.get_image_offset();
-    const ojph::ui32 components = siz.get_num_components();
-    const ojph::point sub = components > 0 ? siz.get_downsampling(0) : ojph::point(1, 1);
-    checkHeader(shape, what, "HTJ2K", static_cast<long long>(extent.x) - offset.x,
-                static_cast<long long>(extent.y) - offset.y, components,
-                components > 0 ? siz.get_bit_depth(0) : 0, sub.x != 1 || sub.y != 1);
-    checkHtj2kLayout(siz, cs.access_cod(), what);
-    cs.create();
-    for (int y = 0; y < shape.rows; ++y) {
-      ojph::ui32 comp = 0;
-      const ojph::line_buf* line = cs.pull(comp);
-      if (line == nullptr || comp != 0 || line->size < static_cast<std::size_t>(shape.columns)) {
-        throw std::runtime_error("row " + std::to_string(y) + " is missing");
-      }
-      const std::size_t row = static_cast<std::size_t>(y) * shape.columns;
-      for (int x = 0; x < shape.columns; ++x) {
-        putSample(out, row + x, line->i32[x], shape.bitsAllocated);
-      }
-    }
-    cs.close();
-  } catch (const Error&) {
-    throw;
-  } catch (const std::exception& e) {
-    const std::string why = e.what();
-    // OpenJPH's own handler throws its bare prefix; ours carries the reason.
-    throw InputError(what + ": the HTJ2K frame cannot be decoded (" +
-                     (why == "ojph error" ? std::string("OpenJPH") : why) +
-                     "; corrupt or truncated?)");
-  }
   return out;
 }
 

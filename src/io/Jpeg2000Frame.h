@@ -1,8 +1,7 @@
 #pragma once
 // JPEG 2000 (PS3.5 A.4.4: transfer syntaxes 1.2.840.10008.1.2.4.90 and .91)
-// and High-Throughput JPEG 2000 (A.4.11: .201, .202, .203) frames of a DICOM
-// image, decoded by Debian's libraries: OpenJPEG (libopenjp2) and OpenJPH
-// (libopenjph). Each frame is checked against what the file declares (rows,
+// frames of a DICOM image, decoded by Debian's OpenJPEG (libopenjp2). Each
+// frame is checked against what the file declares (rows,
 // columns, one greyscale component, at most the bits stored) before a sample
 // is written, so that a frame's own header never sizes an allocation.
 #include <cstdint>
@@ -28,7 +27,5 @@ struct FrameShape {
 // `shape` (more than one component is refused: not greyscale).
 std::vector<std::uint8_t> decodeJpeg2000Frame(std::span<const std::uint8_t> codestream,
                                               const FrameShape& shape, const std::string& what);
-std::vector<std::uint8_t> decodeHtj2kFrame(std::span<const std::uint8_t> codestream,
-                                           const FrameShape& shape, const std::string& what);
 
 }  // namespace tessera::io_detail

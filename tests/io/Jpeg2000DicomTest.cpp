@@ -1,7 +1,8 @@
-// DICOM frames in JPEG 2000 (OpenJPEG) and HTJ2K (OpenJPH), read through
-// readVolume like any DICOM file: lossless streams give the uncompressed
-// original's voxels exactly, a lossy one OpenJPEG's own command-line decode,
-// and a corrupt or mis-sized frame one line naming the file. The streams are
+// DICOM frames in JPEG 2000 (OpenJPEG), read through readVolume like any
+// DICOM file: lossless streams give the uncompressed original's voxels
+// exactly, a lossy one OpenJPEG's own command-line decode, and a corrupt or
+// mis-sized frame one line naming the file. HTJ2K is refused in one line
+// naming the syntax (Debian 12's OpenJPH is not safe on corrupt data). The streams are
 // pydicom's test files and ones encoded here with Debian's encoders
 // (opj_compress, ojph_compress), wrapped in DICOM by pydicom.
 #include <gtest/gtest.h>
@@ -109,7 +110,7 @@ TEST(Jpeg2000Dicom, PydicomsLosslessJpeg2000EqualsTheUncompressedOriginal) {
   EXPECT_EQ(j2k.origin(), original.origin());
 }
 
-TEST(Jpeg2000Dicom, HtJ2kAndJpeg2000EncodedHereReadBackExactlyOrWithinTheirLoss) {
+TEST(Jpeg2000Dicom, Jpeg2000EncodedHereReadsBackExactlyAndHtJ2kIsRefusedNamingIt) {
   if (!pydicomReady()) GTEST_SKIP() << "needs python3-pydicom's test files and numpy";
   if (!have("command -v ojph_compress") || !have("command -v opj_compress")) {
     GTEST_SKIP() << "needs ojph_compress (openjph-tools) and opj_compress (libopenjp2-tools)";
@@ -117,7 +118,7 @@ TEST(Jpeg2000Dicom, HtJ2kAndJpeg2000EncodedHereReadBackExactlyOrWithinTheirLoss)
   test::TempDir dir;
   test::writeFile(dir.path() / "wrap.py", kWrap);
   const Volume original = readAlone(dir.path(), kPydicomFiles / "MR_small.dcm");
-  for (const std::string kind : {"htj2k-lossless", "j2k-lossless", "htj2k-lossy"}) {
+  for (const std::string kind : {"j2k-lossless", "htj2k-lossless", "htj2k-lossy"}) {
     SCOPED_TRACE(kind);
     const fs::path work = dir.path() / kind;
     fs::create_directories(work);
@@ -125,22 +126,13 @@ TEST(Jpeg2000Dicom, HtJ2kAndJpeg2000EncodedHereReadBackExactlyOrWithinTheirLoss)
     ASSERT_TRUE(have(std::string(kPython) + " " + (dir.path() / "wrap.py").string() + " " +
                      (kPydicomFiles / "MR_small.dcm").string() + " " + out.string() + " " + kind +
                      " " + work.string()));
-    const Volume v = readVolume(out.string());
-    if (kind != "htj2k-lossy") {
-      expectSameVoxels(v, original);
+    if (kind == "j2k-lossless") {
+      expectSameVoxels(readVolume(out.string()), original);
       continue;
     }
-    ASSERT_EQ(v.dims(), original.dims());
-    double err = 0.0, peak = 0.0;
-    for (std::size_t i = 0; i < v.voxelCount(); ++i) {
-      const double d = v.valueAtIndex(i) - original.valueAtIndex(i);
-      err += d * d;
-      peak = std::max(peak, std::abs(original.valueAtIndex(i)));
-    }
-    const double psnr = 10.0 * std::log10(peak * peak / std::max(err / v.voxelCount(), 1e-12));
-    std::printf("  [measured] HTJ2K lossy (qstep 0.0002) against the original: %.1f dB\n", psnr);
-    EXPECT_GT(psnr, 40.0);
-    EXPECT_LT(psnr, 200.0);  // lossy: not the original bytes by accident
+    const std::string message = test::inputErrorMessage([&] { readVolume(out.string()); });
+    EXPECT_EQ(message.rfind(out.string() + ": ", 0), 0u) << message;
+    EXPECT_NE(message.find("1.2.840.10008.1.2.4.20"), std::string::npos) << message;
   }
 }
 
