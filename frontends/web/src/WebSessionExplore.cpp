@@ -34,14 +34,12 @@ std::string rangeText(const lod::VoxelBox& box, int a) {
 
 }  // namespace
 
+// Another volume opened through the session ends its exploration there
+// (Session::setVolume); the zoom swap's stages carry their own names.
 bool WebSession::regionShown() {
-  // The zoom swap's native stage is a block of the grid, shown by the swap.
-  if (zoomActive()) return false;
   if (!explore() || explore()->mode() == session::ExploreMode::Overview) return false;
   const viewer::Viewer& v = viewer();
-  if (v.hasVolume() && v.volumeName() == explore()->shownName()) return true;
-  if (!storeOverview()) session_->endExploration();  // another volume came in since
-  return false;
+  return v.hasVolume() && v.volumeName() == explore()->shownName();
 }
 
 const Volume& WebSession::sliceShape() {
@@ -203,8 +201,7 @@ session::Exploration& WebSession::exploration(int cellSide) {
 // Ends past the volume are clamped; an empty box or one that starts outside
 // is an error. The window, the TF, the zoom and the overview stay.
 void WebSession::showRegion(lod::VoxelBox box) {
-  zoomStop();     // the region replaces the whole volume, not a level of it
-  regionShown();  // forgets an exploration of a volume no longer shown
+  zoomStop();  // the region replaces the whole volume, not a level of it
   session::Exploration& e = exploration();
   e.show(viewer(), e.region(box, session::Follow::Centre));
 }
@@ -307,7 +304,6 @@ void WebSession::showGridBlock(const session::ExploreStep& step) {
 // At the grid point nearest the centre of voxel `voxel` of the overview.
 void WebSession::gridEnter(int cellSide, const glm::ivec3& voxel) {
   zoomStop();  // the grid view's block replaces the whole volume
-  regionShown();
   session::Exploration& e = exploration(cellSide);
   showGridBlock(e.enterGrid(voxel));  // the crosshair is in the slices' voxels, as the grid
 }
