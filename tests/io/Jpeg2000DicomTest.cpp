@@ -108,6 +108,8 @@ TEST(Jpeg2000Dicom, PydicomsLosslessJpeg2000EqualsTheUncompressedOriginal) {
   expectSameVoxels(j2k, original);
   EXPECT_EQ(j2k.spacing(), original.spacing());
   EXPECT_EQ(j2k.origin(), original.origin());
+  EXPECT_EQ(j2k.direction(), original.direction());  // the patient's left stays left
+  EXPECT_EQ(j2k.indexToWorld(), original.indexToWorld());
 }
 
 TEST(Jpeg2000Dicom, Jpeg2000EncodedHereReadsBackExactlyAndHtJ2kIsRefusedNamingIt) {
