@@ -219,6 +219,15 @@ double Volume::finiteValueAtIndex(std::size_t i) const {
   return std::isfinite(v) ? v : nonFiniteValue();
 }
 
+void Volume::setValueRange(ValueRange r) {
+  if (!std::isfinite(r.min) || !std::isfinite(r.max) || r.max < r.min) {
+    throw InputError("value range [" + std::to_string(r.min) + ", " + std::to_string(r.max) +
+                     "] is reversed or not finite; expected min <= max");
+  }
+  range_ = r;
+  rangeValid_ = true;
+}
+
 ValueRange Volume::window() const {
   if (hasWindow_) return window_;
   ValueRange r = valueRange();

@@ -29,6 +29,8 @@ GlFormat glFormat(TexelFormat f) {
       return {GL_RGBA32F, GL_RGBA, GL_FLOAT, 16, 16};
     case TexelFormat::Luminance8:
       return {GL_LUMINANCE, GL_LUMINANCE, GL_UNSIGNED_BYTE, 1, 1};
+    case TexelFormat::LuminanceAlpha8:
+      return {GL_LUMINANCE_ALPHA, GL_LUMINANCE_ALPHA, GL_UNSIGNED_BYTE, 2, 2};
     case TexelFormat::Rgba8Unsized:
       return {GL_RGBA, GL_RGBA, GL_UNSIGNED_BYTE, 4, 4};
     case TexelFormat::RgbaHalfUnsized:
@@ -73,6 +75,8 @@ const char* texelFormatName(TexelFormat f) {
       return "RGBA32F";
     case TexelFormat::Luminance8:
       return "L8";
+    case TexelFormat::LuminanceAlpha8:
+      return "LA8";
     case TexelFormat::Rgba8Unsized:
       return "RGBA8 (ES 2)";
     case TexelFormat::RgbaHalfUnsized:

@@ -8,6 +8,7 @@
 #include <exception>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -349,40 +350,56 @@ void ZarrStore::makeShape(const std::string& attrsText) {
       " scale+translation; NGFF has no orientation: x,y,z taken as R,A,S (RAS+)" +
       (direction_ == glm::dmat3(1.0) ? "" : ", direction from tessera attributes"));
   shape_.setDescription("OME-Zarr " + storage_->describe() + (name_.empty() ? "" : " " + name_));
-  // The window: Tessera's own attribute, else omero's channel window, else
-  // the value range of the coarsest level (one chunk in a full pyramid).
+  // The value range: Tessera's own attribute (the level-0 range `convert`
+  // measured), else omero's channel min/max, else the coarsest level's range
+  // (one chunk in a full pyramid; a mean pyramid's extremes may lie beyond
+  // it). The window: Tessera's own, else omero's start/end, else the value
+  // range, as for the same data read from a file.
+  auto pair = [](const json& j, const char* a, const char* b) -> std::optional<ValueRange> {
+    if (j.contains(a) && j.contains(b) && j[a].is_number() && j[b].is_number()) {
+      return ValueRange{j[a].get<double>(), j[b].get<double>()};
+    }
+    return std::nullopt;
+  };
+  auto array2 = [](const json& j, const char* key) -> std::optional<ValueRange> {
+    if (j.contains(key) && j[key].is_array() && j[key].size() == 2 && j[key][0].is_number() &&
+        j[key][1].is_number()) {
+      return ValueRange{j[key][0].get<double>(), j[key][1].get<double>()};
+    }
+    return std::nullopt;
+  };
+  auto finite = [](const std::optional<ValueRange>& r, bool wide) {
+    return r && std::isfinite(r->min) && std::isfinite(r->max) &&
+           (wide ? r->min < r->max : r->min <= r->max);
+  };
+  std::optional<ValueRange> range, window;
   if (!attrsText.empty()) {
     const json attrs = parseJson(attrsText, storage_->locate(".zattrs"));
-    const json* range = nullptr;
-    if (attrs.contains("tessera") && attrs["tessera"].contains("value_range")) {
-      range = &attrs["tessera"]["value_range"];
-    }
-    if (range && range->is_array() && range->size() == 2 && (*range)[0].is_number() &&
-        (*range)[1].is_number() && (*range)[0].get<double>() < (*range)[1].get<double>()) {
-      shape_.setWindow({(*range)[0].get<double>(), (*range)[1].get<double>()});
-      return;
+    if (attrs.contains("tessera") && attrs["tessera"].is_object()) {
+      range = array2(attrs["tessera"], "value_range");
+      window = array2(attrs["tessera"], "window");
     }
     if (attrs.contains("omero") && attrs["omero"].contains("channels")) {
       const json& ch = attrs["omero"]["channels"];
       const std::size_t c = std::size_t(selection_.channel);
-      if (ch.is_array() && c < ch.size() && ch[c].contains("window")) {
+      if (ch.is_array() && c < ch.size() && ch[c].contains("window") &&
+          ch[c]["window"].is_object()) {
         const json& w = ch[c]["window"];
-        if (w.contains("start") && w.contains("end") && w["start"].is_number() &&
-            w["end"].is_number() && w["start"].get<double>() < w["end"].get<double>()) {
-          shape_.setWindow({w["start"].get<double>(), w["end"].get<double>()});
-          return;
-        }
+        if (!finite(range, false)) range = pair(w, "min", "max");
+        if (!finite(window, true)) window = pair(w, "start", "end");
       }
     }
   }
-  const int coarse = levelCount() - 1;
-  const glm::ivec3 d = levels_.back().dims;
-  const std::uint64_t bytes = std::uint64_t(d.x) * std::uint64_t(d.y) * std::uint64_t(d.z) *
-                              bytesPerVoxel(fine.array.target);
-  if (bytes <= (64ull << 20)) {
-    const ValueRange r = readLevel(coarse).valueRange();
-    if (r.max > r.min) shape_.setWindow(r);
+  if (!finite(range, false)) {
+    range.reset();
+    const int coarse = levelCount() - 1;
+    const glm::ivec3 d = levels_.back().dims;
+    const std::uint64_t bytes = std::uint64_t(d.x) * std::uint64_t(d.y) * std::uint64_t(d.z) *
+                                bytesPerVoxel(fine.array.target);
+    if (bytes <= (64ull << 20)) range = readLevel(coarse).valueRange();
   }
+  if (range) shape_.setValueRange(*range);
+  if (finite(window, true)) shape_.setWindow(*window);
 }
 
 int ZarrStore::finestLevelWithin(std::uint64_t budgetBytes) const {

@@ -101,10 +101,34 @@ struct AtlasShape {
 
 constexpr int kMaxMosaicAtlases = 8;
 
+// How the atlas holds stored values (lod::StoredMapping): u8 in one 8-bit
+// channel; 16-bit values in R16 where the context has EXT_texture_norm16,
+// else as two 8-bit channels (RG8 on ES 3, LUMINANCE_ALPHA on ES 2), NEAREST,
+// that bricks.glsl recombines per texel before it interpolates (GPUs that
+// filter 8-bit channels in fixed point round each filtered byte).
+struct AtlasFormat {
+  gpu::TexelFormat format = gpu::TexelFormat::R8;
+  int texel = 0;  // BRICKS_TEXEL in bricks.glsl
+  std::uint64_t bytes = 1;
+  const char* name = "R8";
+  bool twoBytes() const { return texel >= 2; }  // NEAREST, interpolated in the shader
+};
+
+AtlasFormat atlasFormatFor(ScalarType type, const gpu::DeviceLimits& limits) {
+  const bool es3 = limits.api == gpu::ApiLevel::Gles3;
+  if (type == ScalarType::U8) {
+    return es3 ? AtlasFormat{gpu::TexelFormat::R8, 0, 1, "R8"}
+               : AtlasFormat{gpu::TexelFormat::Luminance8, 0, 1, "L8"};
+  }
+  if (es3 && limits.norm16Textures) return {gpu::TexelFormat::R16, 1, 2, "R16"};
+  if (es3) return {gpu::TexelFormat::RG8, 2, 2, "RG8 (16 bits as two bytes)"};
+  return {gpu::TexelFormat::LuminanceAlpha8, 3, 2, "LA8 (16 bits as two bytes)"};
+}
+
 AtlasShape atlasFor(const gpu::DeviceLimits& limits, int stored, std::uint64_t avail,
-                    std::uint64_t bricks) {
+                    std::uint64_t bricks, std::uint64_t texelBytes) {
   AtlasShape a;
-  const std::uint64_t slotBytes = static_cast<std::uint64_t>(stored) * stored * stored;
+  const std::uint64_t slotBytes = static_cast<std::uint64_t>(stored) * stored * stored * texelBytes;
   const std::uint64_t want = std::min<std::uint64_t>(avail / slotBytes, bricks);
   if (want == 0) return a;
   if (limits.api == gpu::ApiLevel::Gles3 && limits.max3DTextureSize > 0) {
@@ -124,7 +148,7 @@ AtlasShape atlasFor(const gpu::DeviceLimits& limits, int stored, std::uint64_t a
   int depth = static_cast<int>(std::min<std::uint64_t>({255, tiles / stored, want}));
   for (; depth > 0; --depth) {
     a.mosaic = MosaicLayout::geometryFor({stored, stored, depth * stored}, limits.max2DTextureSize);
-    a.bytes = static_cast<std::uint64_t>(a.mosaic.width()) * a.mosaic.height();
+    a.bytes = static_cast<std::uint64_t>(a.mosaic.width()) * a.mosaic.height() * texelBytes;
     if (a.mosaic.tilesX > 0 && a.bytes <= avail) break;
   }
   if (depth <= 0) return a;
@@ -138,6 +162,17 @@ AtlasShape atlasFor(const gpu::DeviceLimits& limits, int stored, std::uint64_t a
   a.slots = {textures, 1, depth};
   a.bytes = perTexture * static_cast<std::uint64_t>(textures);
   return a;
+}
+
+// How values are kept, for the plan.
+std::string storedNote(const Volume& shape) {
+  const lod::StoredMapping m = lod::StoredMapping::of(shape);
+  if (m.bits == 8) return "";
+  if (m.exact) return ", every " + std::string(scalarTypeName(shape.type())) + " value exact";
+  char text[96];
+  std::snprintf(text, sizeof text, ", 16 bits over the value range (a step of %.3g)",
+                m.width / m.maxStored());
+  return text;
 }
 
 std::uint64_t pyramidBricks(const std::vector<glm::ivec3>& levels, int brick) {
@@ -180,14 +215,15 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
     return plan;
   }
   const std::uint64_t avail = atlasCap(limits, options, pages.bytes);
-  const AtlasShape a = atlasFor(limits, stored, avail, pyramidBricks(levels, b));
+  const AtlasFormat format = atlasFormatFor(shape.type(), limits);
+  const AtlasShape a = atlasFor(limits, stored, avail, pyramidBricks(levels, b), format.bytes);
   const bool es3 = a.mosaic.tilesX == 0;
   const int atlases = es3 ? 1 : std::max(1, a.slots.x);
   PlannedTexture atlas{
       .label = "brick atlas",
       .size = es3 ? a.slots * stored : glm::ivec3(a.mosaic.width(), a.mosaic.height(), 1),
       .is3D = es3,
-      .format = es3 ? "R8" : "L8",
+      .format = format.name,
       .bytes = a.bytes / static_cast<std::uint64_t>(atlases)};
   for (int t = 0; t < atlases; ++t) {
     plan.textures.push_back(atlas);
@@ -201,8 +237,7 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
                            (atlases > 1 ? numbered("", atlases, " x ") : std::string()) +
                            dimsText(atlas.size) + (es3 ? " 3D" : " mosaic") + ", " +
                            formatBytes(a.bytes) + ") through a " + std::to_string(cells.x) + "x" +
-                           std::to_string(cells.y * cells.z) + " page table" +
-                           (shape.type() == ScalarType::U8 ? "" : ", quantised to 8 bits");
+                           std::to_string(cells.y * cells.z) + " page table" + storedNote(shape);
   if (a.count() <= topBricks) {
     plan.reason = what + ": the budget (" + formatBytes(avail) + ") holds no more than the " +
                   std::to_string(topBricks) + " coarsest bricks";
@@ -237,20 +272,24 @@ std::unique_ptr<BricksLayout> BricksLayout::create(
   const std::uint64_t avail = atlasCap(limits, options, pageBytes);
   std::uint64_t bricks = 0;
   for (int lv = 0; lv < l->grid_.levelCount(); ++lv) bricks += l->grid_.brickCount(lv);
-  const AtlasShape a = atlasFor(limits, stored, avail, bricks);
+  const AtlasFormat format = atlasFormatFor(source->shape().type(), limits);
+  l->atlasTexel_ = format.texel;
+  const AtlasShape a = atlasFor(limits, stored, avail, bricks, format.bytes);
   l->slotGrid_ = a.slots;
   l->mosaic_ = a.mosaic;
   if (a.mosaic.tilesX == 0) {
     l->atlasTexels_ = a.slots * stored;
-    l->atlases_.push_back(gpu::Texture::create3D(ledger, "brick atlas (R8)", gpu::TexelFormat::R8,
-                                                 l->atlasTexels_.x, l->atlasTexels_.y,
-                                                 l->atlasTexels_.z));
+    l->atlases_.push_back(gpu::Texture::create3D(
+        ledger, "brick atlas (" + std::string(gpu::texelFormatName(format.format)) + ")",
+        format.format, l->atlasTexels_.x, l->atlasTexels_.y, l->atlasTexels_.z));
+    if (format.twoBytes()) l->atlases_.back().setFilter(gpu::Filter::Nearest);
   } else {
     l->atlasTexels_ = glm::ivec3(stored, stored, a.slots.z * stored);  // each texture's
     for (int t = 0; t < a.slots.x; ++t) {
       l->atlases_.push_back(
           gpu::Texture::create2D(ledger, numbered("brick atlas ", t + 1, " (mosaic)"),
-                                 gpu::r8For(limits.api), a.mosaic.width(), a.mosaic.height()));
+                                 format.format, a.mosaic.width(), a.mosaic.height()));
+      if (format.twoBytes()) l->atlases_.back().setFilter(gpu::Filter::Nearest);
     }
   }
   const glm::ivec3 cells = l->grid_.bricks(0);
@@ -261,6 +300,7 @@ std::unique_ptr<BricksLayout> BricksLayout::create(
   l->slotKey_.assign(static_cast<std::size_t>(a.count()), -1);
   l->slotUsed_.assign(l->slotKey_.size(), 0);
   l->slotPinned_.assign(l->slotKey_.size(), false);
+  l->slotFine_.assign(l->slotKey_.size(), {});
 
   lod::BrickStreamerOptions so;
   so.workers = options.workers;
@@ -316,16 +356,52 @@ int BricksLayout::slotFor(std::uint64_t id, std::uint64_t frame) {
 void BricksLayout::upload(int slot, const lod::StoredBrick& brick) {
   const int n = grid_.stored();
   const glm::ivec3 s = slotOrigin(slot);
+  keepFineRanges(slot, brick);
   if (mosaic_.tilesX == 0) {
-    atlases_[0].updateRegion(s * n, glm::ivec3(n), brick.voxels.data());
+    atlases_[0].updateRegion(s * n, glm::ivec3(n), brick.bytes.data());
     return;
   }
   // ES 2: s.x is the texture, s.z the slot in its stack of z-slices.
   gpu::Texture& atlas = atlases_[static_cast<std::size_t>(s.x)];
-  const std::size_t slice = static_cast<std::size_t>(n) * n;
+  const std::size_t slice = static_cast<std::size_t>(n) * n * (brick.bits == 8 ? 1 : 2);
   for (int k = 0; k < n; ++k) {
     const glm::ivec2 at = mosaic_.addressOf(0, 0, s.z * n + k);
-    atlas.updateRegion({at, 0}, {n, n, 1}, brick.voxels.data() + slice * k);
+    atlas.updateRegion({at, 0}, {n, n, 1}, brick.bytes.data() + slice * k);
+  }
+}
+
+// A level-0 brick's ranges per kFineBlock^3 block, each with the one-voxel
+// support its samples reach (the apron holds it): what an in-core layout's
+// ValueBlocks hold for the same voxels, so that empty-space skipping and
+// adaptive steps decide as they do in core.
+void BricksLayout::keepFineRanges(int slot, const lod::StoredBrick& brick) {
+  std::vector<std::uint16_t>& fine = slotFine_[static_cast<std::size_t>(slot)];
+  fine.clear();
+  const int b = grid_.brickSize();
+  const auto id = static_cast<std::uint64_t>(slotKey_[static_cast<std::size_t>(slot)]);
+  if ((id >> 60) != 0 || b % kFineBlock != 0) return;
+  const int per = b / kFineBlock, n = grid_.stored();
+  fine.resize(2ull * per * per * per);
+  std::size_t i = 0;
+  for (int z = 0; z < per; ++z) {
+    for (int y = 0; y < per; ++y) {
+      for (int x = 0; x < per; ++x, i += 2) {
+        // Stored voxel k is brick voxel k - 1: block voxels [xS - 1, xS + S].
+        std::uint16_t lo = 65535, hi = 0;
+        for (int k = z * kFineBlock; k <= (z + 1) * kFineBlock + 1; ++k) {
+          for (int j = y * kFineBlock; j <= (y + 1) * kFineBlock + 1; ++j) {
+            const std::size_t row = (static_cast<std::size_t>(k) * n + j) * n;
+            for (int h = x * kFineBlock; h <= (x + 1) * kFineBlock + 1; ++h) {
+              const std::uint16_t v = brick.value(row + static_cast<std::size_t>(h));
+              lo = std::min(lo, v);
+              hi = std::max(hi, v);
+            }
+          }
+        }
+        fine[i] = lo;
+        fine[i + 1] = hi;
+      }
+    }
   }
 }
 
@@ -337,7 +413,7 @@ std::uint64_t BricksLayout::textureBytes() const {
 
 ValueMapping BricksLayout::rawFromStored() const {
   const lod::StoredMapping& m = streamer_->mapping();
-  return m.identity ? ValueMapping{255.0, 0.0} : ValueMapping{m.width, m.min};
+  return {m.width, m.min};
 }
 
 std::optional<lod::BrickRange> BricksLayout::subtreeBound(const lod::BrickKey& key) const {
@@ -346,26 +422,34 @@ std::optional<lod::BrickRange> BricksLayout::subtreeBound(const lod::BrickKey& k
   // values bounds finer levels; otherwise nothing is known of the bricks
   // under a read one until they are read themselves (a small bright finding
   // averaged into a dim coarse brick must not vanish).
-  const bool mean = source_->meanPyramid() && streamer_->mapping().identity;
+  const lod::StoredMapping& m = streamer_->mapping();
+  const bool mean = source_->meanPyramid() && m.exact;
   for (lod::BrickKey k = key; k.level < grid_.levelCount(); k = grid_.parent(k)) {
     if (auto r = streamer_->range(k)) {
       if (k.level == 0) return r;
       if (!mean) return std::nullopt;
-      return lod::meanPyramidBound(*r, k.level);
+      return lod::meanPyramidBound(*r, k.level, m.maxStored());
     }
   }
   return std::nullopt;
 }
 
-bool BricksLayout::transparent(const lod::BrickKey& key, const TransferFunction&, bool exactOnly,
-                               std::uint8_t* value) const {
-  if (opaquePrefix_.empty()) return false;
+bool BricksLayout::transparent(const lod::BrickKey& key, const TransferFunction& tf, bool exactOnly,
+                               std::uint16_t* value) const {
+  if (!classified_) return false;
   const std::optional<lod::BrickRange> r = exactOnly ? streamer_->range(key) : subtreeBound(key);
   if (!r) return false;
-  const int lo = 2 * r->min, hi = 2 * r->max;
-  const bool any = opaquePrefix_[static_cast<std::size_t>(hi) + 1] -
-                       opaquePrefix_[static_cast<std::size_t>(lo)] >
-                   0;
+  // The TF's input over the brick's values, as the shader computes it:
+  // n = clamp((raw - window min) / window width, 0, 1). The TF is piecewise
+  // linear, so it is transparent over [a, b] when it is at both ends and no
+  // control point inside is opaque.
+  const lod::StoredMapping& m = streamer_->mapping();
+  const ValueRange w = source_->shape().window();
+  const double ww = w.max > w.min ? w.max - w.min : 1.0;
+  const double a = std::clamp((m.raw(r->min) - w.min) / ww, 0.0, 1.0);
+  const double b = std::clamp((m.raw(r->max) - w.min) / ww, 0.0, 1.0);
+  bool any = tf.opacity(a) > 0.0 || tf.opacity(b) > 0.0;
+  for (const OpacityPoint& p : tf.opacities) any = any || (p.alpha > 0.0 && p.x > a && p.x < b);
   if (value) *value = r->min;
   return !any;
 }
@@ -375,7 +459,8 @@ void BricksLayout::rebuildPages(const TransferFunction& tf, BricksFrame& frame) 
   const int levels = grid_.levelCount();
   std::vector<std::uint8_t> pages(pages_host_.size(), 0);
   cellMin_.assign(pages.size() / 4, 0);
-  cellMax_.assign(pages.size() / 4, 255);
+  cellSlot0_.assign(pages.size() / 4, -1);
+  cellMax_.assign(pages.size() / 4, static_cast<std::uint16_t>(streamer_->mapping().maxStored()));
   frame.cellsPerLevel.assign(static_cast<std::size_t>(levels) + 1, 0);
   std::size_t i = 0;
   for (int z = 0; z < cells.z; ++z) {
@@ -391,6 +476,7 @@ void BricksLayout::rebuildPages(const TransferFunction& tf, BricksFrame& frame) 
             e[1] = static_cast<std::uint8_t>(s.y);
             e[2] = static_cast<std::uint8_t>(s.z);
             e[3] = static_cast<std::uint8_t>(l);
+            if (l == 0) cellSlot0_[i] = it->second;
             if (auto r = streamer_->range(key)) {
               cellMin_[i] = r->min;
               cellMax_[i] = r->max;
@@ -398,9 +484,10 @@ void BricksLayout::rebuildPages(const TransferFunction& tf, BricksFrame& frame) 
             ++frame.cellsPerLevel[static_cast<std::size_t>(l)];
             break;
           }
-          std::uint8_t v = 0;
+          std::uint16_t v = 0;
           if (transparent(key, tf, true, &v)) {
-            e[0] = v;
+            e[0] = static_cast<std::uint8_t>(v & 0xff);  // the constant value, low byte first
+            e[1] = static_cast<std::uint8_t>(v >> 8);
             e[3] = 255;
             cellMin_[i] = cellMax_[i] = v;
             ++frame.cellsPerLevel[static_cast<std::size_t>(levels)];
@@ -421,23 +508,7 @@ BricksFrame BricksLayout::update(const Camera& camera, int width, int height,
                                  const TransferFunction& tf) {
   ++frame_;
   BricksFrame frame;
-  // Which stored values (and the spans between neighbours) the TF shows:
-  // mark 2s for value s, 2s + 1 for the interval (s, s + 1), which a TF
-  // control point with opacity inside it makes visible.
-  const lod::StoredMapping& m = streamer_->mapping();
-  const ValueRange w = source_->shape().window();
-  const double ww = w.max > w.min ? w.max - w.min : 1.0;
-  auto norm = [&](double s) { return (m.raw(s) - w.min) / ww; };
-  std::vector<int> marks(512, 0);
-  for (int s = 0; s < 256; ++s) marks[2 * s] = tf.opacity(norm(s)) > 0.0;
-  for (const OpacityPoint& p : tf.opacities) {
-    if (p.alpha <= 0.0) continue;
-    for (int s = 0; s < 255; ++s) {
-      if (p.x > norm(s) && p.x < norm(s + 1)) marks[2 * s + 1] = 1;
-    }
-  }
-  opaquePrefix_.assign(513, 0);
-  for (int k = 0; k < 512; ++k) opaquePrefix_[k + 1] = opaquePrefix_[k] + marks[k];
+  classified_ = true;  // transparent() judges bricks by `tf` from now on
 
   lod::LodView view;
   const glm::dvec3 spacing = source_->shape().spacing();
@@ -506,7 +577,7 @@ BricksFrame BricksLayout::update(const Camera& camera, int width, int height,
     const int slot = slotFor(k.id(), frame_);
     if (slot < 0) continue;  // every slot holds a brick this frame wants
     upload(slot, *brick);
-    bytes += brick->voxels.size();
+    bytes += brick->bytes.size();
     ++frame.uploaded;
     if (cut) --frame.missing;
   }
@@ -533,7 +604,7 @@ BricksLayout::Lookup BricksLayout::lookup(glm::dvec3 x0) const {
   Lookup out;
   if (e[3] == 255) {
     out.level = -1;
-    out.texel = glm::dvec3(e[0], 0.0, 0.0);
+    out.texel = glm::dvec3(e[0] | (e[1] << 8), 0.0, 0.0);
     return out;
   }
   out.level = e[3];
@@ -558,11 +629,28 @@ ValueBlocks BricksLayout::valueBlocks(int blockSize) const {
   for (int z = 0; z < count.z; ++z) {
     for (int y = 0; y < count.y; ++y) {
       for (int x = 0; x < count.x; ++x, ++i) {
+        const glm::ivec3 block(x, y, z);
+        if (blockSize == kFineBlock && b % kFineBlock == 0) {
+          // A block inside one level-0 brick: its own range, as in core.
+          const glm::ivec3 cell = block * kFineBlock / b;
+          const std::size_t c = (static_cast<std::size_t>(cell.z) * cells.y + cell.y) * cells.x +
+                                static_cast<std::size_t>(cell.x);
+          const int slot = cellSlot0_[c];
+          if (slot >= 0 && !slotFine_[static_cast<std::size_t>(slot)].empty()) {
+            const int per = b / kFineBlock;
+            const glm::ivec3 f = block - cell * per;
+            const std::size_t at = 2 * ((static_cast<std::size_t>(f.z) * per + f.y) * per +
+                                        static_cast<std::size_t>(f.x));
+            const std::vector<std::uint16_t>& fine = slotFine_[static_cast<std::size_t>(slot)];
+            mins[i] = static_cast<float>(m.raw(fine[at]));
+            maxs[i] = static_cast<float>(m.raw(fine[at + 1]));
+            continue;
+          }
+        }
         // Samples inside the block read the cells its box [bS, (b+1)S] touches.
-        const glm::ivec3 lo = glm::ivec3(x, y, z) * blockSize / b;
-        const glm::ivec3 hi =
-            glm::min(glm::min((glm::ivec3(x, y, z) + 1) * blockSize, d) / b, cells - 1);
-        int mn = 255, mx = 0;
+        const glm::ivec3 lo = block * blockSize / b;
+        const glm::ivec3 hi = glm::min(glm::min((block + 1) * blockSize, d) / b, cells - 1);
+        int mn = m.maxStored(), mx = 0;
         for (int cz = lo.z; cz <= hi.z; ++cz) {
           for (int cy = lo.y; cy <= hi.y; ++cy) {
             for (int cx = lo.x; cx <= hi.x; ++cx) {
@@ -582,10 +670,13 @@ ValueBlocks BricksLayout::valueBlocks(int blockSize) const {
 
 gpu::ShaderPart BricksLayout::glsl() const {
   gpu::ShaderPart part = gpu::embeddedShaderPart("layout/bricks.glsl");
-  // The number of ES 2 atlas samplers must be a compile-time constant; it
-  // replaces the file's first line, a comment, so line numbers stay.
-  part.text.replace(0, part.text.find('\n'),
-                    "#define BRICKS_ATLASES " + std::to_string(atlases_.size()));
+  // The number of ES 2 atlas samplers and the atlas' texel format must be
+  // compile-time constants; they replace the file's first two lines,
+  // comments, so line numbers stay.
+  const std::size_t second = part.text.find('\n') + 1;
+  part.text.replace(0, part.text.find('\n', second),
+                    "#define BRICKS_ATLASES " + std::to_string(atlases_.size()) +
+                        "\n#define BRICKS_TEXEL " + std::to_string(atlasTexel_));
   return part;
 }
 

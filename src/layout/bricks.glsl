@@ -1,4 +1,5 @@
-// Line 1 is replaced by "#define BRICKS_ATLASES <N>" (BricksLayout::glsl()).
+// Line 1 is replaced by "#define BRICKS_ATLASES <N>" (BricksLayout::glsl()),
+// line 2 by "#define BRICKS_TEXEL <T>": how a stored value is read (below).
 // sampleVolume for BricksLayout: bricks of several resolution levels in one
 // atlas, found through a page table (Schultz 2016 §7.3; the page-table
 // scheme of ImageVis3D and Neuroglancer). Valid GLSL ES 1.00 and 3.00.
@@ -18,6 +19,20 @@
 // slots are stacked along z in up to 8 textures, each a mosaic of z-slices
 // (MosaicLayout's addressing, layout/mosaic.glsl): page r = texture, b =
 // slot in its stack; two bilinear fetches and a mix.
+//
+// Stored values keep the data's precision (lod::StoredMapping): BRICKS_TEXEL
+// 0: 8 bits in .r (R8, LUMINANCE); 1: 16 bits in .r (R16, normalised); 2 and
+// 3: 16 bits as a low and a high byte in .r and .g (RG8) or .r and .a
+// (LUMINANCE_ALPHA), sampled NEAREST and interpolated after recombining (8
+// fetches a sample instead of 1 or 2). A transparent cell's constant value is
+// the page texel's r (8 bits) or r + 256 g (16 bits).
+#if BRICKS_TEXEL == 2
+#define BRICKS_VALUE(t) dot((t).rg, vec2(255.0 / 65535.0, 65280.0 / 65535.0))
+#elif BRICKS_TEXEL == 3
+#define BRICKS_VALUE(t) dot((t).ra, vec2(255.0 / 65535.0, 65280.0 / 65535.0))
+#else
+#define BRICKS_VALUE(t) (t).r
+#endif
 #if TESSERA_GLSL == 300
 uniform highp sampler2D u_layoutPages;
 uniform highp sampler3D u_layoutAtlas;
@@ -79,27 +94,27 @@ float layoutAtlasSlice(float t, float z, vec2 texel) {
 #if BRICKS_ATLASES > 6
             if (t > 5.5) {
 #if BRICKS_ATLASES > 7
-              if (t > 6.5) return TEX2D(u_layoutAtlas7, uv).r;
+              if (t > 6.5) return BRICKS_VALUE(TEX2D(u_layoutAtlas7, uv));
 #endif
-              return TEX2D(u_layoutAtlas6, uv).r;
+              return BRICKS_VALUE(TEX2D(u_layoutAtlas6, uv));
             }
 #endif
-            return TEX2D(u_layoutAtlas5, uv).r;
+            return BRICKS_VALUE(TEX2D(u_layoutAtlas5, uv));
           }
 #endif
-          return TEX2D(u_layoutAtlas4, uv).r;
+          return BRICKS_VALUE(TEX2D(u_layoutAtlas4, uv));
         }
 #endif
-        return TEX2D(u_layoutAtlas3, uv).r;
+        return BRICKS_VALUE(TEX2D(u_layoutAtlas3, uv));
       }
 #endif
-      return TEX2D(u_layoutAtlas2, uv).r;
+      return BRICKS_VALUE(TEX2D(u_layoutAtlas2, uv));
     }
 #endif
-    return TEX2D(u_layoutAtlas1, uv).r;
+    return BRICKS_VALUE(TEX2D(u_layoutAtlas1, uv));
   }
 #endif
-  return TEX2D(u_layoutAtlas0, uv).r;
+  return BRICKS_VALUE(TEX2D(u_layoutAtlas0, uv));
 }
 #endif
 
@@ -109,19 +124,60 @@ float sampleVolume(vec3 p) {
   vec4 page = TEX2D(u_layoutPages,
                     (vec2(cell.x, cell.y + cell.z * u_layoutCells.y) + 0.5) * u_layoutPagesInv);
   vec4 e = floor(page * 255.0 + 0.5);
+#if BRICKS_TEXEL == 0
   if (e.a > 254.5) return page.r;
+#else
+  if (e.a > 254.5) return (e.r + 256.0 * e.g) / 65535.0;
+#endif
   float shrink = exp2(-e.a);
   vec3 brick = floor(cell * shrink + 0.001);  // c >> l (the +0.001 guards exp2 rounding)
   vec3 local = clamp(x0 * shrink - brick * u_layoutBrick, 0.0, u_layoutBrick) + 1.0;
 #if TESSERA_GLSL == 300
   vec3 texel = e.rgb * (u_layoutBrick + 2.0) + local;
-  return texture(u_layoutAtlas, texel / u_layoutAtlasTexels).r;
+#if BRICKS_TEXEL == 2
+  // Two bytes filtered apart are each rounded to 8 bits by GPUs that filter
+  // 8-bit textures in fixed point (llvmpipe): a value crossing a multiple of
+  // 256 would be off by up to 128. The atlas is NEAREST and the 8 corners
+  // are recombined first, then interpolated.
+  vec3 c = texel - 0.5;
+  vec3 f = c - floor(c);
+  ivec3 i = ivec3(floor(c));
+  float v000 = BRICKS_VALUE(texelFetch(u_layoutAtlas, i, 0));
+  float v100 = BRICKS_VALUE(texelFetch(u_layoutAtlas, i + ivec3(1, 0, 0), 0));
+  float v010 = BRICKS_VALUE(texelFetch(u_layoutAtlas, i + ivec3(0, 1, 0), 0));
+  float v110 = BRICKS_VALUE(texelFetch(u_layoutAtlas, i + ivec3(1, 1, 0), 0));
+  float v001 = BRICKS_VALUE(texelFetch(u_layoutAtlas, i + ivec3(0, 0, 1), 0));
+  float v101 = BRICKS_VALUE(texelFetch(u_layoutAtlas, i + ivec3(1, 0, 1), 0));
+  float v011 = BRICKS_VALUE(texelFetch(u_layoutAtlas, i + ivec3(0, 1, 1), 0));
+  float v111 = BRICKS_VALUE(texelFetch(u_layoutAtlas, i + ivec3(1, 1, 1), 0));
+  return mix(mix(mix(v000, v100, f.x), mix(v010, v110, f.x), f.y),
+             mix(mix(v001, v101, f.x), mix(v011, v111, f.x), f.y), f.z);
+#else
+  return BRICKS_VALUE(texture(u_layoutAtlas, texel / u_layoutAtlasTexels));
+#endif
 #else
   // e.r: the atlas texture; e.b: the slot in its stack.
   vec3 texel = vec3(0.0, 0.0, e.b * (u_layoutBrick + 2.0)) + local;
   float zc = texel.z - 0.5;
   float z0 = floor(zc);
+#if BRICKS_TEXEL == 3
+  // As for RG8 above: NEAREST, each corner recombined, then interpolated.
+  vec2 c = texel.xy - 0.5;
+  vec2 f = c - floor(c);
+  vec2 a = floor(c) + 0.5;  // the lower corner's texel centre
+  vec2 dx = vec2(1.0, 0.0);
+  vec2 dy = vec2(0.0, 1.0);
+  float s0 = mix(mix(layoutAtlasSlice(e.r, z0, a), layoutAtlasSlice(e.r, z0, a + dx), f.x),
+                 mix(layoutAtlasSlice(e.r, z0, a + dy), layoutAtlasSlice(e.r, z0, a + 1.0), f.x),
+                 f.y);
+  float s1 = mix(
+      mix(layoutAtlasSlice(e.r, z0 + 1.0, a), layoutAtlasSlice(e.r, z0 + 1.0, a + dx), f.x),
+      mix(layoutAtlasSlice(e.r, z0 + 1.0, a + dy), layoutAtlasSlice(e.r, z0 + 1.0, a + 1.0), f.x),
+      f.y);
+  return mix(s0, s1, zc - z0);
+#else
   return mix(layoutAtlasSlice(e.r, z0, texel.xy), layoutAtlasSlice(e.r, z0 + 1.0, texel.xy),
              zc - z0);
+#endif
 #endif
 }

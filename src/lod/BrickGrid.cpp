@@ -64,18 +64,34 @@ std::vector<BrickKey> BrickGrid::children(const BrickKey& key) const {
 
 StoredMapping StoredMapping::of(const Volume& shape) {
   StoredMapping m;
-  if (shape.type() == ScalarType::U8) return m;
-  const ValueRange w = shape.window();
-  m.identity = false;
-  m.min = w.min;
-  m.width = w.max > w.min ? w.max - w.min : 1.0;
+  switch (shape.type()) {
+    case ScalarType::U8:
+      return m;
+    case ScalarType::U16:
+      m.bits = 16;
+      m.width = 65535.0;
+      return m;
+    case ScalarType::I16:
+      m.bits = 16;
+      m.min = -32768.0;
+      m.width = 65535.0;
+      return m;
+    case ScalarType::F32:
+      break;
+  }
+  const ValueRange r = shape.valueRange();
+  m.bits = 16;
+  m.exact = false;
+  m.min = r.min;
+  m.width = r.max > r.min ? r.max - r.min : 1.0;
   return m;
 }
 
-std::uint8_t StoredMapping::store(double raw) const {
+std::uint16_t StoredMapping::store(double raw) const {
   if (!std::isfinite(raw)) return 0;
-  const double s = identity ? raw : (raw - min) / width * 255.0;
-  return static_cast<std::uint8_t>(std::lround(std::clamp(s, 0.0, 255.0)));
+  const double top = maxStored();
+  const double s = exact ? raw - min : (raw - min) / width * top;
+  return static_cast<std::uint16_t>(std::lround(std::clamp(s, 0.0, top)));
 }
 
 StoredBrick readStoredBrick(const MultiresSource& source, const BrickGrid& grid,
@@ -92,11 +108,13 @@ StoredBrick readStoredBrick(const MultiresSource& source, const BrickGrid& grid,
   const glm::ivec3 first = key.brick * grid.brickSize() - 1;  // level index of stored voxel 0
   const glm::ivec3 last = box.end - 1;
   StoredBrick out;
-  out.voxels.resize(grid.storedVoxels());
-  std::uint8_t lo = 255, hi = 0;
-  const bool u8 = v.type() == ScalarType::U8 && mapping.identity;
+  out.bits = mapping.bits;
+  const std::size_t bytesPer = mapping.bits == 8 ? 1 : 2;
+  out.bytes.resize(grid.storedVoxels() * bytesPer);
+  std::uint16_t lo = 65535, hi = 0;
+  const bool u8 = v.type() == ScalarType::U8 && mapping.bits == 8 && mapping.exact;
   const std::uint8_t* src = u8 ? v.dataAs<std::uint8_t>() : nullptr;
-  std::size_t i = 0;
+  std::uint8_t* dst = out.bytes.data();
   for (int z = 0; z < n; ++z) {
     const int sz = std::clamp(first.z + z, box.begin.z, last.z) - box.begin.z;
     for (int y = 0; y < n; ++y) {
@@ -104,8 +122,13 @@ StoredBrick readStoredBrick(const MultiresSource& source, const BrickGrid& grid,
       for (int x = 0; x < n; ++x) {
         const int sx = std::clamp(first.x + x, box.begin.x, last.x) - box.begin.x;
         const std::size_t at = v.index(sx, sy, sz);
-        const std::uint8_t s = u8 ? src[at] : mapping.store(v.valueAtIndex(at));
-        out.voxels[i++] = s;
+        const std::uint16_t s = u8 ? src[at] : mapping.store(v.valueAtIndex(at));
+        if (bytesPer == 1) {
+          *dst++ = static_cast<std::uint8_t>(s);
+        } else {
+          *dst++ = static_cast<std::uint8_t>(s & 0xff);
+          *dst++ = static_cast<std::uint8_t>(s >> 8);
+        }
         lo = std::min(lo, s);
         hi = std::max(hi, s);
       }

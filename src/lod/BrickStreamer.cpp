@@ -98,13 +98,14 @@ std::shared_ptr<const StoredBrick> BrickStreamer::find(const BrickKey& key) {
   return it->second->second;
 }
 
-BrickRange meanPyramidBound(BrickRange ancestor, int levelsUp) {
+BrickRange meanPyramidBound(BrickRange ancestor, int levelsUp, int maxStored) {
+  const double top = maxStored;
   double lo = ancestor.min, hi = ancestor.max;
-  for (int i = 0; i < levelsUp && (lo > 0.0 || hi < 255.0); ++i) {
-    lo = std::max(0.0, 8.0 * (lo - 1.0) - 7.0 * 255.0);
-    hi = std::min(255.0, 8.0 * (hi + 1.0));
+  for (int i = 0; i < levelsUp && (lo > 0.0 || hi < top); ++i) {
+    lo = std::max(0.0, 8.0 * (lo - 1.0) - 7.0 * top);
+    hi = std::min(top, 8.0 * (hi + 1.0));
   }
-  return {static_cast<std::uint8_t>(lo), static_cast<std::uint8_t>(hi)};
+  return {static_cast<std::uint16_t>(lo), static_cast<std::uint16_t>(hi)};
 }
 
 std::optional<BrickRange> BrickStreamer::range(const BrickKey& key) const {
@@ -144,14 +145,14 @@ void BrickStreamer::store(const BrickKey& key, std::shared_ptr<const StoredBrick
   ranges_[id] = {brick->min, brick->max};
   failures_.erase(id);
   ++stats_.bricksRead;
-  stats_.bytesRead += brick->voxels.size();
+  stats_.bytesRead += brick->bytes.size();
   if (cached_.count(id)) return;
-  stats_.cacheBytes += brick->voxels.size();
+  stats_.cacheBytes += brick->bytes.size();
   lru_.emplace_front(id, std::move(brick));
   cached_[id] = lru_.begin();
   // Least recently used out while over the budget (the newest always stays).
   while (stats_.cacheBytes > options_.cacheBytes && lru_.size() > 1) {
-    stats_.cacheBytes -= lru_.back().second->voxels.size();
+    stats_.cacheBytes -= lru_.back().second->bytes.size();
     cached_.erase(lru_.back().first);
     lru_.pop_back();
   }

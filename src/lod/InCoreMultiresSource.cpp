@@ -63,6 +63,7 @@ InCoreMultiresSource::InCoreMultiresSource(std::shared_ptr<const Volume> volume,
   shape_.setDirection(volume->direction());
   shape_.setOrigin(volume->origin());
   shape_.setGeometrySource(volume->geometrySource());
+  shape_.setValueRange(volume->valueRange());
   shape_.setWindow(volume->window());
   shape_.setDescription(volume->description());
 }

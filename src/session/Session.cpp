@@ -9,6 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "tessera/core/Error.h"
+#include "tessera/lod/MultiresVolumeSource.h"
+#include "tessera/lod/WindowedSource.h"
 #include "tessera/reference/ReferenceRaycaster.h"
 #include "tessera/render/LabelTable.h"
 
@@ -122,9 +124,17 @@ Exploration& Session::exploration() {
   return *exploration_;
 }
 
-// The settings that change the in-core voxels' meaning: the window (raw
-// values mapped to the TF) and a label volume's preparation.
+// The settings that change the voxels' meaning: the window (raw values
+// mapped to the TF) and a label volume's preparation. A streamed volume is
+// seen through the window (lod::WindowedSource), so that its bricks are
+// classified and drawn with it.
 void Session::applyVolumeSettings() {
+  if (streamed_) {
+    std::shared_ptr<const lod::MultiresSource> seen = streamed_;
+    if (settings_.window)
+      seen = std::make_shared<lod::WindowedSource>(streamed_, *settings_.window);
+    streamedView_ = std::make_unique<lod::MultiresVolumeSource>(std::move(seen));
+  }
   if (!inCore_) return;
   Volume& v = inCore_->volume();
   if (settings_.window) v.setWindow(*settings_.window);

@@ -61,7 +61,7 @@ std::shared_ptr<const lod::MultiresSource> streamedSource(const std::string& spe
   if (!isZarrStore(spec)) return nullptr;
   const ZarrSelection zarr{.time = o.time, .channel = o.channel};
   if (streamsBricks(s.layout)) return lod::ZarrMultiresSource::open(spec, zarr);
-  if (s.layout != "auto" || o.hostVoxels || s.window || s.labels) return nullptr;
+  if (s.layout != "auto" || o.hostVoxels || s.labels) return nullptr;
   auto store = lod::ZarrMultiresSource::open(spec, zarr);
   if (!plannerStreams(s, device, *store)) return nullptr;
   return store;
@@ -123,9 +123,9 @@ void Session::open(const std::string& spec, const OpenOptions& options) {
     inCore_.reset();
     region_.reset();
     streamed_ = std::move(pyramid);
-    streamedView_ = std::make_unique<lod::MultiresVolumeSource>(streamed_);
     exploration_.reset();
     name_ = spec;
+    applyVolumeSettings();  // the streamed view, through the window asked for
     return;
   }
   setVolume(

@@ -73,14 +73,19 @@ TEST(ZarrCommand, StoreToStoreStreamsAndRenderPicksTheLevelThatFits) {
   ASSERT_EQ(render.exitCode, 0) << render.err;
   EXPECT_NE(render.err.find("read level 0 (200x200x200)"), std::string::npos) << render.err;
   // 200^3 u8 = 7.6 MiB does not fit 6 MiB: render streams it through bricks;
-  // an option that needs the voxels in core (here --window) reads level 1
+  // an option that needs the voxels in core (here --labels) reads level 1
   // (100^3, 1 MiB), the finest that fits.
   setenv("TESSERA_HOST_BUDGET_MB", "6", 1);
   const auto streamed =
       runCli("render " + out.string() + " --size 64x64 --out " + (tmp / "r.png").string());
-  const auto small = runCli("render " + out.string() + " --size 64x64 --window 0 255 --out " +
-                            (tmp / "r.png").string());
+  const auto small =
+      runCli("render " + out.string() + " --size 64x64 --labels --out " + (tmp / "r.png").string());
+  // A window streams like the default one (the bricks see it).
+  const auto windowed = runCli("render " + out.string() + " --size 64x64 --window 0 200 --out " +
+                               (tmp / "w.png").string());
   unsetenv("TESSERA_HOST_BUDGET_MB");
+  ASSERT_EQ(windowed.exitCode, 0) << windowed.err;
+  EXPECT_NE(windowed.out.find("layout   bricks:"), std::string::npos) << windowed.out;
   ASSERT_EQ(streamed.exitCode, 0) << streamed.err;
   EXPECT_NE(streamed.out.find("layout   bricks:"), std::string::npos) << streamed.out;
   EXPECT_NE(streamed.out.find("needs 7.6 MiB of host memory in core, over the host budget 6 MiB"),

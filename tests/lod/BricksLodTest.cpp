@@ -65,7 +65,7 @@ TEST(BricksLod, StoredBrickIsTheBrickAndItsApronForEveryVoxel) {
         for (int bx = 0; bx < n.x; ++bx) {
           const lod::BrickKey key{level, {bx, by, bz}};
           const lod::StoredBrick b = lod::readStoredBrick(*src, grid, key, m);
-          ASSERT_EQ(b.voxels.size(), 14u * 14u * 14u);
+          ASSERT_EQ(b.count(), 14u * 14u * 14u);
           std::size_t i = 0;
           int lo = 255, hi = 0;
           for (int z = 0; z < 14; ++z)
@@ -74,9 +74,9 @@ TEST(BricksLod, StoredBrickIsTheBrickAndItsApronForEveryVoxel) {
                 // Stored voxel (x,y,z) is level voxel brick*B - 1 + (x,y,z), clamped.
                 const glm::ivec3 g = glm::clamp(key.brick * 12 - 1 + glm::ivec3(x, y, z),
                                                 glm::ivec3(0), lv.dims() - 1);
-                ASSERT_EQ(b.voxels[i], lv.valueAt(g.x, g.y, g.z)) << level << " " << i;
-                lo = std::min<int>(lo, b.voxels[i]);
-                hi = std::max<int>(hi, b.voxels[i]);
+                ASSERT_EQ(b.value(i), lv.valueAt(g.x, g.y, g.z)) << level << " " << i;
+                lo = std::min<int>(lo, b.value(i));
+                hi = std::max<int>(hi, b.value(i));
               }
           EXPECT_EQ(b.min, lo);
           EXPECT_EQ(b.max, hi);
@@ -284,7 +284,7 @@ TEST(BricksLod, MeanPyramidBoundHoldsForEveryBrickUnderEveryAncestor) {
           for (lod::BrickKey a = grid.parent(k); a.level < grid.levelCount();
                a = grid.parent(a), ++up) {
             const lod::BrickRange ar = ranges[a.level][a.id()];
-            const lod::BrickRange bound = lod::meanPyramidBound(ar, up);
+            const lod::BrickRange bound = lod::meanPyramidBound(ar, up, 255);
             EXPECT_LE(bound.min, r.min) << "level " << l << " up " << up;
             EXPECT_GE(bound.max, r.max) << "level " << l << " up " << up;
             if (r.max == 255 && ar.max < 64) ++dimAncestorOfBright;
@@ -295,6 +295,6 @@ TEST(BricksLod, MeanPyramidBoundHoldsForEveryBrickUnderEveryAncestor) {
   EXPECT_GT(checked, 100);
   EXPECT_GT(dimAncestorOfBright, 0) << "the volume should hold bright voxels averaged away";
   // Over empty space the bound stays tight: a coarse maximum of 0.
-  EXPECT_EQ(lod::meanPyramidBound({0, 0}, 1).max, 8);
-  EXPECT_EQ(lod::meanPyramidBound({0, 0}, 2).max, 72);
+  EXPECT_EQ(lod::meanPyramidBound({0, 0}, 1, 255).max, 8);
+  EXPECT_EQ(lod::meanPyramidBound({0, 0}, 2, 255).max, 72);
 }

@@ -95,6 +95,11 @@ class Volume {
   // (call invalidateRange() after writing through bytes()/dataAs()).
   ValueRange valueRange() const;
   void invalidateRange() { rangeValid_ = false; }
+  // A shape without voxels (a streamed source's shape()) has the range its
+  // metadata declares; without one, [0, 255] for u8 and [0, 1] otherwise.
+  // Throws InputError for a non-finite or reversed range; ignored once
+  // voxels are written (invalidateRange()).
+  void setValueRange(ValueRange r);
 
   // NaN and +-Inf voxels (f32 only; 0 for integer types): every renderer,
   // the reference and the layouts read them as `nonFiniteValue()`, the

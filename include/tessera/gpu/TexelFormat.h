@@ -20,6 +20,7 @@ enum class TexelFormat {
   RGBA16F,          // ES 3: upload 4 x float, stored as half
   RGBA32F,          // ES 3: 4 x float
   Luminance8,       // ES 2: 1 x uint8 (GL_LUMINANCE)
+  LuminanceAlpha8,  // ES 2: 2 x uint8 (GL_LUMINANCE_ALPHA: sampled as (L, L, L, A))
   Rgba8Unsized,     // ES 2: 4 x uint8 (GL_RGBA)
   RgbaHalfUnsized,  // ES 2 + OES_texture_half_float: 4 x uint16 halves
 };

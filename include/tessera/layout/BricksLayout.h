@@ -18,8 +18,12 @@
 // uploaded. The atlas is allocated once, within the texture budget: the
 // ledger never grows after create().
 //
-// Values are stored in 8 bits: u8 exactly, other types normalised over the
-// volume's window (a quantisation of up to half a step of width / 255).
+// Values keep the data's precision (lod::StoredMapping): u8 in 8 bits, u16
+// and i16 exactly in 16 bits, f32 in 16 bits over its value range; the
+// window is applied in the shader as for in-core layouts, so any window,
+// however narrow, gives the in-core image. 16-bit values live in R16 where
+// the context has EXT_texture_norm16, else in two 8-bit channels (RG8 on
+// ES 3, LUMINANCE_ALPHA on ES 2) recombined in bricks.glsl.
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -108,8 +112,6 @@ class BricksLayout final : public Layout, public StreamingLayout {
     glm::dvec3 texel{0.0};
   };
   Lookup lookup(glm::dvec3 x0) const;
-  // The stored (8-bit) value the atlas holds at integer atlas texel t.
-  std::uint8_t atlasTexel(glm::ivec3 t) const;
 
   static LayoutEntry registration();
 
@@ -117,12 +119,13 @@ class BricksLayout final : public Layout, public StreamingLayout {
   BricksLayout() = default;
   int slotFor(std::uint64_t id, std::uint64_t frame);
   void upload(int slot, const lod::StoredBrick& brick);
+  void keepFineRanges(int slot, const lod::StoredBrick& brick);
   // Whether the TF makes the brick transparent: by its own range read
   // (exactOnly, for the page table), or else the brick and every brick
   // under it by subtreeBound() (for the level selection, which leaves such
   // a brick's whole subtree out).
   bool transparent(const lod::BrickKey& key, const TransferFunction& tf, bool exactOnly,
-                   std::uint8_t* value) const;
+                   std::uint16_t* value) const;
   std::optional<lod::BrickRange> subtreeBound(const lod::BrickKey& key) const;
   void rebuildPages(const TransferFunction& tf, BricksFrame& frame);
   glm::ivec3 slotOrigin(int slot) const;
@@ -141,13 +144,18 @@ class BricksLayout final : public Layout, public StreamingLayout {
   std::vector<std::int64_t> slotKey_;    // brick id per slot, -1 free
   std::vector<std::uint64_t> slotUsed_;  // frame last wanted
   std::vector<bool> slotPinned_;
+  // Per slot holding a level-0 brick: (min, max) stored values of each
+  // kFineBlock^3 block with its one-voxel support (valueBlocks()).
+  static constexpr int kFineBlock = 8;
+  std::vector<std::vector<std::uint16_t>> slotFine_;
+  std::vector<int> cellSlot0_;  // per level-0 cell: the slot of its level-0 brick, or -1
   std::unordered_map<std::uint64_t, int> slotOf_;
   std::vector<std::uint8_t> pages_host_;
-  std::vector<std::uint8_t> cellMin_, cellMax_;  // stored range of what each cell samples
+  std::vector<std::uint16_t> cellMin_, cellMax_;  // stored range of what each cell samples
   std::uint64_t frame_ = 0;
   std::uint64_t contentVersion_ = 1;
-  // The TF's opacity > 0 over stored values 0..255 (prefix counts).
-  std::vector<int> opaquePrefix_;
+  int atlasTexel_ = 0;       // BRICKS_TEXEL: how bricks.glsl reads a stored value
+  bool classified_ = false;  // update() has seen a TF: transparent() may judge bricks
 };
 
 }  // namespace tessera::layout

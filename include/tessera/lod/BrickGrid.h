@@ -6,6 +6,7 @@
 // all, so trilinear interpolation anywhere inside the brick reads only the
 // brick and the bricked volume shows no seams. Brick (l, b) covers level-0
 // voxels [b B 2^l, (b + 1) B 2^l); its parent is (l + 1, b / 2).
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -61,23 +62,37 @@ class BrickGrid {
   std::vector<glm::ivec3> bricks_;
 };
 
-// A brick as stored: (B + 2)^3 8-bit values (x fastest), apron included,
-// and their range (stored units, 0..255).
-struct StoredBrick {
-  std::vector<std::uint8_t> voxels;
-  std::uint8_t min = 0;
-  std::uint8_t max = 0;
+// How raw values are stored in bricks: in 8 bits for u8 volumes (as they
+// are), in 16 bits otherwise. u16 and i16 are stored exactly (raw - min of
+// the type); f32 is normalised over the volume's value range (a step of
+// width / 65535), so any window, however narrow, keeps its grey levels.
+// raw = min + stored / maxStored() * width.
+struct StoredMapping {
+  int bits = 8;          // 8 or 16 bits per stored value
+  bool exact = true;     // every raw value is stored without rounding
+  double min = 0.0;      // the raw value of stored 0
+  double width = 255.0;  // the raw width stored maxStored() spans
+  static StoredMapping of(const Volume& shape);
+  int maxStored() const { return bits == 8 ? 255 : 65535; }
+  std::uint16_t store(double raw) const;
+  double raw(double stored) const { return min + stored / maxStored() * width; }
 };
 
-// Raw value -> stored 8-bit value: u8 volumes are stored as they are; other
-// types are normalised over `window` (raw = min + stored / 255 * width).
-struct StoredMapping {
-  bool identity = true;
-  double min = 0.0;
-  double width = 255.0;
-  static StoredMapping of(const Volume& shape);
-  std::uint8_t store(double raw) const;
-  double raw(double stored) const { return identity ? stored : min + stored / 255.0 * width; }
+// A brick as stored: (B + 2)^3 values (x fastest), apron included, of
+// mapping.bits each (16-bit values little-endian, as GL takes them: R16
+// reads one unsigned short, RG8 and LUMINANCE_ALPHA the low byte in their
+// first channel and the high byte in their second), and their range in
+// stored units.
+struct StoredBrick {
+  int bits = 8;
+  std::vector<std::uint8_t> bytes;
+  std::uint16_t min = 0;
+  std::uint16_t max = 0;
+  std::size_t count() const { return bits == 8 ? bytes.size() : bytes.size() / 2; }
+  std::uint16_t value(std::size_t i) const {
+    return bits == 8 ? bytes[i]
+                     : static_cast<std::uint16_t>(bytes[2 * i] | (bytes[2 * i + 1] << 8));
+  }
 };
 
 // Reads the brick through source.readBox and pads it to (B + 2)^3 with

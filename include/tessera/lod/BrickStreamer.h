@@ -37,20 +37,21 @@ struct BrickStreamerOptions {
   int prefetchAhead = 16;
 };
 
-struct BrickRange {
-  std::uint8_t min = 0;
-  std::uint8_t max = 0;
+struct BrickRange {  // in stored units (StoredMapping)
+  std::uint16_t min = 0;
+  std::uint16_t max = 0;
 };
 
-// What a brick `levelsUp` levels above tells of the stored values (0..255,
-// 0 = the smallest the source holds) of the bricks under it, in a mean
-// pyramid (MultiresSource::meanPyramid()): a coarse voxel m is the mean of
-// n <= 8 finer ones, none below 0 or above 255, so each of them lies in
-// [8m - 7*255, 8m]; rounding of the stored means adds one either way. The
-// bound widens eightfold a level; it is tight where it matters, over empty
-// space (a coarse maximum of 0 bounds every finer voxel at 8), and a lone
-// bright voxel averaged into a dim coarse one is never bounded away.
-BrickRange meanPyramidBound(BrickRange ancestor, int levelsUp);
+// What a brick `levelsUp` levels above tells of the stored values (0..M,
+// M = maxStored, 0 = the smallest the mapping stores) of the bricks under
+// it, in a mean pyramid (MultiresSource::meanPyramid()) stored exactly
+// (StoredMapping::exact): a coarse voxel m is the mean of n <= 8 finer
+// ones, none below 0 or above M, so each of them lies in [8m - 7M, 8m];
+// rounding of the stored means adds one either way. The bound widens
+// eightfold a level; it is tight where it matters, over empty space (a
+// coarse maximum of 0 bounds every finer voxel at 8), and a lone bright
+// voxel averaged into a dim coarse one is never bounded away.
+BrickRange meanPyramidBound(BrickRange ancestor, int levelsUp, int maxStored);
 
 struct StreamerStats {
   std::uint64_t bricksRead = 0;
