@@ -66,6 +66,11 @@ struct RenderOptions {
   bool reference = false;
   std::string referenceOut;
   double referenceStep = 0.0;
+  int referenceLevel = 0;
+  CLI::Option* referenceLevelOption = nullptr;
+  bool referenceLevelGiven() const {
+    return referenceLevelOption != nullptr && referenceLevelOption->count() > 0;
+  }
   int repeat = 1;
   double rotate = 10.0;
   int skipBlock = 8;
@@ -155,10 +160,10 @@ const std::map<std::string, std::vector<std::string>>& settingKeys() {
 const std::set<std::string>& runOptions() {
   static const std::set<std::string> names = {
       "file",        "--series",    "--time",          "--channel",        "--size",
-      "--out",       "--reference", "--reference-out", "--reference-step", "--repeat",
-      "--rotate",    "--profile",   "--json",          "--overlays",       "--overlay-opacity",
-      "--offscreen", "--roi",       "--region",        "--level",          "--state",
-      "--save-state"};
+      "--out",       "--reference", "--reference-out", "--reference-step", "--reference-level",
+      "--repeat",    "--rotate",    "--profile",       "--json",           "--overlays",
+      "--offscreen", "--roi",       "--region",        "--level",          "--overlay-opacity",
+      "--state",     "--save-state"};
   return names;
 }
 
@@ -310,7 +315,9 @@ RenderRequest requestFrom(const RenderOptions& o) {
     throw InputError("--reference-step must be a positive number of voxels");
   }
   req.referenceStep = o.referenceStep;
-  req.reference = o.reference || !o.referenceOut.empty() || o.referenceStep > 0.0;
+  req.reference =
+      o.reference || !o.referenceOut.empty() || o.referenceStep > 0.0 || o.referenceLevelGiven();
+  if (o.referenceLevelGiven()) req.referenceLevel = o.referenceLevel;
   return req;
 }
 
@@ -319,7 +326,8 @@ RenderRequest requestFrom(const RenderOptions& o) {
 // at the finest level that fits the host budget.
 bool needsHostVoxels(const RenderOptions& o) {
   return !o.overlays.empty() || !o.offscreen.empty() || !o.roi.empty() || o.reference ||
-         !o.referenceOut.empty() || o.referenceStep > 0.0 || o.lattice != "cartesian";
+         !o.referenceOut.empty() || o.referenceStep > 0.0 || o.referenceLevelGiven() ||
+         o.lattice != "cartesian";
 }
 
 // --overlays, --offscreen or --roi: the hybrid compositor's run.
@@ -430,6 +438,13 @@ void printRenderJson(const RenderOptions& o, const RenderRequest& req, const Ren
     j["reference_step"] = r.referenceStep;
     j["reference_is_twin"] = req.referenceStep <= 0.0;
   }
+  if (r.referenceLevel) {
+    j["reference_level"] = *r.referenceLevel;
+    j["reference_level_dims"] = {r.referenceLevelDims.x, r.referenceLevelDims.y,
+                                 r.referenceLevelDims.z};
+    j["reference_level_mixed"] = r.referenceLevelMixed;
+    j["reference_level_note"] = r.referenceLevelNote;
+  }
   if (r.samplesPerRay > 0.0) j["samples_per_ray"] = r.samplesPerRay;
   j["shade"] = req.settings.render.shading.enabled;
   j["tf"] = req.settings.tf.name;
@@ -517,6 +532,10 @@ void printRenderText(const RenderOptions& o, const RenderRequest& req, const Ren
             : "reference (the render's own samples)";
     std::printf("reference %s: %.0f ms on the CPU; PSNR %.2f dB, SSIM %.5f\n", what.c_str(),
                 r.referenceMs, *r.psnrDb, *r.ssim);
+    if (r.referenceLevel) {
+      std::printf("ref level %d (%dx%dx%d): %s\n", *r.referenceLevel, r.referenceLevelDims.x,
+                  r.referenceLevelDims.y, r.referenceLevelDims.z, r.referenceLevelNote.c_str());
+    }
     if (r.samplesPerRay > 0.0) {
       std::printf("samples  %.1f per ray that meets the volume\n", r.samplesPerRay);
     }
@@ -674,6 +693,13 @@ void addRenderCommand(CLI::App& app) {
                   "Judge quality against a fine reference instead: the CPU reference at this "
                   "step in voxels (e.g. 0.25), every sample, post-classified (implies "
                   "--reference; without it the reference takes the render's own samples)");
+  o->referenceLevelOption = cmd->add_option(
+      "--reference-level", o->referenceLevel,
+      "With a layout that streams a pyramid (bricks: OME-Zarr stores, head:, --layout "
+      "bricks): the level the CPU reference reads whole, 0 = the finest (native) level. "
+      "Default: the finest level the refined frame shows (reported as reference_level, with "
+      "a note when it shows several). The level and its double-precision copy must fit the "
+      "host budget: pick a coarser level when they do not (implies --reference)");
   addDefaultedOption(cmd, "--repeat", o->repeat,
                      "Render N frames, rotating the camera, and report timings");
   addDefaultedOption(cmd, "--rotate", o->rotate, "Azimuth step in degrees between repeated frames");

@@ -37,6 +37,7 @@ VolumeUpload uploadVolume(gpu::GlContext& context, const gpu::DeviceLimits& limi
     if (limits.textureBudget != 0) volumeLimits.textureBudget -= technique.bytes;
     if (!entry.stream) throw Error("layout " + entry.name + " streams bricks but cannot stream");
     upload.layout = entry.stream(pyramid, volumeLimits, context.ledger());
+    upload.pyramid = std::move(pyramid);
     // The plan made from the shape alone did not know the source's chunks
     // (which set the brick size) nor its levels: report what was built.
     const std::string planned = upload.plan.layout.reason;

@@ -43,4 +43,21 @@ double NearestReconstruction::value(glm::dvec3 p) const {
   return at(i.x, i.y, i.z);
 }
 
+PyramidLevelReconstruction::PyramidLevelReconstruction(const Volume& level, int levelIndex,
+                                                       glm::ivec3 finestDims, bool nearest)
+    : values_(level),
+      level_(levelIndex),
+      finest_(finestDims),
+      scale_(glm::dvec3(finestDims) / (glm::dvec3(level.dims()) * double(1 << levelIndex))),
+      nearest_(nearest) {}
+
+double PyramidLevelReconstruction::value(glm::dvec3 p) const {
+  p = glm::clamp(p, 0.0, 1.0);
+  if (nearest_) {
+    const glm::dvec3 d(finest_);
+    p = (glm::clamp(glm::floor(p * d), glm::dvec3(0.0), d - 1.0) + 0.5) / d;
+  }
+  return values_.value(p * scale_);
+}
+
 }  // namespace tessera

@@ -6,8 +6,10 @@
 #include <cstdio>
 
 #include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"
 #include "tessera/layout/StreamingLayout.h"
+#include "tessera/lod/ReadLevel.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
 #include "tessera/reference/VoxelGradients.h"
@@ -100,7 +102,7 @@ void describeStorage(const render::TechniqueOnVolume& t, RenderResult& result) {
 // --reference-step the reference is the fine truth: that step, every sample,
 // post-classified.
 void compareWithReference(const Volume& volume, const render::Technique& technique,
-                          const layout::Layout* layout, const TransferFunction& tf,
+                          const layout::ReferenceField& own, const TransferFunction& tf,
                           const RenderRequest& req, RenderResult& result) {
   const render::SamplingTwin twin = technique.samplingTwin(req.settings.render);
   const bool fine = req.referenceStep > 0.0;
@@ -115,7 +117,6 @@ void compareWithReference(const Volume& volume, const render::Technique& techniq
                  static_cast<int>(std::ceil(req.settings.render.maxSteps *
                                             req.settings.render.stepVoxels / req.referenceStep)));
   }
-  const layout::ReferenceField own = layout ? layout->referenceField() : layout::ReferenceField{};
   const auto render = [&](const RenderSettings& s, const StepGrid* g, ReferenceStats* stats,
                           int width, int height) {
     if (own.ownField()) {
@@ -150,6 +151,81 @@ void compareWithReference(const Volume& volume, const render::Technique& techniq
   }
 }
 
+// The host memory the reference of a pyramid level takes: the level read
+// whole (unless it is the in-core volume itself) and the double-precision
+// copy its reconstruction keeps (reference/Reconstruction.h).
+std::uint64_t referenceBytes(const lod::MultiresSource& pyramid, int level, bool held) {
+  const std::uint64_t voxels =
+      lod::levelBytes(pyramid, level) / bytesPerVoxel(pyramid.shape().type());
+  return (held ? 0 : lod::levelBytes(pyramid, level)) + voxels * sizeof(double);
+}
+
+// The asked level exists, and its reference fits the host budget; else an
+// error that names the level, its size and the budget and says which level
+// would fit.
+void checkReferenceLevel(const lod::MultiresSource& pyramid, int level, bool heldLevel0) {
+  const int levels = pyramid.levelCount();
+  const std::string range = "levels 0.." + std::to_string(levels - 1) + " (0 = the finest)";
+  if (level < 0 || level >= levels) {
+    throw InputError("--reference-level " + std::to_string(level) + ": " + pyramid.describe() +
+                     " has " + range);
+  }
+  const std::uint64_t budget = HostBudget::global().limitBytes();
+  const auto need = [&](int l) { return referenceBytes(pyramid, l, heldLevel0 && l == 0); };
+  if (need(level) <= budget) return;
+  int fits = level + 1;
+  while (fits < levels && need(fits) > budget) ++fits;
+  throw BudgetError(
+      "the reference at " + lod::describeLevel(pyramid, level) + " of " + pyramid.describe() +
+      " needs " + formatBytes(need(level)) +
+      " of host memory (the level read whole and a double-precision copy), over the host budget "
+      "of " +
+      formatBytes(budget) + ": choose a coarser level with --reference-level N (" +
+      (fits < levels ? "level " + std::to_string(fits) + " is the finest that fits" : "none fits") +
+      "; the pyramid has levels 0.." + std::to_string(levels - 1) + ")");
+}
+
+// The level the reference of a streamed layout reads by default: the one
+// the refined frame 0 shows, or the finest of those it shows (and says so).
+int shownLevel(const BricksRun& run, int levels, RenderResult& result) {
+  std::vector<int> shown;
+  for (int l = 0; l < levels && l + 1 < static_cast<int>(run.cellsPerLevel.size()); ++l) {
+    if (run.cellsPerLevel[static_cast<std::size_t>(l)] > 0) shown.push_back(l);
+  }
+  const std::string stopped = run.complete ? "" : " (refining stopped before it completed)";
+  if (shown.empty()) {
+    result.referenceLevelNote =
+        "frame 0 shows no brick (every cell is transparent): the coarsest level" + stopped;
+    return levels - 1;
+  }
+  result.referenceLevelMixed = shown.size() > 1;
+  result.referenceLevelNote =
+      result.referenceLevelMixed
+          ? "the finest of the levels frame 0 shows (page-table cells " +
+                levelsText(run.cellsPerLevel, true) +
+                "): the cells shown at a coarser level differ from it" + stopped
+          : "the level frame 0 shows in every cell that is not transparent" + stopped;
+  return shown.front();
+}
+
+// The field the reference renders for a layout that streams a pyramid: a
+// level of it, as bricks.glsl samples it, over level 0's box.
+layout::ReferenceField streamedField(const lod::MultiresSource& pyramid, const Volume& volume,
+                                     int level, const RenderRequest& req) {
+  checkReferenceLevel(pyramid, level, volume.hasData());
+  const glm::ivec3 finest = pyramid.shape().dims();
+  const bool nearest = req.settings.render.nearest;
+  layout::ReferenceField field;
+  field.box = &volume;
+  if (level == 0 && volume.hasData()) {
+    field.field = std::make_shared<PyramidLevelReconstruction>(volume, 0, finest, nearest);
+  } else {
+    field.field = std::make_shared<PyramidLevelReconstruction>(lod::readLevel(pyramid, level),
+                                                               level, finest, nearest);
+  }
+  return field;
+}
+
 }  // namespace
 
 double RenderResult::median() const {
@@ -166,9 +242,20 @@ RenderResult runRender(gpu::DeviceSession& device, const lod::VolumeSource& sour
                        RenderRequest req) {
   req.settings.validate();
   if (req.repeat < 1) throw InputError("repeat " + std::to_string(req.repeat) + ": expected >= 1");
+  if (req.referenceLevel && !req.reference) {
+    throw InputError("--reference-level needs the reference (--reference)");
+  }
   const Settings& s = req.settings;
   render::TechniqueOnVolume t = render::createTechnique(s.technique, *device.context, device.limits,
                                                         source, req.techniqueOptions(), s.layout);
+  // An asked level is checked before the frames are drawn.
+  if (req.referenceLevel) {
+    if (!t.upload.pyramid) {
+      throw InputError("--reference-level applies to a layout that streams a pyramid (bricks); " +
+                       t.storageName() + " holds the volume it renders, which the reference reads");
+    }
+    checkReferenceLevel(*t.upload.pyramid, *req.referenceLevel, t.upload.volume->hasData());
+  }
   const Volume& volume = *t.upload.volume;
   const TransferFunction& tf = s.tf;
   RenderResult result;
@@ -204,11 +291,20 @@ RenderResult runRender(gpu::DeviceSession& device, const lod::VolumeSource& sour
     result.bricks->lastError = stats.lastError;
   }
   if (req.reference) {
-    if (!volume.hasData()) {
-      throw InputError("the reference needs the volume in host memory; " + result.layout +
-                       " streams it");
+    layout::ReferenceField field;
+    if (t.upload.pyramid) {
+      const lod::MultiresSource& pyramid = *t.upload.pyramid;
+      const int level = req.referenceLevel ? *req.referenceLevel
+                        : result.bricks ? shownLevel(*result.bricks, pyramid.levelCount(), result)
+                                        : 0;
+      if (req.referenceLevel) result.referenceLevelNote = "asked for (--reference-level)";
+      field = streamedField(pyramid, volume, level, req);
+      result.referenceLevel = level;
+      result.referenceLevelDims = pyramid.levelInfo(level).dims;
+    } else if (t.upload.layout) {
+      field = t.upload.layout->referenceField();
     }
-    compareWithReference(volume, *t.technique, t.upload.layout.get(), tf, req, result);
+    compareWithReference(volume, *t.technique, field, tf, req, result);
   }
   return result;
 }

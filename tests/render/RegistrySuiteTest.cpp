@@ -7,7 +7,11 @@
 // the suite, after every static initialiser ran: an entry registered anywhere
 // in this binary (tests/render/RegistryExtensionTest.cpp registers two) is
 // image-tested here with no test edited. What may not run is decided from
-// the entries' properties and skipped with the reason.
+// the entries' properties and skipped with the reason. A layout that streams
+// bricks runs twice: on the in-core volume (the reference reads its voxels)
+// and on the same volume as a streamed pyramid, held nowhere whole (the
+// reference reads the pyramid level the refined frame shows, as
+// `tessera render STORE --layout bricks --reference` does).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -23,7 +27,9 @@
 #include "tessera/gpu/DeviceSession.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/layout/LayoutRegistry.h"
+#include "tessera/lod/InCoreMultiresSource.h"
 #include "tessera/lod/InCoreVolumeSource.h"
+#include "tessera/lod/MultiresVolumeSource.h"
 #include "tessera/render/TechniqueRegistry.h"
 #include "tessera/session/RenderRun.h"
 
@@ -60,11 +66,13 @@ struct Combo {
   std::string layout;  // "auto" for a technique with its own storage
   std::string profile;
   Case which = Case::Composite;
+  bool streamed = false;  // the volume as a pyramid read box by box (MultiresVolumeSource)
 };
 
 // gtest prints it in messages and in the test list (ctest shows that list).
 void PrintTo(const Combo& c, std::ostream* os) {
-  *os << c.technique << " on " << c.layout << ", " << c.profile << ", " << caseName(c.which);
+  *os << c.technique << " on " << c.layout << (c.streamed ? " (streamed)" : "") << ", " << c.profile
+      << ", " << caseName(c.which);
 }
 
 // A technique with its own storage plans no layout; asked with generic
@@ -79,17 +87,18 @@ bool ownsStorage(const render::TechniqueEntry& t) {
 std::vector<Combo> combos() {
   std::vector<Combo> all;
   for (const render::TechniqueEntry& t : render::TechniqueRegistry::global().entries()) {
-    std::vector<std::string> layouts;
+    std::vector<std::pair<std::string, bool>> layouts;  // name, streamed
     if (ownsStorage(t)) {
-      layouts.push_back("auto");
+      layouts.emplace_back("auto", false);
     } else {
       for (const layout::LayoutEntry& l : layout::LayoutRegistry::global().entries()) {
-        layouts.push_back(l.name);
+        layouts.emplace_back(l.name, false);
+        if (l.streamsBricks) layouts.emplace_back(l.name, true);
       }
     }
     for (const char* profile : kProfiles) {
-      for (const std::string& l : layouts) {
-        for (Case c : kCases) all.push_back({t.name, l, profile, c});
+      for (const auto& [l, streamed] : layouts) {
+        for (Case c : kCases) all.push_back({t.name, l, profile, c, streamed});
       }
     }
   }
@@ -105,8 +114,8 @@ std::string identifier(const std::string& s) {
 std::string comboName(const testing::TestParamInfo<Combo>& info) {
   const Combo& c = info.param;
   return identifier(c.technique) + "_" +
-         (c.layout == "auto" ? "ownStorage" : identifier(c.layout)) + "_" + c.profile + "_" +
-         caseName(c.which);
+         (c.layout == "auto" ? "ownStorage" : identifier(c.layout)) +
+         (c.streamed ? "_streamed" : "") + "_" + c.profile + "_" + caseName(c.which);
 }
 
 // Two planes and a crop box that cut into the volume (ClippingTest's).
@@ -197,7 +206,11 @@ TEST_P(RegistrySuite, MatchesItsCpuTwin) {
       render::TechniqueRegistry::global().find(combo.technique);
   const test::BudgetOverride keep(HostBudget::global().limitBytes());
   gpu::DeviceSession device = gpu::openDevice(combo.profile);
-  const lod::InCoreVolumeSource source(volumeFor(combo.which));
+  const lod::InCoreVolumeSource inCore(volumeFor(combo.which));
+  const lod::MultiresVolumeSource pyramid(
+      std::make_shared<lod::InCoreMultiresSource>(inCore.level(glm::ivec3(1))));
+  const lod::VolumeSource& source =
+      combo.streamed ? static_cast<const lod::VolumeSource&>(pyramid) : inCore;
   if (combo.layout != "auto") {
     const layout::LayoutEntry& entry = layout::LayoutRegistry::global().find(combo.layout);
     if (!entry.runsOn(device.limits)) {
@@ -245,6 +258,13 @@ TEST_P(RegistrySuite, MatchesItsCpuTwin) {
   if (combo.layout != "auto") {
     EXPECT_EQ(r.layout, combo.layout);
   }
+  // A streamed layout's reference reads the level the refined frame shows:
+  // at these sizes every cell shows level 0.
+  if (r.bricks) {
+    ASSERT_TRUE(r.referenceLevel);
+    EXPECT_EQ(*r.referenceLevel, 0) << r.referenceLevelNote;
+    EXPECT_FALSE(r.referenceLevelMixed) << r.referenceLevelNote;
+  }
   ASSERT_TRUE(r.referenceImage);
   // The reference shows the volume (not an empty frame that any empty
   // frame would match): the smallest, the clipped sphere, lights a few
@@ -262,10 +282,10 @@ TEST_P(RegistrySuite, MatchesItsCpuTwin) {
       technique,
       combo.layout == "auto" ? nullptr : &layout::LayoutRegistry::global().find(combo.layout),
       combo.which);
-  std::printf("  [measured] %s on %s, %s, %s: %.2f dB, SSIM %.4f (bar %.0f dB, %.2f)%s%s\n",
-              combo.technique.c_str(), r.layout.c_str(), combo.profile.c_str(),
-              caseName(combo.which), *r.psnrDb, *r.ssim, bar.psnrDb, bar.ssim,
-              r.adaptive ? ", adaptive steps" : "", r.bricks ? ", bricks refined" : "");
+  std::printf("  [measured] %s on %s%s, %s, %s: %.2f dB, SSIM %.4f (bar %.0f dB, %.2f)%s%s\n",
+              combo.technique.c_str(), r.layout.c_str(), combo.streamed ? " (streamed)" : "",
+              combo.profile.c_str(), caseName(combo.which), *r.psnrDb, *r.ssim, bar.psnrDb,
+              bar.ssim, r.adaptive ? ", adaptive steps" : "", r.bricks ? ", bricks refined" : "");
   EXPECT_GE(*r.psnrDb, bar.psnrDb);
   EXPECT_GE(*r.ssim, bar.ssim);
 }

@@ -33,6 +33,9 @@ struct VolumeUpload {
   // source's own volume at full resolution, else a reduction owned here.
   std::shared_ptr<Volume> volume;
   std::unique_ptr<Layout> layout;  // null when the technique stores the volume itself
+  // A layout that streams: the pyramid it reads (the source's own, or one
+  // built here from the in-core volume); the CPU reference reads its levels.
+  std::shared_ptr<const lod::MultiresSource> pyramid;
 };
 
 // `layoutWish`: "auto" or a registered layout's name. Throws InputError for

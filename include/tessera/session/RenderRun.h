@@ -29,6 +29,10 @@ struct RenderRequest {
   // the CPU reference at this step (voxels), post-classified, every sample
   // (no pre-integration, no adaptive steps), the render's other settings.
   double referenceStep = 0.0;
+  // A layout that streams a pyramid (bricks): the level the reference reads
+  // whole (0: the finest), within the host budget. Unset: the finest level
+  // the refined frame 0 shows. Needs `reference`.
+  std::optional<int> referenceLevel;
   // A streamed volume: where refining frame 0 stops.
   RefineLimits refine;
 
@@ -67,6 +71,14 @@ struct RenderResult {
   std::uint64_t referenceSamples = 0;  // samples the reference took for frame 0
   std::uint64_t referenceRays = 0;     // rays of frame 0 that meet the volume
   double referenceStep = 0.0;          // the reference's step (voxels)
+  // A layout that streams: the pyramid level the reference read, its dims,
+  // and why that one (asked for, the level frame 0 shows, or the finest of
+  // several it shows: `referenceLevelMixed`, where cells shown at a coarser
+  // level differ from it).
+  std::optional<int> referenceLevel;
+  glm::ivec3 referenceLevelDims{0};
+  bool referenceLevelMixed = false;
+  std::string referenceLevelNote;
   // What the render took (the twin reference walks its samples, see
   // ReferenceRaycaster.h): samples per ray hitting the volume, frame 0; set
   // with the twin reference only (not with --reference-step).
