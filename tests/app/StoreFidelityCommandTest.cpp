@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "support/CliRunner.h"
 #include "support/TestSupport.h"
 #include "tessera/core/Image.h"
@@ -20,6 +22,7 @@ namespace {
 
 using tessera::Image;
 using tessera::test::runCli;
+using tessera::test::runCliJson;
 using tessera::test::TempDir;
 
 const std::string kInia = "/usr/share/mricron/templates/inia19-t1-brain.nii.gz";
@@ -112,6 +115,36 @@ TEST(StoreFidelity, SixteenBitStoresUnderWindowsOfOneTenAndAHundredPercent) {
       EXPECT_GE(db, 55.0) << tessera::scalarTypeName(k.type) << " window " << fraction;
       std::printf("  [measured] %s store, window %g%% of the range: bricks vs texture3d %.2f dB\n",
                   std::string(tessera::scalarTypeName(k.type)).c_str(), 100.0 * fraction, db);
+    }
+  }
+}
+
+// Both layouts against the CPU reference (which reads the level the bricked
+// frame shows) on stores of every type under a narrow window (5 % of the
+// range, on the phantom's tissue).
+TEST(StoreFidelity, BricksAndTexture3dMatchTheReferenceUnderANarrowWindowOnEveryStoreType) {
+  const TempDir tmp;
+  struct Case {
+    tessera::ScalarType type;
+    double lo, hi;
+  };
+  for (const Case& k :
+       {Case{tessera::ScalarType::U8, 0.0, 255.0}, Case{tessera::ScalarType::U16, 0.0, 60000.0},
+        Case{tessera::ScalarType::I16, -1024.0, 3071.0},
+        Case{tessera::ScalarType::F32, -1024.0, 3071.0}}) {
+    const std::string file = phantomFile(tmp, k.type, k.lo, k.hi);
+    const auto store = tmp / (std::string(tessera::scalarTypeName(k.type)) + ".ome.zarr");
+    convert(file, store, "--chunk 64");
+    const double w = 0.05 * (k.hi - k.lo), c = k.lo + 0.4 * (k.hi - k.lo);
+    const std::string opts = " --size 160x160 --tf grey --reference --json --window " +
+                             std::to_string(c - w / 2) + " " + std::to_string(c + w / 2);
+    for (const std::string layout : {"texture3d", "bricks"}) {
+      const nlohmann::json j = runCliJson("render " + store.string() + " --layout " + layout +
+                                          opts + " --out " + (tmp / "r.png").string());
+      const double db = j["psnr_db"].get<double>();
+      EXPECT_GE(db, 45.0) << tessera::scalarTypeName(k.type) << " " << layout;
+      std::printf("  [measured] %s store, window 5%% of the range, %s vs reference %.2f dB\n",
+                  std::string(tessera::scalarTypeName(k.type)).c_str(), layout.c_str(), db);
     }
   }
 }
