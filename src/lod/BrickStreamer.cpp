@@ -130,7 +130,11 @@ bool BrickStreamer::failing(const BrickKey& key) const {
 
 bool BrickStreamer::failingLocked(std::uint64_t id) const {
   const auto it = failures_.find(id);
-  return it != failures_.end() && it->second.attempts >= options_.attemptsBeforeFailing;
+  return it != failures_.end() && failingAfter(it->second);
+}
+
+bool BrickStreamer::failingAfter(const Failure& f) const {
+  return f.attempts > 0 && f.attempts >= options_.attemptsBeforeFailing;
 }
 
 bool BrickStreamer::givenUp(std::uint64_t id) const {
@@ -185,7 +189,7 @@ void BrickStreamer::store(const BrickKey& key, std::shared_ptr<const StoredBrick
   const std::uint64_t id = key.id();
   ranges_[id] = {brick->min, brick->max};
   if (const auto f = failures_.find(id); f != failures_.end()) {
-    if (failingLocked(id)) countFailing(f->second, -1);
+    if (failingAfter(f->second)) countFailing(f->second, -1);
     failures_.erase(f);
   }
   ++stats_.bricksRead;
@@ -205,10 +209,10 @@ void BrickStreamer::store(const BrickKey& key, std::shared_ptr<const StoredBrick
 
 void BrickStreamer::recordFailure(const BrickKey& key, const std::string& what) {
   Failure& f = failures_[key.id()];
-  if (failingLocked(key.id())) countFailing(f, -1);
+  if (failingAfter(f)) countFailing(f, -1);
   ++f.attempts;
   f.error = what;
-  if (failingLocked(key.id())) countFailing(f, +1);
+  if (failingAfter(f)) countFailing(f, +1);
   const double wait =
       std::min(options_.maxRetryMs, options_.firstRetryMs * std::ldexp(1.0, f.attempts - 1));
   f.retryAtMs = nowMs() + wait;

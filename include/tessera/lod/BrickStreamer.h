@@ -120,6 +120,7 @@ class BrickStreamer {
     double retryAtMs = 0.0;
     std::string error;  // the last read's
   };
+  bool failingAfter(const Failure& f) const;
   bool failingLocked(std::uint64_t id) const;  // lock held
   bool givenUp(std::uint64_t id) const;        // lock held
   // The failing bricks' errors, counted per message (lock held).
