@@ -2,6 +2,7 @@
 // The `tessera` subcommands; each registers itself on the CLI11 app and
 // returns a callback run after parsing.
 #include <functional>
+#include <stdexcept>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -13,6 +14,23 @@
 #include "tessera/session/VolumePyramid.h"
 
 namespace tessera::app {
+
+// Exit statuses (docs/cli.md "Exit status"): 0 done; 1 an error, its one
+// line on stderr (nothing written); 2 an internal error; 3 the output was
+// written but is incomplete (render: bricks left at a coarser level
+// because their reads kept failing, or the refinement stopped at its
+// limit); CLI11's 100-127 for options it cannot parse.
+inline constexpr int kExitError = 1;
+inline constexpr int kExitInternal = 2;
+inline constexpr int kExitIncomplete = 3;
+
+// Thrown once a command has written its outputs and reported, when they are
+// incomplete; main prints "tessera: incomplete: <what>" and exits with
+// kExitIncomplete.
+class IncompleteOutput : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 // The session types every command uses.
 using gpu::DeviceSession;

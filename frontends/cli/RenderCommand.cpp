@@ -414,6 +414,8 @@ void printRenderJson(const RenderOptions& o, const RenderRequest& req, const Ren
                    {"bytes_read", b.bytesRead},
                    {"bricks_read", b.bricksRead},
                    {"read_errors", b.readErrors},
+                   {"failed_reads", b.failedReads},
+                   {"failed_read_count", b.failedReadCount},
                    {"cache_peak_bytes", b.cachePeakBytes}};
   }
   if (fetch) {
@@ -519,6 +521,10 @@ void printRenderText(const RenderOptions& o, const RenderRequest& req, const Ren
         static_cast<unsigned long long>(b.readErrors), b.failing,
         formatBytes(b.cachePeakBytes).c_str(), b.slots);
     std::printf("levels   bricks wanted:%s; page-table cells:%s\n", wanted.c_str(), cells.c_str());
+    for (const std::string& e : b.failedReads) std::printf("failed   %s\n", e.c_str());
+    if (b.failedReadCount > b.failedReads.size()) {
+      std::printf("failed   ... and %zu more\n", b.failedReadCount - b.failedReads.size());
+    }
   }
   if (fetch) {
     std::printf("http     fetched %s in %llu requests (%llu retries)\n",
@@ -553,6 +559,35 @@ void createParentFolders(const std::string& path) {
   if (ec) {
     throw InputError(path + ": cannot create its folder " + parent.string() + ": " + ec.message());
   }
+}
+
+// Frame 0 of a streamed volume is the refined one unless bricks were given
+// up (their reads kept failing) or refining stopped at its limit: the PNG
+// and the report are written all the same, then the command ends with
+// kExitIncomplete, naming what failed.
+void checkRefined(const RenderOptions& o, const RenderResult& r) {
+  if (!r.bricks || (r.bricks->complete && r.bricks->failing == 0)) return;
+  const BricksRun& b = *r.bricks;
+  std::string why = o.out;
+  if (b.failing > 0) {
+    why += " shows " + std::to_string(b.failing) +
+           " bricks at a coarser level because their reads kept failing: ";
+    for (std::size_t i = 0; i < b.failedReads.size(); ++i) {
+      why += (i ? "; " : "") + b.failedReads[i];
+    }
+    if (b.failedReadCount > b.failedReads.size()) {
+      why += " (and " + std::to_string(b.failedReadCount - b.failedReads.size()) + " more)";
+    }
+  }
+  if (!b.complete) {
+    char limit[160];
+    std::snprintf(limit, sizeof limit,
+                  "%srefining stopped at its limit (%d frames, %.0f s) with bricks still missing",
+                  b.failing > 0 ? "; " : " is not refined: ", b.refineFrames,
+                  b.completeMs / 1000.0);
+    why += limit;
+  }
+  throw IncompleteOutput(why);
 }
 
 // --save-state: the session's state after the render (version, volume,
@@ -599,6 +634,7 @@ void runRenderCommand(const RenderOptions& o) {
       printRenderText(o, req, r, device, session.shape(), spec, times,
                       httpFetch(*session.pyramid()));
     }
+    checkRefined(o, r);
     return;
   }
   if (o.lattice != "cartesian") checkSamplesLayout(o, device, session.volume(), req);
@@ -621,6 +657,7 @@ void runRenderCommand(const RenderOptions& o) {
     printRenderText(o, req, r, device, session.volume(), spec, times);
     if (!regionReport.is_null()) std::printf("region   %s\n", regionReport.dump().c_str());
   }
+  checkRefined(o, r);
 }
 
 }  // namespace
@@ -754,6 +791,12 @@ void addRenderCommand(CLI::App& app) {
                   "viewer's saved exploration is not replayed (render draws the whole volume or "
                   "--region)",
                   "after the render, creating its folder; --state reads it back");
+  cmd->footer(
+      "Exit status: 0 written; 1 an error (one line on stderr naming the file or URL, nothing "
+      "written); 2 an internal error; 3 written but incomplete: a streamed volume's bricks whose "
+      "reads kept failing show their coarser level (each failed chunk, file or URL is named on "
+      "stderr, \"tessera: incomplete: ...\"), or refining stopped at its limit; 100-127 options "
+      "that do not parse.");
   o->command = cmd;
   checkOptionsClassified(*cmd);
   cmd->callback([o] { runRenderCommand(*o); });

@@ -33,12 +33,15 @@ int main(int argc, char** argv) {
     // One line, like every other error (scripts grep stderr).
     std::fprintf(stderr, "tessera: error: %s (see tessera --help)\n", e.what());
     return e.get_exit_code();
+  } catch (const tessera::app::IncompleteOutput& e) {
+    std::fprintf(stderr, "tessera: incomplete: %s\n", e.what());
+    return tessera::app::kExitIncomplete;
   } catch (const tessera::Error& e) {
     std::fprintf(stderr, "tessera: error: %s\n", e.what());
-    return 1;
+    return tessera::app::kExitError;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "tessera: internal error: %s\n", e.what());
-    return 2;
+    return tessera::app::kExitInternal;
   }
   return 0;
 }

@@ -2,6 +2,7 @@
 
 #include <curl/curl.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <mutex>
@@ -36,6 +37,10 @@ struct Body {
   std::vector<std::byte> bytes;
   std::uint64_t limit = 0;
   bool tooBig = false;
+  // The stall check: the request's start or its last body byte.
+  std::chrono::steady_clock::time_point lastByte = std::chrono::steady_clock::now();
+  std::chrono::milliseconds stallAfter{0};
+  bool stalled = false;
 };
 
 std::size_t onBody(char* data, std::size_t size, std::size_t count, void* user) {
@@ -47,7 +52,18 @@ std::size_t onBody(char* data, std::size_t size, std::size_t count, void* user) 
   }
   const auto* p = reinterpret_cast<const std::byte*>(data);
   body->bytes.insert(body->bytes.end(), p, p + n);
+  body->lastByte = std::chrono::steady_clock::now();
   return n;
+}
+
+// Called by libcurl at least once a second: a request whose answer has not
+// begun or whose body has stopped for stallAfter is aborted. (libcurl's
+// LOW_SPEED_TIME averages the speed over its last 5 s, so a body that stops
+// half-way was only caught 5 s late.)
+int onProgress(void* user, curl_off_t, curl_off_t, curl_off_t, curl_off_t) {
+  auto* body = static_cast<Body*>(user);
+  body->stalled = std::chrono::steady_clock::now() - body->lastByte > body->stallAfter;
+  return body->stalled ? 1 : 0;  // non-zero aborts (CURLE_ABORTED_BY_CALLBACK)
 }
 
 }  // namespace
@@ -99,9 +115,31 @@ HttpStorage::HttpStorage(std::string rootUrl, HttpOptions options)
 
 HttpStorage::~HttpStorage() = default;
 
+void HttpStorage::throwIfFailedRecently(const std::string& url) const {
+  const std::lock_guard lock(failedMutex_);
+  const auto it = failed_.find(url);
+  if (it == failed_.end()) return;
+  if (std::chrono::steady_clock::now() < it->second.until) throw Error(it->second.error);
+  failed_.erase(it);
+}
+
+void HttpStorage::fail(const std::string& url, const std::string& error,
+                       std::chrono::steady_clock::time_point started) const {
+  const auto now = std::chrono::steady_clock::now();
+  const auto memory = std::max<std::chrono::steady_clock::duration>(
+      std::chrono::milliseconds(options_.failureMemoryMs), now - started);
+  {
+    const std::lock_guard lock(failedMutex_);
+    failed_[url] = {error, now + memory};
+  }
+  throw Error(error);
+}
+
 std::optional<std::vector<std::byte>> HttpStorage::get(const std::string& key,
                                                        std::uint64_t maxBytes) const {
   const std::string url = locate(key);
+  throwIfFailedRecently(url);
+  const auto started = std::chrono::steady_clock::now();
   CURL* h = pool_->acquire();
   struct Return {
     Pool& pool;
@@ -130,15 +168,23 @@ std::optional<std::vector<std::byte>> HttpStorage::get(const std::string& key,
     curl_easy_setopt(h, CURLOPT_MAXREDIRS, 5L);
     curl_easy_setopt(h, CURLOPT_CONNECTTIMEOUT_MS, long(options_.connectTimeoutMs));
     curl_easy_setopt(h, CURLOPT_TIMEOUT_MS, long(options_.requestTimeoutMs));
-    // A stall: under 1 byte/s for stallTimeoutMs.
-    curl_easy_setopt(h, CURLOPT_LOW_SPEED_LIMIT, 1L);
-    curl_easy_setopt(h, CURLOPT_LOW_SPEED_TIME, long((options_.stallTimeoutMs + 999) / 1000));
+    // A stall: no body byte for stallTimeoutMs, from the start (a server
+    // that never answers) or from the last byte (a body that stops).
+    body.stallAfter = std::chrono::milliseconds(options_.stallTimeoutMs);
+    curl_easy_setopt(h, CURLOPT_NOPROGRESS, 0L);
+    curl_easy_setopt(h, CURLOPT_XFERINFOFUNCTION, onProgress);
+    curl_easy_setopt(h, CURLOPT_XFERINFODATA, &body);
     ++requests_;
     const CURLcode rc = curl_easy_perform(h);
     bytes_ += body.bytes.size();
     if (body.tooBig) {
       throw InputError(url + ": more than " + std::to_string(maxBytes) +
                        " bytes, more than any valid content of this key can have");
+    }
+    if (body.stalled) {
+      problem = "stalled: no byte for " + std::to_string(options_.stallTimeoutMs) +
+                " ms (TESSERA_HTTP_STALL_MS)";
+      continue;
     }
     if (rc != CURLE_OK) {
       problem = std::string(curl_easy_strerror(rc)) + (error[0] ? std::string(": ") + error : "");
@@ -163,8 +209,9 @@ std::optional<std::vector<std::byte>> HttpStorage::get(const std::string& key,
     }
     return std::move(body.bytes);
   }
-  throw Error(url + ": " + problem + " (gave up after " + std::to_string(options_.attempts) +
-              " attempts)");
+  fail(url,
+       url + ": " + problem + " (gave up after " + std::to_string(options_.attempts) + " attempts)",
+       started);
 }
 
 }  // namespace tessera

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <exception>
 #include <system_error>
 
@@ -53,13 +54,21 @@ void BrickStreamer::request(const std::vector<BrickKey>& keys) {
     queue_.clear();
     const double now = nowMs();
     std::unordered_set<std::uint64_t> queued;
+    // Bricks whose reads failed go after every brick not tried yet: a few
+    // failing bricks near the eye, each as slow to fail as the source's own
+    // retries, would otherwise keep the readers busy and the rest unread.
+    std::vector<BrickKey> retries;
     for (const BrickKey& k : keys) {
       const std::uint64_t id = k.id();
       if (cached_.count(id) || reading_.count(id) || !queued.insert(id).second) continue;
       const auto f = failures_.find(id);
-      if (f != failures_.end() && f->second.retryAtMs > now) continue;
-      queue_.push_back(k);
+      if (f == failures_.end()) {
+        queue_.push_back(k);
+      } else if (f->second.retryAtMs <= now && !givenUp(id)) {
+        retries.push_back(k);
+      }
     }
+    queue_.insert(queue_.end(), retries.begin(), retries.end());
   }
   wake_.notify_all();
   if (workers_.empty()) readQueuedInline(options_.inlineReadsPerRequest);
@@ -117,8 +126,39 @@ std::optional<BrickRange> BrickStreamer::range(const BrickKey& key) const {
 
 bool BrickStreamer::failing(const BrickKey& key) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  const auto it = failures_.find(key.id());
-  return it != failures_.end() && it->second.attempts >= options_.attemptsBeforeFailing;
+  return failingLocked(key.id());
+}
+
+bool BrickStreamer::failingLocked(std::uint64_t id) const {
+  const auto it = failures_.find(id);
+  return it != failures_.end() && failingAfter(it->second);
+}
+
+bool BrickStreamer::failingAfter(const Failure& f) const {
+  return f.attempts > 0 && f.attempts >= options_.attemptsBeforeFailing;
+}
+
+bool BrickStreamer::givenUp(std::uint64_t id) const {
+  return !retryFailing_ && failingLocked(id);
+}
+
+void BrickStreamer::retryFailing(bool retry) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    retryFailing_ = retry;
+  }
+  wake_.notify_all();
+}
+
+void BrickStreamer::countFailing(const Failure& f, int delta) {
+  std::uint64_t& n = failingErrors_[f.error];
+  if (delta > 0) {
+    ++n;
+    ++stats_.failingBricks;
+    return;
+  }
+  --stats_.failingBricks;
+  if (--n == 0) failingErrors_.erase(f.error);
 }
 
 bool BrickStreamer::idle() const {
@@ -128,7 +168,13 @@ bool BrickStreamer::idle() const {
 
 StreamerStats BrickStreamer::stats() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return stats_;
+  StreamerStats s = stats_;
+  s.failingErrorCount = failingErrors_.size();
+  for (const auto& [error, bricks] : failingErrors_) {
+    if (s.failingErrors.size() == StreamerStats::kListedErrors) break;
+    s.failingErrors.push_back(error);
+  }
+  return s;
 }
 
 void BrickStreamer::waitForProgress(double ms) {
@@ -143,7 +189,10 @@ std::shared_ptr<const StoredBrick> BrickStreamer::readOne(const BrickKey& key) {
 void BrickStreamer::store(const BrickKey& key, std::shared_ptr<const StoredBrick> brick) {
   const std::uint64_t id = key.id();
   ranges_[id] = {brick->min, brick->max};
-  failures_.erase(id);
+  if (const auto f = failures_.find(id); f != failures_.end()) {
+    if (failingAfter(f->second)) countFailing(f->second, -1);
+    failures_.erase(f);
+  }
   ++stats_.bricksRead;
   stats_.bytesRead += brick->bytes.size();
   if (cached_.count(id)) return;
@@ -161,7 +210,10 @@ void BrickStreamer::store(const BrickKey& key, std::shared_ptr<const StoredBrick
 
 void BrickStreamer::recordFailure(const BrickKey& key, const std::string& what) {
   Failure& f = failures_[key.id()];
+  if (failingAfter(f)) countFailing(f, -1);
   ++f.attempts;
+  f.error = what;
+  if (failingAfter(f)) countFailing(f, +1);
   const double wait =
       std::min(options_.maxRetryMs, options_.firstRetryMs * std::ldexp(1.0, f.attempts - 1));
   f.retryAtMs = nowMs() + wait;
@@ -178,7 +230,9 @@ void BrickStreamer::work() {
       if (stop_) return;
       key = queue_.front();
       queue_.pop_front();
-      if (cached_.count(key.id()) || !reading_.insert(key.id()).second) continue;
+      if (cached_.count(key.id()) || givenUp(key.id()) || !reading_.insert(key.id()).second) {
+        continue;
+      }
     }
     std::string error;
     readAndStore(key, error);

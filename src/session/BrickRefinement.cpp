@@ -38,6 +38,9 @@ RefineRun BrickRefinement::refine(const Camera& camera, int width, int height,
   RefineRun run;
   double lastReportMs = 0.0;
   idle_ = false;
+  // This run must end: a brick that keeps failing is given up, not read
+  // again every back-off while the rest waits.
+  layout_.retryFailingReads(false);
   while (true) {
     run.last = step(camera, width, height, tf, {.streamMs = 0.0, .idleWaitMs = 50.0});
     draw();
@@ -52,6 +55,9 @@ RefineRun BrickRefinement::refine(const Camera& camera, int width, int height,
     }
   }
   run.completeMs = msSince(t0);
+  const lod::StreamerStats stats = layout_.streamerStats();
+  run.failedReads = stats.failingErrors;
+  run.failedReadCount = stats.failingErrorCount;
   return run;
 }
 

@@ -48,8 +48,8 @@ void refineFirstFrame(layout::StreamingLayout& bricks, render::Technique& techni
       req.refine,
       [&](const RefineRun& now, double ms) {
         reported = true;
-        std::fprintf(stderr, "\rbricks: frame %d, %.0f s, %d of %d bricks missing   ", now.frames,
-                     ms / 1000.0, now.last.missing, now.last.wanted);
+        std::fprintf(stderr, "\rbricks: frame %d, %.0f s, %d of %d bricks missing (%d failing)   ",
+                     now.frames, ms / 1000.0, now.last.missing, now.last.wanted, now.last.failing);
       });
   if (reported) std::fprintf(stderr, "\n");
   run.refineFrames = r.frames;
@@ -57,6 +57,8 @@ void refineFirstFrame(layout::StreamingLayout& bricks, render::Technique& techni
   run.completeMs = r.completeMs;
   run.complete = r.last.complete;
   run.failing = r.last.failing;
+  run.failedReads = r.failedReads;
+  run.failedReadCount = r.failedReadCount;
   run.wantedPerLevel = r.last.wantedPerLevel;
   run.cellsPerLevel = r.last.cellsPerLevel;
 }

@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstring>
+#include <thread>
 
 #include "io/ZarrTestSupport.h"
 #include "support/TestSupport.h"
@@ -114,6 +116,74 @@ TEST_F(ZarrHttp, ChunkThatKeepsFailingIsAnErrorNamingItsUrl) {
   }
   // Boxes that avoid it still read.
   EXPECT_NO_THROW(remote.readBox(0, {0, 0, 0}, {16, 16, 16}));
+}
+
+// A key that failed all its attempts fails again at once with the same error
+// (no request) while remembered, and is fetched again after.
+TEST_F(ZarrHttp, AKeyThatFailedFailsAtOnceWhileRemembered) {
+  test::ChildProcess proxy({test::kZarrPython, test::zarrScript("fault_proxy.py").string(),
+                            std::to_string(nginx_->port()), "broken", "0", "/0/2/3/4"});
+  const std::string port = proxy.readLine();
+  ASSERT_TRUE(test::waitForPort(std::stoi(port), 10.0));
+  HttpOptions o;
+  o.attempts = 3;
+  o.backoffMs = 10;
+  o.failureMemoryMs = 500;
+  auto http = std::make_shared<HttpStorage>("http://127.0.0.1:" + port + "/store.ome.zarr", o);
+  std::string first;
+  try {
+    http->get("0/2/3/4", 1 << 20);
+  } catch (const Error& e) {
+    first = e.what();
+  }
+  ASSERT_NE(first.find("HTTP 500 (gave up after 3 attempts)"), std::string::npos) << first;
+  EXPECT_EQ(http->requests(), 3u);
+  for (int i = 0; i < 5; ++i) {
+    try {
+      http->get("0/2/3/4", 1 << 20);
+      FAIL() << "read";
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()), first);
+    }
+  }
+  EXPECT_EQ(http->requests(), 3u) << "fetched again while remembered";
+  EXPECT_TRUE(http->get("0/0/0/0", 1 << 20)) << "other keys are fetched";
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  EXPECT_THROW(http->get("0/2/3/4", 1 << 20), Error);
+  EXPECT_EQ(http->requests(), 3u + 1u + 3u) << "fetched again once forgotten";
+}
+
+// A server that never answers a chunk, and one that stops half-way through
+// its body: each attempt ends after the stall timeout (checked about once
+// a second), not after the request timeout.
+TEST_F(ZarrHttp, HangingAndStalledChunksFailWithinTheStallTimeout) {
+  for (const std::string mode : {"hang", "stall"}) {
+    SCOPED_TRACE(mode);
+    test::ChildProcess proxy({test::kZarrPython, test::zarrScript("fault_proxy.py").string(),
+                              std::to_string(nginx_->port()), mode, "0", "/0/2/3/4"});
+    const std::string port = proxy.readLine();
+    ASSERT_TRUE(test::waitForPort(std::stoi(port), 10.0));
+    HttpOptions o;
+    o.attempts = 2;
+    o.backoffMs = 10;
+    o.stallTimeoutMs = 1000;
+    HttpStorage http("http://127.0.0.1:" + port + "/store.ome.zarr", o);
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      http.get("0/2/3/4", 1 << 20);
+      FAIL() << "read";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("/0/2/3/4: stalled: no byte for 1000 ms"),
+                std::string::npos)
+          << e.what();
+    }
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("  [measured] %s: 2 attempts failed after %.2f s (stall 1 s, bound 2 x 2 s)\n",
+                mode.c_str(), s);
+    EXPECT_GE(s, 2.0);
+    EXPECT_LE(s, 2 * (1.0 + 1.0) + 0.1);
+    EXPECT_TRUE(http.get("0/0/0/0", 1 << 20)) << "the others pass through";
+  }
 }
 
 TEST_F(ZarrHttp, UnreachableServerAndMissingStoreNameTheUrl) {

@@ -120,11 +120,13 @@ class ChildProcess {
 };
 
 // nginx serving `root` on a free port of 127.0.0.1, from a generated
-// config in `prefix`; stopped when the object goes.
+// config in `prefix`; stopped when the object goes. `locations`: more of the
+// server block, e.g. "location = /s.zarr/0/1/1/1 { return 500; }".
 class Nginx {
  public:
   static constexpr const char* kBinary = "/usr/sbin/nginx";
-  Nginx(const std::filesystem::path& root, const std::filesystem::path& prefix)
+  Nginx(const std::filesystem::path& root, const std::filesystem::path& prefix,
+        const std::string& locations = "")
       : port_(freePort()) {
     std::filesystem::create_directories(prefix / "tmp");
     const std::string p = prefix.string();
@@ -135,9 +137,9 @@ class Nginx {
                  "http {\n access_log off;\n client_body_temp_path %s/tmp;\n"
                  " proxy_temp_path %s/tmp;\n fastcgi_temp_path %s/tmp;\n uwsgi_temp_path %s/tmp;\n"
                  " scgi_temp_path %s/tmp;\n"
-                 " server { listen 127.0.0.1:%d; root %s; location / { } }\n}\n",
+                 " server { listen 127.0.0.1:%d; root %s; location / { } %s }\n}\n",
                  p.c_str(), p.c_str(), p.c_str(), p.c_str(), p.c_str(), p.c_str(), p.c_str(), port_,
-                 root.c_str());
+                 root.c_str(), locations.c_str());
     std::fclose(f);
     process_ = std::make_unique<ChildProcess>(
         std::vector<std::string>{kBinary, "-p", p, "-c", (prefix / "nginx.conf").string()});

@@ -11,6 +11,9 @@ through; chunk requests are damaged by their path:
          each path is served intact.
   broken (one chunk keeps failing): the chunk whose path ends with BROKEN
          answers 500 every time; the others pass through.
+  hang   the same, but that chunk's request is read and never answered.
+  stall  the same, but that chunk sends its headers (the full
+         Content-Length) and half its body, then nothing more.
 
 usage: fault_proxy.py UPSTREAM_PORT MODE [DELAY] [BROKEN]
 Prints the port it listens on (127.0.0.1), then serves until killed.
@@ -52,8 +55,11 @@ class Handler(http.server.BaseHTTPRequestHandler):
         if chunk and MODE == "flaky" and count == 0:
             fault = ["500", "500", "truncate", "truncate", "garble", "garble", "delay", None,
                      None, None][hashlib.md5(self.path.encode()).digest()[0] % 10]
-        if chunk and MODE == "broken" and self.path.endswith(BROKEN):
-            fault = "500"
+        if chunk and MODE in ("broken", "hang", "stall") and self.path.endswith(BROKEN):
+            fault = {"broken": "500", "hang": "hang", "stall": "stall"}[MODE]
+        if fault == "hang":
+            time.sleep(3600)  # the client's stall timeout ends it
+            return
         if fault == "500":
             self.send_response(500)
             self.send_header("Content-Length", "0")
@@ -76,6 +82,11 @@ class Handler(http.server.BaseHTTPRequestHandler):
             self.wfile.write(body[: len(body) // 2])
             self.wfile.flush()
             self.close_connection = True
+            return
+        if fault == "stall":
+            self.wfile.write(body[: len(body) // 2])
+            self.wfile.flush()
+            time.sleep(3600)
             return
         if fault == "garble":
             body = bytes(b ^ 0xFF for b in body)

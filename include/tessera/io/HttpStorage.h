@@ -7,10 +7,20 @@
 // body shorter than its Content-Length is retried with exponential
 // back-off; a 404 (or 410) is an absent key (a missing chunk = fill_value,
 // Zarr's semantics); other 4xx fail at once. Every error names the URL.
+// One get() of a key that keeps failing takes at most
+//   attempts * (the request's time: <= requestTimeoutMs, and <= the
+//   stall timeout past its last byte) + the back-off waits (100, 200, 400 ms
+//   by default, each up to 1.5x with jitter),
+// e.g. 4 x 500: about 1 s; a server that accepts and never answers: 4 x 5 s
+// + 1 s. A key whose attempts all failed then fails at once with the same
+// error for a while (failureMemoryMs) instead of being fetched again.
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <unordered_map>
 
 #include "tessera/io/ZarrStorage.h"
 
@@ -22,7 +32,15 @@ struct HttpOptions {
   int backoffMs = 100;  // first retry's wait; doubles each time
   int connectTimeoutMs = 5000;
   int requestTimeoutMs = 60000;  // a whole request, transfer included
-  int stallTimeoutMs = 10000;    // no byte for this long: a timeout
+  // No byte for this long (waiting for the answer or inside the body): a
+  // timeout, then a retry.
+  int stallTimeoutMs = 5000;
+  // After a key failed all its attempts, get() fails at once with the same
+  // error for max(failureMemoryMs, the time those attempts took): the
+  // bricks around one dead chunk (each reads it for its apron) and the
+  // streamer's own retries do not fetch it again and again. The page's
+  // fetch storage waits 3 s too.
+  int failureMemoryMs = 3000;
 
   // Defaults, overridden by TESSERA_HTTP_CONNECTIONS, TESSERA_HTTP_ATTEMPTS,
   // TESSERA_HTTP_TIMEOUT_MS (request) and TESSERA_HTTP_STALL_MS.
@@ -53,12 +71,23 @@ class HttpStorage final : public ZarrStorage {
 
  private:
   struct Pool;
+  struct Failed {
+    std::string error;
+    std::chrono::steady_clock::time_point until;
+  };
+  // Throws the remembered error if `url` failed recently.
+  void throwIfFailedRecently(const std::string& url) const;
+  [[noreturn]] void fail(const std::string& url, const std::string& error,
+                         std::chrono::steady_clock::time_point started) const;
+
   std::string root_;
   HttpOptions options_;
   std::unique_ptr<Pool> pool_;
   mutable std::atomic<std::uint64_t> bytes_{0};
   mutable std::atomic<std::uint64_t> requests_{0};
   mutable std::atomic<std::uint64_t> retries_{0};
+  mutable std::mutex failedMutex_;
+  mutable std::unordered_map<std::string, Failed> failed_;  // by URL
 };
 
 }  // namespace tessera

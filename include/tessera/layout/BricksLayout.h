@@ -99,6 +99,7 @@ class BricksLayout final : public Layout, public StreamingLayout {
   const lod::MultiresSource& source() const { return *source_; }
   int slotCount() const override { return static_cast<int>(slotKey_.size()); }
   lod::StreamerStats streamerStats() const override { return streamer_->stats(); }
+  void retryFailingReads(bool retry) override { streamer_->retryFailing(retry); }
   // The page table as uploaded (RGBA per level-0 cell, x fastest): the CPU
   // twin of the lookup in bricks.glsl reads it.
   const std::vector<std::uint8_t>& pageTable() const { return pages_host_; }

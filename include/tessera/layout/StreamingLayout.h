@@ -16,12 +16,12 @@ namespace tessera::layout {
 
 // What one update() did and what the page table now holds.
 struct BricksFrame {
-  bool complete = false;  // every brick the view wants is resident (or its read keeps failing)
-  int wanted = 0;         // bricks in the view's cut
-  int uploaded = 0;       // bricks uploaded this frame
-  int missing = 0;        // wanted, not resident
-  int failing = 0;        // missing because their reads keep failing
-  bool limitedByBudget = false;     // some brick stayed coarser because the atlas is full
+  bool complete = false;         // every brick the view wants is resident or failing (left coarser)
+  int wanted = 0;                // bricks in the view's cut
+  int uploaded = 0;              // bricks uploaded this frame
+  int missing = 0;               // wanted, not resident
+  int failing = 0;               // missing because their reads keep failing
+  bool limitedByBudget = false;  // some brick stayed coarser because the atlas is full
   std::vector<int> wantedPerLevel;  // the cut, bricks per level
   std::vector<int> cellsPerLevel;   // page-table cells drawn from each level (last: transparent)
 };
@@ -36,6 +36,10 @@ class StreamingLayout {
   // Waits (up to ms) for a read to finish: the render loop's idle.
   virtual void waitForBricks(double ms) = 0;
   virtual lod::StreamerStats streamerStats() const = 0;
+  // Whether bricks whose reads keep failing are read again after their
+  // back-off (lod::BrickStreamer::retryFailing): yes while a viewer shows
+  // the volume; a run that refines to completion gives them up.
+  virtual void retryFailingReads(bool retry) = 0;
   virtual int slotCount() const = 0;               // atlas slots
   virtual const lod::BrickGrid& grid() const = 0;  // the bricks and levels it streams
   virtual const LayoutPlan& plan() const = 0;      // what it allocated (Layout::plan)

@@ -3,14 +3,19 @@
 // stored bricks that stays within a host byte budget (DESIGN.md "Large
 // data"; Schultz 2016 §7.3 loads sub-volumes on demand). The render loop
 // asks each frame for the bricks it wants, nearest first (request()); the
-// workers take them in that order. A read that throws is retried later with
-// exponential back-off, so the coarser level stays on screen meanwhile. The
-// range of every brick ever read is kept (16 bytes a brick) after the brick
-// itself leaves the cache, for empty-space decisions.
+// workers take them in that order, bricks never tried before bricks whose
+// reads failed. A read that throws is retried later with exponential
+// back-off, so the coarser level stays on screen meanwhile; after
+// attemptsBeforeFailing failures the brick is failing: the viewers keep
+// retrying it (a server may come back), a run that refines to completion
+// gives it up (retryFailing(false)). The range of every brick ever read is
+// kept (16 bytes a brick) after the brick itself leaves the cache, for
+// empty-space decisions.
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <list>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -29,9 +34,15 @@ struct BrickStreamerOptions {
   int workers = 2;                         // 0: request() reads inline
   int inlineReadsPerRequest = 8;           // without workers
   std::uint64_t cacheBytes = 64ull << 20;  // decoded bricks kept on the host
-  double firstRetryMs = 20.0;              // back-off: doubles per failure...
-  double maxRetryMs = 2000.0;              // ...up to this
-  int attemptsBeforeFailing = 3;           // then failing() is true (still retried)
+  // The failure policy. A brick's k-th failed read (k = 1, 2, ...) waits
+  // min(maxRetryMs, firstRetryMs * 2^(k-1)) before the next; after
+  // attemptsBeforeFailing failed reads failing() is true. Giving a brick up
+  // therefore takes attemptsBeforeFailing reads (each as long as the source
+  // takes to fail: HttpStorage's own retries and timeouts) plus the waits
+  // between them (20 + 40 ms by default).
+  double firstRetryMs = 20.0;
+  double maxRetryMs = 2000.0;
+  int attemptsBeforeFailing = 3;
   // Without workers: queued bricks whose source is not ready yet
   // (MultiresSource::prefetch) looked at per request before it gives up.
   int prefetchAhead = 16;
@@ -60,6 +71,13 @@ struct StreamerStats {
   std::uint64_t cacheBytes = 0;
   std::uint64_t cachePeakBytes = 0;
   std::string lastError;
+  // The bricks failing now (BrickStreamer::failing), and their distinct
+  // last errors (each names the chunk, file or URL that failed), sorted, at
+  // most kListedErrors of failingErrorCount.
+  std::uint64_t failingBricks = 0;
+  std::vector<std::string> failingErrors;
+  std::size_t failingErrorCount = 0;
+  static constexpr std::size_t kListedErrors = 8;
 };
 
 class BrickStreamer {
@@ -86,6 +104,12 @@ class BrickStreamer {
   std::optional<BrickRange> range(const BrickKey& key) const;
   // True once the brick's reads failed attemptsBeforeFailing times in a row.
   bool failing(const BrickKey& key) const;
+  // Whether a failing brick is read again after its back-off (the default:
+  // a viewer keeps trying, the server may come back). false gives failing
+  // bricks up: request() and the workers skip them, so a run that refines
+  // to completion ends within the failure policy's time and no read of a
+  // given-up brick is left in flight.
+  void retryFailing(bool retry);
   // Waits until a read finishes or `ms` pass.
   void waitForProgress(double ms);
   bool idle() const;  // nothing queued or being read
@@ -95,7 +119,13 @@ class BrickStreamer {
   struct Failure {
     int attempts = 0;
     double retryAtMs = 0.0;
+    std::string error;  // the last read's
   };
+  bool failingAfter(const Failure& f) const;
+  bool failingLocked(std::uint64_t id) const;  // lock held
+  bool givenUp(std::uint64_t id) const;        // lock held
+  // The failing bricks' errors, counted per message (lock held).
+  void countFailing(const Failure& f, int delta);
   void work();
   void readQueuedInline(int count);
   std::shared_ptr<const StoredBrick> readOne(const BrickKey& key);            // no lock held
@@ -121,6 +151,8 @@ class BrickStreamer {
   std::unordered_map<std::uint64_t, decltype(lru_)::iterator> cached_;
   std::unordered_map<std::uint64_t, BrickRange> ranges_;
   std::unordered_map<std::uint64_t, Failure> failures_;
+  std::map<std::string, std::uint64_t> failingErrors_;  // message -> failing bricks
+  bool retryFailing_ = true;
   StreamerStats stats_;
   bool stop_ = false;
   std::vector<std::thread> workers_;

@@ -6,8 +6,11 @@
 // as bricks arrive (Schultz 2016 §7.3). The CLI refines frame 0 to the end
 // before writing it; the web page streams for a slice of each animation
 // frame while its fetches arrive.
+#include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <string>
+#include <vector>
 
 #include "tessera/core/Camera.h"
 #include "tessera/core/TransferFunction.h"
@@ -27,7 +30,11 @@ struct StreamPace {
   double idleWaitMs = 0.0;
 };
 
-// Where refining a view to completion stops.
+// Where refining a view to completion stops. A brick whose reads keep
+// failing does not hold it up: it is given up after the streamer's failure
+// policy (lod::BrickStreamerOptions: attemptsBeforeFailing reads and the
+// back-off between them) and shows its coarser level, so a dead chunk ends
+// the run in seconds; these limits are for a source that is merely slow.
 struct RefineLimits {
   int maxFrames = 10000;
   double maxSeconds = 600.0;
@@ -39,6 +46,11 @@ struct RefineRun {
   double firstFrameMs = 0.0;  // to the first image (coarsest level)
   double completeMs = 0.0;    // to the refined image
   layout::BricksFrame last;   // the last step's state (complete, failing, per level)
+  // The distinct errors of the bricks given up (each names the chunk, file
+  // or URL that failed), sorted, at most lod::StreamerStats::kListedErrors
+  // of failedReadCount.
+  std::vector<std::string> failedReads;
+  std::size_t failedReadCount = 0;
 };
 
 class BrickRefinement {
@@ -51,8 +63,11 @@ class BrickRefinement {
                            const StreamPace& pace);
 
   // Steps and draws (`draw` after every step) until every brick the view
-  // wants is resident, or a limit is reached; `progress` (may be empty) is
-  // told about once a second while it takes long.
+  // wants is resident or given up, or a limit is reached; `progress` (may
+  // be empty) is told about once a second while it takes long. Bricks given
+  // up stay given up for the layout's life (StreamingLayout::
+  // retryFailingReads(false)); the viewers, which only step(), keep
+  // retrying theirs.
   RefineRun refine(const Camera& camera, int width, int height, const TransferFunction& tf,
                    const std::function<void()>& draw, const RefineLimits& limits,
                    const std::function<void(const RefineRun&, double ms)>& progress = {});

@@ -50,6 +50,8 @@ struct BricksRun {
   double completeMs = 0.0;    // to the refined image
   bool complete = false;      // false: stopped at the frame or time limit
   int failing = 0;            // bricks left at a coarser level because their reads keep failing
+  std::vector<std::string> failedReads;  // their distinct errors (RefineRun::failedReads)
+  std::size_t failedReadCount = 0;
   std::vector<int> wantedPerLevel;          // the final view's cut, bricks per level
   std::vector<int> cellsPerLevel;           // page-table cells per level (last: transparent)
   std::vector<std::string> rotatingLevels;  // per rotating frame, "L0:12 L1:40 ..."
