@@ -3,10 +3,10 @@
 # the browser tests of the web viewer (scripts/browser-test.sh), the CPU
 # layers' tests under ASan + UBSan (scripts/sanitize.sh; the GPU image tests
 # run once, above) and a short fuzz run of every parser under ASan
-# (scripts/fuzz.sh, FUZZ_SECONDS each, default 15).
+# (scripts/fuzz.sh, FUZZ_SECONDS each, default 10).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-FUZZ_SECONDS=${FUZZ_SECONDS:-15}
+FUZZ_SECONDS=${FUZZ_SECONDS:-10}
 
 timings=()
 timed() {
