@@ -399,7 +399,13 @@ void ZarrStore::makeShape(const std::string& attrsText) {
     if (bytes <= (64ull << 20)) range = readLevel(coarse).valueRange();
   }
   if (range) shape_.setValueRange(*range);
-  if (finite(window, true)) shape_.setWindow(*window);
+  // Set, not left to default: every box and level read carries it, so a
+  // level renders with the same mapping as the whole (bricks, the reference).
+  if (finite(window, true)) {
+    shape_.setWindow(*window);
+  } else if (range && range->max > range->min) {
+    shape_.setWindow(*range);
+  }
 }
 
 int ZarrStore::finestLevelWithin(std::uint64_t budgetBytes) const {

@@ -1,6 +1,7 @@
 #include "tessera/layout/Planner.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
@@ -98,7 +99,11 @@ Plan planLayout(const Volume& volume, const gpu::DeviceLimits& limits, const Pla
   plan.volumeUnits = units;
   glm::ivec3 dims = volume.dims();
   for (int round = 0; round < 64; ++round) {
-    const Volume shape = Volume::shapeOnly(dims, volume.type());
+    Volume shape = Volume::shapeOnly(dims, volume.type());
+    const ValueRange range = volume.valueRange();  // what a layout says of how it stores values
+    if (std::isfinite(range.min) && std::isfinite(range.max) && range.min <= range.max) {
+      shape.setValueRange(range);
+    }
     for (const LayoutEntry* candidate : candidates) {
       LayoutPlan p = candidate->plan(shape, volumeLimits, units);
       const std::uint64_t hostBytes = shape.voxelCount() * bytesPerVoxel(shape.type());
