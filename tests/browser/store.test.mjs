@@ -17,6 +17,7 @@ test('OME-Zarr ?url=: coarse first, refined to the native render; errors name th
 test('OME-Zarr region: bounded reads, renders like `tessera render STORE --region`', checks(zarrRegionFromUrl));
 test('OME-Zarr grid view: each block reads only its chunks', checks(zarrGridFromUrl));
 test('OME-Zarr slices: level-0 slabs equal `tessera slice STORE`', checks(zarrSlicesFromUrl));
+test('OME-Zarr f32 store: 16-bit bricks on WebGL 2 and 1 match the native render', checks(zarrF32Store));
 
 // ?url= of an OME-Zarr store (issue 14): ch2 written by `tessera convert
 // --compressor zlib`, served as a folder tree and read key by key with
@@ -361,4 +362,30 @@ async function zarrSlicesFromUrl(context, url, tmp, run) {
   check('OME-Zarr slices: no script errors', errors.length === 0, errors.join(' | ') || value);
   await page.close();
   console.log(`     (OME-Zarr slices: ${((Date.now() - t) / 1000).toFixed(1)} s)`);
+}
+
+// An f32 store (inia19, 0..383) streams in 16-bit bricks: R16 or two bytes
+// (RG8) on WebGL 2, two bytes (LUMINANCE_ALPHA) on WebGL 1, recombined in the
+// shader. The page refines to what the native CLI renders of the store with
+// the same profile.
+async function zarrF32Store(context, url, tmp, run) {
+  const inia = path.join(path.dirname(CH2), 'inia19-t1-brain.nii.gz');
+  if (!fs.existsSync(inia)) { check(`f32 store test needs ${inia} (mricron-data)`, false); return; }
+  const store = path.join(tmp, 'inia.ome.zarr');
+  run('convert', inia, store, '--chunk', '64');
+  for (const [gl, profile] of [[2, 'webgl2'], [1, 'webgl1']]) {
+    const nativePng = path.join(tmp, `native-inia-${profile}.png`);
+    const native = JSON.parse(run('render', store, '--layout', 'bricks', '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`,
+                                  '--profile', profile, ...PAGE_SAMPLING, '--json', '--out', nativePng));
+    const { page, logs } = await openPage(context, url, `size=${SIZE}&url=/data/inia.ome.zarr${gl === 1 ? '&webgl=1' : ''}`);
+    await page.waitForFunction(() => window.tessera.zarr() && window.tessera.zarr().completeMs !== null, null, { timeout: 60000 });
+    await withoutOverlays(page);
+    const m = await psnrAgainst(page, nativePng);
+    const atlas = (native.plan_reason.match(/brick (\S+)/) || [])[1] || native.plan_reason;
+    check(`OME-Zarr f32 store on WebGL ${gl}: the refined image matches the native render (PSNR >= 50 dB)`, m.psnr >= 50,
+          m.error || `${m.psnr.toFixed(2)} dB; native plan: ${atlas}`);
+    const errors = logs.filter((l) => (l.startsWith('pageerror') || l.startsWith('error')) && !/status of 404/.test(l));
+    check(`no script errors on the f32 store page (WebGL ${gl})`, errors.length === 0, errors.join(' | '));
+    await page.close();
+  }
 }
