@@ -164,6 +164,26 @@ AtlasShape atlasFor(const gpu::DeviceLimits& limits, int stored, std::uint64_t a
   return a;
 }
 
+// The page table and bricks.glsl map level l to level 0 by 2^l on every
+// axis. A pyramid that keeps an axis (microscopy's (1, 2, 2) scales) would be
+// drawn stretched: it is refused, naming the level and the axis, until the
+// layout takes each level's own factors.
+void refuseUnlessHalving(const lod::MultiresSource& source, const std::vector<glm::ivec3>& levels) {
+  const char* axes = "xyz";
+  for (std::size_t l = 1; l < levels.size(); ++l) {
+    const glm::ivec3 prev = levels[l - 1], cur = levels[l];
+    for (int a = 0; a < 3; ++a) {
+      if (cur[a] == (prev[a] + 1) / 2 || cur[a] == prev[a] / 2) continue;
+      throw InputError(source.describe() + ": level " + std::to_string(l) + " (" + dimsText(cur) +
+                       ") does not halve level " + std::to_string(l - 1) + " (" + dimsText(prev) +
+                       ") along " + axes[a] +
+                       "; the bricks layout streams only pyramids that halve every axis per "
+                       "level. Render it in core (--layout texture3d, or --region for a part) "
+                       "or rewrite it with `tessera convert`, which writes a factor-2 pyramid");
+    }
+  }
+}
+
 // How values are kept, for the plan.
 std::string storedNote(const Volume& shape) {
   const lod::StoredMapping m = lod::StoredMapping::of(shape);
@@ -263,6 +283,7 @@ std::unique_ptr<BricksLayout> BricksLayout::create(
   const glm::ivec3 chunk = source->levelInfo(0).chunk;
   std::vector<glm::ivec3> levels;
   for (int lv = 0; lv < source->levelCount(); ++lv) levels.push_back(source->levelInfo(lv).dims);
+  refuseUnlessHalving(*source, levels);
   l->plan_ = planFor(source->shape(), limits, options, chunk, levels);
   if (!l->plan_.fits) throw GpuError("bricks layout: " + l->plan_.reason);
   const int b = brickSizeFor(options, chunk);

@@ -307,3 +307,38 @@ TEST(BricksRender, ASmallBrightFindingUnderDimCoarseBricksIsReadAndShown) {
               static_cast<unsigned long long>(s.bricksRead), lit(viaBricks), lit(viaInCore));
   EXPECT_LT(s.bricksRead, 585u / 2);
 }
+
+// A microscopy pyramid that keeps z ((1, 2, 2) scales): the bricks layout
+// maps every level by 2^l on all axes and would draw it stretched, so it is
+// refused, naming the level and the axis.
+TEST(BricksRender, APyramidThatKeepsAnAxisIsRefusedNamingTheLevelAndAxis) {
+  class KeepsZ final : public lod::MultiresSource {
+   public:
+    KeepsZ() : shape_(Volume::shapeOnly({64, 64, 16}, ScalarType::U8)) {}
+    const Volume& shape() const override { return shape_; }
+    int levelCount() const override { return 3; }
+    lod::LevelInfo levelInfo(int level) const override {
+      return {.dims = {64 >> level, 64 >> level, 16}, .spacing = glm::vec3(1.0f), .chunk = {}};
+    }
+    Volume readBox(int, const lod::VoxelBox& box) const override {
+      return Volume::allocate(box.size(), ScalarType::U8);
+    }
+    std::string describe() const override { return "keeps-z.ome.zarr"; }
+
+   private:
+    Volume shape_;
+  };
+  gpu::GlContext& c = test::gpuContext();
+  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());
+  try {
+    layout::BricksLayout::create(std::make_shared<KeepsZ>(), limits, c.ledger(), smallBricks(16));
+    ADD_FAILURE() << "a (1, 2, 2) pyramid was accepted";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("keeps-z.ome.zarr: level 1 (32x32x16) does not halve level 0 (64x64x16) "
+                     "along z"),
+              std::string::npos)
+        << m;
+    EXPECT_NE(m.find("--layout texture3d"), std::string::npos) << m;
+  }
+}
