@@ -45,6 +45,18 @@ class ZarrHttp : public ::testing::Test {
     nginx_ = std::make_unique<test::Nginx>(tmp_ / "www", tmp_ / "nginx");
   }
   std::string localStore() const { return (tmp_ / "www" / "store.ome.zarr").string(); }
+  // tests/zarr/fault_proxy.py in front of nginx (`how`: its mode and its
+  // arguments); the store's URL through it once it listens ("" if it did not).
+  std::string proxiedStore(std::unique_ptr<test::ChildProcess>& proxy,
+                           const std::vector<std::string>& how) {
+    std::vector<std::string> argv = {test::kZarrPython, test::zarrScript("fault_proxy.py").string(),
+                                     std::to_string(nginx_->port())};
+    argv.insert(argv.end(), how.begin(), how.end());
+    proxy = std::make_unique<test::ChildProcess>(argv);
+    const std::string port = proxy->readLine();
+    if (port.empty() || !test::waitForPort(std::stoi(port), 10.0)) return "";
+    return "http://127.0.0.1:" + port + "/store.ome.zarr";
+  }
 
   TempDir tmp_;
   std::unique_ptr<test::Nginx> nginx_;
@@ -73,16 +85,14 @@ TEST_F(ZarrHttp, NginxServedStoreReadsIdenticallyToTheFolder) {
 }
 
 TEST_F(ZarrHttp, FlakyProxyEveryChunkEventuallyRight) {
-  test::ChildProcess proxy({test::kZarrPython, test::zarrScript("fault_proxy.py").string(),
-                            std::to_string(nginx_->port()), "flaky", "3"});
-  const std::string port = proxy.readLine();
-  ASSERT_FALSE(port.empty());
-  ASSERT_TRUE(test::waitForPort(std::stoi(port), 10.0));
+  std::unique_ptr<test::ChildProcess> proxy;
+  const std::string url = proxiedStore(proxy, {"flaky", "3"});
+  ASSERT_FALSE(url.empty());
   HttpOptions o;
   o.attempts = 4;
   o.backoffMs = 10;
   o.requestTimeoutMs = 700;  // the proxy's 3 s stall is a timeout, then a retry
-  auto http = std::make_shared<HttpStorage>("http://127.0.0.1:" + port + "/store.ome.zarr", o);
+  auto http = std::make_shared<HttpStorage>(url, o);
   const auto t0 = std::chrono::steady_clock::now();
   const ZarrStore remote(http);
   const ZarrStore local(openZarrStorage(localStore()));
@@ -96,14 +106,12 @@ TEST_F(ZarrHttp, FlakyProxyEveryChunkEventuallyRight) {
 }
 
 TEST_F(ZarrHttp, ChunkThatKeepsFailingIsAnErrorNamingItsUrl) {
-  test::ChildProcess proxy({test::kZarrPython, test::zarrScript("fault_proxy.py").string(),
-                            std::to_string(nginx_->port()), "broken", "0", "/0/2/3/4"});
-  const std::string port = proxy.readLine();
-  ASSERT_TRUE(test::waitForPort(std::stoi(port), 10.0));
+  std::unique_ptr<test::ChildProcess> proxy;
+  const std::string url = proxiedStore(proxy, {"broken", "0", "/0/2/3/4"});
+  ASSERT_FALSE(url.empty());
   HttpOptions o;
   o.attempts = 3;
   o.backoffMs = 10;
-  const std::string url = "http://127.0.0.1:" + port + "/store.ome.zarr";
   const ZarrStore remote(std::make_shared<HttpStorage>(url, o));
   try {
     remote.readLevel(0);
@@ -121,15 +129,14 @@ TEST_F(ZarrHttp, ChunkThatKeepsFailingIsAnErrorNamingItsUrl) {
 // A key that failed all its attempts fails again at once with the same error
 // (no request) while remembered, and is fetched again after.
 TEST_F(ZarrHttp, AKeyThatFailedFailsAtOnceWhileRemembered) {
-  test::ChildProcess proxy({test::kZarrPython, test::zarrScript("fault_proxy.py").string(),
-                            std::to_string(nginx_->port()), "broken", "0", "/0/2/3/4"});
-  const std::string port = proxy.readLine();
-  ASSERT_TRUE(test::waitForPort(std::stoi(port), 10.0));
+  std::unique_ptr<test::ChildProcess> proxy;
+  const std::string url = proxiedStore(proxy, {"broken", "0", "/0/2/3/4"});
+  ASSERT_FALSE(url.empty());
   HttpOptions o;
   o.attempts = 3;
   o.backoffMs = 10;
   o.failureMemoryMs = 500;
-  auto http = std::make_shared<HttpStorage>("http://127.0.0.1:" + port + "/store.ome.zarr", o);
+  auto http = std::make_shared<HttpStorage>(url, o);
   std::string first;
   try {
     http->get("0/2/3/4", 1 << 20);
@@ -159,15 +166,14 @@ TEST_F(ZarrHttp, AKeyThatFailedFailsAtOnceWhileRemembered) {
 TEST_F(ZarrHttp, HangingAndStalledChunksFailWithinTheStallTimeout) {
   for (const std::string mode : {"hang", "stall"}) {
     SCOPED_TRACE(mode);
-    test::ChildProcess proxy({test::kZarrPython, test::zarrScript("fault_proxy.py").string(),
-                              std::to_string(nginx_->port()), mode, "0", "/0/2/3/4"});
-    const std::string port = proxy.readLine();
-    ASSERT_TRUE(test::waitForPort(std::stoi(port), 10.0));
+    std::unique_ptr<test::ChildProcess> proxy;
+    const std::string url = proxiedStore(proxy, {mode, "0", "/0/2/3/4"});
+    ASSERT_FALSE(url.empty());
     HttpOptions o;
     o.attempts = 2;
     o.backoffMs = 10;
     o.stallTimeoutMs = 1000;
-    HttpStorage http("http://127.0.0.1:" + port + "/store.ome.zarr", o);
+    HttpStorage http(url, o);
     const auto t0 = std::chrono::steady_clock::now();
     try {
       http.get("0/2/3/4", 1 << 20);
