@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench/BenchBrickWalk.h"
 #include "bench/BenchBricks.h"
 #include "bench/BenchExplore.h"
 #include "bench/BenchFcc.h"
@@ -55,6 +56,9 @@ struct BenchOptions {
   double goalMs = 0.0;
   std::vector<std::string> bricks;  // --bricks: generated volumes to stream
   std::vector<std::string> bricksProfiles{"shield-k1", "ipad2"};
+  std::vector<std::string> bricksVsInCore;  // --bricks-vs-incore
+  bool bricksVsInCoreSet = false;
+  int rounds = 3;
   bool printTf = false;
   bool roofline = false;
   int fetches = 128;
@@ -399,6 +403,20 @@ void addBenchCommand(CLI::App& app) {
       "frame time while streaming (default 8 frames), levels, texture bytes vs the "
       "budget, bricks read, peak RSS, and the in-core layout as baseline where it fits");
   addDefaultedOption(cmd, "--bricks-profiles", o->bricksProfiles, "Profiles for --bricks");
+  cmd->add_option_function<std::vector<std::string>>(
+         "--bricks-vs-incore",
+         [o](const std::vector<std::string>& v) {
+           for (const std::string& s : v) {
+             if (!s.empty()) o->bricksVsInCore.push_back(s);
+           }
+           o->bricksVsInCoreSet = true;
+         },
+         "What the bricks layout costs against in-core for volumes that fit both: alternating "
+         "runs of the same view at full resolution, frame time ratio and PSNR between the "
+         "images. Files or gen: specs, u16:SPEC widens SPEC to 16 bits (default: ch2, "
+         "gen:shepp-logan:384, u16:gen:shepp-logan:512)")
+      ->expected(0, -1);
+  addDefaultedOption(cmd, "--rounds", o->rounds, "With --bricks-vs-incore: alternating rounds");
   cmd->add_option("--goal-ms", o->goalMs,
                   "With --interactive: frame-time goal (default: a sixth of a full-quality frame)");
   addDefaultedOption(cmd, "--fetches", o->fetches,
@@ -502,6 +520,19 @@ void addBenchCommand(CLI::App& app) {
                        .tf = o->tf,
                        .outDir = o->slicingOut,
                        .quick = o->slicingQuick});
+      return;
+    }
+    if (o->bricksVsInCoreSet) {
+      BrickWalkBenchOptions b;
+      b.volumes = o->bricksVsInCore;
+      if (b.volumes.empty()) {
+        b.volumes = {defaultVolumeSpec(), "gen:shepp-logan:384", "u16:gen:shepp-logan:512"};
+      }
+      b.size = o->size;
+      b.frames = o->frames == 36 ? 6 : o->frames;
+      b.rounds = o->rounds;
+      b.tf = o->tf == "bench" ? "mr-default" : o->tf;
+      runBrickWalkBench(b);
       return;
     }
     if (!o->bricks.empty()) {

@@ -668,9 +668,12 @@ ValueBlocks BricksLayout::valueBlocks(int blockSize) const {
             continue;
           }
         }
-        // Samples inside the block read the cells its box [bS, (b+1)S] touches.
+        // Samples inside the block read the cells its box [bS, (b+1)S] touches;
+        // a block inside one cell (b a multiple of S), only that cell's page:
+        // a transparent cell's constant, a coarser brick's range.
         const glm::ivec3 lo = block * blockSize / b;
-        const glm::ivec3 hi = glm::min(glm::min((block + 1) * blockSize, d) / b, cells - 1);
+        const glm::ivec3 hi =
+            b % blockSize == 0 ? lo : glm::min(glm::min((block + 1) * blockSize, d) / b, cells - 1);
         int mn = m.maxStored(), mx = 0;
         for (int cz = lo.z; cz <= hi.z; ++cz) {
           for (int cy = lo.y; cy <= hi.y; ++cy) {

@@ -118,22 +118,59 @@ float layoutAtlasSlice(float t, float z, vec2 texel) {
 }
 #endif
 
-float sampleVolume(vec3 p) {
-  vec3 x0 = clamp(p, 0.0, 1.0) * u_layoutDims0;
+// The page of one level-0 cell, decoded into the affine map from texture
+// space p to the texel coordinates of its brick's slot: texel = clamp(p *
+// scale + offset, lo, hi) (the brick and its apron: [lo - 1, hi + 1]); a
+// transparent cell (page a = 255) returns `constant` instead (isConstant 1).
+struct BrickPage {
+  vec3 scale;
+  vec3 offset;
+  vec3 lo;
+  vec3 hi;
+  float atlas;  // ES 2: the atlas texture
+  float constant;
+  float isConstant;
+};
+
+// The page of the level-0 cell holding x0 (level-0 voxels, inside the volume).
+BrickPage brickPage(vec3 x0) {
   vec3 cell = min(floor(x0 / u_layoutBrick), u_layoutCells - 1.0);
+#if TESSERA_GLSL == 300
+  vec4 page = texelFetch(u_layoutPages, ivec2(cell.x, cell.y + cell.z * u_layoutCells.y), 0);
+#else
   vec4 page = TEX2D(u_layoutPages,
                     (vec2(cell.x, cell.y + cell.z * u_layoutCells.y) + 0.5) * u_layoutPagesInv);
-  vec4 e = floor(page * 255.0 + 0.5);
-#if BRICKS_TEXEL == 0
-  if (e.a > 254.5) return page.r;
-#else
-  if (e.a > 254.5) return (e.r + 256.0 * e.g) / 65535.0;
 #endif
-  float shrink = exp2(-e.a);
-  vec3 brick = floor(cell * shrink + 0.001);  // c >> l (the +0.001 guards exp2 rounding)
-  vec3 local = clamp(x0 * shrink - brick * u_layoutBrick, 0.0, u_layoutBrick) + 1.0;
+  vec4 e = floor(page * 255.0 + 0.5);
+  BrickPage b;
+  b.isConstant = step(254.5, e.a);
+#if BRICKS_TEXEL == 0
+  b.constant = page.r;
+#else
+  b.constant = (e.r + 256.0 * e.g) / 65535.0;
+#endif
+  float level = e.a * (1.0 - b.isConstant);  // a constant cell reads slot 0 and is replaced
 #if TESSERA_GLSL == 300
-  vec3 texel = e.rgb * (u_layoutBrick + 2.0) + local;
+  float shrink = 1.0 / float(1 << int(level));
+  vec3 slot = e.rgb * (1.0 - b.isConstant);
+#else
+  float shrink = exp2(-level);
+  vec3 slot = vec3(0.0, 0.0, e.b * (1.0 - b.isConstant));
+#endif
+  b.atlas = e.r * (1.0 - b.isConstant);
+  vec3 brick = floor(cell * shrink + 0.001);  // c >> l (the +0.001 guards exp2 rounding)
+  // Level-l coordinate x0 * shrink, local to the brick, + 1 for the apron.
+  b.lo = slot * (u_layoutBrick + 2.0) + 1.0;
+  b.hi = b.lo + u_layoutBrick;
+  b.scale = u_layoutDims0 * shrink;
+  b.offset = b.lo - brick * u_layoutBrick;
+  return b;
+}
+
+// The value at texel coordinates `texel` of the slot of brick `b`.
+float brickValue(BrickPage b, vec3 texel) {
+  float v;
+#if TESSERA_GLSL == 300
 #if BRICKS_TEXEL == 2
   // Two bytes filtered apart are each rounded to 8 bits by GPUs that filter
   // 8-bit textures in fixed point (llvmpipe): a value crossing a multiple of
@@ -150,14 +187,12 @@ float sampleVolume(vec3 p) {
   float v101 = BRICKS_VALUE(texelFetch(u_layoutAtlas, i + ivec3(1, 0, 1), 0));
   float v011 = BRICKS_VALUE(texelFetch(u_layoutAtlas, i + ivec3(0, 1, 1), 0));
   float v111 = BRICKS_VALUE(texelFetch(u_layoutAtlas, i + ivec3(1, 1, 1), 0));
-  return mix(mix(mix(v000, v100, f.x), mix(v010, v110, f.x), f.y),
-             mix(mix(v001, v101, f.x), mix(v011, v111, f.x), f.y), f.z);
+  v = mix(mix(mix(v000, v100, f.x), mix(v010, v110, f.x), f.y),
+          mix(mix(v001, v101, f.x), mix(v011, v111, f.x), f.y), f.z);
 #else
-  return BRICKS_VALUE(texture(u_layoutAtlas, texel / u_layoutAtlasTexels));
+  v = BRICKS_VALUE(texture(u_layoutAtlas, texel / u_layoutAtlasTexels));
 #endif
 #else
-  // e.r: the atlas texture; e.b: the slot in its stack.
-  vec3 texel = vec3(0.0, 0.0, e.b * (u_layoutBrick + 2.0)) + local;
   float zc = texel.z - 0.5;
   float z0 = floor(zc);
 #if BRICKS_TEXEL == 3
@@ -167,17 +202,59 @@ float sampleVolume(vec3 p) {
   vec2 a = floor(c) + 0.5;  // the lower corner's texel centre
   vec2 dx = vec2(1.0, 0.0);
   vec2 dy = vec2(0.0, 1.0);
-  float s0 = mix(mix(layoutAtlasSlice(e.r, z0, a), layoutAtlasSlice(e.r, z0, a + dx), f.x),
-                 mix(layoutAtlasSlice(e.r, z0, a + dy), layoutAtlasSlice(e.r, z0, a + 1.0), f.x),
+  float t = b.atlas;
+  float s0 = mix(mix(layoutAtlasSlice(t, z0, a), layoutAtlasSlice(t, z0, a + dx), f.x),
+                 mix(layoutAtlasSlice(t, z0, a + dy), layoutAtlasSlice(t, z0, a + 1.0), f.x),
                  f.y);
-  float s1 = mix(
-      mix(layoutAtlasSlice(e.r, z0 + 1.0, a), layoutAtlasSlice(e.r, z0 + 1.0, a + dx), f.x),
-      mix(layoutAtlasSlice(e.r, z0 + 1.0, a + dy), layoutAtlasSlice(e.r, z0 + 1.0, a + 1.0), f.x),
-      f.y);
-  return mix(s0, s1, zc - z0);
+  float s1 =
+      mix(mix(layoutAtlasSlice(t, z0 + 1.0, a), layoutAtlasSlice(t, z0 + 1.0, a + dx), f.x),
+          mix(layoutAtlasSlice(t, z0 + 1.0, a + dy), layoutAtlasSlice(t, z0 + 1.0, a + 1.0), f.x),
+          f.y);
+  v = mix(s0, s1, zc - z0);
 #else
-  return mix(layoutAtlasSlice(e.r, z0, texel.xy), layoutAtlasSlice(e.r, z0 + 1.0, texel.xy),
-             zc - z0);
+  v = mix(layoutAtlasSlice(b.atlas, z0, texel.xy), layoutAtlasSlice(b.atlas, z0 + 1.0, texel.xy),
+          zc - z0);
 #endif
+#endif
+  return mix(v, b.constant, b.isConstant);
+}
+
+float sampleVolume(vec3 p) {
+  vec3 q = clamp(p, 0.0, 1.0);
+  BrickPage b = brickPage(q * u_layoutDims0);
+  return brickValue(b, clamp(q * b.scale + b.offset, b.lo, b.hi));
+}
+
+#ifdef LAYOUT_BLOCK_WALK
+// The brick walk (render/raycast.frag.glsl): the ray caster calls
+// layoutEnterBlock with the centre of each empty-space block its ray enters
+// and then samples inside that block with sampleVolumeInBlock. A block lies
+// in one level-0 cell (the brick size is a multiple of the block size,
+// BricksLayout::walksBlocks), so the page is read once per block, not per
+// sample (ImageVis3D's and Gigavoxels' brick marching).
+// The samples of a block lie in its cell's brick (up to rounding, which the
+// apron covers): no clamp; a filtered ES 3 atlas maps p straight to its
+// normalised coordinates.
+BrickPage walkPage;
+#if TESSERA_GLSL == 300 && BRICKS_TEXEL < 2
+vec3 walkScale;
+vec3 walkOffset;
+#endif
+
+void layoutEnterBlock(vec3 blockCentre) {
+  walkPage = brickPage(clamp(blockCentre, 0.0, 1.0) * u_layoutDims0);
+#if TESSERA_GLSL == 300 && BRICKS_TEXEL < 2
+  walkScale = walkPage.scale / u_layoutAtlasTexels;
+  walkOffset = walkPage.offset / u_layoutAtlasTexels;
 #endif
 }
+
+float sampleVolumeInBlock(vec3 p) {
+#if TESSERA_GLSL == 300 && BRICKS_TEXEL < 2
+  return mix(BRICKS_VALUE(texture(u_layoutAtlas, p * walkScale + walkOffset)), walkPage.constant,
+             walkPage.isConstant);
+#else
+  return brickValue(walkPage, p * walkPage.scale + walkPage.offset);
+#endif
+}
+#endif

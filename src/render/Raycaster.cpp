@@ -211,6 +211,12 @@ std::vector<std::string> Raycaster::definesFor(const RenderSettings& settings) c
   // Fewer samples (docs/sampling.md): both for composite only; adaptive steps
   // live in the block grid.
   if (usesPreintegration(settings)) defines.push_back("PREINTEGRATED 1");
+  // The brick walk reads the layout's page once per block; a pre-integrated
+  // segment's front may lie in the block before, so it samples per sample.
+  if (blockSize_ > 0 && skippable && !usesPreintegration(settings) &&
+      layout_.walksBlocks(blockSize_)) {
+    defines.push_back("LAYOUT_BLOCK_WALK 1");
+  }
   if (blockSize_ > 0 && usesAdaptiveSampling(settings)) {
     defines.push_back("ADAPTIVE_SAMPLING 1");
     if (settings.sampling.opacityGrowth) defines.push_back("OPACITY_GROWTH 1");

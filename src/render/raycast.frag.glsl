@@ -142,6 +142,33 @@ float nextSample(float k, float m, float kExit, float mAhead, float kExitAhead) 
 #endif
 #endif
 
+#ifdef EMPTY_SPACE_SKIPPING
+// The ray enters the block holding p at sample k: reads it and sets the
+// first sample at or past its exit face (where an empty block is left for,
+// and where adaptive steps end unless the block ahead lets them cross) and,
+// with ADAPTIVE_SAMPLING, the exit sample of the block ahead. Returns the
+// block's cell.
+vec3 enterBlock(vec3 p, float k, RayBlocks rb, out vec4 block, out float blockExit,
+                out float aheadExit) {
+  vec3 cell = clamp(floor(p * u_blocksPerUnit), vec3(0.0), u_blockCount - 1.0);
+  block = blockAt(cell);
+#ifdef MODE_MIP
+  float radius = 0.0;
+#else
+  // An empty block is left with the cube of empty blocks around it.
+  float radius = max(floor(block.r * 255.0 + 0.5) - 1.0, 0.0);
+#endif
+  vec2 exits = exitT(cell, radius, rb);
+  blockExit = exitSample(exits.x, rb, k);
+#ifdef ADAPTIVE_SAMPLING
+  aheadExit = exitSample(exits.y, rb, k);
+#else
+  aheadExit = -1.0;
+#endif
+  return cell;
+}
+#endif
+
 // Whether clipping keeps the sample at p.
 bool sampleKept(vec3 p) {
 #ifdef CLIPPING
@@ -207,11 +234,29 @@ void main() {
     float blockExit = -1.0;
     vec4 block = vec4(0.0);
     RayBlocks rb = rayBlocks(to, td, invTd, t0, j);
-#ifdef ADAPTIVE_SAMPLING
     float aheadExit = -1.0;  // the exit sample of the next block along the ray
 #endif
+#ifdef LAYOUT_BLOCK_WALK
+    // The brick walk: the outer loop enters one block per iteration (its
+    // skip data and the layout's page for it: one lookup per block, not per
+    // sample); the inner loop takes the block's samples. The same samples,
+    // in the same order, as the single loop below reading the block when k
+    // passes blockExit; on a SIMD rasteriser (llvmpipe runs both sides of
+    // every branch) the per-block reads leave the per-sample loop.
+    for (int w = 0; w < MAX_STEPS; w++) {
+      if (k >= u_maxSteps) break;
+      if (t0 + (k + j) * u_step >= t1) break;
+#if !defined(MODE_MIP)
+      if (acc.a >= u_ert) break;
+#endif
+      vec3 entered = enterBlock(to + (t0 + (k + j) * u_step) * td, k, rb, block, blockExit,
+                                aheadExit);
+      layoutEnterBlock((entered + 0.5) / u_blocksPerUnit);
 #endif
     for (int i = 0; i < MAX_STEPS; i++) {
+#ifdef LAYOUT_BLOCK_WALK
+      if (k >= blockExit) break;
+#endif
       if (k >= u_maxSteps) break;
       float t = t0 + (k + j) * u_step;
       if (t >= t1) break;
@@ -219,24 +264,11 @@ void main() {
       float kNext = k + 1.0;
       bool empty = false;
 #ifdef EMPTY_SPACE_SKIPPING
+#ifndef LAYOUT_BLOCK_WALK
       if (k >= blockExit) {
-        vec3 cell = clamp(floor(p * u_blocksPerUnit), vec3(0.0), u_blockCount - 1.0);
-        block = blockAt(cell);
-        // The first sample at or past the block's exit face: where an empty
-        // block is left for, and where adaptive steps end unless the block
-        // ahead lets them cross.
-#ifdef MODE_MIP
-        float radius = 0.0;
-#else
-        // An empty block is left with the cube of empty blocks around it.
-        float radius = max(floor(block.r * 255.0 + 0.5) - 1.0, 0.0);
-#endif
-        vec2 exits = exitT(cell, radius, rb);
-        blockExit = exitSample(exits.x, rb, k);
-#ifdef ADAPTIVE_SAMPLING
-        aheadExit = exitSample(exits.y, rb, k);
-#endif
+        enterBlock(p, k, rb, block, blockExit, aheadExit);
       }
+#endif
 #ifdef MODE_MIP
       empty = block.g <= maxValue;
 #else
@@ -338,6 +370,9 @@ void main() {
 #endif
       k = kNext;
     }
+#ifdef LAYOUT_BLOCK_WALK
+    }
+#endif
   }
 #ifdef MODE_MIP
   if (maxValue >= 0.0) {

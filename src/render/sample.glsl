@@ -3,6 +3,16 @@
 // function, and with SHADING the light (render/shading.glsl, from sampleVolumeGradient). Techniques
 // call this instead of writing the chain in their main(), so a stage added here reaches all of
 // them.
+// With LAYOUT_BLOCK_WALK (the ray caster's brick walk, raycast.frag.glsl) a
+// sample's value comes from the block the ray is in (the layout's
+// sampleVolumeInBlock, its page read once per block); the gradient's
+// neighbours may lie outside it and read through sampleVolume.
+#ifdef LAYOUT_BLOCK_WALK
+#define FIELD_SAMPLE sampleVolumeInBlock
+#else
+#define FIELD_SAMPLE sampleVolume
+#endif
+
 #ifdef NEAREST
 uniform vec3 u_sampleDims;  // the volume's dims
 
@@ -10,11 +20,11 @@ uniform vec3 u_sampleDims;  // the volume's dims
 // layout's interpolation weights vanish): no interpolation across labels.
 float fieldValue(vec3 p) {
   vec3 cell = clamp(floor(p * u_sampleDims), vec3(0.0), u_sampleDims - 1.0);
-  return sampleVolume((cell + 0.5) / u_sampleDims);
+  return FIELD_SAMPLE((cell + 0.5) / u_sampleDims);
 }
 #else
 float fieldValue(vec3 p) {
-  return sampleVolume(p);
+  return FIELD_SAMPLE(p);
 }
 #endif
 

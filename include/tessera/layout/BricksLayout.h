@@ -94,6 +94,10 @@ class BricksLayout final : public Layout, public StreamingLayout {
   int textureUnits() const override { return 1 + static_cast<int>(atlases_.size()); }
   ValueBlocks valueBlocks(int blockSize) const override;
   std::uint64_t contentVersion() const override { return contentVersion_; }
+  // A block inside one level-0 brick (the brick size a multiple of it).
+  bool walksBlocks(int blockSize) const override {
+    return blockSize > 0 && grid_.brickSize() % blockSize == 0;
+  }
 
   const lod::BrickGrid& grid() const override { return grid_; }
   const lod::MultiresSource& source() const { return *source_; }
