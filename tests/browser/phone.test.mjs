@@ -45,11 +45,14 @@ async function restoreContext(page) {
 }
 
 // The head at 256x256, with settings away from their defaults (camera,
-// window, shading, technique step), lost and restored: the frame after must
-// be the frame before, and the view must still turn.
+// window, shading), lost and restored: the frame after must be the frame
+// before, and the view must still turn. In WebGL 2 also with a region of
+// the head shown at native resolution and the crop box on (the session's
+// exploration and the page's own view settings).
 async function contextLoss(context, url) {
   if (!fs.existsSync(CH2)) { check(`context loss test needs ${CH2} (mricron-data)`, false); return; }
-  for (const webgl of [2, 1]) {
+  for (const [webgl, region] of [[2, false], [1, false], [2, true]]) {
+    const what = `WebGL ${webgl}${region ? ', a region shown, crop box on' : ''}`;
     const { page, logs } = await openPage(context, url, `size=256&url=/templates/ch2.nii.gz${webgl === 1 ? '&webgl=1' : ''}`);
     await page.check('#shade');
     await page.evaluate(async () => {
@@ -58,7 +61,13 @@ async function contextLoss(context, url) {
       w.dispatchEvent(new Event('input'));
       await window.tessera.setCamera(35, 12, 1.25);
     });
+    if (region) {
+      await page.evaluate(() => window.tessera.slices.showRegion({ begin: [40, 90, 70], end: [140, 190, 170] }));
+      await page.check('#cropShow');
+      await page.evaluate(() => window.tessera.setCamera(35, 12, 1.25));
+    }
     const s0 = await page.evaluate(() => window.tessera.state());
+    const e0 = await page.evaluate(() => window.tessera.slices.state());
     const before = (await snapshot(page)).pixels;
     await loseContext(page);
     const lostStatus = await statusOf(page);
@@ -68,23 +77,27 @@ async function contextLoss(context, url) {
     await restoreContext(page);
     const restoredStatus = await statusOf(page);
     const s1 = await page.evaluate(() => window.tessera.state());
+    const e1 = await page.evaluate(() => window.tessera.slices.state());
     const after = (await snapshot(page)).pixels;
     const psnr = psnrOf(before, after);
     await page.evaluate(() => window.tessera.setCamera(80, 12, 1.25));
     const turned = (await snapshot(page)).pixels;
     const error = await page.evaluate(() => window.tessera.error());
     const same = (a, b) => JSON.stringify(a) === JSON.stringify(b);
-    console.log(`webgl ${webgl}: status while lost "${lostStatus}"; after "${restoredStatus}"`);
-    check(`WebGL ${webgl}: context lost and restored: the frame after equals the frame before (>= 60 dB) and the view still turns`,
-          s1.webgl === webgl && psnr >= 60 && changedFraction(after, turned) > 0.05 && error === '' &&
+    const regionKept = same(e0.explore.region, e1.explore.region) && e0.showing_region === e1.showing_region &&
+      e1.showing_region === region && same(s0.dims, s1.dims);
+    console.log(`${what}: status while lost "${lostStatus}"; after "${restoredStatus}"`);
+    check(`${what}: context lost and restored: the frame after equals the frame before (>= 60 dB) and the view still turns`,
+          s1.webgl === webgl && psnr >= 60 && changedFraction(after, turned) > 0.05 && error === '' && regionKept &&
           same(s0.window, s1.window) && same(s0.camera, s1.camera) && s0.layout === s1.layout,
           `${psnr >= 999 ? 'identical (inf dB)' : `${psnr.toFixed(2)} dB`}; ${(100 * changedFraction(after, turned)).toFixed(1)} % ` +
-          `changed by a turn after; ${s1.description}; window ${s1.window.map((v) => v.toFixed(1)).join('..')}; error "${error}"`);
-    check(`WebGL ${webgl}: the status line says "WebGL context lost — waiting", then "WebGL context restored"`,
+          `changed by a turn after; ${s1.description}; window ${s1.window.map((v) => v.toFixed(1)).join('..')}; ` +
+          `region ${region ? JSON.stringify(e1.explore.region) : 'none'} (kept: ${regionKept}); error "${error}"`);
+    check(`${what}: the status line says "WebGL context lost — waiting", then "WebGL context restored"`,
           lostStatus.includes('WebGL context lost — waiting') && restoredStatus.includes('WebGL context restored'),
           `"${lostStatus}" / "${restoredStatus}"`);
     const errors = logs.filter((l) => l.startsWith('pageerror') || (l.startsWith('error') && !l.includes('favicon')));
-    check(`WebGL ${webgl}: no script errors around the context loss`, errors.length === 0, errors.join(' | '));
+    check(`${what}: no script errors around the context loss`, errors.length === 0, errors.join(' | '));
     await page.close();
   }
 }
