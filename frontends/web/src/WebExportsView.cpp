@@ -111,11 +111,11 @@ EMSCRIPTEN_KEEPALIVE double tessera_refine() {
   return ms;
 }
 
-// Pointer input in canvas pixels; action 0 orbit, 1 pan. The page sends CSS
-// pixels over a view of tessera_pointer_viewport's size, so that a drag
-// turns the view by the same angle per CSS pixel at every devicePixelRatio
-// (the frame's render sets the viewport to its own pixels: call it before
-// each pointer call).
+// Pointer input, y down; action 0 orbit, 1 pan. The page sends CSS pixels
+// over a view of tessera_pointer_viewport's CSS size, so that a drag turns
+// the view by the same angle per CSS pixel at every devicePixelRatio (each
+// frame sets the viewport to its own pixels: call it before each pointer
+// call).
 EMSCRIPTEN_KEEPALIVE void tessera_pointer_viewport(double width, double height) {
   if (viewer::Viewer* v = viewerIfAny()) {
     v->controller().setViewport(static_cast<int>(std::lround(width)),
