@@ -27,6 +27,13 @@ import { TesseraViewer } from './tessera.js';
   // Axial, coronal and sagittal views beside the 3D view (frontends/web/slices.js;
   // ?slices=0: the 3D view alone).
   const withSlices = params.get('slices') !== '0' && !!window.TesseraSlices;
+  // ?dragdensity=device: camera drags keep the full pixel density (see
+  // backingRatio; for comparisons).
+  const dragAtDeviceDensity = params.get('dragdensity') === 'device';
+  // The viewer's frame time goal while dragging (?dragms=MS): below its own
+  // 66 ms, since the browser composes the page after each frame (on a
+  // phone's software GL, about 30 ms more at 390x844 ratio 3).
+  const dragGoalMs = Math.max(5, parseFloat(params.get('dragms') || '40') || 40);
 
   const $ = (id) => document.getElementById(id);
   const canvas = $('canvas');
@@ -41,11 +48,21 @@ import { TesseraViewer } from './tessera.js';
     $('view').classList.add('responsive');
   }
 
+  // While the camera is dragged the canvas has one pixel per CSS pixel (at
+  // ratio 3 a ninth of its pixels): the box, the axes and the compositing
+  // then cost what the interactive volume does, not the screen's full
+  // density; full density again once released.
+  let cameraDragged = false;
+  function backingRatio() {
+    const dpr = window.devicePixelRatio || 1;
+    return cameraDragged && !dragAtDeviceDensity ? Math.min(dpr, 1) : dpr;
+  }
+
   // Backing size = CSS size x devicePixelRatio (capped per side); returns
   // true when it changed (the canvas is cleared then and needs a frame).
   function fitCanvas() {
     if (fixedSize) return false;
-    const dpr = window.devicePixelRatio || 1;
+    const dpr = backingRatio();
     let w = Math.max(1, Math.round(canvas.clientWidth * dpr));
     let h = Math.max(1, Math.round(canvas.clientHeight * dpr));
     const s = Math.min(1, MAX_BACKING / Math.max(w, h));
@@ -86,6 +103,7 @@ import { TesseraViewer } from './tessera.js';
     const c = (name, ret, args) => M.cwrap(name, ret, args);
     return {
       lastError: c('tessera_last_error', 'string', []),
+      pointerViewport: c('tessera_pointer_viewport', null, ['number', 'number']),
       pointerDown: c('tessera_pointer_down', null, ['number', 'number', 'number', 'number']),
       pointerMove: c('tessera_pointer_move', null, ['number', 'number', 'number']),
       pointerUp: c('tessera_pointer_up', null, ['number']),
@@ -108,6 +126,7 @@ import { TesseraViewer } from './tessera.js';
       setOverlays: c('tessera_set_overlays', null, ['number', 'number']),
       setQuality: c('tessera_set_quality', null, ['number']),
       setMaxVolumePixels: c('tessera_set_max_volume_pixels', null, ['number']),
+      setInteractionGoal: c('tessera_set_interaction_goal', null, ['number']),
       setProgressive: c('tessera_set_progressive', null, ['number', 'number']),
       refining: c('tessera_refining', 'number', []),
       refine: c('tessera_refine', 'number', []),
@@ -212,6 +231,10 @@ import { TesseraViewer } from './tessera.js';
   // of the pending full-quality one; render() promises resolve once the
   // frame is complete.
   function loop() {
+    if (viewer && viewer.contextLost) {
+      requestAnimationFrame(loop);  // nothing to draw on until it is restored
+      return;
+    }
     if (api && zarr && zarr.active()) {
       // An OME-Zarr store (frontends/web/zarr-url.js): frames while bricks arrive.
       let ms = -1;
@@ -261,7 +284,33 @@ import { TesseraViewer } from './tessera.js';
     const vol = s.has_volume ? s.description : 'no volume';
     const what = s.refining ? 'preview' : 'frame';
     $('status').textContent = `${vol} · ${api} · ${what} ${s.render_size[0]}×${s.render_size[1]} in ${s.frame_ms.toFixed(0)} ms` +
-      (s.refining ? ' · refining…' : '');
+      (s.refining ? ' · refining…' : '') + (contextNote ? ` · ${contextNote}` : '');
+  }
+
+  // ---------------------------------------------------------------- context loss
+
+  // A phone that sends the page to the background (or a GPU reset) takes
+  // the WebGL context away: TesseraViewer (tessera.js) stops drawing, and
+  // when the browser gives it back makes the session again on it (same
+  // volume and state); the page says so and shows the restored frame.
+  let contextNote = '';  // on the status line until the next load or drag
+  function watchContext() {
+    viewer.on('contextlost', () => {
+      contextNote = '';
+      $('status').textContent = 'WebGL context lost — waiting';
+    });
+    viewer.on('contextrestored', ({ error }) => {
+      contextNote = 'WebGL context restored';
+      if (error) {
+        if (zarr) { zarr.close(); zarr = null; }  // the store's GPU side is gone
+        showError(error);
+      }
+      volumeChanged();
+      $('status').textContent = contextNote;
+      // The zoom swap (grid.js) ended with the old context: on again.
+      if ($('zoomSwap').checked) $('zoomSwap').dispatchEvent(new Event('change'));
+      requestRender();
+    });
   }
 
   // ---------------------------------------------------------------- files
@@ -317,6 +366,7 @@ import { TesseraViewer } from './tessera.js';
     }
     if (zarr) zarr.close();  // the files' volume replaces the store
     clearError();
+    contextNote = '';
     volumeChanged();
     await requestRender();
     return true;
@@ -551,6 +601,18 @@ import { TesseraViewer } from './tessera.js';
     const r = canvas.getBoundingClientRect();
     return [(e.clientX - r.left) * canvas.width / r.width, (e.clientY - r.top) * canvas.height / r.height];
   }
+  // Camera input in CSS pixels over the view's CSS size: a drag turns the
+  // view by the same angle per CSS pixel at every devicePixelRatio.
+  function cameraPos(e) {
+    const r = canvas.getBoundingClientRect();
+    api.pointerViewport(r.width, r.height);
+    return [e.clientX - r.left, e.clientY - r.top];
+  }
+  function setCameraDragged(on) {
+    if (cameraDragged === on) return;
+    cameraDragged = on;
+    requestRender();  // at the new backing size
+  }
   canvas.addEventListener('contextmenu', (e) => e.preventDefault());
   // A left press on a crop box handle drags that face instead of the camera.
   let cropPointer = null;
@@ -566,7 +628,8 @@ import { TesseraViewer } from './tessera.js';
       requestRender();
       return;
     }
-    api.pointerDown(e.pointerId, x, y, e.button === 2 || e.shiftKey ? 1 : 0);
+    contextNote = '';
+    api.pointerDown(e.pointerId, ...cameraPos(e), e.button === 2 || e.shiftKey ? 1 : 0);
     canvas.setPointerCapture(e.pointerId);
     e.preventDefault();
   });
@@ -577,8 +640,11 @@ import { TesseraViewer } from './tessera.js';
       if (api.cropMove(x, y)) { syncCropControls(); requestRender(); }
       return;
     }
-    api.pointerMove(e.pointerId, x, y);
-    if (api.interacting()) requestRender();
+    api.pointerMove(e.pointerId, ...cameraPos(e));
+    if (api.interacting()) {
+      setCameraDragged(true);
+      requestRender();
+    }
   });
   const viewEnd = (e) => {
     if (!api) return;
@@ -589,6 +655,7 @@ import { TesseraViewer } from './tessera.js';
       return;
     }
     api.pointerUp(e.pointerId);
+    if (!api.interacting()) setCameraDragged(false);
     requestRender();  // full quality once released
   };
   canvas.addEventListener('pointerup', viewEnd);
@@ -600,19 +667,36 @@ import { TesseraViewer } from './tessera.js';
     e.preventDefault();
   }, { passive: false });
 
-  // Drag and drop of files onto the view.
+  // Drag and drop of files anywhere on the page (the 3D view shows the
+  // hint); a visible file input keeps its own drops.
   const view = $('view');
-  ['dragenter', 'dragover'].forEach((t) => view.addEventListener(t, (e) => {
+  const carriesFiles = (e) => !!e.dataTransfer && Array.from(e.dataTransfer.types || []).includes('Files') &&
+    !(e.target instanceof Element && e.target.closest('input[type=file]'));
+  let dragDepth = 0;  // dragenter/dragleave pairs of the elements crossed
+  document.addEventListener('dragenter', (e) => {
+    if (!carriesFiles(e)) return;
+    dragDepth++;
+    view.classList.add('dragover');
+  });
+  document.addEventListener('dragover', (e) => {
+    if (!carriesFiles(e)) return;
     e.preventDefault();
     view.classList.add('dragover');
-  }));
-  ['dragleave', 'drop'].forEach((t) => view.addEventListener(t, () => view.classList.remove('dragover')));
-  view.addEventListener('drop', (e) => {
+  });
+  document.addEventListener('dragleave', (e) => {
+    if (!carriesFiles(e)) return;
+    dragDepth = Math.max(0, dragDepth - 1);
+    if (dragDepth === 0) view.classList.remove('dragover');
+  });
+  document.addEventListener('drop', (e) => {
+    if (!carriesFiles(e)) return;
     e.preventDefault();
+    dragDepth = 0;
+    view.classList.remove('dragover');
     const folder = TesseraFolders.droppedFolderEntries(e.dataTransfer);
     if (folder) {
       TesseraFolders.walk(folder).then(openFolder, (err) => showError(`cannot read the dropped folder: ${err.message}`));
-    } else if (e.dataTransfer && e.dataTransfer.files.length) {
+    } else if (e.dataTransfer.files.length) {
       openFiles(e.dataTransfer.files);
     }
   });
@@ -777,6 +861,7 @@ import { TesseraViewer } from './tessera.js';
     M = viewer.module;
     api = wrap(M);
     bindControls();
+    watchContext();
     if (withSlices) {
       slices = window.TesseraSlices.attach({ M, canvas, requestRender, showError, clearError,
         storeRegion: zarrRegion, storeOverview: zarrOverview,
@@ -795,6 +880,7 @@ import { TesseraViewer } from './tessera.js';
     $('preint').checked = state.sampling.preintegrate;  // webDefaultSampling()
     $('adaptive').checked = state.sampling.adaptive;
     api.setMaxVolumePixels(maxVolumePixels);
+    api.setInteractionGoal(dragGoalMs);
     api.setProgressive(progressive ? 1 : 0, frameBudgetMs);
     new ResizeObserver(() => { if (fitCanvas()) requestRender(); }).observe(canvas);
     window.addEventListener('resize', () => { if (fitCanvas()) requestRender(); });

@@ -348,10 +348,18 @@ window.TesseraSlices = (function () {
       }
     }
 
+    // The crosshair voxel's position in RAS+ millimetres (the volume's affine).
+    function crossMm() {
+      const a = explore.index_to_world;
+      if (!a) return '';
+      const mm = a.map((r) => r[0] * cross[0] + r[1] * cross[1] + r[2] * cross[2] + r[3]);
+      return ` at (${mm.map((v) => v.toFixed(1)).join(', ')}) mm RAS`;
+    }
+
     function updateInfo() {
       const v = explore.has_volume ? api.value(cross[0], cross[1], cross[2]) : NaN;
       $('crosshairInfo').textContent = explore.has_volume
-        ? `crosshair voxel (${cross.join(', ')}): value ${Number.isFinite(v) ? +v.toPrecision(6) : '–'}` : '';
+        ? `crosshair voxel (${cross.join(', ')})${crossMm()}: value ${Number.isFinite(v) ? +v.toPrecision(6) : '–'}` : '';
       const r = region;
       const text = r ? `region x ${r.begin[0]}:${r.end[0]}, y ${r.begin[1]}:${r.end[1]}, z ${r.begin[2]}:${r.end[2]} ` +
         `(${r.end.map((e, a) => e - r.begin[a]).join('×')} voxels, native resolution)` : 'no region picked';

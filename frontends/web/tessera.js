@@ -86,6 +86,7 @@ export class TesseraViewer {
     let ok = profile === 'webgl1' ? 0 : viewer.#c.init(selector, 2);
     if (!ok && profile !== 'webgl2') ok = viewer.#c.init(selector, 1);  // the ES 2.0 path
     if (!ok) throw new Error(viewer.#c.lastError());
+    viewer.#watchContext();
     return viewer;
   }
 
@@ -93,6 +94,8 @@ export class TesseraViewer {
   #canvas;
   #c;  // the C API (frontends/web/src/WebExports*.cpp), cwrapped
   #listeners = new Map();
+  #lost = false;
+  #contextEvents = [];  // [type, handler] on the canvas
 
   constructor(module, canvas) {
     this.#module = module;
@@ -101,6 +104,7 @@ export class TesseraViewer {
     this.#c = {
       init: c('tessera_init', 'number', ['string', 'number']),
       dispose: c('tessera_dispose', null, []),
+      contextRestored: c('tessera_context_restored', 'number', []),
       lastError: c('tessera_last_error', 'string', []),
       loadGenerated: c('tessera_load_generated', 'number', ['string']),
       addFile: c('tessera_add_file', null, ['string', 'number', 'number']),
@@ -126,10 +130,14 @@ export class TesseraViewer {
 
   // on('loaded', (state) => …) after a volume is loaded; on('frame',
   // ({ms}) => …) after each render(); on('error', (error) => …) when a call
-  // fails (it also throws). Returns a function that removes the listener.
+  // fails (it also throws); on('contextlost', () => …) when the browser
+  // takes the WebGL context away, on('contextrestored', ({error, state}) =>
+  // …) once the viewer is back on it (error: what could not be brought
+  // back, else ''). Returns a function that removes the listener.
   on(event, callback) {
-    if (!['loaded', 'frame', 'error'].includes(event)) {
-      throw new Error(`TesseraViewer.on: no event "${event}" (loaded, frame, error)`);
+    const events = ['loaded', 'frame', 'error', 'contextlost', 'contextrestored'];
+    if (!events.includes(event)) {
+      throw new Error(`TesseraViewer.on: no event "${event}" (${events.join(', ')})`);
     }
     if (!this.#listeners.has(event)) this.#listeners.set(event, new Set());
     this.#listeners.get(event).add(callback);
@@ -150,6 +158,28 @@ export class TesseraViewer {
   #check(ok) {
     if (!ok) this.#fail(this.#c.lastError());
   }
+
+  // A lost WebGL context (a phone sends the page to the background, the GPU
+  // resets): render() draws nothing until the browser restores it; then the
+  // session is made again on it with the same volume and state. The loss's
+  // preventDefault is what lets the browser restore the context at all.
+  #watchContext() {
+    const lost = (e) => {
+      e.preventDefault();
+      this.#lost = true;
+      this.#emit('contextlost', {});
+    };
+    const restored = () => {
+      this.#lost = false;
+      const error = this.#c.contextRestored() ? '' : this.#c.lastError();
+      this.#emit('contextrestored', { error, state: this.state() });
+    };
+    this.#contextEvents = [['webglcontextlost', lost], ['webglcontextrestored', restored]];
+    for (const [type, handler] of this.#contextEvents) this.#canvas.addEventListener(type, handler);
+  }
+
+  // True between the loss of the WebGL context and its restoration.
+  get contextLost() { return this.#lost; }
 
   // The viewer's state (volume, dims, geometry, camera, sampling, …) as the
   // C API's tessera_state_json reports it.
@@ -254,8 +284,10 @@ export class TesseraViewer {
     this.#c.setOverlays(box ? 1 : 0, axes ? 1 : 0);
   }
 
-  // Renders a frame at the canvas's size; returns its time in ms.
+  // Renders a frame at the canvas's size; returns its time in ms (0, and
+  // nothing drawn, while the WebGL context is lost).
   render() {
+    if (this.#lost) return 0;
     const ms = this.#c.render(this.#canvas.width, this.#canvas.height);
     if (ms < 0) this.#fail(this.#c.lastError());
     this.#emit('frame', { ms });
@@ -272,6 +304,7 @@ export class TesseraViewer {
   // Ends the session: the WebGL context, the volume and every GPU object go.
   dispose() {
     if (!this.#c) return;
+    for (const [type, handler] of this.#contextEvents) this.#canvas.removeEventListener(type, handler);
     this.#c.dispose();
     this.#listeners.clear();
   }

@@ -91,8 +91,8 @@ EMSCRIPTEN_KEEPALIVE double tessera_voxel_value(int x, int y, int z) {
 }
 
 // The overview volume and the region: JSON {has_volume, tf_revision, name,
-// dims, spacing, region: null or {begin, end}, showing_region, region_side,
-// region_side_reason}.
+// dims, spacing, index_to_world (3 rows of 4), region: null or {begin, end}, showing_region,
+// region_side, region_side_reason}.
 EMSCRIPTEN_KEEPALIVE const char* tessera_explore_json() {
   nlohmann::json j;
   j["has_volume"] = false;
@@ -110,6 +110,12 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_explore_json() {
     j["name"] = s->overviewName();
     j["dims"] = {d.x, d.y, d.z};
     j["spacing"] = {sp.x, sp.y, sp.z};
+    // Voxel index -> RAS+ millimetres (rows), for the crosshair's position.
+    const glm::dmat4 a = volume.indexToWorld();
+    j["index_to_world"] = nlohmann::json::array();
+    for (int row = 0; row < 3; ++row) {
+      j["index_to_world"].push_back({a[0][row], a[1][row], a[2][row], a[3][row]});
+    }
     j["showing_region"] = inRegion;
     // A store: the slices, crosshair and regions are in level-0 voxels (these
     // dims), the slices read at the level their panel shows (tessera_slice);

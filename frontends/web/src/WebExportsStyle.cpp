@@ -96,6 +96,17 @@ EMSCRIPTEN_KEEPALIVE void tessera_set_quality(int adaptive) {
     v->quality = adaptive ? viewer::Quality::Adaptive : viewer::Quality::Full;
   }
 }
+// The frame time (ms) adaptive quality aims at while the user drags. The
+// browser composes the page after each frame, on the same (software) GPU
+// on phones without one, so the page asks for less than the viewer's own
+// goal to keep the drag's frame rate.
+EMSCRIPTEN_KEEPALIVE void tessera_set_interaction_goal(double ms) {
+  viewer::Viewer* v = viewerIfAny();
+  if (!v || !(ms > 0.0)) return;
+  render::QualityController::Options options = v->qualityController().options();
+  options.goalMs = ms;
+  v->qualityController() = render::QualityController(options);
+}
 EMSCRIPTEN_KEEPALIVE int tessera_set_technique(const char* name) {
   return guarded([&] { web::session().viewer().setTechnique(name); });
 }

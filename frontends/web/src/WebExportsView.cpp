@@ -3,6 +3,7 @@
 // Each export marshals its arguments to the session (WebSession.h) and its
 // results back: numbers, or JSON strings valid until the next call.
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -39,6 +40,14 @@ extern "C" {
 // profile webgl2 / webgl1) and the session; a session made before is ended.
 EMSCRIPTEN_KEEPALIVE int tessera_init(const char* canvasSelector, int webglVersion) {
   return guarded([&] { web::startSession(canvasSelector, webglVersion); });
+}
+
+// After the browser restored the canvas's lost WebGL context
+// (webglcontextrestored): the session made again on it, with the same
+// volume and state (WebSession::recoverContext); 0 with the reason when
+// something could not be brought back.
+EMSCRIPTEN_KEEPALIVE int tessera_context_restored() {
+  return guarded([&] { web::session().recoverContext(); });
 }
 
 // Ends the session: the viewer's GPU objects, the WebGL context and every
@@ -102,7 +111,17 @@ EMSCRIPTEN_KEEPALIVE double tessera_refine() {
   return ms;
 }
 
-// Pointer input in canvas pixels; action 0 orbit, 1 pan.
+// Pointer input, y down; action 0 orbit, 1 pan. The page sends CSS pixels
+// over a view of tessera_pointer_viewport's CSS size, so that a drag turns
+// the view by the same angle per CSS pixel at every devicePixelRatio (each
+// frame sets the viewport to its own pixels: call it before each pointer
+// call).
+EMSCRIPTEN_KEEPALIVE void tessera_pointer_viewport(double width, double height) {
+  if (viewer::Viewer* v = viewerIfAny()) {
+    v->controller().setViewport(static_cast<int>(std::lround(width)),
+                                static_cast<int>(std::lround(height)));
+  }
+}
 EMSCRIPTEN_KEEPALIVE void tessera_pointer_down(int id, double x, double y, int action) {
   if (viewer::Viewer* v = viewerIfAny()) {
     v->controller().pointerDown(

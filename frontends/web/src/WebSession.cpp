@@ -3,6 +3,7 @@
 #include "WebSession.h"
 
 #include <algorithm>
+#include <optional>
 #include <span>
 
 #include <glm/geometric.hpp>
@@ -62,7 +63,17 @@ void endSession() {
 }
 
 WebSession::WebSession(const std::string& canvasSelector, int webglVersion)
-    : context_(canvasSelector, webglVersion) {
+    : canvasSelector_(canvasSelector),
+      context_(std::make_unique<gpu::WebGlContext>(canvasSelector, webglVersion)) {
+  makeSession();
+}
+
+WebSession::~WebSession() {
+  // GPU objects are deleted while their context is current.
+  if (context_) context_->makeCurrent();
+}
+
+void WebSession::makeSession() {
   session_ = std::make_unique<session::Session>(
       gpu::borrowDevice(context(), gpu::DeviceProfile::find(context().platform())));
   session::Settings settings = session_->settings();
@@ -71,9 +82,80 @@ WebSession::WebSession(const std::string& canvasSelector, int webglVersion)
   session_->view();  // the 3D view from the start (its TF editor, camera)
 }
 
-WebSession::~WebSession() {
-  // GPU objects are deleted while their context is current.
-  context_.makeCurrent();
+namespace {
+
+// What the view holds beyond the session's state (Session::state): the
+// page's quality settings (and adaptive quality's goal), its overlays, the clip plane that
+// follows the camera and a label table read from a file.
+struct ViewKnobs {
+  viewer::Quality quality = viewer::Quality::Adaptive;
+  int maxVolumePixels = 0;
+  bool showBoundingBox = true, showAxes = true;
+  bool progressive = false;
+  double frameBudgetMs = 12.0;
+  bool clipPlaneFollowsCamera = false;
+  double followingPlaneDistance = 0.0;
+  std::optional<render::LabelTable> labels;
+  render::QualityController::Options adaptive;  // its frame-time goal
+
+  static ViewKnobs of(viewer::Viewer& v) {
+    ViewKnobs k{
+        v.quality,     v.maxVolumePixels, v.showBoundingBox,        v.showAxes,
+        v.progressive, v.frameBudgetMs,   v.clipPlaneFollowsCamera, v.followingPlaneDistance,
+        std::nullopt};
+    if (v.labelsOn()) k.labels = v.labelTable();
+    k.adaptive = v.qualityController().options();
+    return k;
+  }
+  void applyTo(viewer::Viewer& v) const {
+    v.quality = quality;
+    v.maxVolumePixels = maxVolumePixels;
+    v.showBoundingBox = showBoundingBox;
+    v.showAxes = showAxes;
+    v.progressive = progressive;
+    v.frameBudgetMs = frameBudgetMs;
+    v.clipPlaneFollowsCamera = clipPlaneFollowsCamera;
+    v.followingPlaneDistance = followingPlaneDistance;
+    if (labels && v.hasVolume()) v.setLabels(*labels);
+    v.qualityController() = render::QualityController(adaptive);
+  }
+};
+
+}  // namespace
+
+// The old session's objects were the lost context's: deleting them on the
+// restored one only raises GL errors, cleared before the new session starts.
+void WebSession::recoverContext() {
+  zoomStop();
+  const bool hadStore = zarr_ != nullptr;
+  std::shared_ptr<Volume> volume;
+  if (!hadStore && session_->hasVolume() && !session_->streamed()) {
+    volume = session_->source().level(glm::ivec3(1));  // the volume itself, shared
+  }
+  const std::string name = session_->name();
+  const nlohmann::json state = session_->state();
+  const ViewKnobs knobs = ViewKnobs::of(viewer());
+  const int webglVersion = context_->webglVersion();
+  const int cell = askedCell_;
+  zarr_.reset();
+  session_.reset();
+  context_.reset();
+  context_ = std::make_unique<gpu::WebGlContext>(canvasSelector_, webglVersion);
+  gpu::clearErrors();
+  makeSession();
+  exploreKey_.clear();
+  if (volume) {
+    session_->setVolume(std::move(volume), name);
+    exploration(cell > 0 ? cell : -1);  // the page's exploration, for the state to fill
+    session_->restore(state);
+  } else {
+    session_->restore({{"version", state["version"]}, {"settings", state["settings"]}});
+  }
+  knobs.applyTo(viewer());
+  refreshExtraLines();
+  if (hadStore) {
+    throw InputError("the WebGL context was lost and restored: open the OME-Zarr store again");
+  }
 }
 
 void WebSession::loadGenerated(const std::string& spec) {

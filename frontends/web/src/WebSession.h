@@ -98,8 +98,15 @@ class WebSession {
   // what tessera_state_json saves and tessera_state_restore restores.
   session::Session& rendering() { return *session_; }
   viewer::Viewer& viewer() { return session_->view(); }
-  gpu::GlContext& context() { return context_.gl(); }
-  int webglVersion() const { return context_.webglVersion(); }
+  gpu::GlContext& context() { return context_->gl(); }
+  int webglVersion() const { return context_->webglVersion(); }
+  // After the browser restored a lost WebGL context (a phone sent the page to
+  // the background, the GPU reset): the context is made again on the canvas
+  // and the session on it, with the same volume (shared, not read again),
+  // its state (Session::state: settings, camera, TF, window, exploration)
+  // and the view's own settings. An open OME-Zarr store is closed
+  // (InputError saying so, after the rest is back).
+  void recoverContext();
 
   // ---- volumes and frames (WebSession.cpp)
   void loadGenerated(const std::string& spec);
@@ -203,6 +210,8 @@ class WebSession {
  private:
   void applyMarkBoxes();
   std::string overviewKey(const Volume& v);
+  // The session on the context, with the page's sampling and its view made.
+  void makeSession();
   void showGridBlock(const session::ExploreStep& step);
   // The session's exploration, or null before one was made.
   session::Exploration* explore() {
@@ -211,7 +220,8 @@ class WebSession {
 
   // Declared in destruction order's reverse: the viewer's GPU objects go
   // before the context.
-  gpu::WebGlContext context_;
+  std::string canvasSelector_;
+  std::unique_ptr<gpu::WebGlContext> context_;  // made again by recoverContext
   std::unique_ptr<ZarrStoreView> zarr_;
   std::unique_ptr<session::Session> session_;
   std::vector<PickedFile> picked_;
