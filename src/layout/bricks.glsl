@@ -80,17 +80,14 @@ uniform vec3 u_layoutLevelShrink[BRICKS_LEVELS];  // 1 / s_l per level (see abov
 
 // Level-l voxels per level-0 voxel along each axis: x_l = x0 * this.
 vec3 layoutLevelShrink(float level) {
-#if TESSERA_GLSL == 300
-  return u_layoutLevelShrink[int(level)];
-#else
   // GLSL ES 1.00 (Appendix A) indexes uniforms by constant-index expressions
-  // only: the loop's index is one.
+  // only, the loop's index being one (the conformance test holds ES 3.00
+  // shaders to the same rule).
   vec3 s = u_layoutLevelShrink[0];
-  for (int i = 1; i < BRICKS_LEVELS; ++i) {
+  for (int i = 1; i < BRICKS_LEVELS; i++) {
     if (float(i) == level) s = u_layoutLevelShrink[i];
   }
   return s;
-#endif
 }
 
 #if TESSERA_GLSL != 300
