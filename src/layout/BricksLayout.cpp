@@ -164,26 +164,6 @@ AtlasShape atlasFor(const gpu::DeviceLimits& limits, int stored, std::uint64_t a
   return a;
 }
 
-// The page table and bricks.glsl map level l to level 0 by 2^l on every
-// axis. A pyramid that keeps an axis (microscopy's (1, 2, 2) scales) would be
-// drawn stretched: it is refused, naming the level and the axis, until the
-// layout takes each level's own factors.
-void refuseUnlessHalving(const lod::MultiresSource& source, const std::vector<glm::ivec3>& levels) {
-  const char* axes = "xyz";
-  for (std::size_t l = 1; l < levels.size(); ++l) {
-    const glm::ivec3 prev = levels[l - 1], cur = levels[l];
-    for (int a = 0; a < 3; ++a) {
-      if (cur[a] == (prev[a] + 1) / 2 || cur[a] == prev[a] / 2) continue;
-      throw InputError(source.describe() + ": level " + std::to_string(l) + " (" + dimsText(cur) +
-                       ") does not halve level " + std::to_string(l - 1) + " (" + dimsText(prev) +
-                       ") along " + axes[a] +
-                       "; the bricks layout streams only pyramids that halve every axis per "
-                       "level. Render it in core (--layout texture3d, or --region for a part) "
-                       "or rewrite it with `tessera convert`, which writes a factor-2 pyramid");
-    }
-  }
-}
-
 // How values are kept, for the plan.
 std::string storedNote(const Volume& shape) {
   const lod::StoredMapping m = lod::StoredMapping::of(shape);
@@ -283,11 +263,12 @@ std::unique_ptr<BricksLayout> BricksLayout::create(
   const glm::ivec3 chunk = source->levelInfo(0).chunk;
   std::vector<glm::ivec3> levels;
   for (int lv = 0; lv < source->levelCount(); ++lv) levels.push_back(source->levelInfo(lv).dims);
-  refuseUnlessHalving(*source, levels);
-  l->plan_ = planFor(source->shape(), limits, options, chunk, levels);
-  if (!l->plan_.fits) throw GpuError("bricks layout: " + l->plan_.reason);
+  // Each level's own factor per axis (InputError naming the level and axis
+  // where a level is no integer reduction of the one before).
   const int b = brickSizeFor(options, chunk);
   l->grid_ = lod::BrickGrid::of(*source, b);
+  l->plan_ = planFor(source->shape(), limits, options, chunk, levels);
+  if (!l->plan_.fits) throw GpuError("bricks layout: " + l->plan_.reason);
   const int stored = l->grid_.stored();
   const std::uint64_t pageBytes = l->plan_.textures.back().bytes;
   const std::uint64_t avail = atlasCap(limits, options, pageBytes);
@@ -449,7 +430,9 @@ std::optional<lod::BrickRange> BricksLayout::subtreeBound(const lod::BrickKey& k
     if (auto r = streamer_->range(k)) {
       if (k.level == 0) return r;
       if (!mean) return std::nullopt;
-      return lod::meanPyramidBound(*r, k.level, m.maxStored());
+      std::vector<int> fanIns;  // from k's level down to level 1
+      for (int l = k.level; l >= 1; --l) fanIns.push_back(grid_.fanIn(l));
+      return lod::meanPyramidBound(*r, fanIns, m.maxStored());
     }
   }
   return std::nullopt;
@@ -629,7 +612,7 @@ BricksLayout::Lookup BricksLayout::lookup(glm::dvec3 x0) const {
     return out;
   }
   out.level = e[3];
-  const double shrink = std::ldexp(1.0, -out.level);
+  const glm::dvec3 shrink = 1.0 / glm::dvec3(grid_.scale(out.level));
   const glm::dvec3 brick = glm::floor(cell * shrink + 0.001);
   const glm::dvec3 local = glm::clamp(x0 * shrink - brick * b, 0.0, b) + 1.0;
   const bool es3 = mosaic_.tilesX == 0;
@@ -694,13 +677,16 @@ ValueBlocks BricksLayout::valueBlocks(int blockSize) const {
 
 gpu::ShaderPart BricksLayout::glsl() const {
   gpu::ShaderPart part = gpu::embeddedShaderPart("layout/bricks.glsl");
-  // The number of ES 2 atlas samplers and the atlas' texel format must be
-  // compile-time constants; they replace the file's first two lines,
-  // comments, so line numbers stay.
+  // The number of ES 2 atlas samplers, the atlas' texel format and the
+  // number of levels (the size of a uniform array) must be compile-time
+  // constants; they replace the file's first three lines, comments, so line
+  // numbers stay.
   const std::size_t second = part.text.find('\n') + 1;
-  part.text.replace(0, part.text.find('\n', second),
+  const std::size_t third = part.text.find('\n', second) + 1;
+  part.text.replace(0, part.text.find('\n', third),
                     "#define BRICKS_ATLASES " + std::to_string(atlases_.size()) +
-                        "\n#define BRICKS_TEXEL " + std::to_string(atlasTexel_));
+                        "\n#define BRICKS_TEXEL " + std::to_string(atlasTexel_) +
+                        "\n#define BRICKS_LEVELS " + std::to_string(grid_.levelCount()));
   return part;
 }
 
@@ -721,6 +707,10 @@ int BricksLayout::bind(const gpu::Program& program, int firstUnit) const {
   program.set("u_layoutPagesInv", glm::vec2(1.0f / static_cast<float>(cells.x),
                                             1.0f / static_cast<float>(cells.y * cells.z)));
   program.set("u_layoutAtlasTexels", glm::vec3(atlasTexels_));
+  for (int l = 0; l < grid_.levelCount(); ++l) {
+    const std::string name = numbered("u_layoutLevelShrink[", l, "]");
+    program.set(name.c_str(), 1.0f / glm::vec3(grid_.scale(l)));
+  }
   if (mosaic_.tilesX > 0) {
     program.set("u_layoutTilesX", static_cast<float>(mosaic_.tilesX));
     program.set("u_layoutMosaicInv", glm::vec2(1.0f / static_cast<float>(mosaic_.width()),

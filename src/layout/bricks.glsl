@@ -1,5 +1,6 @@
 // Line 1 is replaced by "#define BRICKS_ATLASES <N>" (BricksLayout::glsl()),
-// line 2 by "#define BRICKS_TEXEL <T>": how a stored value is read (below).
+// line 2 by "#define BRICKS_TEXEL <T>": how a stored value is read (below),
+// line 3 by "#define BRICKS_LEVELS <L>": the pyramid's levels.
 // sampleVolume for BricksLayout: bricks of several resolution levels in one
 // atlas, found through a page table (Schultz 2016 §7.3; the page-table
 // scheme of ImageVis3D and Neuroglancer). Valid GLSL ES 1.00 and 3.00.
@@ -9,9 +10,11 @@
 // level l of the finest resident brick that covers the cell (the CPU falls
 // back to coarser levels when finer bricks are missing, so there are no
 // holes), or a = 255 when the cell is known to be transparent, with r the
-// constant stored value to return. The brick of level l covering cell c is
-// floor(c / 2^l); a level-l voxel spans 2^l level-0 voxels, so the level-0
-// coordinate x0 is x0 / 2^l there. The slot stores (B + 2)^3 voxels, the
+// constant stored value to return. A level-l voxel spans s_l level-0 voxels
+// per axis (lod::BrickGrid::scale: 2^l on every axis in a factor-2 pyramid,
+// (1, 2^l, 2^l) in one that keeps z), so the level-0 coordinate x0 is
+// x0 / s_l there (layoutLevelShrink) and the brick of level l covering cell
+// c is floor(c / s_l). The slot stores (B + 2)^3 voxels, the
 // brick and a one-voxel apron, so the hardware filter inside the slot is the
 // trilinear interpolation of the level: no seams between bricks.
 //
@@ -73,6 +76,19 @@ uniform float u_layoutBrick;       // B
 uniform vec3 u_layoutCells;        // level-0 brick cells
 uniform vec2 u_layoutPagesInv;     // 1 / page table size
 uniform vec3 u_layoutAtlasTexels;  // atlas (3D) size in texels
+uniform vec3 u_layoutLevelShrink[BRICKS_LEVELS];  // 1 / s_l per level (see above)
+
+// Level-l voxels per level-0 voxel along each axis: x_l = x0 * this.
+vec3 layoutLevelShrink(float level) {
+  // GLSL ES 1.00 (Appendix A) indexes uniforms by constant-index expressions
+  // only, the loop's index being one (the conformance test holds ES 3.00
+  // shaders to the same rule).
+  vec3 s = u_layoutLevelShrink[0];
+  for (int i = 1; i < BRICKS_LEVELS; i++) {
+    if (float(i) == level) s = u_layoutLevelShrink[i];
+  }
+  return s;
+}
 
 #if TESSERA_GLSL != 300
 // Slice z of atlas texture t (samplers take constant indices only in GLSL
@@ -150,15 +166,14 @@ BrickPage brickPage(vec3 x0) {
   b.constant = (e.r + 256.0 * e.g) / 65535.0;
 #endif
   float level = e.a * (1.0 - b.isConstant);  // a constant cell reads slot 0 and is replaced
+  vec3 shrink = layoutLevelShrink(level);  // 1 / s_l per axis
 #if TESSERA_GLSL == 300
-  float shrink = 1.0 / float(1 << int(level));
   vec3 slot = e.rgb * (1.0 - b.isConstant);
 #else
-  float shrink = exp2(-level);
   vec3 slot = vec3(0.0, 0.0, e.b * (1.0 - b.isConstant));
 #endif
   b.atlas = e.r * (1.0 - b.isConstant);
-  vec3 brick = floor(cell * shrink + 0.001);  // c >> l (the +0.001 guards exp2 rounding)
+  vec3 brick = floor(cell * shrink + 0.001);  // c / s_l (the +0.001 guards 1 / s_l's rounding)
   // Level-l coordinate x0 * shrink, local to the brick, + 1 for the apron.
   b.lo = slot * (u_layoutBrick + 2.0) + 1.0;
   b.hi = b.lo + u_layoutBrick;

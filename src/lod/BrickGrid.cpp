@@ -4,20 +4,49 @@
 #include <cmath>
 
 #include "tessera/core/Error.h"
+#include "tessera/lod/LevelScale.h"
 
 namespace tessera::lod {
 
+namespace {
+
+std::vector<glm::ivec3> factorsOfDims(const std::vector<glm::ivec3>& dims) {
+  std::vector<LevelInfo> levels;
+  for (glm::ivec3 d : dims) levels.push_back({.dims = d, .spacing = glm::vec3(0.0f), .chunk = {}});
+  return levelFactors(levels, "brick grid");
+}
+
+}  // namespace
+
 BrickGrid::BrickGrid(std::vector<glm::ivec3> levelDims, int brickSize)
-    : brickSize_(brickSize), dims_(std::move(levelDims)) {
+    : BrickGrid(levelDims, factorsOfDims(levelDims), brickSize) {}
+
+BrickGrid::BrickGrid(std::vector<glm::ivec3> levelDims, std::vector<glm::ivec3> levelFactors,
+                     int brickSize)
+    : brickSize_(brickSize),
+      dims_(std::move(levelDims)),
+      factors_(std::move(levelFactors)),
+      scales_(levelScales(factors_)) {
   if (brickSize < 2) throw InputError("brick size must be >= 2, got " + std::to_string(brickSize));
   if (dims_.empty()) throw Error("a brick grid needs at least one level");
+  if (factors_.size() != dims_.size()) throw Error("a brick grid needs one factor per level");
   for (glm::ivec3 d : dims_) bricks_.push_back((d + brickSize - 1) / brickSize);
 }
 
 BrickGrid BrickGrid::of(const MultiresSource& source, int brickSize) {
   std::vector<glm::ivec3> dims;
   for (int l = 0; l < source.levelCount(); ++l) dims.push_back(source.levelInfo(l).dims);
-  return BrickGrid(std::move(dims), brickSize);
+  return BrickGrid(std::move(dims), levelFactors(source), brickSize);
+}
+
+int BrickGrid::fanIn(int level) const {
+  const glm::ivec3 f = factor(level);
+  return f.x * f.y * f.z;
+}
+
+BrickKey BrickGrid::parent(const BrickKey& key) const {
+  if (key.level + 1 >= levelCount()) return {key.level + 1, key.brick};
+  return {key.level + 1, key.brick / factor(key.level + 1)};
 }
 
 std::uint64_t BrickGrid::brickCount(int level) const {
@@ -40,21 +69,22 @@ VoxelBox BrickGrid::readBox(const BrickKey& key) const {
 }
 
 glm::dvec3 BrickGrid::lowerCorner(const BrickKey& key) const {
-  return glm::dvec3(key.brick * brickSize_) * std::ldexp(1.0, key.level);
+  return glm::dvec3(key.brick * brickSize_) * glm::dvec3(scale(key.level));
 }
 
 glm::dvec3 BrickGrid::upperCorner(const BrickKey& key) const {
-  return glm::min(glm::dvec3((key.brick + 1) * brickSize_) * std::ldexp(1.0, key.level),
+  return glm::min(glm::dvec3((key.brick + 1) * brickSize_) * glm::dvec3(scale(key.level)),
                   glm::dvec3(dims(0)));
 }
 
 std::vector<BrickKey> BrickGrid::children(const BrickKey& key) const {
   std::vector<BrickKey> out;
   if (key.level == 0) return out;
-  for (int dz = 0; dz < 2; ++dz) {
-    for (int dy = 0; dy < 2; ++dy) {
-      for (int dx = 0; dx < 2; ++dx) {
-        const BrickKey c{key.level - 1, key.brick * 2 + glm::ivec3(dx, dy, dz)};
+  const glm::ivec3 f = factor(key.level);
+  for (int dz = 0; dz < f.z; ++dz) {
+    for (int dy = 0; dy < f.y; ++dy) {
+      for (int dx = 0; dx < f.x; ++dx) {
+        const BrickKey c{key.level - 1, key.brick * f + glm::ivec3(dx, dy, dz)};
         if (contains(c)) out.push_back(c);
       }
     }

@@ -107,14 +107,20 @@ std::shared_ptr<const StoredBrick> BrickStreamer::find(const BrickKey& key) {
   return it->second->second;
 }
 
-BrickRange meanPyramidBound(BrickRange ancestor, int levelsUp, int maxStored) {
+BrickRange meanPyramidBound(BrickRange ancestor, const std::vector<int>& fanIns, int maxStored) {
   const double top = maxStored;
   double lo = ancestor.min, hi = ancestor.max;
-  for (int i = 0; i < levelsUp && (lo > 0.0 || hi < top); ++i) {
-    lo = std::max(0.0, 8.0 * (lo - 1.0) - 7.0 * top);
-    hi = std::min(top, 8.0 * (hi + 1.0));
+  for (std::size_t i = 0; i < fanIns.size() && (lo > 0.0 || hi < top); ++i) {
+    const double n = fanIns[i];
+    lo = std::max(0.0, n * (lo - 1.0) - (n - 1.0) * top);
+    hi = std::min(top, n * (hi + 1.0));
   }
   return {static_cast<std::uint16_t>(lo), static_cast<std::uint16_t>(hi)};
+}
+
+BrickRange meanPyramidBound(BrickRange ancestor, int levelsUp, int maxStored) {
+  return meanPyramidBound(ancestor, std::vector<int>(static_cast<std::size_t>(levelsUp), 8),
+                          maxStored);
 }
 
 std::optional<BrickRange> BrickStreamer::range(const BrickKey& key) const {

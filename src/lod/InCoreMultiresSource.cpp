@@ -17,10 +17,18 @@ std::string boxText(const VoxelBox& b) {
 }
 }  // namespace
 
-std::vector<glm::ivec3> pyramidDims(glm::ivec3 dims, int coarsestSide) {
+std::vector<glm::ivec3> pyramidDims(glm::ivec3 dims, int coarsestSide, glm::ivec3 factor) {
+  if (glm::any(glm::lessThan(factor, glm::ivec3(1)))) {
+    throw InputError("pyramid factors must be >= 1");
+  }
   std::vector<glm::ivec3> out{dims};
-  while (std::max({out.back().x, out.back().y, out.back().z}) > std::max(1, coarsestSide)) {
-    out.push_back((out.back() + 1) / 2);
+  auto longestReduced = [&](glm::ivec3 d) {
+    int m = 0;
+    for (int a = 0; a < 3; ++a) m = factor[a] > 1 ? std::max(m, d[a]) : m;
+    return m;
+  };
+  while (longestReduced(out.back()) > std::max(1, coarsestSide)) {
+    out.push_back((out.back() + factor - 1) / factor);
   }
   return out;
 }
@@ -51,12 +59,13 @@ Volume copyBox(const Volume& volume, const VoxelBox& box) {
   return out;
 }
 
-InCoreMultiresSource::InCoreMultiresSource(std::shared_ptr<const Volume> volume, int coarsestSide) {
+InCoreMultiresSource::InCoreMultiresSource(std::shared_ptr<const Volume> volume, int coarsestSide,
+                                           glm::ivec3 factor) {
   if (!volume || !volume->hasData()) throw Error("InCoreMultiresSource: no voxels");
   levels_.push_back(volume);
-  const std::vector<glm::ivec3> dims = pyramidDims(volume->dims(), coarsestSide);
+  const std::vector<glm::ivec3> dims = pyramidDims(volume->dims(), coarsestSide, factor);
   for (std::size_t l = 1; l < dims.size(); ++l) {
-    levels_.push_back(std::make_shared<const Volume>(downsample(*levels_.back(), glm::ivec3(2))));
+    levels_.push_back(std::make_shared<const Volume>(downsample(*levels_.back(), factor)));
   }
   shape_ = Volume::shapeOnly(volume->dims(), volume->type());
   shape_.setSpacing(volume->spacing());

@@ -15,10 +15,12 @@ double brickDistance(const BrickGrid& grid, const BrickKey& key, const LodView& 
 
 namespace {
 
-// How many pixels one voxel of the brick's level covers at its nearest point.
+// How many pixels one voxel of the brick's level covers at its nearest point:
+// its longest world extent (a level that keeps z, (1, 2, 2), has voxels as
+// deep as level 0's and twice as wide; the widest side decides).
 double pixelsPerVoxel(const BrickGrid& grid, const BrickKey& key, const LodView& view) {
-  const double voxel =
-      std::ldexp(std::max({view.spacing.x, view.spacing.y, view.spacing.z}), key.level);
+  const glm::dvec3 extent = view.spacing * glm::dvec3(grid.scale(key.level));
+  const double voxel = std::max({extent.x, extent.y, extent.z});
   const double pixel = view.orthographic
                            ? view.pixelSize
                            : view.pixelSize * std::max(brickDistance(grid, key, view), 1e-9);

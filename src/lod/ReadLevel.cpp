@@ -2,6 +2,7 @@
 
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/lod/LevelScale.h"
 
 namespace tessera::lod {
 
@@ -36,10 +37,10 @@ Volume readLevel(const MultiresSource& source, int level) {
                              describeLevel(source, level) + " of " + source.describe());
   const Volume& shape = source.shape();
   Volume out = source.readBox(level, {glm::ivec3(0), source.levelInfo(level).dims});
-  const double factor = static_cast<double>(1 << level);
-  out.setSpacing(shape.spacing() * factor);
+  const glm::dvec3 scale(levelScale(source, level));
+  out.setSpacing(shape.spacing() * scale);
   out.setDirection(shape.direction());
-  out.setOrigin(shape.worldOf(glm::dvec3(0.5 * (factor - 1.0))));
+  out.setOrigin(shape.worldOf(0.5 * (scale - 1.0)));
   out.setGeometrySource(shape.geometrySource());
   if (shape.hasWindow()) out.setWindow(shape.window());
   out.setDescription(shape.description() + " level " + std::to_string(level));

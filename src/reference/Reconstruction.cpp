@@ -1,5 +1,7 @@
 #include "tessera/reference/Reconstruction.h"
 
+#include <algorithm>
+
 #include <glm/common.hpp>
 
 namespace tessera {
@@ -43,13 +45,17 @@ double NearestReconstruction::value(glm::dvec3 p) const {
   return at(i.x, i.y, i.z);
 }
 
-PyramidLevelReconstruction::PyramidLevelReconstruction(const Volume& level, int levelIndex,
+PyramidLevelReconstruction::PyramidLevelReconstruction(const Volume& level, glm::ivec3 scale,
                                                        glm::ivec3 finestDims, bool nearest)
     : values_(level),
-      level_(levelIndex),
+      levelScale_(scale),
       finest_(finestDims),
-      scale_(glm::dvec3(finestDims) / (glm::dvec3(level.dims()) * double(1 << levelIndex))),
+      scale_(glm::dvec3(finestDims) / (glm::dvec3(level.dims()) * glm::dvec3(scale))),
       nearest_(nearest) {}
+
+int PyramidLevelReconstruction::supportVoxels() const {
+  return std::max({levelScale_.x, levelScale_.y, levelScale_.z});
+}
 
 double PyramidLevelReconstruction::value(glm::dvec3 p) const {
   p = glm::clamp(p, 0.0, 1.0);

@@ -9,6 +9,7 @@
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/Timing.h"
 #include "tessera/layout/StreamingLayout.h"
+#include "tessera/lod/LevelScale.h"
 #include "tessera/lod/ReadLevel.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
@@ -220,10 +221,11 @@ layout::ReferenceField streamedField(const lod::MultiresSource& pyramid, const V
   layout::ReferenceField field;
   field.box = &volume;
   if (level == 0 && volume.hasData()) {
-    field.field = std::make_shared<PyramidLevelReconstruction>(volume, 0, finest, nearest);
+    field.field =
+        std::make_shared<PyramidLevelReconstruction>(volume, glm::ivec3(1), finest, nearest);
   } else {
-    field.field = std::make_shared<PyramidLevelReconstruction>(lod::readLevel(pyramid, level),
-                                                               level, finest, nearest);
+    field.field = std::make_shared<PyramidLevelReconstruction>(
+        lod::readLevel(pyramid, level), lod::levelScale(pyramid, level), finest, nearest);
   }
   return field;
 }

@@ -308,22 +308,25 @@ TEST(BricksRender, ASmallBrightFindingUnderDimCoarseBricksIsReadAndShown) {
   EXPECT_LT(s.bricksRead, 585u / 2);
 }
 
-// A microscopy pyramid that keeps z ((1, 2, 2) scales): the bricks layout
-// maps every level by 2^l on all axes and would draw it stretched, so it is
-// refused, naming the level and the axis.
-TEST(BricksRender, APyramidThatKeepsAnAxisIsRefusedNamingTheLevelAndAxis) {
-  class KeepsZ final : public lod::MultiresSource {
+// A pyramid whose level is no integer reduction of the one before (64 -> 40
+// along y) has no place for its voxels over level 0's box: refused, naming
+// the level and the axis. (A level that keeps an axis, microscopy's
+// (1, 2, 2), is drawn: BricksAnisotropicPyramidTest.cpp.)
+TEST(BricksRender, APyramidWhoseLevelIsNoIntegerReductionIsRefusedNamingTheLevelAndAxis) {
+  class OddY final : public lod::MultiresSource {
    public:
-    KeepsZ() : shape_(Volume::shapeOnly({64, 64, 16}, ScalarType::U8)) {}
+    OddY() : shape_(Volume::shapeOnly({64, 64, 16}, ScalarType::U8)) {}
     const Volume& shape() const override { return shape_; }
-    int levelCount() const override { return 3; }
+    int levelCount() const override { return 2; }
     lod::LevelInfo levelInfo(int level) const override {
-      return {.dims = {64 >> level, 64 >> level, 16}, .spacing = glm::vec3(1.0f), .chunk = {}};
+      return {.dims = level == 0 ? glm::ivec3(64, 64, 16) : glm::ivec3(32, 40, 16),
+              .spacing = glm::vec3(1.0f),
+              .chunk = {}};
     }
     Volume readBox(int, const lod::VoxelBox& box) const override {
       return Volume::allocate(box.size(), ScalarType::U8);
     }
-    std::string describe() const override { return "keeps-z.ome.zarr"; }
+    std::string describe() const override { return "odd-y.ome.zarr"; }
 
    private:
     Volume shape_;
@@ -331,12 +334,12 @@ TEST(BricksRender, APyramidThatKeepsAnAxisIsRefusedNamingTheLevelAndAxis) {
   gpu::GlContext& c = test::gpuContext();
   const gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());
   try {
-    layout::BricksLayout::create(std::make_shared<KeepsZ>(), limits, c.ledger(), smallBricks(16));
-    ADD_FAILURE() << "a (1, 2, 2) pyramid was accepted";
+    layout::BricksLayout::create(std::make_shared<OddY>(), limits, c.ledger(), smallBricks(16));
+    ADD_FAILURE() << "a level of 64 -> 40 voxels was accepted";
   } catch (const InputError& e) {
     const std::string m = e.what();
-    EXPECT_NE(m.find("keeps-z.ome.zarr: level 1 (32x32x16) does not halve level 0 (64x64x16) "
-                     "along z"),
+    EXPECT_NE(m.find("odd-y.ome.zarr: level 1 (32x40x16) does not reduce level 0 (64x64x16) by "
+                     "an integer factor along y"),
               std::string::npos)
         << m;
     EXPECT_NE(m.find("--layout texture3d"), std::string::npos) << m;

@@ -38,7 +38,7 @@ TEST(PyramidLevelField, EveryLevelOfALinearFieldReconstructsItWhereItsBlocksAreW
   const TrilinearReconstruction finest(*volume);
   for (int l = 0; l < source.levelCount(); ++l) {
     SCOPED_TRACE(l);
-    const PyramidLevelReconstruction field(lod::readLevel(source, l), l, d);
+    const PyramidLevelReconstruction field(lod::readLevel(source, l), glm::ivec3(1 << l), d);
     EXPECT_EQ(field.dims(), d);
     const double f = double(1 << l);
     // Level-0 index x: inside the first and the last whole block's centres
@@ -68,13 +68,13 @@ TEST(PyramidLevelField, LevelZeroIsTheTrilinearFieldAndOutsideTheBoxIsClamped) {
   const glm::ivec3 d{13, 9, 7};
   const auto volume = linear(d);
   const TrilinearReconstruction trilinear(*volume);
-  const PyramidLevelReconstruction field(*volume, 0, d);
+  const PyramidLevelReconstruction field(*volume, glm::ivec3(1), d);
   for (double t : {-0.2, 0.0, 0.013, 0.31, 0.5, 0.77, 0.999, 1.0, 1.3}) {
     const glm::dvec3 p(t, 1.0 - t, 0.5 * t);
     EXPECT_NEAR(field.value(p), trilinear.value(p), 1e-9) << t;
   }
   // With nearest, every point of a voxel's cell reads its value.
-  const PyramidLevelReconstruction nearest(*volume, 0, d, true);
+  const PyramidLevelReconstruction nearest(*volume, glm::ivec3(1), d, true);
   const NearestReconstruction cells(*volume);
   for (double t : {0.01, 0.2, 0.49, 0.51, 0.93}) {
     const glm::dvec3 p(t, 0.7 * t, 1.0 - t);

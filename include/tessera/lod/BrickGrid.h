@@ -4,8 +4,11 @@
 // axis may be partial); each brick is stored with a one-voxel apron of its
 // neighbours' voxels (replicated at the volume's faces), (B + 2)^3 voxels in
 // all, so trilinear interpolation anywhere inside the brick reads only the
-// brick and the bricked volume shows no seams. Brick (l, b) covers level-0
-// voxels [b B 2^l, (b + 1) B 2^l); its parent is (l + 1, b / 2).
+// brick and the bricked volume shows no seams. Each level keeps or divides
+// each axis of the one before by its own factor f_l (lod/LevelScale.h: 2 per
+// axis in a factor-2 pyramid, (1, 2, 2) where z is kept), so brick (l, b)
+// covers level-0 voxels [b B s_l, (b + 1) B s_l) per axis, s_l the product of
+// the factors up to l; its parent is (l + 1, b / f_(l+1)).
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -30,7 +33,12 @@ struct BrickKey {
 class BrickGrid {
  public:
   BrickGrid() = default;
+  // The factors from the dims alone (lod::levelFactors; 2 where an axis of
+  // one voxel leaves it open).
   BrickGrid(std::vector<glm::ivec3> levelDims, int brickSize);
+  // `levelFactors`: per level, what lod::levelFactors gives (level 0's is 1).
+  BrickGrid(std::vector<glm::ivec3> levelDims, std::vector<glm::ivec3> levelFactors, int brickSize);
+  // The source's level dims and factors (InputError as lod::levelFactors).
   static BrickGrid of(const MultiresSource& source, int brickSize);
 
   int brickSize() const { return brickSize_; }
@@ -41,6 +49,13 @@ class BrickGrid {
   int levelCount() const { return static_cast<int>(dims_.size()); }
   glm::ivec3 dims(int level) const { return dims_[static_cast<std::size_t>(level)]; }
   glm::ivec3 bricks(int level) const { return bricks_[static_cast<std::size_t>(level)]; }
+  // Level-(l - 1) voxels per level-l voxel along each axis (1 at level 0).
+  glm::ivec3 factor(int level) const { return factors_[static_cast<std::size_t>(level)]; }
+  // Level-0 voxels per level-l voxel along each axis.
+  glm::ivec3 scale(int level) const { return scales_[static_cast<std::size_t>(level)]; }
+  // The level-(l - 1) voxels a level-l voxel averages in a mean pyramid (8
+  // for a factor of 2 on every axis, 4 for (1, 2, 2)); 1 at level 0.
+  int fanIn(int level) const;
   std::uint64_t brickCount(int level) const;
   bool contains(const BrickKey& key) const;
 
@@ -50,16 +65,19 @@ class BrickGrid {
   // Level-0 continuous voxel coordinates of the region the brick covers.
   glm::dvec3 lowerCorner(const BrickKey& key) const;
   glm::dvec3 upperCorner(const BrickKey& key) const;
-  BrickKey parent(const BrickKey& key) const { return {key.level + 1, key.brick / 2}; }
+  // Past the coarsest level: {levelCount(), brick}, which contains() refuses.
+  BrickKey parent(const BrickKey& key) const;
   // The existing children at key.level - 1 (none at level 0).
   std::vector<BrickKey> children(const BrickKey& key) const;
   // The brick of `level` that covers level-0 brick cell `cell`.
-  BrickKey ancestorOf(glm::ivec3 cell, int level) const { return {level, cell >> level}; }
+  BrickKey ancestorOf(glm::ivec3 cell, int level) const { return {level, cell / scale(level)}; }
 
  private:
   int brickSize_ = 32;
   std::vector<glm::ivec3> dims_;
   std::vector<glm::ivec3> bricks_;
+  std::vector<glm::ivec3> factors_;
+  std::vector<glm::ivec3> scales_;
 };
 
 // How raw values are stored in bricks: in 8 bits for u8 volumes (as they

@@ -53,15 +53,19 @@ struct BrickRange {  // in stored units (StoredMapping)
   std::uint16_t max = 0;
 };
 
-// What a brick `levelsUp` levels above tells of the stored values (0..M,
-// M = maxStored, 0 = the smallest the mapping stores) of the bricks under
-// it, in a mean pyramid (MultiresSource::meanPyramid()) stored exactly
-// (StoredMapping::exact): a coarse voxel m is the mean of n <= 8 finer
-// ones, none below 0 or above M, so each of them lies in [8m - 7M, 8m];
-// rounding of the stored means adds one either way. The bound widens
-// eightfold a level; it is tight where it matters, over empty space (a
-// coarse maximum of 0 bounds every finer voxel at 8), and a lone bright
+// What a brick tells of the stored values (0..M, M = maxStored, 0 = the
+// smallest the mapping stores) of the bricks under it, in a mean pyramid
+// (MultiresSource::meanPyramid()) stored exactly (StoredMapping::exact): a
+// coarse voxel m is the mean of at most n finer ones (n = the level's
+// BrickGrid::fanIn: 8 for factors (2, 2, 2), 4 for (1, 2, 2)), none below 0
+// or above M, so each of them lies in [n m - (n - 1) M, n m]; rounding of
+// the stored means adds one either way. `fanIns`: n of each level from the
+// brick's down to the bricks bounded (the brick's own first). The bound
+// widens n-fold a level; it is tight where it matters, over empty space (a
+// coarse maximum of 0 bounds every finer voxel at n), and a lone bright
 // voxel averaged into a dim coarse one is never bounded away.
+BrickRange meanPyramidBound(BrickRange ancestor, const std::vector<int>& fanIns, int maxStored);
+// The same `levelsUp` levels down a factor-2 pyramid (n = 8 a level).
 BrickRange meanPyramidBound(BrickRange ancestor, int levelsUp, int maxStored);
 
 struct StreamerStats {

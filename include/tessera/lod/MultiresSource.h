@@ -1,8 +1,10 @@
 #pragma once
 // A multiresolution volume that is never held whole: a pyramid of levels,
 // each readable one box at a time (Schultz 2016 section 7.1.2 and 7.3;
-// DESIGN.md "Large data"). Level 0 is the finest; level l+1 halves each
-// axis (rounded up) of level l. A chunked store on disk or over HTTP
+// DESIGN.md "Large data"). Level 0 is the finest; level l+1 divides each
+// axis of level l by an integer factor, its dims rounded up or down: 2 on
+// every axis (tessera convert), or 1 on an axis it keeps (microscopy's
+// (1, 2, 2) scales keep z; lod/LevelScale.h). A chunked store on disk or over HTTP
 // (OME-Zarr) implements it with bounded reads; an in-core volume implements
 // it by downsampling on request. The bricked layout and the streaming
 // scheduler read through this interface only, so they do not know where

@@ -19,14 +19,16 @@ std::string describeLevel(const MultiresSource& source, int level);
 // Level `level` read whole (readBox over its dims), after its bytes are
 // checked against the host budget (BudgetError naming the level, its size
 // and the budget). Its geometry is where lod::BrickGrid and bricks.glsl put
-// it, whatever the store's metadata says: level-l voxel i covers level-0
-// voxels [i 2^l, (i + 1) 2^l), so its centre lies at level-0 index
-// (i + 0.5) 2^l - 0.5: spacing 2^l times level 0's, level 0's direction,
-// the origin (2^l - 1) / 2 level-0 voxels in (lod::downsample's placement).
-// The level's box reaches past level 0's by up to 2^l - 1 level-0 voxels
-// where 2^l does not divide the dims; the bricks layout clamps to level 0's
-// box (reference::PyramidLevelReconstruction does the same). InputError for
-// a level outside 0..levelCount() - 1.
+// it, whatever the store's metadata says: with s = lod::levelScale(source,
+// level) per axis (2^l in a factor-2 pyramid, (1, 2^l, 2^l) where z is
+// kept), level-l voxel i covers level-0 voxels [i s, (i + 1) s), so its
+// centre lies at level-0 index (i + 0.5) s - 0.5: spacing s times level 0's,
+// level 0's direction, the origin (s - 1) / 2 level-0 voxels in
+// (lod::downsample's placement). The level's box reaches past level 0's by
+// up to s - 1 level-0 voxels where s does not divide the dims; the bricks
+// layout clamps to level 0's box (reference::PyramidLevelReconstruction does
+// the same). InputError for a level outside 0..levelCount() - 1, or a
+// pyramid whose levels do not reduce by integer factors.
 Volume readLevel(const MultiresSource& source, int level);
 
 }  // namespace tessera::lod

@@ -66,29 +66,31 @@ class NearestReconstruction final : public GridReconstruction {
   double value(glm::dvec3 p) const override;
 };
 
-// A coarser level of a factor-2 pyramid over the finest level's box, as the
-// bricks layout samples it (layout/bricks.glsl, lod/BrickGrid.h): level-l
-// voxel i covers finest voxels [i 2^l, (i + 1) 2^l), so p (clamped to the
-// box, as the layout clamps it) is level coordinate p finestDims / 2^l, voxel
-// centres at i + 0.5, trilinear with clamp to edge. Where 2^l does not divide
-// the finest dims the level reaches past the box and p = 1 falls short of its
-// last centre. With `nearest`, p first moves to the centre of the finest
-// voxel holding it (render/sample.glsl's fieldValue under NEAREST, which then
-// samples the layout). dims() are the finest: the GPU's central differences
-// step one finest voxel (layout/gradient.glsl). Level 0 is the volume's
-// trilinear (or nearest) field.
+// A coarser level of a pyramid over the finest level's box, as the bricks
+// layout samples it (layout/bricks.glsl, lod/BrickGrid.h): with `scale` the
+// finest voxels per level voxel along each axis (lod::levelScale: 2^l in a
+// factor-2 pyramid, (1, 2^l, 2^l) where z is kept), level voxel i covers
+// finest voxels [i scale, (i + 1) scale), so p (clamped to the box, as the
+// layout clamps it) is level coordinate p finestDims / scale, voxel centres
+// at i + 0.5, trilinear with clamp to edge. Where the scale does not divide
+// the finest dims the level reaches past the box and p = 1 falls short of
+// its last centre. With `nearest`, p first moves to the centre of the finest
+// voxel holding it (render/sample.glsl's fieldValue under NEAREST, which
+// then samples the layout). dims() are the finest: the GPU's central
+// differences step one finest voxel (layout/gradient.glsl). Scale 1 is the
+// volume's trilinear (or nearest) field.
 class PyramidLevelReconstruction final : public Reconstruction {
  public:
-  PyramidLevelReconstruction(const Volume& level, int levelIndex, glm::ivec3 finestDims,
+  PyramidLevelReconstruction(const Volume& level, glm::ivec3 scale, glm::ivec3 finestDims,
                              bool nearest = false);
   double value(glm::dvec3 p) const override;
   glm::ivec3 dims() const override { return finest_; }
-  int supportVoxels() const override { return 1 << level_; }
-  int level() const { return level_; }
+  int supportVoxels() const override;
+  glm::ivec3 scale() const { return levelScale_; }
 
  private:
   TrilinearReconstruction values_;
-  int level_;
+  glm::ivec3 levelScale_;
   glm::ivec3 finest_;
   glm::dvec3 scale_;  // box texture space -> the level's
   bool nearest_;
