@@ -5,7 +5,13 @@
 namespace tessera {
 
 namespace {
-constexpr std::uint64_t kEntryOverhead = 96;  // the key, list and map nodes, roughly
+// A missing chunk (fill_value) costs its key, list and map nodes, roughly;
+// a stored one its bytes (its nodes are under 0.01% of any real chunk), so
+// that a budget of every chunk's bytes holds every chunk.
+constexpr std::uint64_t kEntryOverhead = 96;
+std::uint64_t cost(const ZarrChunkCache::Chunk& chunk) {
+  return std::max<std::uint64_t>(kEntryOverhead, chunk ? chunk->size() : 0);
+}
 }  // namespace
 
 ZarrChunkCache::Chunk ZarrChunkCache::get(const std::string& key, const Decode& decode) {
@@ -53,7 +59,7 @@ void ZarrChunkCache::finish(const std::string& key, const std::shared_ptr<Slot>&
     if (error) {
       entries_.erase(it);  // not remembered: the next read tries again
     } else {
-      it->second.bytes = kEntryOverhead + (chunk ? chunk->size() : 0);
+      it->second.bytes = cost(chunk);
       uses_.push_front(key);
       it->second.use = uses_.begin();
       stats_.heldBytes += it->second.bytes;
