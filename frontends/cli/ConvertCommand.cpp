@@ -30,7 +30,7 @@ struct ConvertOptions {
   int time = 0;  // OME-Zarr input: time point and channel
   int channel = 0;
   // OME-Zarr output.
-  int chunk = 64;
+  std::string chunk = "64";
   std::string levels = "auto";
   std::string compressor = "zstd";
   bool quiet = false;
@@ -120,12 +120,35 @@ std::string dimsText(glm::ivec3 d) {
   return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
 }
 
+// "Z,Y,X" (array order, as NGFF writes chunks): each an even size in
+// 8..1024; returned as x, y, z.
+glm::ivec3 parseChunkShape(const std::string& text) {
+  const std::string what =
+      "--chunk '" + text + "': expected 64, 128 or Z,Y,X (even sizes in 8..1024)";
+  int zyx[3] = {0, 0, 0};
+  std::size_t at = 0;
+  for (int a = 0; a < 3; ++a) {
+    const std::size_t comma = a < 2 ? text.find(',', at) : text.size();
+    if (comma == std::string::npos) throw InputError(what);
+    const std::string part = text.substr(at, comma - at);
+    if (part.empty() || part.size() > 4 ||
+        part.find_first_not_of("0123456789") != std::string::npos)
+      throw InputError(what);
+    zyx[a] = std::stoi(part);
+    if (zyx[a] < 8 || zyx[a] > 1024 || zyx[a] % 2 != 0) throw InputError(what);
+    at = comma + 1;
+  }
+  if (at != text.size() + 1) throw InputError(what);
+  return {zyx[2], zyx[1], zyx[0]};
+}
+
 OmeZarrWriteOptions zarrOptions(const ConvertOptions& o, Progress& progress) {
   OmeZarrWriteOptions z;
-  if (o.chunk != 64 && o.chunk != 128) {
-    throw InputError("--chunk " + std::to_string(o.chunk) + ": expected 64 or 128");
+  if (o.chunk == "64" || o.chunk == "128") {
+    z.chunk = std::stoi(o.chunk);
+  } else {
+    z.chunkShape = parseChunkShape(o.chunk);
   }
-  z.chunk = o.chunk;
   if (o.levels != "auto") {
     try {
       std::size_t used = 0;
@@ -153,10 +176,11 @@ void printZarrResult(const ConvertOptions& o, const Volume& shape, const OmeZarr
   for (std::size_t l = 0; l < r.levelDims.size(); ++l) {
     std::printf("%s%s", l ? ", " : "", dimsText(r.levelDims[l]).c_str());
   }
-  std::printf("), chunks %d^3 %s: %llu written, %llu all-zero skipped, %s\n", o.chunk,
-              o.compressor.c_str(), static_cast<unsigned long long>(r.chunksWritten),
-              static_cast<unsigned long long>(r.chunksSkipped),
-              formatBytes(r.bytesWritten).c_str());
+  std::printf(
+      "), chunks %s %s: %llu written, %llu all-zero skipped, %s\n",
+      (o.chunk.find(',') == std::string::npos ? o.chunk + "^3" : o.chunk + " (z,y,x)").c_str(),
+      o.compressor.c_str(), static_cast<unsigned long long>(r.chunksWritten),
+      static_cast<unsigned long long>(r.chunksSkipped), formatBytes(r.bytesWritten).c_str());
   for (const std::string& note : writeLossNotes(shape, o.out)) {
     std::fprintf(stderr, "note: %s\n", note.c_str());
   }
@@ -245,8 +269,10 @@ void addConvertCommand(CLI::App& app) {
   cmd->add_option("--crop", o->crop, "Keep voxels x0:x1,y0:y1,z0:z1 (end exclusive)");
   cmd->add_option("--downsample", o->downsample, "Box-filter by N or AxBxC");
   addTimeChannelOptions(cmd, o->time, o->channel);
-  cmd->add_option("--chunk", o->chunk, "OME-Zarr output: chunk edge, 64 or 128 voxels")
-      ->default_val(64);
+  cmd->add_option("--chunk", o->chunk,
+                  "OME-Zarr output: chunk edge, 64 or 128 voxels, or Z,Y,X per axis (even, "
+                  "8..1024; e.g. 32,512,512)")
+      ->default_val("64");
   cmd->add_option("--levels", o->levels,
                   "OME-Zarr output: pyramid levels, N or auto (halve until one chunk holds the "
                   "level)")

@@ -132,7 +132,9 @@ double elementValue(const std::byte* p, const ZarrArrayMeta& m) {
 }  // namespace
 
 ZarrStore::ZarrStore(std::shared_ptr<const ZarrStorage> storage, ZarrSelection selection)
-    : storage_(std::move(storage)), selection_(selection) {
+    : storage_(std::move(storage)),
+      selection_(selection),
+      chunks_(std::make_shared<ZarrChunkCache>(0)) {
   const auto attrs = storage_->get(".zattrs", kMaxMetadataBytes);
   const std::string attrsText = attrs ? text(*attrs) : std::string();
   // A metadata field of the wrong JSON type is a bad store, not a crash.
@@ -502,6 +504,35 @@ Volume ZarrStore::readBox(int l, glm::ivec3 begin, glm::ivec3 end, const Progres
   return out;
 }
 
+ZarrChunkCache::Chunk ZarrStore::decodeChunk(const ZarrArrayMeta& m, const std::string& key) const {
+  for (int attempt = 0;; ++attempt) {
+    auto stored = storage_->get(key, m.maxStoredChunkBytes());
+    if (!stored) return nullptr;
+    try {
+      return std::make_shared<const std::vector<std::byte>>(
+          storage_->decodesChunks(m.compressor)
+              ? decodedZarrChunk(m, std::move(*stored), storage_->locate(key))
+              : decodeZarrChunk(m, *stored, storage_->locate(key)));
+    } catch (const InputError&) {
+      // A network may have damaged the body: fetch it again.
+      if (attempt >= storage_->refetches()) throw;
+      storage_->forget(key);
+    }
+  }
+}
+
+std::uint64_t ZarrStore::allChunkBytes() const {
+  std::uint64_t bytes = 0;
+  for (const ZarrLevel& lv : levels_) {
+    std::uint64_t chunks = 1;
+    for (int r = kX; r <= kZ; ++r) {
+      chunks *= std::uint64_t(lv.array.chunkCount(axis_[r]));
+    }
+    bytes += chunks * lv.array.chunkBytes();
+  }
+  return bytes;
+}
+
 std::string ZarrStore::chunkKeyAt(int l, const std::vector<std::int64_t>& spatial) const {
   const ZarrLevel& lv = levels_[std::size_t(l)];
   const ZarrArrayMeta& m = lv.array;
@@ -548,21 +579,7 @@ void ZarrStore::readChunkInto(int l, const std::vector<std::int64_t>& spatial, g
       glm::ivec3(int(spatial[0]), int(spatial[1]), int(spatial[2])) * lv.chunk;
   const glm::ivec3 lo = glm::max(begin, origin);
   const glm::ivec3 hi = glm::min(end, origin + lv.chunk);
-  std::optional<std::vector<std::byte>> raw;
-  for (int attempt = 0;; ++attempt) {
-    const auto stored = storage_->get(key, m.maxStoredChunkBytes());
-    if (!stored) break;
-    try {
-      raw = storage_->decodesChunks(m.compressor)
-                ? decodedZarrChunk(m, std::move(*stored), storage_->locate(key))
-                : decodeZarrChunk(m, *stored, storage_->locate(key));
-      break;
-    } catch (const InputError&) {
-      // A network may have damaged the body: fetch it again.
-      if (attempt >= storage_->refetches()) throw;
-      storage_->forget(key);
-    }
-  }
+  const ZarrChunkCache::Chunk raw = chunks_->get(key, [&] { return decodeChunk(m, key); });
   const std::size_t bpv = bytesPerVoxel(m.target);
   const std::int64_t sx = stride[std::size_t(axis_[kX])];
   const std::int64_t sy = stride[std::size_t(axis_[kY])];

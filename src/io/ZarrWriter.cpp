@@ -88,12 +88,12 @@ class PyramidWriter {
   PyramidWriter(const Volume& shape, const fs::path& root, const OmeZarrWriteOptions& o)
       : type_(shape.type()), root_(root), options_(o) {
     glm::ivec3 d = shape.dims();
-    const int count = o.levels > 0 ? o.levels : omeZarrAutoLevels(d, o.chunk);
+    const int count = o.levels > 0 ? o.levels : omeZarrAutoLevels(d, o.chunkXyz());
     for (int l = 0; l < count; ++l) {
       LevelWriter w;
       w.index = l;
       w.dims = d;
-      w.chunk = glm::min(d, glm::ivec3(o.chunk));
+      w.chunk = glm::min(d, o.chunkXyz());
       w.dir = root / std::to_string(l);
       w.slab = Volume::allocate({d.x, d.y, w.chunk.z}, type_,
                                 "OME-Zarr level " + std::to_string(l) + " slab");
@@ -303,8 +303,12 @@ bool isOmeZarrName(const fs::path& path) {
 }
 
 int omeZarrAutoLevels(glm::ivec3 dims, int chunk) {
+  return omeZarrAutoLevels(dims, glm::ivec3(chunk));
+}
+
+int omeZarrAutoLevels(glm::ivec3 dims, glm::ivec3 chunk) {
   int levels = 1;
-  while (dims.x > chunk || dims.y > chunk || dims.z > chunk) {
+  while (dims.x > chunk.x || dims.y > chunk.y || dims.z > chunk.z) {
     dims = (dims + 1) / 2;
     ++levels;
   }
@@ -313,8 +317,11 @@ int omeZarrAutoLevels(glm::ivec3 dims, int chunk) {
 
 OmeZarrWriteResult writeOmeZarr(const Volume& shape, const SlabReader& slabs, const fs::path& out,
                                 const OmeZarrWriteOptions& o) {
-  if (o.chunk < 8 || o.chunk > 1024 || o.chunk % 2 != 0) {
-    throw InputError("--chunk " + std::to_string(o.chunk) + ": expected an even size in 8..1024");
+  for (int a = 0; a < 3; ++a) {
+    const int c = o.chunkXyz()[a];
+    if (c < 8 || c > 1024 || c % 2 != 0) {
+      throw InputError("--chunk " + std::to_string(c) + ": expected an even size in 8..1024");
+    }
   }
   if (o.levels < 0 || o.levels > 30) {
     throw InputError("--levels " + std::to_string(o.levels) + ": expected auto or 1..30");
@@ -326,7 +333,8 @@ OmeZarrWriteResult writeOmeZarr(const Volume& shape, const SlabReader& slabs, co
   // under 4/3 of the finest) plus the slab being read and its halving.
   const glm::ivec3 d = shape.dims();
   const std::uint64_t slab = std::uint64_t(d.x) * std::uint64_t(d.y) *
-                             std::uint64_t(std::min(d.z, o.chunk)) * bytesPerVoxel(shape.type());
+                             std::uint64_t(std::min(d.z, o.chunkXyz().z)) *
+                             bytesPerVoxel(shape.type());
   HostBudget::global().check(3 * slab, path.string() + ": OME-Zarr slabs of " + dimsText(d));
   std::error_code ec;
   const bool replace = fs::exists(path, ec);

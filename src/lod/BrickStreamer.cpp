@@ -1,6 +1,7 @@
 #include "tessera/lod/BrickStreamer.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -16,6 +17,7 @@ BrickStreamer::BrickStreamer(std::shared_ptr<const MultiresSource> source, Brick
       grid_(std::move(grid)),
       mapping_(StoredMapping::of(source_->shape())),
       options_(options) {
+  for (int l = 0; l < grid_.levelCount(); ++l) chunks_.push_back(source_->levelInfo(l).chunk);
   // Without threads (workers = 0, or a platform that cannot start them, such
   // as the browser build) request() reads a few bricks itself.
   try {
@@ -57,21 +59,49 @@ void BrickStreamer::request(const std::vector<BrickKey>& keys) {
     // Bricks whose reads failed go after every brick not tried yet: a few
     // failing bricks near the eye, each as slow to fail as the source's own
     // retries, would otherwise keep the readers busy and the rest unread.
+    std::vector<BrickKey> fresh;
     std::vector<BrickKey> retries;
     for (const BrickKey& k : keys) {
       const std::uint64_t id = k.id();
       if (cached_.count(id) || reading_.count(id) || !queued.insert(id).second) continue;
       const auto f = failures_.find(id);
       if (f == failures_.end()) {
-        queue_.push_back(k);
+        fresh.push_back(k);
       } else if (f->second.retryAtMs <= now && !givenUp(id)) {
         retries.push_back(k);
       }
     }
+    fresh = groupedByChunk(std::move(fresh));
+    queue_.assign(fresh.begin(), fresh.end());
     queue_.insert(queue_.end(), retries.begin(), retries.end());
   }
   wake_.notify_all();
   if (workers_.empty()) readQueuedInline(options_.inlineReadsPerRequest);
+}
+
+std::vector<BrickKey> BrickStreamer::groupedByChunk(std::vector<BrickKey> keys) const {
+  // The chunk holding the brick's centre; its apron may reach into the
+  // neighbours, which the source's chunk cache keeps meanwhile.
+  const auto chunkOf = [&](const BrickKey& k) {
+    const glm::ivec3 chunk = chunks_[std::size_t(k.level)];
+    const VoxelBox box = grid_.readBox(k);
+    const glm::ivec3 c = (box.begin + box.end) / 2 / chunk;
+    return std::array<int, 4>{k.level, c.z, c.y, c.x};
+  };
+  std::map<std::array<int, 4>, std::size_t> groupOf;
+  std::vector<std::vector<BrickKey>> groups;
+  for (const BrickKey& k : keys) {
+    if (std::size_t(k.level) >= chunks_.size() ||
+        glm::any(glm::lessThanEqual(chunks_[std::size_t(k.level)], glm::ivec3(0)))) {
+      return keys;  // the source reads no chunks: keep the order
+    }
+    const auto [it, added] = groupOf.try_emplace(chunkOf(k), groups.size());
+    if (added) groups.emplace_back();
+    groups[it->second].push_back(k);
+  }
+  keys.clear();
+  for (const std::vector<BrickKey>& g : groups) keys.insert(keys.end(), g.begin(), g.end());
+  return keys;
 }
 
 void BrickStreamer::readQueuedInline(int count) {

@@ -1,5 +1,8 @@
 #include "tessera/lod/ZarrMultiresSource.h"
 
+#include <algorithm>
+
+#include "tessera/core/HostBudget.h"
 #include "tessera/io/ZarrCachedStorage.h"
 
 namespace tessera::lod {
@@ -7,16 +10,23 @@ namespace tessera::lod {
 ZarrMultiresSource::ZarrMultiresSource(std::shared_ptr<const ZarrStore> store)
     : store_(std::move(store)) {}
 
+std::uint64_t ZarrMultiresSource::decodedChunkBudget(const ZarrStore& store,
+                                                     std::uint64_t hostBudget) {
+  return std::min(store.allChunkBytes(), hostBudget / kDecodedChunkShare);
+}
+
 #ifndef __EMSCRIPTEN__
 std::unique_ptr<ZarrMultiresSource> ZarrMultiresSource::open(const std::string& spec,
                                                              ZarrSelection selection) {
   // Bricks read with an apron touch their neighbours' chunks: keep the
   // stored bytes of the last few MiB of chunks (a fixed overhead beside the
-  // host budget's brick cache; compressed, so many chunks).
+  // host budget's brick cache; compressed, so many chunks), for a chunk the
+  // decoded cache let go and a server would be asked for again.
   constexpr std::uint64_t kChunkCacheBytes = 8ull << 20;
   auto storage = std::make_shared<const CachedStorage>(openZarrStorage(spec), kChunkCacheBytes);
-  return std::make_unique<ZarrMultiresSource>(
-      std::make_shared<const ZarrStore>(std::move(storage), selection));
+  auto store = std::make_shared<ZarrStore>(std::move(storage), selection);
+  store->keepDecodedChunks(decodedChunkBudget(*store, HostBudget::global().limitBytes()));
+  return std::make_unique<ZarrMultiresSource>(std::move(store));
 }
 #endif
 

@@ -185,11 +185,33 @@ TEST(ZarrCommand, BricksOverHttpEqualTheFolderAndFetchLessThanTheFinestLevel) {
   EXPECT_LT(fetched, finest);
 }
 
+// Microscopy stores chunk z thinner than y and x: --chunk Z,Y,X.
+TEST(ZarrCommand, ConvertWritesPerAxisChunks) {
+  const TempDir tmp;
+  const auto store = tmp / "m.ome.zarr";
+  const auto r =
+      runCli("convert gen:shepp-logan:100x90x40 " + store.string() + " --chunk 16,32,64 --quiet");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("3 levels (100x90x40, 50x45x20, 25x23x10), chunks 16,32,64 (z,y,x)"),
+            std::string::npos)
+      << r.out;
+  EXPECT_EQ(zarray(store / "0" / ".zarray")["chunks"], nlohmann::json({16, 32, 64}));
+  EXPECT_EQ(zarray(store / "2" / ".zarray")["chunks"], nlohmann::json({10, 23, 25}));
+  const auto back =
+      runCli("convert " + store.string() + " " + (tmp / "b.nrrd").string() + " --quiet");
+  ASSERT_EQ(back.exitCode, 0) << back.err;
+  const tessera::Volume a = tessera::readVolume("gen:shepp-logan:100x90x40");
+  const tessera::Volume b = tessera::readVolume((tmp / "b.nrrd").string());
+  ASSERT_EQ(a.byteSize(), b.byteSize());
+  EXPECT_TRUE(std::equal(a.bytes().begin(), a.bytes().end(), b.bytes().begin()));
+}
+
 TEST(ZarrCommand, BadOptionsAreRefusedBeforeReading) {
   const TempDir tmp;
   const auto out = (tmp / "o.ome.zarr").string();
   for (const std::string args :
-       {"--chunk 32", "--levels 0", "--levels many", "--compressor lzma"}) {
+       {"--chunk 32", "--chunk 32,512", "--chunk 7,512,512", "--chunk 32,512,512,8", "--levels 0",
+        "--levels many", "--compressor lzma"}) {
     const auto r = runCli("convert gen:sphere:16 " + out + " " + args + " --quiet");
     EXPECT_EQ(r.exitCode, 1) << args;
     EXPECT_NE(r.err.find(args.substr(0, args.find(' '))), std::string::npos) << r.err;

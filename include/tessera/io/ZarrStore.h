@@ -19,6 +19,7 @@
 
 #include "tessera/core/Volume.h"
 #include "tessera/io/ZarrArray.h"
+#include "tessera/io/ZarrChunkCache.h"
 #include "tessera/io/ZarrStorage.h"
 
 namespace tessera {
@@ -45,6 +46,12 @@ class ZarrStore {
   // selection and every level against the host budget. InputError naming
   // the key's path or URL.
   explicit ZarrStore(std::shared_ptr<const ZarrStorage> storage, ZarrSelection selection = {});
+
+  // Keeps decoded chunks up to `bytes` from now on (io/ZarrChunkCache.h;
+  // the default 0 keeps none, though a chunk being decoded is still shared
+  // between readers): what a reader of many small boxes (bricks) needs; a
+  // reader of whole levels does not.
+  void keepDecodedChunks(std::uint64_t bytes) { chunks_ = std::make_shared<ZarrChunkCache>(bytes); }
 
   // The finest level's dims, type and geometry with the value window of
   // the store (from its metadata or its coarsest level); no voxels.
@@ -85,6 +92,12 @@ class ZarrStore {
   std::string describe() const;
   const ZarrStorage& storage() const { return *storage_; }
   const ZarrSelection& selection() const { return selection_; }
+  // Chunks decoded, found decoded, waited for; bytes held.
+  ZarrChunkCacheStats chunkStats() const { return chunks_->stats(); }
+  std::uint64_t chunkCacheBytes() const { return chunks_->budgetBytes(); }
+  // The decoded bytes of every chunk of every level: the most that reading
+  // the whole store (every brick of every level) holds in the chunk cache.
+  std::uint64_t allChunkBytes() const;
 
  private:
   struct AxisMap;
@@ -96,9 +109,11 @@ class ZarrStore {
   std::string chunkKeyAt(int l, const std::vector<std::int64_t>& spatial) const;
   void readChunkInto(int l, const std::vector<std::int64_t>& chunkIndex, glm::ivec3 begin,
                      glm::ivec3 end, Volume& out) const;
+  ZarrChunkCache::Chunk decodeChunk(const ZarrArrayMeta& m, const std::string& key) const;
 
   std::shared_ptr<const ZarrStorage> storage_;
   ZarrSelection selection_;
+  std::shared_ptr<ZarrChunkCache> chunks_;
   std::string version_;
   std::string name_;
   std::string reduction_;

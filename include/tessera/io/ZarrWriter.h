@@ -19,6 +19,7 @@
 #include <vector>
 
 #include <glm/vec3.hpp>
+#include <glm/vector_relational.hpp>
 
 #include "tessera/core/Volume.h"
 #include "tessera/io/ZarrArray.h"
@@ -27,6 +28,13 @@ namespace tessera {
 
 struct OmeZarrWriteOptions {
   int chunk = 64;  // chunk edge in voxels (capped per axis at a level's size)
+  // Per-axis chunk (x, y, z) instead of a cube of `chunk` where set (every
+  // axis > 0): microscopy stores' 512x512x32. Capped the same way.
+  glm::ivec3 chunkShape{0};
+  // The chunk this asks for on each axis (x, y, z).
+  glm::ivec3 chunkXyz() const {
+    return glm::all(glm::greaterThan(chunkShape, glm::ivec3(0))) ? chunkShape : glm::ivec3(chunk);
+  }
   int levels = 0;  // 0: down to a level that fits one chunk
   ZarrCompressor compressor = ZarrCompressor::Zstd;
   // Called with the fraction of the finest level's slices done.
@@ -47,6 +55,7 @@ struct OmeZarrWriteResult {
 
 // The number of levels `auto` gives: halve until every axis fits one chunk.
 int omeZarrAutoLevels(glm::ivec3 dims, int chunk);
+int omeZarrAutoLevels(glm::ivec3 dims, glm::ivec3 chunk);
 
 // Writes the store at `path` (a folder, by convention NAME.ome.zarr): built
 // in a temporary folder beside it and renamed into place when complete; an

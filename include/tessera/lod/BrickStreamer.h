@@ -97,7 +97,10 @@ class BrickStreamer {
 
   // The bricks wanted now, most urgent first: replaces the queue of reads not
   // yet started with those of `keys` that are neither cached, being read,
-  // nor waiting out a back-off.
+  // nor waiting out a back-off. Bricks of one source chunk (LevelInfo::
+  // chunk) are queued together, in the order their chunks are first
+  // wanted: the readers then take a chunk's bricks one after the other and
+  // the source decodes it once (io/ZarrChunkCache.h) however large it is.
   void request(const std::vector<BrickKey>& keys);
   // The cached brick (and marks it recently used), or null.
   std::shared_ptr<const StoredBrick> find(const BrickKey& key);
@@ -132,6 +135,8 @@ class BrickStreamer {
   void countFailing(const Failure& f, int delta);
   void work();
   void readQueuedInline(int count);
+  // `keys` grouped by the chunk that holds each (stable otherwise).
+  std::vector<BrickKey> groupedByChunk(std::vector<BrickKey> keys) const;
   std::shared_ptr<const StoredBrick> readOne(const BrickKey& key);            // no lock held
   void store(const BrickKey& key, std::shared_ptr<const StoredBrick> brick);  // lock held
   void recordFailure(const BrickKey& key, const std::string& what);           // lock held
@@ -145,6 +150,7 @@ class BrickStreamer {
   BrickGrid grid_;
   StoredMapping mapping_;
   BrickStreamerOptions options_;
+  std::vector<glm::ivec3> chunks_;  // per level (0: the source has none)
 
   mutable std::mutex mutex_;
   std::condition_variable wake_;      // workers: the queue changed or stop

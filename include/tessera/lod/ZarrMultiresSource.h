@@ -14,9 +14,9 @@ namespace tessera::lod {
 class ZarrMultiresSource final : public MultiresSource {
  public:
   explicit ZarrMultiresSource(std::shared_ptr<const ZarrStore> store);
-  // Opens a folder or URL (see io/ZarrStore.h), with a time point and channel.
-  // Native only: the browser reads stores through the page's fetch()
-  // (frontends/web/src/ZarrFetchStorage.h).
+  // Opens a folder or URL (see io/ZarrStore.h), with a time point and
+  // channel, keeping decodedChunkBudget() of decoded chunks. Native only: the browser reads stores
+  // through the page's fetch() (frontends/web/src/ZarrFetchStorage.h).
   static std::unique_ptr<ZarrMultiresSource> open(const std::string& spec,
                                                   ZarrSelection selection = {});
 
@@ -30,6 +30,14 @@ class ZarrMultiresSource final : public MultiresSource {
   bool meanPyramid() const override { return store_->reduction() == "mean"; }
 
   const ZarrStore& store() const { return *store_; }
+
+  // The decoded chunks kept while bricks are read: every chunk of the store
+  // (a refinement reads each once, however many bricks a chunk holds, in
+  // whatever order the view wants them) when that is at most an eighth of
+  // the host budget; else that eighth, least recently used out, and the
+  // streamer's queue, grouped by chunk, keeps the chunks it needs together.
+  static constexpr std::uint64_t kDecodedChunkShare = 8;
+  static std::uint64_t decodedChunkBudget(const ZarrStore& store, std::uint64_t hostBudget);
 
  private:
   std::shared_ptr<const ZarrStore> store_;
