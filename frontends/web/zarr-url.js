@@ -401,6 +401,13 @@
       record.calls.push({ t: performance.now() - t0, ms: f.ms, stream_ms: f.stream_ms, shown: f.shown, pending: f.pending,
         preview: f.preview_size[0] > 0, uploaded: f.uploaded });
       if (record.calls.length > 4000) record.calls.splice(0, 1000);
+      if (!f.shown && !f.pending) {
+        // Streamed, and nothing new to draw: the canvas shows these bricks.
+        lastFrameAt = performance.now();
+        bricksRead = last ? last.bricks_read : 0;
+        last = { ...f, ms: last ? last.ms : f.ms };
+        if (f.complete && record.completeMs === null) record.completeMs = performance.now() - t0;
+      }
       if (!f.shown) return f;
       lastFrameAt = performance.now();
       const prevRead = last ? last.bricks_read : 0;

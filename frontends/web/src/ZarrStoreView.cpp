@@ -137,7 +137,7 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
     f.streamMs = msSince(t0);
     return drawWhole(v, f, t0);
   }
-  pending_ = {.active = true, .streaming = true, .view = v};
+  pending_ = {.active = true, .streaming = true, .viewChanged = pace.viewChanged, .view = v};
   if (pace.viewChanged) {
     // The new view's selection and requests (they go out now; what has
     // arrived is read and uploaded by the pending frame's streaming), and
@@ -177,6 +177,7 @@ StoreFrame ZarrStoreView::drawWhole(const FrameView& v, StoreFrame f,
                                     std::chrono::steady_clock::time_point t0) {
   const auto t1 = std::chrono::steady_clock::now();
   show(active_.technique->render(v.camera, v.pass, v.renderWidth, v.renderHeight, 0.0), v);
+  shownVersion_ = active_.upload.layout->contentVersion();
   msPerPixel_ = msSince(t1) / (static_cast<double>(v.renderWidth) * v.renderHeight);
   f.shown = true;
   f.ms = msSince(t0);
@@ -235,6 +236,11 @@ StoreFrame ZarrStoreView::refine() {
   f.bricks = p.bricks;
   f.renderWidth = p.view.renderWidth;
   f.renderHeight = p.view.renderHeight;
+  if (!p.streaming && !p.viewChanged && active_.upload.layout->contentVersion() == shownVersion_) {
+    // Nothing new to draw: the canvas shows this view of these bricks.
+    f.pending = false;
+    pending_ = {};
+  }
   f.ms = f.streamMs = msSince(t0);
   return f;
 }
@@ -270,6 +276,7 @@ StoreFrame ZarrStoreView::strip() {
   f.pending = p.done < 1.0;
   if (!f.pending) {
     show(*image, v);
+    shownVersion_ = active_.upload.layout->contentVersion();
     f.shown = true;
     pending_ = {};
   }

@@ -135,6 +135,7 @@ class ZarrStoreView {
   struct Pending {
     bool active = false;
     bool streaming = true;  // still streaming; then strips
+    bool viewChanged = true;
     FrameView view;
     layout::BricksFrame bricks;
     double streamedMs = 0.0;
@@ -148,6 +149,8 @@ class ZarrStoreView {
   void preview(const FrameView& v, StoreFrame& f);
   StoreFrame strip();
   Pending pending_;
+  // What the last full frame on the canvas sampled (Layout::contentVersion).
+  std::uint64_t shownVersion_ = 0;
   double budgetMs_ = 12.0;
   double msPerPixel_ = 0.0;  // the ray march at full quality, from strips and whole frames
   // The preview's resolution and step, fed back to meet its share of the budget.
