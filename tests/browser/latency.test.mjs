@@ -113,9 +113,11 @@ async function storeInputLatency(context, url, tmp, run) {
   const z = await page.evaluate(() => window.tessera.zarr());
   served.delayMs = () => 0;
   // The store's own calls meanwhile (zarr-url.js): the work each did.
-  const during = z.calls.filter((c) => c.t > z.firstImageMs);
+  const during = (z.calls || []).filter((c) => c.t > z.firstImageMs);
   const work = stats(during.map((c) => c.ms));
   const previews = stats(during.filter((c) => c.preview).map((c) => c.ms));
+  const streaming = stats(during.filter((c) => !c.preview && c.stream_ms > 0).map((c) => c.ms));
+  const stripCalls = stats(during.filter((c) => !c.preview && !(c.stream_ms > 0)).map((c) => c.ms));
 
   const latencies = { pointermove: [], pointerup: [], wheel: [] };
   let unanswered = 0, duringRefinement = 0;
@@ -133,7 +135,9 @@ async function storeInputLatency(context, url, tmp, run) {
   console.log(`latency: ${lat.frames.length} canvas frames; frame callbacks that drew took median ${stats(lat.frames.map((f) => f.end - f.start)).median.toFixed(1)} ms, ` +
               `worst ${stats(lat.frames.map((f) => f.end - f.start)).worst.toFixed(1)} ms; refined ${z.completeMs === null ? 'not yet' : `after ${z.completeMs.toFixed(0)} ms`}`);
   console.log(`latency: the store's calls while refining: ${work.n}, work median ${work.median.toFixed(1)} ms, worst ${work.worst.toFixed(1)} ms; ` +
-              `previews ${previews.n}, median ${previews.median.toFixed(1)} ms, worst ${previews.worst.toFixed(1)} ms`);
+              `previews ${previews.n}, median ${previews.median.toFixed(1)} ms, worst ${previews.worst.toFixed(1)} ms; ` +
+              `streaming steps ${streaming.n}, median ${streaming.median.toFixed(1)} ms, worst ${streaming.worst.toFixed(1)} ms; ` +
+              `strips ${stripCalls.n}, median ${stripCalls.median.toFixed(1)} ms, worst ${stripCalls.worst.toFixed(1)} ms`);
   check('latency: the drag and the wheel turns were handled while the store refined',
         latencies.pointermove.length >= 5 && latencies.wheel.length >= WHEELS / 2 && duringRefinement >= all.n / 2 && unanswered === 0,
         `${all.n} events answered (${duringRefinement} while refining), ${unanswered} without a frame after them`);
@@ -150,7 +154,7 @@ async function storeInputLatency(context, url, tmp, run) {
     return ms;
   });
   const wholePixels = await snapshot(page);
-  const calls = (await page.evaluate(() => window.tessera.zarr())).calls;
+  const calls = (await page.evaluate(() => window.tessera.zarr())).calls || [];
   const last = calls[calls.length - 1];
   const differing = differingPixels(strips.pixels, wholePixels.pixels, 0);
   check('latency: refined, the frame drawn in strips equals the whole frame (every pixel)',

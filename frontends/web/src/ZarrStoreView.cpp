@@ -213,7 +213,8 @@ StoreFrame ZarrStoreView::refine() {
   if (!pending_.active) return {};
   const auto t0 = std::chrono::steady_clock::now();
   Pending& p = pending_;
-  gpu::clearErrors();
+  // No gpu::clearErrors() here: every step ends checking them, and each
+  // query waits for the browser's GPU process.
   if (!p.streaming) return strip();
   // What arrived, streamed in budget-sized steps up to as long as a whole
   // frame streams before it draws (while they make progress); the bricks
@@ -222,9 +223,11 @@ StoreFrame ZarrStoreView::refine() {
   const int uploadedBefore = p.bricks.uploaded;
   bricks_->setUpdatePace(streamPace());
   p.bricks = stream(p.view, 0.0);
-  // The upload is done in the browser's GPU process after this call
-  // returns: waited for here, it is this step's cost, not the next one's.
-  gpu::checkErrors("OME-Zarr streaming");
+  // An upload is done in the browser's GPU process after this call returns:
+  // waited for here, it is this step's cost, not the next one's. Without
+  // one there is nothing to wait for (a query would wait for whatever the
+  // GPU process does meanwhile, such as composing the page).
+  if (p.bricks.uploaded > 0) gpu::checkErrors("OME-Zarr streaming");
   p.bricks.uploaded += uploadedBefore;
   p.streamedMs += msSince(t0);
   const bool progress =
