@@ -257,6 +257,9 @@ StoreFrame ZarrStoreView::strip() {
   const double pixels = static_cast<double>(v.renderWidth) * v.renderHeight;
   const double minStrip = 1.0 / v.renderHeight;
   double rows = msPerPixel_ > 0.0 ? budgetMs_ / (msPerPixel_ * pixels) : kFirstStrip;
+  // At most twice the last strip's rows: the rows below may cover more of
+  // the volume than those the cost was learnt on.
+  if (p.rows > 0.0) rows = std::min(rows, 2.0 * p.rows);
   rows = std::clamp(rows, minStrip, 1.0 - p.done);
   if (1.0 - (p.done + rows) < 0.5 * minStrip) rows = 1.0 - p.done;
   const gpu::Texture* image = nullptr;
@@ -267,9 +270,11 @@ StoreFrame ZarrStoreView::strip() {
     std::uint8_t pixel[4];
     gpu::readPixelsRgba8({0, 0, 1, 1}, pixel);  // waits for the strip
   }
-  // Smoothed: a strip's time varies with what its rows cover.
+  // A strip's time varies with what its rows cover: a dearer one is taken
+  // at once, a cheaper one only in part, so that strips overrun seldom.
   const double perPixel = msSince(t0) / (rows * pixels);
-  msPerPixel_ = msPerPixel_ > 0.0 ? 0.5 * (msPerPixel_ + perPixel) : perPixel;
+  msPerPixel_ = perPixel > msPerPixel_ ? perPixel : 0.75 * msPerPixel_ + 0.25 * perPixel;
+  p.rows = rows;
   p.done = p.done + rows >= 1.0 - 1e-9 ? 1.0 : p.done + rows;
   gpu::checkErrors("OME-Zarr frame strip");
   StoreFrame f;

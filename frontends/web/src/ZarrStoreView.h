@@ -140,6 +140,7 @@ class ZarrStoreView {
     layout::BricksFrame bricks;
     double streamedMs = 0.0;
     double done = 0.0;  // fraction of the rows drawn
+    double rows = 0.0;  // the last strip's
   };
   layout::UpdatePace streamPace() const;
   layout::BricksFrame stream(const FrameView& v, double ms);
