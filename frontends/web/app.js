@@ -236,20 +236,7 @@ import { TesseraViewer } from './tessera.js';
       return;
     }
     if (api && zarr && zarr.active()) {
-      // An OME-Zarr store (frontends/web/zarr-url.js): frames while bricks arrive.
-      let ms = -1;
-      if (needsRender || zarr.wantsFrame()) {
-        needsRender = false;
-        fitCanvas();
-        ms = zarr.frame(canvas.width, canvas.height);
-        frames++;
-        if (slices) slices.frameShown(refreshState());  // the store's slice views
-      }
-      if (!needsRender && renderWaiters.length) {
-        const waiters = renderWaiters;
-        renderWaiters = [];
-        waiters.forEach((w) => w(ms));
-      }
+      storeFrameStep();
     } else if (api) {
       let ms = -1;
       if (needsRender) {
@@ -269,6 +256,35 @@ import { TesseraViewer } from './tessera.js';
       }
     }
     requestAnimationFrame(loop);
+  }
+
+  // An OME-Zarr store (frontends/web/zarr-url.js): frames while bricks arrive,
+  // about frameBudgetMs of work per animation frame as for in-core volumes:
+  // a changed view shows a preview at once and its full frame follows
+  // (bricks that arrived streamed first, then strips of the ray march);
+  // render() promises resolve once the full frame is on the canvas.
+  function storeFrameStep() {
+    let f = null;
+    if (needsRender || (!zarr.refining() && zarr.wantsFrame())) {
+      const viewChanged = needsRender;
+      needsRender = false;
+      fitCanvas();
+      f = zarr.frame(canvas.width, canvas.height, viewChanged);
+    } else if (zarr.refining() && performance.now() >= refineNotBefore) {
+      f = zarr.refine();
+      // As for in-core strips: one that cost more than the budget is
+      // followed by as much idle time.
+      refineNotBefore = f && f.ms > frameBudgetMs ? performance.now() + f.ms : 0;
+    }
+    if (f && f.shown) {
+      frames++;
+      if (slices) slices.frameShown(refreshState());  // the store's slice views
+    }
+    if (!needsRender && !zarr.refining() && renderWaiters.length) {
+      const waiters = renderWaiters;
+      renderWaiters = [];
+      waiters.forEach((w) => w(f ? f.ms : -1));
+    }
   }
 
   // Patient directions at the view's edges; blank when the file has no orientation.

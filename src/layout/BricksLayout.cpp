@@ -565,6 +565,11 @@ BricksFrame BricksLayout::update(const Camera& camera, int width, int height,
   for (const lod::BrickKey& k : needed) {
     const bool cut = inCut[k.id()];
     if (slotOf_.count(k.id())) continue;
+    // Read since the selection above (a reader thread finished meanwhile)
+    // and transparent by its own range: its cells draw the constant, as
+    // they would had the read come first, so what is drawn does not depend
+    // on which reader thread finishes first.
+    if (cut && transparent(k, tf, true, nullptr)) continue;
     if (cut) ++frame.missing;
     std::shared_ptr<const lod::StoredBrick> brick = streamer_->find(k);
     if (!brick) {

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "WebExports.h"
@@ -25,6 +26,35 @@ web::ZarrStoreView* storeIfAny() {
 
 lod::VoxelBox boxOf(int x0, int x1, int y0, int y1, int z0, int z1) {
   return {{x0, y0, z0}, {x1, y1, z1}};
+}
+
+std::string frameJson(const web::StoreFrame& f, web::ZarrStoreView& z) {
+  const lod::StreamerStats st = z.bricks().streamerStats();
+  const web::FetchStats fetched = z.storage().stats();
+  nlohmann::json j;
+  j["ms"] = f.ms;
+  j["stream_ms"] = f.streamMs;
+  j["shown"] = f.shown;
+  j["pending"] = f.pending;
+  j["streamed"] = f.streamed;
+  j["render_size"] = {f.renderWidth, f.renderHeight};
+  j["preview_size"] = {f.previewWidth, f.previewHeight};
+  j["complete"] = f.bricks.complete;
+  j["wanted"] = f.bricks.wanted;
+  j["missing"] = f.bricks.missing;
+  j["failing"] = f.bricks.failing;
+  j["uploaded"] = f.bricks.uploaded;
+  j["limited_by_budget"] = f.bricks.limitedByBudget;
+  j["wanted_per_level"] = f.bricks.wantedPerLevel;
+  j["cells_per_level"] = f.bricks.cellsPerLevel;  // last: transparent cells
+  j["bricks_read"] = st.bricksRead;
+  j["read_errors"] = st.readErrors;
+  j["last_error"] = st.lastError;
+  j["fetched_keys"] = fetched.keys;
+  j["fetched_bytes"] = fetched.bytes;
+  j["fetch_failures"] = fetched.failed;
+  j["held_bytes"] = fetched.heldBytes;
+  return j.dump();
 }
 
 }  // namespace
@@ -84,36 +114,36 @@ EMSCRIPTEN_KEEPALIVE int tessera_zarr_page_decodes(const char* compressor) {
 }
 
 // A frame of the open store on the canvas, with the picked region (red) and
-// the grid view's last block (cyan) composed by depth: JSON with the bricks'
-// state ("complete", "wanted", "missing", "failing", "uploaded", cells per
-// level), or "" on error (tessera_last_error).
-EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_frame(int width, int height) {
+// the grid view's last block (cyan) composed by depth, paced as the
+// viewer's progressive frames (tessera_set_progressive): when the whole
+// frame costs more than the budget, a preview now if `viewChanged` (else the
+// canvas keeps its image), and the full frame through tessera_zarr_refine.
+// JSON with the bricks' state ("complete", "wanted", "missing", "failing",
+// "uploaded", cells per level), "shown" (drew on the canvas) and "pending"
+// (the full frame is still to come), or "" on error (tessera_last_error).
+EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_frame(int width, int height, int viewChanged) {
   web::scratch().clear();
   guarded([&] {
     web::WebSession& s = web::session();
-    const web::StoreFrame f = s.storeFrame(width, height);
-    web::ZarrStoreView& z = s.theStore();
-    const lod::StreamerStats st = z.bricks().streamerStats();
-    const web::FetchStats fetched = z.storage().stats();
-    nlohmann::json j;
-    j["ms"] = f.ms;
-    j["render_size"] = {f.renderWidth, f.renderHeight};
-    j["complete"] = f.bricks.complete;
-    j["wanted"] = f.bricks.wanted;
-    j["missing"] = f.bricks.missing;
-    j["failing"] = f.bricks.failing;
-    j["uploaded"] = f.bricks.uploaded;
-    j["limited_by_budget"] = f.bricks.limitedByBudget;
-    j["wanted_per_level"] = f.bricks.wantedPerLevel;
-    j["cells_per_level"] = f.bricks.cellsPerLevel;  // last: transparent cells
-    j["bricks_read"] = st.bricksRead;
-    j["read_errors"] = st.readErrors;
-    j["last_error"] = st.lastError;
-    j["fetched_keys"] = fetched.keys;
-    j["fetched_bytes"] = fetched.bytes;
-    j["fetch_failures"] = fetched.failed;
-    j["held_bytes"] = fetched.heldBytes;
-    web::scratch() = j.dump();
+    web::scratch() = frameJson(s.storeFrame(width, height, viewChanged != 0), s.theStore());
+  });
+  return web::scratch().c_str();
+}
+
+// 1 while a store frame is pending (tessera_zarr_refine draws it).
+EMSCRIPTEN_KEEPALIVE int tessera_zarr_refining() {
+  const web::ZarrStoreView* z = storeIfAny();
+  return z && z->refining() ? 1 : 0;
+}
+
+// About a budget of the pending frame: streaming what arrived, then a strip
+// of its ray march; the same JSON as tessera_zarr_frame ("shown" once the
+// last strip is drawn and the frame is on the canvas), "" on error.
+EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_refine() {
+  web::scratch().clear();
+  guarded([&] {
+    web::WebSession& s = web::session();
+    web::scratch() = frameJson(s.storeRefine(), s.theStore());
   });
   return web::scratch().c_str();
 }

@@ -184,8 +184,12 @@ class WebSession {
   bool storeRegionPrefetch(const lod::VoxelBox& asked);
   void showStoreRegion(const lod::VoxelBox& asked);
   void storeRegionOverview();
-  // The store's frame with the region and grid block marked.
-  StoreFrame storeFrame(int width, int height);
+  // The store's frame with the region and grid block marked, paced as the
+  // viewer's progressive frames (its frameBudgetMs); `viewChanged`: a
+  // preview at once, else the canvas keeps its image until the frame is done.
+  StoreFrame storeFrame(int width, int height, bool viewChanged);
+  // About a budget of the pending store frame (ZarrStoreView::refine).
+  StoreFrame storeRefine() { return theStore().refine(); }
   // The grid view's last block over a store, while the store is drawn.
   std::optional<lod::VoxelBox> storeGridBlock();
 

@@ -93,7 +93,7 @@ std::optional<lod::VoxelBox> WebSession::storeGridBlock() {
   return explore()->gridBlock();
 }
 
-StoreFrame WebSession::storeFrame(int width, int height) {
+StoreFrame WebSession::storeFrame(int width, int height, bool viewChanged) {
   viewer::Viewer& v = viewer();
   ZarrStoreView& z = theStore();
   // The picked region (red) and the grid view's last block (cyan) over the
@@ -110,9 +110,10 @@ StoreFrame WebSession::storeFrame(int width, int height) {
         viewer::boxLines(*block, shape.dims(), shape.extent(), session::kGridBlockColour);
     marks.insert(marks.end(), cyan.begin(), cyan.end());
   }
-  return z.frame(v.camera(), v.frameSettings(), v.tfEditor().transferFunction(),
-                 v.tfEditor().revision(), v.showBoundingBox, v.showAxes, width, height,
-                 v.maxVolumePixels, marks);
+  return z.frame(
+      v.camera(), v.frameSettings(), v.tfEditor().transferFunction(), v.tfEditor().revision(),
+      v.showBoundingBox, v.showAxes, width, height, v.maxVolumePixels, marks,
+      {.progressive = v.progressive, .budgetMs = v.frameBudgetMs, .viewChanged = viewChanged});
 }
 
 }  // namespace tessera::web

@@ -22,6 +22,14 @@ constexpr int kPlanImageSize = 1024;
 constexpr int kSkipBlock = 8;
 // Streaming (reading and uploading arrived bricks) before a frame is drawn.
 constexpr double kStreamMs = 150.0;
+// The preview's share of the budget (the rest: the update before it), and
+// its least resolution. It keeps the full frame's sample distance: another
+// would rebuild the ray caster's tables (classification per block) twice
+// per preview, costing more than the preview itself.
+constexpr double kPreviewShare = 0.5;
+constexpr double kPreviewMinScale = 1.0 / 16.0;
+// The first strip's rows (a fraction of the frame) before any cost is known.
+constexpr double kFirstStrip = 1.0 / 64.0;
 
 }  // namespace
 
@@ -78,44 +86,208 @@ bool ZarrStoreView::open() {
 StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings& settings,
                                 const TransferFunction& tf, std::uint64_t tfRevision, bool box,
                                 bool axes, int width, int height, int maxVolumePixels,
-                                const std::vector<render::OverlayLine>& marks) {
+                                const std::vector<render::OverlayLine>& marks,
+                                const StorePace& pace) {
   const auto t0 = std::chrono::steady_clock::now();
+  pending_ = {};
   StoreFrame f;
   if (tfRevision != tfRevision_) {
     active_.technique->setTransferFunction(tf);
     tfRevision_ = tfRevision;
   }
   // The viewer's orbit, zoom and pan, framed on this volume.
-  Camera camera = viewerCamera;
+  FrameView v{.camera = viewerCamera, .pass = settings, .tf = tf};
   const Volume& shape = store_->shape();
-  camera.frame(shape);
+  v.camera.frame(shape);
   double scale = 1.0;
   const double pixels = static_cast<double>(width) * height;
   if (maxVolumePixels > 0 && pixels > maxVolumePixels) scale = std::sqrt(maxVolumePixels / pixels);
-  f.renderWidth = std::max(1, static_cast<int>(std::lround(width * scale)));
-  f.renderHeight = std::max(1, static_cast<int>(std::lround(height * scale)));
-  gpu::clearErrors();
-  // A ray march costs far more than an update (SwiftShader: most of a
-  // second), so stream for up to kStreamMs before drawing, and a frame
-  // shows everything that has arrived; the page fetches between frames.
-  f.bricks = session::BrickRefinement(*bricks_).step(camera, f.renderWidth, f.renderHeight, tf,
-                                                     {.streamMs = kStreamMs, .idleWaitMs = 0.0});
+  v.width = width;
+  v.height = height;
+  v.renderWidth = std::max(1, static_cast<int>(std::lround(width * scale)));
+  v.renderHeight = std::max(1, static_cast<int>(std::lround(height * scale)));
   // Over transparent black; the compositor adds the background and lines.
-  RenderSettings pass = settings;
-  pass.background = glm::dvec4(0.0);
-  const gpu::Texture& image =
-      active_.technique->render(camera, pass, f.renderWidth, f.renderHeight, 0.0);
+  v.background = glm::vec4(settings.background);
+  v.pass.background = glm::dvec4(0.0);
   render::OverlayOptions overlays;
   overlays.box = box;
   overlays.axes = axes;
   std::vector<render::OverlayLine> lines = render::overlayLines(shape, overlays);
   lines.insert(lines.end(), marks.begin(), marks.end());
   compositor_->setOverlayLines(std::move(lines));
-  compositor_->composeInto(image, camera, glm::vec4(settings.background), shape.extent(), 0,
-                           glm::ivec4(0, 0, width, height));
+  f.renderWidth = v.renderWidth;
+  f.renderHeight = v.renderHeight;
+  gpu::clearErrors();
+  budgetMs_ = pace.budgetMs;
+  if (!pace.progressive) {
+    bricks_->setUpdatePace({});
+    // A ray march costs far more than an update (SwiftShader: most of a
+    // second), so stream for up to kStreamMs before drawing, and a frame
+    // shows everything that has arrived; the page fetches between frames.
+    f.bricks = stream(v, kStreamMs);
+    f.streamed = true;
+    f.streamMs = msSince(t0);
+    return drawWhole(v, f, t0);
+  }
+  const double wholeMs = msPerPixel_ * v.renderWidth * v.renderHeight;
+  if (msPerPixel_ > 0.0 && wholeMs <= 0.5 * budgetMs_) {
+    bricks_->setUpdatePace(streamPace());
+    f.bricks = stream(v, 0.0);
+    f.streamed = true;
+    f.streamMs = msSince(t0);
+    return drawWhole(v, f, t0);
+  }
+  pending_ = {.active = true, .streaming = true, .viewChanged = pace.viewChanged, .view = v};
+  if (pace.viewChanged) {
+    // The new view's selection and requests (they go out now; what has
+    // arrived is read and uploaded by the pending frame's streaming), and
+    // a preview of what is on the GPU.
+    bricks_->setUpdatePace({.uploadMs = 0.0, .uploadBytes = 0, .inlineReads = 0});
+    pending_.bricks = f.bricks = stream(v, 0.0);
+    f.streamed = true;
+    f.streamMs = msSince(t0);
+    preview(v, f);
+  }
+  f.pending = true;
+  f.ms = msSince(t0);
+  return f;
+}
+
+// A budget-sized streaming step: one update that reads a brick and uploads
+// one (an upload's cost is mostly the GPU's, which a time limit on the
+// calls does not see).
+layout::UpdatePace ZarrStoreView::streamPace() const {
+  return {.uploadMs = 0.5 * budgetMs_, .uploadBytes = 1, .inlineReads = 1};
+}
+
+layout::BricksFrame ZarrStoreView::stream(const FrameView& v, double ms) {
+  return session::BrickRefinement(*bricks_).step(v.camera, v.renderWidth, v.renderHeight, v.tf,
+                                                 {.streamMs = ms, .idleWaitMs = 0.0});
+}
+
+void ZarrStoreView::show(const gpu::Texture& image, const FrameView& v) {
+  compositor_->composeInto(image, v.camera, v.background, store_->shape().extent(), 0,
+                           glm::ivec4(0, 0, v.width, v.height));
   std::uint8_t pixel[4];
   gpu::readPixelsRgba8({0, 0, 1, 1}, pixel);  // waits for the frame (glFinish does not)
   gpu::checkErrors("OME-Zarr frame");
+}
+
+StoreFrame ZarrStoreView::drawWhole(const FrameView& v, StoreFrame f,
+                                    std::chrono::steady_clock::time_point t0) {
+  const auto t1 = std::chrono::steady_clock::now();
+  show(active_.technique->render(v.camera, v.pass, v.renderWidth, v.renderHeight, 0.0), v);
+  shownVersion_ = active_.upload.layout->contentVersion();
+  msPerPixel_ = msSince(t1) / (static_cast<double>(v.renderWidth) * v.renderHeight);
+  f.shown = true;
+  f.ms = msSince(t0);
+  return f;
+}
+
+// At the resolution that met the preview's share of the budget before
+// (render::QualityController's feedback; the first at the least).
+void ZarrStoreView::preview(const FrameView& v, StoreFrame& f) {
+  if (!previewQuality_) {
+    previewQuality_ = std::make_unique<render::QualityController>(
+        render::QualityController::Options{.goalMs = kPreviewShare * budgetMs_,
+                                           .minResolutionScale = kPreviewMinScale,
+                                           .maxStepScale = 1.0});
+    previewQuality_->setInteracting(true);
+  }
+  const render::QualityLevel level =
+      previewMeasured_ ? previewQuality_->next() : previewQuality_->levelFor(0.0);
+  FrameView p = v;
+  p.renderWidth = std::max(1, static_cast<int>(std::lround(v.renderWidth * level.resolutionScale)));
+  p.renderHeight =
+      std::max(1, static_cast<int>(std::lround(v.renderHeight * level.resolutionScale)));
+  const auto t0 = std::chrono::steady_clock::now();
+  show(active_.technique->render(p.camera, p.pass, p.renderWidth, p.renderHeight, 0.0), p);
+  previewQuality_->report(level, msSince(t0));
+  previewMeasured_ = true;
+  f.shown = true;
+  f.previewWidth = p.renderWidth;
+  f.previewHeight = p.renderHeight;
+}
+
+StoreFrame ZarrStoreView::refine() {
+  if (!pending_.active) return {};
+  const auto t0 = std::chrono::steady_clock::now();
+  Pending& p = pending_;
+  // No gpu::clearErrors() here: every step ends checking them, and each
+  // query waits for the browser's GPU process.
+  if (!p.streaming) return strip();
+  // What arrived, streamed in budget-sized steps up to as long as a whole
+  // frame streams before it draws (while they make progress); the bricks
+  // then stay as they are until the frame is drawn.
+  const std::uint64_t read = bricks_->streamerStats().bricksRead;
+  const int uploadedBefore = p.bricks.uploaded;
+  bricks_->setUpdatePace(streamPace());
+  p.bricks = stream(p.view, 0.0);
+  // An upload is done in the browser's GPU process after this call returns:
+  // waited for here, it is this step's cost, not the next one's. Without
+  // one there is nothing to wait for (a query would wait for whatever the
+  // GPU process does meanwhile, such as composing the page).
+  if (p.bricks.uploaded > 0) gpu::checkErrors("OME-Zarr streaming");
+  p.bricks.uploaded += uploadedBefore;
+  p.streamedMs += msSince(t0);
+  const bool progress =
+      p.bricks.uploaded > uploadedBefore || bricks_->streamerStats().bricksRead != read;
+  if (p.bricks.complete || !progress || p.streamedMs >= kStreamMs) p.streaming = false;
+  StoreFrame f;
+  f.pending = true;
+  f.streamed = true;
+  f.bricks = p.bricks;
+  f.renderWidth = p.view.renderWidth;
+  f.renderHeight = p.view.renderHeight;
+  if (!p.streaming && !p.viewChanged && active_.upload.layout->contentVersion() == shownVersion_) {
+    // Nothing new to draw: the canvas shows this view of these bricks.
+    f.pending = false;
+    pending_ = {};
+  }
+  f.ms = f.streamMs = msSince(t0);
+  return f;
+}
+
+// One strip of about the budget, sized by the cost per pixel of the strips
+// before (as viewer::Viewer::refine sizes its strips).
+StoreFrame ZarrStoreView::strip() {
+  const auto t0 = std::chrono::steady_clock::now();
+  Pending& p = pending_;
+  const FrameView& v = p.view;
+  const double pixels = static_cast<double>(v.renderWidth) * v.renderHeight;
+  const double minStrip = 1.0 / v.renderHeight;
+  double rows = msPerPixel_ > 0.0 ? budgetMs_ / (msPerPixel_ * pixels) : kFirstStrip;
+  // At most twice the last strip's rows: the rows below may cover more of
+  // the volume than those the cost was learnt on.
+  if (p.rows > 0.0) rows = std::min(rows, 2.0 * p.rows);
+  rows = std::clamp(rows, minStrip, 1.0 - p.done);
+  if (1.0 - (p.done + rows) < 0.5 * minStrip) rows = 1.0 - p.done;
+  const gpu::Texture* image = nullptr;
+  {
+    const gpu::RegionScope region(
+        glm::vec4(0.0f, static_cast<float>(p.done), 1.0f, static_cast<float>(p.done + rows)));
+    image = &active_.technique->render(v.camera, v.pass, v.renderWidth, v.renderHeight, 0.0);
+    std::uint8_t pixel[4];
+    gpu::readPixelsRgba8({0, 0, 1, 1}, pixel);  // waits for the strip
+  }
+  // A strip's time varies with what its rows cover: a dearer one is taken
+  // at once, a cheaper one only in part, so that strips overrun seldom.
+  const double perPixel = msSince(t0) / (rows * pixels);
+  msPerPixel_ = perPixel > msPerPixel_ ? perPixel : 0.75 * msPerPixel_ + 0.25 * perPixel;
+  p.rows = rows;
+  p.done = p.done + rows >= 1.0 - 1e-9 ? 1.0 : p.done + rows;
+  gpu::checkErrors("OME-Zarr frame strip");
+  StoreFrame f;
+  f.bricks = p.bricks;
+  f.renderWidth = v.renderWidth;
+  f.renderHeight = v.renderHeight;
+  f.pending = p.done < 1.0;
+  if (!f.pending) {
+    show(*image, v);
+    shownVersion_ = active_.upload.layout->contentVersion();
+    f.shown = true;
+    pending_ = {};
+  }
   f.ms = msSince(t0);
   return f;
 }

@@ -6,6 +6,7 @@
 // have not arrived is skipped (MultiresSource::prefetch) and its chunks
 // are listed for the page to fetch. The viewer core's camera, transfer
 // function and render settings drive it, so the page's controls work on it.
+#include <chrono>
 #include <memory>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "tessera/lod/ZarrMultiresSource.h"
 #include "tessera/render/HybridCompositor.h"
 #include "tessera/render/Overlay.h"
+#include "tessera/render/QualityController.h"
 #include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::web {
@@ -48,9 +50,26 @@ class FetchedZarrSource final : public lod::MultiresSource {
 };
 
 struct StoreFrame {
-  layout::BricksFrame bricks;
-  double ms = 0.0;
+  layout::BricksFrame bricks;  // as drawn (a pending frame: as it will be drawn)
+  double ms = 0.0;             // this call's work
+  double streamMs = 0.0;       // of which reading and uploading bricks
   int renderWidth = 0, renderHeight = 0;
+  bool shown = false;     // drew on the canvas: a preview or the finished frame
+  bool pending = false;   // the full frame is still to come (ZarrStoreView::refine)
+  bool streamed = false;  // this call read and uploaded what had arrived
+  int previewWidth = 0, previewHeight = 0;  // the preview this call showed, if any
+};
+
+// How store frames are paced, as the viewer core paces its progressive
+// frames (viewer::Viewer::progressive, frameBudgetMs): a whole ray march
+// costs up to seconds in software WebGL, so each call does about
+// `budgetMs` of work and input is answered between calls.
+struct StorePace {
+  bool progressive = false;  // false: each frame streams and draws whole
+  double budgetMs = 12.0;
+  // The view, the settings or the canvas changed: a preview at once. Else
+  // (bricks arrived) the canvas keeps its image until the new one is done.
+  bool viewChanged = true;
 };
 
 class ZarrStoreView {
@@ -77,10 +96,20 @@ class ZarrStoreView {
   // (width x height), the volume at most maxVolumePixels (0: all) and
   // upscaled with the overlay lines as the viewer core draws them.
   // `marks`: more lines (level-0 model frame), composed by depth like the box.
+  // Progressive (`pace`): when the whole frame would cost more than the
+  // budget, one update and a preview within the budget (a changed view),
+  // and the full frame follows through refine(); a new frame() cancels it.
   StoreFrame frame(const Camera& viewerCamera, const RenderSettings& settings,
                    const TransferFunction& tf, std::uint64_t tfRevision, bool box, bool axes,
                    int width, int height, int maxVolumePixels,
-                   const std::vector<render::OverlayLine>& marks = {});
+                   const std::vector<render::OverlayLine>& marks = {}, const StorePace& pace = {});
+  // The pending full frame, about the budget per call: first streaming
+  // what has arrived (up to as long as a whole frame streamed), then the
+  // ray march in horizontal strips (gpu::RegionScope) into the technique's
+  // target, shown once the last is drawn. The bricks do not change between
+  // its strips, so the finished image is the whole frame's.
+  StoreFrame refine();
+  bool refining() const { return pending_.active; }
 
  private:
   gpu::GlContext& context_;
@@ -93,6 +122,41 @@ class ZarrStoreView {
   layout::StreamingLayout* bricks_ = nullptr;
   std::unique_ptr<render::HybridCompositor> compositor_;
   std::uint64_t tfRevision_ = 0;
+
+  // A frame of the view: what the technique renders and how it is shown.
+  struct FrameView {
+    Camera camera;  // framed on the store's shape
+    RenderSettings pass;
+    TransferFunction tf;
+    glm::vec4 background{0.0f};
+    int width = 0, height = 0;              // the canvas
+    int renderWidth = 0, renderHeight = 0;  // the volume layer
+  };
+  struct Pending {
+    bool active = false;
+    bool streaming = true;  // still streaming; then strips
+    bool viewChanged = true;
+    FrameView view;
+    layout::BricksFrame bricks;
+    double streamedMs = 0.0;
+    double done = 0.0;  // fraction of the rows drawn
+    double rows = 0.0;  // the last strip's
+  };
+  layout::UpdatePace streamPace() const;
+  layout::BricksFrame stream(const FrameView& v, double ms);
+  // The technique's image of `v` composed into the canvas, waited for.
+  void show(const gpu::Texture& image, const FrameView& v);
+  StoreFrame drawWhole(const FrameView& v, StoreFrame f, std::chrono::steady_clock::time_point t0);
+  void preview(const FrameView& v, StoreFrame& f);
+  StoreFrame strip();
+  Pending pending_;
+  // What the last full frame on the canvas sampled (Layout::contentVersion).
+  std::uint64_t shownVersion_ = 0;
+  double budgetMs_ = 12.0;
+  double msPerPixel_ = 0.0;  // the ray march at full quality, from strips and whole frames
+  // The preview's resolution and step, fed back to meet its share of the budget.
+  std::unique_ptr<render::QualityController> previewQuality_;
+  bool previewMeasured_ = false;
 };
 
 }  // namespace tessera::web

@@ -104,6 +104,11 @@ class BricksLayout final : public Layout, public StreamingLayout {
   int slotCount() const override { return static_cast<int>(slotKey_.size()); }
   lod::StreamerStats streamerStats() const override { return streamer_->stats(); }
   void retryFailingReads(bool retry) override { streamer_->retryFailing(retry); }
+  void setUpdatePace(const UpdatePace& pace) override {
+    options_.uploadMsPerFrame = pace.uploadMs;
+    options_.uploadBytesPerFrame = pace.uploadBytes;
+    streamer_->setInlineReadsPerRequest(pace.inlineReads);
+  }
   // The page table as uploaded (RGBA per level-0 cell, x fastest): the CPU
   // twin of the lookup in bricks.glsl reads it.
   const std::vector<std::uint8_t>& pageTable() const { return pages_host_; }

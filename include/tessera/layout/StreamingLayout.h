@@ -4,6 +4,7 @@
 // frame it selects what the view wants, requests and uploads it, and says how
 // far the refinement has come. A caller asks Layout::streaming() for it
 // rather than knowing the layout's class or name.
+#include <cstdint>
 #include <vector>
 
 #include "tessera/core/Camera.h"
@@ -26,6 +27,13 @@ struct BricksFrame {
   std::vector<int> cellsPerLevel;   // page-table cells drawn from each level (last: transparent)
 };
 
+// What one update() may do besides selecting levels and requesting bricks.
+struct UpdatePace {
+  double uploadMs = 40.0;                   // stop uploading after about this long
+  std::uint64_t uploadBytes = 16ull << 20;  // or this many bytes (0: upload nothing)
+  int inlineReads = 8;  // without reader threads: bricks read (0: none, they wait)
+};
+
 class StreamingLayout {
  public:
   virtual ~StreamingLayout() = default;
@@ -40,6 +48,10 @@ class StreamingLayout {
   // back-off (lod::BrickStreamer::retryFailing): yes while a viewer shows
   // the volume; a run that refines to completion gives them up.
   virtual void retryFailingReads(bool retry) = 0;
+  // How much one update() does besides selecting and requesting: a front
+  // end that draws within a frame budget between updates keeps each to a
+  // part of it.
+  virtual void setUpdatePace(const UpdatePace& pace) = 0;
   virtual int slotCount() const = 0;               // atlas slots
   virtual const lod::BrickGrid& grid() const = 0;  // the bricks and levels it streams
   virtual const LayoutPlan& plan() const = 0;      // what it allocated (Layout::plan)

@@ -117,6 +117,9 @@ class BrickStreamer {
   // to completion ends within the failure policy's time and no read of a
   // given-up brick is left in flight.
   void retryFailing(bool retry);
+  // Without workers: how many queued bricks one request() reads (0: none,
+  // they wait for a later request).
+  void setInlineReadsPerRequest(int count) { options_.inlineReadsPerRequest = count; }
   // Waits until a read finishes or `ms` pass.
   void waitForProgress(double ms);
   bool idle() const;  // nothing queued or being read
