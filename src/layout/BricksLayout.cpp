@@ -258,6 +258,7 @@ std::unique_ptr<BricksLayout> BricksLayout::create(
   if (!source) throw Error("bricks layout: no source");
   std::unique_ptr<BricksLayout> l(new BricksLayout());
   l->options_ = options;
+  l->walk_ = options.walk;
   l->api_ = limits.api;
   l->source_ = source;
   const glm::ivec3 chunk = source->levelInfo(0).chunk;

@@ -240,31 +240,35 @@ float sampleVolume(vec3 p) {
   return brickValue(b, clamp(q * b.scale + b.offset, b.lo, b.hi));
 }
 
-#ifdef LAYOUT_BLOCK_WALK
+#ifdef LAYOUT_BRICK_WALK
 // The brick walk (render/raycast.frag.glsl): the ray caster calls
-// layoutEnterBlock with the centre of each empty-space block its ray enters
-// and then samples inside that block with sampleVolumeInBlock. A block lies
-// in one level-0 cell (the brick size is a multiple of the block size,
-// BricksLayout::walksBlocks), so the page is read once per block, not per
-// sample (ImageVis3D's and Gigavoxels' brick marching).
-// The samples of a block lie in its cell's brick (up to rounding, which the
-// apron covers): no clamp; a filtered ES 3 atlas maps p straight to its
-// normalised coordinates.
+// layoutEnterCell when its ray enters a level-0 brick cell, reading the page
+// once, and samples inside that cell with sampleVolumeInCell, which maps p
+// straight into the slot: one multiply-add and the atlas fetch a sample. A
+// sample lies in the cell's brick up to rounding, which the apron covers: no
+// clamp; a filtered ES 3 atlas takes normalised coordinates directly.
 BrickPage walkPage;
 #if TESSERA_GLSL == 300 && BRICKS_TEXEL < 2
 vec3 walkScale;
 vec3 walkOffset;
 #endif
 
-void layoutEnterBlock(vec3 blockCentre) {
-  walkPage = brickPage(clamp(blockCentre, 0.0, 1.0) * u_layoutDims0);
+vec3 layoutWalkCellsPerUnit() {
+  return u_layoutDims0 / u_layoutBrick;
+}
+
+// Reads the page of the cell holding p; returns the cell.
+vec3 layoutEnterCell(vec3 p) {
+  vec3 x0 = clamp(p, 0.0, 1.0) * u_layoutDims0;
+  walkPage = brickPage(x0);
 #if TESSERA_GLSL == 300 && BRICKS_TEXEL < 2
   walkScale = walkPage.scale / u_layoutAtlasTexels;
   walkOffset = walkPage.offset / u_layoutAtlasTexels;
 #endif
+  return min(floor(x0 / u_layoutBrick), u_layoutCells - 1.0);
 }
 
-float sampleVolumeInBlock(vec3 p) {
+float sampleVolumeInCell(vec3 p) {
 #if TESSERA_GLSL == 300 && BRICKS_TEXEL < 2
   return mix(BRICKS_VALUE(texture(u_layoutAtlas, p * walkScale + walkOffset)), walkPage.constant,
              walkPage.isConstant);

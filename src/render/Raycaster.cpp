@@ -211,11 +211,11 @@ std::vector<std::string> Raycaster::definesFor(const RenderSettings& settings) c
   // Fewer samples (docs/sampling.md): both for composite only; adaptive steps
   // live in the block grid.
   if (usesPreintegration(settings)) defines.push_back("PREINTEGRATED 1");
-  // The brick walk reads the layout's page once per block; a pre-integrated
-  // segment's front may lie in the block before, so it samples per sample.
-  if (blockSize_ > 0 && skippable && !usesPreintegration(settings) &&
-      layout_.walksBlocks(blockSize_)) {
-    defines.push_back("LAYOUT_BLOCK_WALK 1");
+  // The brick walk reads the layout's page once per brick cell a ray
+  // enters; a pre-integrated segment's front may lie in the cell before, so
+  // it samples through the page per sample.
+  if (layout_.walksBricks() && !usesPreintegration(settings)) {
+    defines.push_back("LAYOUT_BRICK_WALK 1");
   }
   if (blockSize_ > 0 && usesAdaptiveSampling(settings)) {
     defines.push_back("ADAPTIVE_SAMPLING 1");

@@ -146,9 +146,8 @@ float nextSample(float k, float m, float kExit, float mAhead, float kExitAhead) 
 // The ray enters the block holding p at sample k: reads it and sets the
 // first sample at or past its exit face (where an empty block is left for,
 // and where adaptive steps end unless the block ahead lets them cross) and,
-// with ADAPTIVE_SAMPLING, the exit sample of the block ahead. Returns the
-// block's cell.
-vec3 enterBlock(vec3 p, float k, RayBlocks rb, out vec4 block, out float blockExit,
+// with ADAPTIVE_SAMPLING, the exit sample of the block ahead.
+void enterBlock(vec3 p, float k, RayBlocks rb, out vec4 block, out float blockExit,
                 out float aheadExit) {
   vec3 cell = clamp(floor(p * u_blocksPerUnit), vec3(0.0), u_blockCount - 1.0);
   block = blockAt(cell);
@@ -165,7 +164,6 @@ vec3 enterBlock(vec3 p, float k, RayBlocks rb, out vec4 block, out float blockEx
 #else
   aheadExit = -1.0;
 #endif
-  return cell;
 }
 #endif
 
@@ -236,26 +234,36 @@ void main() {
     RayBlocks rb = rayBlocks(to, td, invTd, t0, j);
     float aheadExit = -1.0;  // the exit sample of the next block along the ray
 #endif
-#ifdef LAYOUT_BLOCK_WALK
-    // The brick walk: the outer loop enters one block per iteration (its
-    // skip data and the layout's page for it: one lookup per block, not per
-    // sample); the inner loop takes the block's samples. The same samples,
-    // in the same order, as the single loop below reading the block when k
-    // passes blockExit; on a SIMD rasteriser (llvmpipe runs both sides of
-    // every branch) the per-block reads leave the per-sample loop.
+#ifdef LAYOUT_BRICK_WALK
+    // The brick walk (ImageVis3D's and Gigavoxels' brick marching): the outer
+    // loop enters one brick cell of the layout per iteration and reads its
+    // page once (layoutEnterCell); the inner loop takes the samples before
+    // the ray leaves the cell, sampling that brick directly
+    // (sampleVolumeInCell, through fieldValue). The same samples, in the
+    // same order, as one loop; on a SIMD rasteriser (llvmpipe runs both sides
+    // of every branch for the whole group) the page read leaves the
+    // per-sample loop.
+    vec3 walkScale = invTd / layoutWalkCellsPerUnit();
+    vec3 walkBias = -to * invTd;
+    vec3 walkSide = step(0.0, td);
+    float walkInvStep = 1.0 / u_step;
+    float walkSampleBias = t0 * walkInvStep + j;
     for (int w = 0; w < MAX_STEPS; w++) {
       if (k >= u_maxSteps) break;
-      if (t0 + (k + j) * u_step >= t1) break;
-#if !defined(MODE_MIP)
+      float tw = t0 + (k + j) * u_step;
+      if (tw >= t1) break;
+#if !defined(MODE_MIP) && !defined(MODE_MINIP) && !defined(MODE_AVERAGE)
       if (acc.a >= u_ert) break;
 #endif
-      vec3 entered = enterBlock(to + (t0 + (k + j) * u_step) * td, k, rb, block, blockExit,
-                                aheadExit);
-      layoutEnterBlock((entered + 0.5) / u_blocksPerUnit);
+      vec3 walkCell = layoutEnterCell(to + tw * td);
+      // The first sample at or past the cell's exit face.
+      vec3 tb = (walkCell + walkSide) * walkScale + walkBias;
+      float cellExit =
+          max(ceil(min(min(tb.x, tb.y), tb.z) * walkInvStep - walkSampleBias), k + 1.0);
 #endif
     for (int i = 0; i < MAX_STEPS; i++) {
-#ifdef LAYOUT_BLOCK_WALK
-      if (k >= blockExit) break;
+#ifdef LAYOUT_BRICK_WALK
+      if (k >= cellExit) break;
 #endif
       if (k >= u_maxSteps) break;
       float t = t0 + (k + j) * u_step;
@@ -264,11 +272,9 @@ void main() {
       float kNext = k + 1.0;
       bool empty = false;
 #ifdef EMPTY_SPACE_SKIPPING
-#ifndef LAYOUT_BLOCK_WALK
       if (k >= blockExit) {
         enterBlock(p, k, rb, block, blockExit, aheadExit);
       }
-#endif
 #ifdef MODE_MIP
       empty = block.g <= maxValue;
 #else
@@ -370,7 +376,7 @@ void main() {
 #endif
       k = kNext;
     }
-#ifdef LAYOUT_BLOCK_WALK
+#ifdef LAYOUT_BRICK_WALK
     }
 #endif
   }

@@ -3,12 +3,12 @@
 // function, and with SHADING the light (render/shading.glsl, from sampleVolumeGradient). Techniques
 // call this instead of writing the chain in their main(), so a stage added here reaches all of
 // them.
-// With LAYOUT_BLOCK_WALK (the ray caster's brick walk, raycast.frag.glsl) a
-// sample's value comes from the block the ray is in (the layout's
-// sampleVolumeInBlock, its page read once per block); the gradient's
+// With LAYOUT_BRICK_WALK (the ray caster's brick walk, raycast.frag.glsl) a
+// sample's value comes from the brick cell the ray is in (the layout's
+// sampleVolumeInCell, its page read once per cell); the gradient's
 // neighbours may lie outside it and read through sampleVolume.
-#ifdef LAYOUT_BLOCK_WALK
-#define FIELD_SAMPLE sampleVolumeInBlock
+#ifdef LAYOUT_BRICK_WALK
+#define FIELD_SAMPLE sampleVolumeInCell
 #else
 #define FIELD_SAMPLE sampleVolume
 #endif

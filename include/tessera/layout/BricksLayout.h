@@ -56,6 +56,9 @@ struct BricksOptions {
   double uploadMsPerFrame = 40.0;  // stop uploading after this long in a frame
   double pixelsPerVoxel = 1.0;     // refine while a voxel covers more pixels
   int workers = 2;                 // reader threads
+  // The ray caster walks the bricks (one page read per brick cell a ray
+  // enters); false: a page read per sample (tests compare the two).
+  bool walk = true;
 };
 
 class BricksLayout final : public Layout, public StreamingLayout {
@@ -94,10 +97,7 @@ class BricksLayout final : public Layout, public StreamingLayout {
   int textureUnits() const override { return 1 + static_cast<int>(atlases_.size()); }
   ValueBlocks valueBlocks(int blockSize) const override;
   std::uint64_t contentVersion() const override { return contentVersion_; }
-  // A block inside one level-0 brick (the brick size a multiple of it).
-  bool walksBlocks(int blockSize) const override {
-    return blockSize > 0 && grid_.brickSize() % blockSize == 0;
-  }
+  bool walksBricks() const override { return walk_; }
 
   const lod::BrickGrid& grid() const override { return grid_; }
   const lod::MultiresSource& source() const { return *source_; }
@@ -164,6 +164,7 @@ class BricksLayout final : public Layout, public StreamingLayout {
   std::vector<std::uint16_t> cellMin_, cellMax_;  // stored range of what each cell samples
   std::uint64_t frame_ = 0;
   std::uint64_t contentVersion_ = 1;
+  bool walk_ = true;
   int atlasTexel_ = 0;       // BRICKS_TEXEL: how bricks.glsl reads a stored value
   bool classified_ = false;  // update() has seen a TF: transparent() may judge bricks
 };

@@ -88,12 +88,13 @@ class Layout {
   // compute it from the volume they were made from; a layout without one
   // (bricks streamed from disk) overrides it with its own metadata.
   virtual ValueBlocks valueBlocks(int blockSize) const;
-  // Whether the layout's GLSL offers the brick walk for empty-space blocks
-  // of blockSize^3 voxels (LAYOUT_BLOCK_WALK: layoutEnterBlock() once per
-  // block a ray enters, then sampleVolumeInBlock() for the samples inside
-  // it; render/raycast.frag.glsl). Layouts that look something up per
-  // sample (bricks: the page table) read it once per block that way.
-  virtual bool walksBlocks(int /*blockSize*/) const { return false; }
+  // Whether the layout's GLSL offers the brick walk (LAYOUT_BRICK_WALK,
+  // render/raycast.frag.glsl): layoutWalkCellsPerUnit(), the cells of its
+  // grid per texture-space unit; layoutEnterCell(p), read once when a ray
+  // enters the cell holding p, returning that cell; sampleVolumeInCell(p)
+  // for the samples inside it. Layouts that look something up per sample
+  // (bricks: the page table) read it once per cell that way.
+  virtual bool walksBricks() const { return false; }
   // Changes whenever what sampleVolume() returns may have changed (a
   // streamed layout's page table), so techniques rebuild their value blocks.
   virtual std::uint64_t contentVersion() const { return 0; }
