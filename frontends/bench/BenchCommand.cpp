@@ -398,7 +398,7 @@ void addBenchCommand(CLI::App& app) {
   for (const BenchFolder& f : kBenchFolders) cmd->add_option(f.name, (*o).*f.member, f.help);
   cmd->add_option(
       "--bricks", o->bricks,
-      "Large volumes through the bricks layout: generated head:WxHxD specs (e.g. "
+      "Large volumes through the bricks layout: generated head:WxHxD specs (head16: in u16; e.g. "
       "head:512x512x894 head:1024); per profile the first and refined image, rotating "
       "frame time while streaming (default 8 frames), levels, texture bytes vs the "
       "budget, bricks read, peak RSS, and the in-core layout as baseline where it fits");

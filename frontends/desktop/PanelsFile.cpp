@@ -4,13 +4,14 @@
 #include <string>
 
 #include "DesktopApp.h"
+#include "tessera/lod/ProceduralMultiresSource.h"
 
 namespace tessera::desktop {
 
 namespace {
 
 bool generated(const std::string& spec) {
-  return spec.rfind("gen:", 0) == 0 || spec.rfind("head:", 0) == 0;
+  return spec.rfind("gen:", 0) == 0 || lod::ProceduralMultiresSource::isSpec(spec);
 }
 
 // Files and folders (not generated volumes) go to the recent list, by their

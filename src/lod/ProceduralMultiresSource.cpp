@@ -12,6 +12,11 @@ namespace tessera::lod {
 namespace {
 
 constexpr const char* kPrefix = "head:";
+constexpr const char* kPrefix16 = "head16:";
+
+bool sixteenBits(const std::string& spec) {
+  return spec.rfind(kPrefix16, 0) == 0;
+}
 
 // Integer lattice hash -> [0, 1).
 double hash3(int x, int y, int z) {
@@ -44,9 +49,11 @@ double valueNoise(glm::dvec3 p) {
 
 glm::ivec3 parseDims(const std::string& spec) {
   if (!ProceduralMultiresSource::isSpec(spec)) {
-    throw InputError("'" + spec + "': expected head:WxHxD or head:N (a generated large volume)");
+    throw InputError("'" + spec +
+                     "': expected head:WxHxD or head:N (a generated large volume; head16: for "
+                     "u16)");
   }
-  const std::string size = spec.substr(std::string(kPrefix).size());
+  const std::string size = spec.substr(std::string(sixteenBits(spec) ? kPrefix16 : kPrefix).size());
   std::vector<int> parts;
   std::size_t b = 0;
   while (true) {
@@ -73,15 +80,18 @@ glm::ivec3 parseDims(const std::string& spec) {
 }  // namespace
 
 bool ProceduralMultiresSource::isSpec(const std::string& spec) {
-  return spec.rfind(kPrefix, 0) == 0;
+  return spec.rfind(kPrefix, 0) == 0 || sixteenBits(spec);
 }
 
 ProceduralMultiresSource::ProceduralMultiresSource(const std::string& spec, int coarsestSide)
     : spec_(spec) {
   const glm::ivec3 d = parseDims(spec);
   dims_ = pyramidDims(d, coarsestSide);
-  shape_ = Volume::shapeOnly(d, ScalarType::U8);
-  shape_.setWindow({0.0, 255.0});
+  sixteen_ = sixteenBits(spec);
+  shape_ = Volume::shapeOnly(d, sixteen_ ? ScalarType::U16 : ScalarType::U8);
+  const double top = sixteen_ ? 65535.0 : 255.0;
+  shape_.setValueRange({0.0, top});
+  shape_.setWindow({0.0, top});
   shape_.setDescription("generated: " + spec + " (computed brick by brick)");
   shape_.setGeometrySource("generated");
 }
@@ -110,6 +120,16 @@ double ProceduralMultiresSource::valueAt(glm::dvec3 x) const {
   return tissue;
 }
 
+double ProceduralMultiresSource::value16At(glm::dvec3 x) const {
+  const double v = valueAt(x);
+  if (v <= 0.0) return 0.0;
+  // The 8-bit field times 257, and a fine texture of up to 200 (less than
+  // one 8-bit step) that only 16-bit storage keeps.
+  const glm::dvec3 d(shape_.dims());
+  const glm::dvec3 q = (x - 0.5 * d) / (0.5 * std::max({d.x, d.y, d.z}));
+  return std::min(65535.0, v * 257.0 + 200.0 * valueNoise(q * 64.0 + 3.1));
+}
+
 Volume ProceduralMultiresSource::readBox(int level, const VoxelBox& box) const {
   const LevelInfo info = levelInfo(level);
   if (box.count() == 0 || glm::any(glm::lessThan(box.begin, glm::ivec3(0))) ||
@@ -117,17 +137,22 @@ Volume ProceduralMultiresSource::readBox(int level, const VoxelBox& box) const {
     throw Error(spec_ + ": box outside level " + std::to_string(level));
   }
   const glm::ivec3 s = box.size();
-  Volume out = Volume::allocate(s, ScalarType::U8, spec_ + " box");
+  Volume out = Volume::allocate(s, shape_.type(), spec_ + " box");
   const double scale = static_cast<double>(1 << level);
   out.setSpacing(glm::dvec3(scale));
   out.setOrigin((glm::dvec3(box.begin) + 0.5) * scale - 0.5);
   out.setWindow(shape_.window());
   std::uint8_t* dst = out.dataAs<std::uint8_t>();
+  std::uint16_t* dst16 = out.dataAs<std::uint16_t>();
   for (int z = 0; z < s.z; ++z) {
     for (int y = 0; y < s.y; ++y) {
       for (int x = 0; x < s.x; ++x) {
         const glm::dvec3 c = (glm::dvec3(box.begin + glm::ivec3(x, y, z)) + 0.5) * scale;
-        *dst++ = static_cast<std::uint8_t>(std::lround(valueAt(c)));
+        if (sixteen_) {
+          *dst16++ = static_cast<std::uint16_t>(std::lround(value16At(c)));
+        } else {
+          *dst++ = static_cast<std::uint8_t>(std::lround(valueAt(c)));
+        }
       }
     }
   }

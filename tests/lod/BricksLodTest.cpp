@@ -3,6 +3,8 @@
 // streamer's cache, retries and failures.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <algorithm>
 #include <chrono>
 #include <memory>
@@ -178,6 +180,27 @@ TEST(BricksLod, GeneratedVolumeComputesAnyBoxConsistently) {
   EXPECT_EQ(big.valueAt(50, 40, 30), std::lround(src.valueAt({101.0, 81.0, 61.0})));
   EXPECT_THROW(lod::ProceduralMultiresSource("head:0"), InputError);
   EXPECT_THROW(lod::ProceduralMultiresSource("head:12x12"), InputError);
+}
+
+// head16: the same head in u16: the 8-bit field times 257 plus a texture
+// finer than one 8-bit step, so 16-bit bricks have something to keep.
+TEST(BricksLod, GeneratedSixteenBitHeadIsTheEightBitHeadWidened) {
+  const lod::ProceduralMultiresSource u8("head:96x80x64"), u16("head16:96x80x64");
+  EXPECT_EQ(u16.shape().type(), ScalarType::U16);
+  EXPECT_EQ(u16.shape().valueRange().max, 65535.0);
+  EXPECT_EQ(u16.levelCount(), u8.levelCount());
+  const Volume a = u8.readBox(0, {{10, 20, 30}, {60, 50, 40}});
+  const Volume b = u16.readBox(0, {{10, 20, 30}, {60, 50, 40}});
+  ASSERT_EQ(b.type(), ScalarType::U16);
+  std::size_t fine = 0;
+  for (std::size_t i = 0; i < a.voxelCount(); ++i) {
+    const double wide = b.valueAtIndex(i), narrow = a.valueAtIndex(i);
+    ASSERT_GE(wide, narrow * 257.0 - 129.0) << i;
+    ASSERT_LE(wide, narrow * 257.0 + 329.0) << i;  // < 0.5 rounding + 200 texture
+    fine += narrow > 0 && std::fmod(wide, 257.0) != 0.0;
+  }
+  EXPECT_GT(fine, a.voxelCount() / 4) << "the low byte carries a texture";
+  EXPECT_THROW(lod::ProceduralMultiresSource("head16:0"), InputError);
 }
 
 TEST(BricksLod, WithoutWorkerThreadsRequestReadsInline) {

@@ -19,7 +19,9 @@ namespace tessera::lod {
 
 class ProceduralMultiresSource final : public MultiresSource {
  public:
-  // "head:WxHxD" (or "head:N" for a cube). InputError on anything else.
+  // "head:WxHxD" (or "head:N" for a cube); "head16:..." the same head in
+  // u16 (the 8-bit field times 257 plus a texture finer than one 8-bit
+  // step). InputError on anything else.
   static bool isSpec(const std::string& spec);
   explicit ProceduralMultiresSource(const std::string& spec, int coarsestSide = 16);
 
@@ -32,11 +34,14 @@ class ProceduralMultiresSource final : public MultiresSource {
   // The field at level-0 continuous voxel coordinate x (voxel centres at
   // i + 0.5), 0 .. 255.
   double valueAt(glm::dvec3 x) const;
+  // The head16: field, 0 .. 65535.
+  double value16At(glm::dvec3 x) const;
 
  private:
   std::string spec_;
   Volume shape_;
   std::vector<glm::ivec3> dims_;
+  bool sixteen_ = false;
 };
 
 }  // namespace tessera::lod
