@@ -686,8 +686,14 @@ import { TesseraViewer } from './tessera.js';
   // Drag and drop of files anywhere on the page (the 3D view shows the
   // hint); a visible file input keeps its own drops.
   const view = $('view');
-  const carriesFiles = (e) => !!e.dataTransfer && Array.from(e.dataTransfer.types || []).includes('Files') &&
-    !(e.target instanceof Element && e.target.closest('input[type=file]'));
+  // Files or folders: the 'Files' type, or (where a browser leaves types
+  // empty) a file item or file.
+  const carriesFiles = (e) => {
+    const dt = e.dataTransfer;
+    if (!dt || (e.target instanceof Element && e.target.closest('input[type=file]'))) return false;
+    return Array.from(dt.types || []).includes('Files') ||
+      Array.from(dt.items || []).some((i) => i.kind === 'file') || (dt.files && dt.files.length > 0);
+  };
   let dragDepth = 0;  // dragenter/dragleave pairs of the elements crossed
   document.addEventListener('dragenter', (e) => {
     if (!carriesFiles(e)) return;

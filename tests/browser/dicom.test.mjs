@@ -43,7 +43,7 @@ async function dicomFolder(context, url, tmp, run) {
         return { readEntries: (ok) => { const b = given ? [] : files.map(fileEntry); given = true; ok(b); } };
       } };
       const e = new Event('drop', { bubbles: true, cancelable: true });
-      Object.defineProperty(e, 'dataTransfer', { value: { files: [], items: [{ kind: 'file', webkitGetAsEntry: () => dir }] } });
+      Object.defineProperty(e, 'dataTransfer', { value: { types: ['Files'], files: [], items: [{ kind: 'file', webkitGetAsEntry: () => dir }] } });
       document.getElementById('error').hidden = true;
       document.getElementById('view').dispatchEvent(e);
     }, { folderName, which });

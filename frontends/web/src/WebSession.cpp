@@ -99,10 +99,15 @@ struct ViewKnobs {
   render::QualityController::Options adaptive;  // its frame-time goal
 
   static ViewKnobs of(viewer::Viewer& v) {
-    ViewKnobs k{
-        v.quality,     v.maxVolumePixels, v.showBoundingBox,        v.showAxes,
-        v.progressive, v.frameBudgetMs,   v.clipPlaneFollowsCamera, v.followingPlaneDistance,
-        std::nullopt};
+    ViewKnobs k;
+    k.quality = v.quality;
+    k.maxVolumePixels = v.maxVolumePixels;
+    k.showBoundingBox = v.showBoundingBox;
+    k.showAxes = v.showAxes;
+    k.progressive = v.progressive;
+    k.frameBudgetMs = v.frameBudgetMs;
+    k.clipPlaneFollowsCamera = v.clipPlaneFollowsCamera;
+    k.followingPlaneDistance = v.followingPlaneDistance;
     if (v.labelsOn()) k.labels = v.labelTable();
     k.adaptive = v.qualityController().options();
     return k;

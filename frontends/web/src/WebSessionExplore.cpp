@@ -28,10 +28,6 @@ std::string dimsText(const glm::ivec3& d) {
   return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
 }
 
-std::string rangeText(const lod::VoxelBox& box, int a) {
-  return std::to_string(box.begin[a]) + ":" + std::to_string(box.end[a]);
-}
-
 }  // namespace
 
 // Another volume opened through the session ends its exploration there
