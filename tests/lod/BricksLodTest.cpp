@@ -3,6 +3,8 @@
 // streamer's cache, retries and failures.
 #include <gtest/gtest.h>
 
+#include "support/BricksTestSupport.h"
+
 #include <cmath>
 
 #include <algorithm>
@@ -284,17 +286,7 @@ TEST(BricksLod, MeanPyramidBoundHoldsForEveryBrickUnderEveryAncestor) {
   ASSERT_TRUE(source->meanPyramid());
   const lod::BrickGrid grid = lod::BrickGrid::of(*source, 8);
   const lod::StoredMapping identity = lod::StoredMapping::of(source->shape());
-  std::vector<std::unordered_map<std::uint64_t, lod::BrickRange>> ranges(grid.levelCount());
-  for (int l = 0; l < grid.levelCount(); ++l) {
-    const glm::ivec3 n = grid.bricks(l);
-    for (int z = 0; z < n.z; ++z)
-      for (int y = 0; y < n.y; ++y)
-        for (int x = 0; x < n.x; ++x) {
-          const lod::BrickKey k{l, {x, y, z}};
-          const lod::StoredBrick b = lod::readStoredBrick(*source, grid, k, identity);
-          ranges[l][k.id()] = {b.min, b.max};
-        }
-  }
+  auto ranges = test::storedRanges(*source, grid, identity);
   int checked = 0, dimAncestorOfBright = 0;
   for (int l = 0; l + 1 < grid.levelCount(); ++l) {
     const glm::ivec3 n = grid.bricks(l);

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "support/BricksTestSupport.h"
 #include "support/EachApi.h"
 #include "support/GpuTestContext.h"
 #include "support/TestCameras.h"
@@ -33,21 +34,11 @@ namespace {
 constexpr int kImage = 96;
 
 layout::BricksOptions levelZero(int b, bool walk = true) {
-  layout::BricksOptions o;
-  o.walk = walk;
-  o.brickSize = b;
-  o.pixelsPerVoxel = 0.05;  // every brick at level 0
-  o.workers = 0;            // inline reads: deterministic residency
-  return o;
+  return test::levelZeroBricks(b, walk);
 }
 
 void refine(layout::BricksLayout& bricks, const Camera& cam, const TransferFunction& tf) {
-  for (int frame = 1; frame <= 400; ++frame) {
-    const layout::BricksFrame f = bricks.update(cam, kImage, kImage, tf);
-    if (f.complete) return;
-    if (f.uploaded == 0) bricks.waitForBricks(20.0);
-  }
-  ADD_FAILURE() << "bricks never completed";
+  test::refineBricks(bricks, cam, tf, kImage);
 }
 
 // Shepp-Logan widened to u16 with a ramp along x (the low byte varies).

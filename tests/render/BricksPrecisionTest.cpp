@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "support/BricksTestSupport.h"
 #include "support/EachApi.h"
 #include "support/GpuTestContext.h"
 #include "support/TestCameras.h"
@@ -52,21 +53,10 @@ std::shared_ptr<Volume> phantom(ScalarType type, double lo, double hi, glm::ivec
   return v;
 }
 
-layout::BricksOptions levelZeroBricks(int b) {
-  layout::BricksOptions o;
-  o.brickSize = b;
-  o.pixelsPerVoxel = 0.05;  // every brick at level 0 for these small volumes
-  o.workers = 0;            // inline reads: deterministic residency
-  return o;
-}
+using test::levelZeroBricks;
 
 void refine(layout::BricksLayout& bricks, const Camera& cam, const TransferFunction& tf) {
-  for (int frame = 1; frame <= 400; ++frame) {
-    const layout::BricksFrame f = bricks.update(cam, kImage, kImage, tf);
-    if (f.complete) return;
-    if (f.uploaded == 0) bricks.waitForBricks(20.0);
-  }
-  ADD_FAILURE() << "bricks never completed";
+  test::refineBricks(bricks, cam, tf, kImage);
 }
 
 // Every voxel centre through sampleVolume() equals the voxel's raw value
