@@ -19,6 +19,10 @@ PACKAGES=(
   libopenjp2-tools openjph-tools                         # JPEG 2000 and HTJ2K encoders, for the tests' data
   python3-zarr python3-numcodecs nginx-light             # zarr-python interop tests; nginx serves stores in HTTP tests
   python3-vtk9 python3-matplotlib                        # bench/peers: VTK side by side (PNGs, plots) and its smoke tests
+  orthanc orthanc-dicomweb                               # a real PACS (DICOMweb) started by the DICOMweb tests on loopback
+  pybind11-dev python3-pybind11 python3-pytest           # the Python module (import tessera) and its tests
+  python3-ipywidgets python3-ipykernel python3-nbclient python3-nbconvert  # Jupyter display, widget, the example notebook run headless
+  python3-dask python3-distributed                       # tessera.zarr.write_pyramid on a dask cluster
 )
 
 # playwright-core for the browser test, pinned by tests/browser/package-lock.json;
