@@ -177,8 +177,11 @@ def make_nifti(c):
            "dim[3] is 2147483648", nifti_header((1, 1, 1 << 31), version=2, big=True) + bytes(64))
     c.case("nifti/2d-image.nii", f, "dim[0] = 2", "dim[0] is 2",
            nifti_header((4, 3, 1), ndim=2) + bytes(12))
-    c.case("nifti/time-series.nii", f, "dim[0] = 4 with 5 time points", "dim[4] is 5",
-           nifti_header((2, 2, 2), ndim=4, extra_dims=(5, 1, 1, 1)) + bytes(40))
+    c.case("nifti/vector-image.nii", f, "dim[0] = 5 with 3 vector components", "dim[5] is 3",
+           nifti_header((2, 2, 2), ndim=5, extra_dims=(1, 3, 1, 1)) + bytes(24))
+    c.case("nifti/time-series-short.nii", f, "5 time points declared, data for 2",
+           "past the end|file has|truncated|beyond",
+           nifti_header((2, 2, 2), ndim=4, extra_dims=(5, 1, 1, 1)) + bytes(16))
     c.case("nifti/bad-magic.nii", f, "magic 'xyz' instead of 'n+1'", "magic",
            nifti_header(magic=b"xyz\0") + bytes(24))
     c.case("nifti/bad-sizeof-hdr.nii", f, "sizeof_hdr 349", "sizeof_hdr is 349",

@@ -82,7 +82,8 @@ inline void addVolumeOptions(CLI::App* cmd, std::string& file, std::string& seri
 // --time and --channel: which 3D volume of a 4D/5D (t, c, z, y, x) OME-Zarr
 // image the command reads.
 inline void addTimeChannelOptions(CLI::App* cmd, int& time, int& channel) {
-  cmd->add_option("--time", time, "OME-Zarr: time point to read from a t axis (default 0)")
+  cmd->add_option("--time", time,
+                  "time point to read: an OME-Zarr t axis or a 4-D NIfTI (0-based, default 0)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--channel", channel, "OME-Zarr: channel to read from a c axis (default 0)")
       ->check(CLI::NonNegativeNumber);

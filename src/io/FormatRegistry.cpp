@@ -205,6 +205,10 @@ std::vector<VolumeFormat> makeFormats() {
         "inside gzip";
     n.sniff = sniffNifti;
     n.read = [](const ByteSource& s, const FileSet& fs) { return readNifti(s, fs); };
+    n.timePoints = [](const ByteSource& s) { return niftiTimePoints(s); };
+    n.readTimePoint = [](const ByteSource& s, const FileSet& fs, int t) {
+      return readNifti(s, fs, t);
+    };
     n.loses = "nothing (sform and qform hold the affine)";
     n.nativeWrite = "nifticlib, zlib";
     n.browserReads = true;

@@ -258,7 +258,7 @@ void validate(const Header& h, const std::string& p) {
   if (ndim < 3 || ndim > 7) {
     throw InputError(p + ": dim[0] is " + std::to_string(ndim) +
                      (ndim == 1 || ndim == 2 ? " (a " + std::to_string(ndim) + "-D image)" : "") +
-                     "; Tessera reads 3-D volumes (dim[0] = 3, or 4 with a single time point)");
+                     "; Tessera reads 3-D volumes and 4-D time series (dim[0] = 3 or 4)");
   }
   for (int a = 1; a <= 3; ++a) {
     if (h.dim[a] <= 0 || h.dim[a] > kMaxDim) {
@@ -266,11 +266,17 @@ void validate(const Header& h, const std::string& p) {
                        ", expected 1.." + std::to_string(kMaxDim));
     }
   }
-  for (int a = 4; a <= ndim; ++a) {
+  // dim[4] is time (NIfTI-1 §dim): any number of time points, one read at
+  // a time. dim[5..7] (vector components, further axes) must be 1.
+  if (ndim >= 4 && (h.dim[4] <= 0 || h.dim[4] > kMaxDim)) {
+    throw InputError(p + ": dim[4] (time points) is " + std::to_string(h.dim[4]) +
+                     ", expected 1.." + std::to_string(kMaxDim));
+  }
+  for (int a = 5; a <= ndim; ++a) {
     if (h.dim[a] != 1) {
       throw InputError(p + ": dim[" + std::to_string(a) + "] is " + std::to_string(h.dim[a]) +
                        " (dim[0] = " + std::to_string(ndim) +
-                       "); only a single 3-D volume is supported, expected 1");
+                       "); vector or 5-D images are not supported, expected 1");
     }
   }
   for (int a = 1; a <= 3; ++a) {
@@ -287,6 +293,10 @@ void validate(const Header& h, const std::string& p) {
                      ", expected a finite value >= 0");
   }
   diskTypeOf(h.datatype, p);
+}
+
+int timePointsOf(const Header& h) {
+  return h.dim[0] >= 4 ? static_cast<int>(h.dim[4]) : 1;
 }
 
 // The .img of a .hdr (or of a .nii with magic "ni1"/"ni2"), as nifticlib's
@@ -309,14 +319,28 @@ std::unique_ptr<ByteSource> openImageFile(const ByteSource& header, const FileSe
 
 }  // namespace
 
-Volume readNifti(const std::filesystem::path& path) {
-  return readNifti(FileSource(path), FolderFiles());
+Volume readNifti(const std::filesystem::path& path, int time) {
+  return readNifti(FileSource(path), FolderFiles(), time);
 }
 
-Volume readNifti(const ByteSource& file, const FileSet& files) {
+int niftiTimePoints(const ByteSource& file) {
+  const Header h = readHeader(file);
+  validate(h, file.name());
+  return timePointsOf(h);
+}
+
+Volume readNifti(const ByteSource& file, const FileSet& files, int time) {
   const std::string& p = file.name();
   const Header h = readHeader(file);
   validate(h, p);
+  const int timePoints = timePointsOf(h);
+  if (time < 0 || time >= timePoints) {
+    throw InputError(p + ": time point " + std::to_string(time) +
+                     " asked for, but the file holds " +
+                     (timePoints == 1 ? std::string("one volume (time point 0)")
+                                      : std::to_string(timePoints) + " (time points 0.." +
+                                            std::to_string(timePoints - 1) + ")"));
+  }
 
   io_detail::VoxelFormat format;
   format.dims = glm::ivec3(static_cast<int>(h.dim[1]), static_cast<int>(h.dim[2]),
@@ -357,6 +381,24 @@ Volume readNifti(const ByteSource& file, const FileSet& files) {
     offset = std::max<std::uint64_t>(
         offset, static_cast<std::uint64_t>(h.version == 2 ? kNifti2HeaderSize : kNifti1HeaderSize));
   }
+  // Time point t follows t whole volumes (NIfTI stores i fastest, then j,
+  // k, t). Each factor is at most kMaxDim, so the products fit 64 bits; the
+  // loader checks the end against what the file holds. A series shorter
+  // than its header is refused whichever time point is asked for (as
+  // nibabel does), where the file size tells without inflating it.
+  const std::uint64_t volumeBytes =
+      static_cast<std::uint64_t>(format.dims.x) * static_cast<std::uint64_t>(format.dims.y) *
+      static_cast<std::uint64_t>(format.dims.z) * io_detail::diskTypeSize(format.type);
+  if (timePoints > 1 && !gzipped &&
+      offset + static_cast<std::uint64_t>(timePoints) * volumeBytes > data.size()) {
+    const std::uint64_t whole = data.size() > offset ? (data.size() - offset) / volumeBytes : 0;
+    throw InputError(p + ": header says " + std::to_string(timePoints) + " time points of " +
+                     formatBytes(volumeBytes) + " from offset " + std::to_string(offset) +
+                     ", but " + (image ? data.name() : std::string("the file")) + " (" +
+                     formatBytes(data.size()) + ") holds " + std::to_string(whole) +
+                     " complete ones: truncated");
+  }
+  offset += static_cast<std::uint64_t>(time) * volumeBytes;
 
   io_detail::VoxelSource source;
   source.file = &data;
@@ -382,6 +424,9 @@ Volume readNifti(const ByteSource& file, const FileSet& files) {
     description += ", converted to f32";
   } else if (format.type == DiskType::I8) {
     description += ", widened to i16";
+  }
+  if (timePoints > 1) {
+    description += ", time point " + std::to_string(time) + " of " + std::to_string(timePoints);
   }
   v.setDescription(description + ")");
   return v;

@@ -39,11 +39,19 @@ Volume readVolume(const std::string& spec, const ReadOptions& options) {
     std::fprintf(stderr, "note: %s: %s\n", spec.c_str(), note.c_str());
     return v;
   }
-  if (options.time != 0 || options.channel != 0) {
-    throw InputError(spec + ": --time/--channel select within an OME-Zarr store; this is not one");
+  if (options.channel != 0) {
+    throw InputError(spec + ": --channel selects within an OME-Zarr store; this is not one");
   }
+  auto noTime = [&] {
+    if (options.time != 0) {
+      throw InputError(spec +
+                       ": --time selects a time point of an OME-Zarr store or a 4-D NIfTI file; "
+                       "this is neither");
+    }
+  };
   if (spec.rfind("gen:", 0) == 0) {
     notDicom();
+    noTime();
     return makeProcedural(spec);
   }
   const std::filesystem::path path(spec);
@@ -54,14 +62,33 @@ Volume readVolume(const std::string& spec, const ReadOptions& options) {
   }
   // A folder is a DICOM series (the only file format that is a folder; an
   // OME-Zarr store was recognised above by its metadata files).
-  if (std::filesystem::is_directory(path, ec)) return readDicomFolder(path, options.dicomSeries);
+  if (std::filesystem::is_directory(path, ec)) {
+    noTime();
+    return readDicomFolder(path, options.dicomSeries);
+  }
   const FileSource file(path);
   const VolumeFormat& format = chooseReadFormat(file);
   // DICOM from disk: the decoder that reads every syntax of the series
   // (DCMTK in the native build), from the files beside it.
-  if (format.id == "dicom") return readDicomFolder(path, options.dicomSeries);
+  if (format.id == "dicom") {
+    noTime();
+    return readDicomFolder(path, options.dicomSeries);
+  }
   notDicom();
-  return format.read(file, FolderFiles());
+  if (!format.timePoints) {
+    noTime();
+    return format.read(file, FolderFiles());
+  }
+  // A time series: which time point is shown, of how many, is for the
+  // user to know (the default is the first).
+  const int timePoints = format.timePoints(file);
+  Volume v = format.readTimePoint(file, FolderFiles(), options.time);
+  if (timePoints > 1) {
+    std::fprintf(stderr,
+                 "note: %s: %d time points; reading time point %d (--time T reads another)\n",
+                 spec.c_str(), timePoints, options.time);
+  }
+  return v;
 }
 
 Volume readVolume(const ByteSource& file, const FileSet& files) {

@@ -8,6 +8,7 @@
 
 #include "support/CliRunner.h"
 #include "support/TestSupport.h"
+#include "tessera/io/NiftiReader.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/io/VolumeReader.h"
 #include "tessera/io/VolumeWriter.h"
@@ -23,6 +24,34 @@ void expectSameVoxels(const tessera::Volume& a, const tessera::Volume& b) {
   ASSERT_TRUE(std::equal(a.bytes().begin(), a.bytes().end(), b.bytes().begin()));
 }
 }  // namespace
+
+// A 4-D NIfTI (nibabel's fMRI example, 2 mm, 3 time points): --time picks
+// the volume, the default is the first with a note, and a time point past
+// the end is refused naming the file and the count.
+TEST(ConvertCommand, TimePointOfA4DNiftiIsConvertedAndOthersAreRefused) {
+  const std::string series = "/usr/lib/python3/dist-packages/nibabel/tests/data/example4d.nii.gz";
+  if (!fs::exists(series)) GTEST_SKIP() << series << " (python3-nibabel's test data) is missing";
+  const tessera::test::TempDir tmp;
+  const int timePoints = tessera::niftiTimePoints(tessera::FileSource(series));
+  ASSERT_GT(timePoints, 1);
+  for (const int t : {0, timePoints - 1}) {
+    const auto out = tmp / ("t" + std::to_string(t) + ".nii");
+    const auto r = runCli("convert " + series + (t ? " --time " + std::to_string(t) : "") + " " +
+                          out.string() + " --quiet");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("note: " + series + ": " + std::to_string(timePoints) +
+                         " time points; reading time point " + std::to_string(t)),
+              std::string::npos)
+        << r.err;
+    expectSameVoxels(tessera::readVolume(out.string()), tessera::readNifti(series, t));
+  }
+  const auto past = runCli("info " + series + " --time " + std::to_string(timePoints));
+  EXPECT_EQ(past.exitCode, 1);
+  EXPECT_NE(past.err.find(series + ": time point " + std::to_string(timePoints) +
+                          " asked for, but the file holds " + std::to_string(timePoints)),
+            std::string::npos)
+      << past.err;
+}
 
 TEST(ConvertCommand, EveryFormatRoundTripsExactly) {
   const tessera::test::TempDir tmp;

@@ -219,7 +219,15 @@ TEST(ZarrCommand, BadOptionsAreRefusedBeforeReading) {
   }
   const auto t = runCli("info gen:sphere:16 --time 1");
   EXPECT_EQ(t.exitCode, 1);
-  EXPECT_NE(t.err.find("--time/--channel"), std::string::npos) << t.err;
+  EXPECT_NE(t.err.find("gen:sphere:16: --time selects a time point of an OME-Zarr store or a "
+                       "4-D NIfTI file; this is neither"),
+            std::string::npos)
+      << t.err;
+  const auto c = runCli("info gen:sphere:16 --channel 1");
+  EXPECT_EQ(c.exitCode, 1);
+  EXPECT_NE(c.err.find("gen:sphere:16: --channel selects within an OME-Zarr store"),
+            std::string::npos)
+      << c.err;
 }
 
 }  // namespace

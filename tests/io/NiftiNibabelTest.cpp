@@ -3,12 +3,16 @@
 // nibabel with ours. Skipped when Debian's python3 has no nibabel.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <fstream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "io/GeometryFixtures.h"
 #include "support/Nibabel.h"
+#include "tessera/core/Error.h"
 #include "tessera/core/PatientFrame.h"
 #include "tessera/io/NiftiReader.h"
 #include "tessera/io/NiftiWriter.h"
@@ -176,6 +180,79 @@ TEST(NiftiNibabel, NibabelReadsOurObliqueAndReflectedFramesFromBothForms) {
     test::expectAffineNear(test::affineFromRows(back.at("affine")), affine, 1e-6);
     // The qform (quaternion + qfac) is the same frame: no shear here.
     test::expectAffineNear(test::affineFromRows(back.at("qform")), affine, 1e-6);
+  }
+}
+
+// nibabel's own 4-D test files (fMRI time series, one gzipped, one plain):
+// each time point is written by nibabel as float64 (scaling applied) for
+// the reader's time point to be compared voxel for voxel.
+constexpr const char* kTimeSeries = R"PY(
+import json, os, sys
+import numpy as np
+import nibabel as nib
+out = sys.argv[1]
+data = os.path.join(os.path.dirname(nib.__file__), 'tests', 'data')
+result = {}
+for name in ('example4d.nii.gz', 'functional.nii'):
+    path = os.path.join(data, name)
+    if not os.path.exists(path):
+        continue
+    img = nib.load(path)
+    n = img.shape[3]
+    points = sorted({0, n // 2, n - 1})
+    for t in points:
+        np.asarray(img.dataobj[..., t], dtype=np.float64).ravel(order='F').tofile(
+            os.path.join(out, '%s.%d.f64' % (name, t)))
+    result[name] = {'path': path, 'shape': list(img.shape), 'points': points,
+                    'affine': img.affine.tolist()}
+print(json.dumps(result))
+)PY";
+
+TEST(NiftiNibabel, EachTimePointOfA4DFileIsNibabelsVolumeAtThatTime) {
+  if (const auto why = test::nibabelMissing()) GTEST_SKIP() << *why;
+  TempDir dir;
+  const auto files = nlohmann::json::parse(test::runPython(dir, kTimeSeries, dir.path().string()));
+  if (files.empty()) GTEST_SKIP() << "nibabel's test data (example4d.nii.gz) is not installed";
+  for (const auto& [name, f] : files.items()) {
+    SCOPED_TRACE(name);
+    const auto shape = f.at("shape").get<std::vector<int>>();
+    ASSERT_EQ(shape.size(), 4u);
+    const FileSource file(f.at("path").get<std::string>());
+    EXPECT_EQ(niftiTimePoints(file), shape[3]);
+    for (const int t : f.at("points").get<std::vector<int>>()) {
+      SCOPED_TRACE("time point " + std::to_string(t));
+      const Volume v = readNifti(file, FolderFiles(), t);
+      ASSERT_EQ(v.dims(), glm::ivec3(shape[0], shape[1], shape[2]));
+      test::expectAffineNear(v.indexToWorld(), test::affineFromRows(f.at("affine")), 1e-5);
+      EXPECT_NE(v.description().find("time point " + std::to_string(t) + " of " +
+                                     std::to_string(shape[3])),
+                std::string::npos)
+          << v.description();
+      std::ifstream in(dir / (name + "." + std::to_string(t) + ".f64"), std::ios::binary);
+      std::vector<double> expected(v.voxelCount());
+      in.read(reinterpret_cast<char*>(expected.data()),
+              static_cast<std::streamsize>(expected.size() * sizeof(double)));
+      ASSERT_TRUE(in) << "nibabel's time point is missing";
+      std::size_t differing = 0;
+      for (std::size_t i = 0; i < expected.size(); ++i) {
+        if (std::abs(v.valueAtIndex(i) - expected[i]) > 1e-4 * (1.0 + std::abs(expected[i]))) {
+          ++differing;
+        }
+      }
+      EXPECT_EQ(differing, 0u);
+    }
+    // Past the last time point: refused, naming the file and the count.
+    try {
+      readNifti(file, FolderFiles(), shape[3]);
+      ADD_FAILURE() << "time point " << shape[3] << " was read";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(
+                    f.at("path").get<std::string>() + ": time point " + std::to_string(shape[3]) +
+                    " asked for, but the file holds " + std::to_string(shape[3]) +
+                    " (time points 0.." + std::to_string(shape[3] - 1) + ")"),
+                std::string::npos)
+          << e.what();
+    }
   }
 }
 

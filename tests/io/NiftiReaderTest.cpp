@@ -288,11 +288,51 @@ TEST(NiftiReaderRejects, WrongDimensionality) {
   }
   {
     NiftiFields f;
+    f.dim[0] = 5;
+    f.dim[5] = 3;  // three vector components per voxel
+    const auto path = writeNifti(dir, "5d.nii", f, voxelBytes(ramp(72), false));
+    expectRejected<InputError>([&] { readNifti(path); }, {path.string(), "dim[5] is 3"});
+  }
+  {
+    // 10 time points declared, the data for 6: refused whichever is asked.
+    NiftiFields f;
     f.dim[0] = 4;
     f.dim[4] = 10;
-    const auto path = writeNifti(dir, "4d.nii", f, voxelBytes(ramp(240), false));
-    expectRejected<InputError>([&] { readNifti(path); }, {path.string(), "dim[4] is 10"});
+    const auto path = writeNifti(dir, "short4d.nii", f, voxelBytes(ramp(144), false));
+    for (const int t : {0, 5, 6}) {
+      expectRejected<InputError>(
+          [&] { readNifti(path, t); },
+          {path.string(), "header says 10 time points of 24 B", "holds 6 complete ones"});
+    }
   }
+}
+
+// A 4-D file (4x3x2 voxels, 10 time points, the ramp running through all of
+// them): time point t is the t-th block of 24 voxels, i fastest.
+TEST(NiftiReader, TimePointsOfA4DFileAreConsecutiveVolumes) {
+  TempDir dir;
+  NiftiFields f;
+  f.dim[0] = 4;
+  f.dim[4] = 10;
+  const auto values = ramp(240);
+  const auto path = writeNifti(dir, "4d.nii", f, voxelBytes(values, false));
+  EXPECT_EQ(niftiTimePoints(FileSource(path)), 10);
+  for (const int t : {0, 3, 9}) {
+    const Volume v = readNifti(path, t);
+    ASSERT_EQ(v.dims(), glm::ivec3(4, 3, 2));
+    for (int k = 0; k < 2; ++k) {
+      for (int j = 0; j < 3; ++j) {
+        for (int i = 0; i < 4; ++i) {
+          ASSERT_EQ(v.valueAt(i, j, k),
+                    values[static_cast<std::size_t>(t * 24 + i + 4 * (j + 3 * k))])
+              << "t " << t << " voxel " << i << "," << j << "," << k;
+        }
+      }
+    }
+  }
+  expectRejected<InputError>([&] { readNifti(path, 10); },
+                             {path.string(), "time point 10 asked for, but the file holds 10"});
+  expectRejected<InputError>([&] { readNifti(path, -1); }, {path.string(), "time point -1"});
 }
 
 TEST(NiftiReaderRejects, NanAndZeroVoxelSize) {

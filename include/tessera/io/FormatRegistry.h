@@ -67,6 +67,11 @@ struct VolumeFormat {
   // Reads one file of this format, the files it names found in `files`.
   // Empty for folders and specs (readVolume(string) handles those).
   std::function<Volume(const ByteSource&, const FileSet&)> read;
+  // Formats whose files may hold a time series (4-D NIfTI): how many time
+  // points a file holds, and the reader of one of them (0-based; `read`
+  // reads time point 0). Empty: one volume per file.
+  std::function<int(const ByteSource&)> timePoints;
+  std::function<Volume(const ByteSource&, const FileSet&, int time)> readTimePoint;
   // Writes `volume` to `path` (complete or not at all). Empty: read only,
   // and always empty in the browser build (its writers are native).
   std::function<void(const Volume&, const std::filesystem::path&)> write;

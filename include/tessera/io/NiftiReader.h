@@ -15,7 +15,14 @@ namespace tessera {
 // f32). Header dims, datatype and vox_offset are checked against the file
 // size (for gzip, against the bytes the stream actually inflates to) before
 // the voxel buffer is allocated. The .img of a pair is looked up in `files`.
-Volume readNifti(const ByteSource& file, const FileSet& files);
-Volume readNifti(const std::filesystem::path& path);
+// A 4-D file (dim[4] > 1: a time series such as fMRI) gives the volume at
+// time point `time` (0-based; an InputError naming the count when out of
+// range), its description saying which of how many; dim[5..7] must be 1.
+Volume readNifti(const ByteSource& file, const FileSet& files, int time = 0);
+Volume readNifti(const std::filesystem::path& path, int time = 0);
+
+// The number of time points (dim[4], 1 for a 3-D file) of a NIfTI file,
+// from its header alone.
+int niftiTimePoints(const ByteSource& file);
 
 }  // namespace tessera
