@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "tessera/core/Error.h"
 
@@ -24,13 +25,19 @@ ZoomLevelPolicy::ZoomLevelPolicy(std::vector<ZoomStage> stages, ZoomPolicyOption
 std::vector<ZoomStage> ZoomLevelPolicy::overviewStages(int coarseLevel, int mediumLevel,
                                                        double pixelsPerVoxelAtZoom1,
                                                        double volumeRadius, double blockRadius,
-                                                       const ZoomPolicyOptions& options) {
+                                                       const ZoomPolicyOptions& options,
+                                                       const std::vector<double>& levelVoxels) {
   if (!(pixelsPerVoxelAtZoom1 > 0.0) || mediumLevel < 0 || coarseLevel < mediumLevel) {
     throw InputError("zoom policy: need coarse level >= medium level >= 0 and a positive view");
   }
+  if (!levelVoxels.empty() && static_cast<int>(levelVoxels.size()) <= coarseLevel) {
+    throw InputError("zoom policy: voxel scales for " + std::to_string(levelVoxels.size()) +
+                     " levels, level " + std::to_string(coarseLevel) + " asked for");
+  }
   // The zoom at which a voxel of `level` covers refineAbove pixels.
   auto magnified = [&](int level) {
-    return options.refineAbove / (std::ldexp(1.0, level) * pixelsPerVoxelAtZoom1);
+    const double voxels = levelVoxels.empty() ? std::ldexp(1.0, level) : levelVoxels[level];
+    return options.refineAbove / (voxels * pixelsPerVoxelAtZoom1);
   };
   std::vector<ZoomStage> stages;
   if (coarseLevel > mediumLevel) stages.push_back({"coarse", coarseLevel, false, 0.0});

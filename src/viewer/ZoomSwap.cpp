@@ -8,6 +8,7 @@
 #include "tessera/core/Error.h"
 #include "tessera/gpu/Draw.h"
 #include "tessera/gpu/TexelFormat.h"
+#include "tessera/lod/LevelScale.h"
 
 namespace tessera::viewer {
 
@@ -21,8 +22,16 @@ std::vector<lod::ZoomStage> zoomStagesFor(const Explorer& explorer, int mediumLe
   const double blockRadius = 0.5 * glm::length(glm::dvec3(glm::min(2 * cell, d)) * sp);
   const int coarse = std::min(mediumLevel + 1, explorer.source().levelCount() - 1);
   const double pxPerVoxel = std::max(1.0, viewPixels) / glm::length(glm::dvec3(d));
+  // Each level's voxel in level-0 voxels along its most reduced axis: a
+  // (1, 2, 2) pyramid's level 1 shows its coarseness from zoom 1/2 as a
+  // halving one's does, its level 2 from 1/4 only where z is halved too.
+  std::vector<double> levelVoxels;
+  for (int l = 0; l < explorer.source().levelCount(); ++l) {
+    const glm::ivec3 s = lod::levelScale(explorer.source(), l);
+    levelVoxels.push_back(static_cast<double>(std::max({s.x, s.y, s.z})));
+  }
   return lod::ZoomLevelPolicy::overviewStages(coarse, mediumLevel, pxPerVoxel, volumeRadius,
-                                              blockRadius, options);
+                                              blockRadius, options, levelVoxels);
 }
 
 ZoomSwap::ZoomSwap(gpu::GlContext& context, Explorer& explorer, std::vector<lod::ZoomStage> stages,

@@ -30,6 +30,27 @@ TEST(ZoomLevelPolicy, OverviewStagesFollowTheDocumentedThresholds) {
   EXPECT_EQ(ZoomLevelPolicy::overviewStages(1, 0, k, diag / 2, diag / 4).size(), 2u);
 }
 
+TEST(ZoomLevelPolicy, ThresholdsFollowEachLevelsOwnScale) {
+  // A (1, 2, 2) pyramid with z halved from level 2 on: level scales
+  // (1,1,1), (1,2,2), (2,4,4) -> 1, 2, 4 voxels on the most reduced axis,
+  // the same thresholds as halving; one keeping z and x: 1, 2, 2.
+  const double diag = std::sqrt(512.0 * 512 + 512.0 * 512 + 64.0 * 64);
+  const double k = 800.0 / diag;
+  const auto halving = ZoomLevelPolicy::overviewStages(2, 1, k, diag / 2, diag / 4);
+  const auto same = ZoomLevelPolicy::overviewStages(2, 1, k, diag / 2, diag / 4, {}, {1, 2, 4});
+  ASSERT_EQ(same.size(), halving.size());
+  for (std::size_t s = 0; s < same.size(); ++s) EXPECT_EQ(same[s].enterZoom, halving[s].enterZoom);
+  const auto kept = ZoomLevelPolicy::overviewStages(2, 1, k, diag / 2, diag / 4, {}, {1, 2, 2});
+  ASSERT_EQ(kept.size(), 3u);
+  // medium from the zoom where a level-2 voxel (2 level-0 voxels) covers a pixel
+  EXPECT_NEAR(kept[1].enterZoom, 1.0 / (2.0 * k), 1e-12);
+  // native: where the view shows no more than the block, after medium
+  const double medium = 1.0 / (2.0 * k);
+  EXPECT_NEAR(kept[2].enterZoom, std::max({2.0, medium, medium * 1.001}), 1e-12);
+  EXPECT_THROW(ZoomLevelPolicy::overviewStages(2, 1, k, diag / 2, diag / 4, {}, {1, 2}),
+               InputError);
+}
+
 TEST(ZoomLevelPolicy, HysteresisKeepsTheStageNearAThreshold) {
   const ZoomLevelPolicy p(
       {{"coarse", 2, false, 0.0}, {"medium", 1, false, 1.0}, {"native", 0, true, 2.0}},

@@ -62,10 +62,15 @@ class ZoomLevelPolicy {
   // when mediumLevel > 0, the native block. `pixelsPerVoxelAtZoom1`: screen
   // pixels per level-0 voxel at zoom 1 (view height / volume diagonal in
   // voxels); blockRadius / volumeRadius: half diagonals (any same unit).
+  // `levelVoxels[l]`: level-0 voxels per level-l voxel along its most
+  // reduced axis (the largest component of lod::levelScale): 1, 2, 4 for a
+  // pyramid halving every axis; 1, 2, 2 for one whose levels keep z and
+  // halve x and y. Empty: 2^l.
   static std::vector<ZoomStage> overviewStages(int coarseLevel, int mediumLevel,
                                                double pixelsPerVoxelAtZoom1, double volumeRadius,
                                                double blockRadius,
-                                               const ZoomPolicyOptions& options = {});
+                                               const ZoomPolicyOptions& options = {},
+                                               const std::vector<double>& levelVoxels = {});
 
   const std::vector<ZoomStage>& stages() const { return stages_; }
   const ZoomPolicyOptions& options() const { return options_; }
