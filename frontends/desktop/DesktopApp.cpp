@@ -49,6 +49,7 @@ void drawPanel(DesktopApp& ds, int windowHeight) {
   ImGui::Begin("Tessera", nullptr,
                ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
   panelFile(ds);
+  panelTime(ds);
   panelExplore(ds);
   const bool labelsFirst = ds.view().labelsOn();  // the list before the TF it drives
   if (labelsFirst) panelLabels(ds);
@@ -108,6 +109,14 @@ void runFrame(DesktopApp& ds) {
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
+  // A playing time series moves on when its next time point is due and read.
+  if (ds.session->series()) {
+    const int before = ds.session->timePoint();
+    if (ds.session->stepPlayback(steadyNowMs()) != before) {
+      ++ds.timePointsShown;
+      for (auto& tile : ds.slices) tile.key.clear();
+    }
+  }
   handleViewInput(ds, tiles.view3d, scale);
   handleSliceInput(ds, tiles);
   handleShortcuts(ds);
@@ -128,6 +137,18 @@ void runFrame(DesktopApp& ds) {
 
   ++ds.frame;
   if (!ds.options.screenshot.empty() && ds.frame >= ds.options.frames && !ds.view().refining()) {
+    if (ds.session->series() && ds.session->playback().playing()) {
+      // What the playback reached: frames drawn and time points shown per
+      // second, and the frames where a due time point was not read yet.
+      const double seconds = (steadyNowMs() - ds.playStartMs) / 1000.0;
+      const session::Playback& play = ds.session->playback();
+      std::printf(
+          "playback: %d frames, %d time points shown in %.2f s (%.1f frames/s, %.1f "
+          "time points/s, asked %.1f), %llu late frames, %d read ahead\n",
+          ds.frame, ds.timePointsShown, seconds, ds.frame / seconds, ds.timePointsShown / seconds,
+          play.fps(), static_cast<unsigned long long>(play.lateFrames()),
+          ds.session->series()->keep() - 1);
+    }
     takeScreenshot(ds, fb.x, fb.y);
   }
   ds.window->swapBuffers();
@@ -164,6 +185,13 @@ void applyOptions(DesktopApp& ds, const ViewOptions& o) {
     std::snprintf(ds.labelPathBuf, sizeof ds.labelPathBuf, "%s", o.labels.c_str());
   }
   if (!o.state.empty()) loadState(ds, o.state);
+  if (o.play > 0.0) {
+    if (!ds.session->series())
+      throw InputError("--play: " + ds.view().description() + " is not a time series");
+    ds.session->playback().setFps(o.play);
+    ds.playStartMs = steadyNowMs();
+    ds.session->playback().play(ds.playStartMs);
+  }
   ds.error = recentTrouble;
 }
 

@@ -13,6 +13,7 @@
 //   PanelsFile.cpp     open, recent and dropped volumes
 //   PanelsStyle.cpp    TF editor, window/level, rendering, shading, clipping, labels
 //   PanelsExplore.cpp  the slice views and the exploring panel (zoom stages)
+#include <chrono>
 #include <memory>
 #include <optional>
 #include <string>
@@ -67,6 +68,9 @@ struct DesktopApp {
   char statePathBuf[512] = "tessera-state.json";
   bool logHistogram = true;
   int frame = 0;
+  // Playback of a time series: time points shown, from the first frame.
+  int timePointsShown = 0;
+  double playStartMs = -1.0;
   bool showHelp = false;
   viewer::RecentFiles recent{viewer::RecentFiles::defaultPath()};
 
@@ -140,7 +144,15 @@ void openVolume(DesktopApp& ds, const std::string& spec);
 // Restores a saved session state (Session::loadState) and what the window
 // shows of it (the crop box, the slice views); throws on error.
 void loadState(DesktopApp& ds, const std::string& path);
+// Milliseconds on a steady clock: the playback's time.
+inline double steadyNowMs() {
+  return std::chrono::duration<double, std::milli>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
 void panelFile(DesktopApp& ds);
+void panelTime(DesktopApp& ds);
 
 // PanelsStyle.cpp
 void section(const char* title);

@@ -91,4 +91,32 @@ void panelFile(DesktopApp& ds) {
   }
 }
 
+// A time series: the time point shown (a slider), play / pause and the
+// rate. The session reads ahead and decides what is shown (Session::
+// stepPlayback); a time point not read yet is asked for and shown when read.
+void panelTime(DesktopApp& ds) {
+  session::Session& s = *ds.session;
+  const session::TimeSeries* series = s.series();
+  if (!series || !ImGui::CollapsingHeader("Time", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  int t = s.timePoint();
+  if (ImGui::SliderInt("time point", &t, 0, series->count() - 1)) {
+    s.playback().pause();
+    reportErrors(ds, [&] { s.showTimePoint(t); });
+  }
+  session::Playback& play = s.playback();
+  if (ImGui::Button(play.playing() ? "Pause" : "Play")) {
+    if (play.playing()) {
+      play.pause();
+    } else {
+      play.play(steadyNowMs());
+    }
+  }
+  ImGui::SameLine();
+  float fps = static_cast<float>(play.fps());
+  ImGui::SetNextItemWidth(120.0f);
+  if (ImGui::SliderFloat("per second", &fps, 1.0f, 60.0f, "%.0f")) play.setFps(fps);
+  ImGui::TextDisabled("%d time points, %d read ahead; %llu late frames", series->count(),
+                      series->keep() - 1, static_cast<unsigned long long>(play.lateFrames()));
+}
+
 }  // namespace tessera::desktop

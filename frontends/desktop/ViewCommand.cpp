@@ -53,6 +53,11 @@ void addViewCommand(CLI::App& app) {
   cmd->add_option("--screenshot", o->screenshot,
                   "Write the window to this PNG after --frames frames and exit");
   addDefaultedOption(cmd, "--frames", o->frames, "Frames before --screenshot");
+  cmd->add_option("--play", o->play,
+                  "A time series (4-D NIfTI): start playing at FPS time points per second (the "
+                  "Time panel plays, pauses and picks one); with --screenshot, the playback's "
+                  "rate, time points shown and late frames are printed")
+      ->check(CLI::Range(0.1, 120.0));
   addStateOptions(cmd, o->state, o->saveState,
                   "camera, transfer function, window, rendering settings, labels, crosshair, "
                   "region and grid of the volume given; applied after the other options",

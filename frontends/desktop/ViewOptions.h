@@ -24,6 +24,7 @@ struct ViewOptions {
   std::string state;      // a saved session state to start from
   std::string saveState;  // where the session's state goes when the window closes
   int frames = 3;
+  double play = 0.0;  // a time series played at this many time points per second (0: paused)
   bool helpOverlay = false;
   std::string layout = "four";  // four: axial, 3D, sagittal, coronal; single: 3D only
   std::vector<int> crosshair;   // X Y Z (level-0 voxel)

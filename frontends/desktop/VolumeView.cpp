@@ -18,14 +18,15 @@ std::string viewKey(viewer::Viewer& v, int viewW, int viewH) {
   const Camera& c = v.camera();
   std::ostringstream key;
   key.precision(17);
-  key << v.volumeName() << '|' << c.azimuthDeg << '|' << c.elevationDeg << '|' << c.zoom << '|'
-      << c.target.x << c.target.y << c.target.z << '|' << v.tfEditor().revision() << '|'
-      << static_cast<int>(v.settings().mode) << '|' << v.settings().stepVoxels << '|'
-      << v.settings().sampling.preintegrate << v.settings().sampling.preintegrateLitOnly
-      << v.settings().sampling.adaptive << '|' << v.settings().opacityScale << '|' << v.window().min
-      << v.window().max << '|' << v.technique() << static_cast<int>(v.quality)
-      << v.controller().interacting() << '|' << v.showBoundingBox << v.showAxes << '|'
-      << v.settings().nearest << '|' << viewW << 'x' << viewH;
+  key << v.volumeName() << '#' << v.volumeRevision() << '|' << c.azimuthDeg << '|' << c.elevationDeg
+      << '|' << c.zoom << '|' << c.target.x << c.target.y << c.target.z << '|'
+      << v.tfEditor().revision() << '|' << static_cast<int>(v.settings().mode) << '|'
+      << v.settings().stepVoxels << '|' << v.settings().sampling.preintegrate
+      << v.settings().sampling.preintegrateLitOnly << v.settings().sampling.adaptive << '|'
+      << v.settings().opacityScale << '|' << v.window().min << v.window().max << '|'
+      << v.technique() << static_cast<int>(v.quality) << v.controller().interacting() << '|'
+      << v.showBoundingBox << v.showAxes << '|' << v.settings().nearest << '|' << viewW << 'x'
+      << viewH;
   for (const render::OverlayLine& l : v.extraLines) {
     key << "|l" << l.a.x << ',' << l.a.y << ',' << l.a.z << ',' << l.b.x << ',' << l.b.y << ','
         << l.b.z;

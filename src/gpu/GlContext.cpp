@@ -219,6 +219,7 @@ GlContext::~GlContext() {
 
 void GlContext::makeCurrent() {
   if (!display_) return;  // adopted: its owner makes it current (adoptCurrent)
+  if (eglGetCurrentContext() == context_) return;
   if (!eglMakeCurrent(display_, surface_, surface_, context_)) {
     throw GpuError("eglMakeCurrent failed: " + eglErrorName(eglGetError()));
   }

@@ -91,6 +91,33 @@ Volume readVolume(const std::string& spec, const ReadOptions& options) {
   return v;
 }
 
+namespace {
+
+// A file (not a spec, folder or store) whose format holds time series.
+bool mayHoldTimeSeries(const std::string& spec) {
+  std::error_code ec;
+  return spec.rfind("gen:", 0) != 0 && !isZarrStore(spec) &&
+         std::filesystem::is_regular_file(spec, ec);
+}
+
+}  // namespace
+
+int timePointCount(const std::string& spec) {
+  if (!mayHoldTimeSeries(spec)) return 1;
+  const FileSource file{std::filesystem::path(spec)};
+  const VolumeFormat& format = chooseReadFormat(file);
+  return format.timePoints ? format.timePoints(file) : 1;
+}
+
+Volume readTimePoint(const std::string& spec, int time) {
+  if (mayHoldTimeSeries(spec)) {
+    const FileSource file{std::filesystem::path(spec)};
+    const VolumeFormat& format = chooseReadFormat(file);
+    if (format.readTimePoint) return format.readTimePoint(file, FolderFiles(), time);
+  }
+  return readVolume(spec, {.dicomSeries = "", .time = time, .channel = 0});
+}
+
 Volume readVolume(const ByteSource& file, const FileSet& files) {
   // By extension, the content deciding when the extension is unknown or
   // contradicts it (FormatRegistry.h); DICOM through the decoder that

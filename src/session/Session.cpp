@@ -24,9 +24,22 @@ const nlohmann::json kNoRegion;
 
 Session::Session(gpu::DeviceSession device) : device_(std::move(device)) {}
 
-Session::~Session() = default;
+// The view's and the exploration's GL objects are released on this
+// session's context, whichever session drew last on this thread.
+Session::~Session() {
+  try {
+    makeCurrent();
+  } catch (const Error&) {
+    // The context is gone: its objects went with it.
+  }
+}
+
+void Session::makeCurrent() {
+  if (device_.context) device_.context->makeCurrent();
+}
 
 viewer::Viewer& Session::view() {
+  makeCurrent();
   if (view_) return *view_;
   view_ = std::make_unique<viewer::Viewer>(*device_.context, device_.profile);
   if (inCore_) showInView();
@@ -93,10 +106,58 @@ void Session::setVolume(Volume volume, const std::string& name) {
   setVolume(std::make_shared<Volume>(std::move(volume)), name);
 }
 
+bool Session::showTimePoint(int t) {
+  if (!series_) throw InputError("no time series is open");
+  std::shared_ptr<Volume> v = series_->want(t);
+  if (!v) return false;
+  if (inCore_ && &inCore_->volume() == v.get()) return true;
+  v->setWindow(seriesWindow_.value_or(v->window()));
+  auto next = std::make_shared<lod::InCoreVolumeSource>(v);
+  if (view_) {
+    makeCurrent();
+    // The same scene at another time: the camera and the look stay.
+    const Camera camera = view_->camera();
+    const Settings look = currentSettings();
+    view_->setVolume(next->level(glm::ivec3(1)), name_);
+    view_->camera() = camera;
+    view_->setWindow(v->window());
+    settings_ = look;
+  }
+  inCore_ = std::move(next);
+  exploration_.reset();
+  timePoint_ = t;
+  applyVolumeSettings();
+  return true;
+}
+
+void Session::waitTimePoint(int t) {
+  if (!series_) throw InputError("no time series is open");
+  series_->wait(t);
+  showTimePoint(t);
+}
+
+int Session::stepPlayback(double nowMs) {
+  if (!series_) return timePoint_;
+  // A time point is shown when its full frame is: while the view refines
+  // it (progressive strips), the next one waits.
+  if (view_ && view_->refining()) return timePoint_;
+  const int count = series_->count();
+  const int next = (timePoint_ + 1) % count;
+  const bool ready = series_->want(next) != nullptr;
+  series_->want(timePoint_);  // keeps the window of reads anchored here
+  const int shown = playback_.step(nowMs, timePoint_, count, ready);
+  if (shown != timePoint_) showTimePoint(shown);
+  return timePoint_;
+}
+
 void Session::setVolume(std::shared_ptr<Volume> volume, const std::string& name) {
   if (!volume) throw InputError("setVolume: no volume");
+  series_.reset();
+  seriesWindow_.reset();
+  timePoint_ = 0;
   auto next = std::make_shared<lod::InCoreVolumeSource>(std::move(volume));
   if (view_) {
+    makeCurrent();
     // The view's look carries over to the new volume, except its window and
     // labels, which are the new volume's own (viewer::Viewer::setVolume).
     view_->setVolume(next->level(glm::ivec3(1)), name);  // on error the old volume stays
@@ -113,6 +174,7 @@ void Session::setVolume(std::shared_ptr<Volume> volume, const std::string& name)
 }
 
 Exploration& Session::exploration() {
+  makeCurrent();
   if (exploration_) return *exploration_;
   if (!hasVolume()) throw InputError("exploring: no volume is open");
   const gpu::DeviceLimits& limits = device_.limits;
@@ -156,6 +218,7 @@ const Volume& Session::volume() const {
 
 Exploration& Session::explore(std::shared_ptr<const lod::MultiresSource> source,
                               std::uint64_t overviewVoxels, const std::string& label) {
+  makeCurrent();
   exploration_ = std::make_unique<Exploration>(
       std::move(source), viewer::regionBudgetBytes(device_.limits), overviewVoxels, label);
   return *exploration_;
@@ -187,6 +250,7 @@ RenderRequest Session::request(int width, int height) const {
 }
 
 RenderResult Session::run(const RenderRequest& request) {
+  makeCurrent();
   return runRender(device_, source(), request);
 }
 

@@ -122,6 +122,9 @@ void Session::open(const std::string& spec, const OpenOptions& options) {
   if (auto pyramid = streamedSource(spec, options, settings_, device_)) {
     inCore_.reset();
     region_.reset();
+    series_.reset();
+    seriesWindow_.reset();
+    timePoint_ = 0;
     streamed_ = std::move(pyramid);
     exploration_.reset();
     name_ = spec;
@@ -136,6 +139,11 @@ void Session::open(const std::string& spec, const OpenOptions& options) {
 
 void Session::openInView(const std::string& spec, const OpenOptions& options) {
   viewer::Viewer& v = view();
+  // A time series is shown one time point at a time, each in core.
+  if (timePointCount(spec) > 1) {
+    openSeries(spec, options);
+    return;
+  }
   const VolumePyramid pyramid = openVolumePyramid(
       spec, {.series = options.series, .time = options.time, .channel = options.channel});
   auto explore = std::make_unique<Exploration>(
@@ -145,12 +153,33 @@ void Session::openInView(const std::string& spec, const OpenOptions& options) {
   v.setVolume(Volume(*explore->overview()), explore->overviewName());
   settings_ = currentSettings();  // the view's new window is the volume's own
   settings_.window.reset();
+  series_.reset();
+  seriesWindow_.reset();
+  timePoint_ = 0;
   inCore_.reset();
   region_.reset();
   streamed_ = pyramid.source;
   streamedView_ = std::make_unique<lod::MultiresVolumeSource>(streamed_);
   exploration_ = std::move(explore);
   name_ = spec;
+}
+
+void Session::openSeries(const std::string& spec, const OpenOptions& options) {
+  const int count = timePointCount(spec);
+  if (count < 2) {
+    throw InputError(spec + ": one time point, not a time series (a 4-D NIfTI is)");
+  }
+  auto first = std::make_shared<Volume>(readTimePoint(spec, options.time));
+  const int keep =
+      TimeSeries::keepWithin(HostBudget::global().limitBytes() / 4, first->byteSize(), count);
+  auto series = std::make_unique<TimeSeries>(
+      count, [spec](int t) { return readTimePoint(spec, t); }, keep);
+  setVolume(first, spec);
+  // Every time point in the first one's window, unless the settings say one.
+  seriesWindow_ = settings_.window ? *settings_.window : first->window();
+  series_ = std::move(series);
+  timePoint_ = options.time;
+  series_->want(timePoint_);  // reads ahead from here
 }
 
 }  // namespace tessera::session

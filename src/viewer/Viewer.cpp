@@ -141,6 +141,7 @@ void Viewer::setVolume(std::shared_ptr<Volume> volume, const std::string& name) 
   frameMsPerPixel_ = stripMsPerPixel_ = 0.0;
   volume_ = source.level(glm::ivec3(1));
   volumeName_ = name;
+  ++volumeRevision_;
   uploadedTfRevision_ = tfEditor_.revision();
   updateHistogram();
   resetCamera();

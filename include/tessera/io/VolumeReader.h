@@ -32,6 +32,13 @@ struct ReadOptions {
 
 Volume readVolume(const std::string& spec, const ReadOptions& options = {});
 
+// A file whose format holds time series (4-D NIfTI): how many time points
+// it holds (1 for any other file, folder, store or spec), and time point
+// `time` of it, read as readVolume does but without its note (what a
+// time-series player reads ahead with). InputError as readVolume.
+int timePointCount(const std::string& spec);
+Volume readTimePoint(const std::string& spec, int time);
+
 // The same choice and readers on a byte source, the other files it names
 // found in `files`: what the browser reads picked or dropped files with.
 // DICOM: the series of `file` from the files beside it, by the first decoder

@@ -29,6 +29,7 @@
 #include "tessera/session/Exploration.h"
 #include "tessera/session/RenderRun.h"
 #include "tessera/session/Settings.h"
+#include "tessera/session/TimeSeries.h"
 #include "tessera/session/VolumePyramid.h"
 #include "tessera/viewer/Viewer.h"
 
@@ -85,6 +86,31 @@ class Session {
   // budget, and exploration() works on the whole pyramid. On error the
   // previous volume stays.
   void openInView(const std::string& spec, const OpenOptions& options = {});
+
+  // A time series (a 4-D NIfTI): time point `options.time` is read now and
+  // shown in core as open() would; the time points after it are read ahead
+  // on the series' thread, as many as a quarter of the host budget holds
+  // (at least the next one). Every time point is shown with the first one's
+  // window (or the settings' window) so that values keep their colour over
+  // time. InputError when `spec` holds one time point.
+  void openSeries(const std::string& spec, const OpenOptions& options = {});
+  // The open series (null when the volume is not one).
+  TimeSeries* series() { return series_.get(); }
+  const TimeSeries* series() const { return series_.get(); }
+  int timePoint() const { return timePoint_; }
+  // Shows time point `t` when it has been read, keeping the view's camera,
+  // window and look, and returns true; otherwise asks for it and returns
+  // false (the time point shown stays). The exploration is of the time
+  // point shown. InputError without a series or for t out of range.
+  bool showTimePoint(int t);
+  // As showTimePoint, waiting for the read (headless runs, benchmarks).
+  void waitTimePoint(int t);
+  // Playback of the series (session/TimeSeries.h): called once per drawn
+  // frame, it shows the next time point when it is due, read, and the
+  // view has finished the frame of the one shown (not refining); the
+  // number of the time point shown.
+  Playback& playback() { return playback_; }
+  int stepPlayback(double nowMs);
 
   bool hasVolume() const { return inCore_ != nullptr || streamed_ != nullptr; }
   // Read from a pyramid level by level and box by box, not held whole.
@@ -154,6 +180,9 @@ class Session {
   void loadState(const std::string& path);
 
  private:
+  // Several sessions on one thread each draw on their own context: every
+  // entry point that touches GL makes it current first (a no-op when it is).
+  void makeCurrent();
   void applyVolumeSettings();
   void applyToView();
   void applyCameraToView();
@@ -167,6 +196,10 @@ class Session {
   std::shared_ptr<const lod::MultiresSource> streamed_;
   std::unique_ptr<lod::VolumeSource> streamedView_;
   std::unique_ptr<nlohmann::json> region_;
+  std::unique_ptr<TimeSeries> series_;
+  std::optional<ValueRange> seriesWindow_;
+  int timePoint_ = 0;
+  Playback playback_;
   // Both go before device_ (declared first), while its context lives: the
   // view's GL objects and the exploration's zoom swap.
   std::unique_ptr<viewer::Viewer> view_;

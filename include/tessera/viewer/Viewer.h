@@ -4,6 +4,7 @@
 // TF editor, window/level, render mode, technique and quality, draws the
 // bounding box and axes, and times every frame. A front end only turns its
 // input events into calls here and shows the frame.
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -65,6 +66,9 @@ class Viewer {
   // The same volume, shared (an exploration keeps it as its overview).
   std::shared_ptr<const Volume> sharedVolume() const { return volume_; }
   const std::string& volumeName() const { return volumeName_; }
+  // Counts setVolume calls: a front end caching frames keys them by it (a
+  // time series swaps volumes of one name).
+  std::uint64_t volumeRevision() const { return volumeRevision_; }
   // How the technique's upload stored the volume (empty for a technique with
   // its own storage: see storageName()).
   const layout::Plan& plan() const { return active_.upload.plan; }
@@ -228,6 +232,7 @@ class Viewer {
   // reduction), and the technique refers to it.
   std::shared_ptr<Volume> volume_;  // as loaded
   std::string volumeName_;
+  std::uint64_t volumeRevision_ = 0;
   render::TechniqueOnVolume active_;  // the volume on the GPU and the technique on it
   std::unique_ptr<Gpu> gpu_;
 };

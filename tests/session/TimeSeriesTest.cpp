@@ -1,0 +1,208 @@
+// Time series: the time points after the one shown are read ahead within
+// the number kept, a time point let go is read again on a later visit, a
+// reader's error reaches the one who waits for it, and playback shows every
+// time point in order at its rate, a late one late and none skipped; a
+// session shows each time point of a 4-D NIfTI exactly as reading that time
+// point alone does, in the first one's window.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "support/ExpectError.h"
+#include "support/TestSupport.h"
+#include "tessera/core/Error.h"
+#include "tessera/io/NiftiWriter.h"
+#include "tessera/io/Procedural.h"
+#include "tessera/io/VolumeReader.h"
+#include "tessera/session/Session.h"
+#include "tessera/session/TimeSeries.h"
+
+namespace tessera::session {
+namespace {
+
+// The InputError `action` throws contains every part.
+template <class Action>
+void expectInputError(Action action, std::initializer_list<const char*> parts) {
+  const std::string message = test::inputErrorMessage(action);
+  for (const char* part : parts) EXPECT_NE(message.find(part), std::string::npos) << message;
+}
+
+// A 2x2x2 volume whose every voxel is t.
+Volume constant(int t) {
+  Volume v = Volume::allocate(glm::ivec3(2), ScalarType::U8);
+  for (std::size_t i = 0; i < v.voxelCount(); ++i) v.setValueAtIndex(i, t);
+  return v;
+}
+
+TEST(TimeSeries, ReadsAheadOfTheTimePointAskedForWithinWhatItKeeps) {
+  TimeSeries series(
+      10, [](int t) { return constant(t); }, 3);
+  EXPECT_EQ(series.wait(0)->valueAt(0, 0, 0), 0.0);
+  EXPECT_EQ(series.wait(2)->valueAt(1, 1, 1), 2.0);  // asks for 2, 3, 4 from here
+  EXPECT_EQ(series.wait(4)->valueAt(0, 1, 0), 4.0);
+  // 0, 1 read first (and 2); asking for 2 kept 2 and read 3 and 4; 4 was held.
+  const std::vector<int> log = series.readLog();
+  ASSERT_GE(log.size(), 5u);
+  EXPECT_EQ(std::vector<int>(log.begin(), log.begin() + 3), (std::vector<int>{0, 1, 2}));
+  for (const int t : log) EXPECT_LE(t, 6) << "read beyond the window kept";
+  // Past the last it wraps, as looped playback does: 9, 0, 1.
+  EXPECT_EQ(series.wait(9)->valueAt(0, 0, 0), 9.0);
+  EXPECT_EQ(series.wait(0)->valueAt(0, 0, 0), 0.0);
+  EXPECT_GE(series.readLog().back(), 0);
+  expectInputError([&] { series.want(10); }, {"time point 10", "0..9"});
+  expectInputError(
+      [&] {
+        TimeSeries(
+            4, [](int t) { return constant(t); }, 5);
+      },
+      {"keeping 5 of 4"});
+}
+
+TEST(TimeSeries, KeepsWhatTheBudgetHoldsAndAtLeastTheNext) {
+  EXPECT_EQ(TimeSeries::keepWithin(100, 10, 20), 10);
+  EXPECT_EQ(TimeSeries::keepWithin(1000, 10, 20), 20);
+  EXPECT_EQ(TimeSeries::keepWithin(5, 10, 20), 2);
+  EXPECT_EQ(TimeSeries::keepWithin(5, 10, 1), 1);
+}
+
+TEST(TimeSeries, AReadersErrorReachesWhoWaitsForThatTimePoint) {
+  TimeSeries series(
+      5,
+      [](int t) {
+        if (t == 3) throw InputError("series.nii: time point 3 is corrupt");
+        return constant(t);
+      },
+      5);
+  EXPECT_EQ(series.wait(2)->valueAt(0, 0, 0), 2.0);
+  expectInputError([&] { series.wait(3); }, {"series.nii: time point 3 is corrupt"});
+  EXPECT_EQ(series.wait(4)->valueAt(0, 0, 0), 4.0);
+}
+
+TEST(Playback, ShowsEveryTimePointInOrderALateOneLate) {
+  // 10 time points per second, frames every 16 ms for 3 s; time point 4 is
+  // read 400 ms late, every other one on time.
+  Playback play(10.0);
+  play.play(0.0);
+  int shown = 0;
+  std::vector<int> sequence{0};
+  std::vector<double> shownAt{0.0};
+  for (double now = 0.0; now < 3000.0; now += 16.0) {
+    const int next = (shown + 1) % 10;
+    const bool ready = next != 4 || now >= 800.0;
+    const int s = play.step(now, shown, 10, ready);
+    if (s != shown) {
+      sequence.push_back(s);
+      shownAt.push_back(now);
+      shown = s;
+    }
+  }
+  for (std::size_t i = 1; i < sequence.size(); ++i) {
+    EXPECT_EQ(sequence[i], (sequence[i - 1] + 1) % 10) << "skipped at " << i;
+  }
+  EXPECT_GT(play.lateFrames(), 0u);
+  EXPECT_EQ(play.advances(), sequence.size() - 1);
+  // 4 shown when it arrived, and the rest a period apart after it.
+  const auto four = std::find(sequence.begin(), sequence.end(), 4) - sequence.begin();
+  EXPECT_NEAR(shownAt[four], 800.0, 16.0);
+  EXPECT_NEAR(shownAt[four + 1] - shownAt[four], 100.0, 16.0);
+  // On time elsewhere: 1, 2, 3 at 100, 200, 300 ms (within a frame).
+  for (int i = 1; i <= 3; ++i) EXPECT_NEAR(shownAt[i], 100.0 * i, 16.0);
+  expectInputError([&] { play.setFps(0.0); }, {"playback rate"});
+}
+
+// A 4-D NIfTI of spheres growing with t: writeNifti's 3-D file with the
+// time points after the first appended and dim[0], dim[4] set.
+std::filesystem::path writeSeries(const test::TempDir& dir, int count) {
+  const auto path = dir / "series.nii";
+  std::vector<Volume> volumes;
+  for (int t = 0; t < count; ++t) {
+    volumes.push_back(makeProcedural("gen:sphere:24"));
+    Volume& v = volumes.back();
+    for (std::size_t i = 0; i < v.voxelCount(); ++i) {
+      v.setValueAtIndex(i, std::min(255.0, v.valueAtIndex(i) * (0.4 + 0.03 * t)));
+    }
+  }
+  writeNifti(volumes[0], path);
+  const std::uint64_t size = std::filesystem::file_size(path);
+  const std::uint64_t bytes = volumes[0].byteSize();
+  EXPECT_GE(size, bytes);
+  std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+  const std::int16_t dims[2] = {4, static_cast<std::int16_t>(count)};
+  f.seekp(40);  // dim[0]
+  f.write(reinterpret_cast<const char*>(&dims[0]), 2);
+  f.seekp(48);  // dim[4]
+  f.write(reinterpret_cast<const char*>(&dims[1]), 2);
+  f.seekp(0, std::ios::end);
+  for (int t = 1; t < count; ++t) {
+    f.write(reinterpret_cast<const char*>(volumes[t].bytes().data()),
+            static_cast<std::streamsize>(bytes));
+  }
+  return path;
+}
+
+TEST(SessionSeries, EachTimePointRendersAsThatTimePointReadAloneInTheFirstOnesWindow) {
+  const test::TempDir dir;
+  const auto path = writeSeries(dir, 6);
+  ASSERT_EQ(timePointCount(path.string()), 6);
+  Session s("native");
+  s.settings().tf = TransferFunction::preset("grey");
+  s.openSeries(path.string());
+  ASSERT_NE(s.series(), nullptr);
+  EXPECT_EQ(s.series()->count(), 6);
+  const ValueRange window = s.volume().window();
+  for (const int t : {0, 3, 5, 1}) {
+    SCOPED_TRACE("time point " + std::to_string(t));
+    s.waitTimePoint(t);
+    EXPECT_EQ(s.timePoint(), t);
+    EXPECT_EQ(s.volume().window().min, window.min);
+    EXPECT_EQ(s.volume().window().max, window.max);
+    const Image image = s.render(64, 64);
+    Session alone("native");
+    alone.settings().tf = TransferFunction::preset("grey");
+    alone.settings().window = window;
+    alone.setVolume(readVolume(path.string(), {.dicomSeries = "", .time = t, .channel = 0}),
+                    "alone");
+    EXPECT_EQ(image.rgba(), alone.render(64, 64).rgba());
+  }
+  expectInputError([&] { s.showTimePoint(6); }, {"time point 6", "0..5"});
+  Session flat("native");
+  const auto one = dir / "one.nii";
+  writeNifti(makeProcedural("gen:sphere:8"), one);
+  expectInputError([&] { flat.openSeries(one.string()); }, {"one.nii", "not a time series"});
+}
+
+TEST(SessionSeries, PlaybackThroughTheSessionShowsEveryTimePoint) {
+  const test::TempDir dir;
+  const auto path = writeSeries(dir, 5);
+  Session s("native");
+  s.openSeries(path.string());
+  s.playback().setFps(50.0);
+  const auto start = std::chrono::steady_clock::now();
+  auto nowMs = [&] {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+        .count();
+  };
+  s.playback().play(nowMs());
+  std::vector<int> sequence{s.timePoint()};
+  while (sequence.size() < 11 && nowMs() < 10000.0) {
+    const int t = s.stepPlayback(nowMs());
+    if (t != sequence.back()) sequence.push_back(t);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ASSERT_EQ(sequence.size(), 11u) << "playback stalled";
+  for (std::size_t i = 1; i < sequence.size(); ++i) {
+    EXPECT_EQ(sequence[i], (sequence[i - 1] + 1) % 5) << "skipped at " << i;
+  }
+}
+
+}  // namespace
+}  // namespace tessera::session
