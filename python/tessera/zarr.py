@@ -240,36 +240,36 @@ def _geometry(spacing, affine):
 
 def _mean_2x2x2(block: np.ndarray) -> np.ndarray:
     """lod::downsample(v, 2) of a block that starts on an even voxel: the mean
-    of the voxels present, summed in double in z, y, x order."""
+    of the voxels present (non-finite ones skipped), summed in double in z, y,
+    x order, integers rounded half away from zero (std::lround)."""
     dz, dy, dx = block.shape
-    oz, oy, ox = (dz + 1) // 2, (dy + 1) // 2, (dx + 1) // 2
-    integer = block.dtype.kind in "ui"
-    total = np.zeros((oz, oy, ox), dtype=np.float64)
-    count = np.zeros((oz, oy, ox), dtype=np.int64)
-    for z in range(2):
-        for y in range(2):
-            for x in range(2):
-                part = block[z::2, y::2, x::2]
-                if part.size == 0:
-                    continue
-                pz, py, px = part.shape
-                v = part.astype(np.float64)
-                if integer:
-                    total[:pz, :py, :px] += v
-                    count[:pz, :py, :px] += 1
-                else:
-                    finite = np.isfinite(v)
-                    total[:pz, :py, :px] += np.where(finite, v, 0.0)
-                    count[:pz, :py, :px] += finite
+    out = ((dz + 1) // 2, (dy + 1) // 2, (dx + 1) // 2)
+    parts = [block[z::2, y::2, x::2] for z in range(2) for y in range(2) for x in range(2)]
+    if block.dtype.kind in "ui":
+        # Integer sums are exact in any order: sum in int32 (8 x 65535 fits).
+        total = np.zeros(out, dtype=np.int32)
+        for p in parts:
+            total[: p.shape[0], : p.shape[1], : p.shape[2]] += p
+        per_axis = [np.minimum(2, n - 2 * np.arange(o)) for n, o in zip(block.shape, out)]
+        count = per_axis[0][:, None, None] * per_axis[1][None, :, None] * per_axis[2][None, None, :]
+        mean = total / count
+        info = np.iinfo(block.dtype)
+        # std::lround: halves away from zero (numpy's round is half to even).
+        rounded = np.copysign(np.floor(np.abs(mean) + 0.5), mean)
+        return np.clip(rounded, info.min, info.max).astype(block.dtype)
+    total = np.zeros(out, dtype=np.float64)
+    count = np.zeros(out, dtype=np.int32)
+    for p in parts:  # in the C++ loop's order: float sums depend on it
+        v = p.astype(np.float64)
+        finite = np.isfinite(v)
+        total[: p.shape[0], : p.shape[1], : p.shape[2]] += np.where(finite, v, 0.0)
+        count[: p.shape[0], : p.shape[1], : p.shape[2]] += finite
     with np.errstate(invalid="ignore", divide="ignore"):
         mean = total / count
-    if not integer:
-        return mean.astype(block.dtype)
-    info = np.iinfo(block.dtype)
-    mean = np.clip(mean, info.min, info.max)
-    # std::lround: halves away from zero (numpy's round is half to even).
-    rounded = np.copysign(np.floor(np.abs(mean) + 0.5), mean)
-    return rounded.astype(block.dtype)
+    # A block of no finite voxel is std::numeric_limits<double>::quiet_NaN()
+    # (sign bit clear); x86's 0/0 would set it, and the chunk bytes differ.
+    mean[count == 0] = np.nan
+    return mean.astype(block.dtype)
 
 
 def _encode(raw: np.ndarray, compressor: str) -> bytes:
