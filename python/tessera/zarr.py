@@ -479,13 +479,7 @@ def write_pyramid(
             with open(os.path.join(temp, str(index), ".zarray"), "w", encoding="utf-8") as f:
                 f.write(_zarray_text(shape, chunk, dtype, compressor))
             if index > 0:
-                # 2x2x2 chunks of the level above make one chunk of this one.
-                merged = tuple(min(2 * c, d) for c, d in zip(chunk, level.shape))
-                level = level.rechunk(merged).map_blocks(
-                    _mean_2x2x2, chunks=tuple(
-                        tuple((b + 1) // 2 for b in axis) for axis in level.rechunk(merged).chunks
-                    ), dtype=dtype
-                )
+                level = _halved(level, chunk)
             nz, ny, nx = level.numblocks
             stats.append(
                 level.map_blocks(
@@ -506,7 +500,12 @@ def write_pyramid(
         old = f"{path}.old-{os.getpid()}"
         if replace:
             os.rename(path, old)
-        os.rename(temp, path)
+        try:
+            os.rename(temp, path)
+        except BaseException:
+            if replace:
+                os.rename(old, path)  # the store that was there stays
+            raise
     except BaseException:
         _remove_tree(temp)
         raise
@@ -514,6 +513,15 @@ def write_pyramid(
         _remove_tree(old)
     result.seconds = time.perf_counter() - started
     return result
+
+
+def _halved(level, chunk):
+    """The next level as a dask array in chunks of `chunk`: 2x2x2 chunks of
+    `level` (ending on even voxels, since chunks are even unless one holds a
+    whole axis) merged into one block and reduced by one task."""
+    merged = level.rechunk(tuple(min(2 * c, d) for c, d in zip(chunk, level.shape)))
+    halves = tuple(tuple((b + 1) // 2 for b in axis) for axis in merged.chunks)
+    return merged.map_blocks(_mean_2x2x2, chunks=halves, dtype=level.dtype)
 
 
 def _run(stats, client, dask):
