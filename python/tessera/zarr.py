@@ -302,29 +302,71 @@ def _mkdir(path: str) -> None:
         pass
 
 
-def _write_chunk(block, root, level, chunk_zyx, compressor, track_range, block_info=None):
-    """Writes one chunk (block = the chunk's voxels) and returns its numbers:
-    [written, skipped, stored bytes, finite min, finite max, finite count]."""
-    cz, cy, cx = block_info[0]["chunk-location"]
-    raw = np.zeros(chunk_zyx, dtype=block.dtype)
-    raw[: block.shape[0], : block.shape[1], : block.shape[2]] = block
-    stats = np.zeros((1, 1, 1, 6), dtype=np.float64)
-    if track_range:
-        finite = block[np.isfinite(block)] if block.dtype.kind == "f" else block
-        if finite.size:
-            stats[0, 0, 0, 3:] = (float(finite.min()), float(finite.max()), finite.size)
+def _write_one(sub, root, level, index, chunk_zyx, compressor):
+    """Stores one chunk (sub = its voxels); returns the stored size, or None
+    when it is all zero (it reads as fill_value: nothing to store)."""
+    raw = np.zeros(chunk_zyx, dtype=sub.dtype)
+    raw[: sub.shape[0], : sub.shape[1], : sub.shape[2]] = sub
     if not raw.view(np.uint8).any():
-        stats[0, 0, 0, 1] = 1  # all zero: reads as fill_value, nothing stored
-        return stats
+        return None
     stored = _encode(raw, compressor)
-    zdir = os.path.join(root, str(level), str(cz))
+    zdir = os.path.join(root, str(level), str(index[0]))
     _mkdir(zdir)
-    _mkdir(os.path.join(zdir, str(cy)))
-    with open(os.path.join(zdir, str(cy), str(cx)), "wb") as f:
+    _mkdir(os.path.join(zdir, str(index[1])))
+    with open(os.path.join(zdir, str(index[1]), str(index[2])), "wb") as f:
         f.write(stored)
-    stats[0, 0, 0, 0] = 1
-    stats[0, 0, 0, 2] = len(stored)
+    return len(stored)
+
+
+def _write_block(block, root, level, chunk_zyx, compressor, track_range, block_info=None):
+    """Writes the chunks of one block (a whole number of chunks, starting on
+    one) and returns per chunk-deep slab of it: [written, skipped, stored
+    bytes, finite min, finite max, finite count]."""
+    starts = [a for a, _ in block_info[0]["array-location"]]
+    first = [s // c for s, c in zip(starts, chunk_zyx)]
+    counts = [-(-n // c) for n, c in zip(block.shape, chunk_zyx)]
+    stats = np.zeros((counts[0], 1, 1, 6), dtype=np.float64)
+    stats[:, 0, 0, 3] = np.inf
+    stats[:, 0, 0, 4] = -np.inf
+    cz, cy, cx = chunk_zyx
+    for iz in range(counts[0]):
+        row = stats[iz, 0, 0]
+        for iy in range(counts[1]):
+            for ix in range(counts[2]):
+                sub = block[iz * cz : (iz + 1) * cz, iy * cy : (iy + 1) * cy, ix * cx : (ix + 1) * cx]
+                index = (first[0] + iz, first[1] + iy, first[2] + ix)
+                size = _write_one(sub, root, level, index, chunk_zyx, compressor)
+                row[0 if size is not None else 1] += 1
+                row[2] += size or 0
+                if track_range:
+                    finite = sub[np.isfinite(sub)] if sub.dtype.kind == "f" else sub
+                    if finite.size:
+                        row[3] = min(row[3], float(finite.min()))
+                        row[4] = max(row[4], float(finite.max()))
+                        row[5] += finite.size
     return stats
+
+
+def _block_shape(chunk_zyx, itemsize, target=16 << 20) -> Tuple[int, int, int]:
+    """A dask block: 2^k chunks per axis, the largest of at most `target`
+    bytes. A task per block, not per chunk, keeps the graph and the
+    scheduler small (a 1024^3 u8 level 0 is 64 tasks, not 4096)."""
+    k, voxels = 1, int(np.prod(chunk_zyx)) * itemsize
+    while (2 * k) ** 3 * voxels <= target:
+        k *= 2
+    return tuple(k * c for c in chunk_zyx)
+
+
+def _level0_blocks(a, chunk_zyx, block_zyx):
+    """The input in blocks that hold whole chunks: its own when every block
+    boundary is on a chunk boundary (no data moves between workers), else
+    rechunked."""
+    chunk = [min(c, d) for c, d in zip(chunk_zyx, a.shape)]
+    aligned = all(all(b % c == 0 for b in axis[:-1]) for axis, c in zip(a.chunks, chunk))
+    largest = a.dtype.itemsize * int(np.prod([max(axis) for axis in a.chunks]))
+    if aligned and largest <= 64 << 20:
+        return a
+    return a.rechunk(tuple(min(b, d) for b, d in zip(block_zyx, a.shape)))
 
 
 # ---------------------------------------------------------------- the store
@@ -388,7 +430,7 @@ def _remove_tree(path: str) -> None:
         time.sleep(0.1)
 
 
-def _as_dask(array, axes: str, dtype: np.dtype, chunks_zyx):
+def _as_dask(array, axes: str, dtype: np.dtype, block_zyx):
     import dask.array as da
 
     if axes not in ("xyz", "zyx"):
@@ -399,7 +441,7 @@ def _as_dask(array, axes: str, dtype: np.dtype, chunks_zyx):
     if any(isinstance(s, float) and math.isnan(s) for s in a.shape):
         raise ValueError("array has unknown chunk sizes: call compute_chunk_sizes() first")
     if not isinstance(a, da.Array):
-        a = da.from_array(a if axes == "zyx" else a.transpose(2, 1, 0), chunks=chunks_zyx)
+        a = da.from_array(a if axes == "zyx" else a.transpose(2, 1, 0), chunks=block_zyx)
     elif axes == "xyz":
         a = a.transpose(2, 1, 0)
     if a.dtype != dtype:
@@ -452,6 +494,8 @@ def write_pyramid(
             f"compressor {compressor!r}: expected zstd, blosc, zlib, gzip or none"
         )
     path = _local_path(str(url))
+    if not hasattr(array, "dtype"):
+        array = np.asarray(array)
     dtype = _checked_dtype(array.dtype)
     spacing_xyz, origin_xyz, direction = _geometry(spacing, affine)
     if window is not None and not (len(window) == 2 and window[1] > window[0]):
@@ -463,7 +507,7 @@ def write_pyramid(
     if replace and not _is_zarr_store(path):
         raise FileExistsError(f"{path}: exists and is not an OME-Zarr store; not replacing it")
 
-    level0 = _as_dask(array, axes, dtype, chunks_zyx)
+    level0 = _as_dask(array, axes, dtype, _block_shape(chunks_zyx, dtype.itemsize))
     shapes = _level_shapes(level0.shape, chunks_zyx, levels)
     level_chunks = [tuple(min(d, c) for d, c in zip(s, chunks_zyx)) for s in shapes]
 
@@ -473,18 +517,20 @@ def write_pyramid(
     os.mkdir(temp)
     try:
         stats = []
-        level = level0.rechunk(level_chunks[0])
+        block = _block_shape(chunks_zyx, dtype.itemsize)
+        level = _level0_blocks(level0, chunks_zyx, block)
         for index, (shape, chunk) in enumerate(zip(shapes, level_chunks)):
             os.mkdir(os.path.join(temp, str(index)))
             with open(os.path.join(temp, str(index), ".zarray"), "w", encoding="utf-8") as f:
                 f.write(_zarray_text(shape, chunk, dtype, compressor))
             if index > 0:
-                level = _halved(level, chunk)
-            nz, ny, nx = level.numblocks
+                level = _halved(level, block)
+            _, ny, nx = level.numblocks
+            slabs = tuple(-(-b // chunk[0]) for b in level.chunks[0])
             stats.append(
                 level.map_blocks(
-                    _write_chunk, temp, index, chunk, compressor, index == 0,
-                    chunks=((1,) * nz, (1,) * ny, (1,) * nx, (6,)), new_axis=3,
+                    _write_block, temp, index, chunk, compressor, index == 0,
+                    chunks=(slabs, (1,) * ny, (1,) * nx, (6,)), new_axis=3,
                     dtype=np.float64, name=f"tessera-write-{index}-{uuid.uuid4().hex}",
                 )
             )
@@ -515,13 +561,13 @@ def write_pyramid(
     return result
 
 
-def _halved(level, chunk):
-    """The next level as a dask array in chunks of `chunk`: 2x2x2 chunks of
-    `level` (ending on even voxels, since chunks are even unless one holds a
-    whole axis) merged into one block and reduced by one task."""
-    merged = level.rechunk(tuple(min(2 * c, d) for c, d in zip(chunk, level.shape)))
-    halves = tuple(tuple((b + 1) // 2 for b in axis) for axis in merged.chunks)
-    return merged.map_blocks(_mean_2x2x2, chunks=halves, dtype=level.dtype)
+def _halved(level, block):
+    """The next level: each block of `level` (whole chunks, so it starts on an
+    even voxel) reduced by one task, then merged into blocks of `block` again
+    (the data that moves between workers is the smaller level's)."""
+    halves = tuple(tuple((b + 1) // 2 for b in axis) for axis in level.chunks)
+    half = level.map_blocks(_mean_2x2x2, chunks=halves, dtype=level.dtype)
+    return half.rechunk(tuple(min(b, d) for b, d in zip(block, half.shape)))
 
 
 def _run(stats, client, dask):
