@@ -114,6 +114,9 @@ def main():
     ap.add_argument("--workers", type=int, nargs="+", default=[2, 1])
     ap.add_argument("--cli", default=str(ROOT / "build" / "tessera"))
     ap.add_argument("--workdir", default=None)
+    ap.add_argument("--convert-store", default=None,
+                    help="a `tessera convert` store of this volume from an earlier run: "
+                    "compare with it instead of writing the NIfTI and converting again")
     args = ap.parse_args()
 
     from distributed import Client, LocalCluster
@@ -124,18 +127,24 @@ def main():
     print(f"{n}^3 u8 ({mib(n**3):.0f} MiB), chunks {args.chunks}^3, zstd; work folder {work}")
     print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}")
 
-    t = time.perf_counter()
-    write_nifti(work / "vol.nii", n)
-    print(f"NIfTI written in {time.perf_counter() - t:.1f} s")
-    (work / "cli").mkdir(exist_ok=True)
-    shutil.rmtree(work / "cli" / "vol.ome.zarr", ignore_errors=True)
-    t = time.perf_counter()
-    subprocess.run([args.cli, "convert", str(work / "vol.nii"), str(work / "cli" / "vol.ome.zarr"),
-                    "--chunk", str(args.chunks)], check=True, capture_output=True)
-    convert_s = time.perf_counter() - t
-    convert_rss = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * 1024
-    print(f"tessera convert: {convert_s:.1f} s, peak RSS {mib(convert_rss):.0f} MiB")
-    os.remove(work / "vol.nii")
+    if args.convert_store:
+        reference = Path(args.convert_store)
+        print(f"tessera convert: the store of an earlier run, {reference}")
+        convert_s = convert_rss = None
+    else:
+        reference = work / "cli" / "vol.ome.zarr"
+        t = time.perf_counter()
+        write_nifti(work / "vol.nii", n)
+        print(f"NIfTI written in {time.perf_counter() - t:.1f} s")
+        reference.parent.mkdir(exist_ok=True)
+        shutil.rmtree(reference, ignore_errors=True)
+        t = time.perf_counter()
+        subprocess.run([args.cli, "convert", str(work / "vol.nii"), str(reference),
+                        "--chunk", str(args.chunks)], check=True, capture_output=True)
+        convert_s = time.perf_counter() - t
+        convert_rss = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * 1024
+        print(f"tessera convert: {convert_s:.1f} s, peak RSS {mib(convert_rss):.0f} MiB")
+        os.remove(work / "vol.nii")
 
     rows = []
     volume = lazy_volume(n, 128)
@@ -150,7 +159,7 @@ def main():
         worker_rss = max(client.run(worker_peak_rss).values())
         client.close()
         cluster.close()
-        same, files = identical(work / "cli" / "vol.ome.zarr", out)
+        same, files = identical(reference, out)
         rows.append((workers, r.seconds, mib(rss.peak - rss.start), mib(rss.peak),
                      mib(worker_rss), same, files))
         print(f"{workers} worker(s): {r.seconds:.1f} s, client RSS +{mib(rss.peak - rss.start):.1f}"
@@ -166,7 +175,9 @@ def main():
     for workers, seconds, growth, _, worker_rss, same, files in rows:
         print(f"| {workers} | {seconds:.1f} | {base / seconds:.2f}x | {growth:.1f} MiB "
               f"| {worker_rss:.0f} MiB | {'identical' if same else 'DIFFERENT'} ({files} files) |")
-    print(f"| convert | {convert_s:.1f} | | | {mib(convert_rss):.0f} MiB (one process) | |")
+    if convert_s is not None:
+        print(f"| convert | {convert_s:.1f} | | | {mib(convert_rss):.0f} MiB (one process) | |")
+    print(f"load average after: {os.getloadavg()[0]:.1f}")
     if not args.workdir:
         shutil.rmtree(work)
     return 0 if all(r[5] for r in rows) else 1

@@ -4,10 +4,12 @@
 same voxels: OME-NGFF 0.4 multiscales on Zarr v2, a factor-2 mean pyramid down
 to one chunk, the same ``.zarray``/``.zattrs``/``.zgroup`` and the same chunk
 files byte for byte. Each level is computed chunk-parallel by dask from the
-level above (2x2x2 blocks of chunks merged, halved, cut into chunks) and every
-chunk is compressed and written by the task that computed it, on a worker when a
-``distributed.Client`` runs the graph; the client only writes the metadata and
-gathers a few numbers per chunk. No level is ever held whole anywhere.
+level above: a task per block of 2^k x 2^k x 2^k chunks (about 16 MiB) halves
+its block, the halves are merged into blocks again, and the task that computed
+a block compresses and writes its chunks, on a worker when a
+``distributed.Client`` runs the graph. The client writes only the metadata and
+gathers a few numbers per chunk-deep slab of a block. No level is ever held
+whole anywhere.
 
 The reduction is ``lod::downsample(v, 2)`` of the C++ library: the mean of the
 voxels present in each 2x2x2 block (partial blocks at odd edges average what
