@@ -121,6 +121,7 @@ void Session::open(const std::string& spec, const OpenOptions& options) {
   }
   if (auto pyramid = streamedSource(spec, options, settings_, device_)) {
     inCore_.reset();
+    resident_.reset();
     region_.reset();
     streamed_ = std::move(pyramid);
     exploration_.reset();
@@ -146,6 +147,7 @@ void Session::openInView(const std::string& spec, const OpenOptions& options) {
   settings_ = currentSettings();  // the view's new window is the volume's own
   settings_.window.reset();
   inCore_.reset();
+  resident_.reset();
   region_.reset();
   streamed_ = pyramid.source;
   streamedView_ = std::make_unique<lod::MultiresVolumeSource>(streamed_);
