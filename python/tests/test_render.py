@@ -169,3 +169,17 @@ def test_render_camera_keywords_and_repr_png():
     assert not np.array_equal(front, side)
     png = s._repr_png_()
     assert png.startswith(b"\x89PNG") and len(png) > 1000
+
+
+def test_render_keeps_the_technique_and_draws_what_a_fresh_run_draws():
+    s = tessera.Session(tessera.from_array(blob((48, 40, 32), np.uint16)), tf="ct-bone")
+    s.render(96, 96)
+    t0 = time.perf_counter()
+    for azimuth, tf, shade in [(30, "ct-bone", False), (75, "mr-default", False),
+                               (120, "grey", True), (200, "ct-bone", True)]:
+        s.update(azimuth=azimuth, tf=tf, shade=shade)
+        kept = s.render(96, 96)
+        fresh, report = s.run(96, 96)  # uploads and prepares anew (runRender)
+        assert np.array_equal(kept, fresh), (azimuth, tf, shade, psnr(kept, fresh))
+        assert report["frame_ms"] and report["layout"]
+    assert (time.perf_counter() - t0) < 30
