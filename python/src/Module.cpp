@@ -114,9 +114,11 @@ py::array_t<std::uint8_t> imageArray(Image image) {
                                    rgba->data(), owner);
 }
 
-// One session on its own headless device. Its EGL context is made current
-// before each call, so sessions may be driven from any thread, one call at a
-// time per session (a lock serialises them).
+// One session on its own headless device, whose EGL context is current on
+// the thread that made the session: calls come from that thread (another
+// thread's call is refused with a GpuError saying so, as EGL would refuse
+// it), one at a time (a lock serialises them); sessions made on different
+// threads render in parallel.
 class PySession {
  public:
   explicit PySession(const std::string& profile) {
@@ -223,11 +225,19 @@ class PySession {
  private:
   // While a call runs: the GIL released, the session locked, its context current.
   struct Use {
-    explicit Use(PySession& s) : lock(s.mutex_) { s.session_->device().context->makeCurrent(); }
+    explicit Use(PySession& s) : lock(s.mutex_) {
+      if (std::this_thread::get_id() != s.thread_) {
+        throw tessera::GpuError(
+            "this Session's GL context is current on the thread that made it; make one Session "
+            "per thread (EGL makes a context current on one thread at a time)");
+      }
+      s.session_->device().context->makeCurrent();
+    }
     py::gil_scoped_release unlocked;
     std::lock_guard<std::mutex> lock;
   };
   std::unique_ptr<tessera::session::Session> session_;
+  std::thread::id thread_ = std::this_thread::get_id();
   std::mutex mutex_;
 };
 

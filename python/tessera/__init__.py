@@ -17,10 +17,11 @@ the GL driver :class:`GpuError` (a ``RuntimeError``); each carries the
 library's message.
 
 Threads: the GIL is released while a session renders and while volumes are
-read. A :class:`Session` may be used from any thread, one call at a time (a
-lock serialises calls; its GL context is made current for each);
-different sessions render in parallel. :class:`Volume` objects are
-immutable once made and may be shared between threads and sessions.
+read. A :class:`Session` belongs to the thread that made it (its GL context
+is current there): a call from another thread raises :class:`GpuError`;
+sessions made on different threads render in parallel, and calls to one
+session are serialised. :class:`Volume` objects are immutable once made and
+may be shared between threads and sessions.
 """
 from __future__ import annotations
 
@@ -452,8 +453,9 @@ class Session:
     - and the rest of the schema: background, max_steps, opacity_scale, ert,
       jitter, sampling, skip_block, lut, slices, classify, gradient.
 
-    Threads: one call at a time per session (calls from several threads are
-    serialised); the GIL is released while it renders or reads."""
+    Threads: a session is used from the thread that made it (another
+    thread's call raises GpuError; make one session per thread, they render
+    in parallel); the GIL is released while it renders or reads."""
 
     def __init__(
         self,

@@ -183,3 +183,27 @@ def test_render_keeps_the_technique_and_draws_what_a_fresh_run_draws():
         assert np.array_equal(kept, fresh), (azimuth, tf, shade, psnr(kept, fresh))
         assert report["frame_ms"] and report["layout"]
     assert (time.perf_counter() - t0) < 30
+
+
+def test_a_session_belongs_to_its_thread_and_sessions_on_threads_render_in_parallel():
+    v = tessera.from_array(blob((32, 32, 32), np.uint8))
+    s = tessera.Session(v, tf="ct-bone")
+    mine = s.render(48, 48)
+    out = {}
+
+    def elsewhere():
+        try:
+            s.render(48, 48)
+        except tessera.GpuError as e:
+            out["error"] = str(e)
+        own = tessera.Session(v, tf="ct-bone")  # the same volume, shared
+        out["frame"] = own.render(48, 48)
+
+    threads = [threading.Thread(target=elsewhere) for _ in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert "thread that made it" in out["error"]
+    assert np.array_equal(out["frame"], mine)
+    assert np.array_equal(s.render(48, 48), mine)  # still usable on its own thread
