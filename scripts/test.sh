@@ -20,6 +20,7 @@ ctest_build() { (cd build && ctest --output-on-failure --timeout 900 -j2); }
 timed setup scripts/setup.sh
 timed build scripts/build.sh
 timed ctest ctest_build
+timed python /usr/bin/python3 -m pytest -q -p no:cacheprovider python/tests  # import tessera (docs/python.md)
 timed embed scripts/embed-test.sh  # examples/embed against an installed Tessera
 timed readme scripts/readme-commands.sh  # every command the README shows
 timed browser scripts/browser-test.sh  # web viewer in headless Chromium vs build/tessera

@@ -11,6 +11,7 @@
 #include "tessera/io/DicomSeriesReader.h"
 #include "tessera/io/VolumeReader.h"
 #include "tessera/io/ZarrStore.h"
+#include "tessera/session/VolumeInfo.h"
 
 namespace tessera::app {
 
@@ -30,29 +31,6 @@ struct InfoOptions {
   bool json = false;
 };
 
-// The index -> world (RAS+ mm) affine as 4 rows, as nibabel prints it.
-nlohmann::json affineRows(const Volume& v) {
-  const glm::dmat4 a = v.indexToWorld();
-  nlohmann::json rows = nlohmann::json::array();
-  for (int r = 0; r < 4; ++r) rows.push_back({a[0][r], a[1][r], a[2][r], a[3][r]});
-  return rows;
-}
-
-nlohmann::json zarrJson(const ZarrStore& store) {
-  nlohmann::json levels = nlohmann::json::array();
-  for (int l = 0; l < store.levelCount(); ++l) {
-    const ZarrLevel& lv = store.level(l);
-    levels.push_back({{"path", lv.path},
-                      {"dims", {lv.dims.x, lv.dims.y, lv.dims.z}},
-                      {"chunks", {lv.chunk.x, lv.chunk.y, lv.chunk.z}},
-                      {"spacing", {lv.spacing.x, lv.spacing.y, lv.spacing.z}},
-                      {"origin", {lv.origin.x, lv.origin.y, lv.origin.z}},
-                      {"dtype", lv.array.dtype},
-                      {"compressor", lv.array.compressorText}});
-  }
-  return {{"store", store.describe()}, {"levels", levels}, {"notes", store.notes()}};
-}
-
 void printZarrLevels(const ZarrStore& store) {
   std::printf("store       %s\n", store.describe().c_str());
   for (int l = 0; l < store.levelCount(); ++l) {
@@ -68,6 +46,10 @@ void runInfo(const InfoOptions& o) {
   const std::string spec = o.file.empty() ? defaultVolumeSpec() : o.file;
   const Volume v =
       readVolume(spec, {.dicomSeries = o.series, .time = o.time, .channel = o.channel});
+  if (o.json) {
+    std::printf("%s\n", session::volumeInfo(spec, v, o.time, o.channel).dump(2).c_str());
+    return;
+  }
   // An OME-Zarr store: its levels, chunks and codec beside the level read.
   std::unique_ptr<ZarrStore> store;
   if (isZarrStore(spec)) {
@@ -80,40 +62,6 @@ void runInfo(const InfoOptions& o) {
   std::error_code ec;
   if (std::filesystem::is_directory(spec, ec)) series = listDicomSeries(spec);
   const ValueRange r = v.valueRange();
-  if (o.json) {
-    nlohmann::json j;
-    j["file"] = spec;
-    j["dims"] = {v.dims().x, v.dims().y, v.dims().z};
-    j["spacing"] = {v.spacing().x, v.spacing().y, v.spacing().z};
-    j["origin"] = {v.origin().x, v.origin().y, v.origin().z};
-    const Orientation orient = orientationOf(v.direction());
-    j["orientation"] = orient.code;
-    j["oblique"] = orient.oblique;
-    j["orientation_text"] = orient.describe();
-    j["affine"] = affineRows(v);
-    j["world_frame"] = "RAS";
-    j["geometry_source"] = v.geometrySource();
-    j["type"] = std::string(scalarTypeName(v.type()));
-    j["value_min"] = r.min;
-    j["value_max"] = r.max;
-    j["non_finite_voxels"] = v.nonFiniteCount();
-    j["mean"] = h.mean();
-    j["percentiles"] = {
-        {"1", h.percentile(0.01)}, {"50", h.percentile(0.5)}, {"99", h.percentile(0.99)}};
-    j["bytes"] = v.byteSize();
-    j["description"] = v.description();
-    if (store) j["zarr"] = zarrJson(*store);
-    if (!series.empty()) {
-      j["dicom_series"] = nlohmann::json::array();
-      for (const auto& s : series) {
-        j["dicom_series"].push_back({{"series_instance_uid", s.seriesInstanceUid},
-                                     {"description", s.description},
-                                     {"slices", s.slices}});
-      }
-    }
-    std::printf("%s\n", j.dump(2).c_str());
-    return;
-  }
   std::printf("file        %s\n", spec.c_str());
   if (!v.description().empty()) std::printf("description %s\n", v.description().c_str());
   std::printf("dims        %d x %d x %d\n", v.dims().x, v.dims().y, v.dims().z);

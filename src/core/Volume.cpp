@@ -56,7 +56,23 @@ Volume Volume::allocate(glm::ivec3 dims, ScalarType type, const std::string& wha
   Volume v;
   v.dims_ = dims;
   v.type_ = type;
-  v.data_.assign(bytes, std::byte{0});
+  v.data_.assign(bytes);
+  return v;
+}
+
+Volume Volume::borrow(glm::ivec3 dims, ScalarType type, std::span<std::byte> voxels,
+                      std::shared_ptr<const void> lender, const std::string& what) {
+  Volume v = shapeOnly(dims, type);
+  v.rangeValid_ = false;
+  const std::uint64_t expected = v.voxelCount() * bytesPerVoxel(type);
+  if (dims.x <= 0 || dims.y <= 0 || dims.z <= 0 || voxels.size() != expected) {
+    throw InputError(what + ": " + std::to_string(dims.x) + "x" + std::to_string(dims.y) + "x" +
+                     std::to_string(dims.z) + " " + std::string(scalarTypeName(type)) + " needs " +
+                     std::to_string(expected) + " bytes, the buffer has " +
+                     std::to_string(voxels.size()));
+  }
+  if (!lender) throw InputError(what + ": borrowed voxels need an owner that keeps them alive");
+  v.data_ = VoxelStorage(voxels, std::move(lender));
   return v;
 }
 

@@ -61,11 +61,12 @@ void cubicBSplinePrefilter(std::vector<double>& f) {
   auto mirrored = [&](int k) { return f[static_cast<std::size_t>(mirrorIndex(k, n))]; };
   double y0 = 0.0, power = 1.0;
   for (int j = 0; j < kPoleTerms; ++j, power *= kPole) y0 += power * mirrored(-j);
-  std::vector<double> y(f.size());
-  y[0] = y0;
-  for (int k = 1; k < n; ++k)
-    y[static_cast<std::size_t>(k)] =
-        f[static_cast<std::size_t>(k)] + kPole * y[static_cast<std::size_t>(k - 1)];
+  // Appended rather than assigned: GCC 12 with -fPIC otherwise warns of a
+  // null dereference of an empty vector (n >= 2 here).
+  std::vector<double> y;
+  y.reserve(f.size());
+  y.push_back(y0);
+  for (int k = 1; k < n; ++k) y.push_back(f[static_cast<std::size_t>(k)] + kPole * y.back());
   // d_{n-1} = sum_j a^j y_{n-1+j}, continuing the causal recursion past the end.
   double dLast = 0.0, yk = y[static_cast<std::size_t>(n - 1)];
   power = 1.0;

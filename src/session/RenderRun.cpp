@@ -242,10 +242,29 @@ double RenderResult::max() const {
   return frameMs.empty() ? 0.0 : *std::max_element(frameMs.begin(), frameMs.end());
 }
 
+void prepareFrame(render::Technique& technique, const Volume& volume, RenderRequest& req) {
+  technique.setTransferFunction(req.settings.tf);
+  req.settings.camera.frame(volume);
+  // Pre-integration and adaptive steps are the ray caster's; the slicers draw
+  // planes, and their reference must not assume either.
+  const render::TechniqueEntry& entry =
+      render::TechniqueRegistry::global().find(req.settings.technique);
+  if (!entry.honoursSampling) req.settings.render.sampling = Sampling();
+  technique.prepare(req.settings.camera, req.settings.render);
+}
+
+void checkImageSize(int width, int height) {
+  if (width < 1 || height < 1 || width > 16384 || height > 16384) {
+    throw InputError("size " + std::to_string(width) + "x" + std::to_string(height) +
+                     ": width and height must be 1..16384");
+  }
+}
+
 RenderResult runRender(gpu::DeviceSession& device, const lod::VolumeSource& source,
                        RenderRequest req) {
   req.settings.validate();
   if (req.repeat < 1) throw InputError("repeat " + std::to_string(req.repeat) + ": expected >= 1");
+  checkImageSize(req.width, req.height);
   if (req.referenceLevel && !req.reference) {
     throw InputError("--reference-level needs the reference (--reference)");
   }
@@ -263,14 +282,8 @@ RenderResult runRender(gpu::DeviceSession& device, const lod::VolumeSource& sour
   const Volume& volume = *t.upload.volume;
   const TransferFunction& tf = s.tf;
   RenderResult result;
-  t.technique->setTransferFunction(tf);
-  req.settings.camera.frame(volume);
-  // Pre-integration and adaptive steps are the ray caster's; the slicers draw
-  // planes, and their reference must not assume either.
-  const render::TechniqueEntry& entry = render::TechniqueRegistry::global().find(s.technique);
-  if (!entry.honoursSampling) req.settings.render.sampling = Sampling();
   const auto tPrepare = std::chrono::steady_clock::now();
-  t.technique->prepare(req.settings.camera, req.settings.render);
+  prepareFrame(*t.technique, volume, req);
   result.prepareMs = msSince(tPrepare);
   layout::StreamingLayout* bricks = t.upload.layout ? t.upload.layout->streaming() : nullptr;
   if (bricks) {

@@ -22,6 +22,20 @@ const nlohmann::json kNoRegion;
 
 }  // namespace
 
+namespace {
+
+// What the upload and the technique depend on: every setting but the camera
+// and the TF (set on each frame), and the image size.
+std::string residentKey(const RenderRequest& r) {
+  nlohmann::json j = r.settings.toJson();
+  j.erase("camera");
+  j.erase("tf");
+  j["size"] = {r.width, r.height};
+  return j.dump();
+}
+
+}  // namespace
+
 Session::Session(gpu::DeviceSession device) : device_(std::move(device)) {}
 
 // The view's and the exploration's GL objects are released on this
@@ -167,6 +181,7 @@ void Session::setVolume(std::shared_ptr<Volume> volume, const std::string& name)
   streamed_.reset();
   streamedView_.reset();
   region_.reset();
+  resident_.reset();
   inCore_ = std::move(next);
   exploration_.reset();
   name_ = name;
@@ -255,10 +270,29 @@ RenderResult Session::run(const RenderRequest& request) {
 }
 
 Image Session::render(int width, int height) {
-  return run(request(width, height)).first;
+  if (!inCore_) return run(request(width, height)).first;
+  RenderRequest req = request(width, height);
+  checkImageSize(width, height);
+  req.settings.validate();
+  const std::string key = residentKey(req);
+  if (!resident_ || resident_->source != inCore_ || resident_->key != key) {
+    resident_.reset();  // its textures go before the next ones are made
+    auto next = std::make_unique<Resident>();
+    next->technique =
+        render::createTechnique(req.settings.technique, *device_.context, device_.limits, *inCore_,
+                                req.techniqueOptions(), req.settings.layout);
+    next->source = inCore_;
+    next->key = key;
+    resident_ = std::move(next);
+  }
+  render::Technique& technique = *resident_->technique.technique;
+  prepareFrame(technique, *resident_->technique.upload.volume, req);
+  technique.render(req.settings.camera, req.settings.render, width, height, 0.0);
+  return technique.readImage();
 }
 
 Image Session::renderReference(int width, int height) {
+  checkImageSize(width, height);
   settings_.validate();
   Camera camera = settings_.camera;
   const Volume& v = volume();

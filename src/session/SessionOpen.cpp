@@ -121,6 +121,7 @@ void Session::open(const std::string& spec, const OpenOptions& options) {
   }
   if (auto pyramid = streamedSource(spec, options, settings_, device_)) {
     inCore_.reset();
+    resident_.reset();
     region_.reset();
     series_.reset();
     seriesWindow_.reset();
@@ -157,6 +158,7 @@ void Session::openInView(const std::string& spec, const OpenOptions& options) {
   seriesWindow_.reset();
   timePoint_ = 0;
   inCore_.reset();
+  resident_.reset();
   region_.reset();
   streamed_ = pyramid.source;
   streamedView_ = std::make_unique<lod::MultiresVolumeSource>(streamed_);

@@ -5,7 +5,10 @@
 
 #include <cstdint>
 #include <limits>
+#include <memory>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
@@ -180,6 +183,45 @@ TEST(HostBudget, FormatsBytesForMessages) {
   EXPECT_EQ(formatBytes(12 * 1024), "12 KiB");
   EXPECT_EQ(formatBytes(200ull << 20), "200 MiB");
   EXPECT_EQ(formatBytes(3ull << 29), "1.5 GiB");
+}
+
+// Volume::borrow (the Python module's from_array): the voxels are the
+// lender's memory, kept alive by it; a copy owns a copy; a move stays borrowed.
+TEST(Volume, BorrowUsesTheLendersMemoryAndACopyOwnsACopy) {
+  auto lender = std::make_shared<std::vector<std::uint16_t>>(4 * 3 * 2, 7);
+  (*lender)[5] = 900;
+  std::span<std::byte> bytes(reinterpret_cast<std::byte*>(lender->data()), lender->size() * 2);
+  Volume v = Volume::borrow({4, 3, 2}, ScalarType::U16, bytes, lender);
+  std::weak_ptr<std::vector<std::uint16_t>> alive = lender;
+  lender.reset();
+  ASSERT_FALSE(alive.expired());  // the volume keeps its lender
+  EXPECT_TRUE(v.borrowsVoxels());
+  EXPECT_EQ(v.bytes().data(), bytes.data());
+  EXPECT_EQ(v.byteSize(), 48u);
+  EXPECT_EQ(v.valueRange().max, 900.0);
+  EXPECT_EQ(v.valueAt(1, 1, 0), 900.0);
+
+  Volume copy = v;
+  EXPECT_FALSE(copy.borrowsVoxels());
+  EXPECT_NE(copy.bytes().data(), bytes.data());
+  copy.setValueAtIndex(5, 1.0);
+  EXPECT_EQ(v.valueAt(1, 1, 0), 900.0);  // the lender's memory is untouched
+
+  Volume moved = std::move(v);
+  EXPECT_TRUE(moved.borrowsVoxels());
+  EXPECT_EQ(moved.bytes().data(), bytes.data());
+  moved = Volume();
+  EXPECT_TRUE(alive.expired());  // released with the last volume holding it
+}
+
+TEST(Volume, BorrowRejectsABufferOfAnotherSize) {
+  auto lender = std::make_shared<std::vector<std::byte>>(10);
+  try {
+    Volume::borrow({2, 2, 2}, ScalarType::U16, *lender, lender, "scan");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "scan: 2x2x2 u16 needs 16 bytes, the buffer has 10");
+  }
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // procedural source, and the input of every layout.
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include <glm/vec3.hpp>
 
 #include "tessera/core/ScalarType.h"
+#include "tessera/core/VoxelStorage.h"
 
 namespace tessera {
 
@@ -34,7 +36,15 @@ class Volume {
   // A volume's shape without voxels (for planning what a volume of these
   // dims and type would need): hasData() is false, value access is invalid.
   static Volume shapeOnly(glm::ivec3 dims, ScalarType type);
+  // A volume over voxels another owner holds (x fastest, then y, then z),
+  // not copied: `lender` keeps them alive while this volume (or a move of
+  // it) lives; a copy of the volume owns a copy of them. InputError unless
+  // `voxels` holds exactly dims of `type`. The Python module's from_array.
+  static Volume borrow(glm::ivec3 dims, ScalarType type, std::span<std::byte> voxels,
+                       std::shared_ptr<const void> lender, const std::string& what = "array");
   bool hasData() const { return !data_.empty(); }
+  // The voxels are another owner's (borrow()).
+  bool borrowsVoxels() const { return data_.borrowed(); }
 
   glm::ivec3 dims() const { return dims_; }
   glm::dvec3 spacing() const { return spacing_; }
@@ -72,8 +82,8 @@ class Volume {
   void setSpacing(glm::dvec3 spacing);
   void setOrigin(glm::dvec3 origin) { origin_ = origin; }
 
-  std::span<std::byte> bytes() { return data_; }
-  std::span<const std::byte> bytes() const { return data_; }
+  std::span<std::byte> bytes() { return data_.bytes(); }
+  std::span<const std::byte> bytes() const { return data_.bytes(); }
   template <class T>
   T* dataAs() {
     return reinterpret_cast<T*>(data_.data());
@@ -128,7 +138,7 @@ class Volume {
   glm::dmat3 direction_{1.0};
   std::string geometrySource_;
   ScalarType type_ = ScalarType::U8;
-  std::vector<std::byte> data_;
+  VoxelStorage data_;
   mutable ValueRange range_;
   mutable bool rangeValid_ = false;
   ValueRange window_;

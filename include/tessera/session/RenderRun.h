@@ -107,6 +107,15 @@ struct RenderResult {
   double max() const;
 };
 
+// Frame 0's set-up on a technique holding `volume` (what runRender does before
+// drawing, and Session::render before each frame on the technique it keeps):
+// the TF, the camera framing the volume, the sampling the technique honours,
+// prepare(). `req.settings` is left as drawn.
+void prepareFrame(render::Technique& technique, const Volume& volume, RenderRequest& req);
+
+// InputError "size WxH: width and height must be 1..16384" otherwise.
+void checkImageSize(int width, int height);
+
 // The TF is request.settings.tf; a label volume's is its table's.
 RenderResult runRender(gpu::DeviceSession& device, const lod::VolumeSource& source,
                        RenderRequest request);

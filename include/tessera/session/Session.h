@@ -26,6 +26,7 @@
 #include "tessera/gpu/DeviceSession.h"
 #include "tessera/lod/InCoreVolumeSource.h"
 #include "tessera/lod/MultiresSource.h"
+#include "tessera/render/TechniqueRegistry.h"
 #include "tessera/session/Exploration.h"
 #include "tessera/session/RenderRun.h"
 #include "tessera/session/Settings.h"
@@ -144,7 +145,11 @@ class Session {
   bool hasView() const { return view_ != nullptr; }
 
   // A frame of width x height at the current settings, refined to the end
-  // when streamed.
+  // when streamed. An in-core volume's technique is kept between calls (the
+  // volume uploaded once): made again when the volume, the image size or a
+  // setting other than the camera and the TF changes, so that a front end
+  // drawing frame after frame (the Python module's widget) pays for the
+  // frame only. The image is the one run() draws for the same settings.
   Image render(int width, int height);
   // A run (frames, rotation, reference): what `tessera render` reports.
   RenderResult run(const RenderRequest& request);
@@ -204,6 +209,13 @@ class Session {
   // view's GL objects and the exploration's zoom swap.
   std::unique_ptr<viewer::Viewer> view_;
   std::unique_ptr<Exploration> exploration_;
+  // render()'s technique on the in-core volume (before device_ goes).
+  struct Resident {
+    std::shared_ptr<lod::InCoreVolumeSource> source;
+    std::string key;
+    render::TechniqueOnVolume technique;
+  };
+  std::unique_ptr<Resident> resident_;
 };
 
 }  // namespace tessera::session
