@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <exception>
+#include <future>
 #include <limits>
 #include <mutex>
 #include <optional>
@@ -620,27 +621,47 @@ struct ZarrStore::ShardIndex {
 
 std::shared_ptr<const ZarrStore::ShardIndex> ZarrStore::shardIndex(const ZarrArrayMeta& m,
                                                                    const std::string& key) const {
+  // One read per shard: a reader wanting an index being read waits for it.
+  std::promise<std::shared_ptr<const ShardIndex>> mine;
+  std::shared_future<std::shared_ptr<const ShardIndex>> pending;
+  bool reader = false;
   {
     const std::lock_guard lock(shardMutex_);
     const auto it = shards_.find(key);
-    if (it != shards_.end()) return it->second;
+    if (it != shards_.end()) {
+      pending = it->second;
+    } else {
+      // Indexes are small (16 B per inner chunk); a store of very many
+      // shards starts over rather than grow without bound.
+      if (shards_.size() >= 4096) shards_.clear();
+      pending = mine.get_future().share();
+      shards_[key] = pending;
+      reader = true;
+    }
   }
-  const std::uint64_t n = m.shardIndexBytes();
-  const auto r =
-      storage_->getRange(key, m.indexAtEnd ? -std::int64_t(n) : 0, n, m.maxStoredShardBytes());
-  std::shared_ptr<const ShardIndex> index;
-  if (r) {
-    auto built = std::make_shared<ShardIndex>();
-    built->entries = parseShardIndex(m, r->bytes, r->total, storage_->locate(key));
-    built->bytes = r->total;
-    index = std::move(built);
+  if (!reader) return pending.get();
+  try {
+    const std::uint64_t n = m.shardIndexBytes();
+    const auto r =
+        storage_->getRange(key, m.indexAtEnd ? -std::int64_t(n) : 0, n, m.maxStoredShardBytes());
+    std::shared_ptr<const ShardIndex> index;
+    if (r) {
+      auto built = std::make_shared<ShardIndex>();
+      built->entries = parseShardIndex(m, r->bytes, r->total, storage_->locate(key));
+      built->bytes = r->total;
+      index = std::move(built);
+    }
+    mine.set_value(index);
+    return index;
+  } catch (...) {
+    // Not remembered: the next reader asks again (a network may recover).
+    {
+      const std::lock_guard lock(shardMutex_);
+      shards_.erase(key);
+    }
+    mine.set_exception(std::current_exception());
+    throw;
   }
-  const std::lock_guard lock(shardMutex_);
-  // Indexes are small (16 B per inner chunk); a store of very many shards
-  // starts over rather than grow without bound.
-  if (shards_.size() >= 4096) shards_.clear();
-  shards_[key] = index;
-  return index;
 }
 
 ZarrChunkCache::Chunk ZarrStore::decodeChunk(const ZarrArrayMeta& m, const std::string& key,

@@ -16,6 +16,7 @@
 // `info` prints this as the geometry source.
 #include <cstdint>
 #include <functional>
+#include <future>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -153,7 +154,7 @@ class ZarrStore {
   std::string ngffText_;    // what holds multiscales and omero (v3: attributes.ome)
   std::vector<ZarrChannel> channels_;
   mutable std::mutex shardMutex_;
-  mutable std::map<std::string, std::shared_ptr<const ShardIndex>> shards_;
+  mutable std::map<std::string, std::shared_future<std::shared_ptr<const ShardIndex>>> shards_;
   std::string version_;
   std::string name_;
   std::string reduction_;
