@@ -168,9 +168,14 @@ std::optional<std::vector<std::byte>> HttpStorage::get(const std::string& key,
 std::optional<ZarrRange> HttpStorage::getRange(const std::string& key, std::int64_t offset,
                                                std::uint64_t length, std::uint64_t maxWhole) const {
   const std::string url = locate(key);
-  const std::string range = offset < 0 ? "-" + std::to_string(length)
-                                       : std::to_string(offset) + "-" +
-                                             std::to_string(std::uint64_t(offset) + length - 1);
+  std::string range;  // appended, not "-" + string: GCC 12's -Wrestrict false positive
+  if (offset < 0) {
+    range.append("-").append(std::to_string(length));
+  } else {
+    range.append(std::to_string(offset))
+        .append("-")
+        .append(std::to_string(std::uint64_t(offset) + length - 1));
+  }
   if (length == 0) throw InputError(url + ": an empty range asked");
   auto r = fetch(key, std::max(length, maxWhole), range);
   if (!r) return std::nullopt;
@@ -205,7 +210,12 @@ std::optional<ZarrRange> HttpStorage::getRange(const std::string& key, std::int6
 std::optional<HttpStorage::Fetched> HttpStorage::fetch(const std::string& key,
                                                        std::uint64_t maxBytes,
                                                        const std::string& range) const {
-  const std::string url = locate(key) + (range.empty() ? "" : " (bytes " + range + ")");
+  std::string url = locate(key);
+  if (!range.empty()) {
+    url.append(" (bytes ");
+    url.append(range);
+    url.append(")");
+  }
   throwIfFailedRecently(url);
   const auto started = std::chrono::steady_clock::now();
   CURL* h = pool_->acquire();
