@@ -455,7 +455,7 @@ std::vector<std::byte> decodeZarrV3Chunk(const ZarrArrayMeta& m, std::span<const
     switch (m.bytesCodecs[i]) {
       case ZarrBytesCodec::Crc32c:
         checkCrc(buf, where, "chunk");
-        buf.resize(buf.size() - 4);
+        buf.erase(buf.end() - 4, buf.end());  // checkCrc made sure it has 4
         break;
       case ZarrBytesCodec::Gzip:
         buf = inflateZarrChunk(buf, before[i], true, where);

@@ -94,17 +94,23 @@ const codecChains = {
     { name: "bytes", configuration: { endian: "little" } },
     { name: "blosc", configuration: { cname: "lz4", clevel: 5, shuffle: "shuffle", typesize: 2, blocksize: 0 } },
   ],
-  "transpose+crc32c": [
+  transpose: [
     { name: "transpose", configuration: { order: [2, 1, 0] } },
     { name: "bytes", configuration: { endian: "little" } },
-    { name: "crc32c" },
+  ],
+  "transpose+blosc": [
+    { name: "transpose", configuration: { order: [1, 2, 0] } },
+    { name: "bytes", configuration: { endian: "big" } },
+    { name: "blosc", configuration: { cname: "zstd", clevel: 3, shuffle: "bitshuffle", typesize: 2, blocksize: 0 } },
   ],
 };
+// zarrita 0.7.5 encodes neither gzip nor crc32c (decode only): those codecs
+// are in the spec-built sharded stores below instead.
 
 const cases = [
-  ["uint8", "bytes"], ["int8", "gzip"], ["uint16", "blosc"], ["int16", "bytes-big"],
-  ["int32", "zstd"], ["uint32", "transpose+crc32c"], ["float32", "gzip"], ["float64", "bytes-big"],
-  ["uint16", "zstd"], ["int16", "transpose+crc32c"],
+  ["uint8", "bytes"], ["int8", "zstd"], ["uint16", "blosc"], ["int16", "bytes-big"],
+  ["int32", "zstd"], ["uint32", "transpose"], ["float32", "blosc"], ["float64", "bytes-big"],
+  ["uint16", "transpose+blosc"], ["int16", "transpose"],
 ];
 
 const table = [];
@@ -221,12 +227,18 @@ for (const location of ["end", "start"]) {
     writeShardedStore(dir, data, location, skip);
     const want = Uint16Array.from(data);
     for (let z = 0; z < 4; z++) for (let y = 4; y < 8; y++) for (let x = 4; x < 8; x++) want[(z * SHAPE[1] + y) * SHAPE[2] + x] = 9;
-    const arr = await zarr.open.v3(zarr.root(new FileSystemStore(dir)).resolve("0"), { kind: "array" });
-    const z = await zarr.get(arr);
-    assert.deepEqual(Array.from(z.data), Array.from(want), "zarrita reads the hand-built shards");
+    // zarrita 0.7.5 ignores index_location (it reads the index from the
+    // end), so the index-at-start store is checked by Tessera alone.
+    let readers = "Tessera";
+    if (location === "end") {
+      const arr = await zarr.open.v3(zarr.root(new FileSystemStore(dir)).resolve("0"), { kind: "array" });
+      const z = await zarr.get(arr);
+      assert.deepEqual(Array.from(z.data), Array.from(want), "zarrita reads the hand-built shards");
+      readers = "zarrita and Tessera";
+    }
     const got = tesseraRead(dir, Uint16Array);
     assert.deepEqual(Array.from(got), Array.from(want));
-    table.push(`spec-built sharded (index ${location}, gzip+crc32c, 1 missing inner chunk) -> zarrita and Tessera: equal`);
+    table.push(`spec-built sharded (index ${location}, gzip+crc32c, 1 missing inner chunk) -> ${readers}: equal`);
   });
 }
 
@@ -240,7 +252,7 @@ for (const [compressor, shard] of [["zstd", 2], ["blosc", 2], ["zlib", 3], ["non
     const refBytes = fs.readFileSync(ref);
     const refJson = JSON.parse(fs.readFileSync(ref + ".json", "utf8"));
     const dir = path.join(tmp, `tessera-${compressor}-${shard}.ome.zarr`);
-    const args = ["convert", src, dir, "--zarr-format", "3", "--chunk", "8", "--compressor", compressor, "--quiet"];
+    const args = ["convert", src, dir, "--zarr-format", "3", "--chunk", "8,8,8", "--compressor", compressor, "--quiet"];
     if (shard) args.push("--shard", String(shard));
     execFileSync(tessera, args);
     const root = zarr.root(new FileSystemStore(dir));
