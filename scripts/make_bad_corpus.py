@@ -819,6 +819,102 @@ def make_zarr(c):
     c.write("zarr/oversized-chunk.zarr/0/0.0.0", b"\x78" * (63 * 1024))
 
 
+# ------------------------------------------------------- OME-Zarr 0.5 (Zarr v3)
+# A group zarr.json with NGFF 0.5 metadata under "ome", an array zarr.json
+# and shards built from the sharding spec (inner chunks, then an index of
+# (offset, nbytes) uint64 pairs and its crc32c).
+
+def crc32c(data):
+    c = 0xFFFFFFFF
+    for b in data:
+        c ^= b
+        for _ in range(8):
+            c = (0x82F63B78 ^ (c >> 1)) if c & 1 else c >> 1
+    return c ^ 0xFFFFFFFF
+
+
+V3_GROUP = json.dumps({"zarr_format": 3, "node_type": "group", "attributes": {"ome": {
+    "version": "0.5", "multiscales": [{"axes": [
+        {"name": a, "type": "space", "unit": "millimeter"} for a in "zyx"],
+        "datasets": [{"path": "0", "coordinateTransformations": [
+            {"type": "scale", "scale": [1.0, 1.0, 1.0]}]}]}]}}})
+
+
+def v3_array(dtype="uint8", shard=(4, 4, 4), inner=(2, 2, 2), inner_codecs=None, **extra):
+    inner_codecs = inner_codecs or [{"name": "bytes", "configuration": {"endian": "little"}}]
+    d = {"zarr_format": 3, "node_type": "array", "shape": [4, 4, 4], "data_type": dtype,
+         "chunk_grid": {"name": "regular", "configuration": {"chunk_shape": list(shard)}},
+         "chunk_key_encoding": {"name": "default", "configuration": {"separator": "/"}},
+         "fill_value": 0,
+         "codecs": [{"name": "sharding_indexed", "configuration": {
+             "chunk_shape": list(inner), "codecs": inner_codecs,
+             "index_codecs": [{"name": "bytes", "configuration": {"endian": "little"}},
+                              {"name": "crc32c"}],
+             "index_location": "end"}}]}
+    d.update(extra)
+    return json.dumps(d)
+
+
+def v3_shard(chunks, entries=None, spoil_index_crc=False):
+    """Inner chunks back to back, then the index (entries override the real
+    (offset, nbytes) pairs) and its crc32c."""
+    body, real, at = b"", [], 0
+    for ch in chunks:
+        real.append((at, len(ch)))
+        body += ch
+        at += len(ch)
+    index = b"".join(struct.pack("<QQ", o, n) for o, n in (entries or real))
+    crc = crc32c(index) ^ (1 if spoil_index_crc else 0)
+    return body + index + struct.pack("<I", crc)
+
+
+def make_zarr_v3(c):
+    f = "zarr"
+
+    def store(name, problem, expect, array, shard):
+        folder = f"zarr/v3-{name}.zarr"
+        c.write(f"{folder}/zarr.json", V3_GROUP)
+        c.write(f"{folder}/0/zarr.json", array)
+        if shard is not None:
+            c.write(f"{folder}/0/c/0/0/0", shard)
+        c.case(folder, f, problem, expect)
+
+    chunk = bytes(range(8))
+    eight = [bytes(range(8 * i, 8 * i + 8)) for i in range(8)]
+    good = v3_array()
+    store("offset-past-end", "shard index entry 0 at offset 2^30 in a 204-byte shard",
+          "lies outside the shard", good,
+          v3_shard(eight, [(1 << 30, 8)] + [(8 * i, 8) for i in range(1, 8)]))
+    store("overlapping-entries", "shard index entries 0 and 1 both at bytes 0..8",
+          "overlap", good, v3_shard(eight, [(0, 8), (4, 8)] + [(8 * i, 8) for i in range(2, 8)]))
+    store("lying-length", "shard index entry 3 claims 2^40 bytes for an 8-byte chunk",
+          "an inner chunk holds", good,
+          v3_shard(eight, [(8 * i, 8) for i in range(3)] + [(24, 1 << 40)] +
+                   [(8 * i, 8) for i in range(4, 8)]))
+    store("index-crc-mismatch", "the shard index's crc32c is off by one bit",
+          "crc32c mismatch", good, v3_shard(eight, spoil_index_crc=True))
+    crc_codecs = [{"name": "bytes", "configuration": {"endian": "little"}}, {"name": "crc32c"}]
+    bad_crc = [ch + struct.pack("<I", crc32c(ch) ^ 0x10) for ch in eight]
+    store("chunk-crc-mismatch", "every inner chunk's crc32c is wrong", "crc32c mismatch",
+          v3_array(inner_codecs=crc_codecs), v3_shard(bad_crc))
+    store("unknown-codec", "inner codec lz4hc", "codec \"lz4hc\" is not supported",
+          v3_array(inner_codecs=[{"name": "lz4hc"}]), v3_shard(eight))
+    store("dtype-mismatch", "data_type uint32 where the inner chunks hold 8 one-byte values",
+          "expected 32", v3_array(dtype="uint32"), v3_shard(eight))
+    store("nested-sharding", "a sharding_indexed inside a shard", "nested sharding_indexed",
+          v3_array(inner_codecs=[{"name": "sharding_indexed", "configuration": {
+              "chunk_shape": [1, 1, 1], "codecs": [{"name": "bytes"}]}}]), None)
+    store("short-shard", "a 20-byte shard whose index alone is 132 bytes", "asked of a value of 20",
+          good, bytes(20))
+    store("too-many-inner-chunks", "a 2^30-voxel shard of 1-voxel inner chunks",
+          "inner chunks per shard",
+          v3_array(shard=(1024, 1024, 1024), inner=(1, 1, 1)), None)
+    store("unknown-data-type", "data_type complex64", "data_type \"complex64\" is not supported",
+          v3_array(dtype="complex64"), None)
+    store("bad-chunk-grid", "chunk_grid rectilinear", "only the \"regular\" chunk grid",
+          v3_array(chunk_grid={"name": "rectilinear"}), None)
+
+
 def fuzz_seeds(root):
     def put(target, name, data):
         path = os.path.join(root, target, name)
@@ -893,6 +989,28 @@ def fuzz_seeds(root):
     put("zarr", "big-endian-slash.bin",
         zarray((4, 5, 6), (4, 5, 6), ">i2", None, dimension_separator="/").encode() + b"\0" +
         b"".join(struct.pack(">h", i - 60) for i in range(120)))
+    # fuzz_zarr_v3: an array zarr.json, a NUL byte, then chunk 0/c/0/0/0.
+    eight = [bytes(range(8 * i, 8 * i + 8)) for i in range(8)]
+    crc_codecs = [{"name": "bytes", "configuration": {"endian": "little"}}, {"name": "crc32c"}]
+    put("zarr_v3", "sharded.bin", v3_array().encode() + b"\0" + v3_shard(eight))
+    put("zarr_v3", "sharded-crc.bin", v3_array(inner_codecs=crc_codecs).encode() + b"\0" +
+        v3_shard([ch + struct.pack("<I", crc32c(ch)) for ch in eight]))
+    plain = json.loads(v3_array())
+    plain["chunk_grid"]["configuration"]["chunk_shape"] = [4, 5, 6]
+    plain["shape"] = [4, 5, 6]
+    plain["data_type"] = "int16"
+    plain["codecs"] = [{"name": "transpose", "configuration": {"order": [2, 1, 0]}},
+                       {"name": "bytes", "configuration": {"endian": "big"}},
+                       {"name": "gzip", "configuration": {"level": 1}}, {"name": "crc32c"}]
+    big = gz(b"".join(struct.pack(">h", i - 60) for i in range(120)))
+    put("zarr_v3", "transpose-big-gzip-crc.bin",
+        json.dumps(plain).encode() + b"\0" + big + struct.pack("<I", crc32c(big)))
+    # fuzz_zarr_shard_index: 2 layout bytes, the shard size, the index.
+    index = v3_shard(eight)[64:]
+    put("zarr_shard_index", "2x2x2-end-crc.bin", bytes([0x09, 0x19]) + struct.pack("<Q", 64 + 132) +
+        index)
+    put("zarr_shard_index", "2x2x2-start.bin", bytes([0x09, 0x01]) + struct.pack("<Q", 64 + 128) +
+        b"".join(struct.pack("<QQ", 128 + 8 * i, 8) for i in range(8)))
 
 
 # ---------------------------------------------------------------------- main
@@ -912,7 +1030,7 @@ def generate(bad_root, seed_root):
         shutil.rmtree(seed_root)
     c = Corpus(bad_root)
     for make in (make_nifti, make_nrrd, make_metaimage, make_vti, make_pvm, make_raw, make_dicom,
-                 make_zarr):
+                 make_zarr, make_zarr_v3):
         make(c)
     for rel, fmt, problem, expect in FUZZ_REGRESSIONS:
         if not os.path.exists(os.path.join(bad_root, rel)):

@@ -33,6 +33,8 @@ struct ConvertOptions {
   std::string chunk = "64";
   std::string levels = "auto";
   std::string compressor = "zstd";
+  int zarrFormat = 2;
+  int shard = 0;
   bool quiet = false;
 };
 
@@ -163,6 +165,8 @@ OmeZarrWriteOptions zarrOptions(const ConvertOptions& o, Progress& progress) {
   } catch (const InputError& e) {
     throw InputError(std::string("--") + e.what());
   }
+  z.zarrFormat = o.zarrFormat;
+  z.shard = o.shard;
   z.progress = [&progress](double f, const std::string& what) {
     progress.stage("writing " + what, 0.05 + 0.95 * f);
   };
@@ -170,9 +174,11 @@ OmeZarrWriteOptions zarrOptions(const ConvertOptions& o, Progress& progress) {
 }
 
 void printZarrResult(const ConvertOptions& o, const Volume& shape, const OmeZarrWriteResult& r) {
-  std::printf("%s: %s %s -> %s: OME-Zarr, %zu levels (", o.in.c_str(),
+  std::printf("%s: %s %s -> %s: OME-Zarr (NGFF %s on Zarr v%d%s), %zu levels (", o.in.c_str(),
               dimsText(shape.dims()).c_str(), std::string(scalarTypeName(shape.type())).c_str(),
-              o.out.c_str(), r.levelDims.size());
+              o.out.c_str(), o.zarrFormat == 3 ? "0.5" : "0.4", o.zarrFormat,
+              o.shard > 0 ? (", " + std::to_string(o.shard) + "^3 chunks per shard").c_str() : "",
+              r.levelDims.size());
   for (std::size_t l = 0; l < r.levelDims.size(); ++l) {
     std::printf("%s%s", l ? ", " : "", dimsText(r.levelDims[l]).c_str());
   }
@@ -259,7 +265,8 @@ void addConvertCommand(CLI::App& app) {
       "Convert between volume formats (by extension), optionally cropping and downsampling.\n"
       "Output: " +
           writeExtensionsText() +
-          "\n(OME-Zarr: NGFF 0.4, a factor-2 pyramid of 2x2x2 means down to one chunk,\n"
+          "\n(OME-Zarr: NGFF 0.4 on Zarr v2, or 0.5 on v3 with --zarr-format 3, a factor-2 pyramid "
+          "of 2x2x2 means down to one chunk,\n"
           "written slab by slab; OME-Zarr input is streamed too, other inputs are read whole).\n"
           "The output appears only when complete (temporary file or folder + rename).\n"
           "`tessera formats` lists what each format keeps and loses.");
@@ -280,6 +287,13 @@ void addConvertCommand(CLI::App& app) {
   cmd->add_option("--compressor", o->compressor,
                   "OME-Zarr output: zstd (level 3), blosc (lz4 + byte shuffle), zlib or none")
       ->default_val("zstd");
+  cmd->add_option("--zarr-format", o->zarrFormat,
+                  "OME-Zarr output: 2 (NGFF 0.4 on Zarr v2) or 3 (NGFF 0.5 on Zarr v3)")
+      ->default_val(2);
+  cmd->add_option("--shard", o->shard,
+                  "OME-Zarr output with --zarr-format 3: N chunks per shard edge "
+                  "(sharding_indexed; 0 = unsharded)")
+      ->default_val(0);
   cmd->add_flag("--quiet", o->quiet, "No progress on stderr");
   cmd->callback([o] { runConvert(*o); });
 }

@@ -328,9 +328,11 @@ std::vector<VolumeFormat> makeFormats() {
     n.container = FormatContainer::Folder;
     n.extensions = {".ome.zarr", ".zarr", "http://", "https://"};
     n.writeExtensions = {".ome.zarr", ".zarr"};
-    n.magic = "a folder with `.zgroup`, `.zattrs` or `.zarray` (any name), or an http(s) URL";
+    n.magic =
+        "a folder with `.zgroup`, `.zattrs`, `.zarray` or `zarr.json` (any name), or an http(s) "
+        "URL";
     n.lossNotes = zarrLossNotes;
-    n.loses = "orientation for other readers (NGFF 0.4 has none; Tessera keeps it)";
+    n.loses = "orientation for other readers (NGFF 0.4 and 0.5 have none; Tessera keeps it)";
     n.nativeRead = "zlib, zstd, blosc; libcurl for URLs (the page: fetch, pako, numcodecs)";
     n.nativeWrite = "zlib, zstd, blosc";
     n.browserReads = true;

@@ -3,6 +3,7 @@
 #include <curl/curl.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdlib>
 #include <mutex>
@@ -35,6 +36,7 @@ void globalInit() {
 
 struct Body {
   std::vector<std::byte> bytes;
+  std::string contentRange;  // "bytes 0-99/1234" of a 206
   std::uint64_t limit = 0;
   bool tooBig = false;
   // The stall check: the request's start or its last body byte.
@@ -54,6 +56,27 @@ std::size_t onBody(char* data, std::size_t size, std::size_t count, void* user) 
   body->bytes.insert(body->bytes.end(), p, p + n);
   body->lastByte = std::chrono::steady_clock::now();
   return n;
+}
+
+std::size_t onHeader(char* data, std::size_t size, std::size_t count, void* user) {
+  auto* body = static_cast<Body*>(user);
+  const std::string line(data, size * count);
+  constexpr const char* kName = "content-range:";
+  if (line.size() > 14) {
+    std::string head = line.substr(0, 14);
+    std::transform(head.begin(), head.end(), head.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
+    if (head == kName) body->contentRange = line.substr(14);
+  }
+  return size * count;
+}
+
+// The whole value's size in a Content-Range ("bytes 0-99/1234"); 0 if
+// none is given.
+std::uint64_t rangeTotal(const std::string& header) {
+  const auto slash = header.find('/');
+  if (slash == std::string::npos) return 0;
+  return std::strtoull(header.c_str() + slash + 1, nullptr, 10);
 }
 
 // Called by libcurl at least once a second: a request whose answer has not
@@ -137,7 +160,62 @@ void HttpStorage::fail(const std::string& url, const std::string& error,
 
 std::optional<std::vector<std::byte>> HttpStorage::get(const std::string& key,
                                                        std::uint64_t maxBytes) const {
+  auto r = fetch(key, maxBytes, "");
+  if (!r) return std::nullopt;
+  return std::move(r->bytes);
+}
+
+std::optional<ZarrRange> HttpStorage::getRange(const std::string& key, std::int64_t offset,
+                                               std::uint64_t length, std::uint64_t maxWhole) const {
   const std::string url = locate(key);
+  std::string range;  // appended, not "-" + string: GCC 12's -Wrestrict false positive
+  if (offset < 0) {
+    range.append("-").append(std::to_string(length));
+  } else {
+    range.append(std::to_string(offset))
+        .append("-")
+        .append(std::to_string(std::uint64_t(offset) + length - 1));
+  }
+  if (length == 0) throw InputError(url + ": an empty range asked");
+  auto r = fetch(key, std::max(length, maxWhole), range);
+  if (!r) return std::nullopt;
+  if (r->total == 0) {
+    // The server ignored Range (200 with the whole body): cut it out here.
+    ++wholeBodies_;
+    const std::uint64_t total = r->bytes.size();
+    const std::uint64_t begin =
+        offset < 0 ? total - std::min(total, length) : std::uint64_t(offset);
+    if ((offset < 0 && length > total) || begin > total || length > total - begin) {
+      throw InputError(url + ": bytes " + range + " asked of a value of " + std::to_string(total) +
+                       " bytes");
+    }
+    ZarrRange out;
+    out.total = total;
+    out.bytes.assign(r->bytes.begin() + std::ptrdiff_t(begin),
+                     r->bytes.begin() + std::ptrdiff_t(begin + length));
+    return out;
+  }
+  if (r->bytes.size() != length) {
+    throw InputError(url + ": range " + range + " answered with " +
+                     std::to_string(r->bytes.size()) + " bytes, expected " +
+                     std::to_string(length));
+  }
+  if (r->total > maxWhole) {
+    throw InputError(url + ": " + std::to_string(r->total) + " bytes, more than the " +
+                     std::to_string(maxWhole) + " any valid content of this key can have");
+  }
+  return ZarrRange{std::move(r->bytes), r->total};
+}
+
+std::optional<HttpStorage::Fetched> HttpStorage::fetch(const std::string& key,
+                                                       std::uint64_t maxBytes,
+                                                       const std::string& range) const {
+  std::string url = locate(key);
+  if (!range.empty()) {
+    url.append(" (bytes ");
+    url.append(range);
+    url.append(")");
+  }
   throwIfFailedRecently(url);
   const auto started = std::chrono::steady_clock::now();
   CURL* h = pool_->acquire();
@@ -159,7 +237,10 @@ std::optional<std::vector<std::byte>> HttpStorage::get(const std::string& key,
     body.limit = maxBytes;
     char error[CURL_ERROR_SIZE] = {0};
     curl_easy_reset(h);
-    curl_easy_setopt(h, CURLOPT_URL, url.c_str());
+    curl_easy_setopt(h, CURLOPT_URL, locate(key).c_str());
+    if (!range.empty()) curl_easy_setopt(h, CURLOPT_RANGE, range.c_str());
+    curl_easy_setopt(h, CURLOPT_HEADERFUNCTION, onHeader);
+    curl_easy_setopt(h, CURLOPT_HEADERDATA, &body);
     curl_easy_setopt(h, CURLOPT_WRITEFUNCTION, onBody);
     curl_easy_setopt(h, CURLOPT_WRITEDATA, &body);
     curl_easy_setopt(h, CURLOPT_ERRORBUFFER, error);
@@ -197,6 +278,9 @@ std::optional<std::vector<std::byte>> HttpStorage::get(const std::string& key,
       problem = "HTTP " + std::to_string(status);
       continue;
     }
+    if (status == 416) {
+      throw InputError(url + ": HTTP 416, the range lies outside the value");
+    }
     if (status < 200 || status >= 300) {
       throw InputError(url + ": HTTP " + std::to_string(status));
     }
@@ -207,7 +291,13 @@ std::optional<std::vector<std::byte>> HttpStorage::get(const std::string& key,
                 std::to_string(declared) + " bytes of Content-Length";
       continue;
     }
-    return std::move(body.bytes);
+    Fetched f;
+    f.bytes = std::move(body.bytes);
+    f.total = status == 206 ? rangeTotal(body.contentRange) : 0;
+    if (status == 206 && f.total == 0) {
+      throw InputError(url + ": HTTP 206 without a Content-Range total");
+    }
+    return f;
   }
   fail(url,
        url + ": " + problem + " (gave up after " + std::to_string(options_.attempts) + " attempts)",

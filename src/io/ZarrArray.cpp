@@ -139,12 +139,27 @@ std::uint64_t ZarrArrayMeta::maxStoredChunkBytes() const {
 }
 
 std::string ZarrArrayMeta::chunkKey(std::span<const std::int64_t> index) const {
-  std::string key;
+  std::string key = keyPrefix;
   for (std::size_t i = 0; i < index.size(); ++i) {
     if (i) key += separator;
-    key += std::to_string(index[i]);
+    key += std::to_string(sharded() ? index[i] * chunks[i] / shard[i] : index[i]);
   }
   return key;
+}
+
+std::uint64_t ZarrArrayMeta::chunksPerShard() const {
+  std::uint64_t n = 1;
+  for (std::size_t a = 0; a < shard.size(); ++a) n *= std::uint64_t(shard[a] / chunks[a]);
+  return n;
+}
+
+std::uint64_t ZarrArrayMeta::innerChunkIndex(std::span<const std::int64_t> index) const {
+  std::uint64_t linear = 0;
+  for (std::size_t a = 0; a < shard.size(); ++a) {
+    const std::int64_t per = shard[a] / chunks[a];
+    linear = linear * std::uint64_t(per) + std::uint64_t(index[a] % per);
+  }
+  return linear;
 }
 
 namespace {
@@ -262,6 +277,7 @@ std::vector<std::byte> decodedZarrChunk(const ZarrArrayMeta& meta, std::vector<s
 
 std::vector<std::byte> decodeZarrChunk(const ZarrArrayMeta& meta, std::span<const std::byte> stored,
                                        const std::string& where) {
+  if (meta.format == 3) return io_detail::decodeZarrV3Chunk(meta, stored, where);
   const std::uint64_t expected = meta.chunkBytes();
   if (stored.size() > meta.maxStoredChunkBytes()) {
     throw InputError(where + ": chunk of " + std::to_string(stored.size()) +

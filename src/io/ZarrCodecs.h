@@ -20,3 +20,14 @@ std::vector<std::byte> bloscZarrChunk(std::span<const std::byte> in, std::uint64
                                       const std::string& where);
 
 }  // namespace tessera::io_detail
+
+namespace tessera {
+struct ZarrArrayMeta;
+namespace io_detail {
+// A Zarr v3 chunk through its codec pipeline in reverse (io/ZarrV3.cpp):
+// exactly meta.chunkBytes() bytes in C order and the array's byte order.
+std::vector<std::byte> decodeZarrV3Chunk(const ZarrArrayMeta& meta,
+                                         std::span<const std::byte> stored,
+                                         const std::string& where);
+}  // namespace io_detail
+}  // namespace tessera

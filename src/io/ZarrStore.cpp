@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <exception>
+#include <future>
 #include <limits>
 #include <mutex>
 #include <optional>
@@ -136,22 +137,76 @@ ZarrStore::ZarrStore(std::shared_ptr<const ZarrStorage> storage, ZarrSelection s
       selection_(selection),
       chunks_(std::make_shared<ZarrChunkCache>(0)) {
   const auto attrs = storage_->get(".zattrs", kMaxMetadataBytes);
-  const std::string attrsText = attrs ? text(*attrs) : std::string();
   // A metadata field of the wrong JSON type is a bad store, not a crash.
   try {
-    const bool multiscales =
-        attrs && parseJson(attrsText, storage_->locate(".zattrs")).contains("multiscales");
+    bool multiscales = false;
+    if (attrs) {
+      attrsWhere_ = storage_->locate(".zattrs");
+      attrsText_ = ngffText_ = text(*attrs);
+      multiscales = parseJson(attrsText_, attrsWhere_).contains("multiscales");
+    } else if (const auto root = storage_->get("zarr.json", kMaxMetadataBytes)) {
+      format_ = 3;
+      multiscales = readV3Root(text(*root));
+    }
     if (multiscales) {
-      readMultiscales(attrsText);
+      readMultiscales();
     } else {
       readLoneArray();
     }
     checkSelection();
-    makeShape(attrsText);
+    makeShape();
   } catch (const json::exception& e) {
     throw InputError(storage_->describe() + ": metadata field of the wrong type or value (" +
                      e.what() + ")");
   }
+}
+
+bool ZarrStore::readV3Root(const std::string& body) {
+  attrsWhere_ = storage_->locate("zarr.json");
+  const json doc = parseJson(body, attrsWhere_);
+  if (!doc.is_object() || !doc.contains("zarr_format") || doc["zarr_format"] != 3) {
+    throw InputError(
+        attrsWhere_ + ": zarr_format is " +
+        (doc.is_object() && doc.contains("zarr_format") ? doc["zarr_format"].dump() : "missing") +
+        ", expected 3 (Zarr v3)");
+  }
+  const std::string node = doc.value("node_type", std::string());
+  if (node == "array") return false;  // a lone array at the root
+  if (node != "group") {
+    throw InputError(attrsWhere_ + ": node_type is " +
+                     (doc.contains("node_type") ? doc["node_type"].dump() : "missing") +
+                     ", expected \"group\" or \"array\"");
+  }
+  const json attributes = doc.contains("attributes") ? doc["attributes"] : json::object();
+  if (!attributes.is_object()) throw InputError(attrsWhere_ + ": attributes is not an object");
+  attrsText_ = attributes.dump();
+  // NGFF 0.5: everything under "ome" (its version there); an older layout
+  // on v3 keeps multiscales at the top of the attributes.
+  if (attributes.contains("ome") && attributes["ome"].is_object()) {
+    const json& ome = attributes["ome"];
+    ngffText_ = ome.dump();
+    version_ = ome.contains("version") && ome["version"].is_string()
+                   ? ome["version"].get<std::string>()
+                   : "?";
+    if (ome.contains("multiscales")) return true;
+  } else {
+    ngffText_ = attrsText_;
+    if (attributes.contains("multiscales")) return true;
+  }
+  throw InputError(attrsWhere_ + ": a Zarr v3 group without OME-NGFF multiscales (no " +
+                   "attributes.ome.multiscales)");
+}
+
+ZarrArrayMeta ZarrStore::readArrayMeta(const std::string& path) const {
+  const std::string key =
+      (path.empty() ? "" : path + "/") + (format_ == 3 ? "zarr.json" : ".zarray");
+  const auto meta = storage_->get(key, kMaxMetadataBytes);
+  if (!meta) {
+    throw InputError(storage_->locate(key) + ": missing" +
+                     (path.empty() ? std::string() : " (dataset \"" + path + "\")"));
+  }
+  return format_ == 3 ? parseZarrJsonArray(text(*meta), storage_->locate(key))
+                      : parseZarray(text(*meta), storage_->locate(key));
 }
 
 const ZarrLevel& ZarrStore::level(int l) const {
@@ -163,17 +218,18 @@ const ZarrLevel& ZarrStore::level(int l) const {
 }
 
 void ZarrStore::readLoneArray() {
-  if (!storage_->get(".zarray", kMaxMetadataBytes)) {
+  const char* metaKey = format_ == 3 ? "zarr.json" : ".zarray";
+  if (format_ == 2 && !storage_->get(".zarray", kMaxMetadataBytes)) {
     throw InputError(storage_->describe() +
-                     ": not an OME-Zarr store (no .zattrs with \"multiscales\" and no .zarray)");
+                     ": not an OME-Zarr store (no .zattrs with \"multiscales\", no .zarray and "
+                     "no zarr.json)");
   }
-  version_ = "plain Zarr array";
+  version_ = format_ == 3 ? "plain Zarr v3 array" : "plain Zarr array";
   notes_.push_back("no OME-NGFF multiscales: one level, spacing 1 mm, origin 0");
-  const auto meta = storage_->get(".zarray", kMaxMetadataBytes);
-  const ZarrArrayMeta m = parseZarray(text(*meta), storage_->locate(".zarray"));
+  const ZarrArrayMeta m = readArrayMeta("");
   const int rank = m.rank();
   if (rank < 3) {
-    throw InputError(storage_->locate(".zarray") + ": " + std::to_string(rank) +
+    throw InputError(storage_->locate(metaKey) + ": " + std::to_string(rank) +
                      " axes; a volume needs 3 (z, y, x) to 5 (t, c, z, y, x)");
   }
   axis_[kX] = rank - 1;
@@ -186,16 +242,21 @@ void ZarrStore::readLoneArray() {
   addLevel("", glm::dvec3(1.0), glm::dvec3(0.0));
 }
 
-void ZarrStore::readMultiscales(const std::string& attrsText) {
-  const std::string where = storage_->locate(".zattrs");
-  const json attrs = parseJson(attrsText, where);
-  const json& all = attrs["multiscales"];
+void ZarrStore::readMultiscales() {
+  const std::string where = attrsWhere_;
+  const json attrs = parseJson(attrsText_, where);
+  const json ngff = parseJson(ngffText_, where);
+  const json& all = ngff["multiscales"];
   if (!all.is_array() || all.empty() || !all[0].is_object()) {
     throw InputError(where + ": \"multiscales\" must be a non-empty list of objects");
   }
   if (all.size() > 1) notes_.push_back("the store holds several multiscales; reading the first");
   const json& ms = all[0];
-  version_ = ms.value("version", std::string("?"));
+  if (ms.contains("version") && ms["version"].is_string()) {
+    version_ = ms["version"].get<std::string>();
+  } else if (version_.empty()) {
+    version_ = "?";
+  }
   name_ = ms.contains("name") && ms["name"].is_string() ? ms["name"].get<std::string>() : "";
   reduction_ = ms.contains("type") && ms["type"].is_string() ? ms["type"].get<std::string>() : "";
   if (!ms.contains("datasets") || !ms["datasets"].is_array() || ms["datasets"].empty()) {
@@ -261,11 +322,9 @@ void ZarrStore::readMultiscales(const std::string& attrsText) {
     applyTransforms(
         ms.contains("coordinateTransformations") ? ms["coordinateTransformations"] : json(), rank,
         where, scale, translation);
-    const std::string key = path + "/.zarray";
-    const auto meta = storage_->get(key, kMaxMetadataBytes);
-    if (!meta) throw InputError(storage_->locate(key) + ": missing (dataset \"" + path + "\")");
+    const std::string key = path + (format_ == 3 ? "/zarr.json" : "/.zarray");
     levels_.push_back({});
-    levels_.back().array = parseZarray(text(*meta), storage_->locate(key));
+    levels_.back().array = readArrayMeta(path);
     if (levels_.back().array.rank() != static_cast<int>(rank)) {
       throw InputError(storage_->locate(key) + ": " + std::to_string(levels_.back().array.rank()) +
                        " axes, multiscales has " + std::to_string(rank));
@@ -293,12 +352,61 @@ void ZarrStore::readMultiscales(const std::string& attrsText) {
       }
     }
     direction_ = m;
+    // Stores written since translations were fixed give them in the
+    // array's own axes (what NGFF means): a level's world origin is level
+    // 0's plus the direction applied to its half-voxel shift. Older
+    // Tessera stores wrote the world shift itself.
+    if (attrs["tessera"].value("translations", std::string()) == "array axes") {
+      const glm::dvec3 t0 = levels_.front().origin;
+      for (ZarrLevel& lv : levels_) lv.origin = t0 + direction_ * (lv.origin - t0);
+    }
+  }
+  readChannels();
+}
+
+void ZarrStore::readChannels() {
+  const json ngff = parseJson(ngffText_, attrsWhere_);
+  if (!ngff.contains("omero") || !ngff["omero"].is_object()) return;
+  const json& ch = ngff["omero"].contains("channels") ? ngff["omero"]["channels"] : json();
+  if (!ch.is_array()) return;
+  for (const json& c : ch) {
+    ZarrChannel out;
+    if (!c.is_object()) {
+      channels_.push_back(out);
+      continue;
+    }
+    if (c.contains("label") && c["label"].is_string()) out.label = c["label"].get<std::string>();
+    if (c.contains("active") && c["active"].is_boolean()) out.active = c["active"].get<bool>();
+    if (c.contains("color") && c["color"].is_string()) {
+      const std::string hex = c["color"].get<std::string>();
+      if (hex.size() == 6 && hex.find_first_not_of("0123456789abcdefABCDEF") == std::string::npos) {
+        const unsigned long rgb = std::stoul(hex, nullptr, 16);
+        out.color =
+            glm::vec3(float((rgb >> 16) & 0xff), float((rgb >> 8) & 0xff), float(rgb & 0xff)) /
+            255.0f;
+      } else {
+        notes_.push_back("omero channel colour \"" + hex + "\" is not RRGGBB: white");
+      }
+    }
+    if (c.contains("window") && c["window"].is_object()) {
+      const json& w = c["window"];
+      const auto num = [&](const char* k, double& v) {
+        if (w.contains(k) && w[k].is_number()) v = w[k].get<double>();
+      };
+      num("start", out.window.min);
+      num("end", out.window.max);
+      num("min", out.range.min);
+      num("max", out.range.max);
+      out.hasWindow = w.contains("start") && w.contains("end");
+    }
+    channels_.push_back(out);
   }
 }
 
 void ZarrStore::addLevel(const std::string& path, glm::dvec3 scale, glm::dvec3 translation) {
   ZarrLevel& lv = levels_.back();
-  const std::string where = storage_->locate(path.empty() ? ".zarray" : path + "/.zarray");
+  const std::string meta = format_ == 3 ? "zarr.json" : ".zarray";
+  const std::string where = storage_->locate(path.empty() ? meta : path + "/" + meta);
   lv.path = path;
   for (int r = 0; r < 3; ++r) {
     const std::int64_t n = lv.array.shape[std::size_t(axis_[r])];
@@ -341,7 +449,7 @@ void ZarrStore::checkSelection() {
   }
 }
 
-void ZarrStore::makeShape(const std::string& attrsText) {
+void ZarrStore::makeShape() {
   const ZarrLevel& fine = levels_.front();
   shape_ = Volume::shapeOnly(fine.dims, fine.array.target);
   shape_.setSpacing(fine.spacing);
@@ -375,14 +483,15 @@ void ZarrStore::makeShape(const std::string& attrsText) {
            (wide ? r->min < r->max : r->min <= r->max);
   };
   std::optional<ValueRange> range, window;
-  if (!attrsText.empty()) {
-    const json attrs = parseJson(attrsText, storage_->locate(".zattrs"));
+  if (!attrsText_.empty()) {
+    const json attrs = parseJson(attrsText_, attrsWhere_);
+    const json ngff = parseJson(ngffText_, attrsWhere_);
     if (attrs.contains("tessera") && attrs["tessera"].is_object()) {
       range = array2(attrs["tessera"], "value_range");
       window = array2(attrs["tessera"], "window");
     }
-    if (attrs.contains("omero") && attrs["omero"].contains("channels")) {
-      const json& ch = attrs["omero"]["channels"];
+    if (ngff.contains("omero") && ngff["omero"].is_object() && ngff["omero"].contains("channels")) {
+      const json& ch = ngff["omero"]["channels"];
       const std::size_t c = std::size_t(selection_.channel);
       if (ch.is_array() && c < ch.size() && ch[c].contains("window") &&
           ch[c]["window"].is_object()) {
@@ -425,9 +534,10 @@ int ZarrStore::finestLevelWithin(std::uint64_t budgetBytes) const {
 
 std::string ZarrStore::describe() const {
   return "OME-Zarr " + storage_->describe() + " (" +
-         (version_ == "plain Zarr array" ? version_ : "NGFF " + version_) + ", " +
-         std::to_string(levelCount()) + " level" + (levelCount() == 1 ? "" : "s") + ", " +
-         levels_.front().array.dtype + ", " + levels_.front().array.compressorText + ")";
+         (version_.rfind("plain", 0) == 0 ? version_ : "NGFF " + version_) +
+         (format_ == 3 ? " on Zarr v3" : "") + ", " + std::to_string(levelCount()) + " level" +
+         (levelCount() == 1 ? "" : "s") + ", " + levels_.front().array.dtype + ", " +
+         levels_.front().array.compressorText + ")";
 }
 
 Volume ZarrStore::readBox(int l, glm::ivec3 begin, glm::ivec3 end, const Progress& progress) const {
@@ -504,15 +614,80 @@ Volume ZarrStore::readBox(int l, glm::ivec3 begin, glm::ivec3 end, const Progres
   return out;
 }
 
-ZarrChunkCache::Chunk ZarrStore::decodeChunk(const ZarrArrayMeta& m, const std::string& key) const {
+struct ZarrStore::ShardIndex {
+  std::vector<ZarrShardEntry> entries;
+  std::uint64_t bytes = 0;  // the whole shard's
+};
+
+std::shared_ptr<const ZarrStore::ShardIndex> ZarrStore::shardIndex(const ZarrArrayMeta& m,
+                                                                   const std::string& key) const {
+  // One read per shard: a reader wanting an index being read waits for it.
+  std::promise<std::shared_ptr<const ShardIndex>> mine;
+  std::shared_future<std::shared_ptr<const ShardIndex>> pending;
+  bool reader = false;
+  {
+    const std::lock_guard lock(shardMutex_);
+    const auto it = shards_.find(key);
+    if (it != shards_.end()) {
+      pending = it->second;
+    } else {
+      // Indexes are small (16 B per inner chunk); a store of very many
+      // shards starts over rather than grow without bound.
+      if (shards_.size() >= 4096) shards_.clear();
+      pending = mine.get_future().share();
+      shards_[key] = pending;
+      reader = true;
+    }
+  }
+  if (!reader) return pending.get();
+  try {
+    const std::uint64_t n = m.shardIndexBytes();
+    const auto r =
+        storage_->getRange(key, m.indexAtEnd ? -std::int64_t(n) : 0, n, m.maxStoredShardBytes());
+    std::shared_ptr<const ShardIndex> index;
+    if (r) {
+      auto built = std::make_shared<ShardIndex>();
+      built->entries = parseShardIndex(m, r->bytes, r->total, storage_->locate(key));
+      built->bytes = r->total;
+      index = std::move(built);
+    }
+    mine.set_value(index);
+    return index;
+  } catch (...) {
+    // Not remembered: the next reader asks again (a network may recover).
+    {
+      const std::lock_guard lock(shardMutex_);
+      shards_.erase(key);
+    }
+    mine.set_exception(std::current_exception());
+    throw;
+  }
+}
+
+ZarrChunkCache::Chunk ZarrStore::decodeChunk(const ZarrArrayMeta& m, const std::string& key,
+                                             std::int64_t inner) const {
+  std::shared_ptr<const ShardIndex> index;
+  if (inner >= 0) {
+    index = shardIndex(m, key);
+    if (!index || index->entries[std::size_t(inner)].missing()) return nullptr;  // fill_value
+  }
+  const std::string where =
+      storage_->locate(key) + (inner >= 0 ? " (inner chunk " + std::to_string(inner) + ")" : "");
+  const bool decoded = m.format == 2 && storage_->decodesChunks(m.compressor);
   for (int attempt = 0;; ++attempt) {
-    auto stored = storage_->get(key, m.maxStoredChunkBytes());
+    std::optional<std::vector<std::byte>> stored;
+    if (inner >= 0) {
+      const ZarrShardEntry& e = index->entries[std::size_t(inner)];
+      auto r = storage_->getRange(key, std::int64_t(e.offset), e.bytes, index->bytes);
+      if (r) stored = std::move(r->bytes);
+    } else {
+      stored = storage_->get(key, m.maxStoredChunkBytes());
+    }
     if (!stored) return nullptr;
     try {
       return std::make_shared<const std::vector<std::byte>>(
-          storage_->decodesChunks(m.compressor)
-              ? decodedZarrChunk(m, std::move(*stored), storage_->locate(key))
-              : decodeZarrChunk(m, *stored, storage_->locate(key)));
+          decoded ? decodedZarrChunk(m, std::move(*stored), where)
+                  : decodeZarrChunk(m, *stored, where));
     } catch (const InputError&) {
       // A network may have damaged the body: fetch it again.
       if (attempt >= storage_->refetches()) throw;
@@ -533,16 +708,21 @@ std::uint64_t ZarrStore::allChunkBytes() const {
   return bytes;
 }
 
-std::string ZarrStore::chunkKeyAt(int l, const std::vector<std::int64_t>& spatial) const {
-  const ZarrLevel& lv = levels_[std::size_t(l)];
-  const ZarrArrayMeta& m = lv.array;
+std::vector<std::int64_t> ZarrStore::chunkIndexAt(int l,
+                                                  const std::vector<std::int64_t>& spatial) const {
+  const ZarrArrayMeta& m = levels_[std::size_t(l)].array;
   std::vector<std::int64_t> index(std::size_t(m.rank()), 0);
   for (int r = 0; r < 3; ++r) index[std::size_t(axis_[r])] = spatial[std::size_t(r)];
   const int sel[2] = {selection_.time, selection_.channel};
   for (int r = kT; r <= kC; ++r) {
     if (axis_[r] >= 0) index[std::size_t(axis_[r])] = sel[r - kT] / m.chunks[std::size_t(axis_[r])];
   }
-  return (lv.path.empty() ? "" : lv.path + "/") + m.chunkKey(index);
+  return index;
+}
+
+std::string ZarrStore::chunkKeyAt(int l, const std::vector<std::int64_t>& spatial) const {
+  const ZarrLevel& lv = levels_[std::size_t(l)];
+  return (lv.path.empty() ? "" : lv.path + "/") + lv.array.chunkKey(chunkIndexAt(l, spatial));
 }
 
 std::vector<std::string> ZarrStore::chunkKeys(int l, glm::ivec3 begin, glm::ivec3 end) const {
@@ -552,7 +732,13 @@ std::vector<std::string> ZarrStore::chunkKeys(int l, glm::ivec3 begin, glm::ivec
   std::vector<std::string> keys;
   for (int z = c0.z; z < c1.z; ++z) {
     for (int y = c0.y; y < c1.y; ++y) {
-      for (int x = c0.x; x < c1.x; ++x) keys.push_back(chunkKeyAt(l, {x, y, z}));
+      for (int x = c0.x; x < c1.x; ++x) {
+        std::string key = chunkKeyAt(l, {x, y, z});
+        // A sharded level's inner chunks share their shard's key.
+        if (!lv.array.sharded() || std::find(keys.begin(), keys.end(), key) == keys.end()) {
+          keys.push_back(std::move(key));
+        }
+      }
     }
   }
   return keys;
@@ -574,12 +760,16 @@ void ZarrStore::readChunkInto(int l, const std::vector<std::int64_t>& spatial, g
     if (axis_[r] < 0) continue;
     base += (sel[r - kT] % m.chunks[std::size_t(axis_[r])]) * stride[std::size_t(axis_[r])];
   }
-  const std::string key = chunkKeyAt(l, spatial);
+  const std::vector<std::int64_t> index = chunkIndexAt(l, spatial);
+  const std::string key = (lv.path.empty() ? "" : lv.path + "/") + m.chunkKey(index);
+  const std::int64_t inner = m.sharded() ? std::int64_t(m.innerChunkIndex(index)) : -1;
   const glm::ivec3 origin =
       glm::ivec3(int(spatial[0]), int(spatial[1]), int(spatial[2])) * lv.chunk;
   const glm::ivec3 lo = glm::max(begin, origin);
   const glm::ivec3 hi = glm::min(end, origin + lv.chunk);
-  const ZarrChunkCache::Chunk raw = chunks_->get(key, [&] { return decodeChunk(m, key); });
+  const ZarrChunkCache::Chunk raw =
+      chunks_->get(inner >= 0 ? key + "#" + std::to_string(inner) : key,
+                   [&] { return decodeChunk(m, key, inner); });
   const std::size_t bpv = bytesPerVoxel(m.target);
   const std::int64_t sx = stride[std::size_t(axis_[kX])];
   const std::int64_t sy = stride[std::size_t(axis_[kY])];

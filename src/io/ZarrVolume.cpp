@@ -20,7 +20,7 @@ bool isZarrStore(const std::string& spec) {
   std::error_code ec;
   const std::filesystem::path p(spec);
   if (!std::filesystem::is_directory(p, ec)) return false;
-  for (const char* key : {".zgroup", ".zattrs", ".zarray"}) {
+  for (const char* key : {".zgroup", ".zattrs", ".zarray", "zarr.json"}) {
     if (std::filesystem::is_regular_file(p / key, ec)) return true;
   }
   return false;

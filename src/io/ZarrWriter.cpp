@@ -3,11 +3,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <thread>
@@ -73,10 +75,18 @@ Volume halve(const Volume& src, int depth) {
 
 // One level of the pyramid being written: a slab of chunk.z slices that
 // fills up, is cut into chunks, and is halved into the next level.
+// A shard being appended to: the index entries of its inner chunks so far.
+struct OpenShard {
+  std::vector<ZarrShardEntry> entries;
+  std::uint64_t bytes = 0;
+};
+
 struct LevelWriter {
   int index = 0;
   glm::ivec3 dims{0};
   glm::ivec3 chunk{0};
+  glm::ivec3 shard{0};                             // inner chunks per shard per axis (0: unsharded)
+  std::map<std::array<int, 3>, OpenShard> shards;  // by shard (x, y, z)
   fs::path dir;
   Volume slab;  // dims.x x dims.y x chunk.z
   int slabZ0 = 0;
@@ -94,6 +104,9 @@ class PyramidWriter {
       w.index = l;
       w.dims = d;
       w.chunk = glm::min(d, o.chunkXyz());
+      if (o.zarrFormat == 3 && o.shard > 0) {
+        w.shard = glm::min(glm::ivec3(o.shard), (d + w.chunk - 1) / w.chunk);
+      }
       w.dir = root / std::to_string(l);
       w.slab = Volume::allocate({d.x, d.y, w.chunk.z}, type_,
                                 "OME-Zarr level " + std::to_string(l) + " slab");
@@ -141,17 +154,23 @@ class PyramidWriter {
   void flush(int l) {
     LevelWriter& w = levels_[std::size_t(l)];
     writeChunks(w);
+    if (w.shard.x > 0) {
+      // The slab that ends a row of shards (or the level) completes them.
+      const int cz = w.slabZ0 / w.chunk.z;
+      if ((cz + 1) % w.shard.z == 0 || w.slabZ0 + w.filled == w.dims.z)
+        closeShards(w, cz / w.shard.z);
+    }
     if (l + 1 < levelCount()) push(l + 1, halve(w.slab, w.filled));
     w.slabZ0 += w.filled;
     w.filled = 0;
   }
 
   // The chunks of one slab, compressed on a few threads.
-  void writeChunks(const LevelWriter& w) {
+  void writeChunks(LevelWriter& w) {
     const int cz = w.slabZ0 / w.chunk.z;
     const int ny = (w.dims.y + w.chunk.y - 1) / w.chunk.y;
     const int nx = (w.dims.x + w.chunk.x - 1) / w.chunk.x;
-    const fs::path zdir = w.dir / std::to_string(cz);
+    const fs::path zdir = w.dir / (options_.zarrFormat == 3 ? "c/" : "") / std::to_string(cz);
     std::atomic<int> next{0};
     std::mutex mutex;
     std::exception_ptr failure;
@@ -174,7 +193,7 @@ class PyramidWriter {
     if (failure) std::rethrow_exception(failure);
   }
 
-  void writeChunk(const LevelWriter& w, const fs::path& zdir, int cx, int cy) {
+  void writeChunk(LevelWriter& w, const fs::path& zdir, int cx, int cy) {
     const std::size_t bpv = bytesPerVoxel(type_);
     const glm::ivec3 c = w.chunk;
     std::vector<std::byte> raw(std::size_t(c.x) * std::size_t(c.y) * std::size_t(c.z) * bpv);
@@ -199,14 +218,64 @@ class PyramidWriter {
       ++skipped_;
       return;
     }
-    const std::vector<std::byte> stored = encodeZarrChunk(options_.compressor, int(bpv), raw);
-    {
-      const std::lock_guard lock(dirMutex_);
-      fs::create_directories(zdir / std::to_string(cy));
+    const ZarrCompressor codec =
+        options_.zarrFormat == 3 && options_.compressor == ZarrCompressor::Zlib
+            ? ZarrCompressor::Gzip
+            : options_.compressor;
+    const std::vector<std::byte> stored = encodeZarrChunk(codec, int(bpv), raw);
+    const int cz = w.slabZ0 / c.z;
+    if (w.shard.x > 0) {
+      appendToShard(w, {cx, cy, cz}, stored);
+    } else {
+      {
+        const std::lock_guard lock(dirMutex_);
+        fs::create_directories(zdir / std::to_string(cy));
+      }
+      writeBytes(zdir / std::to_string(cy) / std::to_string(cx), stored.data(), stored.size());
     }
-    writeBytes(zdir / std::to_string(cy) / std::to_string(cx), stored.data(), stored.size());
     bytes_ += stored.size();
     ++written_;
+  }
+
+  fs::path shardPath(const LevelWriter& w, const std::array<int, 3>& s) const {
+    return w.dir / "c" / std::to_string(s[2]) / std::to_string(s[1]) / std::to_string(s[0]);
+  }
+
+  // Appends one inner chunk to its shard's file and records where.
+  void appendToShard(LevelWriter& w, glm::ivec3 c, const std::vector<std::byte>& stored) {
+    const std::array<int, 3> s = {c.x / w.shard.x, c.y / w.shard.y, c.z / w.shard.z};
+    const glm::ivec3 in = c - glm::ivec3(s[0], s[1], s[2]) * w.shard;
+    const std::size_t inner =
+        (std::size_t(in.z) * std::size_t(w.shard.y) + std::size_t(in.y)) * std::size_t(w.shard.x) +
+        std::size_t(in.x);
+    const std::lock_guard lock(dirMutex_);
+    OpenShard& shard = w.shards[s];
+    if (shard.entries.empty()) {
+      shard.entries.assign(std::size_t(w.shard.x) * std::size_t(w.shard.y) * std::size_t(w.shard.z),
+                           {~std::uint64_t{0}, ~std::uint64_t{0}});
+      fs::create_directories(shardPath(w, s).parent_path());
+    }
+    appendBytes(shardPath(w, s), stored);
+    shard.entries[inner] = {shard.bytes, stored.size()};
+    shard.bytes += stored.size();
+  }
+
+  void closeShards(LevelWriter& w, int sz) {
+    for (auto it = w.shards.begin(); it != w.shards.end();) {
+      if (it->first[2] != sz) {
+        ++it;
+        continue;
+      }
+      appendBytes(shardPath(w, it->first), encodeShardIndex(it->second.entries));
+      it = w.shards.erase(it);
+    }
+  }
+
+  static void appendBytes(const fs::path& path, const std::vector<std::byte>& b) {
+    std::ofstream out(path, std::ios::binary | std::ios::app);
+    out.write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+    out.close();
+    if (!out) throw Error(path.string() + ": cannot write");
   }
 
   ScalarType type_;
@@ -223,7 +292,7 @@ nlohmann::json zyx(glm::dvec3 v) {
 }
 
 std::string attributes(const Volume& shape, const PyramidWriter& p, const std::string& name,
-                       const ValueRange& range) {
+                       const ValueRange& range, int format) {
   using nlohmann::json;
   json axes = json::array();
   for (const char* a : {"z", "y", "x"}) {
@@ -234,9 +303,10 @@ std::string attributes(const Volume& shape, const PyramidWriter& p, const std::s
     const double f = std::ldexp(1.0, l);
     const glm::dvec3 spacing = shape.spacing() * f;
     // A level-l voxel is the mean of 2^l finer voxels per axis: its centre
-    // lies (2^l - 1)/2 finest voxels past the first of them.
-    const glm::dvec3 origin =
-        shape.origin() + shape.direction() * (shape.spacing() * (0.5 * (f - 1.0)));
+    // lies (2^l - 1)/2 finest voxels past the first of them, in the array's
+    // own axes (NGFF has no direction; the reader applies tessera.direction
+    // to the shift, "translations": "array axes").
+    const glm::dvec3 origin = shape.origin() + shape.spacing() * (0.5 * (f - 1.0));
     datasets.push_back({{"path", std::to_string(l)},
                         {"coordinateTransformations",
                          json::array({{{"type", "scale"}, {"scale", zyx(spacing)}},
@@ -252,7 +322,8 @@ std::string attributes(const Volume& shape, const PyramidWriter& p, const std::s
                 "tessera convert: 2x2x2 mean (lod::downsample), partial edge blocks "
                 "average the voxels present"},
                {"world_frame", "RAS+ millimetres; x->R, y->A, z->S when direction is identity"}}}};
-  json tessera = {{"world_frame", "RAS"}};
+  if (format == 3) ms.erase("version");  // 0.5: the version is the "ome" object's
+  json tessera = {{"world_frame", "RAS"}, {"translations", "array axes"}};
   json dir = json::array();
   for (int c = 0; c < 3; ++c) {
     dir.push_back({shape.direction()[c][0], shape.direction()[c][1], shape.direction()[c][2]});
@@ -260,6 +331,11 @@ std::string attributes(const Volume& shape, const PyramidWriter& p, const std::s
   tessera["direction"] = dir;
   if (range.max >= range.min) tessera["value_range"] = {range.min, range.max};
   if (shape.hasWindow()) tessera["window"] = {shape.window().min, shape.window().max};
+  if (format == 3) {
+    const json attrs = {{"ome", {{"version", "0.5"}, {"multiscales", json::array({ms})}}},
+                        {"tessera", tessera}};
+    return json({{"zarr_format", 3}, {"node_type", "group"}, {"attributes", attrs}}).dump(2);
+  }
   return json({{"multiscales", json::array({ms})}, {"tessera", tessera}}).dump(2);
 }
 
@@ -270,9 +346,20 @@ void build(const Volume& shape, const SlabReader& slabs, const fs::path& root,
   for (int l = 0; l < pyramid.levelCount(); ++l) {
     const LevelWriter& w = pyramid.level(l);
     fs::create_directories(w.dir);
-    writeText(w.dir / ".zarray",
-              zarrayJson({w.dims.z, w.dims.y, w.dims.x}, {w.chunk.z, w.chunk.y, w.chunk.x},
-                         shape.type(), o.compressor));
+    if (o.zarrFormat == 3) {
+      std::vector<std::int64_t> shard;
+      if (w.shard.x > 0) {
+        shard = {std::int64_t(w.chunk.z) * w.shard.z, std::int64_t(w.chunk.y) * w.shard.y,
+                 std::int64_t(w.chunk.x) * w.shard.x};
+      }
+      writeText(w.dir / "zarr.json",
+                zarrJsonArray({w.dims.z, w.dims.y, w.dims.x}, {w.chunk.z, w.chunk.y, w.chunk.x},
+                              shard, shape.type(), o.compressor));
+    } else {
+      writeText(w.dir / ".zarray",
+                zarrayJson({w.dims.z, w.dims.y, w.dims.x}, {w.chunk.z, w.chunk.y, w.chunk.x},
+                           shape.type(), o.compressor));
+    }
   }
   const glm::ivec3 d = shape.dims();
   const int step = pyramid.level(0).chunk.z;
@@ -288,9 +375,13 @@ void build(const Volume& shape, const SlabReader& slabs, const fs::path& root,
       o.progress(double(z1) / d.z, "slices " + std::to_string(z1) + "/" + std::to_string(d.z));
     }
   }
-  writeText(root / ".zgroup", "{\n  \"zarr_format\": 2\n}");
   result = pyramid.result();
-  writeText(root / ".zattrs", attributes(shape, pyramid, name, result.range));
+  if (o.zarrFormat == 3) {
+    writeText(root / "zarr.json", attributes(shape, pyramid, name, result.range, 3));
+  } else {
+    writeText(root / ".zgroup", "{\n  \"zarr_format\": 2\n}");
+    writeText(root / ".zattrs", attributes(shape, pyramid, name, result.range, 2));
+  }
   for (int l = 0; l < pyramid.levelCount(); ++l) result.levelDims.push_back(pyramid.level(l).dims);
 }
 
@@ -322,6 +413,13 @@ OmeZarrWriteResult writeOmeZarr(const Volume& shape, const SlabReader& slabs, co
     if (c < 8 || c > 1024 || c % 2 != 0) {
       throw InputError("--chunk " + std::to_string(c) + ": expected an even size in 8..1024");
     }
+  }
+  if (o.zarrFormat != 2 && o.zarrFormat != 3) {
+    throw InputError("--zarr-format " + std::to_string(o.zarrFormat) + ": expected 2 or 3");
+  }
+  if (o.shard < 0 || o.shard > 64 || (o.shard > 0 && o.zarrFormat != 3)) {
+    throw InputError("--shard " + std::to_string(o.shard) +
+                     ": expected 1..64 chunks per shard edge, with --zarr-format 3");
   }
   if (o.levels < 0 || o.levels > 30) {
     throw InputError("--levels " + std::to_string(o.levels) + ": expected auto or 1..30");

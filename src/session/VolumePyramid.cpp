@@ -23,6 +23,15 @@ std::optional<std::vector<std::byte>> CountingStorage::get(const std::string& ke
   return bytes;
 }
 
+std::optional<ZarrRange> CountingStorage::getRange(const std::string& key, std::int64_t offset,
+                                                   std::uint64_t length,
+                                                   std::uint64_t maxWhole) const {
+  auto r = inner_->getRange(key, offset, length, maxWhole);
+  ++chunks_;
+  if (r) bytes_ += r->bytes.size();
+  return r;
+}
+
 VolumePyramid openVolumePyramid(const std::string& spec, const PyramidOptions& options) {
   if (lod::ProceduralMultiresSource::isSpec(spec)) {
     return {std::make_shared<lod::ProceduralMultiresSource>(spec), nullptr};

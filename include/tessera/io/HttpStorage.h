@@ -59,6 +59,10 @@ class HttpStorage final : public ZarrStorage {
 
   std::optional<std::vector<std::byte>> get(const std::string& key,
                                             std::uint64_t maxBytes) const override;
+  // A Range request; a server that ignores Range (200 with the whole
+  // body) still works, its body cut here (counted in wholeBodies()).
+  std::optional<ZarrRange> getRange(const std::string& key, std::int64_t offset,
+                                    std::uint64_t length, std::uint64_t maxWhole) const override;
   std::string locate(const std::string& key) const override { return root_ + "/" + key; }
   int refetches() const override { return options_.attempts - 1; }
   int parallelism() const override { return options_.connections; }
@@ -68,9 +72,19 @@ class HttpStorage final : public ZarrStorage {
   std::uint64_t bytesFetched() const { return bytes_.load(); }
   std::uint64_t requests() const { return requests_.load(); }
   std::uint64_t retries() const { return retries_.load(); }
+  // Range requests answered with the whole body (200).
+  std::uint64_t wholeBodies() const { return wholeBodies_.load(); }
 
  private:
   struct Pool;
+  struct Fetched {
+    std::vector<std::byte> bytes;
+    std::uint64_t total = 0;  // a 206's whole value; 0 for a 200
+  };
+  // One GET (with a Range when `range` is not empty: "0-99", "-100"),
+  // retried as the class comment says; nullopt for 404/410.
+  std::optional<Fetched> fetch(const std::string& key, std::uint64_t maxBytes,
+                               const std::string& range) const;
   struct Failed {
     std::string error;
     std::chrono::steady_clock::time_point until;
@@ -86,6 +100,7 @@ class HttpStorage final : public ZarrStorage {
   mutable std::atomic<std::uint64_t> bytes_{0};
   mutable std::atomic<std::uint64_t> requests_{0};
   mutable std::atomic<std::uint64_t> retries_{0};
+  mutable std::atomic<std::uint64_t> wholeBodies_{0};
   mutable std::mutex failedMutex_;
   mutable std::unordered_map<std::string, Failed> failed_;  // by URL
 };

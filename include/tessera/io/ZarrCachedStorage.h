@@ -22,6 +22,10 @@ class CachedStorage final : public ZarrStorage {
 
   std::optional<std::vector<std::byte>> get(const std::string& key,
                                             std::uint64_t maxBytes) const override;
+  // Ranges are kept as their own entries ("key#offset+length"), so a
+  // shard's index and inner chunks are fetched once.
+  std::optional<ZarrRange> getRange(const std::string& key, std::int64_t offset,
+                                    std::uint64_t length, std::uint64_t maxWhole) const override;
   void forget(const std::string& key) const override;
   std::string locate(const std::string& key) const override { return inner_->locate(key); }
   int refetches() const override { return inner_->refetches(); }
@@ -34,9 +38,12 @@ class CachedStorage final : public ZarrStorage {
  private:
   struct Entry {
     std::optional<std::vector<std::byte>> bytes;
+    std::uint64_t total = 0;  // a range's whole value
     std::list<std::string>::iterator use;
   };
   std::uint64_t cost(const Entry& e) const;
+  void keep(const std::string& key, std::optional<std::vector<std::byte>> bytes,
+            std::uint64_t total) const;
 
   std::shared_ptr<const ZarrStorage> inner_;
   std::uint64_t budget_;

@@ -1,5 +1,5 @@
 #pragma once
-// Where a Zarr store's keys live ("0/.zarray", "0/1/2/3"): a folder on
+// Where a Zarr store's keys live ("0/.zarray", "0/1/2/3", "0/c/1/2/3"): a folder on
 // disk, bytes in memory (tests, fuzzers, and the browser, where a JS
 // fetch() source fills it), or an HTTP(S) server (io/HttpStorage.h). The
 // store reader (io/ZarrStore.h) sees only this interface.
@@ -15,9 +15,25 @@
 
 namespace tessera {
 
+// Part of a key's bytes (a shard's index, one inner chunk) and the size
+// of the whole value.
+struct ZarrRange {
+  std::vector<std::byte> bytes;
+  std::uint64_t total = 0;
+};
+
 class ZarrStorage {
  public:
   virtual ~ZarrStorage() = default;
+
+  // Bytes [offset, offset + length) of `key`, or with offset < 0 its last
+  // `length` bytes (a shard's index at its end); nullopt when there is no
+  // such key. A range outside the value: InputError naming the key. A
+  // value larger than `maxWhole` is an InputError too. The default reads
+  // the whole value (get) and cuts the range out; folders and HTTP read
+  // only the range.
+  virtual std::optional<ZarrRange> getRange(const std::string& key, std::int64_t offset,
+                                            std::uint64_t length, std::uint64_t maxWhole) const;
 
   // The bytes stored under `key`, or nullopt when there are none (a
   // missing chunk is fill_value in Zarr). More than `maxBytes` is an
@@ -57,6 +73,8 @@ class FolderStorage final : public ZarrStorage {
   explicit FolderStorage(std::filesystem::path root);
   std::optional<std::vector<std::byte>> get(const std::string& key,
                                             std::uint64_t maxBytes) const override;
+  std::optional<ZarrRange> getRange(const std::string& key, std::int64_t offset,
+                                    std::uint64_t length, std::uint64_t maxWhole) const override;
   std::string locate(const std::string& key) const override;
   std::string describe() const override { return root_.string(); }
 

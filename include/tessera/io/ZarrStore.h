@@ -1,17 +1,25 @@
 #pragma once
-// An OME-Zarr multiscale image (OME-NGFF 0.4 on Zarr v2), read one box at a
-// time through a ZarrStorage (folder, memory or HTTP).
+// An OME-Zarr multiscale image (OME-NGFF 0.4 on Zarr v2, 0.5 on Zarr v3:
+// the group's zarr.json with the metadata under attributes.ome, sharded
+// arrays read one inner chunk at a time), read one box at a time through a
+// ZarrStorage (folder, memory or HTTP).
 //
 // World frame: NGFF axes carry no patient orientation. Tessera maps the
 // array's x, y, z space axes to index axes i, j, k and assigns the RAS+
 // frame to them (i -> Right, j -> Anterior, k -> Superior), so world =
 // scale * index + translation with direction = identity, in the axes' unit
 // converted to mm. A store Tessera wrote may add "tessera": {"direction"}
-// to .zattrs, restoring the direction of the volume it came from. `info`
-// prints this as the geometry source.
+// to its attributes, restoring the direction of the volume it came from;
+// with "translations": "array axes" (every store written since) the
+// levels' translations are NGFF's own (the half-voxel shift of a coarser
+// level in the array's axes) and the direction is applied to them here.
+// `info` prints this as the geometry source.
 #include <cstdint>
 #include <functional>
+#include <future>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -28,6 +36,17 @@ namespace tessera {
 struct ZarrSelection {
   int time = 0;
   int channel = 0;
+};
+
+// One channel's OMERO rendering metadata (omero.channels[c]): what a
+// viewer shows it with by default.
+struct ZarrChannel {
+  std::string label;
+  glm::vec3 color{1.0f};  // "RRGGBB" as 0..1
+  bool active = true;
+  bool hasWindow = false;
+  ValueRange window{0.0, 0.0};  // start, end
+  ValueRange range{0.0, 0.0};   // min, max
 };
 
 struct ZarrLevel {
@@ -85,6 +104,10 @@ class ZarrStore {
   // Things the user should know ("dtype <i4 is read as f32", "axes have no
   // unit: taken as mm").
   const std::vector<std::string>& notes() const { return notes_; }
+  // The omero channels, in the store's channel order (empty without omero).
+  const std::vector<ZarrChannel>& channels() const { return channels_; }
+  // 2 or 3: the store's Zarr format.
+  int zarrFormat() const { return format_; }
   // The multiscales "type": how the coarser levels were made ("mean",
   // "gaussian", "nearest", ...; "" when the metadata does not say).
   const std::string& reduction() const { return reduction_; }
@@ -101,19 +124,37 @@ class ZarrStore {
 
  private:
   struct AxisMap;
-  void readMultiscales(const std::string& attrsText);
+  bool readV3Root(const std::string& body);
+  ZarrArrayMeta readArrayMeta(const std::string& path) const;
+  void readMultiscales();
+  void readChannels();
   void readLoneArray();
   void addLevel(const std::string& path, glm::dvec3 scale, glm::dvec3 translation);
   void checkSelection();
-  void makeShape(const std::string& attrsText);
+  void makeShape();
+  std::vector<std::int64_t> chunkIndexAt(int l, const std::vector<std::int64_t>& spatial) const;
   std::string chunkKeyAt(int l, const std::vector<std::int64_t>& spatial) const;
+  struct ShardIndex;
+  // A shard's checked index, read once (nullptr: the shard is absent).
+  std::shared_ptr<const ShardIndex> shardIndex(const ZarrArrayMeta& m,
+                                               const std::string& key) const;
   void readChunkInto(int l, const std::vector<std::int64_t>& chunkIndex, glm::ivec3 begin,
                      glm::ivec3 end, Volume& out) const;
-  ZarrChunkCache::Chunk decodeChunk(const ZarrArrayMeta& m, const std::string& key) const;
+  // `inner` < 0: the chunk stored under `key`; else that inner chunk of
+  // the shard stored under `key`.
+  ZarrChunkCache::Chunk decodeChunk(const ZarrArrayMeta& m, const std::string& key,
+                                    std::int64_t inner) const;
 
   std::shared_ptr<const ZarrStorage> storage_;
   ZarrSelection selection_;
   std::shared_ptr<ZarrChunkCache> chunks_;
+  int format_ = 2;
+  std::string attrsWhere_;  // .zattrs or the group's zarr.json
+  std::string attrsText_;   // the attributes (Tessera's own "tessera" among them)
+  std::string ngffText_;    // what holds multiscales and omero (v3: attributes.ome)
+  std::vector<ZarrChannel> channels_;
+  mutable std::mutex shardMutex_;
+  mutable std::map<std::string, std::shared_future<std::shared_ptr<const ShardIndex>>> shards_;
   std::string version_;
   std::string name_;
   std::string reduction_;
@@ -127,7 +168,7 @@ class ZarrStore {
 };
 
 // True when `spec` is an http:// or https:// URL, or a folder holding
-// .zgroup, .zattrs or .zarray.
+// .zgroup, .zattrs, .zarray or zarr.json.
 bool isZarrStore(const std::string& spec);
 
 // The storage for a folder or a URL.

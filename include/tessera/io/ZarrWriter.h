@@ -1,5 +1,6 @@
 #pragma once
-// Writes an OME-Zarr store (OME-NGFF 0.4 multiscales on Zarr v2): a
+// Writes an OME-Zarr store (OME-NGFF 0.4 multiscales on Zarr v2, or 0.5 on
+// Zarr v3, optionally sharded): a
 // factor-2 pyramid from the finest level down to one chunk, streamed slab
 // by slab so that host memory holds one chunk-deep slab per level (about
 // 4/3 of a finest-level slab), never the volume.
@@ -37,6 +38,13 @@ struct OmeZarrWriteOptions {
   }
   int levels = 0;  // 0: down to a level that fits one chunk
   ZarrCompressor compressor = ZarrCompressor::Zstd;
+  // 2: NGFF 0.4 on Zarr v2; 3: NGFF 0.5 on Zarr v3 (zlib is written as
+  // gzip there, v3 having no zlib codec).
+  int zarrFormat = 2;
+  // Zarr v3: chunks per shard edge (sharding_indexed, index at the end with
+  // a crc32c); 0 = unsharded. A shard is appended to as its slabs stream
+  // by, so memory stays one chunk-deep slab per level.
+  int shard = 0;
   // Called with the fraction of the finest level's slices done.
   std::function<void(double fraction, const std::string& what)> progress;
 };

@@ -22,6 +22,9 @@ class CountingStorage final : public ZarrStorage {
   explicit CountingStorage(std::shared_ptr<const ZarrStorage> inner) : inner_(std::move(inner)) {}
   std::optional<std::vector<std::byte>> get(const std::string& key,
                                             std::uint64_t maxBytes) const override;
+  // A sharded store's reads (an index, an inner chunk): counted as chunks.
+  std::optional<ZarrRange> getRange(const std::string& key, std::int64_t offset,
+                                    std::uint64_t length, std::uint64_t maxWhole) const override;
   std::string locate(const std::string& key) const override { return inner_->locate(key); }
   int refetches() const override { return inner_->refetches(); }
   int parallelism() const override { return inner_->parallelism(); }
