@@ -138,6 +138,16 @@ void HttpStorage::fail(const std::string& url, const std::string& error,
 std::optional<std::vector<std::byte>> HttpStorage::get(const std::string& key,
                                                        std::uint64_t maxBytes) const {
   const std::string url = locate(key);
+  HttpResponse r = fetch(url, {}, maxBytes);
+  if (r.status == 404 || r.status == 410) return std::nullopt;
+  if (r.status < 200 || r.status >= 300) {
+    throw InputError(url + ": HTTP " + std::to_string(r.status));
+  }
+  return std::move(r.body);
+}
+
+HttpResponse HttpStorage::fetch(const std::string& url, const std::vector<std::string>& headers,
+                                std::uint64_t maxBytes) const {
   throwIfFailedRecently(url);
   const auto started = std::chrono::steady_clock::now();
   CURL* h = pool_->acquire();
@@ -146,6 +156,15 @@ std::optional<std::vector<std::byte>> HttpStorage::get(const std::string& key,
     CURL* h;
     ~Return() { pool.release(h); }
   } giveBack{*pool_, h};
+  struct HeaderList {
+    curl_slist* list = nullptr;
+    ~HeaderList() { curl_slist_free_all(list); }
+  } headerList;
+  for (const std::string& header : headers) {
+    curl_slist* grown = curl_slist_append(headerList.list, header.c_str());
+    if (!grown) throw Error("libcurl: curl_slist_append failed");
+    headerList.list = grown;
+  }
   std::string problem;
   thread_local std::mt19937 jitter(std::random_device{}());
   for (int attempt = 0; attempt < options_.attempts; ++attempt) {
@@ -160,6 +179,7 @@ std::optional<std::vector<std::byte>> HttpStorage::get(const std::string& key,
     char error[CURL_ERROR_SIZE] = {0};
     curl_easy_reset(h);
     curl_easy_setopt(h, CURLOPT_URL, url.c_str());
+    if (headerList.list) curl_easy_setopt(h, CURLOPT_HTTPHEADER, headerList.list);
     curl_easy_setopt(h, CURLOPT_WRITEFUNCTION, onBody);
     curl_easy_setopt(h, CURLOPT_WRITEDATA, &body);
     curl_easy_setopt(h, CURLOPT_ERRORBUFFER, error);
@@ -192,22 +212,21 @@ std::optional<std::vector<std::byte>> HttpStorage::get(const std::string& key,
     }
     long status = 0;
     curl_easy_getinfo(h, CURLINFO_RESPONSE_CODE, &status);
-    if (status == 404 || status == 410) return std::nullopt;
     if (status >= 500 || status == 408 || status == 429) {
       problem = "HTTP " + std::to_string(status);
       continue;
     }
-    if (status < 200 || status >= 300) {
-      throw InputError(url + ": HTTP " + std::to_string(status));
-    }
     curl_off_t declared = -1;
     curl_easy_getinfo(h, CURLINFO_CONTENT_LENGTH_DOWNLOAD_T, &declared);
-    if (declared >= 0 && std::uint64_t(declared) != body.bytes.size()) {
+    if (status >= 200 && status < 300 && declared >= 0 &&
+        std::uint64_t(declared) != body.bytes.size()) {
       problem = "received " + std::to_string(body.bytes.size()) + " of the " +
                 std::to_string(declared) + " bytes of Content-Length";
       continue;
     }
-    return std::move(body.bytes);
+    const char* type = nullptr;
+    curl_easy_getinfo(h, CURLINFO_CONTENT_TYPE, &type);
+    return HttpResponse{status, type ? type : "", std::move(body.bytes)};
   }
   fail(url,
        url + ": " + problem + " (gave up after " + std::to_string(options_.attempts) + " attempts)",

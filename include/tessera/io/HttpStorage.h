@@ -16,11 +16,13 @@
 // error for a while (failureMemoryMs) instead of being fetched again.
 #include <atomic>
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <unordered_map>
+#include <vector>
 
 #include "tessera/io/ZarrStorage.h"
 
@@ -50,6 +52,14 @@ struct HttpOptions {
 // True for "http://..." and "https://...".
 bool isHttpUrl(const std::string& spec);
 
+// One answer of HttpStorage::fetch: its final status (after the retries),
+// Content-Type and body.
+struct HttpResponse {
+  long status = 0;
+  std::string contentType;
+  std::vector<std::byte> body;
+};
+
 class HttpStorage final : public ZarrStorage {
  public:
   explicit HttpStorage(std::string rootUrl, HttpOptions options = HttpOptions::fromEnvironment());
@@ -60,6 +70,13 @@ class HttpStorage final : public ZarrStorage {
   std::optional<std::vector<std::byte>> get(const std::string& key,
                                             std::uint64_t maxBytes) const override;
   std::string locate(const std::string& key) const override { return root_ + "/" + key; }
+
+  // GET `url` (any URL, not only under the root) with extra request headers
+  // ("Name: value"; never printed or logged, errors name the URL only), the
+  // body at most `maxBytes` (InputError past that). Retried and remembered
+  // as get(); any other status (2xx, 4xx) is returned for the caller to judge.
+  HttpResponse fetch(const std::string& url, const std::vector<std::string>& headers,
+                     std::uint64_t maxBytes) const;
   int refetches() const override { return options_.attempts - 1; }
   int parallelism() const override { return options_.connections; }
   std::string describe() const override { return root_; }

@@ -126,7 +126,8 @@ class ZarrStore {
   std::vector<std::string> notes_;
 };
 
-// True when `spec` is an http:// or https:// URL, or a folder holding
+// True when `spec` is an http:// or https:// URL (other than a DICOMweb
+// series URL, io/DicomWeb.h), or a folder holding
 // .zgroup, .zattrs or .zarray.
 bool isZarrStore(const std::string& spec);
 
