@@ -94,10 +94,12 @@ def main():
             files = sorted(os.listdir(folder))
             sizes[kind] = sum(os.path.getsize(os.path.join(folder, f)) for f in files)
             for i in range(0, len(files), 50):
-                args = ["curl", "-sf"]
+                args = ["curl"]
                 for f in files[i:i + 50]:
-                    args += ["-X", "POST", "--data-binary", "@" + os.path.join(folder, f),
-                             base + "/instances", "-o", "/dev/null"]
+                    # --next: each file its own request (data options are per request).
+                    args += ["-sf", "-X", "POST", "--data-binary", "@" + os.path.join(folder, f),
+                             base + "/instances", "-o", "/dev/null", "--next"]
+                args.pop()
                 run(args)
         listing = json.loads(run([TESSERA, "dicomweb", base + "/dicom-web", "--json"]).stdout)
         urls = {s["uid"]: s["url"] for st in listing["studies"] for s in st["series"]}

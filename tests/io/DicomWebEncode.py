@@ -8,8 +8,10 @@ and benchmark, with Debian's encoders:
                  (JPEG 2000 lossless only: 1.2.840.10008.1.2.4.90)
   jpeg-ls        DCMTK's dcmcjpls (JPEG-LS lossless: 1.2.840.10008.1.2.4.80)
 
-Every file gets a new Series and SOP Instance UID derived from SUFFIX (so
-that one archive can hold the same slices in several syntaxes).
+Every file gets a new Series Instance UID (the old one's first 50
+characters + "." + SUFFIX) and SOP Instance UID (derived from the old one
+and SUFFIX), so that one archive can hold the same slices in several
+syntaxes.
 
 usage: DicomWebEncode.py IN_FOLDER OUT_FOLDER KIND SUFFIX
 """
@@ -21,6 +23,7 @@ import tempfile
 import numpy as np
 import pydicom
 from pydicom.encaps import encapsulate
+from pydicom.uid import generate_uid
 
 src, dst, kind, suffix = sys.argv[1:5]
 os.makedirs(dst, exist_ok=True)
@@ -29,7 +32,9 @@ work = tempfile.mkdtemp()
 
 def reuid(d, name):
     d.SeriesInstanceUID = d.SeriesInstanceUID[:50] + "." + suffix
-    d.SOPInstanceUID = d.SOPInstanceUID[:50] + "." + suffix
+    # Derived from the old one (generate_uid hashes its sources): distinct
+    # per file and per suffix, as long UIDs that share a prefix stay.
+    d.SOPInstanceUID = generate_uid(None, [d.SOPInstanceUID, suffix])
     d.file_meta.MediaStorageSOPInstanceUID = d.SOPInstanceUID
     d.save_as(name, write_like_original=False)
 

@@ -86,13 +86,14 @@ class OrthancServer {
     for (const auto& e : std::filesystem::directory_iterator(folder)) {
       if (e.is_regular_file()) files.push_back(e.path());
     }
-    // One curl for all files: -T with a list would PUT; each --data-binary
-    // POST is its own URL repetition.
-    std::string cmd = "curl -sf" + auth();
+    // One curl for all files, each its own request (--next: data options
+    // are per request, else curl would send them all as one body).
+    std::string cmd = "curl";
     for (const auto& file : files) {
-      cmd +=
-          " -X POST --data-binary @'" + file.string() + "' '" + root() + "/instances' -o /dev/null";
+      cmd += " -sf" + auth() + " -X POST --data-binary @'" + file.string() + "' '" + root() +
+             "/instances' -o /dev/null --next";
     }
+    cmd.resize(cmd.size() - std::string(" --next").size());
     return std::system((cmd + " 2>/dev/null").c_str()) == 0;
   }
 
