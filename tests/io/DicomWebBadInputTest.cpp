@@ -38,15 +38,15 @@ std::string hex(const std::string& bytes) {
   return out;
 }
 
-// Metadata of a 4x4 u16 series of `slices` axial slices, 1 mm apart.
-std::string metadata(int slices) {
+// Metadata of a 4x4 u16 series `uid` of `slices` axial slices, 1 mm apart.
+std::string metadata(int slices, const std::string& uid = "3.4") {
   nlohmann::json a = nlohmann::json::array();
   for (int k = 0; k < slices; ++k) {
     auto v = [](nlohmann::json value, const char* vr) {
       return nlohmann::json{{"vr", vr}, {"Value", value}};
     };
     a.push_back({{"00080018", v({"9." + std::to_string(k + 1)}, "UI")},
-                 {"0020000E", v({"3.4"}, "UI")},
+                 {"0020000E", v({uid}, "UI")},
                  {"00080060", v({"CT"}, "CS")},
                  {"00200013", v({k + 1}, "IS")},
                  {"00200032", v({-1.5, 2.25, k * 1.0}, "DS")},
@@ -85,20 +85,27 @@ std::string pixels(int first) {
 
 using Route = std::tuple<int, std::string, std::string>;  // status, content type, body
 
-// The canned server with the good series' routes, `changes` replacing some.
+// The good series' routes under `series` (its UID the path's last part),
+// `changes` (paths relative to the series) replacing some.
+void addSeries(std::map<std::string, Route>& routes, const std::string& series,
+               const std::map<std::string, Route>& changes) {
+  routes[series + "/metadata"] = {200, "application/dicom+json",
+                                  metadata(2, series.substr(series.rfind('/') + 1))};
+  for (int k = 1; k <= 2; ++k) {
+    routes[series + "/instances/9." + std::to_string(k) + "/frames/1"] = {
+        200, "multipart/related; type=\"application/octet-stream\"; boundary=XyZ",
+        multipart("XyZ", kOctet, pixels(100 * k))};
+  }
+  for (const auto& [path, route] : changes) routes[series + path] = route;
+}
+
+// The canned server, serving `routes` (plus the good series and an empty
+// study list).
 class Canned {
  public:
-  Canned(const test::TempDir& dir, std::map<std::string, Route> changes, int dieAfter = -1) {
-    std::map<std::string, Route> routes = {
-        {kSeries + "/metadata", {200, "application/dicom+json", metadata(2)}},
-        {"/dw/studies", {200, "application/dicom+json", "[]"}},
-    };
-    for (int k = 1; k <= 2; ++k) {
-      routes[kSeries + "/instances/9." + std::to_string(k) + "/frames/1"] = {
-          200, "multipart/related; type=\"application/octet-stream\"; boundary=XyZ",
-          multipart("XyZ", kOctet, pixels(100 * k))};
-    }
-    for (auto& [path, route] : changes) routes[path] = route;
+  Canned(const test::TempDir& dir, std::map<std::string, Route> routes, int dieAfter = -1) {
+    addSeries(routes, kSeries, {});
+    routes.emplace("/dw/studies", Route{200, "application/dicom+json", "[]"});
     nlohmann::json spec = {{"routes", nlohmann::json::object()}};
     for (const auto& [path, r] : routes) {
       spec["routes"][path] = {std::get<0>(r), std::get<1>(r), hex(std::get<2>(r))};
@@ -161,13 +168,13 @@ TEST_F(DicomWebBadInput, TheGoodSeriesReadsWithItsGeometry) {
 }
 
 TEST_F(DicomWebBadInput, EachBadAnswerIsOneLineNamingTheUrl) {
-  const std::string frame2 = kSeries + "/instances/9.2/frames/1";
-  const std::string meta = kSeries + "/metadata";
+  const std::string frame2 = "/instances/9.2/frames/1";
+  const std::string meta = "/metadata";
   const std::string multi = "multipart/related; type=\"application/octet-stream\"; boundary=XyZ";
   struct Case {
     std::string name;
     std::map<std::string, Route> changes;
-    std::string at;  // the path the error names
+    std::string at;  // the path the error names, under the series
     std::string message;
   };
   const std::vector<Case> cases = {
@@ -258,11 +265,19 @@ TEST_F(DicomWebBadInput, EachBadAnswerIsOneLineNamingTheUrl) {
        frame2,
        ": HTTP 404 Not Found: no such study, series or instance, or not a DICOMweb service root"},
   };
-  for (const Case& k : cases) {
+  // One server, each case its own series (3.4.N); the HTTP failure memory
+  // is per URL, so the cases do not see each other's errors.
+  std::map<std::string, Route> routes;
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    addSeries(routes, kSeries + "." + std::to_string(i), cases[i].changes);
+  }
+  const Canned c(dir_, routes);
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const Case& k = cases[i];
     SCOPED_TRACE(k.name);
-    const Canned c(dir_, k.changes);
-    const std::string m = errorOf(c.url());
-    EXPECT_EQ(m.rfind(c.url(k.at) + k.message, 0), 0u) << m;
+    const std::string series = kSeries + "." + std::to_string(i);
+    const std::string m = errorOf(c.url(series));
+    EXPECT_EQ(m.rfind(c.url(series + k.at) + k.message, 0), 0u) << m;
     EXPECT_EQ(m.find('\n'), std::string::npos) << m;
     std::printf("[bad input] %-30s %s\n", k.name.c_str(), m.c_str());
   }
