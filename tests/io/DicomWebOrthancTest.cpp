@@ -117,7 +117,9 @@ const StoredSeries kStored[] = {
     {"JPEG 2000 lossless", std::string(kSeriesUid) + ".3", "1.2.840.10008.1.2.4.90"},
 };
 
-TEST_F(DicomWebOrthanc, EachStoredSyntaxReadsLikeTheFolderVoxelForVoxel) {
+// One test, as the suite's setup (encoding, Orthanc, uploads) is most of
+// its time and ctest runs each test in its own process.
+TEST_F(DicomWebOrthanc, StoredSyntaxesReadLikeTheFolderQidoListsThemUnknownIs404) {
   const Volume folder = readVolume((dir_->path() / "plain").string());
   const std::string study = studyUid();
   ASSERT_FALSE(study.empty());
@@ -134,9 +136,8 @@ TEST_F(DicomWebOrthanc, EachStoredSyntaxReadsLikeTheFolderVoxelForVoxel) {
     EXPECT_EQ(transfer.requests, 13u);
     EXPECT_NE(web.description().find(s.transferSyntax), std::string::npos) << web.description();
   }
-}
 
-TEST_F(DicomWebOrthanc, QidoListsTheStudyAndItsThreeSeries) {
+  // QIDO: the study and its three series.
   const DicomWebClient client(orthanc_->dicomWebRoot(), DicomWebOptions{});
   const auto studies = client.studies();
   ASSERT_EQ(studies.size(), 1u);
@@ -152,9 +153,8 @@ TEST_F(DicomWebOrthanc, QidoListsTheStudyAndItsThreeSeries) {
     EXPECT_TRUE(isDicomWebSeriesUrl(s.url)) << s.url;
   }
   EXPECT_TRUE(client.studies("PatientName=NOBODY*").empty());
-}
 
-TEST_F(DicomWebOrthanc, UnknownSeriesIsHttp404NamingTheUrl) {
+  // A series the archive does not hold.
   const std::string url = seriesUrl("1.2.3.999");
   const std::string m = test::inputErrorMessage([&] { readVolume(url); });
   EXPECT_EQ(m, url +
