@@ -16,7 +16,7 @@ cd "$(dirname "$0")/.."
 ROOT=$PWD
 SECS=${1:-20}
 [ $# -gt 0 ] && shift
-ALL=(nifti nrrd metaimage vti pvm raw_sidecar dicom dicom_basic transfer_function device_profile zarr zarr_v3 zarr_shard_index)
+ALL=(nifti nrrd metaimage vti pvm raw_sidecar dicom dicom_basic transfer_function device_profile zarr zarr_v3 zarr_shard_index dicomweb)
 if [ $# -gt 0 ]; then TARGETS=("$@"); else TARGETS=("${ALL[@]}"); fi
 JOBS=$(nproc)
 PARALLEL=$((JOBS >= 2 ? 2 : 1))
@@ -52,6 +52,7 @@ seed() {
     pvm) pattern="$bad/pvm/*.pvm" ;;
     raw_sidecar) pattern="$bad/raw/*.json" ;;
     dicom | dicom_basic) pattern="$bad/dicom/*/*" ;;
+    dicomweb) pattern="$bad/dicomweb/*" ;;
     *) pattern="" ;;
   esac
   local i=0 f regressions=()

@@ -55,6 +55,7 @@ void addConvertCommand(CLI::App& app);   // ConvertCommand.cpp
 void addViewCommand(CLI::App& app);      // ViewCommand.cpp (desktop viewer)
 void addSliceCommand(CLI::App& app);     // SliceCommand.cpp
 void addFormatsCommand(CLI::App& app);   // FormatsCommand.cpp
+void addDicomWebCommand(CLI::App& app);  // DicomWebCommand.cpp
 
 // The volume argument's help (its formats from io/FormatRegistry.h), and the
 // --series option every command that reads a volume offers.

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   tessera::app::addViewCommand(app);
   tessera::app::addSliceCommand(app);
   tessera::app::addFormatsCommand(app);
+  tessera::app::addDicomWebCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -160,9 +160,18 @@ void HttpStorage::fail(const std::string& url, const std::string& error,
 
 std::optional<std::vector<std::byte>> HttpStorage::get(const std::string& key,
                                                        std::uint64_t maxBytes) const {
-  auto r = fetch(key, maxBytes, "");
-  if (!r) return std::nullopt;
-  return std::move(r->bytes);
+  const std::string url = locate(key);
+  HttpResponse r = request(url, url, {}, maxBytes, "");
+  if (r.status == 404 || r.status == 410) return std::nullopt;
+  if (r.status < 200 || r.status >= 300) {
+    throw InputError(url + ": HTTP " + std::to_string(r.status));
+  }
+  return std::move(r.body);
+}
+
+HttpResponse HttpStorage::fetch(const std::string& url, const std::vector<std::string>& headers,
+                                std::uint64_t maxBytes) const {
+  return request(url, url, headers, maxBytes, "");
 }
 
 std::optional<ZarrRange> HttpStorage::getRange(const std::string& key, std::int64_t offset,
@@ -177,12 +186,18 @@ std::optional<ZarrRange> HttpStorage::getRange(const std::string& key, std::int6
         .append(std::to_string(std::uint64_t(offset) + length - 1));
   }
   if (length == 0) throw InputError(url + ": an empty range asked");
-  auto r = fetch(key, std::max(length, maxWhole), range);
-  if (!r) return std::nullopt;
-  if (r->total == 0) {
+  std::string label = url;
+  label.append(" (bytes ").append(range).append(")");
+  HttpResponse r = request(url, label, {}, std::max(length, maxWhole), range);
+  if (r.status == 404 || r.status == 410) return std::nullopt;
+  if (r.status == 416) throw InputError(label + ": HTTP 416, the range lies outside the value");
+  if (r.status < 200 || r.status >= 300) {
+    throw InputError(label + ": HTTP " + std::to_string(r.status));
+  }
+  if (r.status != 206) {
     // The server ignored Range (200 with the whole body): cut it out here.
     ++wholeBodies_;
-    const std::uint64_t total = r->bytes.size();
+    const std::uint64_t total = r.body.size();
     const std::uint64_t begin =
         offset < 0 ? total - std::min(total, length) : std::uint64_t(offset);
     if ((offset < 0 && length > total) || begin > total || length > total - begin) {
@@ -191,32 +206,26 @@ std::optional<ZarrRange> HttpStorage::getRange(const std::string& key, std::int6
     }
     ZarrRange out;
     out.total = total;
-    out.bytes.assign(r->bytes.begin() + std::ptrdiff_t(begin),
-                     r->bytes.begin() + std::ptrdiff_t(begin + length));
+    out.bytes.assign(r.body.begin() + std::ptrdiff_t(begin),
+                     r.body.begin() + std::ptrdiff_t(begin + length));
     return out;
   }
-  if (r->bytes.size() != length) {
-    throw InputError(url + ": range " + range + " answered with " +
-                     std::to_string(r->bytes.size()) + " bytes, expected " +
-                     std::to_string(length));
+  if (r.rangeTotal == 0) throw InputError(label + ": HTTP 206 without a Content-Range total");
+  if (r.body.size() != length) {
+    throw InputError(url + ": range " + range + " answered with " + std::to_string(r.body.size()) +
+                     " bytes, expected " + std::to_string(length));
   }
-  if (r->total > maxWhole) {
-    throw InputError(url + ": " + std::to_string(r->total) + " bytes, more than the " +
+  if (r.rangeTotal > maxWhole) {
+    throw InputError(url + ": " + std::to_string(r.rangeTotal) + " bytes, more than the " +
                      std::to_string(maxWhole) + " any valid content of this key can have");
   }
-  return ZarrRange{std::move(r->bytes), r->total};
+  return ZarrRange{std::move(r.body), r.rangeTotal};
 }
 
-std::optional<HttpStorage::Fetched> HttpStorage::fetch(const std::string& key,
-                                                       std::uint64_t maxBytes,
-                                                       const std::string& range) const {
-  std::string url = locate(key);
-  if (!range.empty()) {
-    url.append(" (bytes ");
-    url.append(range);
-    url.append(")");
-  }
-  throwIfFailedRecently(url);
+HttpResponse HttpStorage::request(const std::string& url, const std::string& label,
+                                  const std::vector<std::string>& headers, std::uint64_t maxBytes,
+                                  const std::string& range) const {
+  throwIfFailedRecently(label);
   const auto started = std::chrono::steady_clock::now();
   CURL* h = pool_->acquire();
   struct Return {
@@ -224,6 +233,15 @@ std::optional<HttpStorage::Fetched> HttpStorage::fetch(const std::string& key,
     CURL* h;
     ~Return() { pool.release(h); }
   } giveBack{*pool_, h};
+  struct HeaderList {
+    curl_slist* list = nullptr;
+    ~HeaderList() { curl_slist_free_all(list); }
+  } headerList;
+  for (const std::string& header : headers) {
+    curl_slist* grown = curl_slist_append(headerList.list, header.c_str());
+    if (!grown) throw Error("libcurl: curl_slist_append failed");
+    headerList.list = grown;
+  }
   std::string problem;
   thread_local std::mt19937 jitter(std::random_device{}());
   for (int attempt = 0; attempt < options_.attempts; ++attempt) {
@@ -237,8 +255,9 @@ std::optional<HttpStorage::Fetched> HttpStorage::fetch(const std::string& key,
     body.limit = maxBytes;
     char error[CURL_ERROR_SIZE] = {0};
     curl_easy_reset(h);
-    curl_easy_setopt(h, CURLOPT_URL, locate(key).c_str());
+    curl_easy_setopt(h, CURLOPT_URL, url.c_str());
     if (!range.empty()) curl_easy_setopt(h, CURLOPT_RANGE, range.c_str());
+    if (headerList.list) curl_easy_setopt(h, CURLOPT_HTTPHEADER, headerList.list);
     curl_easy_setopt(h, CURLOPT_HEADERFUNCTION, onHeader);
     curl_easy_setopt(h, CURLOPT_HEADERDATA, &body);
     curl_easy_setopt(h, CURLOPT_WRITEFUNCTION, onBody);
@@ -259,7 +278,7 @@ std::optional<HttpStorage::Fetched> HttpStorage::fetch(const std::string& key,
     const CURLcode rc = curl_easy_perform(h);
     bytes_ += body.bytes.size();
     if (body.tooBig) {
-      throw InputError(url + ": more than " + std::to_string(maxBytes) +
+      throw InputError(label + ": more than " + std::to_string(maxBytes) +
                        " bytes, more than any valid content of this key can have");
     }
     if (body.stalled) {
@@ -273,34 +292,27 @@ std::optional<HttpStorage::Fetched> HttpStorage::fetch(const std::string& key,
     }
     long status = 0;
     curl_easy_getinfo(h, CURLINFO_RESPONSE_CODE, &status);
-    if (status == 404 || status == 410) return std::nullopt;
     if (status >= 500 || status == 408 || status == 429) {
       problem = "HTTP " + std::to_string(status);
       continue;
     }
-    if (status == 416) {
-      throw InputError(url + ": HTTP 416, the range lies outside the value");
-    }
-    if (status < 200 || status >= 300) {
-      throw InputError(url + ": HTTP " + std::to_string(status));
-    }
     curl_off_t declared = -1;
     curl_easy_getinfo(h, CURLINFO_CONTENT_LENGTH_DOWNLOAD_T, &declared);
-    if (declared >= 0 && std::uint64_t(declared) != body.bytes.size()) {
+    if (status >= 200 && status < 300 && declared >= 0 &&
+        std::uint64_t(declared) != body.bytes.size()) {
       problem = "received " + std::to_string(body.bytes.size()) + " of the " +
                 std::to_string(declared) + " bytes of Content-Length";
       continue;
     }
-    Fetched f;
-    f.bytes = std::move(body.bytes);
-    f.total = status == 206 ? rangeTotal(body.contentRange) : 0;
-    if (status == 206 && f.total == 0) {
-      throw InputError(url + ": HTTP 206 without a Content-Range total");
-    }
-    return f;
+    const char* type = nullptr;
+    curl_easy_getinfo(h, CURLINFO_CONTENT_TYPE, &type);
+    HttpResponse response{status, type ? type : "", std::move(body.bytes), 0};
+    if (status == 206) response.rangeTotal = rangeTotal(body.contentRange);
+    return response;
   }
-  fail(url,
-       url + ": " + problem + " (gave up after " + std::to_string(options_.attempts) + " attempts)",
+  fail(label,
+       label + ": " + problem + " (gave up after " + std::to_string(options_.attempts) +
+           " attempts)",
        started);
 }
 

@@ -5,6 +5,7 @@
 #include "io/HeaderText.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/DicomDecoder.h"
+#include "tessera/io/DicomWeb.h"
 #include "tessera/io/FormatRegistry.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/io/ZarrStore.h"
@@ -31,6 +32,20 @@ Volume readVolume(const std::string& spec, const ReadOptions& options) {
                        ") was asked for, but this is not DICOM");
     }
   };
+  // A DICOMweb series URL is a DICOM series (before any other URL, which
+  // is an OME-Zarr store).
+  if (isDicomWebSeriesUrl(spec)) {
+    if (!options.dicomSeries.empty() &&
+        options.dicomSeries != parseDicomWebSeriesUrl(spec).series) {
+      throw InputError(spec + ": --series " + options.dicomSeries +
+                       " differs from the series the URL names");
+    }
+    if (options.time != 0 || options.channel != 0) {
+      throw InputError(spec +
+                       ": --time/--channel select within an OME-Zarr store; this is not one");
+    }
+    return readDicomWebSeries(spec);
+  }
   if (isZarrStore(spec)) {
     notDicom();
     std::string note;

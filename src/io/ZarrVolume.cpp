@@ -10,13 +10,14 @@
 
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/io/DicomWeb.h"
 #include "tessera/io/HttpStorage.h"
 #include "tessera/io/ZarrStore.h"
 
 namespace tessera {
 
 bool isZarrStore(const std::string& spec) {
-  if (isHttpUrl(spec)) return true;
+  if (isHttpUrl(spec)) return !isDicomWebSeriesUrl(spec);
   std::error_code ec;
   const std::filesystem::path p(spec);
   if (!std::filesystem::is_directory(p, ec)) return false;

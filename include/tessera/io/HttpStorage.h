@@ -16,11 +16,13 @@
 // error for a while (failureMemoryMs) instead of being fetched again.
 #include <atomic>
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <unordered_map>
+#include <vector>
 
 #include "tessera/io/ZarrStorage.h"
 
@@ -50,6 +52,15 @@ struct HttpOptions {
 // True for "http://..." and "https://...".
 bool isHttpUrl(const std::string& spec);
 
+// One answer of HttpStorage::fetch: its final status (after the retries),
+// Content-Type and body.
+struct HttpResponse {
+  long status = 0;
+  std::string contentType;
+  std::vector<std::byte> body;
+  std::uint64_t rangeTotal = 0;  // a 206's whole value (Content-Range); 0 otherwise
+};
+
 class HttpStorage final : public ZarrStorage {
  public:
   explicit HttpStorage(std::string rootUrl, HttpOptions options = HttpOptions::fromEnvironment());
@@ -64,6 +75,13 @@ class HttpStorage final : public ZarrStorage {
   std::optional<ZarrRange> getRange(const std::string& key, std::int64_t offset,
                                     std::uint64_t length, std::uint64_t maxWhole) const override;
   std::string locate(const std::string& key) const override { return root_ + "/" + key; }
+
+  // GET `url` (any URL, not only under the root) with extra request headers
+  // ("Name: value"; never printed or logged, errors name the URL only), the
+  // body at most `maxBytes` (InputError past that). Retried and remembered
+  // as get(); any other status (2xx, 4xx) is returned for the caller to judge.
+  HttpResponse fetch(const std::string& url, const std::vector<std::string>& headers,
+                     std::uint64_t maxBytes) const;
   int refetches() const override { return options_.attempts - 1; }
   int parallelism() const override { return options_.connections; }
   std::string describe() const override { return root_; }
@@ -77,14 +95,12 @@ class HttpStorage final : public ZarrStorage {
 
  private:
   struct Pool;
-  struct Fetched {
-    std::vector<std::byte> bytes;
-    std::uint64_t total = 0;  // a 206's whole value; 0 for a 200
-  };
-  // One GET (with a Range when `range` is not empty: "0-99", "-100"),
-  // retried as the class comment says; nullopt for 404/410.
-  std::optional<Fetched> fetch(const std::string& key, std::uint64_t maxBytes,
-                               const std::string& range) const;
+  // One GET of `url` (with a Range when `range` is not empty: "0-99",
+  // "-100"; with `headers`), retried as the class comment says; errors and
+  // the failure memory name `label`. Any final status is returned.
+  HttpResponse request(const std::string& url, const std::string& label,
+                       const std::vector<std::string>& headers, std::uint64_t maxBytes,
+                       const std::string& range) const;
   struct Failed {
     std::string error;
     std::chrono::steady_clock::time_point until;

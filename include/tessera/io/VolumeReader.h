@@ -14,7 +14,8 @@ namespace tessera {
 // `tessera formats`): by extension, the content deciding when the extension
 // is unknown or contradicts it (`scan.dat` holding a NIfTI opens as NIfTI);
 // a folder is an OME-Zarr store (.zgroup/.zattrs/.zarray) or a DICOM series,
-// an http(s):// URL an OME-Zarr store (the finest level that fits the host
+// an http(s):// URL a DICOMweb series when it ends in /studies/UID/series/UID
+// (io/DicomWeb.h), else an OME-Zarr store (the finest level that fits the host
 // budget, see io/ZarrStore.h); "gen:" specs are generated (io/Procedural.h).
 // DICOM is read by the preferred decoder that decodes the series
 // (DicomDecoder.h: DCMTK natively). Throws InputError naming the file and

@@ -167,8 +167,9 @@ class ZarrStore {
   std::vector<std::string> notes_;
 };
 
-// True when `spec` is an http:// or https:// URL, or a folder holding
-// .zgroup, .zattrs, .zarray or zarr.json.
+// True when `spec` is an http:// or https:// URL (other than a DICOMweb
+// series URL, io/DicomWeb.h), or a folder holding .zgroup, .zattrs,
+// .zarray or zarr.json.
 bool isZarrStore(const std::string& spec);
 
 // The storage for a folder or a URL.

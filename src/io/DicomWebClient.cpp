@@ -1,0 +1,356 @@
+// QIDO-RS and WADO-RS (PS3.18 10.6 and 10.4) over HttpStorage's pool; the
+// series is assembled by the folder reader's code (io/DicomSeries.cpp) from
+// the metadata, its frames fetched and decoded in parallel.
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "io/DicomSeries.h"
+#include "io/DicomWebFrame.h"
+#include "io/DicomWebParts.h"
+#include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
+#include "tessera/io/DicomWeb.h"
+#include "tessera/io/HttpStorage.h"
+
+namespace tessera {
+
+namespace {
+
+using io_detail::DicomJsonAttributes;
+using io_detail::DicomTag;
+using io_detail::Slice;
+
+// Larger answers are no QIDO or metadata answer of a series that could be
+// read: the metadata of 4,000 instances is under 40 MiB.
+constexpr std::uint64_t kMaxJsonBytes = 256ull << 20;
+// A part's headers and the boundaries around one frame.
+constexpr std::uint64_t kMultipartOverhead = 64 * 1024;
+// A compressed frame is never much larger than the pixels it holds (JPEG
+// lossless and JPEG 2000 at worst a few percent over); twice is the bound.
+constexpr std::uint64_t kCompressedExpansion = 2;
+
+constexpr DicomTag kSopInstanceUid{0x0008, 0x0018};
+constexpr DicomTag kStudyInstanceUid{0x0020, 0x000d};
+constexpr DicomTag kPatientName{0x0010, 0x0010};
+constexpr DicomTag kPatientId{0x0010, 0x0020};
+constexpr DicomTag kStudyDate{0x0008, 0x0020};
+constexpr DicomTag kStudyDescription{0x0008, 0x1030};
+constexpr DicomTag kModalitiesInStudy{0x0008, 0x0061};
+constexpr DicomTag kStudySeries{0x0020, 0x1206};
+constexpr DicomTag kStudyInstances{0x0020, 0x1208};
+constexpr DicomTag kSeriesNumber{0x0020, 0x0011};
+constexpr DicomTag kSeriesInstances{0x0020, 0x1209};
+
+const char* kJsonAccept = "Accept: application/dicom+json";
+const char* kFrameAccept =
+    "Accept: multipart/related; type=\"application/octet-stream\"; "
+    "transfer-syntax=*";
+
+long number(const DicomJsonAttributes& a, DicomTag tag) {
+  const auto t = a.text(tag);
+  if (!t || t->empty()) return -1;
+  char* end = nullptr;
+  const long n = std::strtol(t->c_str(), &end, 10);
+  return end != t->c_str() && *end == '\0' ? n : -1;
+}
+
+std::string textOf(const DicomJsonAttributes& a, DicomTag tag) {
+  return a.text(tag).value_or("");
+}
+
+}  // namespace
+
+bool isDicomWebSeriesUrl(const std::string& spec) {
+  if (!isHttpUrl(spec)) return false;
+  std::string s = spec;
+  while (!s.empty() && s.back() == '/') s.pop_back();
+  const auto series = s.rfind("/series/");
+  if (series == std::string::npos || series + 8 >= s.size()) return false;
+  const auto studies = s.rfind("/studies/", series);
+  return studies != std::string::npos && studies + 9 < series &&
+         s.find('/', studies + 9) == series && s.find('/', series + 8) == std::string::npos;
+}
+
+DicomWebSeriesUrl parseDicomWebSeriesUrl(const std::string& url) {
+  if (!isDicomWebSeriesUrl(url)) {
+    throw InputError(url + ": not a DICOMweb series URL (expected ROOT/studies/UID/series/UID)");
+  }
+  std::string s = url;
+  while (!s.empty() && s.back() == '/') s.pop_back();
+  const auto series = s.rfind("/series/");
+  const auto studies = s.rfind("/studies/", series);
+  return {s.substr(0, studies), s.substr(studies + 9, series - studies - 9), s.substr(series + 8)};
+}
+
+DicomWebOptions DicomWebOptions::fromEnvironment() {
+  DicomWebOptions o;
+  if (const char* auth = std::getenv("TESSERA_DICOMWEB_AUTH"); auth && *auth) {
+    o.headers.push_back(std::string("Authorization: ") + auth);
+  }
+  return o;
+}
+
+namespace {
+
+// One line for an answer that is not 2xx; never the credentials, only
+// whether some were sent.
+[[noreturn]] void refuse(const std::string& url, long status, bool credentials) {
+  std::string why = "HTTP " + std::to_string(status);
+  if (status == 401) {
+    why += credentials ? " Unauthorized: the credentials given were refused"
+                       : " Unauthorized: the server wants credentials (set TESSERA_DICOMWEB_AUTH "
+                         "to the Authorization header's value, e.g. 'Basic <base64 of "
+                         "user:password>', or pass --header)";
+  } else if (status == 403) {
+    why += " Forbidden: the credentials given do not allow this";
+  } else if (status == 404) {
+    why += " Not Found: no such study, series or instance, or not a DICOMweb service root";
+  }
+  throw InputError(url + ": " + why);
+}
+
+}  // namespace
+
+DicomWebClient::DicomWebClient(std::string root, DicomWebOptions options)
+    : root_(std::move(root)), options_(std::move(options)) {
+  while (!root_.empty() && root_.back() == '/') root_.pop_back();
+  if (!isHttpUrl(root_)) throw InputError(root_ + ": not an http:// or https:// URL");
+  http_ = std::make_unique<HttpStorage>(root_);
+}
+
+DicomWebClient::~DicomWebClient() = default;
+
+namespace {
+
+nlohmann::json getJson(const HttpStorage& http, const std::string& url,
+                       const std::vector<std::string>& headers, bool credentials) {
+  std::vector<std::string> h = headers;
+  h.push_back(kJsonAccept);
+  const HttpResponse r = http.fetch(url, h, kMaxJsonBytes);
+  if (r.status == 204) return nlohmann::json::array();  // QIDO: no match
+  if (r.status < 200 || r.status >= 300) refuse(url, r.status, credentials);
+  return io_detail::parseDicomJson(r.body, url);
+}
+
+}  // namespace
+
+std::vector<DicomWebStudy> DicomWebClient::studies(const std::string& query) const {
+  const std::string url = root_ +
+                          "/studies?includefield=00081030&includefield=00080061&includefield="
+                          "00201206&includefield=00201208" +
+                          (query.empty() ? "" : "&" + query);
+  const nlohmann::json j = getJson(*http_, url, options_.headers, !options_.headers.empty());
+  std::vector<DicomWebStudy> out;
+  for (const nlohmann::json& d : j) {
+    const DicomJsonAttributes a(d);
+    out.push_back({textOf(a, kStudyInstanceUid), textOf(a, kPatientName), textOf(a, kPatientId),
+                   textOf(a, kStudyDate), textOf(a, kStudyDescription),
+                   textOf(a, kModalitiesInStudy), number(a, kStudySeries),
+                   number(a, kStudyInstances)});
+    if (out.back().uid.empty()) {
+      throw InputError(url + ": study " + std::to_string(out.size()) +
+                       " of the answer has no Study Instance UID (0020,000D)");
+    }
+  }
+  return out;
+}
+
+std::vector<DicomWebSeries> DicomWebClient::series(const std::string& studyUid) const {
+  const std::string url = root_ + "/studies/" + studyUid +
+                          "/series?includefield=0008103E&includefield=00200011&includefield="
+                          "00201209";
+  const nlohmann::json j = getJson(*http_, url, options_.headers, !options_.headers.empty());
+  std::vector<DicomWebSeries> out;
+  for (const nlohmann::json& d : j) {
+    const DicomJsonAttributes a(d);
+    DicomWebSeries s{studyUid,
+                     textOf(a, io_detail::kTagSeriesInstanceUid),
+                     textOf(a, io_detail::kTagModality),
+                     textOf(a, io_detail::kTagSeriesDescription),
+                     number(a, kSeriesNumber),
+                     number(a, kSeriesInstances),
+                     ""};
+    if (s.uid.empty()) {
+      throw InputError(url + ": series " + std::to_string(out.size() + 1) +
+                       " of the answer has no Series Instance UID (0020,000E)");
+    }
+    s.url = root_ + "/studies/" + studyUid + "/series/" + s.uid;
+    out.push_back(std::move(s));
+  }
+  std::sort(out.begin(), out.end(),
+            [](const DicomWebSeries& a, const DicomWebSeries& b) { return a.number < b.number; });
+  return out;
+}
+
+namespace {
+
+// The frames of a series' slices, fetched and decoded in parallel on first
+// use (the series code asks for them one by one, in z order, once its
+// checks have passed).
+class FrameFetcher {
+ public:
+  FrameFetcher(const HttpStorage& http, std::vector<std::string> headers, int connections,
+               std::string seriesUrl)
+      : http_(http),
+        headers_(std::move(headers)),
+        connections_(std::max(1, connections)),
+        seriesUrl_(std::move(seriesUrl)) {
+    headers_.push_back(kFrameAccept);
+  }
+
+  io_detail::StoredRange decode(const Slice& s, const std::vector<Slice>& all, Volume& stored,
+                                int z) {
+    if (!fetched_) fetchAll(all);
+    const auto it = frames_.find(s.file.string());
+    if (it == frames_.end()) throw Error(s.file.string() + ": frame was not fetched");
+    const io_detail::StoredRange r =
+        io_detail::storePixels(s, it->second.data(), it->second.size(), stored, z);
+    frames_.erase(it);  // held no longer than needed
+    return r;
+  }
+
+  std::vector<std::string> syntaxes() const {
+    const std::lock_guard lock(mutex_);
+    return {syntaxes_.begin(), syntaxes_.end()};
+  }
+
+ private:
+  std::vector<std::byte> fetchOne(const Slice& s, bool credentials) {
+    const std::string url = s.file.string() + "/frames/1";
+    const std::uint64_t pixels = static_cast<std::uint64_t>(s.rows) *
+                                 static_cast<std::uint64_t>(s.columns) *
+                                 static_cast<std::uint64_t>(std::max(1, s.bitsAllocated / 8));
+    const HttpResponse r =
+        http_.fetch(url, headers_, pixels * kCompressedExpansion + kMultipartOverhead);
+    if (r.status < 200 || r.status >= 300) refuse(url, r.status, credentials);
+    const auto parts = io_detail::parseMultipart(r.contentType, r.body, url, 1);
+    const std::string syntax = io_detail::frameTransferSyntax(parts.front().contentType);
+    if (syntax.empty()) {
+      throw InputError(url + ": the frame's Content-Type '" +
+                       parts.front().contentType.substr(0, 80) + "' names no transfer syntax");
+    }
+    {
+      const std::lock_guard lock(mutex_);
+      if (std::find(syntaxes_.begin(), syntaxes_.end(), syntax) == syntaxes_.end()) {
+        syntaxes_.push_back(syntax);
+      }
+    }
+    return io_detail::decodeWebFrame(s, syntax, parts.front().body, url);
+  }
+
+  void fetchAll(const std::vector<Slice>& all) {
+    fetched_ = true;
+    const bool credentials = headers_.size() > 1;
+    std::atomic<std::size_t> next{0};
+    std::atomic<std::size_t> done{0};
+    std::atomic<bool> failed{false};
+    std::exception_ptr error;
+    std::size_t errorIndex = all.size();
+    const bool tty = ::isatty(2) != 0;
+    const auto t0 = std::chrono::steady_clock::now();
+    auto work = [&] {
+      for (;;) {
+        const std::size_t i = next++;
+        if (i >= all.size() || failed) return;
+        try {
+          std::vector<std::byte> frame = fetchOne(all[i], credentials);
+          const std::lock_guard lock(mutex_);
+          frames_.emplace(all[i].file.string(), std::move(frame));
+        } catch (...) {
+          const std::lock_guard lock(mutex_);
+          // The first slice's error, of those that failed, is the one told.
+          if (i < errorIndex) {
+            errorIndex = i;
+            error = std::current_exception();
+          }
+          failed = true;
+          return;
+        }
+        const std::size_t n = ++done;
+        if (tty && all.size() >= 32 && (n % 16 == 0 || n == all.size())) {
+          const double sec =
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+          std::fprintf(stderr, "\rreading %s: %zu/%zu frames  %.1f s%s", seriesUrl_.c_str(), n,
+                       all.size(), sec, n == all.size() ? "\n" : "");
+        }
+      }
+    };
+    const int n = static_cast<int>(std::min<std::size_t>(connections_, all.size()));
+    std::vector<std::thread> threads;
+    for (int t = 1; t < n; ++t) threads.emplace_back(work);
+    work();
+    for (auto& t : threads) t.join();
+    if (error) std::rethrow_exception(error);
+  }
+
+  const HttpStorage& http_;
+  std::vector<std::string> headers_;
+  int connections_;
+  std::string seriesUrl_;
+  bool fetched_ = false;
+  mutable std::mutex mutex_;
+  std::map<std::string, std::vector<std::byte>> frames_;
+  std::vector<std::string> syntaxes_;
+};
+
+}  // namespace
+
+Volume DicomWebClient::readSeries(const std::string& studyUid, const std::string& seriesUid) const {
+  const std::string seriesUrl = root_ + "/studies/" + studyUid + "/series/" + seriesUid;
+  const bool credentials = !options_.headers.empty();
+  const std::string metadataUrl = seriesUrl + "/metadata";
+  const nlohmann::json datasets = getJson(*http_, metadataUrl, options_.headers, credentials);
+
+  io_detail::FolderScan scan;
+  scan.where = "DICOMweb series " + seriesUrl;
+  for (std::size_t i = 0; i < datasets.size(); ++i) {
+    const DicomJsonAttributes a(datasets[i]);
+    const std::string sop = textOf(a, kSopInstanceUid);
+    if (sop.empty() || sop.find('/') != std::string::npos || sop.size() > 64) {
+      throw InputError(metadataUrl + ": instance " + std::to_string(i + 1) +
+                       " has no valid SOP Instance UID (0008,0018)");
+    }
+    if (!a.has(io_detail::kTagPixelData) && !a.has(io_detail::kTagRows)) {
+      ++scan.nonImageObjects;
+      continue;
+    }
+    Slice s = io_detail::sliceHeader(seriesUrl + "/instances/" + sop, a);
+    s.transferSyntax = "as stored (WADO-RS transfer-syntax=*)";
+    scan.slices.push_back(std::move(s));
+  }
+  const std::vector<Slice> all = scan.slices;
+  FrameFetcher fetcher(*http_, options_.headers, http_->parallelism(), seriesUrl);
+  Volume v = io_detail::readSeries(
+      std::move(scan), seriesUid, seriesUrl,
+      [&](const Slice& s, Volume& stored, int z) { return fetcher.decode(s, all, stored, z); });
+  syntaxes_ = fetcher.syntaxes();
+  std::string received;
+  for (const std::string& t : syntaxes_) received += (received.empty() ? "" : ", ") + t;
+  v.setDescription(v.description() + "; frames received in transfer syntax " + received + "; " +
+                   formatBytes(http_->bytesFetched()) + " in " + std::to_string(http_->requests()) +
+                   " requests");
+  return v;
+}
+
+DicomWebTransfer DicomWebClient::transfer() const {
+  return {http_->bytesFetched(), http_->requests(), http_->retries(), syntaxes_};
+}
+
+Volume readDicomWebSeries(const std::string& url, DicomWebTransfer* transfer) {
+  const DicomWebSeriesUrl u = parseDicomWebSeriesUrl(url);
+  const DicomWebClient client(u.root);
+  Volume v = client.readSeries(u.study, u.series);
+  if (transfer) *transfer = client.transfer();
+  return v;
+}
+
+}  // namespace tessera

@@ -1,0 +1,217 @@
+// DICOMweb against a real PACS: Orthanc with its DICOMweb plugin, started by
+// the suite (tests/support/OrthancServer.h). One CT series written by
+// writeDicomSeries is stored three times: uncompressed, JPEG lossless (DCMTK's
+// dcmcjpeg) and JPEG 2000 lossless (OpenJPEG's opj_compress), each under its
+// own Series Instance UID; read over WADO-RS (frames as stored), each must
+// equal the folder read voxel for voxel with the same affine. QIDO lists
+// them; 401 and 404 are one line naming the URL.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+
+#include "io/IoFixtures.h"
+#include "support/ExpectError.h"
+#include "support/OrthancServer.h"
+#include "support/TestSupport.h"
+#include "tessera/core/Error.h"
+#include "tessera/io/DicomSeriesReader.h"
+#include "tessera/io/DicomWeb.h"
+#include "tessera/io/VolumeReader.h"
+
+namespace tessera {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kEncode = fs::path(TESSERA_TEST_DATA_DIR) / ".." / "io" / "DicomWebEncode.py";
+constexpr const char* kSeriesUid = "1.2.826.0.1.3680043.10.543.77";
+
+// A 40x32x12 CT-like i16 volume (-1024 air, noisy tissue, a bright marker
+// at voxel (5,7,3)), oblique, anisotropic: what the reads must agree on.
+Volume ctVolume() {
+  Volume v = Volume::allocate({40, 32, 12}, ScalarType::I16, "ct");
+  std::mt19937 rng(7);
+  for (int z = 0; z < 12; ++z) {
+    for (int y = 0; y < 32; ++y) {
+      for (int x = 0; x < 40; ++x) {
+        const double r = std::hypot(x - 20.0, y - 16.0);
+        const int value = r < 14 ? 40 + static_cast<int>(rng() % 200) : -1024;
+        v.setValueAtIndex(x + 40 * (y + 32 * static_cast<std::size_t>(z)), value);
+      }
+    }
+  }
+  v.setValueAtIndex(5 + 40 * (7 + 32 * 3), 3000);
+  v.invalidateRange();
+  v.setSpacing({0.7, 0.8, 2.5});
+  v.setOrigin({-12.5, 30.25, 7.0});
+  const double a = 0.3;
+  v.setDirection(glm::dmat3(std::cos(a), std::sin(a), 0, -std::sin(a), std::cos(a), 0, 0, 0, 1));
+  return v;
+}
+
+struct StoredSeries {
+  std::string kind;
+  std::string seriesUid;
+  std::string transferSyntax;
+};
+
+class DicomWebOrthanc : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    if (!test::OrthancServer::missing().empty()) return;
+    dir_ = new test::TempDir;
+    const fs::path plain = dir_->path() / "plain";
+    DicomWriteOptions o;
+    o.seriesInstanceUid = kSeriesUid;
+    o.seriesDescription = "tessera dicomweb test";
+    o.modality = "CT";
+    writeDicomSeries(ctVolume(), plain, o);
+    for (const char* kind : {"jpeg-lossless", "j2k-lossless"}) {
+      const std::string suffix = std::string(kind) == "jpeg-lossless" ? "2" : "3";
+      const std::string cmd = "/usr/bin/python3 '" + kEncode.string() + "' '" + plain.string() +
+                              "' '" + (dir_->path() / kind).string() + "' " + kind + " " + suffix;
+      if (std::system((cmd + " >/dev/null 2>&1").c_str()) != 0) {
+        setupError_ = "encoding failed: " + cmd;
+        return;
+      }
+    }
+    orthanc_ = new test::OrthancServer(dir_->path() / "orthanc");
+    for (const char* kind : {"plain", "jpeg-lossless", "j2k-lossless"}) {
+      if (!orthanc_->upload(dir_->path() / kind)) setupError_ = std::string("upload of ") + kind;
+    }
+  }
+  static void TearDownTestSuite() {
+    delete orthanc_;  // stopped here, also when a test failed
+    orthanc_ = nullptr;
+    delete dir_;
+    dir_ = nullptr;
+  }
+  void SetUp() override {
+    if (const std::string m = test::OrthancServer::missing(); !m.empty()) GTEST_SKIP() << m;
+    ASSERT_TRUE(setupError_.empty()) << setupError_;
+  }
+
+  static std::string studyUid() {
+    const DicomWebClient client(orthanc_->dicomWebRoot(), DicomWebOptions{});
+    const auto studies = client.studies();
+    return studies.empty() ? "" : studies.front().uid;
+  }
+  static std::string seriesUrl(const std::string& seriesUid) {
+    return orthanc_->dicomWebRoot() + "/studies/" + studyUid() + "/series/" + seriesUid;
+  }
+
+  static test::TempDir* dir_;
+  static test::OrthancServer* orthanc_;
+  static std::string setupError_;
+};
+test::TempDir* DicomWebOrthanc::dir_ = nullptr;
+test::OrthancServer* DicomWebOrthanc::orthanc_ = nullptr;
+std::string DicomWebOrthanc::setupError_;
+
+const StoredSeries kStored[] = {
+    {"uncompressed", kSeriesUid, "1.2.840.10008.1.2.1"},
+    {"JPEG lossless", std::string(kSeriesUid) + ".2", "1.2.840.10008.1.2.4.70"},
+    {"JPEG 2000 lossless", std::string(kSeriesUid) + ".3", "1.2.840.10008.1.2.4.90"},
+};
+
+// One test, as the suite's setup (encoding, Orthanc, uploads) is most of
+// its time and ctest runs each test in its own process.
+TEST_F(DicomWebOrthanc, StoredSyntaxesReadLikeTheFolderQidoListsThemUnknownIs404) {
+  const Volume folder = readVolume((dir_->path() / "plain").string());
+  const std::string study = studyUid();
+  ASSERT_FALSE(study.empty());
+  for (const StoredSeries& s : kStored) {
+    SCOPED_TRACE(s.kind);
+    DicomWebTransfer transfer;
+    const Volume web = readDicomWebSeries(seriesUrl(s.seriesUid), &transfer);
+    test::expectSameVolume(web, folder);
+    EXPECT_EQ(web.indexToWorld(), folder.indexToWorld());
+    EXPECT_EQ(web.direction(), folder.direction());
+    EXPECT_EQ(web.valueAtIndex(5 + 40 * (7 + 32 * 3)), 3000.0);  // the marker, in place
+    EXPECT_EQ(transfer.transferSyntaxes, std::vector<std::string>{s.transferSyntax});
+    // The metadata and one request per frame.
+    EXPECT_EQ(transfer.requests, 13u);
+    EXPECT_NE(web.description().find(s.transferSyntax), std::string::npos) << web.description();
+  }
+
+  // QIDO: the study and its three series.
+  const DicomWebClient client(orthanc_->dicomWebRoot(), DicomWebOptions{});
+  const auto studies = client.studies();
+  ASSERT_EQ(studies.size(), 1u);
+  EXPECT_EQ(studies[0].modalities, "CT");
+  EXPECT_EQ(studies[0].series, 3);
+  EXPECT_EQ(studies[0].instances, 36);
+  const auto series = client.series(studies[0].uid);
+  ASSERT_EQ(series.size(), 3u);
+  for (const auto& s : series) {
+    EXPECT_EQ(s.modality, "CT");
+    EXPECT_EQ(s.instances, 12);
+    EXPECT_EQ(s.description, "tessera dicomweb test");
+    EXPECT_TRUE(isDicomWebSeriesUrl(s.url)) << s.url;
+  }
+  EXPECT_TRUE(client.studies("PatientName=NOBODY*").empty());
+
+  // A series the archive does not hold.
+  const std::string url = seriesUrl("1.2.3.999");
+  const std::string m = test::inputErrorMessage([&] { readVolume(url); });
+  EXPECT_EQ(m, url +
+                   "/metadata: HTTP 404 Not Found: no such study, series or instance, or not a "
+                   "DICOMweb service root");
+}
+
+TEST(DicomWebAuth, OrthancWithAuthenticationWants401CredentialsAndNeverPrintsThem) {
+  if (const std::string m = test::OrthancServer::missing(); !m.empty()) GTEST_SKIP() << m;
+  test::TempDir dir;
+  DicomWriteOptions o;
+  o.seriesInstanceUid = kSeriesUid;
+  o.modality = "CT";
+  writeDicomSeries(ctVolume(), dir.path() / "plain", o);
+  test::OrthancServer orthanc(dir.path() / "orthanc", "alice", "s3cret-pw");
+  ASSERT_TRUE(orthanc.upload(dir.path() / "plain"));
+  const std::string studies = orthanc.dicomWebRoot() +
+                              "/studies?includefield=00081030&"
+                              "includefield=00080061&includefield="
+                              "00201206&includefield=00201208";
+  // No credentials: 401, and how to give them.
+  const std::string none = test::inputErrorMessage(
+      [&] { DicomWebClient(orthanc.dicomWebRoot(), DicomWebOptions{}).studies(); });
+  EXPECT_EQ(none.rfind(studies + ": HTTP 401 Unauthorized: the server wants credentials", 0), 0u)
+      << none;
+  EXPECT_NE(none.find("TESSERA_DICOMWEB_AUTH"), std::string::npos);
+  // Wrong ones: refused, and the header's value is not in the message.
+  DicomWebOptions wrong;
+  wrong.headers = {"Authorization: Basic YWxpY2U6d3Jvbmc="};  // alice:wrong
+  const std::string refused =
+      test::inputErrorMessage([&] { DicomWebClient(orthanc.dicomWebRoot(), wrong).studies(); });
+  EXPECT_EQ(refused, studies + ": HTTP 401 Unauthorized: the credentials given were refused");
+  EXPECT_EQ(refused.find("YWxpY2U6d3Jvbmc"), std::string::npos);
+  // The right ones from the environment: the series reads.
+  ::setenv("TESSERA_DICOMWEB_AUTH", "Basic YWxpY2U6czNjcmV0LXB3", 1);  // alice:s3cret-pw
+  const DicomWebClient client(orthanc.dicomWebRoot());
+  const auto list = client.studies();
+  ASSERT_EQ(list.size(), 1u);
+  const Volume v =
+      readVolume(orthanc.dicomWebRoot() + "/studies/" + list[0].uid + "/series/" + kSeriesUid);
+  ::unsetenv("TESSERA_DICOMWEB_AUTH");
+  test::expectSameVolume(v, readVolume((dir.path() / "plain").string()));
+}
+
+TEST(DicomWebUrl, SeriesUrlsAreRecognisedAndSplit) {
+  EXPECT_TRUE(isDicomWebSeriesUrl("http://h:8042/dicom-web/studies/1.2/series/3.4"));
+  EXPECT_TRUE(isDicomWebSeriesUrl("https://h/wado/studies/1.2/series/3.4/"));
+  EXPECT_FALSE(isDicomWebSeriesUrl("http://h/dicom-web/studies/1.2"));
+  EXPECT_FALSE(isDicomWebSeriesUrl("http://h/store.ome.zarr"));
+  EXPECT_FALSE(isDicomWebSeriesUrl("http://h/studies/1.2/series/3.4/instances/5"));
+  EXPECT_FALSE(isDicomWebSeriesUrl("/data/studies/1.2/series/3.4"));
+  const DicomWebSeriesUrl u =
+      parseDicomWebSeriesUrl("http://h:8042/dicom-web/studies/1.2/series/3.4/");
+  EXPECT_EQ(u.root, "http://h:8042/dicom-web");
+  EXPECT_EQ(u.study, "1.2");
+  EXPECT_EQ(u.series, "3.4");
+}
+
+}  // namespace
+}  // namespace tessera
