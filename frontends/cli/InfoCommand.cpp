@@ -60,7 +60,11 @@ void runInfo(const InfoOptions& o) {
   // A DICOM folder may hold several series: list them so --series can pick.
   std::vector<DicomSeriesInfo> series;
   std::error_code ec;
-  if (std::filesystem::is_directory(spec, ec)) series = listDicomSeries(spec);
+  // A file of a DICOM series: the series (and stacks) beside it.
+  if (std::filesystem::is_directory(spec, ec) || (std::filesystem::is_regular_file(spec, ec) &&
+                                                  v.description().starts_with("DICOM series "))) {
+    series = listDicomSeries(spec);
+  }
   const ValueRange r = v.valueRange();
   std::printf("file        %s\n", spec.c_str());
   if (!v.description().empty()) std::printf("description %s\n", v.description().c_str());
@@ -83,11 +87,9 @@ void runInfo(const InfoOptions& o) {
   std::printf("percentiles 1%%: %.4g  50%%: %.4g  99%%: %.4g\n", h.percentile(0.01),
               h.percentile(0.5), h.percentile(0.99));
   for (const auto& s : series) {
-    std::printf("series      %s: %d slices, %s%s\n", s.seriesInstanceUid.c_str(), s.slices,
-                s.description.c_str(),
-                v.description().rfind("DICOM series " + s.seriesInstanceUid + " ", 0) == 0
-                    ? " (read)"
-                    : "");
+    std::printf(
+        "series      %s: %d slices, %s%s\n", s.selector().c_str(), s.slices, s.description.c_str(),
+        v.description().rfind("DICOM series " + s.selector() + " ", 0) == 0 ? " (read)" : "");
   }
   if (store) printZarrLevels(*store);
   std::printf("bytes       %s (%llu)\n", formatBytes(v.byteSize()).c_str(),

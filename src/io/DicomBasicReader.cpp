@@ -153,6 +153,92 @@ struct Element {
   std::array<char, 2> vr{};  // {0, 0} in implicit VR
 };
 
+// One item of a sequence that is read (the functional groups of
+// multi-frame objects): its elements and the items of its sequences.
+struct ItemNode {
+  std::map<std::uint32_t, Element> elements;
+  std::map<std::uint32_t, std::vector<ItemNode>> sequences;
+};
+
+// The top-level sequences whose items are kept; every other sequence is
+// skipped (its items walked only as far as their lengths need).
+bool keepsItems(std::uint32_t tag) {
+  using namespace io_detail;
+  for (DicomTag t : {kTagSharedFunctionalGroups, kTagPerFrameFunctionalGroups,
+                     kTagDetectorInformationSequence}) {
+    if (tag == tagKey(t.group, t.element)) return true;
+  }
+  return false;
+}
+
+// An element's value as the shared series code reads it (see
+// DicomAttributes in io/DicomSeries.h).
+std::optional<std::string> elementText(const Element* e, const std::uint8_t* bytes) {
+  if (e == nullptr || e->length > kLongestAttribute) return std::nullopt;
+  return trimmed(std::string_view(reinterpret_cast<const char*>(bytes + e->offset), e->length));
+}
+
+std::optional<int> elementUint16(const Element* e, const std::uint8_t* bytes) {
+  if (e == nullptr) return std::nullopt;
+  const std::string_view vr(e->vr.data(), 2);
+  // US may hold several values (the first is read); implicit VR and UN
+  // (PS3.5 6.2.2) must be one value.
+  const bool us = vr == "US" && e->length >= 2 && e->length % 2 == 0;
+  if (!us && !(vr != "US" && (e->vr[0] == 0 || vr == "UN") && e->length == 2)) {
+    return std::nullopt;
+  }
+  return bytes[e->offset] | (bytes[e->offset + 1] << 8);
+}
+
+std::optional<std::uint32_t> elementUint32(const Element* e, const std::uint8_t* bytes) {
+  if (e == nullptr) return std::nullopt;
+  const std::string_view vr(e->vr.data(), 2);
+  const bool ul = vr == "UL" && e->length >= 4 && e->length % 4 == 0;
+  if (!ul && !(vr != "UL" && (e->vr[0] == 0 || vr == "UN") && e->length == 4)) {
+    return std::nullopt;
+  }
+  const std::uint8_t* p = bytes + e->offset;
+  return static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
+         (static_cast<std::uint32_t>(p[2]) << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
+}
+
+const Element* findIn(const std::map<std::uint32_t, Element>& elements, DicomTag tag) {
+  const auto it = elements.find(tagKey(tag.group, tag.element));
+  return it == elements.end() ? nullptr : &it->second;
+}
+
+// A kept item as attributes; the file's bytes outlive it.
+class ItemAttributes final : public io_detail::DicomAttributes {
+ public:
+  ItemAttributes(const ItemNode& node, const std::uint8_t* bytes) : node_(node), bytes_(bytes) {}
+  std::optional<std::string> text(DicomTag tag) const override {
+    return elementText(findIn(node_.elements, tag), bytes_);
+  }
+  std::optional<int> uint16(DicomTag tag) const override {
+    return elementUint16(findIn(node_.elements, tag), bytes_);
+  }
+  std::optional<std::uint32_t> uint32(DicomTag tag) const override {
+    return elementUint32(findIn(node_.elements, tag), bytes_);
+  }
+  std::vector<std::unique_ptr<io_detail::DicomAttributes>> items(DicomTag tag) const override {
+    return itemsOf(node_.sequences, tag, bytes_);
+  }
+
+  static std::vector<std::unique_ptr<io_detail::DicomAttributes>> itemsOf(
+      const std::map<std::uint32_t, std::vector<ItemNode>>& sequences, DicomTag tag,
+      const std::uint8_t* bytes) {
+    std::vector<std::unique_ptr<io_detail::DicomAttributes>> out;
+    const auto it = sequences.find(tagKey(tag.group, tag.element));
+    if (it == sequences.end()) return out;
+    for (const ItemNode& n : it->second) out.push_back(std::make_unique<ItemAttributes>(n, bytes));
+    return out;
+  }
+
+ private:
+  const ItemNode& node_;
+  const std::uint8_t* bytes_;
+};
+
 // One Part-10 file, parsed from its bytes (read whole: the file's size is
 // what justifies the allocation). Keeps the top-level elements found before
 // a failure, so that an unreadable file still tells its series and position.
@@ -204,31 +290,25 @@ class Part10File final : public io_detail::DicomAttributes {
   const std::uint8_t* at(std::uint64_t offset) const { return bytes_.data() + offset; }
 
   std::optional<std::string> text(DicomTag tag) const override {
-    const Element* e = find(tag);
-    if (e == nullptr || e->length > kLongestAttribute) return std::nullopt;
-    return trimmed(std::string_view(reinterpret_cast<const char*>(at(e->offset)), e->length));
+    return elementText(find(tag), bytes_.data());
   }
-
   std::optional<int> uint16(DicomTag tag) const override {
-    const Element* e = find(tag);
-    if (e == nullptr) return std::nullopt;
-    const std::string_view vr(e->vr.data(), 2);
-    // US may hold several values (the first is read); implicit VR and UN
-    // (PS3.5 6.2.2) must be one value.
-    const bool us = vr == "US" && e->length >= 2 && e->length % 2 == 0;
-    if (!us && !(vr != "US" && (e->vr[0] == 0 || vr == "UN") && e->length == 2)) {
-      return std::nullopt;
-    }
-    return at(e->offset)[0] | (at(e->offset)[1] << 8);
+    return elementUint16(find(tag), bytes_.data());
   }
+  std::optional<std::uint32_t> uint32(DicomTag tag) const override {
+    return elementUint32(find(tag), bytes_.data());
+  }
+  std::vector<std::unique_ptr<io_detail::DicomAttributes>> items(DicomTag tag) const override {
+    return ItemAttributes::itemsOf(sequences_, tag, bytes_.data());
+  }
+  // Fragments' item offsets from the first fragment's item, as the Basic
+  // Offset Table counts them (PS3.5 A.4), and the table itself.
+  const std::vector<std::uint32_t>& offsetTable() const { return offsetTable_; }
 
  private:
   [[noreturn]] void fail(const std::string& what) const { throw InputError(name_ + ": " + what); }
 
-  const Element* find(DicomTag tag) const {
-    const auto it = elements_.find(tagKey(tag.group, tag.element));
-    return it == elements_.end() ? nullptr : &it->second;
-  }
+  const Element* find(DicomTag tag) const { return findIn(elements_, tag); }
 
   std::uint16_t u16(std::uint64_t at) const {
     return static_cast<std::uint16_t>(bytes_[at] | (bytes_[at + 1] << 8));
@@ -346,17 +426,25 @@ class Part10File final : public io_detail::DicomAttributes {
         parsePixelData(h);
         return;  // nothing after the pixels is read
       }
-      pos = skipValue(h, implicitVr, 0, size());
+      std::vector<ItemNode>* keep = keepsItems(h.tag) ? &sequences_[h.tag] : nullptr;
+      pos = skipValue(h, implicitVr, 0, size(), keep);
       if ((h.tag >> 16) != 0x0002) elements_[h.tag] = {h.valueOffset, h.length, h.vr};
     }
   }
 
   // Where the element after `h` begins; sequences (and undefined-length UN,
-  // PS3.5 6.2.2, which holds implicit VR) are walked item by item.
-  std::uint64_t skipValue(const Header& h, bool implicitVr, int depth, std::uint64_t end) {
+  // PS3.5 6.2.2, which holds implicit VR) are walked item by item. With
+  // `keep`, a sequence's items are read into it (also those of defined
+  // length, and a sequence of defined length: VR SQ, or any element in
+  // implicit VR that the walk finds items in).
+  std::uint64_t skipValue(const Header& h, bool implicitVr, int depth, std::uint64_t end,
+                          std::vector<ItemNode>* keep = nullptr) {
     const std::string_view vr(h.vr.data(), 2);
     if (h.length != kUndefinedLength) {
       needValue(h, end);
+      if (keep != nullptr && (vr == "SQ" || (implicitVr && looksLikeItem(h)))) {
+        readDefinedSequence(h, implicitVr, depth + 1, *keep);
+      }
       return h.valueOffset + h.length;
     }
     if (!implicitVr && vr != "SQ" && vr != "UN") {
@@ -364,10 +452,69 @@ class Part10File final : public io_detail::DicomAttributes {
            " has an undefined length but VR " + printable(vr) +
            " (only sequences, UN and encapsulated Pixel Data may)");
     }
-    return skipSequence(h, implicitVr || vr == "UN", depth + 1, end);
+    return skipSequence(h, implicitVr || vr == "UN", depth + 1, end, keep);
   }
 
-  std::uint64_t skipSequence(const Header& seq, bool implicitVr, int depth, std::uint64_t end) {
+  // Whether an implicit-VR value of defined length holds items (a sequence).
+  bool looksLikeItem(const Header& h) const {
+    return h.length >= 8 && h.valueOffset + 8 <= size() &&
+           tagKey(u16(h.valueOffset), u16(h.valueOffset + 2)) == kItem;
+  }
+
+  // A sequence of defined length: items up to its end.
+  void readDefinedSequence(const Header& seq, bool implicitVr, int depth,
+                           std::vector<ItemNode>& keep) {
+    if (depth > io_detail::kMaxSequenceNesting) {
+      throw InputError(io_detail::sequencesTooDeepMessage(name_));
+    }
+    const std::uint64_t end = seq.valueOffset + seq.length;
+    std::uint64_t pos = seq.valueOffset;
+    while (pos < end) {
+      const Header item = header(pos, true);
+      if (item.tag != kItem) {
+        fail("sequence " + tagText(seq.tag) + " holds " + tagText(item.tag) + " at offset " +
+             std::to_string(pos) + " where an item (FFFE,E000) belongs (corrupt file)");
+      }
+      keep.emplace_back();
+      if (item.length == kUndefinedLength) {
+        pos = readItem(item.valueOffset, end, true, implicitVr, depth, &keep.back());
+      } else {
+        needValue(item, end);
+        readItem(item.valueOffset, item.valueOffset + item.length, false, implicitVr, depth,
+                 &keep.back());
+        pos = item.valueOffset + item.length;
+      }
+    }
+  }
+
+  // The elements of one item into `node`: up to `end` for an item of defined
+  // length, up to its delimiter otherwise. Returns where the item ends.
+  std::uint64_t readItem(std::uint64_t pos, std::uint64_t end, bool delimited, bool implicitVr,
+                         int depth, ItemNode* node) {
+    for (;;) {
+      if (!delimited && pos >= end) return pos;
+      if (pos >= end) {
+        fail(
+            "an item of undefined length has no Item Delimitation Item (FFFE,E00D) before the "
+            "end (truncated)");
+      }
+      const Header h = header(pos, implicitVr);
+      if (delimited && h.tag == kItemEnd) return h.valueOffset;
+      if ((h.tag >> 16) == 0xfffe) {
+        fail(tagText(h.tag) + " at offset " + std::to_string(pos) +
+             " inside an item, where an element or (FFFE,E00D) belongs (corrupt file)");
+      }
+      std::vector<ItemNode>* keep = node != nullptr ? &node->sequences[h.tag] : nullptr;
+      pos = skipValue(h, implicitVr, depth, end, keep);
+      if (node != nullptr) {
+        node->elements[h.tag] = {h.valueOffset, h.length, h.vr};
+        if (keep->empty()) node->sequences.erase(h.tag);
+      }
+    }
+  }
+
+  std::uint64_t skipSequence(const Header& seq, bool implicitVr, int depth, std::uint64_t end,
+                             std::vector<ItemNode>* keep = nullptr) {
     // The walk recurses once per level: bounded like DCMTK's reader.
     if (depth > io_detail::kMaxSequenceNesting) {
       throw InputError(io_detail::sequencesTooDeepMessage(name_));
@@ -383,6 +530,18 @@ class Part10File final : public io_detail::DicomAttributes {
       if (item.tag != kItem) {
         fail("sequence " + tagText(seq.tag) + " holds " + tagText(item.tag) + " at offset " +
              std::to_string(pos) + " where an item (FFFE,E000) belongs (corrupt file)");
+      }
+      if (keep != nullptr) {
+        keep->emplace_back();
+        if (item.length == kUndefinedLength) {
+          pos = readItem(item.valueOffset, end, true, implicitVr, depth, &keep->back());
+        } else {
+          needValue(item, end);
+          readItem(item.valueOffset, item.valueOffset + item.length, false, implicitVr, depth,
+                   &keep->back());
+          pos = item.valueOffset + item.length;
+        }
+        continue;
       }
       if (item.length != kUndefinedLength) {
         needValue(item, end);
@@ -443,7 +602,13 @@ class Part10File final : public io_detail::DicomAttributes {
              std::to_string(pos) + " where an item of defined length belongs (corrupt file)");
       }
       needValue(item, size());
-      if (!offsetTable) fragments_.push_back({item.valueOffset, item.length, {}});
+      if (offsetTable) {
+        for (std::uint32_t k = 0; k + 4 <= item.length; k += 4) {
+          offsetTable_.push_back(u32(item.valueOffset + k));
+        }
+      } else {
+        fragments_.push_back({item.valueOffset, item.length, {}});
+      }
       offsetTable = false;
       pos = item.valueOffset + item.length;
     }
@@ -457,12 +622,14 @@ class Part10File final : public io_detail::DicomAttributes {
   std::uint64_t datasetStart_ = 0;
   bool encapsulated_ = false;
   std::map<std::uint32_t, Element> elements_;
+  std::map<std::uint32_t, std::vector<ItemNode>> sequences_;
+  std::vector<std::uint32_t> offsetTable_;
   std::optional<Element> pixelData_;
   std::vector<Element> fragments_;
 };
 
-// What the shared series code needs of a parsed file.
-Slice sliceOf(const Part10File& f) {
+// What the shared series code needs of a parsed file: a slice per frame.
+std::vector<Slice> slicesOf(const Part10File& f) {
   Slice s = io_detail::sliceHeader(f.name(), f);
   s.transferSyntax = f.syntaxText();
   if (f.pixelData()) s.pixelBytes = f.pixelData()->length;
@@ -472,8 +639,9 @@ Slice sliceOf(const Part10File& f) {
     const bool rle = f.codec() == Codec::Rle;
     s.decodedBytesBound = compressed * (rle ? kMaxRleRatio : kMaxJpeg2000Ratio);
     s.compression = rle ? "RLE Lossless" : f.syntaxText();
+    s.fragments = f.fragments().size();
   }
-  return s;
+  return io_detail::framesOf(std::move(s), f);
 }
 
 // One PackBits segment (PS3.5 G.3.1) into `out`, which it must fill exactly.
@@ -513,7 +681,7 @@ void unpackSegment(const std::uint8_t* in, std::size_t inSize, std::uint8_t* out
 // count and offsets; one segment per byte of a sample, most significant
 // first. Returns the samples in host order (8- or 16-bit).
 std::vector<std::uint8_t> decodeRle(const Slice& s, const std::vector<std::uint8_t>& frame) {
-  const std::string f = s.file.string();
+  const std::string f = io_detail::sliceName(s);
   const auto u32 = [&](std::size_t at) {
     return static_cast<std::uint32_t>(frame[at]) |
            (static_cast<std::uint32_t>(frame[at + 1]) << 8) |
@@ -563,7 +731,7 @@ std::vector<std::uint8_t> decodeFrame(const Slice& s, Codec codec,
                                       .bitsAllocated = s.bitsAllocated,
                                       .bitsStored = s.bitsStored,
                                       .samplesPerPixel = s.samplesPerPixel};
-    return io_detail::decodeJpeg2000Frame(frame, shape, s.file.string());
+    return io_detail::decodeJpeg2000Frame(frame, shape, io_detail::sliceName(s));
   }
 #endif
   if (codec != Codec::Rle) throw InputError(s.file.string() + ": no decoder for its pixel data");
@@ -572,29 +740,82 @@ std::vector<std::uint8_t> decodeFrame(const Slice& s, Codec codec,
 
 using Opener = std::function<std::unique_ptr<ByteSource>(const fs::path&)>;
 
-// Decodes a slice's pixels (the file is parsed again: only the headers of
-// every file are kept while the series is assembled).
+// The fragments of frame `s.frame` (PS3.5 A.4): all of them for a file of
+// one frame; one each when there are as many fragments as frames; else as
+// the Basic Offset Table divides them.
+std::vector<std::uint8_t> frameCodestream(const Part10File& f, const Slice& s) {
+  const std::vector<Element>& fragments = f.fragments();
+  std::vector<std::uint8_t> out;
+  const auto append = [&](const Element& e) {
+    out.insert(out.end(), f.at(e.offset), f.at(e.offset) + e.length);
+  };
+  if (s.frames <= 1) {
+    for (const Element& e : fragments) append(e);
+    return out;
+  }
+  const auto k = static_cast<std::size_t>(s.frame);
+  if (fragments.size() == static_cast<std::size_t>(s.frames)) {
+    append(fragments[k]);
+    return out;
+  }
+  const std::vector<std::uint32_t>& table = f.offsetTable();
+  if (table.size() != static_cast<std::size_t>(s.frames)) {
+    throw InputError(io_detail::sliceName(s) + ": " + std::to_string(fragments.size()) +
+                     " fragments for " + std::to_string(s.frames) + " frames, and the Basic " +
+                     "Offset Table has " + std::to_string(table.size()) +
+                     " entries, so the frames cannot be told apart");
+  }
+  // Offsets count from the first fragment's item tag, 8 bytes before its value.
+  const std::uint64_t first = fragments.front().offset - 8;
+  const std::uint64_t begin = table[k];
+  const std::uint64_t end = k + 1 < table.size() ? table[k + 1] : ~std::uint64_t{0};
+  for (const Element& e : fragments) {
+    const std::uint64_t at = e.offset - 8 - first;
+    if (at >= begin && at < end) append(e);
+  }
+  if (out.empty()) {
+    throw InputError(io_detail::sliceName(s) + ": the Basic Offset Table puts frame " +
+                     std::to_string(k + 1) + " at byte " + std::to_string(begin) +
+                     ", where no fragment begins (corrupt offset table)");
+  }
+  return out;
+}
+
+// A parsed file kept while its frames are decoded.
+struct ParsedFile {
+  fs::path file;
+  std::unique_ptr<Part10File> parsed;
+};
+
+// Decodes a slice's pixels. Only the headers of every file are kept while
+// the series is assembled; a file is parsed again for its pixels, once for
+// all its frames (the file last parsed is kept).
 io_detail::PixelDecoder pixelDecoder(const Opener& open) {
-  return [open](const Slice& s, Volume& stored, int z) -> StoredRange {
-    Part10File f(*open(s.file));
-    f.parse();
+  auto last = std::make_shared<ParsedFile>();
+  return [open, last](const Slice& s, Volume& stored, int z) -> StoredRange {
+    if (!last->parsed || last->file != s.file) {
+      last->parsed.reset();
+      auto parsed = std::make_unique<Part10File>(*open(s.file));
+      parsed->parse();
+      last->parsed = std::move(parsed);
+      last->file = s.file;
+    }
+    const Part10File& f = *last->parsed;
     if (!f.hasPixelData()) throw InputError(s.file.string() + ": no Pixel Data (7fe0,0010)");
     if (f.encapsulated()) {
-      std::vector<std::uint8_t> frame;
-      for (const Element& e : f.fragments())
-        frame.insert(frame.end(), f.at(e.offset), f.at(e.offset) + e.length);
-      const std::vector<std::uint8_t> samples = decodeFrame(s, f.codec(), frame);
+      const std::vector<std::uint8_t> samples = decodeFrame(s, f.codec(), frameCodestream(f, s));
       return io_detail::storePixels(s, samples.data(), samples.size(), stored, z);
     }
     const Element& e = *f.pixelData();
-    if (s.bitsAllocated == 8) return io_detail::storePixels(s, f.at(e.offset), e.length, stored, z);
+    const auto [begin, length] = io_detail::frameRange(s, e.length);
+    const std::uint8_t* p = f.at(e.offset + begin);
+    if (s.bitsAllocated == 8) return io_detail::storePixels(s, p, length, stored, z);
     // Little endian on disk, host order for storePixels.
-    std::vector<std::uint16_t> words(e.length / 2);
-    const std::uint8_t* p = f.at(e.offset);
+    std::vector<std::uint16_t> words(length / 2);
     for (std::size_t i = 0; i < words.size(); ++i) {
       words[i] = static_cast<std::uint16_t>(p[2 * i] | (p[2 * i + 1] << 8));
     }
-    return io_detail::storePixels(s, words.data(), e.length, stored, z);
+    return io_detail::storePixels(s, words.data(), length, stored, z);
   };
 }
 
@@ -626,7 +847,7 @@ void addFile(const ByteSource& source, bool mustBeImage, FolderScan& scan) {
     ++scan.nonImageObjects;
     return;
   }
-  scan.slices.push_back(sliceOf(f));
+  for (auto& frame : slicesOf(f)) scan.slices.push_back(std::move(frame));
 }
 
 std::unique_ptr<ByteSource> openFile(const fs::path& p) {

@@ -68,8 +68,18 @@ std::string attributeName(const char* name, DicomTag tag) {
   return std::string(name) + " " + tag.text();
 }
 
-// The numbers of a decimal (DS) or integer (IS) string "a\b\c"; nullopt
-// unless there are exactly `count` of them. Parsed without the C locale's
+// How a malformed value is shown in a message: its text, or its size when
+// it is not text at all.
+std::string shownValue(const std::string& text) {
+  const bool printable = std::all_of(text.begin(), text.end(), [](char c) {
+    return static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7f;
+  });
+  return printable ? quoted(text) : std::to_string(text.size()) + " bytes that are not text";
+}
+
+}  // namespace
+
+// Parsed without the C locale's
 // help (std::from_chars), so a decimal comma never passes.
 std::optional<std::vector<double>> parseNumbers(const std::string& text, std::size_t count) {
   std::vector<double> out;
@@ -92,16 +102,87 @@ std::optional<std::vector<double>> parseNumbers(const std::string& text, std::si
   return out;
 }
 
-// How a malformed value is shown in a message: its text, or its size when
-// it is not text at all.
-std::string shownValue(const std::string& text) {
-  const bool printable = std::all_of(text.begin(), text.end(), [](char c) {
-    return static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7f;
-  });
-  return printable ? quoted(text) : std::to_string(text.size()) + " bytes that are not text";
+std::optional<std::uint32_t> DicomAttributes::uint32(DicomTag tag) const {
+  const auto t = text(tag);
+  const auto v = t ? parseNumbers(*t, 1) : std::nullopt;
+  if (!v || (*v)[0] < 0 || (*v)[0] > 4294967295.0 || std::floor((*v)[0]) != (*v)[0]) {
+    return std::nullopt;
+  }
+  return static_cast<std::uint32_t>((*v)[0]);
 }
 
-}  // namespace
+std::vector<std::unique_ptr<DicomAttributes>> DicomAttributes::items(DicomTag) const {
+  return {};
+}
+
+std::string sliceName(const Slice& s) {
+  return s.frames > 1 ? s.file.string() + " frame " + std::to_string(s.frame + 1) : s.file.string();
+}
+
+void readPlaneAttributes(const DicomAttributes& ds, Slice& s) {
+  auto defect = [&](const std::string& msg) {
+    if (s.defect.empty()) s.defect = msg;
+  };
+  // Decimal strings: absent is fine (nullopt), present but malformed is a defect.
+  auto numbers = [&](DicomTag tag, const char* name,
+                     std::size_t count) -> std::optional<std::vector<double>> {
+    const auto text = ds.text(tag);
+    if (!text || text->empty()) return std::nullopt;
+    auto v = parseNumbers(*text, count);
+    if (!v) {
+      defect(attributeName(name, tag) + " is " + shownValue(*text) + ", expected " +
+             std::to_string(count) + (count == 1 ? " number" : " numbers"));
+    }
+    return v;
+  };
+  if (auto p = numbers(kTagImagePositionPatient, "Image Position (Patient)", 3)) {
+    s.position = glm::dvec3((*p)[0], (*p)[1], (*p)[2]);
+  }
+  if (auto o = numbers(kTagImageOrientationPatient, "Image Orientation (Patient)", 6)) {
+    const glm::dvec3 r((*o)[0], (*o)[1], (*o)[2]);
+    const glm::dvec3 c((*o)[3], (*o)[4], (*o)[5]);
+    if (glm::length(r) < 0.5 || glm::length(c) < 0.5 ||
+        std::abs(glm::dot(glm::normalize(r), glm::normalize(c))) > kOrientationTolerance) {
+      defect("Image Orientation (Patient) " + vecText(r) + " " + vecText(c) +
+             " is not two perpendicular unit vectors");
+    } else {
+      s.rowDir = glm::normalize(r);
+      // Exactly perpendicular to the row, as the normal and the affine need.
+      s.colDir = glm::normalize(c - glm::dot(c, *s.rowDir) * *s.rowDir);
+    }
+  }
+  if (auto p = numbers(kTagPixelSpacing, "Pixel Spacing", 2)) {
+    if ((*p)[0] <= 0 || (*p)[1] <= 0) {
+      defect("Pixel Spacing is " + number((*p)[0]) + "\\" + number((*p)[1]) +
+             ", expected two positive numbers");
+    } else {
+      s.pixelSpacing = glm::dvec2((*p)[0], (*p)[1]);
+    }
+  }
+  if (auto v = numbers(kTagRescaleSlope, "Rescale Slope", 1)) {
+    if ((*v)[0] == 0.0) defect("Rescale Slope is 0");
+    s.slope = (*v)[0];
+  }
+  if (auto v = numbers(kTagRescaleIntercept, "Rescale Intercept", 1)) s.intercept = (*v)[0];
+  if (auto v = numbers(kTagSliceThickness, "Slice Thickness", 1)) s.sliceThickness = (*v)[0];
+  if (auto v = numbers(kTagSpacingBetweenSlices, "Spacing Between Slices", 1)) {
+    s.spacingBetweenSlices = (*v)[0];
+  }
+  // Window Center/Width may hold several windows; the first is the default
+  // (PS3.3 C.11.2.1.2), in rescaled units.
+  const auto firstOf = [&](DicomTag tag) -> std::optional<double> {
+    const auto t = ds.text(tag);
+    if (!t) return std::nullopt;
+    const auto v = parseNumbers(t->substr(0, t->find('\\')), 1);
+    return v ? std::optional<double>((*v)[0]) : std::nullopt;
+  };
+  const auto center = firstOf(kTagWindowCenter);
+  const auto width = firstOf(kTagWindowWidth);
+  if (center && width && *width > 0) {
+    s.windowCenter = center;
+    s.windowWidth = width;
+  }
+}
 
 // Reads the attributes a slice needs; problems are recorded in `defect`, not
 // thrown, so that a broken file of a series nobody asked for does no harm.
@@ -152,51 +233,7 @@ Slice sliceHeader(const fs::path& file, const DicomAttributes& ds) {
   s.frames = integer(kTagNumberOfFrames).value_or(1);
   s.instanceNumber = integer(kTagInstanceNumber);
 
-  // Decimal strings: absent is fine (nullopt), present but malformed is a defect.
-  auto numbers = [&](DicomTag tag, const char* name,
-                     std::size_t count) -> std::optional<std::vector<double>> {
-    const auto text = ds.text(tag);
-    if (!text || text->empty()) return std::nullopt;
-    auto v = parseNumbers(*text, count);
-    if (!v) {
-      defect(attributeName(name, tag) + " is " + shownValue(*text) + ", expected " +
-             std::to_string(count) + (count == 1 ? " number" : " numbers"));
-    }
-    return v;
-  };
-  if (auto p = numbers(kTagImagePositionPatient, "Image Position (Patient)", 3)) {
-    s.position = glm::dvec3((*p)[0], (*p)[1], (*p)[2]);
-  }
-  if (auto o = numbers(kTagImageOrientationPatient, "Image Orientation (Patient)", 6)) {
-    const glm::dvec3 r((*o)[0], (*o)[1], (*o)[2]);
-    const glm::dvec3 c((*o)[3], (*o)[4], (*o)[5]);
-    if (glm::length(r) < 0.5 || glm::length(c) < 0.5 ||
-        std::abs(glm::dot(glm::normalize(r), glm::normalize(c))) > kOrientationTolerance) {
-      defect("Image Orientation (Patient) " + vecText(r) + " " + vecText(c) +
-             " is not two perpendicular unit vectors");
-    } else {
-      s.rowDir = glm::normalize(r);
-      // Exactly perpendicular to the row, as the normal and the affine need.
-      s.colDir = glm::normalize(c - glm::dot(c, *s.rowDir) * *s.rowDir);
-    }
-  }
-  if (auto p = numbers(kTagPixelSpacing, "Pixel Spacing", 2)) {
-    if ((*p)[0] <= 0 || (*p)[1] <= 0) {
-      defect("Pixel Spacing is " + number((*p)[0]) + "\\" + number((*p)[1]) +
-             ", expected two positive numbers");
-    } else {
-      s.pixelSpacing = glm::dvec2((*p)[0], (*p)[1]);
-    }
-  }
-  if (auto v = numbers(kTagRescaleSlope, "Rescale Slope", 1)) {
-    if ((*v)[0] == 0.0) defect("Rescale Slope is 0");
-    s.slope = (*v)[0];
-  }
-  if (auto v = numbers(kTagRescaleIntercept, "Rescale Intercept", 1)) s.intercept = (*v)[0];
-  if (auto v = numbers(kTagSliceThickness, "Slice Thickness", 1)) s.sliceThickness = (*v)[0];
-  if (auto v = numbers(kTagSpacingBetweenSlices, "Spacing Between Slices", 1)) {
-    s.spacingBetweenSlices = (*v)[0];
-  }
+  readPlaneAttributes(ds, s);
   return s;
 }
 
@@ -212,25 +249,38 @@ UnreadableFile unreadableFile(const fs::path& file, std::string error, const Dic
 
 namespace {
 
+// One stack of one series: the slices of one volume. Single-frame files
+// have no stack ("") and form one group per series; the frames of
+// multi-frame objects form one group per stack.
 struct SeriesGroup {
   std::string uid;
+  std::string stack;
   std::vector<Slice> slices;
+  bool severalStacks = false;  // other groups share the UID: the key names the stack
+  // What --series takes to choose this group: the UID, with ":stack" when
+  // the series holds several stacks.
+  std::string key() const { return severalStacks ? uid + ":" + stack : uid; }
   std::string label() const {
     const Slice& s = slices.front();
-    std::string t = uid.empty() ? "(no Series Instance UID)" : uid;
+    std::string t = uid.empty() && !severalStacks ? "(no Series Instance UID)" : key();
     t += " (" + std::to_string(slices.size()) + " slice" + (slices.size() == 1 ? "" : "s");
+    if (s.frames > 1) t += " of " + s.file.filename().string();
     if (!s.modality.empty()) t += ", " + s.modality;
     if (!s.seriesDescription.empty()) t += ", \"" + s.seriesDescription + "\"";
     return t + ")";
   }
 };
 
-// Series by Series Instance UID, the largest first.
+// Series by Series Instance UID and stack, the largest first.
 std::vector<SeriesGroup> groupSeries(std::vector<Slice> slices) {
-  std::map<std::string, std::vector<Slice>> byUid;
-  for (auto& s : slices) byUid[s.seriesUid].push_back(std::move(s));
+  std::map<std::pair<std::string, std::string>, std::vector<Slice>> byKey;
+  for (auto& s : slices) byKey[{s.seriesUid, s.stack}].push_back(std::move(s));
+  std::map<std::string, int> stacksOf;
+  for (const auto& [key, v] : byKey) ++stacksOf[key.first];
   std::vector<SeriesGroup> groups;
-  for (auto& [uid, v] : byUid) groups.push_back({uid, std::move(v)});
+  for (auto& [key, v] : byKey) {
+    groups.push_back({key.first, key.second, std::move(v), stacksOf[key.first] > 1});
+  }
   std::stable_sort(groups.begin(), groups.end(), [](const SeriesGroup& a, const SeriesGroup& b) {
     return a.slices.size() > b.slices.size();
   });
@@ -252,13 +302,13 @@ std::string othersText(const std::vector<SeriesGroup>& groups, std::size_t chose
   return t;
 }
 
-// The group to read: the one with Series Instance UID `uid` when given, else
-// the one holding the `named` file (a file names its own series, also when
-// it has no UID), else the largest.
+// The group to read: the one `uid` names when given (a Series Instance UID,
+// its largest stack, or "UID:stack"), else the one holding the `named` file
+// (a file names its own series, also when it has no UID), else the largest.
 std::size_t chooseGroup(const std::vector<SeriesGroup>& groups, const std::string& uid,
                         const fs::path& named, const std::string& what) {
   const auto holds = [&](const SeriesGroup& g) {
-    if (!uid.empty()) return g.uid == uid;
+    if (!uid.empty()) return g.uid == uid || (g.severalStacks && g.key() == uid);
     return std::any_of(g.slices.begin(), g.slices.end(),
                        [&](const Slice& s) { return s.file == named; });
   };
@@ -266,7 +316,7 @@ std::size_t chooseGroup(const std::vector<SeriesGroup>& groups, const std::strin
   const auto it = std::find_if(groups.begin(), groups.end(), holds);
   if (it != groups.end()) return static_cast<std::size_t>(it - groups.begin());
   if (!uid.empty()) {
-    throw InputError(what + ": no series with Series Instance UID " + uid +
+    throw InputError(what + ": no series " + uid + " (Series Instance UID, or UID:stack)" +
                      "; found: " + othersText(groups, groups.size()));
   }
   throw InputError(what + ": the file was not found again when its folder was read");
@@ -343,11 +393,12 @@ std::uint64_t checkPixelBytes(const Slice& s, std::uint64_t length) {
   const std::uint64_t expected =
       static_cast<std::uint64_t>(s.rows) * static_cast<std::uint64_t>(s.columns) * bytes;
   if (length < expected || (length > expected + 1 && length >= 2 * expected)) {
-    throw InputError(
-        s.file.string() + ": pixel data has " + std::to_string(length) + " bytes, but " +
-        std::to_string(s.columns) + "x" + std::to_string(s.rows) + " pixels x " +
-        std::to_string(bytes) + " bytes = " + std::to_string(expected) + " bytes" +
-        (length < expected ? " (truncated)" : " (more than one frame, but Number of Frames is 1)"));
+    throw InputError(sliceName(s) + ": pixel data has " + std::to_string(length) + " bytes, but " +
+                     std::to_string(s.columns) + "x" + std::to_string(s.rows) + " pixels x " +
+                     std::to_string(bytes) + " bytes = " + std::to_string(expected) + " bytes" +
+                     (length < expected ? " (truncated)"
+                      : s.frames > 1    ? " (a frame holds no more)"
+                                        : " (more than one frame, but Number of Frames is 1)"));
   }
   return length - expected;
 }
@@ -356,10 +407,6 @@ std::uint64_t checkPixelBytes(const Slice& s, std::uint64_t length) {
 void checkSlice(const Slice& s) {
   const std::string f = s.file.string();
   if (!s.defect.empty()) throw InputError(f + ": " + s.defect);
-  if (s.frames > 1) {
-    throw InputError(f + ": Number of Frames is " + std::to_string(s.frames) +
-                     "; multi-frame not supported (only one image per file)");
-  }
   if (s.samplesPerPixel != 1) {
     throw InputError(f + ": Samples per Pixel is " + std::to_string(s.samplesPerPixel) + " (" +
                      (s.photometric.empty() ? "colour" : s.photometric) +
@@ -383,15 +430,17 @@ void checkSlice(const Slice& s) {
                      std::to_string(s.bitsAllocated) +
                      " is not supported (expected High Bit = Bits Stored - 1)");
   }
-  if (s.pixelBytes) checkPixelBytes(s, *s.pixelBytes);
-  const std::uint64_t expected = static_cast<std::uint64_t>(s.rows) *
-                                 static_cast<std::uint64_t>(s.columns) *
-                                 static_cast<std::uint64_t>(s.bitsAllocated / 8);
+  if (s.pixelBytes && s.frames == 1) checkPixelBytes(s, *s.pixelBytes);
+  const std::uint64_t expected =
+      static_cast<std::uint64_t>(s.rows) * static_cast<std::uint64_t>(s.columns) *
+      static_cast<std::uint64_t>(s.bitsAllocated / 8) * static_cast<std::uint64_t>(s.frames);
   if (s.decodedBytesBound && expected > *s.decodedBytesBound) {
     throw InputError(f + ": " + std::to_string(s.columns) + "x" + std::to_string(s.rows) +
-                     " pixels need " + std::to_string(expected) + " bytes, but its " +
-                     s.compression + " pixel data can decode to at most " +
-                     std::to_string(*s.decodedBytesBound) + " (truncated or corrupt)");
+                     " pixels" +
+                     (s.frames > 1 ? " x " + std::to_string(s.frames) + " frames" : std::string()) +
+                     " need " + std::to_string(expected) + " bytes, but its " + s.compression +
+                     " pixel data can decode to at most " + std::to_string(*s.decodedBytesBound) +
+                     " (truncated or corrupt)");
   }
 }
 
@@ -413,14 +462,14 @@ void checkConsistent(const std::vector<Slice>& slices) {
   }
   for (const auto& s : slices) {
     if (s.rows != ref->rows || s.columns != ref->columns) {
-      throw InputError(s.file.string() + ": Rows x Columns is " + std::to_string(s.rows) + "x" +
+      throw InputError(sliceName(s) + ": Rows x Columns is " + std::to_string(s.rows) + "x" +
                        std::to_string(s.columns) + ", but the other slices of the series (e.g. " +
-                       ref->file.string() + ") are " + std::to_string(ref->rows) + "x" +
+                       sliceName(*ref) + ") are " + std::to_string(ref->rows) + "x" +
                        std::to_string(ref->columns));
     }
     if (s.bitsAllocated != ref->bitsAllocated || s.isSigned != ref->isSigned) {
-      throw InputError(s.file.string() + ": " + std::to_string(s.bitsAllocated) + "-bit " +
-                       (s.isSigned ? "signed" : "unsigned") + " pixels, but " + ref->file.string() +
+      throw InputError(sliceName(s) + ": " + std::to_string(s.bitsAllocated) + "-bit " +
+                       (s.isSigned ? "signed" : "unsigned") + " pixels, but " + sliceName(*ref) +
                        " has " + std::to_string(ref->bitsAllocated) + "-bit " +
                        (ref->isSigned ? "signed" : "unsigned"));
     }
@@ -431,8 +480,8 @@ void checkConsistent(const std::vector<Slice>& slices) {
         return x.pixelSpacing ? number(x.pixelSpacing->x) + "\\" + number(x.pixelSpacing->y)
                               : std::string("absent");
       };
-      throw InputError(s.file.string() + ": Pixel Spacing is " + text(s) + ", but " +
-                       ref->file.string() + " has " + text(*ref));
+      throw InputError(sliceName(s) + ": Pixel Spacing is " + text(s) + ", but " + sliceName(*ref) +
+                       " has " + text(*ref));
     }
   }
 }
@@ -456,13 +505,13 @@ void sliceAxes(const std::vector<Slice>& slices, Geometry& g) {
     if (s.rowDir.has_value() != first.rowDir.has_value()) {
       const Slice& without = s.rowDir ? first : s;
       const Slice& with = s.rowDir ? s : first;
-      throw InputError(without.file.string() +
-                       ": no Image Orientation (Patient) (0020,0037), but " + with.file.string() +
+      throw InputError(sliceName(without) + ": no Image Orientation (Patient) (0020,0037), but " +
+                       sliceName(with) +
                        " of the same series has one; slices of one volume must share it");
     }
     if (!sameOrientation(s, first)) {
-      throw InputError(s.file.string() + ": Image Orientation (Patient) is " + vecText(*s.rowDir) +
-                       " " + vecText(*s.colDir) + ", but " + first.file.string() + " has " +
+      throw InputError(sliceName(s) + ": Image Orientation (Patient) is " + vecText(*s.rowDir) +
+                       " " + vecText(*s.colDir) + ", but " + sliceName(first) + " has " +
                        vecText(*first.rowDir) + " " + vecText(*first.colDir) +
                        "; slices of one volume must share an orientation");
     }
@@ -504,7 +553,7 @@ void singleSliceGeometry(const Slice& s, Geometry& g) {
 double sortAndCheckGaps(std::vector<Slice>& slices, const glm::dvec3& normal) {
   for (const auto& s : slices) {
     if (!s.position) {
-      throw InputError(s.file.string() +
+      throw InputError(sliceName(s) +
                        ": no Image Position (Patient) (0020,0032); the slices of a series cannot "
                        "be ordered without it");
     }
@@ -525,7 +574,7 @@ double sortAndCheckGaps(std::vector<Slice>& slices, const glm::dvec3& normal) {
   for (std::size_t i = 0; i < gaps.size(); ++i) {
     const Slice& a = slices[i];
     const Slice& b = slices[i + 1];
-    const std::string pair = a.file.string() + " and " + b.file.string();
+    const std::string pair = sliceName(a) + " and " + sliceName(b);
     if (gaps[i] <= std::max(tolerance, 1e-6)) {
       throw InputError(pair + " are at the same position (" + number(a.distance) +
                        " mm along the slice normal): duplicate slices (two acquisitions with one "
@@ -574,10 +623,10 @@ void sliceStep(const std::vector<Slice>& slices, double pixel, Geometry& g) {
     const glm::dvec3 off = *slices[k].position - (p0 + static_cast<double>(k) * step);
     const glm::dvec3 inPlane = off - glm::dot(off, normal) * normal;
     if (glm::length(inPlane) > kIrregularTolerancePixels * pixel) {
-      throw InputError(slices[k].file.string() + ": position " + vecText(*slices[k].position) +
+      throw InputError(sliceName(slices[k]) + ": position " + vecText(*slices[k].position) +
                        " is " + number(glm::length(inPlane)) +
                        " mm off the line through the first and last slice (" +
-                       slices.front().file.string() + ", " + slices.back().file.string() +
+                       sliceName(slices.front()) + ", " + sliceName(slices.back()) +
                        ") within the slice plane; the slices do not form a regular stack");
     }
   }
@@ -671,6 +720,23 @@ StoredRange storePixels(const Slice& s, const void* samples, std::uint64_t lengt
   return r;
 }
 
+std::pair<std::uint64_t, std::uint64_t> frameRange(const Slice& s, std::uint64_t length) {
+  if (s.frames <= 1) return {0, length};
+  const std::uint64_t frameBytes = static_cast<std::uint64_t>(s.rows) *
+                                   static_cast<std::uint64_t>(s.columns) *
+                                   static_cast<std::uint64_t>(s.bitsAllocated / 8);
+  const std::uint64_t begin = static_cast<std::uint64_t>(s.frame) * frameBytes;
+  if (begin + frameBytes > length) {
+    throw InputError(sliceName(s) + ": the pixel data ends after " + std::to_string(length) +
+                     " bytes, but frame " + std::to_string(s.frame + 1) + " of " +
+                     std::to_string(s.frames) + " needs bytes " + std::to_string(begin) + " to " +
+                     std::to_string(begin + frameBytes) +
+                     " (Number of Frames says more frames than the data holds; truncated?)");
+  }
+  const bool last = s.frame + 1 == s.frames;
+  return {begin, last ? length - begin : frameBytes};
+}
+
 namespace {
 
 bool isInteger(double v) {
@@ -761,6 +827,19 @@ void applyGeometry(const Geometry& g, Volume& v) {
   v.setDirection(lpsToRas() * g.direction);
   v.setOrigin(lpsToRas() * g.origin);
   v.setGeometrySource(g.source);
+}
+
+// The series' own window (Window Center/Width, PS3.3 C.11.2.1.2, already in
+// rescaled units) becomes the volume's window, so that classification
+// starts where the scanner's operator left it; its linear-exact form
+// [c - w/2, c + w/2] is used (the DICOM "linear" function differs by half a
+// stored step, nothing a transfer function can show).
+void applySeriesWindow(const Slice& s, Volume& v, std::vector<std::string>& notes) {
+  if (!s.windowCenter || !s.windowWidth) return;
+  const double c = *s.windowCenter;
+  const double w = *s.windowWidth;
+  v.setWindow({c - 0.5 * w, c + 0.5 * w});
+  notes.push_back("window " + number(c) + "/" + number(w) + " (centre/width) from the series");
 }
 
 // The series picked from a folder scan, with what was set aside on the way.
@@ -860,6 +939,7 @@ Volume assembleSeries(FolderScan scan, const std::string& seriesUid, const std::
   notes.insert(notes.end(), g.notes.begin(), g.notes.end());
   Volume v = readVoxels(p.slices, what, decode, notes);
   applyGeometry(g, v);
+  applySeriesWindow(p.slices.front(), v, notes);
   addSkipNotes(p, scan, named, notes);
 
   std::string d = "DICOM series " + p.label + ", " + p.slices.front().transferSyntax + "; series " +
@@ -947,7 +1027,7 @@ std::vector<DicomSeriesInfo> listSeries(FolderScan scan) {
     const Slice& s = g.slices.front();
     std::string d = s.seriesDescription;
     if (!s.modality.empty()) d += (d.empty() ? "" : ", ") + s.modality;
-    out.push_back({g.uid, d, static_cast<int>(g.slices.size())});
+    out.push_back({g.uid, d, static_cast<int>(g.slices.size()), g.severalStacks ? g.stack : ""});
   }
   return out;
 }

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -48,6 +49,22 @@ inline constexpr DicomTag kTagInstanceNumber{0x0020, 0x0013};
 inline constexpr DicomTag kTagImagePositionPatient{0x0020, 0x0032};
 inline constexpr DicomTag kTagImageOrientationPatient{0x0020, 0x0037};
 inline constexpr DicomTag kTagPixelData{0x7fe0, 0x0010};
+inline constexpr DicomTag kTagWindowCenter{0x0028, 0x1050};
+inline constexpr DicomTag kTagWindowWidth{0x0028, 0x1051};
+// Multi-frame objects (PS3.3 C.7.6.16): the functional groups and the
+// macros read from them, and the classic ways of placing frames.
+inline constexpr DicomTag kTagSharedFunctionalGroups{0x5200, 0x9229};
+inline constexpr DicomTag kTagPerFrameFunctionalGroups{0x5200, 0x9230};
+inline constexpr DicomTag kTagPlanePositionSequence{0x0020, 0x9113};
+inline constexpr DicomTag kTagPlaneOrientationSequence{0x0020, 0x9116};
+inline constexpr DicomTag kTagPixelMeasuresSequence{0x0028, 0x9110};
+inline constexpr DicomTag kTagPixelValueTransformationSequence{0x0028, 0x9145};
+inline constexpr DicomTag kTagFrameVoiLutSequence{0x0028, 0x9132};
+inline constexpr DicomTag kTagFrameContentSequence{0x0020, 0x9111};
+inline constexpr DicomTag kTagStackId{0x0020, 0x9056};
+inline constexpr DicomTag kTagInStackPositionNumber{0x0020, 0x9057};
+inline constexpr DicomTag kTagDetectorInformationSequence{0x0054, 0x0022};
+inline constexpr DicomTag kTagGridFrameOffsetVector{0x3004, 0x000c};
 
 // Sequences within sequences (a sequence at the top level is level 1) a
 // reader accepts. Parsers that recurse per level (DCMTK's; the basic
@@ -71,6 +88,13 @@ class DicomAttributes {
   virtual std::optional<std::string> text(DicomTag tag) const = 0;
   // An unsigned short (US, or UN of two bytes); nullopt when absent.
   virtual std::optional<int> uint16(DicomTag tag) const = 0;
+  // An unsigned long (UL, or UN of four bytes); nullopt when absent. By
+  // default parsed from text(), for attribute sources that give text.
+  virtual std::optional<std::uint32_t> uint32(DicomTag tag) const;
+  // The items of a sequence (SQ) at this level, in order; empty when absent.
+  // The default has none: a source without sequences reads multi-frame
+  // objects as classic multi-frame (no functional groups).
+  virtual std::vector<std::unique_ptr<DicomAttributes>> items(DicomTag sequence) const;
 };
 
 // One image file of a series: what the header says, before any pixel is read.
@@ -90,7 +114,18 @@ struct Slice {
   int samplesPerPixel = 1;
   long frames = 1;
   std::string photometric;
-  std::optional<long> instanceNumber;
+  std::optional<long> instanceNumber;  // of a frame: In-Stack Position Number, else frame + 1
+  // A frame of a multi-frame object: its index in the file (0-based; the
+  // frame number users see is frame + 1) and its stack: Frame Content's
+  // Stack ID, else one per orientation ("1", "2", ... when the file holds
+  // several), "" for single-frame files. One volume is one stack.
+  int frame = 0;
+  std::string stack;
+  // Encapsulated pixel data: its fragment count (each frame needs one at least).
+  std::optional<std::uint64_t> fragments;
+  // The series' window (Window Center/Width, first value, rescaled units).
+  std::optional<double> windowCenter;
+  std::optional<double> windowWidth;
   std::optional<glm::dvec3> position;      // Image Position (Patient), LPS mm
   std::optional<glm::dvec3> rowDir;        // LPS direction of increasing column index
   std::optional<glm::dvec3> colDir;        // LPS direction of increasing row index
@@ -136,6 +171,29 @@ struct FolderScan {
 // The transfer syntax and pixel lengths are the parser's to fill in.
 Slice sliceHeader(const std::filesystem::path& file, const DicomAttributes& attributes);
 
+// The slices a parsed header stands for: `header` itself for a single-frame
+// file, one per frame for a multi-frame object (io/DicomMultiFrame.cpp),
+// placed by its functional groups (enhanced objects) or by the classic
+// attributes (Grid Frame Offset Vector, Spacing Between Slices). The parser
+// fills in transfer syntax, pixel lengths and fragments before calling this.
+std::vector<Slice> framesOf(Slice header, const DicomAttributes& attributes);
+
+// "scan.dcm" for a single-frame file, "scan.dcm frame 7" for a frame of a
+// multi-frame one (frames counted from 1, as DICOM numbers them).
+std::string sliceName(const Slice& s);
+
+// The numbers of a decimal (DS) or integer (IS) string "a\b\c"; nullopt
+// unless there are exactly `count` of them.
+std::optional<std::vector<double>> parseNumbers(const std::string& text, std::size_t count);
+
+// Reads the Image Plane and rescale attributes present in `ds` (Image
+// Position and Orientation (Patient), Pixel Spacing, Slice Thickness, Spacing
+// Between Slices, Rescale Slope and Intercept, Window Center and Width) into
+// `s`, leaving those absent as they are; a malformed one is `s`'s defect.
+// The top level of a file and the functional-group macros hold the same
+// attributes, so one function reads both.
+void readPlaneAttributes(const DicomAttributes& ds, Slice& s);
+
 // What an unusable file's header says, as far as it was parsed.
 UnreadableFile unreadableFile(const std::filesystem::path& file, std::string error,
                               const DicomAttributes& attributes);
@@ -145,6 +203,13 @@ struct StoredRange {
   std::int64_t max = std::numeric_limits<std::int64_t>::min();
   std::uint64_t padding = 0;  // bytes after the pixels (see storePixels)
 };
+
+// The byte range of frame `s.frame` within pixel data of `length` bytes
+// (native, or decoded as a whole): what storePixels gets for it. A file of
+// one frame gets all of it (padding is judged there); the last frame of
+// several its remainder. InputError naming the file and frame when the data
+// ends before the frame does.
+std::pair<std::uint64_t, std::uint64_t> frameRange(const Slice& s, std::uint64_t length);
 
 // One slice's decoded pixels, `length` bytes of 8-bit samples or 16-bit
 // samples in host byte order, stored into z-plane `z` of `stored` (masked to

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <memory>
 #include <optional>
 #include <string>
 #include <system_error>
@@ -22,6 +23,9 @@
 #include <dcmtk/dcmdata/dcdeftag.h>
 #include <dcmtk/dcmdata/dcfilefo.h>
 #include <dcmtk/dcmdata/dcmetinf.h>
+#include <dcmtk/dcmdata/dcpixel.h>
+#include <dcmtk/dcmdata/dcpixseq.h>
+#include <dcmtk/dcmdata/dcsequen.h>
 #include <dcmtk/dcmdata/dcstack.h>
 
 namespace tessera {
@@ -172,16 +176,50 @@ class DcmAttributes final : public io_detail::DicomAttributes {
   std::optional<int> uint16(DicomTag tag) const override {
     return uint16Attr(ds_, DcmTagKey(tag.group, tag.element));
   }
+  std::optional<std::uint32_t> uint32(DicomTag tag) const override {
+    Uint32 v = 0;
+    if (ds_.findAndGetUint32(DcmTagKey(tag.group, tag.element), v).good()) return v;
+    return io_detail::DicomAttributes::uint32(tag);  // UN or text
+  }
+  std::vector<std::unique_ptr<io_detail::DicomAttributes>> items(DicomTag tag) const override {
+    std::vector<std::unique_ptr<io_detail::DicomAttributes>> out;
+    DcmSequenceOfItems* seq = nullptr;
+    if (ds_.findAndGetSequence(DcmTagKey(tag.group, tag.element), seq).bad() || seq == nullptr) {
+      return out;
+    }
+    for (unsigned long i = 0; i < seq->card(); ++i) {
+      if (DcmItem* item = seq->getItem(i)) out.push_back(std::make_unique<DcmAttributes>(*item));
+    }
+    return out;
+  }
 
  private:
   DcmItem& ds_;
 };
 
+// The number of fragments of encapsulated pixel data (the offset table
+// item is none); nullopt when DCMTK cannot say.
+std::optional<std::uint64_t> fragmentCount(DcmDataset& ds, E_TransferSyntax xfer) {
+  DcmElement* elem = nullptr;
+  if (ds.findAndGetElement(DCM_PixelData, elem).bad() || elem == nullptr ||
+      elem->ident() != EVR_PixelData) {
+    return std::nullopt;
+  }
+  DcmPixelSequence* seq = nullptr;
+  if (static_cast<DcmPixelData*>(elem)->getEncapsulatedRepresentation(xfer, nullptr, seq).bad() ||
+      seq == nullptr || seq->card() == 0) {
+    return std::nullopt;
+  }
+  return seq->card() - 1;
+}
+
 // The shared header, and what only DCMTK knows: the transfer syntax and
-// the length of uncompressed pixel data.
-Slice sliceHeader(const fs::path& file, DcmFileFormat& ff) {
+// the length of uncompressed pixel data (or the fragments of compressed);
+// one slice per frame of a multi-frame object.
+std::vector<Slice> sliceHeaders(const fs::path& file, DcmFileFormat& ff) {
   DcmDataset& ds = *ff.getDataset();
-  Slice s = io_detail::sliceHeader(file, DcmAttributes(ds));
+  const DcmAttributes attributes(ds);
+  Slice s = io_detail::sliceHeader(file, attributes);
   const E_TransferSyntax xfer = ds.getOriginalXfer();
   s.transferSyntax = transferSyntaxText(xfer);
   DcmElement* pixels = nullptr;
@@ -189,7 +227,8 @@ Slice sliceHeader(const fs::path& file, DcmFileFormat& ff) {
       pixels != nullptr) {
     s.pixelBytes = pixels->getLength();
   }
-  return s;
+  if (DcmXfer(xfer).isEncapsulated()) s.fragments = fragmentCount(ds, xfer);
+  return io_detail::framesOf(std::move(s), attributes);
 }
 
 UnreadableFile unreadableFile(const fs::path& file, std::string error, DcmDataset& ds) {
@@ -233,15 +272,25 @@ void addFile(const fs::path& file, bool mustBeImage, FolderScan& scan) {
     scan.unreadable.push_back(unreadableFile(file, std::move(error), ds));
     return;
   }
-  scan.slices.push_back(sliceHeader(file, ff));
+  for (auto& frame : sliceHeaders(file, ff)) scan.slices.push_back(std::move(frame));
 }
 
-// Decodes one slice's pixels into z-plane `z` of `stored`.
-StoredRange readPixels(const Slice& s, Volume& stored, int z) {
+// One file's pixel data, loaded (and decoded) once for all its frames.
+struct LoadedPixels {
+  fs::path file;
+  std::unique_ptr<DcmFileFormat> ff;
+  const void* samples = nullptr;  // 8-bit or host-order 16-bit
+  std::uint64_t length = 0;
+};
+
+// Loads `s`'s file and decodes its whole pixel data (every frame).
+void loadPixels(const Slice& s, LoadedPixels& out) {
   const std::string f = s.file.string();
-  DcmFileFormat ff;
-  if (!loadDicom(s.file, ff)) throw InputError(f + ": is no longer a DICOM file");
-  DcmDataset& ds = *ff.getDataset();
+  out.file.clear();
+  out.samples = nullptr;
+  out.ff = std::make_unique<DcmFileFormat>();
+  if (!loadDicom(s.file, *out.ff)) throw InputError(f + ": is no longer a DICOM file");
+  DcmDataset& ds = *out.ff->getDataset();
   const E_TransferSyntax xfer = ds.getOriginalXfer();
   if (DcmXfer(xfer).isEncapsulated()) {
     const OFCondition c = ds.chooseRepresentation(EXS_LittleEndianExplicit, nullptr);
@@ -262,24 +311,38 @@ StoredRange readPixels(const Slice& s, Volume& stored, int z) {
     return InputError(f + ": pixel data cannot be read (DCMTK: " + conditionText(c) +
                       "; truncated file?)");
   };
-  const std::uint64_t length = elem->getLength();
+  OFCondition c;
   if (s.bitsAllocated == 8) {
     Uint8* p = nullptr;
-    const OFCondition c = elem->getUint8Array(p);
-    if (c.bad() || p == nullptr) throw loadFailed(c);
-    return io_detail::storePixels(s, p, length, stored, z);
+    c = elem->getUint8Array(p);
+    out.samples = p;
+  } else {
+    Uint16* p = nullptr;
+    c = elem->getUint16Array(p);
+    out.samples = p;
   }
-  Uint16* p = nullptr;
-  const OFCondition c = elem->getUint16Array(p);
-  if (c.bad() || p == nullptr) throw loadFailed(c);
-  return io_detail::storePixels(s, p, length, stored, z);
+  if (c.bad() || out.samples == nullptr) throw loadFailed(c);
+  out.length = elem->getLength();
+  out.file = s.file;
+}
+
+// Decodes slices into z-planes of `stored`; the frames of one file share
+// one load and decode (the file last read is kept).
+io_detail::PixelDecoder pixelDecoder() {
+  auto loaded = std::make_shared<LoadedPixels>();
+  return [loaded](const Slice& s, Volume& stored, int z) -> StoredRange {
+    if (loaded->file != s.file || loaded->samples == nullptr) loadPixels(s, *loaded);
+    const auto [begin, length] = io_detail::frameRange(s, loaded->length);
+    const auto* bytes = static_cast<const std::uint8_t*>(loaded->samples) + begin;
+    return io_detail::storePixels(s, bytes, length, stored, z);
+  };
 }
 
 }  // namespace
 
 Volume readDicomSeries(const fs::path& folderOrFile, const std::string& seriesUid) {
   io_detail::initDicomToolkit();
-  return io_detail::readFolderOrFile(folderOrFile, seriesUid, addFile, readPixels);
+  return io_detail::readFolderOrFile(folderOrFile, seriesUid, addFile, pixelDecoder());
 }
 
 Volume readDicomFiles(const std::vector<fs::path>& files, const std::string& seriesUid) {
@@ -292,7 +355,7 @@ Volume readDicomFiles(const std::vector<fs::path>& files, const std::string& ser
     if (!fs::is_regular_file(f, ec)) throw InputError(f.string() + ": no such file");
     addFile(f, true, scan);
   }
-  return io_detail::readSeries(std::move(scan), seriesUid, files.front().string(), readPixels);
+  return io_detail::readSeries(std::move(scan), seriesUid, files.front().string(), pixelDecoder());
 }
 
 std::vector<DicomSeriesInfo> listDicomSeries(const fs::path& folder) {

@@ -69,12 +69,17 @@ nlohmann::json volumeInfo(const std::string& spec, const Volume& v, int time, in
   }
   // A DICOM folder may hold several series: listed so that --series can pick.
   std::error_code ec;
-  if (std::filesystem::is_directory(spec, ec)) {
+  // A DICOM folder, or a file of a DICOM series: the series (and stacks)
+  // there, each with the --series value that selects it.
+  if (std::filesystem::is_directory(spec, ec) || (std::filesystem::is_regular_file(spec, ec) &&
+                                                  v.description().starts_with("DICOM series "))) {
     const std::vector<DicomSeriesInfo> series = listDicomSeries(spec);
     if (!series.empty()) {
       j["dicom_series"] = nlohmann::json::array();
       for (const auto& s : series) {
         j["dicom_series"].push_back({{"series_instance_uid", s.seriesInstanceUid},
+                                     {"stack", s.stack},
+                                     {"select", s.selector()},
                                      {"description", s.description},
                                      {"slices", s.slices}});
       }

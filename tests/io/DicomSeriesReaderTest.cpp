@@ -390,13 +390,14 @@ TEST(DicomSeriesReader, RejectsColourSlices) {
                      {"slice_0005.dcm", "Samples per Pixel is 3"});
 }
 
-TEST(DicomSeriesReader, RejectsMultiFrameFiles) {
+TEST(DicomSeriesReader, RejectsANumberOfFramesThePixelsDoNotHold) {
   test::TempDir dir;
   writeDicomSeries(smallSeries(), dir.path());
   editSlice(dir / "slice_0000.dcm",
             [](DcmDataset& ds) { ds.putAndInsertString(DCM_NumberOfFrames, "2"); });
-  expectRejectedFast([&] { readDicomSeries(dir.path()); },
-                     {"slice_0000.dcm", "multi-frame not supported"});
+  expectRejectedFast(
+      [&] { readDicomSeries(dir.path()); },
+      {"slice_0000.dcm", "Number of Frames (0028,0008) is 2", "frame 2 has no pixels"});
 }
 
 TEST(DicomSeriesReader, RejectsATruncatedFile) {

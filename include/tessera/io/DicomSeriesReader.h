@@ -15,6 +15,13 @@ struct DicomSeriesInfo {
   std::string seriesInstanceUid;
   std::string description;  // SeriesDescription, modality
   int slices = 0;
+  // A series of several stacks (a multi-frame object's Stack IDs, or its
+  // orientations) is listed once per stack; "" when it has one.
+  std::string stack;
+  // What `--series` takes to read it: the UID, or "UID:stack".
+  std::string selector() const {
+    return stack.empty() ? seriesInstanceUid : seriesInstanceUid + ":" + stack;
+  }
 };
 
 // Reads the series in a folder (a directory of slice files, not searched
