@@ -301,7 +301,7 @@ function parsePart10(bytes) {
   }
   const ts = SYNTAXES[syntax];
   if (!ts) return null;
-  const info = { syntax, ts, meta, datasetStart: at, numbers: {} };
+  const info = { syntax, ts, meta, datasetStart: at, numbers: {}, omit: [] };
   for (;;) {
     const e = elementAt(r, bytes, at, true);
     if (e.group === 0x7fe0 && e.element === 0x0010) {
@@ -316,6 +316,7 @@ function parsePart10(bytes) {
     if (key === 0x00280008) info.numbers[key] = parseInt(r.text(e.value, e.length), 10);
     if (key === 0x7fe00001 || key === 0x7fe00002) {
       info.numbers[key] = Array.from({ length: Math.floor(e.length / 8) }, (_, k) => r.u64(e.value + 8 * k));
+      info.omit.push([at, end]);  // the extended offset table describes nothing once decoded
     }
     at = end;
     if (at >= bytes.length) throw new Error(`no pixel data in its ${ts.name} data set`);
@@ -391,7 +392,11 @@ function rewritten(bytes, info, pixels, end) {
   const metaLength = info.meta.reduce((n, m) => n + m.length, 0) + tsElement.length;
   const ow = info.numbers[0x00280100] === 8 ? [0x4f, 0x42] : [0x4f, 0x57];
   const padded = pixels.length + (pixels.length & 1);
-  const head = info.pixelStart - info.datasetStart;
+  const kept = [];  // the data set before the pixel data, less omitted elements
+  let from = info.datasetStart;
+  for (const [a, b] of info.omit) { kept.push(bytes.subarray(from, a)); from = b; }
+  kept.push(bytes.subarray(from, info.pixelStart));
+  const head = kept.reduce((n, k) => n + k.length, 0);
   const out = new Uint8Array(132 + 12 + metaLength + head + 12 + padded + (bytes.length - end));
   const v = new DataView(out.buffer);
   out.set(bytes.subarray(0, 132));
@@ -400,7 +405,7 @@ function rewritten(bytes, info, pixels, end) {
   for (const m of [...info.meta.filter((m) => m[2] < 0x10 && m[3] === 0), tsElement, ...info.meta.filter((m) => !(m[2] < 0x10 && m[3] === 0))]) {
     out.set(m, o); o += m.length;
   }
-  out.set(bytes.subarray(info.datasetStart, info.pixelStart), o); o += head;
+  for (const k of kept) { out.set(k, o); o += k.length; }
   out.set([0xe0, 0x7f, 0x10, 0x00, ow[0], ow[1], 0, 0], o); v.setUint32(o + 8, padded, true); o += 12;
   out.set(pixels, o); o += padded;
   out.set(bytes.subarray(end), o);
