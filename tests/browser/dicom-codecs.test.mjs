@@ -114,7 +114,7 @@ async function codecs(context, url, tmp) {
     const shown = await dropServed(page, folderOf(e), e.files);
     const c = shown.error ? null : await compareDecoded(page, { original: served(e.original), native: served(e.native) }, e.bits);
     const render = shown.error ? null : psnrOf(shown.pixels, originals[e.bits].pixels);
-    const cliText = !e.cli.ok ? `refused: ${e.cli.error}` : e.lossless
+    const cliText = !e.cli.ok ? `refused: ${e.cli.error.replace(/^tessera: error: \S+: /, '').slice(0, 60)}…` : e.lossless
       ? (e.cli.differing === 0 ? 'identical' : `${e.cli.differing} voxels differ`) : db(e.cli.psnr);
     const browserText = shown.error ? `refused: ${shown.error.split(' (')[0]}` : e.lossless
       ? (c.original.differing === 0 ? 'identical' : `${c.original.differing} voxels differ`) : db(c.original.psnr);
@@ -128,14 +128,20 @@ async function codecs(context, url, tmp) {
     }
     if (shown.error) { check(`${e.kind}: opens in the page`, false, shown.error); continue; }
     times.push({ kind: e.kind, ms: shown.ms, decodeMs: c.stats.ms, bits: e.bits, bytes: e.bytes });
+    if (e.kind.startsWith('htj2k')) {
+      // Natively HTJ2K is refused naming the syntax: on corrupt data Debian
+      // 12's OpenJPH overflows and its OpenJPEG 2.5.0 aborts (fuzzing).
+      check(`${e.kind}: the CLI refuses HTJ2K naming the syntax`, !e.cli.ok && e.cli.error.includes(e.syntax), e.cli.error);
+    }
     if (e.lossless) {
+      const cliOk = e.kind.startsWith('htj2k') || (e.cli.ok && e.cli.differing === 0);
       check(`${e.kind} (${e.syntax}): the page's voxels equal the uncompressed original, and so do the CLI's`,
-        c.original.differing === 0 && e.cli.ok && e.cli.differing === 0 && c.stats.frames === e.files.length,
+        c.original.differing === 0 && cliOk && c.stats.frames === e.files.length,
         `page ${c.original.differing}/${c.original.voxels} differ, CLI ${e.cli.differing ?? e.cli.error}, ${c.stats.frames} frames in ${c.stats.ms.toFixed(0)} ms`);
       check(`${e.kind}: renders exactly like the uncompressed series`, render >= 999, db(render));
     } else {
       check(`${e.kind} (${e.syntax}): lossy within 35 dB of the original in the page and the CLI, and equal to the command-line decoders' values (±1)`,
-        c.original.psnr > 35 && e.cli.ok && e.cli.psnr > 35 && c.native.max <= 1,
+        c.original.psnr > 35 && (e.kind.startsWith('htj2k') || (e.cli.ok && e.cli.psnr > 35)) && c.native.max <= 1,
         `page ${db(c.original.psnr)}, CLI ${db(e.cli.psnr)}, page vs native: ${c.native.differing} differ, max ${c.native.max}`);
     }
   }
@@ -145,7 +151,7 @@ async function codecs(context, url, tmp) {
   for (const e of manifest.pydicom) {
     const shown = await dropServed(page, folderOf(e), e.files, { render: false });
     const c = shown.error ? null : await compareDecoded(page, { native: served(e.native) }, e.bits);
-    const cliText = e.cli.ok ? (e.cli.differing === 0 ? 'equal' : `${e.cli.differing} differ`) : `refused: ${e.cli.error}`;
+    const cliText = e.cli.ok ? (e.cli.differing === 0 ? 'equal' : `${e.cli.differing} differ`) : `refused: ${e.cli.error.replace(/^tessera: error: \S+: /, '').slice(0, 80)}`;
     const pageText = shown.error ? `refused: ${shown.error}` : c.native ? (c.native.differing === 0 ? 'equal' : `${c.native.differing} differ (max ${c.native.max})`) : 'read (no command-line decode)';
     pyRows.push(`| ${e.file} | ${e.syntax} | ${cliText} | ${pageText} |`);
   }

@@ -9,7 +9,8 @@ OUT/manifest.json lists every series: its folder, transfer syntax, whether it
 is lossless, and raw files of its stored values in file-name order (LE):
 `original` (the uncompressed source, ours only) and `native` (the same files
 decoded by the command-line tools of the libraries the CLI uses: DCMTK's
-dcmdjpeg/dcmdjpls, OpenJPEG's opj_decompress for JPEG 2000 and HTJ2K). For
+dcmdjpeg/dcmdjpls, OpenJPEG's opj_decompress for JPEG 2000, and for HTJ2K,
+which the CLI refuses, OpenJPEG 2.5's opj_decompress too). For
 each series the CLI converts the folder to NIfTI and the voxels are compared
 with the uncompressed series' (ours) or with the command-line decode
 (pydicom's), recorded in the manifest as `cli`.
