@@ -113,6 +113,34 @@ foreach(f ${TESSERA_NUMCODECS_JS})
 endforeach()
 configure_file(${CMAKE_SOURCE_DIR}/frontends/web/node_modules/numcodecs/LICENSE
                ${TESSERA_WEB_SITE}/numcodecs/LICENSE COPYONLY)
+# The compressed-DICOM decoders (frontends/web/dicom-codecs.js loads each
+# only when a frame needs it): WebAssembly builds of libjpeg-turbo, CharLS,
+# OpenJPEG and OpenJPH, and jpeg-lossless-decoder-js, into the site's codecs/.
+set(TESSERA_NPM ${CMAKE_SOURCE_DIR}/frontends/web/node_modules)
+set(TESSERA_CODEC_FILES
+  @cornerstonejs/codec-libjpeg-turbo-8bit/dist/libjpegturbowasm_decode.js
+  @cornerstonejs/codec-libjpeg-turbo-8bit/dist/libjpegturbowasm_decode.wasm
+  @cornerstonejs/codec-charls/dist/charlswasm_decode.js
+  @cornerstonejs/codec-charls/dist/charlswasm_decode.wasm
+  @cornerstonejs/codec-openjpeg/dist/openjpegwasm_decode.js
+  @cornerstonejs/codec-openjpeg/dist/openjpegwasm_decode.wasm
+  @cornerstonejs/codec-openjph/dist/openjphjs.js
+  @cornerstonejs/codec-openjph/dist/openjphjs.wasm
+  jpeg-lossless-decoder-js/release/lossless-min.js)
+foreach(f ${TESSERA_CODEC_FILES})
+  if(NOT EXISTS ${TESSERA_NPM}/${f})
+    message(FATAL_ERROR "${TESSERA_NPM}/${f} is missing: run `npm ci` in frontends/web/ (scripts/web.sh does)")
+  endif()
+  get_filename_component(n ${f} NAME)
+  configure_file(${TESSERA_NPM}/${f} ${TESSERA_WEB_SITE}/codecs/${n} COPYONLY)
+endforeach()
+foreach(p codec-libjpeg-turbo-8bit codec-charls codec-openjpeg codec-openjph)
+  if(EXISTS ${TESSERA_NPM}/@cornerstonejs/${p}/LICENSE)
+    configure_file(${TESSERA_NPM}/@cornerstonejs/${p}/LICENSE ${TESSERA_WEB_SITE}/codecs/LICENSE-${p} COPYONLY)
+  endif()
+endforeach()
+configure_file(${TESSERA_NPM}/jpeg-lossless-decoder-js/LICENSE
+               ${TESSERA_WEB_SITE}/codecs/LICENSE-jpeg-lossless-decoder-js COPYONLY)
 file(GLOB TESSERA_WEB_STATIC CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/frontends/web/*.html
      ${CMAKE_SOURCE_DIR}/frontends/web/*.js ${CMAKE_SOURCE_DIR}/frontends/web/*.css)
 foreach(f ${TESSERA_WEB_STATIC} ${TESSERA_PAKO})

@@ -64,6 +64,10 @@ FUZZ_REGRESSIONS = [
      "fuzz_dicom_basic: an HTJ2K frame with sane headers and corrupt code-block data; Debian 12's "
      "OpenJPH 0.9 wrote past its buffers (heap overflow; its own ojph_expand crashes too), so "
      "HTJ2K is refused", "1.2.840.10008.1.2.4.201"),
+    ("fuzz-regressions/dicom/htj2k-mel-assert-abort.dcm", "dicom",
+     "fuzz_dicom_basic: an HTJ2K frame whose MEL segment starts past 0x8F; Debian 12's OpenJPEG "
+     "2.5.0, tried as HTJ2K's decoder, aborted on an assertion in ht_dec.c (mel_init), so HTJ2K "
+     "stays refused", "1.2.840.10008.1.2.4.201"),
     ("fuzz-regressions/device_profile/number-overflow-crash.json", "device_profile",
      "fuzz_device_profile: a number too large for a double made nlohmann::json throw "
      "out_of_range.406, which escaped DeviceProfile::fromJson", "device profile"),

@@ -10,7 +10,9 @@ export NODE_PATH=${NODE_PATH:-/usr/share/nodejs}  # Debian's emscripten needs ac
 command -v emcmake >/dev/null || { echo "web.sh: emscripten missing (scripts/setup.sh)" >&2; exit 1; }
 # pako (the page's inflater for the io readers) and numcodecs (blosc and zstd
 # for OME-Zarr stores), pinned by frontends/web/package-lock.json.
-if [ ! -f frontends/web/node_modules/pako/dist/pako_inflate.min.js ] || [ ! -f frontends/web/node_modules/numcodecs/dist/blosc.js ]; then
+# The compressed-DICOM decoders (frontends/web/dicom-codecs.js) likewise.
+if [ ! -f frontends/web/node_modules/pako/dist/pako_inflate.min.js ] || [ ! -f frontends/web/node_modules/numcodecs/dist/blosc.js ] ||
+   [ ! -f frontends/web/node_modules/@cornerstonejs/codec-openjph/dist/openjphjs.wasm ]; then
   (cd frontends/web && npm ci --no-audit --no-fund --loglevel=error)
 fi
 if [ ! -f "$BUILD/build.ninja" ] && [ ! -f "$BUILD/Makefile" ]; then

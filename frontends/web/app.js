@@ -375,6 +375,7 @@ import { TesseraViewer } from './tessera.js';
   // failure's message into what the page shows.
   async function openEntries(entries, explain) {
     try {
+      entries = await TesseraFolders.decodeCompressed(entries, (done, total) => { $('status').textContent = `decoding ${done} of ${total} files`; });
       await viewer.openFiles(entries, { explain });
     } catch (e) {
       showError(e.message + keeps());

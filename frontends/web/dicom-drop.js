@@ -2,7 +2,9 @@
 // dropped directories (DataTransferItem.webkitGetAsEntry) and a
 // webkitdirectory picker's files, and reads them as {name, bytes} entries
 // for app.js, which hands them to the module's io readers
-// (io/DicomBasicReader.h reads the series). Exposed as window.TesseraFolders.
+// (io/DicomBasicReader.h reads the series). Compressed DICOM files are
+// decoded first by dicom-codecs.js, loaded only when one is among them.
+// Exposed as window.TesseraFolders.
 'use strict';
 
 window.TesseraFolders = (function () {
@@ -91,5 +93,32 @@ window.TesseraFolders = (function () {
     return dicom;
   }
 
-  return { droppedFolderEntries, walk, pickedFiles, readAll, forReading };
+  // The transfer syntax of a Part-10 file's meta group (PS3.10 7.1: explicit
+  // VR little endian), '' when it has none.
+  function transferSyntax(bytes) {
+    const v = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+    if (bytes.length < 144 || v.getUint32(128) !== 0x4449434d) return '';
+    for (let at = 132; at + 8 <= bytes.length && v.getUint16(at, true) === 0x0002;) {
+      const vr = String.fromCharCode(bytes[at + 4], bytes[at + 5]);
+      const long = ['OB', 'OW', 'UN', 'UT', 'SQ', 'UC', 'UR'].includes(vr);
+      const length = long ? v.getUint32(at + 8, true) : v.getUint16(at + 6, true);
+      const value = at + (long ? 12 : 8);
+      if (v.getUint16(at + 2, true) === 0x0010) {
+        return String.fromCharCode(...bytes.subarray(value, Math.min(value + length, bytes.length))).replace(/[\0 ]+$/, '');
+      }
+      at = value + length;
+    }
+    return '';
+  }
+  const COMPRESSED = /^1\.2\.840\.10008\.1\.2\.4\.(50|51|57|70|80|81|90|91|201|202|203)$/;
+
+  // Entries with their compressed DICOM files decoded (dicom-codecs.js and
+  // the decoders it needs are loaded only then); onProgress(done, total).
+  async function decodeCompressed(entries, onProgress = () => {}) {
+    if (!entries.some((e) => COMPRESSED.test(transferSyntax(e.bytes)))) return entries;
+    const codecs = await import('./dicom-codecs.js');
+    return codecs.decodeEntries(entries, onProgress);
+  }
+
+  return { droppedFolderEntries, walk, pickedFiles, readAll, forReading, decodeCompressed };
 })();

@@ -98,9 +98,10 @@ constexpr TransferSyntax kSyntaxes[] = {
     {"1.2.840.10008.1.2.4.90", "JPEG 2000 (Lossless only)", kJpeg2000Codecs, false,
      Codec::Jpeg2000},
     {"1.2.840.10008.1.2.4.91", "JPEG 2000", kJpeg2000Codecs, false, Codec::Jpeg2000},
-    // HTJ2K is named but not read: Debian 12's OpenJPH (0.9.0) writes past
-    // its buffers on corrupt code-block data (its own ojph_expand too; found
-    // by scripts/fuzz.sh), which no header check here can rule out.
+    // HTJ2K is named but not read: on corrupt code-block data Debian 12's
+    // OpenJPH (0.9.0) writes past its buffers and its OpenJPEG (2.5.0)
+    // aborts on an assertion in its HT decoder (both found by
+    // scripts/fuzz.sh), which no header check here can rule out.
     {"1.2.840.10008.1.2.4.201", "HTJ2K (Lossless only)", false, false, Codec::None},
     {"1.2.840.10008.1.2.4.202", "HTJ2K with RPCL Options (Lossless only)", false, false,
      Codec::None},

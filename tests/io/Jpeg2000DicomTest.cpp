@@ -1,8 +1,9 @@
 // DICOM frames in JPEG 2000 (OpenJPEG), read through readVolume like any
 // DICOM file: lossless streams give the uncompressed original's voxels
 // exactly, a lossy one OpenJPEG's own command-line decode, and a corrupt or
-// mis-sized frame one line naming the file. HTJ2K is refused in one line
-// naming the syntax (Debian 12's OpenJPH is not safe on corrupt data). The streams are
+// mis-sized frame one line naming the file. HTJ2K is refused in one line,
+// also when its codestream sits in a file that says JPEG 2000: on corrupt
+// data Debian 12's OpenJPH overflows and its OpenJPEG aborts. The streams are
 // pydicom's test files and ones encoded here with Debian's encoders
 // (opj_compress, ojph_compress), wrapped in DICOM by pydicom.
 #include <gtest/gtest.h>
@@ -75,12 +76,14 @@ a = d.pixel_array.astype(np.int16)
 raw = work + '/frame.raw'
 a.astype('<i2').tofile(raw)
 rows, cols = a.shape
-if kind.startswith('htj2k'):
+if kind.startswith('htj2k'):  # htj2k-in-j2k-syntax: an HTJ2K stream in a file saying .90
     stream = work + '/frame.j2c'
     args = ['ojph_compress', '-i', raw, '-o', stream, '-dims', '{%d,%d}' % (cols, rows),
             '-num_comps', '1', '-signed', 'true', '-bit_depth', '16', '-downsamp', '{1,1}']
-    args += ['-reversible', 'true'] if kind == 'htj2k-lossless' else ['-qstep', '0.0002']
+    args += ['-reversible', 'true'] if kind != 'htj2k-lossy' else ['-qstep', '0.0002']
     uid = '1.2.840.10008.1.2.4.201' if kind == 'htj2k-lossless' else '1.2.840.10008.1.2.4.203'
+    if kind == 'htj2k-in-j2k-syntax':
+        uid = '1.2.840.10008.1.2.4.90'
 else:
     # MR_small's values are positive: an unsigned 16-bit PGM carries them.
     stream = work + '/frame.j2k'
@@ -120,7 +123,8 @@ TEST(Jpeg2000Dicom, Jpeg2000EncodedHereReadsBackExactlyAndHtJ2kIsRefusedNamingIt
   test::TempDir dir;
   test::writeFile(dir.path() / "wrap.py", kWrap);
   const Volume original = readAlone(dir.path(), kPydicomFiles / "MR_small.dcm");
-  for (const std::string kind : {"j2k-lossless", "htj2k-lossless", "htj2k-lossy"}) {
+  for (const std::string kind :
+       {"j2k-lossless", "htj2k-lossless", "htj2k-lossy", "htj2k-in-j2k-syntax"}) {
     SCOPED_TRACE(kind);
     const fs::path work = dir.path() / kind;
     fs::create_directories(work);
@@ -134,7 +138,10 @@ TEST(Jpeg2000Dicom, Jpeg2000EncodedHereReadsBackExactlyAndHtJ2kIsRefusedNamingIt
     }
     const std::string message = test::inputErrorMessage([&] { readVolume(out.string()); });
     EXPECT_EQ(message.rfind(out.string() + ": ", 0), 0u) << message;
-    EXPECT_NE(message.find("1.2.840.10008.1.2.4.20"), std::string::npos) << message;
+    EXPECT_NE(message.find(kind == "htj2k-in-j2k-syntax" ? "an HTJ2K codestream"
+                                                         : "1.2.840.10008.1.2.4.20"),
+              std::string::npos)
+        << message;
   }
 }
 
