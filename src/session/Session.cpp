@@ -271,6 +271,7 @@ RenderResult Session::run(const RenderRequest& request) {
 
 Image Session::render(int width, int height) {
   if (!inCore_) return run(request(width, height)).first;
+  makeCurrent();
   RenderRequest req = request(width, height);
   checkImageSize(width, height);
   req.settings.validate();
