@@ -26,13 +26,18 @@ PACKAGES=(
 )
 
 # playwright-core for the browser test, pinned by tests/browser/package-lock.json;
-# pako for the web page (its inflater), pinned by frontends/web/package-lock.json.
+# pako for the web page (its inflater), pinned by frontends/web/package-lock.json;
+# zarrita for the Zarr v3 interop test, pinned by tests/interop/package-lock.json.
 npm_deps() {
   local root
   root="$(cd "$(dirname "$0")/.." && pwd)"
   if [ ! -d "$root/tests/browser/node_modules/playwright-core" ]; then
     echo "setup: npm ci in tests/browser (playwright-core)"
     (cd "$root/tests/browser" && npm ci --no-audit --no-fund --loglevel=error)
+  fi
+  if [ ! -d "$root/tests/interop/node_modules/zarrita" ]; then
+    echo "setup: npm ci in tests/interop (zarrita)"
+    (cd "$root/tests/interop" && npm ci --no-audit --no-fund --loglevel=error)
   fi
   if [ ! -d "$root/frontends/web/node_modules/pako" ]; then
     echo "setup: npm ci in web (pako)"
