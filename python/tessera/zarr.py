@@ -154,13 +154,10 @@ def _zattrs_text(name, spacing, origin, direction, levels, value_range, window) 
         f = math.ldexp(1.0, level)
         scale = [spacing[a] * f for a in range(3)]
         # A level-l voxel is the mean of 2^l finer voxels per axis: its centre
-        # lies (2^l - 1)/2 finest voxels past the first of them. Evaluated in
-        # glm's order (column by column) so the doubles are the C++ ones.
-        v = [spacing[a] * (0.5 * (f - 1.0)) for a in range(3)]
-        moved = [
-            origin[r] + (direction[r][0] * v[0] + direction[r][1] * v[1] + direction[r][2] * v[2])
-            for r in range(3)
-        ]
+        # lies (2^l - 1)/2 finest voxels past the first of them, a shift in
+        # the array's own axes (NGFF has no direction; a reader applies
+        # tessera.direction to it: "translations": "array axes").
+        moved = [origin[a] + spacing[a] * (0.5 * (f - 1.0)) for a in range(3)]
         datasets.append(
             {
                 "path": str(level),
@@ -184,6 +181,7 @@ def _zattrs_text(name, spacing, origin, direction, levels, value_range, window) 
     # glm is column-major: the C++ writes direction()[c] (column c) as row c.
     tessera = {
         "world_frame": "RAS",
+        "translations": "array axes",
         "direction": [[float(direction[r][c]) for r in range(3)] for c in range(3)],
     }
     if value_range is not None and value_range[1] >= value_range[0]:
