@@ -32,10 +32,6 @@ namespace {
 // is refused before a slice is made per frame.
 constexpr long kMostFrames = 1 << 20;
 
-// Orientations of two frames agree when every component is within this
-// (as kOrientationTolerance in DicomSeries.cpp).
-constexpr double kSameOrientation = 1e-3;
-
 std::string count(std::uint64_t n, const char* what) {
   return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
 }
@@ -169,15 +165,6 @@ std::vector<Slice> classicFrames(Slice header, const DicomAttributes& ds) {
     frames.push_back(std::move(f));
   }
   return frames;
-}
-
-bool sameOrientation(const Slice& a, const Slice& b) {
-  if (a.rowDir.has_value() != b.rowDir.has_value()) return false;
-  if (!a.rowDir) return true;
-  const glm::dvec3 dr = *a.rowDir - *b.rowDir;
-  const glm::dvec3 dc = *a.colDir - *b.colDir;
-  return std::max({std::abs(dr.x), std::abs(dr.y), std::abs(dr.z), std::abs(dc.x), std::abs(dc.y),
-                   std::abs(dc.z)}) <= kSameOrientation;
 }
 
 // Frames without a Stack ID form one stack per orientation: "1", "2", ...

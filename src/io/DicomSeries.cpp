@@ -79,6 +79,15 @@ std::string shownValue(const std::string& text) {
 
 }  // namespace
 
+bool sameOrientation(const Slice& a, const Slice& b) {
+  if (a.rowDir.has_value() != b.rowDir.has_value()) return false;
+  if (!a.rowDir) return true;
+  const glm::dvec3 dr = *a.rowDir - *b.rowDir;
+  const glm::dvec3 dc = *a.colDir - *b.colDir;
+  return std::max({std::abs(dr.x), std::abs(dr.y), std::abs(dr.z), std::abs(dc.x), std::abs(dc.y),
+                   std::abs(dc.z)}) <= kOrientationTolerance;
+}
+
 // Parsed without the C locale's
 // help (std::from_chars), so a decimal comma never passes.
 std::optional<std::vector<double>> parseNumbers(const std::string& text, std::size_t count) {
@@ -320,15 +329,6 @@ std::size_t chooseGroup(const std::vector<SeriesGroup>& groups, const std::strin
                      "; found: " + othersText(groups, groups.size()));
   }
   throw InputError(what + ": the file was not found again when its folder was read");
-}
-
-bool sameOrientation(const Slice& a, const Slice& b) {
-  if (a.rowDir.has_value() != b.rowDir.has_value()) return false;
-  if (!a.rowDir) return true;
-  const glm::dvec3 dr = *a.rowDir - *b.rowDir;
-  const glm::dvec3 dc = *a.colDir - *b.colDir;
-  return std::max({std::abs(dr.x), std::abs(dr.y), std::abs(dr.z), std::abs(dc.x), std::abs(dc.y),
-                   std::abs(dc.z)}) <= kOrientationTolerance;
 }
 
 bool samePixelSpacing(const Slice& a, const Slice& b) {

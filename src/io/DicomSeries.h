@@ -182,6 +182,10 @@ std::vector<Slice> framesOf(Slice header, const DicomAttributes& attributes);
 // multi-frame one (frames counted from 1, as DICOM numbers them).
 std::string sliceName(const Slice& s);
 
+// Two slices (or frames) whose row and column directions agree within 1e-3
+// per component, or that both have none: one stack, one volume.
+bool sameOrientation(const Slice& a, const Slice& b);
+
 // The numbers of a decimal (DS) or integer (IS) string "a\b\c"; nullopt
 // unless there are exactly `count` of them.
 std::optional<std::vector<double>> parseNumbers(const std::string& text, std::size_t count);

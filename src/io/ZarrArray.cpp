@@ -162,6 +162,23 @@ std::uint64_t ZarrArrayMeta::innerChunkIndex(std::span<const std::int64_t> index
   return linear;
 }
 
+json io_detail::parseZarrDocument(std::string_view text, const std::string& name, int format) {
+  json doc;
+  try {
+    doc = json::parse(text);
+  } catch (const json::exception& e) {
+    throw InputError(name + ": not valid JSON (" + e.what() + ")");
+  }
+  if (!doc.is_object()) throw InputError(name + ": not a JSON object");
+  if (!doc.contains("zarr_format") || doc["zarr_format"] != format) {
+    throw InputError(name + ": zarr_format is " +
+                     (doc.contains("zarr_format") ? doc["zarr_format"].dump() : "missing") +
+                     ", expected " + std::to_string(format) + " (Zarr v" + std::to_string(format) +
+                     ")");
+  }
+  return doc;
+}
+
 namespace {
 ZarrArrayMeta parseZarrayFields(std::string_view text, const std::string& name);
 }  // namespace
@@ -178,18 +195,7 @@ ZarrArrayMeta parseZarray(std::string_view text, const std::string& name) {
 
 namespace {
 ZarrArrayMeta parseZarrayFields(std::string_view text, const std::string& name) {
-  json doc;
-  try {
-    doc = json::parse(text);
-  } catch (const json::exception& e) {
-    throw InputError(name + ": not valid JSON (" + e.what() + ")");
-  }
-  if (!doc.is_object()) throw InputError(name + ": not a JSON object");
-  if (!doc.contains("zarr_format") || doc["zarr_format"] != 2) {
-    throw InputError(name + ": zarr_format is " +
-                     (doc.contains("zarr_format") ? doc["zarr_format"].dump() : "missing") +
-                     ", expected 2 (Zarr v2)");
-  }
+  json doc = io_detail::parseZarrDocument(text, name, 2);
   ZarrArrayMeta m;
   m.shape = positiveList(doc, "shape", name);
   m.chunks = positiveList(doc, "chunks", name);

@@ -8,9 +8,16 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 namespace tessera::io_detail {
+
+// `text` (the metadata document `name`: .zarray, zarr.json) parsed as a JSON
+// object whose zarr_format is `format`; InputError naming `name` otherwise.
+nlohmann::json parseZarrDocument(std::string_view text, const std::string& name, int format);
 
 std::vector<std::byte> inflateZarrChunk(std::span<const std::byte> in, std::uint64_t expected,
                                         bool gzip, const std::string& where);

@@ -285,18 +285,7 @@ std::string parseCodecs(const json& list, const std::string& field, const std::s
 }
 
 ZarrArrayMeta parseZarrJsonFields(std::string_view text, const std::string& name) {
-  json doc;
-  try {
-    doc = json::parse(text);
-  } catch (const json::exception& e) {
-    throw InputError(name + ": not valid JSON (" + e.what() + ")");
-  }
-  if (!doc.is_object()) throw InputError(name + ": not a JSON object");
-  if (!doc.contains("zarr_format") || doc["zarr_format"] != 3) {
-    throw InputError(name + ": zarr_format is " +
-                     (doc.contains("zarr_format") ? doc["zarr_format"].dump() : "missing") +
-                     ", expected 3 (Zarr v3)");
-  }
+  json doc = io_detail::parseZarrDocument(text, name, 3);
   if (doc.value("node_type", std::string()) != "array") {
     throw InputError(name + ": node_type is " +
                      (doc.contains("node_type") ? doc["node_type"].dump() : "missing") +
