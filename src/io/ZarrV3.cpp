@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -93,9 +94,21 @@ double parseFillV3(const json& f, const ZarrArrayMeta& m, const std::string& nam
     if (s == "-Infinity") return -std::numeric_limits<double>::infinity();
     // A float's bytes as hex ("0x7fc00000"), big-endian digits.
     if (m.kind == 'f' && s.size() == 2 + 2 * std::size_t(m.itemSize) && s.rfind("0x", 0) == 0) {
-      const std::uint64_t bits = std::stoull(s.substr(2), nullptr, 16);
-      if (m.itemSize == 4) return double(std::bit_cast<float>(std::uint32_t(bits)));
-      return std::bit_cast<double>(bits);
+      std::uint64_t bits = 0;
+      const char* end = s.data() + s.size();
+      const auto [at, ec] = std::from_chars(s.data() + 2, end, bits, 16);
+      if (ec == std::errc() && at == end) {
+        // memcpy, not std::bit_cast: emscripten's libc++ here lacks it.
+        if (m.itemSize == 4) {
+          const auto narrow = static_cast<std::uint32_t>(bits);
+          float f32 = 0.0f;
+          std::memcpy(&f32, &narrow, sizeof f32);
+          return double(f32);
+        }
+        double f64 = 0.0;
+        std::memcpy(&f64, &bits, sizeof f64);
+        return f64;
+      }
     }
   }
   throw InputError(name + ": fill_value " + f.dump() + " is not a number of data_type " + m.dtype);
