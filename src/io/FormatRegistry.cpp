@@ -312,7 +312,8 @@ std::vector<VolumeFormat> makeFormats() {
     n.sniff = sniffDicom;
     n.read = [](const ByteSource& s, const FileSet& fs) { return readDicom(s, fs, ""); };
     n.loses = "f32 precision (16-bit integers with a rescale slope)";
-    n.nativeRead = "DCMTK for JPEG, JPEG-LS and deflate (the basic reader needs none)";
+    n.nativeRead =
+        "DCMTK for JPEG, JPEG-LS and deflate, OpenJPEG for JPEG 2000 (the basic reader needs none)";
     n.nativeWrite = "DCMTK";
     n.browserReads = true;
 #ifndef __EMSCRIPTEN__
@@ -610,7 +611,8 @@ std::string formatsTable(bool markdown) {
     std::string magic = f.magic;
     if (!markdown) magic.erase(std::remove(magic.begin(), magic.end(), '`'), magic.end());
     std::string browser = f.browserReads ? "reads" : "-";
-    if (f.id == "dicom") browser = "reads (basic decoder)";
+    if (f.id == "dicom")
+      browser = "reads (basic decoder; JPEG, JPEG-LS, JPEG 2000, HTJ2K through npm's decoders)";
     if (f.id == "ome-zarr") browser = "reads URLs";
     std::vector<std::string> write;
     for (const std::string& e : f.writeExtensions) write.push_back(e == "/" ? "FOLDER/" : e);
