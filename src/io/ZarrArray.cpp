@@ -67,14 +67,7 @@ std::vector<std::int64_t> positiveList(const json& doc, const char* key, const s
 
 double parseFill(const json& f, const std::string& name) {
   if (f.is_null()) return 0.0;
-  if (f.is_boolean()) return f.get<bool>() ? 1.0 : 0.0;
-  if (f.is_number()) return f.get<double>();
-  if (f.is_string()) {
-    const std::string s = f.get<std::string>();
-    if (s == "NaN") return std::numeric_limits<double>::quiet_NaN();
-    if (s == "Infinity") return std::numeric_limits<double>::infinity();
-    if (s == "-Infinity") return -std::numeric_limits<double>::infinity();
-  }
+  if (const auto v = io_detail::zarrFillNumber(f)) return *v;
   throw InputError(name + ": fill_value " + f.dump() +
                    " is not a number, null, \"NaN\", \"Infinity\" or \"-Infinity\"");
 }
@@ -160,6 +153,18 @@ std::uint64_t ZarrArrayMeta::innerChunkIndex(std::span<const std::int64_t> index
     linear = linear * std::uint64_t(per) + std::uint64_t(index[a] % per);
   }
   return linear;
+}
+
+std::optional<double> io_detail::zarrFillNumber(const json& f) {
+  if (f.is_boolean()) return f.get<bool>() ? 1.0 : 0.0;
+  if (f.is_number()) return f.get<double>();
+  if (f.is_string()) {
+    const std::string s = f.get<std::string>();
+    if (s == "NaN") return std::numeric_limits<double>::quiet_NaN();
+    if (s == "Infinity") return std::numeric_limits<double>::infinity();
+    if (s == "-Infinity") return -std::numeric_limits<double>::infinity();
+  }
+  return std::nullopt;
 }
 
 json io_detail::parseZarrDocument(std::string_view text, const std::string& name, int format) {

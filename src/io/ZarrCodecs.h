@@ -6,6 +6,7 @@
 // throws InputError naming `where` (the chunk's path or URL).
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -18,6 +19,10 @@ namespace tessera::io_detail {
 // `text` (the metadata document `name`: .zarray, zarr.json) parsed as a JSON
 // object whose zarr_format is `format`; InputError naming `name` otherwise.
 nlohmann::json parseZarrDocument(std::string_view text, const std::string& name, int format);
+
+// A fill_value both Zarr versions spell alike: a number, a boolean, "NaN",
+// "Infinity" or "-Infinity"; nothing for anything else.
+std::optional<double> zarrFillNumber(const nlohmann::json& f);
 
 std::vector<std::byte> inflateZarrChunk(std::span<const std::byte> in, std::uint64_t expected,
                                         bool gzip, const std::string& where);

@@ -85,13 +85,9 @@ std::vector<std::int64_t> positiveInts(const json& v, const std::string& what,
 }
 
 double parseFillV3(const json& f, const ZarrArrayMeta& m, const std::string& name) {
-  if (f.is_boolean()) return f.get<bool>() ? 1.0 : 0.0;
-  if (f.is_number()) return f.get<double>();
+  if (const auto v = io_detail::zarrFillNumber(f)) return *v;
   if (f.is_string()) {
     const std::string s = f.get<std::string>();
-    if (s == "NaN") return std::numeric_limits<double>::quiet_NaN();
-    if (s == "Infinity") return std::numeric_limits<double>::infinity();
-    if (s == "-Infinity") return -std::numeric_limits<double>::infinity();
     // A float's bytes as hex ("0x7fc00000"), big-endian digits.
     if (m.kind == 'f' && s.size() == 2 + 2 * std::size_t(m.itemSize) && s.rfind("0x", 0) == 0) {
       std::uint64_t bits = 0;
