@@ -16,6 +16,7 @@ PACKAGES=(
   python3-nibabel python3-pydicom python3-numpy          # independent NIfTI/DICOM readers in geometry tests
   libblosc-dev libzstd-dev libcurl4-openssl-dev          # OME-Zarr chunks (blosc, zstd) and HTTP(S) stores
   libopenjp2-7-dev                                       # DICOM frames in JPEG 2000
+  libopenjph-dev                                         # DICOM frames in HTJ2K (OpenJPH)
   libopenjp2-tools openjph-tools                         # JPEG 2000 and HTJ2K encoders, for the tests' data
   python3-zarr python3-numcodecs nginx-light             # zarr-python interop tests; nginx serves stores in HTTP tests
   python3-vtk9 python3-matplotlib                        # bench/peers: VTK side by side (PNGs, plots) and its smoke tests
