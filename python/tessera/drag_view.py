@@ -9,7 +9,9 @@ and sends pointer drags to the kernel as custom messages
 one drag is in flight: moves made while the kernel draws are summed into the
 next message (``moves`` counts them), sent when the kernel answers
 ``{"event": "frame", "seq"}`` after the new frame. The view says
-``{"event": "ready"}`` when it is on the page; where the module cannot load
+``{"event": "ready"}`` when it is on the page (and keeps the last 100
+round trips, drag sent to answer received, in ms on the image element as
+``roundTripsMs``); where the module cannot load
 (JupyterLab, a headless nbclient run) it never does, and the viewer keeps
 its plain ``ipywidgets.Image`` and sliders.
 
@@ -83,6 +85,7 @@ if (typeof define === 'function' && define.amd) {
         this.inFlight = true;
         this.seq += 1;
         this.send({ event: 'drag', dx: p.dx, dy: p.dy, moves: p.moves, seq: this.seq });
+        this.sentAt = performance.now();
         this.pending = { dx: 0, dy: 0, moves: 0 };
         var self = this, seq = this.seq;
         // A kernel that never answers (an error, a restart) must not stop the drag.
@@ -90,6 +93,10 @@ if (typeof define === 'function' && define.amd) {
       },
       onMessage: function (content) {
         if (content.event === 'frame' && content.seq === this.seq) {
+          // What a drag costs seen from the page (message out, frame and answer in).
+          var trips = this.img.roundTripsMs = this.img.roundTripsMs || [];
+          trips.push(performance.now() - this.sentAt);
+          if (trips.length > 100) trips.shift();
           this.inFlight = false;
           this.flush();
         }
