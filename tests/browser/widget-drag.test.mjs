@@ -5,7 +5,9 @@
 // with the mouse, and checks that the page's image changed to exactly the
 // frame a Session renders at the dragged camera, that the azimuth slider moved
 // by 0.4 degrees per pixel (viewer::CameraController), and that the moves
-// made while a frame was drawn were coalesced into fewer kernel messages.
+// made while a frame was drawn were coalesced into fewer kernel messages;
+// and that where the view's module cannot load, the plain image and the
+// sliders still work.
 // Needs the Python module built (build/python/tessera, or TESSERA_BUILD_DIR),
 // not the web build: scripts/browser-test.sh widget-drag, or
 // node --test tests/browser/widget-drag.test.mjs.
@@ -72,7 +74,9 @@ function notebook() {
 before(async () => {
   tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'tessera-widget-'));
   for (const d of ['config', 'data', 'runtime', 'ipython', 'nb']) fs.mkdirSync(path.join(tmp, d));
-  fs.writeFileSync(path.join(tmp, 'nb', 'drag.ipynb'), JSON.stringify(notebook()));
+  for (const name of ['drag', 'plain']) {
+    fs.writeFileSync(path.join(tmp, 'nb', `${name}.ipynb`), JSON.stringify(notebook()));
+  }
   const port = await freePort();
   const logs = [];
   server = spawn(python, ['-m', 'notebook', '--no-browser', `--port=${port}`, '--ip=127.0.0.1',
@@ -122,16 +126,24 @@ const readout = (page, name) => page.evaluate((n) => {
   return null;
 }, name);
 
+// The notebook `name` open in a new page, its kernel connected and the
+// widgets' extension loaded; `prepare` runs in the page before its cell does.
+async function runNotebook(name, prepare) {
+  const page = await browser.newPage({ viewport: { width: 1200, height: 900 } });
+  const logs = [];
+  page.on('pageerror', (e) => logs.push(`pageerror: ${e.message}`));
+  await page.goto(`${url}/notebooks/${name}.ipynb`);
+  await page.waitForFunction(() => window.Jupyter && Jupyter.notebook && Jupyter.notebook.kernel
+    && Jupyter.notebook.kernel.is_connected() && window.requirejs
+    && requirejs.defined('nbextensions/jupyter-js-widgets/extension'), null, { timeout: 30000 });
+  if (prepare) await page.evaluate(prepare);
+  await page.evaluate(() => Jupyter.notebook.execute_all_cells());
+  return { page, logs };
+}
+
 test('dragging on tessera.widget\'s frame rotates the view in the kernel', { timeout: 60000 },
   () => checksPassed(async () => {
-    const page = await browser.newPage({ viewport: { width: 1200, height: 900 } });
-    const logs = [];
-    page.on('pageerror', (e) => logs.push(`pageerror: ${e.message}`));
-    await page.goto(`${url}/notebooks/drag.ipynb`);
-    await page.waitForFunction(() => window.Jupyter && Jupyter.notebook && Jupyter.notebook.kernel
-      && Jupyter.notebook.kernel.is_connected() && window.requirejs
-      && requirejs.defined('nbextensions/jupyter-js-widgets/extension'), null, { timeout: 30000 });
-    await page.evaluate(() => Jupyter.notebook.execute_all_cells());
+    const { page, logs } = await runNotebook('drag');
     const img = page.locator('img.tessera-drag');
     await page.waitForFunction(() => {
       const i = document.querySelector('img.tessera-drag');
@@ -208,5 +220,43 @@ test('dragging on tessera.widget\'s frame rotates the view in the kernel', { tim
       `${N}^3 at ${SIZE}^2: ${trips.length} round trips, median ${trips[trips.length >> 1].toFixed(1)} ms,`
       + ` max ${trips[trips.length - 1].toFixed(1)} ms (drag sent to frame and answer in)`);
     check('widget: no page errors', logs.length === 0, logs.join('; '));
+    await page.close();
+  }));
+
+test('without the drag view\'s module the widget shows the plain image and its sliders rotate',
+  { timeout: 60000 }, () => checksPassed(async () => {
+    // As where the Javascript output does not run (JupyterLab, nbclient):
+    // the module's guard finds no AMD define, so the view cannot load.
+    const { page, logs } = await runNotebook('plain', () => { define.amd = undefined; });
+    const plain = `img[width="${SIZE}"]:not(.tessera-drag)`;
+    await page.waitForFunction((sel) => {
+      const i = document.querySelector(sel);
+      return i && i.offsetWidth > 0 && i.naturalWidth > 0;
+    }, plain, { timeout: 30000 });
+    check('plain: no drag view on the page, the plain image shows the frame',
+      (await page.locator('img.tessera-drag').count()) === 0);
+    const src0 = await page.locator(plain).getAttribute('src');
+    const azimuthReadout = page.locator('.widget-label:text-is("azimuth") ~ .widget-readout');
+    await azimuthReadout.click();
+    await page.keyboard.press('Control+A');
+    await page.keyboard.type('30');
+    await page.keyboard.press('Enter');
+    await page.waitForFunction(([sel, s0]) => document.querySelector(sel).src !== s0, [plain, src0],
+      { timeout: 30000 }).catch(() => {});
+    const kernel = JSON.parse(await kernelPrint(page, [
+      'import json',
+      'cam = v.session.settings["camera"]',
+      `s = tessera.Session(tessera.from_array(a), tf="ct-bone", azimuth=30, elevation=0)`,
+      'print(json.dumps({"azimuth": cam["azimuth"], "ready": v.drag_image.ready,',
+      `  "same": bytes(v.image.value) == tessera._png(s.render(${SIZE}, ${SIZE}), level=1)}))`,
+    ].join('\n')));
+    check('plain: typing 30 into the azimuth slider turns the kernel camera to 30',
+      kernel.azimuth === 30 && kernel.ready === false, `azimuth ${kernel.azimuth}, ready ${kernel.ready}`);
+    check('plain: the page\'s image changed to a Session\'s frame at azimuth 30',
+      (await page.locator(plain).getAttribute('src')) !== src0 && kernel.same === true,
+      `same as Session.render: ${kernel.same}`);
+    // The widget manager reports the view it could not make; nothing else.
+    const other = logs.filter((l) => !/Could not (create a view for model|add child view to box)/.test(l));
+    check('plain: no page errors but the missing drag view', other.length === 0, logs.join('; '));
     await page.close();
   }));
