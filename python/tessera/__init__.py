@@ -607,7 +607,8 @@ for _key, _doc in {
 
 
 def widget(volume: Any, **settings: Any):
-    """An ipywidgets viewer rendering on the kernel side (tessera.widget)."""
+    """An ipywidgets viewer rendering on the kernel side (tessera/widget.py):
+    drag on the frame or move the sliders to rotate."""
     from .widget import Viewer
 
     return Viewer(volume, **settings)

@@ -89,7 +89,9 @@ if (typeof define === 'function' && define.amd) {
         this.pending = { dx: 0, dy: 0, moves: 0 };
         var self = this, seq = this.seq;
         // A kernel that never answers (an error, a restart) must not stop the drag.
-        setTimeout(function () { if (self.seq === seq && self.inFlight) { self.inFlight = false; self.flush(); } }, 5000);
+        setTimeout(function () {
+          if (self.seq === seq && self.inFlight) { self.inFlight = false; self.flush(); }
+        }, 5000);
       },
       onMessage: function (content) {
         if (content.event === 'frame' && content.seq === this.seq) {

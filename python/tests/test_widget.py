@@ -112,3 +112,10 @@ def test_frames_go_to_the_drag_view_once_it_is_on_the_page_and_the_sliders_still
 
     assert np.array_equal(png_pixels(base64.b64decode(v.drag_image._b64value)), s.render(64, 64))
     assert "define('tessera-drag'" in tessera.drag_view.JAVASCRIPT
+
+
+def test_session_orbit_wraps_the_azimuth_and_keeps_the_elevation_inside_89_degrees():
+    s = tessera.Session(tessera.from_array(box_volume()), azimuth=170, elevation=80)
+    s.orbit(-50, 30)  # the eye goes left by -20 degrees: 190 is -170; 80 + 12 stops at 89
+    assert (s.azimuth, s.elevation) == pytest.approx((-170.0, 89.0), abs=1e-9)
+    assert (s.azimuth, s.elevation) == pytest.approx(camera_after(170, 80, [(-50, 30)]), abs=1e-9)
