@@ -30,6 +30,7 @@
 #include "tessera/lod/VolumeSource.h"
 #include "tessera/session/Session.h"
 #include "tessera/session/VolumeInfo.h"
+#include "tessera/viewer/CameraController.h"
 
 namespace py = pybind11;
 using tessera::Image;
@@ -214,6 +215,17 @@ class PySession {
     return {imageArray(std::move(r.first)), d};
   }
 
+  // A pointer drag of (dx, dy) pixels (y down) on the frame, as the
+  // viewers' CameraController turns it into an orbit: the widget's drag.
+  void orbit(double dx, double dy) {
+    Use use(*this);
+    tessera::session::Settings s = session_->currentSettings();
+    tessera::viewer::CameraController controller(s.camera);
+    controller.pointerDown(0, {0.0, 0.0});
+    controller.pointerMove(0, {dx, dy});
+    session_->setSettings(std::move(s));
+  }
+
   std::string state() const { return session_->state().dump(); }
   std::string volumeName() const { return session_->name(); }
   bool streamed() const { return session_->streamed(); }
@@ -359,6 +371,7 @@ PYBIND11_MODULE(_tessera, m) {
         py::arg("levels") = "auto", py::arg("compressor") = "zstd");
   m.def("tf_json", &tfJson);
   m.def("tf_presets", &tessera::TransferFunction::presetNames);
+  m.attr("orbit_degrees_per_pixel") = tessera::viewer::CameraController::kDegreesPerPixel;
 
   py::class_<PySession>(m, "SessionCore")
       .def(py::init<const std::string&>(), py::arg("profile") = "native")
@@ -372,6 +385,7 @@ PYBIND11_MODULE(_tessera, m) {
            py::arg("tf") = "")
       .def("run", &PySession::run, py::arg("width"), py::arg("height"), py::arg("repeat") = 1,
            py::arg("rotate") = 0.0, py::arg("reference") = false)
+      .def("orbit", &PySession::orbit, py::arg("dx"), py::arg("dy"))
       .def("state", &PySession::state)
       .def_property_readonly("volume_name", &PySession::volumeName)
       .def_property_readonly("streamed", &PySession::streamed)

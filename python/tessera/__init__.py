@@ -407,8 +407,9 @@ def _apply_setting(j: dict, key: str, value: Any) -> None:
         )
 
 
-def _png(rgba: _np.ndarray) -> bytes:
-    """An 8-bit RGBA PNG of an (H, W, 4) array (no imaging library needed)."""
+def _png(rgba: _np.ndarray, level: int = 6) -> bytes:
+    """An 8-bit RGBA PNG of an (H, W, 4) array (no imaging library needed);
+    ``level``: zlib's (1 is twice as fast as 6 for a frame, 40 % larger)."""
     h, w, _ = rgba.shape
     raw = b"".join(b"\x00" + rgba[y].tobytes() for y in range(h))
 
@@ -419,7 +420,7 @@ def _png(rgba: _np.ndarray) -> bytes:
     return (
         b"\x89PNG\r\n\x1a\n"
         + chunk(b"IHDR", _struct.pack(">IIBBBBB", w, h, 8, 6, 0, 0, 0))
-        + chunk(b"IDAT", _zlib.compress(raw, 6))
+        + chunk(b"IDAT", _zlib.compress(raw, level))
         + chunk(b"IEND", b"")
     )
 
@@ -535,6 +536,14 @@ class Session:
             self.update(**camera)
         return self._core.render_reference(int(width), int(height))
 
+    def orbit(self, dx: float, dy: float) -> "Session":
+        """Turns the camera as a pointer drag of (dx, dy) pixels (y down) on
+        the frame does in the viewers (viewer::CameraController: azimuth
+        -= dx * orbit_degrees_per_pixel, elevation += dy * it, clamped to
+        +-89)."""
+        self._core.orbit(float(dx), float(dy))
+        return self
+
     def slice(
         self,
         axis: int,
@@ -598,7 +607,8 @@ for _key, _doc in {
 
 
 def widget(volume: Any, **settings: Any):
-    """An ipywidgets viewer rendering on the kernel side (tessera.widget)."""
+    """An ipywidgets viewer rendering on the kernel side (tessera/widget.py):
+    drag on the frame or move the sliders to rotate."""
     from .widget import Viewer
 
     return Viewer(volume, **settings)

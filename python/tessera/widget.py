@@ -1,32 +1,48 @@
 """tessera.widget(volume): a Jupyter viewer that renders on the kernel side.
 
 The volume is rendered by a :class:`tessera.Session` in the kernel and each
-frame is sent to the page as a PNG in an ``ipywidgets.Image``. Debian's
-python3-ipywidgets (6.0) has no pointer events and ipyevents is not packaged,
-so rotating is by azimuth/elevation sliders (``continuous_update``: every
-slider step is a frame, as a drag would be); with ipyevents installed a drag
-on the image rotates too. Controls: TF preset, window, shading, mode, and
-three slice views (axial/coronal/sagittal storage axes) with index sliders.
+frame is sent to the page as a PNG. Dragging on the image rotates the view
+(tessera/drag_view.py: a custom ipywidgets view for the classic notebook
+that sends pointer drags, one in flight, the moves made meanwhile summed
+into the next); the kernel turns each drag into an orbit through the
+library's camera controller (``Session.orbit``, the desktop and web viewers'
+``viewer::CameraController``: 0.4 degrees per pixel) and answers with the
+new frame. The azimuth/elevation sliders follow the drag and rotate too;
+where the drag view cannot load (JupyterLab, a headless nbclient run) the
+viewer shows a plain ``ipywidgets.Image`` and the sliders. Controls: TF
+preset, window, shading, mode, and three slice views (axial/coronal/sagittal
+storage axes) with index sliders.
 """
 from __future__ import annotations
 
+import sys
 import time
-from typing import Any, Optional
+import types
+from typing import Any
 
 import ipywidgets as widgets
 
 import tessera
 
+from .drag_view import DragImage, javascript
+
 
 class Viewer:
     """The widget (``viewer.widget`` is the ipywidgets box; a notebook cell
     showing the Viewer shows it). ``last_ms``: the last frame's round trip on
-    the kernel side (render + PNG + hand-over to the widget)."""
+    the kernel side (render + PNG + hand-over to the widget);
+    ``last_drag_ms``: the last drag's (orbit + sliders + frame); ``drags``
+    and ``drag_moves``: drag messages handled and the pointer moves they
+    carried (more moves than messages: coalesced while a frame was drawn)."""
 
     def __init__(self, volume: Any, *, size: int = 384, slice_size: int = 192, **settings: Any):
         self.session = tessera.Session(volume, **settings)
         self.size = int(size)
         self.last_ms = 0.0
+        self.last_drag_ms = 0.0
+        self.drags = 0
+        self.drag_moves = 0
+        self._syncing = False
         s = self.session.settings
         info = tessera.info(self.session.volume) if self.session.volume.in_core else None
         lo = info["value_min"] if info else 0.0
@@ -34,12 +50,14 @@ class Viewer:
         if hi <= lo:
             hi = lo + 1.0
         cam = s["camera"]
+        # Steps of 0.1 degree: a drag sets the angles to tenths (0.4 per pixel).
         slider = dict(continuous_update=True)
+        angle = dict(step=0.1, readout_format=".1f", **slider)
         self.azimuth = widgets.FloatSlider(
-            value=cam["azimuth"], min=-180, max=180, step=2, description="azimuth", **slider
+            value=cam["azimuth"], min=-180, max=180, description="azimuth", **angle
         )
         self.elevation = widgets.FloatSlider(
-            value=cam["elevation"], min=-89, max=89, step=2, description="elevation", **slider
+            value=cam["elevation"], min=-89, max=89, description="elevation", **angle
         )
         self.zoom = widgets.FloatSlider(
             value=cam["zoom"], min=0.25, max=8, step=0.05, description="zoom", **slider
@@ -62,6 +80,12 @@ class Viewer:
             options=["composite", "mip", "minip", "average"], value=s["mode"], description="mode"
         )
         self.image = widgets.Image(format="png", width=self.size, height=self.size)
+        # Hidden until its view says it is on the page; then it replaces the image.
+        self.drag_image = DragImage(
+            format="png", width=self.size, height=self.size, layout=widgets.Layout(display="none")
+        )
+        self.drag_image.drag_handlers.append(self.drag)
+        self.drag_image.ready_handlers.append(self._on_drag_ready)
         self.status = widgets.Label(value="")
         for w in (self.azimuth, self.elevation, self.zoom):
             w.observe(self._on_camera, names="value")
@@ -86,45 +110,54 @@ class Viewer:
                 self.slice_indices.append(idx)
                 self.slice_images.append(img)
                 boxes.append(widgets.VBox([img, idx]))
-        self._attach_drag()
         controls = widgets.VBox(
             [self.azimuth, self.elevation, self.zoom, self.tf, self.window, self.shade, self.mode,
              self.status]
         )
-        self.widget = widgets.VBox([widgets.HBox([self.image, controls]), widgets.HBox(boxes)])
+        frame = widgets.VBox([self.drag_image, self.image])
+        self.widget = widgets.VBox([widgets.HBox([frame, controls]), widgets.HBox(boxes)])
         self.draw()
         for axis in range(len(self.slice_images)):
             self._draw_slice(axis)
 
-    def _attach_drag(self) -> None:
+    def _on_drag_ready(self) -> None:
+        self.drag_image.layout.display = None
+        self.image.layout.display = "none"
+        self.draw()
+
+    def drag(self, dx: float, dy: float, moves: int = 1) -> bytes:
+        """A drag of (dx, dy) pixels on the image (y down; what the page
+        sends, ``moves`` pointer moves summed): orbits the camera as the
+        viewers do (``Session.orbit``), moves the sliders to it without a
+        second frame, draws, and returns the frame's PNG."""
+        t0 = time.perf_counter()
+        self.session.orbit(dx, dy)
+        cam = self.session.settings["camera"]
+        self._syncing = True
         try:
-            from ipyevents import Event  # optional; not packaged by Debian
-        except ImportError:
-            self._events = None
-            return
-        self._events = Event(source=self.image, watched_events=["drag", "mousemove"])
-        self._drag_from: Optional[tuple] = None
+            self.azimuth.value = cam["azimuth"]
+            self.elevation.value = cam["elevation"]
+        finally:
+            self._syncing = False
+        png = self.draw()
+        self.drags += 1
+        self.drag_moves += int(moves)
+        self.last_drag_ms = (time.perf_counter() - t0) * 1000.0
+        return png
 
-        def on_event(e: dict) -> None:
-            if e.get("type") == "mousemove" and e.get("buttons", 0) & 1:
-                x, y = e["relativeX"], e["relativeY"]
-                if self._drag_from is not None:
-                    dx, dy = x - self._drag_from[0], y - self._drag_from[1]
-                    self.azimuth.value = (self.azimuth.value - dx * 0.5 + 180) % 360 - 180
-                    self.elevation.value = max(-89, min(89, self.elevation.value + dy * 0.5))
-                self._drag_from = (x, y)
-            else:
-                self._drag_from = None
-
-        self._events.on_dom_event(on_event)
-
-    def draw(self) -> None:
-        """Renders the current view into the image (the kernel-side round trip)."""
+    def draw(self) -> bytes:
+        """Renders the current view into the image shown (the kernel-side
+        round trip) and returns its PNG."""
         t0 = time.perf_counter()
         frame = self.session.render(self.size, self.size)
-        self.image.value = tessera._png(frame)
+        png = tessera._png(frame, level=1)  # the frame's bytes cross a local socket
+        if self.drag_image.ready:
+            self.drag_image.set_frame(png)
+        else:
+            self.image.value = png
         self.last_ms = (time.perf_counter() - t0) * 1000.0
         self.status.value = f"{self.last_ms:.0f} ms per frame"
+        return png
 
     def _draw_slice(self, axis: int) -> None:
         tf_name = self.tf.value
@@ -134,6 +167,8 @@ class Viewer:
         self.slice_images[axis].value = tessera._png(img)
 
     def _on_camera(self, change: dict) -> None:
+        if self._syncing:
+            return
         self.session.update(
             azimuth=self.azimuth.value, elevation=self.elevation.value, zoom=self.zoom.value
         )
@@ -157,4 +192,18 @@ class Viewer:
     def _ipython_display_(self) -> None:
         from IPython.display import display
 
+        display(javascript())
         display(self.widget)
+
+
+class _CallableModule(types.ModuleType):
+    """Importing this module binds it as ``tessera.widget`` over the
+    package's function of that name (Python sets a package's attribute to
+    each submodule it imports); calling the module does what the function
+    does, so ``tessera.widget(volume)`` works before and after."""
+
+    def __call__(self, volume: Any, **settings: Any) -> Viewer:
+        return Viewer(volume, **settings)
+
+
+sys.modules[__name__].__class__ = _CallableModule
