@@ -239,6 +239,7 @@ import { TesseraViewer } from './tessera.js';
       storeFrameStep();
     } else if (api) {
       let ms = -1;
+      if (time.count > 1) timeStep();
       if (needsRender) {
         needsRender = false;
         ms = renderNow();
@@ -433,9 +434,90 @@ import { TesseraViewer } from './tessera.js';
 
   function volumeChanged() {
     refreshState();
+    timeChanged();
     syncWindowControls();
     drawTf();
   }
+
+  // ---------------------------------------------------------------- time series
+  // A dropped 4-D NIfTI plays back (session/TimeSeries.h): the slider shows
+  // a time point once it is read, Play steps through every time point in
+  // order at the chosen rate (a late one shown late, never skipped).
+  const time = { count: 1, shown: 0, asked: null, log: [], since: 0 };
+
+  function timeChanged() {
+    const t = viewer.timeSeries();
+    time.count = t.count;
+    time.shown = t.shown || 0;
+    time.asked = null;
+    time.log = time.count > 1 ? [time.shown] : [];
+    $('time-controls').hidden = time.count <= 1;
+    $('timePoint').max = Math.max(0, time.count - 1);
+    $('timePoint').value = time.shown;
+    $('timePlay').textContent = 'Play';
+    timeStatus();
+  }
+
+  function timeStatus() {
+    $('timeText').textContent = `${time.shown} of ${time.count}`;
+    const t = time.count > 1 ? viewer.timeSeries() : null;
+    if (!t || !t.playing) {
+      $('timeStatus').textContent = '';
+      return;
+    }
+    const seconds = (performance.now() - time.since) / 1000;
+    const rate = seconds > 0 ? t.advances / seconds : 0;
+    $('timeStatus').textContent = `${rate.toFixed(1)} time points/s of ${t.fps}, ${t.late} late frames`;
+  }
+
+  // Once per animation frame: playback's next time point, or the one the
+  // slider asked for once it is read.
+  function timeStep() {
+    try {
+      if (time.asked !== null) {
+        if (viewer.showTimePoint(time.asked)) {
+          time.shown = time.asked;
+          time.asked = null;
+          time.log.push(time.shown);
+          needsRender = true;
+        }
+      } else if (viewer.timeSeries().playing) {
+        const shown = viewer.stepPlayback(performance.now());
+        if (shown !== time.shown) {
+          time.shown = shown;
+          time.log.push(shown);
+          $('timePoint').value = shown;
+          needsRender = true;
+        }
+      }
+    } catch (e) {
+      showError(e.message);
+      time.asked = null;
+    }
+    timeStatus();
+  }
+
+  function timePlay(play) {
+    try {
+      if (play) {
+        viewer.play({ fps: parseFloat($('timeFps').value) || 10 });
+        time.since = performance.now();
+      } else {
+        viewer.pause();
+      }
+      $('timePlay').textContent = play ? 'Pause' : 'Play';
+    } catch (e) {
+      showError(e.message);
+    }
+  }
+
+  $('timePoint').addEventListener('input', () => {
+    time.asked = parseInt($('timePoint').value, 10);
+  });
+  $('timePlay').addEventListener('click', () => timePlay(!viewer.timeSeries().playing));
+  $('timeFps').addEventListener('change', () => {
+    if (viewer.timeSeries().playing) timePlay(true);
+  });
 
   // ---------------------------------------------------------------- window/level
 
@@ -949,6 +1031,23 @@ import { TesseraViewer } from './tessera.js';
     render: () => requestRender(),
     openFiles,
     openFile: (file) => openFiles([file]),
+    // Time series: {count, shown, playing, fps, late, advances}, the time
+    // points drawn so far in order, play(fps) / pause(), and one time point
+    // shown (resolves once it is drawn).
+    time: () => ({ ...viewer.timeSeries(), log: time.log.slice() }),
+    play: (fps) => {
+      $('timeFps').value = String(fps);
+      timePlay(true);
+    },
+    pause: () => timePlay(false),
+    showTime: (t) => {
+      time.asked = t;
+      return new Promise((resolve) => {
+        const drawn = () => time.asked === null && !needsRender && !api.refining();
+        const wait = () => (drawn() ? resolve(time.shown) : setTimeout(wait, 10));
+        wait();
+      });
+    },
     openUrls,
     lastLoad: () => lastLoad,
     zarr: () => (zarr ? zarr.stats() : null),

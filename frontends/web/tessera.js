@@ -120,6 +120,10 @@ export class TesseraViewer {
       sessionState: c('tessera_session_state', 'string', []),
       sessionRestore: c('tessera_session_restore', 'number', ['string']),
       readPixels: c('tessera_read_pixels', 'number', ['number', 'number']),
+      timeJson: c('tessera_time_json', 'string', []),
+      timeShow: c('tessera_time_show', 'number', ['number']),
+      playback: c('tessera_playback', 'number', ['number', 'number', 'number']),
+      playbackStep: c('tessera_playback_step', 'number', ['number']),
     };
   }
 
@@ -292,6 +296,31 @@ export class TesseraViewer {
     if (ms < 0) this.#fail(this.#c.lastError());
     this.#emit('frame', { ms });
     return ms;
+  }
+
+  // A time series (a 4-D NIfTI opened with openFiles/openUrl): {count,
+  // shown, playing, fps, late, advances}; {count: 1} for a single volume.
+  timeSeries() { return JSON.parse(this.#c.timeJson()); }
+
+  // Shows time point t when it has been read (true); else asks for it,
+  // reads one time point ahead and returns false (call again on a later
+  // frame). Throws for t out of range.
+  showTimePoint(t) {
+    const r = this.#c.timeShow(t);
+    if (r < 0) this.#fail(this.#c.lastError());
+    return r === 1;
+  }
+
+  // Playback at `fps` time points per second: every time point in order,
+  // one that is not read in time shown late, never skipped. Call
+  // stepPlayback() once per animation frame and render() when the time
+  // point it returns changed.
+  play({ fps = 10 } = {}) { this.#check(this.#c.playback(1, fps, performance.now())); }
+  pause() { this.#check(this.#c.playback(0, this.timeSeries().fps || 10, performance.now())); }
+  stepPlayback(nowMs = performance.now()) {
+    const shown = this.#c.playbackStep(nowMs);
+    if (shown < 0) this.#fail(this.#c.lastError());
+    return shown;
   }
 
   // The canvas's RGBA pixels, top row first.

@@ -140,6 +140,21 @@ Volume readVolume(const ByteSource& file, const FileSet& files) {
   return chooseReadFormat(file).read(file, files);
 }
 
+int timePointCount(const ByteSource& file) {
+  const VolumeFormat& format = chooseReadFormat(file);
+  return format.timePoints ? format.timePoints(file) : 1;
+}
+
+Volume readTimePoint(const ByteSource& file, const FileSet& files, int time) {
+  const VolumeFormat& format = chooseReadFormat(file);
+  if (format.readTimePoint) return format.readTimePoint(file, files, time);
+  if (time != 0) {
+    throw InputError(file.name() + ": time point " + std::to_string(time) +
+                     " asked for; the file holds one volume");
+  }
+  return format.read(file, files);
+}
+
 std::string volumeFileAmong(const std::vector<std::string>& names) {
   if (names.empty()) throw InputError("no file to read");
   auto rank = [](const std::string& name) {

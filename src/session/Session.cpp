@@ -157,8 +157,10 @@ int Session::stepPlayback(double nowMs) {
   if (view_ && view_->refining()) return timePoint_;
   const int count = series_->count();
   const int next = (timePoint_ + 1) % count;
-  const bool ready = series_->want(next) != nullptr;
+  bool ready = series_->want(next) != nullptr;
   series_->want(timePoint_);  // keeps the window of reads anchored here
+  // Without a reading thread, one time point ahead is read per frame.
+  if (series_->pump() && !ready) ready = series_->want(next) != nullptr;
   const int shown = playback_.step(nowMs, timePoint_, count, ready);
   if (shown != timePoint_) showTimePoint(shown);
   return timePoint_;

@@ -7,8 +7,16 @@
 
 namespace tessera::session {
 
-TimeSeries::TimeSeries(int count, Reader read, int keep)
-    : count_(count), read_(std::move(read)), keep_(keep) {
+TimeSeries::Reading TimeSeries::defaultReading() {
+#if defined(__EMSCRIPTEN__) && !defined(__EMSCRIPTEN_PTHREADS__)
+  return Reading::OnPump;
+#else
+  return Reading::Background;
+#endif
+}
+
+TimeSeries::TimeSeries(int count, Reader read, int keep, Reading reading)
+    : count_(count), read_(std::move(read)), keep_(keep), mode_(reading) {
   if (count_ < 1) throw InputError("time series: " + std::to_string(count_) + " time points");
   if (keep_ < 1 || keep_ > count_) {
     throw InputError("time series: keeping " + std::to_string(keep_) + " of " +
@@ -16,10 +24,11 @@ TimeSeries::TimeSeries(int count, Reader read, int keep)
                      std::to_string(count_));
   }
   if (!read_) throw InputError("time series: no reader");
-  worker_ = std::thread([this] { work(); });
+  if (mode_ == Reading::Background) worker_ = std::thread([this] { work(); });
 }
 
 TimeSeries::~TimeSeries() {
+  if (!worker_.joinable()) return;
   {
     std::lock_guard lock(mutex_);
     stop_ = true;
@@ -63,6 +72,9 @@ std::shared_ptr<Volume> TimeSeries::want(int t) {
 std::shared_ptr<Volume> TimeSeries::wait(int t) {
   std::unique_lock lock(mutex_);
   askFrom(t);
+  if (mode_ == Reading::OnPump && !held_.count(t) && !failed_.count(t)) {
+    readOne(t, lock);
+  }
   changed_.wait(lock, [&] { return held_.count(t) > 0 || failed_.count(t) > 0; });
   if (const auto f = failed_.find(t); f != failed_.end()) std::rethrow_exception(f->second);
   return held_.at(t);
@@ -73,42 +85,57 @@ std::vector<int> TimeSeries::readLog() const {
   return readLog_;
 }
 
+int TimeSeries::nextToRead() const {
+  for (const int t : wanted_) {
+    if (!held_.count(t) && !failed_.count(t)) return t;
+  }
+  return -1;
+}
+
+void TimeSeries::readOne(int t, std::unique_lock<std::mutex>& lock) {
+  reading_ = t;
+  lock.unlock();
+  std::shared_ptr<Volume> volume;
+  std::exception_ptr error;
+  try {
+    volume = std::make_shared<Volume>(read_(t));
+  } catch (...) {
+    error = std::current_exception();
+  }
+  lock.lock();
+  reading_ = -1;
+  readLog_.push_back(t);
+  // Kept only if still wanted (the viewer may have jumped elsewhere).
+  if (std::find(wanted_.begin(), wanted_.end(), t) != wanted_.end()) {
+    if (error) {
+      failed_[t] = error;
+    } else {
+      held_[t] = std::move(volume);
+    }
+  }
+  changed_.notify_all();
+}
+
+bool TimeSeries::pump() {
+  if (mode_ != Reading::OnPump) return false;
+  std::unique_lock lock(mutex_);
+  const int next = nextToRead();
+  if (next < 0) return false;
+  readOne(next, lock);
+  return true;
+}
+
 void TimeSeries::work() {
   std::unique_lock lock(mutex_);
   for (;;) {
     int next = -1;
     changed_.wait(lock, [&] {
       if (stop_) return true;
-      for (const int t : wanted_) {
-        if (!held_.count(t) && !failed_.count(t)) {
-          next = t;
-          return true;
-        }
-      }
-      return false;
+      next = nextToRead();
+      return next >= 0;
     });
     if (stop_) return;
-    reading_ = next;
-    lock.unlock();
-    std::shared_ptr<Volume> volume;
-    std::exception_ptr error;
-    try {
-      volume = std::make_shared<Volume>(read_(next));
-    } catch (...) {
-      error = std::current_exception();
-    }
-    lock.lock();
-    reading_ = -1;
-    readLog_.push_back(next);
-    // Kept only if still wanted (the viewer may have jumped elsewhere).
-    if (std::find(wanted_.begin(), wanted_.end(), next) != wanted_.end()) {
-      if (error) {
-        failed_[next] = error;
-      } else {
-        held_[next] = std::move(volume);
-      }
-    }
-    changed_.notify_all();
+    readOne(next, lock);
   }
 }
 

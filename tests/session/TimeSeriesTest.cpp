@@ -13,6 +13,8 @@
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <iterator>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -20,6 +22,7 @@
 #include "support/ExpectError.h"
 #include "support/TestSupport.h"
 #include "tessera/core/Error.h"
+#include "tessera/io/ByteSource.h"
 #include "tessera/io/NiftiWriter.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/io/VolumeReader.h"
@@ -77,6 +80,31 @@ TEST(TimeSeries, ReadsAheadOfTheTimePointAskedForWithinWhatItKeeps) {
             4, [](int t) { return constant(t); }, 5);
       },
       {"keeping 5 of 4"});
+}
+
+// Without a thread (the WebAssembly page): nothing is read until pump() or
+// wait(), each pump() reads the next wanted time point, in the window's
+// order, and wait() reads the one it waits for at once.
+TEST(TimeSeries, OnPumpReadsOneTimePointPerPumpInTheWindowsOrder) {
+  TimeSeries series(
+      8, [](int t) { return constant(t); }, 3, TimeSeries::Reading::OnPump);
+  EXPECT_EQ(series.reading(), TimeSeries::Reading::OnPump);
+  EXPECT_EQ(series.want(2), nullptr);
+  EXPECT_TRUE(series.readLog().empty());
+  EXPECT_TRUE(series.pump());
+  EXPECT_EQ(series.readLog(), std::vector<int>({2}));
+  ASSERT_NE(series.want(2), nullptr);
+  EXPECT_EQ(series.want(2)->valueAt(0, 0, 0), 2.0);
+  EXPECT_TRUE(series.pump());
+  EXPECT_TRUE(series.pump());
+  EXPECT_FALSE(series.pump()) << "the window 2..4 is read";
+  EXPECT_EQ(series.readLog(), std::vector<int>({2, 3, 4}));
+  EXPECT_EQ(series.wait(7)->valueAt(1, 1, 1), 7.0);  // read now, no thread to wait for
+  EXPECT_EQ(series.readLog().back(), 7);
+  TimeSeries background(
+      3, [](int t) { return constant(t); }, 2);
+  EXPECT_FALSE(background.pump()) << "a series with its own thread reads there";
+  EXPECT_EQ(background.wait(1)->valueAt(0, 0, 0), 1.0);
 }
 
 TEST(TimeSeries, KeepsWhatTheBudgetHoldsAndAtLeastTheNext) {
@@ -213,6 +241,66 @@ TEST(SessionSeries, PlaybackThroughTheSessionShowsEveryTimePoint) {
   ASSERT_EQ(sequence.size(), 11u) << "playback stalled";
   for (std::size_t i = 1; i < sequence.size(); ++i) {
     EXPECT_EQ(sequence[i], (sequence[i - 1] + 1) % 5) << "skipped at " << i;
+  }
+}
+
+// What the web page does with a dropped 4-D NIfTI: the bytes in memory,
+// the series read from them (io's ByteSource overloads) by a reader the
+// session keeps; each time point equals the file's read from disk, and an
+// OnPump series plays every time point through stepPlayback.
+TEST(SessionSeries, ASeriesFromBytesInMemoryPlaysEveryTimePoint) {
+  const test::TempDir dir;
+  const auto path = writeSeries(dir, 4);
+  std::ifstream in(path, std::ios::binary);
+  const std::vector<char> raw((std::istreambuf_iterator<char>(in)), {});
+  std::vector<std::byte> bytes(raw.size());
+  std::memcpy(bytes.data(), raw.data(), raw.size());
+  auto files = std::make_shared<MemoryFiles>();
+  files->add("series.nii", std::move(bytes));
+  const auto file = files->open("series.nii");
+  ASSERT_EQ(timePointCount(*file), 4);
+  for (int t = 0; t < 4; ++t) {
+    EXPECT_TRUE(std::ranges::equal(readTimePoint(*files->open("series.nii"), *files, t).bytes(),
+                                   readTimePoint(path.string(), t).bytes()))
+        << t;
+  }
+  expectInputError([&] { readTimePoint(*file, *files, 4); }, {"series.nii", "4"});
+  Session s("native");
+  s.openSeries(
+      4, [files](int t) { return readTimePoint(*files->open("series.nii"), *files, t); },
+      "series.nii");
+  ASSERT_NE(s.series(), nullptr);
+  EXPECT_EQ(s.name(), "series.nii");
+  // Read as the page without threads reads: one time point per frame.
+  Session paged("native");
+  paged.openSeries(
+      4, [files](int t) { return readTimePoint(*files->open("series.nii"), *files, t); },
+      "series.nii", 1, TimeSeries::Reading::OnPump);
+  EXPECT_EQ(paged.timePoint(), 1);
+  EXPECT_EQ(paged.series()->reading(), TimeSeries::Reading::OnPump);
+  expectInputError(
+      [&] {
+        paged.openSeries(
+            4, [files](int t) { return readTimePoint(*files->open("series.nii"), *files, t); },
+            "series.nii", 4);
+      },
+      {"series.nii", "time point 4", "0..3"});
+  paged.playback().setFps(100.0);
+  paged.playback().play(0.0);
+  std::vector<int> sequence{paged.timePoint()};
+  for (double now = 0.0; sequence.size() < 9 && now < 5000.0; now += 5.0) {
+    const int t = paged.stepPlayback(now);
+    if (t != sequence.back()) sequence.push_back(t);
+  }
+  ASSERT_EQ(sequence.size(), 9u) << "playback stalled";
+  for (std::size_t i = 1; i < sequence.size(); ++i) {
+    EXPECT_EQ(sequence[i], (sequence[i - 1] + 1) % 4) << "skipped at " << i;
+  }
+  // Each time point's image is its own (the volume shown is time point t's).
+  for (const int t : {2, 0}) {
+    paged.waitTimePoint(t);
+    EXPECT_TRUE(std::ranges::equal(paged.volume().bytes(), readTimePoint(path.string(), t).bytes()))
+        << t;
   }
 }
 

@@ -81,6 +81,59 @@ EMSCRIPTEN_KEEPALIVE void tessera_clear_files() {
   if (web::WebSession* s = web::sessionIfAny()) s->clearFiles();
 }
 
+// The open time series (a dropped 4-D NIfTI; session/TimeSeries.h):
+// {"count": N, "shown": t, "playing": bool, "fps": f, "late": frames,
+// "advances": n}, or {"count": 1} when the volume is not a series.
+EMSCRIPTEN_KEEPALIVE const char* tessera_time_json() {
+  web::WebSession* s = web::sessionIfAny();
+  const session::TimeSeries* series = s ? s->rendering().series() : nullptr;
+  if (!series) return web::jsonOut({{"count", 1}});
+  session::Playback& p = s->rendering().playback();
+  return web::jsonOut({{"count", series->count()},
+                       {"shown", s->rendering().timePoint()},
+                       {"playing", p.playing()},
+                       {"fps", p.fps()},
+                       {"late", p.lateFrames()},
+                       {"advances", p.advances()}});
+}
+
+// Shows time point t if it has been read (1), else asks for it and reads
+// one time point ahead (0: call again next frame); -1 with the reason for
+// a t out of range or no series.
+EMSCRIPTEN_KEEPALIVE int tessera_time_show(int t) {
+  int shown = -1;
+  const int ok = guarded([&] {
+    session::Session& s = web::session().rendering();
+    shown = s.showTimePoint(t) ? 1 : 0;
+    if (!shown && s.series()) s.series()->pump();
+  });
+  return ok ? shown : -1;
+}
+
+// Starts (play 1) or pauses (0) playback at `fps` time points per second;
+// 0 with the reason for a rate outside 0.1..120 or no series.
+EMSCRIPTEN_KEEPALIVE int tessera_playback(int play, double fps, double nowMs) {
+  return guarded([&] {
+    session::Session& s = web::session().rendering();
+    if (!s.series()) throw InputError("no time series is open (drop a 4-D NIfTI file)");
+    s.playback().setFps(fps);
+    if (play) {
+      s.playback().play(nowMs);
+    } else {
+      s.playback().pause();
+    }
+  });
+}
+
+// Once per animation frame while playing: the time point to draw
+// (Session::stepPlayback; it reads one time point ahead per call), -1 on
+// error.
+EMSCRIPTEN_KEEPALIVE int tessera_playback_step(double nowMs) {
+  int shown = -1;
+  const int ok = guarded([&] { shown = web::session().rendering().stepPlayback(nowMs); });
+  return ok ? shown : -1;
+}
+
 EMSCRIPTEN_KEEPALIVE int tessera_load_files() {
   return guarded([&] { web::session().loadPickedFiles(); });
 }

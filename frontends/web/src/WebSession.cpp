@@ -169,16 +169,31 @@ void WebSession::loadGenerated(const std::string& spec) {
 }
 
 void WebSession::loadPickedFiles() {
-  std::vector<PickedFile> picked = std::move(picked_);
+  // Kept by the reader of a time series, which reads its time points from
+  // these bytes as playback asks for them.
+  struct HeldFiles {
+    std::vector<PickedFile> picked;
+    MemoryFiles files;
+  };
+  auto held = std::make_shared<HeldFiles>();
+  held->picked = std::move(picked_);
   picked_.clear();
-  MemoryFiles files;
-  for (const PickedFile& f : picked) {
-    files.add(f.name, std::span<const std::byte>(reinterpret_cast<const std::byte*>(f.bytes.get()),
-                                                 f.size));
+  for (const PickedFile& f : held->picked) {
+    held->files.add(f.name, std::span<const std::byte>(
+                                reinterpret_cast<const std::byte*>(f.bytes.get()), f.size));
   }
-  const std::string name = volumeFileAmong(files.names());
+  const std::string name = volumeFileAmong(held->files.names());
   zoomForget();
-  session_->setVolume(readVolume(*files.open(name), files), name);
+  const std::unique_ptr<ByteSource> file = held->files.open(name);
+  const int count = timePointCount(*file);
+  if (count > 1) {
+    session_->openSeries(
+        count,
+        [held, name](int t) { return readTimePoint(*held->files.open(name), held->files, t); },
+        name);
+    return;
+  }
+  session_->setVolume(readVolume(*file, held->files), name);
 }
 
 double WebSession::renderFrame(int width, int height) {

@@ -46,6 +46,10 @@ Volume readTimePoint(const std::string& spec, int time);
 // that decodes it and reads where the files are (files in memory: the
 // reader without DCMTK, DicomBasicReader.h).
 Volume readVolume(const ByteSource& file, const FileSet& files);
+// The time points of such a file (1 unless its format holds time series)
+// and time point `time` of it (InputError out of range, as above).
+int timePointCount(const ByteSource& file);
+Volume readTimePoint(const ByteSource& file, const FileSet& files, int time);
 
 // Of several files opened together (the browser's picker or a drop), the
 // one to read: a header that names the others (a .json sidecar, .nhdr,

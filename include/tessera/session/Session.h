@@ -95,6 +95,12 @@ class Session {
   // window (or the settings' window) so that values keep their colour over
   // time. InputError when `spec` holds one time point.
   void openSeries(const std::string& spec, const OpenOptions& options = {});
+  // The same for `count` time points that `read` reads (files in memory,
+  // the browser's dropped 4-D NIfTI), shown under `name`, from time point
+  // `time`; read ahead as `reading` says (stepPlayback pumps an OnPump
+  // series: one time point per call).
+  void openSeries(int count, TimeSeries::Reader read, const std::string& name, int time = 0,
+                  TimeSeries::Reading reading = TimeSeries::defaultReading());
   // The open series (null when the volume is not one).
   TimeSeries* series() { return series_.get(); }
   const TimeSeries* series() const { return series_.get(); }

@@ -29,11 +29,19 @@ namespace tessera::session {
 class TimeSeries {
  public:
   using Reader = std::function<Volume(int time)>;
+  // Where the time points ahead are read: on the series' own thread, or one
+  // per pump() call on the caller's (a browser page without threads reads
+  // between its frames).
+  enum class Reading { Background, OnPump };
+  // Background where the build has threads, OnPump in a WebAssembly build
+  // without them.
+  static Reading defaultReading();
 
-  // `count` time points, each read by `read` on the series' own thread (one
-  // at a time; `read` must be callable from there), at most `keep` of them
-  // held at once (1..count). InputError for a count or keep out of range.
-  TimeSeries(int count, Reader read, int keep);
+  // `count` time points, each read by `read` (one at a time; with
+  // Background on the series' own thread, so `read` must be callable from
+  // there), at most `keep` of them held at once (1..count). InputError for
+  // a count or keep out of range.
+  TimeSeries(int count, Reader read, int keep, Reading reading = Reading::Background);
   ~TimeSeries();
   TimeSeries(const TimeSeries&) = delete;
   TimeSeries& operator=(const TimeSeries&) = delete;
@@ -51,8 +59,12 @@ class TimeSeries {
   // that window are let go. Thread-safe.
   std::shared_ptr<Volume> want(int t);
   // Waits until time point `t` is read (asking for it as want() does); the
-  // reader's exception for it is rethrown.
+  // reader's exception for it is rethrown. OnPump: reads it now.
   std::shared_ptr<Volume> wait(int t);
+  // OnPump: reads the first wanted time point not read yet, if any, and
+  // returns true when it read one. Background: does nothing, false.
+  bool pump();
+  Reading reading() const { return mode_; }
   // The time points read so far (a time point read again after it was let
   // go counts again): what a test checks the prefetch by.
   std::vector<int> readLog() const;
@@ -60,10 +72,16 @@ class TimeSeries {
  private:
   void askFrom(int t);
   void work();
+  // Under mutex_: the first wanted time point neither held nor failed, or -1.
+  int nextToRead() const;
+  // Reads `t` with mutex_ held by `lock` (released during the read) and
+  // keeps it if it is still wanted.
+  void readOne(int t, std::unique_lock<std::mutex>& lock);
 
   const int count_;
   const Reader read_;
   const int keep_;
+  const Reading mode_;
   mutable std::mutex mutex_;
   std::condition_variable changed_;
   std::vector<int> wanted_;  // in the order to read
