@@ -373,7 +373,7 @@ export function attach(opts) {
   const q = (sel) => panel.querySelector(sel);
   q('.dw-root').textContent = root;
   q('.dw-search').addEventListener('input', draw);
-  q('.dw-reload').addEventListener('click', () => list());
+  q('.dw-reload').addEventListener('click', () => list().catch(() => {}));  // shown
 
   function draw() {
     const words = q('.dw-search').value.toLowerCase().split(/\s+/).filter((w) => w);
@@ -515,13 +515,14 @@ export function attach(opts) {
       const fetchOne = async (k) => {
         const inst = instances[k];
         let got;
+        const whole = wholeInstances;
         try {
-          got = wholeInstances ? await instanceOf(inst, signal, stats) : await frameOf(inst, signal, stats);
+          got = whole ? await instanceOf(inst, signal, stats) : await frameOf(inst, signal, stats);
         } catch (e) {
           // Some archives cannot send a frame of some syntaxes on its own
           // (Orthanc 1.10 answers HTTP 500 "Not implemented yet" for HTJ2K
           // frames): the instance as it is stored, a Part-10 file, instead.
-          if (wholeInstances || !/: HTTP (500|501|406|400)\b/.test(e.message) || signal.aborted) throw e;
+          if (whole || !/: HTTP (500|501|406|400)\b/.test(e.message) || signal.aborted) throw e;
           try {
             got = await instanceOf(inst, signal, stats);
           } catch (e2) {
@@ -573,10 +574,10 @@ export function attach(opts) {
       if (!ok) throw new Error(document.getElementById('error').textContent);
       return stats;
     } catch (e) {
-      progress(0, 0);
       stats.error = e.message;
       stats.ms = performance.now() - t0;
       if (signal.aborted && busy !== controller) throw new Error('superseded by another series');
+      progress(0, 0);
       if (e.name !== 'AbortError') showError(e.message + opts.keeps());
       status(`${seriesUrl} did not open`);
       throw e;

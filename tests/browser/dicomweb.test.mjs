@@ -14,8 +14,9 @@
 // voxel equal to the stored values + Rescale Intercept, and the page's
 // render equal to its render of the same folder picked as files. Errors: a
 // series the archive does not hold (404), an answer with the wrong
-// multipart boundary and the archive stopped each show one line naming the
-// URL, the previous volume stays, and the page opens a series afterwards.
+// multipart boundary, the archive gone mid-series, a QIDO answer that is not
+// JSON and the archive stopped each show one line naming the URL, the
+// previous volume stays, and the page opens a series afterwards.
 import { test } from 'node:test';
 import fs from 'node:fs';
 import path from 'node:path';
@@ -37,7 +38,9 @@ async function dicomWeb(context, url, tmp) {
   const orthanc = await startOrthanc(path.join(tmp, 'orthanc'));
   let archive = orthanc.root;
   let mangle = false;  // the frames' Content-Type names another boundary
+  let answer = () => null;  // canned answers in the archive's stead
   const web = await serveWithArchive(site, () => archive, {
+    answer: (p) => answer(p),
     contentType: (p, type) => (mangle && p.includes('/frames/') ? type.replace(/boundary=[^;]*/, 'boundary=tessera-wrong') : type),
   });
   try {
@@ -127,6 +130,21 @@ async function dicomWeb(context, url, tmp) {
     const mBoundary = await failing(manifest.series['j2k-lossless'].uid, 'frames whose Content-Type names another boundary');
     check('… its message names the frame URL and the boundary', /\/frames\/1: multipart body: the boundary 'tessera-wrong' of its Content-Type never occurs/.test(mBoundary), mBoundary);
     mangle = false;
+    // The archive gone mid-series: after 10 frames, connections close unanswered.
+    let frames = 0;
+    answer = (p) => (p.includes('/frames/') && ++frames > 10 ? 'hang up' : null);
+    const mHangUp = await failing(manifest.series['jpeg-lossless'].uid, 'the archive gone after 10 frames');
+    check('… its message names a frame URL', /\/instances\/[0-9.]+\/frames\/1: (no answer|the answer stopped)/.test(mHangUp), mHangUp);
+    // A QIDO answer that is not JSON (a login page, a wrong root): the table keeps its rows.
+    answer = (p) => (p.endsWith('/studies') ? { status: 200, type: 'text/html', body: '<html><body>Please log in</body></html>' } : null);
+    await page.click('#dicomweb .dw-reload');
+    await page.waitForFunction(() => window.tessera.error().includes('/studies?'), null, { timeout: 10000 });
+    const mJson = await page.evaluate(() => window.tessera.error());
+    const kept = await page.evaluate(() => window.tessera.dicomweb.shownRows().length);
+    check('a QIDO answer that is not JSON: one line naming the URL, the table keeps its 4 rows',
+          mJson.startsWith(`${web.url}/dicom-web/studies?`) && mJson.includes("the answer is not JSON (Content-Type 'text/html', starts '<html><body>Please log in") && kept === 4,
+          `"${mJson}", ${kept} rows`);
+    answer = () => null;
     await orthanc.stop();
     const mStopped = await failing(manifest.series.original.uid, 'the archive stopped');
     check('… its message names the URL and the proxy\'s 502', mStopped.includes(`${web.url}/dicom-web/studies/${manifest.study}/series/${manifest.series.original.uid}/metadata: HTTP 502`), mStopped);

@@ -84,13 +84,22 @@ const TYPES = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/ja
   '.css': 'text/css', '.wasm': 'application/wasm', '.png': 'image/png', '.json': 'application/json' };
 
 // The site, and /dicom-web/… forwarded to `archive` (its DICOMweb root's
-// origin). `hooks.contentType(path, type)` may change a forwarded answer's
-// Content-Type (the wrong-boundary case); `counts` is what was forwarded.
+// origin). For the bad-input cases, `hooks.answer(path)` may answer in the
+// archive's stead ({status, type, body}, or 'hang up': the connection
+// closed unanswered) and `hooks.contentType(path, type)` change a forwarded
+// answer's Content-Type; `counts` is what was forwarded.
 export async function serveWithArchive(site, archive, hooks = {}) {
   const counts = { requests: 0, bytes: 0 };
   const server = http.createServer((req, res) => {
     const p = decodeURIComponent(new URL(req.url, 'http://x').pathname);
     if (p.startsWith('/dicom-web/')) {
+      const canned = hooks.answer ? hooks.answer(p) : null;
+      if (canned === 'hang up') { req.socket.destroy(); return; }
+      if (canned) {
+        res.writeHead(canned.status, { 'Content-Type': canned.type });
+        res.end(canned.body);
+        return;
+      }
       const up = http.request(`${archive()}${req.url}`, { method: req.method, headers: { accept: req.headers.accept || '*/*' } }, (ur) => {
         let type = ur.headers['content-type'] || '';
         if (hooks.contentType) type = hooks.contentType(p, type);
