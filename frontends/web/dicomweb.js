@@ -330,6 +330,21 @@ async function instanceOf(inst, signal, stats) {
     entry: { name: inst.url, bytes: file } };
 }
 
+// The pixel data of a file dicom-codecs.js decoded (explicit VR LE, OW or
+// OB of the frame's size), found from the end; null when it is not there.
+// (Its last() is shared by concurrent decodes, so it is not used here.)
+function decodedPixels(b, frameBytes) {
+  const padded = frameBytes + (frameBytes & 1);
+  const v = new DataView(b.buffer, b.byteOffset, b.byteLength);
+  for (let at = b.length - padded - 12; at >= 132; at--) {
+    if (b[at] === 0xe0 && b[at + 1] === 0x7f && b[at + 2] === 0x10 && b[at + 3] === 0x00 && b[at + 4] === 0x4f &&
+        (b[at + 5] === 0x57 || b[at + 5] === 0x42) && v.getUint32(at + 8, true) === padded) {
+      return b.subarray(at + 12, at + 12 + frameBytes);
+    }
+  }
+  return null;
+}
+
 // A Part-10 file's transfer syntax (its meta group, explicit VR LE), '' if none.
 function part10Syntax(b) {
   if (b.length < 144 || b[128] !== 0x44 || b[129] !== 0x49 || b[130] !== 0x43 || b[131] !== 0x4d) return '';
@@ -442,6 +457,11 @@ export function attach(opts) {
     const frame = q('.dw-frame'), stack = q('.dw-stack');
     frame.width = cols; frame.height = rowsN;
     stack.width = cols; stack.height = instances.length;
+    // Shown in millimetres: the pixel spacing across, the slice spacing down.
+    const dx = Number(value(ds, '00280030')[1] || 1);
+    const dz = instances.length > 1 ? Math.abs(instances[instances.length - 1].along - instances[0].along) / (instances.length - 1) : dx;
+    stack.style.aspectRatio = `${cols * dx} / ${instances.length * (dz || dx)}`;
+    frame.style.aspectRatio = `${cols * dx} / ${rowsN * Number(value(ds, '00280030')[0] || dx)}`;
     const fctx = frame.getContext('2d'), sctx = stack.getContext('2d');
     sctx.fillStyle = '#223'; sctx.fillRect(0, 0, stack.width, stack.height);
     const slope = Number(first(ds, '00281053', 1)), intercept = Number(first(ds, '00281052', 0));
@@ -541,7 +561,7 @@ export function attach(opts) {
           } catch (e) {
             throw failure(got.url, e.message.startsWith(entry.name) ? e.message.slice(entry.name.length + 2) : e.message);
           }
-          pixels = codecs.last().pixels[0].pixels;
+          pixels = decodedPixels(entry.bytes, inst.frameBytes);
         }
         if (signal.aborted) return;
         inst.entry = entry;

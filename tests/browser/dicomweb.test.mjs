@@ -20,7 +20,7 @@
 import { test } from 'node:test';
 import fs from 'node:fs';
 import path from 'node:path';
-import { SIZE, check, snapshot, openPage, withoutOverlays, differingPixels, browserSuite, run, site } from './fixture.mjs';
+import { SIZE, check, snapshot, openPage, withoutOverlays, differingPixels, browserSuite, run, site, shots } from './fixture.mjs';
 import { orthancMissing, startOrthanc, serveWithArchive, makeSeries } from './orthanc.mjs';
 
 const checks = browserSuite();
@@ -98,18 +98,31 @@ async function dicomWeb(context, url, tmp) {
         const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
         let unfilled = 0;
         for (let y = 0; y < c.height; y++) if (d[4 * y * c.width] === 0x22 && d[4 * y * c.width + 2] === 0x33) unfilled++;
-        return { rows: c.height, unfilled };
+        return { rows: c.height, unfilled, red: Array.from(d.filter((_, i) => i % 4 === 0)) };
       });
+      // The preview's cut: the middle row of every slice, superior at the
+      // top, through the series' window (40/400).
+      let previewWrong = 0;
+      for (let z = 0; z < SLICES; z++) {
+        for (let x = 0; x < COLS; x++) {
+          const hu = stored[(z * ROWS + ROWS / 2) * COLS + x] + manifest.intercept;
+          const grey = Math.max(0, Math.min(255, Math.round(255 * (hu - (40 - 200)) / 400)));
+          if (Math.abs(stackFilled.red[(SLICES - 1 - z) * COLS + x] - grey) > 1) previewWrong++;
+        }
+      }
+      stackFilled.wrong = previewWrong;
       check(`${kind} (${s.syntax}) from Orthanc: dims and affine as \`tessera info\` of the folder, every voxel equal, the render identical`,
             !stats.error && state.dims.join('x') === native.dims.join('x') && affineEqual(state.affine, native.affine) &&
             bad === 0 && differingPixels(pixels, folderPixels, 0) === 0 && stats.syntaxes.join() === s.syntax,
             stats.error || `${stats.frames} frames, ${stats.syntaxes.join()}, ${(stats.bytes / 1024).toFixed(0)} KiB in ${stats.requests} requests, ` +
             `${stats.ms.toFixed(0)} ms (first frame ${stats.firstFrameMs.toFixed(0)} ms); voxels differing ${bad}; ` +
             `pixels differing ${differingPixels(pixels, folderPixels, 0)}; affine ${JSON.stringify(state.affine[0])}`);
-      check(`${kind}: the progress bar showed, and the preview filled in all 40 slices as frames arrived`,
-            progressSeen && stackFilled.rows === SLICES && stackFilled.unfilled === 0 && stats.shown.length === SLICES &&
+      check(`${kind}: the progress bar showed, and the preview's cut filled in all 40 slices with the stored values as frames arrived`,
+            progressSeen && stackFilled.rows === SLICES && stackFilled.unfilled === 0 && stackFilled.wrong === 0 && stats.shown.length === SLICES &&
             !(await page.isVisible('#progress')),
-            `progress seen ${progressSeen}, preview rows ${stackFilled.rows}, unfilled ${stackFilled.unfilled}, shown ${stats.shown.length}`);
+            `progress seen ${progressSeen}, preview rows ${stackFilled.rows}, unfilled ${stackFilled.unfilled}, ` +
+            `pixels unlike the stored values' ${stackFilled.wrong}, shown ${stats.shown.length}`);
+      if (shots && kind === 'j2k-lossless') await page.screenshot({ path: path.join(shots, 'web-dicomweb.jpg'), type: 'jpeg', quality: 85 });
     }
 
     // Errors: each names the URL, the last volume stays, the page goes on.
