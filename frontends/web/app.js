@@ -24,6 +24,9 @@ import { TesseraViewer } from './tessera.js';
   const progressive = params.get('progressive') !== '0';
   const frameBudgetMs = Math.max(1, parseFloat(params.get('budget') || '12') || 12);
   const volumeUrls = params.getAll('url').filter((u) => u.length);
+  // ?dicomweb=ROOT: a DICOMweb archive's studies and series to open
+  // (frontends/web/dicomweb.js).
+  const dicomwebRoot = params.get('dicomweb') || '';
   // Axial, coronal and sagittal views beside the 3D view (frontends/web/slices.js;
   // ?slices=0: the 3D view alone).
   const withSlices = params.get('slices') !== '0' && !!window.TesseraSlices;
@@ -86,6 +89,7 @@ import { TesseraViewer } from './tessera.js';
   let refineNotBefore = 0;  // performance.now() before which no strip is rendered
   let slices = null;        // frontends/web/slices.js, once the module is up
   let zarr = null;  // an open OME-Zarr store (frontends/web/zarr-url.js)
+  let dicomweb = null;  // the DICOMweb browser (frontends/web/dicomweb.js), with ?dicomweb=
 
   function showError(message) {
     const e = $('error');
@@ -1001,9 +1005,22 @@ import { TesseraViewer } from './tessera.js';
       try { viewer.loadGenerated(defaultVolume); } catch (e) { showError(e.message); }
       volumeChanged();
     }
+    if (dicomwebRoot) await attachDicomWeb();
     await requestRender();
     return state;
   })();
+
+  // The archive's series in a table above the view; a series chosen there
+  // is read into {name, bytes} entries and opened by openEntries().
+  async function attachDicomWeb() {
+    const { attach } = await import('./dicomweb.js');
+    dicomweb = attach({ root: dicomwebRoot, openEntries, showError, clearError, keeps,
+      status: (t) => { $('status').textContent = t; },
+      progress: (v, max) => { $('progress').hidden = !(max > 0); if (max > 0) { $('progress').max = max; $('progress').value = v; } } });
+    window.tessera.dicomweb = dicomweb;
+    try { await dicomweb.list(); } catch { /* shown; the page stays usable */ }
+    updateStatus();
+  }
 
   // The bread-slice region [begin, end) of an open store's level 0 at
   // native resolution (bounded reads: only its chunks are fetched), shown
