@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
 #include "tessera/lod/MultiresVolumeSource.h"
 #include "tessera/lod/WindowedSource.h"
 #include "tessera/reference/ReferenceRaycaster.h"
@@ -118,6 +119,25 @@ Settings Session::currentSettings() const {
 
 void Session::setVolume(Volume volume, const std::string& name) {
   setVolume(std::make_shared<Volume>(std::move(volume)), name);
+}
+
+void Session::openSeries(int count, TimeSeries::Reader read, const std::string& name, int time,
+                         TimeSeries::Reading reading) {
+  if (count < 2) throw InputError(name + ": one time point, not a time series");
+  if (time < 0 || time >= count) {
+    throw InputError(name + ": time point " + std::to_string(time) + " asked for, the series has " +
+                     std::to_string(count) + " (0.." + std::to_string(count - 1) + ")");
+  }
+  auto first = std::make_shared<Volume>(read(time));
+  const int keep =
+      TimeSeries::keepWithin(HostBudget::global().limitBytes() / 4, first->byteSize(), count);
+  auto series = std::make_unique<TimeSeries>(count, std::move(read), keep, reading);
+  setVolume(first, name);
+  // Every time point in the first one's window, unless the settings say one.
+  seriesWindow_ = settings_.window ? *settings_.window : first->window();
+  series_ = std::move(series);
+  timePoint_ = time;
+  series_->want(timePoint_);  // reads ahead from here
 }
 
 bool Session::showTimePoint(int t) {

@@ -175,23 +175,4 @@ void Session::openSeries(const std::string& spec, const OpenOptions& options) {
       count, [spec](int t) { return readTimePoint(spec, t); }, spec, options.time);
 }
 
-void Session::openSeries(int count, TimeSeries::Reader read, const std::string& name, int time,
-                         TimeSeries::Reading reading) {
-  if (count < 2) throw InputError(name + ": one time point, not a time series");
-  if (time < 0 || time >= count) {
-    throw InputError(name + ": time point " + std::to_string(time) + " asked for, the series has " +
-                     std::to_string(count) + " (0.." + std::to_string(count - 1) + ")");
-  }
-  auto first = std::make_shared<Volume>(read(time));
-  const int keep =
-      TimeSeries::keepWithin(HostBudget::global().limitBytes() / 4, first->byteSize(), count);
-  auto series = std::make_unique<TimeSeries>(count, std::move(read), keep, reading);
-  setVolume(first, name);
-  // Every time point in the first one's window, unless the settings say one.
-  seriesWindow_ = settings_.window ? *settings_.window : first->window();
-  series_ = std::move(series);
-  timePoint_ = time;
-  series_->want(timePoint_);  // reads ahead from here
-}
-
 }  // namespace tessera::session
