@@ -36,6 +36,11 @@ void updateOverlay(DesktopApp& ds) {
 void loadVolume(DesktopApp& ds, const std::string& spec) {
   session::OpenOptions open;
   open.series = ds.options.series;
+  // --time and --channel choose within the file given on the command line.
+  if (spec == ds.options.file) {
+    open.time = ds.options.time;
+    open.channel = ds.options.channel;
+  }
   ds.session->openInView(spec, open);
   for (auto& tile : ds.slices) {
     tile.geometry.reset();

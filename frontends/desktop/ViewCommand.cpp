@@ -38,6 +38,7 @@ void addViewCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "view", "Interactive viewer: GLFW window with OpenGL ES (EGL) and the TF editor");
   addVolumeOptions(cmd, o->file, o->series);
+  addTimeChannelOptions(cmd, o->time, o->channel);
   addDefaultedOption(cmd, "--tf", o->tf, "Transfer function: preset or FILE.json");
   addSizeOption(cmd, o->size, "Window");
   o->labelsOption = addLabelsOption(
@@ -54,7 +55,8 @@ void addViewCommand(CLI::App& app) {
                   "Write the window to this PNG after --frames frames and exit");
   addDefaultedOption(cmd, "--frames", o->frames, "Frames before --screenshot");
   cmd->add_option("--play", o->play,
-                  "A time series (4-D NIfTI): start playing at FPS time points per second (the "
+                  "A time series (4-D NIfTI, OME-Zarr store with a t axis): start playing at FPS "
+                  "time points per second (the "
                   "Time panel plays, pauses and picks one); with --screenshot, the playback's "
                   "rate, time points shown and late frames are printed")
       ->check(CLI::Range(0.1, 120.0));

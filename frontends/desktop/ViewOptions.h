@@ -15,6 +15,8 @@ namespace tessera::desktop {
 struct ViewOptions {
   std::string file;
   std::string series;
+  int time = 0;     // the time point shown first (a 4-D NIfTI, a store's t axis)
+  int channel = 0;  // a store's channel (c axis)
   std::string tf = "mr-default";
   std::string size = "1280x800";
   std::string profile = "gles3";

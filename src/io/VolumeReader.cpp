@@ -118,19 +118,21 @@ bool mayHoldTimeSeries(const std::string& spec) {
 }  // namespace
 
 int timePointCount(const std::string& spec) {
+  if (isZarrStore(spec)) return ZarrStore(openZarrStorage(spec)).timePoints();
   if (!mayHoldTimeSeries(spec)) return 1;
   const FileSource file{std::filesystem::path(spec)};
   const VolumeFormat& format = chooseReadFormat(file);
   return format.timePoints ? format.timePoints(file) : 1;
 }
 
-Volume readTimePoint(const std::string& spec, int time) {
+Volume readTimePoint(const std::string& spec, int time, int channel) {
+  if (isZarrStore(spec)) return readZarrVolume(spec, {.time = time, .channel = channel});
   if (mayHoldTimeSeries(spec)) {
     const FileSource file{std::filesystem::path(spec)};
     const VolumeFormat& format = chooseReadFormat(file);
     if (format.readTimePoint) return format.readTimePoint(file, FolderFiles(), time);
   }
-  return readVolume(spec, {.dicomSeries = "", .time = time, .channel = 0});
+  return readVolume(spec, {.dicomSeries = "", .time = time, .channel = channel});
 }
 
 Volume readVolume(const ByteSource& file, const FileSet& files) {

@@ -429,6 +429,11 @@ void ZarrStore::addLevel(const std::string& path, glm::dvec3 scale, glm::dvec3 t
   }
 }
 
+int ZarrStore::timePoints() const {
+  const int t = axis_[kT];
+  return t >= 0 ? static_cast<int>(levels_.front().array.shape[std::size_t(t)]) : 1;
+}
+
 void ZarrStore::checkSelection() {
   const ZarrArrayMeta& a = levels_.front().array;
   const auto check = [&](int role, int value, const char* option, const char* axis) {

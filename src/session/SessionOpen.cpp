@@ -23,6 +23,16 @@ namespace tessera::session {
 
 namespace {
 
+// A time series the view plays in core: a 4-D file, or a store with a t
+// axis whose level 0 fits a quarter of the host budget (a larger store is
+// explored streamed, at the time point asked for).
+bool playsInCore(const std::string& spec) {
+  if (!isZarrStore(spec)) return timePointCount(spec) > 1;
+  const ZarrStore store(openZarrStorage(spec));
+  return store.timePoints() > 1 &&
+         store.finestLevelWithin(HostBudget::global().limitBytes() / 4) == 0;
+}
+
 bool streamsBricks(const std::string& layoutWish) {
   return layoutWish != "auto" && layout::LayoutRegistry::global().find(layoutWish).streamsBricks;
 }
@@ -141,7 +151,7 @@ void Session::open(const std::string& spec, const OpenOptions& options) {
 void Session::openInView(const std::string& spec, const OpenOptions& options) {
   viewer::Viewer& v = view();
   // A time series is shown one time point at a time, each in core.
-  if (timePointCount(spec) > 1) {
+  if (playsInCore(spec)) {
     openSeries(spec, options);
     return;
   }
@@ -169,10 +179,13 @@ void Session::openInView(const std::string& spec, const OpenOptions& options) {
 void Session::openSeries(const std::string& spec, const OpenOptions& options) {
   const int count = timePointCount(spec);
   if (count < 2) {
-    throw InputError(spec + ": one time point, not a time series (a 4-D NIfTI is)");
+    throw InputError(
+        spec + ": one time point, not a time series (a 4-D NIfTI or a store with a t axis is)");
   }
+  const int channel = options.channel;
   openSeries(
-      count, [spec](int t) { return readTimePoint(spec, t); }, spec, options.time);
+      count, [spec, channel](int t) { return readTimePoint(spec, t, channel); }, spec,
+      options.time);
 }
 
 }  // namespace tessera::session

@@ -132,6 +132,32 @@ TEST_F(ZarrInterop, TimeAndChannelOutsideTheStoreAreErrors) {
   EXPECT_THROW(readVolume(cases_[0]["store"].get<std::string>(), select(1, 0)), InputError);
 }
 
+// A store's t axis is a time series as a 4-D NIfTI's is: its length counted,
+// each time point (of the channel asked for) read as readVolume reads it;
+// stores without a t axis hold one time point.
+TEST_F(ZarrInterop, AStoresTimeAxisIsATimeSeries) {
+  const std::string store = cases_[4]["store"];
+  ASSERT_EQ(cases_[4]["name"], "tczyx_u16_zstd");
+  EXPECT_EQ(ZarrStore(openZarrStorage(store)).timePoints(), 2);
+  EXPECT_EQ(timePointCount(store), 2);
+  for (int t = 0; t < 2; ++t) {
+    for (const int c : {0, 2}) {
+      const Volume want = readVolume(store, select(t, c));
+      const Volume got = readTimePoint(store, t, c);
+      ASSERT_EQ(got.byteSize(), want.byteSize());
+      EXPECT_EQ(std::memcmp(got.bytes().data(), want.bytes().data(), want.byteSize()), 0)
+          << "t " << t << " c " << c;
+    }
+  }
+  EXPECT_NE(
+      std::memcmp(readTimePoint(store, 0, 0).bytes().data(),
+                  readTimePoint(store, 1, 0).bytes().data(), readTimePoint(store, 0, 0).byteSize()),
+      0)
+      << "the two time points are the same voxels";
+  EXPECT_EQ(timePointCount(cases_[0]["store"].get<std::string>()), 1);
+  EXPECT_THROW(readTimePoint(store, 2, 0), InputError);
+}
+
 // Tessera's writer, checked by zarr-python: level 0 voxel-exact, every
 // level the 2x2x2 mean of the one before, NGFF metadata.
 TEST_F(ZarrInterop, ZarrPythonReadsTesseraStoresVoxelExact) {

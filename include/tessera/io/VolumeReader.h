@@ -33,12 +33,14 @@ struct ReadOptions {
 
 Volume readVolume(const std::string& spec, const ReadOptions& options = {});
 
-// A file whose format holds time series (4-D NIfTI): how many time points
-// it holds (1 for any other file, folder, store or spec), and time point
-// `time` of it, read as readVolume does but without its note (what a
-// time-series player reads ahead with). InputError as readVolume.
+// A file whose format holds time series (4-D NIfTI) or an OME-Zarr store
+// with a t axis: how many time points it holds (1 for any other file,
+// folder or spec), and time point `time` of it (of a store: channel
+// `channel`, the finest level that fits the host budget), read as
+// readVolume does but without its note (what a time-series player reads
+// ahead with). InputError as readVolume.
 int timePointCount(const std::string& spec);
-Volume readTimePoint(const std::string& spec, int time);
+Volume readTimePoint(const std::string& spec, int time, int channel = 0);
 
 // The same choice and readers on a byte source, the other files it names
 // found in `files`: what the browser reads picked or dropped files with.
