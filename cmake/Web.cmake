@@ -59,6 +59,7 @@ endforeach()
 # not its headless device (EGL) nor its opening of named files and stores
 # (the page hands volumes over in memory and fetches stores itself).
 list(REMOVE_ITEM TESSERA_WEB_SOURCES ${CMAKE_SOURCE_DIR}/src/session/SessionOpen.cpp
+     ${CMAKE_SOURCE_DIR}/src/session/Convert.cpp
      ${CMAKE_SOURCE_DIR}/src/session/VolumePyramid.cpp)
 # The EGL platform; src/gpu/GlContextWebGL.cpp is the browser's.
 list(REMOVE_ITEM TESSERA_WEB_SOURCES ${CMAKE_SOURCE_DIR}/src/gpu/GlContext.cpp)

@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
-#include <sstream>
 
 #include "cli/Commands.h"
 #include "tessera/core/Error.h"
@@ -15,7 +14,7 @@
 #include "tessera/io/VolumeWriter.h"
 #include "tessera/io/ZarrStore.h"
 #include "tessera/io/ZarrWriter.h"
-#include "tessera/lod/Downsample.h"
+#include "tessera/session/Convert.h"
 
 namespace tessera::app {
 
@@ -25,16 +24,9 @@ struct ConvertOptions {
   std::string in;
   std::string out;
   std::string series;  // DICOM Series Instance UID
-  std::string crop;
-  std::string downsample;
-  int time = 0;  // OME-Zarr input: time point and channel
+  int time = 0;        // OME-Zarr input: time point and channel
   int channel = 0;
-  // OME-Zarr output.
-  std::string chunk = "64";
-  std::string levels = "auto";
-  std::string compressor = "zstd";
-  int zarrFormat = 2;
-  int shard = 0;
+  session::ConvertRequest request;  // crop, downsample and the OME-Zarr output's options
   bool quiet = false;
 };
 
@@ -64,109 +56,12 @@ class Progress {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
-glm::ivec3 parseFactors(const std::string& text) {
-  int a = 0, b = 0, c = 0;
-  char x1 = 0, x2 = 0;
-  std::istringstream in(text);
-  if ((in >> a) && in.eof()) return {a, a, a};
-  in.clear();
-  in.str(text);
-  if (!(in >> a >> x1 >> b >> x2 >> c) || x1 != 'x' || x2 != 'x' || !in.eof() || a < 1 || b < 1 ||
-      c < 1) {
-    throw InputError("--downsample '" + text + "': expected N or AxBxC with factors >= 1");
-  }
-  return {a, b, c};
-}
-
-// "x0:x1,y0:y1,z0:z1", half-open voxel ranges.
-std::pair<glm::ivec3, glm::ivec3> parseCrop(const std::string& text, glm::ivec3 dims) {
-  glm::ivec3 lo, hi;
-  std::istringstream in(text);
-  char c1, c2, c3, c4, c5;
-  if (!(in >> lo.x >> c1 >> hi.x >> c2 >> lo.y >> c3 >> hi.y >> c4 >> lo.z >> c5 >> hi.z) ||
-      c1 != ':' || c3 != ':' || c5 != ':' || c2 != ',' || c4 != ',' || !in.eof()) {
-    throw InputError("--crop '" + text + "': expected x0:x1,y0:y1,z0:z1 (voxels, end exclusive)");
-  }
-  for (int a = 0; a < 3; ++a) {
-    if (lo[a] < 0 || hi[a] > dims[a] || lo[a] >= hi[a]) {
-      throw InputError("--crop '" + text + "': axis " + std::to_string(a) + " range " +
-                       std::to_string(lo[a]) + ":" + std::to_string(hi[a]) +
-                       " is empty or outside 0:" + std::to_string(dims[a]));
-    }
-  }
-  return {lo, hi};
-}
-
-Volume crop(const Volume& v, glm::ivec3 lo, glm::ivec3 hi) {
-  Volume out = Volume::allocate(hi - lo, v.type(), "cropped volume");
-  out.setSpacing(v.spacing());
-  out.setDirection(v.direction());
-  out.setOrigin(v.worldOf(glm::dvec3(lo)));
-  out.setGeometrySource(v.geometrySource());
-  if (v.hasWindow()) out.setWindow(v.window());
-  out.setDescription(v.description());
-  const std::size_t bpv = bytesPerVoxel(v.type());
-  const std::size_t row = static_cast<std::size_t>(hi.x - lo.x) * bpv;
-  for (int z = lo.z; z < hi.z; ++z) {
-    for (int y = lo.y; y < hi.y; ++y) {
-      const std::byte* src = v.bytes().data() + v.index(lo.x, y, z) * bpv;
-      std::byte* dst = out.bytes().data() + out.index(0, y - lo.y, z - lo.z) * bpv;
-      std::copy(src, src + row, dst);
-    }
-  }
-  out.invalidateRange();
-  return out;
-}
-
 std::string dimsText(glm::ivec3 d) {
   return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
 }
 
-// "Z,Y,X" (array order, as NGFF writes chunks): each an even size in
-// 8..1024; returned as x, y, z.
-glm::ivec3 parseChunkShape(const std::string& text) {
-  const std::string what =
-      "--chunk '" + text + "': expected 64, 128 or Z,Y,X (even sizes in 8..1024)";
-  int zyx[3] = {0, 0, 0};
-  std::size_t at = 0;
-  for (int a = 0; a < 3; ++a) {
-    const std::size_t comma = a < 2 ? text.find(',', at) : text.size();
-    if (comma == std::string::npos) throw InputError(what);
-    const std::string part = text.substr(at, comma - at);
-    if (part.empty() || part.size() > 4 ||
-        part.find_first_not_of("0123456789") != std::string::npos)
-      throw InputError(what);
-    zyx[a] = std::stoi(part);
-    if (zyx[a] < 8 || zyx[a] > 1024 || zyx[a] % 2 != 0) throw InputError(what);
-    at = comma + 1;
-  }
-  if (at != text.size() + 1) throw InputError(what);
-  return {zyx[2], zyx[1], zyx[0]};
-}
-
 OmeZarrWriteOptions zarrOptions(const ConvertOptions& o, Progress& progress) {
-  OmeZarrWriteOptions z;
-  if (o.chunk == "64" || o.chunk == "128") {
-    z.chunk = std::stoi(o.chunk);
-  } else {
-    z.chunkShape = parseChunkShape(o.chunk);
-  }
-  if (o.levels != "auto") {
-    try {
-      std::size_t used = 0;
-      z.levels = std::stoi(o.levels, &used);
-      if (used != o.levels.size() || z.levels < 1) throw InputError("");
-    } catch (const std::exception&) {
-      throw InputError("--levels '" + o.levels + "': expected auto or a count >= 1");
-    }
-  }
-  try {
-    z.compressor = parseZarrCompressor(o.compressor);
-  } catch (const InputError& e) {
-    throw InputError(std::string("--") + e.what());
-  }
-  z.zarrFormat = o.zarrFormat;
-  z.shard = o.shard;
+  OmeZarrWriteOptions z = session::zarrWriteOptions(o.request);
   z.progress = [&progress](double f, const std::string& what) {
     progress.stage("writing " + what, 0.05 + 0.95 * f);
   };
@@ -176,17 +71,21 @@ OmeZarrWriteOptions zarrOptions(const ConvertOptions& o, Progress& progress) {
 void printZarrResult(const ConvertOptions& o, const Volume& shape, const OmeZarrWriteResult& r) {
   std::printf("%s: %s %s -> %s: OME-Zarr (NGFF %s on Zarr v%d%s), %zu levels (", o.in.c_str(),
               dimsText(shape.dims()).c_str(), std::string(scalarTypeName(shape.type())).c_str(),
-              o.out.c_str(), o.zarrFormat == 3 ? "0.5" : "0.4", o.zarrFormat,
-              o.shard > 0 ? (", " + std::to_string(o.shard) + "^3 chunks per shard").c_str() : "",
+              o.out.c_str(), o.request.zarrFormat == 3 ? "0.5" : "0.4", o.request.zarrFormat,
+              o.request.shard > 0
+                  ? (", " + std::to_string(o.request.shard) + "^3 chunks per shard").c_str()
+                  : "",
               r.levelDims.size());
   for (std::size_t l = 0; l < r.levelDims.size(); ++l) {
     std::printf("%s%s", l ? ", " : "", dimsText(r.levelDims[l]).c_str());
   }
-  std::printf(
-      "), chunks %s %s: %llu written, %llu all-zero skipped, %s\n",
-      (o.chunk.find(',') == std::string::npos ? o.chunk + "^3" : o.chunk + " (z,y,x)").c_str(),
-      o.compressor.c_str(), static_cast<unsigned long long>(r.chunksWritten),
-      static_cast<unsigned long long>(r.chunksSkipped), formatBytes(r.bytesWritten).c_str());
+  std::printf("), chunks %s %s: %llu written, %llu all-zero skipped, %s\n",
+              (o.request.chunk.find(',') == std::string::npos ? o.request.chunk + "^3"
+                                                              : o.request.chunk + " (z,y,x)")
+                  .c_str(),
+              o.request.compressor.c_str(), static_cast<unsigned long long>(r.chunksWritten),
+              static_cast<unsigned long long>(r.chunksSkipped),
+              formatBytes(r.bytesWritten).c_str());
   for (const std::string& note : writeLossNotes(shape, o.out)) {
     std::fprintf(stderr, "note: %s\n", note.c_str());
   }
@@ -196,7 +95,8 @@ void printZarrResult(const ConvertOptions& o, const Volume& shape, const OmeZarr
 // time, so memory stays at a few slabs whatever the volume's size.
 bool convertStoreStreaming(const ConvertOptions& o, const OmeZarrWriteOptions& zarr,
                            Progress& progress) {
-  if (!isZarrStore(o.in) || !o.crop.empty() || !o.downsample.empty() || !isOmeZarrName(o.out)) {
+  if (!isZarrStore(o.in) || !o.request.crop.empty() || !o.request.downsample.empty() ||
+      !isOmeZarrName(o.out)) {
     return false;
   }
   const ZarrStore in(openZarrStorage(o.in), {.time = o.time, .channel = o.channel});
@@ -223,15 +123,9 @@ void runConvert(const ConvertOptions& o) {
   Volume v = readVolume(o.in, {.dicomSeries = o.series, .time = o.time, .channel = o.channel});
   const glm::ivec3 inDims = v.dims();
   progress.stage("read " + dimsText(inDims), 0.4);
-  if (!o.crop.empty()) {
-    const auto [lo, hi] = parseCrop(o.crop, v.dims());
-    v = crop(v, lo, hi);
-    progress.stage("cropped to " + dimsText(v.dims()), 0.5);
-  }
-  if (!o.downsample.empty()) {
-    const glm::ivec3 f = parseFactors(o.downsample);
-    if (f != glm::ivec3(1)) v = lod::downsample(v, f);
-    progress.stage("downsampled to " + dimsText(v.dims()), 0.6);
+  if (!o.request.crop.empty() || !o.request.downsample.empty()) {
+    v = session::cropAndDownsample(std::move(v), o.request);
+    progress.stage("cropped/downsampled to " + dimsText(v.dims()), 0.6);
   }
   if (isOmeZarrName(o.out)) {
     // The input is in memory already; the pyramid is still built slab by slab.
@@ -273,24 +167,24 @@ void addConvertCommand(CLI::App& app) {
   cmd->add_option("in", o->in, "Input volume: " + readExtensionsText())->required();
   cmd->add_option("out", o->out, "Output file (format from its extension)")->required();
   addSeriesOption(cmd, o->series);
-  cmd->add_option("--crop", o->crop, "Keep voxels x0:x1,y0:y1,z0:z1 (end exclusive)");
-  cmd->add_option("--downsample", o->downsample, "Box-filter by N or AxBxC");
+  cmd->add_option("--crop", o->request.crop, "Keep voxels x0:x1,y0:y1,z0:z1 (end exclusive)");
+  cmd->add_option("--downsample", o->request.downsample, "Box-filter by N or AxBxC");
   addTimeChannelOptions(cmd, o->time, o->channel);
-  cmd->add_option("--chunk", o->chunk,
+  cmd->add_option("--chunk", o->request.chunk,
                   "OME-Zarr output: chunk edge, 64 or 128 voxels, or Z,Y,X per axis (even, "
                   "8..1024; e.g. 32,512,512)")
       ->default_val("64");
-  cmd->add_option("--levels", o->levels,
+  cmd->add_option("--levels", o->request.levels,
                   "OME-Zarr output: pyramid levels, N or auto (halve until one chunk holds the "
                   "level)")
       ->default_val("auto");
-  cmd->add_option("--compressor", o->compressor,
+  cmd->add_option("--compressor", o->request.compressor,
                   "OME-Zarr output: zstd (level 3), blosc (lz4 + byte shuffle), zlib or none")
       ->default_val("zstd");
-  cmd->add_option("--zarr-format", o->zarrFormat,
+  cmd->add_option("--zarr-format", o->request.zarrFormat,
                   "OME-Zarr output: 2 (NGFF 0.4 on Zarr v2) or 3 (NGFF 0.5 on Zarr v3)")
       ->default_val(2);
-  cmd->add_option("--shard", o->shard,
+  cmd->add_option("--shard", o->request.shard,
                   "OME-Zarr output with --zarr-format 3: N chunks per shard edge "
                   "(sharding_indexed; 0 = unsharded)")
       ->default_val(0);

@@ -28,6 +28,7 @@
 #include "tessera/io/ZarrStore.h"
 #include "tessera/io/ZarrWriter.h"
 #include "tessera/lod/VolumeSource.h"
+#include "tessera/session/Convert.h"
 #include "tessera/session/Session.h"
 #include "tessera/session/VolumeInfo.h"
 #include "tessera/viewer/CameraController.h"
@@ -261,30 +262,24 @@ std::string info(VolumeHandle& v) {
       .dump();
 }
 
-// `tessera convert` for one volume: an OME-Zarr store (its pyramid and
-// chunks as the CLI writes them) or any format the registry writes.
-std::vector<std::string> convert(VolumeHandle& v, const std::string& out, int chunk,
-                                 const std::string& levels, const std::string& compressor) {
-  tessera::OmeZarrWriteOptions z;
-  z.chunk = chunk;
-  if (levels != "auto") {
-    try {
-      std::size_t used = 0;
-      z.levels = std::stoi(levels, &used);
-      if (used != levels.size() || z.levels < 1) throw InputError("");
-    } catch (const std::exception&) {
-      throw InputError("levels '" + levels + "': expected auto or a count >= 1");
-    }
-  }
-  z.compressor = tessera::parseZarrCompressor(compressor);
+// `tessera convert` for one volume: cropped and downsampled as asked, then
+// an OME-Zarr store (its pyramid and chunks as the CLI writes them) or any
+// format the registry writes (session/Convert.h, shared with the CLI).
+std::vector<std::string> convert(VolumeHandle& v, const std::string& out,
+                                 const tessera::session::ConvertRequest& request) {
+  // Checked before anything is read, so that a typo fails at once.
+  const tessera::OmeZarrWriteOptions z = tessera::session::zarrWriteOptions(request);
   const Volume& volume = v.inCore();
   py::gil_scoped_release unlocked;
+  const bool changes = !request.crop.empty() || !request.downsample.empty();
+  const Volume changed = changes ? tessera::session::cropAndDownsample(volume, request) : Volume();
+  const Volume& written = changes ? changed : volume;
   if (tessera::isOmeZarrName(out)) {
-    tessera::writeOmeZarr(volume, out, z);
+    tessera::writeOmeZarr(written, out, z);
   } else {
-    tessera::writeVolume(volume, out);
+    tessera::writeVolume(written, out);
   }
-  return tessera::writeLossNotes(volume, out);
+  return tessera::writeLossNotes(written, out);
 }
 
 std::string tfJson(const std::string& presetOrFileOrJson) {
@@ -367,8 +362,23 @@ PYBIND11_MODULE(_tessera, m) {
   m.def("borrow_array", &borrowArray, py::arg("array"), py::arg("dims"), py::arg("dtype"),
         py::arg("affine"), py::arg("name") = "array");
   m.def("info", &info);
-  m.def("convert", &convert, py::arg("volume"), py::arg("out"), py::arg("chunk") = 64,
-        py::arg("levels") = "auto", py::arg("compressor") = "zstd");
+  m.def(
+      "convert",
+      [](VolumeHandle& v, const std::string& out, const std::string& chunk,
+         const std::string& levels, const std::string& compressor, const std::string& crop,
+         const std::string& downsample, int zarrFormat, int shard) {
+        return convert(v, out,
+                       {.crop = crop,
+                        .downsample = downsample,
+                        .chunk = chunk,
+                        .levels = levels,
+                        .compressor = compressor,
+                        .zarrFormat = zarrFormat,
+                        .shard = shard});
+      },
+      py::arg("volume"), py::arg("out"), py::arg("chunk") = "64", py::arg("levels") = "auto",
+      py::arg("compressor") = "zstd", py::arg("crop") = "", py::arg("downsample") = "",
+      py::arg("zarr_format") = 2, py::arg("shard") = 0);
   m.def("tf_json", &tfJson);
   m.def("tf_presets", &tessera::TransferFunction::presetNames);
   m.attr("orbit_degrees_per_pixel") = tessera::viewer::CameraController::kDegreesPerPixel;

@@ -343,21 +343,48 @@ def convert(
     src: Any,
     dst: PathLike,
     *,
-    chunks: int = 64,
+    chunks: Union[int, Sequence[int]] = 64,
     levels: Union[str, int] = "auto",
     compressor: str = "zstd",
+    crop: Optional[Sequence[Sequence[int]]] = None,
+    downsample: Union[None, int, Sequence[int]] = None,
+    zarr_format: int = 2,
+    shard: int = 0,
 ) -> list:
     """Writes ``src`` (a path, URL, :class:`Volume` or array) to ``dst`` in the
     format its name says (``.nii.gz``, ``.nrrd``, ``.mha``, ``.ome.zarr``…),
-    as ``tessera convert`` does; an OME-Zarr store gets its mean pyramid with
-    ``chunks``, ``levels`` and ``compressor``. Returns what the format could
-    not hold (notes)."""
+    as ``tessera convert`` does, with the same options:
+
+    - ``crop``: ``((x0, x1), (y0, y1), (z0, z1))`` voxels to keep, ends
+      exclusive (``--crop x0:x1,y0:y1,z0:z1``);
+    - ``downsample``: a box-filter factor N or ``(a, b, c)`` per x, y, z
+      (``--downsample``), after the crop;
+    - OME-Zarr output: ``chunks`` (64, 128 or ``(z, y, x)``), ``levels``
+      (``"auto"`` or a count), ``compressor`` (zstd, blosc, zlib, none),
+      ``zarr_format`` (2: NGFF 0.4; 3: NGFF 0.5) and ``shard`` (chunks per
+      shard edge with ``zarr_format=3``).
+
+    Returns what the format could not hold (notes). Bad options raise
+    :class:`InputError` naming the option as the CLI spells it."""
     v = _as_volume(src)
     out = _os.fspath(dst)
+    chunk = str(chunks) if isinstance(chunks, int) else ",".join(str(int(c)) for c in chunks)
+    crop_text = ""
+    if crop is not None:
+        try:
+            crop_text = ",".join(f"{int(a)}:{int(b)}" for a, b in crop)
+        except (TypeError, ValueError):
+            raise InputError(f"crop {crop!r}: expected ((x0, x1), (y0, y1), (z0, z1))") from None
+    if downsample is None:
+        factors = ""
+    elif isinstance(downsample, int):
+        factors = str(downsample)
+    else:
+        factors = "x".join(str(int(f)) for f in downsample)
     _reraising(v.spec, v._handle.load)
     return list(
-        _reraising(out, _tessera.convert, v._handle, out, int(chunks), str(levels), compressor,
-                   writing=True)
+        _reraising(out, _tessera.convert, v._handle, out, chunk, str(levels), compressor,
+                   crop_text, factors, int(zarr_format), int(shard), writing=True)
     )
 
 

@@ -59,9 +59,13 @@ def convert(
     src: Any,
     dst: PathLike,
     *,
-    chunks: int = ...,
+    chunks: Union[int, Sequence[int]] = ...,
     levels: Union[str, int] = ...,
     compressor: str = ...,
+    crop: Optional[Sequence[Sequence[int]]] = ...,
+    downsample: Union[None, int, Sequence[int]] = ...,
+    zarr_format: int = ...,
+    shard: int = ...,
 ) -> List[str]: ...
 
 class Session:

@@ -6,6 +6,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 
 import tessera
@@ -53,6 +54,44 @@ def test_convert_writes_what_the_cli_renders_like_the_array(cli, tmp_path):
     s = tessera.Session(tessera.from_array(a, spacing=(1, 1, 2)), tf="ct-bone")
     t = tessera.Session(tessera.open(zarr), tf="ct-bone")
     assert psnr(s.render(64, 64), t.render(64, 64)) >= 60.0
+
+
+def test_convert_takes_the_clis_crop_downsample_and_zarr_options(cli, tmp_path):
+    """convert()'s crop, downsample, chunks, zarr_format and shard are the
+    CLI's (session/Convert.h): the files written are byte-identical to
+    `tessera convert`'s, and bad options name the option as the CLI does."""
+    rng = np.random.default_rng(5)
+    a = rng.integers(0, 4000, size=(30, 28, 26), dtype=np.uint16)
+    src = str(tmp_path / "in.nii")
+    tessera.convert(tessera.from_array(a, spacing=(0.5, 1.0, 2.0)), src)
+    ours = str(tmp_path / "py.nrrd")
+    theirs = str(tmp_path / "cli.nrrd")
+    tessera.convert(src, ours, crop=((2, 22), (3, 27), (0, 25)), downsample=(2, 1, 3))
+    subprocess.run([cli, "convert", src, theirs, "--crop", "2:22,3:27,0:25",
+                    "--downsample", "2x1x3", "--quiet"], check=True, capture_output=True)
+    assert tessera.info(ours)["dims"] == [10, 24, 9]
+    assert open(ours, "rb").read() == open(theirs, "rb").read()
+    zpy = tmp_path / "py" / "v.ome.zarr"  # the same name: the multiscales name is the file's
+    zcli = tmp_path / "cli" / "v.ome.zarr"
+    zpy.parent.mkdir()
+    zcli.parent.mkdir()
+    tessera.convert(src, str(zpy), chunks=(8, 16, 16), zarr_format=3, shard=2, downsample=2)
+    subprocess.run([cli, "convert", src, str(zcli), "--chunk", "8,16,16", "--zarr-format", "3",
+                    "--shard", "2", "--downsample", "2", "--quiet"], check=True,
+                   capture_output=True)
+    files = sorted(p.relative_to(zpy) for p in zpy.rglob("*") if p.is_file())
+    assert files == sorted(p.relative_to(zcli) for p in zcli.rglob("*") if p.is_file())
+    assert any(str(f).endswith("zarr.json") for f in files)
+    for f in files:
+        assert (zpy / f).read_bytes() == (zcli / f).read_bytes(), f
+    with pytest.raises(tessera.InputError, match="--crop '0:99,0:28,0:26'"):
+        tessera.convert(src, str(tmp_path / "x.nii"), crop=((0, 99), (0, 28), (0, 26)))
+    with pytest.raises(tessera.InputError, match="--downsample '0'"):
+        tessera.convert(src, str(tmp_path / "x.nii"), downsample=0)
+    with pytest.raises(tessera.InputError, match="--chunk '7,16,16'"):
+        tessera.convert(src, str(tmp_path / "x.ome.zarr"), chunks=(7, 16, 16))
+    with pytest.raises(tessera.InputError, match="crop"):
+        tessera.convert(src, str(tmp_path / "x.nii"), crop=(1, 2))
 
 
 def test_tf_presets_and_json():

@@ -162,7 +162,7 @@ std::vector<std::string> pvmLossNotes(const Volume& v) {
 
 std::vector<std::string> zarrLossNotes(const Volume& v) {
   if (v.direction() == glm::dmat3(1.0)) return {};
-  return {"OME-NGFF 0.4 has no orientation: other readers see the axes of orientation " +
+  return {"OME-NGFF (0.4 and 0.5) has no orientation: other readers see the axes of orientation " +
           orientationOf(v.direction()).describe() +
           " as RAS; Tessera reads the direction back from its \"tessera\" attribute"};
 }
