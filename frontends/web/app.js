@@ -495,8 +495,9 @@ import { TesseraViewer } from './tessera.js';
         }
       }
     } catch (e) {
-      showError(e.message);
+      showError(e.message);  // playback has stopped (a time point could not be read)
       time.asked = null;
+      $('timePlay').textContent = 'Play';
     }
     timeStatus();
   }

@@ -181,6 +181,17 @@ int Session::stepPlayback(double nowMs) {
   series_->want(timePoint_);  // keeps the window of reads anchored here
   // Without a reading thread, one time point ahead is read per frame.
   if (series_->pump() && !ready) ready = series_->want(next) != nullptr;
+  // A time point that cannot be read stops playback with the reader's
+  // message, rather than holding the one shown for ever.
+  if (!ready) {
+    try {
+      series_->rethrowFailure(next);
+    } catch (const std::exception& e) {
+      playback_.pause();
+      throw InputError(name_ + ": playback stopped: time point " + std::to_string(next) +
+                       " could not be read: " + e.what());
+    }
+  }
   const int shown = playback_.step(nowMs, timePoint_, count, ready);
   if (shown != timePoint_) showTimePoint(shown);
   return timePoint_;

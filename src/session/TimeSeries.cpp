@@ -116,6 +116,16 @@ void TimeSeries::readOne(int t, std::unique_lock<std::mutex>& lock) {
   changed_.notify_all();
 }
 
+void TimeSeries::rethrowFailure(int t) const {
+  std::exception_ptr failure;
+  {
+    std::lock_guard lock(mutex_);
+    const auto f = failed_.find(t);
+    if (f != failed_.end()) failure = f->second;
+  }
+  if (failure) std::rethrow_exception(failure);
+}
+
 bool TimeSeries::pump() {
   if (mode_ != Reading::OnPump) return false;
   std::unique_lock lock(mutex_);

@@ -55,7 +55,7 @@ async function play(page, fps, advances, limitMs) {
     const seconds = (performance.now() - start) / 1000;
     t.pause();
     const s = t.time();
-    return { log: s.log.slice(before - 1), late: s.late, advances: s.advances, seconds };
+    return { log: s.log.slice(before - 1), late: s.late, advances: s.advances, seconds, error: t.error() };
   }, { fps, advances, limitMs });
 }
 
@@ -130,7 +130,8 @@ async function benchmark(context, url, tmp, run) {
     const order = inOrder(p.log, count);
     const rate = p.advances / p.seconds;
     console.log(`bench: web page, 20 x 256^3 u8 at 512x512, asked ${fps}/s: ${rate.toFixed(2)} time points/s, ` +
-                `${p.advances} shown in ${p.seconds.toFixed(1)} s, ${p.late} late frames, ${order || 'none skipped'}`);
+                `${p.advances} shown in ${p.seconds.toFixed(1)} s, ${p.late} late frames, ${order || 'none skipped'}` +
+                (p.error ? `; error: ${p.error}` : ''));
     check(`asked ${fps}/s: every time point shown in order`, !order && p.advances >= Math.min(count, 2), order);
   }
   await page.close();

@@ -124,6 +124,8 @@ TEST(TimeSeries, AReadersErrorReachesWhoWaitsForThatTimePoint) {
       5);
   EXPECT_EQ(series.wait(2)->valueAt(0, 0, 0), 2.0);
   expectInputError([&] { series.wait(3); }, {"series.nii: time point 3 is corrupt"});
+  expectInputError([&] { series.rethrowFailure(3); }, {"time point 3 is corrupt"});
+  EXPECT_NO_THROW(series.rethrowFailure(2));
   EXPECT_EQ(series.wait(4)->valueAt(0, 0, 0), 4.0);
 }
 
@@ -296,6 +298,30 @@ TEST(SessionSeries, ASeriesFromBytesInMemoryPlaysEveryTimePoint) {
   for (std::size_t i = 1; i < sequence.size(); ++i) {
     EXPECT_EQ(sequence[i], (sequence[i - 1] + 1) % 4) << "skipped at " << i;
   }
+  // A time point that cannot be read stops playback with its message
+  // instead of holding the one shown for ever.
+  Session broken("native");
+  broken.openSeries(
+      4,
+      [files](int t) {
+        if (t == 2) throw InputError("series.nii: time point 2 is cut short");
+        return readTimePoint(*files->open("series.nii"), *files, t);
+      },
+      "series.nii", 0, TimeSeries::Reading::OnPump);
+  broken.playback().setFps(100.0);
+  broken.playback().play(0.0);
+  std::string stopped;
+  for (double now = 0.0; stopped.empty() && now < 5000.0; now += 5.0) {
+    try {
+      broken.stepPlayback(now);
+    } catch (const InputError& e) {
+      stopped = e.what();
+    }
+  }
+  EXPECT_NE(stopped.find("time point 2 could not be read"), std::string::npos) << stopped;
+  EXPECT_NE(stopped.find("cut short"), std::string::npos) << stopped;
+  EXPECT_EQ(broken.timePoint(), 1);
+  EXPECT_FALSE(broken.playback().playing());
   // Each time point's image is its own (the volume shown is time point t's).
   for (const int t : {2, 0}) {
     paged.waitTimePoint(t);

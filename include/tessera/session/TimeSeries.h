@@ -61,6 +61,9 @@ class TimeSeries {
   // Waits until time point `t` is read (asking for it as want() does); the
   // reader's exception for it is rethrown. OnPump: reads it now.
   std::shared_ptr<Volume> wait(int t);
+  // Rethrows the reader's exception for time point `t` if its read failed
+  // (and it is still in the window); else does nothing.
+  void rethrowFailure(int t) const;
   // OnPump: reads the first wanted time point not read yet, if any, and
   // returns true when it read one. Background: does nothing, false.
   bool pump();
