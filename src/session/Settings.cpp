@@ -119,6 +119,7 @@ void Settings::validate() const {
                      render::TechniqueRegistry::global().choices());
   }
   if (layout != "auto") layout::LayoutRegistry::global().find(layout);  // names the choices
+  channels.validate();
   checkRange("zoom", camera.zoom, kZoomRange);
   checkRange("fov", camera.fovYDeg, kFovRange, "degrees");
   checkRange("step", render.stepVoxels, kStepRange, "voxels");

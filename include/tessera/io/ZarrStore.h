@@ -106,6 +106,8 @@ class ZarrStore {
   const std::vector<std::string>& notes() const { return notes_; }
   // The omero channels, in the store's channel order (empty without omero).
   const std::vector<ZarrChannel>& channels() const { return channels_; }
+  // The length of the store's c axis (1 without one).
+  int channelCount() const;
   // 2 or 3: the store's Zarr format.
   int zarrFormat() const { return format_; }
   // The multiscales "type": how the coarser levels were made ("mean",
