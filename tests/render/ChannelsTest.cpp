@@ -138,6 +138,34 @@ TEST_F(Channels, GpuEqualsReferenceOnTexture3dAndEs2) {
   }
 }
 
+// Six channels: two RGBA textures (channels 4 and 5 in the second), the
+// same image on the GPU as in the reference.
+TEST_F(Channels, SixChannelsInTwoTexturesEqualReference) {
+  const ChannelSet three = readZarrChannels(store());
+  ChannelSet six;
+  const glm::dvec3 colors[6] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}, {0, 1, 1}, {1, 0, 1}};
+  for (int i = 0; i < 6; ++i) {
+    Channel c = three[i % 3];
+    c.color = colors[i];
+    c.label += std::to_string(i);
+    if (i >= 3) c.window = {c.window.min, 0.5 * (c.window.min + c.window.max)};
+    six.add(c);
+  }
+  six[1].visible = false;
+  const Camera camera = test::orbitCamera(six.geometry(), -40.0, 10.0);
+  const RenderSettings settings = channelSettings();
+  const Image ref = renderChannelsReference(six, channelRamp(), camera, settings, kSize, kSize);
+  for (gpu::ApiLevel api : {gpu::ApiLevel::Gles3, gpu::ApiLevel::Gles2}) {
+    std::string how;
+    const double db = psnr(gpuImage(api, six, camera, settings, &how), ref);
+    std::printf("6 channels on %s (%s): %.1f dB\n", test::apiName(api), how.c_str(), db);
+    EXPECT_GE(db, 40.0) << test::apiName(api);
+  }
+  // A seventh is refused.
+  EXPECT_EQ(test::inputErrorMessage([&] { six.add(three[0], "store channel 6"); }),
+            "store channel 6: at most 6 channels are rendered together");
+}
+
 // Pixels where a and b differ by more than `tolerance` in any component.
 std::vector<bool> changed(const Image& a, const Image& b, int tolerance) {
   std::vector<bool> out(static_cast<std::size_t>(a.width()) * a.height());
