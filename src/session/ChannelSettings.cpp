@@ -1,7 +1,10 @@
 #include "tessera/session/ChannelSettings.h"
+#include "tessera/session/ChannelSettingsJson.h"
 
 #include <cstdio>
 #include <sstream>
+
+#include <nlohmann/json.hpp>
 
 #include "tessera/core/Error.h"
 
@@ -111,6 +114,49 @@ void ChannelSettings::applyTo(ChannelSet& set, const std::string& spec) const {
     if (!visible.empty()) set[i].visible = visible[u];
   }
   set.mode = mode;
+}
+
+nlohmann::json channelSettingsToJson(const ChannelSettings& c) {
+  nlohmann::json colorList = nlohmann::json::array();
+  for (const glm::dvec3& rgb : c.colors) {
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "%02x%02x%02x", static_cast<unsigned>(rgb.r * 255.0 + 0.5),
+                  static_cast<unsigned>(rgb.g * 255.0 + 0.5),
+                  static_cast<unsigned>(rgb.b * 255.0 + 0.5));
+    colorList.push_back(hex);
+  }
+  nlohmann::json windowList = nlohmann::json::array();
+  for (const ValueRange& w : c.windows) windowList.push_back({w.min, w.max});
+  nlohmann::json visibleList = nlohmann::json::array();
+  for (bool v : c.visible) visibleList.push_back(v);
+  return {{"indices", c.indices},
+          {"colors", colorList},
+          {"windows", windowList},
+          {"visible", visibleList},
+          {"mode", channelModeName(c.mode)}};
+}
+
+ChannelSettings channelSettingsFromJson(const nlohmann::json& j) {
+  ChannelSettings c;
+  c.enabled = true;
+  try {
+    c.indices = j.value("indices", std::vector<int>{});
+    for (const auto& hex : j.value("colors", nlohmann::json::array())) {
+      c.colors.push_back(parseHexColor(hex.get<std::string>()));
+    }
+    for (const auto& w : j.value("windows", nlohmann::json::array())) {
+      if (!w.is_array() || w.size() != 2) throw InputError("channels.windows: expected [lo, hi]");
+      c.windows.push_back({w[0].get<double>(), w[1].get<double>()});
+    }
+    for (const auto& v : j.value("visible", nlohmann::json::array())) {
+      c.visible.push_back(v.get<bool>());
+    }
+    c.mode = parseChannelMode(j.value("mode", std::string("additive")));
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(std::string("session state: channels: ") + e.what());
+  }
+  c.validate();
+  return c;
 }
 
 }  // namespace tessera::session

@@ -4,7 +4,11 @@
 // textures) and ES 2 (mosaics), and a channel's toggle.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <memory>
+
+#include <nlohmann/json.hpp>
 
 #include "support/ChannelStore.h"
 #include "support/ExpectError.h"
@@ -17,6 +21,7 @@
 #include "tessera/reference/ChannelReference.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/render/Raycaster.h"
+#include "tessera/session/Settings.h"
 
 namespace tessera {
 namespace {
@@ -105,6 +110,32 @@ TEST_F(Channels, RejectsBadChannelLists) {
             "channel mode 'sum': expected additive or max");
   EXPECT_EQ(test::inputErrorMessage([] { parseHexColor("ff00"); }),
             "colour 'ff00': expected six hex digits RRGGBB");
+}
+
+TEST(ChannelSettings, ValidatedAndKeptInTheSessionState) {
+  session::Settings s;
+  s.channels.enabled = true;
+  s.channels.indices = {0, 2};
+  s.channels.colors = session::parseChannelColors("ff0000,00ff80");
+  s.channels.windows = session::parseChannelWindows("100:2000,50:900");
+  s.channels.visible = {true, false};
+  s.channels.mode = ChannelMode::Max;
+  const session::Settings back = session::Settings::fromJson(s.toJson());
+  EXPECT_EQ(back.channels.indices, s.channels.indices);
+  EXPECT_EQ(back.channels.colors, s.channels.colors);
+  EXPECT_EQ(back.channels.windows[1].max, 900.0);
+  EXPECT_EQ(back.channels.visible, s.channels.visible);
+  EXPECT_EQ(back.channels.mode, ChannelMode::Max);
+  EXPECT_FALSE(session::Settings().toJson().contains("channels"));
+
+  s.channels.windows = session::parseChannelWindows("100:2000");
+  EXPECT_EQ(test::inputErrorMessage([&] { s.validate(); }),
+            "channels: 1 windows for 2 channels chosen");
+  EXPECT_EQ(test::inputErrorMessage([] { session::parseChannelWindows("100:2000,9"); }),
+            "--channel-windows '100:2000,9': '9' is not LO:HI (expected e.g. 100:2000,50:900)");
+  s.channels.windows = session::parseChannelWindows("100:2000,900:50");
+  EXPECT_EQ(test::inputErrorMessage([&] { s.validate(); }),
+            "channel window 900:50: expected LO < HI");
 }
 
 TEST(ChannelSemantics, AdditiveSampleClampsToItsOpacity) {
