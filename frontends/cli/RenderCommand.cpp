@@ -631,7 +631,7 @@ void runChannelsCommand(const RenderOptions& o, const std::string& spec) {
                         {"mode", channelModeName(c.mode)},
                         {"gpu_ms", f.gpuMs}};
     if (f.reference) {
-      j["psnr_db"] = f.psnr;
+      j["psnr_db"] = numberOrNull(f.psnr);
       j["reference_ms"] = f.referenceMs;
     }
     std::printf("%s\n", j.dump(2).c_str());
