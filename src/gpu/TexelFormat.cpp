@@ -15,6 +15,8 @@ GlFormat glFormat(TexelFormat f) {
       return {GL_R8, GL_RED, GL_UNSIGNED_BYTE, 1, 1};
     case TexelFormat::R16:
       return {GL_R16_EXT, GL_RED, GL_UNSIGNED_SHORT, 2, 2};
+    case TexelFormat::RGBA16:
+      return {GL_RGBA16_EXT, GL_RGBA, GL_UNSIGNED_SHORT, 8, 8};
     case TexelFormat::R16F:
       return {GL_R16F, GL_RED, GL_FLOAT, 2, 4};
     case TexelFormat::R32F:
@@ -61,6 +63,8 @@ const char* texelFormatName(TexelFormat f) {
       return "R8";
     case TexelFormat::R16:
       return "R16";
+    case TexelFormat::RGBA16:
+      return "RGBA16";
     case TexelFormat::R16F:
       return "R16F";
     case TexelFormat::R32F:

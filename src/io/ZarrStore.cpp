@@ -537,6 +537,10 @@ int ZarrStore::finestLevelWithin(std::uint64_t budgetBytes) const {
   return -1;
 }
 
+int ZarrStore::channelCount() const {
+  return axis_[kC] >= 0 ? static_cast<int>(levels_.front().array.shape[std::size_t(axis_[kC])]) : 1;
+}
+
 std::string ZarrStore::describe() const {
   return "OME-Zarr " + storage_->describe() + " (" +
          (version_.rfind("plain", 0) == 0 ? version_ : "NGFF " + version_) +

@@ -18,8 +18,10 @@ inline void addSampleParts(std::vector<gpu::ShaderPart>& parts, const ShadingGra
                            const layout::Layout& layout) {
   gradient.addParts(parts);
   for (gpu::ShaderPart& part : layout.seamParts()) parts.push_back(std::move(part));
-  for (const char* file : {"render/classify.glsl", "render/shading.glsl", "render/clipping.glsl",
-                           "render/sample.glsl"}) {
+  // render/channels.glsl: the channels' classification, when the layout
+  // defines CHANNELS (layout/ChannelLayout.h).
+  for (const char* file : {"render/classify.glsl", "render/channels.glsl", "render/shading.glsl",
+                           "render/clipping.glsl", "render/sample.glsl"}) {
     parts.push_back(gpu::embeddedShaderPart(file));
   }
 }

@@ -348,7 +348,9 @@ void main() {
         continue;
       }
 #endif
-#if defined(MODE_MIP)
+#if defined(MODE_MIP) && defined(CHANNELS)
+      maxValue = channelsTakeMax(p);  // per channel maxima (render/channels.glsl)
+#elif defined(MODE_MIP)
       maxValue = max(maxValue, normalizedValue(fieldValue(p)));
 #elif defined(MODE_MINIP)
       minValue = min(minValue, normalizedValue(fieldValue(p)));
@@ -385,6 +387,9 @@ void main() {
     // MIP shows the TF colour of the maximum, opaque (the classic MIP look:
     // with the grey preset the pixel is the maximum intensity).
     acc = vec4(classify(maxValue).rgb, 1.0);
+#ifdef CHANNELS
+    acc = channelsMaxColor();
+#endif
   }
 #elif defined(MODE_MINIP)
   if (kept > 0.0) acc = vec4(classify(minValue).rgb, 1.0);

@@ -46,7 +46,9 @@ vec4 shadeSample(vec4 c, vec3 p) {
 #endif
 
 vec4 classifiedSample(vec3 p) {
-#ifdef FUSED_VALUE_GRADIENT
+#if defined(CHANNELS)
+  return classifiedChannels(p);  // several channels (render/channels.glsl)
+#elif defined(FUSED_VALUE_GRADIENT)
   vec4 vg = sampleVolumeAndGradient(p);
   return shadeClassified(classify(normalizedValue(vg.w)), vg.xyz * u_shadeGradientScale);
 #else

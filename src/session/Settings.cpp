@@ -10,6 +10,7 @@
 #include "tessera/render/ClippingUniforms.h"
 #include "tessera/render/ShadingUniforms.h"
 #include "tessera/render/TechniqueRegistry.h"
+#include "tessera/session/ChannelSettingsJson.h"
 
 namespace tessera::session {
 
@@ -119,6 +120,7 @@ void Settings::validate() const {
                      render::TechniqueRegistry::global().choices());
   }
   if (layout != "auto") layout::LayoutRegistry::global().find(layout);  // names the choices
+  channels.validate();
   checkRange("zoom", camera.zoom, kZoomRange);
   checkRange("fov", camera.fovYDeg, kFovRange, "degrees");
   checkRange("step", render.stepVoxels, kStepRange, "voxels");
@@ -253,6 +255,8 @@ nlohmann::json Settings::toJson() const {
       {"classify", classify},
       {"gradient", gradient},
       {"labels", labels}};
+  if (channels.enabled)
+    j["channels"] = channelSettingsToJson(channels);  // session/ChannelSettings.h
   renderFields(j, render, kWrite);
   samplingFields(j["sampling"], sa, kWrite);
   shadingFields(j["shading"], sh, kWrite);
@@ -270,6 +274,7 @@ Settings Settings::fromJson(const nlohmann::json& state) {
   checkKinds(state, s.toJson(), "settings");
   try {
     s.technique = state.value("technique", s.technique);
+    if (state.contains("channels")) s.channels = channelSettingsFromJson(state["channels"]);
     s.layout = state.value("layout", s.layout);
     if (state.contains("camera")) {
       const nlohmann::json& c = state["camera"];

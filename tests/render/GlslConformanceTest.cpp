@@ -16,6 +16,7 @@
 #include "tessera/gpu/Program.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/layout/BricksLayout.h"
+#include "tessera/layout/ChannelLayout.h"
 #include "tessera/layout/MosaicLayout.h"
 #include "tessera/layout/PackedMosaicLayout.h"
 #include "tessera/layout/Texture3DLayout.h"
@@ -66,6 +67,14 @@ Validation validate(const std::string& source, const std::string& stage) {
   std::ofstream(path) << source;
   std::ofstream(conf) << es100Limits();
   return run("glslangValidator " + conf.string() + " " + path.string());
+}
+
+// Five channels of v (two RGBA textures), for layout::ChannelLayout.
+ChannelSet fiveChannels(const Volume& v) {
+  ChannelSet set;
+  const auto shared = std::make_shared<const Volume>(v);
+  for (int i = 0; i < 5; ++i) set.add({.volume = shared, .label = std::to_string(i)});
+  return set;
 }
 
 bool haveValidator() {
@@ -160,6 +169,9 @@ TEST(GlslConformance, Es2ShadersPassTheReferenceCompiler) {
   expectConformant(*c, v, *mosaic);
   expectConformant(*c, v, *packed);
   expectConformant(*c, v, *bricks);
+  const ChannelSet five = fiveChannels(v);
+  expectConformant(
+      *c, v, *layout::ChannelLayout::create(five, gpu::DeviceLimits::of(c->caps()), c->ledger()));
   mosaic.reset();
   packed.reset();
   bricks.reset();
@@ -181,6 +193,8 @@ TEST(GlslConformance, Es3ShadersPassTheReferenceCompiler) {
   expectConformant(c, v, *t3d);
   expectConformant(c, v, *mosaic);
   expectConformant(c, v, *bricks);
+  const ChannelSet five = fiveChannels(v);
+  expectConformant(c, v, *layout::ChannelLayout::create(five, limits, c.ledger()));
 }
 
 // The overlay and hybrid-compositor programs, assembled as

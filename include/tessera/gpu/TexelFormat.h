@@ -13,6 +13,7 @@ namespace tessera::gpu {
 enum class TexelFormat {
   R8,               // ES 3: 1 x uint8
   R16,              // ES 3 + EXT_texture_norm16: 1 x uint16, normalised
+  RGBA16,           // ES 3 + EXT_texture_norm16: 4 x uint16, normalised
   R16F,             // ES 3: upload 1 x float, stored as half
   R32F,             // ES 3: 1 x float
   RG8,              // ES 3: 2 x uint8

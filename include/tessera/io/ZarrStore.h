@@ -108,6 +108,8 @@ class ZarrStore {
   const std::vector<ZarrChannel>& channels() const { return channels_; }
   // The length of the store's t axis (1 without one): its time points.
   int timePoints() const;
+  // The length of the store's c axis (1 without one).
+  int channelCount() const;
   // 2 or 3: the store's Zarr format.
   int zarrFormat() const { return format_; }
   // The multiscales "type": how the coarser levels were made ("mean",

@@ -133,6 +133,13 @@ class Session {
   const lod::MultiresSource* pyramid() const { return streamed_.get(); }
   const lod::VolumeSource& source() const;
 
+  // Channels of an OME-Zarr store rendered together with
+  // settings().channels over its omero defaults (docs/channels.md), on
+  // the session's device; with `reference` the CPU reference's frame and
+  // the PSNR between them. Independent of the volume opened.
+  ChannelFrame renderChannels(const std::string& spec, int width, int height, bool reference,
+                              int time = 0);
+
   Settings& settings() { return settings_; }
   const Settings& settings() const { return settings_; }
   // Validated first; the session keeps its old settings on error. With a

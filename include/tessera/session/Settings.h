@@ -18,6 +18,7 @@
 #include "tessera/core/TransferFunction.h"
 #include "tessera/core/Volume.h"
 #include "tessera/render/Technique.h"
+#include "tessera/session/ChannelSettings.h"
 
 namespace tessera::session {
 
@@ -71,6 +72,9 @@ struct Settings {
   bool labels = false;
 
   // Throws InputError naming the first setting out of its range or unknown.
+  // Several channels of a store together (session/ChannelSettings.h).
+  ChannelSettings channels;
+
   void validate() const;
   render::TechniqueOptions techniqueOptions(glm::ivec2 imageSize) const;
 
