@@ -92,7 +92,8 @@ std::vector<std::byte> throughDcmtk(const Slice& s, E_TransferSyntax xfer,
 
 std::vector<std::byte> throughOpenJpeg(const Slice& s, std::span<const std::byte> frame,
                                        const std::string& what) {
-  const FrameShape shape{s.rows, s.columns, s.bitsAllocated, s.bitsStored, s.samplesPerPixel};
+  const FrameShape shape{s.rows,       s.columns,         s.bitsAllocated,
+                         s.bitsStored, s.samplesPerPixel, s.isSigned};
   const std::vector<std::uint8_t> samples = decodeJpeg2000Frame(
       {reinterpret_cast<const std::uint8_t*>(frame.data()), frame.size()}, shape, what);
   return copyOf(samples.data(), samples.size());
@@ -101,7 +102,7 @@ std::vector<std::byte> throughOpenJpeg(const Slice& s, std::span<const std::byte
 }  // namespace
 
 std::string webFrameSyntaxesText() {
-  return "uncompressed, JPEG baseline/extended/lossless, JPEG-LS, RLE and JPEG 2000";
+  return "uncompressed, JPEG baseline/extended/lossless, JPEG-LS, RLE, JPEG 2000 and HTJ2K";
 }
 
 std::vector<std::byte> decodeWebFrame(const Slice& s, const std::string& transferSyntax,
@@ -116,7 +117,10 @@ std::vector<std::byte> decodeWebFrame(const Slice& s, const std::string& transfe
   } else if (transferSyntax == "1.2.840.10008.1.2.2") {
     out = uncompressed(s, frame, true);
   } else if (transferSyntax == "1.2.840.10008.1.2.4.90" ||
-             transferSyntax == "1.2.840.10008.1.2.4.91") {
+             transferSyntax == "1.2.840.10008.1.2.4.91" ||
+             transferSyntax == "1.2.840.10008.1.2.4.201" ||  // HTJ2K lossless
+             transferSyntax == "1.2.840.10008.1.2.4.202" ||  // HTJ2K RPCL lossless
+             transferSyntax == "1.2.840.10008.1.2.4.203") {  // HTJ2K
     out = throughOpenJpeg(s, frame, what);
   } else {
     const DcmXfer x(transferSyntax.c_str());
