@@ -368,7 +368,14 @@ void checkSiz(ojph::param_siz siz, const FrameShape& shape, const std::string& w
   }
 }
 
-void decodeRows(ojph::codestream& cs, const FrameShape& shape, std::vector<std::uint8_t>& out) {
+// The rows, each sample clamped to the codestream's range (`bits` deep,
+// signed or not): the 9/7 wavelet overshoots it near the extremes, and a
+// value wrapped into Bits Allocated would turn black into white.
+void decodeRows(ojph::codestream& cs, const FrameShape& shape, unsigned bits, bool isSigned,
+                std::vector<std::uint8_t>& out) {
+  const std::int32_t lo = isSigned ? -(std::int32_t{1} << (bits - 1)) : 0;
+  const std::int32_t hi = isSigned ? (std::int32_t{1} << (bits - 1)) - 1
+                                   : static_cast<std::int32_t>((std::int64_t{1} << bits) - 1);
   for (int y = 0; y < shape.rows; ++y) {
     ojph::ui32 comp = 0;
     const ojph::line_buf* line = cs.pull(comp);
@@ -378,7 +385,7 @@ void decodeRows(ojph::codestream& cs, const FrameShape& shape, std::vector<std::
     }
     const std::size_t row = static_cast<std::size_t>(y) * shape.columns;
     for (int x = 0; x < shape.columns; ++x) {
-      putFrameSample(out, row + x, line->i32[x], shape.bitsAllocated);
+      putFrameSample(out, row + x, std::clamp(line->i32[x], lo, hi), shape.bitsAllocated);
     }
   }
 }
@@ -399,8 +406,10 @@ std::vector<std::uint8_t> decodeHere(const Rebuilt& rebuilt, const FrameShape& s
     cs.read_headers(&in);
     checkSiz(cs.access_siz(), shape, what);
     checkLayout(cs.access_siz(), cs.access_cod(), what);
+    const unsigned bits = cs.access_siz().get_bit_depth(0);
+    const bool isSigned = cs.access_siz().is_signed(0);
     cs.create();
-    decodeRows(cs, shape, out);
+    decodeRows(cs, shape, bits, isSigned, out);
     cs.close();
   } catch (const Error&) {
     throw;

@@ -139,6 +139,14 @@ std::vector<std::uint8_t> frameSamples(const FrameShape& shape, const std::strin
                                    (shape.bitsAllocated / 8));
 }
 
+std::vector<std::uint8_t> decodeHtj2kSyntaxFrame(std::span<const std::uint8_t> codestream,
+                                                 const FrameShape& shape, const std::string& what) {
+  const bool partOne = codestream.size() >= 2 && codestream[0] == 0xff && codestream[1] == 0x4f &&
+                       !isHtj2k(codestream);
+  return partOne ? decodeJpeg2000Frame(codestream, shape, what)
+                 : decodeHtj2kFrame(codestream, shape, what);
+}
+
 std::vector<std::uint8_t> decodeJpeg2000Frame(std::span<const std::uint8_t> codestream,
                                               const FrameShape& shape, const std::string& what) {
   // Debian 12's OpenJPEG (2.5.0) aborts on an assertion in its HT block

@@ -32,6 +32,12 @@ struct FrameShape {
 std::vector<std::uint8_t> decodeJpeg2000Frame(std::span<const std::uint8_t> codestream,
                                               const FrameShape& shape, const std::string& what);
 
+// A frame of a file that declares HTJ2K (.201, .202, .203): a plain Part-1
+// codestream (SOC without a CAP marker) goes to decodeJpeg2000Frame, anything
+// else to decodeHtj2kFrame (Htj2kFrame.h), whose checks name what is wrong.
+std::vector<std::uint8_t> decodeHtj2kSyntaxFrame(std::span<const std::uint8_t> codestream,
+                                                 const FrameShape& shape, const std::string& what);
+
 // What both codecs share. checkFrameHeader: the frame's header against
 // `shape` (one greyscale component of Columns x Rows, not subsampled, at most
 // Bits Allocated deep), an InputError naming `codec` otherwise.

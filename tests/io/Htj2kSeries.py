@@ -57,10 +57,16 @@ def phantom(bits, signed, z, seed):
 def encode(a, bits, signed, kind, variant, work):
     raw, stream = os.path.join(work, "frame.raw"), os.path.join(work, "frame.j2c")
     comps = 3 if variant == "colour" else 1
-    dt = ("i1" if signed else "u1") if bits <= 8 else ("<i2" if signed else "<u2")
+    # ojph_compress 0.9 reads raw samples as unsigned (never sign-extends),
+    # so signed data is encoded as unsigned after the DC level shift
+    # (ISO 15444-1 G.1.2: u = s + 2^(B-1)) and SIZ then says signed: a
+    # decoder skips the inverse shift and gives s back, exactly.
+    if signed:
+        a = a + (1 << (bits - 1))
+    dt = "u1" if bits <= 8 else "<u2"
     np.stack([a] * comps).astype(dt).tofile(raw)
     args = ["ojph_compress", "-i", raw, "-o", stream, "-dims", "{%d,%d}" % (COLS, ROWS),
-            "-num_comps", str(comps), "-signed", ",".join(["true" if signed else "false"] * comps),
+            "-num_comps", str(comps), "-signed", ",".join(["false"] * comps),
             "-bit_depth", ",".join([str(bits)] * comps),
             "-downsamp", ",".join(["{1,1}"] * comps)]
     if kind == "lossy":
@@ -71,7 +77,11 @@ def encode(a, bits, signed, kind, variant, work):
     if variant == "tiles":
         args += ["-tile_size", "{16,16}"]
     subprocess.run(args, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    data = open(stream, "rb").read()
+    data = bytearray(open(stream, "rb").read())
+    if signed:  # Ssiz of each component (A.5.1): byte 42 + 3c, bit 7 the sign
+        for c in range(comps):
+            data[42 + 3 * c] |= 0x80
+    data = bytes(data)
     if variant == "truncated":
         data = data[:len(data) // 3]
     elif variant == "cut90":
