@@ -61,13 +61,20 @@ for name in sorted(os.listdir(src)):
     bits = d.BitsAllocated
     raw = os.path.join(work, "frame.raw")
     if kind == "htj2k-lossless":
-        a.astype(("<i" if signed else "<u") + str(bits // 8)).tofile(raw)
+        # ojph_compress 0.9 reads raw samples unsigned: signed ones go in
+        # DC-level shifted (ISO 15444-1 G.1.2) and SIZ is then marked signed.
+        shift = 1 << (d.BitsStored - 1) if signed else 0
+        (a.astype(np.int64) + shift).astype("<u" + str(bits // 8)).tofile(raw)
         stream = os.path.join(work, "frame.j2c")
         subprocess.run(["ojph_compress", "-i", raw, "-o", stream, "-dims", "{%d,%d}" % (cols, rows),
-                        "-num_comps", "1", "-signed", "true" if signed else "false",
+                        "-num_comps", "1", "-signed", "false",
                         "-bit_depth", str(d.BitsStored), "-downsamp", "{1,1}",
                         "-reversible", "true"],
                        check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        if signed:
+            data = bytearray(open(stream, "rb").read())
+            data[42] |= 0x80  # Ssiz of component 0 (A.5.1): signed
+            open(stream, "wb").write(data)
         d.file_meta.TransferSyntaxUID = "1.2.840.10008.1.2.4.201"
     else:
         a.astype((">i" if signed else ">u") + str(bits // 8)).tofile(raw)
