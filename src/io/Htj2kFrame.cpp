@@ -31,6 +31,7 @@ namespace {
 
 // ISO 15444-1 A.2: the markers walked here.
 constexpr std::uint16_t kSoc = 0xff4f, kSot = 0xff90, kSod = 0xff93, kEoc = 0xffd9;
+constexpr std::uint16_t kCod = 0xff52, kQcd = 0xff5c;
 constexpr std::uint16_t kTlm = 0xff55, kPlm = 0xff57, kPlt = 0xff58, kCom = 0xff64;
 // Bytes after each rebuilt tile-part that no valid packet reaches (any
 // number > 0 does: a read that touches them is refused).
@@ -158,7 +159,10 @@ class Walker {
     for (int markers = 0; markers < 256; ++markers) {
       if (at + 4 > end_) throw bad("the main header is truncated at byte " + std::to_string(at));
       const std::uint16_t marker = u16(d_, at);
-      if (marker == kSot) return at;
+      if (marker == kSot) {
+        checkQuantization();
+        return at;
+      }
       if ((marker >> 8) != 0xff || marker < 0xff30) {
         throw bad("byte " + std::to_string(at) + " holds " + hex16(marker) + ", not a marker");
       }
@@ -168,6 +172,8 @@ class Walker {
                   std::to_string(length) + " bytes, " + std::to_string(end_ - at - 2) +
                   " remain (truncated?)");
       }
+      if (marker == kCod) cod_ = {at, at + 2 + length};
+      if (marker == kQcd) qcd_ = {at, at + 2 + length};
       // Tile and packet lengths (TLM, PLM) would not match the rebuilt
       // tile-parts; they only index the data, as comments annotate it.
       if (marker != kTlm && marker != kPlm && marker != kCom)
@@ -224,6 +230,26 @@ class Walker {
     return psot == 0 ? partEnd : at + psot;
   }
 
+  // COD and QCD (A.6.1, A.6.4) agree as OpenJPH 0.9 asserts they do (its
+  // param_qcd::get_Kmax and irrev_get_delta, found by fuzz_htj2k): a step
+  // size for each of the 3 NL + 1 subbands, none for the 5/3 wavelet (style
+  // 0) and expounded ones for the 9/7 (style 2).
+  void checkQuantization() const {
+    if (cod_.end < cod_.begin + 14 || qcd_.end < qcd_.begin + 5) {
+      throw bad("no COD or QCD marker, or one too short, in the main header");
+    }
+    const unsigned levels = d_[cod_.begin + 9];
+    const bool reversible = d_[cod_.begin + 13] == 1;
+    const unsigned style = d_[qcd_.begin + 4] & 0x1f;
+    const std::size_t stepBytes = qcd_.end - qcd_.begin - 5;
+    const std::size_t steps = style == 0 ? stepBytes : stepBytes / 2;
+    if (style != (reversible ? 0u : 2u) || steps < 3 * levels + 1) {
+      throw bad("QCD (quantization style " + std::to_string(style) + ", " + std::to_string(steps) +
+                " step sizes) does not fit COD (" + (reversible ? "5/3" : "9/7") + " wavelet, " +
+                std::to_string(levels) + " levels)");
+    }
+  }
+
   // Packet data never holds 0xFF followed by a byte above 0x8F but the SOP
   // and EPH markers (ISO 15444-1 A.1 and B.10.1: bit-stuffing in packet
   // headers, the code-block coders' own stuffing in their data; T.814 keeps
@@ -267,6 +293,7 @@ class Walker {
   const std::string& what_;
   std::size_t end_ = 0;
   std::vector<Span> main_;  // SOC and the main header's segments kept
+  Span cod_, qcd_;
   std::map<unsigned, Tile> tiles_;
 };
 
