@@ -7,6 +7,7 @@
 #include <cstring>
 #include <map>
 #include <mutex>
+#include <set>
 #include <stdexcept>
 #include <utility>
 
@@ -31,8 +32,12 @@ namespace {
 
 // ISO 15444-1 A.2: the markers walked here.
 constexpr std::uint16_t kSoc = 0xff4f, kSot = 0xff90, kSod = 0xff93, kEoc = 0xffd9;
-constexpr std::uint16_t kCod = 0xff52, kQcd = 0xff5c;
+constexpr std::uint16_t kSiz = 0xff51, kCod = 0xff52, kCoc = 0xff53, kQcd = 0xff5c, kQcc = 0xff5d;
 constexpr std::uint16_t kTlm = 0xff55, kPlm = 0xff57, kPlt = 0xff58, kCom = 0xff64;
+// The main header's markers passed to OpenJPH: CAP, SIZ, COD, TLM, PLM,
+// QCD, CRG, COM (A.5-A.9; Part 15 A.2).
+const std::set<std::uint16_t> kMainMarkers = {0xff50, 0xff51, 0xff52, 0xff55,
+                                              0xff57, 0xff5c, 0xff63, 0xff64};
 // Bytes after each rebuilt tile-part that no valid packet reaches (any
 // number > 0 does: a read that touches them is refused).
 constexpr std::size_t kGuard = 16;
@@ -172,6 +177,23 @@ class Walker {
                   std::to_string(length) + " bytes, " + std::to_string(end_ - at - 2) +
                   " remain (truncated?)");
       }
+      // COC and QCC (per-component coding and quantization) are not read:
+      // OpenJPH 0.9 overflows its buffer on a QCC longer than it expects
+      // (found by fuzzing it with ASan), and a greyscale frame needs neither.
+      if (marker == kCoc || marker == kQcc) {
+        throw bad("a " + std::string(marker == kCoc ? "COC" : "QCC") +
+                  " marker (per-component settings) is not read");
+      }
+      // SIZ first (A.4.1), then each of the others OpenJPH 0.9 reads at most
+      // once: it sizes its tables by SIZ (a stream without one overflowed
+      // them: found by fuzzing it with ASan).
+      const bool first = markers == 0;
+      const bool once = marker == kSiz || marker == kCod || marker == kQcd || marker == 0xff50;
+      if ((marker == kSiz) != first || !kMainMarkers.contains(marker) ||
+          (once && !seen_.insert(marker).second)) {
+        throw bad("marker " + hex16(marker) + " at byte " + std::to_string(at) +
+                  (first ? " where SIZ belongs" : " is not one read in the main header here"));
+      }
       if (marker == kCod) cod_ = {at, at + 2 + length};
       if (marker == kQcd) qcd_ = {at, at + 2 + length};
       // Tile and packet lengths (TLM, PLM) would not match the rebuilt
@@ -200,6 +222,12 @@ class Walker {
                 " declares " + std::to_string(psot) + " bytes, " + std::to_string(end_ - at) +
                 " remain (truncated?)");
     }
+    // One tile (A.4.2: index 0): OpenJPH 0.9 decodes tiled codestreams
+    // wrongly, and indexes its tiles by this number unchecked.
+    if (index != 0) {
+      throw InputError(what_ + ": a tiled HTJ2K frame (tile " + std::to_string(index) +
+                       ") is not read: Debian 12's OpenJPH 0.9 decodes tiled codestreams wrongly");
+    }
     Tile& tile = tiles_[index];
     if (tiles_.size() > kMaxTiles) throw bad("more than " + std::to_string(kMaxTiles) + " tiles");
     if (part != tile.parts) {
@@ -217,10 +245,8 @@ class Walker {
       }
       const std::size_t next = h + 2 + u16(d_, h + 2);
       if (marker != kPlt && marker != kCom) {
-        if (tile.parts > 0) {
-          throw bad("marker " + hex16(marker) + " in a later tile-part's header is not read");
-        }
-        tile.header.push_back({h, next});
+        // Tile-level coding settings would bypass the main header's checks.
+        throw bad("marker " + hex16(marker) + " in a tile-part header is not read");
       }
       h = next;
     }
@@ -238,12 +264,17 @@ class Walker {
     if (cod_.end < cod_.begin + 14 || qcd_.end < qcd_.begin + 5) {
       throw bad("no COD or QCD marker, or one too short, in the main header");
     }
+    if (d_[cod_.begin + 5] > 4) {  // LRCP, RLCP, RPCL, PCRL, CPRL (A.6.1); else OpenJPH asserts
+      throw bad("progression order " + std::to_string(d_[cod_.begin + 5]) + " in COD");
+    }
     const unsigned levels = d_[cod_.begin + 9];
     const bool reversible = d_[cod_.begin + 13] == 1;
     const unsigned style = d_[qcd_.begin + 4] & 0x1f;
     const std::size_t stepBytes = qcd_.end - qcd_.begin - 5;
     const std::size_t steps = style == 0 ? stepBytes : stepBytes / 2;
-    if (style != (reversible ? 0u : 2u) || steps < 3 * levels + 1) {
+    // Exactly 3 NL + 1 (A.6.4): OpenJPH 0.9 reads any number into an array
+    // of 97 (a longer QCD overflowed it: found by fuzzing it with ASan).
+    if (style != (reversible ? 0u : 2u) || steps != 3 * levels + 1 || levels > 32) {
       throw bad("QCD (quantization style " + std::to_string(style) + ", " + std::to_string(steps) +
                 " step sizes) does not fit COD (" + (reversible ? "5/3" : "9/7") + " wavelet, " +
                 std::to_string(levels) + " levels)");
@@ -294,6 +325,7 @@ class Walker {
   std::size_t end_ = 0;
   std::vector<Span> main_;  // SOC and the main header's segments kept
   Span cod_, qcd_;
+  std::set<std::uint16_t> seen_;
   std::map<unsigned, Tile> tiles_;
 };
 

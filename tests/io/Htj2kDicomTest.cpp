@@ -124,7 +124,7 @@ TEST(Htj2kDicom, CorruptTruncatedOrMisDeclaredFramesAreNamedErrors) {
       {"lossless-8-u-colour", "a HTJ2K frame of 3 components; only greyscale"},
       // OpenJPH 0.9 decodes 2-D tilings wrongly (its ojph_expand too; OpenJPEG
       // decodes the same stream exactly): refused rather than read wrong.
-      {"rpcl-16-u-tiles", "a tiled HTJ2K frame (3x3 tiles) is not read"},
+      {"rpcl-16-u-tiles", "a tiled HTJ2K frame (tile 1) is not read"},
   };
   std::vector<std::string> names;
   for (const auto& c : cases) names.push_back(c.first);
