@@ -49,7 +49,7 @@ file(GLOB TESSERA_WEB_IO CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/io/*.cpp)
 # link here. DICOM: the reader without DCMTK (DicomBasicReader,
 # DicomSeries), not DCMTK's (DicomSeriesReader, DicomToolkit, DicomNesting).
 list(FILTER TESSERA_WEB_IO EXCLUDE REGEX
-     "/(.*Writer|DicomSeriesReader|DicomToolkit|DicomNesting|InflaterZlib|OutputFile|ZarrVolume|ZarrCodecs|Http.*|DicomWeb.*|Jpeg2000Frame)\\.cpp$")
+     "/(.*Writer|DicomSeriesReader|DicomToolkit|DicomNesting|InflaterZlib|OutputFile|ZarrVolume|ZarrCodecs|Http.*|DicomWeb.*|Jpeg2000Frame|Htj2kFrame)\\.cpp$")
 set(TESSERA_WEB_SOURCES ${TESSERA_GLSL_CPP} ${TESSERA_WEB_IO})
 foreach(layer core gpu lod reference lattice layout render viewer session)
   file(GLOB_RECURSE srcs CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/src/${layer}/*.cpp)

@@ -63,7 +63,7 @@ std::string tagText(std::uint32_t key) {
 }
 
 // How a syntax's pixel data is stored.
-enum class Codec { None, Rle, Jpeg2000 };
+enum class Codec { None, Rle, Jpeg2000, Htj2k };
 
 #ifdef __EMSCRIPTEN__
 // The page has no OpenJPEG or OpenJPH (their WebAssembly builds are not
@@ -98,19 +98,17 @@ constexpr TransferSyntax kSyntaxes[] = {
     {"1.2.840.10008.1.2.4.90", "JPEG 2000 (Lossless only)", kJpeg2000Codecs, false,
      Codec::Jpeg2000},
     {"1.2.840.10008.1.2.4.91", "JPEG 2000", kJpeg2000Codecs, false, Codec::Jpeg2000},
-    // HTJ2K is named but not read: on corrupt code-block data Debian 12's
-    // OpenJPH (0.9.0) writes past its buffers and its OpenJPEG (2.5.0)
-    // aborts on an assertion in its HT decoder (both found by
-    // scripts/fuzz.sh), which no header check here can rule out.
-    {"1.2.840.10008.1.2.4.201", "HTJ2K (Lossless only)", false, false, Codec::None},
-    {"1.2.840.10008.1.2.4.202", "HTJ2K with RPCL Options (Lossless only)", false, false,
-     Codec::None},
-    {"1.2.840.10008.1.2.4.203", "HTJ2K", false, false, Codec::None},
+    // HTJ2K (Part 15): an HTJ2K codestream (one with a CAP marker) goes to
+    // OpenJPH behind Htj2kFrame.h's checks, whatever the file declares.
+    {"1.2.840.10008.1.2.4.201", "HTJ2K (Lossless only)", kJpeg2000Codecs, false, Codec::Htj2k},
+    {"1.2.840.10008.1.2.4.202", "HTJ2K with RPCL Options (Lossless only)", kJpeg2000Codecs, false,
+     Codec::Htj2k},
+    {"1.2.840.10008.1.2.4.203", "HTJ2K", kJpeg2000Codecs, false, Codec::Htj2k},
 };
 
 // What this build reads, for messages and the decoder table.
 constexpr const char* kReadsText =
-    kJpeg2000Codecs ? "implicit and explicit VR little endian, RLE Lossless and JPEG 2000"
+    kJpeg2000Codecs ? "implicit and explicit VR little endian, RLE Lossless, JPEG 2000 and HTJ2K"
                     : "implicit and explicit VR little endian and RLE Lossless";
 
 bool isLongVr(std::string_view vr) {
@@ -726,13 +724,16 @@ std::vector<std::uint8_t> decodeRle(const Slice& s, const std::vector<std::uint8
 std::vector<std::uint8_t> decodeFrame(const Slice& s, Codec codec,
                                       const std::vector<std::uint8_t>& frame) {
 #ifndef __EMSCRIPTEN__
-  if (codec == Codec::Jpeg2000) {
+  if (codec == Codec::Jpeg2000 || codec == Codec::Htj2k) {
     const io_detail::FrameShape shape{.rows = s.rows,
                                       .columns = s.columns,
                                       .bitsAllocated = s.bitsAllocated,
                                       .bitsStored = s.bitsStored,
-                                      .samplesPerPixel = s.samplesPerPixel};
-    return io_detail::decodeJpeg2000Frame(frame, shape, io_detail::sliceName(s));
+                                      .samplesPerPixel = s.samplesPerPixel,
+                                      .isSigned = s.isSigned};
+    return codec == Codec::Htj2k
+               ? io_detail::decodeHtj2kSyntaxFrame(frame, shape, io_detail::sliceName(s))
+               : io_detail::decodeJpeg2000Frame(frame, shape, io_detail::sliceName(s));
   }
 #endif
   if (codec != Codec::Rle) throw InputError(s.file.string() + ": no decoder for its pixel data");
@@ -904,7 +905,7 @@ class BasicDicomDecoder final : public DicomDecoder {
   }
   bool canRead(const FileSet&) const override { return true; }
   std::string decodes() const override {
-    return kJpeg2000Codecs ? "uncompressed little endian, RLE, JPEG 2000"
+    return kJpeg2000Codecs ? "uncompressed little endian, RLE, JPEG 2000, HTJ2K"
                            : "uncompressed little endian, RLE";
   }
   Volume read(const ByteSource& named, const FileSet& files,

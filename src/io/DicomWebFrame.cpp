@@ -90,18 +90,22 @@ std::vector<std::byte> throughDcmtk(const Slice& s, E_TransferSyntax xfer,
   return copyOf(p, length);
 }
 
+// JPEG 2000 through OpenJPEG; HTJ2K (`htj2k`) through OpenJPH's checks.
 std::vector<std::byte> throughOpenJpeg(const Slice& s, std::span<const std::byte> frame,
-                                       const std::string& what) {
-  const FrameShape shape{s.rows, s.columns, s.bitsAllocated, s.bitsStored, s.samplesPerPixel};
-  const std::vector<std::uint8_t> samples = decodeJpeg2000Frame(
-      {reinterpret_cast<const std::uint8_t*>(frame.data()), frame.size()}, shape, what);
+                                       const std::string& what, bool htj2k) {
+  const FrameShape shape{s.rows,       s.columns,         s.bitsAllocated,
+                         s.bitsStored, s.samplesPerPixel, s.isSigned};
+  const std::span<const std::uint8_t> bytes(reinterpret_cast<const std::uint8_t*>(frame.data()),
+                                            frame.size());
+  const std::vector<std::uint8_t> samples =
+      htj2k ? decodeHtj2kSyntaxFrame(bytes, shape, what) : decodeJpeg2000Frame(bytes, shape, what);
   return copyOf(samples.data(), samples.size());
 }
 
 }  // namespace
 
 std::string webFrameSyntaxesText() {
-  return "uncompressed, JPEG baseline/extended/lossless, JPEG-LS, RLE and JPEG 2000";
+  return "uncompressed, JPEG baseline/extended/lossless, JPEG-LS, RLE, JPEG 2000 and HTJ2K";
 }
 
 std::vector<std::byte> decodeWebFrame(const Slice& s, const std::string& transferSyntax,
@@ -117,7 +121,11 @@ std::vector<std::byte> decodeWebFrame(const Slice& s, const std::string& transfe
     out = uncompressed(s, frame, true);
   } else if (transferSyntax == "1.2.840.10008.1.2.4.90" ||
              transferSyntax == "1.2.840.10008.1.2.4.91") {
-    out = throughOpenJpeg(s, frame, what);
+    out = throughOpenJpeg(s, frame, what, false);
+  } else if (transferSyntax == "1.2.840.10008.1.2.4.201" ||  // HTJ2K lossless
+             transferSyntax == "1.2.840.10008.1.2.4.202" ||  // HTJ2K RPCL lossless
+             transferSyntax == "1.2.840.10008.1.2.4.203") {  // HTJ2K
+    out = throughOpenJpeg(s, frame, what, true);
   } else {
     const DcmXfer x(transferSyntax.c_str());
     if (x.getXfer() == EXS_Unknown || !x.isEncapsulated()) {

@@ -313,7 +313,8 @@ std::vector<VolumeFormat> makeFormats() {
     n.read = [](const ByteSource& s, const FileSet& fs) { return readDicom(s, fs, ""); };
     n.loses = "f32 precision (16-bit integers with a rescale slope)";
     n.nativeRead =
-        "DCMTK for JPEG, JPEG-LS and deflate, OpenJPEG for JPEG 2000 (the basic reader needs none)";
+        "DCMTK for JPEG, JPEG-LS and deflate, OpenJPEG for JPEG 2000, OpenJPH for HTJ2K (the basic "
+        "reader needs none)";
     n.nativeWrite = "DCMTK";
     n.browserReads = true;
 #ifndef __EMSCRIPTEN__

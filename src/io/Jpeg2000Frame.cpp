@@ -1,5 +1,7 @@
 #include "io/Jpeg2000Frame.h"
 
+#include "io/Htj2kFrame.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
@@ -15,51 +17,6 @@ namespace {
 
 std::string dims(long long w, long long h) {
   return std::to_string(w) + "x" + std::to_string(h);
-}
-
-// The checks both codecs make on a frame's header before decoding it.
-void checkHeader(const FrameShape& shape, const std::string& what, const std::string& codec,
-                 long long width, long long height, unsigned components, unsigned precision,
-                 bool subsampled) {
-  if (components != 1) {
-    throw InputError(what + ": a " + codec + " frame of " + std::to_string(components) +
-                     " components; only greyscale (one component) is read");
-  }
-  if (shape.samplesPerPixel != 1) {
-    throw InputError(what + ": Samples per Pixel is " + std::to_string(shape.samplesPerPixel) +
-                     "; only greyscale (1) is read");
-  }
-  if (width != shape.columns || height != shape.rows) {
-    throw InputError(what + ": the " + codec + " frame is " + dims(width, height) +
-                     " pixels, but the file declares " + dims(shape.columns, shape.rows) +
-                     " (Columns x Rows)");
-  }
-  if (subsampled) throw InputError(what + ": a subsampled " + codec + " component is not read");
-  if (precision == 0 || precision > static_cast<unsigned>(shape.bitsAllocated)) {
-    throw InputError(what + ": the " + codec + " frame has " + std::to_string(precision) +
-                     "-bit samples, more than the " + std::to_string(shape.bitsAllocated) +
-                     " bits allocated per pixel");
-  }
-}
-
-// Writes one sample as uncompressed pixel data holds it: the low
-// bitsAllocated bits of its two's complement, host byte order.
-void putSample(std::vector<std::uint8_t>& out, std::size_t index, std::int32_t value, int bits) {
-  if (bits == 8) {
-    out[index] = static_cast<std::uint8_t>(static_cast<std::uint32_t>(value) & 0xffu);
-    return;
-  }
-  const auto v = static_cast<std::uint16_t>(static_cast<std::uint32_t>(value) & 0xffffu);
-  std::memcpy(out.data() + 2 * index, &v, 2);
-}
-
-std::vector<std::uint8_t> samplesFor(const FrameShape& shape, const std::string& what) {
-  if (shape.bitsAllocated != 8 && shape.bitsAllocated != 16) {
-    throw InputError(what + ": Bits Allocated is " + std::to_string(shape.bitsAllocated) +
-                     "; compressed frames are read with 8 or 16");
-  }
-  return std::vector<std::uint8_t>(static_cast<std::size_t>(shape.rows) * shape.columns *
-                                   (shape.bitsAllocated / 8));
 }
 
 // ---- OpenJPEG
@@ -139,9 +96,64 @@ bool isHtj2k(std::span<const std::uint8_t> d) {
 
 }  // namespace
 
+void checkFrameHeader(const FrameShape& shape, const std::string& what, const std::string& codec,
+                      long long width, long long height, unsigned components, unsigned precision,
+                      bool subsampled) {
+  if (components != 1) {
+    throw InputError(what + ": a " + codec + " frame of " + std::to_string(components) +
+                     " components; only greyscale (one component) is read");
+  }
+  if (shape.samplesPerPixel != 1) {
+    throw InputError(what + ": Samples per Pixel is " + std::to_string(shape.samplesPerPixel) +
+                     "; only greyscale (1) is read");
+  }
+  if (width != shape.columns || height != shape.rows) {
+    throw InputError(what + ": the " + codec + " frame is " + dims(width, height) +
+                     " pixels, but the file declares " + dims(shape.columns, shape.rows) +
+                     " (Columns x Rows)");
+  }
+  if (subsampled) throw InputError(what + ": a subsampled " + codec + " component is not read");
+  if (precision == 0 || precision > static_cast<unsigned>(shape.bitsAllocated)) {
+    throw InputError(what + ": the " + codec + " frame has " + std::to_string(precision) +
+                     "-bit samples, more than the " + std::to_string(shape.bitsAllocated) +
+                     " bits allocated per pixel");
+  }
+}
+
+void putFrameSample(std::vector<std::uint8_t>& out, std::size_t index, std::int32_t value,
+                    int bits) {
+  if (bits == 8) {
+    out[index] = static_cast<std::uint8_t>(static_cast<std::uint32_t>(value) & 0xffu);
+    return;
+  }
+  const auto v = static_cast<std::uint16_t>(static_cast<std::uint32_t>(value) & 0xffffu);
+  std::memcpy(out.data() + 2 * index, &v, 2);
+}
+
+std::vector<std::uint8_t> frameSamples(const FrameShape& shape, const std::string& what) {
+  if (shape.bitsAllocated != 8 && shape.bitsAllocated != 16) {
+    throw InputError(what + ": Bits Allocated is " + std::to_string(shape.bitsAllocated) +
+                     "; compressed frames are read with 8 or 16");
+  }
+  return std::vector<std::uint8_t>(static_cast<std::size_t>(shape.rows) * shape.columns *
+                                   (shape.bitsAllocated / 8));
+}
+
+std::vector<std::uint8_t> decodeHtj2kSyntaxFrame(std::span<const std::uint8_t> codestream,
+                                                 const FrameShape& shape, const std::string& what) {
+  const bool partOne = codestream.size() >= 2 && codestream[0] == 0xff && codestream[1] == 0x4f &&
+                       !isHtj2k(codestream);
+  return partOne ? decodeJpeg2000Frame(codestream, shape, what)
+                 : decodeHtj2kFrame(codestream, shape, what);
+}
+
 std::vector<std::uint8_t> decodeJpeg2000Frame(std::span<const std::uint8_t> codestream,
                                               const FrameShape& shape, const std::string& what) {
-  std::vector<std::uint8_t> out = samplesFor(shape, what);
+  // Debian 12's OpenJPEG (2.5.0) aborts on an assertion in its HT block
+  // decoder for corrupt HTJ2K code-block data (found by scripts/fuzz.sh), so
+  // an HTJ2K codestream goes to OpenJPH whatever syntax the file declares.
+  if (isHtj2k(codestream)) return decodeHtj2kFrame(codestream, shape, what);
+  std::vector<std::uint8_t> out = frameSamples(shape, what);
   MemoryReader reader{codestream, 0};
   std::unique_ptr<opj_stream_t, StreamFree> stream(opj_stream_create(OPJ_J2K_STREAM_CHUNK_SIZE, 1));
   std::unique_ptr<opj_codec_t, CodecFree> codec(
@@ -158,15 +170,6 @@ std::vector<std::uint8_t> decodeJpeg2000Frame(std::span<const std::uint8_t> code
   opj_set_info_handler(codec.get(), ignoreMessage, nullptr);
   opj_dparameters_t params;
   opj_set_default_decoder_parameters(&params);
-  // Debian 12's OpenJPEG (2.5.0) aborts on an assertion in its HT block
-  // decoder for corrupt HTJ2K code-block data (found by scripts/fuzz.sh), so
-  // an HTJ2K codestream is refused whatever syntax the file declares.
-  if (isHtj2k(codestream)) {
-    throw InputError(what +
-                     ": an HTJ2K codestream (JPEG 2000 Part 15) is not decoded natively: "
-                     "Debian 12's OpenJPEG aborts on corrupt HTJ2K data (the web page "
-                     "decodes it)");
-  }
   const std::string codecName = "JPEG 2000";
   const auto failed = [&](const std::string& step) {
     return InputError(what + ": the " + codecName + " frame cannot be decoded (" + step +
@@ -178,9 +181,9 @@ std::vector<std::uint8_t> decodeJpeg2000Frame(std::span<const std::uint8_t> code
   std::unique_ptr<opj_image_t, ImageFree> image(raw);
   if (!header || !image) throw failed("its header");
   const opj_image_comp_t* c = image->numcomps > 0 ? &image->comps[0] : nullptr;
-  checkHeader(shape, what, codecName, static_cast<long long>(image->x1) - image->x0,
-              static_cast<long long>(image->y1) - image->y0, image->numcomps,
-              c != nullptr ? c->prec : 0, c != nullptr && (c->dx != 1 || c->dy != 1));
+  checkFrameHeader(shape, what, codecName, static_cast<long long>(image->x1) - image->x0,
+                   static_cast<long long>(image->y1) - image->y0, image->numcomps,
+                   c != nullptr ? c->prec : 0, c != nullptr && (c->dx != 1 || c->dy != 1));
   if (!opj_decode(codec.get(), stream.get(), image.get()) ||
       !opj_end_decompress(codec.get(), stream.get())) {
     throw failed("its tiles");
@@ -191,7 +194,7 @@ std::vector<std::uint8_t> decodeJpeg2000Frame(std::span<const std::uint8_t> code
     throw failed("its component came out " + dims(comp.w, comp.h));
   }
   const std::size_t n = static_cast<std::size_t>(shape.rows) * shape.columns;
-  for (std::size_t i = 0; i < n; ++i) putSample(out, i, comp.data[i], shape.bitsAllocated);
+  for (std::size_t i = 0; i < n; ++i) putFrameSample(out, i, comp.data[i], shape.bitsAllocated);
   return out;
 }
 

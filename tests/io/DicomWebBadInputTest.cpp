@@ -255,7 +255,7 @@ TEST_F(DicomWebBadInput, EachBadAnswerIsOneLineNamingTheUrl) {
           multipart("XyZ", "application/octet-stream; transfer-syntax=1.2.3", pixels(0))}}},
        frame2,
        ": the frame's transfer syntax '1.2.3' is not one this build decodes (uncompressed, JPEG "
-       "baseline/extended/lossless, JPEG-LS, RLE and JPEG 2000)"},
+       "baseline/extended/lossless, JPEG-LS, RLE, JPEG 2000 and HTJ2K)"},
       {"frame larger than any 4x4 frame",
        {{frame2, {200, multi, std::string(70000, 'x')}}},
        frame2,

@@ -202,8 +202,8 @@ TEST(DicomDecoder, ChosenByTransferSyntaxAndWhereTheFilesAre) {
   EXPECT_TRUE(basic.canDecode(kRle));
   EXPECT_FALSE(basic.canDecode(kJpegBaseline));
   EXPECT_FALSE(basic.canDecode(kJpegLs));
-  EXPECT_TRUE(basic.canDecode(kJpeg2000));                   // OpenJPEG
-  EXPECT_FALSE(basic.canDecode("1.2.840.10008.1.2.4.201"));  // HTJ2K: Debian's decoders unsafe
+  EXPECT_TRUE(basic.canDecode(kJpeg2000));                  // OpenJPEG
+  EXPECT_TRUE(basic.canDecode("1.2.840.10008.1.2.4.201"));  // HTJ2K: OpenJPH, guarded
   EXPECT_TRUE(dcmtk.canDecode(kExplicitLe));
   EXPECT_TRUE(dcmtk.canDecode(kJpegBaseline));
   EXPECT_TRUE(dcmtk.canDecode(kJpegLs));

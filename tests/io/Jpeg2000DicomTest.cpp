@@ -1,9 +1,9 @@
 // DICOM frames in JPEG 2000 (OpenJPEG), read through readVolume like any
 // DICOM file: lossless streams give the uncompressed original's voxels
 // exactly, a lossy one OpenJPEG's own command-line decode, and a corrupt or
-// mis-sized frame one line naming the file. HTJ2K is refused in one line,
-// also when its codestream sits in a file that says JPEG 2000: on corrupt
-// data Debian 12's OpenJPH overflows and its OpenJPEG aborts. The streams are
+// mis-sized frame one line naming the file. An HTJ2K codestream in a file
+// that says JPEG 2000 is decoded by OpenJPH (Debian 12's OpenJPEG aborts on
+// corrupt HTJ2K data). The streams are
 // pydicom's test files and ones encoded here with Debian's encoders
 // (opj_compress, ojph_compress), wrapped in DICOM by pydicom.
 #include <gtest/gtest.h>
@@ -115,7 +115,7 @@ TEST(Jpeg2000Dicom, PydicomsLosslessJpeg2000EqualsTheUncompressedOriginal) {
   EXPECT_EQ(j2k.indexToWorld(), original.indexToWorld());
 }
 
-TEST(Jpeg2000Dicom, Jpeg2000EncodedHereReadsBackExactlyAndHtJ2kIsRefusedNamingIt) {
+TEST(Jpeg2000Dicom, Jpeg2000AndHtj2kEncodedHereReadBackExactly) {
   if (!pydicomReady()) GTEST_SKIP() << "needs python3-pydicom's test files and numpy";
   if (!have("command -v ojph_compress") || !have("command -v opj_compress")) {
     GTEST_SKIP() << "needs ojph_compress (openjph-tools) and opj_compress (libopenjp2-tools)";
@@ -123,8 +123,9 @@ TEST(Jpeg2000Dicom, Jpeg2000EncodedHereReadsBackExactlyAndHtJ2kIsRefusedNamingIt
   test::TempDir dir;
   test::writeFile(dir.path() / "wrap.py", kWrap);
   const Volume original = readAlone(dir.path(), kPydicomFiles / "MR_small.dcm");
-  for (const std::string kind :
-       {"j2k-lossless", "htj2k-lossless", "htj2k-lossy", "htj2k-in-j2k-syntax"}) {
+  // HTJ2K in a file that says JPEG 2000 goes to OpenJPH too (by its CAP
+  // marker); Htj2kDicomTest covers the HTJ2K syntaxes themselves.
+  for (const std::string kind : {"j2k-lossless", "htj2k-lossless", "htj2k-in-j2k-syntax"}) {
     SCOPED_TRACE(kind);
     const fs::path work = dir.path() / kind;
     fs::create_directories(work);
@@ -132,16 +133,7 @@ TEST(Jpeg2000Dicom, Jpeg2000EncodedHereReadsBackExactlyAndHtJ2kIsRefusedNamingIt
     ASSERT_TRUE(have(std::string(kPython) + " " + (dir.path() / "wrap.py").string() + " " +
                      (kPydicomFiles / "MR_small.dcm").string() + " " + out.string() + " " + kind +
                      " " + work.string()));
-    if (kind == "j2k-lossless") {
-      expectSameVoxels(readVolume(out.string()), original);
-      continue;
-    }
-    const std::string message = test::inputErrorMessage([&] { readVolume(out.string()); });
-    EXPECT_EQ(message.rfind(out.string() + ": ", 0), 0u) << message;
-    EXPECT_NE(message.find(kind == "htj2k-in-j2k-syntax" ? "an HTJ2K codestream"
-                                                         : "1.2.840.10008.1.2.4.20"),
-              std::string::npos)
-        << message;
+    expectSameVoxels(readVolume(out.string()), original);
   }
 }
 
