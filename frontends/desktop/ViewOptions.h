@@ -16,6 +16,7 @@ struct ViewOptions {
   std::string file;
   std::string series;
   std::string tf = "mr-default";
+  bool tfGiven = false;  // --tf given: the volume's modality does not pick the TF
   std::string size = "1280x800";
   std::string profile = "gles3";
   double azimuth = 0.0;

@@ -154,6 +154,7 @@ void Session::openInView(const std::string& spec, const OpenOptions& options) {
   v.setVolume(Volume(*explore->overview()), explore->overviewName());
   settings_ = currentSettings();  // the view's new window is the volume's own
   settings_.window.reset();
+  showDefaultInView(applyModalityDefault(v.volume()));
   series_.reset();
   seriesWindow_.reset();
   timePoint_ = 0;
