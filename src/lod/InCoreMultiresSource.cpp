@@ -73,8 +73,9 @@ InCoreMultiresSource::InCoreMultiresSource(std::shared_ptr<const Volume> volume,
   shape_.setOrigin(volume->origin());
   shape_.setGeometrySource(volume->geometrySource());
   shape_.setValueRange(volume->valueRange());
-  shape_.setWindow(volume->window());
+  if (volume->hasWindow()) shape_.setWindow(volume->window());  // else its value range
   shape_.setDescription(volume->description());
+  shape_.setModality(volume->modality());
 }
 
 LevelInfo InCoreMultiresSource::levelInfo(int level) const {

@@ -56,11 +56,11 @@ std::optional<ValueRange> clinicalPresetWindow(const TransferFunction& tf, const
 }
 
 ValueRange sliceWindow(const Volume& volume, const TransferFunction* tf) {
-  if (volume.hasWindow() || !volume.hasData()) return volume.window();
-  const std::optional<ModalityDefault> d = modalityDefault(volume);
-  const TransferFunction* named = tf ? tf : d ? &d->tf : nullptr;
-  if (!named) return volume.window();
-  return clinicalPresetWindow(*named, volume).value_or(volume.window());
+  if (volume.hasWindow()) return volume.window();
+  const ClinicalPreset* p =
+      tf ? clinicalPresetNamed(tf->name) : defaultClinicalPreset(volume.modality());
+  if (!p || (p->percentiles && !volume.hasData())) return volume.window();
+  return clinicalWindow(*p, volume);
 }
 
 }  // namespace tessera::session

@@ -51,7 +51,7 @@ Volume mrPhantom() {
     for (int y = 0; y < 40; ++y) {
       for (int x = 0; x < 40; ++x) {
         const double r = std::hypot(x - 19.5, y - 19.5, z - 19.5);
-        const bool hot = (x * 7 + y * 13 + z * 3) % 97 == 0;
+        const bool hot = (x * 7 + y * 13 + z * 3) % 331 == 0;  // 0.3 %: above the 99th percentile
         v.setValueAtIndex(v.index(x, y, z), hot ? 4000 : r > 16 ? 20 : 300 + 20 * (x % 5));
       }
     }
@@ -111,7 +111,7 @@ TEST(ModalityDefaultCommand, CtRendersWithCtSoftTissueWhateverItsStoredRange) {
   const auto [before, beforeNote] = render(a.string() + " --tf mr-default", tmp / "before.png");
   const double change = psnr(def, before);
   EXPECT_LT(change, 30.0);
-  EXPECT_GT(covered(def), 0.2);  // the body is drawn, not a blank frame
+  EXPECT_GT(covered(def), 0.1);  // the soft tissue and bone are drawn, not a blank frame
   RecordProperty("psnr_ct_default_vs_mr_default", std::to_string(change));
 }
 

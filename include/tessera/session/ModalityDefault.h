@@ -45,8 +45,9 @@ std::optional<ValueRange> clinicalPresetWindow(const TransferFunction& tf, const
 
 // The window a slice of `volume` shows when the user gave none (rules 2-4):
 // `tf` is the TF the user named, or null for none, when the modality's
-// default preset stands in (a CT without its own window: -160..240 HU). A
-// volume without voxels (a store's shape) keeps its window.
+// default preset stands in (a CT without its own window: -160..240 HU).
+// Percentiles need voxels: a shape without them (a pyramid's) keeps its
+// value range for an MR.
 ValueRange sliceWindow(const Volume& volume, const TransferFunction* tf);
 
 }  // namespace tessera::session
