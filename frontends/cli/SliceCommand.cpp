@@ -65,7 +65,8 @@ void runSliceCommand(const SliceOptions& o) {
   // The render's window (session/ModalityDefault.h): a CT's own, else its
   // default preset's HU; a clinical --tf's.
   const bool tfGiven = o.command && o.command->get_option("--tf")->count() > 0;
-  ValueRange window = session::sliceWindow(source.shape(), tfGiven ? &tf : nullptr);
+  ValueRange window =
+      session::sliceWindow(source.shape(), slab.hasWindow(), tfGiven ? &tf : nullptr);
   if (!o.window.empty()) {
     if (o.window.size() != 2 || !(o.window[1] > o.window[0])) {
       throw InputError("--window takes two numbers MIN MAX with MAX > MIN");

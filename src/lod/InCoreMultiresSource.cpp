@@ -73,7 +73,7 @@ InCoreMultiresSource::InCoreMultiresSource(std::shared_ptr<const Volume> volume,
   shape_.setOrigin(volume->origin());
   shape_.setGeometrySource(volume->geometrySource());
   shape_.setValueRange(volume->valueRange());
-  if (volume->hasWindow()) shape_.setWindow(volume->window());  // else its value range
+  shape_.setWindow(volume->window());
   shape_.setDescription(volume->description());
   shape_.setModality(volume->modality());
 }

@@ -55,8 +55,8 @@ std::optional<ValueRange> clinicalPresetWindow(const TransferFunction& tf, const
   return clinicalWindow(*p, volume);
 }
 
-ValueRange sliceWindow(const Volume& volume, const TransferFunction* tf) {
-  if (volume.hasWindow()) return volume.window();
+ValueRange sliceWindow(const Volume& volume, bool ownWindow, const TransferFunction* tf) {
+  if (ownWindow) return volume.window();
   const ClinicalPreset* p =
       tf ? clinicalPresetNamed(tf->name) : defaultClinicalPreset(volume.modality());
   if (!p || (p->percentiles && !volume.hasData())) return volume.window();

@@ -10,7 +10,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/TestSupport.h"
 #include "tessera/core/ClinicalPresets.h"
+#include "tessera/io/DicomSeriesReader.h"
 #include "tessera/session/ModalityDefault.h"
 #include "tessera/session/Session.h"
 
@@ -128,6 +130,31 @@ TEST(ModalityDefault, ClinicalPresetWindowIsForClinicalPresetsOnly) {
   ASSERT_TRUE(angio);
   EXPECT_EQ(angio->min, -200);
   EXPECT_EQ(angio->max, 800);
+}
+
+// The interactive front ends: the page hands its volume over (setVolume
+// with a view), the desktop opens a pyramid in the view (openInView); both
+// show the default in the TF editor and the HU window on the view.
+TEST(ModalityDefault, TheViewShowsTheDefaultWhenTheVolumeIsHandedOverOrOpenedInIt) {
+  Session page;
+  page.view();
+  page.setVolume(huRamp("CT"));
+  EXPECT_EQ(page.view().tfEditor().transferFunction().name, "ct-soft-tissue");
+  EXPECT_EQ(page.view().window().min, -160);
+  EXPECT_EQ(page.view().window().max, 240);
+
+  const test::TempDir dir;
+  DicomWriteOptions o;
+  o.modality = "CT";
+  o.rescaleSlope = 0.5;
+  o.rescaleIntercept = -1024;
+  writeDicomSeries(*huRamp(""), dir.path(), o);
+  Session desktop;
+  desktop.openInView(dir.path().string());
+  EXPECT_EQ(desktop.view().tfEditor().transferFunction().name, "ct-soft-tissue");
+  EXPECT_EQ(desktop.view().window().min, -160);
+  EXPECT_EQ(desktop.view().window().max, 240);
+  EXPECT_NE(desktop.defaultNote().find("ct-soft-tissue"), std::string::npos);
 }
 
 }  // namespace

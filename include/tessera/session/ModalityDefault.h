@@ -43,11 +43,13 @@ std::optional<ModalityDefault> modalityDefault(const Volume& volume);
 // nullopt when `tf` is not a clinical preset.
 std::optional<ValueRange> clinicalPresetWindow(const TransferFunction& tf, const Volume& volume);
 
-// The window a slice of `volume` shows when the user gave none (rules 2-4):
-// `tf` is the TF the user named, or null for none, when the modality's
+// The window a slice of `volume` shows when the user gave none (rules 2-4;
+// `ownWindow`: the volume came with its own, which a pyramid's shape does
+// not tell, its slab read from level 0 does): `tf` is the TF the user
+// named, or null for none, when the modality's
 // default preset stands in (a CT without its own window: -160..240 HU).
 // Percentiles need voxels: a shape without them (a pyramid's) keeps its
 // value range for an MR.
-ValueRange sliceWindow(const Volume& volume, const TransferFunction* tf);
+ValueRange sliceWindow(const Volume& volume, bool ownWindow, const TransferFunction* tf);
 
 }  // namespace tessera::session
