@@ -79,6 +79,7 @@ void runInfo(const InfoOptions& o) {
                 a[0][row], a[1][row], a[2][row], a[3][row]);
   }
   std::printf("type        %s\n", std::string(scalarTypeName(v.type())).c_str());
+  std::printf("modality    %s\n", v.modality().empty() ? "unknown" : v.modality().c_str());
   std::printf("values      %g .. %g (mean %.4g)\n", r.min, r.max, h.mean());
   if (const std::uint64_t bad = v.nonFiniteCount()) {
     std::printf("missing     %llu NaN/Inf voxels (%.2f %%), rendered transparent\n",

@@ -277,6 +277,8 @@ Settings settingsFrom(const RenderOptions& o) {
   s.layout = latticeLayout(o);
   if (s.labels) render::applyLabelSettings(s.render);
   if (!s.labels) s.tf = TransferFunction::fromPresetOrFile(o.tf);
+  // Without --tf the volume's modality picks the TF (session/ModalityDefault.h).
+  s.tfIsDefault = o.command == nullptr || o.command->get_option("--tf")->count() == 0;
   s.validate();
   return s;
 }
@@ -676,6 +678,10 @@ void runRenderCommand(const RenderOptions& o) {
     req.settings.tf = table.toTransferFunction();
     session.settings().tf = req.settings.tf;
   }
+  req.settings.tf = session.settings().tf;  // the modality's default when --tf was not given
+  if (!session.defaultNote().empty()) {
+    std::fprintf(stderr, "tessera: note: %s\n", session.defaultNote().c_str());
+  }
   times.loadMs = msSince(tLoad);
   const DeviceSession& device = session.device();
   if (session.streamed()) {
@@ -742,7 +748,9 @@ void addRenderCommand(CLI::App& app) {
   addTimeChannelOptions(cmd, o->time, o->channel);
   addDefaultedOption(
       cmd, "--tf", o->tf,
-      "Transfer function: preset (grey, mr-default, ct-bone, ct-muscle, bench) or FILE.json");
+      "Transfer function: preset (grey, mr-default, ct-bone, ct-muscle, bench, ct-soft-tissue, "
+      "ct-lung, ct-angio, mr-percentile) or FILE.json; default: the DICOM modality's "
+      "(CT ct-soft-tissue, MR mr-percentile), else mr-default");
   addSizeOption(cmd, o->size, "Image");
   addDefaultedOption(
       cmd, "--azimuth", o->azimuth,

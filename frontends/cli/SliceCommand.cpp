@@ -12,6 +12,7 @@
 #include "tessera/core/PatientFrame.h"
 #include "tessera/core/SliceImage.h"
 #include "tessera/core/TransferFunction.h"
+#include "tessera/session/ModalityDefault.h"
 #include "tessera/session/VolumePyramid.h"
 
 namespace tessera::app {
@@ -30,6 +31,7 @@ struct SliceOptions {
   std::string tf = "grey";
   std::string out = "slice.png";
   bool json = false;
+  const CLI::App* command = nullptr;  // which options the command line gave
 };
 
 int parseAxis(const std::string& text) {
@@ -60,7 +62,11 @@ void runSliceCommand(const SliceOptions& o) {
   box.end[axis] = o.index + 1;
   const Volume slab = source.readBox(level, box);
 
-  ValueRange window = source.shape().window();
+  // The render's window (session/ModalityDefault.h): a CT's own, else its
+  // default preset's HU; a clinical --tf's.
+  const bool tfGiven = o.command && o.command->get_option("--tf")->count() > 0;
+  ValueRange window =
+      session::sliceWindow(source.shape(), slab.hasWindow(), tfGiven ? &tf : nullptr);
   if (!o.window.empty()) {
     if (o.window.size() != 2 || !(o.window[1] > o.window[0])) {
       throw InputError("--window takes two numbers MIN MAX with MAX > MIN");
@@ -150,6 +156,7 @@ void addSliceCommand(CLI::App& app) {
   addDefaultedOption(cmd, "--out", o->out,
                      "Output PNG (square pixels of the finer in-plane spacing)");
   cmd->add_flag("--json", o->json, "Print one JSON object (edges, mapping, reads)");
+  o->command = cmd;
   cmd->callback([o] { runSliceCommand(*o); });
 }
 

@@ -166,6 +166,7 @@ void applyOptions(DesktopApp& ds, const ViewOptions& o) {
   }
   ds.showHelp = o.helpOverlay;
   ds.view().tfEditor().setTransferFunction(TransferFunction::fromPresetOrFile(o.tf));
+  ds.session->settings().tfIsDefault = !o.tfGiven;
   openVolume(ds, o.file.empty() ? app::defaultVolumeSpec() : o.file);
   if (!ds.error.empty() && !ds.view().hasVolume()) throw InputError(ds.error);
   // What is left is the recent list's trouble (unreadable, or not written):

@@ -90,7 +90,10 @@ void addViewCommand(CLI::App& app) {
       });
   addShadingOptions(cmd, o->shading);
   addClippingOptions(cmd, o->clipping);
-  cmd->callback([o] { desktop::runView(*o); });
+  cmd->callback([o, cmd] {
+    o->tfGiven = cmd->get_option("--tf")->count() > 0;
+    desktop::runView(*o);
+  });
 }
 
 }  // namespace tessera::app

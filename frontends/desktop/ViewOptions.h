@@ -18,6 +18,7 @@ struct ViewOptions {
   int time = 0;     // the time point shown first (a 4-D NIfTI, a store's t axis)
   int channel = 0;  // a store's channel (c axis)
   std::string tf = "mr-default";
+  bool tfGiven = false;  // --tf given: the volume's modality does not pick the TF
   std::string size = "1280x800";
   std::string profile = "gles3";
   double azimuth = 0.0;

@@ -191,6 +191,12 @@ import { TesseraViewer } from './tessera.js';
   function refreshState() {
     state = JSON.parse(api.stateJson($('logHist').checked ? 1 : 0));
     tf = JSON.parse(api.tfJson());
+    // The session's choice (a CT or MR series opens with its modality's
+    // default, session/ModalityDefault.h) shows in the preset menu.
+    const menu = $('preset');
+    if (menu.value !== tf.name && [...menu.options].some((o) => o.value === tf.name)) {
+      menu.value = tf.name;
+    }
     if ($('labels').checked !== !!state.labels) {  // a new volume leaves label mode
       $('labels').checked = !!state.labels;
       drawLabelList();
@@ -824,7 +830,10 @@ import { TesseraViewer } from './tessera.js';
       e.target.value = '';
       await openFolder(named);
     });
-    ['grey', 'mr-default', 'ct-bone', 'ct-muscle', 'bench'].forEach((n) => {
+    // TransferFunction::presetNames(): the window presets, then the clinical
+    // ones (HU for CT, percentiles for MR; core/ClinicalPresets.h).
+    ['grey', 'mr-default', 'ct-bone', 'ct-muscle', 'bench',
+      'ct-soft-tissue', 'ct-lung', 'ct-angio', 'mr-percentile'].forEach((n) => {
       const o = document.createElement('option');
       o.value = n;
       o.textContent = n;

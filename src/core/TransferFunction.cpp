@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tessera/core/ClinicalPresets.h"
 #include "tessera/core/Error.h"
 
 namespace tessera {
@@ -161,8 +162,22 @@ constexpr Preset kPresets[] = {
 
 std::string presetList() {
   std::string s;
-  for (const Preset& p : kPresets) s += std::string(s.empty() ? "" : ", ") + p.name;
+  for (const std::string& name : TransferFunction::presetNames()) {
+    s += (s.empty() ? "" : ", ") + name;
+  }
   return s;
+}
+
+// A clinical preset (ClinicalPresets.h) that no window preset shadows: its
+// TF, whose window the session puts on the volume (session/ModalityDefault.h).
+const TransferFunction* clinicalTf(const std::string& name) {
+  for (const Preset& p : kPresets) {
+    if (name == p.name) return nullptr;
+  }
+  for (const ClinicalPreset& c : clinicalPresets()) {
+    if (c.name == name) return &c.tf;
+  }
+  return nullptr;
 }
 
 bool endsWithJson(const std::string& s) {
@@ -255,11 +270,20 @@ TransferFunction TransferFunction::preset(const std::string& presetName) {
   for (const Preset& p : kPresets) {
     if (presetName == p.name) return p.make();
   }
+  if (const TransferFunction* tf = clinicalTf(presetName)) return *tf;
   throw InputError("unknown transfer-function preset '" + presetName +
                    "'; valid presets: " + presetList());
 }
 
 std::vector<std::string> TransferFunction::presetNames() {
+  std::vector<std::string> names = windowPresetNames();
+  for (const ClinicalPreset& c : clinicalPresets()) {
+    if (clinicalTf(c.name)) names.push_back(c.name);
+  }
+  return names;
+}
+
+std::vector<std::string> TransferFunction::windowPresetNames() {
   std::vector<std::string> names;
   for (const Preset& p : kPresets) names.emplace_back(p.name);
   return names;
@@ -380,8 +404,8 @@ TransferFunction TransferFunction::load(const std::filesystem::path& path) {
 }
 
 TransferFunction TransferFunction::fromPresetOrFile(const std::string& spec) {
-  for (const Preset& p : kPresets) {
-    if (spec == p.name) return p.make();
+  for (const std::string& name : presetNames()) {
+    if (spec == name) return preset(name);
   }
   if (endsWithJson(spec)) return load(spec);
   throw InputError("transfer function '" + spec + "' is neither a preset (" + presetList() +

@@ -940,6 +940,7 @@ Volume assembleSeries(FolderScan scan, const std::string& seriesUid, const std::
   Volume v = readVoxels(p.slices, what, decode, notes);
   applyGeometry(g, v);
   applySeriesWindow(p.slices.front(), v, notes);
+  v.setModality(p.slices.front().modality);  // the session's default TF follows it
   addSkipNotes(p, scan, named, notes);
 
   std::string d = "DICOM series " + p.label + ", " + p.slices.front().transferSyntax + "; series " +

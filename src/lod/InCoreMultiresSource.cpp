@@ -75,6 +75,7 @@ InCoreMultiresSource::InCoreMultiresSource(std::shared_ptr<const Volume> volume,
   shape_.setValueRange(volume->valueRange());
   shape_.setWindow(volume->window());
   shape_.setDescription(volume->description());
+  shape_.setModality(volume->modality());
 }
 
 LevelInfo InCoreMultiresSource::levelInfo(int level) const {

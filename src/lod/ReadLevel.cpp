@@ -43,6 +43,7 @@ Volume readLevel(const MultiresSource& source, int level) {
   out.setOrigin(shape.worldOf(0.5 * (scale - 1.0)));
   out.setGeometrySource(shape.geometrySource());
   if (shape.hasWindow()) out.setWindow(shape.window());
+  out.setModality(shape.modality());
   out.setDescription(shape.description() + " level " + std::to_string(level));
   return out;
 }

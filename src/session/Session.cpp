@@ -14,6 +14,7 @@
 #include "tessera/lod/WindowedSource.h"
 #include "tessera/reference/ReferenceRaycaster.h"
 #include "tessera/render/LabelTable.h"
+#include "tessera/session/ModalityDefault.h"
 
 namespace tessera::session {
 
@@ -218,7 +219,38 @@ void Session::setVolume(std::shared_ptr<Volume> volume, const std::string& name)
   inCore_ = std::move(next);
   exploration_.reset();
   name_ = name;
+  const bool tfChanged = applyModalityDefault(inCore_->volume());
   applyVolumeSettings();
+  if (view_) showDefaultInView(tfChanged);
+}
+
+// The modality default's TF and window into the view (its upload's copy of
+// the window and the editor's histogram).
+void Session::showDefaultInView(bool tfChanged) {
+  viewer::Viewer& v = *view_;
+  if (tfChanged) v.tfEditor().setTransferFunction(settings_.tf);
+  if (ownWindow_ || settings_.window || !v.hasVolume()) return;
+  if (auto w = clinicalPresetWindow(settings_.tf, v.volume())) v.setWindow(*w);
+}
+
+// A TF the user did not name becomes the modality's default; the default
+// of a volume opened before gives way to the front end's own TF again when
+// this one has none.
+bool Session::applyModalityDefault(const Volume& v) {
+  ownWindow_ = v.hasWindow();
+  defaultNote_.clear();
+  if (!settings_.tfIsDefault || settings_.labels) return false;
+  const std::optional<ModalityDefault> chosen = modalityDefault(v);
+  if (!chosen) {
+    if (!tfBeforeDefault_) return false;
+    settings_.tf = *tfBeforeDefault_;
+    tfBeforeDefault_.reset();
+    return true;
+  }
+  if (!tfBeforeDefault_) tfBeforeDefault_ = settings_.tf;
+  settings_.tf = chosen->tf;
+  defaultNote_ = chosen->note;
+  return true;
 }
 
 Exploration& Session::exploration() {
@@ -247,7 +279,11 @@ void Session::applyVolumeSettings() {
   }
   if (!inCore_) return;
   Volume& v = inCore_->volume();
-  if (settings_.window) v.setWindow(*settings_.window);
+  if (settings_.window) {
+    v.setWindow(*settings_.window);
+  } else if (!ownWindow_ && !settings_.labels) {
+    if (auto w = clinicalPresetWindow(settings_.tf, v)) v.setWindow(*w);
+  }
   if (settings_.labels) render::prepareLabelVolume(v);
 }
 

@@ -164,6 +164,13 @@ void Session::openInView(const std::string& spec, const OpenOptions& options) {
   v.setVolume(Volume(*explore->overview()), explore->overviewName());
   settings_ = currentSettings();  // the view's new window is the volume's own
   settings_.window.reset();
+  const bool tfChanged = applyModalityDefault(v.volume());
+  // The overview has the pyramid's window whether the volume came with one
+  // or not: a voxel of level 0 tells (read only where a default applies).
+  if (tfChanged && !v.volume().modality().empty()) {
+    ownWindow_ = pyramid.source->readBox(0, {glm::ivec3(0), glm::ivec3(1)}).hasWindow();
+  }
+  showDefaultInView(tfChanged);
   series_.reset();
   seriesWindow_.reset();
   timePoint_ = 0;

@@ -289,6 +289,7 @@ Settings Settings::fromJson(const nlohmann::json& state) {
       if (c.contains("target")) s.camera.target = vec3From(c["target"], "camera target");
     }
     if (state.contains("tf")) {
+      s.tfIsDefault = false;
       const nlohmann::json& tf = state["tf"];
       s.tf = tf.is_string() ? TransferFunction::fromPresetOrFile(tf.get<std::string>())
                             : TransferFunction::fromJson(tf.dump(), "session state tf");

@@ -62,6 +62,7 @@ nlohmann::json volumeInfo(const std::string& spec, const Volume& v, int time, in
       {"1", h.percentile(0.01)}, {"50", h.percentile(0.5)}, {"99", h.percentile(0.99)}};
   j["bytes"] = v.byteSize();
   j["description"] = v.description();
+  j["modality"] = v.modality();  // DICOM (0008,0060); "" when unknown
   // An OME-Zarr store: its levels, chunks and codec beside the level read.
   if (isZarrStore(spec)) {
     const ZarrStore store(openZarrStorage(spec), ZarrSelection{.time = time, .channel = channel});

@@ -136,6 +136,7 @@ Volume Explorer::readLevel(int level) const {
   v.setOrigin(shape.origin() + shape.direction() * (0.5 * (sl - s0)));
   v.setGeometrySource(shape.geometrySource());
   v.setWindow(shape.window());
+  v.setModality(shape.modality());  // the session's default TF follows it
   return v;
 }
 
@@ -166,6 +167,7 @@ Volume Explorer::readRegion(const lod::VoxelBox& box) const {
   v.setOrigin(glm::dvec3(at));
   v.setGeometrySource(shape.geometrySource());
   v.setWindow(shape.window());
+  v.setModality(shape.modality());  // the session's default TF follows it
   return v;
 }
 

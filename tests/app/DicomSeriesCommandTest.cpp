@@ -71,7 +71,9 @@ TEST(DicomSeriesCommand, MixedFolderWithShuffledNamesReadsAndRendersLikeTheNifti
   ASSERT_EQ(other.exitCode, 0) << other.err;
   EXPECT_EQ(nlohmann::json::parse(other.out)["dims"], nlohmann::json::array({40, 40, 40}));
 
-  const std::string view = " --size 160x160 --azimuth 30 --elevation 20";
+  // mr-default on both: the DICOM copy is an MR series, whose own default
+  // would be mr-percentile (session/ModalityDefault.h).
+  const std::string view = " --size 160x160 --azimuth 30 --elevation 20 --tf mr-default";
   const auto fromNifti = tmp / "nifti.png";
   const auto fromDicom = tmp / "dicom.png";
   ASSERT_EQ(runCli("render " + source + view + " --out " + fromNifti.string()).exitCode, 0);

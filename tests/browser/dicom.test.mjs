@@ -48,16 +48,29 @@ async function dicomFolder(context, url, tmp, run) {
       document.getElementById('view').dispatchEvent(e);
     }, { folderName, which });
   };
+  // The series is an MR (convert writes ch2 so): it opens with mr-percentile
+  // (session/ModalityDefault.h), which the preset menu shows; the NIfTI's
+  // look (mr-default on the value range) is then chosen to compare.
   const shown = async (name) => {
     await page.waitForFunction((n) => window.tessera.state().name === n || window.tessera.error() !== '', name, { timeout: 60000 });
     await page.evaluate(() => window.tessera.render());
+    const preset = await page.evaluate(() => document.getElementById('preset').value);
+    await page.evaluate(() => {
+      const menu = document.getElementById('preset');
+      menu.value = 'mr-default';
+      menu.dispatchEvent(new Event('change'));
+      document.getElementById('resetWindow').click();
+    });
+    await page.evaluate(() => window.tessera.render());
     return { state: await page.evaluate(() => window.tessera.state()), error: await page.evaluate(() => window.tessera.error()),
-      pixels: (await snapshot(page)).pixels };
+      pixels: (await snapshot(page)).pixels, preset };
   };
   const t = Date.now();
   await drop('ch2-dicom', null);
   const dropped = await shown(`ch2-dicom/${names[0]}`);
   const dropMs = Date.now() - t;
+  check('a dropped MR series opens with mr-percentile, shown in the preset menu',
+        dropped.preset === 'mr-percentile', dropped.preset);
   const dropPsnr = psnrOf(dropped.pixels, nifti);
   check('a dropped DICOM folder (ch2) renders like the NIfTI of the same head (PSNR >= 35 dB)',
         !dropped.error && dropped.state.dims.join('x') === '181x217x181' && dropPsnr >= 35,

@@ -56,9 +56,14 @@ class TransferFunction {
   // colour not premultiplied. entries must be 256 or 4096 (InputError otherwise).
   std::vector<float> bake(int entries, double sampleDistance, double opacityScale) const;
 
-  // Named presets: "grey", "mr-default", "ct-bone", "ct-muscle", "bench".
+  // Named presets: those on the volume's own window ("grey", "mr-default",
+  // "ct-bone", "ct-muscle", "bench"), then the clinical presets of
+  // core/ClinicalPresets.h whose names those leave free ("ct-soft-tissue",
+  // "ct-lung", "ct-angio", "mr-percentile"): their TF here, their window
+  // (HU, percentiles) put on the volume by the session.
   static TransferFunction preset(const std::string& name);  // InputError if unknown
   static std::vector<std::string> presetNames();
+  static std::vector<std::string> windowPresetNames();
 
   // JSON: {"name": s, "opacity_unit_length": u,
   //        "color": [{"x": 0, "rgb": [r,g,b]}, ...],

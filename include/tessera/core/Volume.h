@@ -130,6 +130,11 @@ class Volume {
   // Free-form description kept for `tessera info` (source file, generator).
   const std::string& description() const { return description_; }
   void setDescription(std::string d) { description_ = std::move(d); }
+  // DICOM Modality (0008,0060) as the series says it ("CT", "MR", "PT"...);
+  // empty when unknown (every other format). Picks the session's default
+  // transfer function (session/ModalityDefault.h).
+  const std::string& modality() const { return modality_; }
+  void setModality(std::string m) { modality_ = std::move(m); }
 
  private:
   glm::ivec3 dims_{0, 0, 0};
@@ -144,6 +149,7 @@ class Volume {
   ValueRange window_;
   bool hasWindow_ = false;
   std::string description_;
+  std::string modality_;
 };
 
 }  // namespace tessera

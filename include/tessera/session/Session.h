@@ -140,6 +140,12 @@ class Session {
   ChannelFrame renderChannels(const std::string& spec, int width, int height, bool reference,
                               int time = 0);
 
+  // The default the session chose for the volume open now because the
+  // user named no TF (session/ModalityDefault.h): "CT: default transfer
+  // function ct-soft-tissue (modality CT), ...; --tf to change"; empty when
+  // the settings' TF stayed. For the front end to show.
+  const std::string& defaultNote() const { return defaultNote_; }
+
   Settings& settings() { return settings_; }
   const Settings& settings() const { return settings_; }
   // Validated first; the session keeps its old settings on error. With a
@@ -202,6 +208,8 @@ class Session {
   // entry point that touches GL makes it current first (a no-op when it is).
   void makeCurrent();
   void applyVolumeSettings();
+  bool applyModalityDefault(const Volume& v);  // true when it changed the TF
+  void showDefaultInView(bool tfChanged);
   void applyToView();
   void applyCameraToView();
   void showInView();
@@ -216,6 +224,11 @@ class Session {
   std::unique_ptr<nlohmann::json> region_;
   std::unique_ptr<TimeSeries> series_;
   std::optional<ValueRange> seriesWindow_;
+  // The modality default (session/ModalityDefault.h): whether the volume
+  // came with its own window, what was chosen, the TF it replaced.
+  bool ownWindow_ = false;
+  std::string defaultNote_;
+  std::optional<TransferFunction> tfBeforeDefault_;
   int timePoint_ = 0;
   Playback playback_;
   // Both go before device_ (declared first), while its context lives: the

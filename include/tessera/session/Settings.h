@@ -60,6 +60,10 @@ struct Settings {
   TransferFunction tf = TransferFunction::preset("mr-default");
   // Raw values mapped to the TF's [0,1]; none: the volume's own window.
   std::optional<ValueRange> window;
+  // `tf` is the front end's default, not the user's: opening a volume with
+  // a modality replaces it by that modality's default
+  // (session/ModalityDefault.h). Not saved: a state's TF is the user's.
+  bool tfIsDefault = true;
   // Mode, step, sampling, shading, clipping, opacity, ERT, background.
   RenderSettings render = defaultRenderSettings();
   // Technique options (render::TechniqueOptions).
