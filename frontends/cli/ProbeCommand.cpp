@@ -31,6 +31,12 @@ std::string vec3Text(glm::dvec3 v, const char* format) {
   return buf;
 }
 
+std::string numberText(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
 nlohmann::json probeJson(const session::ProbeResult& r) {
   nlohmann::json j = {{"world_mm", {r.worldMm.x, r.worldMm.y, r.worldMm.z}},
                       {"anatomy",
@@ -53,7 +59,7 @@ void printProbeText(const session::ProbeResult& r) {
   std::printf("position %s mm (RAS+: +x right, +y anterior, +z superior)\n",
               vec3Text(r.worldMm, "%.2f, %.2f, %.2f").c_str());
   std::printf("anatomy  voxel %s: %s\n", vec3Text(r.anatomyIndex, "(%.2f, %.2f, %.2f)").c_str(),
-              r.inAnatomy ? ("value " + std::to_string(r.anatomyValue)).c_str() : "outside");
+              r.inAnatomy ? ("value " + numberText(r.anatomyValue)).c_str() : "outside");
   if (!r.hasOverlay) return;
   const std::string value =
       r.inOverlay ? "value " + session::probeOverlayText(r) : std::string("outside");

@@ -94,7 +94,12 @@ Overlay makeOverlay(std::shared_ptr<Volume> volume, const std::string& name,
 
 Overlay openOverlay(const std::string& spec, const OverlayOptions& options, const Volume& anatomy) {
   checkOptions(options);
-  auto volume = std::make_shared<Volume>(readVolume(spec));
+  std::shared_ptr<Volume> volume;
+  try {
+    volume = std::make_shared<Volume>(readVolume(spec));
+  } catch (const InputError& e) {
+    throw InputError("--overlay " + std::string(e.what()));
+  }
   return makeOverlay(std::move(volume), spec, options, anatomy);
 }
 

@@ -137,6 +137,24 @@ TEST(Fusion, RotatedResampledCopyIsPlacedByWorldCoordinates) {
   EXPECT_GE(close, 32.0);  // measured 38.8 dB (the copy was resampled by nearest)
 }
 
+// Another modality's path: trilinear, a window and the hot colour map (here
+// ch2 over itself, windowed to white matter).
+TEST(Fusion, ColourMappedOverlayMatchesTheReference) {
+  if (!haveMricron()) GTEST_SKIP() << "mricron templates not installed";
+  Session s("native");
+  openCh2(s);
+  OverlayOptions o;
+  o.tf = "hot";
+  o.window = ValueRange{90.0, 200.0};
+  o.opacity = 0.7;
+  s.openOverlay(kCh2, o);
+  EXPECT_FALSE(s.overlay()->fused->labels);
+  const RenderResult r = renderWithReference(s, 160);
+  ASSERT_TRUE(r.psnrDb.has_value());
+  std::printf("hot ch2 over ch2: GPU vs reference %.2f dB\n", *r.psnrDb);
+  EXPECT_GE(*r.psnrDb, 40.0);
+}
+
 // A voxel of `label` in the atlas whose mirror (x -> -x in world) is
 // `mirrorLabel`, deep inside both (its 6 neighbours share its label).
 glm::dvec3 labelledPosition(const Volume& aal, int label, int mirrorLabel) {
@@ -213,7 +231,8 @@ TEST(Fusion, BadInputsAreNamed) {
   Session s("native");
   openCh2(s);
   const std::string missing = (dir / "missing.nii.gz").string();
-  EXPECT_NE(errorOf([&] { s.openOverlay(missing, aalLabels()); }).find(missing), std::string::npos);
+  EXPECT_NE(errorOf([&] { s.openOverlay(missing, aalLabels()); }).find("--overlay " + missing),
+            std::string::npos);
   // A map of fractions is no label volume.
   Volume map = Volume::allocate({8, 8, 8}, ScalarType::F32, "map");
   for (std::size_t i = 0; i < map.voxelCount(); ++i) map.setValueAtIndex(i, 0.25 * (i % 7));
