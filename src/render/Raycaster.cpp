@@ -264,7 +264,24 @@ const gpu::Program& Raycaster::programFor(const RenderSettings& settings) {
   });
 }
 
+namespace {
+
+// A fused frame takes every sample post-classified (docs/fusion.md): the
+// fused volume is mixed into classifiedSample, which neither segments nor
+// the block walk's adaptive steps take.
+bool dropsSampling(bool fused, const RenderSettings& settings) {
+  return fused && (settings.sampling.preintegrate || settings.sampling.adaptive);
+}
+
+RenderSettings everySample(RenderSettings settings) {
+  settings.sampling = Sampling();
+  return settings;
+}
+
+}  // namespace
+
 void Raycaster::prepare(const RenderSettings& settings) {
+  if (dropsSampling(fusion_.active(), settings)) return prepare(everySample(settings));
   const glm::dvec3 spacing = volume_.spacing();
   const double ds = sampleDistance(settings, spacing);
   updateLookup(settings, isProjection(settings.mode) ? tf_.opacityUnitLength : ds);
@@ -274,6 +291,9 @@ void Raycaster::prepare(const RenderSettings& settings) {
 
 void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings, int width,
                             int height) {
+  if (dropsSampling(fusion_.active(), settings)) {
+    return renderFrame(camera, everySample(settings), width, height);
+  }
   // A streamed layout (bricks) changed what it samples: new value blocks.
   if (blockSize_ > 0 && layout_.contentVersion() != blocksVersion_) setSkipBlockSize(blockSize_);
   if (width <= 0 || height <= 0 || width > context_.caps().maxRenderbufferSize ||

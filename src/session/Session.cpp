@@ -273,6 +273,9 @@ void Session::clearOverlay() {
 }
 
 ProbeResult Session::probe(glm::dvec3 worldMm) const {
+  // Explored in the view (openInView): its overview holds the values.
+  if (!inCore_ && exploration_)
+    return session::probe(*exploration_->overview(), overlay_.get(), worldMm);
   return session::probe(volume(), overlay_.get(), worldMm);
 }
 

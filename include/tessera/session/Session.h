@@ -166,7 +166,8 @@ class Session {
   void clearOverlay();
   const Overlay* overlay() const { return overlay_.get(); }
   // The crosshair's reading at a world position (RAS+ mm): the anatomy's
-  // value, the overlay's and its label's name (in core only).
+  // value, the overlay's and its label's name (in core, or the exploration's
+  // overview when the volume is explored in the view).
   ProbeResult probe(glm::dvec3 worldMm) const;
 
   // Exploring the volume at native resolution (session/Exploration.h):
