@@ -53,6 +53,7 @@ void addProfilesCommand(CLI::App& app);  // ProfilesCommand.cpp
 void addPlanCommand(CLI::App& app);      // PlanCommand.cpp
 void addConvertCommand(CLI::App& app);   // ConvertCommand.cpp
 void addViewCommand(CLI::App& app);      // ViewCommand.cpp (desktop viewer)
+void addProbeCommand(CLI::App& app);     // ProbeCommand.cpp
 void addSliceCommand(CLI::App& app);     // SliceCommand.cpp
 void addFormatsCommand(CLI::App& app);   // FormatsCommand.cpp
 void addDicomWebCommand(CLI::App& app);  // DicomWebCommand.cpp

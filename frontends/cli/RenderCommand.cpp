@@ -14,6 +14,7 @@
 
 #include "cli/ClippingOptions.h"
 #include "cli/Commands.h"
+#include "cli/FusionOptions.h"
 #include "cli/HybridJob.h"
 #include "cli/SamplingOptions.h"
 #include "cli/ShadingOptions.h"
@@ -112,6 +113,7 @@ struct RenderOptions {
     return !channels.empty() || !channelColors.empty() || !channelWindows.empty() ||
            !channelMode.empty();
   }
+  FusionOptions fusion;  // --overlay and its look (FusionOptions.h)
 };
 
 // Where each option that sets a setting lands in the settings' JSON
@@ -191,7 +193,8 @@ void checkOptionsClassified(const CLI::App& cmd) {
   for (const CLI::Option* opt : cmd.get_options()) {
     if (opt == cmd.get_help_ptr() || opt == cmd.get_help_all_ptr()) continue;
     const std::string name = opt->get_name();
-    if (!settingKeys().contains(name) && !runOptions().contains(name)) {
+    if (!settingKeys().contains(name) && !runOptions().contains(name) &&
+        !fusionOptionNames().contains(name)) {
       throw std::logic_error("tessera render: option " + name +
                              " is in neither settingKeys() nor runOptions() (RenderCommand.cpp)");
     }
@@ -339,8 +342,8 @@ RenderRequest requestFrom(const RenderOptions& o) {
 // at the finest level that fits the host budget.
 bool needsHostVoxels(const RenderOptions& o) {
   return !o.overlays.empty() || !o.offscreen.empty() || !o.roi.empty() || o.reference ||
-         !o.referenceOut.empty() || o.referenceStep > 0.0 || o.referenceLevelGiven() ||
-         o.lattice != "cartesian";
+         !o.fusion.file.empty() || !o.referenceOut.empty() || o.referenceStep > 0.0 ||
+         o.referenceLevelGiven() || o.lattice != "cartesian";
 }
 
 // --overlays, --offscreen or --roi: the hybrid compositor's run.
@@ -682,6 +685,7 @@ void runRenderCommand(const RenderOptions& o) {
   if (!session.defaultNote().empty()) {
     std::fprintf(stderr, "tessera: note: %s\n", session.defaultNote().c_str());
   }
+  openFusion(session, o.fusion);
   times.loadMs = msSince(tLoad);
   const DeviceSession& device = session.device();
   if (session.streamed()) {
@@ -702,6 +706,11 @@ void runRenderCommand(const RenderOptions& o) {
   // Checked even when nothing uses it, so that a typo is not silently ignored.
   const render::OverlayOpacity overlayOpacity = render::parseOverlayOpacity(o.overlayOpacity);
   if (!o.overlays.empty() || !o.offscreen.empty() || !o.roi.empty()) {
+    if (session.overlay()) {
+      throw InputError(
+          "--overlay does not combine with --overlays, --offscreen or --roi (the "
+          "hybrid compositor draws one volume)");
+    }
     runHybridCommand(o, session, req, spec, overlayOpacity);
     saveState(o, session);
     return;
@@ -717,6 +726,7 @@ void runRenderCommand(const RenderOptions& o) {
   } else {
     printRenderText(o, req, r, device, session.volume(), spec, times);
     if (!regionReport.is_null()) std::printf("region   %s\n", regionReport.dump().c_str());
+    if (const session::Overlay* overlay = session.overlay()) printOverlayText(*overlay);
   }
   checkRefined(o, r);
 }
@@ -858,6 +868,7 @@ void addRenderCommand(CLI::App& app) {
                   "level are clamped (with a note)");
   addDefaultedOption(cmd, "--level", o->level,
                      "With --region: pyramid level, native (0, the finest) or N");
+  addFusionOptions(cmd, o->fusion);
   addStateOptions(cmd, o->state, o->saveState,
                   "camera, TF, window, mode, sampling, shading, clipping, technique and layout. "
                   "An option given with it replaces what it sets, the rest stays as saved; the "

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   tessera::app::addConvertCommand(app);
   tessera::app::addViewCommand(app);
   tessera::app::addSliceCommand(app);
+  tessera::app::addProbeCommand(app);
   tessera::app::addFormatsCommand(app);
   tessera::app::addDicomWebCommand(app);
   try {

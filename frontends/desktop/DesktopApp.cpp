@@ -185,6 +185,7 @@ void applyOptions(DesktopApp& ds, const ViewOptions& o) {
                                          : render::LabelTable::load(o.labels));
     std::snprintf(ds.labelPathBuf, sizeof ds.labelPathBuf, "%s", o.labels.c_str());
   }
+  app::openFusion(*ds.session, o.fusion);
   if (!o.state.empty()) loadState(ds, o.state);
   if (o.play > 0.0) {
     if (!ds.session->series())

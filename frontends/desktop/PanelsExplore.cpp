@@ -167,6 +167,10 @@ void panelExplore(DesktopApp& ds) {
               ds.exploration().overviewLevel(), ex.source().levelCount() - 1);
   const glm::dvec4 w = ex.source().shape().indexToWorld() * glm::dvec4(glm::dvec3(c), 1.0);
   ImGui::Text("crosshair (%d, %d, %d), RAS (%.0f, %.0f, %.0f) mm", c.x, c.y, c.z, w.x, w.y, w.z);
+  if (ds.session->overlay()) {
+    const session::ProbeResult p = ds.session->probe(glm::dvec3(w));
+    ImGui::Text("value %g; overlay %s", p.anatomyValue, session::probeOverlayText(p).c_str());
+  }
   int side = ex.regionSide();
   if (ImGui::SliderInt("region side", &side, 16, ex.maxRegionSide())) ex.setRegionSide(side);
   if (const auto& b = ds.exploration().picked())

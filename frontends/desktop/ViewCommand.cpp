@@ -47,6 +47,7 @@ void addViewCommand(CLI::App& app) {
       "and a categorical colour table instead of --tf. TABLE (optional): JSON or a label text file "
       "(ITK-SNAP, FreeSurfer LUT, mricron); without it a default palette. The Labels panel shows "
       "and hides labels");
+  addFusionOptions(cmd, o->fusion);
   addDefaultedOption(cmd, "--profile", o->profile,
                      "Device profile (gles3, gles2, webgl1, ...; its API level picks the context)");
   cmd->add_option("--azimuth", o->azimuth, "Initial camera azimuth in degrees");

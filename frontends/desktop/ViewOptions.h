@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/ClippingOptions.h"
+#include "cli/FusionOptions.h"
 #include "cli/ShadingOptions.h"
 
 namespace tessera::desktop {
@@ -43,6 +44,7 @@ struct ViewOptions {
   std::string labels;
   CLI::Option* labelsOption = nullptr;
   bool labelVolume() const { return labelsOption != nullptr && labelsOption->count() > 0; }
+  app::FusionOptions fusion;  // --overlay: a second volume over this one (docs/fusion.md)
 };
 
 // Opens the window and runs it until it is closed (or --screenshot is written).

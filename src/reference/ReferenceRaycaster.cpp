@@ -43,19 +43,20 @@ double sampleTrilinear(const Volume& volume, glm::dvec3 p) {
 
 Image renderReference(const Volume& volume, const TransferFunction& tf, const Camera& camera,
                       const RenderSettings& settings, int width, int height, int threads,
-                      ReferenceStats* stats, const ReferenceStops* stops, const StepGrid* steps) {
+                      ReferenceStats* stats, const ReferenceStops* stops, const StepGrid* steps,
+                      const FusionTwin* fusion) {
   if (settings.nearest) {
     return renderReference(volume, NearestReconstruction(volume), tf, camera, settings, width,
-                           height, threads, stats, stops, steps);
+                           height, threads, stats, stops, steps, fusion);
   }
   return renderReference(volume, TrilinearReconstruction(volume), tf, camera, settings, width,
-                         height, threads, stats, stops, steps);
+                         height, threads, stats, stops, steps, fusion);
 }
 
 Image renderReference(const Volume& volume, const Reconstruction& field, const TransferFunction& tf,
                       const Camera& camera, const RenderSettings& settings, int width, int height,
                       int threads, ReferenceStats* stats, const ReferenceStops* stops,
-                      const StepGrid* steps) {
+                      const StepGrid* steps, const FusionTwin* fusion) {
   if (width <= 0 || height <= 0) throw InputError("reference: image size must be positive");
   const glm::dvec3 extent = volume.extent();
   const glm::dvec3 spacing = volume.spacing();
@@ -243,6 +244,11 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
               glm::dvec3 c = tf.color(n);
               // A sample stands for the stretch to the next one.
               double a = tf.correctedOpacity(n, ds * (kNext - k), settings.opacityScale);
+              if (fusion) {  // the second volume over this sample (FusedVolume.h)
+                const glm::dvec4 f = fusion->fuse(c, a, p, ds * (kNext - k));
+                c = glm::dvec3(f);
+                a = f.a;
+              }
               if (shade && a > 0.0) {
                 const glm::dvec3 g = field.gradient(p) * gradientScale;
                 c = lightSample(c, g, settings.shading, light);

@@ -22,7 +22,8 @@ Raycaster::Raycaster(gpu::GlContext& context, const Volume& volume, const layout
       volume_(volume),
       layout_(layout),
       tf_(TransferFunction::preset("grey")),
-      gradient_(context, volume, layout, kOwnTextureUnits) {
+      gradient_(context, volume, layout, kOwnTextureUnits),
+      fusion_(context) {
   triangle_ = gpu::FullscreenTriangle(context.ledger());
   setSkipBlockSize(blockSize_);
 }
@@ -56,7 +57,7 @@ void Raycaster::setLutSize(int entries) {
 
 std::uint64_t Raycaster::ownTextureBytes() const {
   return lut_.bytes() + preint_.bytes() + blockTexture_.bytes() + target_.color().bytes() +
-         gradient_.bytes();
+         gradient_.bytes() + fusion_.bytes();
 }
 
 void Raycaster::setPreintegrationEntries(int entries) {
@@ -207,7 +208,9 @@ std::vector<std::string> Raycaster::definesFor(const RenderSettings& settings) c
   // The block grid knows which blocks are transparent and their maxima: it
   // serves composite and MIP; MinIP and the average need every sample.
   const bool skippable = settings.mode == RenderMode::Composite || settings.mode == RenderMode::Mip;
-  if (blockSize_ > 0 && skippable) defines.push_back("EMPTY_SPACE_SKIPPING 1");
+  if (blockSize_ > 0 && skippable && !fusion_.active()) {
+    defines.push_back("EMPTY_SPACE_SKIPPING 1");
+  }
   // Fewer samples (docs/sampling.md): both for composite only; adaptive steps
   // live in the block grid.
   if (usesPreintegration(settings)) defines.push_back("PREINTEGRATED 1");
@@ -229,6 +232,7 @@ std::vector<std::string> Raycaster::definesFor(const RenderSettings& settings) c
   // a 256-entry one keeps the linear lookup.
   if (lutSize_ >= 4096) defines.push_back("TF_NEAREST_ENTRY 1");
   if (logTransmittance(settings)) defines.push_back("LOG_TRANSMITTANCE 1");
+  fusion_.addDefines(defines);
   defines.push_back("MAX_STEPS " + std::to_string(settings.maxSteps));
   return defines;
 }
@@ -245,6 +249,7 @@ std::vector<gpu::ShaderPart> Raycaster::fragmentParts(const RenderSettings& sett
   std::vector<gpu::ShaderPart> parts = {
       gpu::shaderPreamble(context_.caps().api, true, definesFor(settings)),
       gpu::embeddedShaderPart("render/camera_ray.glsl")};
+  fusion_.addParts(parts);
   addSampleParts(parts, gradient_, layout_);
   parts.push_back(gpu::embeddedShaderPart("render/composite.glsl"));
   parts.push_back(gpu::embeddedShaderPart("render/raycast.frag.glsl"));
@@ -259,7 +264,24 @@ const gpu::Program& Raycaster::programFor(const RenderSettings& settings) {
   });
 }
 
+namespace {
+
+// A fused frame takes every sample post-classified (docs/fusion.md): the
+// fused volume is mixed into classifiedSample, which neither segments nor
+// the block walk's adaptive steps take.
+bool dropsSampling(bool fused, const RenderSettings& settings) {
+  return fused && (settings.sampling.preintegrate || settings.sampling.adaptive);
+}
+
+RenderSettings everySample(RenderSettings settings) {
+  settings.sampling = Sampling();
+  return settings;
+}
+
+}  // namespace
+
 void Raycaster::prepare(const RenderSettings& settings) {
+  if (dropsSampling(fusion_.active(), settings)) return prepare(everySample(settings));
   const glm::dvec3 spacing = volume_.spacing();
   const double ds = sampleDistance(settings, spacing);
   updateLookup(settings, isProjection(settings.mode) ? tf_.opacityUnitLength : ds);
@@ -269,6 +291,9 @@ void Raycaster::prepare(const RenderSettings& settings) {
 
 void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings, int width,
                             int height) {
+  if (dropsSampling(fusion_.active(), settings)) {
+    return renderFrame(camera, everySample(settings), width, height);
+  }
   // A streamed layout (bricks) changed what it samples: new value blocks.
   if (blockSize_ > 0 && layout_.contentVersion() != blocksVersion_) setSkipBlockSize(blockSize_);
   if (width <= 0 || height <= 0 || width > context_.caps().maxRenderbufferSize ||
@@ -335,6 +360,7 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
     prog.set("u_tf", unit++);
     prog.set("u_tfSize", static_cast<float>(lutSize_));
   }
+  unit += fusion_.bind(prog, unit, volume_, ds);
   if (blockSize_ > 0) {
     blockTexture_.bind(unit);
     prog.set("u_blocks", unit++);

@@ -32,7 +32,9 @@ float fieldValue(vec3 p) {
 // offers both (the precomputed gradient holding 8-bit voxels,
 // layout/gradient_texture.glsl): the same field, half the fetches.
 #if defined(SHADING) && defined(LAYOUT_HAS_VALUE_AND_GRADIENT) && !defined(NEAREST)
+#ifndef FUSION  // fusion.glsl mixes the fused volume in before the light
 #define FUSED_VALUE_GRADIENT 1
+#endif
 #endif
 
 #ifdef SHADING
@@ -53,6 +55,9 @@ vec4 classifiedSample(vec3 p) {
   return shadeClassified(classify(normalizedValue(vg.w)), vg.xyz * u_shadeGradientScale);
 #else
   vec4 c = classify(normalizedValue(fieldValue(p)));
+#ifdef FUSION
+  c = fuseSample(c, p);  // a second volume over this one (render/fusion.glsl)
+#endif
 #ifdef SHADING
   c = shadeSample(c, p);
 #endif

@@ -14,6 +14,7 @@
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
 #include "tessera/reference/VoxelGradients.h"
+#include "tessera/render/FusionTexture.h"
 #include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::session {
@@ -109,6 +110,12 @@ void compareWithReference(const Volume& volume, const render::Technique& techniq
                           const RenderRequest& req, RenderResult& result) {
   const render::SamplingTwin twin = technique.samplingTwin(req.settings.render);
   const bool fine = req.referenceStep > 0.0;
+  const std::optional<FusionTwin> fusionTwin =
+      req.fusion
+          ? std::optional<FusionTwin>(FusionTwin{
+                *req.fusion, fusedFromAnatomy(own.box ? *own.box : volume, *req.fusion->volume)})
+          : std::nullopt;
+  const FusionTwin* fusion = fusionTwin ? &*fusionTwin : nullptr;
   const Camera& camera = req.settings.camera;
   RenderSettings settings = req.settings.render;
   if (fine) {
@@ -124,7 +131,7 @@ void compareWithReference(const Volume& volume, const render::Technique& techniq
                           int width, int height) {
     if (own.ownField()) {
       return renderReference(*own.box, *own.field, tf, camera, s, width, height, 0, stats, nullptr,
-                             g);
+                             g, fusion);
     }
     // The twin shades the field the GPU shaded: with a precomputed gradient
     // texture its quantised per-voxel differences; the fine reference keeps
@@ -132,9 +139,9 @@ void compareWithReference(const Volume& volume, const render::Technique& techniq
     if (!fine && twin.gradients != nullptr) {
       const TrilinearReconstruction values(volume);
       return renderReference(volume, VoxelGradientReconstruction(values, *twin.gradients), tf,
-                             camera, s, width, height, 0, stats, nullptr, g);
+                             camera, s, width, height, 0, stats, nullptr, g, fusion);
     }
-    return renderReference(volume, tf, camera, s, width, height, 0, stats, nullptr, g);
+    return renderReference(volume, tf, camera, s, width, height, 0, stats, nullptr, g, fusion);
   };
   const auto t0 = std::chrono::steady_clock::now();
   ReferenceStats stats;
@@ -244,6 +251,8 @@ double RenderResult::max() const {
 
 void prepareFrame(render::Technique& technique, const Volume& volume, RenderRequest& req) {
   technique.setTransferFunction(req.settings.tf);
+  if (req.fusion) applyFusionSettings(req.settings.render);
+  technique.setFusion(req.fusion);
   req.settings.camera.frame(volume);
   // Pre-integration and adaptive steps are the ray caster's; the slicers draw
   // planes, and their reference must not assume either.
@@ -251,6 +260,13 @@ void prepareFrame(render::Technique& technique, const Volume& volume, RenderRequ
       render::TechniqueRegistry::global().find(req.settings.technique);
   if (!entry.honoursSampling) req.settings.render.sampling = Sampling();
   technique.prepare(req.settings.camera, req.settings.render);
+}
+
+void applyFusionSettings(RenderSettings& s) {
+  const std::string why = "a fused volume (--overlay) is mixed into composite samples";
+  if (s.mode != RenderMode::Composite) throw InputError(why + ": use --mode composite");
+  if (s.shading.gradientOpacity) throw InputError(why + ": without --gradient-opacity");
+  s.sampling = Sampling();  // every sample, post-classified (docs/fusion.md)
 }
 
 void checkImageSize(int width, int height) {
@@ -268,6 +284,7 @@ RenderResult runRender(gpu::DeviceSession& device, const lod::VolumeSource& sour
   if (req.referenceLevel && !req.reference) {
     throw InputError("--reference-level needs the reference (--reference)");
   }
+  if (req.fusion) render::FusionTexture::checkDevice(device.limits, *req.fusion);
   const Settings& s = req.settings;
   render::TechniqueOnVolume t = render::createTechnique(s.technique, *device.context, device.limits,
                                                         source, req.techniqueOptions(), s.layout);

@@ -13,6 +13,7 @@
 #include "tessera/lod/MultiresVolumeSource.h"
 #include "tessera/lod/WindowedSource.h"
 #include "tessera/reference/ReferenceRaycaster.h"
+#include "tessera/render/FusionTexture.h"
 #include "tessera/render/LabelTable.h"
 #include "tessera/session/ModalityDefault.h"
 
@@ -58,6 +59,7 @@ viewer::Viewer& Session::view() {
   makeCurrent();
   if (view_) return *view_;
   view_ = std::make_unique<viewer::Viewer>(*device_.context, device_.profile);
+  if (overlay_) view_->setFusion(overlay_->fused);
   if (inCore_) showInView();
   applyToView();
   return *view_;
@@ -325,9 +327,31 @@ void Session::setSettings(Settings settings) {
   if (view_) applyToView();
 }
 
+void Session::openOverlay(const std::string& spec, const OverlayOptions& options) {
+  setOverlay(session::openOverlay(spec, options, shape()));
+}
+
+void Session::setOverlay(Overlay overlay) {
+  overlay_ = std::make_unique<Overlay>(std::move(overlay));
+  if (view_) view_->setFusion(overlay_->fused);
+}
+
+void Session::clearOverlay() {
+  overlay_.reset();
+  if (view_) view_->setFusion(nullptr);
+}
+
+ProbeResult Session::probe(glm::dvec3 worldMm) const {
+  // Explored in the view (openInView): its overview holds the values.
+  if (!inCore_ && exploration_)
+    return session::probe(*exploration_->overview(), overlay_.get(), worldMm);
+  return session::probe(volume(), overlay_.get(), worldMm);
+}
+
 RenderRequest Session::request(int width, int height) const {
   RenderRequest r;
   r.settings = settings_;
+  if (overlay_) r.fusion = overlay_->fused;
   r.width = width;
   r.height = height;
   return r;
@@ -335,6 +359,11 @@ RenderRequest Session::request(int width, int height) const {
 
 RenderResult Session::run(const RenderRequest& request) {
   makeCurrent();
+  if (overlay_ && !request.fusion) {
+    RenderRequest withOverlay = request;
+    withOverlay.fusion = overlay_->fused;
+    return runRender(device_, source(), std::move(withOverlay));
+  }
   return runRender(device_, source(), request);
 }
 
@@ -343,6 +372,7 @@ Image Session::render(int width, int height) {
   makeCurrent();
   RenderRequest req = request(width, height);
   checkImageSize(width, height);
+  if (req.fusion) render::FusionTexture::checkDevice(device_.limits, *req.fusion);
   req.settings.validate();
   const std::string key = residentKey(req);
   if (!resident_ || resident_->source != inCore_ || resident_->key != key) {
@@ -367,6 +397,13 @@ Image Session::renderReference(int width, int height) {
   Camera camera = settings_.camera;
   const Volume& v = volume();
   camera.frame(v);
+  if (overlay_) {
+    RenderSettings fused = settings_.render;
+    applyFusionSettings(fused);
+    const FusionTwin twin{*overlay_->fused, fusedFromAnatomy(v, *overlay_->fused->volume)};
+    return tessera::renderReference(v, settings_.tf, camera, fused, width, height, 0, nullptr,
+                                    nullptr, nullptr, &twin);
+  }
   return tessera::renderReference(v, settings_.tf, camera, settings_.render, width, height);
 }
 

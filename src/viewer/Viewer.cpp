@@ -17,6 +17,7 @@
 #include "tessera/gpu/Draw.h"
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/lod/InCoreVolumeSource.h"
+#include "tessera/render/FusionTexture.h"
 #include "tessera/render/HybridCompositor.h"
 #include "tessera/viewer/CropHandles.h"
 
@@ -104,7 +105,23 @@ render::TechniqueOnVolume Viewer::createActive(const std::string& technique,
                                .skipBlock = kSkipBlock,
                                .lutSize = lutSize_});
   t.technique->setTransferFunction(tfEditor_.transferFunction());
+  applyFusion(*t.technique);
   return t;
+}
+
+void Viewer::applyFusion(render::Technique& technique) const {
+  fusionNote_.clear();
+  try {
+    if (fusion_) render::FusionTexture::checkDevice(limits_, *fusion_);
+    technique.setFusion(fusion_);
+  } catch (const InputError& e) {
+    fusionNote_ = e.what();
+  }
+}
+
+void Viewer::setFusion(std::shared_ptr<const FusedVolume> fused) {
+  fusion_ = std::move(fused);
+  if (active_.technique) applyFusion(*active_.technique);
 }
 
 void Viewer::setVolume(Volume volume, const std::string& name) {

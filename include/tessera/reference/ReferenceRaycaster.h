@@ -16,6 +16,7 @@
 #include "tessera/core/TransferFunction.h"
 #include "tessera/core/Volume.h"
 #include "tessera/reference/AdaptiveSteps.h"
+#include "tessera/reference/FusedVolume.h"
 #include "tessera/reference/Reconstruction.h"
 
 namespace tessera {
@@ -50,10 +51,12 @@ struct ReferenceStops {
 // grid the GPU ray caster walks (AdaptiveSteps.h); given, the reference takes
 // exactly its samples (adaptive steps, and empty blocks left as it leaves
 // them); without it every sample of the lattice, as with skipping off.
+// `fusion`: a second volume over this one (FusedVolume.h; composite,
+// post-classified samples, before the light).
 Image renderReference(const Volume& volume, const TransferFunction& tf, const Camera& camera,
                       const RenderSettings& settings, int width, int height, int threads = 0,
                       ReferenceStats* stats = nullptr, const ReferenceStops* stops = nullptr,
-                      const StepGrid* steps = nullptr);
+                      const StepGrid* steps = nullptr, const FusionTwin* fusion = nullptr);
 
 // The same with another reconstruction of the field: `volume` gives the box
 // (extent, spacing for the sample distance) and the value window, `field`
@@ -61,6 +64,7 @@ Image renderReference(const Volume& volume, const TransferFunction& tf, const Ca
 Image renderReference(const Volume& volume, const Reconstruction& field, const TransferFunction& tf,
                       const Camera& camera, const RenderSettings& settings, int width, int height,
                       int threads = 0, ReferenceStats* stats = nullptr,
-                      const ReferenceStops* stops = nullptr, const StepGrid* steps = nullptr);
+                      const ReferenceStops* stops = nullptr, const StepGrid* steps = nullptr,
+                      const FusionTwin* fusion = nullptr);
 
 }  // namespace tessera

@@ -24,6 +24,7 @@
 #include "tessera/layout/Layout.h"
 #include "tessera/layout/ValueBlocks.h"
 #include "tessera/reference/AdaptiveSteps.h"
+#include "tessera/render/FusionTexture.h"
 #include "tessera/render/PreIntegrationTable.h"
 #include "tessera/render/ShadingGradient.h"
 #include "tessera/render/Technique.h"
@@ -39,6 +40,11 @@ class Raycaster final : public Technique {
   ~Raycaster() override;
 
   void setTransferFunction(const TransferFunction& tf) override;
+  // A fused volume (render/FusionTexture.h): composite frames only; empty-space
+  // skipping is off while one is shown (the anatomy's empty blocks may hold it).
+  void setFusion(std::shared_ptr<const FusedVolume> fused) override {
+    fusion_.set(std::move(fused));
+  }
   // Block size of the empty-space grid in voxels; 0 disables skipping.
   void setSkipBlockSize(int voxels);
   // TF lookup-table entries (256 or 4096).
@@ -146,6 +152,7 @@ class Raycaster final : public Technique {
   int preintEntries_ = PreIntegrationTable::kDefaultEntries;
   StepGrid stepGrid_;
   ShadingGradient gradient_;
+  FusionTexture fusion_;
   gpu::Texture blockTexture_;
   gpu::Framebuffer target_;
   gpu::FullscreenTriangle triangle_;

@@ -9,16 +9,19 @@
 // (render/TechniqueRegistry.h), which also says what each one needs of a
 // device before it exists: the planner must leave room for it.
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include <glm/vec2.hpp>
 
 #include "tessera/core/Camera.h"
+#include "tessera/core/Error.h"
 #include "tessera/core/Image.h"
 #include "tessera/core/RenderSettings.h"
 #include "tessera/core/TransferFunction.h"
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/reference/AdaptiveSteps.h"
+#include "tessera/reference/FusedVolume.h"
 #include "tessera/reference/VoxelGradients.h"
 
 namespace tessera::render {
@@ -97,6 +100,12 @@ class Technique {
   virtual SamplingTwin samplingTwin(const RenderSettings& settings) const {
     (void)settings;
     return {};
+  }
+
+  // A second volume mixed into the samples (docs/fusion.md); null: none.
+  // Techniques that cannot fuse refuse one with an InputError.
+  virtual void setFusion(std::shared_ptr<const FusedVolume> fused) {
+    if (fused) throw InputError(name() + " cannot show a fused volume (--overlay): use raycast");
   }
 
   // A width x height frame for a screen of that shape, read back.

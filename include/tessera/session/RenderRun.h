@@ -4,6 +4,7 @@
 // (render::createTechnique), refine a streamed volume's first frame
 // (session/BrickRefinement.h), render N frames (rotating), optionally compare
 // with the CPU reference.
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -35,6 +36,9 @@ struct RenderRequest {
   std::optional<int> referenceLevel;
   // A streamed volume: where refining frame 0 stops.
   RefineLimits refine;
+  // A second volume over this one (session/Fusion.h): composite,
+  // post-classified frames; the reference fuses it too.
+  std::shared_ptr<const FusedVolume> fusion;
 
   render::TechniqueOptions techniqueOptions() const {
     return settings.techniqueOptions({width, height});
@@ -112,6 +116,11 @@ struct RenderResult {
 // the TF, the camera framing the volume, the sampling the technique honours,
 // prepare(). `req.settings` is left as drawn.
 void prepareFrame(render::Technique& technique, const Volume& volume, RenderRequest& req);
+
+// A fused volume is mixed into composite frames without gradient-opacity
+// modulation (InputError otherwise), taking every sample post-classified:
+// `s.sampling` is reset (no pre-integration, no adaptive steps).
+void applyFusionSettings(RenderSettings& s);
 
 // InputError "size WxH: width and height must be 1..16384" otherwise.
 void checkImageSize(int width, int height);

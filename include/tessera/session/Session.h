@@ -28,6 +28,7 @@
 #include "tessera/lod/MultiresSource.h"
 #include "tessera/render/TechniqueRegistry.h"
 #include "tessera/session/Exploration.h"
+#include "tessera/session/Fusion.h"
 #include "tessera/session/RenderRun.h"
 #include "tessera/session/Settings.h"
 #include "tessera/session/TimeSeries.h"
@@ -175,6 +176,19 @@ class Session {
   // The CPU reference of the current settings' view (in core only).
   Image renderReference(int width, int height);
 
+  // A second volume over this one (session/Fusion.h, docs/fusion.md), aligned
+  // by world coordinates, mixed into the ray march of run(), render() and
+  // renderReference(). openOverlay needs the anatomy open; its note (no
+  // overlap in world space) is overlay()->note. clearOverlay() removes it.
+  void openOverlay(const std::string& spec, const OverlayOptions& options = {});
+  void setOverlay(Overlay overlay);
+  void clearOverlay();
+  const Overlay* overlay() const { return overlay_.get(); }
+  // The crosshair's reading at a world position (RAS+ mm): the anatomy's
+  // value, the overlay's and its label's name (in core, or the exploration's
+  // overview when the volume is explored in the view).
+  ProbeResult probe(glm::dvec3 worldMm) const;
+
   // Exploring the volume at native resolution (session/Exploration.h):
   // made on first use for the volume open now (an in-core volume is its own
   // overview, shared; a streamed store's overview is the finest level the
@@ -231,6 +245,7 @@ class Session {
   std::optional<TransferFunction> tfBeforeDefault_;
   int timePoint_ = 0;
   Playback playback_;
+  std::unique_ptr<Overlay> overlay_;
   // Both go before device_ (declared first), while its context lives: the
   // view's GL objects and the exploration's zoom swap.
   std::unique_ptr<viewer::Viewer> view_;

@@ -96,6 +96,11 @@ class Viewer {
   // A technique of render::TechniqueRegistry; the volume is uploaded again
   // for its requirements. InputError if unknown; on any error the old stays.
   void setTechnique(const std::string& name);
+  // A second volume over this one (docs/fusion.md), mixed into the technique's
+  // composite samples; null: none. A technique that cannot fuse shows the
+  // volume alone, and fusionNote() says why.
+  void setFusion(std::shared_ptr<const FusedVolume> fused);
+  const std::string& fusionNote() const { return fusionNote_; }
   const std::string& technique() const { return techniqueName_; }
 
   // Label volumes (atlases), rendered as `tessera render --labels` renders
@@ -223,6 +228,9 @@ class Viewer {
   std::string techniqueName_ = "raycast";
   int lutSize_ = render::TechniqueOptions{}.lutSize;  // kLabelLutSize while labels are shown
   std::optional<render::LabelTable> labels_;
+  std::shared_ptr<const FusedVolume> fusion_;
+  mutable std::string fusionNote_;  // set where a technique is made (createActive)
+  void applyFusion(render::Technique& technique) const;
   void recreateActive();  // the volume uploaded again for techniqueName_ and lutSize_
   std::uint64_t uploadedTfRevision_ = 0;
   FrameStats last_;

@@ -1,0 +1,75 @@
+#pragma once
+// A second volume over the session's anatomy (docs/fusion.md): how the CLI,
+// the viewers and embedders ask for one (OverlayOptions), how it is opened
+// and checked against the anatomy (openFusedVolume), and what the crosshair
+// reads at a world position (ProbeResult, Session::probe).
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <glm/vec3.hpp>
+
+#include "tessera/core/Volume.h"
+#include "tessera/reference/FusedVolume.h"
+#include "tessera/render/LabelTable.h"
+
+namespace tessera::session {
+
+struct OverlayOptions {
+  // Labels: a label table file (LabelTable::load), or "" with `labels` for
+  // the default palette; otherwise `tf` (a preset, "hot", or FILE.json).
+  bool labels = false;
+  std::string labelTable;
+  std::string tf = "hot";
+  double opacity = 0.5;              // (0, 1]
+  std::optional<ValueRange> window;  // raw values; default: the value range (labels: 0..255)
+};
+
+// An opened fused volume and what names its labels.
+struct Overlay {
+  std::shared_ptr<const FusedVolume> fused;
+  render::LabelTable labels;  // empty unless fused->labels
+  std::string name;           // the file
+  std::string note;           // non-empty: e.g. the volumes do not overlap in world space
+};
+
+// Reads `spec` and makes its look. InputError naming the file and option:
+// unreadable file, --overlay-labels on a volume that is not one (values
+// outside 0..255 or not integers), an unreadable table, an opacity outside
+// (0, 1], a reversed window. A fused volume whose box does not meet the
+// anatomy's in world space is accepted with a note.
+Overlay openOverlay(const std::string& spec, const OverlayOptions& options, const Volume& anatomy);
+
+// The look of `options` for a fused volume already in memory.
+Overlay makeOverlay(std::shared_ptr<Volume> volume, const std::string& name,
+                    const OverlayOptions& options, const Volume& anatomy);
+
+// The fused TF for a name: "hot" (black -> red -> yellow -> white, opacity
+// rising from 0), or a preset or file (TransferFunction::fromPresetOrFile).
+TransferFunction overlayTransferFunction(const std::string& spec);
+
+// What the crosshair reads at a world position (RAS+ mm).
+struct ProbeResult {
+  glm::dvec3 worldMm{0.0};
+  glm::dvec3 anatomyIndex{0.0};  // continuous voxel index
+  bool inAnatomy = false;
+  double anatomyValue = 0.0;  // the voxel the position lies in
+  bool hasOverlay = false;
+  bool inOverlay = false;
+  glm::dvec3 overlayIndex{0.0};
+  double overlayValue = 0.0;  // labels: the nearest voxel; otherwise trilinear
+  int label = -1;             // labels: the label value (0: background)
+  std::string labelName;      // its name in the table ("" for 0 or an unnamed label)
+};
+
+// The probe of `anatomy` (in memory) and, when given, `overlay` at worldMm.
+ProbeResult probe(const Volume& anatomy, const Overlay* overlay, glm::dvec3 worldMm);
+
+// The overlay's part of a probe as the readouts show it: "58 Postcentral_R",
+// "0 (background)", "3.25", or "outside".
+std::string probeOverlayText(const ProbeResult& r);
+
+// "X,Y,Z" in mm; InputError naming `what` otherwise.
+glm::dvec3 parseWorldPosition(const std::string& text, const std::string& what);
+
+}  // namespace tessera::session
