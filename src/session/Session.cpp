@@ -180,10 +180,13 @@ int Session::stepPlayback(double nowMs) {
   if (view_ && view_->refining()) return timePoint_;
   const int count = series_->count();
   const int next = (timePoint_ + 1) % count;
-  bool ready = series_->want(next) != nullptr;
-  series_->want(timePoint_);  // keeps the window of reads anchored here
+  // The window of reads starts at the time point shown (and so holds it
+  // and the next): asking for the next one instead would let the shown one
+  // go and read it again, over and over.
+  series_->want(timePoint_);
   // Without a reading thread, one time point ahead is read per frame.
-  if (series_->pump() && !ready) ready = series_->want(next) != nullptr;
+  series_->pump();
+  const bool ready = series_->isRead(next);
   // A time point that cannot be read stops playback with the reader's
   // message, rather than holding the one shown for ever.
   if (!ready) {

@@ -116,6 +116,11 @@ void TimeSeries::readOne(int t, std::unique_lock<std::mutex>& lock) {
   changed_.notify_all();
 }
 
+bool TimeSeries::isRead(int t) const {
+  std::lock_guard lock(mutex_);
+  return held_.count(t) > 0;
+}
+
 void TimeSeries::rethrowFailure(int t) const {
   std::exception_ptr failure;
   {

@@ -298,6 +298,35 @@ TEST(SessionSeries, ASeriesFromBytesInMemoryPlaysEveryTimePoint) {
   for (std::size_t i = 1; i < sequence.size(); ++i) {
     EXPECT_EQ(sequence[i], (sequence[i - 1] + 1) % 4) << "skipped at " << i;
   }
+  // A series longer than the budget holds (2 of 8 time points kept): the
+  // one shown stays held while the next is read, each read once per loop.
+  {
+    const auto longer = writeSeries(dir, 8);
+    std::ifstream f(longer, std::ios::binary);
+    const std::vector<char> raw8((std::istreambuf_iterator<char>(f)), {});
+    std::vector<std::byte> bytes8(raw8.size());
+    std::memcpy(bytes8.data(), raw8.data(), raw8.size());
+    auto files8 = std::make_shared<MemoryFiles>();
+    files8->add("long.nii", std::move(bytes8));
+    const std::uint64_t one = readTimePoint(longer.string(), 0).byteSize();
+    const test::BudgetOverride budget(one * 8 + one / 2);  // a quarter holds 2
+    Session tight("native");
+    tight.openSeries(
+        8, [files8](int t) { return readTimePoint(*files8->open("long.nii"), *files8, t); },
+        "long.nii", 0, TimeSeries::Reading::OnPump);
+    ASSERT_EQ(tight.series()->keep(), 2);
+    tight.playback().setFps(100.0);
+    tight.playback().play(0.0);
+    std::vector<int> shown{0};
+    for (double now = 0.0; shown.size() < 17 && now < 5000.0; now += 5.0) {
+      const int t = tight.stepPlayback(now);
+      if (t != shown.back()) shown.push_back(t);
+    }
+    ASSERT_EQ(shown.size(), 17u) << "playback stalled with 2 of 8 time points kept";
+    for (std::size_t i = 1; i < shown.size(); ++i) EXPECT_EQ(shown[i], (shown[i - 1] + 1) % 8);
+    // Two loops: each time point read about twice, not once per frame.
+    EXPECT_LE(tight.series()->readLog().size(), 20u);
+  }
   // A time point that cannot be read stops playback with its message
   // instead of holding the one shown for ever.
   Session broken("native");

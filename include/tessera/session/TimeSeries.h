@@ -61,6 +61,9 @@ class TimeSeries {
   // Waits until time point `t` is read (asking for it as want() does); the
   // reader's exception for it is rethrown. OnPump: reads it now.
   std::shared_ptr<Volume> wait(int t);
+  // Whether time point `t` is read and held, without asking for anything
+  // (want() moves the window of reads; this does not).
+  bool isRead(int t) const;
   // Rethrows the reader's exception for time point `t` if its read failed
   // (and it is still in the window); else does nothing.
   void rethrowFailure(int t) const;
