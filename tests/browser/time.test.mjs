@@ -48,6 +48,7 @@ async function play(page, fps, advances, limitMs) {
     const t = window.tessera;
     const start = performance.now();
     const before = t.time().log.length;
+    const { advances: advancesBefore, late: lateBefore } = t.time();
     t.play(fps);
     while (t.time().log.length - before < advances && performance.now() - start < limitMs) {
       await new Promise((r) => setTimeout(r, 20));
@@ -55,7 +56,8 @@ async function play(page, fps, advances, limitMs) {
     const seconds = (performance.now() - start) / 1000;
     t.pause();
     const s = t.time();
-    return { log: s.log.slice(before - 1), late: s.late, advances: s.advances, seconds, error: t.error() };
+    return { log: s.log.slice(before - 1), late: s.late - lateBefore, advances: s.advances - advancesBefore,
+      seconds, error: t.error() };
   }, { fps, advances, limitMs });
 }
 
