@@ -19,22 +19,6 @@ std::uint8_t toByte(double v) {
   return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
 }
 
-// The parameters where the ray (texture space) enters and leaves [0,1]^3.
-std::pair<double, double> unitBoxSpan(glm::dvec3 to, glm::dvec3 td) {
-  double tNear = -std::numeric_limits<double>::infinity();
-  double tFar = std::numeric_limits<double>::infinity();
-  for (int a = 0; a < 3; ++a) {
-    if (td[a] == 0.0) {
-      if (to[a] < 0.0 || to[a] > 1.0) tNear = std::numeric_limits<double>::infinity();
-      continue;
-    }
-    const double t0 = (0.0 - to[a]) / td[a], t1 = (1.0 - to[a]) / td[a];
-    tNear = std::max(tNear, std::min(t0, t1));
-    tFar = std::min(tFar, std::max(t0, t1));
-  }
-  return {std::max(tNear, 0.0), tFar};
-}
-
 using ChannelValues = std::array<double, ChannelSet::kMaxChannels>;
 
 // n_i = clamp((v_i - lo_i) / (hi_i - lo_i), 0, 1); 0 for a hidden channel.

@@ -41,6 +41,21 @@ double sampleTrilinear(const Volume& volume, glm::dvec3 p) {
   return acc;
 }
 
+std::pair<double, double> unitBoxSpan(glm::dvec3 to, glm::dvec3 td) {
+  double tNear = -std::numeric_limits<double>::infinity();
+  double tFar = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    if (td[a] == 0.0) {
+      if (to[a] < 0.0 || to[a] > 1.0) tNear = std::numeric_limits<double>::infinity();
+      continue;
+    }
+    const double t0 = (0.0 - to[a]) / td[a], t1 = (1.0 - to[a]) / td[a];
+    tNear = std::max(tNear, std::min(t0, t1));
+    tFar = std::min(tFar, std::max(t0, t1));
+  }
+  return {std::max(tNear, 0.0), tFar};
+}
+
 Image renderReference(const Volume& volume, const TransferFunction& tf, const Camera& camera,
                       const RenderSettings& settings, int width, int height, int threads,
                       ReferenceStats* stats, const ReferenceStops* stops, const StepGrid* steps,
@@ -109,18 +124,7 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
         // Texture space, as on the GPU: t stays in world units.
         const glm::dvec3 to = ray.origin / extent + 0.5;
         const glm::dvec3 td = ray.direction / extent;
-        double tNear = -std::numeric_limits<double>::infinity();
-        double tFar = std::numeric_limits<double>::infinity();
-        for (int a = 0; a < 3; ++a) {
-          if (td[a] == 0.0) {
-            if (to[a] < 0.0 || to[a] > 1.0) tNear = std::numeric_limits<double>::infinity();
-            continue;
-          }
-          const double t0 = (0.0 - to[a]) / td[a], t1 = (1.0 - to[a]) / td[a];
-          tNear = std::max(tNear, std::min(t0, t1));
-          tFar = std::min(tFar, std::max(t0, t1));
-        }
-        const double t0 = std::max(tNear, 0.0);
+        const auto [t0, tFar] = unitBoxSpan(to, td);
         const double tEnd = std::min(tFar, tStop);
         glm::dvec4 acc(0.0);
         double maxValue = -1.0;

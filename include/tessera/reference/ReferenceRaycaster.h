@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <utility>
+
 #include <glm/vec3.hpp>
 
 #include "tessera/core/Camera.h"
@@ -24,6 +26,11 @@ namespace tessera {
 // Trilinear interpolation of raw values at p in [0,1]^3, straight from the
 // volume (TrilinearReconstruction's value without its double copy).
 double sampleTrilinear(const Volume& volume, glm::dvec3 p);
+
+// Where a ray from texture-space point `origin` along `direction` (not
+// normalised: t in world units, as on the GPU) enters and leaves the unit
+// box [0,1]^3, the entry clamped to t >= 0; entry > exit when it misses.
+std::pair<double, double> unitBoxSpan(glm::dvec3 origin, glm::dvec3 direction);
 
 // Work done by one reference frame (the same samples the GPU takes when
 // empty-space skipping is off): how much work a technique has to do.
