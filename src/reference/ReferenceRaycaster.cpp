@@ -124,7 +124,11 @@ Image renderReference(const Volume& volume, const Reconstruction& field, const T
         // Texture space, as on the GPU: t stays in world units.
         const glm::dvec3 to = ray.origin / extent + 0.5;
         const glm::dvec3 td = ray.direction / extent;
-        const auto [t0, tFar] = unitBoxSpan(to, td);
+        // Not a structured binding: lambdas below use t0 (clang 14, the
+        // web build's, cannot capture those).
+        const std::pair<double, double> span = unitBoxSpan(to, td);
+        const double t0 = span.first;
+        const double tFar = span.second;
         const double tEnd = std::min(tFar, tStop);
         glm::dvec4 acc(0.0);
         double maxValue = -1.0;
