@@ -1,18 +1,11 @@
 #include "tessera/session/ModalityDefault.h"
 
-#include <cstdio>
-
 #include "tessera/core/ClinicalPresets.h"
+#include "tessera/session/Settings.h"
 
 namespace tessera::session {
 
 namespace {
-
-std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
 
 // The clinical preset that `name` selects: the window presets' names
 // (ct-bone on the volume's window) shadow a clinical one of the same name,
@@ -31,12 +24,13 @@ const ClinicalPreset* clinicalPresetNamed(const std::string& name) {
 std::string windowText(const ClinicalPreset& p, const Volume& v) {
   const ValueRange w = v.window();
   if (v.hasWindow()) {
-    return "the volume's own window " + number(0.5 * (w.min + w.max)) + "/" + number(w.width()) +
-           " (centre/width)";
+    return "the volume's own window " + numberText(0.5 * (w.min + w.max)) + "/" +
+           numberText(w.width()) + " (centre/width)";
   }
   const ValueRange c = clinicalWindow(p, v);
-  if (p.hounsfield) return "window " + number(c.min) + ".." + number(c.max) + " HU of the preset";
-  return "window " + number(c.min) + ".." + number(c.max) + " (1st..99th percentile)";
+  if (p.hounsfield)
+    return "window " + numberText(c.min) + ".." + numberText(c.max) + " HU of the preset";
+  return "window " + numberText(c.min) + ".." + numberText(c.max) + " (1st..99th percentile)";
 }
 
 }  // namespace

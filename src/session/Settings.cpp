@@ -14,13 +14,13 @@
 
 namespace tessera::session {
 
-namespace {
-
-std::string number(double v) {
+std::string numberText(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
   return buf;
 }
+
+namespace {
 
 void checkOneOf(const std::string& name, const std::string& value,
                 std::initializer_list<const char*> choices) {
@@ -55,15 +55,15 @@ bool Range::contains(double v) const {
 }
 
 std::string Range::text() const {
-  return std::string(minOpen ? "(" : "[") + number(min) + ", " + number(max) +
+  return std::string(minOpen ? "(" : "[") + numberText(min) + ", " + numberText(max) +
          (maxOpen ? ")" : "]");
 }
 
 void checkRange(const std::string& name, double value, const Range& range,
                 const std::string& unit) {
   if (range.contains(value)) return;
-  throw InputError(name + " " + number(value) + ": expected " + (unit.empty() ? "" : unit + " ") +
-                   "in " + range.text());
+  throw InputError(name + " " + numberText(value) + ": expected " +
+                   (unit.empty() ? "" : unit + " ") + "in " + range.text());
 }
 
 RenderMode parseRenderMode(const std::string& text) {
@@ -138,7 +138,7 @@ void Settings::validate() const {
   for (int c = 0; c < 3; ++c) checkRange("background", render.background[c], kBackgroundRange);
   if (window &&
       !(std::isfinite(window->min) && std::isfinite(window->max) && window->max > window->min)) {
-    throw InputError("window " + number(window->min) + " " + number(window->max) +
+    throw InputError("window " + numberText(window->min) + " " + numberText(window->max) +
                      ": expected MIN < MAX, both finite (raw values)");
   }
   checkRange("skip-block", skipBlock, kSkipBlockRange, "voxels");

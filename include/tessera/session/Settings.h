@@ -45,6 +45,9 @@ inline constexpr Range kBackgroundRange{0.0, 1.0, false, false};
 inline constexpr Range kSkipBlockRange{0.0, 256.0, false, false};
 inline constexpr Range kSlicesRange{0.0, 1 << 16, false, false};
 
+// A number as messages and notes show it ("%g": 0.5, 1024, 1e+06).
+std::string numberText(double v);
+
 // InputError "NAME VALUE: expected UNIT in RANGE" unless the range holds it.
 void checkRange(const std::string& name, double value, const Range& range,
                 const std::string& unit = "");
