@@ -18,7 +18,8 @@ needs). The stores alternate (v2, v3, v2, v3 ...) in one run, so a busy
 machine loads both alike. Per render: requests and body bytes from nginx's
 access log (by status: 206 ranges, 200 whole files, 404 absent chunks),
 the client's own count, the wall time of the command and the renderer's
-time to the refined frame. Prints a Markdown table (docs/large-data.md).
+time to the refined frame, and the 1-minute load average before it (the
+machine is shared). Prints a Markdown table (docs/large-data.md).
 """
 import argparse
 import json
@@ -197,6 +198,7 @@ def main():
                 cmd = [a.tessera, "render", nginx.url(name), "--layout", "bricks", "--size",
                        a.image, "--json", "--out", os.path.join(a.work, name + ".png")]
                 cmd += a.extra.split()
+                load = os.getloadavg()[0]
                 t = time.time()
                 p = subprocess.run(cmd, capture_output=True, text=True)
                 wall = time.time() - t
@@ -209,7 +211,7 @@ def main():
                 rows.append({"store": name, "requests": n, "status": dict(status), "body": body,
                              "client_requests": j.get("http", {}).get("requests"),
                              "client_bytes": j.get("http", {}).get("bytes_fetched"),
-                             "wall_s": wall, "complete_ms": b.get("complete_ms"),
+                             "wall_s": wall, "load": load, "complete_ms": b.get("complete_ms"),
                              "complete": b.get("complete"), "frames": b.get("refine_frames"),
                              "wanted_per_level": b.get("wanted_per_level")})
                 print(json.dumps(rows[-1]), file=sys.stderr)
@@ -219,8 +221,8 @@ def main():
     print(f"{a.size}^3 u8 head, {a.chunk}^3 zstd chunks, v3 with --shard {a.shard}; "
           f"`tessera render URL --layout bricks --size {a.image}`, nginx on 127.0.0.1\n")
     print("| store | files | stored | bricks wanted per level | requests (206 / 200 / 404) "
-          "| body bytes | to the refined frame | wall |")
-    print("|---|---|---|---|---|---|---|---|")
+          "| body bytes | to the refined frame | wall | load before |")
+    print("|---|---|---|---|---|---|---|---|---|")
     stats = {n: store_stats(os.path.join(www, n)) for n in ("v2.ome.zarr", "v3.ome.zarr")}
     for r in rows:
         files, total = stats[r["store"]]
@@ -229,7 +231,7 @@ def main():
         print(f"| {label} | {files} | {mib(total)} | {r['wanted_per_level']} | {r['requests']} "
               f"({s.get(206, 0)} / {s.get(200, 0)} / {s.get(404, 0)}) | {mib(r['body'])} | "
               f"{r['complete_ms'] / 1000:.2f} s{'' if r['complete'] else ' (not refined)'} | "
-              f"{r['wall_s']:.2f} s |")
+              f"{r['wall_s']:.2f} s | {r['load']:.1f} |")
 
 
 if __name__ == "__main__":

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <future>
@@ -89,6 +90,28 @@ void applyTransforms(const json& list, std::size_t rank, const std::string& wher
                        " is not scale, translation or identity");
     }
   }
+}
+
+// NGFF 0.4 and later ("Multiscales metadata"): a dataset's
+// coordinateTransformations, and the multiscales' own when present, are
+// exactly one "scale", then at most one "translation". Stores older than
+// 0.4 had none, so they are held to it only from 0.4 on.
+bool ngffHasTransforms(const std::string& version) {
+  return !version.empty() && version != "?" && std::strtod(version.c_str(), nullptr) >= 0.4 - 1e-9;
+}
+
+void checkTransformOrder(const json& list, bool required, const std::string& what,
+                         const std::string& version, const std::string& where) {
+  if (list.is_null() && !required) return;
+  const bool ok = list.is_array() && (list.size() == 1 || list.size() == 2) &&
+                  list[0].is_object() && list[0].value("type", std::string()) == "scale" &&
+                  (list.size() == 1 ||
+                   (list[1].is_object() && list[1].value("type", std::string()) == "translation"));
+  if (ok) return;
+  std::string got = list.is_null() ? std::string("none") : list.dump();
+  if (got.size() > 160) got = got.substr(0, 157) + "...";
+  throw InputError(where + ": " + what + " coordinateTransformations must be one \"scale\", " +
+                   "then at most one \"translation\" (OME-NGFF " + version + "); got " + got);
 }
 
 template <class T>
@@ -273,6 +296,12 @@ void ZarrStore::readMultiscales() {
       } else if (a.is_object() && a.contains("name") && a["name"].is_string()) {
         names.push_back(a["name"].get<std::string>());
         const std::string type = a.value("type", std::string());
+        const std::string& name = names.back();
+        if ((name == "x" || name == "y" || name == "z") && a.contains("type") && type != "space" &&
+            type != "time" && type != "channel") {
+          throw InputError(where + ": axis \"" + name + "\" has type " + a["type"].dump() +
+                           "; x, y and z are \"space\" axes");
+        }
         if (type == "time") names.back() = "t";
         if (type == "channel") names.back() = "c";
         if (a.contains("unit") && a["unit"].is_string() && type == "space") {
@@ -310,11 +339,22 @@ void ZarrStore::readMultiscales() {
     unitToMm_ = 1.0;
   }
   const std::size_t rank = names.size();
+  const bool transformsRequired = ngffHasTransforms(version_);
+  if (transformsRequired) {
+    checkTransformOrder(
+        ms.contains("coordinateTransformations") ? ms["coordinateTransformations"] : json(), false,
+        "multiscales[0]", version_, where);
+  }
   for (const json& d : ms["datasets"]) {
     if (!d.is_object() || !d.contains("path") || !d["path"].is_string()) {
       throw InputError(where + ": dataset " + d.dump() + " has no \"path\"");
     }
     const std::string path = d["path"].get<std::string>();
+    if (transformsRequired) {
+      checkTransformOrder(
+          d.contains("coordinateTransformations") ? d["coordinateTransformations"] : json(), true,
+          "dataset \"" + path + "\"", version_, where);
+    }
     std::vector<double> scale(rank, 1.0), translation(rank, 0.0);
     applyTransforms(
         d.contains("coordinateTransformations") ? d["coordinateTransformations"] : json(), rank,
@@ -377,6 +417,11 @@ void ZarrStore::readChannels() {
     }
     if (c.contains("label") && c["label"].is_string()) out.label = c["label"].get<std::string>();
     if (c.contains("active") && c["active"].is_boolean()) out.active = c["active"].get<bool>();
+    const std::string which = "omero channel " + std::to_string(channels_.size());
+    if (c.contains("color") && !c["color"].is_string()) {
+      notes_.push_back(which + " colour " + c["color"].dump() +
+                       " is not an \"RRGGBB\" string: white");
+    }
     if (c.contains("color") && c["color"].is_string()) {
       const std::string hex = c["color"].get<std::string>();
       if (hex.size() == 6 && hex.find_first_not_of("0123456789abcdefABCDEF") == std::string::npos) {
@@ -390,14 +435,22 @@ void ZarrStore::readChannels() {
     }
     if (c.contains("window") && c["window"].is_object()) {
       const json& w = c["window"];
+      bool numbers = true;
       const auto num = [&](const char* k, double& v) {
-        if (w.contains(k) && w[k].is_number()) v = w[k].get<double>();
+        if (!w.contains(k)) return;
+        if (w[k].is_number()) {
+          v = w[k].get<double>();
+        } else {
+          notes_.push_back(which + " window." + k + " " + w[k].dump() +
+                           " is not a number: the window is ignored");
+          numbers = false;
+        }
       };
       num("start", out.window.min);
       num("end", out.window.max);
       num("min", out.range.min);
       num("max", out.range.max);
-      out.hasWindow = w.contains("start") && w.contains("end");
+      out.hasWindow = numbers && w.contains("start") && w.contains("end");
     }
     channels_.push_back(out);
   }
