@@ -103,10 +103,14 @@ bool ngffHasTransforms(const std::string& version) {
 void checkTransformOrder(const json& list, bool required, const std::string& what,
                          const std::string& version, const std::string& where) {
   if (list.is_null() && !required) return;
-  const bool ok = list.is_array() && (list.size() == 1 || list.size() == 2) &&
-                  list[0].is_object() && list[0].value("type", std::string()) == "scale" &&
-                  (list.size() == 1 ||
-                   (list[1].is_object() && list[1].value("type", std::string()) == "translation"));
+  const auto typeIs = [&list](std::size_t i, const char* type) {
+    const json& t = list[i];
+    if (!t.is_object()) return false;
+    const auto it = t.find("type");
+    return it != t.end() && it->is_string() && it->get<std::string>() == type;
+  };
+  const bool ok = list.is_array() && (list.size() == 1 || list.size() == 2) && typeIs(0, "scale") &&
+                  (list.size() == 1 || typeIs(1, "translation"));
   if (ok) return;
   std::string got = list.is_null() ? std::string("none") : list.dump();
   if (got.size() > 160) got = got.substr(0, 157) + "...";

@@ -79,6 +79,13 @@ std::vector<std::byte> bytesOf(const std::string& s) {
   return b;
 }
 
+// j[key] when j is an object holding a string there, else "".
+std::string stringAt(const json& j, const char* key) {
+  if (!j.is_object()) return "";
+  const auto it = j.find(key);
+  return it != j.end() && it->is_string() ? it->get<std::string>() : std::string();
+}
+
 // A v3 store holding `group` as its zarr.json and, for every dataset of
 // its first multiscales, a uint8 array whose shape fits the axes: space
 // axes 16 voxels halved per level, t `times`, c `channels`, other axes 2.
@@ -86,20 +93,19 @@ std::shared_ptr<MemoryStorage> storeOf(const json& group, std::int64_t times = 2
                                        std::int64_t channels = 3) {
   auto m = std::make_shared<MemoryStorage>("mem://example.ome.zarr");
   m->put("zarr.json", bytesOf(group.dump()));
-  const json* ome = nullptr;
-  if (group.contains("attributes") && group["attributes"].contains("ome")) {
-    ome = &group["attributes"]["ome"];
-  }
-  if (!ome || !ome->contains("multiscales") || !(*ome)["multiscales"].is_array() ||
-      (*ome)["multiscales"].empty()) {
+  const json attributes = group.contains("attributes") ? group["attributes"] : json();
+  const json ome =
+      attributes.is_object() && attributes.contains("ome") ? attributes["ome"] : json();
+  if (!ome.is_object() || !ome.contains("multiscales") || !ome["multiscales"].is_array() ||
+      ome["multiscales"].empty()) {
     return m;
   }
-  const json& ms = (*ome)["multiscales"][0];
+  const json& ms = ome["multiscales"][0];
   std::vector<std::string> kinds;  // "space", "time", "channel", other
   if (ms.contains("axes") && ms["axes"].is_array()) {
     for (const json& a : ms["axes"]) {
-      std::string name = a.is_object() ? a.value("name", std::string()) : std::string();
-      std::string type = a.is_object() ? a.value("type", std::string()) : std::string();
+      const std::string name = stringAt(a, "name");
+      std::string type = stringAt(a, "type");
       if (type.empty() && (name == "x" || name == "y" || name == "z")) type = "space";
       kinds.push_back(type);
     }
