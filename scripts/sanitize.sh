@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds Tessera's CPU layers and their tests with AddressSanitizer +
-# UndefinedBehaviorSanitizer (gcc, warnings as errors) into build-asan/ and
+# UndefinedBehaviorSanitizer (clang-14, warnings as errors) into build-asan-clang/ and
 # runs them: core, io (every reader and the bad-input corpus), lod and the
 # CPU reference. The GPU image tests run once, in the plain build (test.sh);
 # the parsers are fuzzed under ASan as well (scripts/fuzz.sh).
@@ -14,14 +14,13 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SANITIZE="-fsanitize=address,undefined -fno-omit-frame-pointer"
-# GCC's -Wmaybe-uninitialized is unreliable with sanitizers (it fires inside
-# libstdc++'s <regex> and <functional> here); every other warning stays an error.
-QUIET="-Wno-maybe-uninitialized"
-# -O1 -g1: readable reports with file:line, and the quickest sanitizer build.
-cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTESSERA_WERROR=ON \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
-  -DCMAKE_CXX_FLAGS="$SANITIZE $QUIET" \
-  -DCMAKE_EXE_LINKER_FLAGS="$SANITIZE" >/dev/null
+# clang-14 (installed for fuzzing anyway): it compiles these sanitized builds
+# in about 55 % of gcc's CPU time at -O1 (src/io/ZarrStore.cpp 18.7 s vs
+# 32.3 s). Warnings stay errors; gcc's own warnings are the plain build's job.
+# -O1 -gline-tables-only: readable reports with file:line, and a quick build.
+CC=clang-14 CXX=clang++-14 cmake -S . -B build-asan-clang -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DTESSERA_WERROR=ON -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
+  -DCMAKE_CXX_FLAGS="$SANITIZE" -DCMAKE_EXE_LINKER_FLAGS="$SANITIZE" >/dev/null
 targets=(--target test_core test_io test_lod test_reference)
 skip=(-E _NOT_BUILT)  # ctest's stand-in for the test executables not built here
 if [ "${1:-}" = "--all" ]; then
@@ -29,8 +28,8 @@ if [ "${1:-}" = "--all" ]; then
   skip=()
   shift
 fi
-cmake --build build-asan -j"$(nproc)" "${targets[@]}"
-cd build-asan
+cmake --build build-asan-clang -j"$(nproc)" "${targets[@]}"
+cd build-asan-clang
 export ASAN_OPTIONS=detect_leaks=0:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1
 export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 ctest --output-on-failure --timeout 900 -j"$(nproc)" "${skip[@]}" "$@"

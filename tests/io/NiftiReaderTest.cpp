@@ -21,7 +21,6 @@ using test::TempDir;
 using test::voxelBytes;
 using test::writeFile;
 
-constexpr int kDtUint8 = 2;
 constexpr int kDtInt16 = 4;
 constexpr int kDtInt32 = 8;
 constexpr int kDtFloat32 = 16;
