@@ -268,6 +268,12 @@ vec3 layoutEnterCell(vec3 p) {
   return min(floor(x0 / u_layoutBrick), u_layoutCells - 1.0);
 }
 
+// 1.0 when the cell entered last is transparent under the transfer function
+// (its page holds a constant the TF hides): the walk crosses it in one step.
+float layoutCellTransparent() {
+  return walkPage.isConstant;
+}
+
 float sampleVolumeInCell(vec3 p) {
 #if TESSERA_GLSL == 300 && BRICKS_TEXEL < 2
   return mix(BRICKS_VALUE(texture(u_layoutAtlas, p * walkScale + walkOffset)), walkPage.constant,

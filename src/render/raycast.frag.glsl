@@ -260,6 +260,13 @@ void main() {
       vec3 tb = (walkCell + walkSide) * walkScale + walkBias;
       float cellExit =
           max(ceil(min(min(tb.x, tb.y), tb.z) * walkInvStep - walkSampleBias), k + 1.0);
+#if !defined(MODE_MIP) && !defined(MODE_MINIP) && !defined(MODE_AVERAGE) && !defined(FUSION) && !defined(CHANNELS)
+      // A cell the TF makes transparent adds nothing: crossed in one step.
+      if (layoutCellTransparent() > 0.5) {
+        k = cellExit;
+        continue;
+      }
+#endif
 #endif
     for (int i = 0; i < MAX_STEPS; i++) {
 #ifdef LAYOUT_BRICK_WALK

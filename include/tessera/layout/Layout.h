@@ -91,8 +91,9 @@ class Layout {
   // Whether the layout's GLSL offers the brick walk (LAYOUT_BRICK_WALK,
   // render/raycast.frag.glsl): layoutWalkCellsPerUnit(), the cells of its
   // grid per texture-space unit; layoutEnterCell(p), read once when a ray
-  // enters the cell holding p, returning that cell; sampleVolumeInCell(p)
-  // for the samples inside it. Layouts that look something up per sample
+  // enters the cell holding p, returning that cell; layoutCellTransparent(),
+  // 1.0 when that cell is known to be transparent (composite crosses it in
+  // one step); sampleVolumeInCell(p) for the samples inside it. Layouts that look something up per sample
   // (bricks: the page table) read it once per cell that way.
   virtual bool walksBricks() const { return false; }
   // Changes whenever what sampleVolume() returns may have changed (a
