@@ -15,6 +15,7 @@
 #include "bench/BenchPeers.h"
 #include "bench/BenchRoofline.h"
 #include "bench/BenchSampling.h"
+#include "bench/BenchScale.h"
 #include "bench/BenchSlicing.h"
 #include "cli/Commands.h"
 #include "cli/ShadingOptions.h"
@@ -57,6 +58,8 @@ struct BenchOptions {
   std::vector<std::string> bricks;  // --bricks: generated volumes to stream
   std::vector<std::string> bricksProfiles{"shield-k1", "ipad2"};
   std::vector<std::string> bricksVsInCore;  // --bricks-vs-incore
+  bool scale = false;                       // --scale (BenchScale.h)
+  ScaleBenchOptions scaleOptions;
   bool bricksVsInCoreSet = false;
   int rounds = 3;
   bool printTf = false;
@@ -403,6 +406,12 @@ void addBenchCommand(CLI::App& app) {
       "frame time while streaming (default 8 frames), levels, texture bytes vs the "
       "budget, bricks read, peak RSS, and the in-core layout as baseline where it fits");
   addDefaultedOption(cmd, "--bricks-profiles", o->bricksProfiles, "Profiles for --bricks");
+  cmd->add_flag("--scale", o->scale,
+                "The generated u16 head (head16:N) from 512^3 to 8192^3 through bricks per "
+                "profile: first and refined image, bricks generated, texture peak vs budget, "
+                "host RSS peak vs budget, one process per row (docs/large-data.md)");
+  addDefaultedOption(cmd, "--scale-sides", o->scaleOptions.sides, "With --scale: volume sides N");
+  addDefaultedOption(cmd, "--scale-profiles", o->scaleOptions.profiles, "With --scale: profiles");
   cmd->add_option_function<std::vector<std::string>>(
          "--bricks-vs-incore",
          [o](const std::vector<std::string>& v) {
@@ -533,6 +542,12 @@ void addBenchCommand(CLI::App& app) {
       b.rounds = o->rounds;
       b.tf = o->tf == "bench" ? "mr-default" : o->tf;
       runBrickWalkBench(b);
+      return;
+    }
+    if (o->scale) {
+      o->scaleOptions.size = o->size;
+      if (o->tf != "bench") o->scaleOptions.tf = o->tf;
+      runScaleBench(o->scaleOptions);
       return;
     }
     if (!o->bricks.empty()) {

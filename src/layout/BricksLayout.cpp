@@ -83,10 +83,22 @@ std::string dimsText(glm::ivec3 d) {
   return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
 }
 
-int brickSizeFor(const BricksOptions& options, glm::ivec3 chunk) {
+// The page table holds one texel per level-0 brick cell in one column
+// (cells.x wide, cells.y * cells.z tall). For a source without a natural
+// chunk, the brick doubles from 32 up to 128 until that column fits the
+// device's 2D limit: 4096^3 takes 64^3 bricks under webgl2 (8192²), 128^3
+// under ipad2 (2048²); see docs/large-data.md "Scale".
+int brickSizeFor(const BricksOptions& options, glm::ivec3 chunk, glm::ivec3 dims,
+                 const gpu::DeviceLimits& limits) {
   if (options.brickSize > 0) return options.brickSize;
   if (chunk.x == chunk.y && chunk.y == chunk.z && chunk.x >= 16 && chunk.x <= 128) return chunk.x;
-  return 32;
+  int b = 32;
+  for (; b < 128; b *= 2) {
+    const glm::ivec3 cells = (dims + b - 1) / b;
+    const std::int64_t tall = std::int64_t(cells.y) * cells.z;
+    if (cells.x <= limits.max2DTextureSize && tall <= limits.max2DTextureSize) break;
+  }
+  return b;
 }
 
 // The atlas the budget allows: its slot grid and, on ES 2, its mosaic.
@@ -191,9 +203,9 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
                                  const std::vector<glm::ivec3>& sourceLevels) {
   LayoutPlan plan;
   plan.layout = "bricks";
-  const int b = brickSizeFor(options, chunk);
-  const int stored = b + 2;
   const glm::ivec3 d = shape.dims();
+  const int b = brickSizeFor(options, chunk, d, limits);
+  const int stored = b + 2;
   const std::string vol = dimsText(d) + " " + std::string(scalarTypeName(shape.type()));
   const glm::ivec3 cells = (d + b - 1) / b;
   const std::vector<glm::ivec3> levels =
@@ -266,7 +278,7 @@ std::unique_ptr<BricksLayout> BricksLayout::create(
   for (int lv = 0; lv < source->levelCount(); ++lv) levels.push_back(source->levelInfo(lv).dims);
   // Each level's own factor per axis (InputError naming the level and axis
   // where a level is no integer reduction of the one before).
-  const int b = brickSizeFor(options, chunk);
+  const int b = brickSizeFor(options, chunk, source->shape().dims(), limits);
   l->grid_ = lod::BrickGrid::of(*source, b);
   l->plan_ = planFor(source->shape(), limits, options, chunk, levels);
   if (!l->plan_.fits) throw GpuError("bricks layout: " + l->plan_.reason);

@@ -47,6 +47,40 @@ double valueNoise(glm::dvec3 p) {
   return lerp(y0, y1, t.z);
 }
 
+// How much of a noise component of lattice period `period` (level-0
+// voxels) a level whose voxel spans `voxel` level-0 voxels keeps: all of it
+// at level 0 and while a period spans at least 4 of the level's voxels,
+// none (its mean) at 2 voxels (the level's Nyquist limit), linear between.
+double detailWeight(double period, double voxel) {
+  if (voxel <= 1.0) return 1.0;
+  return std::clamp((period / voxel - 2.0) / 2.0, 0.0, 1.0);
+}
+
+// A component's value `v` with weight w, the rest its mean.
+double keptDetail(double v, double mean, double w) {
+  return w == 1.0 ? v : mean + w * (v - mean);
+}
+
+// The fraction of space where valueNoise exceeds 0.86: the mean of the
+// speckle indicator, measured once over 64^3 points of 16^3 lattice cells
+// (the noise is stationary; its mean is 0.5 by symmetry of the hash).
+double speckleShare() {
+  static const double share = [] {
+    std::uint64_t hits = 0;
+    const int n = 64;
+    for (int z = 0; z < n; ++z) {
+      for (int y = 0; y < n; ++y) {
+        for (int x = 0; x < n; ++x) {
+          const glm::dvec3 p = (glm::dvec3(x, y, z) + 0.5) * (16.0 / n) + 0.37;
+          hits += valueNoise(p) > 0.86;
+        }
+      }
+    }
+    return static_cast<double>(hits) / (double(n) * n * n);
+  }();
+  return share;
+}
+
 glm::ivec3 parseDims(const std::string& spec) {
   if (!ProceduralMultiresSource::isSpec(spec)) {
     throw InputError("'" + spec +
@@ -104,6 +138,10 @@ LevelInfo ProceduralMultiresSource::levelInfo(int level) const {
 }
 
 double ProceduralMultiresSource::valueAt(glm::dvec3 x) const {
+  return fieldAt(x, 1.0);
+}
+
+double ProceduralMultiresSource::fieldAt(glm::dvec3 x, double voxel) const {
   const glm::dvec3 d(shape_.dims());
   const double half = 0.5 * std::max({d.x, d.y, d.z});
   // Isotropic coordinates, the longest axis spanning [-1, 1].
@@ -113,21 +151,42 @@ double ProceduralMultiresSource::valueAt(glm::dvec3 x) const {
   if (r >= 1.0) return 0.0;
   if (r >= 0.88) return 230.0;  // skull
   // Soft tissue: 40 .. 140 with a texture of ~16 features across the head.
-  const double tissue = 40.0 + 100.0 * valueNoise(q * 16.0 + 7.3);
+  const double tissue =
+      40.0 + 100.0 * keptDetail(valueNoise(q * 16.0 + 7.3), 0.5, detailWeight(half / 16.0, voxel));
   // Speckles: where fine noise is high, ~4 voxels across at 512^3.
-  const double fine = valueNoise(q * 110.0 + 1.7);
-  if (fine > 0.86 && r < 0.8) return 250.0;
-  return tissue;
+  if (r >= 0.8) return tissue;
+  const double w = detailWeight(half / 110.0, voxel);
+  const bool speckle = w > 0.0 && valueNoise(q * 110.0 + 1.7) > 0.86;
+  if (w == 1.0) return speckle ? 250.0 : tissue;
+  // Band-limited: the share of the voxel the speckles cover, on average.
+  const double share = keptDetail(speckle ? 1.0 : 0.0, speckleShare(), w);
+  return tissue + share * (250.0 - tissue);
 }
 
 double ProceduralMultiresSource::value16At(glm::dvec3 x) const {
-  const double v = valueAt(x);
+  return field16At(x, 1.0);
+}
+
+double ProceduralMultiresSource::field16At(glm::dvec3 x, double voxel) const {
+  const double v = fieldAt(x, voxel);
   if (v <= 0.0) return 0.0;
   // The 8-bit field times 257, and a fine texture of up to 200 (less than
   // one 8-bit step) that only 16-bit storage keeps.
   const glm::dvec3 d(shape_.dims());
-  const glm::dvec3 q = (x - 0.5 * d) / (0.5 * std::max({d.x, d.y, d.z}));
-  return std::min(65535.0, v * 257.0 + 200.0 * valueNoise(q * 64.0 + 3.1));
+  const double half = 0.5 * std::max({d.x, d.y, d.z});
+  const glm::dvec3 q = (x - 0.5 * d) / half;
+  const double w = detailWeight(half / 64.0, voxel);
+  const double texture = w > 0.0 ? valueNoise(q * 64.0 + 3.1) : 0.5;
+  return std::min(65535.0, v * 257.0 + 200.0 * keptDetail(texture, 0.5, w));
+}
+
+double ProceduralMultiresSource::levelValue(int level, glm::ivec3 voxel) const {
+  const double scale = static_cast<double>(1 << level);
+  const glm::dvec3 c = (glm::dvec3(voxel) + 0.5) * scale;
+  // head: point-samples the field at every level; head16: levels >= 1 are
+  // band-limited (see the header).
+  if (!sixteen_) return static_cast<double>(std::lround(valueAt(c)));
+  return static_cast<double>(std::lround(field16At(c, scale)));
 }
 
 Volume ProceduralMultiresSource::readBox(int level, const VoxelBox& box) const {
@@ -149,7 +208,7 @@ Volume ProceduralMultiresSource::readBox(int level, const VoxelBox& box) const {
       for (int x = 0; x < s.x; ++x) {
         const glm::dvec3 c = (glm::dvec3(box.begin + glm::ivec3(x, y, z)) + 0.5) * scale;
         if (sixteen_) {
-          *dst16++ = static_cast<std::uint16_t>(std::lround(value16At(c)));
+          *dst16++ = static_cast<std::uint16_t>(std::lround(field16At(c, scale)));
         } else {
           *dst++ = static_cast<std::uint8_t>(std::lround(valueAt(c)));
         }

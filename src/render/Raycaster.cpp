@@ -25,7 +25,10 @@ Raycaster::Raycaster(gpu::GlContext& context, const Volume& volume, const layout
       gradient_(context, volume, layout, kOwnTextureUnits),
       fusion_(context) {
   triangle_ = gpu::FullscreenTriangle(context.ledger());
-  setSkipBlockSize(blockSize_);
+  // The value blocks are built on first use (or by setSkipBlockSize): the
+  // default 8 over level 0 of an 8192^3 brick source would be 1024^3 blocks
+  // (8 GiB) before the caller's larger block size replaced it.
+  blocksVersion_ = ~std::uint64_t(0);
 }
 
 Raycaster::~Raycaster() = default;
@@ -83,6 +86,7 @@ bool Raycaster::logTransmittance(const RenderSettings& settings) const {
 }
 
 void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistance) {
+  if (blockSize_ > 0 && layout_.contentVersion() != blocksVersion_) setSkipBlockSize(blockSize_);
   const ValueRange w = volume_.window();
   const bool pre = usesPreintegration(settings);
   const bool adaptive = blockSize_ > 0 && usesAdaptiveSampling(settings);

@@ -6,11 +6,17 @@
 //
 // The field ("head"): a noise-textured ellipsoidal head in u8 — a bright
 // shell (skull), soft tissue with a value-noise texture, and small bright
-// speckles (vessels) that only the finest levels resolve. Every level point-
-// samples the same continuous field at its voxel centres (level-l voxel i
-// sits at level-0 coordinate (i + 0.5) 2^l), so levels agree where the field
-// is smooth; it is not a mean pyramid (that would need 8^l evaluations per
-// coarse voxel).
+// speckles (vessels) that only the finest levels resolve. Level-l voxel i
+// sits at level-0 coordinate (i + 0.5) 2^l. head: point-samples the same
+// continuous field there at every level. head16: (the scale runs, 512^3 to
+// 8192^3, docs/large-data.md "Scale") evaluates levels >= 1 band-limited:
+// each noise component keeps its detail while its lattice period spans at
+// least 4 of the level's voxels and fades to its mean by 2 (the level's
+// Nyquist limit), so a coarse level shows what a mean of the finer one
+// would (a speckle field becomes its average share) without aliasing. A
+// true mean pyramid is not computed: level l of 8192^3 would need 8^l
+// evaluations per voxel (2^39 for the 16^3 top), so meanPyramid() stays
+// false and bricks are read before the TF may skip them.
 #include <string>
 
 #include "tessera/lod/MultiresSource.h"
@@ -36,6 +42,13 @@ class ProceduralMultiresSource final : public MultiresSource {
   double valueAt(glm::dvec3 x) const;
   // The head16: field, 0 .. 65535.
   double value16At(glm::dvec3 x) const;
+  // The fields as a level whose voxel spans `voxel` level-0 voxels sees
+  // them (band-limited, see above); voxel 1 is the field itself.
+  double fieldAt(glm::dvec3 x, double voxel) const;
+  double field16At(glm::dvec3 x, double voxel) const;
+  // The stored value of level `level`'s voxel `voxel`, computed directly
+  // (what readBox returns at that voxel; the tests' direct indexing).
+  double levelValue(int level, glm::ivec3 voxel) const;
 
  private:
   std::string spec_;
