@@ -203,6 +203,13 @@ gpu::DeviceLimits shapeLimits(const gpu::DeviceLimits& limits, const BricksOptio
   return l;
 }
 
+// How channels are kept (BricksLayout::createChannels), for the plan.
+std::string channelNote(gpu::TexelFormat format) {
+  if (format == gpu::TexelFormat::RGBA16) return ", 16 bits per channel (u16 and i16 exact)";
+  if (format == gpu::TexelFormat::RGBA16F) return ", half floats (11 bits) per channel";
+  return ", 8 bits over each channel's value range";
+}
+
 std::uint64_t pyramidBricks(const std::vector<glm::ivec3>& levels, int brick) {
   std::uint64_t n = 0;
   for (glm::ivec3 d : levels) {
@@ -270,7 +277,7 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
       (atlases > 1 ? numbered("", atlases, " x ") : std::string()) + dimsText(atlas.size) +
       (es3 ? " 3D" : " mosaic") + ", " + formatBytes(a.bytes) + ") through a " +
       std::to_string(cells.x) + "x" + std::to_string(cells.y * cells.z) + " page table" +
-      storedNote(shape);
+      (options.channels > 0 ? channelNote(format.format) : storedNote(shape));
   if (a.count() <= topBricks) {
     plan.reason = what + ": the budget (" + formatBytes(avail) + ") holds no more than the " +
                   std::to_string(topBricks) + " coarsest bricks";

@@ -111,13 +111,16 @@ ChannelFrame Session::renderChannels(const std::string& spec, int width, int hei
     RenderSettings render = s.render;
     render.mode = renderModeFor(set.mode);
     if (layout::StreamingLayout* bricks = layout->streaming()) {
-      // Refined while the view stays still, as a single volume's frame 0.
-      const RefineRun r = BrickRefinement(*bricks).refine(
-          camera, width, height, s.tf, [&] { caster.render(camera, render, width, height, 0.0); },
-          {});
+      // Refined before it is drawn (one frame, not a progressive view).
+      const RefineRun r = BrickRefinement(*bricks).refine(camera, width, height, s.tf, [] {},
+                                                          {});  // one frame: drawn once refined
       level = std::max(0, shownLevel(r.last));
-      frame.layout += "; refined in " + std::to_string(r.frames) + " frames, level " +
-                      std::to_string(level) + " shown";
+      frame.layout += "; refined in " + std::to_string(r.frames) + " frames, page cells per level";
+      for (std::size_t l = 0; l < r.last.cellsPerLevel.size(); ++l) {
+        frame.layout += " L" + std::to_string(l) + ":" + std::to_string(r.last.cellsPerLevel[l]);
+      }
+      frame.layout += "; the reference: level " +
+                      std::to_string(level) + (r.last.limitedByBudget ? ", atlas full" : "");
     }
     frame.image = caster.renderImage(camera, render, width, height);
   }
