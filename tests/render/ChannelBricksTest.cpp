@@ -21,6 +21,7 @@
 #include "tessera/reference/ChannelReference.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/render/Raycaster.h"
+#include "tessera/session/Session.h"
 
 namespace tessera {
 namespace {
@@ -210,6 +211,21 @@ TEST_F(ChannelBricks, LayoutWishIsHonouredOrRefused) {
                 [&] { layout::createChannelLayout("fcc", set, sources, limits, gl.ledger()); }),
             "--layout fcc cannot draw channels on " + limits.profile +
                 ": channel frames draw in texture3d or bricks");
+}
+
+// Through the session (what `render --channels ... --layout L` runs): the
+// wish reaches the channel frame, and a refused one is the user's message.
+TEST_F(ChannelBricks, SessionHonoursTheLayoutWish) {
+  session::Session session;
+  session.settings().channels.enabled = true;
+  session.settings().layout = "bricks";
+  const session::ChannelFrame f = session.renderChannels(store(), 64, 64, true);
+  EXPECT_NE(f.layout.find("^3 bricks (+1 voxel apron)"), std::string::npos) << f.layout;
+  EXPECT_GE(f.psnr, 40.0) << f.layout;
+  session.settings().layout = "fcc";
+  EXPECT_EQ(test::inputErrorMessage([&] { session.renderChannels(store(), 64, 64, false); }),
+            "--layout fcc cannot draw channels on native: channel frames draw in texture3d or "
+            "bricks");
 }
 
 }  // namespace
