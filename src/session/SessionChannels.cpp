@@ -119,8 +119,8 @@ ChannelFrame Session::renderChannels(const std::string& spec, int width, int hei
       for (std::size_t l = 0; l < r.last.cellsPerLevel.size(); ++l) {
         frame.layout += " L" + std::to_string(l) + ":" + std::to_string(r.last.cellsPerLevel[l]);
       }
-      frame.layout += "; the reference: level " +
-                      std::to_string(level) + (r.last.limitedByBudget ? ", atlas full" : "");
+      frame.layout += "; the reference: level " + std::to_string(level) +
+                      (r.last.limitedByBudget ? ", atlas full" : "");
     }
     frame.image = caster.renderImage(camera, render, width, height);
   }
