@@ -113,6 +113,11 @@ struct AtlasShape {
 
 constexpr int kMaxMosaicAtlases = 8;
 
+// Channels of a slot: four a texel, in one atlas or two at the same slot.
+int channelAtlases(int channels) {
+  return (channels + 3) / 4;
+}
+
 // How the atlas holds stored values (lod::StoredMapping): u8 in one 8-bit
 // channel; 16-bit values in R16 where the context has EXT_texture_norm16,
 // else as two 8-bit channels (RG8 on ES 3, LUMINANCE_ALPHA on ES 2), NEAREST,
@@ -126,7 +131,22 @@ struct AtlasFormat {
   bool twoBytes() const { return texel >= 2; }  // NEAREST, interpolated in the shader
 };
 
-AtlasFormat atlasFormatFor(ScalarType type, const gpu::DeviceLimits& limits) {
+// Channels (BricksLayout::createChannels): four a texel, 16 bits each on
+// ES 3 (RGBA16 with EXT_texture_norm16, else RGBA16F), 8 on ES 2 (RGBA8, as
+// ChannelLayout's mosaic), filtered; `bytes` counts every atlas of a slot.
+AtlasFormat channelAtlasFormat(int channels, const gpu::DeviceLimits& limits) {
+  const auto atlases = static_cast<std::uint64_t>(channelAtlases(channels));
+  if (limits.api != gpu::ApiLevel::Gles3) {
+    return {gpu::rgba8For(limits.api), 0, 4 * atlases, "RGBA8 (4 channels a texel)"};
+  }
+  if (limits.norm16Textures) {
+    return {gpu::TexelFormat::RGBA16, 1, 8 * atlases, "RGBA16 (4 channels a texel)"};
+  }
+  return {gpu::TexelFormat::RGBA16F, 1, 8 * atlases, "RGBA16F (4 channels a texel)"};
+}
+
+AtlasFormat atlasFormatFor(ScalarType type, const gpu::DeviceLimits& limits, int channels) {
+  if (channels > 0) return channelAtlasFormat(channels, limits);
   const bool es3 = limits.api == gpu::ApiLevel::Gles3;
   if (type == ScalarType::U8) {
     return es3 ? AtlasFormat{gpu::TexelFormat::R8, 0, 1, "R8"}
@@ -187,6 +207,21 @@ std::string storedNote(const Volume& shape) {
   return text;
 }
 
+// The limits the atlas is shaped within: with channels, one mosaic texture
+// per four channels on ES 2 (their samplers take the units).
+gpu::DeviceLimits shapeLimits(const gpu::DeviceLimits& limits, const BricksOptions& options) {
+  gpu::DeviceLimits l = limits;
+  if (options.channels > 0) l.textureUnits = std::min(l.textureUnits, 2);
+  return l;
+}
+
+// How channels are kept (BricksLayout::createChannels), for the plan.
+std::string channelNote(gpu::TexelFormat format) {
+  if (format == gpu::TexelFormat::RGBA16) return ", 16 bits per channel (u16 and i16 exact)";
+  if (format == gpu::TexelFormat::RGBA16F) return ", half floats (11 bits) per channel";
+  return ", 8 bits over each channel's value range";
+}
+
 std::uint64_t pyramidBricks(const std::vector<glm::ivec3>& levels, int brick) {
   std::uint64_t n = 0;
   for (glm::ivec3 d : levels) {
@@ -227,10 +262,13 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
     return plan;
   }
   const std::uint64_t avail = atlasCap(limits, options, pages.bytes);
-  const AtlasFormat format = atlasFormatFor(shape.type(), limits);
-  const AtlasShape a = atlasFor(limits, stored, avail, pyramidBricks(levels, b), format.bytes);
+  const AtlasFormat format = atlasFormatFor(shape.type(), limits, options.channels);
+  const AtlasShape a =
+      atlasFor(shapeLimits(limits, options), stored, avail, pyramidBricks(levels, b), format.bytes);
   const bool es3 = a.mosaic.tilesX == 0;
-  const int atlases = es3 ? 1 : std::max(1, a.slots.x);
+  const int atlases = options.channels > 0 ? channelAtlases(options.channels)
+                      : es3                ? 1
+                                           : std::max(1, a.slots.x);
   PlannedTexture atlas{
       .label = "brick atlas",
       .size = es3 ? a.slots * stored : glm::ivec3(a.mosaic.width(), a.mosaic.height(), 1),
@@ -243,13 +281,15 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
   }
   plan.textures.push_back(pages);
   plan.totalBytes = a.bytes + pages.bytes;
-  const std::string what = vol + " as " + std::to_string(b) + "^3 bricks (+1 voxel apron) of " +
-                           std::to_string(levels.size()) + " levels, streamed into a " +
-                           std::to_string(a.count()) + "-brick " + atlas.format + " atlas (" +
-                           (atlases > 1 ? numbered("", atlases, " x ") : std::string()) +
-                           dimsText(atlas.size) + (es3 ? " 3D" : " mosaic") + ", " +
-                           formatBytes(a.bytes) + ") through a " + std::to_string(cells.x) + "x" +
-                           std::to_string(cells.y * cells.z) + " page table" + storedNote(shape);
+  const std::string what =
+      (options.channels > 0 ? numbered("", options.channels, " channels of ") : std::string()) +
+      vol + " as " + std::to_string(b) + "^3 bricks (+1 voxel apron) of " +
+      std::to_string(levels.size()) + " levels, streamed into a " + std::to_string(a.count()) +
+      "-brick " + atlas.format + " atlas (" +
+      (atlases > 1 ? numbered("", atlases, " x ") : std::string()) + dimsText(atlas.size) +
+      (es3 ? " 3D" : " mosaic") + ", " + formatBytes(a.bytes) + ") through a " +
+      std::to_string(cells.x) + "x" + std::to_string(cells.y * cells.z) + " page table" +
+      (options.channels > 0 ? channelNote(format.format) : storedNote(shape));
   if (a.count() <= topBricks) {
     plan.reason = what + ": the budget (" + formatBytes(avail) + ") holds no more than the " +
                   std::to_string(topBricks) + " coarsest bricks";
@@ -262,13 +302,46 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
 
 BricksLayout::~BricksLayout() {
   streamer_.reset();  // stop the readers before the textures go
+  channelStreamers_.clear();
 }
 
 std::unique_ptr<BricksLayout> BricksLayout::create(
     std::shared_ptr<const lod::MultiresSource> source, const gpu::DeviceLimits& limits,
     gpu::MemoryLedger& ledger, const BricksOptions& options) {
+  BricksOptions single = options;
+  single.channels = 0;
+  return build({std::move(source)}, nullptr, limits, ledger, single);
+}
+
+std::unique_ptr<BricksLayout> BricksLayout::createChannels(
+    std::vector<std::shared_ptr<const lod::MultiresSource>> sources, const ChannelSet& set,
+    const gpu::DeviceLimits& limits, gpu::MemoryLedger& ledger, BricksOptions options) {
+  if (sources.empty() || static_cast<int>(sources.size()) != set.size()) {
+    throw Error("bricks layout: " + std::to_string(sources.size()) + " sources for " +
+                std::to_string(set.size()) + " channels");
+  }
+  for (std::size_t c = 1; c < sources.size(); ++c) {
+    for (int lv = 0; lv < sources[0]->levelCount(); ++lv) {
+      if (sources[c]->levelCount() != sources[0]->levelCount() ||
+          sources[c]->levelInfo(lv).dims != sources[0]->levelInfo(lv).dims) {
+        throw InputError("channel " + set[static_cast<int>(c)].label + " (" +
+                         sources[c]->describe() + "): its levels differ from channel " +
+                         set[0].label + "'s; the channels of one brick must share one grid");
+      }
+    }
+  }
+  options.channels = set.size();
+  options.walk = false;  // channels sample through sampleChannels, not the walk
+  return build(std::move(sources), &set, limits, ledger, options);
+}
+
+std::unique_ptr<BricksLayout> BricksLayout::build(
+    std::vector<std::shared_ptr<const lod::MultiresSource>> sources, const ChannelSet* set,
+    const gpu::DeviceLimits& limits, gpu::MemoryLedger& ledger, const BricksOptions& options) {
+  std::shared_ptr<const lod::MultiresSource> source = sources.front();
   if (!source) throw Error("bricks layout: no source");
   std::unique_ptr<BricksLayout> l(new BricksLayout());
+  l->channels_ = set;
   l->options_ = options;
   l->walk_ = options.walk;
   l->api_ = limits.api;
@@ -287,12 +360,28 @@ std::unique_ptr<BricksLayout> BricksLayout::create(
   const std::uint64_t avail = atlasCap(limits, options, pageBytes);
   std::uint64_t bricks = 0;
   for (int lv = 0; lv < l->grid_.levelCount(); ++lv) bricks += l->grid_.brickCount(lv);
-  const AtlasFormat format = atlasFormatFor(source->shape().type(), limits);
+  const AtlasFormat format = atlasFormatFor(source->shape().type(), limits, options.channels);
   l->atlasTexel_ = format.texel;
-  const AtlasShape a = atlasFor(limits, stored, avail, bricks, format.bytes);
+  l->channelFormat_ = format.format;
+  const AtlasShape a = atlasFor(shapeLimits(limits, options), stored, avail, bricks, format.bytes);
   l->slotGrid_ = a.slots;
   l->mosaic_ = a.mosaic;
-  if (a.mosaic.tilesX == 0) {
+  if (set) {
+    for (int t = 0; t < channelAtlases(set->size()); ++t) {
+      const std::string label = numbered("brick atlas, channels ", 4 * t, "..") +
+                                std::to_string(std::min(set->size(), 4 * t + 4) - 1) + " (" +
+                                gpu::texelFormatName(format.format) + ")";
+      if (a.mosaic.tilesX == 0) {
+        l->atlasTexels_ = a.slots * stored;
+        l->atlases_.push_back(gpu::Texture::create3D(
+            ledger, label, format.format, l->atlasTexels_.x, l->atlasTexels_.y, l->atlasTexels_.z));
+      } else {
+        l->atlasTexels_ = glm::ivec3(stored, stored, a.slots.z * stored);
+        l->atlases_.push_back(gpu::Texture::create2D(ledger, label, format.format, a.mosaic.width(),
+                                                     a.mosaic.height()));
+      }
+    }
+  } else if (a.mosaic.tilesX == 0) {
     l->atlasTexels_ = a.slots * stored;
     l->atlases_.push_back(gpu::Texture::create3D(
         ledger, "brick atlas (" + std::string(gpu::texelFormatName(format.format)) + ")",
@@ -320,7 +409,21 @@ std::unique_ptr<BricksLayout> BricksLayout::create(
   lod::BrickStreamerOptions so;
   so.workers = options.workers;
   so.cacheBytes = cacheBytesFor(limits, options, a.bytes, pageBytes);
+  if (set) so.cacheBytes /= sources.size();  // one cache per channel, the same in all
   l->streamer_ = std::make_unique<lod::BrickStreamer>(source, l->grid_, so);
+  for (std::size_t c = 1; c < sources.size(); ++c) {
+    l->channelStreamers_.push_back(std::make_unique<lod::BrickStreamer>(sources[c], l->grid_, so));
+  }
+  for (std::size_t c = 0; set && c < sources.size(); ++c) {
+    const lod::StoredMapping m = lod::StoredMapping::of(sources[c]->shape());
+    glm::dvec2 packing(0.0, m.maxStored());
+    const ValueRange r = sources[c]->shape().valueRange();
+    if (format.format != gpu::TexelFormat::RGBA16 && format.format != gpu::TexelFormat::RGBA16F &&
+        r.max > r.min) {
+      packing = {m.store(r.min), m.store(r.max)};
+    }
+    l->channelPacking_.push_back(packing);
+  }
   // The coarsest level, pinned: what every cell falls back to.
   const int top = l->grid_.levelCount() - 1;
   const glm::ivec3 n = l->grid_.bricks(top);
@@ -329,7 +432,11 @@ std::unique_ptr<BricksLayout> BricksLayout::create(
       for (int x = 0; x < n.x; ++x) {
         const lod::BrickKey key{top, {x, y, z}};
         const int slot = l->slotFor(key.id(), 0);
-        l->upload(slot, *l->streamer_->readNow(key));
+        if (set) {
+          l->uploadChannels(slot, l->channelBricks(key, true));
+        } else {
+          l->upload(slot, *l->streamer_->readNow(key));
+        }
         l->slotPinned_[static_cast<std::size_t>(slot)] = true;
       }
     }
@@ -431,16 +538,17 @@ ValueMapping BricksLayout::rawFromStored() const {
   return {m.width, m.min};
 }
 
-std::optional<lod::BrickRange> BricksLayout::subtreeBound(const lod::BrickKey& key) const {
+std::optional<lod::BrickRange> BricksLayout::subtreeBound(
+    const lod::BrickKey& key, const lod::BrickStreamer& streamer) const {
   // The nearest range read (the brick's own or an ancestor's, with its
   // apron), widened down to level 0. Only a mean pyramid of identity-stored
   // values bounds finer levels; otherwise nothing is known of the bricks
   // under a read one until they are read themselves (a small bright finding
   // averaged into a dim coarse brick must not vanish).
-  const lod::StoredMapping& m = streamer_->mapping();
+  const lod::StoredMapping& m = streamer.mapping();
   const bool mean = source_->meanPyramid() && m.exact;
   for (lod::BrickKey k = key; k.level < grid_.levelCount(); k = grid_.parent(k)) {
-    if (auto r = streamer_->range(k)) {
+    if (auto r = streamer.range(k)) {
       if (k.level == 0) return r;
       if (!mean) return std::nullopt;
       std::vector<int> fanIns;  // from k's level down to level 1
@@ -454,7 +562,9 @@ std::optional<lod::BrickRange> BricksLayout::subtreeBound(const lod::BrickKey& k
 bool BricksLayout::transparent(const lod::BrickKey& key, const TransferFunction& tf, bool exactOnly,
                                std::uint16_t* value) const {
   if (!classified_) return false;
-  const std::optional<lod::BrickRange> r = exactOnly ? streamer_->range(key) : subtreeBound(key);
+  if (channels_) return value == nullptr && channelsTransparent(key, tf, exactOnly);
+  const std::optional<lod::BrickRange> r =
+      exactOnly ? streamer_->range(key) : subtreeBound(key, *streamer_);
   if (!r) return false;
   // The TF's input over the brick's values, as the shader computes it:
   // n = clamp((raw - window min) / window width, 0, 1). The TF is piecewise
@@ -585,6 +695,11 @@ BricksFrame BricksLayout::update(const Camera& camera, int width, int height,
     if (cut && transparent(k, tf, true, nullptr)) continue;
     if (cut) ++frame.missing;
     std::shared_ptr<const lod::StoredBrick> brick = streamer_->find(k);
+    std::vector<std::shared_ptr<const lod::StoredBrick>> bricks;
+    if (channels_) {
+      bricks = channelBricks(k, false);
+      if (bricks.empty()) brick.reset();
+    }
     if (!brick) {
       if (cut && streamer_->failing(k)) ++frame.failing;
       toRead.push_back(k);
@@ -598,12 +713,17 @@ BricksFrame BricksLayout::update(const Camera& camera, int width, int height,
     if (!budgetLeft) continue;
     const int slot = slotFor(k.id(), frame_);
     if (slot < 0) continue;  // every slot holds a brick this frame wants
-    upload(slot, *brick);
-    bytes += brick->bytes.size();
+    if (channels_) {
+      uploadChannels(slot, bricks);
+    } else {
+      upload(slot, *brick);
+    }
+    bytes += brick->bytes.size() * (bricks.empty() ? 1 : bricks.size());
     ++frame.uploaded;
     if (cut) --frame.missing;
   }
   streamer_->request(toRead);
+  for (auto& s : channelStreamers_) s->request(toRead);
   rebuildPages(tf, frame);
   frame.complete = frame.missing == frame.failing;
   return frame;
@@ -693,6 +813,12 @@ ValueBlocks BricksLayout::valueBlocks(int blockSize) const {
   return ValueBlocks(count, blockSize, supportVoxels(), std::move(mins), std::move(maxs));
 }
 
+std::vector<gpu::ShaderPart> BricksLayout::glslParts() const {
+  if (!channels_) return {glsl()};
+  return {glsl(), gpu::embeddedShaderPart("layout/channels_bricks.glsl"),
+          gpu::embeddedShaderPart("layout/channels.glsl")};
+}
+
 gpu::ShaderPart BricksLayout::glsl() const {
   gpu::ShaderPart part = gpu::embeddedShaderPart("layout/bricks.glsl");
   // The number of ES 2 atlas samplers, the atlas' texel format and the
@@ -702,7 +828,7 @@ gpu::ShaderPart BricksLayout::glsl() const {
   const std::size_t second = part.text.find('\n') + 1;
   const std::size_t third = part.text.find('\n', second) + 1;
   part.text.replace(0, part.text.find('\n', third),
-                    "#define BRICKS_ATLASES " + std::to_string(atlases_.size()) +
+                    "#define BRICKS_ATLASES " + std::to_string(channels_ ? 1 : atlases_.size()) +
                         "\n#define BRICKS_TEXEL " + std::to_string(atlasTexel_) +
                         "\n#define BRICKS_LEVELS " + std::to_string(grid_.levelCount()));
   return part;
@@ -711,7 +837,8 @@ gpu::ShaderPart BricksLayout::glsl() const {
 int BricksLayout::bind(const gpu::Program& program, int firstUnit) const {
   pages_.bind(firstUnit);
   program.set("u_layoutPages", firstUnit);
-  for (std::size_t t = 0; t < atlases_.size(); ++t) {
+  if (channels_) bindChannels(program, firstUnit + 1);
+  for (std::size_t t = 0; t < (channels_ ? 0 : atlases_.size()); ++t) {
     const int unit = firstUnit + 1 + static_cast<int>(t);
     atlases_[t].bind(unit);
     const std::string name = mosaic_.tilesX == 0 ? std::string("u_layoutAtlas")

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "layout/ChannelUniforms.h"
 #include "layout/Fit3DTexture.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
@@ -196,31 +197,7 @@ int ChannelLayout::bind(const gpu::Program& program, int firstUnit) const {
   }
   program.set("u_layoutChannels0", firstUnit);
   program.set("u_layoutChannels1", firstUnit + 1);
-  program.set("u_layoutChannelTextures", static_cast<float>(textures_.size()));
-  // normalised n = stored * scale + bias: raw = width * stored + min,
-  // n = (raw - lo) / (hi - lo) (docs/channels.md).
-  glm::vec4 scale[2]{}, bias[2]{}, on[2]{}, red[2]{}, green[2]{}, blue[2]{};
-  for (int i = 0; i < set_->size(); ++i) {
-    const Channel& c = (*set_)[i];
-    const ValueMapping& m = mappings_[static_cast<std::size_t>(i)];
-    const double ww = c.window.max - c.window.min;
-    const int t = i / kChannelsPerTexture, k = i % kChannelsPerTexture;
-    scale[t][k] = static_cast<float>(m.scale / ww);
-    bias[t][k] = static_cast<float>((m.offset - c.window.min) / ww);
-    on[t][k] = c.visible ? 1.0f : 0.0f;
-    red[t][k] = static_cast<float>(c.color.r);
-    green[t][k] = static_cast<float>(c.color.g);
-    blue[t][k] = static_cast<float>(c.color.b);
-  }
-  for (int t = 0; t < 2; ++t) {
-    const std::string s = std::to_string(t);
-    program.set(("u_layoutChannelScale" + s).c_str(), scale[t]);
-    program.set(("u_layoutChannelBias" + s).c_str(), bias[t]);
-    program.set(("u_layoutChannelOn" + s).c_str(), on[t]);
-    program.set(("u_layoutChannelRed" + s).c_str(), red[t]);
-    program.set(("u_layoutChannelGreen" + s).c_str(), green[t]);
-    program.set(("u_layoutChannelBlue" + s).c_str(), blue[t]);
-  }
+  setChannelUniforms(program, *set_, mappings_, static_cast<int>(textures_.size()));
   if (mosaic_) {
     program.set("u_layoutDims", glm::vec3(dims_));
     program.set("u_layoutTilesX", static_cast<float>(tilesX_));

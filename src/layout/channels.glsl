@@ -26,5 +26,8 @@ void sampleChannels(vec3 p, out vec4 n0, out vec4 n1) {
   }
 }
 
-// The seam's scalar (gradients, probes): channel 0's stored value.
+// The seam's scalar (gradients, probes): channel 0's stored value (the
+// bricks layout's own sampleVolume reads it already).
+#ifndef LAYOUT_HAS_SAMPLE_VOLUME
 float sampleVolume(vec3 p) { return layoutChannelTexel0(p).r; }
+#endif

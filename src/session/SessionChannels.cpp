@@ -5,10 +5,14 @@
 #include <cstdio>
 
 #include "tessera/io/ZarrChannels.h"
-#include "tessera/layout/ChannelLayout.h"
+#include "tessera/layout/ChannelLayouts.h"
+#include "tessera/lod/InCoreMultiresSource.h"
+#include "tessera/lod/ReadLevel.h"
+#include "tessera/lod/ZarrMultiresSource.h"
 #include "tessera/reference/ChannelReference.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/render/Raycaster.h"
+#include "tessera/session/BrickRefinement.h"
 #include "tessera/session/Session.h"
 
 namespace tessera::session {
@@ -29,6 +33,56 @@ std::string describe(const Channel& c) {
   return s;
 }
 
+// One source per channel for the bricks layout: the store's levels, read
+// brick by brick, when it has a pyramid; else (one level) a pyramid of the
+// channels read in `set`, so that coarser levels stand in while the finest
+// streams to the device.
+layout::ChannelSources channelSources(const std::string& spec, std::vector<int> indices,
+                                      const ChannelSet& set, int time) {
+  if (indices.empty()) {
+    for (int c = 0; c < set.size(); ++c) indices.push_back(c);
+  }
+  return [spec, indices, time, &set] {
+    std::vector<std::shared_ptr<const lod::MultiresSource>> out;
+    for (int c : indices) {
+      auto store = lod::ZarrMultiresSource::open(spec, {.time = time, .channel = c});
+      if (store->levelCount() < 2) break;
+      out.push_back(std::move(store));
+    }
+    if (out.size() == indices.size()) return out;
+    out.clear();
+    for (const Channel& c : set.channels()) {
+      out.push_back(std::make_shared<lod::InCoreMultiresSource>(c.volume));
+    }
+    return out;
+  };
+}
+
+// The finest level a streamed frame shows (the reference renders it, as for
+// one volume): -1 when every cell is transparent.
+int shownLevel(const layout::BricksFrame& f) {
+  for (std::size_t l = 0; l + 1 < f.cellsPerLevel.size(); ++l) {
+    if (f.cellsPerLevel[l] > 0) return static_cast<int>(l);
+  }
+  return -1;
+}
+
+// The channels at pyramid level `level` of the layout's sources, with the
+// set's colours, windows and visibility.
+ChannelSet channelsAtLevel(const ChannelSet& set,
+                           const std::vector<std::shared_ptr<const lod::MultiresSource>>& sources,
+                           int level) {
+  ChannelSet out;
+  out.mode = set.mode;
+  for (int c = 0; c < set.size(); ++c) {
+    Channel ch = set[c];
+    ch.volume =
+        std::make_shared<Volume>(lod::readLevel(*sources[static_cast<std::size_t>(c)], level));
+    out.add(ch);
+  }
+  return out;
+}
+
 }  // namespace
 
 ChannelFrame Session::renderChannels(const std::string& spec, int width, int height, bool reference,
@@ -43,21 +97,40 @@ ChannelFrame Session::renderChannels(const std::string& spec, int width, int hei
   camera.frame(set.geometry());
   gpu::GlContext& gl = *device_.context;
   gl.makeCurrent();
-  const auto layout = layout::ChannelLayout::create(set, device_.limits, gl.ledger());
+  std::vector<std::shared_ptr<const lod::MultiresSource>> sources;  // opened for bricks
+  const layout::ChannelSources open = channelSources(spec, s.channels.indices, set, time);
+  const auto layout = layout::createChannelLayout(
+      s.layout, set, [&] { return sources = open(); }, device_.limits, gl.ledger());
   frame.layout = layout->plan().reason;
   const auto t0 = std::chrono::steady_clock::now();
+  int level = 0;
   {
     render::Raycaster caster(gl, set.geometry(), *layout);
     caster.setSkipBlockSize(0);  // the block grid is one volume's
     caster.setTransferFunction(s.tf);
     RenderSettings render = s.render;
     render.mode = renderModeFor(set.mode);
+    if (layout::StreamingLayout* bricks = layout->streaming()) {
+      // Refined before it is drawn (one frame, not a progressive view).
+      const RefineRun r = BrickRefinement(*bricks).refine(camera, width, height, s.tf, [] {},
+                                                          {});  // one frame: drawn once refined
+      level = std::max(0, shownLevel(r.last));
+      frame.layout += "; refined in " + std::to_string(r.frames) + " frames, page cells per level";
+      for (std::size_t l = 0; l < r.last.cellsPerLevel.size(); ++l) {
+        frame.layout += " L" + std::to_string(l) + ":" + std::to_string(r.last.cellsPerLevel[l]);
+      }
+      frame.layout += "; the reference: level " + std::to_string(level) +
+                      (r.last.limitedByBudget ? ", atlas full" : "");
+    }
     frame.image = caster.renderImage(camera, render, width, height);
   }
   frame.gpuMs = msSince(t0);
   if (reference) {
     const auto t1 = std::chrono::steady_clock::now();
-    frame.reference = renderChannelsReference(set, s.tf, camera, s.render, width, height);
+    frame.reference = level == 0
+                          ? renderChannelsReference(set, s.tf, camera, s.render, width, height)
+                          : renderChannelsReference(channelsAtLevel(set, sources, level), s.tf,
+                                                    camera, s.render, width, height);
     frame.referenceMs = msSince(t1);
     frame.psnr = psnr(frame.image, *frame.reference);
   }

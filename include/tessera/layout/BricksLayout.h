@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "tessera/core/Camera.h"
+#include "tessera/core/ChannelSet.h"
 #include "tessera/core/TransferFunction.h"
 #include "tessera/gpu/GlObjects.h"
 #include "tessera/gpu/MemoryLedger.h"
@@ -59,6 +60,8 @@ struct BricksOptions {
   // The ray caster walks the bricks (one page read per brick cell a ray
   // enters); false: a page read per sample (tests compare the two).
   bool walk = true;
+  // > 0: the channels of createChannels() (planFor weighs their atlases).
+  int channels = 0;
 };
 
 class BricksLayout final : public Layout, public StreamingLayout {
@@ -76,6 +79,17 @@ class BricksLayout final : public Layout, public StreamingLayout {
                                               const gpu::DeviceLimits& limits,
                                               gpu::MemoryLedger& ledger,
                                               const BricksOptions& options = {});
+  // Several channels of one grid (docs/channels.md "bricks"): one source
+  // per channel of `set` (the same level dims), one page table and one slot
+  // per brick holding all its channels, four per RGBA texel (RGBA16 3D on
+  // ES 3 with EXT_texture_norm16, RGBA16F without, RGBA8 mosaic on ES 2);
+  // channels 4-5 in a second atlas at the same slot. A brick is uploaded
+  // once every channel of it has been read. Windows, colours, visibility and
+  // mode are read from `set` (which must outlive the layout) at update() and
+  // bind(). InputError when the sources' grids differ.
+  static std::unique_ptr<BricksLayout> createChannels(
+      std::vector<std::shared_ptr<const lod::MultiresSource>> sources, const ChannelSet& set,
+      const gpu::DeviceLimits& limits, gpu::MemoryLedger& ledger, BricksOptions options = {});
   ~BricksLayout() override;
 
   // One frame's level selection, requests, uploads and page table. The
@@ -90,24 +104,34 @@ class BricksLayout final : public Layout, public StreamingLayout {
   std::string name() const override { return "bricks"; }
   const LayoutPlan& plan() const override { return plan_; }
   gpu::ShaderPart glsl() const override;
+  // glsl(), and for channels layout/channels_bricks.glsl and channels.glsl.
+  std::vector<gpu::ShaderPart> glslParts() const override;
   int bind(const gpu::Program& program, int firstUnit) const override;
   ValueMapping rawFromStored() const override;
   glm::ivec3 volumeDims() const override { return grid_.dims(0); }
   std::uint64_t textureBytes() const override;
-  int textureUnits() const override { return 1 + static_cast<int>(atlases_.size()); }
+  // Channels: the page table and two channel atlases (the second the first
+  // again when there are four channels or fewer).
+  int textureUnits() const override {
+    return 1 + (channels_ ? 2 : static_cast<int>(atlases_.size()));
+  }
   ValueBlocks valueBlocks(int blockSize) const override;
   std::uint64_t contentVersion() const override { return contentVersion_; }
-  bool walksBricks() const override { return walk_; }
+  bool walksBricks() const override { return walk_ && !channels_; }
 
   const lod::BrickGrid& grid() const override { return grid_; }
   const lod::MultiresSource& source() const { return *source_; }
   int slotCount() const override { return static_cast<int>(slotKey_.size()); }
   lod::StreamerStats streamerStats() const override { return streamer_->stats(); }
-  void retryFailingReads(bool retry) override { streamer_->retryFailing(retry); }
+  void retryFailingReads(bool retry) override {
+    streamer_->retryFailing(retry);
+    for (auto& s : channelStreamers_) s->retryFailing(retry);
+  }
   void setUpdatePace(const UpdatePace& pace) override {
     options_.uploadMsPerFrame = pace.uploadMs;
     options_.uploadBytesPerFrame = pace.uploadBytes;
     streamer_->setInlineReadsPerRequest(pace.inlineReads);
+    for (auto& s : channelStreamers_) s->setInlineReadsPerRequest(pace.inlineReads);
   }
   // The page table as uploaded (RGBA per level-0 cell, x fastest): the CPU
   // twin of the lookup in bricks.glsl reads it.
@@ -127,6 +151,17 @@ class BricksLayout final : public Layout, public StreamingLayout {
 
  private:
   BricksLayout() = default;
+  static std::unique_ptr<BricksLayout> build(
+      std::vector<std::shared_ptr<const lod::MultiresSource>> sources, const ChannelSet* set,
+      const gpu::DeviceLimits& limits, gpu::MemoryLedger& ledger, const BricksOptions& options);
+  // Every channel's brick `key` when all are cached (readNow: read them
+  // now), else empty.
+  std::vector<std::shared_ptr<const lod::StoredBrick>> channelBricks(const lod::BrickKey& key,
+                                                                     bool readNow);
+  void bindChannels(const gpu::Program& program, int firstUnit) const;
+  void uploadChannels(int slot, const std::vector<std::shared_ptr<const lod::StoredBrick>>& bricks);
+  bool channelsTransparent(const lod::BrickKey& key, const TransferFunction& tf,
+                           bool exactOnly) const;
   int slotFor(std::uint64_t id, std::uint64_t frame);
   void upload(int slot, const lod::StoredBrick& brick);
   void keepFineRanges(int slot, const lod::StoredBrick& brick);
@@ -136,7 +171,8 @@ class BricksLayout final : public Layout, public StreamingLayout {
   // a brick's whole subtree out).
   bool transparent(const lod::BrickKey& key, const TransferFunction& tf, bool exactOnly,
                    std::uint16_t* value) const;
-  std::optional<lod::BrickRange> subtreeBound(const lod::BrickKey& key) const;
+  std::optional<lod::BrickRange> subtreeBound(const lod::BrickKey& key,
+                                              const lod::BrickStreamer& streamer) const;
   void rebuildPages(const TransferFunction& tf, BricksFrame& frame);
   glm::ivec3 slotOrigin(int slot) const;
 
@@ -146,6 +182,15 @@ class BricksLayout final : public Layout, public StreamingLayout {
   std::shared_ptr<const lod::MultiresSource> source_;
   lod::BrickGrid grid_;
   std::unique_ptr<lod::BrickStreamer> streamer_;
+  // Channels: the streamers of channels 1.. (streamer_ reads channel 0), the set
+  // and the atlas format (gpu::TexelFormat) the channels are packed in.
+  std::vector<std::unique_ptr<lod::BrickStreamer>> channelStreamers_;
+  const ChannelSet* channels_ = nullptr;
+  gpu::TexelFormat channelFormat_ = gpu::TexelFormat::RGBA8;
+  // Per channel the stored values 0 and 1 of its texel component: the whole
+  // stored range in 16 bits; in 8 bits (ES 2) the source's value range, so
+  // that 100..3000 of a u16 channel keeps 8 bits, not 8 bits of 0..65535.
+  std::vector<glm::dvec2> channelPacking_;
   std::vector<gpu::Texture> atlases_;  // ES 3: one 3D texture; ES 2: 1..8 mosaics
   gpu::Texture pages_;
   MosaicLayout::Geometry mosaic_;  // ES 2: the atlas' z-slices as tiles

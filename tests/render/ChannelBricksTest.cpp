@@ -1,0 +1,232 @@
+// Several channels in the bricks layout (docs/channels.md "Layouts"): one
+// page table, each brick's channels packed four a RGBA texel (RGBA16 3D on
+// ES 3, RGBA8 mosaic on ES 2), streamed and refined like one volume; the GPU
+// image against the CPU reference of the level shown, a channel's toggle,
+// six channels in two atlases, and the layouts that cannot draw channels.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <memory>
+
+#include "support/ChannelStore.h"
+#include "support/ExpectError.h"
+#include "support/GpuTestContext.h"
+#include "support/TestCameras.h"
+#include "support/TestSupport.h"
+#include "tessera/gpu/DeviceProfile.h"
+#include "tessera/io/ZarrChannels.h"
+#include "tessera/layout/BricksLayout.h"
+#include "tessera/layout/ChannelLayouts.h"
+#include "tessera/lod/InCoreMultiresSource.h"
+#include "tessera/reference/ChannelReference.h"
+#include "tessera/reference/ImageMetrics.h"
+#include "tessera/render/Raycaster.h"
+#include "tessera/session/Session.h"
+
+namespace tessera {
+namespace {
+
+constexpr int kSize = 128;
+
+TransferFunction channelRamp() {
+  TransferFunction tf;
+  tf.addColor(0.0, {1.0, 1.0, 1.0});
+  tf.addOpacity(0.0, 0.0);
+  tf.addOpacity(0.1, 0.0);
+  tf.addOpacity(1.0, 0.35);
+  return tf;
+}
+
+RenderSettings channelSettings() {
+  RenderSettings s;
+  s.background = {0.0, 0.0, 0.0, 1.0};
+  return s;
+}
+
+std::vector<std::shared_ptr<const lod::MultiresSource>> pyramids(const ChannelSet& set) {
+  std::vector<std::shared_ptr<const lod::MultiresSource>> out;
+  for (const Channel& c : set.channels())
+    out.push_back(std::make_shared<lod::InCoreMultiresSource>(c.volume));
+  return out;
+}
+
+struct BricksImage {
+  Image image;
+  std::string plan;
+  std::vector<int> cellsPerLevel;
+};
+
+// The refined frame of the channels through BricksLayout::createChannels
+// (16^3 bricks: 6 x 6 x 3 cells) over `shown`, one image for each of
+// `sets` (the same channels, other mode or visibility) copied into it.
+std::vector<BricksImage> bricksImages(gpu::ApiLevel api, ChannelSet& shown,
+                                      const std::vector<const ChannelSet*>& sets,
+                                      const Camera& camera) {
+  test::ApiContext context(api);
+  gpu::GlContext& gl = context.get();
+  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(gl.caps());
+  auto layout = layout::BricksLayout::createChannels(pyramids(shown), shown, limits, gl.ledger(),
+                                                     {.brickSize = 16, .workers = 0});
+  render::Raycaster caster(gl, shown.geometry(), *layout);
+  caster.setSkipBlockSize(0);
+  caster.setTransferFunction(channelRamp());
+  std::vector<BricksImage> out;
+  for (const ChannelSet* set : sets) {
+    shown = *set;  // the layout reads windows, colours and visibility from it
+    layout::BricksFrame f;
+    for (int i = 0; i < 100 && !f.complete; ++i)
+      f = layout->update(camera, kSize, kSize, channelRamp());
+    EXPECT_TRUE(f.complete);
+    RenderSettings s = channelSettings();
+    s.mode = renderModeFor(shown.mode);
+    out.push_back(
+        {caster.renderImage(camera, s, kSize, kSize), layout->plan().reason, f.cellsPerLevel});
+  }
+  return out;
+}
+
+class ChannelBricks : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = std::make_unique<test::TempDir>();
+    test::writeChannelStore(dir_->path() / "three.ome.zarr");
+  }
+  static void TearDownTestSuite() { dir_.reset(); }
+  static std::string store() { return (dir_->path() / "three.ome.zarr").string(); }
+  static std::unique_ptr<test::TempDir> dir_;
+};
+
+std::unique_ptr<test::TempDir> ChannelBricks::dir_;
+
+// 96 voxels across 128 pixels: level 0 wherever a channel shows, so the
+// reference is the channels' own trilinear field.
+TEST_F(ChannelBricks, GpuEqualsReferenceOnEs3AndEs2) {
+  ChannelSet set = readZarrChannels(store());
+  const Camera camera = test::orbitCamera(set.geometry(), 30.0, 20.0);
+  for (gpu::ApiLevel api : {gpu::ApiLevel::Gles3, gpu::ApiLevel::Gles2}) {
+    ChannelSet additive = set, max = set;
+    max.mode = ChannelMode::Max;
+    ChannelSet shown = additive;
+    const std::vector<BricksImage> images = bricksImages(api, shown, {&additive, &max}, camera);
+    for (std::size_t i = 0; i < images.size(); ++i) {
+      const ChannelSet& s = i == 0 ? additive : max;
+      const Image ref =
+          renderChannelsReference(s, channelRamp(), camera, channelSettings(), kSize, kSize);
+      const double db = psnr(images[i].image, ref);
+      std::printf("channel bricks %s on %s (%s): %.1f dB\n", channelModeName(s.mode),
+                  test::apiName(api), images[i].plan.c_str(), db);
+      EXPECT_GE(db, 40.0) << channelModeName(s.mode) << " " << test::apiName(api);
+      // Level 0 where the channels show; cells no visible channel shows
+      // fall back to a coarser brick (not fetched).
+      ASSERT_GE(images[i].cellsPerLevel.size(), 2u);
+      EXPECT_GT(images[i].cellsPerLevel[0], 0);
+    }
+  }
+}
+
+// Pixels where a and b differ by more than `tolerance` in any component.
+std::vector<bool> changed(const Image& a, const Image& b, int tolerance) {
+  std::vector<bool> out(static_cast<std::size_t>(a.width()) * a.height());
+  for (int y = 0; y < a.height(); ++y) {
+    for (int x = 0; x < a.width(); ++x) {
+      bool diff = false;
+      for (int c = 0; c < 3; ++c)
+        diff = diff || std::abs(a.pixel(x, y)[c] - b.pixel(x, y)[c]) > tolerance;
+      out[static_cast<std::size_t>(y) * a.width() + x] = diff;
+    }
+  }
+  return out;
+}
+
+// Hiding the slab on the same layout (nothing re-uploaded) changes only
+// the pixels where the slab projects.
+TEST_F(ChannelBricks, TogglingAChannelChangesOnlyItsStructuresPixels) {
+  ChannelSet set = readZarrChannels(store());
+  const Camera camera = test::orbitCamera(set.geometry(), 30.0, 20.0);
+  ChannelSet slabOnly = set;
+  slabOnly[0].visible = false;
+  slabOnly[2].visible = false;
+  const Image footprint =
+      renderChannelsReference(slabOnly, channelRamp(), camera, channelSettings(), kSize, kSize);
+  const std::vector<bool> slab = changed(footprint, Image(kSize, kSize), 0);
+  ChannelSet all = set, noSlab = set;
+  noSlab[1].visible = false;
+  ChannelSet shown = all;
+  const std::vector<BricksImage> images =
+      bricksImages(gpu::ApiLevel::Gles3, shown, {&all, &noSlab}, camera);
+  const std::vector<bool> diff = changed(images[0].image, images[1].image, 1);
+  int inside = 0, outside = 0;
+  for (std::size_t i = 0; i < diff.size(); ++i) {
+    if (diff[i]) (slab[i] ? inside : outside) += 1;
+  }
+  std::printf("hiding the slab: %d pixels changed inside its projection, %d outside\n", inside,
+              outside);
+  EXPECT_GT(inside, kSize * kSize / 20) << "the slab's pixels should change";
+  EXPECT_EQ(outside, 0) << "pixels outside the slab's projection changed";
+}
+
+// Six channels: channels 4 and 5 in a second atlas at the same slots.
+TEST_F(ChannelBricks, SixChannelsInTwoAtlasesEqualReference) {
+  const ChannelSet three = readZarrChannels(store());
+  ChannelSet six;
+  const glm::dvec3 colors[6] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}, {0, 1, 1}, {1, 0, 1}};
+  for (int i = 0; i < 6; ++i) {
+    Channel c = three[i % 3];
+    c.color = colors[i];
+    if (i >= 3) c.window = {c.window.min, 0.5 * (c.window.min + c.window.max)};
+    six.add(c);
+  }
+  six[1].visible = false;
+  const Camera camera = test::orbitCamera(six.geometry(), -40.0, 10.0);
+  const Image ref =
+      renderChannelsReference(six, channelRamp(), camera, channelSettings(), kSize, kSize);
+  ChannelSet shown = six;
+  const std::vector<BricksImage> images = bricksImages(gpu::ApiLevel::Gles3, shown, {&six}, camera);
+  const double db = psnr(images[0].image, ref);
+  std::printf("6 channel bricks (%s): %.1f dB\n", images[0].plan.c_str(), db);
+  EXPECT_GE(db, 40.0);
+  EXPECT_NE(images[0].plan.find("6 channels of"), std::string::npos) << images[0].plan;
+}
+
+// --layout bricks streams channels; texture3d draws them in core; a layout
+// that cannot draw channels is refused, naming the ones that can.
+TEST_F(ChannelBricks, LayoutWishIsHonouredOrRefused) {
+  const ChannelSet set = readZarrChannels(store());
+  test::ApiContext context(gpu::ApiLevel::Gles3);
+  gpu::GlContext& gl = context.get();
+  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(gl.caps());
+  int opened = 0;
+  const layout::ChannelSources sources = [&] {
+    ++opened;
+    return pyramids(set);
+  };
+  const auto bricks = layout::createChannelLayout("bricks", set, sources, limits, gl.ledger());
+  EXPECT_NE(bricks->streaming(), nullptr);
+  EXPECT_EQ(bricks->name(), "bricks");
+  const auto inCore = layout::createChannelLayout("auto", set, sources, limits, gl.ledger());
+  EXPECT_EQ(inCore->streaming(), nullptr);
+  EXPECT_EQ(inCore->name(), "texture3d");
+  EXPECT_EQ(opened, 1);  // only bricks open the sources
+  EXPECT_EQ(test::inputErrorMessage(
+                [&] { layout::createChannelLayout("fcc", set, sources, limits, gl.ledger()); }),
+            "--layout fcc cannot draw channels on " + limits.profile +
+                ": channel frames draw in texture3d or bricks");
+}
+
+// Through the session (what `render --channels ... --layout L` runs): the
+// wish reaches the channel frame, and a refused one is the user's message.
+TEST_F(ChannelBricks, SessionHonoursTheLayoutWish) {
+  session::Session session;
+  session.settings().channels.enabled = true;
+  session.settings().layout = "bricks";
+  const session::ChannelFrame f = session.renderChannels(store(), 64, 64, true);
+  EXPECT_NE(f.layout.find("^3 bricks (+1 voxel apron)"), std::string::npos) << f.layout;
+  EXPECT_GE(f.psnr, 40.0) << f.layout;
+  session.settings().layout = "fcc";
+  EXPECT_EQ(test::inputErrorMessage([&] { session.renderChannels(store(), 64, 64, false); }),
+            "--layout fcc cannot draw channels on native: channel frames draw in texture3d or "
+            "bricks");
+}
+
+}  // namespace
+}  // namespace tessera
