@@ -50,6 +50,7 @@ void drawPanel(DesktopApp& ds, int windowHeight) {
                ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
   panelFile(ds);
   panelTime(ds);
+  panelChannels(ds);
   panelExplore(ds);
   const bool labelsFirst = ds.view().labelsOn();  // the list before the TF it drives
   if (labelsFirst) panelLabels(ds);
@@ -123,6 +124,7 @@ void runFrame(DesktopApp& ds) {
   handleArrowKeys(ds, tiles);
   updateOverlay(ds);
   drawPanel(ds, win.y);
+  const bool channels = drawChannelView(ds, tiles.view3d, view.width, view.height);
   for (int t = 0; t < 3 && ds.fourUp; ++t) drawSliceTile(ds, ds.slices[t], tiles.slice[t]);
   drawHelpOverlay(ds, kPanelWidth, static_cast<float>(win.x), static_cast<float>(win.y));
   const EdgeLabels labels = ds.view().orientationLabels();
@@ -131,7 +133,7 @@ void runFrame(DesktopApp& ds) {
   ImGui::Render();
   gpu::bindFramebuffer(0, {0, 0, fb.x, fb.y});
   gpu::clearColor(glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
-  drawVolumeView(ds, view.origin, view.width, view.height);
+  if (!channels) drawVolumeView(ds, view.origin, view.width, view.height);
   gpu::setViewport({0, 0, fb.x, fb.y});
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
@@ -187,6 +189,7 @@ void applyOptions(DesktopApp& ds, const ViewOptions& o) {
   }
   app::openFusion(*ds.session, o.fusion);
   if (!o.state.empty()) loadState(ds, o.state);
+  if (!o.file.empty()) openChannels(ds, o.file);
   if (o.play > 0.0) {
     if (!ds.session->series())
       throw InputError("--play: " + ds.view().description() + " is not a time series");

@@ -13,6 +13,7 @@
 //   PanelsFile.cpp     open, recent and dropped volumes
 //   PanelsStyle.cpp    TF editor, window/level, rendering, shading, clipping, labels
 //   PanelsExplore.cpp  the slice views and the exploring panel (zoom stages)
+//   PanelsChannels.cpp a store's channels shown together and their list
 #include <chrono>
 #include <memory>
 #include <optional>
@@ -166,6 +167,13 @@ void panelLabels(DesktopApp& ds);
 // PanelsExplore.cpp
 void panelExplore(DesktopApp& ds);
 void drawSliceTile(DesktopApp& ds, DesktopApp::SliceTile& tile, const Rect& r);
+
+// PanelsChannels.cpp: a store with several channels (session::ChannelView)
+void openChannels(DesktopApp& ds, const std::string& spec);
+void panelChannels(DesktopApp& ds);
+// Queues the channels' frame into the 3D view's rectangle; false when no
+// channels are shown (the viewer's frame is drawn instead).
+bool drawChannelView(DesktopApp& ds, const Rect& rect, int viewW, int viewH);
 
 // Input.cpp
 void handleViewInput(DesktopApp& ds, const Rect& view, double scale);

@@ -89,6 +89,7 @@ import { TesseraViewer } from './tessera.js';
   let refineNotBefore = 0;  // performance.now() before which no strip is rendered
   let slices = null;        // frontends/web/slices.js, once the module is up
   let zarr = null;  // an open OME-Zarr store (frontends/web/zarr-url.js)
+  let channelList = null;  // its channels shown together (frontends/web/channels-panel.js)
   let dicomweb = null;  // the DICOMweb browser (frontends/web/dicomweb.js), with ?dicomweb=
 
   function showError(message) {
@@ -245,7 +246,9 @@ import { TesseraViewer } from './tessera.js';
       requestAnimationFrame(loop);  // nothing to draw on until it is restored
       return;
     }
-    if (api && zarr && zarr.active()) {
+    if (api && channelList && channelList.active()) {
+      channelFrameStep();
+    } else if (api && zarr && zarr.active()) {
       storeFrameStep();
     } else if (api) {
       let ms = -1;
@@ -267,6 +270,23 @@ import { TesseraViewer } from './tessera.js';
       }
     }
     requestAnimationFrame(loop);
+  }
+
+  // A store's channels (frontends/web/channels-panel.js): a whole frame when
+  // something changed.
+  function channelFrameStep() {
+    let ms = -1;
+    if (needsRender) {
+      needsRender = false;
+      fitCanvas();
+      ms = channelList.frame(canvas.width, canvas.height);
+      frames++;
+    }
+    if (!needsRender && renderWaiters.length) {
+      const waiters = renderWaiters;
+      renderWaiters = [];
+      waiters.forEach((w) => w(ms));
+    }
   }
 
   // An OME-Zarr store (frontends/web/zarr-url.js): frames while bricks arrive,
@@ -1007,7 +1027,9 @@ import { TesseraViewer } from './tessera.js';
     if (volumeUrls.length === 1 && window.TesseraZarr && TesseraZarr.isStoreUrl(volumeUrls[0])) {
       zarr = TesseraZarr.create(M, { showError, clearError, status: (t) => { $('status').textContent = t; },
         progress: (v, max) => { $('progress').hidden = !(max > 0); if (max > 0) { $('progress').max = max; $('progress').value = v; } } });
-      await zarr.open(volumeUrls[0]);
+      if (await zarr.open(volumeUrls[0]) && window.TesseraChannels) {
+        channelList = await TesseraChannels.attach(M, zarr, { requestRender, showError, clearError });
+      }
       volumeChanged();
     } else if (volumeUrls.length) {
       if (!(await openUrls(volumeUrls))) volumeChanged();
@@ -1078,6 +1100,8 @@ import { TesseraViewer } from './tessera.js';
     openUrls,
     lastLoad: () => lastLoad,
     zarr: () => (zarr ? zarr.stats() : null),
+    // The channels shown together ({open, name, mode, channels}), or null.
+    channels: () => (channelList ? channelList.state() : null),
     // The bread-slice region [begin, end) of an open store's level 0 at
     // native resolution (bounded reads: only its chunks are fetched); the
     // keys fetched for it. zarrOverview() returns to the store.

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
 #include "tessera/io/ZarrStore.h"
 
 namespace tessera {
@@ -31,8 +32,11 @@ std::vector<int> parseChannelList(const std::string& text) {
   return out;
 }
 
-ChannelSet readZarrChannels(const std::string& spec, const std::vector<int>& indices, int time) {
-  const ZarrStore store(openZarrStorage(spec), ZarrSelection{.time = time, .channel = 0});
+namespace {
+
+// The channels chosen (every one when `indices` is empty), checked.
+std::vector<int> chosenChannels(const ZarrStore& store, const std::string& spec,
+                                const std::vector<int>& indices) {
   const int count = store.channelCount();
   std::vector<int> chosen = indices;
   if (chosen.empty()) {
@@ -54,26 +58,70 @@ ChannelSet readZarrChannels(const std::string& spec, const std::vector<int>& ind
       throw InputError(spec + ": channel " + std::to_string(chosen[i]) + " is chosen twice");
     }
   }
+  return chosen;
+}
+
+// The finest level that fits the host budget (BudgetError when none does).
+int channelLevel(const ZarrStore& store, const std::string& spec) {
+  const std::uint64_t budget = HostBudget::global().limitBytes();
+  const int l = store.finestLevelWithin(budget);
+  if (l < 0) {
+    const ZarrLevel& coarse = store.level(store.levelCount() - 1);
+    throw BudgetError(spec + ": even the coarsest level (" + std::to_string(coarse.dims.x) + "x" +
+                      std::to_string(coarse.dims.y) + "x" + std::to_string(coarse.dims.z) +
+                      ") does not fit the host budget " + formatBytes(budget));
+  }
+  return l;
+}
+
+Channel channelFrom(const ZarrStore& store, int c, Volume volume) {
   const std::vector<ZarrChannel>& omero = store.channels();
+  Channel ch;
+  ch.label = "channel " + std::to_string(c);
+  ch.window = volume.window();  // the reader applies omero's window for the channel
+  if (static_cast<std::size_t>(c) < omero.size()) {
+    const ZarrChannel& o = omero[static_cast<std::size_t>(c)];
+    if (!o.label.empty()) ch.label = o.label;
+    ch.color = glm::dvec3(o.color);
+    ch.visible = o.active;
+    if (o.hasWindow && o.window.max > o.window.min) ch.window = o.window;
+  }
+  if (!(ch.window.max > ch.window.min)) ch.window = {ch.window.min, ch.window.min + 1.0};
+  ch.volume = std::make_shared<Volume>(std::move(volume));
+  return ch;
+}
+
+}  // namespace
+
+ChannelSet readZarrChannels(const std::string& spec, const std::vector<int>& indices, int time) {
+  return readZarrChannels(openZarrStorage(spec), spec, indices, time);
+}
+
+ChannelSet readZarrChannels(std::shared_ptr<const ZarrStorage> storage, const std::string& name,
+                            const std::vector<int>& indices, int time) {
+  const ZarrStore first(storage, ZarrSelection{.time = time, .channel = 0});
   ChannelSet set;
-  for (int c : chosen) {
-    // readZarrVolume applies omero's window for the selected channel.
-    auto volume = std::make_shared<Volume>(readZarrVolume(spec, {.time = time, .channel = c}));
-    Channel ch;
-    ch.label = "channel " + std::to_string(c);
-    ch.window = volume->window();
-    if (static_cast<std::size_t>(c) < omero.size()) {
-      const ZarrChannel& o = omero[static_cast<std::size_t>(c)];
-      if (!o.label.empty()) ch.label = o.label;
-      ch.color = glm::dvec3(o.color);
-      ch.visible = o.active;
-      if (o.hasWindow && o.window.max > o.window.min) ch.window = o.window;
-    }
-    if (!(ch.window.max > ch.window.min)) ch.window = {ch.window.min, ch.window.min + 1.0};
-    ch.volume = std::move(volume);
-    set.add(std::move(ch), spec + " channel " + std::to_string(c));
+  for (int c : chosenChannels(first, name, indices)) {
+    const ZarrStore store(storage, ZarrSelection{.time = time, .channel = c});
+    Volume volume = store.readLevel(channelLevel(store, name));
+    set.add(channelFrom(store, c, std::move(volume)), name + " channel " + std::to_string(c));
   }
   return set;
+}
+
+std::vector<std::string> zarrChannelKeys(std::shared_ptr<const ZarrStorage> storage,
+                                         const std::string& name, const std::vector<int>& indices,
+                                         int time) {
+  const ZarrStore first(storage, ZarrSelection{.time = time, .channel = 0});
+  std::vector<std::string> keys;
+  for (int c : chosenChannels(first, name, indices)) {
+    const ZarrStore store(storage, ZarrSelection{.time = time, .channel = c});
+    const int l = channelLevel(store, name);
+    for (std::string& k : store.chunkKeys(l, glm::ivec3(0), store.level(l).dims)) {
+      keys.push_back(std::move(k));
+    }
+  }
+  return keys;
 }
 
 }  // namespace tessera

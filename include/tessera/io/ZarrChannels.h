@@ -2,10 +2,12 @@
 // Several channels of an OME-Zarr image read together (core/ChannelSet.h),
 // with the store's omero rendering metadata as their defaults: colour,
 // window (start/end) and visibility (active).
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "tessera/core/ChannelSet.h"
+#include "tessera/io/ZarrStorage.h"
 
 namespace tessera {
 
@@ -16,6 +18,16 @@ namespace tessera {
 // ChannelSet::kMaxChannels.
 ChannelSet readZarrChannels(const std::string& spec, const std::vector<int>& indices = {},
                             int time = 0);
+
+// The same over a storage the caller opened (the page's fetch() storage),
+// `name` naming the store in the messages.
+ChannelSet readZarrChannels(std::shared_ptr<const ZarrStorage> storage, const std::string& name,
+                            const std::vector<int>& indices = {}, int time = 0);
+// The storage keys of the chunks readZarrChannels(storage, ...) reads: what
+// an asynchronous storage must hold before the read (the same checks).
+std::vector<std::string> zarrChannelKeys(std::shared_ptr<const ZarrStorage> storage,
+                                         const std::string& name,
+                                         const std::vector<int>& indices = {}, int time = 0);
 
 // "0,2,3" as channel indices; InputError naming the text otherwise.
 std::vector<int> parseChannelList(const std::string& text);

@@ -27,6 +27,7 @@
 #include "tessera/lod/InCoreVolumeSource.h"
 #include "tessera/lod/MultiresSource.h"
 #include "tessera/render/TechniqueRegistry.h"
+#include "tessera/session/ChannelView.h"
 #include "tessera/session/Exploration.h"
 #include "tessera/session/Fusion.h"
 #include "tessera/session/RenderRun.h"
@@ -141,6 +142,12 @@ class Session {
   ChannelFrame renderChannels(const std::string& spec, int width, int height, bool reference,
                               int time = 0);
 
+  // Channels shown together in the interactive front ends' channel lists
+  // (session/ChannelView.h; docs/channels.md): read, edited and drawn here,
+  // their state in settings().channels.
+  ChannelView& channelView();
+  bool hasChannelView() const { return channelView_ != nullptr; }
+
   // The default the session chose for the volume open now because the
   // user named no TF (session/ModalityDefault.h): "CT: default transfer
   // function ct-soft-tissue (modality CT), ...; --tf to change"; empty when
@@ -250,6 +257,7 @@ class Session {
   // view's GL objects and the exploration's zoom swap.
   std::unique_ptr<viewer::Viewer> view_;
   std::unique_ptr<Exploration> exploration_;
+  std::unique_ptr<ChannelView> channelView_;  // its layout's textures too
   // render()'s technique on the in-core volume (before device_ goes).
   struct Resident {
     std::shared_ptr<lod::InCoreVolumeSource> source;

@@ -1,0 +1,84 @@
+#pragma once
+// The channels of a store shown together in the interactive front ends
+// (docs/channels.md): the desktop viewer's and the page's channel lists
+// only call these (a colour, a window, a visibility toggle per channel and
+// the mode) and show render()'s frame in the 3D view. The state is the
+// session's settings().channels, so that state()/restore() keep it; the
+// channels' voxels are uploaded once (layout::ChannelLayout) and an edit
+// changes uniforms only.
+//
+//   session.channelView().open("cells.ome.zarr");
+//   session.channelView().setVisible(1, false);
+//   const gpu::Texture& frame = session.channelView().render(512, 512);
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "tessera/core/ChannelSet.h"
+#include "tessera/core/Image.h"
+#include "tessera/gpu/GlObjects.h"
+
+namespace tessera::session {
+
+class Session;
+
+class ChannelView {
+ public:
+  explicit ChannelView(Session& session);
+  ~ChannelView();
+  ChannelView(const ChannelView&) = delete;
+  ChannelView& operator=(const ChannelView&) = delete;
+
+  // Reads the channels of the OME-Zarr store `spec` (settings().channels'
+  // indices, colours, windows and visibility over the store's omero
+  // defaults) and shows them; false, with nothing changed, when `spec` is
+  // not a store or has one channel. InputError as readZarrChannels.
+  bool open(const std::string& spec, int time = 0);
+  // Channels the caller read (the page's store over fetch()), shown under
+  // `name` with settings().channels applied.
+  void show(ChannelSet set, const std::string& name);
+  // Back to the session's volume alone (settings().channels disabled).
+  void close();
+  bool isOpen() const { return set_ != nullptr; }
+  const std::string& name() const { return name_; }
+  // The channels shown, with their current colour, window and visibility.
+  const ChannelSet& channels() const;
+
+  // One channel's colour (linear RGB in [0,1]), window (stored units,
+  // lo < hi) or visibility; InputError for an index out of range or a
+  // value settings validation refuses. Each edit goes to settings().channels.
+  void setColor(int i, glm::dvec3 rgb);
+  void setWindow(int i, ValueRange window);
+  void setVisible(int i, bool visible);
+  void setMode(ChannelMode mode);
+  // Counts the edits (a front end redraws its list when it changes).
+  std::uint64_t revision() const { return revision_; }
+
+  // The channels' frame at the session's current settings (the view's
+  // camera, transfer function and render settings when it has a view),
+  // rendered again only when one of them, an edit or the size changed. Row 0
+  // at the bottom; valid until the next call.
+  const gpu::Texture& render(int width, int height);
+  // The last frame, top row first.
+  Image readImage() const;
+  // Draws the last frame into `framebuffer`'s box (x, y, width, height; 0:
+  // the window or canvas), scaled to it (the page's canvas).
+  void present(unsigned framebuffer, glm::ivec4 box);
+
+ private:
+  struct Gpu;
+  void requireOpen(int i) const;
+  void edited();
+
+  Session& session_;
+  std::string name_;
+  std::unique_ptr<ChannelSet> set_;  // the layout reads it at every frame
+  std::unique_ptr<Gpu> gpu_;
+  std::uint64_t revision_ = 0;
+  std::string frameKey_;
+};
+
+}  // namespace tessera::session

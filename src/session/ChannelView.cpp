@@ -1,0 +1,192 @@
+// ChannelView: the channel lists' one path to a multi-channel frame
+// (docs/channels.md). The frame is the one Session::renderChannels draws
+// for the same settings (the ray caster over layout::ChannelLayout), kept
+// on the GPU between edits.
+#include "tessera/session/ChannelView.h"
+
+#include <sstream>
+
+#include "tessera/core/Error.h"
+#include "tessera/io/ZarrChannels.h"
+#include "tessera/io/ZarrStore.h"
+#include "tessera/layout/ChannelLayout.h"
+#include "tessera/render/HybridCompositor.h"
+#include "tessera/render/Raycaster.h"
+#include "tessera/session/Session.h"
+
+namespace tessera::session {
+
+struct ChannelView::Gpu {
+  std::unique_ptr<layout::ChannelLayout> layout;
+  std::unique_ptr<render::Raycaster> caster;
+  const gpu::Texture* frame = nullptr;
+  std::string tfKey;
+  std::unique_ptr<render::HybridCompositor> compositor;  // present()'s, made on first use
+};
+
+namespace {
+
+// What a frame depends on besides the channels' own state.
+std::string frameKey(const Settings& s, const Camera& c, int width, int height) {
+  std::ostringstream key;
+  key.precision(17);
+  key << width << 'x' << height << '|' << c.azimuthDeg << ',' << c.elevationDeg << ',' << c.zoom
+      << ',' << c.fovYDeg << ',' << static_cast<int>(c.projection) << ',' << c.target.x << ','
+      << c.target.y << ',' << c.target.z << '|' << s.render.stepVoxels << ','
+      << s.render.opacityScale << ',' << s.render.ertThreshold << s.render.jitter << ','
+      << s.render.background.r << s.render.background.g << s.render.background.b;
+  return key.str();
+}
+
+}  // namespace
+
+ChannelView::ChannelView(Session& session) : session_(session) {}
+ChannelView::~ChannelView() = default;
+
+bool ChannelView::open(const std::string& spec, int time) {
+  if (!isZarrStore(spec)) return false;
+  if (ZarrStore(openZarrStorage(spec)).channelCount() < 2) return false;
+  show(readZarrChannels(spec, session_.settings().channels.indices, time), spec);
+  return true;
+}
+
+void ChannelView::show(ChannelSet set, const std::string& name) {
+  ChannelSettings& c = session_.settings().channels;
+  c.applyTo(set, name);
+  auto owned = std::make_unique<ChannelSet>(std::move(set));
+  gpu::DeviceSession& device = session_.device();
+  device.context->makeCurrent();
+  auto gpu = std::make_unique<Gpu>();
+  gpu->layout = layout::ChannelLayout::create(*owned, device.limits, device.context->ledger());
+  gpu->caster =
+      std::make_unique<render::Raycaster>(*device.context, owned->geometry(), *gpu->layout);
+  gpu->caster->setSkipBlockSize(0);  // the block grid is one volume's
+  gpu_.reset();                      // the old layout before the old set it reads
+  set_ = std::move(owned);
+  gpu_ = std::move(gpu);
+  name_ = name;
+  c.enabled = true;
+  c.mode = set_->mode;
+  edited();
+}
+
+void ChannelView::close() {
+  if (gpu_) session_.device().context->makeCurrent();
+  gpu_.reset();
+  set_.reset();
+  name_.clear();
+  session_.settings().channels.enabled = false;
+  edited();
+}
+
+const ChannelSet& ChannelView::channels() const {
+  if (!set_) throw InputError("no channels are shown");
+  return *set_;
+}
+
+void ChannelView::requireOpen(int i) const {
+  const int n = channels().size();
+  if (i < 0 || i >= n) {
+    throw InputError(name_ + ": channel " + std::to_string(i) + " is outside the " +
+                     std::to_string(n) + " channels shown (0.." + std::to_string(n - 1) + ")");
+  }
+}
+
+// The settings' lists hold one entry per channel shown once any is edited,
+// so that a saved state reproduces the frame.
+void ChannelView::edited() {
+  ++revision_;
+  frameKey_.clear();
+  if (!set_) return;
+  ChannelSettings& c = session_.settings().channels;
+  c.colors.clear();
+  c.windows.clear();
+  c.visible.clear();
+  for (const Channel& ch : set_->channels()) {
+    c.colors.push_back(ch.color);
+    c.windows.push_back(ch.window);
+    c.visible.push_back(ch.visible);
+  }
+  c.mode = set_->mode;
+}
+
+void ChannelView::setColor(int i, glm::dvec3 rgb) {
+  requireOpen(i);
+  for (int k = 0; k < 3; ++k) {
+    if (!(rgb[k] >= 0.0 && rgb[k] <= 1.0)) {
+      throw InputError("channel colour component " + std::to_string(rgb[k]) + ": expected 0..1");
+    }
+  }
+  (*set_)[i].color = rgb;
+  edited();
+}
+
+void ChannelView::setWindow(int i, ValueRange window) {
+  requireOpen(i);
+  if (!(window.max > window.min)) {
+    throw InputError("channel " + std::to_string(i) + " window " + std::to_string(window.min) +
+                     ".." + std::to_string(window.max) + ": expected LO < HI");
+  }
+  (*set_)[i].window = window;
+  edited();
+}
+
+void ChannelView::setVisible(int i, bool visible) {
+  requireOpen(i);
+  (*set_)[i].visible = visible;
+  edited();
+}
+
+void ChannelView::setMode(ChannelMode mode) {
+  channels();
+  set_->mode = mode;
+  edited();
+}
+
+const gpu::Texture& ChannelView::render(int width, int height) {
+  const ChannelSet& set = channels();
+  const Settings s = session_.currentSettings();
+  Camera camera = s.camera;
+  camera.frame(set.geometry());
+  const std::string key = frameKey(s, camera, width, height);
+  const std::string tfKey = s.tf.toJson();
+  if (gpu_->frame && key == frameKey_ && tfKey == gpu_->tfKey) return *gpu_->frame;
+  session_.device().context->makeCurrent();
+  if (tfKey != gpu_->tfKey) {
+    gpu_->caster->setTransferFunction(s.tf);
+    gpu_->tfKey = tfKey;
+  }
+  RenderSettings render = s.render;
+  render.mode = renderModeFor(set.mode);
+  gpu_->frame = &gpu_->caster->render(camera, render, width, height, 0.0);
+  frameKey_ = key;
+  return *gpu_->frame;
+}
+
+Image ChannelView::readImage() const {
+  if (!gpu_ || !gpu_->frame) throw InputError("no channel frame has been rendered");
+  session_.device().context->makeCurrent();
+  return gpu_->caster->readImage();
+}
+
+void ChannelView::present(unsigned framebuffer, glm::ivec4 box) {
+  if (!gpu_ || !gpu_->frame) throw InputError("no channel frame has been rendered");
+  gpu::GlContext& gl = *session_.device().context;
+  gl.makeCurrent();
+  if (!gpu_->compositor) gpu_->compositor = std::make_unique<render::HybridCompositor>(gl);
+  // No lines: the frame (its background composited already) scaled into the box.
+  const Settings s = session_.currentSettings();
+  gpu_->compositor->composeInto(*gpu_->frame, s.camera, glm::vec4(s.render.background),
+                                set_->geometry().extent(), framebuffer, box);
+}
+
+}  // namespace tessera::session
+
+namespace tessera::session {
+
+ChannelView& Session::channelView() {
+  if (!channelView_) channelView_ = std::make_unique<ChannelView>(*this);
+  return *channelView_;
+}
+
+}  // namespace tessera::session
