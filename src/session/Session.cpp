@@ -420,7 +420,8 @@ nlohmann::json Session::state() const {
   return {{"version", kSettingsVersion},
           {"volume", volume},
           {"settings", currentSettings().toJson()},
-          {"exploration", exploration_ ? exploration_->state() : nlohmann::json(nullptr)}};
+          {"exploration", exploration_ ? exploration_->state() : nlohmann::json(nullptr)},
+          {"overlay", overlayState(overlay_.get())}};
 }
 
 void Session::restore(const nlohmann::json& state) {
@@ -428,6 +429,7 @@ void Session::restore(const nlohmann::json& state) {
     throw InputError("session state: expected {\"version\", \"volume\", \"settings\"}");
   }
   setSettings(Settings::fromJson(state["settings"]));
+  restoreOverlay(state);
   if (!state.contains("exploration") || state["exploration"].is_null()) return;
   Exploration& e = exploration();
   const std::optional<ExploreStep> step = e.restore(state["exploration"]);

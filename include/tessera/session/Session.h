@@ -222,6 +222,9 @@ class Session {
   // entry point that touches GL makes it current first (a no-op when it is).
   void makeCurrent();
   void applyVolumeSettings();
+  // The state's "overlay" (session/Fusion.h overlayState): the open
+  // overlay's file is restyled, another file opened; null or absent: kept.
+  void restoreOverlay(const nlohmann::json& state);
   bool applyModalityDefault(const Volume& v);  // true when it changed the TF
   void showDefaultInView(bool tfChanged);
   void applyToView();
