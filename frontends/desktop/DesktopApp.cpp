@@ -51,6 +51,7 @@ void drawPanel(DesktopApp& ds, int windowHeight) {
   panelFile(ds);
   panelTime(ds);
   panelExplore(ds);
+  panelOverlay(ds);
   const bool labelsFirst = ds.view().labelsOn();  // the list before the TF it drives
   if (labelsFirst) panelLabels(ds);
   panelTransferFunction(ds);
@@ -97,7 +98,7 @@ PixelRect toPixels(const Rect& r, double scale, int framebufferHeight) {
 void runFrame(DesktopApp& ds) {
   ds.window->pollEvents();
   if (!ds.pendingDrop.empty()) {
-    openVolume(ds, ds.pendingDrop);
+    offerDrop(ds, ds.pendingDrop);
     ds.pendingDrop.clear();
   }
   const glm::ivec2 fb = ds.window->framebufferSize(), win = ds.window->windowSize();
@@ -123,6 +124,7 @@ void runFrame(DesktopApp& ds) {
   handleArrowKeys(ds, tiles);
   updateOverlay(ds);
   drawPanel(ds, win.y);
+  drawDropOffer(ds);
   for (int t = 0; t < 3 && ds.fourUp; ++t) drawSliceTile(ds, ds.slices[t], tiles.slice[t]);
   drawHelpOverlay(ds, kPanelWidth, static_cast<float>(win.x), static_cast<float>(win.y));
   const EdgeLabels labels = ds.view().orientationLabels();
