@@ -330,10 +330,6 @@ void Session::setSettings(Settings settings) {
   if (view_) applyToView();
 }
 
-void Session::openOverlay(const std::string& spec, const OverlayOptions& options) {
-  setOverlay(session::openOverlay(spec, options, shape()));
-}
-
 void Session::setOverlay(Overlay overlay) {
   overlay_ = std::make_unique<Overlay>(std::move(overlay));
   if (view_) view_->setFusion(overlay_->fused);

@@ -180,6 +180,8 @@ class Session {
   // by world coordinates, mixed into the ray march of run(), render() and
   // renderReference(). openOverlay needs the anatomy open; its note (no
   // overlap in world space) is overlay()->note. clearOverlay() removes it.
+  // openOverlay opens a named file (SessionOpen.cpp; in the web build the
+  // page hands files over instead and it refuses, WebSessionOverlay.cpp).
   void openOverlay(const std::string& spec, const OverlayOptions& options = {});
   void setOverlay(Overlay overlay);
   void clearOverlay();
