@@ -574,7 +574,9 @@ window.TesseraSlices = (function () {
     new ResizeObserver(() => draw3dOverlay()).observe(canvas);
 
     $('pickRegion').addEventListener('click', () => { picking = !picking; updateInfo(); });
-    window.addEventListener('tessera-overlay', () => updateInfo());  // frontends/web/overlay-panel.js
+    // An overlay added, restyled or removed (frontends/web/overlay-panel.js): the
+    // slices mix it in (session::fuseSliceImage) and the readout reads it.
+    window.addEventListener('tessera-overlay', () => { drawAllSlices(); redrawOverlays(); });
     $('showRegion').addEventListener('click', () => { if (region) showRegion(region); });
     $('overview').addEventListener('click', () => overview());
     $('crosshair3d').addEventListener('change', () => draw3dOverlay());

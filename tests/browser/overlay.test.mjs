@@ -80,6 +80,15 @@ async function overlay(context, url, tmp) {
         m.psnr >= 40, m.error || `${m.psnr.toFixed(2)} dB`);
 
   lap('fused frame compared');
+  // The slice views mix the overlay in: the grey axial slice gets the labels' colours.
+  const coloured = await page.evaluate(() => {
+    const px = window.tessera.slices.imagePixels('axial');
+    let n = 0;
+    for (let i = 0; i < px.length; i += 4) if (px[i] !== px[i + 1] || px[i + 1] !== px[i + 2]) n++;
+    return { n, of: px.length / 4 };
+  });
+  check('the axial slice view shows the atlas\'s colours over the grey anatomy (> 5 % of its pixels)',
+        coloured.n > 0.05 * coloured.of, `${coloured.n} of ${coloured.of} pixels coloured`);
   // The crosshair (slice views' readout): position in mm, both values, the region.
   const right = await crosshairAt(page, [40, -25, 52]);
   const left = await crosshairAt(page, [-40, -25, 52]);
