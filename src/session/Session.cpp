@@ -331,6 +331,9 @@ void Session::setSettings(Settings settings) {
 }
 
 void Session::setOverlay(Overlay overlay) {
+  // An interactive view refuses it up front (ES 2: no 3D textures) rather
+  // than showing the anatomy alone; run() checks its own frames.
+  if (view_ && overlay.fused) render::FusionTexture::checkDevice(device_.limits, *overlay.fused);
   overlay_ = std::make_unique<Overlay>(std::move(overlay));
   if (view_) view_->setFusion(overlay_->fused);
 }

@@ -165,6 +165,25 @@ TEST(FusionState, SliceViewPixelsAreTheAnatomyMixedWithTheLabelColour) {
   EXPECT_EQ(wrong, 0);
 }
 
+// With an interactive view (the viewers), an ES 2 profile refuses the
+// overlay up front, and the previous state stays.
+TEST(FusionState, AViewOnEs2RefusesTheOverlay) {
+  if (!haveMricron()) GTEST_SKIP() << "mricron templates not installed";
+  Session s("webgl1");
+  openCh2(s);
+  s.view();
+  OverlayOptions o;
+  o.labels = true;
+  std::string message;
+  try {
+    s.openOverlay(kAal, o);
+  } catch (const InputError& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find("needs 3D textures"), std::string::npos) << message;
+  EXPECT_EQ(s.overlay(), nullptr);
+}
+
 TEST(FusionState, BadOverlayValuesAreNamed) {
   if (!haveMricron()) GTEST_SKIP() << "mricron templates not installed";
   Session s("native");

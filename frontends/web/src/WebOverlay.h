@@ -12,8 +12,9 @@ namespace tessera::web {
 
 // Reads the picked files (the one that names the others, as
 // loadPickedFiles) as the overlay over the open volume; drops them all.
-// InputError on WebGL 1 (no 3D textures), without a volume, or naming the
-// file or option that is wrong; the previous overlay then stays.
+// InputError on WebGL 1 (Session::setOverlay: no 3D textures), without a
+// volume, or naming the file or option that is wrong; the previous overlay
+// then stays.
 void openPickedOverlay(WebSession& s, const session::OverlayOptions& options);
 // The open overlay with another look (labels, table, colour map, alpha, window).
 void restyleOverlay(WebSession& s, const session::OverlayOptions& options);

@@ -10,21 +10,8 @@
 #include "tessera/io/ByteSource.h"
 #include "tessera/io/VolumeReader.h"
 #include "tessera/reference/FusedVolume.h"
-#include "tessera/render/FusionTexture.h"
 
 namespace tessera::web {
-
-namespace {
-
-void checkCanFuse(WebSession& s, const session::Overlay& overlay) {
-  if (s.webglVersion() < 2) {
-    throw InputError("an overlay needs WebGL 2 (3D textures); this page runs on WebGL 1: " +
-                     overlay.name + " was not added");
-  }
-  render::FusionTexture::checkDevice(s.rendering().device().limits, *overlay.fused);
-}
-
-}  // namespace
 
 void openPickedOverlay(WebSession& s, const session::OverlayOptions& options) {
   std::vector<PickedFile> picked = s.takeFiles();
@@ -40,7 +27,6 @@ void openPickedOverlay(WebSession& s, const session::OverlayOptions& options) {
   auto volume = std::make_shared<Volume>(readVolume(*files.open(name), files));
   session::Overlay overlay =
       session::makeOverlay(std::move(volume), name, options, session.shape());
-  checkCanFuse(s, overlay);
   s.zoomStop();  // the zoom swap's levels carry no overlay
   session.setOverlay(std::move(overlay));
 }
