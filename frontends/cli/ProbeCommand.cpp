@@ -37,24 +37,6 @@ std::string numberText(double v) {
   return buf;
 }
 
-nlohmann::json probeJson(const session::ProbeResult& r) {
-  nlohmann::json j = {{"world_mm", {r.worldMm.x, r.worldMm.y, r.worldMm.z}},
-                      {"anatomy",
-                       {{"index", {r.anatomyIndex.x, r.anatomyIndex.y, r.anatomyIndex.z}},
-                        {"inside", r.inAnatomy},
-                        {"value", r.inAnatomy ? nlohmann::json(r.anatomyValue) : nullptr}}}};
-  if (r.hasOverlay) {
-    j["overlay"] = {{"index", {r.overlayIndex.x, r.overlayIndex.y, r.overlayIndex.z}},
-                    {"inside", r.inOverlay},
-                    {"value", r.inOverlay ? nlohmann::json(r.overlayValue) : nullptr}};
-    if (r.label >= 0) {
-      j["overlay"]["label"] = r.label;
-      j["overlay"]["label_name"] = r.labelName;
-    }
-  }
-  return j;
-}
-
 void printProbeText(const session::ProbeResult& r) {
   std::printf("position %s mm (RAS+: +x right, +y anterior, +z superior)\n",
               vec3Text(r.worldMm, "%.2f, %.2f, %.2f").c_str());
@@ -77,7 +59,7 @@ void runProbe(const ProbeOptions& o) {
   openFusion(session, o.fusion);
   const session::ProbeResult r = session.probe(at);
   if (o.json) {
-    std::printf("%s\n", probeJson(r).dump(2).c_str());
+    std::printf("%s\n", session::probeJson(r).dump(2).c_str());
   } else {
     printProbeText(r);
   }

@@ -52,6 +52,7 @@ void drawPanel(DesktopApp& ds, int windowHeight) {
   panelTime(ds);
   panelChannels(ds);
   panelExplore(ds);
+  panelOverlay(ds);
   const bool labelsFirst = ds.view().labelsOn();  // the list before the TF it drives
   if (labelsFirst) panelLabels(ds);
   panelTransferFunction(ds);
@@ -98,7 +99,7 @@ PixelRect toPixels(const Rect& r, double scale, int framebufferHeight) {
 void runFrame(DesktopApp& ds) {
   ds.window->pollEvents();
   if (!ds.pendingDrop.empty()) {
-    openVolume(ds, ds.pendingDrop);
+    offerDrop(ds, ds.pendingDrop);
     ds.pendingDrop.clear();
   }
   const glm::ivec2 fb = ds.window->framebufferSize(), win = ds.window->windowSize();
@@ -125,6 +126,7 @@ void runFrame(DesktopApp& ds) {
   updateOverlay(ds);
   drawPanel(ds, win.y);
   const bool channels = drawChannelView(ds, tiles.view3d, view.width, view.height);
+  drawDropOffer(ds);
   for (int t = 0; t < 3 && ds.fourUp; ++t) drawSliceTile(ds, ds.slices[t], tiles.slice[t]);
   drawHelpOverlay(ds, kPanelWidth, static_cast<float>(win.x), static_cast<float>(win.y));
   const EdgeLabels labels = ds.view().orientationLabels();

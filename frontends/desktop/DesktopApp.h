@@ -14,6 +14,7 @@
 //   PanelsStyle.cpp    TF editor, window/level, rendering, shading, clipping, labels
 //   PanelsExplore.cpp  the slice views and the exploring panel (zoom stages)
 //   PanelsChannels.cpp a store's channels shown together and their list
+//   PanelsOverlay.cpp  a second volume over the first; a dropped file's offer
 #include <chrono>
 #include <memory>
 #include <optional>
@@ -98,6 +99,18 @@ struct DesktopApp {
   // The crop box drawn with a handle on each face (viewer/CropHandles.h).
   bool showCropBox = false;
   viewer::CropHandles crop;
+  // PanelsOverlay.cpp: the overlay's controls and a dropped file's offer.
+  struct OverlayControls {
+    char path[512] = "";
+    char table[512] = "";
+    bool labels = false;
+    int colourMap = 0;
+    float alpha = 0.5f;
+    bool window = false;
+    double lo = 0.0, hi = 1.0;
+    const session::Overlay* synced = nullptr;  // the overlay the controls show
+    std::string dropped;  // dropped while a volume is open: overlay or replace?
+  } overlayUi;
 };
 
 // Runs `action`; its Error goes to the panel's error line (and true means
@@ -163,6 +176,13 @@ void panelRendering(DesktopApp& ds);
 void panelShading(viewer::Viewer& v);
 void panelClipping(DesktopApp& ds);
 void panelLabels(DesktopApp& ds);
+
+// PanelsOverlay.cpp
+void panelOverlay(DesktopApp& ds);
+// A file dropped on the window: opened, or (a volume open) offered as the
+// overlay by drawDropOffer's popup.
+void offerDrop(DesktopApp& ds, const std::string& path);
+void drawDropOffer(DesktopApp& ds);
 
 // PanelsExplore.cpp
 void panelExplore(DesktopApp& ds);

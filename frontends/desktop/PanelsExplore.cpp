@@ -35,11 +35,14 @@ bool refreshSliceTexture(DesktopApp& ds, DesktopApp::SliceTile& tile) {
   std::ostringstream key;
   key.precision(17);
   const TransferFunction* colours = v.sliceColours(ds.sliceColour);
+  const session::Overlay* overlay = ds.session->overlay();
   key << index << '|' << w.min << '|' << w.max << '|' << (colours != nullptr) << '|'
-      << (colours ? v.tfEditor().revision() : 0);
+      << (colours ? v.tfEditor().revision() : 0) << '|'
+      << static_cast<const void*>(overlay ? overlay->fused.get() : nullptr);
   if (key.str() == tile.key) return true;
   try {
-    const Image img = g.render(ex.source(), 0, index, w, colours);
+    Image img = g.render(ex.source(), 0, index, w, colours);
+    if (overlay) session::fuseSliceImage(img, ex.source().shape(), g.frame(), index, *overlay);
     tile.texture = gpu::Texture();
     tile.texture =
         gpu::Texture::create2D(ds.context().ledger(), "slice view",

@@ -6,6 +6,7 @@
 // io readers as the CLI's, whose gzip/zlib the page's pako inflates) and
 // error messages. window.tessera exposes the same operations to tests.
 import { TesseraViewer } from './tessera.js';
+import { attachOverlayPanel } from './overlay-panel.js';
 
 (function () {
   const params = new URLSearchParams(location.search);
@@ -91,6 +92,7 @@ import { TesseraViewer } from './tessera.js';
   let zarr = null;  // an open OME-Zarr store (frontends/web/zarr-url.js)
   let channelList = null;  // its channels shown together (frontends/web/channels-panel.js)
   let dicomweb = null;  // the DICOMweb browser (frontends/web/dicomweb.js), with ?dicomweb=
+  let overlayPanel = null;  // the second volume (frontends/web/overlay-panel.js)
 
   function showError(message) {
     const e = $('error');
@@ -464,6 +466,7 @@ import { TesseraViewer } from './tessera.js';
 
   function volumeChanged() {
     refreshState();
+    if (overlayPanel) overlayPanel.refresh();
     timeChanged();
     syncWindowControls();
     drawTf();
@@ -833,7 +836,8 @@ import { TesseraViewer } from './tessera.js';
     if (folder) {
       TesseraFolders.walk(folder).then(openFolder, (err) => showError(`cannot read the dropped folder: ${err.message}`));
     } else if (e.dataTransfer.files.length) {
-      openFiles(e.dataTransfer.files);
+      // A second file while one is open: offered as the overlay.
+      if (overlayPanel) overlayPanel.offer(e.dataTransfer.files); else openFiles(e.dataTransfer.files);
     }
   });
 
@@ -1004,12 +1008,16 @@ import { TesseraViewer } from './tessera.js';
     if (withSlices) {
       slices = window.TesseraSlices.attach({ M, canvas, requestRender, showError, clearError,
         storeRegion: zarrRegion, storeOverview: zarrOverview,
-        storeFetch: () => (zarr ? zarr.fetchWanted() : Promise.resolve([])) });
+        storeFetch: () => (zarr ? zarr.fetchWanted() : Promise.resolve([])),
+        crosshairNote: (voxel) => (overlayPanel ? overlayPanel.crosshairText(voxel) : '') });
       window.tessera.slices = slices.testApi;
     } else {
       $('slice-controls').hidden = true;
     }
     refreshState();
+    overlayPanel = attachOverlayPanel({ M, webgl: state.webgl, state: () => state, openFiles,
+      requestRender, showError, clearError });
+    window.tessera.overlay = overlayPanel.testApi;
     state.techniques.forEach((n) => {
       const o = document.createElement('option');
       o.value = n;

@@ -359,7 +359,8 @@ window.TesseraSlices = (function () {
     function updateInfo() {
       const v = explore.has_volume ? api.value(cross[0], cross[1], cross[2]) : NaN;
       $('crosshairInfo').textContent = explore.has_volume
-        ? `crosshair voxel (${cross.join(', ')})${crossMm()}: value ${Number.isFinite(v) ? +v.toPrecision(6) : '–'}` : '';
+        ? `crosshair voxel (${cross.join(', ')})${crossMm()}: value ${Number.isFinite(v) ? +v.toPrecision(6) : '–'}` +
+          (opts.crosshairNote ? opts.crosshairNote(cross) : '') : '';
       const r = region;
       const text = r ? `region x ${r.begin[0]}:${r.end[0]}, y ${r.begin[1]}:${r.end[1]}, z ${r.begin[2]}:${r.end[2]} ` +
         `(${r.end.map((e, a) => e - r.begin[a]).join('×')} voxels, native resolution)` : 'no region picked';
@@ -573,6 +574,9 @@ window.TesseraSlices = (function () {
     new ResizeObserver(() => draw3dOverlay()).observe(canvas);
 
     $('pickRegion').addEventListener('click', () => { picking = !picking; updateInfo(); });
+    // An overlay added, restyled or removed (frontends/web/overlay-panel.js): the
+    // slices mix it in (session::fuseSliceImage) and the readout reads it.
+    window.addEventListener('tessera-overlay', () => { drawAllSlices(); redrawOverlays(); });
     $('showRegion').addEventListener('click', () => { if (region) showRegion(region); });
     $('overview').addEventListener('click', () => overview());
     $('crosshair3d').addEventListener('change', () => draw3dOverlay());

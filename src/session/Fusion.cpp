@@ -60,22 +60,31 @@ TransferFunction overlayTransferFunction(const std::string& spec) {
                                       {{0.0, 0.0}, {0.1, 0.0}, {1.0, 1.0}});
 }
 
-Overlay makeOverlay(std::shared_ptr<Volume> volume, const std::string& name,
-                    const OverlayOptions& options, const Volume& anatomy) {
-  checkOptions(options);
+namespace {
+
+// The label table of `options`: a file, text handed over, or the palette of
+// the labels present.
+render::LabelTable labelTableOf(const OverlayOptions& options, const Volume& volume) {
+  if (!options.labelTable.empty()) return render::LabelTable::load(options.labelTable);
+  if (options.labelTableText.empty()) return render::LabelTable::defaultFor(volume);
+  const std::string& text = options.labelTableText;
+  const std::string name = options.labelTableName.empty() ? "label table" : options.labelTableName;
+  const auto first = text.find_first_not_of(" \t\r\n");
+  const bool json = first != std::string::npos && text[first] == '{';
+  return json ? render::LabelTable::fromJson(text, name) : render::LabelTable::fromText(text, name);
+}
+
+// The look of `options` (and of `table` for labels) over a prepared volume.
+Overlay lookOf(std::shared_ptr<const Volume> volume, const std::string& name,
+               const OverlayOptions& options, render::LabelTable table, const Volume& anatomy) {
   Overlay o;
   o.name = name;
+  o.options = options;
   auto fused = std::make_shared<FusedVolume>();
   fused->labels = options.labels;
   fused->opacity = options.opacity;
   if (options.labels) {
-    try {
-      render::prepareLabelVolume(*volume);
-    } catch (const InputError& e) {
-      throw InputError("--overlay-labels: " + name + " is not a label volume: " + e.what());
-    }
-    o.labels = options.labelTable.empty() ? render::LabelTable::defaultFor(*volume)
-                                          : render::LabelTable::load(options.labelTable);
+    o.labels = std::move(table);
     fused->tf = o.labels.toTransferFunction();
     fused->window = {0.0, 255.0};
   } else {
@@ -90,6 +99,49 @@ Overlay makeOverlay(std::shared_ptr<Volume> volume, const std::string& name,
   fused->volume = std::move(volume);
   o.fused = std::move(fused);
   return o;
+}
+
+void prepareLabels(Volume& volume, const std::string& name) {
+  try {
+    render::prepareLabelVolume(volume);
+  } catch (const InputError& e) {
+    throw InputError("--overlay-labels: " + name + " is not a label volume: " + e.what());
+  }
+}
+
+}  // namespace
+
+Overlay makeOverlay(std::shared_ptr<Volume> volume, const std::string& name,
+                    const OverlayOptions& options, const Volume& anatomy) {
+  checkOptions(options);
+  render::LabelTable table;
+  if (options.labels) {
+    prepareLabels(*volume, name);
+    table = labelTableOf(options, *volume);
+  }
+  return lookOf(std::move(volume), name, options, std::move(table), anatomy);
+}
+
+Overlay restyleOverlay(const Overlay& current, const OverlayOptions& options,
+                       const Volume& anatomy) {
+  if (!current.fused || !current.fused->volume) throw InputError("no overlay to restyle");
+  checkOptions(options);
+  std::shared_ptr<const Volume> volume = current.fused->volume;
+  if (!options.labels) return lookOf(volume, current.name, options, {}, anatomy);
+  if (!current.fused->labels) {  // prepared as labels now, on a copy
+    auto copy = std::make_shared<Volume>(*volume);
+    prepareLabels(*copy, current.name);
+    volume = std::move(copy);
+  }
+  const OverlayOptions& was = current.options;
+  const bool sameTable =
+      current.fused->labels && options.labelTable == was.labelTable &&
+      (options.labelTableText.empty() || options.labelTableText == was.labelTableText) &&
+      options.labelTableName == was.labelTableName;
+  OverlayOptions kept = options;
+  if (sameTable) kept.labelTableText = was.labelTableText;
+  render::LabelTable table = sameTable ? current.labels : labelTableOf(options, *volume);
+  return lookOf(std::move(volume), current.name, kept, std::move(table), anatomy);
 }
 
 Overlay openOverlay(const std::string& spec, const OverlayOptions& options, const Volume& anatomy) {

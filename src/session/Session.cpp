@@ -330,11 +330,10 @@ void Session::setSettings(Settings settings) {
   if (view_) applyToView();
 }
 
-void Session::openOverlay(const std::string& spec, const OverlayOptions& options) {
-  setOverlay(session::openOverlay(spec, options, shape()));
-}
-
 void Session::setOverlay(Overlay overlay) {
+  // An interactive view refuses it up front (ES 2: no 3D textures) rather
+  // than showing the anatomy alone; run() checks its own frames.
+  if (view_ && overlay.fused) render::FusionTexture::checkDevice(device_.limits, *overlay.fused);
   overlay_ = std::make_unique<Overlay>(std::move(overlay));
   if (view_) view_->setFusion(overlay_->fused);
 }
@@ -420,7 +419,8 @@ nlohmann::json Session::state() const {
   return {{"version", kSettingsVersion},
           {"volume", volume},
           {"settings", currentSettings().toJson()},
-          {"exploration", exploration_ ? exploration_->state() : nlohmann::json(nullptr)}};
+          {"exploration", exploration_ ? exploration_->state() : nlohmann::json(nullptr)},
+          {"overlay", overlayState(overlay_.get())}};
 }
 
 void Session::restore(const nlohmann::json& state) {
@@ -428,6 +428,7 @@ void Session::restore(const nlohmann::json& state) {
     throw InputError("session state: expected {\"version\", \"volume\", \"settings\"}");
   }
   setSettings(Settings::fromJson(state["settings"]));
+  restoreOverlay(state);
   if (!state.contains("exploration") || state["exploration"].is_null()) return;
   Exploration& e = exploration();
   const std::optional<ExploreStep> step = e.restore(state["exploration"]);

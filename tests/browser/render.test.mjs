@@ -235,6 +235,7 @@ async function webglPages(context, url, tmp, run) {
     return dt;
   }, fs.readFileSync(path.join(tmp, 'phantom64.nrrd')).toString('base64'));
   await page.dispatchEvent('#view', 'drop', { dataTransfer: dropped });
+  await replaceOnOffer(page);
   await page.waitForFunction(() => window.tessera.state().name === 'dropped.nrrd', null, { timeout: 30000 });
   s = await page.evaluate(() => window.tessera.state());
   check('a file dropped on the view opens', s.dims.join('x') === '64x64x64', s.description);
@@ -265,6 +266,7 @@ async function webglPages(context, url, tmp, run) {
   }, ['pil.raw.json', 'pil.raw'].map((n) => [n, fs.readFileSync(path.join(tmp, n)).toString('base64')]));
   await openThroughPicker(page, [path.join(tmp, 'sphere48.nii.gz')], 'sphere48.nii.gz');
   await page.dispatchEvent('#view', 'drop', { dataTransfer: droppedPair });
+  await replaceOnOffer(page);
   await page.waitForFunction(() => window.tessera.state().name === 'pil.raw.json', null, { timeout: 30000 });
   s = await page.evaluate(() => window.tessera.state());
   check('raw data and its JSON sidecar dropped together open', s.orientation === 'PIL', `${s.dims.join('x')} ${s.orientation}`);
@@ -332,4 +334,13 @@ async function benchmark(context, url) {
                 `min ${r.min.toFixed(0)}, max ${r.max.toFixed(0)} over ${r.times.length} frames`);
     await page.close();
   }
+}
+
+// A file dropped while another file's volume is open is offered as an
+// overlay (frontends/web/overlay-panel.js; tests/browser/overlay.test.mjs):
+// "Replace" opens it as the volume, as a drop did before.
+async function replaceOnOffer(page) {
+  const offered = await page.evaluate(() => window.tessera.overlay.promptShown());
+  check('a file dropped while another is open is offered (replace or add as overlay)', offered);
+  await page.evaluate(() => window.tessera.overlay.choose('replace'));
 }

@@ -139,6 +139,8 @@ void WebSession::recoverContext() {
   }
   const std::string name = session_->name();
   const nlohmann::json state = session_->state();
+  std::optional<session::Overlay> overlay;  // kept in memory: its file is not read again
+  if (session_->overlay()) overlay = *session_->overlay();
   const ViewKnobs knobs = ViewKnobs::of(viewer());
   const int webglVersion = context_->webglVersion();
   const int cell = askedCell_;
@@ -151,6 +153,7 @@ void WebSession::recoverContext() {
   exploreKey_.clear();
   if (volume) {
     session_->setVolume(std::move(volume), name);
+    if (overlay) session_->setOverlay(std::move(*overlay));
     exploration(cell > 0 ? cell : -1);  // the page's exploration, for the state to fill
     session_->restore(state);
   } else {

@@ -112,6 +112,8 @@ class WebSession {
   void loadGenerated(const std::string& spec);
   void addFile(PickedFile file) { picked_.push_back(std::move(file)); }
   void clearFiles() { picked_.clear(); }
+  // The files handed over, taken (frontends/web/src/WebOverlay.h reads them as an overlay).
+  std::vector<PickedFile> takeFiles() { return std::exchange(picked_, {}); }
   // Reads the picked file that names the others; drops them all.
   void loadPickedFiles();
   double renderFrame(int width, int height);  // ms

@@ -113,6 +113,9 @@ SliceResult WebSession::slice(int axis, int index, bool colour, double maxPixels
   const TransferFunction* tf = v.sliceColours(colour);
   if (!store) {
     image = sliceImage(volume, f, index, window, tf);
+    if (const session::Overlay* o = session_->overlay()) {
+      session::fuseSliceImage(image, volume, f, index, *o);  // docs/fusion.md
+    }
     return out;
   }
   const FetchedZarrSource& src = theStore().source();

@@ -8,7 +8,10 @@
 #include <string>
 
 #include <glm/vec3.hpp>
+#include <nlohmann/json_fwd.hpp>
 
+#include "tessera/core/Image.h"
+#include "tessera/core/SliceImage.h"
 #include "tessera/core/Volume.h"
 #include "tessera/reference/FusedVolume.h"
 #include "tessera/render/LabelTable.h"
@@ -23,6 +26,11 @@ struct OverlayOptions {
   std::string tf = "hot";
   double opacity = 0.5;              // (0, 1]
   std::optional<ValueRange> window;  // raw values; default: the value range (labels: 0..255)
+  // A label table handed over as text (a page's or a widget's file: JSON, or
+  // the text forms LabelTable::fromText reads), named `labelTableName`;
+  // used when `labelTable` (a path) is empty.
+  std::string labelTableText;
+  std::string labelTableName;
 };
 
 // An opened fused volume and what names its labels.
@@ -31,6 +39,7 @@ struct Overlay {
   render::LabelTable labels;  // empty unless fused->labels
   std::string name;           // the file
   std::string note;           // non-empty: e.g. the volumes do not overlap in world space
+  OverlayOptions options;     // what it was opened with (the session's state saves them)
 };
 
 // Reads `spec` and makes its look. InputError naming the file and option:
@@ -44,9 +53,31 @@ Overlay openOverlay(const std::string& spec, const OverlayOptions& options, cons
 Overlay makeOverlay(std::shared_ptr<Volume> volume, const std::string& name,
                     const OverlayOptions& options, const Volume& anatomy);
 
+// The same fused volume (not read again) with another look: labels or a
+// colour map, table, opacity, window. A table named as the current one's is
+// kept (a page's table text is not in the state).
+Overlay restyleOverlay(const Overlay& current, const OverlayOptions& options,
+                       const Volume& anatomy);
+
+// The overlay as the session's state holds it (Session::state()): null
+// without one, else {"file", "labels", "label_table", "tf", "alpha",
+// "window": [lo, hi] or null}.
+nlohmann::json overlayState(const Overlay* overlay);
+// The options of a saved overlay and its file; InputError naming the key.
+OverlayOptions overlayOptionsFromState(const nlohmann::json& state, std::string& file);
+
 // The fused TF for a name: "hot" (black -> red -> yellow -> white, opacity
 // rising from 0), or a preset or file (TransferFunction::fromPresetOrFile).
 TransferFunction overlayTransferFunction(const std::string& spec);
+
+// The overlay in a slice view: `image` is sliceImage(anatomy, frame, index,
+// ...) (the slice views' pixels of the anatomy's voxels; `anatomy` gives the
+// shape and index -> world affine, its voxels are not read). Each pixel's
+// voxel centre is looked up in the fused volume by world position and its
+// colour mixed in by its weight w (the fusion rule's colour, docs/fusion.md);
+// outside the fused volume's box the pixel stays.
+void fuseSliceImage(Image& image, const Volume& anatomy, const SliceFrame& frame, int index,
+                    const Overlay& overlay);
 
 // What the crosshair reads at a world position (RAS+ mm).
 struct ProbeResult {
@@ -68,6 +99,12 @@ ProbeResult probe(const Volume& anatomy, const Overlay* overlay, glm::dvec3 worl
 // The overlay's part of a probe as the readouts show it: "58 Postcentral_R",
 // "0 (background)", "3.25", or "outside".
 std::string probeOverlayText(const ProbeResult& r);
+
+// The probe as JSON (`tessera probe --json`, the viewers' readouts):
+// {"world_mm", "anatomy": {"index", "inside", "value"}, "overlay": {"index",
+// "inside", "value", "label", "label_name"}, "overlay_text"}; no "overlay"
+// without one.
+nlohmann::json probeJson(const ProbeResult& r);
 
 // "X,Y,Z" in mm; InputError naming `what` otherwise.
 glm::dvec3 parseWorldPosition(const std::string& text, const std::string& what);

@@ -187,6 +187,8 @@ class Session {
   // by world coordinates, mixed into the ray march of run(), render() and
   // renderReference(). openOverlay needs the anatomy open; its note (no
   // overlap in world space) is overlay()->note. clearOverlay() removes it.
+  // openOverlay opens a named file (SessionOpen.cpp; in the web build the
+  // page hands files over instead and it refuses, WebSessionOverlay.cpp).
   void openOverlay(const std::string& spec, const OverlayOptions& options = {});
   void setOverlay(Overlay overlay);
   void clearOverlay();
@@ -229,6 +231,9 @@ class Session {
   // entry point that touches GL makes it current first (a no-op when it is).
   void makeCurrent();
   void applyVolumeSettings();
+  // The state's "overlay" (session/Fusion.h overlayState): the open
+  // overlay's file is restyled, another file opened; null or absent: kept.
+  void restoreOverlay(const nlohmann::json& state);
   bool applyModalityDefault(const Volume& v);  // true when it changed the TF
   void showDefaultInView(bool tfChanged);
   void applyToView();

@@ -1,0 +1,148 @@
+// Browser test: a second volume over the first in the page (overlay.test.mjs
+// of tests/browser; fixture.mjs serves the site and launches Chromium). The
+// atlas aal with its table, added over ch2 through the "Add overlay…"
+// picker, fused in the 3D view's ray march: the page's frame equals
+// `tessera render ch2 --overlay aal --overlay-labels aal.nii.txt` at the same
+// camera and crop; the crosshair at (40, -25, 52) mm reads Postcentral_R and
+// at (-40, -25, 52) mm Postcentral_L (left and right not swapped); a file
+// dropped while ch2 is open is offered as the overlay and added; the
+// overlay's look is in the session's state (its restore: tests/session/
+// FusionStateTest.cpp); on WebGL 1 the overlay is refused with a message.
+import { test } from 'node:test';
+import fs from 'node:fs';
+import path from 'node:path';
+import { execFile } from 'node:child_process';
+import { promisify } from 'node:util';
+import {
+  CH2, cli, check, psnrAgainst, openPage, openThroughPicker, withoutOverlays, writePilNifti, browserSuite,
+} from './fixture.mjs';
+
+const AAL = '/usr/share/mricron/templates/aal.nii.gz';
+const AAL_NAMES = '/usr/share/mricron/templates/aal.nii.txt';
+const SIZE = 192;
+const checks = browserSuite();
+const have = [CH2, AAL, AAL_NAMES].every((f) => fs.existsSync(f));
+
+test('aal over ch2 in the page: the CLI\'s fused image, the crosshair names the region, a drop offers it',
+  { skip: !have && 'needs mricron-data (ch2, aal)' }, checks(overlay));
+
+// The crosshair's readout once it is at the voxel nearest `mm`.
+async function crosshairAt(page, mm) {
+  return page.evaluate(async (p) => {
+    const v = window.tessera.overlay.voxelAtWorld(p[0], p[1], p[2]);
+    window.tessera.slices.setCross(v[0], v[1], v[2]);
+    return { voxel: v, text: document.getElementById('crosshairInfo').textContent };
+  }, mm);
+}
+
+async function overlay(context, url, tmp) {
+  const t0 = Date.now();
+  const laps = [];
+  const lap = (what) => laps.push(`${what} ${((Date.now() - t0) / 1000).toFixed(1)} s`);
+  const ref = path.join(tmp, 'fused.png');
+  // The CLI's reference while the page loads.
+  const reference = promisify(execFile)(cli, ['render', CH2, '--overlay', AAL, '--overlay-labels', AAL_NAMES,
+    '--overlay-alpha', '0.6', '--tf', 'mr-default', '--preintegrate', 'off', '--azimuth', '90', '--elevation', '20',
+    '--crop', '0:0.68,0:1,0:1', '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', '--out', ref]);
+  const dropped = path.join(tmp, 'ball.nii');  // a small second volume to drop
+  writePilNifti(dropped);
+
+  const { page, logs } = await openPage(context, url, `size=${SIZE}`);
+  const opened = await openThroughPicker(page, [CH2], 'ch2.nii.gz');
+  check('ch2 opens', !opened.error, opened.error);
+  lap('ch2 open');
+  await withoutOverlays(page);
+  await page.evaluate(async () => {
+    const menu = document.getElementById('preset');
+    menu.value = 'mr-default';
+    menu.dispatchEvent(new Event('change'));
+    const x1 = document.getElementById('cropX1');
+    x1.value = 0.68;
+    x1.dispatchEvent(new Event('input'));
+    document.getElementById('overlayAlpha').value = 0.6;
+    await window.tessera.setCamera(90, 20, 1);
+  });
+
+  // The picker: the atlas and its table together (the table turns labels on).
+  await page.setInputFiles('#overlayFile', [AAL, AAL_NAMES]);
+  await page.waitForFunction(() => window.tessera.overlay.info().open || window.tessera.error() !== '', null, { timeout: 30000 });
+  await page.evaluate(() => window.tessera.render());
+  const info = await page.evaluate(() => window.tessera.overlay.info());
+  const error = await page.evaluate(() => window.tessera.error());
+  check('"Add overlay…" opens aal over ch2 as labels with its table (116 names), alpha 0.6',
+        info.open && info.labels && info.labels_table.length === 116 && Math.abs(info.alpha - 0.6) < 1e-9 && !error,
+        error || `${info.file} ${info.dims && info.dims.join('x')}, ${info.labels_table && info.labels_table.length} names, ` +
+        `alpha ${info.alpha}, note "${info.note}", fusion note "${info.fusion_note}"`);
+  lap('aal added');
+  await reference;
+  const m = await psnrAgainst(page, ref);
+  check(`the page's fused frame equals tessera render --overlay aal --overlay-labels (PSNR >= 40 dB)`,
+        m.psnr >= 40, m.error || `${m.psnr.toFixed(2)} dB`);
+
+  lap('fused frame compared');
+  // The slice views mix the overlay in: the grey axial slice gets the labels' colours.
+  const coloured = await page.evaluate(() => {
+    const px = window.tessera.slices.imagePixels('axial');
+    let n = 0;
+    for (let i = 0; i < px.length; i += 4) if (px[i] !== px[i + 1] || px[i + 1] !== px[i + 2]) n++;
+    return { n, of: px.length / 4 };
+  });
+  check('the axial slice view shows the atlas\'s colours over the grey anatomy (> 5 % of its pixels)',
+        coloured.n > 0.05 * coloured.of, `${coloured.n} of ${coloured.of} pixels coloured`);
+  // The crosshair (slice views' readout): position in mm, both values, the region.
+  const right = await crosshairAt(page, [40, -25, 52]);
+  const left = await crosshairAt(page, [-40, -25, 52]);
+  check('the crosshair at (40, -25, 52) mm names Postcentral_R, with its position and both values',
+        /Postcentral_R/.test(right.text) && /\(40\.0, -25\.0, 52\.0\) mm/.test(right.text) && /value \d/.test(right.text),
+        `voxel ${right.voxel}: "${right.text}"`);
+  check('the crosshair at (-40, -25, 52) mm names Postcentral_L (left and right not swapped)',
+        /Postcentral_L/.test(left.text) && !/Postcentral_R/.test(left.text), `voxel ${left.voxel}: "${left.text}"`);
+
+  // The overlay's look is in the session's state, and restored from it.
+  const saved = await page.evaluate(() => window.tessera.viewer().sessionState());
+  check('the session state holds the overlay (file, labels, table name, alpha)',
+        saved && saved.overlay && saved.overlay.file === 'aal.nii.gz' && saved.overlay.labels === true &&
+        saved.overlay.label_table_name === 'aal.nii.txt' && Math.abs(saved.overlay.alpha - 0.6) < 1e-9,
+        JSON.stringify(saved && saved.overlay));
+
+  lap('crosshair, state');
+  // A second file dropped while ch2 is open: the offer, then "Add as overlay".
+  await page.evaluate(async () => {
+    const input = document.createElement('input');
+    input.type = 'file';
+    input.id = 'testDrop';
+    input.multiple = true;
+    input.hidden = true;
+    document.body.appendChild(input);
+  });
+  await page.setInputFiles('#testDrop', [dropped]);
+  await page.evaluate(() => {
+    const files = document.getElementById('testDrop').files;
+    const e = new Event('drop', { bubbles: true, cancelable: true });
+    Object.defineProperty(e, 'dataTransfer', { value: { types: ['Files'], files, items: [] } });
+    document.getElementById('view').dispatchEvent(e);
+  });
+  await page.waitForFunction(() => window.tessera.overlay.promptShown(), null, { timeout: 10000 });
+  const offer = await page.evaluate(() => window.tessera.overlay.promptText());
+  check('a file dropped while ch2 is open is offered as an overlay (replace or add)',
+        /ch2\.nii\.gz is open/.test(offer) && /ball\.nii/.test(offer) && /overlay/.test(offer), offer);
+  await page.click('#overlayPromptAdd');
+  await page.waitForFunction(() => !window.tessera.overlay.promptShown(), null, { timeout: 30000 });
+  const afterDrop = await page.evaluate(() => ({ info: window.tessera.overlay.info(), name: window.tessera.state().name }));
+  check('"Add as overlay" keeps ch2 and makes the dropped file the overlay',
+        afterDrop.name === 'ch2.nii.gz' && afterDrop.info.open && afterDrop.info.file === 'ball.nii',
+        `volume ${afterDrop.name}; overlay ${afterDrop.info.file}`);
+  const errors = logs.filter((l) => l.startsWith('pageerror') || (l.startsWith('error') && !l.includes('favicon')));
+  check('no script errors on the page', errors.length === 0, errors.join(' | '));
+  await page.close();
+
+  lap('drop');
+  // WebGL 1: refused with a message naming WebGL 2.
+  const p1 = await openPage(context, url, 'size=64&webgl=1');
+  const refusal = await p1.page.evaluate(() => document.getElementById('overlayInfo').textContent +
+    ' | ' + document.getElementById('overlayFile').disabled);
+  check('on WebGL 1 the overlay control is off and says it needs WebGL 2', /WebGL 2/.test(refusal) && /true$/.test(refusal), refusal);
+  await p1.page.close();
+  lap('WebGL 1');
+  console.log(`overlay test: ${laps.join(', ')}`);
+}
