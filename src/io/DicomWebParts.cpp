@@ -293,4 +293,21 @@ std::optional<int> DicomJsonAttributes::uint16(DicomTag tag) const {
   return std::nullopt;
 }
 
+// A sequence's items (PS3.18 F.2.5: "Value" holds one object per item);
+// the items point into the answer, which outlives them while the series'
+// headers are read. Nesting is bounded before parsing (kMaxJsonNesting).
+std::vector<std::unique_ptr<DicomAttributes>> DicomJsonAttributes::items(DicomTag tag) const {
+  std::vector<std::unique_ptr<DicomAttributes>> out;
+  const nlohmann::json* e = element(tag);
+  if (e == nullptr) return out;
+  const auto vr = e->find("vr");
+  if (vr != e->end() && !(vr->is_string() && vr->get_ref<const std::string&>() == "SQ")) return out;
+  const auto values = e->find("Value");
+  if (values == e->end() || !values->is_array()) return out;
+  for (const nlohmann::json& item : *values) {
+    if (item.is_object()) out.push_back(std::make_unique<DicomJsonAttributes>(item));
+  }
+  return out;
+}
+
 }  // namespace tessera::io_detail
