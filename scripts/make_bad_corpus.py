@@ -1079,6 +1079,9 @@ def fuzz_seeds(root):
     # fuzz_functional_groups: multi-frame headers as DICOM JSON (WADO-RS metadata).
     for name, datasets in functional_group_seeds():
         put("functional_groups", name, json.dumps(datasets, indent=None, sort_keys=True))
+    # Found by fuzz_functional_groups: nlohmann's out_of_range escaped parseDicomJson.
+    put("functional_groups", "number-overflow-crash.json",
+        '[{"00280008": {"vr": "IS", "Value": [1e999]}}]')
 
 
 def dj(vr, *values):

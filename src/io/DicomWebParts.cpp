@@ -208,6 +208,10 @@ nlohmann::json parseDicomJson(std::span<const std::byte> body, const std::string
   } catch (const nlohmann::json::parse_error& e) {
     throw InputError(what + ": not JSON (" + std::to_string(text.size()) + " bytes starting " +
                      excerpt(text) + "; parse error at byte " + std::to_string(e.byte) + ")");
+  } catch (const nlohmann::json::out_of_range&) {
+    // A number no double holds (1e999): found by fuzz_functional_groups.
+    throw InputError(what + ": not DICOM JSON (" + std::to_string(text.size()) +
+                     " bytes starting " + excerpt(text) + "): a number too large for a double");
   }
   if (!j.is_array()) {
     throw InputError(what + ": JSON " + std::string(j.type_name()) +
