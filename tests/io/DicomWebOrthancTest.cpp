@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <memory>
 
 #include "io/IoFixtures.h"
@@ -150,7 +151,10 @@ const StoredSeries kStored[] = {
 
 // One test, as the suite's setup (encoding, Orthanc, uploads) is most of
 // its time and ctest runs each test in its own process.
-TEST_F(DicomWebOrthanc, StoredSyntaxesReadLikeTheFolderQidoListsThemUnknownIs404) {
+void expectEnhancedReadLikeTheFile(const fs::path& uploaded,
+                                   const std::function<std::string(const std::string&)>& url);
+
+TEST_F(DicomWebOrthanc, StoredSyntaxesAndEnhancedCtReadLikeTheFolderQidoListsThemUnknownIs404) {
   const Volume folder = readVolume((dir_->path() / "plain").string());
   const std::string study = studyUid();
   ASSERT_FALSE(study.empty());
@@ -204,21 +208,26 @@ TEST_F(DicomWebOrthanc, StoredSyntaxesReadLikeTheFolderQidoListsThemUnknownIs404
   EXPECT_EQ(m, url +
                    "/metadata: HTTP 404 Not Found: no such study, series or instance, or not a "
                    "DICOMweb service root");
+
+  expectEnhancedReadLikeTheFile(dir_->path() / "upload-mf", seriesUrl);
 }
 
 // Enhanced CT objects (one file of 90 frames stored in reverse z order,
 // placed by their functional groups; native and RLE Lossless with two
 // fragments per frame) over DICOMweb: the same volume and affine as the
 // same file read from disk, its frames asked 64 to a request.
-TEST_F(DicomWebOrthanc, EnhancedMultiFrameCtReadsLikeTheSameFileOnDisk) {
+// (Part of the suite's one test: ctest runs each test in its own process,
+// and the suite's setup is most of its time.)
+void expectEnhancedReadLikeTheFile(const fs::path& uploaded,
+                                   const std::function<std::string(const std::string&)>& url) {
   for (const char* name : kEnhanced) {
     SCOPED_TRACE(name);
-    const fs::path folder = dir_->path() / "upload-mf" / name;
+    const fs::path folder = uploaded / name;
     const Volume local = readVolume((folder / name).string());
     const auto listed = listDicomSeries(folder);
     ASSERT_EQ(listed.size(), 1u);
     DicomWebTransfer transfer;
-    const Volume web = readDicomWebSeries(seriesUrl(listed[0].seriesInstanceUid), &transfer);
+    const Volume web = readDicomWebSeries(url(listed[0].seriesInstanceUid), &transfer);
     test::expectSameVolume(web, local);
     EXPECT_EQ(web.indexToWorld(), local.indexToWorld());
     EXPECT_EQ(web.dims(), local.dims());
