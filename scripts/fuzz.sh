@@ -16,7 +16,7 @@ cd "$(dirname "$0")/.."
 ROOT=$PWD
 SECS=${1:-20}
 [ $# -gt 0 ] && shift
-ALL=(nifti nrrd metaimage vti pvm raw_sidecar dicom dicom_basic transfer_function device_profile zarr zarr_v3 zarr_shard_index dicomweb htj2k)
+ALL=(nifti nrrd metaimage vti pvm raw_sidecar dicom dicom_basic transfer_function device_profile zarr zarr_v3 zarr_shard_index dicomweb htj2k functional_groups)
 if [ $# -gt 0 ]; then TARGETS=("$@"); else TARGETS=("${ALL[@]}"); fi
 JOBS=$(nproc)
 PARALLEL=$((JOBS >= 2 ? 2 : 1))

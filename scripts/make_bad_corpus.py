@@ -14,7 +14,10 @@ quickly and without allocating what the file cannot justify
               "a|b" accepts either a or b
   companions  other files the case needs (detached data, sidecars)
 
-The fuzz seeds are small valid files, one folder per fuzz target.
+The fuzz seeds are small valid files, one folder per fuzz target. Seeds
+written here are rewritten; other files in fuzz/corpus/ (seeds encoded by
+other tools: DICOMweb answers, HTJ2K codestreams, DICOM files from pydicom,
+fuzz finds) are kept, and --check compares only the seeds written here.
 
 Standard library only, deterministic: running it twice gives the same bytes
 (with the same zlib). Files in tests/data/bad/fuzz-regressions/ are crash
@@ -59,18 +62,24 @@ FUZZ_REGRESSIONS = [
      "string makes DCMTK allocate them (OOM)", DICOM_HUGE_LENGTH),
     ("fuzz-regressions/dicom/htj2k-zero-tile-size-fpe.dcm", "dicom",
      "fuzz_dicom_basic: an HTJ2K frame whose SIZ marker declares a zero tile size; OpenJPH's "
-     "pre-allocation divided by it (SIGFPE)", "1.2.840.10008.1.2.4.201"),
+     "pre-allocation divided by it (SIGFPE); the tiling is checked before OpenJPH sizes anything",
+     "HTJ2K frame"),
     ("fuzz-regressions/dicom/htj2k-corrupt-codeblocks-overflow.dcm", "dicom",
      "fuzz_dicom_basic: an HTJ2K frame with sane headers and corrupt code-block data; Debian 12's "
-     "OpenJPH 0.9 wrote past its buffers (heap overflow; its own ojph_expand crashes too), so "
-     "HTJ2K is refused", "1.2.840.10008.1.2.4.201"),
-    ("fuzz-regressions/dicom/htj2k-mel-assert-abort.dcm", "dicom",
-     "fuzz_dicom_basic: an HTJ2K frame whose MEL segment starts past 0x8F; Debian 12's OpenJPEG "
-     "2.5.0, tried as HTJ2K's decoder, aborted on an assertion in ht_dec.c (mel_init), so HTJ2K "
-     "stays refused", "1.2.840.10008.1.2.4.201"),
+     "OpenJPH 0.9 wrote past its buffers (heap overflow; its own ojph_expand crashes too); now "
+     "the claim runs into io/Htj2kFrame's guard bytes and is refused before OpenJPH writes",
+     "HTJ2K frame"),
     ("fuzz-regressions/device_profile/number-overflow-crash.json", "device_profile",
      "fuzz_device_profile: a number too large for a double made nlohmann::json throw "
      "out_of_range.406, which escaped DeviceProfile::fromJson", "device profile"),
+    ("fuzz-regressions/dicom/htj2k-mel-assert-abort.dcm", "dicom",
+     "fuzz_dicom_basic: an HTJ2K frame whose MEL segment starts past 0x8F; Debian 12's OpenJPEG "
+     "2.5.0, tried as HTJ2K's decoder, aborted on an assertion in ht_dec.c (mel_init); HTJ2K now "
+     "goes to OpenJPH, which rejects the code-block", "HTJ2K frame"),
+    ("fuzz-regressions/dicom/htj2k-terminate-assert-abort.dcm", "dicom",
+     "fuzz_htj2k: a packet header ending in two 0xFF bytes; Debian 12's OpenJPH 0.9 (assertions "
+     "on) aborted in bb_terminate (unstuff == false); marker codes in packet data are now refused "
+     "before OpenJPH reads them (and OpenJPH decodes in a child process)", "HTJ2K frame"),
 ]
 
 
@@ -661,6 +670,48 @@ def nested_sequences(depth):
     return (seq + item) * depth + inner + (item_end + seq_end) * depth
 
 
+def dcm_sq(group, elem, *items):
+    """A sequence of defined length whose items (element bytes) have defined
+    lengths (PS3.5 7.5)."""
+    body = b"".join(struct.pack("<HHI", 0xFFFE, 0xE000, len(i)) + i for i in items)
+    return struct.pack("<HH2sHI", group, elem, b"SQ", 0, len(body)) + body
+
+
+def enhanced_ct(frames=3, items=3, missing_position=None):
+    """An Enhanced CT Image Storage object (PS3.3 C.7.6.16) of 8x8 u16
+    frames: orientation and pixel measures shared, a position per frame
+    (frame `missing_position`, counted from 1, without one); `items`
+    per-frame functional-group items for `frames` frames of pixels."""
+    sop_class = "1.2.840.10008.5.1.4.1.1.2.1"
+    sop = f"{UID_ROOT}.2.77.{frames}.{items}.{missing_position or 0}"
+    meta = (dcm_el(0x0002, 0x0001, "OB", b"\0\1") + dcm_el(0x0002, 0x0002, "UI", sop_class) +
+            dcm_el(0x0002, 0x0003, "UI", sop) + dcm_el(0x0002, 0x0010, "UI", EXPLICIT_LE) +
+            dcm_el(0x0002, 0x0012, "UI", UID_ROOT + ".99"))
+    meta = dcm_el(0x0002, 0x0000, "UL", struct.pack("<I", len(meta))) + meta
+    shared = (dcm_sq(0x0020, 0x9116, dcm_el(0x0020, 0x0037, "DS", ds(1, 0, 0, 0, 1, 0))) +
+              dcm_sq(0x0028, 0x9110, dcm_el(0x0018, 0x0050, "DS", "2") +
+                     dcm_el(0x0028, 0x0030, "DS", "0.5\\0.5")))
+    per_frame = [b"" if k + 1 == missing_position else
+                 dcm_sq(0x0020, 0x9113, dcm_el(0x0020, 0x0032, "DS", ds(0.0, 0.0, 2.0 * k)))
+                 for k in range(items)]
+    pixels = bytes((i * 5 + k) & 0xFF for k in range(frames) for i in range(128))
+    body = (dcm_el(0x0008, 0x0016, "UI", sop_class) + dcm_el(0x0008, 0x0018, "UI", sop) +
+            dcm_el(0x0008, 0x0060, "CS", "CT") + dcm_el(0x0020, 0x000D, "UI", UID_ROOT + ".3") +
+            dcm_el(0x0020, 0x000E, "UI", f"{UID_ROOT}.76.{frames}.{items}") +
+            dcm_el(0x0020, 0x0013, "IS", "1") +
+            dcm_el(0x0028, 0x0002, "US", struct.pack("<H", 1)) +
+            dcm_el(0x0028, 0x0004, "CS", "MONOCHROME2") + dcm_el(0x0028, 0x0008, "IS", str(frames)) +
+            dcm_el(0x0028, 0x0010, "US", struct.pack("<H", 8)) +
+            dcm_el(0x0028, 0x0011, "US", struct.pack("<H", 8)) +
+            dcm_el(0x0028, 0x0100, "US", struct.pack("<H", 16)) +
+            dcm_el(0x0028, 0x0101, "US", struct.pack("<H", 16)) +
+            dcm_el(0x0028, 0x0102, "US", struct.pack("<H", 15)) +
+            dcm_el(0x0028, 0x0103, "US", struct.pack("<H", 0)) +
+            dcm_sq(0x5200, 0x9229, shared) + dcm_sq(0x5200, 0x9230, *per_frame) +
+            struct.pack("<HH2sHI", 0x7FE0, 0x0010, b"OW", 0, len(pixels)) + pixels)
+    return bytes(128) + b"DICM" + meta + body
+
+
 def make_dicom(c):
     f = "dicom"
 
@@ -717,6 +768,16 @@ def make_dicom(c):
            "sequences nested deeper than 64 levels; refused", {"IM0001.dcm": dicom_slice(0, nested=100)})
     series("bad-magic", "128-byte preamble followed by 'DICX' and junk", "DICOM|magic|read|parse",
            {"IM0001.dcm": bytes(128) + b"DICX" + noise(200, 31)})
+    series("enhanced-frame-without-position",
+           "an Enhanced CT object of 3 frames whose frame 2 has no Plane Position (Patient) in its "
+           "per-frame functional groups, nor the shared ones",
+           "frame 2 has no Plane Position (Patient) (0020,9113)",
+           {"enhanced.dcm": enhanced_ct(missing_position=2)})
+    series("enhanced-per-frame-items-lie",
+           "an Enhanced CT object of 3 frames of pixels whose Per-frame Functional Groups "
+           "Sequence has 2 items",
+           "Number of Frames (0028,0008) is 3, but the Per-frame Functional Groups Sequence "
+           "(5200,9230) has 2 items", {"enhanced.dcm": enhanced_ct(items=2)})
 
 
 # --------------------------------------------------------------- fuzz seeds
@@ -1015,6 +1076,74 @@ def fuzz_seeds(root):
         index)
     put("zarr_shard_index", "2x2x2-start.bin", bytes([0x09, 0x01]) + struct.pack("<Q", 64 + 128) +
         b"".join(struct.pack("<QQ", 128 + 8 * i, 8) for i in range(8)))
+    # fuzz_functional_groups: multi-frame headers as DICOM JSON (WADO-RS metadata).
+    for name, datasets in functional_group_seeds():
+        put("functional_groups", name, json.dumps(datasets, indent=None, sort_keys=True))
+    # Found by fuzz_functional_groups: nlohmann's out_of_range escaped parseDicomJson.
+    put("functional_groups", "number-overflow-crash.json",
+        '[{"00280008": {"vr": "IS", "Value": [1e999]}}]')
+
+
+def dj(vr, *values):
+    """One DICOM JSON element (PS3.18 F.2.2)."""
+    return {"vr": vr, "Value": list(values)} if values else {"vr": vr}
+
+
+def sq(*items):
+    return dj("SQ", *items)
+
+
+def multiframe_header(frames, sop_class, modality, **extra):
+    d = {"00080016": dj("UI", sop_class), "00080018": dj("UI", UID_ROOT + ".70." + modality),
+         "00080060": dj("CS", modality), "0020000E": dj("UI", UID_ROOT + ".71"),
+         "00280002": dj("US", 1), "00280004": dj("CS", "MONOCHROME2"),
+         "00280008": dj("IS", str(frames)), "00280010": dj("US", 8), "00280011": dj("US", 8),
+         "00280100": dj("US", 16), "00280101": dj("US", 12), "00280102": dj("US", 11),
+         "00280103": dj("US", 0), "7FE00010": {"vr": "OW", "BulkDataURI": "http://h/bulk"}}
+    d.update(extra)
+    return d
+
+
+def functional_group_seeds():
+    """Enhanced CT of one stack (the plane shared, positions per frame, the
+    frames in reverse order), an Enhanced MR of two stacks (each frame its own
+    measures and orientation), classic RT Dose (Grid Frame Offset Vector) and
+    classic NM (the plane in the Detector Information Sequence)."""
+    axial = ["1", "0", "0", "0", "1", "0"]
+    sagittal = ["0", "1", "0", "0", "0", "-1"]
+    shared = {"00289110": sq({"00280030": dj("DS", "0.5", "0.5"), "00180050": dj("DS", "2")}),
+              "00209116": sq({"00200037": dj("DS", *axial)}),
+              "00289145": sq({"00281052": dj("DS", "-1024"), "00281053": dj("DS", "1")}),
+              "00289132": sq({"00281050": dj("DS", "40"), "00281051": dj("DS", "400")})}
+
+    def frame(position, stack, number, own=None):
+        f = {"00209113": sq({"00200032": dj("DS", *position)}),
+             "00209111": sq({"00209056": dj("SH", stack), "00209057": dj("UL", number)})}
+        f.update(own or {})
+        return f
+
+    ct = multiframe_header(3, "1.2.840.10008.5.1.4.1.1.2.1", "CT",
+                           **{"52009229": sq(shared),
+                              "52009230": sq(*[frame(["-2", "-2", str(2.0 * k)], "1", k + 1)
+                                               for k in (2, 1, 0)])})
+    planes = []
+    for stack, iop in (("1", axial), ("2", sagittal)):
+        own = {"00289110": sq({"00280030": dj("DS", "0.8", "0.8"), "00180050": dj("DS", "1.5")}),
+               "00209116": sq({"00200037": dj("DS", *iop)})}
+        planes += [frame([str(1.5 * k), "0", "0"] if stack == "2" else ["0", "0", str(1.5 * k)],
+                         stack, k + 1, own) for k in range(2)]
+    mr = multiframe_header(4, "1.2.840.10008.5.1.4.1.1.4.1", "MR",
+                           **{"52009229": sq({}), "52009230": sq(*planes)})
+    dose = multiframe_header(3, "1.2.840.10008.5.1.4.1.1.481.2", "RTDOSE",
+                             **{"00200032": dj("DS", "0", "0", "10"),
+                                "00200037": dj("DS", *axial), "00280030": dj("DS", "2", "2"),
+                                "3004000C": dj("DS", "10", "12.5", "15")})
+    nm = multiframe_header(2, "1.2.840.10008.5.1.4.1.1.20", "NM",
+                           **{"00180088": dj("DS", "3.5"), "00280030": dj("DS", "2", "2.5"),
+                              "00540022": sq({"00200032": dj("DS", "10", "-20", "30"),
+                                              "00200037": dj("DS", *axial)})})
+    return [("enhanced-ct.json", [ct]), ("enhanced-mr-two-stacks.json", [mr]),
+            ("rtdose-grid-offsets.json", [dose]), ("nm-detector.json", [nm])]
 
 
 # ---------------------------------------------------------------------- main
@@ -1030,8 +1159,6 @@ def generate(bad_root, seed_root):
                 shutil.rmtree(p)
             else:
                 os.remove(p)
-    if os.path.isdir(seed_root):
-        shutil.rmtree(seed_root)
     c = Corpus(bad_root)
     for make in (make_nifti, make_nrrd, make_metaimage, make_vti, make_pvm, make_raw, make_dicom,
                  make_zarr, make_zarr_v3):
@@ -1074,7 +1201,9 @@ def main():
                 shutil.copytree(os.path.join(bad_root, "fuzz-regressions"),
                                 os.path.join(tb, "fuzz-regressions"))
             generate(tb, ts)
-            ok = tree(tb) == tree(bad_root) and tree(ts) == tree(seed_root)
+            committed = tree(seed_root)
+            ok = tree(tb) == tree(bad_root) and all(
+                committed.get(p) == d for p, d in tree(ts).items())
         print("corpus is up to date" if ok else "corpus differs from scripts/make_bad_corpus.py")
         return 0 if ok else 1
     cases = generate(bad_root, seed_root)

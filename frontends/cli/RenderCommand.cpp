@@ -758,9 +758,11 @@ void addRenderCommand(CLI::App& app) {
   addTimeChannelOptions(cmd, o->time, o->channel);
   addDefaultedOption(
       cmd, "--tf", o->tf,
-      "Transfer function: preset (grey, mr-default, ct-bone, ct-muscle, bench, ct-soft-tissue, "
-      "ct-lung, ct-angio, mr-percentile) or FILE.json; default: the DICOM modality's "
-      "(CT ct-soft-tissue, MR mr-percentile), else mr-default");
+      "Transfer function: preset (grey, mr-default, ct-bone, ct-muscle, bench: over the "
+      "volume's window; clinical, each with its own window: ct-bone-hu, ct-soft-tissue, "
+      "ct-lung, ct-angio in HU, mr-percentile) or FILE.json; default: the DICOM modality's "
+      "(CT ct-soft-tissue, MR mr-percentile), else mr-default. ct-bone is the older bone ramp "
+      "on the volume's window; for a CT in HU use ct-bone-hu");
   addSizeOption(cmd, o->size, "Image");
   addDefaultedOption(
       cmd, "--azimuth", o->azimuth,

@@ -132,7 +132,7 @@ void panelTransferFunction(DesktopApp& ds) {
   transferFunctionEditor(ed, ds.logHistogram);
   if (ImGui::BeginCombo("preset", ed.transferFunction().name.c_str())) {
     for (const std::string& name : TransferFunction::presetNames()) {
-      if (ImGui::Selectable(name.c_str())) ed.loadPreset(name);
+      if (ImGui::Selectable(name.c_str())) ds.session->choosePreset(name);  // with its window
     }
     ImGui::EndCombo();
   }

@@ -145,10 +145,16 @@ class PySession {
   }
 
   std::string settings() const { return session_->currentSettings().toJson().dump(); }
-  void setSettings(const std::string& json) {
+  // `tfDefault`: the user named no TF, so that a volume opened later gets
+  // its modality's default (session/ModalityDefault.h) as the CLI's does.
+  void setSettings(const std::string& json, bool tfDefault) {
     Use use(*this);
-    session_->setSettings(tessera::session::Settings::fromJson(nlohmann::json::parse(json)));
+    tessera::session::Settings s =
+        tessera::session::Settings::fromJson(nlohmann::json::parse(json));
+    s.tfIsDefault = tfDefault;
+    session_->setSettings(std::move(s));
   }
+  std::string defaultNote() const { return session_->defaultNote(); }
 
   py::array_t<std::uint8_t> render(int width, int height) {
     Image image;
@@ -388,7 +394,8 @@ PYBIND11_MODULE(_tessera, m) {
       .def("open", &PySession::open, py::arg("volume"), py::arg("region") = "",
            py::arg("level") = "")
       .def("settings", &PySession::settings)
-      .def("set_settings", &PySession::setSettings)
+      .def("set_settings", &PySession::setSettings, py::arg("json"), py::arg("tf_default") = false)
+      .def_property_readonly("default_note", &PySession::defaultNote)
       .def("render", &PySession::render)
       .def("render_reference", &PySession::renderReference)
       .def("slice", &PySession::slice, py::arg("axis"), py::arg("index"), py::arg("window"),

@@ -498,6 +498,9 @@ class Session:
     ):
         self._volume = _as_volume(volume)
         self._core = _tessera.SessionCore(profile or "native")
+        # No tf given: the volume's modality picks it (CT ct-soft-tissue over
+        # its HU window, MR mr-percentile), as `tessera render` does.
+        self._tf_default = "tf" not in settings
         self.update(layout=layout, technique=technique, **settings)
         _reraising(
             self._volume.spec,
@@ -522,8 +525,17 @@ class Session:
         j = self.settings
         for key, value in settings.items():
             _apply_setting(j, key, value)
-        self._core.set_settings(_json.dumps(j))
+        tf_default = getattr(self, "_tf_default", False) and "tf" not in settings
+        self._core.set_settings(_json.dumps(j), tf_default)
+        self._tf_default = tf_default
         return self
+
+    @property
+    def default_note(self) -> str:
+        """What the session chose because no ``tf`` was given ("CT: default
+        transfer function ct-soft-tissue (modality CT), window -160..240 HU
+        of the preset; ..."), or a note on the ``tf`` given; "" when none."""
+        return self._core.default_note
 
     def state(self) -> Dict[str, Any]:
         """The session's state (version, volume, settings), as `tessera render

@@ -4,6 +4,10 @@
 // so that the opacity ramps sit inside them; tissue HU from the same
 // tables (air -1000, lung -900..-500, fat -100, soft tissue 20..80,
 // contrast-filled vessels 150..500, cortical bone 700..3000).
+//
+// Names: one per preset. The HU bone preset is ct-bone-hu, as ct-bone names
+// the older bone ramp over the volume's own window (TransferFunction.cpp),
+// which benchmarks and scripts keep using for data that is not in HU.
 #include "tessera/core/ClinicalPresets.h"
 
 #include <algorithm>
@@ -44,7 +48,7 @@ std::vector<ClinicalPreset> makePresets() {
   const glm::dvec3 flesh(0.85, 0.35, 0.28);
   const glm::dvec3 red(0.80, 0.10, 0.08);
   std::vector<ClinicalPreset> out;
-  out.push_back(ctPreset("ct-bone", {-1000, 3000},
+  out.push_back(ctPreset("ct-bone-hu", {-1000, 3000},
                          {{-1000, black}, {150, {0.75, 0.62, 0.48}}, {400, ivory}, {3000, white}},
                          {{-1000, 0.0}, {150, 0.0}, {300, 0.5}, {1000, 0.8}, {3000, 0.8}}));
   out.push_back(

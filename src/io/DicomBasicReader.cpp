@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "io/DicomSeries.h"
+#include "io/DicomWebInstance.h"
 #ifndef __EMSCRIPTEN__
 #include "io/Jpeg2000Frame.h"
 #endif
@@ -276,6 +277,20 @@ class Part10File final : public io_detail::DicomAttributes {
     encapsulated_ = ts->codec != Codec::None;
     parseDataset(ts->implicitVr);
   }
+
+  // For one frame's bytes only (io/DicomWebInstance.h): every syntax whose
+  // dataset is little endian, whatever this build's codecs decode.
+  void parseAnyLittleEndian() {
+    parseMeta();
+    const TransferSyntax* ts = syntax_;
+    const bool compressed =
+        ts != nullptr && std::string_view(ts->uid).starts_with("1.2.840.10008.1.2.4.");
+    if (ts == nullptr || (!ts->readable && !compressed))
+      throw InputError(unsupportedSyntaxMessage());
+    encapsulated_ = compressed || ts->codec != Codec::None;
+    parseDataset(ts->implicitVr);
+  }
+  const std::string& syntaxUid() const { return syntaxUid_; }
 
   const std::string& name() const { return name_; }
   std::string syntaxText() const {
@@ -917,6 +932,27 @@ class BasicDicomDecoder final : public DicomDecoder {
   }
 };
 }  // namespace
+
+io_detail::InstanceFrame io_detail::instanceFrame(const ByteSource& file, const Slice& s) {
+  Part10File f(file);
+  if (!f.isPart10()) {
+    throw InputError(file.name() + ": not a DICOM Part-10 file (no 'DICM' marker at byte 128)");
+  }
+  f.parseAnyLittleEndian();
+  if (!f.hasPixelData()) throw InputError(file.name() + ": no Pixel Data (7fe0,0010)");
+  InstanceFrame out{f.syntaxUid(), {}};
+  if (f.encapsulated()) {
+    const std::vector<std::uint8_t> c = frameCodestream(f, s);
+    out.bytes.resize(c.size());
+    if (!c.empty()) std::memcpy(out.bytes.data(), c.data(), c.size());
+    return out;
+  }
+  const Element& e = *f.pixelData();
+  const auto [begin, length] = io_detail::frameRange(s, e.length);
+  out.bytes.resize(length);
+  if (length > 0) std::memcpy(out.bytes.data(), f.at(e.offset + begin), length);
+  return out;
+}
 
 const DicomDecoder& basicDicomDecoder() {
   static const BasicDicomDecoder decoder;

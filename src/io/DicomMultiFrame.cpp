@@ -29,8 +29,10 @@ namespace {
 
 // No object holds more frames than this (a 4D cardiac MR has some
 // thousands); a header claiming more while its pixel data's size is unknown
-// is refused before a slice is made per frame.
-constexpr long kMostFrames = 1 << 20;
+// (DICOMweb metadata) is refused before a slice is made per frame: at about
+// half a KiB per slice, 32 MiB of headers at most (a 20-byte DICOM JSON
+// header could otherwise make a million).
+constexpr long kMostFrames = 1 << 16;
 
 std::string count(std::uint64_t n, const char* what) {
   return std::to_string(n) + " " + what + (n == 1 ? "" : "s");

@@ -11,13 +11,16 @@
 #include <exception>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include "io/DicomSeries.h"
 #include "io/DicomWebFrame.h"
+#include "io/DicomWebInstance.h"
 #include "io/DicomWebParts.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/io/ByteSource.h"
 #include "tessera/io/DicomWeb.h"
 #include "tessera/io/HttpStorage.h"
 
@@ -193,25 +196,68 @@ std::vector<DicomWebSeries> DicomWebClient::series(const std::string& studyUid) 
 
 namespace {
 
+// A Part-10 instance holds its header besides its frames: the functional
+// groups of an enhanced object take some KiB per frame.
+constexpr std::uint64_t kInstanceOverhead = 16ull << 20;
+
+// Frames asked in one request (.../frames/1,2,...): a multi-frame object's
+// request stays a few hundred bytes of URL and some MiB of answer.
+constexpr std::size_t kFramesPerRequest = 64;
+
+const char* kInstanceAccept =
+    "Accept: multipart/related; type=\"application/dicom\"; transfer-syntax=*";
+
+std::uint64_t pixelBytesOf(const Slice& s) {
+  return static_cast<std::uint64_t>(s.rows) * static_cast<std::uint64_t>(s.columns) *
+         static_cast<std::uint64_t>(std::max(1, s.bitsAllocated / 8));
+}
+
+// The slices of one instance: a single-frame file's one, or the frames of a
+// multi-frame object (in frame order), fetched together.
+struct InstanceFrames {
+  std::string url;  // ROOT/studies/S/series/S/instances/SOP
+  std::vector<const Slice*> frames;
+};
+
+std::vector<InstanceFrames> byInstance(const std::vector<Slice>& all) {
+  std::vector<InstanceFrames> out;
+  std::map<std::string, std::size_t> index;
+  for (const Slice& s : all) {
+    const auto [it, added] = index.emplace(s.file.string(), out.size());
+    if (added) out.push_back({s.file.string(), {}});
+    out[it->second].frames.push_back(&s);
+  }
+  for (InstanceFrames& i : out) {
+    std::sort(i.frames.begin(), i.frames.end(),
+              [](const Slice* a, const Slice* b) { return a->frame < b->frame; });
+  }
+  return out;
+}
+
 // The frames of a series' slices, fetched and decoded in parallel on first
 // use (the series code asks for them one by one, in z order, once its
-// checks have passed).
+// checks have passed): one WADO-RS request per instance, for all its
+// frames (.../frames/1,2,3). Archives that cannot send an instance's frames
+// alone (Orthanc 1.10 answers HTTP 500 for HTJ2K frames; 400, 406 and 501
+// say the same) send the whole instance instead, and its frames are cut out
+// of the file (io/DicomWebInstance.h) for the same decoders. The first
+// instance is asked once without retries, so that such an archive costs one
+// failed request, and the rest of the series is then asked whole.
 class FrameFetcher {
  public:
-  FrameFetcher(const HttpStorage& http, std::vector<std::string> headers, int connections,
-               std::string seriesUrl)
+  FrameFetcher(const HttpStorage& http, const HttpStorage& probe, std::vector<std::string> headers,
+               int connections, std::string seriesUrl)
       : http_(http),
+        probe_(probe),
         headers_(std::move(headers)),
         connections_(std::max(1, connections)),
-        seriesUrl_(std::move(seriesUrl)) {
-    headers_.push_back(kFrameAccept);
-  }
+        seriesUrl_(std::move(seriesUrl)) {}
 
   io_detail::StoredRange decode(const Slice& s, const std::vector<Slice>& all, Volume& stored,
                                 int z) {
     if (!fetched_) fetchAll(all);
-    const auto it = frames_.find(s.file.string());
-    if (it == frames_.end()) throw Error(s.file.string() + ": frame was not fetched");
+    const auto it = frames_.find(io_detail::sliceName(s));
+    if (it == frames_.end()) throw Error(io_detail::sliceName(s) + ": frame was not fetched");
     const io_detail::StoredRange r =
         io_detail::storePixels(s, it->second.data(), it->second.size(), stored, z);
     frames_.erase(it);  // held no longer than needed
@@ -222,81 +268,176 @@ class FrameFetcher {
     const std::lock_guard lock(mutex_);
     return {syntaxes_.begin(), syntaxes_.end()};
   }
+  std::uint64_t wholeInstances() const { return wholeCount_; }
 
  private:
-  std::vector<std::byte> fetchOne(const Slice& s, bool credentials) {
-    const std::string url = s.file.string() + "/frames/1";
-    const std::uint64_t pixels = static_cast<std::uint64_t>(s.rows) *
-                                 static_cast<std::uint64_t>(s.columns) *
-                                 static_cast<std::uint64_t>(std::max(1, s.bitsAllocated / 8));
-    const HttpResponse r =
-        http_.fetch(url, headers_, pixels * kCompressedExpansion + kMultipartOverhead);
-    if (r.status < 200 || r.status >= 300) refuse(url, r.status, credentials);
-    const auto parts = io_detail::parseMultipart(r.contentType, r.body, url, 1);
-    const std::string syntax = io_detail::frameTransferSyntax(parts.front().contentType);
-    if (syntax.empty()) {
-      throw InputError(url + ": the frame's Content-Type '" +
-                       parts.front().contentType.substr(0, 80) + "' names no transfer syntax");
+  using Frames = std::vector<std::vector<std::byte>>;
+
+  void noteSyntax(const std::string& syntax) {
+    const std::lock_guard lock(mutex_);
+    if (std::find(syntaxes_.begin(), syntaxes_.end(), syntax) == syntaxes_.end()) {
+      syntaxes_.push_back(syntax);
     }
-    {
-      const std::lock_guard lock(mutex_);
-      if (std::find(syntaxes_.begin(), syntaxes_.end(), syntax) == syntaxes_.end()) {
-        syntaxes_.push_back(syntax);
+  }
+
+  std::vector<std::string> headers(const char* accept) const {
+    std::vector<std::string> h = headers_;
+    h.push_back(accept);
+    return h;
+  }
+
+  // The instance's frames as frames (multipart/related, one part each),
+  // kFramesPerRequest at a time; nullopt when the archive cannot send them
+  // so: a request failed (a 5xx after its retries, a connection that
+  // failed) or was answered 400, 406 or 501. `failure` then says how.
+  std::optional<Frames> asFrames(const InstanceFrames& inst, const HttpStorage& via,
+                                 bool credentials, std::string& failure) {
+    Frames out;
+    for (std::size_t from = 0; from < inst.frames.size(); from += kFramesPerRequest) {
+      const std::size_t n = std::min(kFramesPerRequest, inst.frames.size() - from);
+      std::string list;
+      for (std::size_t k = from; k < from + n; ++k) {
+        if (!list.empty()) list += ',';  // appended: GCC 12's -Wrestrict false positive
+        list += std::to_string(inst.frames[k]->frame + 1);
+      }
+      const std::string url = inst.url + "/frames/" + list;
+      HttpResponse r;
+      try {
+        r = via.fetch(
+            url, headers(kFrameAccept),
+            n * (pixelBytesOf(*inst.frames.front()) * kCompressedExpansion + kMultipartOverhead));
+      } catch (const InputError&) {
+        throw;  // an answer too large: a whole instance would be larger
+      } catch (const Error& e) {
+        failure = e.what();
+        return std::nullopt;
+      }
+      if (r.status == 400 || r.status == 406 || r.status == 501) {
+        failure = url + ": HTTP " + std::to_string(r.status);
+        return std::nullopt;
+      }
+      if (r.status < 200 || r.status >= 300) refuse(url, r.status, credentials);
+      const auto parts = io_detail::parseMultipart(r.contentType, r.body, url, n);
+      if (parts.size() != n) {
+        throw InputError(url + ": " + std::to_string(parts.size()) + " parts for " +
+                         std::to_string(n) + " frames");
+      }
+      for (std::size_t k = 0; k < n; ++k) {
+        const std::string syntax = io_detail::frameTransferSyntax(parts[k].contentType);
+        if (syntax.empty()) {
+          throw InputError(url + ": the frame's Content-Type '" +
+                           parts[k].contentType.substr(0, 80) + "' names no transfer syntax");
+        }
+        noteSyntax(syntax);
+        const std::string what = n == 1 ? url : url + " (part " + std::to_string(k + 1) + ")";
+        out.push_back(
+            io_detail::decodeWebFrame(*inst.frames[from + k], syntax, parts[k].body, what));
       }
     }
-    return io_detail::decodeWebFrame(s, syntax, parts.front().body, url);
+    return out;
+  }
+
+  // The instance as the archive stores it (a Part-10 file), its frames cut
+  // out of it and decoded.
+  Frames asInstance(const InstanceFrames& inst, bool credentials) {
+    const Slice& first = *inst.frames.front();
+    const std::uint64_t limit = static_cast<std::uint64_t>(std::max(1L, first.frames)) *
+                                    pixelBytesOf(first) * kCompressedExpansion +
+                                kInstanceOverhead;
+    const HttpResponse r = http_.fetch(inst.url, headers(kInstanceAccept), limit);
+    if (r.status < 200 || r.status >= 300) refuse(inst.url, r.status, credentials);
+    const auto parts = io_detail::parseMultipart(r.contentType, r.body, inst.url, 1);
+    const MemorySource file(inst.url, parts.front().body);
+    Frames out;
+    for (const Slice* f : inst.frames) {
+      const io_detail::InstanceFrame frame = io_detail::instanceFrame(file, *f);
+      noteSyntax(frame.transferSyntax);
+      const std::string what =
+          f->frames > 1 ? inst.url + " frame " + std::to_string(f->frame + 1) : inst.url;
+      out.push_back(io_detail::decodeWebFrame(*f, frame.transferSyntax, frame.bytes, what));
+    }
+    ++wholeCount_;
+    return out;
+  }
+
+  Frames fetchOne(const InstanceFrames& inst, bool credentials, bool probe) {
+    if (!whole_) {
+      std::string failure;
+      if (auto frames = asFrames(inst, probe ? probe_ : http_, credentials, failure)) {
+        return std::move(*frames);
+      }
+      whole_ = true;  // the rest of the series likewise
+      try {
+        return asInstance(inst, credentials);
+      } catch (const Error& e) {
+        throw InputError(failure + "; and the instance itself: " + e.what());
+      }
+    }
+    return asInstance(inst, credentials);
   }
 
   void fetchAll(const std::vector<Slice>& all) {
     fetched_ = true;
-    const bool credentials = headers_.size() > 1;
-    std::atomic<std::size_t> next{0};
+    const std::vector<InstanceFrames> instances = byInstance(all);
+    const bool credentials = !headers_.empty();
+    std::atomic<std::size_t> next{1};
     std::atomic<std::size_t> done{0};
     std::atomic<bool> failed{false};
     std::exception_ptr error;
-    std::size_t errorIndex = all.size();
+    std::size_t errorIndex = instances.size();
     const bool tty = ::isatty(2) != 0;
     const auto t0 = std::chrono::steady_clock::now();
-    auto work = [&] {
+    const auto one = [&](std::size_t i) {
+      try {
+        Frames frames = fetchOne(instances[i], credentials, i == 0);
+        const std::lock_guard lock(mutex_);
+        for (std::size_t k = 0; k < frames.size(); ++k) {
+          frames_.emplace(io_detail::sliceName(*instances[i].frames[k]), std::move(frames[k]));
+        }
+      } catch (...) {
+        const std::lock_guard lock(mutex_);
+        // The first instance's error, of those that failed, is the one told.
+        if (i < errorIndex) {
+          errorIndex = i;
+          error = std::current_exception();
+        }
+        failed = true;
+        return false;
+      }
+      const std::size_t n = done += instances[i].frames.size();
+      if (tty && all.size() >= 32) {
+        const double sec =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        std::fprintf(stderr, "\rreading %s: %zu/%zu frames  %.1f s%s", seriesUrl_.c_str(), n,
+                     all.size(), sec, n == all.size() ? "\n" : "");
+      }
+      return true;
+    };
+    const auto work = [&] {
       for (;;) {
         const std::size_t i = next++;
-        if (i >= all.size() || failed) return;
-        try {
-          std::vector<std::byte> frame = fetchOne(all[i], credentials);
-          const std::lock_guard lock(mutex_);
-          frames_.emplace(all[i].file.string(), std::move(frame));
-        } catch (...) {
-          const std::lock_guard lock(mutex_);
-          // The first slice's error, of those that failed, is the one told.
-          if (i < errorIndex) {
-            errorIndex = i;
-            error = std::current_exception();
-          }
-          failed = true;
-          return;
-        }
-        const std::size_t n = ++done;
-        if (tty && all.size() >= 32 && (n % 16 == 0 || n == all.size())) {
-          const double sec =
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-          std::fprintf(stderr, "\rreading %s: %zu/%zu frames  %.1f s%s", seriesUrl_.c_str(), n,
-                       all.size(), sec, n == all.size() ? "\n" : "");
-        }
+        if (i >= instances.size() || failed || !one(i)) return;
       }
     };
-    const int n = static_cast<int>(std::min<std::size_t>(connections_, all.size()));
-    std::vector<std::thread> threads;
-    for (int t = 1; t < n; ++t) threads.emplace_back(work);
-    work();
-    for (auto& t : threads) t.join();
+    // The first instance alone: it tells whether the archive sends frames.
+    if (!instances.empty() && one(0)) {
+      const int n = static_cast<int>(std::min<std::size_t>(connections_, instances.size()));
+      std::vector<std::thread> threads;
+      for (int t = 1; t < n; ++t) threads.emplace_back(work);
+      work();
+      for (auto& t : threads) t.join();
+    }
     if (error) std::rethrow_exception(error);
   }
 
   const HttpStorage& http_;
+  const HttpStorage& probe_;
   std::vector<std::string> headers_;
   int connections_;
   std::string seriesUrl_;
   bool fetched_ = false;
+  std::atomic<bool> whole_{false};
+  std::atomic<std::uint64_t> wholeCount_{0};
   mutable std::mutex mutex_;
   std::map<std::string, std::vector<std::byte>> frames_;
   std::vector<std::string> syntaxes_;
@@ -325,24 +466,41 @@ Volume DicomWebClient::readSeries(const std::string& studyUid, const std::string
     }
     Slice s = io_detail::sliceHeader(seriesUrl + "/instances/" + sop, a);
     s.transferSyntax = "as stored (WADO-RS transfer-syntax=*)";
-    scan.slices.push_back(std::move(s));
+    // A multi-frame object (enhanced CT/MR: its functional groups are in the
+    // metadata) becomes one slice per frame, as in a folder.
+    for (Slice& frame : io_detail::framesOf(std::move(s), a)) {
+      scan.slices.push_back(std::move(frame));
+    }
   }
   const std::vector<Slice> all = scan.slices;
-  FrameFetcher fetcher(*http_, options_.headers, http_->parallelism(), seriesUrl);
+  HttpOptions once = HttpOptions::fromEnvironment();
+  once.attempts = 1;
+  once.connections = 1;
+  const HttpStorage probe(root_, once);
+  FrameFetcher fetcher(*http_, probe, options_.headers, http_->parallelism(), seriesUrl);
   Volume v = io_detail::readSeries(
       std::move(scan), seriesUid, seriesUrl,
       [&](const Slice& s, Volume& stored, int z) { return fetcher.decode(s, all, stored, z); });
   syntaxes_ = fetcher.syntaxes();
+  probeBytes_ += probe.bytesFetched();
+  probeRequests_ += probe.requests();
+  wholeInstances_ += fetcher.wholeInstances();
   std::string received;
   for (const std::string& t : syntaxes_) received += (received.empty() ? "" : ", ") + t;
-  v.setDescription(v.description() + "; frames received in transfer syntax " + received + "; " +
-                   formatBytes(http_->bytesFetched()) + " in " + std::to_string(http_->requests()) +
-                   " requests");
+  const DicomWebTransfer t = transfer();
+  v.setDescription(v.description() + "; frames received in transfer syntax " + received +
+                   (t.wholeInstances > 0
+                        ? " (" + std::to_string(t.wholeInstances) +
+                              " instances retrieved whole: the archive does not send their "
+                              "frames alone)"
+                        : std::string()) +
+                   "; " + formatBytes(t.bytes) + " in " + std::to_string(t.requests) + " requests");
   return v;
 }
 
 DicomWebTransfer DicomWebClient::transfer() const {
-  return {http_->bytesFetched(), http_->requests(), http_->retries(), syntaxes_};
+  return {http_->bytesFetched() + probeBytes_, http_->requests() + probeRequests_, http_->retries(),
+          syntaxes_, wholeInstances_};
 }
 
 Volume readDicomWebSeries(const std::string& url, DicomWebTransfer* transfer) {

@@ -208,6 +208,10 @@ nlohmann::json parseDicomJson(std::span<const std::byte> body, const std::string
   } catch (const nlohmann::json::parse_error& e) {
     throw InputError(what + ": not JSON (" + std::to_string(text.size()) + " bytes starting " +
                      excerpt(text) + "; parse error at byte " + std::to_string(e.byte) + ")");
+  } catch (const nlohmann::json::out_of_range&) {
+    // A number no double holds (1e999): found by fuzz_functional_groups.
+    throw InputError(what + ": not DICOM JSON (" + std::to_string(text.size()) +
+                     " bytes starting " + excerpt(text) + "): a number too large for a double");
   }
   if (!j.is_array()) {
     throw InputError(what + ": JSON " + std::string(j.type_name()) +
@@ -291,6 +295,23 @@ std::optional<int> DicomJsonAttributes::uint16(DicomTag tag) const {
     if (r.ec == std::errc() && r.ptr == s.data() + s.size() && n >= 0 && n <= 65535) return n;
   }
   return std::nullopt;
+}
+
+// A sequence's items (PS3.18 F.2.5: "Value" holds one object per item);
+// the items point into the answer, which outlives them while the series'
+// headers are read. Nesting is bounded before parsing (kMaxJsonNesting).
+std::vector<std::unique_ptr<DicomAttributes>> DicomJsonAttributes::items(DicomTag tag) const {
+  std::vector<std::unique_ptr<DicomAttributes>> out;
+  const nlohmann::json* e = element(tag);
+  if (e == nullptr) return out;
+  const auto vr = e->find("vr");
+  if (vr != e->end() && !(vr->is_string() && vr->get_ref<const std::string&>() == "SQ")) return out;
+  const auto values = e->find("Value");
+  if (values == e->end() || !values->is_array()) return out;
+  for (const nlohmann::json& item : *values) {
+    if (item.is_object()) out.push_back(std::make_unique<DicomJsonAttributes>(item));
+  }
+  return out;
 }
 
 }  // namespace tessera::io_detail

@@ -4,6 +4,7 @@
 // body (nothing copied), and DICOM JSON (PS3.18 F.2) read as the attributes
 // the series code reads. Every error is an InputError "WHAT: ..." in one line.
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -59,6 +60,7 @@ class DicomJsonAttributes final : public DicomAttributes {
   explicit DicomJsonAttributes(const nlohmann::json& dataset) : dataset_(dataset) {}
   std::optional<std::string> text(DicomTag tag) const override;
   std::optional<int> uint16(DicomTag tag) const override;
+  std::vector<std::unique_ptr<DicomAttributes>> items(DicomTag sequence) const override;
   // Whether the element is present (with or without a value).
   bool has(DicomTag tag) const;
 

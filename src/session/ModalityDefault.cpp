@@ -1,7 +1,9 @@
 #include "tessera/session/ModalityDefault.h"
 
 #include "tessera/core/ClinicalPresets.h"
+#include "tessera/session/Session.h"
 #include "tessera/session/Settings.h"
+#include "tessera/viewer/Viewer.h"
 
 namespace tessera::session {
 
@@ -55,6 +57,39 @@ ValueRange sliceWindow(const Volume& volume, bool ownWindow, const TransferFunct
       tf ? clinicalPresetNamed(tf->name) : defaultClinicalPreset(volume.modality());
   if (!p || (p->percentiles && !volume.hasData())) return volume.window();
   return clinicalWindow(*p, volume);
+}
+
+std::string presetNote(const TransferFunction& tf, const Volume& volume) {
+  if (tf.name != "ct-bone" || volume.modality() != "CT") return "";
+  return "CT: ct-bone is the bone ramp over the volume's own window; the bone preset in "
+         "Hounsfield units, the same on every CT, is ct-bone-hu";
+}
+
+// Session's (session/Session.h), here with the rules it follows: the TF the
+// user chose, then the window rules 1-4 of ModalityDefault.h, so that a
+// preset picked from a menu looks as `--tf NAME` renders.
+void Session::choosePreset(const std::string& name) {
+  settings_.tf = TransferFunction::preset(name);  // InputError naming the presets
+  settings_.tfIsDefault = false;
+  tfBeforeDefault_.reset();
+  defaultNote_.clear();
+  if (inCore_) {
+    Volume& v = inCore_->volume();
+    defaultNote_ = presetNote(settings_.tf, v);
+    // Rule 3 replaces the window of the TF chosen before, if it was one.
+    if (!settings_.window && !ownWindow_) v.resetWindow();
+  }
+  applyVolumeSettings();
+  if (!view_) return;
+  viewer::Viewer& view = *view_;
+  if (!settings_.labels) view.tfEditor().setTransferFunction(settings_.tf);
+  if (!inCore_ || !view.hasVolume() || settings_.window) return;
+  const Volume& v = inCore_->volume();
+  if (v.hasWindow()) {
+    view.setWindow(v.window());
+  } else {
+    view.resetWindow();
+  }
 }
 
 }  // namespace tessera::session

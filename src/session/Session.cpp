@@ -244,6 +244,7 @@ void Session::showDefaultInView(bool tfChanged) {
 bool Session::applyModalityDefault(const Volume& v) {
   ownWindow_ = v.hasWindow();
   defaultNote_.clear();
+  if (!settings_.tfIsDefault) defaultNote_ = presetNote(settings_.tf, v);
   if (!settings_.tfIsDefault || settings_.labels) return false;
   const std::optional<ModalityDefault> chosen = modalityDefault(v);
   if (!chosen) {

@@ -213,9 +213,9 @@ TEST(TransferFunction, JsonRoundTripPreservesEveryPointExactly) {
 
 TEST(TransferFunction, EveryPresetLoadsAndRoundTrips) {
   const std::vector<std::string> names = TransferFunction::presetNames();
-  EXPECT_EQ(names,
-            (std::vector<std::string>{"grey", "mr-default", "ct-bone", "ct-muscle", "bench",
-                                      "ct-soft-tissue", "ct-lung", "ct-angio", "mr-percentile"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"grey", "mr-default", "ct-bone", "ct-muscle", "bench",
+                                             "ct-bone-hu", "ct-soft-tissue", "ct-lung", "ct-angio",
+                                             "mr-percentile"}));
   TempDir dir;
   for (const std::string& name : names) {
     const TransferFunction tf = TransferFunction::preset(name);

@@ -56,7 +56,7 @@ TEST(ClinicalDefaults, CtBonePresetGivesTheSameHuTheSameOpacityWhateverTheStored
   ASSERT_EQ(ctA.valueRange().max, 2024);
   ASSERT_EQ(ctB.valueRange().min, -1000);
   EXPECT_NE(ctA.description().find("intercept -1024 applied"), std::string::npos);
-  const ClinicalPreset& bone = clinicalPreset("ct-bone");
+  const ClinicalPreset& bone = clinicalPreset("ct-bone-hu");
   for (double hu : {-1000.0, 0.0, 150.0, 225.0, 300.0, 700.0, 1000.0, 1200.0}) {
     SCOPED_TRACE(hu);
     EXPECT_DOUBLE_EQ(clinicalOpacity(bone, ctA, hu), clinicalOpacity(bone, ctB, hu));
@@ -64,7 +64,7 @@ TEST(ClinicalDefaults, CtBonePresetGivesTheSameHuTheSameOpacityWhateverTheStored
   EXPECT_EQ(clinicalOpacity(bone, ctA, 0.0), 0.0);             // soft tissue invisible
   EXPECT_NEAR(clinicalOpacity(bone, ctA, 300.0), 0.5, 1e-12);  // the ramp's middle point
   EXPECT_GT(clinicalOpacity(bone, ctA, 700.0), 0.6);           // cortical bone
-  // The old ct-bone preset, on each volume's own window, does not agree.
+  // The older ct-bone preset, on each volume's own window, does not agree.
   const TransferFunction old = TransferFunction::preset("ct-bone");
   const auto oldOpacity = [&](const Volume& v, double hu) {
     const ValueRange w = v.window();

@@ -324,6 +324,18 @@ TEST(DicomWebParts, MultipartSplitsPartsAndKeepsTheirBytes) {
             "image/jp2; transfer-syntax=1.2");
 }
 
+// Found by fuzz_functional_groups: a number no double holds made
+// nlohmann::json throw out_of_range, which escaped as no InputError.
+TEST(DicomWebParts, DicomJsonWithANumberTooLargeIsOneLine) {
+  const std::string text = R"([{"00280008": {"vr": "IS", "Value": [1e999]}}])";
+  const std::string m = test::inputErrorMessage([&] {
+    io_detail::parseDicomJson(
+        std::span(reinterpret_cast<const std::byte*>(text.data()), text.size()), "meta");
+  });
+  EXPECT_EQ(m.rfind("meta: not DICOM JSON (46 bytes starting", 0), 0u) << m;
+  EXPECT_NE(m.find("): a number too large for a double"), std::string::npos) << m;
+}
+
 TEST(DicomWebParts, DicomJsonGivesTheTextsTheFolderReaderReads) {
   const auto j = nlohmann::json::parse(
       R"([{"00200032": {"vr": "DS", "Value": [-83.9063, 0.1, 1e-7]},

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/ExpectError.h"
 #include "support/TestSupport.h"
 #include "tessera/core/ClinicalPresets.h"
 #include "tessera/io/DicomSeriesReader.h"
@@ -123,8 +124,14 @@ TEST(ModalityDefault, AStatesTfIsTheUsersChoice) {
 TEST(ModalityDefault, ClinicalPresetWindowIsForClinicalPresetsOnly) {
   const Volume ct = *huRamp("CT");
   EXPECT_FALSE(clinicalPresetWindow(TransferFunction::preset("grey"), ct));
-  // ct-bone is the preset on the volume's own window; its HU twin is not named.
+  // ct-bone is the older ramp on the volume's own window; the HU bone
+  // preset has its own name, ct-bone-hu, and its window.
   EXPECT_FALSE(clinicalPresetWindow(TransferFunction::preset("ct-bone"), ct));
+  const std::optional<ValueRange> bone =
+      clinicalPresetWindow(TransferFunction::preset("ct-bone-hu"), ct);
+  ASSERT_TRUE(bone);
+  EXPECT_EQ(bone->min, -1000);
+  EXPECT_EQ(bone->max, 3000);
   const std::optional<ValueRange> angio =
       clinicalPresetWindow(TransferFunction::preset("ct-angio"), ct);
   ASSERT_TRUE(angio);
@@ -155,6 +162,47 @@ TEST(ModalityDefault, TheViewShowsTheDefaultWhenTheVolumeIsHandedOverOrOpenedInI
   EXPECT_EQ(desktop.view().window().min, -160);
   EXPECT_EQ(desktop.view().window().max, 240);
   EXPECT_NE(desktop.defaultNote().find("ct-soft-tissue"), std::string::npos);
+}
+
+// A preset picked from the desktop's or the page's menu goes through the
+// session (Session::choosePreset): a clinical one brings its window to the
+// volume and the view, another gives the volume's own window back, a
+// user's window stays; on a CT, ct-bone gets a note naming ct-bone-hu.
+TEST(ModalityDefault, APresetChosenFromAMenuSetsItsWindowThroughTheSession) {
+  Session s;
+  s.view();
+  s.setVolume(huRamp("CT"));
+  s.choosePreset("ct-bone-hu");
+  EXPECT_EQ(s.settings().tf.name, "ct-bone-hu");
+  EXPECT_FALSE(s.settings().tfIsDefault);
+  EXPECT_EQ(s.view().tfEditor().transferFunction().name, "ct-bone-hu");
+  expectWindow(s.volume(), -1000, 3000);
+  EXPECT_EQ(s.view().window().min, -1000);
+  EXPECT_EQ(s.view().window().max, 3000);
+  s.choosePreset("ct-lung");
+  expectWindow(s.volume(), -1350, 150);
+  EXPECT_EQ(s.view().window().min, -1350);
+  EXPECT_EQ(s.view().window().max, 150);
+  EXPECT_EQ(s.defaultNote(), "");
+  // Not clinical: the volume's value range again (rule 4).
+  s.choosePreset("ct-bone");
+  expectWindow(s.volume(), -1000, 1000);
+  EXPECT_EQ(s.view().window().min, -1000);
+  EXPECT_EQ(s.view().window().max, 1000);
+  EXPECT_EQ(s.defaultNote(),
+            "CT: ct-bone is the bone ramp over the volume's own window; the bone preset in "
+            "Hounsfield units, the same on every CT, is ct-bone-hu");
+  // The user's window wins over the preset's.
+  Settings mine = s.settings();
+  mine.window = ValueRange{-50, 50};
+  s.setSettings(mine);
+  s.choosePreset("ct-angio");
+  expectWindow(s.volume(), -50, 50);
+  EXPECT_EQ(s.view().window().min, -50);
+  // An unknown name changes nothing and names the presets.
+  const std::string m = test::inputErrorMessage([&] { s.choosePreset("ct-nothing"); });
+  EXPECT_NE(m.find("ct-bone-hu"), std::string::npos) << m;
+  EXPECT_EQ(s.settings().tf.name, "ct-angio");
 }
 
 }  // namespace

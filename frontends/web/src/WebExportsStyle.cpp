@@ -25,7 +25,7 @@ EMSCRIPTEN_KEEPALIVE int tessera_tf_set_json(const char* json) {
   return guarded([&] { web::session().viewer().tfEditor().loadJson(json); });
 }
 EMSCRIPTEN_KEEPALIVE int tessera_tf_preset(const char* name) {
-  return guarded([&] { web::session().viewer().tfEditor().loadPreset(name); });
+  return guarded([&] { web::session().rendering().choosePreset(name); });  // with its window
 }
 EMSCRIPTEN_KEEPALIVE void tessera_tf_pointer_down(int channel, double x, double y, double rx,
                                                   double ry) {

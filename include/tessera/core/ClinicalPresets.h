@@ -20,7 +20,7 @@
 namespace tessera {
 
 struct ClinicalPreset {
-  std::string name;      // "ct-bone", "ct-soft-tissue", "ct-lung", "ct-angio", "mr-percentile"
+  std::string name;      // "ct-bone-hu", "ct-soft-tissue", "ct-lung", "ct-angio", "mr-percentile"
   std::string modality;  // "CT" or "MR"
   TransferFunction tf;
   // CT: the HU that x = 0 and x = 1 stand for.

@@ -71,6 +71,9 @@ struct DicomWebTransfer {
   std::uint64_t retries = 0;
   std::vector<std::string>
       transferSyntaxes;  // of the frames received, e.g. "1.2.840.10008.1.2.4.90"
+  // Instances retrieved whole (application/dicom) because the archive did
+  // not send their frames alone (Orthanc 1.10 and HTJ2K).
+  std::uint64_t wholeInstances = 0;
 };
 
 class DicomWebClient {
@@ -99,6 +102,9 @@ class DicomWebClient {
   DicomWebOptions options_;
   std::unique_ptr<HttpStorage> http_;
   mutable std::vector<std::string> syntaxes_;
+  mutable std::uint64_t probeBytes_ = 0;  // the single-attempt first request's
+  mutable std::uint64_t probeRequests_ = 0;
+  mutable std::uint64_t wholeInstances_ = 0;
 };
 
 // A series URL read as readVolume reads a folder; `transfer`, when given,

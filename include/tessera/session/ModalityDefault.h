@@ -52,4 +52,9 @@ std::optional<ValueRange> clinicalPresetWindow(const TransferFunction& tf, const
 // value range for an MR.
 ValueRange sliceWindow(const Volume& volume, bool ownWindow, const TransferFunction* tf);
 
+// A note for a TF the user named that is easily mistaken on `volume`:
+// ct-bone on a CT (the bone ramp over the volume's window, not the HU
+// preset ct-bone-hu); "" otherwise.
+std::string presetNote(const TransferFunction& tf, const Volume& volume);
+
 }  // namespace tessera::session

@@ -154,6 +154,12 @@ class Session {
   // the settings' TF stayed. For the front end to show.
   const std::string& defaultNote() const { return defaultNote_; }
 
+  // A preset chosen from a front end's menu (desktop, page): the look of
+  // `--tf NAME` (session/ModalityDefault.h): the TF into the settings and
+  // the view's editor, and the window by the rules there (the user's, the
+  // volume's own, a clinical preset's, the value range).
+  void choosePreset(const std::string& name);
+
   Settings& settings() { return settings_; }
   const Settings& settings() const { return settings_; }
   // Validated first; the session keeps its old settings on error. With a
