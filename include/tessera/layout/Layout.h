@@ -93,8 +93,8 @@ class Layout {
   // grid per texture-space unit; layoutEnterCell(p), read once when a ray
   // enters the cell holding p, returning that cell; layoutCellTransparent(),
   // 1.0 when that cell is known to be transparent (composite crosses it in
-  // one step); sampleVolumeInCell(p) for the samples inside it. Layouts that look something up per sample
-  // (bricks: the page table) read it once per cell that way.
+  // one step); sampleVolumeInCell(p) for the samples inside it. Layouts that look something up per
+  // sample (bricks: the page table) read it once per cell that way.
   virtual bool walksBricks() const { return false; }
   // Changes whenever what sampleVolume() returns may have changed (a
   // streamed layout's page table), so techniques rebuild their value blocks.
