@@ -17,23 +17,6 @@ namespace tessera::app {
 
 namespace {
 
-std::uint64_t peakRssBytes() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return static_cast<std::uint64_t>(u.ru_maxrss) * 1024;  // Linux: KiB
-}
-
-std::string levels(const std::vector<int>& perLevel) {
-  std::string s;
-  for (std::size_t l = 0; l < perLevel.size(); ++l) {
-    if (perLevel[l] == 0) continue;
-    char item[40];
-    std::snprintf(item, sizeof item, "%sL%zu:%d", s.empty() ? "" : " ", l, perLevel[l]);
-    s += item;
-  }
-  return s;
-}
-
 RenderRequest requestFor(const BricksBenchOptions& o, const TransferFunction& tf,
                          const std::string& layout) {
   RenderRequest req;
@@ -47,6 +30,23 @@ RenderRequest requestFor(const BricksBenchOptions& o, const TransferFunction& tf
 }
 
 }  // namespace
+
+std::uint64_t peakRssBytes() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<std::uint64_t>(u.ru_maxrss) * 1024;  // Linux: KiB
+}
+
+std::string levelsText(const std::vector<int>& perLevel) {
+  std::string s;
+  for (std::size_t l = 0; l < perLevel.size(); ++l) {
+    if (perLevel[l] == 0) continue;
+    char item[40];
+    std::snprintf(item, sizeof item, "%sL%zu:%d", s.empty() ? "" : " ", l, perLevel[l]);
+    s += item;
+  }
+  return s;
+}
 
 void runBricksBench(const BricksBenchOptions& o) {
   const TransferFunction tf = TransferFunction::fromPresetOrFile(o.tf);
@@ -83,7 +83,7 @@ void runBricksBench(const BricksBenchOptions& o) {
           ratio = text;
         }
       }
-      const std::string lv = r.bricks ? levels(r.bricks->wantedPerLevel) : "L0 (in core)";
+      const std::string lv = r.bricks ? levelsText(r.bricks->wantedPerLevel) : "L0 (in core)";
       std::printf(
           "| %s | %s | %s | %.0f | %.0f | %.0f | %s | %s | %s | %s / %s | %llu (%s) | %s |\n",
           spec.c_str(), profile.c_str(), r.layout.c_str(),

@@ -6,6 +6,7 @@
 // bricks read, the process's peak RSS (always --layout bricks); and, where
 // the volume also fits the profile in core, the in-core layout's rotating frame time in the same
 // run as the baseline of the ratio.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -22,5 +23,10 @@ struct BricksBenchOptions {
 };
 
 void runBricksBench(const BricksBenchOptions& options);
+
+// Shared with `bench --scale`: this process's peak resident set, and the
+// bricks wanted per level as "L0:12 L1:3" (levels with none left out).
+std::uint64_t peakRssBytes();
+std::string levelsText(const std::vector<int>& perLevel);
 
 }  // namespace tessera::app

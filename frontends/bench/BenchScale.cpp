@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "bench/BenchBricks.h"
 #include "cli/Commands.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
@@ -20,23 +21,6 @@
 namespace tessera::app {
 
 namespace {
-
-std::uint64_t peakRssBytes() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return static_cast<std::uint64_t>(u.ru_maxrss) * 1024;  // Linux: KiB
-}
-
-std::string levels(const std::vector<int>& perLevel) {
-  std::string s;
-  for (std::size_t l = 0; l < perLevel.size(); ++l) {
-    if (perLevel[l] == 0) continue;
-    char item[40];
-    std::snprintf(item, sizeof item, "%sL%zu:%d", s.empty() ? "" : " ", l, perLevel[l]);
-    s += item;
-  }
-  return s;
-}
 
 // "64^3" from the plan's reason ("... as 64^3 bricks (+1 voxel apron) ...").
 std::string brickText(const std::string& reason) {
@@ -82,7 +66,7 @@ void runRow(const ScaleBenchOptions& o, int side, const std::string& profile) {
         "%s %s | %.2f / %d | %.0f | %.0f%s | %d | %s | %llu (%s) | %s / %s | %s / %s |\n", head,
         brickText(r.layoutReason).c_str(), req.settings.render.stepVoxels, req.settings.skipBlock,
         firstMs, refinedMs, b.complete ? "" : " (limit)", b.refineFrames,
-        levels(b.wantedPerLevel).c_str(), static_cast<unsigned long long>(b.bricksRead),
+        levelsText(b.wantedPerLevel).c_str(), static_cast<unsigned long long>(b.bricksRead),
         formatBytes(b.bytesRead).c_str(), formatBytes(device.context->ledger().peakBytes()).c_str(),
         formatBytes(device.limits.textureBudget).c_str(), formatBytes(peakRssBytes()).c_str(),
         formatBytes(HostBudget::global().limitBytes()).c_str());

@@ -61,19 +61,6 @@ std::vector<int> chosenChannels(const ZarrStore& store, const std::string& spec,
   return chosen;
 }
 
-// The finest level that fits the host budget (BudgetError when none does).
-int channelLevel(const ZarrStore& store, const std::string& spec) {
-  const std::uint64_t budget = HostBudget::global().limitBytes();
-  const int l = store.finestLevelWithin(budget);
-  if (l < 0) {
-    const ZarrLevel& coarse = store.level(store.levelCount() - 1);
-    throw BudgetError(spec + ": even the coarsest level (" + std::to_string(coarse.dims.x) + "x" +
-                      std::to_string(coarse.dims.y) + "x" + std::to_string(coarse.dims.z) +
-                      ") does not fit the host budget " + formatBytes(budget));
-  }
-  return l;
-}
-
 Channel channelFrom(const ZarrStore& store, int c, Volume volume) {
   const std::vector<ZarrChannel>& omero = store.channels();
   Channel ch;
@@ -103,7 +90,7 @@ ChannelSet readZarrChannels(std::shared_ptr<const ZarrStorage> storage, const st
   ChannelSet set;
   for (int c : chosenChannels(first, name, indices)) {
     const ZarrStore store(storage, ZarrSelection{.time = time, .channel = c});
-    Volume volume = store.readLevel(channelLevel(store, name));
+    Volume volume = store.readLevel(store.finestLevelInHostBudget(name));
     set.add(channelFrom(store, c, std::move(volume)), name + " channel " + std::to_string(c));
   }
   return set;
@@ -116,7 +103,7 @@ std::vector<std::string> zarrChannelKeys(std::shared_ptr<const ZarrStorage> stor
   std::vector<std::string> keys;
   for (int c : chosenChannels(first, name, indices)) {
     const ZarrStore store(storage, ZarrSelection{.time = time, .channel = c});
-    const int l = channelLevel(store, name);
+    const int l = store.finestLevelInHostBudget(name);
     for (std::string& k : store.chunkKeys(l, glm::ivec3(0), store.level(l).dims)) {
       keys.push_back(std::move(k));
     }

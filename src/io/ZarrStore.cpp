@@ -594,6 +594,18 @@ int ZarrStore::finestLevelWithin(std::uint64_t budgetBytes) const {
   return -1;
 }
 
+int ZarrStore::finestLevelInHostBudget(const std::string& spec) const {
+  const std::uint64_t budget = HostBudget::global().limitBytes();
+  const int l = finestLevelWithin(budget);
+  if (l < 0) {
+    const ZarrLevel& coarse = level(levelCount() - 1);
+    throw BudgetError(spec + ": even the coarsest level (" + std::to_string(coarse.dims.x) + "x" +
+                      std::to_string(coarse.dims.y) + "x" + std::to_string(coarse.dims.z) +
+                      ") does not fit the host budget " + formatBytes(budget));
+  }
+  return l;
+}
+
 int ZarrStore::channelCount() const {
   return axis_[kC] >= 0 ? static_cast<int>(levels_.front().array.shape[std::size_t(axis_[kC])]) : 1;
 }

@@ -34,14 +34,8 @@ std::shared_ptr<const ZarrStorage> openZarrStorage(const std::string& spec) {
 
 Volume readZarrVolume(const std::string& spec, ZarrSelection selection, std::string* chosenNote) {
   const ZarrStore store(openZarrStorage(spec), selection);
+  const int l = store.finestLevelInHostBudget(spec);
   const std::uint64_t budget = HostBudget::global().limitBytes();
-  const int l = store.finestLevelWithin(budget);
-  if (l < 0) {
-    const ZarrLevel& coarse = store.level(store.levelCount() - 1);
-    throw BudgetError(spec + ": even the coarsest level (" + std::to_string(coarse.dims.x) + "x" +
-                      std::to_string(coarse.dims.y) + "x" + std::to_string(coarse.dims.z) +
-                      ") does not fit the host budget " + formatBytes(budget));
-  }
   // A level of many chunks (over HTTP: many requests) shows its progress
   // on a terminal.
   const bool tty = ::isatty(2) != 0;

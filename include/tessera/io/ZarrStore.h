@@ -100,6 +100,9 @@ class ZarrStore {
   // The finest level whose voxels (plus one chunk per reader) fit the host
   // budget; -1 if none does.
   int finestLevelWithin(std::uint64_t budgetBytes) const;
+  // finestLevelWithin(the global host budget), or a BudgetError naming
+  // `spec` and the coarsest level when none fits.
+  int finestLevelInHostBudget(const std::string& spec) const;
 
   // Things the user should know ("dtype <i4 is read as f32", "axes have no
   // unit: taken as mm").
