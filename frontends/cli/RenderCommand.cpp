@@ -686,6 +686,10 @@ void runRenderCommand(const RenderOptions& o) {
     std::fprintf(stderr, "tessera: note: %s\n", session.defaultNote().c_str());
   }
   openFusion(session, o.fusion);
+  // --state without --overlay: the state's overlay, as the viewers restore it.
+  if (!o.state.empty() && o.fusion.file.empty()) {
+    session.restoreOverlay(session::readStateFile(o.state));
+  }
   times.loadMs = msSince(tLoad);
   const DeviceSession& device = session.device();
   if (session.streamed()) {

@@ -176,3 +176,25 @@ TEST(RenderState, ASettingOfTheWrongKindIsNamedWithItsPath) {
   expectEdit("/settings/mode", "xray", "mode 'xray': expected composite, mip, minip or average");
   expectEdit("/settings/step", 99, "step 99: expected voxels in (0, 8]");
 }
+
+// A state saved with a fused overlay brings the overlay back: `render
+// --state` alone draws the same fused PNG, byte for byte.
+TEST(RenderState, TheStatesOverlayIsFusedAgain) {
+  const std::string templates = "/usr/share/mricron/templates/";
+  if (!fs::exists(templates + "aal.nii.gz")) GTEST_SKIP() << "mricron's templates are missing";
+  const tessera::test::TempDir tmp;
+  const std::string render = "render " + templates + "ch2.nii.gz --size 64x64 --azimuth 90 ";
+  const fs::path state = tmp / "fused.json";
+  mustRun(render + "--overlay " + templates + "aal.nii.gz --overlay-labels " + templates +
+          "aal.nii.txt --overlay-alpha 0.6 --out " + (tmp / "fused.png").string() +
+          " --save-state " + state.string());
+  ASSERT_TRUE(jsonOf(state).contains("overlay"));
+  EXPECT_EQ(jsonOf(state)["overlay"]["alpha"], 0.6);
+  mustRun(render + "--state " + state.string() + " --out " + (tmp / "restored.png").string());
+  mustRun(render + "--out " + (tmp / "plain.png").string());
+
+  const std::string fused = bytesOf(tmp / "fused.png");
+  ASSERT_GT(fused.size(), 100u);
+  EXPECT_TRUE(bytesOf(tmp / "restored.png") == fused);
+  EXPECT_TRUE(bytesOf(tmp / "plain.png") != fused);  // the overlay shows
+}

@@ -231,15 +231,17 @@ class Session {
   // JSON or is not a session state (with what is wrong in it).
   void saveState(const std::string& path) const;
   void loadState(const std::string& path);
+  // The state's "overlay" alone (session/Fusion.h overlayState): the open
+  // overlay's file is restyled, another file opened; null or absent: kept.
+  // restore() does this too; `render --state` takes the settings merged with
+  // its options and the overlay from here.
+  void restoreOverlay(const nlohmann::json& state);
 
  private:
   // Several sessions on one thread each draw on their own context: every
   // entry point that touches GL makes it current first (a no-op when it is).
   void makeCurrent();
   void applyVolumeSettings();
-  // The state's "overlay" (session/Fusion.h overlayState): the open
-  // overlay's file is restyled, another file opened; null or absent: kept.
-  void restoreOverlay(const nlohmann::json& state);
   bool applyModalityDefault(const Volume& v);  // true when it changed the TF
   void showDefaultInView(bool tfChanged);
   void applyToView();
