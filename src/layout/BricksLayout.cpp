@@ -290,7 +290,11 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
       (es3 ? " 3D" : " mosaic") + ", " + formatBytes(a.bytes) + ") through a " +
       std::to_string(cells.x) + "x" + std::to_string(cells.y * cells.z) + " page table" +
       (options.channels > 0 ? channelNote(format.format) : storedNote(shape));
-  if (a.count() <= topBricks) {
+  // The coarsest bricks are pinned, so refining needs a slot beyond them;
+  // a pyramid of one level (a single-level store) needs none: it fits when
+  // the atlas holds all of it.
+  const bool wholePyramid = static_cast<std::uint64_t>(a.count()) >= pyramidBricks(levels, b);
+  if (a.count() <= topBricks && !wholePyramid) {
     plan.reason = what + ": the budget (" + formatBytes(avail) + ") holds no more than the " +
                   std::to_string(topBricks) + " coarsest bricks";
     return plan;

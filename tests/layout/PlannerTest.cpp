@@ -249,3 +249,25 @@ TEST(Planner, BricksAtlasLeavesTheHostBudgetRoomForItsCache) {
   limits.hostBudget = 0;
   EXPECT_GE(layout::BricksLayout::planFor(shape, limits).totalBytes, k1);
 }
+
+// A single-level store: its one level is also its coarsest, pinned in the
+// atlas; it fits when the atlas holds all of it (before, the planner refused
+// "holds no more than the 1 coarsest bricks" with 256 MiB to spare), and
+// is refused when it does not.
+TEST(Planner, ASingleLevelSourceFitsWhenTheAtlasHoldsAllOfIt) {
+  const Volume shape = Volume::shapeOnly({64, 64, 64}, ScalarType::U8);
+  layout::BricksOptions options;
+  options.brickSize = 64;
+  const gpu::DeviceLimits limits = limitsOf("shield-k1");
+  const layout::LayoutPlan one =
+      layout::BricksLayout::planFor(shape, limits, options, glm::ivec3(64), {{64, 64, 64}});
+  EXPECT_TRUE(one.fits) << one.reason;
+  EXPECT_NE(one.reason.find("1-brick"), std::string::npos) << one.reason;
+  // 2x2x2 bricks of one level in a budget of less than eight slots.
+  const Volume big = Volume::shapeOnly({128, 128, 128}, ScalarType::U8);
+  options.atlasBytesCap = 5ull * 66 * 66 * 66;
+  const layout::LayoutPlan refused =
+      layout::BricksLayout::planFor(big, limits, options, glm::ivec3(64), {{128, 128, 128}});
+  EXPECT_FALSE(refused.fits);
+  EXPECT_NE(refused.reason.find("coarsest bricks"), std::string::npos) << refused.reason;
+}
