@@ -42,11 +42,9 @@ void addOverlay(DesktopApp& ds, const std::string& path) {
 }
 
 void restyle(DesktopApp& ds) {
-  const session::Overlay* o = ds.session->overlay();
-  if (!o) return;
+  if (!ds.session->overlay()) return;
   reportErrors(ds, [&] {
-    ds.session->setOverlay(
-        session::restyleOverlay(*o, optionsOf(ds.overlayUi), ds.session->shape()));
+    ds.session->restyleOpenOverlay(optionsOf(ds.overlayUi));
     overlayChanged(ds);
   });
 }

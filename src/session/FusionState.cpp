@@ -87,7 +87,7 @@ void Session::restoreOverlay(const nlohmann::json& state) {
   const OverlayOptions options = overlayOptionsFromState(saved, file);
   try {
     if (overlay_ && overlay_->name == file) {
-      setOverlay(restyleOverlay(*overlay_, options, shape()));
+      restyleOpenOverlay(options);
     } else {
       openOverlay(file, options);
     }

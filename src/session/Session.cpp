@@ -339,6 +339,11 @@ void Session::setOverlay(Overlay overlay) {
   if (view_) view_->setFusion(overlay_->fused);
 }
 
+void Session::restyleOpenOverlay(const OverlayOptions& options) {
+  if (!overlay_) throw InputError("no overlay is open");
+  setOverlay(restyleOverlay(*overlay_, options, shape()));
+}
+
 void Session::clearOverlay() {
   overlay_.reset();
   if (view_) view_->setFusion(nullptr);

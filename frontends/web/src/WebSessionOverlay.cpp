@@ -32,9 +32,7 @@ void openPickedOverlay(WebSession& s, const session::OverlayOptions& options) {
 }
 
 void restyleOverlay(WebSession& s, const session::OverlayOptions& options) {
-  session::Session& session = s.rendering();
-  if (!session.overlay()) throw InputError("no overlay is open");
-  session.setOverlay(session::restyleOverlay(*session.overlay(), options, session.shape()));
+  s.rendering().restyleOpenOverlay(options);
 }
 
 nlohmann::json overlayJson(WebSession& s) {

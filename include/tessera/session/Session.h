@@ -197,6 +197,9 @@ class Session {
   // page hands files over instead and it refuses, WebSessionOverlay.cpp).
   void openOverlay(const std::string& spec, const OverlayOptions& options = {});
   void setOverlay(Overlay overlay);
+  // The open overlay with a new look (labels, colour map, alpha, window),
+  // its volume kept; InputError when none is open.
+  void restyleOpenOverlay(const OverlayOptions& options);
   void clearOverlay();
   const Overlay* overlay() const { return overlay_.get(); }
   // The crosshair's reading at a world position (RAS+ mm): the anatomy's
