@@ -142,6 +142,41 @@ foreach(p codec-libjpeg-turbo-8bit codec-charls codec-openjpeg codec-openjph)
 endforeach()
 configure_file(${TESSERA_NPM}/jpeg-lossless-decoder-js/LICENSE
                ${TESSERA_WEB_SITE}/codecs/LICENSE-jpeg-lossless-decoder-js COPYONLY)
+# 12-bit JPEG extended: the JavaScript decoder of cornerstone's image loader
+# (only this one file of the package), as codecs/jpeg12.js.
+set(TESSERA_JPEG12 ${TESSERA_NPM}/@cornerstonejs/dicom-image-loader/dist/esm/codecs/jpeg.js)
+if(NOT EXISTS ${TESSERA_JPEG12})
+  message(FATAL_ERROR "${TESSERA_JPEG12} is missing: run `npm ci` in frontends/web/ (scripts/web.sh does)")
+endif()
+# Its output stage (quantizeAndInverse) scales 8-bit's level shift and range
+# by 4095/255 instead of 16, which adds 15-16 to every 12-bit sample (against
+# dcmdjpeg: every pixel of pydicom's JPGExtended.dcm 14-15 too high). The
+# three constants are rewritten for any precision P (M = 2^P - 1): level
+# shift (M + 1) * 8 + 8 and upper limit 8 * M - 16, which are 2056 and 2024
+# at P = 8, as before. The copy fails the build if the pinned text changes.
+file(READ ${TESSERA_JPEG12} jpeg12)
+set(jpeg12_fixes
+  "2056 / component.bitConversion" "((Math.round(255 / component.bitConversion) + 1) * 8 + 8)" 2
+  "2024 / component.bitConversion" "(Math.round(255 / component.bitConversion) * 8 - 16)" 1
+  "? 255 / component.bitConversion" "? Math.round(255 / component.bitConversion)" 1)
+while(jpeg12_fixes)
+  list(POP_FRONT jpeg12_fixes from to times)
+  string(REPLACE "${from}" "" without "${jpeg12}")
+  string(LENGTH "${jpeg12}" all)
+  string(LENGTH "${without}" rest)
+  string(LENGTH "${from}" one)
+  math(EXPR n "(${all} - ${rest}) / ${one}")
+  if(NOT n EQUAL times)
+    message(FATAL_ERROR "${TESSERA_JPEG12}: expected '${from}' ${times} time(s), found ${n}: the pinned decoder changed")
+  endif()
+  string(REPLACE "${from}" "${to}" jpeg12 "${jpeg12}")
+endwhile()
+file(WRITE ${TESSERA_WEB_SITE}/codecs/jpeg12.js.new "${jpeg12}")
+configure_file(${TESSERA_WEB_SITE}/codecs/jpeg12.js.new ${TESSERA_WEB_SITE}/codecs/jpeg12.js COPYONLY)
+file(REMOVE ${TESSERA_WEB_SITE}/codecs/jpeg12.js.new)
+set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${TESSERA_JPEG12})
+configure_file(${TESSERA_NPM}/@cornerstonejs/dicom-image-loader/LICENSE
+               ${TESSERA_WEB_SITE}/codecs/LICENSE-dicom-image-loader COPYONLY)
 file(GLOB TESSERA_WEB_STATIC CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/frontends/web/*.html
      ${CMAKE_SOURCE_DIR}/frontends/web/*.js ${CMAKE_SOURCE_DIR}/frontends/web/*.css)
 foreach(f ${TESSERA_WEB_STATIC} ${TESSERA_PAKO})

@@ -40,8 +40,8 @@ npm_deps() {
     echo "setup: npm ci in tests/interop (zarrita)"
     (cd "$root/tests/interop" && npm ci --no-audit --no-fund --loglevel=error)
   fi
-  if [ ! -d "$root/frontends/web/node_modules/pako" ]; then
-    echo "setup: npm ci in web (pako)"
+  if [ ! -f "$root/frontends/web/node_modules/@cornerstonejs/dicom-image-loader/dist/esm/codecs/jpeg.js" ]; then
+    echo "setup: npm ci in web (pako, numcodecs, DICOM decoders)"
     (cd "$root/frontends/web" && npm ci --no-audit --no-fund --loglevel=error)
   fi
 }

@@ -12,7 +12,8 @@ command -v emcmake >/dev/null || { echo "web.sh: emscripten missing (scripts/set
 # for OME-Zarr stores), pinned by frontends/web/package-lock.json.
 # The compressed-DICOM decoders (frontends/web/dicom-codecs.js) likewise.
 if [ ! -f frontends/web/node_modules/pako/dist/pako_inflate.min.js ] || [ ! -f frontends/web/node_modules/numcodecs/dist/blosc.js ] ||
-   [ ! -f frontends/web/node_modules/@cornerstonejs/codec-openjph/dist/openjphjs.wasm ]; then
+   [ ! -f frontends/web/node_modules/@cornerstonejs/codec-openjph/dist/openjphjs.wasm ] ||
+   [ ! -f frontends/web/node_modules/@cornerstonejs/dicom-image-loader/dist/esm/codecs/jpeg.js ]; then
   (cd frontends/web && npm ci --no-audit --no-fund --loglevel=error)
 fi
 if [ ! -f "$BUILD/build.ninja" ] && [ ! -f "$BUILD/Makefile" ]; then

@@ -10,10 +10,13 @@
 //   JPEG-LS lossless and near-lossless (.80, .81)          @cornerstonejs/codec-charls
 //   JPEG 2000 (.90, .91)                                    @cornerstonejs/codec-openjpeg
 //   HTJ2K (.201, .202, .203)                                @cornerstonejs/codec-openjph
+//   JPEG extended, 12-bit samples (.51)                     @cornerstonejs/dicom-image-loader's
+//                                                           JavaScript JPEG decoder (codecs/jpeg.js)
 //
-// JPEG extended with 12-bit samples (.51) has no decoder here (libjpeg-turbo's
-// build is 8-bit, jpeg-lossless-decoder-js decodes only lossless) and is
-// refused naming the syntax. Every frame's own header is checked against the
+// libjpeg-turbo's WebAssembly build is 8-bit and jpeg-lossless-decoder-js
+// decodes only lossless, so 12-bit lossy frames go to the JavaScript decoder
+// cornerstone's image loader uses for them (decodeJPEGBaseline12Bit-js); only
+// its one file is copied to the site. Every frame's own header is checked against the
 // file's Rows, Columns, Samples per Pixel and Bits Allocated before it is
 // decoded, and the decoded size again after; a corrupt codestream is an error
 // naming the file and the frame.
@@ -62,6 +65,14 @@ function loadEmscripten(file) {
     p.catch(() => loaded.delete(file));
   }
   return loaded.get(file);
+}
+function loadJpeg12() {
+  if (!loaded.has('jpeg12')) {
+    const p = import(CODEC_DIR + 'jpeg12.js');
+    loaded.set('jpeg12', p);
+    p.catch(() => loaded.delete('jpeg12'));
+  }
+  return loaded.get('jpeg12');
 }
 function loadLossless() {
   if (!loaded.has('lossless')) {
@@ -176,6 +187,28 @@ function describeWasmError(m, e) {
   return typeof e === 'number' ? 'it threw a C++ exception' : String(e);
 }
 
+// A 12-bit JPEG extended frame (DCT, Huffman; SOF1) through the JavaScript
+// decoder, which throws strings; its 16-bit samples as stored pixel data
+// holds them.
+async function jpeg12Decode(frame, shape) {
+  const JpegImage = (await loadJpeg12()).default;
+  const d = new JpegImage();
+  let samples;
+  try {
+    d.parse(frame);
+    d.colorTransform = false;
+    checkShape({ columns: d.width, rows: d.height, components: d.components.length, precision: 12 }, shape, 'JPEG');
+    samples = d.getData16(shape.columns, shape.rows);
+  } catch (e) {
+    if (e instanceof Error && /frame (is|has|of)/.test(e.message)) throw e;
+    throw new Error(`the 12-bit JPEG decoder failed: ${e instanceof Error ? e.message : String(e)}; corrupt or truncated?`);
+  }
+  if (samples.length !== shape.columns * shape.rows) {
+    throw new Error(`the 12-bit JPEG decoder returned ${samples.length} samples for a ${shape.columns}x${shape.rows} frame`);
+  }
+  return { bytes: new Uint8Array(samples.buffer, samples.byteOffset, samples.byteLength), sampleBytes: 2 };
+}
+
 async function losslessDecode(frame, shape) {
   const { Decoder } = await loadLossless();
   const d = new Decoder();
@@ -209,9 +242,10 @@ function decoderFor(codec, frame, shape) {
   if (h.marker === 0xf7) return 'jpegls';
   if (h.marker === 0xc3) return 'lossless';
   if (h.marker === 0xc0 || h.marker === 0xc1) {
+    if (h.precision === 12 && shape.bitsAllocated === 16) return 'jpeg12';
     if (h.precision !== 8) {
-      throw new Error(`a ${h.precision}-bit JPEG extended frame: the page has no 12-bit JPEG decoder ` +
-        '(open it with the tessera CLI, or convert it with dcmdjpeg)');
+      throw new Error(`a ${h.precision}-bit JPEG frame in ${shape.bitsAllocated}-bit pixels: JPEG's DCT processes ` +
+        'code 8 or 12 bits per sample');
     }
     return 'jpeg';
   }
@@ -219,7 +253,9 @@ function decoderFor(codec, frame, shape) {
 }
 
 function decodeFrame(decoder, frame, shape) {
-  return decoder === 'lossless' ? losslessDecode(frame, shape) : wasmDecode(decoder, frame, shape);
+  if (decoder === 'lossless') return losslessDecode(frame, shape);
+  if (decoder === 'jpeg12') return jpeg12Decode(frame, shape);
+  return wasmDecode(decoder, frame, shape);
 }
 
 function hasCapMarker(b) {
