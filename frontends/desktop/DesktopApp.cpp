@@ -171,7 +171,7 @@ void applyOptions(DesktopApp& ds, const ViewOptions& o) {
   ds.showHelp = o.helpOverlay;
   ds.view().tfEditor().setTransferFunction(TransferFunction::fromPresetOrFile(o.tf));
   ds.session->settings().tfIsDefault = !o.tfGiven;
-  openVolume(ds, o.file.empty() ? app::defaultVolumeSpec() : o.file);
+  openVolume(ds, o.file.empty() ? app::defaultVolumeSpec() : o.file, false);
   if (!ds.error.empty() && !ds.view().hasVolume()) throw InputError(ds.error);
   // What is left is the recent list's trouble (unreadable, or not written):
   // shown in the panel, while errors of the options below end the command.

@@ -154,7 +154,9 @@ void keepZoomSwap(DesktopApp& ds, const std::vector<lod::ZoomStage>& stages,
 void updateOverlay(DesktopApp& ds);
 
 // PanelsFile.cpp
-void openVolume(DesktopApp& ds, const std::string& spec);
+// A store with several channels shows them together unless `channels` is
+// false (the command line's file: its channels open after --state).
+void openVolume(DesktopApp& ds, const std::string& spec, bool channels = true);
 // Restores a saved session state (Session::loadState) and what the window
 // shows of it (the crop box, the slice views); throws on error.
 void loadState(DesktopApp& ds, const std::string& path);

@@ -45,7 +45,9 @@ void channelRow(DesktopApp& ds, session::ChannelView& view, int i) {
 }  // namespace
 
 void openChannels(DesktopApp& ds, const std::string& spec) {
-  reportErrors(ds, [&] { ds.session->channelView().open(spec, ds.options.time); });
+  // --time chooses within the file given on the command line.
+  const int time = spec == ds.options.file ? ds.options.time : 0;
+  reportErrors(ds, [&] { ds.session->channelView().open(spec, time); });
 }
 
 void panelChannels(DesktopApp& ds) {

@@ -37,9 +37,10 @@ void forgetIfGone(DesktopApp& ds, const std::string& spec) {
 
 }  // namespace
 
-// Shows the volume's overview (Exploring.cpp); an error is shown in the
-// panel and the previous volume stays.
-void openVolume(DesktopApp& ds, const std::string& spec) {
+// Shows the volume's overview (Exploring.cpp), and a store's channels
+// together when it has several and `channels` asks for them; an error is
+// shown in the panel and the previous volume stays.
+void openVolume(DesktopApp& ds, const std::string& spec, bool channels) {
   try {
     loadVolume(ds, spec);
     ds.error.clear();
@@ -49,6 +50,7 @@ void openVolume(DesktopApp& ds, const std::string& spec) {
     return;
   }
   rememberOpened(ds, spec);
+  if (channels) openChannels(ds, spec);
 }
 
 void loadState(DesktopApp& ds, const std::string& path) {

@@ -223,10 +223,18 @@ void Session::setVolume(std::shared_ptr<Volume> volume, const std::string& name)
   resident_.reset();
   inCore_ = std::move(next);
   exploration_.reset();
+  closeChannelView();
   name_ = name;
   const bool tfChanged = applyModalityDefault(inCore_->volume());
   applyVolumeSettings();
   if (view_) showDefaultInView(tfChanged);
+}
+
+// Another volume replaces the one whose channels were shown together: the
+// view shows the new one (a front end opens its channels again if it has
+// several).
+void Session::closeChannelView() {
+  if (channelView_ && channelView_->isOpen()) channelView_->close();
 }
 
 // The modality default's TF and window into the view (its upload's copy of

@@ -180,6 +180,7 @@ void Session::openInView(const std::string& spec, const OpenOptions& options) {
   streamed_ = pyramid.source;
   streamedView_ = std::make_unique<lod::MultiresVolumeSource>(streamed_);
   exploration_ = std::move(explore);
+  closeChannelView();
   name_ = spec;
 }
 

@@ -129,6 +129,36 @@ TEST_F(ChannelViewTest, ToggleChangesOnlyThatChannelsPixels) {
   EXPECT_EQ(outside, 0);
 }
 
+// A volume opened while a store's channels are shown replaces them, in
+// the view too (the desktop's Open and drop used to keep showing the
+// store's channels over the new volume): the frame is the new volume's.
+TEST_F(ChannelViewTest, AnotherVolumeOpenedReplacesTheChannels) {
+  for (const bool inView : {false, true}) {
+    Session s("native");
+    look(s.settings());
+    ASSERT_TRUE(s.channelView().open(store()));
+    ASSERT_TRUE(s.settings().channels.enabled);
+    if (inView) {
+      s.openInView("gen:shepp-logan:32");
+    } else {
+      s.open("gen:shepp-logan:32");
+    }
+    EXPECT_FALSE(s.channelView().isOpen()) << "inView " << inView;
+    EXPECT_FALSE(s.settings().channels.enabled) << "inView " << inView;
+    Session fresh("native");
+    look(fresh.settings());
+    if (inView) {
+      fresh.openInView("gen:shepp-logan:32");
+    } else {
+      fresh.open("gen:shepp-logan:32");
+    }
+    const double db = psnr(s.render(kSize, kSize), fresh.render(kSize, kSize));
+    std::printf("after the store's channels, %s: %.1f dB against a fresh session\n",
+                inView ? "openInView" : "open", db);
+    EXPECT_GE(db, 99.0) << "inView " << inView;
+  }
+}
+
 TEST_F(ChannelViewTest, RefusesWhatTheSettingsRefuse) {
   Session s("native");
   ChannelView& view = s.channelView();

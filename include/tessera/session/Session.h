@@ -245,6 +245,7 @@ class Session {
   // entry point that touches GL makes it current first (a no-op when it is).
   void makeCurrent();
   void applyVolumeSettings();
+  void closeChannelView();
   bool applyModalityDefault(const Volume& v);  // true when it changed the TF
   void showDefaultInView(bool tfChanged);
   void applyToView();
