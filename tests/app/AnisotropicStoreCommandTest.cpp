@@ -161,8 +161,9 @@ TEST(AnisotropicStoreCommand, ConvertWithPyramidFactorsWritesAStoreThatRendersAs
   const fs::path nifti0 = tmp / "level0.nii.gz";
   writeVolume(lv[0], nifti0);
   const fs::path store = tmp / "converted.ome.zarr";
-  const auto c = runCli("convert " + nifti0.string() + " " + store.string() +
-                        " --pyramid-factors 1,2,2 --chunk 32,32,32 --zarr-format 3 --shard 2 --quiet");
+  const auto c =
+      runCli("convert " + nifti0.string() + " " + store.string() +
+             " --pyramid-factors 1,2,2 --chunk 32,32,32 --zarr-format 3 --shard 2 --quiet");
   ASSERT_EQ(c.exitCode, 0) << c.err;
   EXPECT_NE(c.out.find("3 levels (factors 1,2,2 (z,y,x): 96x80x40, 48x40x40, 24x20x40)"),
             std::string::npos)
