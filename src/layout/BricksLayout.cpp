@@ -17,10 +17,11 @@ namespace {
 
 constexpr std::uint64_t kDefaultAtlasCap = 256ull << 20;
 constexpr int kCoarsestSide = 16;
-// What the process holds besides the atlas and the brick cache while it
-// streams: code, the GL driver, the render target and its read-back, bricks
-// in flight in the reader threads and in upload, the page table, a store's
-// chunk cache. Measured on llvmpipe: head:1024 on shield-k1 (512² image)
+// What the process holds besides the atlas, the brick cache and a store's
+// decoded chunks while it streams: code, the GL driver, the render target
+// and its read-back, bricks in flight in the reader threads and in upload,
+// a store's few MiB of stored (compressed) chunk bytes. Measured on
+// llvmpipe: head:1024 on shield-k1 (512² image)
 // peaked at 468 MiB with a 255 MiB atlas and a 54 MiB cache, so 159 MiB;
 // with a margin.
 constexpr std::uint64_t kHostOverhead = 176ull << 20;
@@ -57,19 +58,40 @@ std::uint64_t atlasCap(const gpu::DeviceLimits& limits, const BricksOptions& opt
   return avail;
 }
 
-// The host cache of decoded bricks: the host budget less the atlas, the
-// page table and the overhead (see atlasCap), at most a quarter of the
-// budget; 64 MiB without a host budget.
-std::uint64_t cacheBytesFor(const gpu::DeviceLimits& limits, const BricksOptions& options,
-                            std::uint64_t atlasBytes, std::uint64_t pageBytes) {
-  if (options.cacheBytes != 0) return options.cacheBytes;
-  if (limits.hostBudget == 0) return 64ull << 20;
-  if (!weighsAtlas(limits, options, pageBytes)) return limits.hostBudget / 4;
-  // At most a quarter of the budget, as before the atlas was weighed: a
-  // roomy host (half of a desktop's RAM) keeps a cache of the usual size.
-  const std::uint64_t used = atlasBytes + pageBytes + kHostOverhead;
-  const std::uint64_t left = limits.hostBudget > used ? limits.hostBudget - used : 0;
-  return std::max(kMinCacheBytes, std::min(left, limits.hostBudget / 4));
+// The sources' decoded chunks take at most an eighth of the host budget
+// (the share a store opened alone keeps, ZarrMultiresSource).
+constexpr std::uint64_t kChunkCacheShare = 8;
+
+// The host budget shared out (BricksHostSplit): the atlas, the page table
+// and the overhead first (atlasCap left at least a minimal brick cache
+// beside them), then the sources' decoded chunks (what they would keep, at
+// most an eighth of the budget, never eating into the minimal brick
+// cache), then the brick cache (the rest, at most a quarter of the budget:
+// a roomy host, half of a desktop's RAM, keeps a cache of the usual size).
+// Without a host budget: a 64 MiB brick cache, the chunks the sources keep.
+BricksHostSplit splitHost(const gpu::DeviceLimits& limits, const BricksOptions& options,
+                          std::uint64_t atlasBytes, std::uint64_t pageBytes,
+                          std::uint64_t chunksWanted) {
+  BricksHostSplit s;
+  s.budget = limits.hostBudget;
+  const std::uint64_t chunkShare = s.budget ? s.budget / kChunkCacheShare : chunksWanted;
+  s.chunkCache = std::min(chunksWanted, chunkShare);
+  if (options.cacheBytes != 0) {
+    s.brickCache = options.cacheBytes;
+  } else if (s.budget == 0) {
+    s.brickCache = 64ull << 20;
+  } else if (!weighsAtlas(limits, options, pageBytes)) {
+    s.brickCache = s.budget / 4;
+  } else {
+    s.atlas = atlasBytes;
+    s.pages = pageBytes;
+    s.overhead = kHostOverhead;
+    const std::uint64_t used = atlasBytes + pageBytes + kHostOverhead;
+    const std::uint64_t left = s.budget > used ? s.budget - used : 0;
+    s.chunkCache = std::min(s.chunkCache, left > kMinCacheBytes ? left - kMinCacheBytes : 0);
+    s.brickCache = std::max(kMinCacheBytes, std::min(left - s.chunkCache, s.budget / 4));
+  }
+  return s;
 }
 
 // "prefix7suffix" (snprintf: GCC 12 -Wrestrict misfires on "literal" + std::string).
@@ -412,8 +434,13 @@ std::unique_ptr<BricksLayout> BricksLayout::build(
 
   lod::BrickStreamerOptions so;
   so.workers = options.workers;
-  so.cacheBytes = cacheBytesFor(limits, options, a.bytes, pageBytes);
-  if (set) so.cacheBytes /= sources.size();  // one cache per channel, the same in all
+  std::uint64_t chunksWanted = 0;
+  for (const auto& s : sources) chunksWanted += s->decodedCacheWanted();
+  l->hostSplit_ = splitHost(limits, options, a.bytes, pageBytes, chunksWanted);
+  // One brick cache per channel, the same in all; each source's decoded
+  // chunks within an equal part of the chunks' share.
+  so.cacheBytes = l->hostSplit_.brickCache / sources.size();
+  for (const auto& s : sources) s->limitDecodedCache(l->hostSplit_.chunkCache / sources.size());
   l->streamer_ = std::make_unique<lod::BrickStreamer>(source, l->grid_, so);
   for (std::size_t c = 1; c < sources.size(); ++c) {
     l->channelStreamers_.push_back(std::make_unique<lod::BrickStreamer>(sources[c], l->grid_, so));

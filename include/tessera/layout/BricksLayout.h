@@ -64,6 +64,24 @@ struct BricksOptions {
   int channels = 0;
 };
 
+// How the device profile's host budget is shared while a volume streams:
+// the atlas and page table (weighed against the host: see BricksLayout.cpp),
+// a fixed overhead (code, driver, render target, bricks in flight, stored
+// chunk bytes), the cache of read bricks and the sources' decoded chunks
+// (MultiresSource::limitDecodedCache). With a budget that can be honoured,
+// total() <= budget; atlas, pages and overhead are 0 when the budget is
+// too small to weigh them (the caches then take a quarter and an eighth of
+// it) or there is none (budget 0).
+struct BricksHostSplit {
+  std::uint64_t budget = 0;
+  std::uint64_t atlas = 0;
+  std::uint64_t pages = 0;
+  std::uint64_t overhead = 0;
+  std::uint64_t brickCache = 0;  // all channels together
+  std::uint64_t chunkCache = 0;  // all sources together
+  std::uint64_t total() const { return atlas + pages + overhead + brickCache + chunkCache; }
+};
+
 class BricksLayout final : public Layout, public StreamingLayout {
  public:
   // The atlas and page table for a volume of `shape` within `limits`.
@@ -121,6 +139,7 @@ class BricksLayout final : public Layout, public StreamingLayout {
 
   const lod::BrickGrid& grid() const override { return grid_; }
   const lod::MultiresSource& source() const { return *source_; }
+  const BricksHostSplit& hostSplit() const { return hostSplit_; }
   int slotCount() const override { return static_cast<int>(slotKey_.size()); }
   lod::StreamerStats streamerStats() const override { return streamer_->stats(); }
   void retryFailingReads(bool retry) override {
@@ -178,6 +197,7 @@ class BricksLayout final : public Layout, public StreamingLayout {
 
   LayoutPlan plan_;
   BricksOptions options_;
+  BricksHostSplit hostSplit_;
   gpu::ApiLevel api_ = gpu::ApiLevel::Gles3;
   std::shared_ptr<const lod::MultiresSource> source_;
   lod::BrickGrid grid_;
