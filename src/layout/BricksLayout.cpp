@@ -764,6 +764,15 @@ void BricksLayout::waitForBricks(double ms) {
   streamer_->waitForProgress(ms);
 }
 
+std::vector<int> BricksLayout::cellLevels() const {
+  std::vector<int> out(pages_host_.size() / 4);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const std::uint8_t a = pages_host_[4 * i + 3];
+    out[i] = a == 255 ? -1 : a;
+  }
+  return out;
+}
+
 BricksLayout::Lookup BricksLayout::lookup(glm::dvec3 x0) const {
   const double b = grid_.brickSize();
   const glm::dvec3 dims0(grid_.dims(0));

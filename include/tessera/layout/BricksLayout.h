@@ -155,6 +155,7 @@ class BricksLayout final : public Layout, public StreamingLayout {
   // The page table as uploaded (RGBA per level-0 cell, x fastest): the CPU
   // twin of the lookup in bricks.glsl reads it.
   const std::vector<std::uint8_t>& pageTable() const { return pages_host_; }
+  std::vector<int> cellLevels() const override;
   glm::ivec3 atlasTexels() const { return atlasTexels_; }  // ES 2: of each texture
   // Where level-0 continuous voxel coordinate x0 is read: the atlas texel
   // coordinate (3D, continuous) and the level, or level -1 and the constant
