@@ -79,8 +79,15 @@ bool ZarrStoreView::open() {
   }
   bricks_ = active_.upload.layout ? active_.upload.layout->streaming() : nullptr;
   if (!bricks_) throw Error(storage_->describe() + ": the bricks layout was not created");
+  active_.technique->setFusion(fused_);
   compositor_ = std::make_unique<render::HybridCompositor>(context_);
   return true;
+}
+
+void ZarrStoreView::setFusion(std::shared_ptr<const FusedVolume> fused) {
+  if (fused == fused_) return;
+  fused_ = std::move(fused);
+  if (active_.technique) active_.technique->setFusion(fused_);
 }
 
 StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings& settings,

@@ -90,6 +90,9 @@ class ZarrStoreView {
   std::shared_ptr<const FetchedZarrSource> sharedSource() const { return source_; }
   // The coarsest level, read once at open (for the page's histogram).
   const Volume& coarsest() const { return coarsest_; }
+  // A second volume fused into the store's ray march (docs/fusion.md),
+  // aligned with level 0 by world coordinates; null: none.
+  void setFusion(std::shared_ptr<const FusedVolume> fused);
 
   // Selects levels for the view, uploads the bricks that arrived, requests
   // the missing ones (storage().takeWanted()), and draws into the canvas
@@ -122,6 +125,7 @@ class ZarrStoreView {
   layout::StreamingLayout* bricks_ = nullptr;
   std::unique_ptr<render::HybridCompositor> compositor_;
   std::uint64_t tfRevision_ = 0;
+  std::shared_ptr<const FusedVolume> fused_;
 
   // A frame of the view: what the technique renders and how it is shown.
   struct FrameView {
