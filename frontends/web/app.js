@@ -411,9 +411,9 @@ import { attachOverlayPanel } from './overlay-panel.js';
   async function openEntries(entries, explain, dicomSelection = '') {
     try {
       entries = await TesseraFolders.decodeCompressed(entries, (done, total) => { $('status').textContent = `decoding ${done} of ${total} files`; });
-      dicomStacks.select(dicomSelection);  // a series or stack chosen (dicom-stacks.js)
+      dicomStacks?.select(dicomSelection);  // a series or stack chosen (dicom-stacks.js)
       await viewer.openFiles(entries, { explain });
-      dicomStacks.opened(entries);
+      dicomStacks?.opened(entries, viewer.state().name);
     } catch (e) {
       showError(e.message + keeps());
       return false;

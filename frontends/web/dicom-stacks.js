@@ -31,10 +31,12 @@ export function attachStacks({ module, reopen }) {
     select(selector) {
       module.ccall('tessera_dicom_select', null, ['string'], [selector || '']);
     },
-    // After an open succeeded: what the module found, and the list when
-    // there is a choice. `entries` are kept only then.
-    opened(entries) {
+    // After an open of `name` succeeded: what the module found, and the
+    // list when there is a choice. `entries` are kept only then. (A file
+    // the DICOM reader did not read, a time series, leaves no list.)
+    opened(entries, name) {
       last = JSON.parse(module.ccall('tessera_dicom_stacks_json', 'string', [], []));
+      if (last.name !== name) last = { name, read: '', series: [] };
       const several = last.series.length > 1;
       held = several ? entries : null;
       box.hidden = !several;

@@ -20,6 +20,7 @@ namespace {
 
 struct DicomChoice {
   std::string pending;  // for the next open only
+  std::string name;     // the file the last list is of (a time series skips this reader)
   std::vector<DicomSeriesInfo> listed;
   std::string read;  // the selector of what the last open read
 };
@@ -34,6 +35,7 @@ DicomChoice& choice() {
 Volume readPickedVolume(const ByteSource& file, const FileSet& files) {
   DicomChoice& c = choice();
   const std::string selection = std::exchange(c.pending, "");
+  c.name = file.name();
   if (!hasDicomMarker(file)) {
     if (!selection.empty()) {
       throw InputError(file.name() + ": a DICOM series (" + selection +
@@ -64,7 +66,8 @@ EMSCRIPTEN_KEEPALIVE void tessera_dicom_select(const char* selector) {
   web::choice().pending = selector ? selector : "";
 }
 
-// What the last open found: {"read": selector, "series": [{"select",
+// What the last open found: {"name": the file read, "read": selector,
+// "series": [{"select",
 // "series_instance_uid", "stack", "slices", "description"}, ...]} (empty
 // when it was not DICOM), the largest first.
 EMSCRIPTEN_KEEPALIVE const char* tessera_dicom_stacks_json() {
@@ -77,7 +80,7 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_dicom_stacks_json() {
                     {"slices", s.slices},
                     {"description", s.description}});
   }
-  return web::jsonOut({{"read", c.read}, {"series", list}});
+  return web::jsonOut({{"name", c.name}, {"read", c.read}, {"series", list}});
 }
 
 }  // extern "C"
