@@ -6,6 +6,7 @@
 // io readers as the CLI's, whose gzip/zlib the page's pako inflates) and
 // error messages. window.tessera exposes the same operations to tests.
 import { TesseraViewer } from './tessera.js';
+import { attachStacks } from './dicom-stacks.js';
 import { attachOverlayPanel } from './overlay-panel.js';
 
 (function () {
@@ -91,6 +92,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
   let slices = null;        // frontends/web/slices.js, once the module is up
   let zarr = null;  // an open OME-Zarr store (frontends/web/zarr-url.js)
   let channelList = null;  // its channels shown together (frontends/web/channels-panel.js)
+  let dicomStacks = null;  // the series/stack chooser (frontends/web/dicom-stacks.js)
   let dicomweb = null;  // the DICOMweb browser (frontends/web/dicomweb.js), with ?dicomweb=
   let overlayPanel = null;  // the second volume (frontends/web/overlay-panel.js)
 
@@ -406,10 +408,12 @@ import { attachOverlayPanel } from './overlay-panel.js';
 
   // Hands {name, bytes} entries to the io readers; `explain` turns a
   // failure's message into what the page shows.
-  async function openEntries(entries, explain) {
+  async function openEntries(entries, explain, dicomSelection = '') {
     try {
       entries = await TesseraFolders.decodeCompressed(entries, (done, total) => { $('status').textContent = `decoding ${done} of ${total} files`; });
+      dicomStacks?.select(dicomSelection);  // a series or stack chosen (dicom-stacks.js)
       await viewer.openFiles(entries, { explain });
+      dicomStacks?.opened(entries, viewer.state().name);
     } catch (e) {
       showError(e.message + keeps());
       return false;
@@ -1018,6 +1022,8 @@ import { attachOverlayPanel } from './overlay-panel.js';
     overlayPanel = attachOverlayPanel({ M, webgl: state.webgl, state: () => state, openFiles,
       requestRender, showError, clearError });
     window.tessera.overlay = overlayPanel.testApi;
+    dicomStacks = attachStacks({ module: M, reopen: (entries, selection) => openEntries(entries, (m) => m, selection) });
+    window.tessera.dicomStacks = dicomStacks;
     state.techniques.forEach((n) => {
       const o = document.createElement('option');
       o.value = n;

@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
+#include "WebDicomStacks.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/DeviceSession.h"
@@ -196,7 +197,7 @@ void WebSession::loadPickedFiles() {
         name);
     return;
   }
-  session_->setVolume(readVolume(*file, held->files), name);
+  session_->setVolume(readPickedVolume(*file, held->files), name);  // WebDicomStacks.h
 }
 
 double WebSession::renderFrame(int width, int height) {
