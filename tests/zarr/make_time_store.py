@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Writes an OME-NGFF 0.4 store (Zarr v2, zlib) of a time series with
 zarr-python: N^3 u8 voxels per time point, COUNT time points on a t axis,
-two levels (the second the 2x2x2 mean). Each time point is a thin dim shell with
+two levels (the second the 2x2x2 mean). Each time point is a thin smooth dim shell with
 a bright cube whose x position moves with t, so every time point renders
 differently and a frame shows which one it is. The omero window (0..255)
 is the series' one window.
@@ -18,11 +18,11 @@ import zarr
 def shell(n):
     c = (n - 1) / 2.0
     z, y, x = np.ogrid[0:n, 0:n, 0:n]
-    r2 = (x - c) ** 2 + (y - c) ** 2 + (z - c) ** 2
-    v = np.zeros((n, n, n), dtype=np.uint8)  # z, y, x
-    # Two voxels thick at any size, so that it never hides the cube.
-    v[(r2 > (0.44 * n) ** 2) & (r2 < (0.44 * n + 2) ** 2)] = 60
-    return v
+    d = np.sqrt((x - c) ** 2 + (y - c) ** 2 + (z - c) ** 2, dtype=np.float32) - np.float32(0.44 * n)
+    # A smooth profile about a voxel and a half wide at any size: never
+    # thick enough to hide the cube, and band-limited, so that ray casters
+    # sampling it at different points do not draw different moire.
+    return np.round(60.0 * np.exp(-(d / 1.5) ** 2)).astype(np.uint8)  # z, y, x
 
 
 def time_point(base, t, count):
