@@ -91,6 +91,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
   let refineNotBefore = 0;  // performance.now() before which no strip is rendered
   let slices = null;        // frontends/web/slices.js, once the module is up
   let zarr = null;  // an open OME-Zarr store (frontends/web/zarr-url.js)
+  let storeTime = null;  // its t axis played as a time series (frontends/web/store-time.js)
   let channelList = null;  // its channels shown together (frontends/web/channels-panel.js)
   let dicomStacks = null;  // the series/stack chooser (frontends/web/dicom-stacks.js)
   let dicomweb = null;  // the DICOMweb browser (frontends/web/dicomweb.js), with ?dicomweb=
@@ -252,7 +253,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
     }
     if (api && channelList && channelList.active()) {
       channelFrameStep();
-    } else if (api && zarr && zarr.active()) {
+    } else if (api && zarr && zarr.active() && !storeTime) {
       storeFrameStep();
     } else if (api) {
       let ms = -1;
@@ -1044,6 +1045,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
       if (await zarr.open(volumeUrls[0]) && window.TesseraChannels) {
         channelList = await TesseraChannels.attach(M, zarr, { requestRender, showError, clearError });
       }
+      if (zarr.active() && !channelList && window.TesseraStoreTime) storeTime = await TesseraStoreTime.attach(M, zarr, { showError });
       volumeChanged();
     } else if (volumeUrls.length) {
       if (!(await openUrls(volumeUrls))) volumeChanged();
