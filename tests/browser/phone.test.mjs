@@ -399,8 +399,7 @@ async function storeContextLoss(context, url, tmp, run) {
     const s1 = await page.evaluate(() => window.tessera.state());
     const after = (await snapshot(page)).pixels;
     const psnr = psnrOf(before, after);
-    await page.evaluate(() => window.tessera.setCamera(80, 12, 1.25));
-    await storeRefined(page);
+    await page.evaluate(() => window.tessera.setCamera(80, 12, 1.25));  // one frame, refined or not
     const turned = (await snapshot(page)).pixels;
     const error = await page.evaluate(() => window.tessera.error());
     console.log(`${what}: status while lost "${lostStatus}"; after "${restoredStatus}"; reopened in ${(z1.reopenMs || 0).toFixed(0)} ms ` +
