@@ -106,7 +106,7 @@ function explainWorst(lat, z) {
     return `${k} ${v.length}: ${text(v.map((c) => c.ms))} [update ${text(v.map((c) => c.update_ms || 0))}; upload wait ${text(v.map((c) => c.upload_wait_ms || 0))}; ` +
       `tables ${text(v.map((c) => c.tables_ms || 0))}; preview ${text(v.map((c) => c.preview_ms || 0))}]`;
   }).join('; '));
-  console.log(`latency: chunks decoded (zlib in a worker: the wait for it) ${(z.decodes || []).length}: ${text((z.decodes || []).map((d) => d.ms))} ms; ` +
+  console.log(`latency: chunks decoded in the page ${(z.decodes || []).length}: ${text((z.decodes || []).map((d) => d.ms))} ms; ` +
               `handed to the module ${(z.tasks || []).length}: ${text((z.tasks || []).map((d) => d.put_ms))} ms; ` +
               `animation-frame callbacks ${lat.callbacks.length}: ${text(lat.callbacks.map((c) => c.end - c.start))} ms`);
 }
