@@ -126,9 +126,9 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
   compositor_->setOverlayLines(std::move(lines));
   f.renderWidth = v.renderWidth;
   f.renderHeight = v.renderHeight;
+  gpu::clearErrors();
   budgetMs_ = pace.budgetMs;
   if (!pace.progressive) {
-    gpu::clearErrors();
     bricks_->setUpdatePace({});
     // A ray march costs far more than an update (SwiftShader: most of a
     // second), so stream for up to kStreamMs before drawing, and a frame
@@ -146,9 +146,6 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
     f.streamMs = msSince(t0);
     return drawWhole(v, f, t0);
   }
-  // No gpu::clearErrors() here (as in refine()): every step ends checking
-  // them, and a query waits for the browser's GPU process, in the way of
-  // the preview that answers input.
   pending_ = {.active = true,
               .streaming = true,
               .viewChanged = pace.viewChanged,
