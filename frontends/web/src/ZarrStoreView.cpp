@@ -245,8 +245,11 @@ StoreFrame ZarrStoreView::refine() {
     // The bricks changed what the ray caster samples: its tables (empty-
     // space blocks) are rebuilt in a step of their own, not in a strip or
     // in the preview that answers the next input.
+    // Its uploads waited for here, as a streaming step's: this step's
+    // cost, not the next one's (the preview that answers input).
     StoreFrame f;
     f.tablesMs = prepareTables(p.view);
+    gpu::checkErrors("OME-Zarr tables");
     f.pending = true;
     f.bricks = p.bricks;
     f.renderWidth = p.view.renderWidth;
