@@ -359,6 +359,9 @@ import { attachOverlayPanel } from './overlay-panel.js';
       }
       volumeChanged();
       $('status').textContent = contextNote;
+      // A store's view was made again on the new context: its GPU side is
+      // rebuilt from the chunks the page holds (zarr-url.js).
+      if (zarr && !error) zarr.reopen().then(() => { volumeChanged(); requestRender(); });
       // The zoom swap (grid.js) ended with the old context: on again.
       if ($('zoomSwap').checked) $('zoomSwap').dispatchEvent(new Event('change'));
       requestRender();
@@ -1040,7 +1043,8 @@ import { attachOverlayPanel } from './overlay-panel.js';
     window.addEventListener('resize', () => { if (fitCanvas()) requestRender(); });
     requestAnimationFrame(loop);
     if (volumeUrls.length === 1 && window.TesseraZarr && TesseraZarr.isStoreUrl(volumeUrls[0])) {
-      zarr = TesseraZarr.create(M, { showError, clearError, status: (t) => { $('status').textContent = t; },
+      zarr = TesseraZarr.create(M, { showError, clearError,
+        status: (t) => { $('status').textContent = contextNote ? `${t} · ${contextNote}` : t; },
         progress: (v, max) => { $('progress').hidden = !(max > 0); if (max > 0) { $('progress').max = max; $('progress').value = v; } } });
       if (await zarr.open(volumeUrls[0]) && window.TesseraChannels) {
         channelList = await TesseraChannels.attach(M, zarr, { requestRender, showError, clearError });

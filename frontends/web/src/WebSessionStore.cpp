@@ -27,17 +27,25 @@ void WebSession::beginStore(const std::string& url) {
   session_->endExploration();
   session_->drawPyramid(nullptr);
   zarr_ = std::make_unique<ZarrStoreView>(context(), viewer().limits(), url);
+  storeReopened_ = false;
+}
+
+void WebSession::reopenStore(ZarrStoreView::Host host) {
+  zarr_ = std::make_unique<ZarrStoreView>(context(), viewer().limits(), std::move(host));
+  storeReopened_ = true;
 }
 
 // True once open (the coarsest level is on the GPU): its histogram goes to
-// the TF editor and the camera frames it.
+// the TF editor and the camera frames it (a store opened again after a
+// context loss keeps the restored camera).
 bool WebSession::storeOpenStep() {
   ZarrStoreView& z = theStore();
   if (!z.open()) return false;
   session_->drawPyramid(z.sharedSource());  // what an overlay goes over and the probe reads
   viewer::Viewer& v = viewer();
   v.tfEditor().setHistogram(Histogram::compute(z.coarsest(), 256, z.store().shape().window()));
-  v.resetCamera();
+  if (!storeReopened_) v.resetCamera();
+  storeReopened_ = false;
   return true;
 }
 
