@@ -5,8 +5,11 @@
 // atlas, found through a page table (Schultz 2016 §7.3; the page-table
 // scheme of ImageVis3D and Neuroglancer). Valid GLSL ES 1.00 and 3.00.
 //
-// The page table has one RGBA8 texel per level-0 brick cell c (texel
-// (c.x, c.y + c.z * cells.y), NEAREST): rgb = the atlas slot and a = the
+// The page table has one RGBA8 texel per level-0 brick cell c, NEAREST, its
+// z-slices side by side as tiles of cells.x x cells.y texels, u_layoutPageTiles
+// per row (MosaicLayout::Geometry's addressing: texel (c.x + (c.z % tiles) *
+// cells.x, c.y + floor(c.z / tiles) * cells.y), so the table fits the 2D
+// limit however deep the grid; pageTexel below): rgb = the atlas slot and a = the
 // level l of the finest resident brick that covers the cell (the CPU falls
 // back to coarser levels when finer bricks are missing, so there are no
 // holes), or a = 255 when the cell is known to be transparent, with r the
@@ -75,6 +78,7 @@ uniform vec3 u_layoutDims0;        // level-0 voxels
 uniform float u_layoutBrick;       // B
 uniform vec3 u_layoutCells;        // level-0 brick cells
 uniform vec2 u_layoutPagesInv;     // 1 / page table size
+uniform float u_layoutPageTiles;   // page table: z-slice tiles per row
 uniform vec3 u_layoutAtlasTexels;  // atlas (3D) size in texels
 uniform vec3 u_layoutLevelShrink[BRICKS_LEVELS];  // 1 / s_l per level (see above)
 
@@ -148,14 +152,21 @@ struct BrickPage {
   float isConstant;
 };
 
+// The page table texel of level-0 cell `cell` (whole numbers, exact in
+// float: the table is at most the 2D limit on a side).
+vec2 pageTexel(vec3 cell) {
+  float row = floor((cell.z + 0.5) / u_layoutPageTiles);
+  float col = cell.z - row * u_layoutPageTiles;
+  return cell.xy + vec2(col, row) * u_layoutCells.xy;
+}
+
 // The page of the level-0 cell holding x0 (level-0 voxels, inside the volume).
 BrickPage brickPage(vec3 x0) {
   vec3 cell = min(floor(x0 / u_layoutBrick), u_layoutCells - 1.0);
 #if TESSERA_GLSL == 300
-  vec4 page = texelFetch(u_layoutPages, ivec2(cell.x, cell.y + cell.z * u_layoutCells.y), 0);
+  vec4 page = texelFetch(u_layoutPages, ivec2(pageTexel(cell)), 0);
 #else
-  vec4 page = TEX2D(u_layoutPages,
-                    (vec2(cell.x, cell.y + cell.z * u_layoutCells.y) + 0.5) * u_layoutPagesInv);
+  vec4 page = TEX2D(u_layoutPages, (pageTexel(cell) + 0.5) * u_layoutPagesInv);
 #endif
   vec4 e = floor(page * 255.0 + 0.5);
   BrickPage b;
