@@ -1,6 +1,7 @@
 // Line 1 is replaced by "#define BRICKS_ATLASES <N>" (BricksLayout::glsl()),
 // line 2 by "#define BRICKS_TEXEL <T>": how a stored value is read (below),
-// line 3 by "#define BRICKS_LEVELS <L>": the pyramid's levels.
+// line 3 by "#define BRICKS_LEVELS <L>": the pyramid's levels,
+// line 4 by "#define BRICKS_WALK_PAGES <0|1>": the walk reads float pages.
 // sampleVolume for BricksLayout: bricks of several resolution levels in one
 // atlas, found through a page table (Schultz 2016 §7.3; the page-table
 // scheme of ImageVis3D and Neuroglancer). Valid GLSL ES 1.00 and 3.00.
@@ -268,6 +269,36 @@ vec3 layoutWalkCellsPerUnit() {
   return u_layoutDims0 / u_layoutBrick;
 }
 
+#if BRICKS_WALK_PAGES
+// ES 3, filtered atlas, a pyramid of equal factors per axis: a float page
+// per cell holds the walk's map directly, xyz = the offset into the atlas
+// (normalised), w = 1 / s_l (0: a transparent cell, x its constant).
+uniform highp sampler2D u_layoutWalkPages;
+uniform vec3 u_layoutWalkScale0;  // level-0 voxels / atlas texels
+float walkConstant;
+float walkIsConstant;
+
+vec3 layoutEnterCell(vec3 p) {
+  vec3 x0 = clamp(p, 0.0, 1.0) * u_layoutDims0;
+  vec3 cell = min(floor(x0 / u_layoutBrick), u_layoutCells - 1.0);
+  vec4 w = texelFetch(u_layoutWalkPages, ivec2(pageTexel(cell)), 0);
+  walkIsConstant = step(w.w, 0.0);
+  walkConstant = w.x;
+  walkScale = u_layoutWalkScale0 * w.w;
+  walkOffset = w.xyz;
+  return cell;
+}
+
+float layoutCellTransparent() {
+  return walkIsConstant;
+}
+
+float sampleVolumeInCell(vec3 p) {
+  return mix(BRICKS_VALUE(texture(u_layoutAtlas, p * walkScale + walkOffset)), walkConstant,
+             walkIsConstant);
+}
+#else
+
 // Reads the page of the cell holding p; returns the cell.
 vec3 layoutEnterCell(vec3 p) {
   vec3 x0 = clamp(p, 0.0, 1.0) * u_layoutDims0;
@@ -293,4 +324,5 @@ float sampleVolumeInCell(vec3 p) {
   return brickValue(walkPage, p * walkPage.scale + walkPage.offset);
 #endif
 }
+#endif
 #endif

@@ -121,7 +121,7 @@ class BricksLayout final : public Layout, public StreamingLayout {
   // Channels: the page table and two channel atlases (the second the first
   // again when there are four channels or fewer).
   int textureUnits() const override {
-    return 1 + (channels_ ? 2 : static_cast<int>(atlases_.size()));
+    return 1 + (channels_ ? 2 : static_cast<int>(atlases_.size())) + (walkHost_.empty() ? 0 : 1);
   }
   ValueBlocks valueBlocks(int blockSize) const override;
   std::uint64_t contentVersion() const override { return contentVersion_; }
@@ -204,7 +204,10 @@ class BricksLayout final : public Layout, public StreamingLayout {
   std::vector<gpu::Texture> atlases_;  // ES 3: one 3D texture; ES 2: 1..8 mosaics
   gpu::Texture pages_;
   MosaicLayout::Geometry pageGeometry_;  // the page table's tiles (pageTableGeometry)
-  MosaicLayout::Geometry mosaic_;        // ES 2: the atlas' z-slices as tiles
+  // ES 3, filtered atlas, isotropic pyramid: the walk's map per cell (RGBA32F).
+  gpu::Texture walkPages_;
+  std::vector<float> walkHost_;
+  MosaicLayout::Geometry mosaic_;  // ES 2: the atlas' z-slices as tiles
   glm::ivec3 slotGrid_{1};
   glm::ivec3 atlasTexels_{0};
   std::vector<std::int64_t> slotKey_;    // brick id per slot, -1 free
