@@ -476,8 +476,10 @@ std::unique_ptr<BricksLayout> BricksLayout::build(
   // faster). 16 bytes a cell, so only up to 64^3 cells (4 MiB).
   const glm::ivec3 cells0 = l->grid_.bricks(0);
   const bool fewCells = std::int64_t(cells0.x) * cells0.y * cells0.z <= (std::int64_t(1) << 18);
+  std::uint64_t walkBytes = 0;
   if (limits.api == gpu::ApiLevel::Gles3 && format.texel < 2 && isotropic && l->walk_ && !set &&
       fewCells) {
+    walkBytes = std::uint64_t(pagesWide) * std::uint64_t(pagesTall) * 16;
     l->walkHost_.assign(l->pages_host_.size(), 0.0f);
     l->walkPages_ = gpu::Texture::create2D(ledger, "brick walk pages", gpu::TexelFormat::RGBA32F,
                                            pagesWide, pagesTall, l->walkHost_.data());
@@ -492,7 +494,8 @@ std::unique_ptr<BricksLayout> BricksLayout::build(
   so.workers = options.workers;
   std::uint64_t chunksWanted = 0;
   for (const auto& s : sources) chunksWanted += s->decodedCacheWanted();
-  l->hostSplit_ = splitHost(limits, options, a.bytes, pageBytes, chunksWanted);
+  // The walk's float pages count with the page table (texture and host).
+  l->hostSplit_ = splitHost(limits, options, a.bytes, pageBytes + walkBytes, chunksWanted);
   // One brick cache per channel, the same in all; each source's decoded
   // chunks within an equal part of the chunks' share.
   so.cacheBytes = l->hostSplit_.brickCache / sources.size();
