@@ -372,7 +372,8 @@ PYBIND11_MODULE(_tessera, m) {
       "convert",
       [](VolumeHandle& v, const std::string& out, const std::string& chunk,
          const std::string& levels, const std::string& compressor, const std::string& crop,
-         const std::string& downsample, int zarrFormat, int shard) {
+         const std::string& downsample, int zarrFormat, int shard,
+         const std::string& pyramidFactors) {
         return convert(v, out,
                        {.crop = crop,
                         .downsample = downsample,
@@ -380,11 +381,12 @@ PYBIND11_MODULE(_tessera, m) {
                         .levels = levels,
                         .compressor = compressor,
                         .zarrFormat = zarrFormat,
-                        .shard = shard});
+                        .shard = shard,
+                        .pyramidFactors = pyramidFactors});
       },
       py::arg("volume"), py::arg("out"), py::arg("chunk") = "64", py::arg("levels") = "auto",
       py::arg("compressor") = "zstd", py::arg("crop") = "", py::arg("downsample") = "",
-      py::arg("zarr_format") = 2, py::arg("shard") = 0);
+      py::arg("zarr_format") = 2, py::arg("shard") = 0, py::arg("pyramid_factors") = "2,2,2");
   m.def("tf_json", &tfJson);
   m.def("tf_presets", &tessera::TransferFunction::presetNames);
   m.attr("orbit_degrees_per_pixel") = tessera::viewer::CameraController::kDegreesPerPixel;

@@ -350,6 +350,7 @@ def convert(
     downsample: Union[None, int, Sequence[int]] = None,
     zarr_format: int = 2,
     shard: int = 0,
+    pyramid_factors: Sequence[int] = (2, 2, 2),
 ) -> list:
     """Writes ``src`` (a path, URL, :class:`Volume` or array) to ``dst`` in the
     format its name says (``.nii.gz``, ``.nrrd``, ``.mha``, ``.ome.zarr``…),
@@ -361,8 +362,11 @@ def convert(
       (``--downsample``), after the crop;
     - OME-Zarr output: ``chunks`` (64, 128 or ``(z, y, x)``), ``levels``
       (``"auto"`` or a count), ``compressor`` (zstd, blosc, zlib, none),
-      ``zarr_format`` (2: NGFF 0.4; 3: NGFF 0.5) and ``shard`` (chunks per
-      shard edge with ``zarr_format=3``).
+      ``zarr_format`` (2: NGFF 0.4; 3: NGFF 0.5), ``shard`` (chunks per
+      shard edge with ``zarr_format=3``) and ``pyramid_factors`` (each
+      level's factor against the one before, ``(z, y, x)``, each 1 or 2:
+      ``(1, 2, 2)`` keeps z, as microscopy pyramids do;
+      ``--pyramid-factors``).
 
     Returns what the format could not hold (notes). Bad options raise
     :class:`InputError` naming the option as the CLI spells it."""
@@ -384,7 +388,8 @@ def convert(
     _reraising(v.spec, v._handle.load)
     return list(
         _reraising(out, _tessera.convert, v._handle, out, chunk, str(levels), compressor,
-                   crop_text, factors, int(zarr_format), int(shard), writing=True)
+                   crop_text, factors, int(zarr_format), int(shard),
+                   ",".join(str(int(f)) for f in pyramid_factors), writing=True)
     )
 
 

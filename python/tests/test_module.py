@@ -75,10 +75,11 @@ def test_convert_takes_the_clis_crop_downsample_and_zarr_options(cli, tmp_path):
     zcli = tmp_path / "cli" / "v.ome.zarr"
     zpy.parent.mkdir()
     zcli.parent.mkdir()
-    tessera.convert(src, str(zpy), chunks=(8, 16, 16), zarr_format=3, shard=2, downsample=2)
+    tessera.convert(src, str(zpy), chunks=(8, 16, 16), zarr_format=3, shard=2, downsample=2,
+                    pyramid_factors=(1, 2, 2))
     subprocess.run([cli, "convert", src, str(zcli), "--chunk", "8,16,16", "--zarr-format", "3",
-                    "--shard", "2", "--downsample", "2", "--quiet"], check=True,
-                   capture_output=True)
+                    "--shard", "2", "--downsample", "2", "--pyramid-factors", "1,2,2",
+                    "--quiet"], check=True, capture_output=True)
     files = sorted(p.relative_to(zpy) for p in zpy.rglob("*") if p.is_file())
     assert files == sorted(p.relative_to(zcli) for p in zcli.rglob("*") if p.is_file())
     assert any(str(f).endswith("zarr.json") for f in files)
@@ -92,6 +93,8 @@ def test_convert_takes_the_clis_crop_downsample_and_zarr_options(cli, tmp_path):
         tessera.convert(src, str(tmp_path / "x.ome.zarr"), chunks=(7, 16, 16))
     with pytest.raises(tessera.InputError, match="crop"):
         tessera.convert(src, str(tmp_path / "x.nii"), crop=(1, 2))
+    with pytest.raises(tessera.InputError, match="--pyramid-factors"):
+        tessera.convert(src, str(tmp_path / "x.ome.zarr"), pyramid_factors=(3, 2, 2))
 
 
 def test_tf_presets_and_json():
