@@ -164,7 +164,15 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
     // new view, and nothing else: the new view's selection, requests,
     // uploads and page table (which would also rebuild the ray caster's
     // tables inside the preview) are the pending frame's first steps, one
-    // animation frame later.
+    // animation frame later. The store's first frame has nothing on the
+    // GPU to preview: it selects first (the coarsest bricks, resident from
+    // the open, are then what it shows).
+    if (shownBricks_.cellsPerLevel.empty()) {
+      bricks_->setUpdatePace({.uploadMs = 0.0, .uploadBytes = 0, .inlineReads = 0});
+      pending_.bricks = f.bricks = stream(v, 0.0);
+      f.streamed = true;
+      f.streamMs = msSince(t0);
+    }
     preview(v, f);
   }
   f.pending = true;
