@@ -208,16 +208,20 @@ void Slice3DRenderer::drawChannelMaxima(const gpu::Program& slices,
   accumulator_.resolveWith(resolve, unit, settings);
 }
 
+std::vector<gpu::ShaderPart> Slice3DRenderer::channelResolveParts() const {
+  std::vector<gpu::ShaderPart> frag = {gpu::shaderPreamble(context_.caps().api, true, {})};
+  addSampleParts(frag, gradient_, layout_);
+  frag.push_back(gpu::embeddedShaderPart("render/slice_channels_resolve.frag.glsl"));
+  return frag;
+}
+
 const gpu::Program& Slice3DRenderer::channelResolveProgram() {
   return programs_.get(layout_.name() + "|channel maxima resolve", [&] {
     const gpu::ApiLevel api = context_.caps().api;
-    std::vector<gpu::ShaderPart> frag = {gpu::shaderPreamble(api, true, {})};
-    addSampleParts(frag, gradient_, layout_);
-    frag.push_back(gpu::embeddedShaderPart("render/slice_channels_resolve.frag.glsl"));
     return gpu::Program::build("slice3d channel maxima resolve",
                                {gpu::shaderPreamble(api, false, {}),
                                 gpu::embeddedShaderPart("render/fullscreen.vert.glsl")},
-                               frag);
+                               channelResolveParts());
   });
 }
 

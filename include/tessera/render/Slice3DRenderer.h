@@ -82,6 +82,8 @@ class Slice3DRenderer final : public Technique {
 
   std::vector<gpu::ShaderPart> vertexParts() const;
   std::vector<gpu::ShaderPart> fragmentParts(const RenderSettings& settings) const;
+  // The resolve pass of channel maxima (a layout that drawsChannels(), max).
+  std::vector<gpu::ShaderPart> channelResolveParts() const;
   std::string accumulationFormat() const { return accumulator_.accumulationFormat(); }
   std::uint64_t ownTextureBytes() const override;
 
