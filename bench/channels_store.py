@@ -12,6 +12,12 @@ y (4000); omero colours red, green, azure and windows per channel. Render:
     build/tessera render OUT.ome.zarr --channels 0,1,2 --reference --size 512x512
     build/tessera render OUT.ome.zarr --channel-mode max --reference
     build/tessera render OUT.ome.zarr --channels 0,2 --profile webgl1-desktop-2012 --reference
+    build/tessera render OUT.ome.zarr --channels 0,1,2 --layout bricks --size 256x256 --ortho \
+        --azimuth 30 --elevation 20 --tf grey --opacity-scale 20 --reference --json
+
+The last one mixes levels (the atlas holds 528 of the 1792 level-0 bricks);
+its reference reads each brick cell's level as the GPU does
+(docs/channels.md "Bricks").
 """
 import argparse
 import json

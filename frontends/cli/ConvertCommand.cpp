@@ -76,6 +76,9 @@ void printZarrResult(const ConvertOptions& o, const Volume& shape, const OmeZarr
                   ? (", " + std::to_string(o.request.shard) + "^3 chunks per shard").c_str()
                   : "",
               r.levelDims.size());
+  if (o.request.pyramidFactors != "2,2,2") {
+    std::printf("factors %s (z,y,x): ", o.request.pyramidFactors.c_str());
+  }
   for (std::size_t l = 0; l < r.levelDims.size(); ++l) {
     std::printf("%s%s", l ? ", " : "", dimsText(r.levelDims[l]).c_str());
   }
@@ -159,8 +162,8 @@ void addConvertCommand(CLI::App& app) {
       "Convert between volume formats (by extension), optionally cropping and downsampling.\n"
       "Output: " +
           writeExtensionsText() +
-          "\n(OME-Zarr: NGFF 0.4 on Zarr v2, or 0.5 on v3 with --zarr-format 3, a factor-2 pyramid "
-          "of 2x2x2 means down to one chunk,\n"
+          "\n(OME-Zarr: NGFF 0.4 on Zarr v2, or 0.5 on v3 with --zarr-format 3, a pyramid of "
+          "2x2x2 means (--pyramid-factors 1,2,2: 1x2x2, z kept) down to one chunk,\n"
           "written slab by slab; OME-Zarr input is streamed too, other inputs are read whole).\n"
           "The output appears only when complete (temporary file or folder + rename).\n"
           "`tessera formats` lists what each format keeps and loses.");
@@ -188,6 +191,10 @@ void addConvertCommand(CLI::App& app) {
                   "OME-Zarr output with --zarr-format 3: N chunks per shard edge "
                   "(sharding_indexed; 0 = unsharded)")
       ->default_val(0);
+  cmd->add_option("--pyramid-factors", o->request.pyramidFactors,
+                  "OME-Zarr output: each level's factor per axis against the one before, Z,Y,X, "
+                  "each 2 (halved) or 1 (kept); 1,2,2 keeps z, as microscopy pyramids do")
+      ->default_val("2,2,2");
   cmd->add_flag("--quiet", o->quiet, "No progress on stderr");
   cmd->callback([o] { runConvert(*o); });
 }

@@ -9,6 +9,7 @@
 #include "tessera/core/HostBudget.h"
 #include "tessera/core/PatientFrame.h"
 #include "tessera/io/DicomSeriesReader.h"
+#include "tessera/io/DicomWeb.h"
 #include "tessera/io/VolumeReader.h"
 #include "tessera/io/ZarrStore.h"
 #include "tessera/session/VolumeInfo.h"
@@ -65,6 +66,8 @@ void runInfo(const InfoOptions& o) {
                                                   v.description().starts_with("DICOM series "))) {
     series = listDicomSeries(spec);
   }
+  // A DICOMweb series: its stacks (a multi-frame object may hold several).
+  if (isDicomWebSeriesUrl(spec)) series = listDicomWebSeries(spec);
   const ValueRange r = v.valueRange();
   std::printf("file        %s\n", spec.c_str());
   if (!v.description().empty()) std::printf("description %s\n", v.description().c_str());

@@ -339,11 +339,12 @@ RenderRequest requestFrom(const RenderOptions& o) {
 
 // Options that need the voxels in host memory (the hybrid compositor, the
 // CPU reference, the FCC resampling): with these a store is read in core,
-// at the finest level that fits the host budget.
+// at the finest level that fits the host budget. A fused volume does not:
+// it is fused into a streamed store's bricks too (docs/fusion.md).
 bool needsHostVoxels(const RenderOptions& o) {
   return !o.overlays.empty() || !o.offscreen.empty() || !o.roi.empty() || o.reference ||
-         !o.fusion.file.empty() || !o.referenceOut.empty() || o.referenceStep > 0.0 ||
-         o.referenceLevelGiven() || o.lattice != "cartesian";
+         !o.referenceOut.empty() || o.referenceStep > 0.0 || o.referenceLevelGiven() ||
+         o.lattice != "cartesian";
 }
 
 // --overlays, --offscreen or --roi: the hybrid compositor's run.

@@ -33,6 +33,7 @@
 #include "tessera/lod/MultiresSource.h"
 #include "tessera/lod/ZoomLevelPolicy.h"
 #include "tessera/session/Exploration.h"
+#include "tessera/session/OverlayPanel.h"
 #include "tessera/session/Session.h"
 #include "tessera/viewer/CropHandles.h"
 #include "tessera/viewer/RecentFiles.h"
@@ -102,12 +103,8 @@ struct DesktopApp {
   // PanelsOverlay.cpp: the overlay's controls and a dropped file's offer.
   struct OverlayControls {
     char path[512] = "";
-    char table[512] = "";
-    bool labels = false;
-    int colourMap = 0;
-    float alpha = 0.5f;
-    bool window = false;
-    double lo = 0.0, hi = 1.0;
+    char table[512] = "";                      // ImGui's buffer of controls.table
+    session::OverlayControls controls;         // session/OverlayPanel.h: what the actions take
     const session::Overlay* synced = nullptr;  // the overlay the controls show
     std::string dropped;  // dropped while a volume is open: overlay or replace?
   } overlayUi;

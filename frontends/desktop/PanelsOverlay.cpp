@@ -2,95 +2,89 @@
 // `tessera view --overlay` opens it: a file, labels with a table or a colour
 // map, alpha and window; and the offer made for a file dropped while a
 // volume is open (replace it, or add it as the overlay). The session opens,
-// restyles and clears it (Session::openOverlay / setOverlay); the 3D view
+// restyles and clears it through session/OverlayPanel.h (the calls a test
+// drives: tests/session/OverlayPanelTest.cpp); the 3D view
 // fuses it and the slice views mix it in (session::fuseSliceImage).
 #include <cstdio>
 #include <filesystem>
-#include <iterator>
 #include <string>
+#include <vector>
 
 #include "DesktopApp.h"
-#include "tessera/session/Fusion.h"
+#include "tessera/session/OverlayPanel.h"
 
 namespace tessera::desktop {
 
 namespace {
 
-constexpr const char* kColourMaps[] = {"hot", "grey", "mr-default", "ct-bone", "bench"};
 constexpr const char* kDropOffer = "A second volume";
-
-session::OverlayOptions optionsOf(const DesktopApp::OverlayControls& c) {
-  session::OverlayOptions o;
-  o.labels = c.labels;
-  if (c.labels) o.labelTable = c.table;
-  o.tf = kColourMaps[c.colourMap];
-  o.opacity = c.alpha;
-  if (c.window) o.window = ValueRange{c.lo, c.hi};
-  return o;
-}
 
 // The slice views show the overlay mixed in: drawn again.
 void overlayChanged(DesktopApp& ds) {
   for (auto& tile : ds.slices) tile.key.clear();
 }
 
+// The panel's actions are session/OverlayPanel.h's, with the controls as
+// they are (a test drives the same calls).
+session::OverlayControls& controlsOf(DesktopApp& ds) {
+  session::OverlayControls& c = ds.overlayUi.controls;
+  c.table = ds.overlayUi.table;
+  return c;
+}
+
 void addOverlay(DesktopApp& ds, const std::string& path) {
   reportErrors(ds, [&] {
-    ds.session->openOverlay(path, optionsOf(ds.overlayUi));
+    session::addOverlayFromPanel(*ds.session, path, controlsOf(ds));
     overlayChanged(ds);
   });
 }
 
 void restyle(DesktopApp& ds) {
-  if (!ds.session->overlay()) return;
   reportErrors(ds, [&] {
-    ds.session->restyleOpenOverlay(optionsOf(ds.overlayUi));
-    overlayChanged(ds);
+    if (session::restyleOverlayFromPanel(*ds.session, controlsOf(ds))) overlayChanged(ds);
   });
 }
 
 // The controls from an overlay opened elsewhere (--overlay, a state).
-void syncControls(DesktopApp::OverlayControls& c, const session::Overlay& o) {
-  c.labels = o.options.labels;
-  c.alpha = static_cast<float>(o.options.opacity);
-  c.window = o.options.window.has_value();
-  if (c.window) {
-    c.lo = o.options.window->min;
-    c.hi = o.options.window->max;
-  }
+void syncControls(DesktopApp::OverlayControls& ui, const session::Overlay& o) {
+  session::syncOverlayControls(ui.controls, o);
+  std::snprintf(ui.table, sizeof ui.table, "%s", ui.controls.table.c_str());
 }
 
 void overlayInfo(const session::Overlay& o, const viewer::Viewer& v) {
-  const glm::ivec3 d = o.fused->volume->dims();
-  ImGui::TextWrapped("%s %dx%dx%d: %s", std::filesystem::path(o.name).filename().c_str(), d.x, d.y,
-                     d.z,
-                     o.fused->labels ? (std::to_string(o.labels.labels.size()) + " labels").c_str()
-                                     : ("colour map " + o.options.tf).c_str());
+  ImGui::TextWrapped("%s", session::overlayPanelLine(o).c_str());
   if (!o.note.empty()) ImGui::TextWrapped("%s", o.note.c_str());
   if (!v.fusionNote().empty()) ImGui::TextWrapped("3D view: %s", v.fusionNote().c_str());
+}
+
+// The colour maps' names for ImGui's combo.
+bool colourMapCombo(int& chosen) {
+  std::vector<const char*> names;
+  for (const std::string& m : session::overlayColourMaps()) names.push_back(m.c_str());
+  return ImGui::Combo("colour map", &chosen, names.data(), static_cast<int>(names.size()));
 }
 
 }  // namespace
 
 void panelOverlay(DesktopApp& ds) {
-  DesktopApp::OverlayControls& c = ds.overlayUi;
+  DesktopApp::OverlayControls& ui = ds.overlayUi;
+  session::OverlayControls& c = ui.controls;
   section("Overlay (a second volume)");
   const session::Overlay* o = ds.session->overlay();
-  if (o && o != c.synced) {
-    syncControls(c, *o);
-    c.synced = o;
+  if (o && o != ui.synced) {
+    syncControls(ui, *o);
+    ui.synced = o;
   }
-  ImGui::InputText("##overlaypath", c.path, sizeof c.path);
+  ImGui::InputText("##overlaypath", ui.path, sizeof ui.path);
   ImGui::SameLine();
-  if (ImGui::Button("Add overlay") && c.path[0]) addOverlay(ds, c.path);
+  if (ImGui::Button("Add overlay") && ui.path[0]) addOverlay(ds, ui.path);
   bool changed = ImGui::Checkbox("labels (atlas)", &c.labels);
   if (c.labels) {
-    ImGui::InputText("##overlaytable", c.table, sizeof c.table);
+    ImGui::InputText("##overlaytable", ui.table, sizeof ui.table);
     ImGui::SameLine();
     changed |= ImGui::Button("table");
   } else {
-    changed |= ImGui::Combo("colour map", &c.colourMap, kColourMaps,
-                            static_cast<int>(std::size(kColourMaps)));
+    changed |= colourMapCombo(c.colourMap);
     changed |= ImGui::Checkbox("window", &c.window);
     if (c.window) {
       ImGui::SameLine();
@@ -109,8 +103,8 @@ void panelOverlay(DesktopApp& ds) {
   }
   overlayInfo(*o, ds.view());
   if (ImGui::Button("Remove overlay")) {
-    ds.session->clearOverlay();
-    c.synced = nullptr;
+    session::removeOverlayFromPanel(*ds.session);
+    ui.synced = nullptr;
     overlayChanged(ds);
   }
 }

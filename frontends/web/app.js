@@ -6,6 +6,7 @@
 // io readers as the CLI's, whose gzip/zlib the page's pako inflates) and
 // error messages. window.tessera exposes the same operations to tests.
 import { TesseraViewer } from './tessera.js';
+import { attachStacks } from './dicom-stacks.js';
 import { attachOverlayPanel } from './overlay-panel.js';
 
 (function () {
@@ -90,7 +91,9 @@ import { attachOverlayPanel } from './overlay-panel.js';
   let refineNotBefore = 0;  // performance.now() before which no strip is rendered
   let slices = null;        // frontends/web/slices.js, once the module is up
   let zarr = null;  // an open OME-Zarr store (frontends/web/zarr-url.js)
+  let storeTime = null;  // its t axis played as a time series (frontends/web/store-time.js)
   let channelList = null;  // its channels shown together (frontends/web/channels-panel.js)
+  let dicomStacks = null;  // the series/stack chooser (frontends/web/dicom-stacks.js)
   let dicomweb = null;  // the DICOMweb browser (frontends/web/dicomweb.js), with ?dicomweb=
   let overlayPanel = null;  // the second volume (frontends/web/overlay-panel.js)
 
@@ -250,7 +253,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
     }
     if (api && channelList && channelList.active()) {
       channelFrameStep();
-    } else if (api && zarr && zarr.active()) {
+    } else if (api && zarr && zarr.active() && !storeTime) {
       storeFrameStep();
     } else if (api) {
       let ms = -1;
@@ -356,6 +359,9 @@ import { attachOverlayPanel } from './overlay-panel.js';
       }
       volumeChanged();
       $('status').textContent = contextNote;
+      // A store's view was made again on the new context: its GPU side is
+      // rebuilt from the chunks the page holds (zarr-url.js).
+      if (zarr && !error) zarr.reopen().then(() => { volumeChanged(); requestRender(); });
       // The zoom swap (grid.js) ended with the old context: on again.
       if ($('zoomSwap').checked) $('zoomSwap').dispatchEvent(new Event('change'));
       requestRender();
@@ -406,10 +412,12 @@ import { attachOverlayPanel } from './overlay-panel.js';
 
   // Hands {name, bytes} entries to the io readers; `explain` turns a
   // failure's message into what the page shows.
-  async function openEntries(entries, explain) {
+  async function openEntries(entries, explain, dicomSelection = '') {
     try {
       entries = await TesseraFolders.decodeCompressed(entries, (done, total) => { $('status').textContent = `decoding ${done} of ${total} files`; });
+      dicomStacks?.select(dicomSelection);  // a series or stack chosen (dicom-stacks.js)
       await viewer.openFiles(entries, { explain });
+      dicomStacks?.opened(entries, viewer.state().name);
     } catch (e) {
       showError(e.message + keeps());
       return false;
@@ -1018,6 +1026,8 @@ import { attachOverlayPanel } from './overlay-panel.js';
     overlayPanel = attachOverlayPanel({ M, webgl: state.webgl, state: () => state, openFiles,
       requestRender, showError, clearError });
     window.tessera.overlay = overlayPanel.testApi;
+    dicomStacks = attachStacks({ module: M, reopen: (entries, selection) => openEntries(entries, (m) => m, selection) });
+    window.tessera.dicomStacks = dicomStacks;
     state.techniques.forEach((n) => {
       const o = document.createElement('option');
       o.value = n;
@@ -1033,11 +1043,13 @@ import { attachOverlayPanel } from './overlay-panel.js';
     window.addEventListener('resize', () => { if (fitCanvas()) requestRender(); });
     requestAnimationFrame(loop);
     if (volumeUrls.length === 1 && window.TesseraZarr && TesseraZarr.isStoreUrl(volumeUrls[0])) {
-      zarr = TesseraZarr.create(M, { showError, clearError, status: (t) => { $('status').textContent = t; },
+      zarr = TesseraZarr.create(M, { showError, clearError,
+        status: (t) => { $('status').textContent = contextNote ? `${t} · ${contextNote}` : t; },
         progress: (v, max) => { $('progress').hidden = !(max > 0); if (max > 0) { $('progress').max = max; $('progress').value = v; } } });
       if (await zarr.open(volumeUrls[0]) && window.TesseraChannels) {
         channelList = await TesseraChannels.attach(M, zarr, { requestRender, showError, clearError });
       }
+      if (zarr.active() && !channelList && window.TesseraStoreTime) storeTime = await TesseraStoreTime.attach(M, zarr, { showError });
       volumeChanged();
     } else if (volumeUrls.length) {
       if (!(await openUrls(volumeUrls))) volumeChanged();

@@ -22,6 +22,9 @@ const ACCEPT_FRAMES = 'multipart/related; type="application/octet-stream"; trans
 const ACCEPT_INSTANCE = 'multipart/related; type="application/dicom"; transfer-syntax=*';
 const ACCEPT_JSON = 'application/dicom+json, application/json';
 const CONNECTIONS = 6;  // a browser's HTTP/1.1 connections per origin
+const FRAMES_PER_REQUEST = 64;  // of a multi-frame object (as the CLI asks)
+const MOST_FRAMES = 1 << 16;  // io/DicomMultiFrame.cpp's bound
+const MOST_PIXEL_BYTES = 1024 * 1048576;  // of one instance (dicom-codecs.js decodes no more)
 const MAX_JSON = 256 * 1048576;
 const UNCOMPRESSED = new Set(['1.2.840.10008.1.2', '1.2.840.10008.1.2.1', '1.2.840.10008.1.2.1.99']);
 const BIG_ENDIAN = '1.2.840.10008.1.2.2';
@@ -251,9 +254,13 @@ function concat(chunks) {
   return out;
 }
 
-// A Part-10 file from an instance's metadata and its one frame: stored
-// uncompressed (defined length) or encapsulated in `syntax` (PS3.5 A.4).
-function part10(ds, syntax, frame, encapsulated) {
+// A Part-10 file from an instance's metadata and its frames (an array, in
+// frame order): stored uncompressed (defined length, the frames one after
+// another) or encapsulated in `syntax`, one fragment per frame and an
+// empty Basic Offset Table (PS3.5 A.4). A multi-frame object keeps its
+// Number of Frames and functional groups (DICOM JSON sequences), which the
+// module's reader places its frames by (io/DicomMultiFrame.cpp).
+function part10(ds, syntax, frames, encapsulated) {
   const ui = (s) => { const b = new TextEncoder().encode(s); return b.length & 1 ? concat([b, new Uint8Array(1)]) : b; };
   const metaElements = concat([
     header(0x0002, 0x0001, 'OB', 2), new Uint8Array([0, 1]),
@@ -264,17 +271,18 @@ function part10(ds, syntax, frame, encapsulated) {
   const groupLength = concat([header(0x0002, 0x0000, 'UL', 4), new Uint8Array(new Uint32Array([metaElements.length]).buffer)]);
   // Text is written as UTF-8 (DICOM JSON is), so the character set says so.
   const withCharset = { ...ds, '00080005': { vr: 'CS', Value: ['ISO_IR 192'] } };
-  const body = dataSetBytes(withCharset, (tag) => (tag >>> 16) === 0x0002 || tag >= 0x7fe00000 || tag === 0x00280008);
+  const body = dataSetBytes(withCharset, (tag) => (tag >>> 16) === 0x0002 || tag >= 0x7fe00000);
   const ob = first(ds, '00280100', 16) === 8 || encapsulated ? 'OB' : 'OW';
   let pixels;
+  const even = (b) => (b.length & 1 ? concat([b, new Uint8Array(1)]) : b);
   if (encapsulated) {
-    const padded = frame.length & 1 ? concat([frame, new Uint8Array(1)]) : frame;
     const item = (n) => { const h = new Uint8Array(8); const v = new DataView(h.buffer); v.setUint32(0, 0xe000fffe, true); v.setUint32(4, n, true); return h; };
     const end = new Uint8Array(8);
     new DataView(end.buffer).setUint32(0, 0xe0ddfffe, true);
-    pixels = concat([header(0x7fe0, 0x0010, 'OB', 0xffffffff), item(0), item(padded.length), padded, end]);
+    const fragments = frames.flatMap((f) => { const p = even(f); return [item(p.length), p]; });
+    pixels = concat([header(0x7fe0, 0x0010, 'OB', 0xffffffff), item(0), ...fragments, end]);
   } else {
-    const padded = frame.length & 1 ? concat([frame, new Uint8Array(1)]) : frame;
+    const padded = even(frames.length === 1 ? frames[0] : concat(frames));
     pixels = concat([header(0x7fe0, 0x0010, ob, padded.length), padded]);
   }
   const preamble = new Uint8Array(132);
@@ -282,44 +290,60 @@ function part10(ds, syntax, frame, encapsulated) {
   return concat([preamble, groupLength, metaElements, body, pixels]);
 }
 
-// An instance's frame (WADO-RS frames/1, as stored): {url, syntax, entry
-// (a Part-10 file), pixels (uncompressed, else null), compressed}.
-async function frameOf(inst, signal, stats) {
-  const url = `${inst.url}/frames/1`;
-  const { bytes, type } = await get(url, ACCEPT_FRAMES, stats, signal);
-  if (bytes.length > 2 * inst.frameBytes + 65536) {
-    throw failure(url, `an answer of ${bytes.length} bytes for a frame of ${inst.frameBytes} bytes (at most twice that, plus 64 KiB)`);
+// An instance's frames (WADO-RS frames/1,2,…, as stored, FRAMES_PER_REQUEST
+// to a request): {url, syntax, entry (a Part-10 file), pixels (uncompressed
+// frames one after another, else null), compressed}.
+async function framesOf(inst, signal, stats) {
+  const frames = [];
+  let syntax = '';
+  let url = '';
+  for (let from = 1; from <= inst.frames; from += FRAMES_PER_REQUEST) {
+    const n = Math.min(FRAMES_PER_REQUEST, inst.frames - from + 1);
+    const list = Array.from({ length: n }, (_, k) => from + k).join(',');
+    url = `${inst.url}/frames/${list}`;
+    const { bytes, type } = await get(url, ACCEPT_FRAMES, stats, signal);
+    if (bytes.length > n * (2 * inst.frameBytes + 65536)) {
+      throw failure(url, `an answer of ${bytes.length} bytes for ${n} frame(s) of ${inst.frameBytes} bytes (at most twice that, plus 64 KiB, each)`);
+    }
+    const parts = multipartParts(url, type, bytes);
+    if (parts.length !== n) throw failure(url, `${parts.length} parts for ${n} frame(s)`);
+    for (const part of parts) {
+      const ts = partSyntax(part.type);
+      if (!ts) throw failure(url, `the part's Content-Type '${part.type}' names no transfer syntax`);
+      if (syntax && ts !== syntax) throw failure(url, `frames in transfer syntaxes ${syntax} and ${ts}: one instance has one`);
+      syntax = ts;
+      frames.push(part.data);
+    }
   }
-  const parts = multipartParts(url, type, bytes);
-  if (parts.length !== 1) throw failure(url, `${parts.length} parts for one frame`);
-  let syntax = partSyntax(parts[0].type);
-  if (!syntax) throw failure(url, `the part's Content-Type '${parts[0].type}' names no transfer syntax`);
-  let data = parts[0].data;
   let pixels = null;
   if (UNCOMPRESSED.has(syntax) || syntax === BIG_ENDIAN) {
     const ds = inst.ds;
-    if (data.length !== inst.frameBytes && data.length !== inst.frameBytes + 1) {
-      throw failure(url, `the frame holds ${data.length} bytes, but its ${first(ds, '00280011')}x${first(ds, '00280010')} pixels x ${first(ds, '00280100') / 8} bytes = ${inst.frameBytes} bytes`);
-    }
-    data = data.slice(0, inst.frameBytes);
-    if (syntax === BIG_ENDIAN && first(ds, '00280100') === 16) {
-      for (let i = 0; i + 1 < data.length; i += 2) { const t = data[i]; data[i] = data[i + 1]; data[i + 1] = t; }
+    for (let k = 0; k < frames.length; k++) {
+      let data = frames[k];
+      if (data.length !== inst.frameBytes && data.length !== inst.frameBytes + 1) {
+        throw failure(url, `${frames.length > 1 ? `frame ${k + 1}` : 'the frame'} holds ${data.length} bytes, but its ${first(ds, '00280011')}x${first(ds, '00280010')} pixels x ${first(ds, '00280100') / 8} bytes = ${inst.frameBytes} bytes`);
+      }
+      data = data.slice(0, inst.frameBytes);
+      if (syntax === BIG_ENDIAN && first(ds, '00280100') === 16) {
+        for (let i = 0; i + 1 < data.length; i += 2) { const t = data[i]; data[i] = data[i + 1]; data[i + 1] = t; }
+      }
+      frames[k] = data;
     }
     syntax = '1.2.840.10008.1.2.1';
-    pixels = data;
+    pixels = frames.length === 1 ? frames[0] : concat(frames);
   }
   const encapsulated = syntax !== '1.2.840.10008.1.2.1';
   return { url, syntax, pixels, compressed: encapsulated && syntax !== RLE,
-    entry: { name: inst.url, bytes: part10(inst.ds, syntax, data, encapsulated) } };
+    entry: { name: inst.url, bytes: part10(inst.ds, syntax, frames, encapsulated) } };
 }
 
 // The instance as the archive stores it (WADO-RS, application/dicom,
-// transfer-syntax=*): the same result as frameOf().
+// transfer-syntax=*): the same result as framesOf().
 async function instanceOf(inst, signal, stats) {
   const url = inst.url;
   const { bytes, type } = await get(url, ACCEPT_INSTANCE, stats, signal);
-  if (bytes.length > 2 * inst.frameBytes + 16 * 1048576) {
-    throw failure(url, `an answer of ${bytes.length} bytes for an image of ${inst.frameBytes} bytes`);
+  if (bytes.length > 2 * inst.frames * inst.frameBytes + 16 * 1048576) {
+    throw failure(url, `an answer of ${bytes.length} bytes for ${inst.frames} frame(s) of ${inst.frameBytes} bytes`);
   }
   const parts = multipartParts(url, type, bytes);
   if (parts.length !== 1) throw failure(url, `${parts.length} parts for one instance`);
@@ -449,18 +473,19 @@ export function attach(opts) {
 
   // The preview: the last frame, and a cut through the stack (the middle
   // row of each frame, one line per slice in position order).
-  function preview(instances) {
+  // Rows of the cut: one per frame (a multi-frame object's in frame order).
+  function preview(instances, total) {
     const box = q('.dw-preview');
     box.hidden = false;
     const ds = instances[0].ds;
     const cols = first(ds, '00280011'), rowsN = first(ds, '00280010');
     const frame = q('.dw-frame'), stack = q('.dw-stack');
     frame.width = cols; frame.height = rowsN;
-    stack.width = cols; stack.height = instances.length;
+    stack.width = cols; stack.height = total;
     // Shown in millimetres: the pixel spacing across, the slice spacing down.
     const dx = Number(value(ds, '00280030')[1] || 1);
     const dz = instances.length > 1 ? Math.abs(instances[instances.length - 1].along - instances[0].along) / (instances.length - 1) : dx;
-    stack.style.aspectRatio = `${cols * dx} / ${instances.length * (dz || dx)}`;
+    stack.style.aspectRatio = `${cols * dx} / ${total * (dz || dx)}`;
     frame.style.aspectRatio = `${cols * dx} / ${rowsN * Number(value(ds, '00280030')[0] || dx)}`;
     const fctx = frame.getContext('2d'), sctx = stack.getContext('2d');
     sctx.fillStyle = '#223'; sctx.fillRect(0, 0, stack.width, stack.height);
@@ -488,7 +513,7 @@ export function attach(opts) {
       const line = sctx.createImageData(cols, 1);
       const r0 = Math.floor(rowsN / 2) * cols;
       for (let x = 0; x < cols; x++) { const g = grey(sample(pixels, r0 + x)); line.data.set([g, g, g, 255], 4 * x); }
-      sctx.putImageData(line, 0, instances.length - 1 - k);  // superior at the top
+      sctx.putImageData(line, 0, total - 1 - k);  // superior at the top
     };
   }
 
@@ -516,20 +541,34 @@ export function attach(opts) {
         const sop = first(ds, '00080018');
         const url = `${seriesUrl}/instances/${sop}`;
         if (!sop) throw failure(`${seriesUrl}/metadata`, 'an instance without SOP Instance UID');
+        // A multi-frame object (Enhanced CT/MR, legacy converted enhanced,
+        // classic) is read whole: its frames are placed by the module's
+        // reader from the functional groups its metadata holds.
         const frames = Number(first(ds, '00280008', 1));
-        if (frames !== 1) throw failure(url, `${frames} frames: multi-frame instances are not read from DICOMweb (as in a folder)`);
         const rowsN = first(ds, '00280010'), cols = first(ds, '00280011'), bits = first(ds, '00280100');
         if (!(rowsN > 0 && cols > 0) || (bits !== 8 && bits !== 16)) throw failure(url, `Rows ${rowsN}, Columns ${cols}, Bits Allocated ${bits}: not an image the page reads`);
         const spp = first(ds, '00280002', 1);
-        const ipp = value(ds, '00200032').map(Number), iop = value(ds, '00200037').map(Number);
+        const frameBytes = rowsN * cols * spp * bits / 8;
+        if (!(Number.isInteger(frames) && frames >= 1 && frames <= MOST_FRAMES)) throw failure(url, `Number of Frames (0028,0008) is ${first(ds, '00280008')}: expected 1 to ${MOST_FRAMES}`);
+        if (frames * frameBytes > MOST_PIXEL_BYTES) throw failure(url, `${frames} frames of ${cols}x${rowsN} are ${(frames * frameBytes / 1048576).toFixed(0)} MiB of pixels, more than the page reads (${MOST_PIXEL_BYTES / 1048576} MiB)`);
+        // Its plane for the preview's order: the first frame's, for an
+        // enhanced object from its functional groups.
+        const perFrame = first(ds, '52009230', null), shared = first(ds, '52009229', null);
+        const macro = (tag) => first(perFrame, tag, null) || first(shared, tag, null);
+        const ipp = (value(ds, '00200032').length ? value(ds, '00200032') : value(macro('00209113'), '00200032')).map(Number);
+        const iop = (value(ds, '00200037').length ? value(ds, '00200037') : value(macro('00209116'), '00200037')).map(Number);
         const n = iop.length === 6 ? [iop[1] * iop[5] - iop[2] * iop[4], iop[2] * iop[3] - iop[0] * iop[5], iop[0] * iop[4] - iop[1] * iop[3]] : [0, 0, 1];
         const along = ipp.length === 3 ? ipp[0] * n[0] + ipp[1] * n[1] + ipp[2] * n[2] : Number(first(ds, '00200013', 0));
-        return { ds, sop, url, along, frameBytes: rowsN * cols * spp * bits / 8, entry: null };
+        return { ds, sop, url, along, frames, frameBytes, row: 0, entry: null };
       });
       instances.sort((a, b) => a.along - b.along);
+      let rowsSoFar = 0;
+      for (const inst of instances) { inst.row = rowsSoFar; rowsSoFar += inst.frames; }
+      const totalFrames = rowsSoFar;
       stats.instances = instances.length;
-      const show = preview(instances);
-      progress(0, instances.length);
+      stats.multiFrame = instances.filter((i) => i.frames > 1).length;
+      const show = preview(instances, totalFrames);
+      progress(0, totalFrames);
       let done = 0;
       let wholeInstances = false;
       const fetchOne = async (k) => {
@@ -537,7 +576,7 @@ export function attach(opts) {
         let got;
         const whole = wholeInstances;
         try {
-          got = whole ? await instanceOf(inst, signal, stats) : await frameOf(inst, signal, stats);
+          got = whole ? await instanceOf(inst, signal, stats) : await framesOf(inst, signal, stats);
         } catch (e) {
           // Some archives cannot send a frame of some syntaxes on its own
           // (Orthanc 1.10 answers HTTP 500 "Not implemented yet" for HTJ2K
@@ -561,17 +600,19 @@ export function attach(opts) {
           } catch (e) {
             throw failure(got.url, e.message.startsWith(entry.name) ? e.message.slice(entry.name.length + 2) : e.message);
           }
-          pixels = decodedPixels(entry.bytes, inst.frameBytes);
+          pixels = decodedPixels(entry.bytes, inst.frames * inst.frameBytes);
         }
         if (signal.aborted) return;
         inst.entry = entry;
-        done++;
+        if (done === 0) stats.firstFrameMs = performance.now() - t0;
+        done += inst.frames;
         stats.frames = done;
-        if (done === 1) stats.firstFrameMs = performance.now() - t0;
-        show(k, pixels);
+        for (let f = 0; f < inst.frames && pixels; f++) {
+          show(inst.row + f, pixels.subarray(f * inst.frameBytes, (f + 1) * inst.frameBytes));
+        }
         stats.shown.push(k);
-        progress(done, instances.length);
-        status(`${done} of ${instances.length} frames from ${seriesUrl} (${(stats.bytes / 1048576).toFixed(1)} MB)`);
+        progress(done, totalFrames);
+        status(`${done} of ${totalFrames} frames from ${seriesUrl} (${(stats.bytes / 1048576).toFixed(1)} MB)`);
       };
       // CONNECTIONS requests at a time, in slice order.
       let next = 0;

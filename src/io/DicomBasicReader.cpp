@@ -908,6 +908,12 @@ std::vector<DicomSeriesInfo> listDicomSeriesBasic(const fs::path& folder) {
   return io_detail::listFolderSeries(folder, addFileOnDisk);
 }
 
+std::vector<DicomSeriesInfo> listDicomSeriesBasic(const ByteSource& named, const FileSet& files) {
+  FolderScan scan;  // filesBeside holds `named` too
+  for (const auto& n : files.filesBeside(named)) addFile(*files.open(n), false, scan);
+  return io_detail::listSeries(std::move(scan));
+}
+
 namespace {
 // The reader without DCMTK behind the DicomDecoder interface: the syntaxes
 // marked readable in kSyntaxes, from files on disk or in memory.

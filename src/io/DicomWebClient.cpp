@@ -445,8 +445,9 @@ class FrameFetcher {
 
 }  // namespace
 
-Volume DicomWebClient::readSeries(const std::string& studyUid, const std::string& seriesUid) const {
-  const std::string seriesUrl = root_ + "/studies/" + studyUid + "/series/" + seriesUid;
+// The series' instances as the slices a folder scan finds (one per frame
+// of a multi-frame object), from its WADO-RS metadata.
+io_detail::FolderScan DicomWebClient::scanSeries(const std::string& seriesUrl) const {
   const bool credentials = !options_.headers.empty();
   const std::string metadataUrl = seriesUrl + "/metadata";
   const nlohmann::json datasets = getJson(*http_, metadataUrl, options_.headers, credentials);
@@ -472,14 +473,28 @@ Volume DicomWebClient::readSeries(const std::string& studyUid, const std::string
       scan.slices.push_back(std::move(frame));
     }
   }
+  return scan;
+}
+
+std::vector<DicomSeriesInfo> DicomWebClient::stacks(const std::string& studyUid,
+                                                    const std::string& seriesUid) const {
+  return io_detail::listSeries(scanSeries(root_ + "/studies/" + studyUid + "/series/" + seriesUid));
+}
+
+Volume DicomWebClient::readSeries(const std::string& studyUid, const std::string& seriesUid,
+                                  const std::string& stack) const {
+  const std::string seriesUrl = root_ + "/studies/" + studyUid + "/series/" + seriesUid;
+  io_detail::FolderScan scan = scanSeries(seriesUrl);
   const std::vector<Slice> all = scan.slices;
   HttpOptions once = HttpOptions::fromEnvironment();
   once.attempts = 1;
   once.connections = 1;
   const HttpStorage probe(root_, once);
   FrameFetcher fetcher(*http_, probe, options_.headers, http_->parallelism(), seriesUrl);
+  // A stack of a series of several ("UID:stack", as --series takes for a
+  // folder); without one, the largest, the others named in the description.
   Volume v = io_detail::readSeries(
-      std::move(scan), seriesUid, seriesUrl,
+      std::move(scan), stack.empty() ? seriesUid : seriesUid + ":" + stack, seriesUrl,
       [&](const Slice& s, Volume& stored, int z) { return fetcher.decode(s, all, stored, z); });
   syntaxes_ = fetcher.syntaxes();
   probeBytes_ += probe.bytesFetched();
@@ -503,12 +518,31 @@ DicomWebTransfer DicomWebClient::transfer() const {
           syntaxes_, wholeInstances_};
 }
 
-Volume readDicomWebSeries(const std::string& url, DicomWebTransfer* transfer) {
+Volume readDicomWebSeries(const std::string& url, DicomWebTransfer* transfer,
+                          const std::string& selection) {
   const DicomWebSeriesUrl u = parseDicomWebSeriesUrl(url);
   const DicomWebClient client(u.root);
-  Volume v = client.readSeries(u.study, u.series);
+  Volume v = client.readSeries(u.study, u.series, dicomWebStack(url, selection));
   if (transfer) *transfer = client.transfer();
   return v;
+}
+
+std::string dicomWebStack(const std::string& url, const std::string& selection) {
+  if (selection.empty()) return "";
+  const std::string series = parseDicomWebSeriesUrl(url).series;
+  if (selection == series) return "";
+  if (selection.starts_with(series + ":") && selection.size() > series.size() + 1) {
+    return selection.substr(series.size() + 1);
+  }
+  throw InputError(url + ": --series " + selection + " is not the series the URL names (" + series +
+                   ", or " + series +
+                   ":STACK for one of its stacks; `tessera info URL` lists them)");
+}
+
+std::vector<DicomSeriesInfo> listDicomWebSeries(const std::string& url) {
+  const DicomWebSeriesUrl u = parseDicomWebSeriesUrl(url);
+  const DicomWebClient client(u.root);
+  return client.stacks(u.study, u.series);
 }
 
 }  // namespace tessera

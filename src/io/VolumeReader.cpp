@@ -35,16 +35,12 @@ Volume readVolume(const std::string& spec, const ReadOptions& options) {
   // A DICOMweb series URL is a DICOM series (before any other URL, which
   // is an OME-Zarr store).
   if (isDicomWebSeriesUrl(spec)) {
-    if (!options.dicomSeries.empty() &&
-        options.dicomSeries != parseDicomWebSeriesUrl(spec).series) {
-      throw InputError(spec + ": --series " + options.dicomSeries +
-                       " differs from the series the URL names");
-    }
+    dicomWebStack(spec, options.dicomSeries);  // refuses another series than the URL's
     if (options.time != 0 || options.channel != 0) {
       throw InputError(spec +
                        ": --time/--channel select within an OME-Zarr store; this is not one");
     }
-    return readDicomWebSeries(spec);
+    return readDicomWebSeries(spec, nullptr, options.dicomSeries);
   }
   if (isZarrStore(spec)) {
     notDicom();

@@ -79,6 +79,17 @@ void ZarrChunkCache::evictOver() {
   }
 }
 
+std::uint64_t ZarrChunkCache::budgetBytes() const {
+  const std::lock_guard lock(mutex_);
+  return budget_;
+}
+
+void ZarrChunkCache::setBudget(std::uint64_t bytes) {
+  const std::lock_guard lock(mutex_);
+  budget_ = bytes;
+  evictOver();
+}
+
 ZarrChunkCacheStats ZarrChunkCache::stats() const {
   const std::lock_guard lock(mutex_);
   return stats_;

@@ -42,21 +42,21 @@ std::string dimsText(glm::ivec3 d) {
   return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
 }
 
-// Slices [0, depth) of `src` reduced 2x2x2 into a new volume of
-// ceil(dims/2) (depth for z): the mean of the voxels present, NaN skipped,
-// as lod::downsample.
-Volume halve(const Volume& src, int depth) {
+// Slices [0, depth) of `src` reduced by `f` per axis into a new volume of
+// ceil(dims/f) (depth for z): the mean of the voxels present, NaN skipped,
+// as lod::downsample(src, f).
+Volume reduce(const Volume& src, int depth, glm::ivec3 f) {
   const glm::ivec3 d(src.dims().x, src.dims().y, depth);
-  const glm::ivec3 o = (d + 1) / 2;
+  const glm::ivec3 o = (d + f - 1) / f;
   Volume out = Volume::allocate(o, src.type(), "pyramid slab");
   for (int oz = 0; oz < o.z; ++oz) {
     for (int oy = 0; oy < o.y; ++oy) {
       for (int ox = 0; ox < o.x; ++ox) {
         double sum = 0.0;
         int n = 0;
-        for (int z = 2 * oz; z < std::min(d.z, 2 * oz + 2); ++z) {
-          for (int y = 2 * oy; y < std::min(d.y, 2 * oy + 2); ++y) {
-            for (int x = 2 * ox; x < std::min(d.x, 2 * ox + 2); ++x) {
+        for (int z = f.z * oz; z < std::min(d.z, f.z * oz + f.z); ++z) {
+          for (int y = f.y * oy; y < std::min(d.y, f.y * oy + f.y); ++y) {
+            for (int x = f.x * ox; x < std::min(d.x, f.x * ox + f.x); ++x) {
               const double v = src.valueAt(x, y, z);
               if (std::isfinite(v)) {
                 sum += v;
@@ -73,8 +73,13 @@ Volume halve(const Volume& src, int depth) {
   return out;
 }
 
+// "2x2x2", "1x2x2": the factors as text in NGFF's axis order (z by y by x).
+std::string factorsText(glm::ivec3 f) {
+  return dimsText({f.z, f.y, f.x});
+}
+
 // One level of the pyramid being written: a slab of chunk.z slices that
-// fills up, is cut into chunks, and is halved into the next level.
+// fills up, is cut into chunks, and is reduced into the next level.
 // A shard being appended to: the index entries of its inner chunks so far.
 struct OpenShard {
   std::vector<ZarrShardEntry> entries;
@@ -98,7 +103,7 @@ class PyramidWriter {
   PyramidWriter(const Volume& shape, const fs::path& root, const OmeZarrWriteOptions& o)
       : type_(shape.type()), root_(root), options_(o) {
     glm::ivec3 d = shape.dims();
-    const int count = o.levels > 0 ? o.levels : omeZarrAutoLevels(d, o.chunkXyz());
+    const int count = o.levels > 0 ? o.levels : omeZarrAutoLevels(d, o.chunkXyz(), o.factors);
     for (int l = 0; l < count; ++l) {
       LevelWriter w;
       w.index = l;
@@ -111,8 +116,9 @@ class PyramidWriter {
       w.slab = Volume::allocate({d.x, d.y, w.chunk.z}, type_,
                                 "OME-Zarr level " + std::to_string(l) + " slab");
       levels_.push_back(std::move(w));
-      if (d == glm::ivec3(1)) break;
-      d = (d + 1) / 2;
+      const glm::ivec3 next = (d + o.factors - 1) / o.factors;
+      if (next == d) break;  // every reduced axis is down to one voxel
+      d = next;
     }
   }
 
@@ -160,7 +166,7 @@ class PyramidWriter {
       if ((cz + 1) % w.shard.z == 0 || w.slabZ0 + w.filled == w.dims.z)
         closeShards(w, cz / w.shard.z);
     }
-    if (l + 1 < levelCount()) push(l + 1, halve(w.slab, w.filled));
+    if (l + 1 < levelCount()) push(l + 1, reduce(w.slab, w.filled, options_.factors));
     w.slabZ0 += w.filled;
     w.filled = 0;
   }
@@ -292,7 +298,8 @@ nlohmann::json zyx(glm::dvec3 v) {
 }
 
 std::string attributes(const Volume& shape, const PyramidWriter& p, const std::string& name,
-                       const ValueRange& range, int format) {
+                       const ValueRange& range, const OmeZarrWriteOptions& o) {
+  const int format = o.zarrFormat;
   using nlohmann::json;
   json axes = json::array();
   for (const char* a : {"z", "y", "x"}) {
@@ -300,12 +307,14 @@ std::string attributes(const Volume& shape, const PyramidWriter& p, const std::s
   }
   json datasets = json::array();
   for (int l = 0; l < p.levelCount(); ++l) {
-    const double f = std::ldexp(1.0, l);
+    // Level l's scale per axis: the factor to the power l (1 on a kept axis).
+    const glm::dvec3 f(std::pow(double(o.factors.x), l), std::pow(double(o.factors.y), l),
+                       std::pow(double(o.factors.z), l));
     const glm::dvec3 spacing = shape.spacing() * f;
-    // A level-l voxel is the mean of 2^l finer voxels per axis: its centre
-    // lies (2^l - 1)/2 finest voxels past the first of them, in the array's
-    // own axes (NGFF has no direction; the reader applies tessera.direction
-    // to the shift, "translations": "array axes").
+    // A level-l voxel is the mean of f finer voxels per axis: its centre
+    // lies (f - 1)/2 finest voxels past the first of them (none on a kept
+    // axis), in the array's own axes (NGFF has no direction; the reader
+    // applies tessera.direction to the shift, "translations": "array axes").
     const glm::dvec3 origin = shape.origin() + shape.spacing() * (0.5 * (f - 1.0));
     datasets.push_back({{"path", std::to_string(l)},
                         {"coordinateTransformations",
@@ -318,9 +327,9 @@ std::string attributes(const Volume& shape, const PyramidWriter& p, const std::s
              {"datasets", datasets},
              {"type", "mean"},
              {"metadata",
-              {{"method",
-                "tessera convert: 2x2x2 mean (lod::downsample), partial edge blocks "
-                "average the voxels present"},
+              {{"method", "tessera convert: " + factorsText(o.factors) +
+                              " (z by y by x) mean (lod::downsample), partial edge blocks "
+                              "average the voxels present"},
                {"world_frame", "RAS+ millimetres; x->R, y->A, z->S when direction is identity"}}}};
   if (format == 3) ms.erase("version");  // 0.5: the version is the "ome" object's
   json tessera = {{"world_frame", "RAS"}, {"translations", "array axes"}};
@@ -377,10 +386,10 @@ void build(const Volume& shape, const SlabReader& slabs, const fs::path& root,
   }
   result = pyramid.result();
   if (o.zarrFormat == 3) {
-    writeText(root / "zarr.json", attributes(shape, pyramid, name, result.range, 3));
+    writeText(root / "zarr.json", attributes(shape, pyramid, name, result.range, o));
   } else {
     writeText(root / ".zgroup", "{\n  \"zarr_format\": 2\n}");
-    writeText(root / ".zattrs", attributes(shape, pyramid, name, result.range, 2));
+    writeText(root / ".zattrs", attributes(shape, pyramid, name, result.range, o));
   }
   for (int l = 0; l < pyramid.levelCount(); ++l) result.levelDims.push_back(pyramid.level(l).dims);
 }
@@ -397,10 +406,16 @@ int omeZarrAutoLevels(glm::ivec3 dims, int chunk) {
   return omeZarrAutoLevels(dims, glm::ivec3(chunk));
 }
 
-int omeZarrAutoLevels(glm::ivec3 dims, glm::ivec3 chunk) {
+int omeZarrAutoLevels(glm::ivec3 dims, glm::ivec3 chunk, glm::ivec3 factors) {
   int levels = 1;
-  while (dims.x > chunk.x || dims.y > chunk.y || dims.z > chunk.z) {
-    dims = (dims + 1) / 2;
+  const auto over = [&](glm::ivec3 d) {
+    for (int a = 0; a < 3; ++a) {
+      if (factors[a] > 1 && d[a] > chunk[a]) return true;
+    }
+    return false;
+  };
+  while (over(dims)) {
+    dims = (dims + factors - 1) / factors;
     ++levels;
   }
   return levels;
@@ -421,19 +436,31 @@ OmeZarrWriteResult writeOmeZarr(const Volume& shape, const SlabReader& slabs, co
     throw InputError("--shard " + std::to_string(o.shard) +
                      ": expected 1..64 chunks per shard edge, with --zarr-format 3");
   }
+  const glm::ivec3 f = o.factors;
+  if (f.x < 1 || f.x > 2 || f.y < 1 || f.y > 2 || f.z < 1 || f.z > 2 || f == glm::ivec3(1)) {
+    throw InputError("--pyramid-factors " + std::to_string(f.z) + "," + std::to_string(f.y) + "," +
+                     std::to_string(f.x) +
+                     ": expected Z,Y,X each 1 (axis kept) or 2 (halved), at least one 2");
+  }
   if (o.levels < 0 || o.levels > 30) {
     throw InputError("--levels " + std::to_string(o.levels) + ": expected auto or 1..30");
   }
   std::string trimmed = out.string();
   while (trimmed.size() > 1 && trimmed.back() == '/') trimmed.pop_back();
   const fs::path path(trimmed);
-  // Slab buffers: one chunk-deep slab per level (a geometric series
-  // under 4/3 of the finest) plus the slab being read and its halving.
+  // Slab buffers: one chunk-deep slab per level (a geometric series under
+  // 4/3 of the finest when x and y halve; as many finest slabs as levels
+  // when they are kept) plus the slab being read and its reduction.
   const glm::ivec3 d = shape.dims();
-  const std::uint64_t slab = std::uint64_t(d.x) * std::uint64_t(d.y) *
-                             std::uint64_t(std::min(d.z, o.chunkXyz().z)) *
-                             bytesPerVoxel(shape.type());
-  HostBudget::global().check(3 * slab, path.string() + ": OME-Zarr slabs of " + dimsText(d));
+  const auto slabOf = [&](glm::ivec3 dims) {
+    return std::uint64_t(dims.x) * std::uint64_t(dims.y) *
+           std::uint64_t(std::min(dims.z, o.chunkXyz().z)) * bytesPerVoxel(shape.type());
+  };
+  std::uint64_t slabBytes = 2 * slabOf(d);
+  glm::ivec3 ld = d;
+  const int count = o.levels > 0 ? o.levels : omeZarrAutoLevels(d, o.chunkXyz(), f);
+  for (int l = 0; l < count; ++l, ld = (ld + f - 1) / f) slabBytes += slabOf(ld);
+  HostBudget::global().check(slabBytes, path.string() + ": OME-Zarr slabs of " + dimsText(d));
   std::error_code ec;
   const bool replace = fs::exists(path, ec);
   if (replace && !isZarrStore(path.string())) {

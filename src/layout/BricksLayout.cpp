@@ -1,6 +1,7 @@
 #include "tessera/layout/BricksLayout.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 
@@ -17,10 +18,11 @@ namespace {
 
 constexpr std::uint64_t kDefaultAtlasCap = 256ull << 20;
 constexpr int kCoarsestSide = 16;
-// What the process holds besides the atlas and the brick cache while it
-// streams: code, the GL driver, the render target and its read-back, bricks
-// in flight in the reader threads and in upload, the page table, a store's
-// chunk cache. Measured on llvmpipe: head:1024 on shield-k1 (512² image)
+// What the process holds besides the atlas, the brick cache and a store's
+// decoded chunks while it streams: code, the GL driver, the render target
+// and its read-back, bricks in flight in the reader threads and in upload,
+// a store's few MiB of stored (compressed) chunk bytes. Measured on
+// llvmpipe: head:1024 on shield-k1 (512² image)
 // peaked at 468 MiB with a 255 MiB atlas and a 54 MiB cache, so 159 MiB;
 // with a margin.
 constexpr std::uint64_t kHostOverhead = 176ull << 20;
@@ -38,9 +40,19 @@ constexpr std::uint64_t kMinCacheBytes = 32ull << 20;
 // A host budget below the process's own footprint (tests of the planner
 // with a few MiB) cannot be honoured this way: the atlas is then not
 // weighed against it and the cache takes a quarter of it.
+//
+// The page table costs the host three times its texture: the host copy the
+// CPU rebuilds in place, each cell's stored range (two u16) for the
+// empty-space blocks, and the driver's copy (llvmpipe's texture is process
+// memory). At 128^3 cells that is 24 MiB.
+std::uint64_t pageHostBytes(std::uint64_t pageBytes) {
+  return 3 * pageBytes;
+}
+
 bool weighsAtlas(const gpu::DeviceLimits& limits, const BricksOptions& options,
                  std::uint64_t pageBytes) {
-  return limits.hostBudget > kHostOverhead + kMinCacheBytes + pageBytes && options.cacheBytes == 0;
+  return limits.hostBudget > kHostOverhead + kMinCacheBytes + pageHostBytes(pageBytes) &&
+         options.cacheBytes == 0;
 }
 
 std::uint64_t atlasCap(const gpu::DeviceLimits& limits, const BricksOptions& options,
@@ -52,24 +64,48 @@ std::uint64_t atlasCap(const gpu::DeviceLimits& limits, const BricksOptions& opt
   }
   if (weighsAtlas(limits, options, pageBytes)) {
     // When the atlas does not fit beside a minimal cache, it shrinks.
-    avail = std::min(avail, limits.hostBudget - kHostOverhead - kMinCacheBytes - pageBytes);
+    avail = std::min(avail,
+                     limits.hostBudget - kHostOverhead - kMinCacheBytes - pageHostBytes(pageBytes));
   }
   return avail;
 }
 
-// The host cache of decoded bricks: the host budget less the atlas, the
-// page table and the overhead (see atlasCap), at most a quarter of the
-// budget; 64 MiB without a host budget.
-std::uint64_t cacheBytesFor(const gpu::DeviceLimits& limits, const BricksOptions& options,
-                            std::uint64_t atlasBytes, std::uint64_t pageBytes) {
-  if (options.cacheBytes != 0) return options.cacheBytes;
-  if (limits.hostBudget == 0) return 64ull << 20;
-  if (!weighsAtlas(limits, options, pageBytes)) return limits.hostBudget / 4;
-  // At most a quarter of the budget, as before the atlas was weighed: a
-  // roomy host (half of a desktop's RAM) keeps a cache of the usual size.
-  const std::uint64_t used = atlasBytes + pageBytes + kHostOverhead;
-  const std::uint64_t left = limits.hostBudget > used ? limits.hostBudget - used : 0;
-  return std::max(kMinCacheBytes, std::min(left, limits.hostBudget / 4));
+// The sources' decoded chunks take at most an eighth of the host budget
+// (the share a store opened alone keeps, ZarrMultiresSource).
+constexpr std::uint64_t kChunkCacheShare = 8;
+
+// The host budget shared out (BricksHostSplit): the atlas, the page table
+// and the overhead first (atlasCap left at least a minimal brick cache
+// beside them), then the sources' decoded chunks (what they would keep, at
+// most an eighth of the budget, never eating into the minimal brick
+// cache), then the brick cache (the rest, at most a quarter of the budget:
+// a roomy host, half of a desktop's RAM, keeps a cache of the usual size).
+// Without a host budget: a 64 MiB brick cache, the chunks the sources keep.
+BricksHostSplit splitHost(const gpu::DeviceLimits& limits, const BricksOptions& options,
+                          std::uint64_t atlasBytes, std::uint64_t pageBytes,
+                          std::uint64_t chunksWanted) {
+  BricksHostSplit s;
+  s.budget = limits.hostBudget;
+  const std::uint64_t chunkShare = s.budget ? s.budget / kChunkCacheShare : chunksWanted;
+  s.chunkCache = std::min(chunksWanted, chunkShare);
+  if (options.cacheBytes != 0) {
+    s.brickCache = options.cacheBytes;
+  } else if (s.budget == 0) {
+    s.brickCache = 64ull << 20;
+  } else if (!weighsAtlas(limits, options, pageBytes)) {
+    s.brickCache = s.budget / 4;
+  } else {
+    s.atlas = atlasBytes;
+    s.pages = pageBytes;
+    // The page table's host copies beyond its texture (pageHostBytes) count
+    // as overhead.
+    s.overhead = kHostOverhead + (pageHostBytes(pageBytes) - pageBytes);
+    const std::uint64_t used = atlasBytes + pageHostBytes(pageBytes) + kHostOverhead;
+    const std::uint64_t left = s.budget > used ? s.budget - used : 0;
+    s.chunkCache = std::min(s.chunkCache, left > kMinCacheBytes ? left - kMinCacheBytes : 0);
+    s.brickCache = std::max(kMinCacheBytes, std::min(left - s.chunkCache, s.budget / 4));
+  }
+  return s;
 }
 
 // "prefix7suffix" (snprintf: GCC 12 -Wrestrict misfires on "literal" + std::string).
@@ -83,11 +119,24 @@ std::string dimsText(glm::ivec3 d) {
   return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
 }
 
-// The page table holds one texel per level-0 brick cell in one column
-// (cells.x wide, cells.y * cells.z tall). For a source without a natural
-// chunk, the brick doubles from 32 up to 128 until that column fits the
-// device's 2D limit: 4096^3 takes 64^3 bricks under webgl2 (8192²), 128^3
-// under ipad2 (2048²); see docs/large-data.md "Scale".
+// The page table's side at most: the device's 2D limit, or less on request.
+int pageTableSide(const gpu::DeviceLimits& limits, const BricksOptions& options) {
+  return options.pageTableMaxSide > 0 ? std::min(options.pageTableMaxSide, limits.max2DTextureSize)
+                                      : limits.max2DTextureSize;
+}
+
+// Level-0 brick cells at most for a brick size chosen here: the page table
+// is rebuilt on the CPU at every update (one texel and a range per cell), so
+// 128^3 cells (8 MiB of texture, 24 MiB of host: pageHostBytes) is where a
+// larger brick is cheaper than a finer cut.
+constexpr std::int64_t kMaxChosenCells = std::int64_t(1) << 21;
+
+// The page table holds one texel per level-0 brick cell, its z-slices tiled
+// in 2D (BricksLayout::pageTableGeometry). For a source without a natural
+// chunk, the brick doubles from 32 up to 128 until the table fits the
+// device's 2D limit and has at most kMaxChosenCells cells: 4096^3 takes 32^3
+// bricks (128^3 cells: 2048 x 1024 texels under ipad2), 8192^3 64^3; see
+// docs/large-data.md "Scale".
 int brickSizeFor(const BricksOptions& options, glm::ivec3 chunk, glm::ivec3 dims,
                  const gpu::DeviceLimits& limits) {
   if (options.brickSize > 0) return options.brickSize;
@@ -95,8 +144,9 @@ int brickSizeFor(const BricksOptions& options, glm::ivec3 chunk, glm::ivec3 dims
   int b = 32;
   for (; b < 128; b *= 2) {
     const glm::ivec3 cells = (dims + b - 1) / b;
-    const std::int64_t tall = std::int64_t(cells.y) * cells.z;
-    if (cells.x <= limits.max2DTextureSize && tall <= limits.max2DTextureSize) break;
+    const std::int64_t count = std::int64_t(cells.x) * cells.y * cells.z;
+    const int side = pageTableSide(limits, options);
+    if (count <= kMaxChosenCells && BricksLayout::pageTableGeometry(cells, side).tilesX > 0) break;
   }
   return b;
 }
@@ -247,14 +297,19 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
       sourceLevels.empty() ? lod::pyramidDims(d, kCoarsestSide) : sourceLevels;
   const glm::ivec3 top = (levels.back() + b - 1) / b;
   const int topBricks = top.x * top.y * top.z;
+  const int pageSide = pageTableSide(limits, options);
+  const MosaicLayout::Geometry pageTiles = pageTableGeometry(cells, pageSide);
   PlannedTexture pages{.label = "brick page table",
-                       .size = {cells.x, cells.y * cells.z, 1},
+                       .size = {pageTiles.width(), pageTiles.height(), 1},
                        .is3D = false,
                        .format = "RGBA8",
-                       .bytes = 4ull * cells.x * cells.y * cells.z};
-  if (pages.size.x > limits.max2DTextureSize || pages.size.y > limits.max2DTextureSize) {
-    plan.reason = vol + ": a " + dimsText(pages.size) + " page table of " + std::to_string(b) +
-                  "^3 bricks exceeds the max 2D texture size of " + limits.profile;
+                       .bytes = 4ull * static_cast<std::uint64_t>(pageTiles.width()) *
+                                static_cast<std::uint64_t>(pageTiles.height())};
+  if (pageTiles.tilesX == 0) {
+    plan.reason = vol + ": the " + dimsText(cells) + " cells of " + std::to_string(b) +
+                  "^3 bricks do not fit a " + std::to_string(pageSide) + "x" +
+                  std::to_string(pageSide) + " page table (max 2D texture size of " +
+                  limits.profile + ")";
     return plan;
   }
   if (limits.textureUnits < 2) {
@@ -288,7 +343,7 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
       "-brick " + atlas.format + " atlas (" +
       (atlases > 1 ? numbered("", atlases, " x ") : std::string()) + dimsText(atlas.size) +
       (es3 ? " 3D" : " mosaic") + ", " + formatBytes(a.bytes) + ") through a " +
-      std::to_string(cells.x) + "x" + std::to_string(cells.y * cells.z) + " page table" +
+      std::to_string(pages.size.x) + "x" + std::to_string(pages.size.y) + " page table" +
       (options.channels > 0 ? channelNote(format.format) : storedNote(shape));
   // The coarsest bricks are pinned, so refining needs a slot beyond them;
   // a pyramid of one level (a single-level store) needs none: it fits when
@@ -302,6 +357,10 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
   plan.fits = true;
   plan.reason = what;
   return plan;
+}
+
+MosaicLayout::Geometry BricksLayout::pageTableGeometry(glm::ivec3 cells, int maxSide) {
+  return MosaicLayout::geometryFor(cells, maxSide);
 }
 
 BricksLayout::~BricksLayout() {
@@ -400,11 +459,30 @@ std::unique_ptr<BricksLayout> BricksLayout::build(
       if (format.twoBytes()) l->atlases_.back().setFilter(gpu::Filter::Nearest);
     }
   }
-  const glm::ivec3 cells = l->grid_.bricks(0);
-  l->pages_host_.assign(4ull * cells.x * cells.y * cells.z, 0);
-  l->pages_ = gpu::Texture::create2D(ledger, "brick page table", gpu::rgba8For(limits.api), cells.x,
-                                     cells.y * cells.z, l->pages_host_.data());
+  l->pageGeometry_ = pageTableGeometry(l->grid_.bricks(0), pageTableSide(limits, options));
+  const int pagesWide = l->pageGeometry_.width();
+  const int pagesTall = l->pageGeometry_.height();
+  l->pages_host_.assign(4ull * static_cast<std::size_t>(pagesWide) * pagesTall, 0);
+  l->pages_ = gpu::Texture::create2D(ledger, "brick page table", gpu::rgba8For(limits.api),
+                                     pagesWide, pagesTall, l->pages_host_.data());
   l->pages_.setFilter(gpu::Filter::Nearest);
+  bool isotropic = true;
+  for (int lv = 0; lv < l->grid_.levelCount(); ++lv) {
+    const glm::ivec3 sc = l->grid_.scale(lv);
+    isotropic = isotropic && sc.x == sc.y && sc.y == sc.z;
+  }
+  // The brick walk's map per cell as floats (bricks.glsl BRICKS_WALK_PAGES):
+  // fewer operations at each cell a ray enters (ch2: bricked frames 2-8 %
+  // faster). 16 bytes a cell, so only up to 64^3 cells (4 MiB).
+  const glm::ivec3 cells0 = l->grid_.bricks(0);
+  const bool fewCells = std::int64_t(cells0.x) * cells0.y * cells0.z <= (std::int64_t(1) << 18);
+  if (limits.api == gpu::ApiLevel::Gles3 && format.texel < 2 && isotropic && l->walk_ && !set &&
+      fewCells) {
+    l->walkHost_.assign(l->pages_host_.size(), 0.0f);
+    l->walkPages_ = gpu::Texture::create2D(ledger, "brick walk pages", gpu::TexelFormat::RGBA32F,
+                                           pagesWide, pagesTall, l->walkHost_.data());
+    l->walkPages_.setFilter(gpu::Filter::Nearest);
+  }
   l->slotKey_.assign(static_cast<std::size_t>(a.count()), -1);
   l->slotUsed_.assign(l->slotKey_.size(), 0);
   l->slotPinned_.assign(l->slotKey_.size(), false);
@@ -412,8 +490,13 @@ std::unique_ptr<BricksLayout> BricksLayout::build(
 
   lod::BrickStreamerOptions so;
   so.workers = options.workers;
-  so.cacheBytes = cacheBytesFor(limits, options, a.bytes, pageBytes);
-  if (set) so.cacheBytes /= sources.size();  // one cache per channel, the same in all
+  std::uint64_t chunksWanted = 0;
+  for (const auto& s : sources) chunksWanted += s->decodedCacheWanted();
+  l->hostSplit_ = splitHost(limits, options, a.bytes, pageBytes, chunksWanted);
+  // One brick cache per channel, the same in all; each source's decoded
+  // chunks within an equal part of the chunks' share.
+  so.cacheBytes = l->hostSplit_.brickCache / sources.size();
+  for (const auto& s : sources) s->limitDecodedCache(l->hostSplit_.chunkCache / sources.size());
   l->streamer_ = std::make_unique<lod::BrickStreamer>(source, l->grid_, so);
   for (std::size_t c = 1; c < sources.size(); ++c) {
     l->channelStreamers_.push_back(std::make_unique<lod::BrickStreamer>(sources[c], l->grid_, so));
@@ -586,51 +669,119 @@ bool BricksLayout::transparent(const lod::BrickKey& key, const TransferFunction&
 }
 
 void BricksLayout::rebuildPages(const TransferFunction& tf, BricksFrame& frame) {
+  // Each cell shows the finest of its ancestors (itself included) that is
+  // resident or that its own range makes transparent. Resolved top-down, one
+  // level at a time, a brick inheriting its parent's page where it is
+  // neither: one lookup per brick of the pyramid (about 8/7 of the cells),
+  // not one per cell and level.
   const glm::ivec3 cells = grid_.bricks(0);
   const int levels = grid_.levelCount();
-  std::vector<std::uint8_t> pages(pages_host_.size(), 0);
-  cellMin_.assign(pages.size() / 4, 0);
-  cellSlot0_.assign(pages.size() / 4, -1);
-  cellMax_.assign(pages.size() / 4, static_cast<std::uint16_t>(streamer_->mapping().maxStored()));
+  const std::uint16_t maxStored = static_cast<std::uint16_t>(streamer_->mapping().maxStored());
+  struct Resolved {
+    std::array<std::uint8_t, 4> page{};
+    std::uint16_t min = 0, max = 0;
+    int level = 0;  // levels: transparent
+  };
+  auto resolve = [&](const lod::BrickKey& key, const Resolved* parent) {
+    Resolved r;
+    const auto it = slotOf_.find(key.id());
+    if (it != slotOf_.end()) {
+      const glm::ivec3 s = slotOrigin(it->second);
+      r.page = {static_cast<std::uint8_t>(s.x), static_cast<std::uint8_t>(s.y),
+                static_cast<std::uint8_t>(s.z), static_cast<std::uint8_t>(key.level)};
+      r.level = key.level;
+      r.max = maxStored;
+      if (auto range = streamer_->range(key)) {
+        r.min = range->min;
+        r.max = range->max;
+      }
+      return r;
+    }
+    std::uint16_t v = 0;
+    if (transparent(key, tf, true, &v)) {
+      // The constant value, low byte first.
+      r.page = {static_cast<std::uint8_t>(v & 0xff), static_cast<std::uint8_t>(v >> 8), 0, 255};
+      r.min = r.max = v;
+      r.level = levels;
+      return r;
+    }
+    if (parent) {
+      return *parent;
+    }
+    r.max = maxStored;  // nothing resident (never: the coarsest level is pinned)
+    r.page[3] = static_cast<std::uint8_t>(key.level);
+    r.level = key.level;
+    return r;
+  };
+  auto indexIn = [&](int level, glm::ivec3 b) {
+    const glm::ivec3 n = grid_.bricks(level);
+    return (static_cast<std::size_t>(b.z) * n.y + b.y) * n.x + static_cast<std::size_t>(b.x);
+  };
+  std::vector<Resolved> above;
+  for (int l = levels - 1; l >= 1; --l) {
+    const glm::ivec3 n = grid_.bricks(l);
+    std::vector<Resolved> here(static_cast<std::size_t>(n.x) * n.y * n.z);
+    std::size_t i = 0;
+    for (int z = 0; z < n.z; ++z) {
+      for (int y = 0; y < n.y; ++y) {
+        for (int x = 0; x < n.x; ++x, ++i) {
+          const lod::BrickKey key{l, {x, y, z}};
+          const Resolved* parent =
+              l + 1 < levels ? &above[indexIn(l + 1, grid_.parent(key).brick)] : nullptr;
+          here[i] = resolve(key, parent);
+        }
+      }
+    }
+    above = std::move(here);
+  }
+  // Rewritten in place (no second copy of the table): only a change is
+  // uploaded.
+  bool changed = false;
+  const std::size_t cellCount = static_cast<std::size_t>(cells.x) * cells.y * cells.z;
+  cellMin_.assign(cellCount, 0);
+  cellMax_.assign(cellCount, maxStored);
+  const std::size_t pagesWide = static_cast<std::size_t>(pageGeometry_.width());
   frame.cellsPerLevel.assign(static_cast<std::size_t>(levels) + 1, 0);
   std::size_t i = 0;
   for (int z = 0; z < cells.z; ++z) {
     for (int y = 0; y < cells.y; ++y) {
+      const glm::ivec2 rowStart = pageGeometry_.addressOf(0, y, z);
+      std::uint8_t* row = &pages_host_[4 * (static_cast<std::size_t>(rowStart.y) * pagesWide +
+                                            static_cast<std::size_t>(rowStart.x))];
       for (int x = 0; x < cells.x; ++x, ++i) {
-        std::uint8_t* e = &pages[4 * i];
-        for (int l = 0; l < levels; ++l) {
-          const lod::BrickKey key = grid_.ancestorOf({x, y, z}, l);
-          const auto it = slotOf_.find(key.id());
-          if (it != slotOf_.end()) {
-            const glm::ivec3 s = slotOrigin(it->second);
-            e[0] = static_cast<std::uint8_t>(s.x);
-            e[1] = static_cast<std::uint8_t>(s.y);
-            e[2] = static_cast<std::uint8_t>(s.z);
-            e[3] = static_cast<std::uint8_t>(l);
-            if (l == 0) cellSlot0_[i] = it->second;
-            if (auto r = streamer_->range(key)) {
-              cellMin_[i] = r->min;
-              cellMax_[i] = r->max;
-            }
-            ++frame.cellsPerLevel[static_cast<std::size_t>(l)];
-            break;
-          }
-          std::uint16_t v = 0;
-          if (transparent(key, tf, true, &v)) {
-            e[0] = static_cast<std::uint8_t>(v & 0xff);  // the constant value, low byte first
-            e[1] = static_cast<std::uint8_t>(v >> 8);
-            e[3] = 255;
-            cellMin_[i] = cellMax_[i] = v;
-            ++frame.cellsPerLevel[static_cast<std::size_t>(levels)];
-            break;
+        const lod::BrickKey key{0, {x, y, z}};
+        const Resolved* parent = levels > 1 ? &above[indexIn(1, grid_.parent(key).brick)] : nullptr;
+        const Resolved r = resolve(key, parent);
+        std::uint8_t* e = row + 4 * x;
+        changed = changed || !std::equal(r.page.begin(), r.page.end(), e);
+        std::copy(r.page.begin(), r.page.end(), e);
+        cellMin_[i] = r.min;
+        cellMax_[i] = r.max;
+        if (!walkHost_.empty()) {
+          float* w = &walkHost_[static_cast<std::size_t>(e - pages_host_.data())];
+          if (r.page[3] == 255) {
+            w[0] = static_cast<float>(r.page[0] | (r.page[1] << 8)) / static_cast<float>(maxStored);
+            w[1] = w[2] = w[3] = 0.0f;
+          } else {
+            const int lv = r.page[3];
+            const int sl = grid_.scale(lv).x;
+            const float b = static_cast<float>(grid_.brickSize());
+            const glm::vec3 slot(r.page[0], r.page[1], r.page[2]);
+            const glm::vec3 brick(glm::ivec3(x, y, z) / sl);
+            const glm::vec3 off = (slot * (b + 2.0f) + 1.0f - brick * b) / glm::vec3(atlasTexels_);
+            w[0] = off.x;
+            w[1] = off.y;
+            w[2] = off.z;
+            w[3] = 1.0f / static_cast<float>(sl);
           }
         }
+        ++frame.cellsPerLevel[static_cast<std::size_t>(r.level)];
       }
     }
   }
-  if (pages != pages_host_) {
-    pages_host_ = std::move(pages);
+  if (changed) {
     pages_.update(pages_host_.data());
+    if (!walkHost_.empty()) walkPages_.update(walkHost_.data());
     ++contentVersion_;
   }
 }
@@ -737,6 +888,15 @@ void BricksLayout::waitForBricks(double ms) {
   streamer_->waitForProgress(ms);
 }
 
+std::vector<int> BricksLayout::cellLevels() const {
+  std::vector<int> out(pages_host_.size() / 4);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const std::uint8_t a = pages_host_[4 * i + 3];
+    out[i] = a == 255 ? -1 : a;
+  }
+  return out;
+}
+
 BricksLayout::Lookup BricksLayout::lookup(glm::dvec3 x0) const {
   const double b = grid_.brickSize();
   const glm::dvec3 dims0(grid_.dims(0));
@@ -744,8 +904,9 @@ BricksLayout::Lookup BricksLayout::lookup(glm::dvec3 x0) const {
   x0 = glm::clamp(x0, glm::dvec3(0.0), dims0);
   const glm::dvec3 cell = glm::min(glm::floor(x0 / b), cellsF - 1.0);
   const glm::ivec3 c(cell);
+  const glm::ivec2 texel = pageGeometry_.addressOf(c.x, c.y, c.z);
   const std::size_t i =
-      (static_cast<std::size_t>(c.z) * grid_.bricks(0).y + c.y) * grid_.bricks(0).x + c.x;
+      static_cast<std::size_t>(texel.y) * pageGeometry_.width() + static_cast<std::size_t>(texel.x);
   const std::uint8_t* e = &pages_host_[4 * i];
   Lookup out;
   if (e[3] == 255) {
@@ -779,9 +940,8 @@ ValueBlocks BricksLayout::valueBlocks(int blockSize) const {
         if (blockSize == kFineBlock && b % kFineBlock == 0) {
           // A block inside one level-0 brick: its own range, as in core.
           const glm::ivec3 cell = block * kFineBlock / b;
-          const std::size_t c = (static_cast<std::size_t>(cell.z) * cells.y + cell.y) * cells.x +
-                                static_cast<std::size_t>(cell.x);
-          const int slot = cellSlot0_[c];
+          const auto found = slotOf_.find(lod::BrickKey{0, cell}.id());
+          const int slot = found == slotOf_.end() ? -1 : found->second;
           if (slot >= 0 && !slotFine_[static_cast<std::size_t>(slot)].empty()) {
             const int per = b / kFineBlock;
             const glm::ivec3 f = block - cell * per;
@@ -831,10 +991,12 @@ gpu::ShaderPart BricksLayout::glsl() const {
   // numbers stay.
   const std::size_t second = part.text.find('\n') + 1;
   const std::size_t third = part.text.find('\n', second) + 1;
-  part.text.replace(0, part.text.find('\n', third),
+  const std::size_t fourth = part.text.find('\n', third) + 1;
+  part.text.replace(0, part.text.find('\n', fourth),
                     "#define BRICKS_ATLASES " + std::to_string(channels_ ? 1 : atlases_.size()) +
                         "\n#define BRICKS_TEXEL " + std::to_string(atlasTexel_) +
-                        "\n#define BRICKS_LEVELS " + std::to_string(grid_.levelCount()));
+                        "\n#define BRICKS_LEVELS " + std::to_string(grid_.levelCount()) +
+                        "\n#define BRICKS_WALK_PAGES " + (walkHost_.empty() ? "0" : "1"));
   return part;
 }
 
@@ -853,8 +1015,15 @@ int BricksLayout::bind(const gpu::Program& program, int firstUnit) const {
   program.set("u_layoutDims0", glm::vec3(grid_.dims(0)));
   program.set("u_layoutBrick", static_cast<float>(grid_.brickSize()));
   program.set("u_layoutCells", glm::vec3(cells));
-  program.set("u_layoutPagesInv", glm::vec2(1.0f / static_cast<float>(cells.x),
-                                            1.0f / static_cast<float>(cells.y * cells.z)));
+  program.set("u_layoutPagesInv", glm::vec2(1.0f / static_cast<float>(pageGeometry_.width()),
+                                            1.0f / static_cast<float>(pageGeometry_.height())));
+  program.set("u_layoutPageTiles", static_cast<float>(pageGeometry_.tilesX));
+  if (!walkHost_.empty()) {
+    const int unit = firstUnit + 1 + static_cast<int>(atlases_.size());
+    walkPages_.bind(unit);
+    program.set("u_layoutWalkPages", unit);
+    program.set("u_layoutWalkScale0", glm::vec3(grid_.dims(0)) / glm::vec3(atlasTexels_));
+  }
   program.set("u_layoutAtlasTexels", glm::vec3(atlasTexels_));
   for (int l = 0; l < grid_.levelCount(); ++l) {
     const std::string name = numbered("u_layoutLevelShrink[", l, "]");

@@ -1,12 +1,16 @@
 // Line 1 is replaced by "#define BRICKS_ATLASES <N>" (BricksLayout::glsl()),
 // line 2 by "#define BRICKS_TEXEL <T>": how a stored value is read (below),
-// line 3 by "#define BRICKS_LEVELS <L>": the pyramid's levels.
+// line 3 by "#define BRICKS_LEVELS <L>": the pyramid's levels,
+// line 4 by "#define BRICKS_WALK_PAGES <0|1>": the walk reads float pages.
 // sampleVolume for BricksLayout: bricks of several resolution levels in one
 // atlas, found through a page table (Schultz 2016 §7.3; the page-table
 // scheme of ImageVis3D and Neuroglancer). Valid GLSL ES 1.00 and 3.00.
 //
-// The page table has one RGBA8 texel per level-0 brick cell c (texel
-// (c.x, c.y + c.z * cells.y), NEAREST): rgb = the atlas slot and a = the
+// The page table has one RGBA8 texel per level-0 brick cell c, NEAREST, its
+// z-slices side by side as tiles of cells.x x cells.y texels, u_layoutPageTiles
+// per row (MosaicLayout::Geometry's addressing: texel (c.x + (c.z % tiles) *
+// cells.x, c.y + floor(c.z / tiles) * cells.y), so the table fits the 2D
+// limit however deep the grid; pageTexel below): rgb = the atlas slot and a = the
 // level l of the finest resident brick that covers the cell (the CPU falls
 // back to coarser levels when finer bricks are missing, so there are no
 // holes), or a = 255 when the cell is known to be transparent, with r the
@@ -75,6 +79,7 @@ uniform vec3 u_layoutDims0;        // level-0 voxels
 uniform float u_layoutBrick;       // B
 uniform vec3 u_layoutCells;        // level-0 brick cells
 uniform vec2 u_layoutPagesInv;     // 1 / page table size
+uniform float u_layoutPageTiles;   // page table: z-slice tiles per row
 uniform vec3 u_layoutAtlasTexels;  // atlas (3D) size in texels
 uniform vec3 u_layoutLevelShrink[BRICKS_LEVELS];  // 1 / s_l per level (see above)
 
@@ -148,14 +153,21 @@ struct BrickPage {
   float isConstant;
 };
 
+// The page table texel of level-0 cell `cell` (whole numbers, exact in
+// float: the table is at most the 2D limit on a side).
+vec2 pageTexel(vec3 cell) {
+  float row = floor((cell.z + 0.5) / u_layoutPageTiles);
+  float col = cell.z - row * u_layoutPageTiles;
+  return cell.xy + vec2(col, row) * u_layoutCells.xy;
+}
+
 // The page of the level-0 cell holding x0 (level-0 voxels, inside the volume).
 BrickPage brickPage(vec3 x0) {
   vec3 cell = min(floor(x0 / u_layoutBrick), u_layoutCells - 1.0);
 #if TESSERA_GLSL == 300
-  vec4 page = texelFetch(u_layoutPages, ivec2(cell.x, cell.y + cell.z * u_layoutCells.y), 0);
+  vec4 page = texelFetch(u_layoutPages, ivec2(pageTexel(cell)), 0);
 #else
-  vec4 page = TEX2D(u_layoutPages,
-                    (vec2(cell.x, cell.y + cell.z * u_layoutCells.y) + 0.5) * u_layoutPagesInv);
+  vec4 page = TEX2D(u_layoutPages, (pageTexel(cell) + 0.5) * u_layoutPagesInv);
 #endif
   vec4 e = floor(page * 255.0 + 0.5);
   BrickPage b;
@@ -257,6 +269,36 @@ vec3 layoutWalkCellsPerUnit() {
   return u_layoutDims0 / u_layoutBrick;
 }
 
+#if BRICKS_WALK_PAGES
+// ES 3, filtered atlas, a pyramid of equal factors per axis: a float page
+// per cell holds the walk's map directly, xyz = the offset into the atlas
+// (normalised), w = 1 / s_l (0: a transparent cell, x its constant).
+uniform highp sampler2D u_layoutWalkPages;
+uniform vec3 u_layoutWalkScale0;  // level-0 voxels / atlas texels
+float walkConstant;
+float walkIsConstant;
+
+vec3 layoutEnterCell(vec3 p) {
+  vec3 x0 = clamp(p, 0.0, 1.0) * u_layoutDims0;
+  vec3 cell = min(floor(x0 / u_layoutBrick), u_layoutCells - 1.0);
+  vec4 w = texelFetch(u_layoutWalkPages, ivec2(pageTexel(cell)), 0);
+  walkIsConstant = step(w.w, 0.0);
+  walkConstant = w.x;
+  walkScale = u_layoutWalkScale0 * w.w;
+  walkOffset = w.xyz;
+  return cell;
+}
+
+float layoutCellTransparent() {
+  return walkIsConstant;
+}
+
+float sampleVolumeInCell(vec3 p) {
+  return mix(BRICKS_VALUE(texture(u_layoutAtlas, p * walkScale + walkOffset)), walkConstant,
+             walkIsConstant);
+}
+#else
+
 // Reads the page of the cell holding p; returns the cell.
 vec3 layoutEnterCell(vec3 p) {
   vec3 x0 = clamp(p, 0.0, 1.0) * u_layoutDims0;
@@ -282,4 +324,5 @@ float sampleVolumeInCell(vec3 p) {
   return brickValue(walkPage, p * walkPage.scale + walkPage.offset);
 #endif
 }
+#endif
 #endif

@@ -8,7 +8,7 @@
 namespace tessera::lod {
 
 ZarrMultiresSource::ZarrMultiresSource(std::shared_ptr<const ZarrStore> store)
-    : store_(std::move(store)) {}
+    : store_(std::move(store)), wanted_(store_->chunkCacheBytes()) {}
 
 std::uint64_t ZarrMultiresSource::decodedChunkBudget(const ZarrStore& store,
                                                      std::uint64_t hostBudget) {
@@ -19,9 +19,10 @@ std::uint64_t ZarrMultiresSource::decodedChunkBudget(const ZarrStore& store,
 std::unique_ptr<ZarrMultiresSource> ZarrMultiresSource::open(const std::string& spec,
                                                              ZarrSelection selection) {
   // Bricks read with an apron touch their neighbours' chunks: keep the
-  // stored bytes of the last few MiB of chunks (a fixed overhead beside the
-  // host budget's brick cache; compressed, so many chunks), for a chunk the
-  // decoded cache let go and a server would be asked for again.
+  // stored bytes of the last few MiB of chunks (inside the bricks layout's
+  // fixed overhead; compressed, so many chunks), for a chunk the decoded
+  // cache let go and a server would be asked for again. The decoded chunks
+  // are what the bricks layout then limits to its share of the host budget.
   constexpr std::uint64_t kChunkCacheBytes = 8ull << 20;
   auto storage = std::make_shared<const CachedStorage>(openZarrStorage(spec), kChunkCacheBytes);
   auto store = std::make_shared<ZarrStore>(std::move(storage), selection);

@@ -21,17 +21,52 @@ std::uint8_t toByte(double v) {
 
 using ChannelValues = std::array<double, ChannelSet::kMaxChannels>;
 
+// Channel i's raw value at p: its own volume's trilinear field, or with
+// `levels` the level p's cell shows.
+double rawAt(const ChannelSet& set, const ChannelLevels* levels, int i, glm::dvec3 p) {
+  if (!levels) return sampleTrilinear(*set[i].volume, p);
+  const auto l = static_cast<std::size_t>(levels->cells.levelAt(p));
+  return sampleLevel(*levels->volumes[static_cast<std::size_t>(i)][l], levels->scales[l],
+                     levels->cells.finestDims, p);
+}
+
 // n_i = clamp((v_i - lo_i) / (hi_i - lo_i), 0, 1); 0 for a hidden channel.
-ChannelValues normalisedAt(const ChannelSet& set, glm::dvec3 p) {
+ChannelValues normalisedAt(const ChannelSet& set, const ChannelLevels* levels, glm::dvec3 p) {
   ChannelValues n{};
   for (int i = 0; i < set.size(); ++i) {
     const Channel& c = set[i];
     if (!c.visible) continue;
     n[static_cast<std::size_t>(i)] = std::clamp(
-        (sampleTrilinear(*c.volume, p) - c.window.min) / (c.window.max - c.window.min), 0.0, 1.0);
+        (rawAt(set, levels, i, p) - c.window.min) / (c.window.max - c.window.min), 0.0, 1.0);
   }
   return n;
 }
+
+// Every cell's level is held for every channel.
+void checkLevels(const ChannelSet& set, const ChannelLevels& levels) {
+  const std::vector<int> n = levels.cells.cellsPerLevel();
+  if (n.back() > 0) {
+    throw InputError("channel reference: " + std::to_string(n.back()) +
+                     " cells are transparent constants, which channel frames do not have");
+  }
+  if (levels.volumes.size() != static_cast<std::size_t>(set.size())) {
+    throw InputError("channel reference: levels for " + std::to_string(levels.volumes.size()) +
+                     " channels, the set has " + std::to_string(set.size()));
+  }
+  for (std::size_t l = 0; l + 1 < n.size(); ++l) {
+    if (n[l] == 0) continue;
+    for (const auto& perLevel : levels.volumes) {
+      if (l >= perLevel.size() || !perLevel[l] || l >= levels.scales.size()) {
+        throw InputError("channel reference: " + std::to_string(n[l]) + " cells show level " +
+                         std::to_string(l) + ", which is not read");
+      }
+    }
+  }
+}
+
+Image render(const ChannelSet& set, const ChannelLevels* levels, const TransferFunction& tf,
+             const Camera& camera, const RenderSettings& settings, int width, int height,
+             int threads);
 
 }  // namespace
 
@@ -53,6 +88,21 @@ ChannelSample combineChannels(const ChannelSet& channels, const double* opacitie
 Image renderChannelsReference(const ChannelSet& set, const TransferFunction& tf,
                               const Camera& camera, const RenderSettings& settings, int width,
                               int height, int threads) {
+  return render(set, nullptr, tf, camera, settings, width, height, threads);
+}
+
+Image renderChannelsReference(const ChannelSet& set, const ChannelLevels& levels,
+                              const TransferFunction& tf, const Camera& camera,
+                              const RenderSettings& settings, int width, int height, int threads) {
+  checkLevels(set, levels);
+  return render(set, &levels, tf, camera, settings, width, height, threads);
+}
+
+namespace {
+
+Image render(const ChannelSet& set, const ChannelLevels* levels, const TransferFunction& tf,
+             const Camera& camera, const RenderSettings& settings, int width, int height,
+             int threads) {
   if (width <= 0 || height <= 0) throw InputError("reference: image size must be positive");
   const Volume& box = set.geometry();
   const glm::dvec3 extent = box.extent();
@@ -77,7 +127,7 @@ Image renderChannelsReference(const ChannelSet& set, const TransferFunction& tf,
         for (double k = 0.0; t0 < t1 && k < settings.maxSteps; k += 1.0) {
           const double t = t0 + (k + j) * ds;
           if (t >= t1) break;
-          const ChannelValues n = normalisedAt(set, to + t * td);
+          const ChannelValues n = normalisedAt(set, levels, to + t * td);
           any = true;
           if (max) {
             for (std::size_t i = 0; i < peak.size(); ++i) peak[i] = std::max(peak[i], n[i]);
@@ -114,5 +164,7 @@ Image renderChannelsReference(const ChannelSet& set, const TransferFunction& tf,
   for (auto& t : pool) t.join();
   return image;
 }
+
+}  // namespace
 
 }  // namespace tessera

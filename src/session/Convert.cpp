@@ -33,6 +33,22 @@ glm::ivec3 parseChunkShape(const std::string& text) {
   return {zyx[2], zyx[1], zyx[0]};
 }
 
+// "Z,Y,X", each 1 or 2, at least one 2; returned as x, y, z.
+glm::ivec3 parsePyramidFactors(const std::string& text) {
+  const std::string what = "--pyramid-factors '" + text +
+                           "': expected Z,Y,X each 1 (axis kept) or 2 (halved), at least one 2 "
+                           "(e.g. 1,2,2 keeps z)";
+  if (text.size() != 5 || text[1] != ',' || text[3] != ',') throw InputError(what);
+  glm::ivec3 f;
+  for (int a = 0; a < 3; ++a) {
+    const char c = text[std::size_t(2 * a)];
+    if (c != '1' && c != '2') throw InputError(what);
+    f[2 - a] = c - '0';
+  }
+  if (f == glm::ivec3(1)) throw InputError(what);
+  return f;
+}
+
 }  // namespace
 
 glm::ivec3 parseDownsample(const std::string& text) {
@@ -112,6 +128,7 @@ OmeZarrWriteOptions zarrWriteOptions(const ConvertRequest& o) {
   }
   z.zarrFormat = o.zarrFormat;
   z.shard = o.shard;
+  z.factors = parsePyramidFactors(o.pyramidFactors);
   return z;
 }
 

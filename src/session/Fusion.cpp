@@ -155,14 +155,22 @@ Overlay openOverlay(const std::string& spec, const OverlayOptions& options, cons
   return makeOverlay(std::move(volume), spec, options, anatomy);
 }
 
-ProbeResult probe(const Volume& anatomy, const Overlay* overlay, glm::dvec3 worldMm) {
+namespace {
+
+// The voxel of `shape` a position lies in.
+glm::ivec3 voxelOf(const ProbeResult& r) {
+  return glm::ivec3(glm::floor(r.anatomyIndex + 0.5));
+}
+
+// The probe but the anatomy's value: positions in `shape` (its voxels are
+// not read) and the overlay's reading.
+ProbeResult probeShape(const Volume& shape, const Overlay* overlay, glm::dvec3 worldMm) {
   ProbeResult r;
   r.worldMm = worldMm;
-  r.anatomyIndex = indexOfWorld(anatomy, worldMm);
-  const glm::ivec3 d = anatomy.dims();
-  const glm::ivec3 i(glm::floor(r.anatomyIndex + 0.5));  // the voxel the position lies in
-  r.inAnatomy = glm::all(glm::greaterThanEqual(i, glm::ivec3(0))) && glm::all(glm::lessThan(i, d));
-  if (r.inAnatomy) r.anatomyValue = anatomy.finiteValueAtIndex(anatomy.index(i.x, i.y, i.z));
+  r.anatomyIndex = indexOfWorld(shape, worldMm);
+  const glm::ivec3 i = voxelOf(r);
+  r.inAnatomy =
+      glm::all(glm::greaterThanEqual(i, glm::ivec3(0))) && glm::all(glm::lessThan(i, shape.dims()));
   if (!overlay || !overlay->fused) return r;
   const FusedVolume& f = *overlay->fused;
   r.hasOverlay = true;
@@ -176,6 +184,35 @@ ProbeResult probe(const Volume& anatomy, const Overlay* overlay, glm::dvec3 worl
     const auto it = overlay->labels.labels.find(r.label);
     if (it != overlay->labels.labels.end()) r.labelName = it->second.name;
   }
+  return r;
+}
+
+}  // namespace
+
+ProbeResult probe(const Volume& anatomy, const Overlay* overlay, glm::dvec3 worldMm) {
+  ProbeResult r = probeShape(anatomy, overlay, worldMm);
+  const glm::ivec3 i = voxelOf(r);
+  if (r.inAnatomy) r.anatomyValue = anatomy.finiteValueAtIndex(anatomy.index(i.x, i.y, i.z));
+  return r;
+}
+
+ProbeResult probe(const lod::MultiresSource& anatomy, const Overlay* overlay, glm::dvec3 worldMm) {
+  const Volume& shape = anatomy.shape();
+  ProbeResult r = probeShape(shape, overlay, worldMm);
+  if (!r.inAnatomy) return r;
+  const glm::ivec3 i = voxelOf(r);
+  lod::VoxelBox box{i, i + 1};
+  int level = 0;
+  if (!anatomy.prefetch(0, box)) {
+    // The coarsest level's voxel holding the same point (levels need not halve).
+    level = anatomy.levelCount() - 1;
+    const glm::ivec3 dl = anatomy.levelInfo(level).dims;
+    const glm::ivec3 c =
+        glm::clamp(glm::ivec3((glm::dvec3(i) + 0.5) * glm::dvec3(dl) / glm::dvec3(shape.dims())),
+                   glm::ivec3(0), dl - 1);
+    box = {c, c + 1};
+  }
+  r.anatomyValue = anatomy.readBox(level, box).finiteValueAtIndex(0);
   return r;
 }
 

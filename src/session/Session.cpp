@@ -349,7 +349,7 @@ void Session::setOverlay(Overlay overlay) {
 
 void Session::restyleOpenOverlay(const OverlayOptions& options) {
   if (!overlay_) throw InputError("no overlay is open");
-  setOverlay(restyleOverlay(*overlay_, options, shape()));
+  setOverlay(restyleOverlay(*overlay_, options, overlayAnatomy()));
 }
 
 void Session::clearOverlay() {
@@ -358,9 +358,11 @@ void Session::clearOverlay() {
 }
 
 ProbeResult Session::probe(glm::dvec3 worldMm) const {
+  if (drawn_) return session::probe(*drawn_, overlay_.get(), worldMm);  // the page's store
   // Explored in the view (openInView): its overview holds the values.
   if (!inCore_ && exploration_)
     return session::probe(*exploration_->overview(), overlay_.get(), worldMm);
+  if (streamed_) return session::probe(*streamed_, overlay_.get(), worldMm);
   return session::probe(volume(), overlay_.get(), worldMm);
 }
 

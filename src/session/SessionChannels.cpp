@@ -4,9 +4,11 @@
 // reference.
 #include <chrono>
 #include <cstdio>
+#include <optional>
 
 #include "tessera/io/ZarrChannels.h"
 #include "tessera/layout/ChannelLayouts.h"
+#include "tessera/layout/StreamingLayout.h"
 #include "tessera/lod/InCoreMultiresSource.h"
 #include "tessera/lod/ReadLevel.h"
 #include "tessera/lod/ZarrMultiresSource.h"
@@ -59,29 +61,43 @@ layout::ChannelSources channelSources(const std::string& spec, std::vector<int> 
   };
 }
 
-// The finest level a streamed frame shows (the reference renders it, as for
-// one volume): -1 when every cell is transparent.
-int shownLevel(const layout::BricksFrame& f) {
-  for (std::size_t l = 0; l + 1 < f.cellsPerLevel.size(); ++l) {
-    if (f.cellsPerLevel[l] > 0) return static_cast<int>(l);
-  }
-  return -1;
-}
-
-// The channels at pyramid level `level` of the layout's sources, with the
-// set's colours, windows and visibility.
-ChannelSet channelsAtLevel(const ChannelSet& set,
-                           const std::vector<std::shared_ptr<const lod::MultiresSource>>& sources,
-                           int level) {
-  ChannelSet out;
-  out.mode = set.mode;
+// The levels the refined frame shows, per level-0 cell (the page table
+// as drawn), each read whole from the layout's sources: level 0 is the
+// set's own channels. What the reference of a frame that mixes levels reads.
+ChannelLevels levelsShown(const ChannelSet& set,
+                          const std::vector<std::shared_ptr<const lod::MultiresSource>>& sources,
+                          const layout::StreamingLayout& bricks) {
+  const lod::BrickGrid& grid = bricks.grid();
+  ChannelLevels out;
+  out.cells.finestDims = grid.dims(0);
+  out.cells.brickSize = grid.brickSize();
+  out.cells.cells = grid.bricks(0);
+  out.cells.levels = bricks.cellLevels();
+  const std::vector<int> shown = out.cells.cellsPerLevel();
+  for (int l = 0; l < grid.levelCount(); ++l) out.scales.push_back(grid.scale(l));
   for (int c = 0; c < set.size(); ++c) {
-    Channel ch = set[c];
-    ch.volume =
-        std::make_shared<Volume>(lod::readLevel(*sources[static_cast<std::size_t>(c)], level));
-    out.add(ch);
+    std::vector<std::shared_ptr<const Volume>> levels(static_cast<std::size_t>(grid.levelCount()));
+    for (std::size_t l = 0; l + 1 < shown.size(); ++l) {
+      if (shown[l] == 0) continue;
+      levels[l] = l == 0 ? set[c].volume
+                         : std::make_shared<const Volume>(lod::readLevel(
+                               *sources[static_cast<std::size_t>(c)], static_cast<int>(l)));
+    }
+    out.volumes.push_back(std::move(levels));
   }
   return out;
+}
+
+// "L0:528 L1:1264": the cells per level a frame shows.
+std::string levelsText(const std::vector<int>& cellsPerLevel) {
+  std::string text;
+  for (std::size_t l = 0; l + 1 < cellsPerLevel.size(); ++l) {
+    if (cellsPerLevel[l] == 0) continue;
+    text +=
+        (text.empty() ? "L" : " L") + std::to_string(l) + ":" + std::to_string(cellsPerLevel[l]);
+  }
+  if (cellsPerLevel.back() > 0) text += " empty:" + std::to_string(cellsPerLevel.back());
+  return text;
 }
 
 // The technique the settings name, when it draws channels: InputError
@@ -125,7 +141,7 @@ ChannelFrame Session::renderChannels(const std::string& spec, int width, int hei
                      "where the channels fit in core");
   }
   const auto t0 = std::chrono::steady_clock::now();
-  int level = 0;
+  std::optional<ChannelLevels> levels;  // a streamed frame's, read after it is drawn
   {
     render::TechniqueOptions options = s.techniqueOptions({width, height});
     options.skipBlock = 0;  // the block grid is one volume's
@@ -134,27 +150,29 @@ ChannelFrame Session::renderChannels(const std::string& spec, int width, int hei
     technique->setTransferFunction(s.tf);
     RenderSettings render = s.render;
     render.mode = renderModeFor(set.mode);
-    if (layout::StreamingLayout* bricks = layout->streaming()) {
+    layout::StreamingLayout* bricks = layout->streaming();
+    if (bricks) {
       // Refined before it is drawn (one frame, not a progressive view).
       const RefineRun r = BrickRefinement(*bricks).refine(camera, width, height, s.tf, [] {},
                                                           {});  // one frame: drawn once refined
-      level = std::max(0, shownLevel(r.last));
-      frame.layout += "; refined in " + std::to_string(r.frames) + " frames, page cells per level";
-      for (std::size_t l = 0; l < r.last.cellsPerLevel.size(); ++l) {
-        frame.layout += " L" + std::to_string(l) + ":" + std::to_string(r.last.cellsPerLevel[l]);
-      }
-      frame.layout += "; the reference: level " + std::to_string(level) +
-                      (r.last.limitedByBudget ? ", atlas full" : "");
+      frame.layout += "; refined in " + std::to_string(r.frames) + " frames, page cells " +
+                      levelsText(r.last.cellsPerLevel) +
+                      (r.last.limitedByBudget ? " (atlas full)" : "");
     }
     frame.image = technique->renderImage(camera, render, width, height);
+    if (bricks && reference) {
+      levels = levelsShown(set, sources, *bricks);
+      frame.layout += levels->cells.mixed()
+                          ? "; the reference reads each cell's level, as the frame does"
+                          : "; the reference reads the level the frame shows";
+    }
   }
   frame.gpuMs = msSince(t0);
   if (reference) {
     const auto t1 = std::chrono::steady_clock::now();
-    frame.reference = level == 0
-                          ? renderChannelsReference(set, s.tf, camera, s.render, width, height)
-                          : renderChannelsReference(channelsAtLevel(set, sources, level), s.tf,
-                                                    camera, s.render, width, height);
+    frame.reference =
+        levels ? renderChannelsReference(set, *levels, s.tf, camera, s.render, width, height)
+               : renderChannelsReference(set, s.tf, camera, s.render, width, height);
     frame.referenceMs = msSince(t1);
     frame.psnr = psnr(frame.image, *frame.reference);
   }

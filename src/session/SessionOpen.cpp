@@ -199,7 +199,7 @@ void Session::openSeries(const std::string& spec, const OpenOptions& options) {
 // A named file, like the volumes above (the web build has the page's own:
 // frontends/web/src/WebSessionOverlay.cpp).
 void Session::openOverlay(const std::string& spec, const OverlayOptions& options) {
-  setOverlay(session::openOverlay(spec, options, shape()));
+  setOverlay(session::openOverlay(spec, options, overlayAnatomy()));
 }
 
 }  // namespace tessera::session

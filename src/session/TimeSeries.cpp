@@ -134,10 +134,38 @@ void TimeSeries::rethrowFailure(int t) const {
 bool TimeSeries::pump() {
   if (mode_ != Reading::OnPump) return false;
   std::unique_lock lock(mutex_);
-  const int next = nextToRead();
-  if (next < 0) return false;
-  readOne(next, lock);
-  return true;
+  if (!arrived_) {
+    const int next = nextToRead();
+    if (next < 0) return false;
+    readOne(next, lock);
+    return true;
+  }
+  // In the order wanted: the first at hand is read; those before it are
+  // asked for, up to `ahead` of them (a copy: the reader may not move the
+  // window, but the list must not change under the loop).
+  int asked = 0;
+  for (const int t : std::vector<int>(wanted_)) {
+    if (held_.count(t) || failed_.count(t)) continue;
+    if (arrived_(t)) {
+      readOne(t, lock);
+      return true;
+    }
+    if (++asked >= ahead_) break;
+  }
+  return false;
+}
+
+void TimeSeries::setArrival(Arrival arrived, int ahead) {
+  if (mode_ != Reading::OnPump) {
+    throw InputError("time series: an arrival applies to a series read on pump()");
+  }
+  if (ahead < 1 || ahead > keep_) {
+    throw InputError("time series: asking " + std::to_string(ahead) +
+                     " time points ahead, expected 1.." + std::to_string(keep_));
+  }
+  std::lock_guard lock(mutex_);
+  arrived_ = std::move(arrived);
+  ahead_ = ahead;
 }
 
 void TimeSeries::work() {

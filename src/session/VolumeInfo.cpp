@@ -7,6 +7,7 @@
 #include "tessera/core/Histogram.h"
 #include "tessera/core/PatientFrame.h"
 #include "tessera/io/DicomSeriesReader.h"
+#include "tessera/io/DicomWeb.h"
 #include "tessera/io/ZarrStore.h"
 
 namespace tessera::session {
@@ -70,11 +71,13 @@ nlohmann::json volumeInfo(const std::string& spec, const Volume& v, int time, in
   }
   // A DICOM folder may hold several series: listed so that --series can pick.
   std::error_code ec;
-  // A DICOM folder, or a file of a DICOM series: the series (and stacks)
-  // there, each with the --series value that selects it.
-  if (std::filesystem::is_directory(spec, ec) || (std::filesystem::is_regular_file(spec, ec) &&
-                                                  v.description().starts_with("DICOM series "))) {
-    const std::vector<DicomSeriesInfo> series = listDicomSeries(spec);
+  // A DICOM folder, a file of a DICOM series or a DICOMweb series URL: the
+  // series (and stacks) there, each with the --series value that selects it.
+  if (std::filesystem::is_directory(spec, ec) || isDicomWebSeriesUrl(spec) ||
+      (std::filesystem::is_regular_file(spec, ec) &&
+       v.description().starts_with("DICOM series "))) {
+    const std::vector<DicomSeriesInfo> series =
+        isDicomWebSeriesUrl(spec) ? listDicomWebSeries(spec) : listDicomSeries(spec);
     if (!series.empty()) {
       j["dicom_series"] = nlohmann::json::array();
       for (const auto& s : series) {

@@ -20,11 +20,13 @@
 import { test } from 'node:test';
 import fs from 'node:fs';
 import path from 'node:path';
-import { SIZE, check, snapshot, openPage, withoutOverlays, differingPixels, browserSuite, run, site, shots } from './fixture.mjs';
+import { execFileSync } from 'node:child_process';
+import { SIZE, check, snapshot, openPage, withoutOverlays, differingPixels, browserSuite, run, site, shots, root } from './fixture.mjs';
 import { orthancMissing, startOrthanc, serveWithArchive, makeSeries } from './orthanc.mjs';
 
 const checks = browserSuite();
 test('a series from Orthanc through ?dicomweb= equals the folder read natively; errors name the URL', checks(dicomWeb));
+test('Enhanced CT (native, RLE, JPEG-LS) dropped and from Orthanc equals the native read; a two-stack object offers its stacks', checks(enhanced));
 
 const [COLS, ROWS, SLICES] = [64, 64, 40];
 const KINDS = ['jpeg-lossless', 'j2k-lossless', 'htj2k-lossless'];
@@ -177,4 +179,196 @@ async function dicomWeb(context, url, tmp) {
     web.server.close();
     await orthanc.stop();
   }
+}
+
+// Multi-frame objects in the page (tests/io/make_multiframe.py): the marked
+// head (90x108x90) as one Enhanced CT object, native, RLE Lossless (two
+// fragments per frame, a Basic Offset Table) and JPEG-LS lossless (DCMTK's
+// dcmcjpls; decoded by dicom-codecs.js), its frames stored in reverse
+// z order and placed by their functional groups; and an Enhanced MR object
+// of two stacks (axial "1", 24 frames, 100 + z; sagittal "2", 20 frames,
+// 200 + z). Each is dropped on the page as a folder and opened from Orthanc
+// through ?dicomweb=; the page's module reads them with the native reader's
+// functional-group code (io/DicomMultiFrame.cpp). Checked against the CLI's
+// read of the same file: dims and affine equal `tessera info --json`'s,
+// every voxel equal to `tessera convert FILE x.nii`'s (hashed), the renders
+// of the dropped and DICOMweb Enhanced CT (native, JPEG-LS) identical; the two-stack object
+// lists both stacks (dropped and from the archive) and the other is chosen
+// from the list, equal to `--series UID:2`.
+async function enhanced(context, url, tmp) {
+  const missing = orthancMissing();
+  if (missing) { console.log(`skipped: ${missing}`); return; }
+  const t0 = Date.now();
+  const mf = path.join(tmp, 'mf');
+  execFileSync('/usr/bin/python3', [path.join(root, 'tests/io/make_multiframe.py'), mf], { stdio: 'ignore' });
+  // The same object JPEG-LS lossless (DCMTK's dcmcjpls, one fragment per
+  // frame) as a series of its own: its frames take the page's codec path
+  // (dicom-codecs.js) dropped and from the archive.
+  execFileSync('dcmcjpls', ['+ua', path.join(mf, 'enhanced.dcm'), path.join(mf, 'enhanced-jls.dcm')], { stdio: 'ignore' });
+  execFileSync('dcmodify', ['-nb', '-m', '(0020,000e)=1.2.826.0.1.3680043.10.543.77.29', path.join(mf, 'enhanced-jls.dcm')], { stdio: 'ignore' });
+  const objects = ['enhanced.dcm', 'enhanced-rle.dcm', 'enhanced-jls.dcm', 'twostack.dcm'];
+  const RENDERED = ['enhanced.dcm', 'enhanced-jls.dcm'];
+  const folders = {};
+  for (const name of objects) {
+    folders[name] = path.join(tmp, 'upload', name.replace('.dcm', ''));
+    fs.mkdirSync(folders[name], { recursive: true });
+    fs.copyFileSync(path.join(mf, name), path.join(folders[name], name));
+  }
+  // The native reads: geometry, and every voxel through a NIfTI.
+  const native = {};
+  for (const name of objects) {
+    const file = path.join(folders[name], name);
+    const info = JSON.parse(run('info', '--json', file));
+    const stacks = info.dicom_series.map((s) => s.select);
+    native[name] = { info, stacks, ...niftiVoxels(file, path.join(tmp, `${name}.nii`)) };
+    if (name === 'twostack.dcm') {
+      native.stack2 = { info: JSON.parse(run('info', '--json', '--series', stacks[1], file)),
+        ...niftiVoxels(file, path.join(tmp, 'stack2.nii'), stacks[1]) };
+    }
+  }
+  const tNative = Date.now();
+  const orthanc = await startOrthanc(path.join(tmp, 'orthanc-mf'));
+  const web = await serveWithArchive(site, () => orthanc.root);
+  try {
+    for (const name of objects) await orthanc.upload(folders[name]);
+    const tStored = Date.now();
+    const { page, logs } = await openPage(context, web.url, 'size=128&dicomweb=/dicom-web');
+    await withoutOverlays(page);
+    const rows = await page.evaluate(() => window.tessera.dicomweb.list());
+    const compare = async (label, want, name, render = false) => {
+      const tc = Date.now();
+      const state = await page.evaluate(() => window.tessera.state());
+      // Every voxel, hashed in the page (FNV-1a over the doubles' bytes, as
+      // niftiVoxels hashes the CLI's): a transfer of 0.9 M numbers would
+      // take longer than the read.
+      const [nx, ny, nz] = want.info.dims;
+      const v = await page.evaluate(([nx, ny, nz, hashText]) => {
+        const value = window.tessera.viewer().module.cwrap('tessera_voxel_value', 'number', ['number', 'number', 'number']);
+        const out = new Float64Array(nx * ny * nz);
+        for (let z = 0, i = 0; z < nz; z++) for (let y = 0; y < ny; y++) for (let x = 0; x < nx; x++, i++) out[i] = value(x, y, z);
+        // eslint-disable-next-line no-new-func
+        return { hash: new Function(`return ${hashText}`)()(out), count: out.length };
+      }, [nx, ny, nz, fnv1a.toString()]);
+      const affine = state.affine.every((row, r) => row.every((x, c) => Math.abs(x - want.info.affine[r][c]) < 1e-9));
+      const tv = Date.now();
+      let pixels = null;
+      if (render) {
+        await page.evaluate(() => window.tessera.render());
+        pixels = (await snapshot(page)).pixels;
+      }
+      check(`${label}: dims and affine as \`tessera info --json\`, every voxel as the CLI's read`,
+            state.dims.join('x') === want.info.dims.join('x') && affine && v.hash === want.hash && v.count === want.count,
+            `${name}: dims ${state.dims.join('x')} (CLI ${want.info.dims.join('x')}), affine ${affine ? 'equal' : JSON.stringify(state.affine)}, ` +
+            `${v.count} voxels hashed ${v.hash} (CLI ${want.count}: ${want.hash}); read in ${tv - tc} ms${render ? `, rendered in ${Date.now() - tv} ms` : ''}`);
+      return pixels;
+    };
+    const dropped = {};
+    for (const name of objects) {
+      const t = Date.now();
+      await dropFolder(page, folders[name]);
+      await page.waitForFunction((n) => window.tessera.state().name.endsWith(n) || window.tessera.error() !== '', name, { timeout: 30000 });
+      const error = await page.evaluate(() => window.tessera.error());
+      check(`${name} dropped as a folder opens`, error === '', error);
+      const ms = Date.now() - t;
+      // Rendered (small, SwiftShader is slow) for the native and the
+      // decoded-in-the-page objects: the DICOMweb read must look the same.
+      dropped[name] = await compare(`${name} dropped (${ms} ms)`, native[name], name, RENDERED.includes(name));
+      if (name === 'twostack.dcm') {
+        const found = await page.evaluate(() => window.tessera.dicomStacks.state());
+        check('the dropped two-stack object lists its two stacks (as `tessera info`), the larger shown, the list visible',
+              JSON.stringify(found.series.map((s) => s.select)) === JSON.stringify(native[name].stacks) &&
+              found.read === native[name].stacks[0] && (await page.isVisible('#dicom-stacks')),
+              JSON.stringify(found));
+        await page.selectOption('#dicom-stacks select', native[name].stacks[1]);
+        await page.waitForFunction((s) => window.tessera.dicomStacks.state().read === s || window.tessera.error() !== '', native[name].stacks[1], { timeout: 30000 });
+        await compare('stack 2 chosen from the list (dropped)', native.stack2, `${name} ${native[name].stacks[1]}`);
+      }
+    }
+    for (const name of objects) {
+      const uid = native[name].info.dicom_series[0].series_instance_uid;
+      const row = rows.find((r) => r.series === uid);
+      check(`${name} is listed by the DICOMweb table`, !!row, rows.map((r) => r.series).join());
+      if (!row) continue;
+      const stats = await page.evaluate((a) => window.tessera.dicomweb.open(a[0], a[1]).then((s) => s, (e) => ({ error: e.message })), [row.study, uid]);
+      const nz = native[name].info.dims[2];
+      const frames = name === 'twostack.dcm' ? 44 : nz;
+      check(`${name} from Orthanc: the metadata and its ${frames} frames 64 to a request, ${stats.syntaxes} as stored`,
+            !stats.error && stats.frames === frames && stats.requests === 1 + Math.ceil(frames / 64) && stats.multiFrame === 1,
+            stats.error || `${stats.frames} frames, ${(stats.bytes / 1024).toFixed(0)} KiB in ${stats.requests} requests, ${stats.ms.toFixed(0)} ms ` +
+            `(metadata ${stats.metadataMs.toFixed(0)} ms, frames ${stats.framesMs.toFixed(0)} ms, open ${stats.openMs.toFixed(0)} ms)`);
+      if (stats.error) continue;
+      const pixels = await compare(`${name} from Orthanc`, native[name], name, !!dropped[name]);
+      if (pixels) {
+        const differing = differingPixels(pixels, dropped[name], 0);
+        check(`${name}: the render from Orthanc is identical to the render of the dropped file`, differing === 0, `${differing} pixels differ`);
+      }
+      if (name === 'twostack.dcm') {
+        const found = await page.evaluate(() => window.tessera.dicomStacks.state());
+        check('the two-stack series from Orthanc lists its two stacks', JSON.stringify(found.series.map((s) => s.select)) === JSON.stringify(native[name].stacks),
+              JSON.stringify(found));
+        await page.selectOption('#dicom-stacks select', native[name].stacks[1]);
+        await page.waitForFunction((s) => window.tessera.dicomStacks.state().read === s || window.tessera.error() !== '', native[name].stacks[1], { timeout: 30000 });
+        await compare('stack 2 chosen from the list (from Orthanc)', native.stack2, `${name} ${native[name].stacks[1]}`);
+      }
+    }
+    const errors = logs.filter((l) => l.startsWith('pageerror'));
+    check('no uncaught script errors on the page', errors.length === 0, errors.join(' | '));
+    console.log(`  multi-frame: forwarded to Orthanc ${web.counts.requests} requests, ${(web.counts.bytes / 1024).toFixed(0)} KiB; ` +
+      `${Date.now() - t0} ms in all (objects and CLI reads ${tNative - t0} ms, Orthanc ${tStored - tNative} ms, page ${Date.now() - tStored} ms)`);
+    await page.close();
+  } finally {
+    web.server.close();
+    await orthanc.stop();
+  }
+}
+
+// FNV-1a (32-bit) over the bytes of a Float64Array: the voxels' identity.
+function fnv1a(values) {
+  const bytes = new Uint8Array(values.buffer, values.byteOffset, values.byteLength);
+  let h = 0x811c9dc5;
+  for (let i = 0; i < bytes.length; i++) h = Math.imul(h ^ bytes[i], 0x01000193) >>> 0;
+  return h.toString(16);
+}
+
+// The voxels of the CLI's read of `file` (`tessera convert` to an
+// uncompressed NIfTI-1: index order, x fastest): {hash, count} of their
+// values as doubles.
+function niftiVoxels(file, out, series = '') {
+  run('convert', ...(series ? ['--series', series] : []), file, out);
+  const b = fs.readFileSync(out);
+  const dv = new DataView(b.buffer, b.byteOffset, b.byteLength);
+  const n = [1, 2, 3].map((k) => dv.getInt16(40 + 2 * k, true)).reduce((a, c) => a * c, 1);
+  const type = dv.getInt16(70, true);
+  const at = Math.round(dv.getFloat32(108, true));
+  const slope = dv.getFloat32(112, true), inter = dv.getFloat32(116, true);
+  const read = { 2: [1, 'getUint8'], 4: [2, 'getInt16'], 8: [4, 'getInt32'], 16: [4, 'getFloat32'], 64: [8, 'getFloat64'], 256: [1, 'getInt8'], 512: [2, 'getUint16'] }[type];
+  if (!read) throw new Error(`${out}: NIfTI datatype ${type} not read here`);
+  const scaled = slope !== 0 && !(slope === 1 && inter === 0);
+  const values = Float64Array.from({ length: n }, (_, i) => { const x = dv[read[1]](at + i * read[0], true); return scaled ? x * slope + inter : x; });
+  return { hash: fnv1a(values), count: n };
+}
+
+// `folder` dropped on the view as a dropped directory is (webkitGetAsEntry,
+// createReader, readEntries), as dicom.test.mjs does.
+async function dropFolder(page, folder) {
+  const names = fs.readdirSync(folder).sort();
+  await page.evaluate(() => {
+    if (document.getElementById('drop-files')) return;
+    const input = Object.assign(document.createElement('input'), { type: 'file', multiple: true, id: 'drop-files' });
+    input.hidden = true;
+    document.body.appendChild(input);
+  });
+  await page.setInputFiles('#drop-files', names.map((n) => path.join(folder, n)));
+  await page.evaluate((folderName) => {
+    const files = Array.from(document.getElementById('drop-files').files);
+    const fileEntry = (f) => ({ isFile: true, isDirectory: false, name: f.name, file: (ok) => ok(f) });
+    const dir = { isFile: false, isDirectory: true, name: folderName, createReader() {
+      let given = false;
+      return { readEntries: (ok) => { const b = given ? [] : files.map(fileEntry); given = true; ok(b); } };
+    } };
+    const e = new Event('drop', { bubbles: true, cancelable: true });
+    Object.defineProperty(e, 'dataTransfer', { value: { types: ['Files'], files: [], items: [{ kind: 'file', webkitGetAsEntry: () => dir }] } });
+    document.getElementById('error').hidden = true;
+    document.getElementById('view').dispatchEvent(e);
+  }, path.basename(folder));
 }

@@ -8,6 +8,9 @@
 // dropped while ch2 is open is offered as the overlay and added; the
 // overlay's look is in the session's state (its restore: tests/session/
 // FusionStateTest.cpp); on WebGL 1 the overlay is refused with a message.
+// Over an OME-Zarr store of ch2 (`tessera convert`, drawn brick by brick):
+// the same atlas fused in the store's ray march equals `tessera render STORE
+// --layout bricks --overlay ...`, and the crosshair names both gyri.
 import { test } from 'node:test';
 import fs from 'node:fs';
 import path from 'node:path';
@@ -25,6 +28,8 @@ const have = [CH2, AAL, AAL_NAMES].every((f) => fs.existsSync(f));
 
 test('aal over ch2 in the page: the CLI\'s fused image, the crosshair names the region, a drop offers it',
   { skip: !have && 'needs mricron-data (ch2, aal)' }, checks(overlay));
+test('aal over a ch2 OME-Zarr store in the page (bricks): the CLI\'s fused image, the crosshair names the region',
+  { skip: !have && 'needs mricron-data (ch2, aal)' }, checks(overlayOverStore));
 
 // The crosshair's readout once it is at the voxel nearest `mm`.
 async function crosshairAt(page, mm) {
@@ -145,4 +150,72 @@ async function overlay(context, url, tmp) {
   await p1.page.close();
   lap('WebGL 1');
   console.log(`overlay test: ${laps.join(', ')}`);
+}
+
+// aal over a store of ch2 (written by `tessera convert`, read over fetch and
+// drawn through the bricks layout): fused in the store's ray march, aligned
+// by world coordinates with the store's level 0.
+async function overlayOverStore(context, url, tmp, run) {
+  const t0 = Date.now();
+  const store = path.join(tmp, 'ch2-overlay.ome.zarr');
+  run('convert', CH2, store);
+  const ref = path.join(tmp, 'fused-store.png');
+  const reference = promisify(execFile)(cli, ['render', store, '--layout', 'bricks', '--overlay', AAL,
+    '--overlay-labels', AAL_NAMES, '--overlay-alpha', '0.6', '--tf', 'mr-default', '--preintegrate', 'off',
+    '--azimuth', '90', '--elevation', '20', '--crop', '0:0.68,0:1,0:1', '--size', `${SIZE}x${SIZE}`,
+    '--profile', 'webgl2', '--out', ref]);
+  const { page, logs } = await openPage(context, url, `size=${SIZE}&url=/data/ch2-overlay.ome.zarr`);
+  await page.waitForFunction(() => window.tessera.zarr().completeMs !== null || window.tessera.error() !== '',
+    null, { timeout: 60000 });
+  await withoutOverlays(page);
+  await page.evaluate(async () => {
+    const menu = document.getElementById('preset');
+    menu.value = 'mr-default';
+    menu.dispatchEvent(new Event('change'));
+    const x1 = document.getElementById('cropX1');
+    x1.value = 0.68;
+    x1.dispatchEvent(new Event('input'));
+    document.getElementById('overlayAlpha').value = 0.6;
+    await window.tessera.setCamera(90, 20, 1);
+  });
+  await page.setInputFiles('#overlayFile', [AAL, AAL_NAMES]);
+  await page.waitForFunction(() => window.tessera.overlay.info().open || window.tessera.error() !== '', null, { timeout: 30000 });
+  const info = await page.evaluate(() => window.tessera.overlay.info());
+  const error = await page.evaluate(() => window.tessera.error());
+  check('"Add overlay…" over the store opens aal as labels (116 names), no error',
+        info.open && info.labels && info.labels_table.length === 116 && !error && !info.note,
+        error || `${info.file}, ${info.labels_table && info.labels_table.length} names, note "${info.note}"`);
+  // The store's frame once every brick this view wants is in.
+  await page.evaluate(() => window.tessera.render());
+  await page.waitForFunction(() => {
+    const z = window.tessera.zarr();
+    return z.last && z.last.complete && !z.last.pending && z.inFlight === 0 && z.queued === 0;
+  }, null, { timeout: 60000 });
+  await page.evaluate(() => window.tessera.render());
+  await page.waitForFunction(() => { const z = window.tessera.zarr(); return z.last && z.last.complete && !z.last.pending; },
+    null, { timeout: 60000 });
+  await reference;
+  const m = await psnrAgainst(page, ref);
+  check('over a store: the page\'s fused frame equals tessera render STORE --layout bricks --overlay aal (PSNR >= 40 dB)',
+        m.psnr >= 40, m.error || `${m.psnr.toFixed(2)} dB`);
+  const right = await crosshairAt(page, [40, -25, 52]);
+  const left = await crosshairAt(page, [-40, -25, 52]);
+  check('over a store: the crosshair at (40, -25, 52) mm names Postcentral_R, with its position',
+        /Postcentral_R/.test(right.text) && /\(40\.0, -25\.0, 52\.0\) mm/.test(right.text),
+        `voxel ${right.voxel}: "${right.text}"`);
+  check('over a store: the crosshair at (-40, -25, 52) mm names Postcentral_L (left and right not swapped)',
+        /Postcentral_L/.test(left.text) && !/Postcentral_R/.test(left.text), `voxel ${left.voxel}: "${left.text}"`);
+  // Removing it gives the store alone back.
+  await page.evaluate(() => document.getElementById('overlayRemove').click());
+  await page.waitForFunction(() => !window.tessera.overlay.info().open, null, { timeout: 10000 });
+  await page.evaluate(() => window.tessera.render());
+  await page.waitForFunction(() => { const z = window.tessera.zarr(); return z.last && z.last.complete && !z.last.pending; },
+    null, { timeout: 60000 });
+  const plain = await psnrAgainst(page, ref);
+  check('over a store: removing the overlay changes the frame (below 35 dB against the fused reference)',
+        plain.psnr < 35, plain.error || `${plain.psnr.toFixed(2)} dB`);
+  const errors = logs.filter((l) => l.startsWith('pageerror') || (l.startsWith('error') && !l.includes('favicon') && !/status of 404/.test(l)));
+  check('no script errors on the store page', errors.length === 0, errors.join(' | '));
+  await page.close();
+  console.log(`overlay over a store: ${((Date.now() - t0) / 1000).toFixed(1)} s`);
 }

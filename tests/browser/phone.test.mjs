@@ -4,7 +4,9 @@
 // and WebGL 1, drags that turn the head by the same angle per CSS pixel at
 // every pixel ratio, the frame rate of a touch drag on the head, and the
 // page's details (a file dropped anywhere opens, disabled and hidden
-// controls, the crosshair in millimetres). fixture.mjs serves the site and
+// controls, the crosshair in millimetres); the same for an OME-Zarr store
+// (a touch drag while it refines; a context loss with it open, its atlas
+// and page table rebuilt from the chunks the page holds). fixture.mjs serves the site and
 // launches Chromium; every figure is printed for the record.
 import { test } from 'node:test';
 import fs from 'node:fs';
@@ -19,6 +21,8 @@ test('WebGL context lost and restored: the same image in WebGL 2 and WebGL 1', c
 test('a drag turns the view by the same angle per CSS pixel at pixel ratios 1, 2 and 3', checks(dragAngle));
 test('touch drag on the head at 390x844, pixel ratio 3: frames per second', checks(dragFrameRate));
 test('a file dropped anywhere opens; disabled and hidden controls; crosshair in mm', checks(pageDetails));
+test('touch drag on an OME-Zarr store at 390x844, pixel ratio 3: frames per second, no freeze', checks(storeDragFrameRate));
+test('WebGL context lost and restored with an OME-Zarr store open: the same image in WebGL 2 and WebGL 1', checks(storeContextLoss));
 
 const PHONE = { width: 390, height: 844, deviceScaleFactor: 3, mobile: true };
 
@@ -96,7 +100,7 @@ async function contextLoss(context, url) {
     check(`${what}: the status line says "WebGL context lost — waiting", then "WebGL context restored"`,
           lostStatus.includes('WebGL context lost — waiting') && restoredStatus.includes('WebGL context restored'),
           `"${lostStatus}" / "${restoredStatus}"`);
-    const errors = logs.filter((l) => l.startsWith('pageerror') || (l.startsWith('error') && !l.includes('favicon')));
+    const errors = logs.filter((l) => l.startsWith('pageerror') || (l.startsWith('error') && !/favicon|status of 404/.test(l)));
     check(`${what}: no script errors around the context loss`, errors.length === 0, errors.join(' | '));
     await page.close();
   }
@@ -246,4 +250,170 @@ async function pageDetails(context, url, tmp) {
   check('the crosshair readout gives the voxel and its position in mm (the file\'s affine)', readout.every((r) => r.ok),
         readout.map((r) => `"${r.text}" (expected (${r.want}) mm)`).join('; '));
   await page.close();
+}
+
+// ch2 as an OME-Zarr store (zlib chunks) under /data/, once per run.
+function ch2Store(tmp, run) {
+  const store = path.join(tmp, 'ch2.ome.zarr');
+  if (!fs.existsSync(store)) run('convert', CH2, store, '--compressor', 'zlib');
+  return '/data/ch2.ome.zarr';
+}
+
+// Runs in the page before its scripts: when each animation-frame callback
+// that drew on the canvas (a draw, clear or blit into the default
+// framebuffer) ended, in window.drawnFrames.
+function recordDrawnFrames() {
+  window.drawnFrames = [];
+  let drew = false;
+  for (const Ctx of [window.WebGL2RenderingContext, window.WebGLRenderingContext]) {
+    if (!Ctx) continue;
+    const p = Ctx.prototype;
+    const bind = p.bindFramebuffer;
+    p.bindFramebuffer = function (target, fb) {
+      if (target !== this.READ_FRAMEBUFFER) this.drawsOnCanvas = fb === null;
+      return bind.call(this, target, fb);
+    };
+    for (const name of ['drawArrays', 'drawElements', 'clear', 'blitFramebuffer']) {
+      const f = p[name];
+      if (!f) continue;
+      p[name] = function (...args) {
+        if (this.drawsOnCanvas !== false) drew = true;
+        return f.apply(this, args);
+      };
+    }
+  }
+  const raf = window.requestAnimationFrame.bind(window);
+  window.requestAnimationFrame = (cb) => raf((ts) => {
+    drew = false;
+    try {
+      cb(ts);
+    } finally {
+      if (drew) window.drawnFrames.push(performance.now());
+    }
+  });
+}
+
+const storeStats = (page) => page.evaluate(() => window.tessera.zarr());
+
+// Frames until the store's frame on the canvas is refined (every brick the
+// view wants drawn) and nothing is being fetched; the frames it took, or 0
+// when it did not refine in 100 (or no store is open).
+async function storeRefined(page) {
+  for (let i = 0; i < 100; i++) {
+    await page.evaluate(() => window.tessera.render());
+    const z = await storeStats(page);
+    if (!z) return 0;
+    if (z.last && z.last.complete && !z.last.pending && z.inFlight === 0 && z.queued === 0) return i + 1;
+    await new Promise((r) => setTimeout(r, 100));
+  }
+  return 0;
+}
+
+// One finger drags on the store (touch events on a 60 Hz clock for 3 s)
+// right after its first image, at 390x844 and ratio 3, while its bricks
+// arrive: the frames the page shows per second and the longest time
+// without a new frame (a freeze).
+async function storeDragFrameRate(context, url, tmp, run) {
+  if (!fs.existsSync(CH2)) { check(`store drag test needs ${CH2} (mricron-data)`, false); return; }
+  const store = ch2Store(tmp, run);
+  const page = await context.newPage();
+  const logs = [];
+  page.on('console', (m) => logs.push(`${m.type()}: ${m.text()}`));
+  page.on('pageerror', (e) => logs.push(`pageerror: ${e.message}`));
+  await page.addInitScript(recordDrawnFrames);
+  await page.goto(`${url}/index.html?url=${store}`);
+  await page.evaluate(() => window.tessera.ready);
+  const cdp = await context.newCDPSession(page);
+  await cdp.send('Emulation.setDeviceMetricsOverride', PHONE);
+  await cdp.send('Emulation.setTouchEmulationEnabled', { enabled: true, maxTouchPoints: 5 });
+  await page.waitForFunction(() => { const z = window.tessera.zarr(); return z && z.firstImageMs !== null; }, null, { timeout: 60000 });
+  await page.locator('#canvas').scrollIntoViewIfNeeded();
+  const box = await page.locator('#canvas').boundingBox();
+  const backing = await page.evaluate(() => [document.getElementById('canvas').width, document.getElementById('canvas').height]);
+  const cx = Math.round(box.x + box.width / 2), cy = Math.round(box.y + box.height / 2);
+  const touch = (type, dx) => cdp.send('Input.dispatchTouchEvent', {
+    type, touchPoints: type === 'touchEnd' ? [] : [{ x: cx + dx, y: cy + Math.round(dx / 4), id: 1 }] });
+  await touch('touchStart', 0);
+  const start = await page.evaluate(() => ({ now: performance.now(), frames: window.tessera.frames() }));
+  const t = Date.now();
+  const sent = [];
+  const MOVES = 180;
+  for (let i = 0; i < MOVES; i++) {
+    sent.push(touch('touchMove', Math.round(80 * Math.sin(2 * Math.PI * i / 90))));
+    const due = t + (i + 1) * 1000 / 60;
+    if (Date.now() < due) await new Promise((r) => setTimeout(r, due - Date.now()));
+  }
+  const end = await page.evaluate(() => ({ now: performance.now(), frames: window.tessera.frames(),
+    canvas: [document.getElementById('canvas').width, document.getElementById('canvas').height] }));
+  await Promise.all(sent);
+  await touch('touchEnd', 0);
+  const z = await storeStats(page);
+  const seconds = (end.now - start.now) / 1000;
+  const fps = (end.frames - start.frames) / seconds;
+  // Animation frames that drew on the canvas, in the page's clock.
+  const drawn = await page.evaluate(() => window.drawnFrames);
+  const shown = [start.now, ...drawn.filter((at) => at > start.now && at < end.now), end.now];
+  let freeze = 0;
+  for (let i = 1; i < shown.length; i++) freeze = Math.max(freeze, shown[i] - shown[i - 1]);
+  const calls = (z.calls || []).filter((c) => c.t + (z.t0 || 0) > start.now && c.t + (z.t0 || 0) < end.now);
+  const worstCall = calls.reduce((a, c) => Math.max(a, c.ms), 0);
+  const previews = calls.filter((c) => c.preview);
+  const median = (v) => (v.length ? [...v].sort((a, b) => a - b)[Math.floor(v.length / 2)] : NaN);
+  const sizes = [...new Set(previews.map((c) => (c.preview_size || ['?']).join('x')))].slice(0, 4).join(', ');
+  console.log(`store drag at 390x844, ratio 3 (backing ${backing.join('x')}, during the drag ${end.canvas.join('x')}): ` +
+              `${fps.toFixed(1)} frames/s (${end.frames - start.frames} in ${seconds.toFixed(1)} s), longest without a frame ${freeze.toFixed(0)} ms; ` +
+              `${calls.length} store calls, worst ${worstCall.toFixed(0)} ms; ${previews.length} previews at ${sizes || 'none'}, ` +
+              `median ${median(previews.map((c) => c.ms)).toFixed(1)} ms (ray march, compose and wait ${median(previews.map((c) => c.preview_ms || 0)).toFixed(1)} ms); ` +
+              `${z.requests} requests; refined ${z.completeMs === null ? 'not yet' : `after ${z.completeMs.toFixed(0)} ms`}`);
+  check('a touch drag of a refining store at 390x844, ratio 3: >= 10 frames/s and never 500 ms without a frame',
+        fps >= 10 && freeze <= 500, `${fps.toFixed(1)} frames/s, longest gap ${freeze.toFixed(0)} ms`);
+  // A store's keys that are not there (.zattrs of a v2 array) answer 404 by design.
+  const errors = logs.filter((l) => l.startsWith('pageerror') || (l.startsWith('error') && !/favicon|status of 404/.test(l)));
+  check('store drag: no script errors', errors.length === 0, errors.join(' | '));
+  await page.close();
+}
+
+// ch2 as a store, refined at a turned view, lost and restored: the page
+// makes the store's atlas, page table and ray caster again on the new
+// context from the chunks it holds (fetching only what its cache let go),
+// refines again, and the frame equals the one before the loss; the status
+// line says so, and the view still turns.
+async function storeContextLoss(context, url, tmp, run) {
+  if (!fs.existsSync(CH2)) { check(`store context loss test needs ${CH2} (mricron-data)`, false); return; }
+  const store = ch2Store(tmp, run);
+  for (const webgl of [2, 1]) {
+    const what = `store, WebGL ${webgl}`;
+    const { page, logs } = await openPage(context, url, `size=256&url=${store}${webgl === 1 ? '&webgl=1' : ''}`);
+    await page.waitForFunction(() => { const z = window.tessera.zarr(); return z && z.firstImageMs !== null; }, null, { timeout: 60000 });
+    await page.evaluate(() => window.tessera.setCamera(35, 12, 1.25));
+    await storeRefined(page);
+    const s0 = await page.evaluate(() => window.tessera.state());
+    const before = (await snapshot(page)).pixels;
+    const z0 = await storeStats(page);
+    await loseContext(page);
+    const lostStatus = await statusOf(page);
+    await restoreContext(page);
+    const frames = await storeRefined(page);
+    const restoredStatus = await statusOf(page);
+    const z1 = (await storeStats(page)) || { requests: 0 };
+    const s1 = await page.evaluate(() => window.tessera.state());
+    const after = (await snapshot(page)).pixels;
+    const psnr = psnrOf(before, after);
+    await page.evaluate(() => window.tessera.setCamera(80, 12, 1.25));  // one frame, refined or not
+    const turned = (await snapshot(page)).pixels;
+    const error = await page.evaluate(() => window.tessera.error());
+    console.log(`${what}: status while lost "${lostStatus}"; after "${restoredStatus}"; reopened in ${(z1.reopenMs || 0).toFixed(0)} ms ` +
+                `with ${z1.reopenRequests} requests (${z1.requests - z0.requests} since the loss; ${z0.requests} before), refined in ${frames} frames`);
+    check(`${what}: context lost and restored: the store is drawn again, the frame equals the one before (>= 60 dB), the view still turns`,
+          s1.webgl === webgl && z1.reopened === 1 && frames > 0 && psnr >= 60 && changedFraction(after, turned) > 0.05 && error === '' &&
+          JSON.stringify(s0.camera) === JSON.stringify(s1.camera),
+          `${psnr >= 999 ? 'identical (inf dB)' : `${psnr.toFixed(2)} dB`}; ${(100 * changedFraction(after, turned)).toFixed(1)} % changed by a turn after; ` +
+          `store ${z1.url ? 'open' : 'closed'}, reopened ${z1.reopened || 0}, ${frames ? `refined in ${frames} frames` : 'not refined'}; camera ${JSON.stringify(s1.camera)}; error "${error}"`);
+    check(`${what}: the status line says "WebGL context lost — waiting", then "WebGL context restored"`,
+          lostStatus.includes('WebGL context lost — waiting') && restoredStatus.includes('WebGL context restored'),
+          `"${lostStatus}" / "${restoredStatus}"`);
+    const errors = logs.filter((l) => l.startsWith('pageerror') || (l.startsWith('error') && !/favicon|status of 404/.test(l)));
+    check(`${what}: no script errors around the context loss`, errors.length === 0, errors.join(' | '));
+    await page.close();
+  }
 }

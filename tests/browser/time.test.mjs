@@ -7,14 +7,17 @@
 // With TESSERA_BENCH=1 it also plays a 20-time-point 256^3 series at
 // 512x512 and prints the rate reached.
 import { test } from 'node:test';
+import { execFile, execFileSync } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
-import { bench, check, psnrAgainst, openPage, openThroughPicker, withoutOverlays, browserSuite } from './fixture.mjs';
+import { bench, check, cli, root, served, psnrAgainst, openPage, openThroughPicker, withoutOverlays, browserSuite } from './fixture.mjs';
 
 const checks = browserSuite();
 
 test('a 4-D NIfTI: every time point as the CLI renders it, playback in order', checks(timeSeries));
+test('an OME-Zarr store with a t axis (?url=): every time point drawn as the CLI renders it, in order', checks(storeSeries));
 test('benchmark: 20 time points of 256^3 at 512x512 (TESSERA_BENCH=1)', { skip: !bench }, checks(benchmark));
+test('benchmark: an OME-Zarr store of 20 time points of 256^3 at 512x512 (TESSERA_BENCH=1)', { skip: !bench }, checks(storeBenchmark));
 
 // A 4-D NIfTI of `count` time points made from the 3-D file `from` (as
 // `tessera convert` writes it): time point t is its voxels shifted by
@@ -135,6 +138,212 @@ async function benchmark(context, url, tmp, run) {
                 `${p.advances} shown in ${p.seconds.toFixed(1)} s, ${p.late} late frames, ${order || 'none skipped'}` +
                 (p.error ? `; error: ${p.error}` : ''));
     check(`asked ${fps}/s: every time point shown in order`, !order && p.advances >= Math.min(count, 2), order);
+  }
+  await page.close();
+}
+
+// An OME-NGFF store of `count` time points of n^3 written by zarr-python
+// (tests/zarr/make_time_store.py): a dim shell and a bright cube whose x
+// position moves with t.
+function writeStore(store, n, count) {
+  execFileSync('/usr/bin/python3', [path.join(root, 'tests/zarr/make_time_store.py'), store, String(n), String(count)]);
+}
+
+// `tessera render STORE --time T` for each T, two at a time.
+async function renderTimes(store, times, size, tmp) {
+  const one = (t) => new Promise((resolve, reject) => execFile(cli, ['render', store, '--time', String(t), '--tf', 'mr-default',
+    '--size', `${size}x${size}`, '--profile', 'webgl2', '--preintegrate', 'off', '--out', path.join(tmp, `store-t${t}.png`)],
+  (e) => (e ? reject(e) : resolve())));
+  for (let i = 0; i < times.length; i += 2) await Promise.all(times.slice(i, i + 2).map(one));
+}
+
+// The cube's x on screen: the mean column of the pixels brighter than the
+// shell (R+G+B > 500), in the page; -1 when there are none.
+const MARKER = 500;
+
+// Plays `advances` time points at `fps` with whole frames (no progressive
+// previews) and samples every frame the page draws, right after it is
+// drawn (an animation-frame callback after the page's own): the time point
+// it says it shows, the cube's column, and its PSNR against the reference
+// render of that time point when the test has one (window.__refs).
+async function playSampled(page, fps, advances, limitMs) {
+  return page.evaluate(async ({ fps, advances, limitMs, MARKER }) => {
+    const T = window.tessera;
+    T.setProgressive(false);
+    const frames = [];
+    const start = performance.now();
+    const before = T.time().log.length;
+    const { advances: advancesBefore, late: lateBefore } = T.time();
+    const framesBefore = T.frames();
+    let drawn = T.frames();
+    T.play(fps);
+    await new Promise((resolve) => {
+      const tick = () => {
+        if (T.frames() !== drawn) {
+          drawn = T.frames();
+          const t = T.time().shown;
+          const px = T.pixels();
+          const w = Math.round(Math.sqrt(px.length / 4));
+          let n = 0;
+          let sx = 0;
+          for (let i = 0; i < px.length; i += 4) {
+            if (px[i] + px[i + 1] + px[i + 2] > MARKER) { n++; sx += (i / 4) % w; }
+          }
+          const f = { t, x: n ? sx / n : -1 };
+          const ref = window.__refs && window.__refs[t];
+          if (ref && ref.length === px.length) {
+            let sum = 0;
+            for (let i = 0; i < px.length; i += 4) for (let k = 0; k < 3; k++) { const d = px[i + k] - ref[i + k]; sum += d * d; }
+            const mse = sum / (px.length / 4 * 3);
+            f.psnr = mse === 0 ? 999 : 10 * Math.log10(255 * 255 / mse);
+          }
+          frames.push(f);
+        }
+        if (T.time().log.length - before >= advances || performance.now() - start >= limitMs) resolve();
+        else requestAnimationFrame(tick);
+      };
+      requestAnimationFrame(tick);
+    });
+    const seconds = (performance.now() - start) / 1000;
+    T.pause();
+    T.setProgressive(true);
+    const s = T.time();
+    return { frames, log: s.log.slice(before - 1), late: s.late - lateBefore, advances: s.advances - advancesBefore,
+      drawn: T.frames() - framesBefore, seconds, error: T.error() };
+  }, { fps, advances, limitMs, MARKER });
+}
+
+// The references' PNGs decoded in the page, as window.__refs[t].
+async function loadRefs(page, files) {
+  await page.evaluate(async (pngs) => {
+    window.__refs = {};
+    for (const [t, b64] of Object.entries(pngs)) {
+      const img = new Image();
+      img.src = `data:image/png;base64,${b64}`;
+      await img.decode();
+      const c = document.createElement('canvas');
+      c.width = img.width;
+      c.height = img.height;
+      const ctx = c.getContext('2d');
+      ctx.drawImage(img, 0, 0);
+      window.__refs[t] = ctx.getImageData(0, 0, c.width, c.height).data;
+    }
+  }, Object.fromEntries(Object.entries(files).map(([t, f]) => [t, fs.readFileSync(f).toString('base64')])));
+}
+
+// The cube's column in a reference PNG (decoded in the page).
+async function markerOf(page, t) {
+  return page.evaluate(({ t, MARKER }) => {
+    const px = window.__refs[t];
+    const w = Math.round(Math.sqrt(px.length / 4));
+    let n = 0;
+    let sx = 0;
+    for (let i = 0; i < px.length; i += 4) if (px[i] + px[i + 1] + px[i + 2] > MARKER) { n++; sx += (i / 4) % w; }
+    return n ? sx / n : -1;
+  }, { t, MARKER });
+}
+
+// Every frame drawn checked: the cube where the time point it is labelled
+// with puts it (within a third of the step between time points, the
+// expected column interpolated between the references'), so no frame
+// shows another time point's (stale) volume; the frames of referenced time
+// points equal the CLI's render (PSNR >= 40 dB).
+function checkFrames(p, count, expectedX, step) {
+  const wrong = p.frames.filter((f) => Math.abs(f.x - expectedX(f.t)) > step / 3);
+  const referenced = p.frames.filter((f) => f.psnr !== undefined);
+  const low = referenced.filter((f) => f.psnr < 40);
+  const shown = new Set(p.frames.map((f) => f.t));
+  return { wrong, referenced, low, shown,
+    minPsnr: referenced.length ? Math.min(...referenced.map((f) => f.psnr)) : NaN, all: shown.size === count };
+}
+
+async function storeSeries(context, url, tmp, run) {
+  const SIZE = 128;
+  const count = 20;
+  const store = path.join(tmp, 'cube.ome.zarr');
+  const started = Date.now();
+  writeStore(store, 64, count);
+  const refTimes = [0, 10, 19];
+  await renderTimes(store, refTimes, SIZE, tmp);
+  const servedBefore = served.paths.length;
+  const { page, logs } = await openPage(context, url, `size=${SIZE}&url=/data/cube.ome.zarr`);
+  await withoutOverlays(page);
+  const s = await page.evaluate(() => window.tessera.time());
+  const panel = await page.evaluate(() => !document.getElementById('time-controls').hidden);
+  check('a store with a t axis of 20 opens as a time series (level 0 fits: read in core) with the Time panel shown',
+        s.count === count && s.shown === 0 && panel, JSON.stringify(s) + (await page.evaluate(() => window.tessera.error())));
+  await loadRefs(page, Object.fromEntries(refTimes.map((t) => [t, path.join(tmp, `store-t${t}.png`)])));
+  const refX = {};
+  for (const t of refTimes) refX[t] = await markerOf(page, t);
+  const expectedX = (t) => {
+    let i = 0;
+    while (i < refTimes.length - 2 && t > refTimes[i + 1]) i++;
+    const [a, b] = [refTimes[i], refTimes[i + 1]];
+    return refX[a] + (refX[b] - refX[a]) * (t - a) / (b - a);
+  };
+  const step = Math.abs(refX[19] - refX[0]) / (count - 1);
+  check('the cube is seen in every reference, a column per time point apart',
+        refTimes.every((t) => refX[t] >= 0) && step > 1, JSON.stringify(refX));
+
+  // The slider's path: a time point asked for is drawn as the CLI draws it.
+  const shown = await page.evaluate(() => window.tessera.showTime(10));
+  const own = await psnrAgainst(page, path.join(tmp, 'store-t10.png'));
+  const other = await psnrAgainst(page, path.join(tmp, 'store-t19.png'));
+  check('store time point 10 equals `tessera render STORE --time 10` (PSNR >= 40 dB) and not time point 19',
+        shown === 10 && own.psnr >= 40 && other.psnr < own.psnr - 10,
+        own.error || `${own.psnr.toFixed(2)} dB (time point 19: ${other.psnr.toFixed(2)} dB)`);
+
+  // Playback: a loop and more, every frame drawn sampled.
+  const p = await playSampled(page, 20, count + 1, 60000);
+  const order = inOrder(p.log, count);
+  const c = checkFrames(p, count, expectedX, step);
+  const rate = p.advances / p.seconds;
+  console.log(`store playback: ${p.advances} time points in ${p.seconds.toFixed(2)} s = ${rate.toFixed(1)} time points/s of 20, ` +
+              `${p.drawn} frames drawn (${(p.drawn / p.seconds).toFixed(1)}/s), ${p.late} late frames; ` +
+              `${c.referenced.length} frames against references, min ${c.minPsnr.toFixed(2)} dB; cube column per step ${step.toFixed(2)} px`);
+  check('store playback shows every time point in order, none skipped (a loop and one more)',
+        p.log.length >= count + 2 && !order && c.all, `${order || ''} log ${p.log.join(',')}`);
+  check('every frame drawn shows the time point it is labelled with (the cube within a third of a step: no stale frame)',
+        p.frames.length >= count && c.wrong.length === 0,
+        `${p.frames.length} frames; wrong: ${JSON.stringify(c.wrong.slice(0, 5).map((f) => ({ t: f.t, x: +f.x.toFixed(1), want: +expectedX(f.t).toFixed(1) })))}`);
+  check('the frames of referenced time points equal the CLI render (PSNR >= 40 dB)',
+        c.referenced.length >= refTimes.length && c.low.length === 0, `${c.referenced.length} frames, min ${c.minPsnr.toFixed(2)} dB`);
+  // Prefetch within the host budget: 20 x 256 KiB are all kept, so each
+  // time point's chunk of level 0 was fetched once (at open, for the
+  // slider, ahead of playback), never again.
+  const keys = served.paths.slice(servedBefore).filter((k) => /\/cube\.ome\.zarr\/0\/\d/.test(k));
+  check('each time point\'s level-0 chunk fetched exactly once over the page\'s life (the series kept in the host budget)',
+        new Set(keys).size === count && keys.length === count, `${keys.length} fetches of ${new Set(keys).size} chunks`);
+  check('no page errors', !logs.some((l) => l.startsWith('pageerror')) && !p.error,
+        p.error || logs.filter((l) => l.startsWith('pageerror')).join('; '));
+  console.log(`store series test: ${((Date.now() - started) / 1000).toFixed(1)} s`);
+  await page.close();
+}
+
+async function storeBenchmark(context, url, tmp) {
+  const count = 20;
+  const store = path.join(tmp, 'cube256.ome.zarr');
+  const t0 = Date.now();
+  writeStore(store, 256, count);
+  console.log(`bench: wrote 20 x 256^3 u8 store in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
+  await renderTimes(store, [0, count - 1], 512, tmp);
+  const { page } = await openPage(context, url, `size=512&url=/data/cube256.ome.zarr`);
+  const s = await page.evaluate(() => window.tessera.time());
+  check('the 20 x 256^3 store opens as a time series', s.count === count, JSON.stringify(s));
+  await loadRefs(page, { 0: path.join(tmp, 'store-t0.png'), [count - 1]: path.join(tmp, `store-t${count - 1}.png`) });
+  const [x0, x1] = [await markerOf(page, 0), await markerOf(page, count - 1)];
+  const step = Math.abs(x1 - x0) / (count - 1);
+  check('the cube is seen in the references at 512x512', x0 >= 0 && x1 >= 0 && step > 1, `${x0} ${x1}`);
+  for (const fps of [10, 30]) {
+    const p = await playSampled(page, fps, count + 1, 180000);
+    const order = inOrder(p.log, count);
+    const c = checkFrames(p, count, (t) => x0 + (x1 - x0) * t / (count - 1), step);
+    const rate = p.advances / p.seconds;
+    console.log(`bench: web page, OME-Zarr 20 x 256^3 u8 at 512x512, asked ${fps}/s: ${rate.toFixed(2)} time points/s, ` +
+                `${p.advances} shown in ${p.seconds.toFixed(1)} s, ${p.drawn} frames drawn, ${p.late} late frames, ` +
+                `${order || 'none skipped'}, ${c.shown.size} of ${count} time points shown, ${c.wrong.length} frames off their time point, ` +
+                `references min ${c.minPsnr.toFixed(2)} dB` + (p.error ? `; error: ${p.error}` : ''));
+    check(`store asked ${fps}/s: every time point shown in order, no stale frame`, !order && c.all && c.wrong.length === 0, order);
   }
   await page.close();
 }

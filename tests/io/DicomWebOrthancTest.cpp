@@ -36,6 +36,8 @@ const fs::path kEncode = fs::path(TESSERA_TEST_DATA_DIR) / ".." / "io" / "DicomW
 const fs::path kMultiFrame = fs::path(TESSERA_TEST_DATA_DIR) / ".." / "io" / "make_multiframe.py";
 // The enhanced objects stored, each read from its own folder too.
 constexpr const char* kEnhanced[] = {"enhanced.dcm", "enhanced-rle.dcm"};
+// An Enhanced MR object of two stacks (axial "1", 24 frames; sagittal "2", 20).
+constexpr const char* kTwoStacks = "twostack.dcm";
 constexpr const char* kSeriesUid = "1.2.826.0.1.3680043.10.543.77";
 
 // A 40x32x12 CT-like i16 volume (-1024 air, noisy tissue, a bright marker
@@ -99,11 +101,13 @@ class DicomWebOrthanc : public ::testing::Test {
       fs::create_directories(dir_->path() / "upload-mf" / name);
       fs::copy_file(mf / name, dir_->path() / "upload-mf" / name / name);
     }
+    fs::create_directories(dir_->path() / "upload-mf" / kTwoStacks);
+    fs::copy_file(mf / kTwoStacks, dir_->path() / "upload-mf" / kTwoStacks / kTwoStacks);
     orthanc_ = new test::OrthancServer(dir_->path() / "orthanc");
     for (const char* kind : {"plain", "jpeg-lossless", "j2k-lossless", "htj2k-lossless"}) {
       if (!orthanc_->upload(dir_->path() / kind)) setupError_ = std::string("upload of ") + kind;
     }
-    for (const char* name : kEnhanced) {
+    for (const char* name : {kEnhanced[0], kEnhanced[1], kTwoStacks}) {
       if (!orthanc_->upload(dir_->path() / "upload-mf" / name)) {
         setupError_ = std::string("upload of ") + name;
       }
@@ -153,6 +157,8 @@ const StoredSeries kStored[] = {
 // its time and ctest runs each test in its own process.
 void expectEnhancedReadLikeTheFile(const fs::path& uploaded,
                                    const std::function<std::string(const std::string&)>& url);
+void expectStacksChosenByUrlLikeTheFile(const fs::path& uploaded,
+                                        const std::function<std::string(const std::string&)>& url);
 
 TEST_F(DicomWebOrthanc, StoredSyntaxesAndEnhancedCtReadLikeTheFolderQidoListsThemUnknownIs404) {
   const Volume folder = readVolume((dir_->path() / "plain").string());
@@ -182,10 +188,11 @@ TEST_F(DicomWebOrthanc, StoredSyntaxesAndEnhancedCtReadLikeTheFolderQidoListsThe
     }
   }
 
-  // QIDO: the CT study and its four series; the enhanced objects' study.
+  // QIDO: the CT study and its four series; the enhanced objects' study and
+  // the two-stack object's.
   const DicomWebClient client(orthanc_->dicomWebRoot(), DicomWebOptions{});
   const auto studies = client.studies();
-  ASSERT_EQ(studies.size(), 2u);
+  ASSERT_EQ(studies.size(), 3u);
   const auto ct = std::find_if(studies.begin(), studies.end(),
                                [&](const DicomWebStudy& s) { return s.uid == study; });
   ASSERT_NE(ct, studies.end());
@@ -210,6 +217,7 @@ TEST_F(DicomWebOrthanc, StoredSyntaxesAndEnhancedCtReadLikeTheFolderQidoListsThe
                    "DICOMweb service root");
 
   expectEnhancedReadLikeTheFile(dir_->path() / "upload-mf", seriesUrl);
+  expectStacksChosenByUrlLikeTheFile(dir_->path() / "upload-mf", seriesUrl);
 }
 
 // Enhanced CT objects (one file of 90 frames stored in reverse z order,
@@ -288,6 +296,64 @@ TEST(DicomWebUrl, SeriesUrlsAreRecognisedAndSplit) {
   EXPECT_EQ(u.root, "http://h:8042/dicom-web");
   EXPECT_EQ(u.study, "1.2");
   EXPECT_EQ(u.series, "3.4");
+}
+
+// A series of two stacks over DICOMweb: listed as `info` lists a folder's
+// (the same selectors and slice counts), each chosen by `--series UID:stack`
+// on the URL exactly as on the file, the largest by default with the other
+// named; an unknown stack is refused listing both, another series' UID
+// naming the URL's.
+void expectStacksChosenByUrlLikeTheFile(const fs::path& uploaded,
+                                        const std::function<std::string(const std::string&)>& url) {
+  const fs::path file = uploaded / kTwoStacks / kTwoStacks;
+  const auto local = listDicomSeries(file.parent_path());
+  ASSERT_EQ(local.size(), 2u);
+  const std::string uid = local[0].seriesInstanceUid;
+  const std::string series = url(uid);
+  const auto listed = listDicomWebSeries(series);
+  ASSERT_EQ(listed.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(listed[i].selector(), local[i].selector());
+    EXPECT_EQ(listed[i].slices, local[i].slices);
+    EXPECT_EQ(listed[i].description, local[i].description);
+  }
+  EXPECT_EQ(listed[0].selector(), uid + ":1");
+  EXPECT_EQ(listed[0].slices, 24);
+  EXPECT_EQ(listed[1].selector(), uid + ":2");
+  EXPECT_EQ(listed[1].slices, 20);
+  for (const std::string stack : {"1", "2"}) {
+    SCOPED_TRACE("stack " + stack);
+    const std::string select = uid + ":" + stack;
+    const Volume fromFile = readVolume(file.string(), {.dicomSeries = select});
+    DicomWebTransfer transfer;
+    const Volume web = readDicomWebSeries(series, &transfer, select);
+    test::expectSameVolume(web, fromFile);
+    EXPECT_EQ(web.indexToWorld(), fromFile.indexToWorld());
+    EXPECT_EQ(web.dims().z, stack == "1" ? 24 : 20);
+    // Frame z of stack "1" holds 100 + z, of "2" 200 + z: the stack asked for.
+    EXPECT_EQ(web.valueAt(5, 7, 3), (stack == "1" ? 100 : 200) + 3);
+    // The metadata, and the object's 44 frames in one request.
+    EXPECT_EQ(transfer.requests, 2u);
+    EXPECT_EQ(readVolume(series, {.dicomSeries = select}).indexToWorld(), web.indexToWorld());
+  }
+  // No selection: the larger stack, the other named in the description.
+  const Volume largest = readVolume(series);
+  EXPECT_EQ(largest.dims().z, 24);
+  EXPECT_NE(largest.description().find("others: " + uid + ":2 (20 slices of "), std::string::npos)
+      << largest.description();
+  const std::string unknown =
+      test::inputErrorMessage([&] { readVolume(series, {.dicomSeries = uid + ":7"}); });
+  EXPECT_EQ(unknown.rfind(series + ": no series " + uid +
+                              ":7 (Series Instance UID, or UID:stack); found: " + uid +
+                              ":1 (24 slices of ",
+                          0),
+            0u)
+      << unknown;
+  EXPECT_NE(unknown.find(", " + uid + ":2 (20 slices of "), std::string::npos) << unknown;
+  const std::string other =
+      test::inputErrorMessage([&] { readVolume(series, {.dicomSeries = "1.2.3:1"}); });
+  EXPECT_EQ(other, series + ": --series 1.2.3:1 is not the series the URL names (" + uid + ", or " +
+                       uid + ":STACK for one of its stacks; `tessera info URL` lists them)");
 }
 
 }  // namespace

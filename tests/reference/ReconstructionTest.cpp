@@ -9,6 +9,7 @@
 #include "support/TestTransferFunctions.h"
 #include "tessera/core/Camera.h"
 #include "tessera/io/Procedural.h"
+#include "tessera/reference/CellLevels.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/Reconstruction.h"
 #include "tessera/reference/ReferenceRaycaster.h"
@@ -86,4 +87,23 @@ TEST(Reconstruction, AnalyticFieldRendersAsComputedByHand) {
   const double a = tf.correctedOpacity(0.5, ds, 1.0);
   const double alpha = 1.0 - std::pow(1.0 - a, n);
   EXPECT_NEAR(img.pixel(8, 8)[0], std::lround(255.0 * alpha), 1.0);
+}
+
+// A streamed frame's cells: levelAt finds the cell as bricks.glsl does (the
+// last, partial cell takes p = 1), and sampleLevel is the field
+// PyramidLevelReconstruction samples, read without a double copy.
+TEST(CellLevels, LevelAtFollowsTheCellsAndSampleLevelIsThePyramidField) {
+  CellLevels cells{{40, 20, 10}, 16, {3, 2, 1}, {0, 1, 2, 0, 1, -1}};
+  EXPECT_EQ(cells.levelAt({0.0, 0.0, 0.5}), 0);
+  EXPECT_EQ(cells.levelAt({16.5 / 40.0, 0.1, 0.5}), 1);
+  EXPECT_EQ(cells.levelAt({1.0, 0.1, 0.5}), 2);    // cell 2 is partial: x in [32, 40]
+  EXPECT_EQ(cells.levelAt({1.5, 2.0, -1.0}), -1);  // clamped to the box: cell (2, 1, 0)
+  EXPECT_EQ(cells.cellsPerLevel(), (std::vector<int>{2, 2, 1, 1}));
+  EXPECT_TRUE(cells.mixed());
+  const Volume level = ramp({10, 5, 3});
+  const PyramidLevelReconstruction field(level, {4, 4, 4}, {40, 20, 10});
+  for (const glm::dvec3 p :
+       {glm::dvec3(0.3, 0.6, 0.2), glm::dvec3(0.97, 0.01, 0.99), glm::dvec3(-0.2, 1.3, 0.5)}) {
+    EXPECT_NEAR(sampleLevel(level, {4, 4, 4}, {40, 20, 10}, p), field.value(p), 1e-9) << p.x;
+  }
 }

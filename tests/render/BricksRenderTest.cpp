@@ -127,6 +127,43 @@ TEST_P(BricksRenderOnEachApi, MatchesInCoreLayoutAndReference) {
   compareWithInCore(GetParam());
 }
 
+// A page table of several tile rows (its side forced down to 10 texels: the
+// 4x5x3 cells of 12^3 bricks as 2 x 2 tiles of 4 x 5) on ES 3 and ES 2:
+// every voxel centre samples its own voxel, and the image is the reference's.
+TEST_P(BricksRenderOnEachApi, PageTableOfSeveralTileRowsMatchesTheReference) {
+  test::ApiContext context(GetParam());
+  gpu::GlContext& c = context.get();
+  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());
+  const auto v = seamVolume();
+  layout::BricksOptions o = smallBricks(12);
+  o.pageTableMaxSide = 10;
+  auto bricks = layout::BricksLayout::create(std::make_shared<lod::InCoreMultiresSource>(v, 8),
+                                             limits, c.ledger(), o);
+  const layout::MosaicLayout::Geometry& g = bricks->pageGeometry();
+  ASSERT_EQ(g.dims, glm::ivec3(4, 5, 3));
+  ASSERT_GE(g.tilesY, 2) << bricks->plan().reason;
+  ASSERT_LE(std::max(g.width(), g.height()), 10);
+  TransferFunction everything;  // every value visible: no transparent cells
+  everything.addOpacity(0.0, 0.5);
+  const Camera cam = viewOf(*v, 35, 25);
+  refine(*bricks, cam, everything);
+  layout::LayoutProbe probe(c);
+  const std::vector<float> got =
+      probe.sample(*bricks, layout::LayoutProbe::voxelCentres(v->dims()));
+  ASSERT_EQ(got.size(), static_cast<std::size_t>(v->voxelCount()));
+  for (std::size_t k = 0; k < got.size(); ++k) {
+    ASSERT_NEAR(got[k] * 255.0, v->valueAtIndex(k), 1e-3) << k;
+  }
+  refine(*bricks, cam, visibleTf());
+  const Image viaBricks = renderWith(c, *v, *bricks, cam);
+  const Image ref = renderReference(*v, visibleTf(), cam, RenderSettings(), kImage, kImage);
+  const double db = psnr(viaBricks, ref);
+  EXPECT_GE(db, 45.0);
+  std::printf("  [measured] %s, %dx%d page table of %d x %d tiles: bricks vs reference %.2f dB\n",
+              GetParam() == gpu::ApiLevel::Gles2 ? "ES2" : "ES3", g.width(), g.height(), g.tilesX,
+              g.tilesY, db);
+}
+
 TEST(BricksRender, PageTableLookupMatchesDirectIndexingForEveryVoxel) {
   gpu::GlContext& c = test::gpuContext();
   const gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());

@@ -18,6 +18,7 @@
 #include "tessera/layout/BricksLayout.h"
 #include "tessera/layout/ChannelLayouts.h"
 #include "tessera/lod/InCoreMultiresSource.h"
+#include "tessera/lod/ReadLevel.h"
 #include "tessera/reference/ChannelReference.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/render/Raycaster.h"
@@ -120,6 +121,68 @@ TEST_F(ChannelBricks, GpuEqualsReferenceOnEs3AndEs2) {
       // fall back to a coarser brick (not fetched).
       ASSERT_GE(images[i].cellsPerLevel.size(), 2u);
       EXPECT_GT(images[i].cellsPerLevel[0], 0);
+    }
+  }
+}
+
+// The levels `layout`'s page table shows, each read from the channels'
+// pyramids: what the reference of its frame reads (Session::renderChannels).
+ChannelLevels levelsShown(const ChannelSet& set, const layout::StreamingLayout& layout) {
+  const lod::BrickGrid& grid = layout.grid();
+  ChannelLevels out;
+  out.cells = {grid.dims(0), grid.brickSize(), grid.bricks(0), layout.cellLevels()};
+  for (int l = 0; l < grid.levelCount(); ++l) out.scales.push_back(grid.scale(l));
+  for (const Channel& c : set.channels()) {
+    const lod::InCoreMultiresSource pyramid(c.volume);
+    out.volumes.emplace_back();
+    for (int l = 0; l < grid.levelCount(); ++l)
+      out.volumes.back().push_back(std::make_shared<const Volume>(lod::readLevel(pyramid, l)));
+  }
+  return out;
+}
+
+// An atlas of about 40 slots holds a third of the 108 level-0 bricks the
+// view wants: the frame shows level 0 in some cells and level 1 in the
+// rest, and equals the reference that reads each cell's level (not the
+// level-0 reference: the levels differ at the structures' edges).
+TEST_F(ChannelBricks, MixedLevelFrameEqualsTheReferenceOfItsLevels) {
+  ChannelSet set = readZarrChannels(store());
+  const Camera camera = test::orbitCamera(set.geometry(), 30.0, 20.0);
+  for (gpu::ApiLevel api : {gpu::ApiLevel::Gles3, gpu::ApiLevel::Gles2}) {
+    for (ChannelMode mode : {ChannelMode::Additive, ChannelMode::Max}) {
+      ChannelSet shown = set;
+      shown.mode = mode;
+      test::ApiContext context(api);
+      gpu::GlContext& gl = context.get();
+      const gpu::DeviceLimits limits = gpu::DeviceLimits::of(gl.caps());
+      const std::uint64_t slot = 18 * 18 * 18 * (api == gpu::ApiLevel::Gles3 ? 8 : 4);
+      auto layout = layout::BricksLayout::createChannels(
+          pyramids(shown), shown, limits, gl.ledger(),
+          {.brickSize = 16, .atlasBytesCap = 40 * slot, .workers = 0});
+      render::Raycaster caster(gl, shown.geometry(), *layout);
+      caster.setSkipBlockSize(0);
+      caster.setTransferFunction(channelRamp());
+      layout::BricksFrame f;
+      for (int i = 0; i < 100 && !f.complete; ++i)
+        f = layout->update(camera, kSize, kSize, channelRamp());
+      RenderSettings s = channelSettings();
+      s.mode = renderModeFor(mode);
+      const Image image = caster.renderImage(camera, s, kSize, kSize);
+      const ChannelLevels levels = levelsShown(shown, *layout);
+      ASSERT_TRUE(levels.cells.mixed()) << layout->plan().reason;
+      const std::vector<int> n = levels.cells.cellsPerLevel();
+      const double mixed = psnr(image, renderChannelsReference(shown, levels, channelRamp(), camera,
+                                                               channelSettings(), kSize, kSize));
+      const double level0 = psnr(image, renderChannelsReference(shown, channelRamp(), camera,
+                                                                channelSettings(), kSize, kSize));
+      std::printf(
+          "mixed-level channel bricks %s on %s (%d slots, cells L0 %d L1 %d L2 %d): "
+          "%.1f dB against its levels, %.1f dB against level 0\n",
+          channelModeName(mode), test::apiName(api), layout->slotCount(), n[0],
+          n.size() > 2 ? n[1] : 0, n.size() > 3 ? n[2] : 0, mixed, level0);
+      EXPECT_GT(n[0], 0);
+      EXPECT_GE(mixed, 40.0) << channelModeName(mode) << " " << test::apiName(api);
+      EXPECT_GT(mixed, level0 + 3.0) << "the level-0 reference should not fit a mixed frame";
     }
   }
 }

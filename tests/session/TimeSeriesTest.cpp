@@ -107,6 +107,46 @@ TEST(TimeSeries, OnPumpReadsOneTimePointPerPumpInTheWindowsOrder) {
   EXPECT_EQ(background.wait(1)->valueAt(0, 0, 0), 1.0);
 }
 
+// A page reading fetched bytes (an OME-Zarr store in the browser): a time
+// point is read only once its bytes have arrived, the most urgent ones
+// asked for first and no more than `ahead` at once; one that arrives late
+// is read then, in the window's order.
+TEST(TimeSeries, OnPumpReadsOnlyWhatHasArrivedAskingForAtMostAheadAtOnce) {
+  TimeSeries series(
+      10, [](int t) { return constant(t); }, 5, TimeSeries::Reading::OnPump);
+  std::vector<bool> here(10, false);
+  std::vector<int> asked;
+  series.setArrival(
+      [&](int t) {
+        if (!here[std::size_t(t)]) asked.push_back(t);
+        return here[std::size_t(t)];
+      },
+      2);
+  EXPECT_EQ(series.want(3), nullptr);
+  EXPECT_FALSE(series.pump()) << "nothing has arrived";
+  EXPECT_EQ(asked, std::vector<int>({3, 4})) << "the two most urgent, no more";
+  EXPECT_TRUE(series.readLog().empty());
+  here[4] = true;  // arrived out of order: read, 3 still asked for
+  asked.clear();
+  EXPECT_TRUE(series.pump());
+  EXPECT_EQ(series.readLog(), std::vector<int>({4}));
+  EXPECT_EQ(asked, std::vector<int>({3}));
+  EXPECT_EQ(series.want(3), nullptr);
+  asked.clear();
+  EXPECT_FALSE(series.pump());
+  EXPECT_EQ(asked, std::vector<int>({3, 5})) << "4 is held: the next two not at hand";
+  here[3] = here[5] = here[6] = here[7] = true;
+  while (series.pump()) {
+  }
+  EXPECT_EQ(series.readLog(), std::vector<int>({4, 3, 5, 6, 7}));
+  ASSERT_NE(series.want(3), nullptr);
+  EXPECT_EQ(series.want(3)->valueAt(0, 0, 0), 3.0);
+  expectInputError([&] { series.setArrival([](int) { return true; }, 6); }, {"6", "1..5"});
+  TimeSeries background(
+      3, [](int t) { return constant(t); }, 2);
+  expectInputError([&] { background.setArrival([](int) { return true; }, 1); }, {"pump"});
+}
+
 TEST(TimeSeries, KeepsWhatTheBudgetHoldsAndAtLeastTheNext) {
   EXPECT_EQ(TimeSeries::keepWithin(100, 10, 20), 10);
   EXPECT_EQ(TimeSeries::keepWithin(1000, 10, 20), 20);
@@ -244,6 +284,38 @@ TEST(SessionSeries, PlaybackThroughTheSessionShowsEveryTimePoint) {
   for (std::size_t i = 1; i < sequence.size(); ++i) {
     EXPECT_EQ(sequence[i], (sequence[i - 1] + 1) % 5) << "skipped at " << i;
   }
+}
+
+// A store's time points fetched by a page: each arrives some frames after
+// it is asked for. Playback shows every one in order, a time point that
+// had not arrived when due shown late (late frames counted), never
+// skipped, and the time point shown is always the volume shown.
+TEST(SessionSeries, TimePointsThatArriveLateAreShownLateNeverSkipped) {
+  Session s("native");
+  s.openSeries(
+      6, [](int t) { return constant(t); }, "store.ome.zarr", 0, TimeSeries::Reading::OnPump);
+  std::vector<int> askedAtFrame(6, -1);
+  askedAtFrame[0] = 0;
+  int frame = 0;
+  s.series()->setArrival(
+      [&](int t) {
+        if (askedAtFrame[std::size_t(t)] < 0) askedAtFrame[std::size_t(t)] = frame;
+        return frame - askedAtFrame[std::size_t(t)] >= 7;  // 7 frames in flight
+      },
+      2);
+  s.playback().setFps(100.0);
+  s.playback().play(0.0);
+  std::vector<int> sequence{s.timePoint()};
+  for (double now = 0.0; sequence.size() < 13 && now < 5000.0; now += 5.0, ++frame) {
+    const int t = s.stepPlayback(now);
+    EXPECT_EQ(s.volume().valueAt(0, 0, 0), double(t)) << "the volume shown is the time point's";
+    if (t != sequence.back()) sequence.push_back(t);
+  }
+  ASSERT_EQ(sequence.size(), 13u) << "playback stalled";
+  for (std::size_t i = 1; i < sequence.size(); ++i) {
+    EXPECT_EQ(sequence[i], (sequence[i - 1] + 1) % 6) << "skipped at " << i;
+  }
+  EXPECT_GT(s.playback().lateFrames(), 0u) << "at 100/s, 7 frames of 5 ms in flight are late";
 }
 
 // What the web page does with a dropped 4-D NIfTI: the bytes in memory,

@@ -34,6 +34,10 @@ std::string frameJson(const web::StoreFrame& f, web::ZarrStoreView& z) {
   nlohmann::json j;
   j["ms"] = f.ms;
   j["stream_ms"] = f.streamMs;
+  j["update_ms"] = f.updateMs;
+  j["upload_wait_ms"] = f.uploadWaitMs;
+  j["tables_ms"] = f.tablesMs;
+  j["preview_ms"] = f.previewMs;
   j["shown"] = f.shown;
   j["pending"] = f.pending;
   j["streamed"] = f.streamed;

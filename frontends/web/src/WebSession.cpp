@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
+#include "WebDicomStacks.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/DeviceSession.h"
@@ -132,7 +133,9 @@ struct ViewKnobs {
 // restored one only raises GL errors, cleared before the new session starts.
 void WebSession::recoverContext() {
   zoomStop();
-  const bool hadStore = zarr_ != nullptr;
+  std::optional<ZarrStoreView::Host> store;
+  if (zarr_) store = zarr_->host();
+  const bool hadStore = store.has_value();
   std::shared_ptr<Volume> volume;
   if (!hadStore && session_->hasVolume() && !session_->streamed()) {
     volume = session_->source().level(glm::ivec3(1));  // the volume itself, shared
@@ -142,6 +145,7 @@ void WebSession::recoverContext() {
   std::optional<session::Overlay> overlay;  // kept in memory: its file is not read again
   if (session_->overlay()) overlay = *session_->overlay();
   const ViewKnobs knobs = ViewKnobs::of(viewer());
+  const Camera camera = viewer().camera();  // a store's (its state holds no volume to frame)
   const int webglVersion = context_->webglVersion();
   const int cell = askedCell_;
   zarr_.reset();
@@ -161,8 +165,9 @@ void WebSession::recoverContext() {
   }
   knobs.applyTo(viewer());
   refreshExtraLines();
-  if (hadStore) {
-    throw InputError("the WebGL context was lost and restored: open the OME-Zarr store again");
+  if (store) {
+    viewer().camera() = camera;
+    reopenStore(std::move(*store));
   }
 }
 
@@ -196,7 +201,7 @@ void WebSession::loadPickedFiles() {
         name);
     return;
   }
-  session_->setVolume(readVolume(*file, held->files), name);
+  session_->setVolume(readPickedVolume(*file, held->files), name);  // WebDicomStacks.h
 }
 
 double WebSession::renderFrame(int width, int height) {

@@ -104,8 +104,9 @@ class WebSession {
   // the background, the GPU reset): the context is made again on the canvas
   // and the session on it, with the same volume (shared, not read again),
   // its state (Session::state: settings, camera, TF, window, exploration)
-  // and the view's own settings. An open OME-Zarr store is closed
-  // (InputError saying so, after the rest is back).
+  // and the view's own settings. An open OME-Zarr store is made again on
+  // it from what the page holds (reopenStore): the page then steps
+  // storeOpenStep until it is open, and the store refines as before.
   void recoverContext();
 
   // ---- volumes and frames (WebSession.cpp)
@@ -179,6 +180,10 @@ class WebSession {
   // The open store's coarsest level (null when no store is open).
   const Volume* storeOverview();
   void beginStore(const std::string& url);
+  // The store of a lost context on the restored one: its chunks, metadata
+  // and levels kept, its GPU side (atlas, page table, ray caster) made again
+  // by storeOpenStep, which then keeps the restored camera and TF.
+  void reopenStore(ZarrStoreView::Host host);
   bool storeOpenStep();
   void closeStore();
   // The store's level-0 box of these ranges (clamped; errors name the store).
@@ -233,8 +238,9 @@ class WebSession {
   std::vector<PickedFile> picked_;
   SliceViews slices_;
   MarkBox marks_[2];
-  std::string exploreKey_;  // the overview it was made for: name and dims
-  int askedCell_ = 0;       // the grid cell side asked for (0: the default)
+  std::string exploreKey_;      // the overview it was made for: name and dims
+  int askedCell_ = 0;           // the grid cell side asked for (0: the default)
+  bool storeReopened_ = false;  // the store being opened again keeps the view's camera
   int zoomMediumLevel_ = 0;
   double zoomLastFrameMs_ = -1.0;
   CropState crop_;

@@ -15,9 +15,6 @@ namespace tessera::web {
 
 void openPickedOverlay(WebSession& s, const session::OverlayOptions& options) {
   std::vector<PickedFile> picked = s.takeFiles();
-  session::Session& session = s.rendering();
-  if (!session.hasVolume()) throw InputError("open a volume first: an overlay goes over one");
-  if (s.store()) throw InputError("an overlay goes over a file's volume, not an OME-Zarr store");
   MemoryFiles files;
   for (const PickedFile& f : picked) {
     files.add(f.name, std::span<const std::byte>(reinterpret_cast<const std::byte*>(f.bytes.get()),
@@ -25,10 +22,8 @@ void openPickedOverlay(WebSession& s, const session::OverlayOptions& options) {
   }
   const std::string name = volumeFileAmong(files.names());
   auto volume = std::make_shared<Volume>(readVolume(*files.open(name), files));
-  session::Overlay overlay =
-      session::makeOverlay(std::move(volume), name, options, session.shape());
+  s.rendering().addOverlay(std::move(volume), name, options);
   s.zoomStop();  // the zoom swap's levels carry no overlay
-  session.setOverlay(std::move(overlay));
 }
 
 void restyleOverlay(WebSession& s, const session::OverlayOptions& options) {

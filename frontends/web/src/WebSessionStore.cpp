@@ -25,17 +25,27 @@ const Volume* WebSession::storeOverview() {
 void WebSession::beginStore(const std::string& url) {
   zoomStop();
   session_->endExploration();
+  session_->drawPyramid(nullptr);
   zarr_ = std::make_unique<ZarrStoreView>(context(), viewer().limits(), url);
+  storeReopened_ = false;
+}
+
+void WebSession::reopenStore(ZarrStoreView::Host host) {
+  zarr_ = std::make_unique<ZarrStoreView>(context(), viewer().limits(), std::move(host));
+  storeReopened_ = true;
 }
 
 // True once open (the coarsest level is on the GPU): its histogram goes to
-// the TF editor and the camera frames it.
+// the TF editor and the camera frames it (a store opened again after a
+// context loss keeps the restored camera).
 bool WebSession::storeOpenStep() {
   ZarrStoreView& z = theStore();
   if (!z.open()) return false;
+  session_->drawPyramid(z.sharedSource());  // what an overlay goes over and the probe reads
   viewer::Viewer& v = viewer();
   v.tfEditor().setHistogram(Histogram::compute(z.coarsest(), 256, z.store().shape().window()));
-  v.resetCamera();
+  if (!storeReopened_) v.resetCamera();
+  storeReopened_ = false;
   return true;
 }
 
@@ -43,6 +53,7 @@ bool WebSession::storeOpenStep() {
 void WebSession::closeStore() {
   zarr_.reset();
   session_->endExploration();
+  session_->drawPyramid(nullptr);
 }
 
 // Ends past the level are clamped; an empty box or one that starts outside
@@ -110,6 +121,8 @@ StoreFrame WebSession::storeFrame(int width, int height, bool viewChanged) {
         viewer::boxLines(*block, shape.dims(), shape.extent(), session::kGridBlockColour);
     marks.insert(marks.end(), cyan.begin(), cyan.end());
   }
+  const session::Overlay* overlay = session_->overlay();
+  z.setFusion(overlay ? overlay->fused : nullptr);  // fused in the store's ray march
   return z.frame(
       v.camera(), v.frameSettings(), v.tfEditor().transferFunction(), v.tfEditor().revision(),
       v.showBoundingBox, v.showAxes, width, height, v.maxVolumePixels, marks,

@@ -58,6 +58,13 @@ ZarrStoreView::ZarrStoreView(gpu::GlContext& context, const gpu::DeviceLimits& l
       limits_(limits),
       storage_(std::make_shared<FetchStorage>(url, kFetchedBytes)) {}
 
+ZarrStoreView::ZarrStoreView(gpu::GlContext& context, const gpu::DeviceLimits& limits, Host host)
+    : context_(context),
+      limits_(limits),
+      storage_(std::move(host.storage)),
+      store_(std::move(host.store)),
+      source_(std::move(host.source)) {}
+
 bool ZarrStoreView::open() {
   if (isOpen()) return true;
   // Each step throws while a key it reads has not arrived; then the keys
@@ -79,8 +86,15 @@ bool ZarrStoreView::open() {
   }
   bricks_ = active_.upload.layout ? active_.upload.layout->streaming() : nullptr;
   if (!bricks_) throw Error(storage_->describe() + ": the bricks layout was not created");
+  active_.technique->setFusion(fused_);
   compositor_ = std::make_unique<render::HybridCompositor>(context_);
   return true;
+}
+
+void ZarrStoreView::setFusion(std::shared_ptr<const FusedVolume> fused) {
+  if (fused == fused_) return;
+  fused_ = std::move(fused);
+  if (active_.technique) active_.technique->setFusion(fused_);
 }
 
 StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings& settings,
@@ -89,6 +103,8 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
                                 const std::vector<render::OverlayLine>& marks,
                                 const StorePace& pace) {
   const auto t0 = std::chrono::steady_clock::now();
+  layout::BricksFrame bricks = pending_.active ? pending_.bricks : shownBricks_;
+  bricks.uploaded = 0;  // by this frame
   pending_ = {};
   StoreFrame f;
   if (tfRevision != tfRevision_) {
@@ -137,15 +153,18 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
     f.streamMs = msSince(t0);
     return drawWhole(v, f, t0);
   }
-  pending_ = {.active = true, .streaming = true, .viewChanged = pace.viewChanged, .view = v};
+  pending_ = {.active = true,
+              .streaming = true,
+              .viewChanged = pace.viewChanged,
+              .view = v,
+              .bricks = bricks};
+  f.bricks = bricks;
   if (pace.viewChanged) {
-    // The new view's selection and requests (they go out now; what has
-    // arrived is read and uploaded by the pending frame's streaming), and
-    // a preview of what is on the GPU.
-    bricks_->setUpdatePace({.uploadMs = 0.0, .uploadBytes = 0, .inlineReads = 0});
-    pending_.bricks = f.bricks = stream(v, 0.0);
-    f.streamed = true;
-    f.streamMs = msSince(t0);
+    // Input is answered by a preview of what is on the GPU, seen from the
+    // new view, and nothing else: the new view's selection, requests,
+    // uploads and page table (which would also rebuild the ray caster's
+    // tables inside the preview) are the pending frame's first steps, one
+    // animation frame later.
     preview(v, f);
   }
   f.pending = true;
@@ -161,8 +180,9 @@ layout::UpdatePace ZarrStoreView::streamPace() const {
 }
 
 layout::BricksFrame ZarrStoreView::stream(const FrameView& v, double ms) {
-  return session::BrickRefinement(*bricks_).step(v.camera, v.renderWidth, v.renderHeight, v.tf,
-                                                 {.streamMs = ms, .idleWaitMs = 0.0});
+  shownBricks_ = session::BrickRefinement(*bricks_).step(v.camera, v.renderWidth, v.renderHeight,
+                                                         v.tf, {.streamMs = ms, .idleWaitMs = 0.0});
+  return shownBricks_;
 }
 
 void ZarrStoreView::show(const gpu::Texture& image, const FrameView& v) {
@@ -175,6 +195,7 @@ void ZarrStoreView::show(const gpu::Texture& image, const FrameView& v) {
 
 StoreFrame ZarrStoreView::drawWhole(const FrameView& v, StoreFrame f,
                                     std::chrono::steady_clock::time_point t0) {
+  f.tablesMs = prepareTables(v);
   const auto t1 = std::chrono::steady_clock::now();
   show(active_.technique->render(v.camera, v.pass, v.renderWidth, v.renderHeight, 0.0), v);
   shownVersion_ = active_.upload.layout->contentVersion();
@@ -182,6 +203,15 @@ StoreFrame ZarrStoreView::drawWhole(const FrameView& v, StoreFrame f,
   f.shown = true;
   f.ms = msSince(t0);
   return f;
+}
+
+// The ray caster's tables for `v` (rebuilt when bricks changed what it
+// samples: its empty-space blocks), apart from its ray march; ms.
+double ZarrStoreView::prepareTables(const FrameView& v) {
+  const auto t0 = std::chrono::steady_clock::now();
+  active_.technique->prepare(v.camera, v.pass);
+  tablesVersion_ = active_.upload.layout->contentVersion();
+  return msSince(t0);
 }
 
 // At the resolution that met the preview's share of the budget before
@@ -200,9 +230,11 @@ void ZarrStoreView::preview(const FrameView& v, StoreFrame& f) {
   p.renderWidth = std::max(1, static_cast<int>(std::lround(v.renderWidth * level.resolutionScale)));
   p.renderHeight =
       std::max(1, static_cast<int>(std::lround(v.renderHeight * level.resolutionScale)));
+  f.tablesMs = prepareTables(v);
   const auto t0 = std::chrono::steady_clock::now();
   show(active_.technique->render(p.camera, p.pass, p.renderWidth, p.renderHeight, 0.0), p);
-  previewQuality_->report(level, msSince(t0));
+  f.previewMs = msSince(t0);
+  previewQuality_->report(level, f.previewMs);
   previewMeasured_ = true;
   f.shown = true;
   f.previewWidth = p.renderWidth;
@@ -215,7 +247,23 @@ StoreFrame ZarrStoreView::refine() {
   Pending& p = pending_;
   // No gpu::clearErrors() here: every step ends checking them, and each
   // query waits for the browser's GPU process.
-  if (!p.streaming) return strip();
+  if (!p.streaming) {
+    if (active_.upload.layout->contentVersion() == tablesVersion_) return strip();
+    // The bricks changed what the ray caster samples: its tables (empty-
+    // space blocks) are rebuilt in a step of their own, not in a strip or
+    // in the preview that answers the next input.
+    // Its uploads waited for here, as a streaming step's: this step's
+    // cost, not the next one's (the preview that answers input).
+    StoreFrame f;
+    f.tablesMs = prepareTables(p.view);
+    gpu::checkErrors("OME-Zarr tables");
+    f.pending = true;
+    f.bricks = p.bricks;
+    f.renderWidth = p.view.renderWidth;
+    f.renderHeight = p.view.renderHeight;
+    f.ms = msSince(t0);
+    return f;
+  }
   // What arrived, streamed in budget-sized steps up to as long as a whole
   // frame streams before it draws (while they make progress); the bricks
   // then stay as they are until the frame is drawn.
@@ -223,17 +271,19 @@ StoreFrame ZarrStoreView::refine() {
   const int uploadedBefore = p.bricks.uploaded;
   bricks_->setUpdatePace(streamPace());
   p.bricks = stream(p.view, 0.0);
+  StoreFrame f;
+  f.updateMs = msSince(t0);
   // An upload is done in the browser's GPU process after this call returns:
   // waited for here, it is this step's cost, not the next one's. Without
   // one there is nothing to wait for (a query would wait for whatever the
   // GPU process does meanwhile, such as composing the page).
   if (p.bricks.uploaded > 0) gpu::checkErrors("OME-Zarr streaming");
+  f.uploadWaitMs = msSince(t0) - f.updateMs;
   p.bricks.uploaded += uploadedBefore;
   p.streamedMs += msSince(t0);
   const bool progress =
       p.bricks.uploaded > uploadedBefore || bricks_->streamerStats().bricksRead != read;
   if (p.bricks.complete || !progress || p.streamedMs >= kStreamMs) p.streaming = false;
-  StoreFrame f;
   f.pending = true;
   f.streamed = true;
   f.bricks = p.bricks;
@@ -262,6 +312,7 @@ StoreFrame ZarrStoreView::strip() {
   if (p.rows > 0.0) rows = std::min(rows, 2.0 * p.rows);
   rows = std::clamp(rows, minStrip, 1.0 - p.done);
   if (1.0 - (p.done + rows) < 0.5 * minStrip) rows = 1.0 - p.done;
+  const double tablesMs = prepareTables(v);
   const gpu::Texture* image = nullptr;
   {
     const gpu::RegionScope region(
@@ -272,12 +323,13 @@ StoreFrame ZarrStoreView::strip() {
   }
   // A strip's time varies with what its rows cover: a dearer one is taken
   // at once, a cheaper one only in part, so that strips overrun seldom.
-  const double perPixel = msSince(t0) / (rows * pixels);
+  const double perPixel = (msSince(t0) - tablesMs) / (rows * pixels);
   msPerPixel_ = perPixel > msPerPixel_ ? perPixel : 0.75 * msPerPixel_ + 0.25 * perPixel;
   p.rows = rows;
   p.done = p.done + rows >= 1.0 - 1e-9 ? 1.0 : p.done + rows;
   gpu::checkErrors("OME-Zarr frame strip");
   StoreFrame f;
+  f.tablesMs = tablesMs;
   f.bricks = p.bricks;
   f.renderWidth = v.renderWidth;
   f.renderHeight = v.renderHeight;

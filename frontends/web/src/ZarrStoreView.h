@@ -58,6 +58,12 @@ struct StoreFrame {
   bool pending = false;   // the full frame is still to come (ZarrStoreView::refine)
   bool streamed = false;  // this call read and uploaded what had arrived
   int previewWidth = 0, previewHeight = 0;  // the preview this call showed, if any
+  // Where this call's time went (the latency browser test reports them):
+  // the layout's update (selection, requests, reads, uploads, page table),
+  // the wait for its uploads in the GPU process, the ray caster's tables
+  // rebuilt for bricks that changed, and the preview (ray march, compose,
+  // wait).
+  double updateMs = 0.0, uploadWaitMs = 0.0, tablesMs = 0.0, previewMs = 0.0;
 };
 
 // How store frames are paced, as the viewer core paces its progressive
@@ -74,7 +80,21 @@ struct StorePace {
 
 class ZarrStoreView {
  public:
+  // What a store view holds in host memory: the fetched chunks, the store's
+  // metadata and its levels. It outlives a lost WebGL context.
+  struct Host {
+    std::shared_ptr<FetchStorage> storage;
+    std::shared_ptr<const ZarrStore> store;
+    std::shared_ptr<const FetchedZarrSource> source;
+  };
+
   ZarrStoreView(gpu::GlContext& context, const gpu::DeviceLimits& limits, const std::string& url);
+  // A view of a store already read, on another context (the restored one
+  // after a context loss): open() makes its atlas, page table and ray
+  // caster again, and the bricks are read again from the chunks held (the
+  // page fetches only those the host cache let go).
+  ZarrStoreView(gpu::GlContext& context, const gpu::DeviceLimits& limits, Host host);
+  Host host() const { return {storage_, store_, source_}; }
 
   FetchStorage& storage() { return *storage_; }
   // One step of opening: the metadata, then the coarsest level (pinned in
@@ -90,6 +110,9 @@ class ZarrStoreView {
   std::shared_ptr<const FetchedZarrSource> sharedSource() const { return source_; }
   // The coarsest level, read once at open (for the page's histogram).
   const Volume& coarsest() const { return coarsest_; }
+  // A second volume fused into the store's ray march (docs/fusion.md),
+  // aligned with level 0 by world coordinates; null: none.
+  void setFusion(std::shared_ptr<const FusedVolume> fused);
 
   // Selects levels for the view, uploads the bricks that arrived, requests
   // the missing ones (storage().takeWanted()), and draws into the canvas
@@ -122,6 +145,7 @@ class ZarrStoreView {
   layout::StreamingLayout* bricks_ = nullptr;
   std::unique_ptr<render::HybridCompositor> compositor_;
   std::uint64_t tfRevision_ = 0;
+  std::shared_ptr<const FusedVolume> fused_;
 
   // A frame of the view: what the technique renders and how it is shown.
   struct FrameView {
@@ -148,10 +172,14 @@ class ZarrStoreView {
   void show(const gpu::Texture& image, const FrameView& v);
   StoreFrame drawWhole(const FrameView& v, StoreFrame f, std::chrono::steady_clock::time_point t0);
   void preview(const FrameView& v, StoreFrame& f);
+  double prepareTables(const FrameView& v);
   StoreFrame strip();
   Pending pending_;
   // What the last full frame on the canvas sampled (Layout::contentVersion).
   std::uint64_t shownVersion_ = 0;
+  // What the ray caster's tables were last built for (prepareTables).
+  std::uint64_t tablesVersion_ = ~std::uint64_t(0);
+  layout::BricksFrame shownBricks_;  // the bricks' state after the last update
   double budgetMs_ = 12.0;
   double msPerPixel_ = 0.0;  // the ray march at full quality, from strips and whole frames
   // The preview's resolution and step, fed back to meet its share of the budget.

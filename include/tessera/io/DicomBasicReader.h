@@ -56,4 +56,8 @@ Volume readDicomSeriesBasic(const ByteSource& named, const FileSet& files,
 // The series in a folder, the largest first.
 std::vector<DicomSeriesInfo> listDicomSeriesBasic(const std::filesystem::path& folder);
 
+// The series (and stacks) of `named` and the files beside it in `files`, the
+// largest first: what the page offers to choose among.
+std::vector<DicomSeriesInfo> listDicomSeriesBasic(const ByteSource& named, const FileSet& files);
+
 }  // namespace tessera

@@ -20,10 +20,14 @@
 #include <vector>
 
 #include "tessera/core/Volume.h"
+#include "tessera/io/DicomSeriesReader.h"
 
 namespace tessera {
 
 class HttpStorage;
+namespace io_detail {
+struct FolderScan;
+}
 
 // A series URL: ROOT/studies/STUDY/series/SERIES (a trailing slash allowed).
 struct DicomWebSeriesUrl {
@@ -93,11 +97,21 @@ class DicomWebClient {
 
   // WADO-RS: the series as one volume, as readDicomSeries reads a folder of
   // its files (same voxels and affine); InputError naming the URL at fault.
-  Volume readSeries(const std::string& studyUid, const std::string& seriesUid) const;
+  // A series of several stacks (a multi-frame object's Stack IDs or
+  // orientations) gives its largest unless `stack` names one; an unknown
+  // stack is an InputError listing the stacks.
+  Volume readSeries(const std::string& studyUid, const std::string& seriesUid,
+                    const std::string& stack = "") const;
+  // The series' stacks (one entry with stack "" when it has one), from its
+  // metadata alone: what `info` lists and `--series UID:stack` selects.
+  std::vector<DicomSeriesInfo> stacks(const std::string& studyUid,
+                                      const std::string& seriesUid) const;
 
   DicomWebTransfer transfer() const;
 
  private:
+  io_detail::FolderScan scanSeries(const std::string& seriesUrl) const;
+
   std::string root_;
   DicomWebOptions options_;
   std::unique_ptr<HttpStorage> http_;
@@ -108,7 +122,17 @@ class DicomWebClient {
 };
 
 // A series URL read as readVolume reads a folder; `transfer`, when given,
-// receives what the read cost.
-Volume readDicomWebSeries(const std::string& url, DicomWebTransfer* transfer = nullptr);
+// receives what the read cost. `selection` is what --series takes for a
+// folder: "" or the URL's series UID (its largest stack), or "UID:stack".
+Volume readDicomWebSeries(const std::string& url, DicomWebTransfer* transfer = nullptr,
+                          const std::string& selection = "");
+
+// The stack `selection` names ("" for the largest); InputError naming the
+// URL when it names another series than the URL's.
+std::string dicomWebStack(const std::string& url, const std::string& selection);
+
+// The stacks of a series URL, the largest first, each with the --series
+// value that selects it (DicomSeriesInfo::selector).
+std::vector<DicomSeriesInfo> listDicomWebSeries(const std::string& url);
 
 }  // namespace tessera

@@ -45,7 +45,9 @@ class ZarrChunkCache {
   // again. Thread-safe.
   Chunk get(const std::string& key, const Decode& decode);
 
-  std::uint64_t budgetBytes() const { return budget_; }
+  std::uint64_t budgetBytes() const;
+  // A new budget from now on; chunks over it are let go at once.
+  void setBudget(std::uint64_t bytes);
   ZarrChunkCacheStats stats() const;
 
  private:

@@ -71,6 +71,9 @@ class ZarrStore {
   // between readers): what a reader of many small boxes (bricks) needs; a
   // reader of whole levels does not.
   void keepDecodedChunks(std::uint64_t bytes) { chunks_ = std::make_shared<ZarrChunkCache>(bytes); }
+  // The decoded chunks' budget changed on the cache already kept (the
+  // bricks layout's share of the host budget), chunks over it let go.
+  void limitDecodedChunks(std::uint64_t bytes) const { chunks_->setBudget(bytes); }
 
   // The finest level's dims, type and geometry with the value window of
   // the store (from its metadata or its coarsest level); no voxels.

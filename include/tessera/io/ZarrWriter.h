@@ -1,13 +1,15 @@
 #pragma once
 // Writes an OME-Zarr store (OME-NGFF 0.4 multiscales on Zarr v2, or 0.5 on
 // Zarr v3, optionally sharded): a
-// factor-2 pyramid from the finest level down to one chunk, streamed slab
-// by slab so that host memory holds one chunk-deep slab per level (about
-// 4/3 of a finest-level slab), never the volume.
+// pyramid from the finest level down to one chunk, each level dividing
+// each axis of the one before by its factor (2 on every axis by default;
+// microscopy's (1, 2, 2), z y x, keeps z), streamed slab by slab so that
+// host memory holds one chunk-deep slab per level, never the volume.
 //
-// The reduction filter is the 2x2x2 mean (partial blocks at odd edges
-// average the voxels present; NaN is skipped), exactly lod::downsample(v,
-// 2): it is what the renderer's own pyramid uses, so a level read from the
+// The reduction filter is the mean over a block of the factors (2x2x2 by
+// default; partial blocks at odd edges average the voxels present; NaN is
+// skipped), exactly lod::downsample(v, factors): it is what the renderer's
+// own pyramid uses, so a level read from the
 // store equals the level Tessera would compute in-core; it is the box
 // filter whose voxel centre sits half a voxel of the finer level into the
 // block, which NGFF's per-level translation states; and, unlike taking
@@ -37,6 +39,9 @@ struct OmeZarrWriteOptions {
     return glm::all(glm::greaterThan(chunkShape, glm::ivec3(0))) ? chunkShape : glm::ivec3(chunk);
   }
   int levels = 0;  // 0: down to a level that fits one chunk
+  // Each level's factor per axis (x, y, z) against the one before: 1 (the
+  // axis kept) or 2, at least one 2. (2, 2, 1) is microscopy's (1, 2, 2).
+  glm::ivec3 factors{2};
   ZarrCompressor compressor = ZarrCompressor::Zstd;
   // 2: NGFF 0.4 on Zarr v2; 3: NGFF 0.5 on Zarr v3 (zlib is written as
   // gzip there, v3 having no zlib codec).
@@ -61,9 +66,11 @@ struct OmeZarrWriteResult {
   ValueRange range;
 };
 
-// The number of levels `auto` gives: halve until every axis fits one chunk.
+// The number of levels `auto` gives: reduce until every axis that the
+// factors (x, y, z; 2 by default) reduce fits one chunk, or no axis can
+// reduce further.
 int omeZarrAutoLevels(glm::ivec3 dims, int chunk);
-int omeZarrAutoLevels(glm::ivec3 dims, glm::ivec3 chunk);
+int omeZarrAutoLevels(glm::ivec3 dims, glm::ivec3 chunk, glm::ivec3 factors = glm::ivec3(2));
 
 // Writes the store at `path` (a folder, by convention NAME.ome.zarr): built
 // in a temporary folder beside it and renamed into place when complete; an

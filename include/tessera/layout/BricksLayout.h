@@ -62,6 +62,27 @@ struct BricksOptions {
   bool walk = true;
   // > 0: the channels of createChannels() (planFor weighs their atlases).
   int channels = 0;
+  // The page table's side at most; 0: the device's 2D limit (tests force a
+  // table of several tile rows with a small one).
+  int pageTableMaxSide = 0;
+};
+
+// How the device profile's host budget is shared while a volume streams:
+// the atlas and page table (weighed against the host: see BricksLayout.cpp),
+// a fixed overhead (code, driver, render target, bricks in flight, stored
+// chunk bytes), the cache of read bricks and the sources' decoded chunks
+// (MultiresSource::limitDecodedCache). With a budget that can be honoured,
+// total() <= budget; atlas, pages and overhead are 0 when the budget is
+// too small to weigh them (the caches then take a quarter and an eighth of
+// it) or there is none (budget 0).
+struct BricksHostSplit {
+  std::uint64_t budget = 0;
+  std::uint64_t atlas = 0;
+  std::uint64_t pages = 0;
+  std::uint64_t overhead = 0;
+  std::uint64_t brickCache = 0;  // all channels together
+  std::uint64_t chunkCache = 0;  // all sources together
+  std::uint64_t total() const { return atlas + pages + overhead + brickCache + chunkCache; }
 };
 
 class BricksLayout final : public Layout, public StreamingLayout {
@@ -71,6 +92,11 @@ class BricksLayout final : public Layout, public StreamingLayout {
   static LayoutPlan planFor(const Volume& shape, const gpu::DeviceLimits& limits,
                             const BricksOptions& options = {}, glm::ivec3 chunk = glm::ivec3(0),
                             const std::vector<glm::ivec3>& levels = {});
+  // Where the page table keeps level-0 brick cell c: its z-slices as tiles of
+  // cells.x x cells.y texels side by side within maxSide x maxSide
+  // (MosaicLayout::Geometry: addressOf(c.x, c.y, c.z) is c's texel, as in
+  // bricks.glsl's pageTexel); tilesX 0 when the cells do not fit.
+  static MosaicLayout::Geometry pageTableGeometry(glm::ivec3 cells, int maxSide);
 
   // Plans, allocates, and reads and uploads the coarsest level (pinned, so
   // there is always something to fall back to). Throws GpuError if the plan
@@ -113,7 +139,7 @@ class BricksLayout final : public Layout, public StreamingLayout {
   // Channels: the page table and two channel atlases (the second the first
   // again when there are four channels or fewer).
   int textureUnits() const override {
-    return 1 + (channels_ ? 2 : static_cast<int>(atlases_.size()));
+    return 1 + (channels_ ? 2 : static_cast<int>(atlases_.size())) + (walkHost_.empty() ? 0 : 1);
   }
   ValueBlocks valueBlocks(int blockSize) const override;
   std::uint64_t contentVersion() const override { return contentVersion_; }
@@ -121,6 +147,7 @@ class BricksLayout final : public Layout, public StreamingLayout {
 
   const lod::BrickGrid& grid() const override { return grid_; }
   const lod::MultiresSource& source() const { return *source_; }
+  const BricksHostSplit& hostSplit() const { return hostSplit_; }
   int slotCount() const override { return static_cast<int>(slotKey_.size()); }
   lod::StreamerStats streamerStats() const override { return streamer_->stats(); }
   void retryFailingReads(bool retry) override {
@@ -133,9 +160,12 @@ class BricksLayout final : public Layout, public StreamingLayout {
     streamer_->setInlineReadsPerRequest(pace.inlineReads);
     for (auto& s : channelStreamers_) s->setInlineReadsPerRequest(pace.inlineReads);
   }
-  // The page table as uploaded (RGBA per level-0 cell, x fastest): the CPU
-  // twin of the lookup in bricks.glsl reads it.
+  // The page table as uploaded (RGBA texels, row 0 first; cell c at
+  // pageGeometry().addressOf(c)): the CPU twin of the lookup in bricks.glsl
+  // reads it.
   const std::vector<std::uint8_t>& pageTable() const { return pages_host_; }
+  std::vector<int> cellLevels() const override;
+  const MosaicLayout::Geometry& pageGeometry() const { return pageGeometry_; }
   glm::ivec3 atlasTexels() const { return atlasTexels_; }  // ES 2: of each texture
   // Where level-0 continuous voxel coordinate x0 is read: the atlas texel
   // coordinate (3D, continuous) and the level, or level -1 and the constant
@@ -178,6 +208,7 @@ class BricksLayout final : public Layout, public StreamingLayout {
 
   LayoutPlan plan_;
   BricksOptions options_;
+  BricksHostSplit hostSplit_;
   gpu::ApiLevel api_ = gpu::ApiLevel::Gles3;
   std::shared_ptr<const lod::MultiresSource> source_;
   lod::BrickGrid grid_;
@@ -193,6 +224,10 @@ class BricksLayout final : public Layout, public StreamingLayout {
   std::vector<glm::dvec2> channelPacking_;
   std::vector<gpu::Texture> atlases_;  // ES 3: one 3D texture; ES 2: 1..8 mosaics
   gpu::Texture pages_;
+  MosaicLayout::Geometry pageGeometry_;  // the page table's tiles (pageTableGeometry)
+  // ES 3, filtered atlas, isotropic pyramid: the walk's map per cell (RGBA32F).
+  gpu::Texture walkPages_;
+  std::vector<float> walkHost_;
   MosaicLayout::Geometry mosaic_;  // ES 2: the atlas' z-slices as tiles
   glm::ivec3 slotGrid_{1};
   glm::ivec3 atlasTexels_{0};
@@ -203,7 +238,6 @@ class BricksLayout final : public Layout, public StreamingLayout {
   // kFineBlock^3 block with its one-voxel support (valueBlocks()).
   static constexpr int kFineBlock = 8;
   std::vector<std::vector<std::uint16_t>> slotFine_;
-  std::vector<int> cellSlot0_;  // per level-0 cell: the slot of its level-0 brick, or -1
   std::unordered_map<std::uint64_t, int> slotOf_;
   std::vector<std::uint8_t> pages_host_;
   std::vector<std::uint16_t> cellMin_, cellMax_;  // stored range of what each cell samples

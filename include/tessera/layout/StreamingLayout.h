@@ -55,6 +55,10 @@ class StreamingLayout {
   virtual int slotCount() const = 0;               // atlas slots
   virtual const lod::BrickGrid& grid() const = 0;  // the bricks and levels it streams
   virtual const LayoutPlan& plan() const = 0;      // what it allocated (Layout::plan)
+  // Per level-0 brick cell of grid() (x fastest), the level the page table
+  // shows there now, or -1 where it shows a transparent cell's constant:
+  // the levels a frame drawn now samples, which its reference reads.
+  virtual std::vector<int> cellLevels() const = 0;
 };
 
 }  // namespace tessera::layout

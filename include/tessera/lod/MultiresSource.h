@@ -78,6 +78,15 @@ class MultiresSource {
   // say nothing of finer values: such bricks are read before they can be
   // skipped. Default false.
   virtual bool meanPyramid() const { return false; }
+  // Decoded data the source keeps between reads (a store's decoded chunks,
+  // io/ZarrChunkCache.h), which the bricks layout counts inside the device
+  // profile's host budget beside its own brick cache: the bytes the source
+  // would keep (0: it keeps none), a smaller budget the layout gives it out
+  // of the host budget (thread-safe; never more than it would keep), and
+  // the most it has held so far.
+  virtual std::uint64_t decodedCacheWanted() const { return 0; }
+  virtual void limitDecodedCache(std::uint64_t bytes) const { (void)bytes; }
+  virtual std::uint64_t decodedCachePeakBytes() const { return 0; }
 
   // A short description for logs and `tessera info` (path or URL).
   virtual std::string describe() const = 0;

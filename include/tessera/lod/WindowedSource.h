@@ -23,6 +23,9 @@ class WindowedSource final : public MultiresSource {
     return inner_->prefetch(level, box);
   }
   bool meanPyramid() const override { return inner_->meanPyramid(); }
+  std::uint64_t decodedCacheWanted() const override { return inner_->decodedCacheWanted(); }
+  void limitDecodedCache(std::uint64_t bytes) const override { inner_->limitDecodedCache(bytes); }
+  std::uint64_t decodedCachePeakBytes() const override { return inner_->decodedCachePeakBytes(); }
   std::string describe() const override { return inner_->describe(); }
 
   const std::shared_ptr<const MultiresSource>& inner() const { return inner_; }

@@ -3,6 +3,7 @@
 // pyramid the bricked layout and the streaming scheduler read: each level
 // is one of the store's datasets, read one box at a time, only the chunks
 // the box touches.
+#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -28,6 +29,13 @@ class ZarrMultiresSource final : public MultiresSource {
   // As the store's multiscales metadata says ("type": "mean", which
   // `tessera convert` writes); a store that does not say is not trusted.
   bool meanPyramid() const override { return store_->reduction() == "mean"; }
+  // The decoded chunks' budget the store was opened with (0 when it keeps
+  // none); a limit lowers it, never above that.
+  std::uint64_t decodedCacheWanted() const override { return wanted_; }
+  void limitDecodedCache(std::uint64_t bytes) const override {
+    store_->limitDecodedChunks(std::min(bytes, wanted_));
+  }
+  std::uint64_t decodedCachePeakBytes() const override { return store_->chunkStats().peakBytes; }
 
   const ZarrStore& store() const { return *store_; }
 
@@ -41,6 +49,7 @@ class ZarrMultiresSource final : public MultiresSource {
 
  private:
   std::shared_ptr<const ZarrStore> store_;
+  std::uint64_t wanted_ = 0;
 };
 
 }  // namespace tessera::lod

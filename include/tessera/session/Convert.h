@@ -2,7 +2,7 @@
 // What `tessera convert` and Python's tessera.convert do to a volume before
 // writing it, and how they write an OME-Zarr store: one reading of the
 // options for both front ends (crop, downsample, chunk shape, levels,
-// compressor, Zarr format, shards). Errors name the option as the CLI
+// compressor, Zarr format, shards, pyramid factors). Errors name the option as the CLI
 // spells it ("--crop '...': ...").
 #include <string>
 
@@ -22,6 +22,9 @@ struct ConvertRequest {
   std::string compressor = "zstd";
   int zarrFormat = 2;  // 2: NGFF 0.4 on Zarr v2; 3: NGFF 0.5 on Zarr v3
   int shard = 0;       // chunks per shard edge (v3), 0: unsharded
+  // Each level's factor against the one before, "Z,Y,X" (array order, as
+  // --chunk): 2 halves an axis, 1 keeps it; "1,2,2" is microscopy's.
+  std::string pyramidFactors = "2,2,2";
 };
 
 // "N" or "AxBxC" as x, y, z factors (>= 1).

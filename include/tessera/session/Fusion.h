@@ -13,6 +13,7 @@
 #include "tessera/core/Image.h"
 #include "tessera/core/SliceImage.h"
 #include "tessera/core/Volume.h"
+#include "tessera/lod/MultiresSource.h"
 #include "tessera/reference/FusedVolume.h"
 #include "tessera/render/LabelTable.h"
 
@@ -95,6 +96,10 @@ struct ProbeResult {
 
 // The probe of `anatomy` (in memory) and, when given, `overlay` at worldMm.
 ProbeResult probe(const Volume& anatomy, const Overlay* overlay, glm::dvec3 worldMm);
+// The same over a pyramid (a store, streamed or drawn by the page): the
+// position in its shape (level 0), the value of level 0's voxel when its
+// chunk is at hand (MultiresSource::prefetch), else of the coarsest level's.
+ProbeResult probe(const lod::MultiresSource& anatomy, const Overlay* overlay, glm::dvec3 worldMm);
 
 // The overlay's part of a probe as the readouts show it: "58 Postcentral_R",
 // "0 (background)", "3.25", or "outside".

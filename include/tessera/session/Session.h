@@ -196,7 +196,21 @@ class Session {
   // openOverlay opens a named file (SessionOpen.cpp; in the web build the
   // page hands files over instead and it refuses, WebSessionOverlay.cpp).
   void openOverlay(const std::string& spec, const OverlayOptions& options = {});
+  // A volume in memory as the overlay (a page's picked files), with the
+  // same rules and messages as openOverlay (SessionOverlay.cpp).
+  void addOverlay(std::shared_ptr<Volume> volume, const std::string& name,
+                  const OverlayOptions& options = {});
   void setOverlay(Overlay overlay);
+  // What an overlay goes over: the pyramid a front end draws itself
+  // (drawPyramid), else the session's volume (its shape: dims and index ->
+  // world). InputError "open a volume first: an overlay goes over one".
+  const Volume& overlayAnatomy() const;
+  // A pyramid a front end draws itself (the page's OME-Zarr store over
+  // fetch, bricked): overlays align with its shape, probe() reads its
+  // voxels; null: the session's own volume again.
+  void drawPyramid(std::shared_ptr<const lod::MultiresSource> pyramid) {
+    drawn_ = std::move(pyramid);
+  }
   // The open overlay with a new look (labels, colour map, alpha, window),
   // its volume kept; InputError when none is open.
   void restyleOpenOverlay(const OverlayOptions& options);
@@ -270,6 +284,7 @@ class Session {
   int timePoint_ = 0;
   Playback playback_;
   std::unique_ptr<Overlay> overlay_;
+  std::shared_ptr<const lod::MultiresSource> drawn_;  // drawPyramid
   // Both go before device_ (declared first), while its context lives: the
   // view's GL objects and the exploration's zoom swap.
   std::unique_ptr<viewer::Viewer> view_;

@@ -29,6 +29,10 @@ namespace tessera::session {
 class TimeSeries {
  public:
   using Reader = std::function<Volume(int time)>;
+  // Whether time point `time`'s bytes are at hand, so that the reader
+  // reads it without waiting; when they are not, it asks for them (a page
+  // fetches them between its frames: an OME-Zarr store in the browser).
+  using Arrival = std::function<bool(int time)>;
   // Where the time points ahead are read: on the series' own thread, or one
   // per pump() call on the caller's (a browser page without threads reads
   // between its frames).
@@ -69,7 +73,14 @@ class TimeSeries {
   void rethrowFailure(int t) const;
   // OnPump: reads the first wanted time point not read yet, if any, and
   // returns true when it read one. Background: does nothing, false.
+  // With an arrival (setArrival): the first one at hand, asking for at
+  // most `ahead` that are not, most urgent first.
   bool pump();
+  // OnPump: time points are read only once `arrived` says their bytes are
+  // at hand, and at most `ahead` (1..keep) not at hand are asked for at
+  // once, so that what is fetched ahead fits what the fetcher keeps.
+  // InputError for `ahead` out of range or a Background series.
+  void setArrival(Arrival arrived, int ahead);
   Reading reading() const { return mode_; }
   // The time points read so far (a time point read again after it was let
   // go counts again): what a test checks the prefetch by.
@@ -88,6 +99,8 @@ class TimeSeries {
   const Reader read_;
   const int keep_;
   const Reading mode_;
+  Arrival arrived_;
+  int ahead_ = 0;
   mutable std::mutex mutex_;
   std::condition_variable changed_;
   std::vector<int> wanted_;  // in the order to read
