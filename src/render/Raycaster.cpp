@@ -464,6 +464,8 @@ TechniqueEntry Raycaster::registration() {
           .summary = "single-pass ray casting",
           .honoursSampling = true,
           .scissorsToVolume = true,
+          .drawsChannels = true,
+          .drawsChannelBricks = true,
           .requirements = &Raycaster::requirements,
           .create = [](const TechniqueSetup& s) -> std::unique_ptr<Technique> {
             if (!s.layout) throw Error("raycast samples a layout, and none was made");

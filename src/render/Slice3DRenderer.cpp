@@ -183,8 +183,46 @@ void Slice3DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
   prog.set("u_tf", unit);
   prog.set("u_tfSize", static_cast<float>(lut_.entries()));
 
+  if (settings.mode == RenderMode::Mip && layout_.drawsChannels()) {
+    drawChannelMaxima(prog, settings);
+    return;
+  }
   gpu::drawArrays(gpu::Primitive::Triangles, vertices_, {{0, 3, 0}}, 3, 0, builtSlices_ * 6);
   accumulator_.resolve(settings, &lut_.texture(), lut_.entries());
+}
+
+// Several channels' maxima (docs/channels.md): the slices twice, channels
+// 0-3 into the accumulation target and 4-5 with the hit flag into a second
+// (one RGBA target a pass: ES 2 has no multiple render targets), then the
+// resolve that colours them.
+void Slice3DRenderer::drawChannelMaxima(const gpu::Program& slices,
+                                        const RenderSettings& settings) {
+  for (int group = 0; group < 2; ++group) {
+    if (group == 1) accumulator_.beginSecond(settings.mode);
+    slices.set("u_channelGroup", static_cast<float>(group));
+    gpu::drawArrays(gpu::Primitive::Triangles, vertices_, {{0, 3, 0}}, 3, 0, builtSlices_ * 6);
+  }
+  const gpu::Program& resolve = channelResolveProgram();
+  resolve.use();
+  const int unit = layout_.bindSeam(resolve, 0);
+  accumulator_.resolveWith(resolve, unit, settings);
+}
+
+std::vector<gpu::ShaderPart> Slice3DRenderer::channelResolveParts() const {
+  std::vector<gpu::ShaderPart> frag = {gpu::shaderPreamble(context_.caps().api, true, {})};
+  addSampleParts(frag, gradient_, layout_);
+  frag.push_back(gpu::embeddedShaderPart("render/slice_channels_resolve.frag.glsl"));
+  return frag;
+}
+
+const gpu::Program& Slice3DRenderer::channelResolveProgram() {
+  return programs_.get(layout_.name() + "|channel maxima resolve", [&] {
+    const gpu::ApiLevel api = context_.caps().api;
+    return gpu::Program::build("slice3d channel maxima resolve",
+                               {gpu::shaderPreamble(api, false, {}),
+                                gpu::embeddedShaderPart("render/fullscreen.vert.glsl")},
+                               channelResolveParts());
+  });
 }
 
 // ---- The Technique interface and the registry's entry.
@@ -233,6 +271,7 @@ TechniqueEntry Slice3DRenderer::registration() {
   return {
       .name = "slice3d",
       .summary = "view-aligned slicing",
+      .drawsChannels = true,
       .requirements = &Slice3DRenderer::requirements,
       .create = [](const TechniqueSetup& s) -> std::unique_ptr<Technique> { return create(s); }};
 }

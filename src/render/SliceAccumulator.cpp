@@ -22,7 +22,8 @@ SliceAccumulator::SliceAccumulator(gpu::GlContext& context, std::optional<bool> 
 }
 
 std::uint64_t SliceAccumulator::ownTextureBytes() const {
-  return accumulation_.color().bytes() + image_.color().bytes();
+  return accumulation_.color().bytes() + image_.color().bytes() +
+         (second_.id() != 0 ? second_.color().bytes() : 0);
 }
 
 const gpu::Program& SliceAccumulator::resolveProgram(RenderMode mode) {
@@ -57,6 +58,7 @@ void SliceAccumulator::begin(int width, int height, RenderMode mode) {
   if (accumulation_.id() == 0 || accumulation_.width() != width ||
       accumulation_.height() != height) {
     accumulation_ = gpu::Framebuffer();
+    second_ = gpu::Framebuffer();
     image_ = gpu::Framebuffer();
     const gpu::TexelFormat rgba8 = gpu::rgba8For(context_.caps().api);
     accumulation_ = gpu::Framebuffer::create(context_.ledger(), "slice accumulation", width, height,
@@ -74,6 +76,36 @@ void SliceAccumulator::begin(int width, int height, RenderMode mode) {
   // Front to back (DESIGN.md): the destination's transmittance 1 - A weighs
   // each new premultiplied slice colour and alpha; MIP keeps the maximum.
   gpu::apply({.blend = mode == RenderMode::Mip ? gpu::Blend::Max : gpu::Blend::FrontToBack});
+}
+
+void SliceAccumulator::beginSecond(RenderMode mode) {
+  if (second_.id() == 0) {
+    second_ = gpu::Framebuffer::create(context_.ledger(), "slice accumulation (channels 4-5)",
+                                       accumulation_.width(), accumulation_.height(),
+                                       floatTarget_.value_or(gpu::rgba8For(context_.caps().api)));
+    second_.color().setFilter(gpu::Filter::Nearest);
+  }
+  second_.bind();
+  gpu::apply({});
+  gpu::clearColor(glm::vec4(0.0f));
+  gpu::apply({.blend = mode == RenderMode::Mip ? gpu::Blend::Max : gpu::Blend::FrontToBack});
+}
+
+void SliceAccumulator::resolveWith(const gpu::Program& program, int firstUnit,
+                                   const RenderSettings& settings) {
+  if (second_.id() == 0) throw GpuError("slice resolve: the second target was not drawn");
+  gpu::apply({});
+  image_.bind();
+  program.use();
+  accumulation_.color().bind(firstUnit);
+  program.set("u_peaks0", firstUnit);
+  second_.color().bind(firstUnit + 1);
+  program.set("u_peaks1", firstUnit + 1);
+  program.set("u_viewport", glm::vec2(image_.width(), image_.height()));
+  program.set("u_background", glm::vec4(settings.background));
+  triangle_.draw();
+  gpu::finish();
+  gpu::checkErrors("slice rendering (channels)");
 }
 
 void SliceAccumulator::resolve(const RenderSettings& settings, const gpu::Texture* lut,

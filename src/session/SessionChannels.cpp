@@ -1,6 +1,7 @@
 // Session::renderChannels: a multi-channel frame of an OME-Zarr store
-// (docs/channels.md) through the ray caster over layout::ChannelLayout, and
-// its CPU reference.
+// (docs/channels.md) through the technique the settings name (one that draws
+// channels: raycast, slice3d) over layout::ChannelLayout, and its CPU
+// reference.
 #include <chrono>
 #include <cstdio>
 #include <optional>
@@ -13,7 +14,7 @@
 #include "tessera/lod/ZarrMultiresSource.h"
 #include "tessera/reference/ChannelReference.h"
 #include "tessera/reference/ImageMetrics.h"
-#include "tessera/render/Raycaster.h"
+#include "tessera/render/TechniqueRegistry.h"
 #include "tessera/session/BrickRefinement.h"
 #include "tessera/session/Session.h"
 
@@ -99,12 +100,27 @@ std::string levelsText(const std::vector<int>& cellsPerLevel) {
   return text;
 }
 
+// The technique the settings name, when it draws channels: InputError
+// naming it and those that do otherwise.
+const render::TechniqueEntry& channelTechnique(const std::string& name) {
+  const render::TechniqueRegistry& registry = render::TechniqueRegistry::global();
+  const render::TechniqueEntry& entry = registry.find(name);
+  if (entry.drawsChannels) return entry;
+  std::string drawing;
+  for (const render::TechniqueEntry& e : registry.entries()) {
+    if (e.drawsChannels) drawing += (drawing.empty() ? "" : " or ") + e.name;
+  }
+  throw InputError("--technique " + name + " cannot draw channels: channel frames draw with " +
+                   drawing);
+}
+
 }  // namespace
 
 ChannelFrame Session::renderChannels(const std::string& spec, int width, int height, bool reference,
                                      int time) {
   const Settings& s = settings_;
   s.validate();
+  const render::TechniqueEntry& entry = channelTechnique(s.technique);
   ChannelSet set = readZarrChannels(spec, s.channels.indices, time);
   s.channels.applyTo(set, spec);
   ChannelFrame frame;
@@ -118,12 +134,20 @@ ChannelFrame Session::renderChannels(const std::string& spec, int width, int hei
   const auto layout = layout::createChannelLayout(
       s.layout, set, [&] { return sources = open(); }, device_.limits, gl.ledger());
   frame.layout = layout->plan().reason;
+  if (layout->streaming() && !entry.drawsChannelBricks) {
+    throw InputError("--technique " + s.technique + " cannot draw channels from bricks (" +
+                     frame.layout +
+                     "): use --technique raycast, or --layout texture3d (ES 3) or mosaic (ES 2) "
+                     "where the channels fit in core");
+  }
   const auto t0 = std::chrono::steady_clock::now();
   std::optional<ChannelLevels> levels;  // a streamed frame's, read after it is drawn
   {
-    render::Raycaster caster(gl, set.geometry(), *layout);
-    caster.setSkipBlockSize(0);  // the block grid is one volume's
-    caster.setTransferFunction(s.tf);
+    render::TechniqueOptions options = s.techniqueOptions({width, height});
+    options.skipBlock = 0;  // the block grid is one volume's
+    const std::unique_ptr<render::Technique> technique = render::TechniqueRegistry::global().create(
+        s.technique, {gl, device_.limits, set.geometry(), layout.get(), options});
+    technique->setTransferFunction(s.tf);
     RenderSettings render = s.render;
     render.mode = renderModeFor(set.mode);
     layout::StreamingLayout* bricks = layout->streaming();
@@ -135,7 +159,7 @@ ChannelFrame Session::renderChannels(const std::string& spec, int width, int hei
                       levelsText(r.last.cellsPerLevel) +
                       (r.last.limitedByBudget ? " (atlas full)" : "");
     }
-    frame.image = caster.renderImage(camera, render, width, height);
+    frame.image = technique->renderImage(camera, render, width, height);
     if (bricks && reference) {
       levels = levelsShown(set, sources, *bricks);
       frame.layout += levels->cells.mixed()

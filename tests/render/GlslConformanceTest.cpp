@@ -109,6 +109,7 @@ void expectSlicingConformant(gpu::GlContext& c, const Volume& v, const layout::L
       }
     }
   }
+  if (layout.drawsChannels()) sources.push_back(gpu::assembleShader(slice3d.channelResolveParts()));
   for (const std::string& src : sources) {
     const bool vertex = src.find("gl_Position") != std::string::npos;
     const Validation r = validate(src, vertex ? "vert" : "frag");

@@ -48,6 +48,7 @@ class ChannelLayout final : public Layout {
   std::uint64_t textureBytes() const override;
   // Windows, colours, visibility and mode are read from the set at bind().
   const ChannelSet& channels() const { return *set_; }
+  bool drawsChannels() const override { return true; }
 
  private:
   ChannelLayout() = default;

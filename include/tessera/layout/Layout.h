@@ -104,6 +104,10 @@ class Layout {
   // drives its per-frame refinement through it.
   virtual StreamingLayout* streaming() { return nullptr; }
   virtual const StreamingLayout* streaming() const { return nullptr; }
+  // True for a layout whose seam defines CHANNELS (several channels,
+  // docs/channels.md): techniques whose MIP needs more than one value per
+  // sample (slice3d's per channel maxima) ask this.
+  virtual bool drawsChannels() const { return false; }
   // What the CPU reference renders as this layout's twin (fcc: the box
   // spline over its lattice); default: the voxels it was made from.
   virtual ReferenceField referenceField() const { return {}; }

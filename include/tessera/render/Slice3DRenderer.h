@@ -12,6 +12,9 @@
 // perspective ray crosses consecutive planes ds / cos(theta) apart, so each
 // fragment corrects its opacity once more by that ratio (DESIGN.md,
 // Rendering semantics). No early termination (blending has no way to stop).
+// Over a layout that draws channels (docs/channels.md) each fragment combines
+// them as the ray caster's samples do; their MIP keeps per channel maxima in
+// two targets and colours them in a resolve pass.
 // The "slice3d" technique of the registry (render/TechniqueRegistry.h).
 #include <cstdint>
 #include <map>
@@ -79,6 +82,8 @@ class Slice3DRenderer final : public Technique {
 
   std::vector<gpu::ShaderPart> vertexParts() const;
   std::vector<gpu::ShaderPart> fragmentParts(const RenderSettings& settings) const;
+  // The resolve pass of channel maxima (a layout that drawsChannels(), max).
+  std::vector<gpu::ShaderPart> channelResolveParts() const;
   std::string accumulationFormat() const { return accumulator_.accumulationFormat(); }
   std::uint64_t ownTextureBytes() const override;
 
@@ -106,6 +111,8 @@ class Slice3DRenderer final : public Technique {
   const gpu::Program& programFor(const RenderSettings& settings);
   void buildGeometry(int slices);
   void updateLookup(const RenderSettings& settings, double spacing);
+  void drawChannelMaxima(const gpu::Program& slices, const RenderSettings& settings);
+  const gpu::Program& channelResolveProgram();
 
   gpu::GlContext& context_;
   const Volume& volume_;

@@ -14,6 +14,10 @@
 // would drift. ES 2 devices accumulate in RGBA8, as the papers' devices did.
 // MIP blends with GL_MAX (ES 3, or ES 2 with EXT_blend_minmax): slices write
 // (n * inside, 0, 0, inside) and the resolve pass classifies the maximum.
+// Several channels' maxima (docs/channels.md) take two targets: channels 0-3
+// in the first, 4-5 and the hit flag in a second (beginSecond), drawn one
+// after the other (ES 2 has no multiple render targets), and a resolve pass
+// of the caller's that colours them (resolveWith).
 #include <optional>
 #include <string>
 
@@ -39,6 +43,13 @@ class SliceAccumulator {
   // Composites into the RGBA8 image and waits for it (glFinish). For MIP,
   // `lut` is the TF table (entries as in render/classify.glsl).
   void resolve(const RenderSettings& settings, const gpu::Texture* lut, int lutEntries);
+  // After begin(): a second accumulation target of the same size and format,
+  // bound, cleared and set to the same blending.
+  void beginSecond(RenderMode mode);
+  // Resolves with the caller's `program`, in use with its own uniforms set:
+  // the first and second targets at units firstUnit and firstUnit + 1
+  // (u_peaks0, u_peaks1), u_viewport and u_background as in resolve().
+  void resolveWith(const gpu::Program& program, int firstUnit, const RenderSettings& settings);
   // The last resolved frame, top row first.
   Image readImage() const;
   // The RGBA8 texture holding the last resolved frame (row 0 at the bottom).
@@ -56,6 +67,7 @@ class SliceAccumulator {
   gpu::GlContext& context_;
   std::optional<gpu::TexelFormat> floatTarget_;  // the half-float target, if any
   gpu::Framebuffer accumulation_;
+  gpu::Framebuffer second_;  // channels 4-5 and the hit flag (beginSecond)
   gpu::Framebuffer image_;
   gpu::FullscreenTriangle triangle_;
   gpu::Program compositeResolve_;

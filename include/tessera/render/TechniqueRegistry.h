@@ -49,6 +49,11 @@ struct TechniqueEntry {
   // transparent black (its rays miss the box), so a frame scissored to that
   // part of the view draws the same image.
   bool scissorsToVolume = false;
+  // drawsChannels: it draws several channels over a layout that holds them
+  // in core (docs/channels.md); drawsChannelBricks: also over the bricks
+  // layout's channel atlases (the streaming refinement).
+  bool drawsChannels = false;
+  bool drawsChannelBricks = false;
   std::function<TechniqueRequirements(const gpu::DeviceLimits& limits, glm::ivec3 volumeDims,
                                       const TechniqueOptions& options)>
       requirements;
