@@ -66,21 +66,14 @@ function loadEmscripten(file) {
   }
   return loaded.get(file);
 }
-function loadJpeg12() {
-  if (!loaded.has('jpeg12')) {
-    const p = import(CODEC_DIR + 'jpeg12.js');
-    loaded.set('jpeg12', p);
-    p.catch(() => loaded.delete('jpeg12'));
+// An ES module from codecs/, imported once.
+function loadModule(file) {
+  if (!loaded.has(file)) {
+    const p = import(CODEC_DIR + file);
+    loaded.set(file, p);
+    p.catch(() => loaded.delete(file));
   }
-  return loaded.get('jpeg12');
-}
-function loadLossless() {
-  if (!loaded.has('lossless')) {
-    const p = import(CODEC_DIR + 'lossless-min.js');
-    loaded.set('lossless', p);
-    p.catch(() => loaded.delete('lossless'));
-  }
-  return loaded.get('lossless');
+  return loaded.get(file);
 }
 // A decoder that trapped may have left its memory inconsistent: the next
 // frame gets a fresh instance.
@@ -191,7 +184,7 @@ function describeWasmError(m, e) {
 // decoder, which throws strings; its 16-bit samples as stored pixel data
 // holds them.
 async function jpeg12Decode(frame, shape) {
-  const JpegImage = (await loadJpeg12()).default;
+  const JpegImage = (await loadModule('jpeg12.js')).default;
   const d = new JpegImage();
   let samples;
   try {
@@ -210,7 +203,7 @@ async function jpeg12Decode(frame, shape) {
 }
 
 async function losslessDecode(frame, shape) {
-  const { Decoder } = await loadLossless();
+  const { Decoder } = await loadModule('lossless-min.js');
   const d = new Decoder();
   const out = d.decode(frame.buffer, frame.byteOffset, frame.length, shape.bitsAllocated / 8);
   checkShape({ columns: d.xDim, rows: d.yDim, components: d.numComp, precision: d.precision }, shape, 'JPEG lossless');
