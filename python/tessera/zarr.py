@@ -64,8 +64,10 @@ _COMPRESSORS = {
     "blosc": {"id": "blosc", "cname": "lz4", "clevel": 5, "shuffle": 1, "blocksize": 0},
 }
 
+# The C++ writer's text for its default factors (io/ZarrWriter.cpp: the
+# factors, z by y by x); this writer halves every axis.
 _METHOD = (
-    "tessera convert: 2x2x2 mean (lod::downsample), partial edge blocks "
+    "tessera convert: 2x2x2 (z by y by x) mean (lod::downsample), partial edge blocks "
     "average the voxels present"
 )
 
