@@ -615,7 +615,7 @@ def ds(*values):
 def dicom_slice(z, rows=8, cols=8, series=UID_ROOT + ".1", orientation=(1, 0, 0, 0, 1, 0),
                 spacing="0.5\\0.5", bits=16, samples=1, photometric="MONOCHROME2",
                 transfer_syntax=EXPLICIT_LE, pixel=None, claimed_pixel_len=None, magic=b"DICM",
-                position=None, instance=1, encapsulated=False, nested=0):
+                position=None, instance=1, encapsulated=False, nested=0, fragment=None):
     sop = f"{UID_ROOT}.2.{instance}.{int(z * 10) & 0xFFFF}"
     meta = (dcm_el(0x0002, 0x0001, "OB", b"\0\1") +
             dcm_el(0x0002, 0x0002, "UI", CT_IMAGE_STORAGE) +
@@ -644,7 +644,7 @@ def dicom_slice(z, rows=8, cols=8, series=UID_ROOT + ".1", orientation=(1, 0, 0,
             dcm_el(0x0028, 0x0103, "US", struct.pack("<H", 0)))
     if encapsulated:
         # Undefined length, an empty offset table item, one fragment, delimiter.
-        frag = noise(64, 29)
+        frag = fragment if fragment is not None else noise(64, 29)
         body += (struct.pack("<HH2sHI", 0x7FE0, 0x0010, b"OB", 0, 0xFFFFFFFF) +
                  struct.pack("<HHI", 0xFFFE, 0xE000, 0) +
                  struct.pack("<HHI", 0xFFFE, 0xE000, len(frag)) + frag +
@@ -762,6 +762,15 @@ def make_dicom(c):
     series("jpeg2000", "transfer syntax JPEG 2000 (1.2.840.10008.1.2.4.90), not decodable by DCMTK",
            "1.2.840.10008.1.2.4.90|JPEG 2000|JPEG2000|transfer syntax",
            ordinary([0, 1, 2], transfer_syntax="1.2.840.10008.1.2.4.90", encapsulated=True))
+    # SOI, a JFIF APP0, then TEM (FF01) where the frame header belongs.
+    tem = (bytes.fromhex("ffd8ffe000104a46494600010100000100010000ff01") +
+           bytes.fromhex("ffc3000b10000800080101") + noise(42, 37))
+    series("jpeg-tem-marker",
+           "JPEG Lossless slices whose frame has a TEM marker (FF01) before its frame header; "
+           "DCMTK 3.6.7's JPEG decoder never returned on it (found by fuzz_dicomweb)",
+           "TEM marker (FF01)",
+           ordinary([0, 1, 2], transfer_syntax="1.2.840.10008.1.2.4.70", encapsulated=True,
+                    fragment=tem))
     series("no-dicom-files", "a folder holding only a text file", "DICOM",
            {"notes.txt": b"not a DICOM file\n"})
     series("nested-sequences", "sequences nested 100 levels deep (the readers accept 64)",

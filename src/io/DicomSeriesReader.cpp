@@ -293,6 +293,7 @@ void loadPixels(const Slice& s, LoadedPixels& out) {
   DcmDataset& ds = *out.ff->getDataset();
   const E_TransferSyntax xfer = ds.getOriginalXfer();
   if (DcmXfer(xfer).isEncapsulated()) {
+    io_detail::checkJpegFragments(ds, f);
     const OFCondition c = ds.chooseRepresentation(EXS_LittleEndianExplicit, nullptr);
     if (!io_detail::canDecodePixels(xfer)) {
       throw InputError(io_detail::undecodableSyntaxMessage(f, xfer));

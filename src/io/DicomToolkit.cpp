@@ -3,7 +3,12 @@
 #include <mutex>
 
 #include <dcmtk/dcmdata/dccodec.h>
+#include <dcmtk/dcmdata/dcdatset.h>
+#include <dcmtk/dcmdata/dcdeftag.h>
 #include <dcmtk/dcmdata/dcdict.h>
+#include <dcmtk/dcmdata/dcpixel.h>
+#include <dcmtk/dcmdata/dcpixseq.h>
+#include <dcmtk/dcmdata/dcpxitem.h>
 #include <dcmtk/dcmdata/dcrledrg.h>
 #include <dcmtk/dcmdata/dcrleerg.h>
 #include <dcmtk/dcmjpeg/djdecode.h>
@@ -67,6 +72,79 @@ std::string undecodableSyntaxMessage(const std::string& file, E_TransferSyntax x
          "baseline/extended/lossless, JPEG-LS and RLE); convert it with e.g. `gdcmconv --raw " +
          file + " out.dcm` (GDCM" +
          (j2k ? ", which decodes JPEG 2000; DCMTK's dcmdjpeg does not)" : ")");
+}
+
+namespace {
+
+bool isJpeg1992(E_TransferSyntax xfer) {
+  return xfer >= EXS_JPEGProcess1 && xfer <= EXS_JPEGProcess14SV1;
+}
+
+// Where dcmjpeg's precision scan goes from the marker at `offset`: the next
+// offset, or npos where the scan ends (a frame header found, or a byte
+// sequence it gives up on). `stalls` is set at a TEM marker, which it
+// neither skips nor accepts.
+constexpr std::size_t kScanEnds = static_cast<std::size_t>(-1);
+
+std::size_t nextScanOffset(std::span<const std::uint8_t> b, std::size_t offset, bool& stalls) {
+  const unsigned marker = (unsigned{b[offset]} << 8) | b[offset + 1];
+  const auto segment = [&] {
+    return offset + ((unsigned{b[offset + 2]} << 8) | b[offset + 3]) + 2;
+  };
+  if (marker == 0xFF01) {
+    stalls = true;
+    return kScanEnds;
+  }
+  const bool frameHeader = marker >= 0xFFC0 && marker <= 0xFFCF && marker != 0xFFC4 &&
+                           marker != 0xFFC8 && marker != 0xFFCC;
+  if (frameHeader) return kScanEnds;
+  if (marker == 0xFFC4 || marker == 0xFFC8 || marker == 0xFFCC) return segment();
+  if (marker >= 0xFFD0 && marker <= 0xFFD9) return offset + 2;  // RSTn, SOI, EOI
+  if (marker >= 0xFFDA && marker <= 0xFFFE) return segment();
+  if (marker == 0xFFFF) return offset + 1;  // fill byte
+  if (b[offset] == 0xFF && b[offset + 1] > 0x02 && b[offset + 1] <= 0xBF) return offset + 2;
+  return kScanEnds;
+}
+
+}  // namespace
+
+void checkJpegFragment(E_TransferSyntax xfer, std::span<const std::uint8_t> fragment,
+                       const std::string& what) {
+  if (!isJpeg1992(xfer)) return;
+  bool stalls = false;
+  for (std::size_t offset = 0; offset != kScanEnds && offset + 4 < fragment.size();) {
+    const std::size_t at = offset;
+    offset = nextScanOffset(fragment, offset, stalls);
+    if (stalls) {
+      throw InputError(what + ": the JPEG frame has a TEM marker (FF01) at byte " +
+                       std::to_string(at) +
+                       " before its frame header, which DCMTK's JPEG decoder cannot pass "
+                       "(corrupt frame?)");
+    }
+  }
+}
+
+void checkJpegFragments(DcmDataset& ds, const std::string& what) {
+  const E_TransferSyntax xfer = ds.getOriginalXfer();
+  if (!isJpeg1992(xfer)) return;
+  DcmElement* elem = nullptr;
+  if (ds.findAndGetElement(DCM_PixelData, elem).bad() || elem == nullptr) return;
+  auto* pixels = dynamic_cast<DcmPixelData*>(elem);
+  DcmPixelSequence* sequence = nullptr;
+  if (pixels == nullptr || pixels->getEncapsulatedRepresentation(xfer, nullptr, sequence).bad() ||
+      sequence == nullptr) {
+    return;  // DCMTK reports what is wrong when it decodes
+  }
+  for (unsigned long i = 1; i < sequence->card(); ++i) {  // item 0: the offset table
+    DcmPixelItem* item = nullptr;
+    Uint8* data = nullptr;
+    if (sequence->getItem(item, i).bad() || item == nullptr || item->getUint8Array(data).bad() ||
+        data == nullptr) {
+      continue;
+    }
+    checkJpegFragment(xfer, {data, item->getLength()},
+                      what + " (fragment " + std::to_string(i) + ")");
+  }
 }
 
 std::string conditionText(const OFCondition& cond) {

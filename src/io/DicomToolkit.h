@@ -2,11 +2,15 @@
 // The DCMTK setup shared by the DICOM series reader and writer: one-time
 // process setup (quiet logging, codecs registered, data dictionary present)
 // and the names users see for transfer syntaxes and DCMTK errors.
+#include <cstdint>
+#include <span>
 #include <string>
 
 #include <dcmtk/config/osconfig.h>  // must come before any other DCMTK header
 #include <dcmtk/dcmdata/dcxfer.h>
 #include <dcmtk/ofstd/ofcond.h>
+
+class DcmDataset;
 
 namespace tessera::io_detail {
 
@@ -27,6 +31,17 @@ bool canDecodePixels(E_TransferSyntax xfer);
 // "scan.dcm: JPEG 2000 (transfer syntax UID 1.2.840.10008.1.2.4.90) is not
 // supported by this build; convert it with e.g. `gdcmconv --raw ...`".
 std::string undecodableSyntaxMessage(const std::string& file, E_TransferSyntax xfer);
+
+// Throws InputError naming `what` when DCMTK's JPEG decoder would never
+// return on `fragment`, the first bytes of a JPEG 1992 frame (`xfer` one of
+// the JPEG processes; other syntaxes pass): before decoding, dcmjpeg 3.6.7
+// walks the markers for the frame header's precision and does not advance
+// past a TEM marker (FF01) met before it (a fuzzed DICOMweb frame hung there).
+void checkJpegFragment(E_TransferSyntax xfer, std::span<const std::uint8_t> fragment,
+                       const std::string& what);
+
+// The same for each fragment of a dataset's encapsulated pixel data.
+void checkJpegFragments(DcmDataset& ds, const std::string& what);
 
 // DCMTK's text for a failed condition, e.g. "I/O suspension or premature end of stream".
 std::string conditionText(const OFCondition& cond);

@@ -44,6 +44,8 @@ std::vector<std::byte> throughDcmtk(const Slice& s, E_TransferSyntax xfer,
                                     std::span<const std::byte> frame, const std::string& what) {
   initDicomToolkit();
   if (!canDecodePixels(xfer)) throw InputError(undecodableSyntaxMessage(what, xfer));
+  checkJpegFragment(xfer, {reinterpret_cast<const std::uint8_t*>(frame.data()), frame.size()},
+                    what);
   DcmDataset ds;
   ds.putAndInsertUint16(DCM_Rows, static_cast<Uint16>(s.rows));
   ds.putAndInsertUint16(DCM_Columns, static_cast<Uint16>(s.columns));

@@ -11,6 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "io/DicomToolkit.h"
+#include "io/DicomWebFrame.h"
 #include "io/DicomWebParts.h"
 #include "io/ZarrTestSupport.h"
 #include "support/ExpectError.h"
@@ -334,6 +336,49 @@ TEST(DicomWebParts, DicomJsonWithANumberTooLargeIsOneLine) {
   });
   EXPECT_EQ(m.rfind("meta: not DICOM JSON (46 bytes starting", 0), 0u) << m;
   EXPECT_NE(m.find("): a number too large for a double"), std::string::npos) << m;
+}
+
+// Found by fuzz_dicomweb (a > 5 s timeout): DCMTK 3.6.7's JPEG decoder
+// looks for the frame header's precision first and loops for ever on a TEM
+// marker (FF01) before it. The frame is refused in one line instead.
+TEST(DicomWebFrame, JpegFrameWithATemMarkerBeforeItsHeaderIsRefused) {
+  io_detail::Slice slice;
+  slice.rows = 64;
+  slice.columns = 64;
+  slice.bitsAllocated = 16;
+  slice.bitsStored = 16;
+  slice.highBit = 15;
+  slice.isSigned = true;
+  slice.photometric = "MONOCHROME2";
+  // SOI, a 16-byte JFIF APP0, then TEM where the SOF3 header was (the
+  // fuzzer's input, shortened), then a lossless frame header and noise.
+  std::vector<std::uint8_t> frame = {0xFF, 0xD8, 0xFF, 0xE0, 0x00, 0x10, 'J',  'F',  'I',  'F',
+                                     0x00, 0x01, 0x01, 0x00, 0x00, 0x01, 0x00, 0x01, 0x00, 0x00,
+                                     0xFF, 0x01, 0x0B, 0x00, 0x10, 0x00, 0x40, 0x00, 0x40, 0x01,
+                                     0xFF, 0xC3, 0x00, 0x0B, 0x10, 0x00, 0x40, 0x00, 0x40, 0x01};
+  for (int i = 0; i < 200; ++i) frame.push_back(static_cast<std::uint8_t>(i * 37 + 11));
+  const auto decode = [&](const std::string& syntax) {
+    return test::inputErrorMessage([&] {
+      io_detail::decodeWebFrame(
+          slice, syntax, {reinterpret_cast<const std::byte*>(frame.data()), frame.size()}, "f.jpg");
+    });
+  };
+  for (const char* syntax : {"1.2.840.10008.1.2.4.70", "1.2.840.10008.1.2.4.57",
+                             "1.2.840.10008.1.2.4.50", "1.2.840.10008.1.2.4.51"}) {
+    EXPECT_EQ(decode(syntax),
+              "f.jpg: the JPEG frame has a TEM marker (FF01) at byte 20 before its frame header, "
+              "which DCMTK's JPEG decoder cannot pass (corrupt frame?)")
+        << syntax;
+  }
+  // JPEG-LS has its own header reading: the check is the JPEG 1992 one only.
+  const std::span<const std::uint8_t> bytes(frame);
+  EXPECT_NO_THROW(io_detail::checkJpegFragment(EXS_JPEGLSLossless, bytes, "f.jls"));
+  // With the marker after the frame header the precision scan ends first.
+  frame[20] = 0xFF;
+  frame[21] = 0xC3;
+  frame[30] = 0xFF;
+  frame[31] = 0x01;
+  EXPECT_NO_THROW(io_detail::checkJpegFragment(EXS_JPEGProcess14, bytes, "f.jpg"));
 }
 
 TEST(DicomWebParts, DicomJsonGivesTheTextsTheFolderReaderReads) {
