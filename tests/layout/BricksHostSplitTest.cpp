@@ -13,6 +13,7 @@
 #include <map>
 #include <mutex>
 
+#include "support/CountingStorage.h"
 #include "support/GpuTestContext.h"
 #include "support/TestCameras.h"
 #include "support/TestSupport.h"
@@ -30,34 +31,7 @@ namespace {
 
 constexpr std::uint64_t kMiB = 1ull << 20;
 
-// A folder store that counts the gets of each chunk key.
-class CountingStorage final : public ZarrStorage {
- public:
-  explicit CountingStorage(std::filesystem::path root) : inner_(std::move(root)) {}
-  std::optional<std::vector<std::byte>> get(const std::string& key,
-                                            std::uint64_t maxBytes) const override {
-    {
-      const std::lock_guard lock(mutex_);
-      if (key.find("/.") == std::string::npos && key[0] != '.') ++gets_[key];
-    }
-    return inner_.get(key, maxBytes);
-  }
-  std::string locate(const std::string& key) const override { return inner_.locate(key); }
-  std::string describe() const override { return inner_.describe(); }
-  std::map<std::string, int> gets() const {
-    const std::lock_guard lock(mutex_);
-    return gets_;
-  }
-  void reset() {
-    const std::lock_guard lock(mutex_);
-    gets_.clear();
-  }
-
- private:
-  FolderStorage inner_;
-  mutable std::mutex mutex_;
-  mutable std::map<std::string, int> gets_;
-};
+using test::CountingStorage;
 
 Volume ramps(glm::ivec3 d) {
   Volume v = Volume::allocate(d, ScalarType::U16, "ramps");

@@ -11,6 +11,7 @@
 #include <mutex>
 #include <random>
 
+#include "support/CountingStorage.h"
 #include "support/TestSupport.h"
 #include "tessera/io/ZarrStorage.h"
 #include "tessera/io/ZarrWriter.h"
@@ -20,34 +21,7 @@
 namespace tessera::lod {
 namespace {
 
-// A folder store that counts the gets of each chunk key.
-class CountingStorage final : public ZarrStorage {
- public:
-  explicit CountingStorage(std::filesystem::path root) : inner_(std::move(root)) {}
-  std::optional<std::vector<std::byte>> get(const std::string& key,
-                                            std::uint64_t maxBytes) const override {
-    {
-      const std::lock_guard lock(mutex_);
-      if (key.find("/.") == std::string::npos && key[0] != '.') ++gets_[key];
-    }
-    return inner_.get(key, maxBytes);
-  }
-  std::string locate(const std::string& key) const override { return inner_.locate(key); }
-  std::string describe() const override { return inner_.describe(); }
-  std::map<std::string, int> gets() const {
-    const std::lock_guard lock(mutex_);
-    return gets_;
-  }
-  void reset() {
-    const std::lock_guard lock(mutex_);
-    gets_.clear();
-  }
-
- private:
-  FolderStorage inner_;
-  mutable std::mutex mutex_;
-  mutable std::map<std::string, int> gets_;
-};
+using test::CountingStorage;
 
 Volume smooth(glm::ivec3 d) {
   Volume v = Volume::allocate(d, ScalarType::U16, "smooth");
