@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "tessera/core/Error.h"
+#include "tessera/render/HybridCompositor.h"
 
 namespace tessera::app {
 
@@ -21,7 +22,7 @@ void addFusionOptions(CLI::App* cmd, FusionOptions& o) {
   o.tfOption = cmd->add_option("--overlay-tf", o.tf,
                                "The overlay's colour map: hot (default), a --tf preset or "
                                "FILE.json");
-  cmd->add_option("--overlay-alpha", o.alpha,
+  cmd->add_option("--overlay-opacity,--overlay-alpha", o.opacity,
                   "How much the overlay's colour replaces the anatomy's, (0, 1] (default 0.5)");
   cmd->add_option("--overlay-window", o.window,
                   "The overlay's value window LO HI (raw values; default its value range)")
@@ -30,12 +31,42 @@ void addFusionOptions(CLI::App* cmd, FusionOptions& o) {
 
 const std::set<std::string>& fusionOptionNames() {
   static const std::set<std::string> names = {"--overlay", "--overlay-labels", "--overlay-tf",
-                                              "--overlay-alpha", "--overlay-window"};
+                                              "--overlay-opacity", "--overlay-window"};
   return names;
 }
 
+namespace {
+
+// --overlay-opacity's value: the overlay's opacity. Until 2026-11 the option
+// named the hybrid compositor's line attenuation, now --line-attenuation; an
+// old command line gets that said rather than "needs --overlay".
+double overlayOpacity(const std::string& text) {
+  if (text.empty()) return 0.5;
+  for (const render::OverlayOpacity m : render::allOverlayOpacities()) {
+    if (render::overlayOpacityName(m) == text) {
+      throw InputError("--overlay-opacity " + text +
+                       ": the attenuation of the --overlays lines is now --line-attenuation " +
+                       text + "; --overlay-opacity is the --overlay volume's opacity, (0, 1]");
+    }
+  }
+  std::size_t used = 0;
+  double value = 0.0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size() || !(value > 0.0 && value <= 1.0)) {
+    throw InputError("--overlay-opacity '" + text + "': expected the overlay's opacity in (0, 1]");
+  }
+  return value;
+}
+
+}  // namespace
+
 void openFusion(session::Session& session, const FusionOptions& o) {
   const CLI::App* cmd = o.command;
+  const double opacity = overlayOpacity(o.opacity);
   if (o.file.empty()) {
     for (const std::string& name : fusionOptionNames()) {
       if (name != "--overlay" && cmd->get_option(name)->count() > 0) {
@@ -53,7 +84,7 @@ void openFusion(session::Session& session, const FusionOptions& o) {
   options.labels = o.labelOverlay();
   options.labelTable = o.labels;
   options.tf = o.tf;
-  options.opacity = o.alpha;
+  options.opacity = opacity;
   if (!o.window.empty()) options.window = ValueRange{o.window[0], o.window[1]};
   session.openOverlay(o.file, options);
   if (!session.overlay()->note.empty()) {
@@ -68,8 +99,8 @@ void printOverlayText(const session::Overlay& overlay) {
       f.labels ? "labels (" + std::to_string(overlay.labels.labels.size()) + " in the table)"
                : "tf " + f.tf.name + ", window " + std::to_string(f.window.min) + ".." +
                      std::to_string(f.window.max);
-  std::printf("overlay  %s %dx%dx%d: %s, alpha %g, fused in the ray march\n", overlay.name.c_str(),
-              d.x, d.y, d.z, look.c_str(), f.opacity);
+  std::printf("overlay  %s %dx%dx%d: %s, opacity %g, fused in the ray march\n",
+              overlay.name.c_str(), d.x, d.y, d.z, look.c_str(), f.opacity);
 }
 
 }  // namespace tessera::app

@@ -1,8 +1,9 @@
 #pragma once
 // A second volume over the anatomy (docs/fusion.md), the options render and
 // probe share: --overlay FILE, --overlay-labels [TABLE] or --overlay-tf
-// PRESET, --overlay-alpha A, --overlay-window LO HI. (--overlays and
-// --overlay-opacity are the hybrid compositor's lines, HybridJob.h.)
+// PRESET, --overlay-opacity A (or its older name --overlay-alpha),
+// --overlay-window LO HI. (--overlays and --line-attenuation are the hybrid
+// compositor's lines, HybridJob.h.)
 #include <set>
 #include <string>
 #include <vector>
@@ -19,7 +20,7 @@ struct FusionOptions {
   std::string labels;
   CLI::Option* labelsOption = nullptr;
   CLI::Option* tfOption = nullptr;
-  double alpha = 0.5;
+  std::string opacity;  // "" (0.5) or a number in (0, 1]
   std::vector<double> window;
   const CLI::App* command = nullptr;
   bool labelOverlay() const { return labelsOption != nullptr && labelsOption->count() > 0; }
@@ -33,7 +34,7 @@ const std::set<std::string>& fusionOptionNames();
 // --overlay-labels and --overlay-tf.
 void openFusion(session::Session& session, const FusionOptions& o);
 
-// "overlay  FILE: labels (N named), alpha A" for render's text report.
+// "overlay  FILE: labels (N named), opacity A" for render's text report.
 void printOverlayText(const session::Overlay& overlay);
 
 }  // namespace tessera::app

@@ -48,7 +48,7 @@ HybridResult runHybridRender(DeviceSession& device, const lod::VolumeSource& sou
   const TransferFunction& tf = req.settings.tf;
   if (req.settings.render.mode != RenderMode::Composite && hybrid.overlays.any() &&
       hybrid.hybrid.opacity != render::OverlayOpacity::Alpha) {
-    throw InputError("--overlay-opacity " + render::overlayOpacityName(hybrid.hybrid.opacity) +
+    throw InputError("--line-attenuation " + render::overlayOpacityName(hybrid.hybrid.opacity) +
                      " needs --mode composite");
   }
   gpu::GlContext& context = *device.context;

@@ -174,7 +174,7 @@ const std::set<std::string>& runOptions() {
       "file",          "--series",     "--time",          "--channel",        "--size",
       "--out",         "--reference",  "--reference-out", "--reference-step", "--reference-level",
       "--repeat",      "--rotate",     "--profile",       "--json",           "--overlays",
-      "--offscreen",   "--roi",        "--region",        "--level",          "--overlay-opacity",
+      "--offscreen",   "--roi",        "--region",        "--level",          "--line-attenuation",
       "--state",       "--save-state", "--channels",      "--channel-colors", "--channel-windows",
       "--channel-mode"};
   return names;
@@ -859,9 +859,10 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--overlays", o->overlays,
                   "Lines drawn at full resolution with the volume: box,axes,roi (any subset); "
                   "with --reference the ground truth stops each ray at its line");
-  addDefaultedOption(cmd, "--overlay-opacity", o->overlayOpacity,
-                     "How lines behind/inside the volume are attenuated: alpha (target alpha), "
-                     "two-pass (renders over black and white), luma-avg, luma-601");
+  addDefaultedOption(cmd, "--line-attenuation", o->overlayOpacity,
+                     "How the lines of --overlays behind/inside the volume are attenuated: "
+                     "alpha (target alpha), two-pass (renders over black and white), luma-avg, "
+                     "luma-601");
   cmd->add_option("--offscreen", o->offscreen,
                   "Render the volume at WxH (e.g. 128x128, 256x512) or a factor (e.g. 0.25) and "
                   "upscale it bilinearly (hybrid rendering; default with --overlays: full)");

@@ -57,7 +57,7 @@ OverlayOpacity parseOverlayOpacity(const std::string& name) {
   for (OverlayOpacity m : allOverlayOpacities()) {
     if (overlayOpacityName(m) == name) return m;
   }
-  throw InputError("--overlay-opacity '" + name +
+  throw InputError("--line-attenuation '" + name +
                    "': expected alpha, two-pass, luma-avg or luma-601");
 }
 

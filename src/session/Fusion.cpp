@@ -16,7 +16,7 @@ namespace {
 
 void checkOptions(const OverlayOptions& o) {
   if (!(o.opacity > 0.0 && o.opacity <= 1.0)) {
-    throw InputError("--overlay-alpha " + std::to_string(o.opacity) + ": expected (0, 1]");
+    throw InputError("--overlay-opacity " + std::to_string(o.opacity) + ": expected (0, 1]");
   }
   if (o.window && !(o.window->max > o.window->min)) {
     throw InputError("--overlay-window " + std::to_string(o.window->min) + " " +

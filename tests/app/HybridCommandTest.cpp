@@ -45,8 +45,16 @@ TEST(HybridCommand, EveryTechniqueMatchesTheGroundTruth) {
 }
 
 TEST(HybridCommand, BadOptionsFailWithOneLine) {
-  expectFailure("render gen:sphere:16 --overlay-opacity foggy --out /dev/null",
-                "--overlay-opacity 'foggy'");
+  expectFailure("render gen:sphere:16 --line-attenuation foggy --out /dev/null",
+                "--line-attenuation 'foggy'");
+  // The option's name before --overlay-opacity became the fused volume's.
+  expectFailure("render gen:sphere:16 --overlays box --overlay-opacity two-pass --out /dev/null",
+                "--overlay-opacity two-pass: the attenuation of the --overlays lines is now "
+                "--line-attenuation two-pass; --overlay-opacity is the --overlay volume's "
+                "opacity, (0, 1]");
+  expectFailure(
+      "render gen:sphere:16 --overlay gen:sphere:16 --overlay-opacity 1.5 --out /dev/null",
+      "--overlay-opacity '1.5': expected the overlay's opacity in (0, 1]");
   expectFailure("render gen:sphere:16 --overlays box --offscreen 0 --out /dev/null", "offscreen");
   expectFailure(
       "render gen:sphere:16 --technique slice2d --layout mosaic --overlays box --out /dev/null",

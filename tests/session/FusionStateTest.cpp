@@ -193,7 +193,8 @@ TEST(FusionState, BadOverlayValuesAreNamed) {
   EXPECT_NE(messageOf(s, state).find("overlay.alpha: expected a number"), std::string::npos)
       << messageOf(s, state);
   state["overlay"] = {{"file", kAal}, {"alpha", 2.0}};
-  EXPECT_NE(messageOf(s, state).find("--overlay-alpha"), std::string::npos) << messageOf(s, state);
+  EXPECT_NE(messageOf(s, state).find("--overlay-opacity"), std::string::npos)
+      << messageOf(s, state);
   state["overlay"] = {{"file", kAal}, {"window", {1}}};
   EXPECT_NE(messageOf(s, state).find("overlay.window: expected [lo, hi]"), std::string::npos);
   state["overlay"] = {{"alpha", 0.5}};

@@ -245,7 +245,7 @@ TEST(Fusion, BadInputsAreNamed) {
       << notLabels;
   OverlayOptions o;
   o.opacity = 1.5;
-  EXPECT_NE(errorOf([&] { s.openOverlay(kAal, o); }).find("--overlay-alpha"), std::string::npos);
+  EXPECT_NE(errorOf([&] { s.openOverlay(kAal, o); }).find("--overlay-opacity"), std::string::npos);
   // Far away in world space: opened, with a note naming both boxes.
   map.setOrigin({1000.0, 0.0, 0.0});
   writeNifti(map, mapPath);
