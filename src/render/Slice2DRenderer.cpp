@@ -46,9 +46,9 @@ Slice2DRenderer::Slice2DRenderer(gpu::GlContext& context, const Volume& volume,
     : context_(context),
       volume_(volume),
       options_(options),
-      stacks_(volume),
       tf_(TransferFunction::preset("grey")),
       accumulator_(context, options.halfFloatAccumulation) {
+  if (!options.channels) stacks_.emplace(volume);
   const int maxSize = options.maxTextureSize > 0
                           ? std::min(options.maxTextureSize, context.caps().max2DTextureSize)
                           : context.caps().max2DTextureSize;
@@ -94,7 +94,7 @@ std::uint64_t Slice2DRenderer::ownTextureBytes() const {
   std::uint64_t bytes =
       stackTextureBytes() + table_.texture().bytes() + accumulator_.ownTextureBytes();
   for (const auto& v : vertices_) bytes += v.bytes();
-  for (const auto& [key, list] : drawLists_) bytes += list.indices.bytes();
+  for (const auto& [key, list] : drawLists_) bytes += list.indices.bytes() + list.vertices.bytes();
   return bytes;
 }
 
@@ -152,6 +152,59 @@ const Slice2DRenderer::DrawList& Slice2DRenderer::drawList(int axis, bool descen
   return drawLists_.emplace(key, std::move(list)).first->second;
 }
 
+// Channel frames: n planes across the axis at (k + 0.5) / n of the extent,
+// each quad its own (no tiles), front to back.
+const Slice2DRenderer::DrawList& Slice2DRenderer::channelPlanes(int axis, bool descending,
+                                                                int planes) {
+  const std::string key =
+      "channels " + std::to_string(axis) + (descending ? "-" : "+") + std::to_string(planes);
+  auto it = drawLists_.find(key);
+  if (it != drawLists_.end()) return it->second;
+  const glm::ivec2 a = sliceTileAxes(axis);
+  const glm::dvec3 extent = volume_.extent();
+  std::vector<float> v;
+  std::vector<std::uint16_t> indices;
+  constexpr int corners[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  for (int s = 0; s < planes; ++s) {
+    glm::dvec3 pos(0.0);
+    pos[axis] = ((s + 0.5) / planes - 0.5) * extent[axis];
+    for (const auto& c : corners) {
+      pos[a.x] = (c[0] - 0.5) * extent[a.x];
+      pos[a.y] = (c[1] - 0.5) * extent[a.y];
+      v.insert(v.end(), {static_cast<float>(pos.x), static_cast<float>(pos.y),
+                         static_cast<float>(pos.z), 0.0f, 0.0f, 0.0f, 0.0f});
+    }
+  }
+  for (int k = 0; k < planes; ++k) {
+    const int s = descending ? planes - 1 - k : k;
+    for (int i : {0, 1, 2, 0, 2, 3}) indices.push_back(static_cast<std::uint16_t>(s * 4 + i));
+  }
+  DrawList list;
+  list.gapRatio = static_cast<double>(plans_[axis].slices) / planes;
+  list.ranges.push_back({0, 0, static_cast<int>(indices.size())});
+  list.vertices =
+      gpu::Buffer::create(context_.ledger(), "slice2d channel planes", gpu::BufferKind::Vertices,
+                          v.size() * sizeof(float), v.data(), gpu::BufferUsage::Static);
+  list.indices = gpu::Buffer::create(
+      context_.ledger(), "slice2d channel draw order", gpu::BufferKind::Indices16,
+      indices.size() * sizeof(std::uint16_t), indices.data(), gpu::BufferUsage::Static);
+  return drawLists_.emplace(key, std::move(list)).first->second;
+}
+
+int Slice2DRenderer::channelPlaneCount(const RenderSettings& settings, int axis) const {
+  constexpr int kMaxPlanes = 65536 / 4;  // 16-bit indices, four vertices a plane
+  const double n =
+      requestedSlices_ > 0
+          ? requestedSlices_
+          : std::ceil(volume_.extent()[axis] / sampleDistance(settings, volume_.spacing()) - 1e-9);
+  if (n > kMaxPlanes) {
+    throw InputError("a step of " + std::to_string(settings.stepVoxels) + " voxels needs " +
+                     std::to_string(static_cast<long long>(n)) + " planes, more than " +
+                     std::to_string(kMaxPlanes) + "; use a larger --step or --slices");
+  }
+  return std::max(1, static_cast<int>(n));
+}
+
 void Slice2DRenderer::uploadStack(int axis) {
   const auto t0 = std::chrono::steady_clock::now();
   const SliceAtlasPlan& p = plans_[axis];
@@ -177,9 +230,9 @@ void Slice2DRenderer::uploadStack(int axis) {
     gpu::Texture& atlas = atlases_[axis][static_cast<std::size_t>(i)];
     for (int b = 0; b < p.bands(); ++b) {
       if (shadedStacks_) {
-        stacks_.fillShadingAtlasBand(p, i, b, band);
+        stacks_->fillShadingAtlasBand(p, i, b, band);
       } else {
-        stacks_.fillAtlasBand(p, i, b, pre ? palette8_.data() : nullptr, band);
+        stacks_->fillAtlasBand(p, i, b, pre ? palette8_.data() : nullptr, band);
       }
       atlas.updateRegion({0, b * p.tile.y, 0}, {p.atlasSize.x, p.bandRows(b), 1}, band.data());
     }
@@ -243,6 +296,7 @@ std::vector<gpu::ShaderPart> Slice2DRenderer::vertexParts() const {
 }
 
 std::vector<gpu::ShaderPart> Slice2DRenderer::fragmentParts(const RenderSettings& settings) const {
+  if (options_.channels) return channelFragmentParts(settings);
   std::vector<std::string> defines;
   if (options_.classification == SliceClassification::Pre) defines.push_back("CLASSIFY_PRE 1");
   if (options_.classification == SliceClassification::Palette) {
@@ -260,7 +314,50 @@ std::vector<gpu::ShaderPart> Slice2DRenderer::fragmentParts(const RenderSettings
           gpu::embeddedShaderPart("render/slice2d.frag.glsl")};
 }
 
+// Channel frames: the layout's seam (sampleChannels and its uniforms), the
+// TF table and render/channels.glsl, then the stack's channel fragment.
+// Shading and clipping are not applied to channel frames (docs/channels.md).
+std::vector<gpu::ShaderPart> Slice2DRenderer::channelFragmentParts(
+    const RenderSettings& settings) const {
+  std::vector<std::string> defines;
+  if (settings.mode == RenderMode::Mip) defines.push_back("MODE_MIP 1");
+  std::vector<gpu::ShaderPart> parts = {gpu::shaderPreamble(context_.caps().api, true, defines)};
+  for (gpu::ShaderPart& part : options_.channels->seamParts()) parts.push_back(std::move(part));
+  for (const char* file : {"render/classify.glsl", "render/channels.glsl",
+                           "render/slice_opacity.glsl", "render/slice2d_channels.frag.glsl"}) {
+    parts.push_back(gpu::embeddedShaderPart(file));
+  }
+  return parts;
+}
+
+std::vector<gpu::ShaderPart> Slice2DRenderer::channelResolveParts() const {
+  std::vector<gpu::ShaderPart> frag = {gpu::shaderPreamble(context_.caps().api, true, {})};
+  for (gpu::ShaderPart& part : options_.channels->seamParts()) frag.push_back(std::move(part));
+  for (const char* file : {"render/classify.glsl", "render/channels.glsl",
+                           "render/slice_channels_resolve.frag.glsl"}) {
+    frag.push_back(gpu::embeddedShaderPart(file));
+  }
+  return frag;
+}
+
+const gpu::Program& Slice2DRenderer::channelResolveProgram() {
+  return programs_.get("channel maxima resolve", [&] {
+    const gpu::ApiLevel api = context_.caps().api;
+    return gpu::Program::build("slice2d channel maxima resolve",
+                               {gpu::shaderPreamble(api, false, {}),
+                                gpu::embeddedShaderPart("render/fullscreen.vert.glsl")},
+                               channelResolveParts());
+  });
+}
+
 const gpu::Program& Slice2DRenderer::programFor(const RenderSettings& settings) {
+  if (options_.channels) {
+    const std::string key =
+        std::string("channels") + (settings.mode == RenderMode::Mip ? "|mip" : "");
+    return programs_.get(key, [&] {
+      return gpu::Program::build("slice2d(" + key + ")", vertexParts(), fragmentParts(settings));
+    });
+  }
   const std::string key =
       std::string(sliceClassificationName(options_.classification)) +
       (settings.mode == RenderMode::Mip ? "|mip" : "") + (shadingActive(settings) ? "|shade" : "") +
@@ -280,6 +377,16 @@ void Slice2DRenderer::prepare(const Camera& camera, const RenderSettings& settin
     throw InputError(
         "MIP by axis-aligned slicing needs --classify post (the maximum of "
         "classified colours is not the colour of the maximum)");
+  }
+  if (options_.channels) {
+    if (options_.classification != SliceClassification::Post) {
+      throw InputError(
+          "slice2d draws channels post-classified (--classify post): pre and palette classify "
+          "one volume's values");
+    }
+    updateClassification(settings);
+    programFor(settings);
+    return;
   }
   const bool shade = shadingActive(settings);
   if (shade && options_.classification != SliceClassification::Post) {
@@ -314,13 +421,16 @@ void Slice2DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
   const int axis = stackAxisFor(camera);
   lastAxis_ = axis;
   const SliceAtlasPlan& plan = plans_[axis];
-  const int slices = requestedSlices_ > 0 ? std::min(requestedSlices_, plan.slices) : plan.slices;
+  const int slices = options_.channels      ? channelPlaneCount(settings, axis)
+                     : requestedSlices_ > 0 ? std::min(requestedSlices_, plan.slices)
+                                            : plan.slices;
   lastSlicesDrawn_ = slices;
   const glm::dvec3 forward = -camera.basis()[2];
   // Front to back: looking towards +axis, the low slices are nearest.
-  const DrawList& list = drawList(axis, forward[axis] < 0.0, slices);
+  const DrawList& list = options_.channels ? channelPlanes(axis, forward[axis] < 0.0, slices)
+                                           : drawList(axis, forward[axis] < 0.0, slices);
 
-  const bool shade = shadingActive(settings);
+  const bool shade = !options_.channels && shadingActive(settings);
   accumulator_.begin(width, height, settings.mode);
   const gpu::Program& prog = programFor(settings);
   prog.use();
@@ -337,6 +447,20 @@ void Slice2DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
   prog.set("u_eye", glm::vec3(camera.eye()));
   prog.set("u_forward", glm::vec3(forward));
   prog.set("u_ortho", camera.projection == Projection::Orthographic ? 1.0f : 0.0f);
+  if (options_.channels) {
+    prog.set("u_invExtent", glm::vec3(1.0 / volume_.extent()));
+    const int unit = options_.channels->bindSeam(prog, 0);
+    table_.texture().bind(unit);
+    prog.set("u_tf", unit);
+    prog.set("u_tfSize", static_cast<float>(table_.entries()));
+    if (settings.mode == RenderMode::Mip) {
+      drawChannelMaxima(prog, axis, list, settings);
+    } else {
+      drawStack(prog, axis, list);
+      accumulator_.resolve(settings, &table_.texture(), table_.entries());
+    }
+    return;
+  }
   prog.set("u_atlas", 0);
   if (settings.clipping.active()) {
     setClippingUniforms(prog, settings, camera, volume_.extent());
@@ -363,13 +487,37 @@ void Slice2DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
     prog.set("u_palette", 1);
   }
 
+  drawStack(prog, axis, list);
+  accumulator_.resolve(settings, &table_.texture(), table_.entries());
+}
+
+// The list's planes front to back; each atlas bound in turn (channel frames
+// sample the layout and bind none).
+void Slice2DRenderer::drawStack(const gpu::Program& prog, int axis, const DrawList& list) {
   const int tileAttribute = prog.attributeLocation("a_tile");
   for (const DrawRange& r : list.ranges) {
-    atlases_[axis][static_cast<std::size_t>(r.atlas)].bind(0);
-    gpu::drawIndexed16(gpu::Primitive::Triangles, vertices_[axis], list.indices,
+    if (!options_.channels) atlases_[axis][static_cast<std::size_t>(r.atlas)].bind(0);
+    gpu::drawIndexed16(gpu::Primitive::Triangles,
+                       list.vertices.id() != 0 ? list.vertices : vertices_[axis], list.indices,
                        {{0, 3, 0}, {tileAttribute, 4, 3}}, kFloatsPerVertex, r.count, r.firstIndex);
   }
-  accumulator_.resolve(settings, &table_.texture(), table_.entries());
+}
+
+// Channel maxima (docs/channels.md) as slice3d takes them: the stack twice,
+// channels 0-3 into the accumulation target, 4-5 and the hit flag into a
+// second (ES 2 has no multiple render targets), then the resolve that
+// colours them (render/slice_channels_resolve.frag.glsl).
+void Slice2DRenderer::drawChannelMaxima(const gpu::Program& prog, int axis, const DrawList& list,
+                                        const RenderSettings& settings) {
+  for (int group = 0; group < 2; ++group) {
+    if (group == 1) accumulator_.beginSecond(settings.mode);
+    prog.set("u_channelGroup", static_cast<float>(group));
+    drawStack(prog, axis, list);
+  }
+  const gpu::Program& resolve = channelResolveProgram();
+  resolve.use();
+  const int unit = options_.channels->bindSeam(resolve, 0);
+  accumulator_.resolveWith(resolve, unit, settings);
 }
 
 // ---- The Technique interface and the registry's entry.
@@ -383,6 +531,12 @@ const gpu::Texture& Slice2DRenderer::render(const Camera& camera, const RenderSe
 
 TechniqueReport Slice2DRenderer::report() const {
   TechniqueReport r;
+  if (options_.channels) {
+    r.note = "slice2d: " + std::to_string(lastSlicesDrawn_) + " " +
+             (lastAxis_ >= 0 ? std::string(1, "xyz"[lastAxis_]) : std::string("?")) +
+             " planes of the channel layout drawn, accumulation " + accumulationFormat();
+    return r;
+  }
   r.storage = "slice-stacks";
   r.storageReason = "three axis-aligned stacks";
   if (lastAxis_ >= 0) {
@@ -410,6 +564,7 @@ std::unique_ptr<Slice2DRenderer> Slice2DRenderer::create(const TechniqueSetup& s
   options.currentStackOnly = s.options.currentStackOnly;
   options.maxTextureSize = s.limits.max2DTextureSize;
   options.halfFloatAccumulation = s.limits.halfFloatRenderTargets;
+  if (s.layout && s.layout->drawsChannels()) options.channels = s.layout;
   auto slicer = std::make_unique<Slice2DRenderer>(s.context, s.volume, options);
   slicer->setSliceCount(s.options.slices);
   return slicer;
@@ -419,6 +574,7 @@ TechniqueEntry Slice2DRenderer::registration() {
   return {
       .name = "slice2d",
       .summary = "axis-aligned slice stacks",
+      .drawsChannels = true,
       .requirements = &Slice2DRenderer::requirements,
       .create = [](const TechniqueSetup& s) -> std::unique_ptr<Technique> { return create(s); }};
 }

@@ -1,7 +1,7 @@
 // ChannelView: the channel lists' one path to a multi-channel frame
 // (docs/channels.md). The frame is the one Session::renderChannels draws
-// for the same settings (the ray caster over layout::ChannelLayout), kept
-// on the GPU between edits.
+// for the same settings (the technique they name — raycast, slice3d or
+// slice2d — over layout::ChannelLayout), kept on the GPU between edits.
 #include "tessera/session/ChannelView.h"
 
 #include <sstream>
@@ -11,20 +11,33 @@
 #include "tessera/io/ZarrStore.h"
 #include "tessera/layout/ChannelLayout.h"
 #include "tessera/render/HybridCompositor.h"
-#include "tessera/render/Raycaster.h"
+#include "tessera/render/TechniqueRegistry.h"
+#include "tessera/session/ChannelTechnique.h"
 #include "tessera/session/Session.h"
 
 namespace tessera::session {
 
 struct ChannelView::Gpu {
   std::unique_ptr<layout::ChannelLayout> layout;
-  std::unique_ptr<render::Raycaster> caster;
+  std::unique_ptr<render::Technique> technique;  // made at the first frame
+  std::string techniqueKey;                      // its name and options
   const gpu::Texture* frame = nullptr;
   std::string tfKey;
   std::unique_ptr<render::HybridCompositor> compositor;  // present()'s, made on first use
+
+  // The technique the settings name, as Session::renderChannels makes it
+  // (channelTechnique refuses one that cannot draw channels).
+  void makeTechnique(gpu::DeviceSession& device, const ChannelSet& set, const Settings& s,
+                     int width, int height);
 };
 
 namespace {
+
+// The technique a frame is drawn with: its name and the options it reads.
+std::string channelTechniqueKey(const Settings& s) {
+  return s.technique + '|' + std::to_string(s.lutSize) + '|' + std::to_string(s.slices) + '|' +
+         s.classify + '|' + s.gradient;
+}
 
 // What a frame depends on besides the channels' own state.
 std::string frameKey(const Settings& s, const Camera& c, int width, int height) {
@@ -34,11 +47,26 @@ std::string frameKey(const Settings& s, const Camera& c, int width, int height) 
       << ',' << c.fovYDeg << ',' << static_cast<int>(c.projection) << ',' << c.target.x << ','
       << c.target.y << ',' << c.target.z << '|' << s.render.stepVoxels << ','
       << s.render.opacityScale << ',' << s.render.ertThreshold << s.render.jitter << ','
-      << s.render.background.r << s.render.background.g << s.render.background.b;
+      << s.render.background.r << s.render.background.g << s.render.background.b << '|'
+      << channelTechniqueKey(s);
   return key.str();
 }
 
 }  // namespace
+
+void ChannelView::Gpu::makeTechnique(gpu::DeviceSession& device, const ChannelSet& set,
+                                     const Settings& s, int width, int height) {
+  const render::TechniqueEntry& entry = channelTechnique(s.technique);
+  render::TechniqueOptions options = s.techniqueOptions({width, height});
+  options.skipBlock = 0;  // the block grid is one volume's
+  frame = nullptr;
+  technique.reset();
+  tfKey.clear();
+  techniqueKey.clear();
+  technique = render::TechniqueRegistry::global().create(
+      entry.name, {*device.context, device.limits, set.geometry(), layout.get(), options});
+  techniqueKey = channelTechniqueKey(s);
+}
 
 ChannelView::ChannelView(Session& session) : session_(session) {}
 ChannelView::~ChannelView() = default;
@@ -58,10 +86,7 @@ void ChannelView::show(ChannelSet set, const std::string& name) {
   device.context->makeCurrent();
   auto gpu = std::make_unique<Gpu>();
   gpu->layout = layout::ChannelLayout::create(*owned, device.limits, device.context->ledger());
-  gpu->caster =
-      std::make_unique<render::Raycaster>(*device.context, owned->geometry(), *gpu->layout);
-  gpu->caster->setSkipBlockSize(0);  // the block grid is one volume's
-  gpu_.reset();                      // the old layout before the old set it reads
+  gpu_.reset();  // the old layout before the old set it reads
   set_ = std::move(owned);
   gpu_ = std::move(gpu);
   name_ = name;
@@ -152,13 +177,16 @@ const gpu::Texture& ChannelView::render(int width, int height) {
   const std::string tfKey = s.tf.toJson();
   if (gpu_->frame && key == frameKey_ && tfKey == gpu_->tfKey) return *gpu_->frame;
   session_.device().context->makeCurrent();
+  if (channelTechniqueKey(s) != gpu_->techniqueKey) {
+    gpu_->makeTechnique(session_.device(), set, s, width, height);
+  }
   if (tfKey != gpu_->tfKey) {
-    gpu_->caster->setTransferFunction(s.tf);
+    gpu_->technique->setTransferFunction(s.tf);
     gpu_->tfKey = tfKey;
   }
   RenderSettings render = s.render;
   render.mode = renderModeFor(set.mode);
-  gpu_->frame = &gpu_->caster->render(camera, render, width, height, 0.0);
+  gpu_->frame = &gpu_->technique->render(camera, render, width, height, 0.0);
   frameKey_ = key;
   return *gpu_->frame;
 }
@@ -166,7 +194,7 @@ const gpu::Texture& ChannelView::render(int width, int height) {
 Image ChannelView::readImage() const {
   if (!gpu_ || !gpu_->frame) throw InputError("no channel frame has been rendered");
   session_.device().context->makeCurrent();
-  return gpu_->caster->readImage();
+  return gpu_->technique->readImage();
 }
 
 void ChannelView::present(unsigned framebuffer, glm::ivec4 box) {

@@ -1,7 +1,7 @@
 // Session::renderChannels: a multi-channel frame of an OME-Zarr store
 // (docs/channels.md) through the technique the settings name (one that draws
-// channels: raycast, slice3d) over layout::ChannelLayout, and its CPU
-// reference.
+// channels: raycast, slice3d, slice2d) over layout::ChannelLayout, and its
+// CPU reference.
 #include <chrono>
 #include <cstdio>
 #include <optional>
@@ -16,6 +16,7 @@
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/render/TechniqueRegistry.h"
 #include "tessera/session/BrickRefinement.h"
+#include "tessera/session/ChannelTechnique.h"
 #include "tessera/session/Session.h"
 
 namespace tessera::session {
@@ -98,20 +99,6 @@ std::string levelsText(const std::vector<int>& cellsPerLevel) {
   }
   if (cellsPerLevel.back() > 0) text += " empty:" + std::to_string(cellsPerLevel.back());
   return text;
-}
-
-// The technique the settings name, when it draws channels: InputError
-// naming it and those that do otherwise.
-const render::TechniqueEntry& channelTechnique(const std::string& name) {
-  const render::TechniqueRegistry& registry = render::TechniqueRegistry::global();
-  const render::TechniqueEntry& entry = registry.find(name);
-  if (entry.drawsChannels) return entry;
-  std::string drawing;
-  for (const render::TechniqueEntry& e : registry.entries()) {
-    if (e.drawsChannels) drawing += (drawing.empty() ? "" : " or ") + e.name;
-  }
-  throw InputError("--technique " + name + " cannot draw channels: channel frames draw with " +
-                   drawing);
 }
 
 }  // namespace

@@ -39,21 +39,25 @@ TEST(ChannelsCommand, BadChannelOptionsFailWithOneLine) {
                       "channel mode 'sum': expected additive or max");
 }
 
-// --technique reaches the channel frame: slice3d draws it (against the same
-// reference, >= 40 dB), slice2d is refused in one line naming it.
-TEST(ChannelsCommand, Slice3dDrawsChannelsAndSlice2dIsRefused) {
+// --technique reaches the channel frame: slice3d and slice2d draw it
+// (against the same reference, >= 40 dB); slice2d pre-classified is refused
+// in one line naming it.
+TEST(ChannelsCommand, SlicersDrawChannelsAndPreClassificationIsRefused) {
   const test::TempDir dir;
   const std::string store = (dir / "three.ome.zarr").string();
   test::writeChannelStore(store, {.dims = {48, 48, 24}});
-  for (const char* mode : {"additive", "max"}) {
-    const nlohmann::json j = test::runCliJson(
-        "render " + store + " --channels 0,1,2 --channel-mode " + mode +
-        " --technique slice3d --tf grey --opacity-scale 20 --size 64x64 --reference --json --out " +
-        (dir / "out.png").string());
-    EXPECT_EQ(j["mode"], mode);
-    EXPECT_GE(j["psnr_db"].get<double>(), 40.0) << mode;
+  for (const char* technique : {"slice3d", "slice2d"}) {
+    for (const char* mode : {"additive", "max"}) {
+      const nlohmann::json j = test::runCliJson(
+          "render " + store + " --channels 0,1,2 --channel-mode " + mode + " --technique " +
+          technique + " --tf grey --opacity-scale 20 --size 64x64 --reference --json --out " +
+          (dir / "out.png").string());
+      EXPECT_EQ(j["mode"], mode);
+      EXPECT_GE(j["psnr_db"].get<double>(), 40.0) << technique << " " << mode;
+    }
   }
-  test::expectFailure("render " + store + " --channels 0,2 --technique slice2d --out /dev/null",
-                      "--technique slice2d cannot draw channels: channel frames draw with raycast "
-                      "or slice3d");
+  test::expectFailure(
+      "render " + store + " --channels 0,2 --technique slice2d --classify pre --out /dev/null",
+      "slice2d draws channels post-classified (--classify post): pre and palette classify one "
+      "volume's values");
 }

@@ -1,5 +1,6 @@
-// Several channels drawn by view-aligned slicing (docs/channels.md,
-// "Techniques"): slice3d over layout::ChannelLayout (3D RGBA textures on
+// Several channels drawn by texture slicing (docs/channels.md,
+// "Techniques"): slice3d (view-aligned) and slice2d (axis-aligned, at the
+// stack's voxel planes) over layout::ChannelLayout (3D RGBA textures on
 // ES 3, RGBA8 mosaics on ES 2) against the CPU reference of the same
 // channels (which ray marches with the same step, as for one volume), in
 // additive and max mode, a channel's toggle, and the combinations the
@@ -20,7 +21,7 @@
 #include "tessera/layout/ChannelLayout.h"
 #include "tessera/reference/ChannelReference.h"
 #include "tessera/reference/ImageMetrics.h"
-#include "tessera/render/Slice3DRenderer.h"
+#include "tessera/render/TechniqueRegistry.h"
 #include "tessera/session/Session.h"
 
 namespace tessera {
@@ -52,16 +53,17 @@ class ChannelSlices : public ::testing::Test {
   static void TearDownTestSuite() { dir_.reset(); }
   static std::string store() { return (dir_->path() / "three.ome.zarr").string(); }
 
-  // slice3d as the registry makes it, over the channels' in-core layout.
-  static Image sliceImage(gpu::ApiLevel api, const ChannelSet& set, const Camera& camera,
-                          std::string* how = nullptr) {
+  // The slicing technique as the registry makes it, over the channels'
+  // in-core layout.
+  static Image sliceImage(const std::string& technique, gpu::ApiLevel api, const ChannelSet& set,
+                          const Camera& camera, std::string* how = nullptr) {
     test::ApiContext context(api);
     gpu::GlContext& gl = context.get();
     const gpu::DeviceLimits limits = gpu::DeviceLimits::of(gl.caps());
     auto layout = layout::ChannelLayout::create(set, limits, gl.ledger());
     const render::TechniqueOptions options;
-    auto slicer =
-        render::Slice3DRenderer::create({gl, limits, set.geometry(), layout.get(), options});
+    auto slicer = render::TechniqueRegistry::global().create(
+        technique, {gl, limits, set.geometry(), layout.get(), options});
     slicer->setTransferFunction(channelRamp());
     RenderSettings settings = channelSettings();
     settings.mode = renderModeFor(set.mode);
@@ -75,6 +77,8 @@ class ChannelSlices : public ::testing::Test {
 
 std::unique_ptr<test::TempDir> ChannelSlices::dir_;
 
+constexpr const char* kSlicers[] = {"slice3d", "slice2d"};
+
 // The 3-channel store in `mode` on ES 3 and ES 2 against the reference.
 void expectSlicesEqualReference(ChannelMode mode) {
   ChannelSet set = readZarrChannels(ChannelSlices::store());
@@ -82,12 +86,15 @@ void expectSlicesEqualReference(ChannelMode mode) {
   const Camera camera = test::orbitCamera(set.geometry(), 30.0, 20.0);
   const Image ref =
       renderChannelsReference(set, channelRamp(), camera, channelSettings(), kSize, kSize);
-  for (gpu::ApiLevel api : {gpu::ApiLevel::Gles3, gpu::ApiLevel::Gles2}) {
-    std::string how;
-    const double db = psnr(ChannelSlices::sliceImage(api, set, camera, &how), ref);
-    std::printf("slice3d channels %s on %s (%s): %.1f dB\n", channelModeName(mode),
-                test::apiName(api), how.c_str(), db);
-    EXPECT_GE(db, 40.0) << channelModeName(mode) << " " << test::apiName(api) << " " << how;
+  for (const char* technique : kSlicers) {
+    for (gpu::ApiLevel api : {gpu::ApiLevel::Gles3, gpu::ApiLevel::Gles2}) {
+      std::string how;
+      const double db = psnr(ChannelSlices::sliceImage(technique, api, set, camera, &how), ref);
+      std::printf("%s channels %s on %s (%s): %.1f dB\n", technique, channelModeName(mode),
+                  test::apiName(api), how.c_str(), db);
+      EXPECT_GE(db, 40.0) << technique << " " << channelModeName(mode) << " " << test::apiName(api)
+                          << " " << how;
+    }
   }
 }
 
@@ -118,11 +125,14 @@ TEST_F(ChannelSlices, SixChannelsEqualReferenceInBothModes) {
     six.mode = mode;
     const Image ref =
         renderChannelsReference(six, channelRamp(), camera, channelSettings(), kSize, kSize);
-    for (gpu::ApiLevel api : {gpu::ApiLevel::Gles3, gpu::ApiLevel::Gles2}) {
-      const double db = psnr(sliceImage(api, six, camera), ref);
-      std::printf("slice3d 6 channels %s on %s: %.1f dB\n", channelModeName(mode),
-                  test::apiName(api), db);
-      EXPECT_GE(db, 40.0) << channelModeName(mode) << " " << test::apiName(api);
+    for (const char* technique : kSlicers) {
+      for (gpu::ApiLevel api : {gpu::ApiLevel::Gles3, gpu::ApiLevel::Gles2}) {
+        const double db = psnr(sliceImage(technique, api, six, camera), ref);
+        std::printf("%s 6 channels %s on %s: %.1f dB\n", technique, channelModeName(mode),
+                    test::apiName(api), db);
+        EXPECT_GE(db, 40.0) << technique << " " << channelModeName(mode) << " "
+                            << test::apiName(api);
+      }
     }
   }
 }
@@ -141,71 +151,92 @@ std::vector<bool> changed(const Image& a, const Image& b, int tolerance) {
   return out;
 }
 
+// Toggling the slab in `technique`'s frames changes only pixels where the
+// slab shows in its own slab-only frame.
+void expectToggleChangesOnlyTheSlab(const char* technique, ChannelMode mode) {
+  const gpu::ApiLevel es3 = gpu::ApiLevel::Gles3;
+  ChannelSet set = readZarrChannels(ChannelSlices::store());
+  set.mode = mode;
+  const Camera camera = test::orbitCamera(set.geometry(), 30.0, 20.0);
+  // Where the slab projects: the pixels where the technique's slab-only
+  // frame differs from its frame of no channel (its own silhouette; the
+  // reference's, printed too, differs in a few edge pixels, because the
+  // slices sample the slab's faces elsewhere than the reference's rays).
+  ChannelSet slabOnly = set;
+  slabOnly[0].visible = false;
+  slabOnly[2].visible = false;
+  ChannelSet none = slabOnly;
+  none[1].visible = false;
+  const std::vector<bool> slab =
+      changed(ChannelSlices::sliceImage(technique, es3, slabOnly, camera),
+              ChannelSlices::sliceImage(technique, es3, none, camera), 0);
+  const std::vector<bool> referenceSlab = changed(
+      renderChannelsReference(slabOnly, channelRamp(), camera, channelSettings(), kSize, kSize),
+      renderChannelsReference(none, channelRamp(), camera, channelSettings(), kSize, kSize), 0);
+  const Image all = ChannelSlices::sliceImage(technique, es3, set, camera);
+  ChannelSet noSlab = set;
+  noSlab[1].visible = false;
+  const std::vector<bool> diff =
+      changed(all, ChannelSlices::sliceImage(technique, es3, noSlab, camera), 1);
+  int inside = 0, outside = 0, outsideReference = 0;
+  for (std::size_t i = 0; i < diff.size(); ++i) {
+    if (!diff[i]) continue;
+    (slab[i] ? inside : outside) += 1;
+    outsideReference += referenceSlab[i] ? 0 : 1;
+  }
+  std::printf(
+      "%s %s: toggling the slab changed %d pixels inside its footprint, %d "
+      "outside (%d outside the reference's)\n",
+      technique, channelModeName(mode), inside, outside, outsideReference);
+  EXPECT_GT(inside, kSize * kSize / 20) << technique << " " << channelModeName(mode);
+  EXPECT_EQ(outside, 0) << technique << " " << channelModeName(mode)
+                        << ": pixels outside the slab's projection";
+}
+
 TEST_F(ChannelSlices, TogglingAChannelChangesOnlyItsStructuresPixels) {
-  for (ChannelMode mode : {ChannelMode::Additive, ChannelMode::Max}) {
-    ChannelSet set = readZarrChannels(store());
-    set.mode = mode;
-    const Camera camera = test::orbitCamera(set.geometry(), 30.0, 20.0);
-    // Where the slab projects: the pixels where slice3d's slab-only frame
-    // differs from its frame of no channel (its own silhouette; the
-    // reference's, printed too, differs in a few edge pixels, because the
-    // slices sample the slab's faces elsewhere than the reference's rays).
-    ChannelSet slabOnly = set;
-    slabOnly[0].visible = false;
-    slabOnly[2].visible = false;
-    ChannelSet none = slabOnly;
-    none[1].visible = false;
-    const std::vector<bool> slab = changed(sliceImage(gpu::ApiLevel::Gles3, slabOnly, camera),
-                                           sliceImage(gpu::ApiLevel::Gles3, none, camera), 0);
-    const std::vector<bool> referenceSlab = changed(
-        renderChannelsReference(slabOnly, channelRamp(), camera, channelSettings(), kSize, kSize),
-        renderChannelsReference(none, channelRamp(), camera, channelSettings(), kSize, kSize), 0);
-    const Image all = sliceImage(gpu::ApiLevel::Gles3, set, camera);
-    ChannelSet noSlab = set;
-    noSlab[1].visible = false;
-    const std::vector<bool> diff =
-        changed(all, sliceImage(gpu::ApiLevel::Gles3, noSlab, camera), 1);
-    int inside = 0, outside = 0, outsideReference = 0;
-    for (std::size_t i = 0; i < diff.size(); ++i) {
-      if (!diff[i]) continue;
-      (slab[i] ? inside : outside) += 1;
-      outsideReference += referenceSlab[i] ? 0 : 1;
+  for (const char* technique : kSlicers) {
+    for (ChannelMode mode : {ChannelMode::Additive, ChannelMode::Max}) {
+      expectToggleChangesOnlyTheSlab(technique, mode);
     }
-    std::printf(
-        "slice3d %s: toggling the slab changed %d pixels inside its footprint, %d "
-        "outside (%d outside the reference's)\n",
-        channelModeName(mode), inside, outside, outsideReference);
-    EXPECT_GT(inside, kSize * kSize / 20) << channelModeName(mode);
-    EXPECT_EQ(outside, 0) << channelModeName(mode) << ": pixels outside the slab's projection";
   }
 }
 
-// What `render STORE --channels ... --technique slice3d` runs: the session's
-// frame equals its reference on ES 3 and an ES 2 profile; slice2d, and
-// slice3d over bricks, are refused by name.
-TEST_F(ChannelSlices, SessionDrawsSlice3dAndRefusesWhatItCannot) {
-  for (const char* profile : {"native", "webgl1-desktop-2012"}) {
-    session::Session session(profile);
-    session.settings().channels.enabled = true;
-    session.settings().technique = "slice3d";
-    session.settings().tf = channelRamp();
-    session.settings().render.background = {0.0, 0.0, 0.0, 1.0};
-    const session::ChannelFrame f = session.renderChannels(store(), 96, 96, true);
-    std::printf("session slice3d on %s (%s): %.1f dB\n", profile, f.layout.c_str(), f.psnr);
-    EXPECT_GE(f.psnr, 40.0) << profile << " " << f.layout;
+// What `render STORE --channels ... --technique slice3d|slice2d` runs: the
+// session's frame equals its reference on ES 3 and an ES 2 profile;
+// slice2d pre-classified, and both over bricks, are refused by name.
+TEST_F(ChannelSlices, SessionDrawsSlicesAndRefusesWhatItCannot) {
+  for (const char* technique : kSlicers) {
+    for (const char* profile : {"native", "webgl1-desktop-2012"}) {
+      session::Session session(profile);
+      session.settings().channels.enabled = true;
+      session.settings().technique = technique;
+      session.settings().tf = channelRamp();
+      session.settings().render.background = {0.0, 0.0, 0.0, 1.0};
+      const session::ChannelFrame f = session.renderChannels(store(), 96, 96, true);
+      std::printf("session %s on %s (%s): %.1f dB\n", technique, profile, f.layout.c_str(), f.psnr);
+      EXPECT_GE(f.psnr, 40.0) << technique << " " << profile << " " << f.layout;
+    }
   }
   session::Session session;
   session.settings().channels.enabled = true;
   session.settings().technique = "slice2d";
+  session.settings().classify = "pre";
   EXPECT_EQ(test::inputErrorMessage([&] { session.renderChannels(store(), 64, 64, false); }),
-            "--technique slice2d cannot draw channels: channel frames draw with raycast or "
-            "slice3d");
-  session.settings().technique = "slice3d";
+            "slice2d draws channels post-classified (--classify post): pre and palette classify "
+            "one volume's values");
+  // Over bricks the slicers are refused (docs/channels.md, "Not done").
+  session.settings().classify = "post";
   session.settings().layout = "bricks";
-  const std::string bricks =
-      test::inputErrorMessage([&] { session.renderChannels(store(), 64, 64, false); });
-  EXPECT_EQ(bricks.rfind("--technique slice3d cannot draw channels from bricks (", 0), 0u)
-      << bricks;
+  for (const char* technique : kSlicers) {
+    session.settings().technique = technique;
+    const std::string bricks =
+        test::inputErrorMessage([&] { session.renderChannels(store(), 64, 64, false); });
+    EXPECT_EQ(
+        bricks.rfind(
+            "--technique " + std::string(technique) + " cannot draw channels from bricks (", 0),
+        0u)
+        << bricks;
+  }
 }
 
 }  // namespace

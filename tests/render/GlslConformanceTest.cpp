@@ -109,7 +109,17 @@ void expectSlicingConformant(gpu::GlContext& c, const Volume& v, const layout::L
       }
     }
   }
-  if (layout.drawsChannels()) sources.push_back(gpu::assembleShader(slice3d.channelResolveParts()));
+  if (layout.drawsChannels()) {
+    sources.push_back(gpu::assembleShader(slice3d.channelResolveParts()));
+    // slice2d at the stacks' planes of the channels (docs/channels.md).
+    render::Slice2DRenderer slice2d(c, v, {.channels = &layout});
+    for (RenderMode mode : {RenderMode::Composite, RenderMode::Mip}) {
+      RenderSettings s;
+      s.mode = mode;
+      sources.push_back(gpu::assembleShader(slice2d.fragmentParts(s)));
+    }
+    sources.push_back(gpu::assembleShader(slice2d.channelResolveParts()));
+  }
   for (const std::string& src : sources) {
     const bool vertex = src.find("gl_Position") != std::string::npos;
     const Validation r = validate(src, vertex ? "vert" : "frag");

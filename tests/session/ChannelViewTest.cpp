@@ -129,6 +129,38 @@ TEST_F(ChannelViewTest, ToggleChangesOnlyThatChannelsPixels) {
   EXPECT_EQ(outside, 0);
 }
 
+// The view draws with the technique the settings (the viewer's menu) name,
+// as `tessera render STORE --channels ... --technique X` does, on ES 3 and an
+// ES 2 profile; a change of technique in the same view makes the new one.
+TEST_F(ChannelViewTest, DrawsTheTechniqueTheSettingsName) {
+  for (const char* profile : {"native", "webgl1-desktop-2012"}) {
+    Session s(profile);
+    look(s.settings());
+    ChannelView& view = s.channelView();
+    ASSERT_TRUE(view.open(store()));
+    view.setVisible(2, false);
+    for (const char* technique : {"slice2d", "raycast", "slice3d"}) {
+      s.settings().technique = technique;
+      view.render(kSize, kSize);
+      const Image image = view.readImage();
+      Session cli(profile);
+      look(cli.settings());
+      cli.settings().technique = technique;
+      ChannelSettings& c = cli.settings().channels;
+      c.enabled = true;
+      c.visible = {true, true, false};
+      const ChannelFrame f = cli.renderChannels(store(), kSize, kSize, true);
+      const double db = psnr(image, f.image);
+      std::printf(
+          "channel view %s on %s: %.1f dB against the CLI's frame (%.1f dB against "
+          "the reference)\n",
+          technique, profile, db, psnr(image, *f.reference));
+      EXPECT_GE(db, 99.0) << technique << " " << profile;
+      EXPECT_GE(psnr(image, *f.reference), 40.0) << technique << " " << profile;
+    }
+  }
+}
+
 // A volume opened while a store's channels are shown replaces them, in
 // the view too (the desktop's Open and drop used to keep showing the
 // store's channels over the new volume): the frame is the new volume's.

@@ -24,6 +24,20 @@
 // fragment stands for the distance its ray travels between drawn planes,
 // (stack spacing * stride) / |cos(angle to the stack axis)|, and corrects
 // its opacity by that ratio.
+//
+// Channels (docs/channels.md, "Techniques"): over a layout that
+// drawsChannels() (Slice2DOptions::channels; the registry passes the
+// session's channel layout) the same stack planes sample the layout's
+// sampleChannels() at their voxel planes instead of stacks of their own —
+// the layout holds four channels a texel once, where three stacks per four
+// channels would hold them three times; on ES 2 the layout is itself 2D (a
+// mosaic of z-slices). As for 2D-texture slicing with intermediate slices
+// (Rezk-Salama et al. 2000: trilinear interpolation between adjacent 2D
+// slices) the planes follow the step, N = ceil(extent / ds) along the stack
+// axis (--slices N: N), so that rays are sampled as densely as the ray
+// caster's. Post-classified only; the additive fragment is
+// classifiedChannels(), the max mode draws the stack twice (channels 0-3,
+// then 4-5 and the hit flag) and resolves as slice3d does.
 #include <array>
 #include <cstdint>
 #include <map>
@@ -42,6 +56,7 @@
 #include "tessera/gpu/LookupTexture.h"
 #include "tessera/gpu/Program.h"
 #include "tessera/gpu/ProgramCache.h"
+#include "tessera/layout/Layout.h"
 #include "tessera/render/SliceAccumulator.h"
 #include "tessera/render/SliceStacks.h"
 #include "tessera/render/Technique.h"
@@ -63,6 +78,9 @@ struct Slice2DOptions {
   // Half-float accumulation (SliceAccumulator): nullopt where the context
   // renders to half floats; the device's limits decide through the registry.
   std::optional<bool> halfFloatAccumulation = std::nullopt;
+  // Non-null: draw these channels (a layout that drawsChannels(), which
+  // must outlive the renderer) instead of stacks of the volume's own.
+  const layout::Layout* channels = nullptr;
 };
 
 class Slice2DRenderer final : public Technique {
@@ -107,7 +125,10 @@ class Slice2DRenderer final : public Technique {
   std::string accumulationFormat() const { return accumulator_.accumulationFormat(); }
 
   std::vector<gpu::ShaderPart> vertexParts() const;
+  // Over channels (Slice2DOptions::channels), the channel fragment's.
   std::vector<gpu::ShaderPart> fragmentParts(const RenderSettings& settings) const;
+  // The resolve pass of channel maxima (channels, max mode).
+  std::vector<gpu::ShaderPart> channelResolveParts() const;
 
   // The Technique interface. The target keeps the screen's shape (see
   // sliceTargetSize): the projection always fills it.
@@ -134,9 +155,17 @@ class Slice2DRenderer final : public Technique {
     gpu::Buffer indices;
     std::vector<DrawRange> ranges;
     double gapRatio = 1.0;  // drawn planes are gapRatio * stack spacing apart
+    gpu::Buffer vertices;   // channel planes: their own quads (else the stack's)
   };
 
   const gpu::Program& programFor(const RenderSettings& settings);
+  std::vector<gpu::ShaderPart> channelFragmentParts(const RenderSettings& settings) const;
+  const gpu::Program& channelResolveProgram();
+  const DrawList& channelPlanes(int axis, bool descending, int planes);
+  int channelPlaneCount(const RenderSettings& settings, int axis) const;
+  void drawStack(const gpu::Program& prog, int axis, const DrawList& list);
+  void drawChannelMaxima(const gpu::Program& prog, int axis, const DrawList& list,
+                         const RenderSettings& settings);
   void buildGeometry(int axis);
   const DrawList& drawList(int axis, bool descending, int slices);
   void uploadStack(int axis);
@@ -146,7 +175,7 @@ class Slice2DRenderer final : public Technique {
   gpu::GlContext& context_;
   const Volume& volume_;
   Slice2DOptions options_;
-  SliceStacks stacks_;
+  std::optional<SliceStacks> stacks_;  // none for channels
   std::array<SliceAtlasPlan, 3> plans_;
   std::array<std::vector<gpu::Texture>, 3> atlases_;
   std::array<gpu::Buffer, 3> vertices_;
