@@ -112,8 +112,12 @@ function noScriptErrors(what, logs) {
 async function inCore(page, webgl) {
   const opened = await page.evaluate(() => window.tessera.openUrls(['/templates/ch2.nii.gz']));
   check(`WebGL ${webgl}: the head opens in the page after the store`, opened !== false, `${opened}`);
-  await page.check('#shade');
+  // Controls set through their events (no pointer actions: they wait for
+  // the element to settle on the emulated phone).
   await page.evaluate(async () => {
+    const shade = document.getElementById('shade');
+    shade.checked = true;
+    shade.dispatchEvent(new Event('change'));
     const w = document.getElementById('winWidth');
     w.value = +w.max * 0.6;
     w.dispatchEvent(new Event('input'));
@@ -123,7 +127,11 @@ async function inCore(page, webgl) {
     const what = `WebGL ${webgl}, head${region ? ', a region shown, crop box on' : ''}`;
     if (region) {
       await page.evaluate(() => window.tessera.slices.showRegion({ begin: [40, 90, 70], end: [140, 190, 170] }));
-      await page.check('#cropShow');
+      await page.evaluate(() => {
+        const crop = document.getElementById('cropShow');
+        crop.checked = true;
+        crop.dispatchEvent(new Event('change'));
+      });
     }
     await page.evaluate(() => window.tessera.setCamera(35, 12, 1.25));
     const s0 = await page.evaluate(() => window.tessera.state());
@@ -217,7 +225,7 @@ async function channels(context, url, tmp, webgl) {
   const { page, logs } = await phonePage(context, url, 'slices=0&url=/data/three.ome.zarr', webgl);
   await page.waitForFunction(() => window.tessera.channels() !== null || window.tessera.error() !== '', null, { timeout: 30000 });
   const what = `WebGL ${webgl}, three channels`;
-  await page.click('[aria-label="show slab"]');
+  await page.$eval('[aria-label="show slab"]', (e) => { e.checked = false; e.dispatchEvent(new Event('change')); });
   await page.$eval('[aria-label="sphere colour"]', (e) => { e.value = '#ffff00'; e.dispatchEvent(new Event('input')); });
   await page.$eval('[aria-label="rod window high"]', (e) => { e.value = '2000'; e.dispatchEvent(new Event('change')); });
   await page.evaluate(() => window.tessera.setCamera(30, 20, 1));
