@@ -360,8 +360,15 @@ import { attachOverlayPanel } from './overlay-panel.js';
       volumeChanged();
       $('status').textContent = contextNote;
       // A store's view was made again on the new context: its GPU side is
-      // rebuilt from the chunks the page holds (zarr-url.js).
-      if (zarr && !error) zarr.reopen().then(() => { volumeChanged(); requestRender(); });
+      // rebuilt from the chunks the page holds (zarr-url.js), and the region
+      // or channels it showed are shown again (the module's).
+      if (zarr && !error) {
+        zarr.reopen().then(() => {
+          volumeChanged();
+          $('status').textContent = contextNote;
+          requestRender();
+        });
+      }
       // The zoom swap (grid.js) ended with the old context: on again.
       if ($('zoomSwap').checked) $('zoomSwap').dispatchEvent(new Event('change'));
       requestRender();

@@ -96,7 +96,9 @@
     return {
       // The channels are drawn (the store is open and no region is shown).
       active: () => {
-        if (open && !zarr.active() && !zarr.showingRegion()) close();  // another volume replaced the store
+        // Another volume replaced the store (not: it is being opened again
+        // after a WebGL context loss; the module shows the channels again).
+        if (open && !zarr.active() && !zarr.showingRegion() && !zarr.reopening()) close();
         return open && zarr.active();
       },
       // A frame on the canvas; its time in ms, or -1 on error.

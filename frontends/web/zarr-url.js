@@ -119,6 +119,7 @@
       regionPrefetch: c('tessera_zarr_region_prefetch', 'number', Array(6).fill('number')),
       regionShow: c('tessera_zarr_region_show', 'number', Array(6).fill('number')),
       regionOverview: c('tessera_zarr_region_overview', null, []),
+      regionShown: c('tessera_zarr_region_shown', 'number', []),
       lastError: c('tessera_last_error', 'string', []),
       pageDecodes: c('tessera_zarr_page_decodes', 'number', ['string']),
     };
@@ -297,10 +298,20 @@
     // store's view again on the new context: tessera_context_restored): its
     // atlas, page table and ray caster are built again, the coarsest level
     // and then the bricks read again from the chunks the module holds (only
-    // those it let go are fetched again). The shown region, if any, is left
-    // for the store's overview. Resolves to true when the store is open.
+    // those it let go are fetched again). A region or grid block the view
+    // showed is shown again by the module (its chunks fetched like the
+    // store's). Resolves to true when the store is open.
+    let reopening = false;
     async function reopen() {
       if (!base) return false;
+      reopening = true;
+      try {
+        return await reopenSteps();
+      } finally {
+        reopening = false;
+      }
+    }
+    async function reopenSteps() {
       open = false;
       regionShown = false;
       last = null;
@@ -308,7 +319,7 @@
       t0 = performance.now();
       const requestsBefore = record.requests;
       Object.assign(record, { firstImageMs: null, completeMs: null, timeline: [], calls: [],
-        reopened: (record.reopened || 0) + 1 });
+        reopened: (record.reopened || 0) + 1, reopenMs: null });
       for (;;) {
         const state = api.openStep();
         if (state === 1) break;
@@ -321,6 +332,7 @@
         await idle();
       }
       open = true;
+      regionShown = api.regionShown() === 1;
       record.reopenMs = performance.now() - t0;
       record.reopenRequests = record.requests - requestsBefore;
       return true;
@@ -488,6 +500,8 @@
         if (base) api.regionOverview();
       },
       showingRegion: () => regionShown,
+      // Being opened again on a restored WebGL context (reopen()).
+      reopening: () => reopening,
       wantsFrame,
       frame,
       refine,

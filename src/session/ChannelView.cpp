@@ -104,6 +104,19 @@ void ChannelView::close() {
   edited();
 }
 
+// The GPU objects go first (the layout reads the set); on a lost context
+// their deletion only raises GL errors, which the caller clears.
+std::optional<ChannelView::Shown> ChannelView::takeShown() {
+  if (!set_) return std::nullopt;
+  gpu_.reset();
+  Shown shown{std::move(*set_), std::move(name_)};
+  set_.reset();
+  name_.clear();
+  ++revision_;
+  frameKey_.clear();
+  return shown;
+}
+
 const ChannelSet& ChannelView::channels() const {
   if (!set_) throw InputError("no channels are shown");
   return *set_;

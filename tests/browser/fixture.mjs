@@ -285,3 +285,52 @@ export function chunkKeys(store, begin, end) {
   }
   return keys;
 }
+
+// The 3-channel u16 store of tests/support/ChannelStore.h (NGFF 0.4 on
+// Zarr v2, one uncompressed chunk per channel and level): a sphere (channel 0), a
+// slab (1), a rod (2) on a background of 100, with omero colours and windows
+// (channels.test.mjs, context-loss.test.mjs).
+export function writeChannelStore(dir, [nx, ny, nz]) {
+  fs.rmSync(dir, { recursive: true, force: true });
+  fs.mkdirSync(path.join(dir, '0'), { recursive: true });
+  fs.writeFileSync(path.join(dir, '.zgroup'), JSON.stringify({ zarr_format: 2 }));
+  const axis = (name) => ({ name, type: 'space', unit: 'millimeter' });
+  const win = (min, max, start, end) => ({ min, max, start, end });
+  fs.writeFileSync(path.join(dir, '.zattrs'), JSON.stringify({
+    multiscales: [{ version: '0.4', name: 'channels',
+      axes: [{ name: 'c', type: 'channel' }, axis('z'), axis('y'), axis('x')],
+      datasets: [{ path: '0', coordinateTransformations: [{ type: 'scale', scale: [1, 1, 1, 1] }] },
+        { path: '1', coordinateTransformations: [{ type: 'scale', scale: [1, 2, 2, 2] },
+          { type: 'translation', translation: [0, 0.5, 0.5, 0.5] }] }] }],
+    omero: { channels: [
+      { label: 'sphere', color: 'FF0000', active: true, window: win(100, 3000, 100, 3000) },
+      { label: 'slab', color: '00FF00', active: true, window: win(100, 2000, 50, 2500) },
+      { label: 'rod', color: '0080FF', active: true, window: win(100, 4000, 100, 4000) }] },
+  }));
+  const inside = (c, x, y, z) => {
+    const fx = (x + 0.5) / nx, fy = (y + 0.5) / ny, fz = (z + 0.5) / nz;
+    if (c === 0) return (fx - 0.35) ** 2 + (fy - 0.4) ** 2 + (fz - 0.5) ** 2 < 0.22 ** 2;
+    if (c === 1) return fy > 0.62 && fy < 0.78;
+    return (fx - 0.72) ** 2 + (fz - 0.45) ** 2 < 0.08 ** 2;
+  };
+  const value = [3000, 2000, 4000];
+  // Level 1 (every other voxel): the page's bricks layout needs a level
+  // coarser than the one it refines to.
+  for (const [level, f] of [[0, 1], [1, 2]]) {
+    const [lx, ly, lz] = [nx / f, ny / f, nz / f];
+    fs.mkdirSync(path.join(dir, String(level)), { recursive: true });
+    fs.writeFileSync(path.join(dir, String(level), '.zarray'), JSON.stringify({
+      zarr_format: 2, shape: [3, lz, ly, lx], chunks: [1, lz, ly, lx], dtype: '<u2', compressor: null,
+      fill_value: 0, order: 'C', filters: null, dimension_separator: '/' }));
+    for (let c = 0; c < 3; c++) {
+      const bytes = Buffer.alloc(lx * ly * lz * 2);
+      let i = 0;
+      for (let z = 0; z < lz; z++) for (let y = 0; y < ly; y++) for (let x = 0; x < lx; x++, i += 2) {
+        bytes.writeUInt16LE(inside(c, x * f, y * f, z * f) ? value[c] : 100, i);
+      }
+      const chunk = path.join(dir, String(level), String(c), '0', '0');
+      fs.mkdirSync(chunk, { recursive: true });
+      fs.writeFileSync(path.join(chunk, '0'), bytes);
+    }
+  }
+}

@@ -1,110 +1,27 @@
 // Browser test: the page on a phone (390x844 CSS pixels, devicePixelRatio
-// 3, emulated through the DevTools protocol): the WebGL context lost and
-// restored (as phones do when the page goes to the background) in WebGL 2
-// and WebGL 1, drags that turn the head by the same angle per CSS pixel at
-// every pixel ratio, the frame rate of a touch drag on the head, and the
-// page's details (a file dropped anywhere opens, disabled and hidden
-// controls, the crosshair in millimetres); the same for an OME-Zarr store
-// (a touch drag while it refines; a context loss with it open, its atlas
-// and page table rebuilt from the chunks the page holds). fixture.mjs serves the site and
-// launches Chromium; every figure is printed for the record.
+// 3, emulated through the DevTools protocol): drags that turn the head by
+// the same angle per CSS pixel at every pixel ratio, the frame rate of a
+// touch drag on the head, and the page's details (a file dropped anywhere
+// opens, disabled and hidden controls, the crosshair in millimetres); the
+// same for an OME-Zarr store (a touch drag while it refines). The WebGL
+// context lost and restored on a phone is context-loss.test.mjs.
+// fixture.mjs serves the site and launches Chromium; every figure is
+// printed for the record.
 import { test } from 'node:test';
 import fs from 'node:fs';
 import path from 'node:path';
 import {
-  CH2, check, snapshot, changedFraction, openPage, psnrOf, browserSuite, writePilNifti,
+  CH2, check, openPage, browserSuite, writePilNifti,
 } from './fixture.mjs';
 
 const checks = browserSuite();
 
-test('WebGL context lost and restored: the same image in WebGL 2 and WebGL 1', checks(contextLoss));
 test('a drag turns the view by the same angle per CSS pixel at pixel ratios 1, 2 and 3', checks(dragAngle));
 test('touch drag on the head at 390x844, pixel ratio 3: frames per second', checks(dragFrameRate));
 test('a file dropped anywhere opens; disabled and hidden controls; crosshair in mm', checks(pageDetails));
 test('touch drag on an OME-Zarr store at 390x844, pixel ratio 3: frames per second, no freeze', checks(storeDragFrameRate));
-test('WebGL context lost and restored with an OME-Zarr store open: the same image in WebGL 2 and WebGL 1', checks(storeContextLoss));
 
 const PHONE = { width: 390, height: 844, deviceScaleFactor: 3, mobile: true };
-
-// The page's status line and shown error.
-const statusOf = (page) => page.evaluate(() => document.getElementById('status').textContent);
-
-// The canvas's WebGL context's WEBGL_lose_context: lose (then wait for the
-// page to say so), or restore (then wait for the page's restored frame).
-async function loseContext(page) {
-  await page.evaluate(() => {
-    const c = document.getElementById('canvas');
-    const gl = c.getContext('webgl2') || c.getContext('webgl');
-    window.loseExt = gl.getExtension('WEBGL_lose_context');
-    window.loseExt.loseContext();
-  });
-  await page.waitForFunction(() => document.getElementById('status').textContent.includes('WebGL context lost'),
-    null, { timeout: 10000 });
-}
-async function restoreContext(page) {
-  await page.evaluate(() => window.loseExt.restoreContext());
-  await page.waitForFunction(() => document.getElementById('status').textContent.includes('WebGL context restored'),
-    null, { timeout: 30000 });
-  await page.evaluate(() => window.tessera.render());
-}
-
-// The head at 256x256, with settings away from their defaults (camera,
-// window, shading), lost and restored: the frame after must be the frame
-// before, and the view must still turn. In WebGL 2 also with a region of
-// the head shown at native resolution and the crop box on (the session's
-// exploration and the page's own view settings).
-async function contextLoss(context, url) {
-  if (!fs.existsSync(CH2)) { check(`context loss test needs ${CH2} (mricron-data)`, false); return; }
-  for (const [webgl, region] of [[2, false], [1, false], [2, true]]) {
-    const what = `WebGL ${webgl}${region ? ', a region shown, crop box on' : ''}`;
-    const { page, logs } = await openPage(context, url, `size=256&url=/templates/ch2.nii.gz${webgl === 1 ? '&webgl=1' : ''}`);
-    await page.check('#shade');
-    await page.evaluate(async () => {
-      const w = document.getElementById('winWidth');
-      w.value = +w.max * 0.6;
-      w.dispatchEvent(new Event('input'));
-      await window.tessera.setCamera(35, 12, 1.25);
-    });
-    if (region) {
-      await page.evaluate(() => window.tessera.slices.showRegion({ begin: [40, 90, 70], end: [140, 190, 170] }));
-      await page.check('#cropShow');
-      await page.evaluate(() => window.tessera.setCamera(35, 12, 1.25));
-    }
-    const s0 = await page.evaluate(() => window.tessera.state());
-    const e0 = await page.evaluate(() => window.tessera.slices.state());
-    const before = (await snapshot(page)).pixels;
-    await loseContext(page);
-    const lostStatus = await statusOf(page);
-    // A camera change while lost must not throw or draw (its frame waits
-    // for the restored context: not awaited here).
-    await page.evaluate(() => { window.tessera.setCamera(35, 12, 1.25); });
-    await restoreContext(page);
-    const restoredStatus = await statusOf(page);
-    const s1 = await page.evaluate(() => window.tessera.state());
-    const e1 = await page.evaluate(() => window.tessera.slices.state());
-    const after = (await snapshot(page)).pixels;
-    const psnr = psnrOf(before, after);
-    await page.evaluate(() => window.tessera.setCamera(80, 12, 1.25));
-    const turned = (await snapshot(page)).pixels;
-    const error = await page.evaluate(() => window.tessera.error());
-    const same = (a, b) => JSON.stringify(a) === JSON.stringify(b);
-    const regionKept = same(e0.explore.region, e1.explore.region) && e0.showing_region === e1.showing_region &&
-      e1.showing_region === region && same(s0.dims, s1.dims);
-    console.log(`${what}: status while lost "${lostStatus}"; after "${restoredStatus}"`);
-    check(`${what}: context lost and restored: the frame after equals the frame before (>= 60 dB) and the view still turns`,
-          s1.webgl === webgl && psnr >= 60 && changedFraction(after, turned) > 0.05 && error === '' && regionKept &&
-          same(s0.window, s1.window) && same(s0.camera, s1.camera) && s0.layout === s1.layout,
-          `${psnr >= 999 ? 'identical (inf dB)' : `${psnr.toFixed(2)} dB`}; ${(100 * changedFraction(after, turned)).toFixed(1)} % ` +
-          `changed by a turn after; ${s1.description}; window ${s1.window.map((v) => v.toFixed(1)).join('..')}; ` +
-          `region ${region ? JSON.stringify(e1.explore.region) : 'none'} (kept: ${regionKept}); error "${error}"`);
-    check(`${what}: the status line says "WebGL context lost — waiting", then "WebGL context restored"`,
-          lostStatus.includes('WebGL context lost — waiting') && restoredStatus.includes('WebGL context restored'),
-          `"${lostStatus}" / "${restoredStatus}"`);
-    const errors = logs.filter((l) => l.startsWith('pageerror') || (l.startsWith('error') && !/favicon|status of 404/.test(l)));
-    check(`${what}: no script errors around the context loss`, errors.length === 0, errors.join(' | '));
-    await page.close();
-  }
-}
 
 // A 50 CSS pixel mouse drag to the right (and 20 down) at pixel ratios 1, 2
 // and 3: the azimuth and elevation turned per CSS pixel.
@@ -295,20 +212,6 @@ function recordDrawnFrames() {
 
 const storeStats = (page) => page.evaluate(() => window.tessera.zarr());
 
-// Frames until the store's frame on the canvas is refined (every brick the
-// view wants drawn) and nothing is being fetched; the frames it took, or 0
-// when it did not refine in 100 (or no store is open).
-async function storeRefined(page) {
-  for (let i = 0; i < 100; i++) {
-    await page.evaluate(() => window.tessera.render());
-    const z = await storeStats(page);
-    if (!z) return 0;
-    if (z.last && z.last.complete && !z.last.pending && z.inFlight === 0 && z.queued === 0) return i + 1;
-    await new Promise((r) => setTimeout(r, 100));
-  }
-  return 0;
-}
-
 // One finger drags on the store (touch events on a 60 Hz clock for 3 s)
 // right after its first image, at 390x844 and ratio 3, while its bricks
 // arrive: the frames the page shows per second and the longest time
@@ -371,49 +274,4 @@ async function storeDragFrameRate(context, url, tmp, run) {
   const errors = logs.filter((l) => l.startsWith('pageerror') || (l.startsWith('error') && !/favicon|status of 404/.test(l)));
   check('store drag: no script errors', errors.length === 0, errors.join(' | '));
   await page.close();
-}
-
-// ch2 as a store, refined at a turned view, lost and restored: the page
-// makes the store's atlas, page table and ray caster again on the new
-// context from the chunks it holds (fetching only what its cache let go),
-// refines again, and the frame equals the one before the loss; the status
-// line says so, and the view still turns.
-async function storeContextLoss(context, url, tmp, run) {
-  if (!fs.existsSync(CH2)) { check(`store context loss test needs ${CH2} (mricron-data)`, false); return; }
-  const store = ch2Store(tmp, run);
-  for (const webgl of [2, 1]) {
-    const what = `store, WebGL ${webgl}`;
-    const { page, logs } = await openPage(context, url, `size=256&url=${store}${webgl === 1 ? '&webgl=1' : ''}`);
-    await page.waitForFunction(() => { const z = window.tessera.zarr(); return z && z.firstImageMs !== null; }, null, { timeout: 60000 });
-    await page.evaluate(() => window.tessera.setCamera(35, 12, 1.25));
-    await storeRefined(page);
-    const s0 = await page.evaluate(() => window.tessera.state());
-    const before = (await snapshot(page)).pixels;
-    const z0 = await storeStats(page);
-    await loseContext(page);
-    const lostStatus = await statusOf(page);
-    await restoreContext(page);
-    const frames = await storeRefined(page);
-    const restoredStatus = await statusOf(page);
-    const z1 = (await storeStats(page)) || { requests: 0 };
-    const s1 = await page.evaluate(() => window.tessera.state());
-    const after = (await snapshot(page)).pixels;
-    const psnr = psnrOf(before, after);
-    await page.evaluate(() => window.tessera.setCamera(80, 12, 1.25));  // one frame, refined or not
-    const turned = (await snapshot(page)).pixels;
-    const error = await page.evaluate(() => window.tessera.error());
-    console.log(`${what}: status while lost "${lostStatus}"; after "${restoredStatus}"; reopened in ${(z1.reopenMs || 0).toFixed(0)} ms ` +
-                `with ${z1.reopenRequests} requests (${z1.requests - z0.requests} since the loss; ${z0.requests} before), refined in ${frames} frames`);
-    check(`${what}: context lost and restored: the store is drawn again, the frame equals the one before (>= 60 dB), the view still turns`,
-          s1.webgl === webgl && z1.reopened === 1 && frames > 0 && psnr >= 60 && changedFraction(after, turned) > 0.05 && error === '' &&
-          JSON.stringify(s0.camera) === JSON.stringify(s1.camera),
-          `${psnr >= 999 ? 'identical (inf dB)' : `${psnr.toFixed(2)} dB`}; ${(100 * changedFraction(after, turned)).toFixed(1)} % changed by a turn after; ` +
-          `store ${z1.url ? 'open' : 'closed'}, reopened ${z1.reopened || 0}, ${frames ? `refined in ${frames} frames` : 'not refined'}; camera ${JSON.stringify(s1.camera)}; error "${error}"`);
-    check(`${what}: the status line says "WebGL context lost — waiting", then "WebGL context restored"`,
-          lostStatus.includes('WebGL context lost — waiting') && restoredStatus.includes('WebGL context restored'),
-          `"${lostStatus}" / "${restoredStatus}"`);
-    const errors = logs.filter((l) => l.startsWith('pageerror') || (l.startsWith('error') && !/favicon|status of 404/.test(l)));
-    check(`${what}: no script errors around the context loss`, errors.length === 0, errors.join(' | '));
-    await page.close();
-  }
 }

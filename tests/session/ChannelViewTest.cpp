@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -159,6 +160,39 @@ TEST_F(ChannelViewTest, DrawsTheTechniqueTheSettingsName) {
       EXPECT_GE(psnr(image, *f.reference), 40.0) << technique << " " << profile;
     }
   }
+}
+
+// A front end whose GPU context was lost (the page's WebGL on a phone)
+// takes the channels out of the session on the lost context and shows them
+// in one made on the restored context: the same frame, the edits kept, the
+// voxels not read again (the first view is closed).
+TEST_F(ChannelViewTest, ChannelsTakenOutShowTheSameFrameInAnotherSession) {
+  Session lost("native");
+  look(lost.settings());
+  ASSERT_TRUE(lost.channelView().open(store()));
+  lost.channelView().setVisible(1, false);
+  lost.channelView().setColor(0, {1.0, 1.0, 0.0});
+  lost.channelView().setWindow(2, {100.0, 2000.0});
+  lost.channelView().render(kSize, kSize);
+  const Image before = lost.channelView().readImage();
+  const nlohmann::json state = lost.state();
+  std::optional<ChannelView::Shown> shown = lost.channelView().takeShown();
+  ASSERT_TRUE(shown.has_value());
+  EXPECT_FALSE(lost.channelView().isOpen());
+  EXPECT_FALSE(lost.channelView().takeShown().has_value());
+
+  Session restored("native");
+  restored.restore({{"version", state["version"]}, {"settings", state["settings"]}});
+  restored.channelView().show(std::move(shown->set), shown->name);
+  ASSERT_TRUE(restored.channelView().isOpen());
+  EXPECT_EQ(restored.channelView().name(), store());
+  EXPECT_FALSE(restored.channelView().channels()[1].visible);
+  EXPECT_EQ(restored.channelView().channels()[2].window.max, 2000.0);
+  restored.channelView().render(kSize, kSize);
+  const double db = psnr(restored.channelView().readImage(), before);
+  std::printf("channels taken out and shown in another session: %.1f dB\n", db);
+  EXPECT_GE(db, 60.0);
+  EXPECT_EQ(restored.state()["settings"]["channels"], state["settings"]["channels"]);
 }
 
 // A volume opened while a store's channels are shown replaces them, in

@@ -87,6 +87,14 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_wanted() {
   return web::jsonOut(keys);
 }
 
+// 1 when the 3D view shows a region or grid block read from the open store
+// (the viewer's frames, not the store's): after a context loss the store
+// opened again shows the one it showed (WebSession::storeOpenStep).
+EMSCRIPTEN_KEEPALIVE int tessera_zarr_region_shown() {
+  web::WebSession* s = web::sessionIfAny();
+  return s && s->storeRegionShown() ? 1 : 0;
+}
+
 // 1 when the key has arrived (or is known missing, or failed moments ago):
 // the page does not fetch it again when it is listed twice.
 EMSCRIPTEN_KEEPALIVE int tessera_zarr_holds(const char* key) {

@@ -148,6 +148,17 @@ void WebSession::recoverContext() {
   const Camera camera = viewer().camera();  // a store's (its state holds no volume to frame)
   const int webglVersion = context_->webglVersion();
   const int cell = askedCell_;
+  regionAgain_.reset();
+  if (hadStore && regionShown()) {
+    StoreRegionAgain& r = regionAgain_.emplace();
+    r.exploration = explore()->state();
+    r.cell = cell;
+    r.overviewCamera = explore()->overviewCamera();
+    r.camera = camera;
+    r.window = viewer().window();
+  }
+  std::optional<session::ChannelView::Shown> channels;
+  if (session_->hasChannelView()) channels = session_->channelView().takeShown();
   zarr_.reset();
   session_.reset();
   context_.reset();
@@ -165,6 +176,7 @@ void WebSession::recoverContext() {
   }
   knobs.applyTo(viewer());
   refreshExtraLines();
+  if (channels) session_->channelView().show(std::move(channels->set), channels->name);
   if (store) {
     viewer().camera() = camera;
     reopenStore(std::move(*store));

@@ -12,6 +12,7 @@
 //   const gpu::Texture& frame = session.channelView().render(512, 512);
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <glm/vec3.hpp>
@@ -43,6 +44,16 @@ class ChannelView {
   // Back to the session's volume alone (settings().channels disabled).
   void close();
   bool isOpen() const { return set_ != nullptr; }
+  // The channels shown (with their colours, windows, visibility and mode)
+  // and their name, taken out of the view, which closes. For a session made
+  // again on a restored GPU context (a phone's browser took WebGL away): its
+  // view's show() draws the same frame, the voxels kept in memory, not read
+  // again. Null when none are shown.
+  struct Shown {
+    ChannelSet set;
+    std::string name;
+  };
+  std::optional<Shown> takeShown();
   const std::string& name() const { return name_; }
   // The channels shown, with their current colour, window and visibility.
   const ChannelSet& channels() const;
