@@ -1,6 +1,7 @@
 // The overlay in the slice views (session/Fusion.h fuseSliceImage): the same
-// pixel -> voxel mapping as sliceImage (core/SliceImage.h), then the fused
-// volume's colour at that voxel's centre, by world coordinates.
+// pixel -> voxel mapping as sliceImage (core/SliceImage.h) and the slice
+// views of a pyramid's level (viewer/SliceView.h), then the fused volume's
+// colour at that voxel's centre, by world coordinates.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -12,19 +13,23 @@
 
 namespace tessera::session {
 
-void fuseSliceImage(Image& image, const Volume& anatomy, const SliceFrame& f, int index,
-                    const Overlay& overlay) {
-  if (!overlay.fused || !overlay.fused->volume) return;
-  const FusedVolume& fused = *overlay.fused;
-  const glm::ivec3 dims = anatomy.dims();
-  const glm::dvec3 spacing = anatomy.spacing();
+namespace {
+
+// Slice `index` of a grid of `dims` voxels of `spacing` whose normalised
+// coordinates p (voxel centres at (i + 0.5) / dims) go to the fused
+// volume's by `toFused`.
+void fuseSliceGrid(Image& image, glm::ivec3 dims, glm::dvec3 spacing, const SliceFrame& f,
+                   int index, const glm::dmat4& toFused, const FusedVolume& fused) {
   const SliceRaster raster = sliceRaster(f, dims, spacing);
   if (image.width() != raster.width || image.height() != raster.height) {
     throw InputError("overlay in a slice view: the image is " + std::to_string(image.width()) +
                      "x" + std::to_string(image.height()) + ", the slice " +
                      std::to_string(raster.width) + "x" + std::to_string(raster.height));
   }
-  const glm::dmat4 toFused = fusedFromAnatomy(anatomy, *fused.volume);
+  if (index < 0 || index >= dims[f.axis]) {
+    throw InputError("overlay in a slice view: slice " + std::to_string(index) +
+                     " is outside 0:" + std::to_string(dims[f.axis]));
+  }
   const glm::dvec3 d(dims);
   for (int row = 0; row < raster.height; ++row) {
     const int vr =
@@ -46,6 +51,31 @@ void fuseSliceImage(Image& image, const Volume& anatomy, const SliceFrame& f, in
       }
     }
   }
+}
+
+}  // namespace
+
+void fuseSliceImage(Image& image, const Volume& anatomy, const SliceFrame& f, int index,
+                    const Overlay& overlay) {
+  if (!overlay.fused || !overlay.fused->volume) return;
+  const FusedVolume& fused = *overlay.fused;
+  fuseSliceGrid(image, anatomy.dims(), anatomy.spacing(), f, index,
+                fusedFromAnatomy(anatomy, *fused.volume), fused);
+}
+
+// A level's normalised coordinates are level 0's: every level spans the
+// same box (levels need not halve), so level 0's affine places them.
+void fuseSliceImage(Image& image, const lod::MultiresSource& anatomy, int level,
+                    const SliceFrame& f, int index, const Overlay& overlay) {
+  if (!overlay.fused || !overlay.fused->volume) return;
+  if (level < 0 || level >= anatomy.levelCount()) {
+    throw InputError("overlay in a slice view: level " + std::to_string(level) +
+                     " is outside 0:" + std::to_string(anatomy.levelCount()));
+  }
+  const FusedVolume& fused = *overlay.fused;
+  const lod::LevelInfo li = anatomy.levelInfo(level);
+  fuseSliceGrid(image, li.dims, glm::dvec3(li.spacing), f, index,
+                fusedFromAnatomy(anatomy.shape(), *fused.volume), fused);
 }
 
 }  // namespace tessera::session

@@ -10,14 +10,18 @@
 // FusionStateTest.cpp); on WebGL 1 the overlay is refused with a message.
 // Over an OME-Zarr store of ch2 (`tessera convert`, drawn brick by brick):
 // the same atlas fused in the store's ray march equals `tessera render STORE
-// --layout bricks --overlay ...`, and the crosshair names both gyri.
+// --layout bricks --overlay ...`, and the crosshair names both gyri. The
+// store's slice views (read at the store's levels) show the atlas too,
+// resampled by world coordinates onto each level's slice grid: at level 0
+// the three views through the right postcentral gyrus equal the file's
+// (in memory) pixel for pixel, and its crosshair readout equals the file's.
 import { test } from 'node:test';
 import fs from 'node:fs';
 import path from 'node:path';
 import { execFile } from 'node:child_process';
 import { promisify } from 'node:util';
 import {
-  CH2, cli, check, psnrAgainst, openPage, openThroughPicker, withoutOverlays, writePilNifti, browserSuite,
+  CH2, cli, check, differingPixels, psnrOf, psnrAgainst, openPage, openThroughPicker, withoutOverlays, writePilNifti, browserSuite,
 } from './fixture.mjs';
 
 const AAL = '/usr/share/mricron/templates/aal.nii.gz';
@@ -30,6 +34,29 @@ test('aal over ch2 in the page: the CLI\'s fused image, the crosshair names the 
   { skip: !have && 'needs mricron-data (ch2, aal)' }, checks(overlay));
 test('aal over a ch2 OME-Zarr store in the page (bricks): the CLI\'s fused image, the crosshair names the region',
   { skip: !have && 'needs mricron-data (ch2, aal)' }, checks(overlayOverStore));
+
+// The three slice views through the voxel nearest `mm` once none is pending
+// (a store's at the level its panels ask for): their pixels, frames and
+// the crosshair's readout.
+async function slicesThrough(page, mm) {
+  const at = await crosshairAt(page, mm);
+  await page.waitForFunction(() => Object.values(window.tessera.slices.state().panels).every((p) => p.frame && !p.frame.pending),
+    null, { timeout: 30000 }).catch(() => {});
+  return page.evaluate((voxel) => {
+    const st = window.tessera.slices.state();
+    const panels = {};
+    for (const [plane, p] of Object.entries(st.panels)) {
+      const px = window.tessera.slices.imagePixels(plane);
+      let coloured = 0;
+      for (let i = 0; i < px.length; i += 4) if (px[i] !== px[i + 1] || px[i + 1] !== px[i + 2]) coloured++;
+      panels[plane] = { pixels: px, coloured, width: p.frame.image_width, height: p.frame.image_height,
+        level: p.frame.level, pending: !!p.frame.pending, index: p.index };
+    }
+    return { voxel, text: document.getElementById('crosshairInfo').textContent, panels };
+  }, at.voxel);
+}
+// The file's slice views with aal (overlay()), for the store's (overlayOverStore).
+let fileSlices = null;
 
 // The crosshair's readout once it is at the voxel nearest `mm`.
 async function crosshairAt(page, mm) {
@@ -102,6 +129,7 @@ async function overlay(context, url, tmp) {
         `voxel ${right.voxel}: "${right.text}"`);
   check('the crosshair at (-40, -25, 52) mm names Postcentral_L (left and right not swapped)',
         /Postcentral_L/.test(left.text) && !/Postcentral_R/.test(left.text), `voxel ${left.voxel}: "${left.text}"`);
+  fileSlices = await slicesThrough(page, [40, -25, 52]);
 
   // The overlay's look is in the session's state, and restored from it.
   const saved = await page.evaluate(() => window.tessera.viewer().sessionState());
@@ -205,6 +233,7 @@ async function overlayOverStore(context, url, tmp, run) {
         `voxel ${right.voxel}: "${right.text}"`);
   check('over a store: the crosshair at (-40, -25, 52) mm names Postcentral_L (left and right not swapped)',
         /Postcentral_L/.test(left.text) && !/Postcentral_R/.test(left.text), `voxel ${left.voxel}: "${left.text}"`);
+  await storeSlices(page);
   // Removing it gives the store alone back.
   await page.evaluate(() => document.getElementById('overlayRemove').click());
   await page.waitForFunction(() => !window.tessera.overlay.info().open, null, { timeout: 10000 });
@@ -218,4 +247,43 @@ async function overlayOverStore(context, url, tmp, run) {
   check('no script errors on the store page', errors.length === 0, errors.join(' | '));
   await page.close();
   console.log(`overlay over a store: ${((Date.now() - t0) / 1000).toFixed(1)} s`);
+}
+
+// The store's slice views with aal: from the coarsest level (panels of one
+// pixel) the atlas's colours are there; at level 0 (panels of 512² pixels)
+// the views through the right postcentral gyrus equal the file's, and the
+// crosshair reads the same (Postcentral_R at x > 0 mm).
+async function storeSlices(page) {
+  const t0 = Date.now();
+  await page.evaluate(() => window.tessera.slices.setPanelPixels(1));
+  const coarse = await slicesThrough(page, [40, -25, 52]);
+  const coarseS = (Date.now() - t0) / 1000;
+  const coarseRows = Object.entries(coarse.panels).map(([q, p]) => `${q} level ${p.level} ${p.width}x${p.height}: ${p.coloured} coloured`);
+  check('over a store: the coarsest level\'s slice views show the atlas (> 5 % of each view\'s pixels coloured)',
+        Object.values(coarse.panels).every((p) => p.level > 0 && p.coloured > 0.05 * p.width * p.height), coarseRows.join('; '));
+  await page.evaluate(() => window.tessera.slices.setPanelPixels(512 * 512));
+  const shown = await slicesThrough(page, [40, -25, 52]);
+  const level0S = (Date.now() - t0) / 1000;
+  const rows = [];
+  let ok = !!fileSlices;
+  for (const [plane, p] of Object.entries(shown.panels)) {
+    const f = fileSlices && fileSlices.panels[plane];
+    const same = f && f.width === p.width && f.height === p.height && f.index === p.index;
+    const differ = same ? differingPixels(p.pixels, f.pixels, 0) : -1;
+    const db = same ? psnrOf(p.pixels, f.pixels) : 0;
+    ok = ok && same && p.level === 0 && !p.pending && p.coloured > 0.05 * p.width * p.height && (differ === 0 || db >= 40);
+    rows.push(`${plane} ${p.index}: level ${p.level}, ${p.width}x${p.height}, ${p.coloured} coloured, ` +
+      `${differ} pixels differ from the file's (${db >= 999 ? 'identical' : `${db.toFixed(2)} dB`})`);
+  }
+  check('over a store: the level-0 slice views through (40, -25, 52) mm show aal as the file\'s do (identical or >= 40 dB)',
+        ok, fileSlices ? rows.join('; ') : 'the file\'s slice views were not taken (the first test failed early)');
+  const overlayPart = (t) => (t.split(' · ')[1] || '');
+  const mmOf = (t) => { const m = /at \(([-\d.]+), ([-\d.]+), ([-\d.]+)\) mm RAS/.exec(t); return m ? m.slice(1).map(Number) : null; };
+  const mm = mmOf(shown.text);
+  check('over a store: the crosshair there reads Postcentral_R at x > 0 mm (RAS), as over the file',
+        /Postcentral_R/.test(overlayPart(shown.text)) && mm && mm[0] > 0 && fileSlices &&
+        overlayPart(shown.text) === overlayPart(fileSlices.text) && shown.voxel.join() === fileSlices.voxel.join(),
+        `store: "${shown.text}"; file: "${fileSlices && fileSlices.text}"`);
+  console.log(`overlay over a store, slice views: coarsest ${coarseS.toFixed(1)} s, level 0 ${level0S.toFixed(1)} s, ` +
+    `compared ${((Date.now() - t0) / 1000).toFixed(1)} s`);
 }

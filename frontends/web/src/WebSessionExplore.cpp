@@ -151,6 +151,9 @@ SliceResult WebSession::slice(int axis, int index, bool colour, double maxPixels
     image = sliceImage(*store, f, indexAt(coarsest), window, tf);
   }
   out.level = level;
+  if (const session::Overlay* o = session_->overlay()) {
+    session::fuseSliceImage(image, src, level, f, indexAt(level), *o);  // docs/fusion.md
+  }
   return out;
 }
 

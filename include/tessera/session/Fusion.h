@@ -79,6 +79,15 @@ TransferFunction overlayTransferFunction(const std::string& spec);
 // outside the fused volume's box the pixel stays.
 void fuseSliceImage(Image& image, const Volume& anatomy, const SliceFrame& frame, int index,
                     const Overlay& overlay);
+// The same in a slice view of a pyramid's level (a store's slices, read at
+// the finest level a view needs): `image` is viewer::SliceGeometry(level's
+// dims and spacing, the shape's direction, frame.axis).render(anatomy,
+// level, index, ...). Every level spans level 0's box, so a level voxel's
+// centre is placed in world space by the shape's (level 0's) affine; the
+// fused volume is resampled there as for a volume in memory. InputError for
+// a level or index outside the pyramid, or an image of another size.
+void fuseSliceImage(Image& image, const lod::MultiresSource& anatomy, int level,
+                    const SliceFrame& frame, int index, const Overlay& overlay);
 
 // What the crosshair reads at a world position (RAS+ mm).
 struct ProbeResult {
