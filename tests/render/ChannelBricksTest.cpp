@@ -5,8 +5,10 @@
 // six channels in two atlases, and the layouts that cannot draw channels.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <set>
 
@@ -387,6 +389,65 @@ TEST_F(ChannelBricks, BrickWalkEqualsPerSampleLookup) {
           ms[1]);
       EXPECT_GE(walkVsLookup, 50.0) << channelModeName(mode) << " " << test::apiName(api);
       EXPECT_GE(walkVsRef, 40.0) << channelModeName(mode) << " " << test::apiName(api);
+    }
+  }
+}
+
+// Not a test: the frame-time bench of the walk (docs/channels.md), run on a
+// store of bench/channels_store.py by
+//   TESSERA_CHANNEL_WALK_BENCH=STORE test_render --gtest_filter=*ChannelWalkBench*
+// Per API and mode, frames of the per-sample lookup and of the walk
+// alternate (5 each, 384x384, after one that compiles); prints the medians.
+TEST(ChannelWalkBench, AlternatingFrames) {
+  const char* path = std::getenv("TESSERA_CHANNEL_WALK_BENCH");
+  if (!path) GTEST_SKIP() << "set TESSERA_CHANNEL_WALK_BENCH=STORE to run the bench";
+  const ChannelSet set = readZarrChannels(path);
+  const Camera camera = test::orbitCamera(set.geometry(), 30.0, 20.0);
+  constexpr int kPixels = 384, kFrames = 5;
+  for (gpu::ApiLevel api : {gpu::ApiLevel::Gles3, gpu::ApiLevel::Gles2}) {
+    test::ApiContext context(api);
+    gpu::GlContext& gl = context.get();
+    const gpu::DeviceLimits limits = gpu::DeviceLimits::of(gl.caps());
+    for (ChannelMode mode : {ChannelMode::Additive, ChannelMode::Max}) {
+      ChannelSet shown = set;
+      shown.mode = mode;
+      RenderSettings s = channelSettings();
+      s.mode = renderModeFor(mode);
+      std::vector<std::unique_ptr<layout::BricksLayout>> layouts;
+      std::vector<std::unique_ptr<render::Raycaster>> casters;
+      for (const bool walk : {false, true}) {
+        layouts.push_back(layout::BricksLayout::createChannels(pyramids(shown), shown, limits,
+                                                               gl.ledger(), {.walk = walk}));
+        layout::BricksFrame f;
+        for (int i = 0; i < 2000 && !f.complete; ++i) {
+          f = layouts.back()->update(camera, kPixels, kPixels, channelRamp());
+          if (!f.complete) layouts.back()->waitForBricks(20.0);
+        }
+        casters.push_back(
+            std::make_unique<render::Raycaster>(gl, shown.geometry(), *layouts.back()));
+        casters.back()->setSkipBlockSize(0);
+        casters.back()->setTransferFunction(channelRamp());
+      }
+      std::vector<double> ms[2];
+      Image images[2];
+      for (int round = 0; round <= kFrames; ++round) {
+        for (int w = 0; w < 2; ++w) {
+          const auto t0 = std::chrono::steady_clock::now();
+          images[w] =
+              casters[static_cast<std::size_t>(w)]->renderImage(camera, s, kPixels, kPixels);
+          const double t =
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                  .count();
+          if (round > 0) ms[w].push_back(t);
+        }
+      }
+      for (auto& m : ms) std::sort(m.begin(), m.end());
+      std::printf(
+          "channel walk bench %s %s %dx%d (%s): per-sample lookup median %.1f ms, walked "
+          "median %.1f ms (%.2fx); walked vs per-sample %.1f dB\n",
+          channelModeName(mode), test::apiName(api), kPixels, kPixels,
+          layouts[1]->plan().reason.c_str(), ms[0][kFrames / 2], ms[1][kFrames / 2],
+          ms[0][kFrames / 2] / ms[1][kFrames / 2], psnr(images[1], images[0]));
     }
   }
 }
