@@ -6,6 +6,7 @@
 #include "cli/Commands.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/io/VolumeReader.h"
+#include "tessera/layout/ChannelLayouts.h"
 #include "tessera/layout/LayoutRegistry.h"
 #include "tessera/lod/ProceduralMultiresSource.h"
 #include "tessera/render/Raycaster.h"
@@ -22,6 +23,7 @@ struct PlanOptions {
   std::string layout = "auto";
   std::string size = "512x512";
   int skipBlock = 8;
+  int channels = 0;  // > 0: also the bricks of that many channels
   bool json = false;
 };
 
@@ -101,6 +103,9 @@ void runPlan(const PlanOptions& o) {
     nlohmann::json rejected = nlohmann::json::array();
     for (const auto& r : plan.rejected) rejected.push_back(planJson(r));
     j["rejected"] = rejected;
+    if (o.channels > 0) {
+      j["channel_bricks"] = planJson(layout::channelBricksPlan(volume, l, o.channels));
+    }
     std::printf("%s\n", j.dump(2).c_str());
     return;
   }
@@ -134,6 +139,9 @@ void runPlan(const PlanOptions& o) {
   if (!needs.note.empty()) std::printf("note     %s\n", needs.note.c_str());
   std::printf("reason   %s\n", plan.reason.c_str());
   std::printf("gradient with --shade: %s\n", gradient.reason.c_str());
+  if (o.channels > 0) {
+    std::printf("channels %s\n", layout::channelBricksPlan(volume, l, o.channels).reason.c_str());
+  }
 }
 
 }  // namespace
@@ -149,6 +157,8 @@ void addPlanCommand(CLI::App& app) {
   addDefaultedOption(cmd, "--size", o->size,
                      "Image size the renderer must also fit (WIDTHxHEIGHT)");
   addDefaultedOption(cmd, "--skip-block", o->skipBlock, "Empty-space block size (0 = off)");
+  addDefaultedOption(cmd, "--channels", o->channels,
+                     "Also plan the bricks of this many channels of the volume's grid (0 = off)");
   cmd->add_flag("--json", o->json, "Print one JSON object");
   cmd->callback([o] { runPlan(*o); });
 }

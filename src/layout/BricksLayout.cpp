@@ -7,6 +7,7 @@
 
 #include <glm/trigonometric.hpp>
 
+#include "layout/ChannelUniforms.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
 #include "tessera/gpu/Draw.h"
@@ -257,11 +258,11 @@ std::string storedNote(const Volume& shape) {
   return text;
 }
 
-// The limits the atlas is shaped within: with channels, one mosaic texture
-// per four channels on ES 2 (their samplers take the units).
+// The limits the atlas is shaped within: with channels, the units one group
+// of four channels may take on ES 2 (channelAtlasUnits).
 gpu::DeviceLimits shapeLimits(const gpu::DeviceLimits& limits, const BricksOptions& options) {
   gpu::DeviceLimits l = limits;
-  if (options.channels > 0) l.textureUnits = std::min(l.textureUnits, 2);
+  if (options.channels > 0) l.textureUnits = channelAtlasUnits(limits, options.channels);
   return l;
 }
 
@@ -321,9 +322,8 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
   const AtlasShape a =
       atlasFor(shapeLimits(limits, options), stored, avail, pyramidBricks(levels, b), format.bytes);
   const bool es3 = a.mosaic.tilesX == 0;
-  const int atlases = options.channels > 0 ? channelAtlases(options.channels)
-                      : es3                ? 1
-                                           : std::max(1, a.slots.x);
+  const int atlases = (options.channels > 0 ? channelAtlases(options.channels) : 1) *
+                      (es3 ? 1 : std::max(1, a.slots.x));
   PlannedTexture atlas{
       .label = "brick atlas",
       .size = es3 ? a.slots * stored : glm::ivec3(a.mosaic.width(), a.mosaic.height(), 1),
@@ -344,7 +344,9 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
       (atlases > 1 ? numbered("", atlases, " x ") : std::string()) + dimsText(atlas.size) +
       (es3 ? " 3D" : " mosaic") + ", " + formatBytes(a.bytes) + ") through a " +
       std::to_string(pages.size.x) + "x" + std::to_string(pages.size.y) + " page table" +
-      (options.channels > 0 ? channelNote(format.format) : storedNote(shape));
+      (options.channels > 0
+           ? channelNote(format.format) + channelSlotsNote(a.slots, es3, options.channels)
+           : storedNote(shape));
   // The coarsest bricks are pinned, so refining needs a slot beyond them;
   // a pyramid of one level (a single-level store) needs none: it fits when
   // the atlas holds all of it.
@@ -394,7 +396,6 @@ std::unique_ptr<BricksLayout> BricksLayout::createChannels(
     }
   }
   options.channels = set.size();
-  options.walk = false;  // channels sample through sampleChannels, not the walk
   return build(std::move(sources), &set, limits, ledger, options);
 }
 
@@ -430,20 +431,7 @@ std::unique_ptr<BricksLayout> BricksLayout::build(
   l->slotGrid_ = a.slots;
   l->mosaic_ = a.mosaic;
   if (set) {
-    for (int t = 0; t < channelAtlases(set->size()); ++t) {
-      const std::string label = numbered("brick atlas, channels ", 4 * t, "..") +
-                                std::to_string(std::min(set->size(), 4 * t + 4) - 1) + " (" +
-                                gpu::texelFormatName(format.format) + ")";
-      if (a.mosaic.tilesX == 0) {
-        l->atlasTexels_ = a.slots * stored;
-        l->atlases_.push_back(gpu::Texture::create3D(
-            ledger, label, format.format, l->atlasTexels_.x, l->atlasTexels_.y, l->atlasTexels_.z));
-      } else {
-        l->atlasTexels_ = glm::ivec3(stored, stored, a.slots.z * stored);
-        l->atlases_.push_back(gpu::Texture::create2D(ledger, label, format.format, a.mosaic.width(),
-                                                     a.mosaic.height()));
-      }
-    }
+    l->createChannelAtlases(ledger, format.format, a.slots, a.mosaic, stored);
   } else if (a.mosaic.tilesX == 0) {
     l->atlasTexels_ = a.slots * stored;
     l->atlases_.push_back(gpu::Texture::create3D(
@@ -982,8 +970,7 @@ ValueBlocks BricksLayout::valueBlocks(int blockSize) const {
 
 std::vector<gpu::ShaderPart> BricksLayout::glslParts() const {
   if (!channels_) return {glsl()};
-  return {glsl(), gpu::embeddedShaderPart("layout/channels_bricks.glsl"),
-          gpu::embeddedShaderPart("layout/channels.glsl")};
+  return {glsl(), channelsGlsl(), gpu::embeddedShaderPart("layout/channels.glsl")};
 }
 
 gpu::ShaderPart BricksLayout::glsl() const {
@@ -995,11 +982,13 @@ gpu::ShaderPart BricksLayout::glsl() const {
   const std::size_t second = part.text.find('\n') + 1;
   const std::size_t third = part.text.find('\n', second) + 1;
   const std::size_t fourth = part.text.find('\n', third) + 1;
-  part.text.replace(0, part.text.find('\n', fourth),
-                    "#define BRICKS_ATLASES " + std::to_string(channels_ ? 1 : atlases_.size()) +
-                        "\n#define BRICKS_TEXEL " + std::to_string(atlasTexel_) +
-                        "\n#define BRICKS_LEVELS " + std::to_string(grid_.levelCount()) +
-                        "\n#define BRICKS_WALK_PAGES " + (walkHost_.empty() ? "0" : "1"));
+  part.text.replace(
+      0, part.text.find('\n', fourth),
+      "#define BRICKS_ATLASES " +
+          std::to_string(channels_ ? channelMosaics() : static_cast<int>(atlases_.size())) +
+          "\n#define BRICKS_TEXEL " + std::to_string(atlasTexel_) + "\n#define BRICKS_LEVELS " +
+          std::to_string(grid_.levelCount()) + "\n#define BRICKS_WALK_PAGES " +
+          (walkHost_.empty() ? "0" : "1"));
   return part;
 }
 

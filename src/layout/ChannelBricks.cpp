@@ -4,6 +4,13 @@
 // page table, the level selection and the slots are the single-channel
 // ones and one page lookup serves all channels (layout/channels_bricks.glsl).
 // Also the channel uniforms ChannelLayout shares (ChannelUniforms.h).
+//
+// ES 2 has no 3D textures: the slots of a group of four channels are
+// stacked in mosaics, and a page names a slot by mosaic (r) and place in its
+// stack (b), 8 bits each, as the single-channel ES 2 atlas does: 255 slots a
+// mosaic. A group takes K mosaics (1 + G K units with the page table), K as
+// the profile's units allow after the ray caster's own, so a 3-channel store
+// on a 16-unit WebGL 1 profile addresses 8 x 255 slots, not 255.
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -12,6 +19,71 @@
 #include "tessera/layout/BricksLayout.h"
 
 namespace tessera::layout {
+
+namespace {
+
+// The ray caster's own units (transfer function, block grid) and a gradient
+// texture: what the channel atlases leave free.
+constexpr int kUnitsLeftForTechnique = 3;
+constexpr int kMaxMosaicsPerGroup = 8;  // bricks.glsl's u_layoutAtlas0..7
+
+int channelGroups(int channels) {
+  return (channels + 3) / 4;
+}
+
+}  // namespace
+
+int channelAtlasUnits(const gpu::DeviceLimits& limits, int channels) {
+  if (limits.api == gpu::ApiLevel::Gles3) return 2;  // one 3D texture a group, 255^3 slots
+  const int free = limits.textureUnits - 1 - kUnitsLeftForTechnique;
+  return 1 + std::clamp(free / channelGroups(channels), 1, kMaxMosaicsPerGroup);
+}
+
+std::string channelSlotsNote(glm::ivec3 slots, bool es3, int channels) {
+  if (es3) return "";
+  const int groups = channelGroups(channels);
+  return "; slots named by mosaic and place (8 bits each): " + std::to_string(slots.x) +
+         (slots.x == 1 ? " mosaic" : " mosaics") + " of " + std::to_string(slots.z) +
+         " slots per 4 channels, " + std::to_string(1 + groups * slots.x) + " texture units";
+}
+
+void BricksLayout::createChannelAtlases(gpu::MemoryLedger& ledger, gpu::TexelFormat format,
+                                        glm::ivec3 slots, const MosaicLayout::Geometry& mosaic,
+                                        int stored) {
+  const int groups = channelGroups(channels_->size());
+  const bool es3 = mosaic.tilesX == 0;
+  atlasTexels_ = es3 ? slots * stored : glm::ivec3(stored, stored, slots.z * stored);
+  for (int k = 0; k < (es3 ? 1 : slots.x); ++k) {
+    for (int g = 0; g < groups; ++g) {
+      std::string label = "brick atlas, channels " + std::to_string(4 * g) + ".." +
+                          std::to_string(std::min(channels_->size(), 4 * g + 4) - 1);
+      if (!es3 && slots.x > 1) label += ", mosaic " + std::to_string(k + 1);
+      label += std::string(" (") + gpu::texelFormatName(format) + ")";
+      atlases_.push_back(
+          es3 ? gpu::Texture::create3D(ledger, label, format, atlasTexels_.x, atlasTexels_.y,
+                                       atlasTexels_.z)
+              : gpu::Texture::create2D(ledger, label, format, mosaic.width(), mosaic.height()));
+    }
+  }
+}
+
+int BricksLayout::channelMosaics() const {
+  return mosaic_.tilesX == 0 ? 1 : slotGrid_.x;
+}
+
+// ES 3: two 3D samplers (the second the first again for four channels or
+// fewer); ES 2: every mosaic of every group.
+int BricksLayout::channelUnits() const {
+  return mosaic_.tilesX == 0 ? 2 : static_cast<int>(atlases_.size());
+}
+
+gpu::ShaderPart BricksLayout::channelsGlsl() const {
+  // Line 1 is a comment replaced by the compile-time counts (line numbers stay).
+  gpu::ShaderPart part = gpu::embeddedShaderPart("layout/channels_bricks.glsl");
+  part.text.replace(0, part.text.find('\n'),
+                    "#define CHANNEL_GROUPS " + std::to_string(channelGroups(channels_->size())));
+  return part;
+}
 
 void setChannelUniforms(const gpu::Program& program, const ChannelSet& set,
                         const std::vector<ValueMapping>& mappings, int textures) {
@@ -92,7 +164,8 @@ void BricksLayout::uploadChannels(
   const glm::ivec3 s = slotOrigin(slot);
   keepFineRanges(slot, *bricks.front());  // channel 0's, for valueBlocks()
   const std::size_t voxels = static_cast<std::size_t>(n) * n * n;
-  for (std::size_t t = 0; t < atlases_.size(); ++t) {
+  const auto atlasGroups = static_cast<std::size_t>(channelGroups(channels_->size()));
+  for (std::size_t t = 0; t < atlasGroups; ++t) {
     const int c0 = 4 * static_cast<int>(t);
     std::vector<std::uint8_t> bytes8;
     std::vector<std::uint16_t> bytes16;
@@ -112,12 +185,13 @@ void BricksLayout::uploadChannels(
       data = bytes8.data();
       texelBytes = 4;
     }
-    gpu::Texture& atlas = atlases_[t];
     if (mosaic_.tilesX == 0) {
+      gpu::Texture& atlas = atlases_[t];
       atlas.updateRegion(s * n, glm::ivec3(n), data);
       continue;
     }
-    // ES 2: one mosaic per four channels, s.z the slot in its stack.
+    // ES 2: mosaic s.x of the group, s.z the slot in its stack.
+    gpu::Texture& atlas = atlases_[static_cast<std::size_t>(s.x) * atlasGroups + t];
     const std::size_t slice = static_cast<std::size_t>(n) * n * texelBytes;
     for (int k = 0; k < n; ++k) {
       const glm::ivec2 at = mosaic_.addressOf(0, 0, s.z * n + k);
@@ -155,14 +229,25 @@ bool BricksLayout::channelsTransparent(const lod::BrickKey& key, const TransferF
 }
 
 void BricksLayout::bindChannels(const gpu::Program& program, int firstUnit) const {
-  // Without a second atlas its sampler reads the first, and its channels are off.
-  for (int t = 0; t < 2; ++t) {
-    atlases_[std::min<std::size_t>(static_cast<std::size_t>(t), atlases_.size() - 1)].bind(
-        firstUnit + t);
+  const int groups = channelGroups(channels_->size());
+  if (mosaic_.tilesX == 0) {
+    // Without a second atlas its sampler reads the first, and its channels are off.
+    for (int t = 0; t < 2; ++t)
+      atlases_[static_cast<std::size_t>(std::min(t, groups - 1))].bind(firstUnit + t);
+    program.set("u_layoutAtlas", firstUnit);
+    program.set("u_layoutChannels0", firstUnit);
+    program.set("u_layoutChannels1", firstUnit + 1);
+  } else {
+    // Group 0's mosaics are bricks.glsl's u_layoutAtlas0..K-1 (channel 0 in .r).
+    for (std::size_t i = 0; i < atlases_.size(); ++i) {
+      const int unit = firstUnit + static_cast<int>(i);
+      const int k = static_cast<int>(i) / groups, g = static_cast<int>(i) % groups;
+      atlases_[i].bind(unit);
+      const std::string name =
+          (g == 0 ? "u_layoutAtlas" : "u_layoutChannels1_") + std::to_string(k);
+      program.set(name.c_str(), unit);
+    }
   }
-  program.set(mosaic_.tilesX == 0 ? "u_layoutAtlas" : "u_layoutAtlas0", firstUnit);
-  program.set("u_layoutChannels0", firstUnit);
-  program.set("u_layoutChannels1", firstUnit + 1);
   std::vector<ValueMapping> mappings;
   for (int c = 0; c < channels_->size(); ++c) {
     // raw = m.raw(lo + f (hi - lo)) for the component's f in [0, 1].
@@ -172,7 +257,7 @@ void BricksLayout::bindChannels(const gpu::Program& program, int firstUnit) cons
     const double perStored = m.width / m.maxStored();
     mappings.push_back({(p.y - p.x) * perStored, m.min + p.x * perStored});
   }
-  setChannelUniforms(program, *channels_, mappings, static_cast<int>(atlases_.size()));
+  setChannelUniforms(program, *channels_, mappings, groups);
 }
 
 }  // namespace tessera::layout

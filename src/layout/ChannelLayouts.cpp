@@ -23,6 +23,10 @@ std::unique_ptr<Layout> channelBricks(const ChannelSet& set, const ChannelSource
 
 }  // namespace
 
+LayoutPlan channelBricksPlan(const Volume& shape, const gpu::DeviceLimits& limits, int channels) {
+  return BricksLayout::planFor(shape, limits, {.channels = channels});
+}
+
 std::string channelLayoutChoices(const ChannelSet& set, const gpu::DeviceLimits& limits) {
   std::string text = ChannelLayout::planFor(set, limits).layout;
   if (const LayoutEntry* e = streamingEntry()) text += " or " + e->name;

@@ -5,8 +5,12 @@
 // six channels in two atlases, and the layouts that cannot draw channels.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
+#include <set>
 
 #include "support/ChannelStore.h"
 #include "support/ExpectError.h"
@@ -14,6 +18,7 @@
 #include "support/TestCameras.h"
 #include "support/TestSupport.h"
 #include "tessera/gpu/DeviceProfile.h"
+#include "tessera/gpu/DeviceSession.h"
 #include "tessera/io/ZarrChannels.h"
 #include "tessera/layout/BricksLayout.h"
 #include "tessera/layout/ChannelLayouts.h"
@@ -274,6 +279,177 @@ TEST_F(ChannelBricks, LayoutWishIsHonouredOrRefused) {
                 [&] { layout::createChannelLayout("fcc", set, sources, limits, gl.ledger()); }),
             "--layout fcc cannot draw channels on " + limits.profile +
                 ": channel frames draw in texture3d or bricks");
+}
+
+// ES 2 names a slot by mosaic and 8-bit place (255 slots a mosaic): on a
+// WebGL 1 profile of 16 units and an iPad 2 of 8, three channels in 8^3
+// bricks (864 at level 0) spread over several mosaics, more than 255 slots
+// are resident and addressed (cells reading mosaic 2 and up), and the image
+// equals the reference.
+TEST_F(ChannelBricks, Es2ProfilesAddressMoreThan255SlotsPerGroup) {
+  const ChannelSet set = readZarrChannels(store());
+  const Camera camera = test::orbitCamera(set.geometry(), 30.0, 20.0);
+  const Image ref =
+      renderChannelsReference(set, channelRamp(), camera, channelSettings(), kSize, kSize);
+  for (const char* profile : {"webgl1-desktop-2012", "ipad2"}) {
+    const test::BudgetOverride keep(HostBudget::global().limitBytes());
+    gpu::DeviceSession device = gpu::openDevice(profile);
+    ChannelSet shown = set;
+    auto layout = layout::BricksLayout::createChannels(pyramids(shown), shown, device.limits,
+                                                       device.context->ledger(),
+                                                       {.brickSize = 8, .workers = 0});
+    render::Raycaster caster(*device.context, shown.geometry(), *layout);
+    caster.setSkipBlockSize(0);
+    caster.setTransferFunction(channelRamp());
+    layout::BricksFrame f;
+    for (int i = 0; i < 200 && !f.complete; ++i)
+      f = layout->update(camera, kSize, kSize, channelRamp());
+    EXPECT_TRUE(f.complete) << profile;
+    const Image image = caster.renderImage(camera, channelSettings(), kSize, kSize);
+    const double db = psnr(image, ref);
+    // Which mosaics the page table names, and the slots its cells read.
+    std::set<int> mosaics;
+    std::set<std::pair<int, int>> slots;
+    const glm::ivec3 cells = layout->grid().bricks(0);
+    for (int z = 0; z < cells.z; ++z) {
+      for (int y = 0; y < cells.y; ++y) {
+        for (int x = 0; x < cells.x; ++x) {
+          const auto at = layout->lookup((glm::dvec3(x, y, z) + 0.5) * 8.0);
+          if (at.level < 0) continue;
+          mosaics.insert(at.texture);
+          slots.insert({at.texture, static_cast<int>(at.texel.z) / 10});
+        }
+      }
+    }
+    std::printf(
+        "ES 2 channel bricks on %s: %d slots, %d wanted, %zu distinct slots read by the "
+        "cells, mosaics up to %d, %.1f dB (%s)\n",
+        profile, layout->slotCount(), f.wanted, slots.size(), *mosaics.rbegin(), db,
+        layout->plan().reason.c_str());
+    EXPECT_GT(layout->slotCount(), 255) << layout->plan().reason;
+    EXPECT_GT(f.wanted, 255) << profile;
+    EXPECT_GT(static_cast<int>(slots.size()), 255) << profile;
+    EXPECT_GE(*mosaics.rbegin(), 1) << profile;
+    EXPECT_NE(layout->plan().reason.find("slots named by mosaic and place"), std::string::npos)
+        << layout->plan().reason;
+    EXPECT_GE(db, 40.0) << profile;
+  }
+}
+
+// The brick walk: one page read per brick cell a ray enters, every channel
+// of the cell's samples read from that slot. Its images equal the page
+// read per sample (walk false) and the reference, additive and max, ES 3
+// and ES 2; the frame times of the two alternate (printed, not asserted).
+TEST_F(ChannelBricks, BrickWalkEqualsPerSampleLookup) {
+  const ChannelSet set = readZarrChannels(store());
+  const Camera camera = test::orbitCamera(set.geometry(), 30.0, 20.0);
+  for (gpu::ApiLevel api : {gpu::ApiLevel::Gles3, gpu::ApiLevel::Gles2}) {
+    test::ApiContext context(api);
+    gpu::GlContext& gl = context.get();
+    const gpu::DeviceLimits limits = gpu::DeviceLimits::of(gl.caps());
+    for (ChannelMode mode : {ChannelMode::Additive, ChannelMode::Max}) {
+      ChannelSet shown = set;
+      shown.mode = mode;
+      RenderSettings s = channelSettings();
+      s.mode = renderModeFor(mode);
+      const Image ref = renderChannelsReference(shown, channelRamp(), camera, s, kSize, kSize);
+      Image images[2];
+      double ms[2] = {0.0, 0.0};
+      std::vector<std::unique_ptr<layout::BricksLayout>> layouts;
+      std::vector<std::unique_ptr<render::Raycaster>> casters;
+      for (const bool walk : {false, true}) {
+        layouts.push_back(
+            layout::BricksLayout::createChannels(pyramids(shown), shown, limits, gl.ledger(),
+                                                 {.brickSize = 16, .workers = 0, .walk = walk}));
+        EXPECT_EQ(layouts.back()->walksBricks(), walk);
+        layout::BricksFrame f;
+        for (int i = 0; i < 100 && !f.complete; ++i)
+          f = layouts.back()->update(camera, kSize, kSize, channelRamp());
+        casters.push_back(
+            std::make_unique<render::Raycaster>(gl, shown.geometry(), *layouts.back()));
+        casters.back()->setSkipBlockSize(0);
+        casters.back()->setTransferFunction(channelRamp());
+      }
+      for (int round = 0; round < 3; ++round) {
+        for (int w = 0; w < 2; ++w) {
+          const auto t0 = std::chrono::steady_clock::now();
+          images[w] = casters[static_cast<std::size_t>(w)]->renderImage(camera, s, kSize, kSize);
+          const double t =
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                  .count();
+          if (round > 0) ms[w] += t / 2.0;  // round 0 compiles
+        }
+      }
+      const double walkVsLookup = psnr(images[1], images[0]);
+      const double walkVsRef = psnr(images[1], ref), lookupVsRef = psnr(images[0], ref);
+      std::printf(
+          "channel brick walk %s on %s: walked vs per-sample %.1f dB, vs reference %.1f dB "
+          "(per-sample %.1f dB); %.1f ms per-sample, %.1f ms walked\n",
+          channelModeName(mode), test::apiName(api), walkVsLookup, walkVsRef, lookupVsRef, ms[0],
+          ms[1]);
+      EXPECT_GE(walkVsLookup, 50.0) << channelModeName(mode) << " " << test::apiName(api);
+      EXPECT_GE(walkVsRef, 40.0) << channelModeName(mode) << " " << test::apiName(api);
+    }
+  }
+}
+
+// Not a test: the frame-time bench of the walk (docs/channels.md), run on a
+// store of bench/channels_store.py by
+//   TESSERA_CHANNEL_WALK_BENCH=STORE test_render --gtest_filter=*ChannelWalkBench*
+// Per API and mode, frames of the per-sample lookup and of the walk
+// alternate (5 each, 384x384, after one that compiles); prints the medians.
+TEST(ChannelWalkBench, AlternatingFrames) {
+  const char* path = std::getenv("TESSERA_CHANNEL_WALK_BENCH");
+  if (!path) GTEST_SKIP() << "set TESSERA_CHANNEL_WALK_BENCH=STORE to run the bench";
+  const ChannelSet set = readZarrChannels(path);
+  const Camera camera = test::orbitCamera(set.geometry(), 30.0, 20.0);
+  constexpr int kPixels = 384, kFrames = 5;
+  for (gpu::ApiLevel api : {gpu::ApiLevel::Gles3, gpu::ApiLevel::Gles2}) {
+    test::ApiContext context(api);
+    gpu::GlContext& gl = context.get();
+    const gpu::DeviceLimits limits = gpu::DeviceLimits::of(gl.caps());
+    for (ChannelMode mode : {ChannelMode::Additive, ChannelMode::Max}) {
+      ChannelSet shown = set;
+      shown.mode = mode;
+      RenderSettings s = channelSettings();
+      s.mode = renderModeFor(mode);
+      std::vector<std::unique_ptr<layout::BricksLayout>> layouts;
+      std::vector<std::unique_ptr<render::Raycaster>> casters;
+      for (const bool walk : {false, true}) {
+        layouts.push_back(layout::BricksLayout::createChannels(pyramids(shown), shown, limits,
+                                                               gl.ledger(), {.walk = walk}));
+        layout::BricksFrame f;
+        for (int i = 0; i < 2000 && !f.complete; ++i) {
+          f = layouts.back()->update(camera, kPixels, kPixels, channelRamp());
+          if (!f.complete) layouts.back()->waitForBricks(20.0);
+        }
+        casters.push_back(
+            std::make_unique<render::Raycaster>(gl, shown.geometry(), *layouts.back()));
+        casters.back()->setSkipBlockSize(0);
+        casters.back()->setTransferFunction(channelRamp());
+      }
+      std::vector<double> ms[2];
+      Image images[2];
+      for (int round = 0; round <= kFrames; ++round) {
+        for (int w = 0; w < 2; ++w) {
+          const auto t0 = std::chrono::steady_clock::now();
+          images[w] =
+              casters[static_cast<std::size_t>(w)]->renderImage(camera, s, kPixels, kPixels);
+          const double t =
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                  .count();
+          if (round > 0) ms[w].push_back(t);
+        }
+      }
+      for (auto& m : ms) std::sort(m.begin(), m.end());
+      std::printf(
+          "channel walk bench %s %s %dx%d (%s): per-sample lookup median %.1f ms, walked "
+          "median %.1f ms (%.2fx); walked vs per-sample %.1f dB\n",
+          channelModeName(mode), test::apiName(api), kPixels, kPixels,
+          layouts[1]->plan().reason.c_str(), ms[0][kFrames / 2], ms[1][kFrames / 2],
+          ms[0][kFrames / 2] / ms[1][kFrames / 2], psnr(images[1], images[0]));
+    }
+  }
 }
 
 // Through the session (what `render --channels ... --layout L` runs): the

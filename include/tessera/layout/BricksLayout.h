@@ -136,14 +136,14 @@ class BricksLayout final : public Layout, public StreamingLayout {
   ValueMapping rawFromStored() const override;
   glm::ivec3 volumeDims() const override { return grid_.dims(0); }
   std::uint64_t textureBytes() const override;
-  // Channels: the page table and two channel atlases (the second the first
-  // again when there are four channels or fewer).
+  // Channels: the page table and the channel atlases (channelUnits()).
   int textureUnits() const override {
-    return 1 + (channels_ ? 2 : static_cast<int>(atlases_.size())) + (walkHost_.empty() ? 0 : 1);
+    return 1 + (channels_ ? channelUnits() : static_cast<int>(atlases_.size())) +
+           (walkHost_.empty() ? 0 : 1);
   }
   ValueBlocks valueBlocks(int blockSize) const override;
   std::uint64_t contentVersion() const override { return contentVersion_; }
-  bool walksBricks() const override { return walk_ && !channels_; }
+  bool walksBricks() const override { return walk_; }
 
   const lod::BrickGrid& grid() const override { return grid_; }
   const lod::MultiresSource& source() const { return *source_; }
@@ -189,6 +189,14 @@ class BricksLayout final : public Layout, public StreamingLayout {
   std::vector<std::shared_ptr<const lod::StoredBrick>> channelBricks(const lod::BrickKey& key,
                                                                      bool readNow);
   void bindChannels(const gpu::Program& program, int firstUnit) const;
+  // The channel atlases (layout/ChannelBricks.cpp): per group of four
+  // channels one 3D texture (ES 3) or slots.x mosaics (ES 2), atlases_[k *
+  // groups + g]; the units they take; the mosaics per group; their GLSL.
+  void createChannelAtlases(gpu::MemoryLedger& ledger, gpu::TexelFormat format, glm::ivec3 slots,
+                            const MosaicLayout::Geometry& mosaic, int stored);
+  int channelUnits() const;
+  int channelMosaics() const;
+  gpu::ShaderPart channelsGlsl() const;
   void uploadChannels(int slot, const std::vector<std::shared_ptr<const lod::StoredBrick>>& bricks);
   bool channelsTransparent(const lod::BrickKey& key, const TransferFunction& tf,
                            bool exactOnly) const;

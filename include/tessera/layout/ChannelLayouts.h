@@ -28,6 +28,11 @@ std::unique_ptr<Layout> createChannelLayout(const std::string& wish, const Chann
                                             const gpu::DeviceLimits& limits,
                                             gpu::MemoryLedger& ledger);
 
+// What BricksLayout::createChannels would allocate for `channels` channels
+// of `shape`'s grid on `limits` (`tessera plan --channels N`): the atlas, and
+// on ES 2 how its slots are named (mosaics per group of four channels).
+LayoutPlan channelBricksPlan(const Volume& shape, const gpu::DeviceLimits& limits, int channels);
+
 // "texture3d or bricks": the layouts that draw channels on `limits`.
 std::string channelLayoutChoices(const ChannelSet& set, const gpu::DeviceLimits& limits);
 
