@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include <glm/trigonometric.hpp>
 
@@ -208,6 +209,70 @@ AtlasFormat atlasFormatFor(ScalarType type, const gpu::DeviceLimits& limits, int
   return {gpu::TexelFormat::LuminanceAlpha8, 3, 2, "LA8 (16 bits as two bytes)"};
 }
 
+// The brick walk's map per cell as floats (bricks.glsl BRICKS_WALK_PAGES,
+// an RGBA32F texel per page-table texel): ES 3, a filtered atlas (R8, R16),
+// one factor on every axis of every level, the walk on, no channels, and at
+// most 64^3 cells (4 MiB). Entering a cell is then one fetch and two
+// multiply-adds instead of the RGBA8 decoding and the loop over the levels'
+// scales.
+bool keepsWalkPages(const gpu::DeviceLimits& limits, const BricksOptions& options,
+                    const AtlasFormat& format, bool isotropic, glm::ivec3 cells0) {
+  const bool fewCells = std::int64_t(cells0.x) * cells0.y * cells0.z <= (std::int64_t(1) << 18);
+  return limits.api == gpu::ApiLevel::Gles3 && format.texel < 2 && isotropic && options.walk &&
+         options.channels == 0 && fewCells;
+}
+
+PlannedTexture walkPagesTexture(const MosaicLayout::Geometry& pages) {
+  return {.label = "brick walk pages",
+          .size = {pages.width(), pages.height(), 1},
+          .is3D = false,
+          .format = "RGBA32F",
+          .bytes = 16ull * static_cast<std::uint64_t>(pages.width()) *
+                   static_cast<std::uint64_t>(pages.height())};
+}
+
+// Whether every level reduces the one before by one factor on all axes,
+// from the level dims alone (an axis of one voxel kept at one fits any
+// factor): the plan's guess at lod::BrickGrid::scale's isotropy.
+bool isotropicLevels(const std::vector<glm::ivec3>& levels) {
+  for (std::size_t l = 1; l < levels.size(); ++l) {
+    int f = 0;
+    for (int a = 0; a < 3; ++a) {
+      const int prev = levels[l - 1][a], cur = levels[l][a];
+      if (prev == 1 && cur == 1) continue;
+      const int fa = cur > 0 ? (prev + cur - 1) / cur : 0;
+      if (f != 0 && fa != f) return false;
+      f = fa;
+    }
+  }
+  return true;
+}
+
+// The page table's bytes and the walk's pages' (every planned texture but
+// the atlases).
+std::uint64_t tableBytes(const LayoutPlan& plan) {
+  std::uint64_t bytes = 0;
+  for (const PlannedTexture& t : plan.textures) {
+    if (t.label.rfind("brick atlas", 0) != 0) bytes += t.bytes;
+  }
+  return bytes;
+}
+
+// The plan as built: its walk pages as the layout keeps them (the pyramid's
+// exact factors decide; planFor guesses them from the dims).
+void syncWalkPagesPlan(LayoutPlan& plan, const MosaicLayout::Geometry& pages, bool kept) {
+  auto& t = plan.textures;
+  const auto it = std::find_if(
+      t.begin(), t.end(), [](const PlannedTexture& p) { return p.label == "brick walk pages"; });
+  if (it != t.end() && !kept) {
+    plan.totalBytes -= it->bytes;
+    t.erase(it);
+  } else if (it == t.end() && kept) {
+    t.push_back(walkPagesTexture(pages));
+    plan.totalBytes += t.back().bytes;
+  }
+}
+
 AtlasShape atlasFor(const gpu::DeviceLimits& limits, int stored, std::uint64_t avail,
                     std::uint64_t bricks, std::uint64_t texelBytes) {
   AtlasShape a;
@@ -317,8 +382,13 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
     plan.reason = "bricks need two texture units (atlas and page table) on " + limits.profile;
     return plan;
   }
-  const std::uint64_t avail = atlasCap(limits, options, pages.bytes);
   const AtlasFormat format = atlasFormatFor(shape.type(), limits, options.channels);
+  const std::optional<PlannedTexture> walkPages =
+      keepsWalkPages(limits, options, format, isotropicLevels(levels), cells)
+          ? std::optional<PlannedTexture>(walkPagesTexture(pageTiles))
+          : std::nullopt;
+  const std::uint64_t pageTableBytes = pages.bytes + (walkPages ? walkPages->bytes : 0);
+  const std::uint64_t avail = atlasCap(limits, options, pageTableBytes);
   const AtlasShape a =
       atlasFor(shapeLimits(limits, options), stored, avail, pyramidBricks(levels, b), format.bytes);
   const bool es3 = a.mosaic.tilesX == 0;
@@ -335,7 +405,8 @@ LayoutPlan BricksLayout::planFor(const Volume& shape, const gpu::DeviceLimits& l
     if (atlases > 1) plan.textures.back().label += numbered(" ", t + 1);
   }
   plan.textures.push_back(pages);
-  plan.totalBytes = a.bytes + pages.bytes;
+  if (walkPages) plan.textures.push_back(*walkPages);
+  plan.totalBytes = a.bytes + pageTableBytes;
   const std::string what =
       (options.channels > 0 ? numbered("", options.channels, " channels of ") : std::string()) +
       vol + " as " + std::to_string(b) + "^3 bricks (+1 voxel apron) of " +
@@ -420,8 +491,7 @@ std::unique_ptr<BricksLayout> BricksLayout::build(
   l->plan_ = planFor(source->shape(), limits, options, chunk, levels);
   if (!l->plan_.fits) throw GpuError("bricks layout: " + l->plan_.reason);
   const int stored = l->grid_.stored();
-  const std::uint64_t pageBytes = l->plan_.textures.back().bytes;
-  const std::uint64_t avail = atlasCap(limits, options, pageBytes);
+  const std::uint64_t avail = atlasCap(limits, options, tableBytes(l->plan_));
   std::uint64_t bricks = 0;
   for (int lv = 0; lv < l->grid_.levelCount(); ++lv) bricks += l->grid_.brickCount(lv);
   const AtlasFormat format = atlasFormatFor(source->shape().type(), limits, options.channels);
@@ -459,20 +529,13 @@ std::unique_ptr<BricksLayout> BricksLayout::build(
     const glm::ivec3 sc = l->grid_.scale(lv);
     isotropic = isotropic && sc.x == sc.y && sc.y == sc.z;
   }
-  // The brick walk's map per cell as floats (bricks.glsl BRICKS_WALK_PAGES):
-  // fewer operations at each cell a ray enters (ch2: bricked frames 2-8 %
-  // faster). 16 bytes a cell, so only up to 64^3 cells (4 MiB).
-  const glm::ivec3 cells0 = l->grid_.bricks(0);
-  const bool fewCells = std::int64_t(cells0.x) * cells0.y * cells0.z <= (std::int64_t(1) << 18);
-  std::uint64_t walkBytes = 0;
-  if (limits.api == gpu::ApiLevel::Gles3 && format.texel < 2 && isotropic && l->walk_ && !set &&
-      fewCells) {
-    walkBytes = std::uint64_t(pagesWide) * std::uint64_t(pagesTall) * 16;
+  if (keepsWalkPages(limits, options, format, isotropic, l->grid_.bricks(0))) {
     l->walkHost_.assign(l->pages_host_.size(), 0.0f);
     l->walkPages_ = gpu::Texture::create2D(ledger, "brick walk pages", gpu::TexelFormat::RGBA32F,
                                            pagesWide, pagesTall, l->walkHost_.data());
     l->walkPages_.setFilter(gpu::Filter::Nearest);
   }
+  syncWalkPagesPlan(l->plan_, l->pageGeometry_, !l->walkHost_.empty());
   l->slotKey_.assign(static_cast<std::size_t>(a.count()), -1);
   l->slotUsed_.assign(l->slotKey_.size(), 0);
   l->slotPinned_.assign(l->slotKey_.size(), false);
@@ -483,7 +546,7 @@ std::unique_ptr<BricksLayout> BricksLayout::build(
   std::uint64_t chunksWanted = 0;
   for (const auto& s : sources) chunksWanted += s->decodedCacheWanted();
   // The walk's float pages count with the page table (texture and host).
-  l->hostSplit_ = splitHost(limits, options, a.bytes, pageBytes + walkBytes, chunksWanted);
+  l->hostSplit_ = splitHost(limits, options, a.bytes, tableBytes(l->plan_), chunksWanted);
   // One brick cache per channel, the same in all; each source's decoded
   // chunks within an equal part of the chunks' share.
   so.cacheBytes = l->hostSplit_.brickCache / sources.size();
@@ -606,7 +669,7 @@ void BricksLayout::keepFineRanges(int slot, const lod::StoredBrick& brick) {
 }
 
 std::uint64_t BricksLayout::textureBytes() const {
-  std::uint64_t bytes = pages_.bytes();
+  std::uint64_t bytes = pages_.bytes() + (walkHost_.empty() ? 0 : walkPages_.bytes());
   for (const gpu::Texture& t : atlases_) bytes += t.bytes();
   return bytes;
 }

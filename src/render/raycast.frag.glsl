@@ -248,18 +248,24 @@ void main() {
     vec3 walkSide = step(0.0, td);
     float walkInvStep = 1.0 / u_step;
     float walkSampleBias = t0 * walkInvStep + j;
+    // The first sample index the loop below would stop at (k >= u_maxSteps
+    // or t >= t1), settled once with the loop's own float expression, so
+    // the inner loop tests one bound a sample: the cell's exit, capped here.
+    float walkEnd = ceil((t1 - t0) * walkInvStep - j);
+    if (t0 + (walkEnd - 1.0 + j) * u_step >= t1) walkEnd -= 1.0;
+    if (t0 + (walkEnd + j) * u_step < t1) walkEnd += 1.0;
+    walkEnd = min(max(walkEnd, 0.0), u_maxSteps);
     for (int w = 0; w < MAX_STEPS; w++) {
-      if (k >= u_maxSteps) break;
+      if (k >= walkEnd) break;
       float tw = t0 + (k + j) * u_step;
-      if (tw >= t1) break;
 #if !defined(MODE_MIP) && !defined(MODE_MINIP) && !defined(MODE_AVERAGE)
       if (acc.a >= u_ert) break;
 #endif
       vec3 walkCell = layoutEnterCell(to + tw * td);
       // The first sample at or past the cell's exit face.
       vec3 tb = (walkCell + walkSide) * walkScale + walkBias;
-      float cellExit =
-          max(ceil(min(min(tb.x, tb.y), tb.z) * walkInvStep - walkSampleBias), k + 1.0);
+      float cellExit = min(
+          max(ceil(min(min(tb.x, tb.y), tb.z) * walkInvStep - walkSampleBias), k + 1.0), walkEnd);
 #if !defined(MODE_MIP) && !defined(MODE_MINIP) && !defined(MODE_AVERAGE) && !defined(FUSION) && !defined(CHANNELS)
       // A cell the TF makes transparent adds nothing: crossed in one step.
       if (layoutCellTransparent() > 0.5) {
@@ -270,11 +276,13 @@ void main() {
 #endif
     for (int i = 0; i < MAX_STEPS; i++) {
 #ifdef LAYOUT_BRICK_WALK
-      if (k >= cellExit) break;
-#endif
+      if (k >= cellExit) break;  // also past the ray's end (walkEnd)
+      float t = t0 + (k + j) * u_step;
+#else
       if (k >= u_maxSteps) break;
       float t = t0 + (k + j) * u_step;
       if (t >= t1) break;
+#endif
       vec3 p = to + t * td;
       float kNext = k + 1.0;
       bool empty = false;

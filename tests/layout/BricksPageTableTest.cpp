@@ -106,3 +106,32 @@ TEST(BricksPageTable, Ipad2PlansTheVirtual8192CubedVolumeWithATiledTable) {
   EXPECT_FALSE(r.fits);
   EXPECT_NE(r.reason.find("do not fit a 100x100 page table"), std::string::npos) << r.reason;
 }
+
+// `tessera plan` lists the walk's float pages (ES 3, R8/R16 atlas, isotropic
+// pyramid, at most 64^3 cells) beside the page table, 16 bytes a texel, and
+// counts them in the total; ES 2 and the two-byte atlas have none.
+TEST(BricksPageTable, ThePlanListsTheWalkPages) {
+  const Volume u16 = Volume::shapeOnly({512, 512, 512}, ScalarType::U16);
+  const layout::LayoutPlan p = layout::BricksLayout::planFor(u16, limitsOf("webgl2"));
+  ASSERT_TRUE(p.fits) << p.reason;
+  ASSERT_GE(p.textures.size(), 3u);
+  const layout::PlannedTexture& pages = p.textures[p.textures.size() - 2];
+  const layout::PlannedTexture& walk = p.textures.back();
+  EXPECT_EQ(pages.label, "brick page table");
+  EXPECT_EQ(walk.label, "brick walk pages");
+  EXPECT_EQ(walk.format, "RGBA32F");
+  EXPECT_EQ(walk.size, pages.size);
+  // 16^3 cells of 32: 16 tiles of 16 x 16 texels.
+  EXPECT_EQ(pages.bytes, 4ull * 16 * 16 * 16);
+  EXPECT_EQ(walk.bytes, 16ull * 16 * 16 * 16);
+  std::uint64_t sum = 0;
+  for (const layout::PlannedTexture& t : p.textures) sum += t.bytes;
+  EXPECT_EQ(p.totalBytes, sum);
+  const layout::LayoutPlan es2 = layout::BricksLayout::planFor(u16, limitsOf("ipad2"));
+  ASSERT_TRUE(es2.fits) << es2.reason;
+  EXPECT_EQ(es2.textures.back().label, "brick page table");
+  layout::BricksOptions noWalk;
+  noWalk.walk = false;
+  EXPECT_EQ(layout::BricksLayout::planFor(u16, limitsOf("webgl2"), noWalk).textures.back().label,
+            "brick page table");
+}

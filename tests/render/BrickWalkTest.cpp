@@ -198,3 +198,40 @@ TEST(BrickWalk, LevelZeroBricksHoldTheInCoreValueBlocks) {
     }
   }
 }
+
+// The walk's float pages (bricks.glsl BRICKS_WALK_PAGES) are a texture like
+// the page table: the ledger, textureBytes() and the plan all count them,
+// 16 bytes per page-table texel.
+TEST(BrickWalk, WalkPagesAreCountedInTheLedgerAndListedInThePlan) {
+  gpu::GlContext& c = test::gpuContext();
+  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(c.caps());
+  if (limits.api != gpu::ApiLevel::Gles3) GTEST_SKIP() << "float walk pages are ES 3 only";
+  auto v = std::make_shared<Volume>(makeSheppLogan({37, 53, 29}));
+  for (const bool walk : {true, false}) {
+    const std::uint64_t before = c.ledger().totalBytes();
+    auto bricks = layout::BricksLayout::create(std::make_shared<lod::InCoreMultiresSource>(v, 8),
+                                               limits, c.ledger(), levelZero(16, walk));
+    const std::uint64_t ledgerBytes = c.ledger().totalBytes() - before;
+    const layout::LayoutPlan& plan = bricks->plan();
+    const layout::PlannedTexture* pages = nullptr;
+    const layout::PlannedTexture* walkPages = nullptr;
+    for (const layout::PlannedTexture& t : plan.textures) {
+      if (t.label == "brick page table") pages = &t;
+      if (t.label == "brick walk pages") walkPages = &t;
+    }
+    ASSERT_NE(pages, nullptr);
+    // 3 x 4 x 2 cells of 16: two tiles of 3 x 4 texels.
+    EXPECT_EQ(pages->bytes, 4u * 24u);
+    if (walk) {
+      ASSERT_NE(walkPages, nullptr);
+      EXPECT_EQ(walkPages->format, "RGBA32F");
+      EXPECT_EQ(walkPages->size, pages->size);
+      EXPECT_EQ(walkPages->bytes, 16u * 24u);
+    } else {
+      EXPECT_EQ(walkPages, nullptr);
+    }
+    EXPECT_EQ(bricks->textureBytes(), ledgerBytes);
+    EXPECT_EQ(bricks->textureBytes(), plan.totalBytes);
+    EXPECT_EQ(bricks->textureUnits(), walk ? 3 : 2);
+  }
+}
