@@ -134,6 +134,7 @@ void Session::open(const std::string& spec, const OpenOptions& options) {
     resident_.reset();
     region_.reset();
     series_.reset();
+    streamedSeries_.reset();
     seriesWindow_.reset();
     timePoint_ = 0;
     streamed_ = std::move(pyramid);
@@ -172,6 +173,7 @@ void Session::openInView(const std::string& spec, const OpenOptions& options) {
   }
   showDefaultInView(tfChanged);
   series_.reset();
+  streamedSeries_.reset();
   seriesWindow_.reset();
   timePoint_ = 0;
   inCore_.reset();
@@ -185,6 +187,10 @@ void Session::openInView(const std::string& spec, const OpenOptions& options) {
 }
 
 void Session::openSeries(const std::string& spec, const OpenOptions& options) {
+  if (isZarrStore(spec) && streamsBricks(settings_.layout)) {
+    openStreamedSeries(spec, options);
+    return;
+  }
   const int count = timePointCount(spec);
   if (count < 2) {
     throw InputError(
