@@ -187,7 +187,8 @@ void Session::openInView(const std::string& spec, const OpenOptions& options) {
 }
 
 void Session::openSeries(const std::string& spec, const OpenOptions& options) {
-  if (isZarrStore(spec) && streamsBricks(settings_.layout)) {
+  // Streamed for run() and render(); the view draws in-core time points.
+  if (!view_ && isZarrStore(spec) && streamsBricks(settings_.layout)) {
     openStreamedSeries(spec, options);
     return;
   }

@@ -104,15 +104,16 @@ class Session {
   // series: one time point per call).
   void openSeries(int count, TimeSeries::Reader read, const std::string& name, int time = 0,
                   TimeSeries::Reading reading = TimeSeries::defaultReading());
-  // With a layout that streams bricks (settings' layout bricks) a store's
-  // t axis plays streamed instead (session/StreamedSeries.h): each time
-  // point drawn by a bricks layout over that time point's pyramid, the
-  // next ones opened and warmed ahead within the host budget
-  // (SessionStreamedSeries.cpp).
+  // openSeries of a store without a view and with a layout that streams
+  // bricks (settings' layout bricks): the store's t axis plays streamed
+  // (session/StreamedSeries.h), each time point drawn by run() and render()
+  // through a bricks layout over that time point's pyramid alone, the next
+  // ones opened and warmed ahead within the host budget
+  // (SessionStreamedSeries.cpp). The view draws in-core time points.
   void openStreamedSeries(const std::string& spec, const OpenOptions& options = {});
-  // The open series (null when the volume is not one); a streamed one's
-  // read-ahead of pyramids.
-  // The channel view's series when it plays one (ChannelView::series).
+  // The open series (null when the volume is not one): the channel view's
+  // when it plays one (ChannelView::series), a streamed one's read-ahead of
+  // pyramids.
   TimeSeries* series();
   const TimeSeries* series() const { return const_cast<Session*>(this)->series(); }
   const StreamedSeries* streamedSeries() const { return streamedSeries_.get(); }
