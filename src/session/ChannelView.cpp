@@ -56,8 +56,8 @@ bool ChannelView::open(const std::string& spec, int time) {
     show(readZarrChannels(spec, indices, time), spec);
     return true;
   }
-  // Read through the series, so that the first time point is not read
-  // twice; as many time points held as a quarter of the host budget holds.
+  // As many time points held as a quarter of the host budget holds (the
+  // series reads the first one again, once, as the start of its window).
   ChannelSet first = readZarrChannels(spec, indices, time);
   const int keep = TimeSeries::keepWithin(HostBudget::global().limitBytes() / 4,
                                           ChannelSeries::bytes(first), count);
