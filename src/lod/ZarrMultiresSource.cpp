@@ -31,6 +31,14 @@ std::unique_ptr<ZarrMultiresSource> ZarrMultiresSource::open(const std::string& 
 }
 #endif
 
+std::shared_ptr<ZarrMultiresSource> ZarrMultiresSource::atTime(int time) const {
+  ZarrSelection selection = store_->selection();
+  selection.time = time;
+  auto store = std::make_shared<ZarrStore>(store_->sharedStorage(), selection);
+  if (wanted_ > 0) store->keepDecodedChunks(wanted_);
+  return std::make_shared<ZarrMultiresSource>(std::move(store));
+}
+
 LevelInfo ZarrMultiresSource::levelInfo(int level) const {
   const ZarrLevel& l = store_->level(level);
   return {.dims = l.dims, .spacing = glm::vec3(l.spacing), .chunk = l.chunk};

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
 #include "tessera/io/ZarrChannels.h"
 #include "tessera/io/ZarrStore.h"
 #include "tessera/layout/ChannelLayout.h"
@@ -73,8 +74,42 @@ ChannelView::~ChannelView() = default;
 
 bool ChannelView::open(const std::string& spec, int time) {
   if (!isZarrStore(spec)) return false;
-  if (ZarrStore(openZarrStorage(spec)).channelCount() < 2) return false;
-  show(readZarrChannels(spec, session_.settings().channels.indices, time), spec);
+  const ZarrStore store(openZarrStorage(spec));
+  if (store.channelCount() < 2) return false;
+  const std::vector<int> indices = session_.settings().channels.indices;
+  const int count = store.timePoints();
+  if (count < 2) {
+    series_.reset();
+    time_ = 0;
+    show(readZarrChannels(spec, indices, time), spec);
+    return true;
+  }
+  // As many time points held as a quarter of the host budget holds (the
+  // series reads the first one again, once, as the start of its window).
+  ChannelSet first = readZarrChannels(spec, indices, time);
+  const int keep = TimeSeries::keepWithin(HostBudget::global().limitBytes() / 4,
+                                          ChannelSeries::bytes(first), count);
+  auto series = std::make_unique<ChannelSeries>(
+      count, [spec, indices](int t) { return readZarrChannels(spec, indices, t); }, keep);
+  show(std::move(first), spec);
+  series_ = std::move(series);
+  time_ = time;
+  series_->want(time);  // reads ahead from here
+  return true;
+}
+
+bool ChannelView::showTime(int t) {
+  if (!series_) throw InputError("no channels of a time series are shown");
+  if (t == time_ && set_) {
+    series_->want(t);
+    return true;
+  }
+  std::shared_ptr<const ChannelSet> set = series_->want(t);
+  if (!set) return false;
+  // The same channels at another time: the camera, colours, windows and
+  // visibility are the settings' and stay.
+  show(*set, name_);
+  time_ = t;
   return true;
 }
 
@@ -99,6 +134,8 @@ void ChannelView::close() {
   if (gpu_) session_.device().context->makeCurrent();
   gpu_.reset();
   set_.reset();
+  series_.reset();
+  time_ = 0;
   name_.clear();
   session_.settings().channels.enabled = false;
   edited();

@@ -144,6 +144,12 @@ void Session::openSeries(int count, TimeSeries::Reader read, const std::string& 
 }
 
 bool Session::showTimePoint(int t) {
+  if (channelView_ && channelView_->series()) {
+    if (!channelView_->showTime(t)) return false;
+    timePoint_ = t;
+    return true;
+  }
+  if (streamedSeries_) return showStreamedTimePoint(t);
   if (!series_) throw InputError("no time series is open");
   std::shared_ptr<Volume> v = series_->want(t);
   if (!v) return false;
@@ -168,44 +174,47 @@ bool Session::showTimePoint(int t) {
 }
 
 void Session::waitTimePoint(int t) {
-  if (!series_) throw InputError("no time series is open");
-  series_->wait(t);
+  if (!series()) throw InputError("no time series is open");
+  series()->wait(t);
   showTimePoint(t);
 }
 
 int Session::stepPlayback(double nowMs) {
-  if (!series_) return timePoint_;
+  TimeSeries* const series = this->series();
+  const int shownNow = timePoint();
+  if (!series) return shownNow;
   // A time point is shown when its full frame is: while the view refines
   // it (progressive strips), the next one waits.
-  if (view_ && view_->refining()) return timePoint_;
-  const int count = series_->count();
-  const int next = (timePoint_ + 1) % count;
+  if (view_ && view_->refining()) return timePoint();
+  const int count = series->count();
+  const int next = (shownNow + 1) % count;
   // The window of reads starts at the time point shown (and so holds it
   // and the next): asking for the next one instead would let the shown one
   // go and read it again, over and over.
-  series_->want(timePoint_);
+  series->want(shownNow);
   // Without a reading thread, one time point ahead is read per frame.
-  series_->pump();
-  const bool ready = series_->isRead(next);
+  series->pump();
+  const bool ready = series->isRead(next);
   // A time point that cannot be read stops playback with the reader's
   // message, rather than holding the one shown for ever.
   if (!ready) {
     try {
-      series_->rethrowFailure(next);
+      series->rethrowFailure(next);
     } catch (const std::exception& e) {
       playback_.pause();
       throw InputError(name_ + ": playback stopped: time point " + std::to_string(next) +
                        " could not be read: " + e.what());
     }
   }
-  const int shown = playback_.step(nowMs, timePoint_, count, ready);
-  if (shown != timePoint_) showTimePoint(shown);
-  return timePoint_;
+  const int shown = playback_.step(nowMs, shownNow, count, ready);
+  if (shown != shownNow) showTimePoint(shown);
+  return timePoint();
 }
 
 void Session::setVolume(std::shared_ptr<Volume> volume, const std::string& name) {
   if (!volume) throw InputError("setVolume: no volume");
   series_.reset();
+  streamedSeries_.reset();
   seriesWindow_.reset();
   timePoint_ = 0;
   auto next = std::make_shared<lod::InCoreVolumeSource>(std::move(volume));

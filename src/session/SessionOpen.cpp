@@ -134,6 +134,7 @@ void Session::open(const std::string& spec, const OpenOptions& options) {
     resident_.reset();
     region_.reset();
     series_.reset();
+    streamedSeries_.reset();
     seriesWindow_.reset();
     timePoint_ = 0;
     streamed_ = std::move(pyramid);
@@ -172,6 +173,7 @@ void Session::openInView(const std::string& spec, const OpenOptions& options) {
   }
   showDefaultInView(tfChanged);
   series_.reset();
+  streamedSeries_.reset();
   seriesWindow_.reset();
   timePoint_ = 0;
   inCore_.reset();
@@ -185,6 +187,11 @@ void Session::openInView(const std::string& spec, const OpenOptions& options) {
 }
 
 void Session::openSeries(const std::string& spec, const OpenOptions& options) {
+  // Streamed for run() and render(); the view draws in-core time points.
+  if (!view_ && isZarrStore(spec) && streamsBricks(settings_.layout)) {
+    openStreamedSeries(spec, options);
+    return;
+  }
   const int count = timePointCount(spec);
   if (count < 2) {
     throw InputError(

@@ -124,6 +124,9 @@ class ZarrStore {
   // "OME-NGFF 0.4 (multiscales 'name'), 3 levels, blosc lz4 shuffle".
   std::string describe() const;
   const ZarrStorage& storage() const { return *storage_; }
+  // The same storage, shared: another selection of the store (a time point
+  // played after this one) reads its keys without opening it again.
+  std::shared_ptr<const ZarrStorage> sharedStorage() const { return storage_; }
   const ZarrSelection& selection() const { return selection_; }
   // Chunks decoded, found decoded, waited for; bytes held.
   ZarrChunkCacheStats chunkStats() const { return chunks_->stats(); }

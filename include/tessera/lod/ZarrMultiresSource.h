@@ -38,6 +38,12 @@ class ZarrMultiresSource final : public MultiresSource {
   std::uint64_t decodedCachePeakBytes() const override { return store_->chunkStats().peakBytes; }
 
   const ZarrStore& store() const { return *store_; }
+  // Time point `time` of the same store (its selection's channel), read
+  // from that time point's chunks only, over the same storage and with a
+  // decoded-chunk cache of its own of the same budget: the pyramid of one
+  // time point that a streamed series plays (session/StreamedSeries.h).
+  // InputError (naming --time and the store) for a time point it lacks.
+  std::shared_ptr<ZarrMultiresSource> atTime(int time) const;
 
   // The decoded chunks kept while bricks are read: every chunk of the store
   // (a refinement reads each once, however many bricks a chunk holds, in

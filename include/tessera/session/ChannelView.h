@@ -21,6 +21,7 @@
 #include "tessera/core/ChannelSet.h"
 #include "tessera/core/Image.h"
 #include "tessera/gpu/GlObjects.h"
+#include "tessera/session/ChannelSeries.h"
 
 namespace tessera::session {
 
@@ -38,6 +39,15 @@ class ChannelView {
   // defaults) and shows them; false, with nothing changed, when `spec` is
   // not a store or has one channel. InputError as readZarrChannels.
   bool open(const std::string& spec, int time = 0);
+  // A store with a t axis: open() shows time point `time` and reads the
+  // ones after it ahead (session/ChannelSeries.h), so that its channels play
+  // together through Session::stepPlayback; null otherwise.
+  ChannelSeries* series() { return series_.get(); }
+  int timePoint() const { return time_; }
+  // Shows time point t's channels when they are read (the colours, windows
+  // and visibility stay: they are the settings'), else asks for them and
+  // returns false. InputError without a series or for t out of range.
+  bool showTime(int t);
   // Channels the caller read (the page's store over fetch()), shown under
   // `name` with settings().channels applied.
   void show(ChannelSet set, const std::string& name);
@@ -88,6 +98,8 @@ class ChannelView {
   std::string name_;
   std::unique_ptr<ChannelSet> set_;  // the layout reads it at every frame
   std::unique_ptr<Gpu> gpu_;
+  std::unique_ptr<ChannelSeries> series_;
+  int time_ = 0;
   std::uint64_t revision_ = 0;
   std::string frameKey_;
 };

@@ -32,6 +32,7 @@
 #include "tessera/session/Fusion.h"
 #include "tessera/session/RenderRun.h"
 #include "tessera/session/Settings.h"
+#include "tessera/session/StreamedSeries.h"
 #include "tessera/session/TimeSeries.h"
 #include "tessera/session/VolumePyramid.h"
 #include "tessera/viewer/Viewer.h"
@@ -103,10 +104,20 @@ class Session {
   // series: one time point per call).
   void openSeries(int count, TimeSeries::Reader read, const std::string& name, int time = 0,
                   TimeSeries::Reading reading = TimeSeries::defaultReading());
-  // The open series (null when the volume is not one).
-  TimeSeries* series() { return series_.get(); }
-  const TimeSeries* series() const { return series_.get(); }
-  int timePoint() const { return timePoint_; }
+  // openSeries of a store without a view and with a layout that streams
+  // bricks (settings' layout bricks): the store's t axis plays streamed
+  // (session/StreamedSeries.h), each time point drawn by run() and render()
+  // through a bricks layout over that time point's pyramid alone, the next
+  // ones opened and warmed ahead within the host budget
+  // (SessionStreamedSeries.cpp). The view draws in-core time points.
+  void openStreamedSeries(const std::string& spec, const OpenOptions& options = {});
+  // The open series (null when the volume is not one): the channel view's
+  // when it plays one (ChannelView::series), a streamed one's read-ahead of
+  // pyramids.
+  TimeSeries* series();
+  const TimeSeries* series() const { return const_cast<Session*>(this)->series(); }
+  const StreamedSeries* streamedSeries() const { return streamedSeries_.get(); }
+  int timePoint() const;  // the channel view's when it plays a series
   // Shows time point `t` when it has been read, keeping the view's camera,
   // window and look, and returns true; otherwise asks for it and returns
   // false (the time point shown stays). The exploration is of the time
@@ -275,6 +286,8 @@ class Session {
   std::unique_ptr<lod::VolumeSource> streamedView_;
   std::unique_ptr<nlohmann::json> region_;
   std::unique_ptr<TimeSeries> series_;
+  std::unique_ptr<StreamedSeries> streamedSeries_;
+  bool showStreamedTimePoint(int t);
   std::optional<ValueRange> seriesWindow_;
   // The modality default (session/ModalityDefault.h): whether the volume
   // came with its own window, what was chosen, the TF it replaced.

@@ -1,0 +1,81 @@
+// Session's streamed time series (session/StreamedSeries.h): a store's t
+// axis played over bricks. Each time point shown is its own pyramid, so the
+// bricks layout that the next frame (run(), render()) makes over it holds
+// that time point's bricks only.
+#include <nlohmann/json.hpp>
+
+#include "tessera/core/Error.h"
+#include "tessera/core/HostBudget.h"
+#include "tessera/lod/MultiresVolumeSource.h"
+#include "tessera/lod/WindowedSource.h"
+#include "tessera/lod/ZarrMultiresSource.h"
+#include "tessera/session/Session.h"
+
+namespace tessera::session {
+
+#ifndef __EMSCRIPTEN__
+// Native only: the page fetches its stores itself (ZarrStoreView).
+void Session::openStreamedSeries(const std::string& spec, const OpenOptions& options) {
+  settings_.validate();
+  std::shared_ptr<const lod::ZarrMultiresSource> first =
+      lod::ZarrMultiresSource::open(spec, {.time = options.time, .channel = options.channel});
+  const int count = first->store().timePoints();
+  if (count < 2) {
+    throw InputError(spec + ": one time point, not a time series (a store with a t axis is)");
+  }
+  // Each time point keeps its decoded chunks within the store's share of
+  // the host budget (ZarrMultiresSource::decodedChunkBudget) and warms as
+  // much: as many time points ahead as a quarter of the budget holds.
+  const std::uint64_t host = HostBudget::global().limitBytes();
+  const std::uint64_t each = lod::ZarrMultiresSource::decodedChunkBudget(first->store(), host);
+  const int keep = TimeSeries::keepWithin(host / 4, each, count);
+  const int firstTime = options.time;
+  auto series = std::make_unique<StreamedSeries>(
+      count,
+      [first, firstTime](int t) -> std::shared_ptr<const lod::MultiresSource> {
+        if (t == firstTime) return first;
+        return first->atTime(t);
+      },
+      each, keep);
+  inCore_.reset();
+  resident_.reset();
+  region_.reset();
+  series_.reset();
+  exploration_.reset();
+  // Every time point in the first one's window, unless the settings say one.
+  seriesWindow_ = settings_.window ? *settings_.window : first->shape().window();
+  streamedSeries_ = std::move(series);
+  name_ = spec;
+  timePoint_ = -1;
+  if (!showStreamedTimePoint(firstTime))
+    throw Error(spec + ": its first time point was not opened");
+}
+#endif
+
+TimeSeries* Session::series() {
+  if (channelView_ && channelView_->series()) return &channelView_->series()->series();
+  if (series_) return series_.get();
+  return streamedSeries_ ? &streamedSeries_->series() : nullptr;
+}
+
+int Session::timePoint() const {
+  if (channelView_ && channelView_->series()) return channelView_->timePoint();
+  return timePoint_;
+}
+
+bool Session::showStreamedTimePoint(int t) {
+  if (t == timePoint_ && streamed_) return true;
+  // The shown one is opened now if it has to be (a jump); playback asks
+  // only for one warmed ahead (stepPlayback waits for isRead).
+  std::shared_ptr<const lod::MultiresSource> source = streamedSeries_->source(t);
+  if (!settings_.window && seriesWindow_) {
+    source = std::make_shared<lod::WindowedSource>(std::move(source), *seriesWindow_);
+  }
+  streamed_ = std::move(source);
+  exploration_.reset();
+  timePoint_ = t;
+  applyVolumeSettings();  // streamedView_: this time point, through the settings' window
+  return true;
+}
+
+}  // namespace tessera::session
