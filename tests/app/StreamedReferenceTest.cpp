@@ -285,3 +285,28 @@ TEST(StreamedReference, AFrameMixingLevelsIsProvenCellByCell) {
   EXPECT_GE(mixedDb, 45.0);
   EXPECT_LT(oneLevelDb, mixedDb - 3.0);
 }
+
+// The levels a mixed frame's reference reads must fit the host budget
+// together (each read whole, with its double-precision copy): the smaller
+// store on ES 2 at 128x112 shows levels 0 and 1 (4.2 MiB together), so a
+// 4 MiB budget stops the reference naming both levels and the one level
+// that fits on its own.
+TEST(StreamedReference, MixedLevelsOverTheHostBudgetAreRefusedNamingOneThatFits) {
+  const TempDir tmp;
+  const std::string store = storeOf(ScalarType::U8, tmp, kSmallDims);
+  setenv("TESSERA_HOST_BUDGET_MB", "4", 1);
+  const auto r = runCli("render " + store + " --layout bricks --reference --size 128x112" +
+                        " --profile gles2" + kView);
+  unsetenv("TESSERA_HOST_BUDGET_MB");
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_NE(r.err.find("the reference of frame 0's levels (level 0 (93x77x61 u8, 426.6 KiB), "
+                       "level 1 (47x39x31 u8, 55.5 KiB) of "),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("needs 4.2 MiB of host memory (each level read whole and a "
+                       "double-precision copy), over the host budget of 4 MiB: choose one level "
+                       "with --reference-level N (level 0 is the finest that fits; the pyramid "
+                       "has levels 0..1)"),
+            std::string::npos)
+      << r.err;
+}
