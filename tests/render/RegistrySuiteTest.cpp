@@ -342,8 +342,8 @@ std::vector<WindowCombo> windowCombos() {
 std::string windowComboName(const testing::TestParamInfo<WindowCombo>& info) {
   const WindowCombo& c = info.param;
   return identifier(c.technique) + "_" + identifier(c.layout) + "_" + c.profile + "_" +
-         scalarTypeName(c.type) + "_window" + std::to_string(std::lround(100.0 * c.fraction)) +
-         "pct";
+         std::string(scalarTypeName(c.type)) + "_window" +
+         std::to_string(std::lround(100.0 * c.fraction)) + "pct";
 }
 
 // Raw value of the u8 phantom's value f in `type`: u16 and i16 (partly
@@ -414,9 +414,9 @@ TEST_P(RegistryWindows, StreamedNarrowWindowMatchesItsCpuTwin) {
   std::printf(
       "  [measured] %s on %s (streamed), %s, %s window %g%%: %.2f dB, SSIM %.4f "
       "(level %d%s)\n",
-      combo.technique.c_str(), r.layout.c_str(), combo.profile.c_str(), scalarTypeName(combo.type),
-      100.0 * combo.fraction, *r.psnrDb, *r.ssim, r.referenceLevel.value_or(-1),
-      r.referenceLevelMixed ? ", mixed" : "");
+      combo.technique.c_str(), r.layout.c_str(), combo.profile.c_str(),
+      std::string(scalarTypeName(combo.type)).c_str(), 100.0 * combo.fraction, *r.psnrDb, *r.ssim,
+      r.referenceLevel.value_or(-1), r.referenceLevelMixed ? ", mixed" : "");
   EXPECT_GE(*r.psnrDb, 45.0);
   EXPECT_GE(*r.ssim, 0.98);
 }
