@@ -696,6 +696,7 @@ void runRenderCommand(const RenderOptions& o) {
   if (session.streamed()) {
     const RenderResult r = session.run(req);
     r.first.writePng(o.out);
+    if (r.referenceImage && !o.referenceOut.empty()) r.referenceImage->writePng(o.referenceOut);
     saveState(o, session);
     times.totalMs = msSince(tStart);
     if (o.json) {
@@ -814,8 +815,9 @@ void addRenderCommand(CLI::App& app) {
       "--reference-level", o->referenceLevel,
       "With a layout that streams a pyramid (bricks: OME-Zarr stores, head:, --layout "
       "bricks): the level the CPU reference reads whole, 0 = the finest (native) level. "
-      "Default: the finest level the refined frame shows (reported as reference_level, with "
-      "a note when it shows several). The level and its double-precision copy must fit the "
+      "Default: per brick cell, the level the refined frame shows there (reference_level: the "
+      "finest of them, with a note when it shows several). The level and its double-precision "
+      "copy must fit the "
       "host budget: pick a coarser level when they do not (implies --reference)");
   addDefaultedOption(cmd, "--repeat", o->repeat,
                      "Render N frames, rotating the camera, and report timings");

@@ -943,10 +943,22 @@ void BricksLayout::waitForBricks(double ms) {
 }
 
 std::vector<int> BricksLayout::cellLevels() const {
-  std::vector<int> out(pages_host_.size() / 4);
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    const std::uint8_t a = pages_host_[4 * i + 3];
-    out[i] = a == 255 ? -1 : a;
+  // Cell by cell (x fastest): the table's texels are its z-slices tiled in
+  // 2D (pageGeometry_), not the cells in order.
+  const glm::ivec3 cells = grid_.bricks(0);
+  std::vector<int> out;
+  out.reserve(static_cast<std::size_t>(cells.x) * cells.y * static_cast<std::size_t>(cells.z));
+  for (int z = 0; z < cells.z; ++z) {
+    for (int y = 0; y < cells.y; ++y) {
+      for (int x = 0; x < cells.x; ++x) {
+        const glm::ivec2 t = pageGeometry_.addressOf(x, y, z);
+        const std::uint8_t a =
+            pages_host_[4 * (static_cast<std::size_t>(t.y) * pageGeometry_.width() +
+                             static_cast<std::size_t>(t.x)) +
+                        3];
+        out.push_back(a == 255 ? -1 : a);
+      }
+    }
   }
   return out;
 }

@@ -1,9 +1,12 @@
 #include "tessera/reference/CellLevels.h"
 
 #include <algorithm>
+#include <string>
+#include <utility>
 
 #include <glm/common.hpp>
 
+#include "tessera/core/Error.h"
 #include "tessera/reference/ReferenceRaycaster.h"
 
 namespace tessera {
@@ -34,6 +37,39 @@ double sampleLevel(const Volume& level, glm::ivec3 scale, glm::ivec3 finestDims,
   const glm::dvec3 toLevel =
       glm::dvec3(finestDims) / (glm::dvec3(level.dims()) * glm::dvec3(scale));
   return sampleTrilinear(level, glm::clamp(p, 0.0, 1.0) * toLevel);
+}
+
+CellLevelsReconstruction::CellLevelsReconstruction(
+    CellLevels cells, std::vector<std::shared_ptr<const Reconstruction>> levels,
+    int transparentLevel)
+    : cells_(std::move(cells)), levels_(std::move(levels)), transparentLevel_(transparentLevel) {
+  const std::size_t expected = static_cast<std::size_t>(cells_.cells.x) * cells_.cells.y *
+                               static_cast<std::size_t>(cells_.cells.z);
+  if (cells_.brickSize < 1 || cells_.levels.size() != expected) {
+    throw InputError("cell levels: " + std::to_string(cells_.levels.size()) +
+                     " cells, the grid has " + std::to_string(expected));
+  }
+  const std::vector<int> n = cells_.cellsPerLevel();
+  const auto held = [&](std::size_t l) { return l < levels_.size() && levels_[l]; };
+  for (std::size_t l = 0; l + 1 < n.size(); ++l) {
+    if (n[l] > 0 && !held(l)) {
+      throw InputError("cell levels: " + std::to_string(n[l]) + " cells show level " +
+                       std::to_string(l) + ", which is not read");
+    }
+  }
+  if (n.back() > 0 &&
+      (transparentLevel_ < 0 || !held(static_cast<std::size_t>(transparentLevel_)))) {
+    throw InputError("cell levels: " + std::to_string(n.back()) + " transparent cells read level " +
+                     std::to_string(transparentLevel_) + ", which is not read");
+  }
+  for (const auto& l : levels_) {
+    if (l) support_ = std::max(support_, l->supportVoxels());
+  }
+}
+
+double CellLevelsReconstruction::value(glm::dvec3 p) const {
+  const int l = cells_.levelAt(p);
+  return levels_[static_cast<std::size_t>(l < 0 ? transparentLevel_ : l)]->value(p);
 }
 
 }  // namespace tessera

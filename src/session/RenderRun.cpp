@@ -11,6 +11,7 @@
 #include "tessera/layout/StreamingLayout.h"
 #include "tessera/lod/LevelScale.h"
 #include "tessera/lod/ReadLevel.h"
+#include "tessera/reference/CellLevels.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/reference/ReferenceRaycaster.h"
 #include "tessera/reference/VoxelGradients.h"
@@ -195,45 +196,110 @@ void checkReferenceLevel(const lod::MultiresSource& pyramid, int level, bool hel
       "; the pyramid has levels 0.." + std::to_string(levels - 1) + ")");
 }
 
-// The level the reference of a streamed layout reads by default: the one
-// the refined frame 0 shows, or the finest of those it shows (and says so).
-int shownLevel(const BricksRun& run, int levels, RenderResult& result) {
-  std::vector<int> shown;
-  for (int l = 0; l < levels && l + 1 < static_cast<int>(run.cellsPerLevel.size()); ++l) {
-    if (run.cellsPerLevel[static_cast<std::size_t>(l)] > 0) shown.push_back(l);
-  }
-  const std::string stopped = run.complete ? "" : " (refining stopped before it completed)";
-  if (shown.empty()) {
-    result.referenceLevelNote =
-        "frame 0 shows no brick (every cell is transparent): the coarsest level" + stopped;
-    return levels - 1;
-  }
-  result.referenceLevelMixed = shown.size() > 1;
-  result.referenceLevelNote =
-      result.referenceLevelMixed
-          ? "the finest of the levels frame 0 shows (page-table cells " +
-                levelsText(run.cellsPerLevel, true) +
-                "): the cells shown at a coarser level differ from it" + stopped
-          : "the level frame 0 shows in every cell that is not transparent" + stopped;
-  return shown.front();
+// The levels a streamed frame shows, per level-0 brick cell (its page
+// table as drawn): what the reference of that frame reads.
+CellLevels shownCells(const layout::StreamingLayout& bricks) {
+  const lod::BrickGrid& grid = bricks.grid();
+  CellLevels cells;
+  cells.finestDims = grid.dims(0);
+  cells.brickSize = grid.brickSize();
+  cells.cells = grid.bricks(0);
+  cells.levels = bricks.cellLevels();
+  return cells;
 }
 
-// The field the reference renders for a layout that streams a pyramid: a
-// level of it, as bricks.glsl samples it, over level 0's box.
+// The levels `cells` shows, finest first.
+std::vector<int> levelsShown(const CellLevels& cells, int levels) {
+  const std::vector<int> n = cells.cellsPerLevel();
+  std::vector<int> shown;
+  for (int l = 0; l < levels && l + 1 < static_cast<int>(n.size()); ++l) {
+    if (n[static_cast<std::size_t>(l)] > 0) shown.push_back(l);
+  }
+  return shown;
+}
+
+// The levels of a mixed frame's reference fit the host budget together;
+// else an error naming them, their size and the budget, and the finest
+// single level that fits (--reference-level).
+void checkShownLevels(const lod::MultiresSource& pyramid, const std::vector<int>& shown,
+                      bool heldLevel0) {
+  const std::uint64_t budget = HostBudget::global().limitBytes();
+  const auto need = [&](int l) { return referenceBytes(pyramid, l, heldLevel0 && l == 0); };
+  std::uint64_t total = 0;
+  std::string names;
+  for (int l : shown) {
+    total += need(l);
+    names += (names.empty() ? "" : ", ") + lod::describeLevel(pyramid, l);
+  }
+  if (total <= budget) return;
+  const int levels = pyramid.levelCount();
+  int fits = shown.front();
+  while (fits < levels && need(fits) > budget) ++fits;
+  throw BudgetError(
+      "the reference of frame 0's levels (" + names + " of " + pyramid.describe() + ") needs " +
+      formatBytes(total) +
+      " of host memory (each level read whole and a double-precision copy), over the host budget "
+      "of " +
+      formatBytes(budget) + ": choose one level with --reference-level N (" +
+      (fits < levels ? "level " + std::to_string(fits) + " is the finest that fits" : "none fits") +
+      "; the pyramid has levels 0.." + std::to_string(levels - 1) + ")");
+}
+
+// Level `level` of a pyramid, as bricks.glsl samples it, over level 0's box:
+// the in-core volume itself at level 0 when it is held.
+std::shared_ptr<const Reconstruction> levelField(const lod::MultiresSource& pyramid,
+                                                 const Volume& volume, int level, bool nearest) {
+  const glm::ivec3 finest = pyramid.shape().dims();
+  if (level == 0 && volume.hasData()) {
+    return std::make_shared<PyramidLevelReconstruction>(volume, glm::ivec3(1), finest, nearest);
+  }
+  return std::make_shared<PyramidLevelReconstruction>(
+      lod::readLevel(pyramid, level), lod::levelScale(pyramid, level), finest, nearest);
+}
+
+// The field the reference renders for one level of a streamed pyramid
+// (--reference-level).
 layout::ReferenceField streamedField(const lod::MultiresSource& pyramid, const Volume& volume,
                                      int level, const RenderRequest& req) {
   checkReferenceLevel(pyramid, level, volume.hasData());
-  const glm::ivec3 finest = pyramid.shape().dims();
-  const bool nearest = req.settings.render.nearest;
   layout::ReferenceField field;
   field.box = &volume;
-  if (level == 0 && volume.hasData()) {
-    field.field =
-        std::make_shared<PyramidLevelReconstruction>(volume, glm::ivec3(1), finest, nearest);
-  } else {
-    field.field = std::make_shared<PyramidLevelReconstruction>(
-        lod::readLevel(pyramid, level), lod::levelScale(pyramid, level), finest, nearest);
+  field.field = levelField(pyramid, volume, level, req.settings.render.nearest);
+  return field;
+}
+
+// The field frame 0 shows: in each level-0 cell the level its page table
+// names (CellLevelsReconstruction), so a frame the atlas could not hold at
+// level 0 everywhere is proven cell by cell; one level read when it shows
+// one. Transparent cells (a constant the transfer function hides) read the
+// finest level shown; a frame of transparent cells only, the coarsest.
+layout::ReferenceField shownField(const lod::MultiresSource& pyramid, const Volume& volume,
+                                  const CellLevels& cells, const BricksRun& run,
+                                  const RenderRequest& req, RenderResult& result) {
+  const int levels = pyramid.levelCount();
+  const std::vector<int> shown = levelsShown(cells, levels);
+  const std::string stopped = run.complete ? "" : " (refining stopped before it completed)";
+  result.referenceLevelMixed = shown.size() > 1;
+  result.referenceLevel = shown.empty() ? levels - 1 : shown.front();
+  result.referenceLevelDims = pyramid.levelInfo(*result.referenceLevel).dims;
+  if (shown.size() < 2) {
+    result.referenceLevelNote =
+        shown.empty()
+            ? "frame 0 shows no brick (every cell is transparent): the coarsest level" + stopped
+            : "the level frame 0 shows in every cell that is not transparent" + stopped;
+    return streamedField(pyramid, volume, *result.referenceLevel, req);
   }
+  checkShownLevels(pyramid, shown, volume.hasData());
+  result.referenceLevelNote = "per cell, the level frame 0 shows there (page-table cells " +
+                              levelsText(cells.cellsPerLevel(), true) + ")" + stopped;
+  std::vector<std::shared_ptr<const Reconstruction>> fields(static_cast<std::size_t>(levels));
+  for (int l : shown) {
+    fields[static_cast<std::size_t>(l)] =
+        levelField(pyramid, volume, l, req.settings.render.nearest);
+  }
+  layout::ReferenceField field;
+  field.box = &volume;
+  field.field = std::make_shared<CellLevelsReconstruction>(cells, std::move(fields), shown.front());
   return field;
 }
 
@@ -303,9 +369,11 @@ RenderResult runRender(gpu::DeviceSession& device, const lod::VolumeSource& sour
   prepareFrame(*t.technique, volume, req);
   result.prepareMs = msSince(tPrepare);
   layout::StreamingLayout* bricks = t.upload.layout ? t.upload.layout->streaming() : nullptr;
+  CellLevels frame0Cells;  // what frame 0 shows, before --repeat's frames stream on
   if (bricks) {
     result.bricks.emplace();
     refineFirstFrame(*bricks, *t.technique, tf, req, *result.bricks);
+    frame0Cells = shownCells(*bricks);
   }
   renderFrames(*t.technique, bricks, tf, req, result);
   result.textureBytes = device.context->ledger().totalBytes();  // while the technique holds its own
@@ -328,13 +396,15 @@ RenderResult runRender(gpu::DeviceSession& device, const lod::VolumeSource& sour
     layout::ReferenceField field;
     if (t.upload.pyramid) {
       const lod::MultiresSource& pyramid = *t.upload.pyramid;
-      const int level = req.referenceLevel ? *req.referenceLevel
-                        : result.bricks ? shownLevel(*result.bricks, pyramid.levelCount(), result)
-                                        : 0;
-      if (req.referenceLevel) result.referenceLevelNote = "asked for (--reference-level)";
-      field = streamedField(pyramid, volume, level, req);
-      result.referenceLevel = level;
-      result.referenceLevelDims = pyramid.levelInfo(level).dims;
+      if (result.bricks && !req.referenceLevel) {
+        field = shownField(pyramid, volume, frame0Cells, *result.bricks, req, result);
+      } else {
+        const int level = req.referenceLevel.value_or(0);
+        result.referenceLevelNote = req.referenceLevel ? "asked for (--reference-level)" : "";
+        field = streamedField(pyramid, volume, level, req);
+        result.referenceLevel = level;
+        result.referenceLevelDims = pyramid.levelInfo(level).dims;
+      }
     } else if (t.upload.layout) {
       field = t.upload.layout->referenceField();
     }

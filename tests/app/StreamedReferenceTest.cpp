@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -64,14 +65,16 @@ Volume phantom(ScalarType type, glm::ivec3 d) {
 }
 
 // The phantom written by the io writer and converted to an OME-Zarr store
-// of 64^3 chunks by `tessera convert`.
-std::string storeOf(ScalarType type, const TempDir& tmp, glm::ivec3 dims = kDims) {
+// of 64^3 chunks (or `chunk`) by `tessera convert`.
+std::string storeOf(ScalarType type, const TempDir& tmp, glm::ivec3 dims = kDims,
+                    const std::string& chunk = "64") {
   const std::string name =
       std::string(tessera::scalarTypeName(type)) + "_" + std::to_string(dims.x);
   const auto nrrd = tmp / (name + ".nrrd");
   tessera::writeVolume(phantom(type, dims), nrrd);
   const auto store = tmp / (name + ".ome.zarr");
-  const auto r = runCli("convert " + nrrd.string() + " " + store.string() + " --chunk 64 --quiet");
+  const auto r =
+      runCli("convert " + nrrd.string() + " " + store.string() + " --chunk " + chunk + " --quiet");
   EXPECT_EQ(r.exitCode, 0) << r.err;
   return store.string();
 }
@@ -150,10 +153,11 @@ TEST(StreamedReference, TheLevelTheFrameShowsIsTheDefaultAndIsPlacedAsTheGpuShow
       << text.out;
 }
 
-// Whatever the frame shows, the default level is the finest level of the
-// page table's cells, and a frame showing several says so: on ES 2 the
-// smaller store's level 0 does not fit the atlas beside its pinned level 1
-// at 128x112 (measured: cells L0:10 L1:8), at 40x36 only level 1 is shown.
+// Whatever the frame shows, the reference level reported is the finest
+// level of the page table's cells, and a frame showing several says so and
+// is proven cell by cell: on ES 2 the smaller store's level 0 does not fit
+// the atlas beside its pinned level 1 at 128x112 (measured: cells L0:10
+// L1:8), at 40x36 only level 1 is shown.
 TEST(StreamedReference, TheDefaultLevelIsTheFinestShownAndAMixedFrameSaysSo) {
   const TempDir tmp;
   const std::string store = storeOf(ScalarType::U8, tmp, kSmallDims);
@@ -176,12 +180,10 @@ TEST(StreamedReference, TheDefaultLevelIsTheFinestShownAndAMixedFrameSaysSo) {
                 cells.dump().c_str(), finest, j["psnr_db"].get<double>(), note.c_str());
     if (shown > 1) {
       ++mixed;
-      EXPECT_NE(note.find("the finest of the levels frame 0 shows (page-table cells L0:"),
-                std::string::npos)
+      EXPECT_EQ(note.rfind("per cell, the level frame 0 shows there (page-table cells L0:", 0), 0u)
           << note;
-    } else {
-      EXPECT_GE(j["psnr_db"].get<double>(), 45.0) << options;
     }
+    EXPECT_GE(j["psnr_db"].get<double>(), 45.0) << options;
   }
   // The bricks' atlas rules decide which frames mix; at least one did here.
   EXPECT_GE(mixed, 1);
@@ -245,4 +247,66 @@ TEST(StreamedReference, AReferenceLevelOutOfRangeOrOnAnInCoreLayoutIsRefused) {
   expectFailure("render gen:sphere:32 --layout texture3d --reference-level 0" + kView,
                 "--reference-level applies to a layout that streams a pyramid (bricks); "
                 "texture3d holds the volume it renders");
+}
+
+// A 128^3 store in 32^3 chunks under a profile whose texture budget (2 MiB,
+// a 36-brick atlas) holds about a third of level 0's 64 bricks: the refined
+// frame shows level 0 where the atlas has room and level 1 elsewhere. The
+// reference reads, cell by cell, the level the page table shows there and
+// matches the frame; one level for the whole frame (the finest shown, as
+// --reference-level 0 asks, what the reference read before) does not.
+TEST(StreamedReference, AFrameMixingLevelsIsProvenCellByCell) {
+  const TempDir tmp;
+  const std::string store = storeOf(ScalarType::U8, tmp, {128, 128, 128}, "32,32,32");
+  const auto profile = tmp / "small-atlas.json";
+  std::ofstream(profile) << R"({"name": "small-atlas", "note": "test", "api": "gles3",
+                               "max_2d_texture_size": 4096, "max_3d_texture_size": 2048,
+                               "texture_units": 8, "texture_budget_mb": 2,
+                               "host_budget_mb": 1024})";
+  const std::string options = "--size 128x128 --profile " + profile.string();
+  const auto perCell = renderStreamed(store, options);
+  const auto cells = perCell["bricks"]["cells_per_level"];
+  ASSERT_GE(cells.size(), 3u) << cells;
+  EXPECT_GT(cells[0].get<int>(), 0) << cells;
+  EXPECT_GT(cells[1].get<int>(), 0) << cells;
+  EXPECT_TRUE(perCell["reference_level_mixed"].get<bool>()) << cells;
+  EXPECT_EQ(perCell["reference_level"], 0);
+  const std::string note = perCell["reference_level_note"];
+  EXPECT_EQ(note.rfind("per cell, the level frame 0 shows there (page-table cells L0:", 0), 0u)
+      << note;
+  const auto oneLevel = renderStreamed(store, options + " --reference-level 0");
+  const double mixedDb = perCell["psnr_db"].get<double>();
+  const double oneLevelDb = oneLevel["psnr_db"].get<double>();
+  std::printf(
+      "  [measured] 128^3 u8, 2 MiB atlas, cells %s: per-cell reference %.2f dB (SSIM "
+      "%.4f), level 0 everywhere %.2f dB (SSIM %.4f)\n",
+      cells.dump().c_str(), mixedDb, perCell["ssim"].get<double>(), oneLevelDb,
+      oneLevel["ssim"].get<double>());
+  EXPECT_GE(mixedDb, 45.0);
+  EXPECT_LT(oneLevelDb, mixedDb - 3.0);
+}
+
+// The levels a mixed frame's reference reads must fit the host budget
+// together (each read whole, with its double-precision copy): the smaller
+// store on ES 2 at 128x112 shows levels 0 and 1 (4.2 MiB together), so a
+// 4 MiB budget stops the reference naming both levels and the one level
+// that fits on its own.
+TEST(StreamedReference, MixedLevelsOverTheHostBudgetAreRefusedNamingOneThatFits) {
+  const TempDir tmp;
+  const std::string store = storeOf(ScalarType::U8, tmp, kSmallDims);
+  setenv("TESSERA_HOST_BUDGET_MB", "4", 1);
+  const auto r = runCli("render " + store + " --layout bricks --reference --size 128x112" +
+                        " --profile gles2" + kView);
+  unsetenv("TESSERA_HOST_BUDGET_MB");
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_NE(r.err.find("the reference of frame 0's levels (level 0 (93x77x61 u8, 426.6 KiB), "
+                       "level 1 (47x39x31 u8, 55.5 KiB) of "),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("needs 4.2 MiB of host memory (each level read whole and a "
+                       "double-precision copy), over the host budget of 4 MiB: choose one level "
+                       "with --reference-level N (level 0 is the finest that fits; the pyramid "
+                       "has levels 0..1)"),
+            std::string::npos)
+      << r.err;
 }

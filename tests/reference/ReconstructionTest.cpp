@@ -4,10 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
+#include <vector>
 
 #include "support/TestCameras.h"
 #include "support/TestTransferFunctions.h"
 #include "tessera/core/Camera.h"
+#include "tessera/core/Error.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/reference/CellLevels.h"
 #include "tessera/reference/ImageMetrics.h"
@@ -106,4 +109,46 @@ TEST(CellLevels, LevelAtFollowsTheCellsAndSampleLevelIsThePyramidField) {
        {glm::dvec3(0.3, 0.6, 0.2), glm::dvec3(0.97, 0.01, 0.99), glm::dvec3(-0.2, 1.3, 0.5)}) {
     EXPECT_NEAR(sampleLevel(level, {4, 4, 4}, {40, 20, 10}, p), field.value(p), 1e-9) << p.x;
   }
+}
+
+// A single-channel frame that mixes levels: each point reads the level its
+// cell shows (a transparent cell the level named for it), gradients step
+// across cells as the GPU's central differences do, and a cell whose level
+// is not read is an error naming it.
+TEST(CellLevels, CellLevelsReconstructionReadsEachCellsLevel) {
+  const glm::ivec3 finest{40, 20, 10};
+  CellLevels cells{finest, 16, {3, 2, 1}, {0, 1, 1, 0, -1, 1}};
+  const Volume level0 = ramp(finest);
+  Volume level1 = ramp({20, 10, 5});
+  for (std::size_t i = 0; i < level1.voxelCount(); ++i) {
+    level1.setValueAtIndex(i, 1000.0 + level1.valueAtIndex(i));  // tells the levels apart
+  }
+  auto f0 = std::make_shared<PyramidLevelReconstruction>(level0, glm::ivec3(1), finest);
+  auto f1 = std::make_shared<PyramidLevelReconstruction>(level1, glm::ivec3(2), finest);
+  const CellLevelsReconstruction mixed(cells, {f0, f1}, 0);
+  EXPECT_EQ(mixed.dims(), finest);
+  EXPECT_EQ(mixed.supportVoxels(), 2);
+  for (const glm::dvec3 p : {glm::dvec3(0.1, 0.2, 0.5), glm::dvec3(0.5, 0.3, 0.4),
+                             glm::dvec3(0.9, 0.9, 0.5), glm::dvec3(0.5, 0.9, 0.5)}) {
+    const int l = cells.levelAt(p);
+    const double expected = l == 1 ? f1->value(p) : f0->value(p);  // -1 reads level 0
+    EXPECT_EQ(mixed.value(p), expected) << p.x << " " << p.y << " level " << l;
+  }
+  // Across the side x = 16 between cell 0 (level 0) and cell 1 (level 1):
+  // the difference quotient of the two levels' values, as the GPU takes it.
+  const glm::dvec3 side(16.0 / 40.0, 0.2, 0.5);
+  const double h = 1.0 / 40.0;
+  EXPECT_NEAR(
+      mixed.gradient(side).x,
+      (f1->value(side + glm::dvec3(h, 0, 0)) - f0->value(side - glm::dvec3(h, 0, 0))) / (2.0 * h),
+      1e-9);
+  try {
+    const CellLevelsReconstruction missing(cells, {f0, nullptr}, 0);
+    ADD_FAILURE() << "level 1 is shown but not read";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "cell levels: 3 cells show level 1, which is not read");
+  }
+  EXPECT_THROW(CellLevelsReconstruction(cells, {nullptr, f1}, 0), InputError);  // transparent
+  cells.levels.pop_back();
+  EXPECT_THROW(CellLevelsReconstruction(cells, {f0, f1}, 0), InputError);
 }

@@ -4,12 +4,15 @@
 // (the finest resident brick over the cell), so one frame shows level 0
 // where the atlas holds it and coarser levels elsewhere. The reference of
 // such a frame reads the same level in the same cell (CellLevels::levelAt)
-// and samples that level as layout/bricks.glsl does (sampleLevel).
+// and samples that level as layout/bricks.glsl does (sampleLevel, or
+// CellLevelsReconstruction for a single-channel frame's field).
+#include <memory>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
 #include "tessera/core/Volume.h"
+#include "tessera/reference/Reconstruction.h"
 
 namespace tessera {
 
@@ -35,5 +38,32 @@ struct CellLevels {
 // PyramidLevelReconstruction samples (reference/Reconstruction.h), read from
 // the volume itself rather than a double-precision copy.
 double sampleLevel(const Volume& level, glm::ivec3 scale, glm::ivec3 finestDims, glm::dvec3 p);
+
+// The field a single-channel streamed frame shows: at p, the field of the
+// level p's cell shows (each a PyramidLevelReconstruction over level 0's
+// box, as bricks.glsl samples that level's brick); a transparent cell (-1)
+// reads `transparentLevel` (the GPU returns a constant the transfer function
+// hides there; the level whose brick was judged transparent is not kept).
+// Gradients are central differences through value(), each offset sample in
+// its own cell, as layout/gradient.glsl differentiates the page-table
+// lookups. InputError when a cell names a level `levels` does not hold.
+class CellLevelsReconstruction final : public Reconstruction {
+ public:
+  CellLevelsReconstruction(CellLevels cells,
+                           std::vector<std::shared_ptr<const Reconstruction>> levels,
+                           int transparentLevel);
+  double value(glm::dvec3 p) const override;
+  glm::ivec3 dims() const override { return cells_.finestDims; }
+  // The widest support of the levels read: a sample near a cell's side
+  // reads the coarsest level next to it.
+  int supportVoxels() const override { return support_; }
+  const CellLevels& cells() const { return cells_; }
+
+ private:
+  CellLevels cells_;
+  std::vector<std::shared_ptr<const Reconstruction>> levels_;  // [level], null where not shown
+  int transparentLevel_;
+  int support_ = 1;
+};
 
 }  // namespace tessera

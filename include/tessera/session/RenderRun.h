@@ -78,9 +78,10 @@ struct RenderResult {
   std::uint64_t referenceRays = 0;     // rays of frame 0 that meet the volume
   double referenceStep = 0.0;          // the reference's step (voxels)
   // A layout that streams: the pyramid level the reference read, its dims,
-  // and why that one (asked for, the level frame 0 shows, or the finest of
-  // several it shows: `referenceLevelMixed`, where cells shown at a coarser
-  // level differ from it).
+  // and why that one (asked for, or the level frame 0 shows). A frame that
+  // shows several (`referenceLevelMixed`): the reference reads, per level-0
+  // cell, the level frame 0 shows there (reference/CellLevels.h); the level
+  // here is the finest of them.
   std::optional<int> referenceLevel;
   glm::ivec3 referenceLevelDims{0};
   bool referenceLevelMixed = false;
