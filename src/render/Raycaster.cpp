@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/packing.hpp>
@@ -60,7 +61,7 @@ void Raycaster::setLutSize(int entries) {
 
 std::uint64_t Raycaster::ownTextureBytes() const {
   return lut_.bytes() + preint_.bytes() + blockTexture_.bytes() + target_.color().bytes() +
-         gradient_.bytes() + fusion_.bytes();
+         spareTarget_.color().bytes() + gradient_.bytes() + fusion_.bytes();
 }
 
 void Raycaster::setPreintegrationEntries(int entries) {
@@ -315,6 +316,13 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
   updateLookup(settings, isProjection(settings.mode) ? tf_.opacityUnitLength : ds);
   gradient_.prepare(settings);
 
+  if (target_.id() == 0 || target_.width() != width || target_.height() != height) {
+    // Previews and full frames alternate between two sizes (the page's
+    // store view, the viewer's interactive frames): the other size's target
+    // is kept, so that neither makes one again (three waits for the GPU
+    // process each: the errors before and after, the completeness check).
+    std::swap(target_, spareTarget_);
+  }
   if (target_.id() == 0 || target_.width() != width || target_.height() != height) {
     target_ = gpu::Framebuffer();
     target_ = gpu::Framebuffer::create(context_.ledger(), "ray-cast target", width, height,
