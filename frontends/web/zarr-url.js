@@ -75,12 +75,67 @@
   const PAGE_CODECS = new Set(['zlib', 'gzip', 'blosc', 'zstd']);
   const codecModules = {};
   const codecErrors = {};
-  // Inflated here, on the page's thread (3 ms for a 64³ chunk; the latency
-  // test reports each). A worker was tried and measured worse on a 2-core
-  // machine: its inflating competed with the GPU process for the cores
-  // during the preview that answers input (previews 76-89 ms against
-  // 19-38 ms in the page).
-  const pakoCodec = { fromConfig: () => ({ decode: (bytes) => globalThis.pako.inflate(bytes) }) };
+  // Inflated here, on the page's thread, in slices of about a millisecond
+  // run in the page's idle time (requestIdleCallback: after an animation
+  // frame's work, before the next), so that no decode holds up input: a
+  // 64³ chunk inflated whole took 3 ms, and up to 100 ms on a loaded
+  // machine, in one task; input that arrived meanwhile waited for it. A
+  // worker was tried and measured worse on a 2-core machine: its inflating
+  // competed with the GPU process for the cores during the preview that
+  // answers input (previews 76-89 ms against 19-38 ms in the page).
+  const SLICE_MS = 1;
+  let sliceBytes = 2048;  // compressed bytes per push, fed back to about SLICE_MS
+  const idleSlice = (f) => (window.requestIdleCallback
+    ? window.requestIdleCallback(f, { timeout: 250 }) : setTimeout(() => f({ timeRemaining: () => 0 }), 0));
+  // Each idle task's start and length (performance.now()), for the tests.
+  const decodeTasks = [];
+  const noteTask = (at) => {
+    decodeTasks.push({ at, ms: performance.now() - at });
+    if (decodeTasks.length > 4000) decodeTasks.splice(0, 1000);
+  };
+  // Resolves to {raw, busyMs, sliceMs (the longest slice), slices}.
+  function inflateSliced(bytes) {
+    const inflater = new globalThis.pako.Inflate();
+    let pos = 0;
+    const out = { busyMs: 0, sliceMs: 0, slices: 0 };
+    return new Promise((resolve, reject) => {
+      const step = (deadline) => {
+        const taskAt = performance.now();
+        do {
+          const at = performance.now();
+          const end = Math.min(bytes.length, pos + sliceBytes);
+          inflater.push(bytes.subarray(pos, end), end === bytes.length);
+          pos = end;
+          const ms = performance.now() - at;
+          out.busyMs += ms;
+          out.sliceMs = Math.max(out.sliceMs, ms);
+          out.slices++;
+          if (ms > SLICE_MS) sliceBytes = Math.max(256, sliceBytes >> 1);
+          else if (ms < SLICE_MS / 4) sliceBytes = Math.min(1 << 16, sliceBytes << 1);
+          if (inflater.err) {
+            reject(new Error(inflater.msg || `zlib error ${inflater.err}`));
+            return;
+          }
+        } while (pos < bytes.length && deadline.timeRemaining() > SLICE_MS);
+        noteTask(taskAt);
+        if (pos < bytes.length) idleSlice(step);
+        else if (!inflater.ended || !inflater.result) reject(new Error('truncated stream'));
+        else resolve({ raw: inflater.result, ...out });
+      };
+      idleSlice(step);
+    });
+  }
+  // Other codecs (numcodecs' wasm builds) decode a chunk in one call: in
+  // idle time too, whole.
+  const inIdleTime = (decode) => (bytes) => new Promise((resolve, reject) => idleSlice(() => {
+    const at = performance.now();
+    Promise.resolve(decode(bytes)).then((raw) => {
+      const ms = performance.now() - at;
+      noteTask(at);
+      resolve({ raw, busyMs: ms, sliceMs: ms, slices: 1 });
+    }, reject);
+  }));
+  const pakoCodec = { fromConfig: () => ({ decode: inflateSliced }) };
   function loadCodec(id) {
     if (id === 'zlib' || id === 'gzip') return Promise.resolve(globalThis.pako ? pakoCodec : null);
     if (!codecModules[id]) {
@@ -194,7 +249,8 @@
       const path = key.slice(0, key.length - '.zarray'.length).replace(/\/$/, '');
       const id = meta && meta.compressor && meta.compressor.id;
       const Codec = PAGE_CODECS.has(id) && Array.isArray(meta.chunks) ? await loadCodec(id) : null;
-      arrays.set(path, { id, codec: Codec ? Codec.fromConfig(meta.compressor) : null,
+      const codec = Codec ? Codec.fromConfig(meta.compressor) : null;
+      arrays.set(path, { id, codec: codec && (Codec === pakoCodec ? codec : { decode: inIdleTime((b) => codec.decode(b)) }),
         chunkBytes: Codec ? chunkBytesOf(meta) : 0 });
       if (Codec && base) api.pageDecodes(id);
     }
@@ -218,8 +274,11 @@
       let raw;
       const decodeAt = performance.now();
       try {
-        raw = await array.codec.decode(r.bytes);
-        record.decodes.push({ t: decodeAt - t0, ms: performance.now() - decodeAt });
+        const d = await array.codec.decode(r.bytes);
+        raw = d.raw;
+        // busy: the decoder's own time; slice_ms: its longest task; ms: until done.
+        record.decodes.push({ t: decodeAt - t0, ms: performance.now() - decodeAt, busy_ms: d.busyMs,
+          slice_ms: d.sliceMs, slices: d.slices });
         if (record.decodes.length > 4000) record.decodes.splice(0, 1000);
       } catch (e) {
         throw new Error(`${url}: corrupt ${array.id} chunk (${e.message})`);
@@ -457,7 +516,7 @@
       // Every call's work: the pacing the tests check.
       record.calls.push({ t: performance.now() - t0, ms: f.ms, stream_ms: f.stream_ms, shown: f.shown, pending: f.pending,
         preview: f.preview_size[0] > 0, uploaded: f.uploaded, update_ms: f.update_ms, upload_wait_ms: f.upload_wait_ms,
-        tables_ms: f.tables_ms, preview_ms: f.preview_ms, preview_size: f.preview_size });
+        tables_ms: f.tables_ms, preview_ms: f.preview_ms, setup_ms: f.setup_ms, preview_size: f.preview_size });
       if (record.calls.length > 4000) record.calls.splice(0, 1000);
       if (!f.shown && !f.pending) {
         // Streamed, and nothing new to draw: the canvas shows these bricks.
@@ -507,7 +566,8 @@
       refine,
       refining: () => open && api.refining() === 1,
       // For tests: what was fetched and the frames' timeline.
-      stats: () => ({ ...record, last, inFlight: inFlight.size, queued: queue.length, t0 }),
+      stats: () => ({ ...record, last, inFlight: inFlight.size, queued: queue.length, t0,
+        decodeTasks: decodeTasks.map((d) => ({ t: d.at - t0, ms: d.ms })) }),
     };
   }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/packing.hpp>
@@ -60,7 +61,7 @@ void Raycaster::setLutSize(int entries) {
 
 std::uint64_t Raycaster::ownTextureBytes() const {
   return lut_.bytes() + preint_.bytes() + blockTexture_.bytes() + target_.color().bytes() +
-         gradient_.bytes() + fusion_.bytes();
+         spareTarget_.color().bytes() + gradient_.bytes() + fusion_.bytes();
 }
 
 void Raycaster::setPreintegrationEntries(int entries) {
@@ -316,9 +317,25 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
   gradient_.prepare(settings);
 
   if (target_.id() == 0 || target_.width() != width || target_.height() != height) {
-    target_ = gpu::Framebuffer();
-    target_ = gpu::Framebuffer::create(context_.ledger(), "ray-cast target", width, height,
-                                       gpu::rgba8For(context_.caps().api));
+    // Previews and full frames alternate between two sizes (the page's
+    // store view, the viewer's interactive frames): of a pair of targets
+    // one at most a sixteenth of the other's pixels (a preview at a
+    // quarter of the width or less), neither is made again (three waits
+    // for the GPU process each: the errors before and after, the
+    // completeness check), for at most a sixteenth more memory. Any other
+    // is let go first.
+    if (spareTarget_.id() != 0 && spareTarget_.width() == width &&
+        spareTarget_.height() == height) {
+      std::swap(target_, spareTarget_);
+    } else {
+      const long long had = static_cast<long long>(target_.width()) * target_.height();
+      const long long wants = static_cast<long long>(width) * height;
+      const bool pair = target_.id() != 0 && (16 * had <= wants || 16 * wants <= had);
+      spareTarget_ = pair ? std::move(target_) : gpu::Framebuffer();
+      target_ = gpu::Framebuffer();
+      target_ = gpu::Framebuffer::create(context_.ledger(), "ray-cast target", width, height,
+                                         gpu::rgba8For(context_.caps().api));
+    }
   }
   target_.bind();
   const gpu::Program& prog = programFor(settings);

@@ -9,9 +9,12 @@
 // hold input up that long; frames in strips of about the budget answer it
 // with a preview, and the target is two budgets. The wait for the next
 // animation frame (up to 16.7 ms: Chromium dispatches moves and wheel turns
-// with it) is part of every latency.
+// with it) is part of every latency, so nothing else may hold the main
+// thread for long: chunks are inflated in slices in idle time, and the
+// worst events are explained frame by frame (explainWorst).
 import { test } from 'node:test';
 import fs from 'node:fs';
+import os from 'node:os';
 import path from 'node:path';
 import { CH2, check, served, browserSuite, snapshot, differingPixels } from './fixture.mjs';
 
@@ -21,7 +24,7 @@ const checks = browserSuite();
 const BUDGET_MS = 12;
 const SIZE = 256;
 
-test('input during a store\'s refinement: every event answered by a frame (worst <= 250 ms; the 2-budget target reported)', checks(storeInputLatency));
+test('input during a store\'s refinement: every event answered by a frame within 2 frame budgets (24 ms; a looser guard on an overloaded machine)', checks(storeInputLatency));
 
 // Runs in the page before its scripts: which animation-frame callbacks drew
 // on the canvas (a draw, clear or blit into the default framebuffer), and
@@ -70,18 +73,23 @@ function instrument() {
   for (const type of ['pointermove', 'pointerup', 'wheel']) window.addEventListener(type, note, { capture: true, passive: true });
 }
 
-// Where the worst latencies came from: for each of the five worst events,
-// the wait until the page handled it (the callback that held the main
-// thread meanwhile, and the store's call in it) and the frame that answered
-// it, with the store call's parts (the layout's update, the wait for its
-// uploads, the ray caster's tables, the preview and its size); then the
-// store's calls by kind and the chunks decoded and handed over meanwhile.
+// Where the worst latencies came from, frame by frame: for each of the five
+// worst events, the wait until the page handled it (the animation-frame
+// callbacks and the chunk decodes in idle time that held the main thread
+// meanwhile, the longest with its store call; the rest: other tasks, or
+// Chromium waiting for the next frame) and the frame that answered it, with
+// the store call's parts (its own work before the preview, the layout's
+// update, the wait for its uploads, the ray caster's tables, the preview
+// and its size); then the store's calls by kind and the chunks decoded and
+// handed over meanwhile.
 function explainWorst(lat, z) {
   const callAt = (cb) => (z.calls || []).find((c) => c.t + z.t0 >= cb.start - 0.5 && c.t + z.t0 <= cb.end + 0.5);
   const parts = (c) => (!c ? 'no store call' : `${c.preview ? 'preview' : c.stream_ms > 0 ? 'streaming' : c.tables_ms > 0.5 && !c.shown ? 'tables' : 'strip'} ` +
-    `${c.ms.toFixed(1)} ms (update ${(c.update_ms || 0).toFixed(1)}, upload wait ${(c.upload_wait_ms || 0).toFixed(1)}, ` +
+    `${c.ms.toFixed(1)} ms (setup ${(c.setup_ms || 0).toFixed(1)}, update ${(c.update_ms || 0).toFixed(1)}, upload wait ${(c.upload_wait_ms || 0).toFixed(1)}, ` +
     `tables ${(c.tables_ms || 0).toFixed(1)}, preview ${(c.preview_ms || 0).toFixed(1)}` +
     `${c.preview ? ` at ${c.preview_size.join('x')}` : ''}, ${c.uploaded || 0} bricks uploaded)`);
+  const decodeTasks = (z.decodeTasks || []).map((d) => ({ start: d.t + z.t0, end: d.t + z.t0 + d.ms }));
+  const overlap = (list, a, b) => list.reduce((sum, x) => sum + Math.max(0, Math.min(b, x.end) - Math.max(a, x.start)), 0);
   const rows = [];
   for (const e of lat.events) {
     if (e.type === 'pointermove' && !e.buttons) continue;
@@ -89,12 +97,16 @@ function explainWorst(lat, z) {
     if (!f) continue;
     const held = lat.callbacks.filter((cb) => cb.end > e.stamp && cb.start < e.handled);
     const longest = held.reduce((a, b) => (!a || b.end - b.start > a.end - a.start ? b : a), null);
-    rows.push({ e, f, latency: f.end - e.stamp, longest });
+    rows.push({ e, f, latency: f.end - e.stamp, longest,
+      frameMs: overlap(lat.callbacks, e.stamp, e.handled), decodeMs: overlap(decodeTasks, e.stamp, e.handled) });
   }
   rows.sort((a, b) => b.latency - a.latency);
   for (const r of rows.slice(0, 5)) {
-    const held = r.longest ? `; meanwhile the longest callback ${(r.longest.end - r.longest.start).toFixed(1)} ms: ${parts(callAt(r.longest))}` : '';
-    console.log(`latency: worst ${r.e.type} ${r.latency.toFixed(1)} ms = handled after ${(r.e.handled - r.e.stamp).toFixed(1)} ms${held}; ` +
+    const wait = r.e.handled - r.e.stamp;
+    const held = r.longest ? `; the longest ${(r.longest.end - r.longest.start).toFixed(1)} ms: ${parts(callAt(r.longest))}` : '';
+    console.log(`latency: worst ${r.e.type} ${r.latency.toFixed(1)} ms = handled after ${wait.toFixed(1)} ms ` +
+                `(frame callbacks ${r.frameMs.toFixed(1)}, chunk decodes ${r.decodeMs.toFixed(1)}, ` +
+                `other tasks or the wait for a frame ${Math.max(0, wait - r.frameMs - r.decodeMs).toFixed(1)}${held}); ` +
                 `answered ${(r.f.start - r.e.handled).toFixed(1)} ms later by a ${(r.f.end - r.f.start).toFixed(1)} ms frame: ${parts(callAt(r.f))}`);
   }
   const calls = (z.calls || []).filter((c) => c.t > z.firstImageMs);
@@ -103,10 +115,13 @@ function explainWorst(lat, z) {
   const text = (v) => { const s = stats(v); return `median ${s.median.toFixed(1)}, worst ${s.worst.toFixed(1)}`; };
   console.log('latency: store calls by kind (ms): ' + Object.entries(kinds).map(([k, is]) => {
     const v = calls.filter(is);
-    return `${k} ${v.length}: ${text(v.map((c) => c.ms))} [update ${text(v.map((c) => c.update_ms || 0))}; upload wait ${text(v.map((c) => c.upload_wait_ms || 0))}; ` +
-      `tables ${text(v.map((c) => c.tables_ms || 0))}; preview ${text(v.map((c) => c.preview_ms || 0))}]`;
+    return `${k} ${v.length}: ${text(v.map((c) => c.ms))} [setup ${text(v.map((c) => c.setup_ms || 0))}; update ${text(v.map((c) => c.update_ms || 0))}; ` +
+      `upload wait ${text(v.map((c) => c.upload_wait_ms || 0))}; tables ${text(v.map((c) => c.tables_ms || 0))}; preview ${text(v.map((c) => c.preview_ms || 0))}]`;
   }).join('; '));
-  console.log(`latency: chunks decoded in the page ${(z.decodes || []).length}: ${text((z.decodes || []).map((d) => d.ms))} ms; ` +
+  const decodes = z.decodes || [];
+  console.log(`latency: chunks decoded in the page ${decodes.length}: ${text(decodes.map((d) => d.ms))} ms until done, ` +
+              `busy ${text(decodes.map((d) => d.busy_ms || d.ms))} ms in ${text(decodes.map((d) => d.slices || 1))} slices, ` +
+              `idle tasks ${text((z.decodeTasks || []).map((d) => d.ms))} ms; ` +
               `handed to the module ${(z.tasks || []).length}: ${text((z.tasks || []).map((d) => d.put_ms))} ms; ` +
               `animation-frame callbacks ${lat.callbacks.length}: ${text(lat.callbacks.map((c) => c.end - c.start))} ms`);
 }
@@ -189,14 +204,31 @@ async function storeInputLatency(context, url, tmp, run) {
   check('latency: the drag and the wheel turns were handled while the store refined',
         latencies.pointermove.length >= 5 && latencies.wheel.length >= WHEELS / 2 && duringRefinement >= all.n / 2 && unanswered === 0,
         `${all.n} events answered (${duringRefinement} while refining), ${unanswered} without a frame after them`);
-  // Issue 31's target is worst <= 2 frame budgets (24 ms). On a loaded
-  // 2-core machine with SwiftShader, Chromium's wait for the next animation
-  // frame and the preview's read-back alone come close to that, so the
-  // target is reported, not asserted; the check guards what strips changed:
-  // one whole ray march per store frame answered input after 0.8-4.4 s.
-  console.log(`latency: target worst <= ${2 * BUDGET_MS} ms (2 frame budgets): ${all.worst <= 2 * BUDGET_MS ? 'met' : 'NOT met'} (worst ${all.worst.toFixed(1)} ms)`);
-  check('latency: worst input-to-frame time while the store refines <= 250 ms (a whole-frame ray march took 0.8-4.4 s)',
-        all.n > 0 && all.worst <= 250, text(all));
+  // Issue 31's target: worst <= 2 frame budgets (24 ms), asserted when the
+  // machine is not overloaded (the last minute's load average at most 1.5
+  // runnable threads per core: Chromium's renderer and GPU process and this
+  // test are about 2 of them). Past that, the page and SwiftShader's GPU
+  // process wait for the cores (at a load of 19 on 2 cores a preview's
+  // own code, with no GL call in it, took up to 199 ms now and then), and
+  // the guard of what strips changed is asserted, scaled by the overload:
+  // 250 ms on a quiet machine; one whole ray march per store frame answered
+  // input after 0.8-4.4 s.
+  const load = os.loadavg()[0];
+  const cores = os.cpus().length;
+  const overload = load / (1.5 * cores);
+  const quiet = overload <= 1;
+  console.log(`latency: target worst <= ${2 * BUDGET_MS} ms (2 frame budgets): ${all.worst <= 2 * BUDGET_MS ? 'met' : 'NOT met'} ` +
+              `(worst ${all.worst.toFixed(1)} ms, median ${all.median.toFixed(1)} ms; load average ${load.toFixed(1)} on ${cores} cores: ` +
+              `${quiet ? 'asserted' : 'not asserted, overloaded'})`);
+  if (quiet) {
+    check(`latency: worst input-to-frame time while the store refines <= 2 frame budgets (${2 * BUDGET_MS} ms; load ${load.toFixed(1)} on ${cores} cores)`,
+          all.n > 0 && all.worst <= 2 * BUDGET_MS, text(all));
+  } else {
+    const guard = 250 * overload;
+    check(`latency: overloaded (load ${load.toFixed(1)} on ${cores} cores), worst input-to-frame time while the store refines <= ${guard.toFixed(0)} ms ` +
+          '(250 ms times the overload; a whole-frame ray march took 0.8-4.4 s on a quiet machine)',
+          all.n > 0 && all.worst <= guard, text(all));
+  }
   // The frame that answers input draws the preview and nothing else: the
   // new view's selection, requests, reads, uploads and page table come in
   // the steps after it (they cost 0.4-53 ms a step here, the preview's

@@ -38,6 +38,7 @@ std::string frameJson(const web::StoreFrame& f, web::ZarrStoreView& z) {
   j["upload_wait_ms"] = f.uploadWaitMs;
   j["tables_ms"] = f.tablesMs;
   j["preview_ms"] = f.previewMs;
+  j["setup_ms"] = f.setupMs;
   j["shown"] = f.shown;
   j["pending"] = f.pending;
   j["streamed"] = f.streamed;

@@ -62,8 +62,9 @@ struct StoreFrame {
   // the layout's update (selection, requests, reads, uploads, page table),
   // the wait for its uploads in the GPU process, the ray caster's tables
   // rebuilt for bricks that changed, and the preview (ray march, compose,
-  // wait).
-  double updateMs = 0.0, uploadWaitMs = 0.0, tablesMs = 0.0, previewMs = 0.0;
+  // wait); and a frame()'s own work before its preview (the view, the
+  // transfer function, the overlay lines).
+  double updateMs = 0.0, uploadWaitMs = 0.0, tablesMs = 0.0, previewMs = 0.0, setupMs = 0.0;
 };
 
 // How store frames are paced, as the viewer core paces its progressive

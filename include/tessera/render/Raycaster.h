@@ -155,6 +155,7 @@ class Raycaster final : public Technique {
   FusionTexture fusion_;
   gpu::Texture blockTexture_;
   gpu::Framebuffer target_;
+  gpu::Framebuffer spareTarget_;  // a preview's or a full frame's beside it (render())
   gpu::FullscreenTriangle triangle_;
   gpu::ProgramCache programs_;
   // What the LUT/block texture were built for, to rebuild only on change.
