@@ -344,7 +344,7 @@ constexpr BenchFlag kBenchFlags[] = {
      "(Moser & Weiskopf 2008 Fig. 6) and quality per count; --frames per cell"},
     {"--slicing-quick", &BenchOptions::slicingQuick, "With --slicing: a small smoke run"},
     {"--hybrid", &BenchOptions::hybrid,
-     "Hybrid low/high-resolution rendering: each overlay-opacity method vs the ground "
+     "Hybrid low/high-resolution rendering: each line-attenuation method vs the ground "
      "truth (Moser & Weiskopf 2008 Fig. 2) and full vs 128x128/256x256/256x512 "
      "offscreen speed at 480x640 and 1024x768; --frames per cell"},
     {"--interactive", &BenchOptions::interactive,

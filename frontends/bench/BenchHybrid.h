@@ -1,6 +1,6 @@
 #pragma once
 // `tessera bench --hybrid` and `tessera bench --interactive`: the hybrid
-// low/high-resolution compositor's quality (each overlay-opacity method vs
+// low/high-resolution compositor's quality (each line-attenuation method vs
 // the ground truth, as numbers for Moser & Weiskopf's Figure 2) and speed
 // (full resolution vs offscreen sizes), and the quality controller holding a
 // frame-time goal during a simulated interaction.

@@ -1,5 +1,5 @@
 // Hybrid low/high-resolution rendering (Moser & Weiskopf 2008, section 4):
-// upscaled low-resolution volume vs full resolution, and each overlay-opacity
+// upscaled low-resolution volume vs full resolution, and each line-attenuation
 // method vs the full-resolution ground truth with correct line occlusion.
 #include <gtest/gtest.h>
 

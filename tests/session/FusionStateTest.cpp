@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/MricronAtlas.h"
 #include "support/TestSupport.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/SliceImage.h"
@@ -20,14 +21,10 @@
 namespace tessera::session {
 namespace {
 
-const char* kCh2 = "/usr/share/mricron/templates/ch2.nii.gz";
-const char* kAal = "/usr/share/mricron/templates/aal.nii.gz";
-const char* kAalNames = "/usr/share/mricron/templates/aal.nii.txt";
-
-bool haveMricron() {
-  return std::filesystem::exists(kCh2) && std::filesystem::exists(kAal) &&
-         std::filesystem::exists(kAalNames);
-}
+using test::haveMricron;
+using test::kAal;
+using test::kAalNames;
+using test::kCh2;
 
 void openCh2(Session& s) {
   OpenOptions open;

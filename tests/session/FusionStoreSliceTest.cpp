@@ -19,6 +19,7 @@
 #include <glm/common.hpp>
 #include <glm/mat4x4.hpp>
 
+#include "support/MricronAtlas.h"
 #include "support/TestSupport.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/VolumeReader.h"
@@ -31,24 +32,13 @@
 namespace tessera::session {
 namespace {
 
-const char* kCh2 = "/usr/share/mricron/templates/ch2.nii.gz";
-const char* kAal = "/usr/share/mricron/templates/aal.nii.gz";
-const char* kAalNames = "/usr/share/mricron/templates/aal.nii.txt";
+using test::aalLabels;
+using test::haveMricron;
+using test::kAal;
+using test::kAalNames;
+using test::kCh2;
 const glm::dvec3 kRightPostcentral{40.0, -25.0, 52.0};
 const glm::dvec3 kLeftPostcentral{-40.0, -25.0, 52.0};
-
-bool haveMricron() {
-  return std::filesystem::exists(kCh2) && std::filesystem::exists(kAal) &&
-         std::filesystem::exists(kAalNames);
-}
-
-OverlayOptions aalLabels(double opacity) {
-  OverlayOptions o;
-  o.labels = true;
-  o.labelTable = kAalNames;
-  o.opacity = opacity;
-  return o;
-}
 
 using Rgb = std::array<int, 3>;
 Rgb rgbAt(const Image& image, glm::ivec2 px) {
@@ -76,26 +66,7 @@ int idNamed(const Overlay& o, const std::string& name) {
   return -1;
 }
 
-class FusionStoreSlice : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    if (!haveMricron()) return;
-    dir_ = new test::TempDir;
-    store_ = (*dir_ / "ch2.ome.zarr").string();
-    writeOmeZarr(readVolume(kCh2), store_);
-  }
-  static void TearDownTestSuite() {
-    delete dir_;
-    dir_ = nullptr;
-  }
-  void SetUp() override {
-    if (!haveMricron()) GTEST_SKIP() << "mricron templates not installed";
-  }
-  static test::TempDir* dir_;
-  static std::string store_;
-};
-test::TempDir* FusionStoreSlice::dir_ = nullptr;
-std::string FusionStoreSlice::store_;
+class FusionStoreSlice : public test::Ch2StoreSuite {};
 
 // The level voxel holding a world position (levels span level 0's box).
 glm::ivec3 levelVoxelAt(const lod::MultiresSource& src, int level, glm::dvec3 worldMm) {
@@ -108,7 +79,7 @@ glm::ivec3 levelVoxelAt(const lod::MultiresSource& src, int level, glm::dvec3 wo
 TEST_F(FusionStoreSlice, LevelZeroEqualsTheFilesSliceViewsByteForByte) {
   const Volume ch2 = readVolume(kCh2);
   const Overlay onFile = openOverlay(kAal, aalLabels(0.6), ch2);
-  const auto src = lod::ZarrMultiresSource::open(store_);
+  const auto src = lod::ZarrMultiresSource::open(store());
   const Overlay onStore = openOverlay(kAal, aalLabels(0.6), src->shape());
   ASSERT_EQ(src->shape().dims(), ch2.dims());
   const lod::LevelInfo l0 = src->levelInfo(0);
@@ -140,7 +111,7 @@ TEST_F(FusionStoreSlice, LevelZeroEqualsTheFilesSliceViewsByteForByte) {
 // Opaque labels over black: each pixel's colour is its label's. Level 1
 // (coarser than aal's grid) checks the resampling by world coordinates.
 TEST_F(FusionStoreSlice, EveryLevelsPixelsCarryTheAtlasLabelAtTheirVoxelCentre) {
-  const auto src = lod::ZarrMultiresSource::open(store_);
+  const auto src = lod::ZarrMultiresSource::open(store());
   ASSERT_GE(src->levelCount(), 2);
   const Overlay o = openOverlay(kAal, aalLabels(1.0), src->shape());
   const std::map<Rgb, int> ids = idsByColour(o);
@@ -200,7 +171,7 @@ TEST_F(FusionStoreSlice, EveryLevelsPixelsCarryTheAtlasLabelAtTheirVoxelCentre) 
 }
 
 TEST_F(FusionStoreSlice, ALevelOrSliceOutsideThePyramidIsAnError) {
-  const auto src = lod::ZarrMultiresSource::open(store_);
+  const auto src = lod::ZarrMultiresSource::open(store());
   const Overlay o = openOverlay(kAal, aalLabels(0.6), src->shape());
   const lod::LevelInfo l0 = src->levelInfo(0);
   const viewer::SliceGeometry g(l0.dims, glm::dvec3(l0.spacing), src->shape().direction(), 2);

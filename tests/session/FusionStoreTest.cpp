@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "support/MricronAtlas.h"
 #include "support/TestSupport.h"
 #include "tessera/io/VolumeReader.h"
 #include "tessera/io/ZarrWriter.h"
@@ -18,23 +19,12 @@
 namespace tessera::session {
 namespace {
 
-const char* kCh2 = "/usr/share/mricron/templates/ch2.nii.gz";
-const char* kAal = "/usr/share/mricron/templates/aal.nii.gz";
-const char* kAalNames = "/usr/share/mricron/templates/aal.nii.txt";
+using test::aalLabels;
+using test::haveMricron;
+using test::kAal;
+using test::kAalNames;
+using test::kCh2;
 constexpr int kSize = 128;
-
-bool haveMricron() {
-  return std::filesystem::exists(kCh2) && std::filesystem::exists(kAal) &&
-         std::filesystem::exists(kAalNames);
-}
-
-OverlayOptions aalLabels() {
-  OverlayOptions o;
-  o.labels = true;
-  o.labelTable = kAalNames;
-  o.opacity = 0.6;
-  return o;
-}
 
 // ch2 (a file or its store) from the patient's right, cut open at x = +32 mm.
 void look(Session& s, const std::string& layout) {
@@ -53,26 +43,7 @@ RenderResult renderWithReference(Session& s) {
   return s.run(req);
 }
 
-class FusionStore : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    if (!haveMricron()) return;
-    dir_ = new test::TempDir;
-    store_ = (*dir_ / "ch2.ome.zarr").string();
-    writeOmeZarr(readVolume(kCh2), store_);
-  }
-  static void TearDownTestSuite() {
-    delete dir_;
-    dir_ = nullptr;
-  }
-  void SetUp() override {
-    if (!haveMricron()) GTEST_SKIP() << "mricron templates not installed";
-  }
-  static test::TempDir* dir_;
-  static std::string store_;
-};
-test::TempDir* FusionStore::dir_ = nullptr;
-std::string FusionStore::store_;
+class FusionStore : public test::Ch2StoreSuite {};
 
 TEST_F(FusionStore, AalOverAStoreReadInCoreMatchesTheReferenceAndTheFile) {
   Session file("native");
@@ -83,7 +54,7 @@ TEST_F(FusionStore, AalOverAStoreReadInCoreMatchesTheReferenceAndTheFile) {
 
   Session s("native");
   look(s, "auto");
-  s.open(store_);
+  s.open(store());
   ASSERT_FALSE(s.streamed());
   s.openOverlay(kAal, aalLabels());
   EXPECT_EQ(s.overlay()->note, "");
@@ -100,7 +71,7 @@ TEST_F(FusionStore, AalOverAStoreReadInCoreMatchesTheReferenceAndTheFile) {
 TEST_F(FusionStore, AalOverABrickedStoreMatchesTheReference) {
   Session s("native");
   look(s, "bricks");
-  s.open(store_);
+  s.open(store());
   ASSERT_TRUE(s.streamed());
   s.openOverlay(kAal, aalLabels());
   EXPECT_EQ(s.overlayAnatomy().dims(), glm::ivec3(181, 217, 181));
@@ -121,7 +92,7 @@ TEST_F(FusionStore, AalOverABrickedStoreMatchesTheReference) {
 TEST_F(FusionStore, TheProbeOverAStreamedStoreNamesBothSides) {
   Session s("native");
   look(s, "bricks");
-  s.open(store_);
+  s.open(store());
   ASSERT_TRUE(s.streamed());
   s.openOverlay(kAal, aalLabels());
   const Volume ch2 = readVolume(kCh2);

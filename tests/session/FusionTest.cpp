@@ -11,6 +11,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "support/MricronAtlas.h"
 #include "support/TestSupport.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/NiftiWriter.h"
@@ -21,22 +22,11 @@
 namespace tessera::session {
 namespace {
 
-const char* kCh2 = "/usr/share/mricron/templates/ch2.nii.gz";
-const char* kAal = "/usr/share/mricron/templates/aal.nii.gz";
-const char* kAalNames = "/usr/share/mricron/templates/aal.nii.txt";
-
-bool haveMricron() {
-  return std::filesystem::exists(kCh2) && std::filesystem::exists(kAal) &&
-         std::filesystem::exists(kAalNames);
-}
-
-OverlayOptions aalLabels() {
-  OverlayOptions o;
-  o.labels = true;
-  o.labelTable = kAalNames;
-  o.opacity = 0.6;
-  return o;
-}
+using test::aalLabels;
+using test::haveMricron;
+using test::kAal;
+using test::kAalNames;
+using test::kCh2;
 
 // ch2 seen from the patient's right, cut open at x = +32 mm (the crop box,
 // in texture coordinates) so that the right hemisphere's cut face, where the

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "support/MricronAtlas.h"
 #include "tessera/core/Error.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/session/OverlayPanel.h"
@@ -16,15 +17,11 @@
 namespace tessera::session {
 namespace {
 
-const char* kCh2 = "/usr/share/mricron/templates/ch2.nii.gz";
-const char* kAal = "/usr/share/mricron/templates/aal.nii.gz";
-const char* kAalNames = "/usr/share/mricron/templates/aal.nii.txt";
+using test::haveMricron;
+using test::kAal;
+using test::kAalNames;
+using test::kCh2;
 constexpr int kSize = 128;
-
-bool haveMricron() {
-  return std::filesystem::exists(kCh2) && std::filesystem::exists(kAal) &&
-         std::filesystem::exists(kAalNames);
-}
 
 // Pixels whose colour differs by more than `tol` in any channel.
 int differing(const Image& a, const Image& b, int tol = 2) {
