@@ -32,9 +32,7 @@ Volume ChannelSeries::read(int t) {
 std::shared_ptr<const ChannelSet> ChannelSeries::want(int t) {
   const bool read = series_->want(t) != nullptr;
   std::lock_guard lock(mutex_);
-  const int n = series_->count();
-  const int keep = series_->keep();
-  std::erase_if(sets_, [&](const auto& kv) { return (kv.first - t + n) % n >= keep; });
+  std::erase_if(sets_, [&](const auto& kv) { return !series_->inWindow(kv.first, t); });
   if (!read) return nullptr;
   const auto it = sets_.find(t);
   return it == sets_.end() ? nullptr : it->second;

@@ -55,9 +55,7 @@ std::shared_ptr<const lod::MultiresSource> StreamedSeries::source(int t) {
   series_->want(t);  // moves the window (and checks t)
   {
     std::lock_guard lock(mutex_);
-    const int n = series_->count();
-    const int keep = series_->keep();
-    std::erase_if(sources_, [&](const auto& kv) { return (kv.first - t + n) % n >= keep; });
+    std::erase_if(sources_, [&](const auto& kv) { return !series_->inWindow(kv.first, t); });
   }
   return opened(t);
 }

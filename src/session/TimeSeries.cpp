@@ -53,9 +53,8 @@ void TimeSeries::askFrom(int t) {
   }
   std::vector<int> window;
   for (int i = 0; i < keep_; ++i) window.push_back((t + i) % count_);
-  auto inWindow = [&](int x) { return std::find(window.begin(), window.end(), x) != window.end(); };
-  std::erase_if(held_, [&](const auto& kv) { return !inWindow(kv.first); });
-  std::erase_if(failed_, [&](const auto& kv) { return !inWindow(kv.first); });
+  std::erase_if(held_, [&](const auto& kv) { return !inWindow(kv.first, t); });
+  std::erase_if(failed_, [&](const auto& kv) { return !inWindow(kv.first, t); });
   if (window != wanted_) {
     wanted_ = std::move(window);
     changed_.notify_all();

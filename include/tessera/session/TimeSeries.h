@@ -56,6 +56,9 @@ class TimeSeries {
 
   int count() const { return count_; }
   int keep() const { return keep_; }
+  // Whether time point `x` is in the window want(t) keeps: t .. t + keep - 1,
+  // wrapping past the last (for what a caller holds beside the series).
+  bool inWindow(int x, int t) const { return (x - t + count_) % count_ < keep_; }
 
   // Time point `t` if it has been read, else null. Either way the reader
   // is asked for t and the keep - 1 time points after it (wrapping past the
