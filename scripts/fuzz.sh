@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (fuzz/fuzz_*.cpp) with clang-14, ASan and UBSan
-# into build-fuzz/, then fuzzes each for SECONDS (default 20), two at a time
-# when there are two cores or more.
+# into build-asan-clang/ (scripts/asan-build.sh, the build scripts/sanitize.sh
+# tests in), then fuzzes each for SECONDS (default 20), two at a time when
+# there are two cores or more.
 #
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     e.g. scripts/fuzz.sh 600 nifti nrrd
 #
@@ -21,20 +22,15 @@ if [ $# -gt 0 ]; then TARGETS=("$@"); else TARGETS=("${ALL[@]}"); fi
 JOBS=$(nproc)
 PARALLEL=$((JOBS >= 2 ? 2 : 1))
 
-# -O1 -gline-tables-only: file:line in reports, and the quickest build (a
-# CI run fuzzes each parser for seconds, not hours).
-CC=clang-14 CXX=clang++-14 cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
-  -DTESSERA_FUZZ=ON -DTESSERA_BUILD_TESTS=OFF >/dev/null
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/tessera-fuzz.XXXXXX")
 trap 'rm -rf "$WORK"' EXIT
-if ! cmake --build build-fuzz -j"$JOBS" --target fuzz_targets >"$WORK/build.log" 2>&1; then
+if ! scripts/asan-build.sh fuzz_targets >"$WORK/build.log" 2>&1; then
   grep -E -A5 "error|Error" "$WORK/build.log" | head -60 >&2
   echo "fuzz: building the fuzz targets failed" >&2
   exit 1
 fi
 for t in "${TARGETS[@]}"; do
-  [ -x "build-fuzz/fuzz_$t" ] || { echo "fuzz: build-fuzz/fuzz_$t was not built" >&2; exit 1; }
+  [ -x "build-asan-clang/fuzz_$t" ] || { echo "fuzz: build-asan-clang/fuzz_$t was not built" >&2; exit 1; }
 done
 
 # Seeds for a target: its valid files, the bad corpus of its format, and the
@@ -71,7 +67,7 @@ run() {
   local dict=()
   [ -f "fuzz/dict/$t.dict" ] && dict=("-dict=fuzz/dict/$t.dict")
   local rc=0
-  "build-fuzz/fuzz_$t" "$WORK/corpus-$t" "${dict[@]}" -max_total_time="$SECS" -max_len=65536 \
+  "build-asan-clang/fuzz_$t" "$WORK/corpus-$t" "${dict[@]}" -max_total_time="$SECS" -max_len=65536 \
     -timeout=5 -rss_limit_mb=1024 -print_final_stats=1 -artifact_prefix="$crashes/" \
     >"$WORK/log-$t" 2>&1 || rc=$?
   echo "$rc" >"$WORK/rc-$t"
@@ -116,6 +112,6 @@ for t in "${TARGETS[@]}"; do
 done
 echo "fuzz: $total_runs runs in all"
 if [ "$failed" -ne 0 ]; then
-  echo "fuzz: FAILED: reproduce with build-fuzz/fuzz_<target> <file>" >&2
+  echo "fuzz: FAILED: reproduce with build-asan-clang/fuzz_<target> <file>" >&2
   exit 1
 fi

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Builds Tessera's CPU layers and their tests with AddressSanitizer +
-# UndefinedBehaviorSanitizer (clang-14, warnings as errors) into build-asan-clang/ and
-# runs them: core, io (every reader and the bad-input corpus), lod and the
-# CPU reference. The GPU image tests run once, in the plain build (test.sh);
+# UndefinedBehaviorSanitizer (clang-14, warnings as errors) into
+# build-asan-clang/ (scripts/asan-build.sh, the build the fuzzers use too) and
+# runs them: core, io (every reader and the bad-input corpus), lod and the CPU
+# reference. The GPU image tests run once, in the plain build (test.sh);
 # the parsers are fuzzed under ASan as well (scripts/fuzz.sh).
 #   scripts/sanitize.sh            the CPU layers' tests
 #   scripts/sanitize.sh --all      every test, the GPU ones too (slow)
@@ -13,22 +14,14 @@
 # that triggered it (halt_on_error).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-SANITIZE="-fsanitize=address,undefined -fno-omit-frame-pointer"
-# clang-14 (installed for fuzzing anyway): it compiles these sanitized builds
-# in about 55 % of gcc's CPU time at -O1 (src/io/ZarrStore.cpp 18.7 s vs
-# 32.3 s). Warnings stay errors; gcc's own warnings are the plain build's job.
-# -O1 -gline-tables-only: readable reports with file:line, and a quick build.
-CC=clang-14 CXX=clang++-14 cmake -S . -B build-asan-clang -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DTESSERA_WERROR=ON -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
-  -DCMAKE_CXX_FLAGS="$SANITIZE" -DCMAKE_EXE_LINKER_FLAGS="$SANITIZE" >/dev/null
-targets=(--target test_core test_io test_lod test_reference)
+targets=(test_core test_io test_lod test_reference)
 skip=(-E _NOT_BUILT)  # ctest's stand-in for the test executables not built here
 if [ "${1:-}" = "--all" ]; then
   targets=()
   skip=()
   shift
 fi
-cmake --build build-asan-clang -j"$(nproc)" "${targets[@]}"
+scripts/asan-build.sh "${targets[@]}"  # shared with scripts/fuzz.sh
 cd build-asan-clang
 export ASAN_OPTIONS=detect_leaks=0:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1
 export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
