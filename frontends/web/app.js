@@ -26,6 +26,9 @@ import { attachOverlayPanel } from './overlay-panel.js';
   const progressive = params.get('progressive') !== '0';
   const frameBudgetMs = Math.max(1, parseFloat(params.get('budget') || '12') || 12);
   const volumeUrls = params.getAll('url').filter((u) => u.length);
+  // ?layout=bricks: a store's t axis plays over bricks even when its level
+  // 0 would fit in core (as `tessera render --layout bricks`).
+  const storeBricks = params.get('layout') === 'bricks';
   // ?dicomweb=ROOT: a DICOMweb archive's studies and series to open
   // (frontends/web/dicomweb.js).
   const dicomwebRoot = params.get('dicomweb') || '';
@@ -252,8 +255,10 @@ import { attachOverlayPanel } from './overlay-panel.js';
       return;
     }
     if (api && channelList && channelList.active()) {
+      if (time.count > 1) timeStep();  // a store's channels with a t axis
       channelFrameStep();
-    } else if (api && zarr && zarr.active() && !storeTime) {
+    } else if (api && zarr && zarr.active() && (!storeTime || storeTime.bricks)) {
+      if (storeTime && time.count > 1) timeStep();
       storeFrameStep();
     } else if (api) {
       let ms = -1;
@@ -1056,7 +1061,11 @@ import { attachOverlayPanel } from './overlay-panel.js';
       if (await zarr.open(volumeUrls[0]) && window.TesseraChannels) {
         channelList = await TesseraChannels.attach(M, zarr, { requestRender, showError, clearError });
       }
-      if (zarr.active() && !channelList && window.TesseraStoreTime) storeTime = await TesseraStoreTime.attach(M, zarr, { showError });
+      if (zarr.active() && !channelList && window.TesseraStoreTime) {
+        storeTime = await TesseraStoreTime.attach(M, zarr, { showError }, { bricks: storeBricks });
+      } else if (channelList && window.TesseraStoreTime && viewer.timeSeries().count > 1) {
+        storeTime = TesseraStoreTime.fetchAhead(zarr);  // the channels' time points ahead
+      }
       volumeChanged();
     } else if (volumeUrls.length) {
       if (!(await openUrls(volumeUrls))) volumeChanged();

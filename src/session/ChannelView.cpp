@@ -4,6 +4,7 @@
 // slice2d — over layout::ChannelLayout), kept on the GPU between edits.
 #include "tessera/session/ChannelView.h"
 
+#include <algorithm>
 #include <sstream>
 
 #include "tessera/core/Error.h"
@@ -84,18 +85,30 @@ bool ChannelView::open(const std::string& spec, int time) {
     show(readZarrChannels(spec, indices, time), spec);
     return true;
   }
+  showSeries(
+      count, readZarrChannels(spec, indices, time),
+      [spec, indices](int t) { return readZarrChannels(spec, indices, t); }, spec, time);
+  return true;
+}
+
+void ChannelView::showSeries(int count, ChannelSet first, ChannelSeries::Reader read,
+                             const std::string& name, int time, TimeSeries::Reading reading,
+                             TimeSeries::Arrival arrived, int ahead) {
+  if (count < 2) throw InputError(name + ": one time point, not a time series");
+  if (time < 0 || time >= count) {
+    throw InputError(name + ": time point " + std::to_string(time) + " asked for, the series has " +
+                     std::to_string(count) + " (0.." + std::to_string(count - 1) + ")");
+  }
   // As many time points held as a quarter of the host budget holds (the
   // series reads the first one again, once, as the start of its window).
-  ChannelSet first = readZarrChannels(spec, indices, time);
   const int keep = TimeSeries::keepWithin(HostBudget::global().limitBytes() / 4,
                                           ChannelSeries::bytes(first), count);
-  auto series = std::make_unique<ChannelSeries>(
-      count, [spec, indices](int t) { return readZarrChannels(spec, indices, t); }, keep);
-  show(std::move(first), spec);
+  auto series = std::make_unique<ChannelSeries>(count, std::move(read), keep, reading);
+  if (arrived) series->series().setArrival(std::move(arrived), std::clamp(ahead, 1, keep));
+  show(std::move(first), name);
   series_ = std::move(series);
   time_ = time;
   series_->want(time);  // reads ahead from here
-  return true;
 }
 
 bool ChannelView::showTime(int t) {

@@ -179,7 +179,7 @@ void Session::waitTimePoint(int t) {
   showTimePoint(t);
 }
 
-int Session::stepPlayback(double nowMs) {
+int Session::stepPlayback(double nowMs, bool shownComplete) {
   TimeSeries* const series = this->series();
   const int shownNow = timePoint();
   if (!series) return shownNow;
@@ -206,7 +206,7 @@ int Session::stepPlayback(double nowMs) {
                        " could not be read: " + e.what());
     }
   }
-  const int shown = playback_.step(nowMs, shownNow, count, ready);
+  const int shown = playback_.step(nowMs, shownNow, count, ready && shownComplete);
   if (shown != shownNow) showTimePoint(shown);
   return timePoint();
 }

@@ -2,6 +2,8 @@
 // axis played over bricks. Each time point shown is its own pyramid, so the
 // bricks layout that the next frame (run(), render()) makes over it holds
 // that time point's bricks only.
+#include <algorithm>
+
 #include <nlohmann/json.hpp>
 
 #include "tessera/core/Error.h"
@@ -45,12 +47,54 @@ void Session::openStreamedSeries(const std::string& spec, const OpenOptions& opt
   // Every time point in the first one's window, unless the settings say one.
   seriesWindow_ = settings_.window ? *settings_.window : first->shape().window();
   streamedSeries_ = std::move(series);
+  seriesDrawn_ = false;
   name_ = spec;
   timePoint_ = -1;
   if (!showStreamedTimePoint(firstTime))
     throw Error(spec + ": its first time point was not opened");
 }
 #endif
+
+void Session::drawStreamedSeries(int count, StreamedSeries::SourceAt at, std::uint64_t warmBytes,
+                                 std::uint64_t heldBytes, const std::string& name, int time,
+                                 TimeSeries::Reading reading) {
+  if (count < 2) throw InputError(name + ": one time point, not a time series");
+  if (time < 0 || time >= count) {
+    throw InputError(name + ": time point " + std::to_string(time) + " asked for, the series has " +
+                     std::to_string(count) + " (0.." + std::to_string(count - 1) + ")");
+  }
+  const int keep = TimeSeries::keepWithin(heldBytes, std::max<std::uint64_t>(1, warmBytes), count);
+  auto series = std::make_unique<StreamedSeries>(count, std::move(at), warmBytes, keep, reading);
+  // The first time point is shown now (the front end draws it already);
+  // it and the ones after it are read ahead from here.
+  std::shared_ptr<const lod::MultiresSource> first = series->source(time);
+  series_.reset();
+  streamedSeries_ = std::move(series);
+  seriesDrawn_ = true;
+  drawn_ = std::move(first);
+  timePoint_ = time;
+}
+
+void Session::drawPyramid(std::shared_ptr<const lod::MultiresSource> pyramid) {
+  if (seriesDrawn_ && streamedSeries_) {
+    streamedSeries_.reset();
+    timePoint_ = 0;
+  }
+  seriesDrawn_ = false;
+  drawn_ = std::move(pyramid);
+}
+
+// The front end's reads never wait: a time point is shown once it is read
+// (its pyramid opened and its levels at hand), a jump too; until then the
+// one shown stays.
+bool Session::showDrawnTimePoint(int t) {
+  const bool read = streamedSeries_->series().want(t) != nullptr;  // checks t
+  if (t == timePoint_) return true;
+  if (!read) return false;
+  drawn_ = streamedSeries_->source(t);
+  timePoint_ = t;
+  return true;
+}
 
 TimeSeries* Session::series() {
   if (channelView_ && channelView_->series()) return &channelView_->series()->series();
@@ -64,6 +108,7 @@ int Session::timePoint() const {
 }
 
 bool Session::showStreamedTimePoint(int t) {
+  if (seriesDrawn_) return showDrawnTimePoint(t);
   if (t == timePoint_ && streamed_) return true;
   // The shown one is opened now if it has to be (a jump); playback asks
   // only for one warmed ahead (stepPlayback waits for isRead).

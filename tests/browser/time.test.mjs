@@ -4,8 +4,13 @@
 // file; playback shows every time point in order (none skipped, a late one
 // shown late), reading one time point ahead per animation frame (the page
 // has no threads: session/TimeSeries.h, Reading::OnPump).
+// A store's t axis over bricks (?layout=bricks, or a level 0 too large for
+// in-core) plays the same way, each time point drawn whole from its own
+// bricks before the next is shown (a late one counted), and a store's
+// channels with a t axis play together.
 // With TESSERA_BENCH=1 it also plays a 20-time-point 256^3 series at
-// 512x512 and prints the rate reached.
+// 512x512 (a 4-D NIfTI, a store in core and a store over bricks) and
+// prints the rate reached.
 import { test } from 'node:test';
 import { execFile, execFileSync } from 'node:child_process';
 import fs from 'node:fs';
@@ -16,8 +21,15 @@ const checks = browserSuite();
 
 test('a 4-D NIfTI: every time point as the CLI renders it, playback in order', checks(timeSeries));
 test('an OME-Zarr store with a t axis (?url=): every time point drawn as the CLI renders it, in order', checks(storeSeries));
+test('an OME-Zarr store with a t axis over bricks (?layout=bricks): each time point drawn whole from its own bricks, in order',
+  checks(bricksSeries));
+test('an OME-Zarr store with channels and a t axis: the channels play together, each frame as the CLI renders it',
+  checks(channelSeries));
 test('benchmark: 20 time points of 256^3 at 512x512 (TESSERA_BENCH=1)', { skip: !bench }, checks(benchmark));
-test('benchmark: an OME-Zarr store of 20 time points of 256^3 at 512x512 (TESSERA_BENCH=1)', { skip: !bench }, checks(storeBenchmark));
+test('benchmark: an OME-Zarr store of 20 time points of 256^3 at 512x512 (TESSERA_BENCH=1)', { skip: !bench },
+  checks((...a) => storeBenchmark(...a, 'in core')));
+test('benchmark: an OME-Zarr store of 20 time points of 256^3 at 512x512 over bricks (TESSERA_BENCH=1)', { skip: !bench },
+  checks((...a) => storeBenchmark(...a, 'bricks')));
 
 // A 4-D NIfTI of `count` time points made from the 3-D file `from` (as
 // `tessera convert` writes it): time point t is its voxels shifted by
@@ -145,14 +157,16 @@ async function benchmark(context, url, tmp, run) {
 // An OME-NGFF store of `count` time points of n^3 written by zarr-python
 // (tests/zarr/make_time_store.py): a dim shell and a bright cube whose x
 // position moves with t.
-function writeStore(store, n, count) {
-  execFileSync('/usr/bin/python3', [path.join(root, 'tests/zarr/make_time_store.py'), store, String(n), String(count)]);
+function writeStore(store, n, count, channels = 1) {
+  execFileSync('/usr/bin/python3', [path.join(root, 'tests/zarr/make_time_store.py'), store, String(n), String(count),
+    String(channels)]);
 }
 
-// `tessera render STORE --time T` for each T, two at a time.
-async function renderTimes(store, times, size, tmp) {
-  const one = (t) => new Promise((resolve, reject) => execFile(cli, ['render', store, '--time', String(t), '--tf', 'mr-default',
-    '--size', `${size}x${size}`, '--profile', 'webgl2', '--preintegrate', 'off', '--out', path.join(tmp, `store-t${t}.png`)],
+// `tessera render STORE --time T` for each T, two at a time (`look`: the
+// options, the TF mr-default unless it names one; `tag`: the PNGs' prefix).
+async function renderTimes(store, times, size, tmp, look = ['--tf', 'mr-default'], tag = 'store') {
+  const one = (t) => new Promise((resolve, reject) => execFile(cli, ['render', store, '--time', String(t), ...look,
+    '--size', `${size}x${size}`, '--profile', 'webgl2', '--preintegrate', 'off', '--out', path.join(tmp, `${tag}-t${t}.png`)],
   (e) => (e ? reject(e) : resolve())));
   for (let i = 0; i < times.length; i += 2) await Promise.all(times.slice(i, i + 2).map(one));
 }
@@ -189,7 +203,10 @@ async function playSampled(page, fps, advances, limitMs) {
           for (let i = 0; i < px.length; i += 4) {
             if (px[i] + px[i + 1] + px[i + 2] > MARKER) { n++; sx += (i / 4) % w; }
           }
-          const f = { t, x: n ? sx / n : -1 };
+          const z = T.zarr();
+          // A store drawn over bricks: whether this frame has every brick
+          // its view wants (else it shows coarser ones while they come).
+          const f = { t, x: n ? sx / n : -1, complete: !(z && z.last) || !!z.last.complete };
           const ref = window.__refs && window.__refs[t];
           if (ref && ref.length === px.length) {
             let sum = 0;
@@ -320,17 +337,150 @@ async function storeSeries(context, url, tmp, run) {
   await page.close();
 }
 
-async function storeBenchmark(context, url, tmp) {
-  const count = 20;
-  const store = path.join(tmp, 'cube256.ome.zarr');
-  const t0 = Date.now();
-  writeStore(store, 256, count);
-  console.log(`bench: wrote 20 x 256^3 u8 store in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
-  await renderTimes(store, [0, count - 1], 512, tmp);
-  const { page } = await openPage(context, url, `size=512&url=/data/cube256.ome.zarr`);
+// Resolves once the store's frame on the canvas has every brick its view
+// wants (or `limitMs`); whether it has.
+function storeComplete(page, limitMs) {
+  return page.evaluate(async (limitMs) => {
+    const start = performance.now();
+    const done = () => { const z = window.tessera.zarr(); return z && z.last && z.last.complete; };
+    while (!done() && performance.now() - start < limitMs) await new Promise((r) => setTimeout(r, 20));
+    return !!done();
+  }, limitMs);
+}
+
+// Each time point a run of frames: whether the last frame of every run
+// (the one the next time point replaced) was whole.
+function runsEndWhole(frames) {
+  const ends = frames.filter((f, i) => i + 1 < frames.length && frames[i + 1].t !== f.t);
+  return { ends: ends.length, partial: ends.filter((f) => !f.complete).map((f) => f.t) };
+}
+
+async function bricksSeries(context, url, tmp) {
+  const SIZE = 128;
+  const count = 6;
+  const store = path.join(tmp, 'cube6.ome.zarr');
+  const started = Date.now();
+  writeStore(store, 64, count);
+  const refTimes = [0, 3, 5];
+  await renderTimes(store, refTimes, SIZE, tmp, undefined, 'bricks');
+  const servedBefore = served.paths.length;
+  const { page, logs } = await openPage(context, url, `size=${SIZE}&slices=0&progressive=0&layout=bricks&url=/data/cube6.ome.zarr`);
+  await withoutOverlays(page);
   const s = await page.evaluate(() => window.tessera.time());
-  check('the 20 x 256^3 store opens as a time series', s.count === count, JSON.stringify(s));
-  await loadRefs(page, { 0: path.join(tmp, 'store-t0.png'), [count - 1]: path.join(tmp, `store-t${count - 1}.png`) });
+  check('a store with a t axis of 6 opens as a time series over bricks (?layout=bricks) with the Time panel shown',
+        s.count === count && s.bricks === true && s.shown === 0 &&
+        await page.evaluate(() => !document.getElementById('time-controls').hidden),
+        JSON.stringify(s) + (await page.evaluate(() => window.tessera.error())));
+  await loadRefs(page, Object.fromEntries(refTimes.map((t) => [t, path.join(tmp, `bricks-t${t}.png`)])));
+  const refX = {};
+  for (const t of refTimes) refX[t] = await markerOf(page, t);
+  const expectedX = (t) => (t <= 3 ? refX[0] + (refX[3] - refX[0]) * t / 3 : refX[3] + (refX[5] - refX[3]) * (t - 3) / 2);
+  const step = Math.abs(refX[5] - refX[0]) / (count - 1);
+  check('the cube is seen in every reference, a column per time point apart',
+        refTimes.every((t) => refX[t] >= 0) && step > 1, JSON.stringify(refX));
+
+  // The slider's path: a time point asked for is drawn from its own bricks.
+  const shown = await page.evaluate(() => window.tessera.showTime(3));
+  const whole = await storeComplete(page, 20000);
+  const own = await psnrAgainst(page, path.join(tmp, 'bricks-t3.png'));
+  const other = await psnrAgainst(page, path.join(tmp, 'bricks-t5.png'));
+  check('over bricks, time point 3 equals `tessera render STORE --time 3` (PSNR >= 40 dB) and not time point 5',
+        shown === 3 && whole && own.psnr >= 40 && other.psnr < own.psnr - 10,
+        own.error || `shown ${shown}, whole ${whole}: ${own.psnr.toFixed(2)} dB (time point 5: ${other.psnr.toFixed(2)} dB)`);
+
+  // Playback: a loop and more, every frame drawn sampled.
+  const p = await playSampled(page, 20, count + 1, 60000);
+  const order = inOrder(p.log, count);
+  const c = checkFrames(p, count, expectedX, step);
+  const runs = runsEndWhole(p.frames);
+  const complete = c.referenced.filter((f) => f.complete);
+  const lowWhole = complete.filter((f) => f.psnr < 40);
+  const rate = p.advances / p.seconds;
+  console.log(`store playback over bricks: ${p.advances} time points in ${p.seconds.toFixed(2)} s = ${rate.toFixed(1)} time points/s of 20, ` +
+              `${p.drawn} frames drawn (${p.frames.filter((f) => !f.complete).length} with bricks still coming), ${p.late} late frames; ` +
+              `${complete.length} whole frames against references, min ${complete.length ? Math.min(...complete.map((f) => f.psnr)).toFixed(2) : 'n/a'} dB`);
+  check('over bricks, playback shows every time point in order, none skipped (a loop and one more)',
+        p.log.length >= count + 2 && !order && c.all, `${order || ''} log ${p.log.join(',')}`);
+  check('over bricks, every frame drawn shows the time point it is labelled with (no stale brick moves the cube)',
+        p.frames.length >= count && c.wrong.length === 0,
+        `${p.frames.length} frames; wrong: ${JSON.stringify(c.wrong.slice(0, 5).map((f) => ({ t: f.t, x: +f.x.toFixed(1), want: +expectedX(f.t).toFixed(1) })))}`);
+  check('over bricks, each time point was drawn whole before the next was shown',
+        runs.ends >= count && runs.partial.length === 0, JSON.stringify(runs));
+  check('over bricks, the whole frames of referenced time points equal the CLI render (PSNR >= 40 dB)',
+        complete.length >= refTimes.length && lowWhole.length === 0,
+        `${complete.length} frames, ${lowWhole.length} below 40 dB`);
+  // Prefetch within the storage's budget: each time point's level-0 chunk
+  // fetched once over the page's life (read ahead, kept until drawn).
+  const keys = served.paths.slice(servedBefore).filter((k) => /\/cube6\.ome\.zarr\/0\/\d/.test(k));
+  check('over bricks, each time point\'s level-0 chunk fetched exactly once',
+        new Set(keys).size === count && keys.length === count, `${keys.length} fetches of ${new Set(keys).size} chunks`);
+  check('over bricks, no page errors', !logs.some((l) => l.startsWith('pageerror')) && !p.error,
+        p.error || logs.filter((l) => l.startsWith('pageerror')).join('; '));
+  console.log(`store series over bricks test: ${((Date.now() - started) / 1000).toFixed(1)} s`);
+  await page.close();
+}
+
+async function channelSeries(context, url, tmp) {
+  const SIZE = 96;
+  const count = 4;
+  const store = path.join(tmp, 'tc.ome.zarr');
+  const started = Date.now();
+  writeStore(store, 32, count, 2);
+  const { page, logs } = await openPage(context, url, `size=${SIZE}&slices=0&url=/data/tc.ome.zarr`);
+  await page.waitForFunction(() => window.tessera.channels() !== null, null, { timeout: 30000 }).catch(() => {});
+  const listed = await page.evaluate(() => window.tessera.channels());
+  const s = await page.evaluate(() => window.tessera.time());
+  check('a store with 2 channels and a t axis of 4 lists its channels and opens as a time series',
+        listed && listed.open && listed.channels.length === 2 && s.count === count && s.shown === 0,
+        JSON.stringify({ listed, s }) + (await page.evaluate(() => window.tessera.error())));
+  const tfPath = path.join(tmp, 'tc-tf.json');
+  fs.writeFileSync(tfPath, JSON.stringify(await page.evaluate(() => window.tessera.tf())));
+  const times = [0, 1, 2, 3];
+  await renderTimes(store, times, SIZE, tmp, ['--tf', tfPath, '--channels', '0,1'], 'tc');
+  await loadRefs(page, Object.fromEntries(times.map((t) => [t, path.join(tmp, `tc-t${t}.png`)])));
+
+  const shown = await page.evaluate(() => window.tessera.showTime(2));
+  await page.evaluate(() => window.tessera.render());
+  const own = await psnrAgainst(page, path.join(tmp, 'tc-t2.png'));
+  const other = await psnrAgainst(page, path.join(tmp, 'tc-t0.png'));
+  check('channels at time point 2 equal `tessera render STORE --channels 0,1 --time 2` (PSNR >= 40 dB), not time point 0',
+        shown === 2 && own.psnr >= 40 && other.psnr < own.psnr - 10,
+        own.error || `${own.psnr.toFixed(2)} dB (time point 0: ${other.psnr.toFixed(2)} dB)`);
+
+  const p = await playSampled(page, 20, count + 1, 60000);
+  const order = inOrder(p.log, count);
+  const scored = p.frames.filter((f) => f.psnr !== undefined);
+  const low = scored.filter((f) => f.psnr < 40);
+  const min = scored.length ? Math.min(...scored.map((f) => f.psnr)) : NaN;
+  console.log(`channels playback: ${p.advances} time points in ${p.seconds.toFixed(2)} s = ${(p.advances / p.seconds).toFixed(1)} ` +
+              `time points/s of 20, ${p.drawn} frames drawn, ${p.late} late frames; every frame against its time point's ` +
+              `CLI render: min ${min.toFixed(2)} dB`);
+  check('channels play every time point in order, none skipped (a loop and one more)',
+        p.log.length >= count + 2 && !order && new Set(p.frames.map((f) => f.t)).size === count, `${order} log ${p.log.join(',')}`);
+  check('every channel frame drawn equals the CLI render of the time point it is labelled with (PSNR >= 40 dB: none stale)',
+        scored.length >= count && low.length === 0,
+        `${scored.length} frames, low: ${JSON.stringify(low.slice(0, 5).map((f) => ({ t: f.t, db: +f.psnr.toFixed(1) })))}`);
+  check('channels: no page errors', !logs.some((l) => l.startsWith('pageerror')) && !p.error,
+        p.error || logs.filter((l) => l.startsWith('pageerror')).join('; '));
+  console.log(`channels series test: ${((Date.now() - started) / 1000).toFixed(1)} s`);
+  await page.close();
+}
+
+async function storeBenchmark(context, url, tmp, run, layout) {
+  const count = 20;
+  const bricks = layout === 'bricks';
+  const store = path.join(tmp, 'cube256.ome.zarr');
+  if (!fs.existsSync(store)) {  // the in-core and bricks runs share it
+    const t0 = Date.now();
+    writeStore(store, 256, count);
+    console.log(`bench: wrote 20 x 256^3 u8 store in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
+    await renderTimes(store, [0, count - 1], 512, tmp, undefined, 'bench256');
+  }
+  const { page } = await openPage(context, url, `size=512&slices=0${bricks ? '&layout=bricks' : ''}&url=/data/cube256.ome.zarr`);
+  await withoutOverlays(page);  // the store view's white box lines would pass for the cube
+  const s = await page.evaluate(() => window.tessera.time());
+  check(`the 20 x 256^3 store opens as a time series ${layout}`, s.count === count && !!s.bricks === bricks, JSON.stringify(s));
+  await loadRefs(page, { 0: path.join(tmp, 'bench256-t0.png'), [count - 1]: path.join(tmp, `bench256-t${count - 1}.png`) });
   const [x0, x1] = [await markerOf(page, 0), await markerOf(page, count - 1)];
   const step = Math.abs(x1 - x0) / (count - 1);
   check('the cube is seen in the references at 512x512', x0 >= 0 && x1 >= 0 && step > 1, `${x0} ${x1}`);
@@ -339,11 +489,16 @@ async function storeBenchmark(context, url, tmp) {
     const order = inOrder(p.log, count);
     const c = checkFrames(p, count, (t) => x0 + (x1 - x0) * t / (count - 1), step);
     const rate = p.advances / p.seconds;
-    console.log(`bench: web page, OME-Zarr 20 x 256^3 u8 at 512x512, asked ${fps}/s: ${rate.toFixed(2)} time points/s, ` +
+    const runs = runsEndWhole(p.frames);
+    console.log(`bench: web page, OME-Zarr 20 x 256^3 u8 at 512x512 ${layout}, asked ${fps}/s: ${rate.toFixed(2)} time points/s, ` +
                 `${p.advances} shown in ${p.seconds.toFixed(1)} s, ${p.drawn} frames drawn, ${p.late} late frames, ` +
+                (bricks ? `${runs.partial.length} time points left before drawn whole, ` : '') +
                 `${order || 'none skipped'}, ${c.shown.size} of ${count} time points shown, ${c.wrong.length} frames off their time point, ` +
-                `references min ${c.minPsnr.toFixed(2)} dB` + (p.error ? `; error: ${p.error}` : ''));
-    check(`store asked ${fps}/s: every time point shown in order, no stale frame`, !order && c.all && c.wrong.length === 0, order);
+                `references min ${c.minPsnr.toFixed(2)} dB` + (p.error ? `; error: ${p.error}` : '') +
+                (c.wrong.length ? `; off: ${JSON.stringify(c.wrong.slice(0, 8).map((f) => ({ t: f.t, x: +f.x.toFixed(1),
+                  want: +(x0 + (x1 - x0) * f.t / (count - 1)).toFixed(1), complete: f.complete })))}` : ''));
+    check(`store ${layout} asked ${fps}/s: every time point shown in order, no stale frame`,
+          !order && c.all && c.wrong.length === 0 && runs.partial.length === 0, order);
   }
   await page.close();
 }

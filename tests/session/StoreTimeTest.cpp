@@ -14,12 +14,15 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "support/TestSupport.h"
 #include "tessera/io/ZarrChannels.h"
+#include "tessera/lod/ReadLevel.h"
+#include "tessera/lod/ZarrMultiresSource.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/session/Session.h"
 
@@ -292,6 +295,141 @@ TEST(StoreTime, ChannelsOfATimePointFromBricksMatchTheReference) {
     std::printf("channels from bricks, time point %d: %.1f dB (%s)\n", t, f.psnr, f.layout.c_str());
     EXPECT_GE(f.psnr, 40.0);
   }
+}
+
+// Level 0 of a pyramid, its bytes.
+std::vector<std::uint8_t> levelZero(const lod::MultiresSource& source) {
+  const Volume v = lod::readLevel(source, 0);
+  const auto* p = reinterpret_cast<const std::uint8_t*>(v.bytes().data());
+  return {p, p + v.byteSize()};
+}
+
+// The page's store over fetch() (frontends/web/src/WebSessionTime.cpp):
+// the front end opens each time point's pyramid and draws it itself, its
+// reads never wait. Here the "fetched" time points are a set the test
+// fills: a time point is shown only once its bytes arrived and it was read
+// (a jump too), the drawn pyramid is that time point's, the session's own
+// volume stays, and playback holds a time point whose frame the front end
+// has not finished (counted late), never skipping one.
+TEST(StoreTime, ASeriesTheFrontEndDrawsShowsATimePointOnlyOnceItArrived) {
+  const test::TempDir dir;
+  const std::string store = writeStore(dir.path(), 5, 1).string();
+  Session s("native");
+  s.open("gen:sphere:16");
+  std::map<int, std::shared_ptr<const lod::MultiresSource>> opened;
+  std::set<int> arrived{0};
+  std::vector<int> asked;
+  constexpr std::uint64_t kWarm = kN * kN * kN + (kN / 2) * (kN / 2) * (kN / 2);
+  s.drawStreamedSeries(
+      5,
+      [&](int t) -> std::shared_ptr<const lod::MultiresSource> {
+        std::shared_ptr<const lod::MultiresSource> p =
+            lod::ZarrMultiresSource::open(store, {.time = t});
+        opened[t] = p;
+        return p;
+      },
+      kWarm, 2 * kWarm, "store", 0, TimeSeries::Reading::OnPump);
+  s.series()->setArrival(
+      [&](int t) {
+        if (!arrived.count(t)) asked.push_back(t);
+        return arrived.count(t) > 0;
+      },
+      1);
+  ASSERT_NE(s.series(), nullptr);
+  EXPECT_EQ(s.series()->count(), 5);
+  EXPECT_EQ(s.series()->keep(), 2);              // what the front end's fetched bytes hold
+  EXPECT_EQ(s.volume().dims(), glm::ivec3(16));  // the session's own volume stays
+  EXPECT_FALSE(s.streamed());
+  ASSERT_NE(s.drawnPyramid(), nullptr);
+  EXPECT_EQ(s.drawnPyramid().get(), opened.at(0).get());
+  EXPECT_EQ(s.timePoint(), 0);
+
+  // A jump to a time point not fetched: asked for, not shown.
+  EXPECT_FALSE(s.showTimePoint(3));
+  EXPECT_FALSE(s.series()->pump());
+  EXPECT_NE(std::find(asked.begin(), asked.end(), 3), asked.end());
+  EXPECT_EQ(s.timePoint(), 0);
+  EXPECT_EQ(s.drawnPyramid().get(), opened.at(0).get());
+  // Its bytes arrive: read on the pump, then shown, its own voxels drawn.
+  arrived.insert(3);
+  EXPECT_TRUE(s.series()->pump());
+  ASSERT_TRUE(s.showTimePoint(3));
+  EXPECT_EQ(s.timePoint(), 3);
+  EXPECT_EQ(s.drawnPyramid().get(), opened.at(3).get());
+  EXPECT_EQ(levelZero(*s.drawnPyramid()),
+            levelZero(*lod::ZarrMultiresSource::open(store, {.time = 3})));
+  EXPECT_THROW(s.showTimePoint(5), InputError);
+
+  // Playback with every time point fetched; the front end finishes each
+  // time point's frame on its second frame.
+  arrived = {0, 1, 2, 3, 4};
+  s.playback().setFps(20.0);
+  s.playback().play(0.0);
+  std::vector<int> sequence{s.timePoint()};
+  double now = 0.0;
+  int held = 0;  // due frames whose shown time point was not finished
+  for (int frame = 0; frame < 60 && sequence.size() < 8; ++frame) {
+    now += 100.0;  // every frame is past the 50 ms period
+    const bool complete = frame % 2 == 1;
+    const int t = s.stepPlayback(now, complete);
+    if (!complete) ++held;
+    if (t == sequence.back()) continue;
+    EXPECT_TRUE(complete) << "time point " << sequence.back() << " left before its frame was done";
+    sequence.push_back(t);
+    EXPECT_EQ(s.drawnPyramid().get(), opened.at(t).get()) << "time point " << t;
+  }
+  EXPECT_EQ(sequence, (std::vector<int>{3, 4, 0, 1, 2, 3, 4, 0}));
+  EXPECT_EQ(s.playback().advances(), 7u);
+  EXPECT_GE(s.playback().lateFrames(), static_cast<std::uint64_t>(held) - 1);
+  std::printf("front end's series: %zu shown, %llu late frames (%d held for their frame)\n",
+              sequence.size(), static_cast<unsigned long long>(s.playback().lateFrames()), held);
+
+  // The front end draws another pyramid (or none): the series ends.
+  s.drawPyramid(nullptr);
+  EXPECT_EQ(s.series(), nullptr);
+  EXPECT_EQ(s.timePoint(), 0);
+  EXPECT_EQ(s.volume().dims(), glm::ivec3(16));
+}
+
+// The page's channels of a store with a t axis: a time point's channels
+// are read once all their bytes arrived (the arrival the page gives), and
+// shown together.
+TEST(StoreTime, ChannelsTheCallerReadsPlayOnceTheirBytesArrived) {
+  const test::TempDir dir;
+  const std::string store = writeStore(dir.path(), 4, 2).string();
+  Session s("native");
+  useLook(s);
+  std::set<int> arrived{0};
+  std::vector<int> asked;
+  ChannelView& view = s.channelView();
+  view.showSeries(
+      4, readZarrChannels(store, {}, 0), [&](int t) { return readZarrChannels(store, {}, t); },
+      "store", 0, TimeSeries::Reading::OnPump,
+      [&](int t) {
+        if (!arrived.count(t)) asked.push_back(t);
+        return arrived.count(t) > 0;
+      },
+      1);
+  ASSERT_NE(s.series(), nullptr);
+  EXPECT_EQ(s.series()->count(), 4);
+  EXPECT_EQ(view.channels().size(), 2);
+  EXPECT_FALSE(s.showTimePoint(2));
+  EXPECT_FALSE(s.series()->pump());
+  EXPECT_NE(std::find(asked.begin(), asked.end(), 2), asked.end());
+  EXPECT_EQ(s.timePoint(), 0);
+  arrived.insert(2);
+  EXPECT_TRUE(s.series()->pump());
+  ASSERT_TRUE(s.showTimePoint(2));
+  EXPECT_EQ(s.timePoint(), 2);
+  const ChannelSet direct = readZarrChannels(store, {}, 2);
+  for (int c = 0; c < 2; ++c) {
+    const Volume& a = *view.channels()[c].volume;
+    const Volume& b = *direct[c].volume;
+    ASSERT_EQ(a.dims(), b.dims());
+    EXPECT_EQ(std::memcmp(a.bytes().data(), b.bytes().data(), a.byteSize()), 0)
+        << "channel " << c << " is another time point's";
+  }
+  EXPECT_THROW(view.showSeries(1, readZarrChannels(store, {}, 0), nullptr, "store", 0), InputError);
 }
 
 }  // namespace

@@ -1,8 +1,10 @@
 // The C API of the page's channel list (frontends/web/channels-panel.js):
 // an open OME-Zarr store with several channels is read through the store's
 // own fetch() storage (the page fetches the keys a step wants, as for the
-// store's bricks) into session::ChannelView, whose calls the list's
+// store's bricks; a store with a t axis plays its channels together, the
+// time points ahead fetched between frames) into session::ChannelView, whose calls the list's
 // toggles, colours and windows marshal to; its frame goes on the canvas.
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -23,13 +25,38 @@ session::ChannelView& channelView() {
 }
 
 // The channels' keys all held: readZarrChannels reads without waiting.
-bool channelKeysReady(const std::shared_ptr<const ZarrStorage>& storage, web::FetchStorage& fetch,
-                      const std::string& name, const std::vector<int>& indices, int time) {
+bool channelKeysReady(const std::shared_ptr<const ZarrStorage>& storage,
+                      const web::FetchStorage& fetch, const std::string& name,
+                      const std::vector<int>& indices, int time) {
   bool ready = true;
   for (const std::string& key : zarrChannelKeys(storage, name, indices, time)) {
     ready = fetch.ready(key) && ready;  // lists every key still to fetch
   }
   return ready;
+}
+
+// A store with a t axis: its channels play together (ChannelView::showSeries),
+// each time point's set read once all its keys have arrived, the page
+// fetching one time point ahead at a time between its frames. The storage
+// is kept alive by the store's source (the lambdas hold it).
+void showChannelSeries(web::ZarrStoreView& z, ChannelSet first, const std::string& name,
+                       const std::vector<int>& indices, int time) {
+  const std::shared_ptr<const web::FetchStorage> fetch(z.sharedSource(), &z.storage());
+  const std::uint64_t each = std::max<std::uint64_t>(1, session::ChannelSeries::bytes(first));
+  const int ahead = static_cast<int>(std::clamp<std::uint64_t>(
+      web::kStoreFetchAheadBytes / each, 1, static_cast<std::uint64_t>(z.store().timePoints())));
+  channelView().showSeries(
+      z.store().timePoints(), std::move(first),
+      [fetch, name, indices](int t) { return readZarrChannels(fetch, name, indices, t); }, name,
+      time, session::TimeSeries::Reading::OnPump,
+      [fetch, name, indices](int t) {
+        try {
+          return channelKeysReady(fetch, *fetch, name, indices, t);
+        } catch (const web::KeyNotFetched&) {
+          return false;  // metadata the storage let go of: wanted again
+        }
+      },
+      ahead);
 }
 
 nlohmann::json channelJson(const Channel& c) {
@@ -70,7 +97,12 @@ EMSCRIPTEN_KEEPALIVE int tessera_channels_open_step() {
       state = 0;  // metadata the storage let go of: wanted again
       return;
     }
-    channelView().show(readZarrChannels(storage, name, indices, time), name);
+    ChannelSet first = readZarrChannels(storage, name, indices, time);
+    if (z.store().timePoints() > 1) {
+      showChannelSeries(z, std::move(first), name, indices, time);
+    } else {
+      channelView().show(std::move(first), name);
+    }
     state = 1;
   });
   return state;

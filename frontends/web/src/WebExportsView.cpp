@@ -82,8 +82,9 @@ EMSCRIPTEN_KEEPALIVE void tessera_clear_files() {
 }
 
 // The open time series (a dropped 4-D NIfTI; session/TimeSeries.h):
-// {"count": N, "shown": t, "playing": bool, "fps": f, "late": frames,
-// "advances": n}, or {"count": 1} when the volume is not a series.
+// {"count": N, "shown": t, "bricks": bool (a store's t axis over bricks),
+// "playing": bool, "fps": f, "late": frames, "advances": n}, or
+// {"count": 1} when the volume is not a series.
 EMSCRIPTEN_KEEPALIVE const char* tessera_time_json() {
   web::WebSession* s = web::sessionIfAny();
   const session::TimeSeries* series = s ? s->rendering().series() : nullptr;
@@ -91,6 +92,7 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_time_json() {
   session::Playback& p = s->rendering().playback();
   return web::jsonOut({{"count", series->count()},
                        {"shown", s->rendering().timePoint()},
+                       {"bricks", s->rendering().streamedSeries() != nullptr},
                        {"playing", p.playing()},
                        {"fps", p.fps()},
                        {"late", p.lateFrames()},
@@ -130,7 +132,10 @@ EMSCRIPTEN_KEEPALIVE int tessera_playback(int play, double fps, double nowMs) {
 // error.
 EMSCRIPTEN_KEEPALIVE int tessera_playback_step(double nowMs) {
   int shown = -1;
-  const int ok = guarded([&] { shown = web::session().rendering().stepPlayback(nowMs); });
+  const int ok = guarded([&] {
+    web::WebSession& w = web::session();
+    shown = w.rendering().stepPlayback(nowMs, w.storeTimeFinished());
+  });
   return ok ? shown : -1;
 }
 

@@ -214,6 +214,10 @@ class WebSession {
   // viewer's progressive frames (its frameBudgetMs); `viewChanged`: a
   // preview at once, else the canvas keeps its image until the frame is done.
   StoreFrame storeFrame(int width, int height, bool viewChanged);
+  // Whether the time point shown is on the canvas whole, as playback's
+  // next one waits for (Session::stepPlayback): the store's, when its t
+  // axis plays over bricks; true otherwise.
+  bool storeTimeFinished();
   // About a budget of the pending store frame (ZarrStoreView::refine).
   StoreFrame storeRefine() { return theStore().refine(); }
   // The grid view's last block over a store, while the store is drawn.

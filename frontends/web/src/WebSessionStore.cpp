@@ -72,10 +72,10 @@ bool WebSession::showStoreRegionAgain() {
 
 // The viewer core's volume shows again.
 void WebSession::closeStore() {
+  session_->drawPyramid(nullptr);  // its time series too, which reads through the store view
   zarr_.reset();
   regionAgain_.reset();
   session_->endExploration();
-  session_->drawPyramid(nullptr);
 }
 
 // Ends past the level are clamped; an empty box or one that starts outside
@@ -129,6 +129,11 @@ std::optional<lod::VoxelBox> WebSession::storeGridBlock() {
 StoreFrame WebSession::storeFrame(int width, int height, bool viewChanged) {
   viewer::Viewer& v = viewer();
   ZarrStoreView& z = theStore();
+  // The store's t axis over bricks (WebSessionTime.cpp): the time point
+  // the session shows is drawn, through its own bricks.
+  if (session_->streamedSeries() && z.timePoint() != session_->timePoint()) {
+    z.showTime(session_->timePoint());
+  }
   // The picked region (red) and the grid view's last block (cyan) over the
   // store, level-0 voxels, as over a file's overview (applyMarkBoxes),
   // composed by depth.
@@ -149,6 +154,15 @@ StoreFrame WebSession::storeFrame(int width, int height, bool viewChanged) {
       v.camera(), v.frameSettings(), v.tfEditor().transferFunction(), v.tfEditor().revision(),
       v.showBoundingBox, v.showAxes, width, height, v.maxVolumePixels, marks,
       {.progressive = v.progressive, .budgetMs = v.frameBudgetMs, .viewChanged = viewChanged});
+}
+
+}  // namespace tessera::web
+
+namespace tessera::web {
+
+bool WebSession::storeTimeFinished() {
+  if (!zarr_ || !zarr_->isOpen() || !session_->streamedSeries()) return true;
+  return zarr_->finished(session_->timePoint());
 }
 
 }  // namespace tessera::web

@@ -1,12 +1,14 @@
 // An OME-Zarr store's t axis in the page (frontends/web/store-time.js drives
-// it). A store whose level 0 fits a quarter of the host budget plays back as
-// a dropped 4-D NIfTI does, through the session (Session::openSeries,
-// session/TimeSeries.h): each time point is read in core from the keys the
-// page fetched with the store's own fetch() storage, the session asks for
-// the time points ahead (TimeSeries::setArrival) and the page fetches their
-// chunks between its frames; one that has not arrived when due is shown
-// late. A store too large for that streams bricks at its first time point
-// (ZarrStoreView), as `tessera view` explores such a store.
+// it), through the session (session/TimeSeries.h): the session asks for the
+// time points ahead (TimeSeries::setArrival) and the page fetches their
+// chunks with the store's own fetch() storage between its frames; one that
+// has not arrived when due is shown late. A store whose level 0 fits a
+// quarter of the host budget plays back as a dropped 4-D NIfTI does
+// (Session::openSeries), each time point read in core. A larger one, or one
+// the page asks to (?layout=bricks), plays over bricks
+// (Session::drawStreamedSeries): the store view draws each time point
+// through a bricks layout of its own (ZarrStoreView::showTime), and the
+// next ones' levels are fetched and read ahead.
 #include <emscripten/emscripten.h>
 
 #include <algorithm>
@@ -19,16 +21,12 @@
 #include "WebSession.h"
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/session/StreamedSeries.h"
 #include "tessera/session/TimeSeries.h"
 
 namespace tessera::web {
 
 namespace {
-
-// The stored bytes the page fetches ahead at once: half of what the
-// store's fetch() storage keeps (ZarrStoreView.cpp's kFetchedBytes), so a
-// time point's chunks are not let go before it is read.
-constexpr std::uint64_t kFetchAheadBytes = 24ull << 20;
 
 // The store's time points, each a ZarrStore of one selection over the same
 // fetched keys, made when first asked for (its metadata may have to be
@@ -81,18 +79,53 @@ class StoreTimePoints {
   std::map<int, std::unique_ptr<ZarrStore>> stores_;
 };
 
+// Whether time point t's levels that are read ahead (those whose voxels
+// fit the bytes fetched ahead, StreamedSeries::levelsWithin) have all
+// arrived; if not, their missing keys are wanted.
+bool levelsArrived(ZarrStoreView& view, int t) {
+  try {
+    const std::shared_ptr<const FetchedZarrSource> source = view.sourceAt(t);
+    bool ready = true;
+    for (const int level : session::StreamedSeries::levelsWithin(*source, kStoreFetchAheadBytes)) {
+      ready = source->prefetch(level, {glm::ivec3(0), source->levelInfo(level).dims}) && ready;
+    }
+    return ready;
+  } catch (const KeyNotFetched&) {
+    return false;  // its metadata: wanted
+  }
+}
+
+// The store's t axis over bricks: a series the page draws
+// (Session::drawStreamedSeries) of the store view's time points, read
+// ahead one at a time as their levels arrive, as many held as two fit
+// what the storage keeps. The store view outlives it (closeStore ends the
+// series first).
+void openBrickedSeries(session::Session& s, ZarrStoreView& view) {
+  const int count = view.store().timePoints();
+  s.drawStreamedSeries(
+      count,
+      [&view](int t) -> std::shared_ptr<const lod::MultiresSource> { return view.sourceAt(t); },
+      kStoreFetchAheadBytes, kStoreFetchedBytes, view.storage().describe(), view.timePoint(),
+      session::TimeSeries::Reading::OnPump);
+  s.series()->setArrival([&view](int t) { return levelsArrived(view, t); }, 1);
+}
+
 }  // namespace
 
-// 1: the store's time series is open in the session (its first time point
-// read); 0: keys are wanted (the page fetches them and calls again); 2: not
-// a series the page plays (one time point, or level 0 beyond a quarter of
-// the host budget: the store streams bricks at its first time point).
-int openStoreSeries(WebSession& web) {
+// 1: the store's time series is open in the session, in core (its first
+// time point read); 3: open over bricks; 0: keys are wanted (the page
+// fetches them and calls again); 2: not a series (one time point).
+// `bricks`: over bricks even when level 0 would fit in core.
+int openStoreSeries(WebSession& web, bool bricks) {
   ZarrStoreView* view = web.store();
   if (!view || !view->isOpen()) throw Error("no OME-Zarr store is open");
   const ZarrStore& store = view->store();
   const int count = store.timePoints();
-  if (count < 2 || store.finestLevelWithin(HostBudget::global().limitBytes() / 4) != 0) return 2;
+  if (count < 2) return 2;
+  if (bricks || store.finestLevelWithin(HostBudget::global().limitBytes() / 4) != 0) {
+    openBrickedSeries(web.rendering(), *view);
+    return 3;
+  }
   // The view's storage, kept alive by its source as long as the series is.
   const std::shared_ptr<const FetchStorage> storage(view->sharedSource(), &view->storage());
   auto points = std::make_shared<StoreTimePoints>(storage, store.selection().channel);
@@ -104,7 +137,7 @@ int openStoreSeries(WebSession& web) {
       session::TimeSeries::Reading::OnPump);
   const std::uint64_t each = std::max<std::uint64_t>(1, points->bytesPerTimePoint(first));
   const int ahead = static_cast<int>(std::clamp<std::uint64_t>(
-      kFetchAheadBytes / each, 1, static_cast<std::uint64_t>(s.series()->keep())));
+      kStoreFetchAheadBytes / each, 1, static_cast<std::uint64_t>(s.series()->keep())));
   s.series()->setArrival([points](int t) { return points->arrived(t); }, ahead);
   return 1;
 }
@@ -113,13 +146,14 @@ int openStoreSeries(WebSession& web) {
 
 extern "C" {
 
-// The open store's t axis as a time series (openStoreSeries above): 1 open,
-// 0 keys wanted (tessera_zarr_wanted), 2 not played (one time point, or
-// streamed), -1 failed (tessera_last_error).
-EMSCRIPTEN_KEEPALIVE int tessera_store_time_open_step() {
+// The open store's t axis as a time series (openStoreSeries above): 1 open
+// in core, 3 open over bricks (asked for with `bricks` 1, or level 0 too
+// large), 0 keys wanted (tessera_zarr_wanted), 2 not a series (one time
+// point), -1 failed (tessera_last_error).
+EMSCRIPTEN_KEEPALIVE int tessera_store_time_open_step(int bricks) {
   int state = -1;
   const int ok = tessera::web::guarded(
-      [&] { state = tessera::web::openStoreSeries(tessera::web::session()); });
+      [&] { state = tessera::web::openStoreSeries(tessera::web::session(), bricks != 0); });
   return ok ? state : -1;
 }
 

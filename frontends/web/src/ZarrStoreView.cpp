@@ -14,9 +14,6 @@ namespace tessera::web {
 
 namespace {
 
-// Decoded chunks' stored bytes the page keeps: compressed, so many chunks
-// (a brick read with its apron touches its neighbours' chunks).
-constexpr std::uint64_t kFetchedBytes = 48ull << 20;
 // As the viewer core plans its uploads (viewer/Viewer.cpp).
 constexpr int kPlanImageSize = 1024;
 constexpr int kSkipBlock = 8;
@@ -61,7 +58,7 @@ ZarrStoreView::ZarrStoreView(gpu::GlContext& context, const gpu::DeviceLimits& l
                              const std::string& url)
     : context_(context),
       limits_(limits),
-      storage_(std::make_shared<FetchStorage>(url, kFetchedBytes)) {}
+      storage_(std::make_shared<FetchStorage>(url, kStoreFetchedBytes)) {}
 
 ZarrStoreView::ZarrStoreView(gpu::GlContext& context, const gpu::DeviceLimits& limits, Host host)
     : context_(context),
@@ -81,19 +78,66 @@ bool ZarrStoreView::open() {
     const lod::VoxelBox all{glm::ivec3(0), store_->level(top).dims};
     if (!source_->prefetch(top, all)) return false;
     coarsest_ = source_->readBox(top, all);
-    const lod::MultiresVolumeSource volumeSource(source_);
-    active_ = render::createTechnique(
-        "raycast", context_, limits_, volumeSource,
-        {.imageSize = {kPlanImageSize, kPlanImageSize}, .skipBlock = kSkipBlock}, "bricks");
+    time_ = store_->selection().time;
+    shown_ = source_;
+    times_[time_] = source_;
+    createBricks();
   } catch (const std::exception&) {
     if (storage_->hasWanted()) return false;
     throw;
   }
+  compositor_ = std::make_unique<render::HybridCompositor>(context_);
+  return true;
+}
+
+// The ray caster over the bricks layout of the time point shown.
+void ZarrStoreView::createBricks() {
+  const lod::MultiresVolumeSource volumeSource(shown_);
+  active_ = render::createTechnique(
+      "raycast", context_, limits_, volumeSource,
+      {.imageSize = {kPlanImageSize, kPlanImageSize}, .skipBlock = kSkipBlock}, "bricks");
   bricks_ = active_.upload.layout ? active_.upload.layout->streaming() : nullptr;
   if (!bricks_) throw Error(storage_->describe() + ": the bricks layout was not created");
   active_.technique->setFusion(fused_);
-  compositor_ = std::make_unique<render::HybridCompositor>(context_);
-  return true;
+}
+
+std::shared_ptr<const FetchedZarrSource> ZarrStoreView::sourceAt(int time) {
+  if (!store_) throw Error(storage_->describe() + ": the store is not open yet");
+  auto it = times_.find(time);
+  if (it != times_.end()) return it->second;
+  if (time < 0 || time >= store_->timePoints()) {
+    throw InputError(storage_->describe() + ": time point " + std::to_string(time) +
+                     " asked for, the store has " + std::to_string(store_->timePoints()));
+  }
+  auto store = std::make_shared<const ZarrStore>(
+      storage_, ZarrSelection{.time = time, .channel = store_->selection().channel});
+  auto source = std::make_shared<const FetchedZarrSource>(std::move(store), storage_);
+  return times_.emplace(time, std::move(source)).first->second;
+}
+
+void ZarrStoreView::showTime(int time) {
+  if (time == time_ && shown_) return;
+  std::shared_ptr<const FetchedZarrSource> next = sourceAt(time);
+  const int top = next->levelCount() - 1;
+  if (!next->resident(top, {glm::ivec3(0), next->levelInfo(top).dims})) {
+    throw Error(storage_->describe() + ": time point " + std::to_string(time) +
+                ": its coarsest level has not arrived");
+  }
+  pending_ = {};
+  active_ = {};  // the time point before's atlas, page table and ray caster
+  bricks_ = nullptr;
+  shown_ = std::move(next);
+  time_ = time;
+  createBricks();
+  shownBricks_ = {};
+  shownVersion_ = 0;
+  tablesVersion_ = ~std::uint64_t(0);
+  tfRevision_ = ~std::uint64_t(0);  // the new ray caster takes the TF at the next frame
+  framedWhole_ = false;
+}
+
+bool ZarrStoreView::finished(int time) const {
+  return time == time_ && framedWhole_ && !pending_.active && shownBricks_.complete;
 }
 
 void ZarrStoreView::setFusion(std::shared_ptr<const FusedVolume> fused) {
@@ -215,6 +259,7 @@ StoreFrame ZarrStoreView::drawWhole(const FrameView& v, StoreFrame f,
   const auto t1 = std::chrono::steady_clock::now();
   show(active_.technique->render(v.camera, v.pass, v.renderWidth, v.renderHeight, 0.0), v);
   shownVersion_ = active_.upload.layout->contentVersion();
+  framedWhole_ = true;
   msPerPixel_ = msSince(t1) / (static_cast<double>(v.renderWidth) * v.renderHeight);
   f.shown = true;
   f.ms = msSince(t0);
@@ -352,6 +397,7 @@ StoreFrame ZarrStoreView::strip() {
   if (!f.pending) {
     show(*image, v);
     shownVersion_ = active_.upload.layout->contentVersion();
+    framedWhole_ = true;
     f.shown = true;
     pending_ = {};
   }

@@ -7,6 +7,8 @@
 // are listed for the page to fetch. The viewer core's camera, transfer
 // function and render settings drive it, so the page's controls work on it.
 #include <chrono>
+#include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -25,6 +27,14 @@
 #include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::web {
+
+// The stored bytes of the chunks a store view keeps (its FetchStorage's
+// budget; compressed, so many chunks: a brick read with its apron touches
+// its neighbours' chunks), and what a time series fetches ahead of the
+// time point shown: half, so that the shown one's chunks are not let go
+// for the next one's.
+inline constexpr std::uint64_t kStoreFetchedBytes = 48ull << 20;
+inline constexpr std::uint64_t kStoreFetchAheadBytes = kStoreFetchedBytes / 2;
 
 // A store's levels read through a FetchStorage: prefetch() lists the
 // chunks a box needs that have not arrived.
@@ -109,6 +119,21 @@ class ZarrStoreView {
   // (prefetch true) reads without the network.
   const FetchedZarrSource& source() const { return *source_; }
   std::shared_ptr<const FetchedZarrSource> sharedSource() const { return source_; }
+  // The store's t axis played over bricks (WebSessionTime.cpp). Time
+  // point t's levels: the store's selection at t over the same fetched
+  // keys, made on first use (its metadata read from the storage:
+  // KeyNotFetched, the keys wanted, while they have not arrived).
+  std::shared_ptr<const FetchedZarrSource> sourceAt(int time);
+  // Draws time point t from now on through a bricks layout of its own, so
+  // that no brick of another time point is drawn for it (the one before's
+  // atlas and page table go first: the texture budget holds one). Its
+  // coarsest level must have arrived (an Error naming the store if not).
+  void showTime(int time);
+  int timePoint() const { return time_; }
+  // Whether a whole frame of time point t is on the canvas with every
+  // brick the view wants (none coming, no frame pending): playback's next
+  // time point waits for it (Session::stepPlayback).
+  bool finished(int time) const;
   // The coarsest level, read once at open (for the page's histogram).
   const Volume& coarsest() const { return coarsest_; }
   // A second volume fused into the store's ray march (docs/fusion.md),
@@ -141,6 +166,12 @@ class ZarrStoreView {
   std::shared_ptr<FetchStorage> storage_;
   std::shared_ptr<const ZarrStore> store_;
   std::shared_ptr<const FetchedZarrSource> source_;
+  // The time point drawn and its levels (source_'s until showTime), and
+  // the others opened (sourceAt).
+  int time_ = 0;
+  std::shared_ptr<const FetchedZarrSource> shown_;
+  std::map<int, std::shared_ptr<const FetchedZarrSource>> times_;
+  bool framedWhole_ = false;  // a whole frame of time_ is on the canvas
   Volume coarsest_;
   render::TechniqueOnVolume active_;
   layout::StreamingLayout* bricks_ = nullptr;
@@ -167,6 +198,7 @@ class ZarrStoreView {
     double done = 0.0;  // fraction of the rows drawn
     double rows = 0.0;  // the last strip's
   };
+  void createBricks();
   layout::UpdatePace streamPace() const;
   layout::BricksFrame stream(const FrameView& v, double ms);
   // The technique's image of `v` composed into the canvas, waited for.

@@ -48,6 +48,17 @@ class ChannelView {
   // and visibility stay: they are the settings'), else asks for them and
   // returns false. InputError without a series or for t out of range.
   bool showTime(int t);
+  // A store's t axis whose channels the caller reads (the page's store
+  // over fetch()): `first`, time point `time`'s set, shown now under
+  // `name` with settings().channels applied, and the time points after it
+  // read ahead by `read` as `reading` says, as many held as a quarter of
+  // the host budget holds. With `arrived` (an OnPump series), a time point
+  // is read once its bytes are at hand, at most `ahead` asked for at once
+  // (TimeSeries::setArrival). open() plays a store's t axis through this.
+  // InputError for fewer than 2 time points or `time` out of range.
+  void showSeries(int count, ChannelSet first, ChannelSeries::Reader read, const std::string& name,
+                  int time, TimeSeries::Reading reading = TimeSeries::defaultReading(),
+                  TimeSeries::Arrival arrived = {}, int ahead = 1);
   // Channels the caller read (the page's store over fetch()), shown under
   // `name` with settings().channels applied.
   void show(ChannelSet set, const std::string& name);

@@ -111,6 +111,19 @@ class Session {
   // ones opened and warmed ahead within the host budget
   // (SessionStreamedSeries.cpp). The view draws in-core time points.
   void openStreamedSeries(const std::string& spec, const OpenOptions& options = {});
+  // A store's t axis over bricks that a front end draws itself (the page's
+  // store over fetch(), whose reads never wait): time point t's pyramid is
+  // opened by `at` and read ahead as StreamedSeries reads (its levels that
+  // fit `warmBytes`, with the series' arrival when the front end fetches:
+  // TimeSeries::setArrival on series()), as many held as `heldBytes` holds
+  // at `warmBytes` each (at least 2). The session's own volume stays; the
+  // shown time point's pyramid is drawnPyramid() (what an overlay aligns
+  // with and probe() reads). A time point, a jump too, is shown only once
+  // read: showTimePoint returns false until then. drawPyramid() ends it.
+  // InputError for fewer than 2 time points or `time` out of range.
+  void drawStreamedSeries(int count, StreamedSeries::SourceAt at, std::uint64_t warmBytes,
+                          std::uint64_t heldBytes, const std::string& name, int time = 0,
+                          TimeSeries::Reading reading = TimeSeries::defaultReading());
   // The open series (null when the volume is not one): the channel view's
   // when it plays one (ChannelView::series), a streamed one's read-ahead of
   // pyramids.
@@ -128,9 +141,12 @@ class Session {
   // Playback of the series (session/TimeSeries.h): called once per drawn
   // frame, it shows the next time point when it is due, read, and the
   // view has finished the frame of the one shown (not refining); the
-  // number of the time point shown.
+  // number of the time point shown. `shownComplete`: whether a front end
+  // that draws the frames itself (drawStreamedSeries) has drawn the shown
+  // time point whole (all its bricks); until it has, the next one waits,
+  // a late frame once it is due.
   Playback& playback() { return playback_; }
-  int stepPlayback(double nowMs);
+  int stepPlayback(double nowMs, bool shownComplete = true);
 
   bool hasVolume() const { return inCore_ != nullptr || streamed_ != nullptr; }
   // Read from a pyramid level by level and box by box, not held whole.
@@ -219,9 +235,10 @@ class Session {
   // A pyramid a front end draws itself (the page's OME-Zarr store over
   // fetch, bricked): overlays align with its shape, probe() reads its
   // voxels; null: the session's own volume again.
-  void drawPyramid(std::shared_ptr<const lod::MultiresSource> pyramid) {
-    drawn_ = std::move(pyramid);
-  }
+  // A series drawn by the front end (drawStreamedSeries) ends here.
+  void drawPyramid(std::shared_ptr<const lod::MultiresSource> pyramid);
+  // The pyramid the front end draws: drawPyramid's, or the shown time point's.
+  const std::shared_ptr<const lod::MultiresSource>& drawnPyramid() const { return drawn_; }
   // The open overlay with a new look (labels, colour map, alpha, window),
   // its volume kept; InputError when none is open.
   void restyleOpenOverlay(const OverlayOptions& options);
@@ -288,6 +305,8 @@ class Session {
   std::unique_ptr<TimeSeries> series_;
   std::unique_ptr<StreamedSeries> streamedSeries_;
   bool showStreamedTimePoint(int t);
+  bool showDrawnTimePoint(int t);
+  bool seriesDrawn_ = false;  // streamedSeries_ is drawn by the front end
   std::optional<ValueRange> seriesWindow_;
   // The modality default (session/ModalityDefault.h): whether the volume
   // came with its own window, what was chosen, the TF it replaced.
