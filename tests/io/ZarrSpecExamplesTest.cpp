@@ -81,9 +81,8 @@ std::vector<std::byte> bytesOf(const std::string& s) {
 
 // j[key] when j is an object holding a string there, else "".
 std::string stringAt(const json& j, const char* key) {
-  if (!j.is_object()) return "";
-  const auto it = j.find(key);
-  return it != j.end() && it->is_string() ? it->get<std::string>() : std::string();
+  if (!j.is_object() || !j.contains(key) || !j.at(key).is_string()) return "";
+  return j.at(key).get<std::string>();
 }
 
 // A v3 store holding `group` as its zarr.json and, for every dataset of

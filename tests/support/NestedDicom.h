@@ -206,7 +206,9 @@ inline std::string nestedDicomFile(const NestedDicomOptions& o) {
   groupLength.u32(static_cast<std::uint32_t>(meta.out.size()));
   const std::string dataset =
       enc == NestedEncoding::Deflated ? nested_detail::deflateRaw(d.out) : d.out;
-  return std::string(128, '\0') + "DICM" + groupLength.out + meta.out + dataset;
+  std::string file(128, '\0');  // the preamble
+  file.append("DICM").append(groupLength.out).append(meta.out).append(dataset);
+  return file;
 }
 
 }  // namespace tessera::test
