@@ -22,6 +22,7 @@
 #include "desktop/Panels.h"
 #include "desktop/RecordingHost.h"
 #include "support/TestSupport.h"
+#include "tessera/gpu/GlObjects.h"
 #include "tessera/io/NiftiWriter.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/session/OverlayPanel.h"
@@ -137,11 +138,37 @@ class PanelsOverlay : public ::testing::Test {
   // The same overlay opened straight through the session (what `tessera
   // render --overlay` does), with the options the panel's controls mean.
   static Image directFrame(const session::OverlayControls& controls) {
+    return directFrame(&controls);
+  }
+  // The same without an overlay (null controls).
+  static Image directFrame(const session::OverlayControls* controls) {
     session::Session direct("native");
     look(direct);
     direct.open(anatomyPath());
-    direct.openOverlay(overlayPath(), session::overlayOptionsOf(controls));
+    if (controls) direct.openOverlay(overlayPath(), session::overlayOptionsOf(*controls));
     return direct.render(kSize, kSize);
+  }
+
+  // The 3D view's frame as the window draws it (the viewer the desktop
+  // renders, session::Session::view()), at full quality.
+  static Image viewFrame(session::Session& session) {
+    viewer::Viewer& v = session.view();
+    v.quality = viewer::Quality::Full;
+    gpu::Framebuffer fb = gpu::Framebuffer::create(session.device().context->ledger(),
+                                                   "panel test view", kSize, kSize);
+    v.render(kSize, kSize, fb.id());
+    Image img(kSize, kSize);
+    fb.readRgba8(img.rgba().data());
+    return img;
+  }
+  // The same view with the volume explored and the overlay opened by the
+  // session's own calls (null controls: no overlay).
+  static Image directViewFrame(const session::OverlayControls* controls) {
+    session::Session direct("native");
+    look(direct);
+    direct.openInView(anatomyPath());
+    if (controls) direct.openOverlay(overlayPath(), session::overlayOptionsOf(*controls));
+    return viewFrame(direct);
   }
 
   session::Session s{"native"};
@@ -261,6 +288,39 @@ TEST_F(PanelsOverlay, ASecondFileDroppedIsOfferedAndAddedAsTheOverlay) {
       db, direct);
   EXPECT_GE(db, 40.0);
   EXPECT_EQ(direct, 0);
+}
+
+// The desktop's own path: the anatomy dropped on the empty window is opened
+// as its file panel opens one (explored in the view), the overlay dropped
+// next is offered and added; the 3D view's frame shows it, equal to the
+// view of a session that made the same calls itself, and "Remove overlay"
+// gives the view's frame back to the bit.
+TEST_F(PanelsOverlay, FilesDroppedInTurnShowTheSecondOverTheFirstInTheView) {
+  look(s);
+  offerDrop(s, overlayUi, host, anatomyPath());
+  ASSERT_EQ(host.opened, std::vector<std::string>({anatomyPath()}));
+  EXPECT_TRUE(s.exploring());
+  ui.frame();
+  const Image alone = viewFrame(s);
+  offerDrop(s, overlayUi, host, overlayPath());
+  ui.frame();
+  ui.click(kDropOfferTitle, {"Add as overlay"});
+  EXPECT_EQ(host.error, "");
+  expectPlacedByWorldCoordinates();
+  const Image fused = viewFrame(s);
+  const int shows = differing(alone, fused, 2);
+  const int aloneOff = differing(alone, directViewFrame(nullptr), 0);
+  const int fusedOff = differing(fused, directViewFrame(&overlayUi.controls), 0);
+  std::printf(
+      "dropped in turn: %d of %d pixels of the view coloured; %d / %d pixels differ from "
+      "the view of the session's own calls (alone / with the overlay)\n",
+      shows, kSize * kSize, aloneOff, fusedOff);
+  EXPECT_GT(shows, kSize * kSize / 20);
+  EXPECT_EQ(aloneOff, 0);
+  EXPECT_EQ(fusedOff, 0);
+  ui.click(kPanelTitle, {"Remove overlay"});
+  EXPECT_EQ(s.overlay(), nullptr);
+  EXPECT_EQ(differing(alone, viewFrame(s), 0), 0);
 }
 
 TEST_F(PanelsOverlay, TheOffersReplaceOpensTheFileAndCancelKeepsTheVolume) {
