@@ -39,6 +39,7 @@ if(TESSERA_DESKTOP_FOUND)
   list(REMOVE_ITEM TESSERA_DESKTOP_SOURCES ${TESSERA_DESKTOP_DIR}/ViewCommand.cpp
        ${TESSERA_DESKTOP_DIR}/ViewUnavailable.cpp ${TESSERA_DESKTOP_PANELS})
   target_sources(tessera_cli PRIVATE ${TESSERA_DESKTOP_SOURCES})
+  # SYSTEM, as above; GLFW's too.
   target_include_directories(tessera_cli SYSTEM PRIVATE ${IMGUI_INCLUDE_DIRS} ${GLFW3_INCLUDE_DIRS})
   target_link_libraries(tessera_cli PRIVATE tessera_desktop_panels tessera_gpu_glfw
                                             PkgConfig::GLFW3 PkgConfig::IMGUI ${CMAKE_DL_LIBS})
