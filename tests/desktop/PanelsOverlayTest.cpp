@@ -238,6 +238,49 @@ TEST_F(PanelsOverlay, AddOverlayOpensTheTypedFileAlignedByWorldCoordinates) {
   EXPECT_EQ(differing(alone, s.render(kSize, kSize), 0), 0);
 }
 
+// Another modality's look: the colour map's menu, the window's checkbox
+// and its two bounds typed in restyle the open overlay (its file not read
+// again), as `--overlay-tf ct-bone --overlay-window 1,2` would open it.
+TEST_F(PanelsOverlay, ColourMapAndWindowControlsRestyleTheOverlay) {
+  openAnatomy();
+  ui.frame();
+  ui.click(kPanelTitle, {"##overlaypath"});
+  ui.type(overlayPath().c_str());
+  ui.click(kPanelTitle, {"Add overlay"});
+  ASSERT_NE(s.overlay(), nullptr);
+  const std::shared_ptr<const FusedVolume> read = s.overlay()->fused;
+  const Image hot = s.render(kSize, kSize);
+
+  ui.click(kPanelTitle, {"colour map"});
+  ui.click("##Combo_00", {3, "ct-bone"});
+  EXPECT_EQ(overlayUi.controls.colourMap, 3);
+  ui.click(kPanelTitle, {"window"});
+  ui.click(kPanelTitle, {"##hi"});
+  ui.type("2");
+  ui.click(kPanelTitle, {"##lo"});
+  ui.type("1");
+  ui.clickAway();
+  EXPECT_EQ(host.error, "");
+  ASSERT_NE(s.overlay(), nullptr);
+  EXPECT_EQ(s.overlay()->options.tf, "ct-bone");
+  ASSERT_TRUE(s.overlay()->options.window.has_value());
+  EXPECT_EQ(s.overlay()->options.window->min, 1.0);
+  EXPECT_EQ(s.overlay()->options.window->max, 2.0);
+  EXPECT_EQ(s.overlay()->fused->volume, read->volume);  // restyled, not read again
+  EXPECT_EQ(session::overlayPanelLine(*s.overlay()), "rotated.nii.gz 32x32x32: colour map ct-bone");
+
+  const Image restyled = s.render(kSize, kSize);
+  const double db = psnr(restyled, s.renderReference(kSize, kSize));
+  const int direct = differing(restyled, directFrame(overlayUi.controls), 0);
+  std::printf(
+      "ct-bone, window 1..2: GPU vs reference %.2f dB, %d pixels changed from hot, %d "
+      "differ from Session::openOverlay's frame\n",
+      db, differing(hot, restyled, 2), direct);
+  EXPECT_GE(db, 40.0);
+  EXPECT_GT(differing(hot, restyled, 2), 0);
+  EXPECT_EQ(direct, 0);
+}
+
 TEST_F(PanelsOverlay, AFileThatCannotBeReadIsNamedOnTheErrorLine) {
   openAnatomy();
   ui.frame();
