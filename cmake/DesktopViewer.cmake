@@ -25,15 +25,45 @@ if(TESSERA_DESKTOP_FOUND)
   target_compile_options(tessera_gpu_glfw PRIVATE ${TESSERA_WARNINGS})
   target_link_libraries(tessera_gpu_glfw PUBLIC tessera_gpu PRIVATE PkgConfig::GLFW3)
 
+  # The panels drawn without a window (frontends/desktop/Panels.h), apart so
+  # that tests/desktop draws and clicks them in an ImGui context of its own.
+  set(TESSERA_DESKTOP_PANELS ${TESSERA_DESKTOP_DIR}/Panels.cpp
+      ${TESSERA_DESKTOP_DIR}/PanelsChannels.cpp ${TESSERA_DESKTOP_DIR}/PanelsOverlay.cpp)
+  add_library(tessera_desktop_panels STATIC ${TESSERA_DESKTOP_PANELS})
+  target_compile_options(tessera_desktop_panels PRIVATE ${TESSERA_WARNINGS})
+  # SYSTEM: ImGui's and GLFW's headers are not ours to keep free of warnings.
+  target_include_directories(tessera_desktop_panels SYSTEM PUBLIC ${IMGUI_INCLUDE_DIRS})
+  target_link_libraries(tessera_desktop_panels PUBLIC tessera PkgConfig::IMGUI)
+
   file(GLOB TESSERA_DESKTOP_SOURCES CONFIGURE_DEPENDS ${TESSERA_DESKTOP_DIR}/*.cpp)
   list(REMOVE_ITEM TESSERA_DESKTOP_SOURCES ${TESSERA_DESKTOP_DIR}/ViewCommand.cpp
-       ${TESSERA_DESKTOP_DIR}/ViewUnavailable.cpp)
+       ${TESSERA_DESKTOP_DIR}/ViewUnavailable.cpp ${TESSERA_DESKTOP_PANELS})
   target_sources(tessera_cli PRIVATE ${TESSERA_DESKTOP_SOURCES})
-  # SYSTEM: ImGui's and GLFW's headers are not ours to keep free of warnings.
+  # SYSTEM, as above; GLFW's too.
   target_include_directories(tessera_cli SYSTEM PRIVATE ${IMGUI_INCLUDE_DIRS} ${GLFW3_INCLUDE_DIRS})
-  target_link_libraries(tessera_cli PRIVATE tessera_gpu_glfw PkgConfig::GLFW3 PkgConfig::IMGUI
-                                            ${CMAKE_DL_LIBS})
+  target_link_libraries(tessera_cli PRIVATE tessera_desktop_panels tessera_gpu_glfw
+                                            PkgConfig::GLFW3 PkgConfig::IMGUI ${CMAKE_DL_LIBS})
 else()
   message(STATUS "tessera view: off (needs libglfw3-dev and libimgui-dev)")
   target_sources(tessera_cli PRIVATE ${TESSERA_DESKTOP_DIR}/ViewUnavailable.cpp)
 endif()
+
+# tests/desktop: the panels of frontends/desktop/Panels.h drawn in an ImGui
+# context without a platform backend and clicked there, over sessions on the
+# headless EGL context (called from the tests' block of CMakeLists.txt).
+function(tessera_desktop_tests)
+  if(NOT TESSERA_DESKTOP_FOUND)
+    return()
+  endif()
+  file(GLOB tsrcs CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/tests/desktop/*.cpp)
+  add_executable(test_desktop ${tsrcs})
+  target_include_directories(test_desktop PRIVATE ${CMAKE_SOURCE_DIR}/frontends ${CMAKE_SOURCE_DIR}/src
+                                                  ${CMAKE_SOURCE_DIR}/tests)
+  target_compile_options(test_desktop PRIVATE ${TESSERA_WARNINGS})
+  target_compile_definitions(test_desktop PRIVATE
+    TESSERA_TEST_DATA_DIR="${CMAKE_SOURCE_DIR}/tests/data")
+  target_link_libraries(test_desktop PRIVATE tessera_desktop_panels tessera GTest::gtest
+                        GTest::gtest_main nlohmann_json::nlohmann_json ZLIB::ZLIB)
+  tessera_precompile(test_desktop <gtest/gtest.h>)
+  gtest_discover_tests(test_desktop DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 600)
+endfunction()

@@ -44,15 +44,12 @@ Tiles layoutTiles(const DesktopApp& ds, int ww, int wh) {
 
 // The control panel at the window's left edge.
 void drawPanel(DesktopApp& ds, int windowHeight) {
-  ImGui::SetNextWindowPos(ImVec2(0, 0));
-  ImGui::SetNextWindowSize(ImVec2(kPanelWidth, static_cast<float>(windowHeight)));
-  ImGui::Begin("Tessera", nullptr,
-               ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+  beginControlPanel(static_cast<float>(windowHeight));
   panelFile(ds);
   panelTime(ds);
-  panelChannels(ds);
+  if (channelsShown(ds)) panelChannels(ds.session->channelView(), ds);
   panelExplore(ds);
-  panelOverlay(ds);
+  panelOverlay(*ds.session, ds.overlayUi, ds);
   const bool labelsFirst = ds.view().labelsOn();  // the list before the TF it drives
   if (labelsFirst) panelLabels(ds);
   panelTransferFunction(ds);
@@ -99,7 +96,7 @@ PixelRect toPixels(const Rect& r, double scale, int framebufferHeight) {
 void runFrame(DesktopApp& ds) {
   ds.window->pollEvents();
   if (!ds.pendingDrop.empty()) {
-    offerDrop(ds, ds.pendingDrop);
+    offerDrop(*ds.session, ds.overlayUi, ds, ds.pendingDrop);
     ds.pendingDrop.clear();
   }
   const glm::ivec2 fb = ds.window->framebufferSize(), win = ds.window->windowSize();
@@ -126,7 +123,7 @@ void runFrame(DesktopApp& ds) {
   updateOverlay(ds);
   drawPanel(ds, win.y);
   const bool channels = drawChannelView(ds, tiles.view3d, view.width, view.height);
-  drawDropOffer(ds);
+  drawDropOffer(*ds.session, ds.overlayUi, ds);
   for (int t = 0; t < 3 && ds.fourUp; ++t) drawSliceTile(ds, ds.slices[t], tiles.slice[t]);
   drawHelpOverlay(ds, kPanelWidth, static_cast<float>(win.x), static_cast<float>(win.y));
   const EdgeLabels labels = ds.view().orientationLabels();

@@ -13,8 +13,9 @@
 //   PanelsFile.cpp     open, recent and dropped volumes
 //   PanelsStyle.cpp    TF editor, window/level, rendering, shading, clipping, labels
 //   PanelsExplore.cpp  the slice views and the exploring panel (zoom stages)
-//   PanelsChannels.cpp a store's channels shown together and their list
-//   PanelsOverlay.cpp  a second volume over the first; a dropped file's offer
+//   Panels.h           the panels drawn without a window (a store's channels,
+//                      the overlay, a dropped file's offer): DesktopApp is
+//                      their PanelHost
 #include <chrono>
 #include <memory>
 #include <optional>
@@ -25,6 +26,7 @@
 #include <imgui.h>
 #include <glm/vec2.hpp>
 
+#include "Panels.h"
 #include "ViewOptions.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/GlObjects.h"
@@ -42,13 +44,18 @@
 
 namespace tessera::desktop {
 
-constexpr float kPanelWidth = 390.0f;
-
 // Everything the desktop viewer holds between frames. The window is the
-// first member: destroyed last, after every GL object of its context.
-struct DesktopApp {
+// first member: destroyed last, after every GL object of its context. It is
+// the host of the window-free panels (Panels.h): their errors go to its
+// error line, a file they open is opened as the file panel opens one.
+struct DesktopApp : PanelHost {
   DesktopApp(const ViewOptions& o, std::unique_ptr<gpu::GlfwWindow> w, bool gles3)
       : window(std::move(w)), options(o), es3(gles3) {}
+  void setError(const std::string& message) override { error = message; }
+  void openFile(const std::string& path) override;  // PanelsFile.cpp
+  void overlayChanged() override {
+    for (auto& tile : slices) tile.key.clear();  // the slice views mix it in
+  }
   std::unique_ptr<gpu::GlfwWindow> window;
   const ViewOptions& options;
   bool es3;
@@ -100,29 +107,9 @@ struct DesktopApp {
   // The crop box drawn with a handle on each face (viewer/CropHandles.h).
   bool showCropBox = false;
   viewer::CropHandles crop;
-  // PanelsOverlay.cpp: the overlay's controls and a dropped file's offer.
-  struct OverlayControls {
-    char path[512] = "";
-    char table[512] = "";                      // ImGui's buffer of controls.table
-    session::OverlayControls controls;         // session/OverlayPanel.h: what the actions take
-    const session::Overlay* synced = nullptr;  // the overlay the controls show
-    std::string dropped;  // dropped while a volume is open: overlay or replace?
-  } overlayUi;
+  // Panels.h: the overlay's controls and a dropped file's offer.
+  OverlayUi overlayUi;
 };
-
-// Runs `action`; its Error goes to the panel's error line (and true means
-// it succeeded, the line cleared).
-template <class Action>
-bool reportErrors(DesktopApp& ds, Action&& action) {
-  try {
-    action();
-    ds.error.clear();
-    return true;
-  } catch (const Error& e) {
-    ds.error = e.what();
-    return false;
-  }
-}
 
 // A rectangle of the window in ImGui (window) units, top-left origin.
 struct Rect {
@@ -166,9 +153,14 @@ inline double steadyNowMs() {
 
 void panelFile(DesktopApp& ds);
 void panelTime(DesktopApp& ds);
+// A store with several channels shown together (session::ChannelView);
+// Panels.h's panelChannels draws their list.
+void openChannels(DesktopApp& ds, const std::string& spec);
+inline bool channelsShown(const DesktopApp& ds) {
+  return ds.session && ds.session->hasChannelView() && ds.session->channelView().isOpen();
+}
 
 // PanelsStyle.cpp
-void section(const char* title);
 void panelTransferFunction(DesktopApp& ds);
 void panelWindowLevel(viewer::Viewer& v);
 void panelRendering(DesktopApp& ds);
@@ -176,23 +168,9 @@ void panelShading(viewer::Viewer& v);
 void panelClipping(DesktopApp& ds);
 void panelLabels(DesktopApp& ds);
 
-// PanelsOverlay.cpp
-void panelOverlay(DesktopApp& ds);
-// A file dropped on the window: opened, or (a volume open) offered as the
-// overlay by drawDropOffer's popup.
-void offerDrop(DesktopApp& ds, const std::string& path);
-void drawDropOffer(DesktopApp& ds);
-
 // PanelsExplore.cpp
 void panelExplore(DesktopApp& ds);
 void drawSliceTile(DesktopApp& ds, DesktopApp::SliceTile& tile, const Rect& r);
-
-// PanelsChannels.cpp: a store with several channels (session::ChannelView)
-void openChannels(DesktopApp& ds, const std::string& spec);
-void panelChannels(DesktopApp& ds);
-// Queues the channels' frame into the 3D view's rectangle; false when no
-// channels are shown (the viewer's frame is drawn instead).
-bool drawChannelView(DesktopApp& ds, const Rect& rect, int viewW, int viewH);
 
 // Input.cpp
 void handleViewInput(DesktopApp& ds, const Rect& view, double scale);
@@ -203,6 +181,9 @@ void drawHelpOverlay(DesktopApp& ds, float x0, float x1, float height);
 
 // VolumeView.cpp
 void drawVolumeView(DesktopApp& ds, glm::ivec2 origin, int viewW, int viewH);
+// Queues the channels' frame into the 3D view's rectangle; false when no
+// channels are shown (the viewer's frame is drawn instead).
+bool drawChannelView(DesktopApp& ds, const Rect& rect, int viewW, int viewH);
 void drawEdgeLetters(const std::string& left, const std::string& right, const std::string& top,
                      const std::string& bottom, ImVec2 p0, ImVec2 p1);
 

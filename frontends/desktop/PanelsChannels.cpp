@@ -1,31 +1,28 @@
 // The channel list (docs/channels.md): a store with several channels is
 // shown as session::ChannelView draws it, and the panel turns each
 // channel's visibility toggle, colour picker and window into that view's
-// calls; the 3D view shows its frame in place of the viewer's.
+// calls. The window shows the view's frame in the 3D view
+// (VolumeView.cpp, drawChannelView); tests/desktop/PanelsChannelsTest.cpp clicks
+// these widgets without one.
 #include <algorithm>
-#include <cstdint>
-#include <cstdio>
 
-#include "DesktopApp.h"
+#include "Panels.h"
+#include "tessera/session/ChannelView.h"
 
 namespace tessera::desktop {
 
 namespace {
 
-bool channelsShown(const DesktopApp& ds) {
-  return ds.session && ds.session->hasChannelView() && ds.session->channelView().isOpen();
-}
-
-void channelRow(DesktopApp& ds, session::ChannelView& view, int i) {
+void channelRow(session::ChannelView& view, PanelHost& host, int i) {
   const Channel& c = view.channels()[i];
   ImGui::PushID(i);
   bool on = c.visible;
-  if (ImGui::Checkbox("##visible", &on)) reportErrors(ds, [&] { view.setVisible(i, on); });
+  if (ImGui::Checkbox("##visible", &on)) reportErrors(host, [&] { view.setVisible(i, on); });
   ImGui::SameLine();
   float rgb[3] = {static_cast<float>(c.color.r), static_cast<float>(c.color.g),
                   static_cast<float>(c.color.b)};
   if (ImGui::ColorEdit3("##colour", rgb, ImGuiColorEditFlags_NoInputs)) {
-    reportErrors(ds, [&] { view.setColor(i, glm::dvec3(rgb[0], rgb[1], rgb[2])); });
+    reportErrors(host, [&] { view.setColor(i, glm::dvec3(rgb[0], rgb[1], rgb[2])); });
   }
   ImGui::SameLine();
   ImGui::TextUnformatted(c.label.c_str());
@@ -37,49 +34,21 @@ void channelRow(DesktopApp& ds, session::ChannelView& view, int i) {
                              static_cast<float>(values.max), "%.0f", "%.0f",
                              ImGuiSliderFlags_AlwaysClamp) &&
       hi > lo) {
-    reportErrors(ds, [&] { view.setWindow(i, {lo, hi}); });
+    reportErrors(host, [&] { view.setWindow(i, {lo, hi}); });
   }
   ImGui::PopID();
 }
 
 }  // namespace
 
-void openChannels(DesktopApp& ds, const std::string& spec) {
-  // --time chooses within the file given on the command line.
-  const int time = spec == ds.options.file ? ds.options.time : 0;
-  reportErrors(ds, [&] { ds.session->channelView().open(spec, time); });
-}
-
-void panelChannels(DesktopApp& ds) {
-  if (!channelsShown(ds)) return;
-  session::ChannelView& view = ds.session->channelView();
+void panelChannels(session::ChannelView& view, PanelHost& host) {
   section("Channels");
-  for (int i = 0; i < view.channels().size(); ++i) channelRow(ds, view, i);
+  for (int i = 0; i < view.channels().size(); ++i) channelRow(view, host, i);
   int mode = view.channels().mode == ChannelMode::Max ? 1 : 0;
   if (ImGui::Combo("mode", &mode, "additive\0max\0")) {
-    reportErrors(ds, [&] { view.setMode(mode == 1 ? ChannelMode::Max : ChannelMode::Additive); });
+    reportErrors(host, [&] { view.setMode(mode == 1 ? ChannelMode::Max : ChannelMode::Additive); });
   }
-  if (ImGui::Button("Show one channel")) reportErrors(ds, [&] { view.close(); });
-}
-
-bool drawChannelView(DesktopApp& ds, const Rect& rect, int viewW, int viewH) {
-  if (!channelsShown(ds)) return false;
-  try {
-    const gpu::Texture& frame = ds.session->channelView().render(viewW, viewH);
-    // Row 0 of the frame is its bottom row: ImGui's v runs down.
-    ImGui::GetBackgroundDrawList()->AddImage(
-        reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(frame.id())), rect.p0, rect.p1,
-        ImVec2(0.0f, 1.0f), ImVec2(1.0f, 0.0f));
-  } catch (const Error& e) {
-    ds.error = e.what();
-    return false;
-  }
-  char line[160];
-  std::snprintf(line, sizeof line, "%d channels of %s (%s)",
-                ds.session->channelView().channels().size(),
-                ds.session->channelView().name().c_str(), ds.context().caps().renderer.c_str());
-  ds.status = line;
-  return true;
+  if (ImGui::Button("Show one channel")) reportErrors(host, [&] { view.close(); });
 }
 
 }  // namespace tessera::desktop

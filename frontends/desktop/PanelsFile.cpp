@@ -53,6 +53,16 @@ void openVolume(DesktopApp& ds, const std::string& spec, bool channels) {
   if (channels) openChannels(ds, spec);
 }
 
+void DesktopApp::openFile(const std::string& path) {
+  openVolume(*this, path);
+}
+
+void openChannels(DesktopApp& ds, const std::string& spec) {
+  // --time chooses within the file given on the command line.
+  const int time = spec == ds.options.file ? ds.options.time : 0;
+  reportErrors(ds, [&] { ds.session->channelView().open(spec, time); });
+}
+
 void loadState(DesktopApp& ds, const std::string& path) {
   ds.session->loadState(path);
   ds.showCropBox = ds.view().settings().clipping.cropped();

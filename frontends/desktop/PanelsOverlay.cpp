@@ -2,59 +2,55 @@
 // `tessera view --overlay` opens it: a file, labels with a table or a colour
 // map, alpha and window; and the offer made for a file dropped while a
 // volume is open (replace it, or add it as the overlay). The session opens,
-// restyles and clears it through session/OverlayPanel.h (the calls a test
-// drives: tests/session/OverlayPanelTest.cpp); the 3D view
-// fuses it and the slice views mix it in (session::fuseSliceImage).
+// restyles and clears it through session/OverlayPanel.h; the 3D view fuses
+// it and the slice views mix it in (session::fuseSliceImage).
+// tests/desktop/PanelsOverlayTest.cpp clicks these widgets without a window.
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
-#include "DesktopApp.h"
+#include "Panels.h"
 #include "tessera/session/OverlayPanel.h"
+#include "tessera/session/Session.h"
 
 namespace tessera::desktop {
 
 namespace {
 
-constexpr const char* kDropOffer = "A second volume";
-
-// The slice views show the overlay mixed in: drawn again.
-void overlayChanged(DesktopApp& ds) {
-  for (auto& tile : ds.slices) tile.key.clear();
-}
-
 // The panel's actions are session/OverlayPanel.h's, with the controls as
-// they are (a test drives the same calls).
-session::OverlayControls& controlsOf(DesktopApp& ds) {
-  session::OverlayControls& c = ds.overlayUi.controls;
-  c.table = ds.overlayUi.table;
+// they are.
+session::OverlayControls& controlsOf(OverlayUi& ui) {
+  session::OverlayControls& c = ui.controls;
+  c.table = ui.table;
   return c;
 }
 
-void addOverlay(DesktopApp& ds, const std::string& path) {
-  reportErrors(ds, [&] {
-    session::addOverlayFromPanel(*ds.session, path, controlsOf(ds));
-    overlayChanged(ds);
+void addOverlay(session::Session& s, OverlayUi& ui, PanelHost& host, const std::string& path) {
+  reportErrors(host, [&] {
+    session::addOverlayFromPanel(s, path, controlsOf(ui));
+    host.overlayChanged();
   });
 }
 
-void restyle(DesktopApp& ds) {
-  reportErrors(ds, [&] {
-    if (session::restyleOverlayFromPanel(*ds.session, controlsOf(ds))) overlayChanged(ds);
+void restyle(session::Session& s, OverlayUi& ui, PanelHost& host) {
+  reportErrors(host, [&] {
+    if (session::restyleOverlayFromPanel(s, controlsOf(ui))) host.overlayChanged();
   });
 }
 
 // The controls from an overlay opened elsewhere (--overlay, a state).
-void syncControls(DesktopApp::OverlayControls& ui, const session::Overlay& o) {
+void syncControls(OverlayUi& ui, const session::Overlay& o) {
   session::syncOverlayControls(ui.controls, o);
   std::snprintf(ui.table, sizeof ui.table, "%s", ui.controls.table.c_str());
 }
 
-void overlayInfo(const session::Overlay& o, const viewer::Viewer& v) {
+void overlayInfo(const session::Overlay& o, session::Session& s) {
   ImGui::TextWrapped("%s", session::overlayPanelLine(o).c_str());
   if (!o.note.empty()) ImGui::TextWrapped("%s", o.note.c_str());
-  if (!v.fusionNote().empty()) ImGui::TextWrapped("3D view: %s", v.fusionNote().c_str());
+  if (s.hasView() && !s.view().fusionNote().empty()) {
+    ImGui::TextWrapped("3D view: %s", s.view().fusionNote().c_str());
+  }
 }
 
 // The colour maps' names for ImGui's combo.
@@ -64,20 +60,9 @@ bool colourMapCombo(int& chosen) {
   return ImGui::Combo("colour map", &chosen, names.data(), static_cast<int>(names.size()));
 }
 
-}  // namespace
-
-void panelOverlay(DesktopApp& ds) {
-  DesktopApp::OverlayControls& ui = ds.overlayUi;
+// The look's controls; true when one changed.
+bool lookControls(OverlayUi& ui) {
   session::OverlayControls& c = ui.controls;
-  section("Overlay (a second volume)");
-  const session::Overlay* o = ds.session->overlay();
-  if (o && o != ui.synced) {
-    syncControls(ui, *o);
-    ui.synced = o;
-  }
-  ImGui::InputText("##overlaypath", ui.path, sizeof ui.path);
-  ImGui::SameLine();
-  if (ImGui::Button("Add overlay") && ui.path[0]) addOverlay(ds, ui.path);
   bool changed = ImGui::Checkbox("labels (atlas)", &c.labels);
   if (c.labels) {
     ImGui::InputText("##overlaytable", ui.table, sizeof ui.table);
@@ -96,34 +81,50 @@ void panelOverlay(DesktopApp& ds) {
     }
   }
   changed |= ImGui::SliderFloat("alpha", &c.alpha, 0.05f, 1.0f, "%.2f");
-  if (changed) restyle(ds);
+  return changed;
+}
+
+}  // namespace
+
+void panelOverlay(session::Session& s, OverlayUi& ui, PanelHost& host) {
+  section("Overlay (a second volume)");
+  const session::Overlay* o = s.overlay();
+  if (o && o != ui.synced) {
+    syncControls(ui, *o);
+    ui.synced = o;
+  }
+  ImGui::InputText("##overlaypath", ui.path, sizeof ui.path);
+  ImGui::SameLine();
+  if (ImGui::Button("Add overlay") && ui.path[0]) addOverlay(s, ui, host, ui.path);
+  if (lookControls(ui)) restyle(s, ui, host);
+  o = s.overlay();  // the one added or restyled now
   if (!o) {
     ImGui::TextDisabled("none; or drop a file on the window while a volume is open");
     return;
   }
-  overlayInfo(*o, ds.view());
+  overlayInfo(*o, s);
   if (ImGui::Button("Remove overlay")) {
-    session::removeOverlayFromPanel(*ds.session);
+    session::removeOverlayFromPanel(s);
     ui.synced = nullptr;
-    overlayChanged(ds);
+    host.overlayChanged();
   }
 }
 
-void offerDrop(DesktopApp& ds, const std::string& path) {
-  if (!ds.session->hasVolume() || ds.session->name().rfind("gen:", 0) == 0) {
-    openVolume(ds, path);
+void offerDrop(session::Session& s, OverlayUi& ui, PanelHost& host, const std::string& path) {
+  if (!s.hasVolume() || s.name().rfind("gen:", 0) == 0) {
+    host.openFile(path);
     return;
   }
-  ds.overlayUi.dropped = path;
+  ui.dropped = path;
 }
 
-void drawDropOffer(DesktopApp& ds) {
-  std::string& dropped = ds.overlayUi.dropped;
+void drawDropOffer(session::Session& s, OverlayUi& ui, PanelHost& host) {
+  std::string& dropped = ui.dropped;
   if (dropped.empty()) return;
-  if (!ImGui::IsPopupOpen(kDropOffer)) ImGui::OpenPopup(kDropOffer);
-  if (!ImGui::BeginPopupModal(kDropOffer, nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
+  if (!ImGui::IsPopupOpen(kDropOfferTitle)) ImGui::OpenPopup(kDropOfferTitle);
+  if (!ImGui::BeginPopupModal(kDropOfferTitle, nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
   const std::string file = std::filesystem::path(dropped).filename().string();
-  const std::string open = std::filesystem::path(ds.session->name()).filename().string();
+  const std::string open = std::filesystem::path(s.name()).filename().string();
   ImGui::Text("%s is open. %s: add it over %s as an overlay, or replace %s?", open.c_str(),
               file.c_str(), open.c_str(), open.c_str());
   std::string chosen;
@@ -137,10 +138,10 @@ void drawDropOffer(DesktopApp& ds) {
     dropped.clear();
     ImGui::CloseCurrentPopup();
     if (chosen == "overlay") {
-      std::snprintf(ds.overlayUi.path, sizeof ds.overlayUi.path, "%s", path.c_str());
-      addOverlay(ds, path);
+      std::snprintf(ui.path, sizeof ui.path, "%s", path.c_str());
+      addOverlay(s, ui, host, path);
     } else if (chosen == "replace") {
-      openVolume(ds, path);
+      host.openFile(path);
     }
   }
   ImGui::EndPopup();

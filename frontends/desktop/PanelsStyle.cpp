@@ -15,12 +15,6 @@
 
 namespace tessera::desktop {
 
-void section(const char* title) {
-  ImGui::Spacing();
-  ImGui::Separator();
-  ImGui::TextUnformatted(title);
-}
-
 namespace {
 
 // The TF editor over the histogram (Moser & Weiskopf 2008): opacity points

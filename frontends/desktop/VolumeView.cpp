@@ -1,6 +1,8 @@
 // The 3D view right of the panel: rendered only when what it shows changed
 // (on ES 3 the last frame is kept in a framebuffer and blitted, and a
-// full-quality frame refines strip by strip), every frame on ES 2.
+// full-quality frame refines strip by strip), every frame on ES 2; or a
+// store's channels, session::ChannelView's frame.
+#include <cstdint>
 #include <cstdio>
 #include <sstream>
 #include <string>
@@ -144,6 +146,26 @@ void drawVolumeView(DesktopApp& ds, glm::ivec2 origin, int viewW, int viewH) {
                 v.refining() ? "refining, strip" : "frame", fs.ms, fs.renderWidth, fs.renderHeight,
                 ds.context().caps().renderer.c_str(), ds.context().caps().version.c_str());
   ds.status = line;
+}
+
+bool drawChannelView(DesktopApp& ds, const Rect& rect, int viewW, int viewH) {
+  if (!channelsShown(ds)) return false;
+  try {
+    const gpu::Texture& frame = ds.session->channelView().render(viewW, viewH);
+    // Row 0 of the frame is its bottom row: ImGui's v runs down.
+    ImGui::GetBackgroundDrawList()->AddImage(
+        reinterpret_cast<ImTextureID>(static_cast<std::intptr_t>(frame.id())), rect.p0, rect.p1,
+        ImVec2(0.0f, 1.0f), ImVec2(1.0f, 0.0f));
+  } catch (const Error& e) {
+    ds.error = e.what();
+    return false;
+  }
+  char line[160];
+  std::snprintf(line, sizeof line, "%d channels of %s (%s)",
+                ds.session->channelView().channels().size(),
+                ds.session->channelView().name().c_str(), ds.context().caps().renderer.c_str());
+  ds.status = line;
+  return true;
 }
 
 }  // namespace tessera::desktop
