@@ -14,6 +14,7 @@
 //   PanelsStyle.cpp    TF editor, window/level, rendering, shading, clipping, labels
 //   PanelsExplore.cpp  the slice views and the exploring panel (zoom stages)
 //   PanelsChannels.cpp a store's channels shown together and their list
+//   StreamedSeriesView.cpp a time series played over bricks in the 3D view
 //   PanelsOverlay.cpp  a second volume over the first; a dropped file's offer
 #include <chrono>
 #include <memory>
@@ -74,6 +75,9 @@ struct DesktopApp {
   // Playback of a time series: time points shown, from the first frame.
   int timePointsShown = 0;
   double playStartMs = -1.0;
+  // Over bricks: the last time point shown (its number in timePointsShown)
+  // whose frame was drawn complete, and so recorded (--play-record).
+  int completeShows = -1;
   bool showHelp = false;
   viewer::RecentFiles recent{viewer::RecentFiles::defaultPath()};
 
@@ -193,6 +197,18 @@ void panelChannels(DesktopApp& ds);
 // Queues the channels' frame into the 3D view's rectangle; false when no
 // channels are shown (the viewer's frame is drawn instead).
 bool drawChannelView(DesktopApp& ds, const Rect& rect, int viewW, int viewH);
+
+// StreamedSeriesView.cpp: a series over bricks (session::StreamedFrames)
+// Queues the time point's streamed frame into the 3D view's rectangle;
+// false when no series plays over bricks or a region or grid block is
+// shown (the viewer's frame is drawn instead).
+bool drawStreamedFrames(DesktopApp& ds, const Rect& rect, int viewW, int viewH);
+// Whether --play-time-points' time points have been shown (over bricks:
+// the last one drawn complete); true without it.
+bool playbackDone(const DesktopApp& ds);
+// The playback's figures for --screenshot: rate, time points, late ones,
+// and the texture and host memory against the profile's budgets.
+void printPlayback(const DesktopApp& ds);
 
 // Input.cpp
 void handleViewInput(DesktopApp& ds, const Rect& view, double scale);
