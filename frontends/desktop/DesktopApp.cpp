@@ -123,6 +123,7 @@ void runFrame(DesktopApp& ds) {
   updateOverlay(ds);
   drawPanel(ds, win.y);
   const bool channels = drawChannelView(ds, tiles.view3d, view.width, view.height);
+  const bool streamed = !channels && drawStreamedFrames(ds, tiles.view3d, view.width, view.height);
   drawDropOffer(*ds.session, ds.overlayUi, ds);
   for (int t = 0; t < 3 && ds.fourUp; ++t) drawSliceTile(ds, ds.slices[t], tiles.slice[t]);
   drawHelpOverlay(ds, kPanelWidth, static_cast<float>(win.x), static_cast<float>(win.y));
@@ -132,24 +133,14 @@ void runFrame(DesktopApp& ds) {
   ImGui::Render();
   gpu::bindFramebuffer(0, {0, 0, fb.x, fb.y});
   gpu::clearColor(glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
-  if (!channels) drawVolumeView(ds, view.origin, view.width, view.height);
+  if (!channels && !streamed) drawVolumeView(ds, view.origin, view.width, view.height);
   gpu::setViewport({0, 0, fb.x, fb.y});
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
   ++ds.frame;
-  if (!ds.options.screenshot.empty() && ds.frame >= ds.options.frames && !ds.view().refining()) {
-    if (ds.session->series() && ds.session->playback().playing()) {
-      // What the playback reached: frames drawn and time points shown per
-      // second, and the frames where a due time point was not read yet.
-      const double seconds = (steadyNowMs() - ds.playStartMs) / 1000.0;
-      const session::Playback& play = ds.session->playback();
-      std::printf(
-          "playback: %d frames, %d time points shown in %.2f s (%.1f frames/s, %.1f "
-          "time points/s, asked %.1f), %llu late frames, %d read ahead\n",
-          ds.frame, ds.timePointsShown, seconds, ds.frame / seconds, ds.timePointsShown / seconds,
-          play.fps(), static_cast<unsigned long long>(play.lateFrames()),
-          ds.session->series()->keep() - 1);
-    }
+  if (!ds.options.screenshot.empty() && ds.frame >= ds.options.frames && !ds.view().refining() &&
+      playbackDone(ds)) {
+    if (ds.session->series() && ds.session->playback().playing()) printPlayback(ds);
     takeScreenshot(ds, fb.x, fb.y);
   }
   ds.window->swapBuffers();
@@ -168,8 +159,14 @@ void applyOptions(DesktopApp& ds, const ViewOptions& o) {
   ds.showHelp = o.helpOverlay;
   ds.view().tfEditor().setTransferFunction(TransferFunction::fromPresetOrFile(o.tf));
   ds.session->settings().tfIsDefault = !o.tfGiven;
+  if (o.bricks) ds.session->settings().layout = "bricks";
   openVolume(ds, o.file.empty() ? app::defaultVolumeSpec() : o.file, false);
   if (!ds.error.empty() && !ds.view().hasVolume()) throw InputError(ds.error);
+  if (o.bricks && ds.error.empty() && !ds.session->streamedSeries()) {
+    throw InputError("--bricks: " + ds.view().description() +
+                     " is not an OME-Zarr store with a t axis (a series is what the view plays "
+                     "over bricks)");
+  }
   // What is left is the recent list's trouble (unreadable, or not written):
   // shown in the panel, while errors of the options below end the command.
   const std::string recentTrouble = ds.error.empty() ? recentError : ds.error;

@@ -16,6 +16,7 @@
 //   Panels.h           the panels drawn without a window (a store's channels,
 //                      the overlay, a dropped file's offer): DesktopApp is
 //                      their PanelHost
+//   StreamedSeriesView.cpp a time series played over bricks in the 3D view
 #include <chrono>
 #include <memory>
 #include <optional>
@@ -81,6 +82,9 @@ struct DesktopApp : PanelHost {
   // Playback of a time series: time points shown, from the first frame.
   int timePointsShown = 0;
   double playStartMs = -1.0;
+  // Over bricks: the last time point shown (its number in timePointsShown)
+  // whose frame was drawn complete, and so recorded (--play-record).
+  int completeShows = -1;
   bool showHelp = false;
   viewer::RecentFiles recent{viewer::RecentFiles::defaultPath()};
 
@@ -171,6 +175,18 @@ void panelLabels(DesktopApp& ds);
 // PanelsExplore.cpp
 void panelExplore(DesktopApp& ds);
 void drawSliceTile(DesktopApp& ds, DesktopApp::SliceTile& tile, const Rect& r);
+
+// StreamedSeriesView.cpp: a series over bricks (session::StreamedFrames)
+// Queues the time point's streamed frame into the 3D view's rectangle;
+// false when no series plays over bricks or a region or grid block is
+// shown (the viewer's frame is drawn instead).
+bool drawStreamedFrames(DesktopApp& ds, const Rect& rect, int viewW, int viewH);
+// Whether --play-time-points' time points have been shown (over bricks:
+// the last one drawn complete); true without it.
+bool playbackDone(const DesktopApp& ds);
+// The playback's figures for --screenshot: rate, time points, late ones,
+// and the texture and host memory against the profile's budgets.
+void printPlayback(const DesktopApp& ds);
 
 // Input.cpp
 void handleViewInput(DesktopApp& ds, const Rect& view, double scale);

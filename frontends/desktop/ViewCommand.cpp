@@ -61,6 +61,19 @@ void addViewCommand(CLI::App& app) {
                   "Time panel plays, pauses and picks one); with --screenshot, the playback's "
                   "rate, time points shown and late frames are printed")
       ->check(CLI::Range(0.1, 120.0));
+  cmd->add_flag("--bricks", o->bricks,
+                "An OME-Zarr store with a t axis plays over bricks (as `tessera render --layout "
+                "bricks`: each time point streamed from its own chunks, the next ones read ahead "
+                "within the host budget) even where its level 0 fits in core; a larger one always "
+                "does");
+  cmd->add_option("--play-time-points", o->playTimePoints,
+                  "With --play and --screenshot: end once N time points have been shown after "
+                  "the first (instead of after --frames frames)")
+      ->check(CLI::Range(1, 1000000));
+  cmd->add_option("--play-record", o->playRecord,
+                  "With --play over bricks: the 3D view's frame of every time point shown, once "
+                  "drawn complete (what playback moves on from), written to DIR/NNNN-tT.png (N: "
+                  "the order shown), and a line per time point shown");
   addStateOptions(cmd, o->state, o->saveState,
                   "camera, transfer function, window, rendering settings, labels, crosshair, "
                   "region and grid of the volume given; applied after the other options",

@@ -28,7 +28,10 @@ struct ViewOptions {
   std::string state;      // a saved session state to start from
   std::string saveState;  // where the session's state goes when the window closes
   int frames = 3;
-  double play = 0.0;  // a time series played at this many time points per second (0: paused)
+  double play = 0.0;       // a time series played at this many time points per second (0: paused)
+  bool bricks = false;     // a store's t axis played over bricks (layout bricks)
+  int playTimePoints = 0;  // with --screenshot: end once this many time points were shown
+  std::string playRecord;  // each time point's frame as shown, into this folder
   bool helpOverlay = false;
   std::string layout = "four";  // four: axial, 3D, sagittal, coronal; single: 3D only
   std::vector<int> crosshair;   // X Y Z (level-0 voxel)

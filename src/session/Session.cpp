@@ -186,6 +186,11 @@ int Session::stepPlayback(double nowMs, bool shownComplete) {
   // A time point is shown when its full frame is: while the view refines
   // it (progressive strips), the next one waits.
   if (view_ && view_->refining()) return timePoint();
+  // Over bricks the same: the front end's frame of the time point shown
+  // must have been drawn with every brick its view wants.
+  if (streamedSeries_ && streamedFrames_ && !streamedFrames_->shownComplete(timePoint_)) {
+    return timePoint();
+  }
   const int count = series->count();
   const int next = (shownNow + 1) % count;
   // The window of reads starts at the time point shown (and so holds it
@@ -215,6 +220,7 @@ void Session::setVolume(std::shared_ptr<Volume> volume, const std::string& name)
   if (!volume) throw InputError("setVolume: no volume");
   series_.reset();
   streamedSeries_.reset();
+  if (streamedFrames_) streamedFrames_->close();
   seriesWindow_.reset();
   timePoint_ = 0;
   auto next = std::make_shared<lod::InCoreVolumeSource>(std::move(volume));
@@ -283,8 +289,8 @@ Exploration& Session::exploration() {
   const gpu::DeviceLimits& limits = device_.limits;
   const std::uint64_t regionBytes = viewer::regionBudgetBytes(limits);
   exploration_ =
-      streamed_ ? std::make_unique<Exploration>(streamed_, regionBytes,
-                                                viewer::overviewVoxelBudget(limits), name_)
+      streamed_ ? std::make_unique<Exploration>(streamed_, regionBytes, explorationOverviewVoxels(),
+                                                name_)
                 : std::make_unique<Exploration>(inCore_->level(glm::ivec3(1)), regionBytes, name_);
   return *exploration_;
 }

@@ -37,6 +37,16 @@ bool streamsBricks(const std::string& layoutWish) {
   return layoutWish != "auto" && layout::LayoutRegistry::global().find(layoutWish).streamsBricks;
 }
 
+// A store's t axis the view plays over bricks: asked for (a layout that
+// streams bricks), or level 0 beyond what playsInCore holds.
+bool playsOverBricks(const std::string& spec, const Settings& s) {
+  if (!isZarrStore(spec)) return false;
+  const ZarrStore store(openZarrStorage(spec));
+  return store.timePoints() > 1 &&
+         (streamsBricks(s.layout) ||
+          store.finestLevelWithin(HostBudget::global().limitBytes() / 4) != 0);
+}
+
 // With layout auto a store streams when the planner, given its finest level
 // as a streamed shape and the technique's own units and bytes (what
 // uploadVolume will ask it), rejects every in-core layout under the profile
@@ -151,6 +161,10 @@ void Session::open(const std::string& spec, const OpenOptions& options) {
 
 void Session::openInView(const std::string& spec, const OpenOptions& options) {
   viewer::Viewer& v = view();
+  if (playsOverBricks(spec, settings_)) {
+    openStreamedSeriesInView(spec, options);
+    return;
+  }
   // A time series is shown one time point at a time, each in core.
   if (playsInCore(spec)) {
     openSeries(spec, options);
@@ -174,6 +188,7 @@ void Session::openInView(const std::string& spec, const OpenOptions& options) {
   showDefaultInView(tfChanged);
   series_.reset();
   streamedSeries_.reset();
+  if (streamedFrames_) streamedFrames_->close();
   seriesWindow_.reset();
   timePoint_ = 0;
   inCore_.reset();

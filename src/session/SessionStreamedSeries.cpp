@@ -12,6 +12,7 @@
 #include "tessera/lod/WindowedSource.h"
 #include "tessera/lod/ZarrMultiresSource.h"
 #include "tessera/session/Session.h"
+#include "tessera/viewer/Explorer.h"
 
 namespace tessera::session {
 
@@ -52,6 +53,29 @@ void Session::openStreamedSeries(const std::string& spec, const OpenOptions& opt
   timePoint_ = -1;
   if (!showStreamedTimePoint(firstTime))
     throw Error(spec + ": its first time point was not opened");
+}
+
+// The view holds the time point's coarsest level, read with it ahead (its
+// histogram, window and camera; the exploration's overview); its frames
+// are the front end's streamedFrames(). The view's look carries over.
+void Session::openStreamedSeriesInView(const std::string& spec, const OpenOptions& options) {
+  viewer::Viewer& v = view();
+  const Settings before = settings_;
+  settings_ = currentSettings();
+  settings_.window.reset();  // the series' own
+  try {
+    openStreamedSeries(spec, options);
+  } catch (...) {
+    settings_ = before;
+    throw;
+  }
+  if (streamedFrames_) streamedFrames_->close();
+  closeChannelView();
+  Exploration& e = exploration();
+  v.setVolume(Volume(*e.overview()), e.overviewName());
+  v.setWindow(*seriesWindow_);
+  const bool tfChanged = applyModalityDefault(v.volume());
+  showDefaultInView(tfChanged);
 }
 #endif
 
@@ -94,6 +118,17 @@ bool Session::showDrawnTimePoint(int t) {
   drawn_ = streamedSeries_->source(t);
   timePoint_ = t;
   return true;
+}
+
+std::uint64_t Session::explorationOverviewVoxels() const {
+  // A series over bricks: the coarsest level, warmed ahead with each time
+  // point, rather than a finer one read again at every time point.
+  if (streamedSeries_ && streamed_) {
+    const glm::ivec3 d = streamed_->levelInfo(streamed_->levelCount() - 1).dims;
+    return static_cast<std::uint64_t>(d.x) * static_cast<std::uint64_t>(d.y) *
+           static_cast<std::uint64_t>(d.z);
+  }
+  return viewer::overviewVoxelBudget(device_.limits);
 }
 
 TimeSeries* Session::series() {

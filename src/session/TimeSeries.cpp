@@ -209,7 +209,9 @@ int Playback::step(double nowMs, int shown, int count, bool nextReady) {
   // after this one was due, so frame jitter does not drift the rate. Late:
   // the clock starts again from now, so the rest are not hurried through.
   const double period = 1000.0 / fps_;
-  dueMs_ = nowMs - dueMs_ > period ? nowMs + period : dueMs_ + period;
+  const bool late = nowMs - dueMs_ > period;
+  if (late) ++lateTimePoints_;
+  dueMs_ = late ? nowMs + period : dueMs_ + period;
   return (shown + 1) % count;
 }
 

@@ -7,6 +7,7 @@
 // before would move the cube back); channels and time play together.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -20,6 +21,7 @@
 #include <vector>
 
 #include "support/TestSupport.h"
+#include "support/TimeStore.h"
 #include "tessera/io/ZarrChannels.h"
 #include "tessera/lod/ReadLevel.h"
 #include "tessera/lod/ZarrMultiresSource.h"
@@ -28,101 +30,6 @@
 
 namespace tessera::session {
 namespace {
-
-constexpr int kN = 64;
-constexpr int kChunk = 32;
-
-void writeText(const std::filesystem::path& path, const std::string& text) {
-  std::filesystem::create_directories(path.parent_path());
-  std::ofstream(path, std::ios::binary) << text;
-}
-
-// Voxel (x, y, z) of channel c at time t: a dim smooth sphere shell and a
-// bright 8^3 cube, moving along x (channel 0) or y (channel 1) with t.
-std::uint8_t voxel(int x, int y, int z, int t, int c) {
-  const double r =
-      std::sqrt((x - 31.5) * (x - 31.5) + (y - 31.5) * (y - 31.5) + (z - 31.5) * (z - 31.5)) - 24.0;
-  double v = 50.0 * std::exp(-(r / 2.0) * (r / 2.0));
-  const int m = 8 + 10 * t;  // the moving axis's first voxel
-  const int along = c == 0 ? x : y;
-  const int across = c == 0 ? y : x;
-  if (along >= m && along < m + 8 && across >= 28 && across < 36 && z >= 28 && z < 36) v = 220.0;
-  return static_cast<std::uint8_t>(std::lround(v));
-}
-
-// NGFF 0.4 on Zarr v2, uncompressed: level 0 (64^3, 32^3 chunks) and
-// level 1 (its 2x2x2 mean), axes t[, c], z, y, x, an omero window 0..255.
-std::filesystem::path writeStore(const std::filesystem::path& dir, int times, int channels) {
-  const auto root = dir / (channels > 1 ? "tc.ome.zarr" : "t.ome.zarr");
-  const bool hasC = channels > 1;
-  writeText(root / ".zgroup", R"({"zarr_format": 2})");
-  const std::string ones = hasC ? "1.0, 1.0, " : "1.0, ";
-  std::string omero;
-  for (int c = 0; c < channels; ++c) {
-    omero += std::string(c ? ", " : "") + R"({"label": "ch)" + std::to_string(c) +
-             R"(", "color": ")" + (c ? "00FF00" : "FF00FF") +
-             R"(", "active": true, "window": {"start": 0, "end": 255, "min": 0, "max": 255}})";
-  }
-  writeText(root / ".zattrs",
-            std::string(R"({"multiscales": [{"version": "0.4", "type": "mean", "axes": [)") +
-                R"({"name": "t", "type": "time"}, )" +
-                (hasC ? R"({"name": "c", "type": "channel"}, )" : "") +
-                R"({"name": "z", "type": "space", "unit": "millimeter"},)" +
-                R"({"name": "y", "type": "space", "unit": "millimeter"},)" +
-                R"({"name": "x", "type": "space", "unit": "millimeter"}], "datasets": [)" +
-                R"({"path": "0", "coordinateTransformations": [{"type": "scale", "scale": [)" +
-                ones + R"(1.0, 1.0, 1.0]}]},)" +
-                R"({"path": "1", "coordinateTransformations": [{"type": "scale", "scale": [)" +
-                ones + R"(2.0, 2.0, 2.0]}, {"type": "translation", "translation": [)" +
-                (hasC ? "0.0, 0.0, " : "0.0, ") + R"(0.5, 0.5, 0.5]}]}]}], )" +
-                R"("omero": {"channels": [)" + omero + "]}}");
-  for (int level = 0; level < 2; ++level) {
-    const int n = kN >> level;
-    const std::string lead =
-        std::to_string(times) + ", " + (hasC ? std::to_string(channels) + ", " : "");
-    const std::string chunkLead = hasC ? "1, 1, " : "1, ";
-    writeText(
-        root / std::to_string(level) / ".zarray",
-        R"({"zarr_format": 2, "shape": [)" + lead + std::to_string(n) + ", " + std::to_string(n) +
-            ", " + std::to_string(n) + R"(], "chunks": [)" + chunkLead + "32, 32, 32" +
-            R"(], "dtype": "|u1", "compressor": null, "fill_value": 0, "order": "C", "filters": null})");
-    for (int t = 0; t < times; ++t) {
-      for (int c = 0; c < channels; ++c) {
-        for (int cz = 0; cz < n / kChunk; ++cz) {
-          for (int cy = 0; cy < n / kChunk; ++cy) {
-            for (int cx = 0; cx < n / kChunk; ++cx) {
-              std::string bytes(kChunk * kChunk * kChunk, '\0');
-              for (int z = 0; z < kChunk; ++z) {
-                for (int y = 0; y < kChunk; ++y) {
-                  for (int x = 0; x < kChunk; ++x) {
-                    const int gx = cx * kChunk + x, gy = cy * kChunk + y, gz = cz * kChunk + z;
-                    int v = 0;
-                    if (level == 0) {
-                      v = voxel(gx, gy, gz, t, c);
-                    } else {
-                      for (int k = 0; k < 8; ++k) {
-                        v +=
-                            voxel(2 * gx + (k & 1), 2 * gy + (k >> 1 & 1), 2 * gz + (k >> 2), t, c);
-                      }
-                      v = (v + 4) / 8;
-                    }
-                    bytes[static_cast<std::size_t>((z * kChunk + y) * kChunk + x)] =
-                        static_cast<char>(v);
-                  }
-                }
-              }
-              const std::string key = std::to_string(t) + "." +
-                                      (hasC ? std::to_string(c) + "." : "") + std::to_string(cz) +
-                                      "." + std::to_string(cy) + "." + std::to_string(cx);
-              writeText(root / std::to_string(level) / key, bytes);
-            }
-          }
-        }
-      }
-    }
-  }
-  return root;
-}
 
 OpenOptions atTime(int t) {
   OpenOptions o;
@@ -151,7 +58,7 @@ std::vector<Image> inCoreFrames(const std::string& store, int times, int size) {
 
 TEST(StoreTime, EachTimePointFromBricksEqualsThatTimePointInCore) {
   const test::TempDir dir;
-  const std::string store = writeStore(dir.path(), 5, 1).string();
+  const std::string store = test::writeTimeStore(dir.path(), 5, 1).string();
   const std::vector<Image> inCore = inCoreFrames(store, 5, 96);
   Session s("native");
   useLook(s);
@@ -177,7 +84,7 @@ TEST(StoreTime, EachTimePointFromBricksEqualsThatTimePointInCore) {
 
 TEST(StoreTime, PlaybackOverBricksShowsEveryTimePointOnceInOrderNeverStale) {
   const test::TempDir dir;
-  const std::string store = writeStore(dir.path(), 5, 1).string();
+  const std::string store = test::writeTimeStore(dir.path(), 5, 1).string();
   const std::vector<Image> inCore = inCoreFrames(store, 5, 64);
   Session s("native");
   useLook(s);
@@ -224,9 +131,116 @@ TEST(StoreTime, PlaybackOverBricksShowsEveryTimePointOnceInOrderNeverStale) {
   EXPECT_EQ(StreamedSeries::levelsWithin(*s.pyramid(), 32 * 32 * 32), (std::vector<int>{1}));
 }
 
+// What a front end with a view (the desktop viewer) plays: a store opened
+// in the view over bricks, its frames drawn by streamedFrames() one step
+// per front-end frame. Playback moves on only once the time point shown
+// has been drawn complete, so every time point's complete frame is shown,
+// in order, each equal to that time point in core; one layout per time
+// point shown, the last one's textures let go before the next is made.
+struct ShownOverBricks {
+  std::vector<int> sequence;  // time points drawn complete, in the order shown
+  std::vector<Image> frames;
+  std::vector<std::uint64_t> textureBytes;  // the ledger at each
+};
+
+ShownOverBricks playInView(Session& s, int shows, int size) {
+  ShownOverBricks shown;
+  s.playback().setFps(30.0);
+  const auto start = std::chrono::steady_clock::now();
+  auto nowMs = [&] {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+        .count();
+  };
+  s.playback().play(nowMs());
+  int show = 0;  // the how-manieth time point shown
+  const gpu::MemoryLedger& ledger = s.device().context->ledger();
+  while (static_cast<int>(shown.sequence.size()) < shows && nowMs() < 20000.0) {
+    const int before = s.timePoint();
+    const int t = s.stepPlayback(nowMs());
+    if (t != before) ++show;
+    StreamedFrames& frames = s.streamedFrames();
+    frames.render(size, size);  // the front end's frame
+    if (static_cast<int>(shown.sequence.size()) == show && frames.shownComplete(t)) {
+      shown.sequence.push_back(t);
+      shown.frames.push_back(frames.readImage());
+      shown.textureBytes.push_back(ledger.totalBytes());
+    }
+  }
+  return shown;
+}
+
+// The view's look as useLook's (the view frames its camera anew at open).
+void useLookInView(Session& s) {
+  s.view().camera().azimuthDeg = 30.0;
+  s.view().camera().elevationDeg = 20.0;
+  s.view().tfEditor().setTransferFunction(TransferFunction::preset("grey"));
+}
+
+TEST(StoreTime, ViewPlaysOverBricksEveryTimePointCompleteInOrder) {
+  const test::TempDir dir;
+  const std::string store = test::writeTimeStore(dir.path(), 5, 1).string();
+  const std::vector<Image> inCore = inCoreFrames(store, 5, 64);
+  Session s("native");
+  s.settings().layout = "bricks";
+  s.openInView(store);
+  ASSERT_NE(s.streamedSeries(), nullptr);
+  ASSERT_TRUE(s.streamed());
+  ASSERT_EQ(s.series()->count(), 5);
+  useLookInView(s);
+  const ShownOverBricks shown = playInView(s, 7, 64);
+  ASSERT_EQ(shown.sequence.size(), 7u) << "playback stalled";
+  for (std::size_t i = 0; i < shown.sequence.size(); ++i) {
+    const int t = shown.sequence[i];
+    EXPECT_EQ(t, static_cast<int>(i % 5)) << "at " << i;
+    const double own = psnr(shown.frames[i], inCore[static_cast<std::size_t>(t)]);
+    double other = 0.0;  // the nearest other time point
+    for (int u = 0; u < 5; ++u) {
+      if (u != t)
+        other = std::max(other, psnr(shown.frames[i], inCore[static_cast<std::size_t>(u)]));
+    }
+    std::printf(
+        "shown %zu: time point %d, %.1f dB against it in core, %.1f against another, %llu "
+        "texture bytes\n",
+        i, t, own, other, static_cast<unsigned long long>(shown.textureBytes[i]));
+    EXPECT_GE(own, 45.0) << "time point " << t;
+    EXPECT_LT(other, 40.0) << "time point " << t << " looks like another";
+  }
+  // A layout per time point shown, one on the GPU at a time: the textures
+  // held are the same at every time point, and never more in between.
+  EXPECT_EQ(s.streamedFrames().layoutsMade(), 7);
+  const auto [low, high] =
+      std::minmax_element(shown.textureBytes.begin(), shown.textureBytes.end());
+  EXPECT_EQ(*low, *high);
+  EXPECT_LE(s.device().context->ledger().peakBytes(), *high);
+  std::printf("%llu late time points\n",
+              static_cast<unsigned long long>(s.playback().lateTimePoints()));
+}
+
+// A store whose level 0 does not fit a quarter of the host budget plays
+// over bricks in the view without being asked (it cannot play in core).
+TEST(StoreTime, AStoreBeyondAQuarterOfTheHostBudgetPlaysOverBricksInTheView) {
+  const test::TempDir dir;
+  const std::string store = test::writeTimeStore(dir.path(), 3, 1).string();
+  const std::vector<Image> inCore = inCoreFrames(store, 3, 48);
+  const test::BudgetOverride budget(768 * 1024);  // a quarter: 192 KiB; level 0: 256 KiB
+  Session s("native");
+  s.openInView(store);
+  ASSERT_NE(s.streamedSeries(), nullptr);
+  ASSERT_EQ(s.series()->count(), 3);
+  useLookInView(s);
+  const ShownOverBricks shown = playInView(s, 4, 48);
+  ASSERT_EQ(shown.sequence, (std::vector<int>{0, 1, 2, 0})) << "playback stalled or skipped";
+  for (std::size_t i = 0; i < shown.sequence.size(); ++i) {
+    const double db = psnr(shown.frames[i], inCore[static_cast<std::size_t>(shown.sequence[i])]);
+    std::printf("host budget 768 KiB, shown %zu: time point %d, %.1f dB against it in core\n", i,
+                shown.sequence[i], db);
+    EXPECT_GE(db, 45.0);
+  }
+}
+
 TEST(StoreTime, ChannelsAndTimePlayTogether) {
   const test::TempDir dir;
-  const std::string store = writeStore(dir.path(), 4, 2).string();
+  const std::string store = test::writeTimeStore(dir.path(), 4, 2).string();
   Session s("native");
   useLook(s);
   ChannelView& view = s.channelView();
@@ -286,7 +300,7 @@ TEST(StoreTime, ChannelsAndTimePlayTogether) {
 // Channels of time point t from bricks: the frame against its reference.
 TEST(StoreTime, ChannelsOfATimePointFromBricksMatchTheReference) {
   const test::TempDir dir;
-  const std::string store = writeStore(dir.path(), 4, 2).string();
+  const std::string store = test::writeTimeStore(dir.path(), 4, 2).string();
   Session s("native");
   useLook(s);
   s.settings().layout = "bricks";

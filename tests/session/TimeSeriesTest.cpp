@@ -192,6 +192,8 @@ TEST(Playback, ShowsEveryTimePointInOrderALateOneLate) {
   }
   EXPECT_GT(play.lateFrames(), 0u);
   EXPECT_EQ(play.advances(), sequence.size() - 1);
+  // Only 4 was shown more than a period after it was due (800 ms for 400).
+  EXPECT_EQ(play.lateTimePoints(), 1u);
   // 4 shown when it arrived, and the rest a period apart after it.
   const auto four = std::find(sequence.begin(), sequence.end(), 4) - sequence.begin();
   EXPECT_NEAR(shownAt[four], 800.0, 16.0);

@@ -32,6 +32,7 @@
 #include "tessera/session/Fusion.h"
 #include "tessera/session/RenderRun.h"
 #include "tessera/session/Settings.h"
+#include "tessera/session/StreamedFrames.h"
 #include "tessera/session/StreamedSeries.h"
 #include "tessera/session/TimeSeries.h"
 #include "tessera/session/VolumePyramid.h"
@@ -88,7 +89,11 @@ class Session {
   // head:WxHxD read box by box, a file read in core and downsampled): the
   // view shows its overview, the finest level within the profile's overview
   // budget, and exploration() works on the whole pyramid. On error the
-  // previous volume stays.
+  // previous volume stays. A time series plays: in core when its level 0
+  // fits a quarter of the host budget, else (or with the settings' layout
+  // bricks, for a store) over bricks (openStreamedSeries): the view then
+  // holds the time point's coarsest level (its histogram, window, camera and
+  // overview) and the front end draws streamedFrames().
   void openInView(const std::string& spec, const OpenOptions& options = {});
 
   // A time series (a 4-D NIfTI): time point `options.time` is read now and
@@ -109,7 +114,8 @@ class Session {
   // (session/StreamedSeries.h), each time point drawn by run() and render()
   // through a bricks layout over that time point's pyramid alone, the next
   // ones opened and warmed ahead within the host budget
-  // (SessionStreamedSeries.cpp). The view draws in-core time points.
+  // (SessionStreamedSeries.cpp). With a view, openInView opens it and
+  // streamedFrames() draws it.
   void openStreamedSeries(const std::string& spec, const OpenOptions& options = {});
   // A store's t axis over bricks that a front end draws itself (the page's
   // store over fetch(), whose reads never wait): time point t's pyramid is
@@ -140,11 +146,12 @@ class Session {
   void waitTimePoint(int t);
   // Playback of the series (session/TimeSeries.h): called once per drawn
   // frame, it shows the next time point when it is due, read, and the
-  // view has finished the frame of the one shown (not refining); the
-  // number of the time point shown. `shownComplete`: whether a front end
-  // that draws the frames itself (drawStreamedSeries) has drawn the shown
-  // time point whole (all its bricks); until it has, the next one waits,
-  // a late frame once it is due.
+  // view has finished the frame of the one shown (not refining; over
+  // bricks, once streamedFrames() drew it complete); the number of the
+  // time point shown. `shownComplete`: whether a front end that draws the
+  // frames itself (drawStreamedSeries) has drawn the shown time point whole
+  // (all its bricks); until it has, the next one waits, a late frame once
+  // it is due.
   Playback& playback() { return playback_; }
   int stepPlayback(double nowMs, bool shownComplete = true);
 
@@ -160,6 +167,12 @@ class Session {
   const nlohmann::json& regionReport() const;
   // A streamed store's pyramid (null otherwise), e.g. for its fetch counts.
   const lod::MultiresSource* pyramid() const { return streamed_.get(); }
+  std::shared_ptr<const lod::MultiresSource> sharedPyramid() const { return streamed_; }
+  // The 3D view's frames of the streamed volume in an interactive front end
+  // (session/StreamedFrames.h: a time series played over bricks), made on
+  // first use.
+  StreamedFrames& streamedFrames();
+  bool hasStreamedFrames() const { return streamedFrames_ != nullptr; }
   const lod::VolumeSource& source() const;
 
   // Channels of an OME-Zarr store rendered together with
@@ -307,6 +320,9 @@ class Session {
   bool showStreamedTimePoint(int t);
   bool showDrawnTimePoint(int t);
   bool seriesDrawn_ = false;  // streamedSeries_ is drawn by the front end
+  void openStreamedSeriesInView(const std::string& spec, const OpenOptions& options);
+  // The voxels of the overview an exploration of the volume reads.
+  std::uint64_t explorationOverviewVoxels() const;
   std::optional<ValueRange> seriesWindow_;
   // The modality default (session/ModalityDefault.h): whether the volume
   // came with its own window, what was chosen, the TF it replaced.
@@ -322,6 +338,7 @@ class Session {
   std::unique_ptr<viewer::Viewer> view_;
   std::unique_ptr<Exploration> exploration_;
   std::unique_ptr<ChannelView> channelView_;  // its layout's textures too
+  std::unique_ptr<StreamedFrames> streamedFrames_;
   // render()'s technique on the in-core volume (before device_ goes).
   struct Resident {
     std::shared_ptr<lod::InCoreVolumeSource> source;

@@ -137,6 +137,9 @@ class Playback {
   // Frames where a due time point was not read yet, and time points shown.
   std::uint64_t lateFrames() const { return late_; }
   std::uint64_t advances() const { return advances_; }
+  // Time points shown late: more than a period after they were due (the
+  // clock then starts again from when it was shown).
+  std::uint64_t lateTimePoints() const { return lateTimePoints_; }
 
  private:
   double fps_;
@@ -144,6 +147,7 @@ class Playback {
   double dueMs_ = 0.0;
   std::uint64_t late_ = 0;
   std::uint64_t advances_ = 0;
+  std::uint64_t lateTimePoints_ = 0;
 };
 
 }  // namespace tessera::session

@@ -1,0 +1,75 @@
+#pragma once
+// The 3D view's frames of a streamed volume in an interactive front end:
+// the session's pyramid (a store's time point played over bricks,
+// session/StreamedSeries.h) drawn through a bricks layout and refined a
+// step per front-end frame (session/BrickRefinement.h), at the session's
+// current settings (the view's camera, transfer function, window and render
+// settings). A new time point's pyramid gets a layout of its own, made
+// after the last one's textures are let go, so that one time point's atlas
+// is on the GPU at a time and no brick of another time point is drawn.
+// Session::stepPlayback moves on only once the time point shown has been
+// drawn complete (every brick its view wants resident): every time point
+// is shown refined, none skipped.
+//
+//   session.openInView("series.ome.zarr");     // a t axis over bricks
+//   const gpu::Texture& frame = session.streamedFrames().render(512, 512);
+//   if (session.streamedFrames().complete()) ...  // refined: playback may move on
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "tessera/core/Image.h"
+#include "tessera/gpu/GlObjects.h"
+#include "tessera/layout/StreamingLayout.h"
+#include "tessera/lod/MultiresSource.h"
+#include "tessera/session/BrickRefinement.h"
+
+namespace tessera::session {
+
+class Session;
+
+class StreamedFrames {
+ public:
+  explicit StreamedFrames(Session& session);
+  ~StreamedFrames();
+  StreamedFrames(const StreamedFrames&) = delete;
+  StreamedFrames& operator=(const StreamedFrames&) = delete;
+
+  // How long one render() may stream (read and upload bricks) before it
+  // draws: the front end answers input between frames.
+  StreamPace pace{.streamMs = 100.0, .idleWaitMs = 10.0};
+
+  // One step for the view: the bricks it wants selected, the arrived ones
+  // uploaded (within `pace`), and the frame drawn. Drawn again only while it
+  // refines or when the pyramid (another time point), the settings or the
+  // size changed; row 0 at the bottom, valid until the next call. InputError
+  // when the session has no streamed volume or its technique does not
+  // stream bricks.
+  const gpu::Texture& render(int width, int height);
+  // Whether the last frame drew every brick its view wants (resident, or
+  // given up after its reads kept failing), and of which time point.
+  bool complete() const { return complete_; }
+  int timePoint() const { return timePoint_; }
+  // Whether time point `t`'s frame has been drawn complete at the current
+  // pyramid: what playback waits for before it moves on.
+  bool shownComplete(int t) const;
+  // The last step's bricks (wanted, missing, levels), and the layouts made
+  // so far (one per time point shown).
+  const layout::BricksFrame& lastBricks() const { return last_; }
+  int layoutsMade() const { return layoutsMade_; }
+  // The last frame, top row first.
+  Image readImage() const;
+  // Lets the GPU objects go (another volume replaced the streamed one).
+  void close();
+
+ private:
+  struct Gpu;
+  Session& session_;
+  std::unique_ptr<Gpu> gpu_;
+  layout::BricksFrame last_;
+  bool complete_ = false;
+  int timePoint_ = -1;
+  int layoutsMade_ = 0;
+};
+
+}  // namespace tessera::session

@@ -1,0 +1,122 @@
+// StreamedFrames: the interactive front ends' frames of a streamed volume
+// (session/StreamedFrames.h), the frames Session::run draws for the same
+// settings (createTechnique with layout bricks, prepareFrame, the one
+// refinement loop), kept on the GPU between front-end frames and refined a
+// step at a time instead of to the end in one call.
+#include "tessera/session/StreamedFrames.h"
+
+#include <nlohmann/json.hpp>
+
+#include "tessera/core/Error.h"
+#include "tessera/lod/MultiresVolumeSource.h"
+#include "tessera/lod/WindowedSource.h"
+#include "tessera/render/TechniqueRegistry.h"
+#include "tessera/session/RenderRun.h"
+#include "tessera/session/Session.h"
+
+namespace tessera::session {
+
+// Declared in the order they may go: the refinement steps the technique's
+// layout, which reads the source.
+struct StreamedFrames::Gpu {
+  std::shared_ptr<const lod::MultiresSource> pyramid;  // the session's, the layout's made over
+  std::unique_ptr<lod::MultiresVolumeSource> source;   // it through the window shown
+  render::TechniqueOnVolume technique;
+  std::unique_ptr<BrickRefinement> refinement;
+  std::string key;       // what the technique was made for
+  std::string frameKey;  // what the last frame drew
+  const gpu::Texture* frame = nullptr;
+};
+
+namespace {
+
+// What makes the layout and technique again: the technique and its options,
+// the size and the window the bricks are classified through.
+std::string techniqueKey(const Settings& s, int width, int height, ValueRange window) {
+  nlohmann::json key = {s.technique, s.lutSize, s.slices,   s.classify, s.gradient,
+                        width,       height,    window.min, window.max};
+  return key.dump();
+}
+
+}  // namespace
+
+StreamedFrames::StreamedFrames(Session& session) : session_(session) {}
+StreamedFrames::~StreamedFrames() = default;
+
+const gpu::Texture& StreamedFrames::render(int width, int height) {
+  checkImageSize(width, height);
+  const std::shared_ptr<const lod::MultiresSource> pyramid = session_.sharedPyramid();
+  if (!pyramid) throw InputError("no streamed volume is open (a store played over bricks)");
+  Settings s = session_.currentSettings();
+  s.validate();
+  const ValueRange window = s.window.value_or(pyramid->shape().window());
+  const std::string key = techniqueKey(s, width, height, window);
+  gpu::DeviceSession& device = session_.device();
+  device.context->makeCurrent();
+  if (!gpu_ || gpu_->pyramid != pyramid || gpu_->key != key) {
+    // The last layout's textures go first: one atlas on the GPU at a time.
+    gpu_.reset();
+    complete_ = false;
+    auto next = std::make_unique<Gpu>();
+    next->pyramid = pyramid;
+    next->source = std::make_unique<lod::MultiresVolumeSource>(
+        std::make_shared<lod::WindowedSource>(pyramid, window));
+    next->technique =
+        render::createTechnique(s.technique, *device.context, device.limits, *next->source,
+                                s.techniqueOptions({width, height}), "bricks");
+    layout::StreamingLayout* bricks =
+        next->technique.upload.layout ? next->technique.upload.layout->streaming() : nullptr;
+    if (!bricks) {
+      throw InputError("technique " + s.technique + " keeps its own storage (" +
+                       next->technique.storageName() +
+                       "), which does not stream bricks: a series over bricks is drawn by one "
+                       "that samples a layout (raycast, slice3d)");
+    }
+    // A viewer keeps asking for a brick whose reads failed, after its back-off.
+    bricks->retryFailingReads(true);
+    next->refinement = std::make_unique<BrickRefinement>(*bricks);
+    next->key = key;
+    gpu_ = std::move(next);
+    timePoint_ = session_.timePoint();
+    ++layoutsMade_;
+  }
+  const std::string frameKey = s.toJson().dump();
+  if (gpu_->frame && complete_ && frameKey == gpu_->frameKey) return *gpu_->frame;
+  RenderRequest req;
+  req.settings = s;
+  req.width = width;
+  req.height = height;
+  render::Technique& technique = *gpu_->technique.technique;
+  prepareFrame(technique, *gpu_->technique.upload.volume, req);  // frames the camera
+  last_ = gpu_->refinement->step(req.settings.camera, width, height, req.settings.tf, pace);
+  gpu_->frame = &technique.render(req.settings.camera, req.settings.render, width, height, 0.0);
+  gpu_->frameKey = frameKey;
+  complete_ = last_.complete;
+  return *gpu_->frame;
+}
+
+bool StreamedFrames::shownComplete(int t) const {
+  return gpu_ && gpu_->frame && complete_ && timePoint_ == t &&
+         gpu_->pyramid == session_.sharedPyramid();
+}
+
+Image StreamedFrames::readImage() const {
+  if (!gpu_ || !gpu_->frame) throw InputError("no streamed frame has been rendered");
+  session_.device().context->makeCurrent();
+  return gpu_->technique.technique->readImage();
+}
+
+void StreamedFrames::close() {
+  if (gpu_) session_.device().context->makeCurrent();
+  gpu_.reset();
+  complete_ = false;
+  timePoint_ = -1;
+  last_ = {};
+}
+
+StreamedFrames& Session::streamedFrames() {
+  if (!streamedFrames_) streamedFrames_ = std::make_unique<StreamedFrames>(*this);
+  return *streamedFrames_;
+}
+
+}  // namespace tessera::session
