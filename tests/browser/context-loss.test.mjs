@@ -5,24 +5,26 @@
 // Session::loseContext / restoreContext, the store's view made again by
 // frontends/web/src/WebSession.cpp recoverContext) and shows the same image
 // as before the loss (>= 60 dB) for
-//  - ch2 as an OME-Zarr store, refined;
+//  - ch2 box-filtered by 2 as an OME-Zarr store, refined;
 //  - then a region of its level 0 shown at native resolution, whose chunks
 //    the page's chunk cache let go just before the loss: the restore fetches
 //    them again and shows the region, not the store;
 //  - then a grid block of the store (the grid view): the same block in the
 //    grid view after, and the grid still moves;
-//  - then, in the same page, the head opened as a file (ch2 box-filtered
-//    by 2, in core), with its look away from the defaults, then with a
+//  - then, in the same page, the same head opened as a file (in core),
+//    with its look away from the defaults, then with a
 //    region of it shown at native resolution and the crop box on;
 //  - a three-channel store shown with its channels together, with a
 //    channel hidden, a colour and a window edited (the same channels after).
 // The status line says the context was lost, then restored; the view still
-// turns after. WebGL 2 and WebGL 1 run side by side in one Chromium (each
-// version's pages in turn: the store and the head, then the channels), so
-// that one version's GPU work fills the other's waits for fetches and
-// frames; each reads its own URL of the store, so that what it fetched is
-// its own. Every wait is on a signal of the page (status line, frames,
-// store statistics), never a fixed sleep. Every figure is printed.
+// turns after. WebGL 2 and WebGL 1 run side by side, each in a Chromium of
+// its own (its pages in turn: the store and the head, then the channels),
+// so that one version's work fills the other's waits for fetches and
+// animation frames; each reads its own URL of the store, so that what it
+// fetched is its own. Every wait is on a signal of the page (status line,
+// frames, store statistics), never a fixed sleep, and only for what a check
+// reads (a turned view's first frame, not its refinement). Every figure is
+// printed.
 import assert from 'node:assert/strict';
 import { before, after, test } from 'node:test';
 import fs from 'node:fs';
@@ -31,22 +33,24 @@ import {
   CH2, changedFraction, chunkKeys, openPage, psnrOf, run, served, startBrowser, writeChannelStore,
 } from './fixture.mjs';
 
-let browser;
-before(async () => { browser = await startBrowser(); });
-after(async () => { if (browser) await browser.close(); });
-
+// One Chromium per WebGL version: a page in a background tab gets no
+// animation frames, so the versions' pages each have a browser of their own.
 const VERSIONS = [2, 1];
+let browsers = [];
+before(async () => { browsers = await Promise.all(VERSIONS.map(() => startBrowser())); });
+after(async () => { await Promise.all(browsers.map((b) => b.close())); });
 
 test('the WebGL context lost and restored in WebGL 2 and WebGL 1 side by side: an OME-Zarr store, a region of it ' +
      'whose chunks were let go, a grid block of it, the head in core and a region of it, a store\'s channels: ' +
      'the same images', { concurrency: VERSIONS.length }, async (t) => {
   if (!fs.existsSync(CH2)) assert.fail(`the context loss test needs ${CH2} (mricron-data)`);
-  prepareFiles(browser.tmp);
-  await Promise.all(VERSIONS.map((webgl) => t.test(`WebGL ${webgl}: the store, its region and grid block, the head ` +
+  prepareFiles(browsers.map((b) => b.tmp));
+  await Promise.all(VERSIONS.map((webgl, i) => t.test(`WebGL ${webgl}: the store, its region and grid block, the head ` +
     'and its region, then the channels', async () => {
     const c = checker();
-    await storeThenFile(c, browser.context, browser.url, browser.tmp, webgl);
-    await channels(c, browser.context, browser.url, webgl);
+    const { context, url, tmp } = browsers[i];
+    await storeThenFile(c, context, url, tmp, webgl);
+    await channels(c, context, url, webgl);
     assert.deepEqual(c.failed, [], `failed checks: ${c.failed.join('; ')}`);
   })));
 });
@@ -67,22 +71,29 @@ function checker() {
   return c;
 }
 
-// The test's files under /data/, made once before the pages open: ch2 as an
-// OME-Zarr store (zlib chunks) with a URL of its own per version (a link),
-// ch2 box-filtered by 2 (91x109x91, uncompressed: the head at an eighth of
-// the voxels, read and uploaded in a fraction of the time) and the
-// three-channel store.
-function prepareFiles(tmp) {
-  const store = path.join(tmp, STORE);
-  if (!fs.existsSync(store)) run('convert', CH2, store, '--compressor', 'zlib');
-  for (const webgl of VERSIONS) {
-    const link = path.join(tmp, storeName(webgl));
-    if (!fs.existsSync(link)) fs.symlinkSync(store, link);
-  }
-  const head = path.join(tmp, 'head.nii');
+// The test's files under /data/ of each version's browser, made once in the
+// first's folder (linked from the others') before the pages open: ch2
+// box-filtered by 2 (91x109x91, uncompressed: the head at an eighth of the
+// voxels, read, refined and uploaded in a fraction of the time), the same as
+// an OME-Zarr store (uncompressed chunks, two levels) with a URL of its own
+// per version (so that what each fetched is its own), and the three-channel
+// store.
+function prepareFiles(tmps) {
+  const made = tmps[0];
+  const head = path.join(made, 'head.nii');
   if (!fs.existsSync(head)) run('convert', CH2, head, '--downsample', '2');
-  const three = path.join(tmp, 'three.ome.zarr');
+  const store = path.join(made, STORE);
+  if (!fs.existsSync(store)) run('convert', head, store, '--compressor', 'none');
+  const three = path.join(made, 'three.ome.zarr');
   if (!fs.existsSync(three)) writeChannelStore(three, [48, 48, 24]);
+  const link = (to, tmp, name) => { if (!fs.existsSync(path.join(tmp, name))) fs.symlinkSync(to, path.join(tmp, name)); };
+  tmps.forEach((tmp, i) => {
+    link(store, tmp, storeName(VERSIONS[i]));
+    if (tmp === made) return;
+    link(store, tmp, STORE);
+    link(head, tmp, 'head.nii');
+    link(three, tmp, 'three.ome.zarr');
+  });
 }
 const storeName = (webgl) => `ch2-webgl${webgl}.ome.zarr`;
 
@@ -152,7 +163,11 @@ async function loseAndRestore(page, webgl, { whileLost = async () => {}, settled
 // state the case names is kept, the status line, no error, the view turns.
 async function checkCase(c, page, what, before, after, kept, detail) {
   const psnr = psnrOf(before, after.pixels);
-  await page.evaluate(() => window.tessera.setCamera(80, 12, 1.25));
+  // The next frame shown at a turned camera (a preview will do: a store's
+  // refinement at the new view is not waited for).
+  const frames = await page.evaluate(() => window.tessera.frames());
+  await page.evaluate(() => { window.tessera.setCamera(80, 12, 1.25); });
+  await page.waitForFunction((n) => window.tessera.frames() > n, frames, { timeout: 30000 });
   const turned = changedFraction(after.pixels, await pixelsOf(page));
   const error = await page.evaluate(() => window.tessera.error());
   console.log(`${what}: ${dB(psnr)} after the loss; lost -> restored -> frame in ${after.ms} ms; ` +
@@ -282,8 +297,16 @@ async function storeThenFile(c, context, url, tmp, webgl) {
   await checkCase(c, page, what, before, after, kept,
     `${s1.description}; region ${JSON.stringify(e1.explore.region)}, shown ${e0.showing_region} -> ${e1.showing_region}; ` +
     `${after.heldLetGo}/${keys.length} chunks let go, ${fetchedAgain} fetched again`);
-  // Back to the store's overview: its own view again (the overview's camera kept over the losses).
-  await page.evaluate(() => window.tessera.zarrOverview());
+  // Back to the store's overview: its own view again at the overview's
+  // camera, kept over the losses, not the region's (turned away first); the
+  // first frame shown then is read, its refinement not waited for.
+  const shownBefore = await page.evaluate(() => {
+    window.tessera.setCamera(10, -20, 1.6);  // (one task: no frame of the region at it)
+    const n = window.tessera.frames();
+    window.tessera.zarrOverview();
+    return n;
+  });
+  await page.waitForFunction((n) => window.tessera.frames() > n, shownBefore, { timeout: 30000 });
   const back = await page.evaluate(() => ({ shown: window.tessera.slices.state().showing_region, camera: window.tessera.state().camera }));
   c(`${what}: back to the store's overview after the restore, at the camera the overview had`,
     !back.shown && same(back.camera, overviewCamera), `showing region ${back.shown}; camera ${JSON.stringify(back.camera)}`);
@@ -291,7 +314,7 @@ async function storeThenFile(c, context, url, tmp, webgl) {
   // A grid block of the store (the grid view), lost and restored: the same
   // block in the grid view, and the grid still moves after.
   what = `WebGL ${webgl}, store, a grid block shown`;
-  const entered = await page.evaluate(() => window.tessera.slices.grid.enter(48));
+  const entered = await page.evaluate(() => window.tessera.slices.grid.enter(32));
   await page.evaluate(() => window.tessera.setCamera(35, 12, 1.25));
   const g0 = await page.evaluate(() => window.tessera.slices.grid.state());
   s0 = await page.evaluate(() => window.tessera.state());
@@ -309,7 +332,6 @@ async function storeThenFile(c, context, url, tmp, webgl) {
   const g2 = await page.evaluate(() => window.tessera.slices.grid.state());
   c(`${what}: the grid still moves after the restore`, moved === 1 && g2.active && !same(g2.block, g1.block),
     `move ${legal >= 0 ? g1.moves[legal].view : '(none legal)'}: ${moved}; block ${g1.block_text} -> ${g2.block_text}`);
-  await page.evaluate(() => window.tessera.slices.grid.leave());
 
   await inCore(c, page, webgl);
   noScriptErrors(c, `WebGL ${webgl}, store and head`, logs);
