@@ -1136,6 +1136,9 @@ import { attachOverlayPanel } from './overlay-panel.js';
     openUrls,
     lastLoad: () => lastLoad,
     zarr: () => (zarr ? zarr.stats() : null),
+    // The open store's chunk cache lets these keys go (see zarr-url.js).
+    zarrLetGo: (keys) => (zarr ? zarr.letGo(keys) : 0),
+    zarrHolds: (key) => (zarr ? zarr.holds(key) : false),
     // The channels shown together ({open, name, mode, channels}), or null.
     channels: () => (channelList ? channelList.state() : null),
     // The bread-slice region [begin, end) of an open store's level 0 at

@@ -52,6 +52,9 @@ Session::~Session() {
 }
 
 void Session::makeCurrent() {
+  if (lost_) {
+    throw GpuError("the GPU context was lost: nothing is drawn until it is restored");
+  }
   if (device_.context) device_.context->makeCurrent();
 }
 
@@ -168,6 +171,7 @@ bool Session::showTimePoint(int t) {
   }
   inCore_ = std::move(next);
   exploration_.reset();
+  again_.reset();
   timePoint_ = t;
   applyVolumeSettings();
   return true;
@@ -238,6 +242,7 @@ void Session::setVolume(std::shared_ptr<Volume> volume, const std::string& name)
   resident_.reset();
   inCore_ = std::move(next);
   exploration_.reset();
+  again_.reset();
   closeChannelView();
   name_ = name;
   const bool tfChanged = applyModalityDefault(inCore_->volume());

@@ -83,104 +83,28 @@ void WebSession::makeSession() {
   session_->view();  // the 3D view from the start (its TF editor, camera)
 }
 
-namespace {
-
-// What the view holds beyond the session's state (Session::state): the
-// page's quality settings (and adaptive quality's goal), its overlays, the clip plane that
-// follows the camera and a label table read from a file.
-struct ViewKnobs {
-  viewer::Quality quality = viewer::Quality::Adaptive;
-  int maxVolumePixels = 0;
-  bool showBoundingBox = true, showAxes = true;
-  bool progressive = false;
-  double frameBudgetMs = 12.0;
-  bool clipPlaneFollowsCamera = false;
-  double followingPlaneDistance = 0.0;
-  std::optional<render::LabelTable> labels;
-  render::QualityController::Options adaptive;  // its frame-time goal
-
-  static ViewKnobs of(viewer::Viewer& v) {
-    ViewKnobs k;
-    k.quality = v.quality;
-    k.maxVolumePixels = v.maxVolumePixels;
-    k.showBoundingBox = v.showBoundingBox;
-    k.showAxes = v.showAxes;
-    k.progressive = v.progressive;
-    k.frameBudgetMs = v.frameBudgetMs;
-    k.clipPlaneFollowsCamera = v.clipPlaneFollowsCamera;
-    k.followingPlaneDistance = v.followingPlaneDistance;
-    if (v.labelsOn()) k.labels = v.labelTable();
-    k.adaptive = v.qualityController().options();
-    return k;
-  }
-  void applyTo(viewer::Viewer& v) const {
-    v.quality = quality;
-    v.maxVolumePixels = maxVolumePixels;
-    v.showBoundingBox = showBoundingBox;
-    v.showAxes = showAxes;
-    v.progressive = progressive;
-    v.frameBudgetMs = frameBudgetMs;
-    v.clipPlaneFollowsCamera = clipPlaneFollowsCamera;
-    v.followingPlaneDistance = followingPlaneDistance;
-    if (labels && v.hasVolume()) v.setLabels(*labels);
-    v.qualityController() = render::QualityController(adaptive);
-  }
-};
-
-}  // namespace
-
-// The old session's objects were the lost context's: deleting them on the
-// restored one only raises GL errors, cleared before the new session starts.
+// The session keeps in host memory what it showed (Session::loseContext:
+// the volume, settings, camera, the view's knobs, the exploration, overlay
+// and channels) and makes its GPU side again on the new context
+// (Session::restoreContext); the page's own parts are made again here: an
+// open store's view (its chunks, metadata and levels kept), which then
+// shows the region or grid block again (storeOpenStep). The old objects
+// were the lost context's: deleting them only raised GL errors, cleared
+// before the new context is used.
 void WebSession::recoverContext() {
   zoomStop();
   std::optional<ZarrStoreView::Host> store;
   if (zarr_) store = zarr_->host();
-  const bool hadStore = store.has_value();
-  std::shared_ptr<Volume> volume;
-  if (!hadStore && session_->hasVolume() && !session_->streamed()) {
-    volume = session_->source().level(glm::ivec3(1));  // the volume itself, shared
-  }
-  const std::string name = session_->name();
-  const nlohmann::json state = session_->state();
-  std::optional<session::Overlay> overlay;  // kept in memory: its file is not read again
-  if (session_->overlay()) overlay = *session_->overlay();
-  const ViewKnobs knobs = ViewKnobs::of(viewer());
-  const Camera camera = viewer().camera();  // a store's (its state holds no volume to frame)
   const int webglVersion = context_->webglVersion();
-  const int cell = askedCell_;
-  regionAgain_.reset();
-  if (hadStore && regionShown()) {
-    StoreRegionAgain& r = regionAgain_.emplace();
-    r.exploration = explore()->state();
-    r.cell = cell;
-    r.overviewCamera = explore()->overviewCamera();
-    r.camera = camera;
-    r.window = viewer().window();
-  }
-  std::optional<session::ChannelView::Shown> channels;
-  if (session_->hasChannelView()) channels = session_->channelView().takeShown();
   zarr_.reset();
-  session_.reset();
+  session_->loseContext();
   context_.reset();
   context_ = std::make_unique<gpu::WebGlContext>(canvasSelector_, webglVersion);
   gpu::clearErrors();
-  makeSession();
-  exploreKey_.clear();
-  if (volume) {
-    session_->setVolume(std::move(volume), name);
-    if (overlay) session_->setOverlay(std::move(*overlay));
-    exploration(cell > 0 ? cell : -1);  // the page's exploration, for the state to fill
-    session_->restore(state);
-  } else {
-    session_->restore({{"version", state["version"]}, {"settings", state["settings"]}});
-  }
-  knobs.applyTo(viewer());
+  session_->restoreContext(
+      gpu::borrowDevice(context(), gpu::DeviceProfile::find(context().platform())));
   refreshExtraLines();
-  if (channels) session_->channelView().show(std::move(channels->set), channels->name);
-  if (store) {
-    viewer().camera() = camera;
-    reopenStore(std::move(*store));
-  }
+  if (store) reopenStore(std::move(*store));
 }
 
 void WebSession::loadGenerated(const std::string& spec) {

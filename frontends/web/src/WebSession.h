@@ -86,18 +86,6 @@ inline constexpr lod::ViewMove kViewMoves[6] = {lod::ViewMove::Forward, lod::Vie
                                                 lod::ViewMove::Left,    lod::ViewMove::Right,
                                                 lod::ViewMove::Up,      lod::ViewMove::Down};
 
-// A store's region or grid block that the 3D view showed when the WebGL
-// context was lost: shown again, with the cameras and window it had, once
-// the store is open on the restored context (WebSession::storeOpenStep).
-struct StoreRegionAgain {
-  nlohmann::json exploration;  // Exploration::state(): mode, boxes, grid
-  int cell = -1;               // the grid cell side asked for
-  Camera overviewCamera;       // the store's view, to go back to
-  Camera camera;               // the region's view
-  ValueRange window;
-  std::optional<session::ExploreStep> step;  // restored; its chunks awaited
-};
-
 class WebSession {
  public:
   // A WebGL context on the canvas named by `canvasSelector` (WebGL 2 for
@@ -116,14 +104,13 @@ class WebSession {
   int webglVersion() const { return context_->webglVersion(); }
   // After the browser restored a lost WebGL context (a phone sent the page to
   // the background, the GPU reset): the context is made again on the canvas
-  // and the session on it, with the same volume (shared, not read again),
-  // its state (Session::state: settings, camera, TF, window, exploration)
-  // and the view's own settings. An open OME-Zarr store is made again on
-  // it from what the page holds (reopenStore): the page then steps
-  // storeOpenStep until it is open (and the region or grid block it showed
-  // is shown again), and the store refines as before. A store's channels
-  // shown together are shown again from the voxels in memory
-  // (ChannelView::takeShown).
+  // and the session's GPU side on it (Session::loseContext, restoreContext:
+  // the same volume, settings, camera, view knobs, exploration, region,
+  // overlay and channels, nothing read again). An open OME-Zarr store is
+  // made again on it from what the page holds (reopenStore): the page then
+  // steps storeOpenStep until it is open and the region or grid block it
+  // showed is shown again (Session::showRegionAgain, its chunks fetched
+  // when the cache let them go), and the store refines as before.
   void recoverContext();
 
   // ---- volumes and frames (WebSession.cpp)
@@ -247,9 +234,6 @@ class WebSession {
   // The session on the context, with the page's sampling and its view made.
   void makeSession();
   void showGridBlock(const session::ExploreStep& step);
-  // storeOpenStep's last part after a context loss: false while the
-  // region's level-0 chunks are wanted.
-  bool showStoreRegionAgain();
   // The session's exploration, or null before one was made.
   session::Exploration* explore() {
     return session_->exploring() ? &session_->exploration() : nullptr;
@@ -267,7 +251,6 @@ class WebSession {
   std::string exploreKey_;      // the overview it was made for: name and dims
   int askedCell_ = 0;           // the grid cell side asked for (0: the default)
   bool storeReopened_ = false;  // the store being opened again keeps the view's camera
-  std::optional<StoreRegionAgain> regionAgain_;
   int zoomMediumLevel_ = 0;
   double zoomLastFrameMs_ = -1.0;
   CropState crop_;

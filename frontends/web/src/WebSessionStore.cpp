@@ -45,28 +45,10 @@ bool WebSession::storeOpenStep() {
   viewer::Viewer& v = viewer();
   v.tfEditor().setHistogram(Histogram::compute(z.coarsest(), 256, z.store().shape().window()));
   if (!storeReopened_) v.resetCamera();
-  if (regionAgain_ && !showStoreRegionAgain()) return false;
+  // After a context loss: the region or grid block it showed, once its
+  // level-0 chunks are held again (the page fetches those the cache let go).
+  if (!session_->showRegionAgain()) return false;
   storeReopened_ = false;
-  return true;
-}
-
-// Restores the exploration the lost context's session had (its picked
-// region, grid) on the store, and shows its region or grid block again once
-// the block's level-0 chunks are held (the page fetches those the host cache
-// let go), with the window and both cameras it had.
-bool WebSession::showStoreRegionAgain() {
-  StoreRegionAgain& r = *regionAgain_;
-  session::Exploration& e = exploration(r.cell > 0 ? r.cell : -1);
-  if (!r.step) r.step = e.restore(r.exploration);
-  if (r.step && !theStore().source().prefetch(0, r.step->box)) return false;
-  if (r.step) {
-    viewer::Viewer& v = viewer();
-    v.camera() = r.overviewCamera;  // what going back to the store shows
-    e.showIn(v, e.read(*r.step), *r.step);
-    v.setWindow(r.window);
-    v.camera() = r.camera;
-  }
-  regionAgain_.reset();
   return true;
 }
 
@@ -74,7 +56,6 @@ bool WebSession::showStoreRegionAgain() {
 void WebSession::closeStore() {
   session_->drawPyramid(nullptr);  // its time series too, which reads through the store view
   zarr_.reset();
-  regionAgain_.reset();
   session_->endExploration();
 }
 

@@ -274,7 +274,10 @@ class Session {
   Exploration& explore(std::shared_ptr<const lod::MultiresSource> source,
                        std::uint64_t overviewVoxels, const std::string& label);
   // Forgets the exploration (the next exploration() starts anew).
-  void endExploration() { exploration_.reset(); }
+  void endExploration() {
+    exploration_.reset();
+    again_.reset();
+  }
 
   // The session's state as JSON: {"version", "volume": {...}, "settings"
   // (currentSettings()), "exploration" (null until exploration() was used)}.
@@ -295,7 +298,63 @@ class Session {
   // its options and the overlay from here.
   void restoreOverlay(const nlohmann::json& state);
 
+  // A lost GPU context (SessionContext.cpp): a phone's browser takes the
+  // page's WebGL context away when the app goes to the background, and a GPU
+  // reset takes any context, with every GL object made on it. loseContext()
+  // lets go of the session's GPU side (the view's, the exploration's zoom
+  // swap, the channels' textures, render()'s technique) and of its device,
+  // and keeps in host memory what it showed: the volume, the settings as the
+  // view had them, the view's camera and its own knobs (quality, box and
+  // axes, budgets, the clip plane that follows the camera, a label table),
+  // the exploration (crosshair, grid, the region or block shown), the
+  // overlay and the channels shown together (their voxels). Nothing draws
+  // (GpuError) until restoreContext(device), on a new context, makes the
+  // GPU side again from that: the same frame, nothing read again.
+  void loseContext();
+  bool contextLost() const { return lost_.has_value(); }
+  void restoreContext(gpu::DeviceSession device);
+  // The region or grid block the view showed when the context was lost,
+  // shown again with its window and camera (the overview's camera kept to
+  // go back to) once its level-0 voxels are held: by restoreContext itself
+  // for the session's own volume; for a pyramid a front end draws itself
+  // (drawPyramid: the page's store over fetch(), whose chunk cache may have
+  // let the block's chunks go) by the front end once it draws it again.
+  // False while chunks are wanted (MultiresSource::prefetch asked for them:
+  // the front end fetches them and calls again); true once shown or when
+  // nothing is left to show.
+  bool showRegionAgain();
+  bool regionAgainPending() const { return again_.has_value(); }
+
  private:
+  // What the view holds beyond the settings, kept over a lost context.
+  struct ViewKnobs {
+    viewer::Quality quality = viewer::Quality::Adaptive;
+    int maxVolumePixels = 0;
+    bool showBoundingBox = true, showAxes = true;
+    bool progressive = false;
+    double frameBudgetMs = 12.0;
+    bool clipPlaneFollowsCamera = false;
+    double followingPlaneDistance = 0.0;
+    std::optional<render::LabelTable> labels;
+    render::QualityController::Options adaptive;  // its frame-time goal
+    static ViewKnobs of(viewer::Viewer& view);
+    void applyTo(viewer::Viewer& view) const;
+  };
+  struct Lost {
+    bool hadView = false;
+    ViewKnobs knobs;
+    Camera camera;
+    std::optional<ChannelView::Shown> channels;
+  };
+  // A region or grid block to show again (showRegionAgain).
+  struct RegionAgain {
+    ExploreStep step;
+    Camera camera;
+    ValueRange window;
+  };
+  std::optional<Lost> lost_;
+  std::optional<RegionAgain> again_;
+
   // Several sessions on one thread each draw on their own context: every
   // entry point that touches GL makes it current first (a no-op when it is).
   void makeCurrent();
