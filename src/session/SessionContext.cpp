@@ -62,6 +62,7 @@ void Session::loseContext() {
   if (exploration_) exploration_->endZoom();
   resident_.reset();
   channelView_.reset();
+  streamedFrames_.reset();  // a series over bricks: drawn again from its time point's pyramid
   view_.reset();
   device_.context.reset();
   lost_ = std::move(lost);

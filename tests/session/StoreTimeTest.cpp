@@ -327,12 +327,13 @@ std::vector<std::uint8_t> levelZero(const lod::MultiresSource& source) {
 // has not finished (counted late), never skipping one.
 TEST(StoreTime, ASeriesTheFrontEndDrawsShowsATimePointOnlyOnceItArrived) {
   const test::TempDir dir;
-  const std::string store = writeStore(dir.path(), 5, 1).string();
+  const std::string store = test::writeTimeStore(dir.path(), 5, 1).string();
   Session s("native");
   s.open("gen:sphere:16");
   std::map<int, std::shared_ptr<const lod::MultiresSource>> opened;
   std::set<int> arrived{0};
   std::vector<int> asked;
+  constexpr std::uint64_t kN = test::kTimeStoreSide;
   constexpr std::uint64_t kWarm = kN * kN * kN + (kN / 2) * (kN / 2) * (kN / 2);
   s.drawStreamedSeries(
       5,
@@ -410,7 +411,7 @@ TEST(StoreTime, ASeriesTheFrontEndDrawsShowsATimePointOnlyOnceItArrived) {
 // shown together.
 TEST(StoreTime, ChannelsTheCallerReadsPlayOnceTheirBytesArrived) {
   const test::TempDir dir;
-  const std::string store = writeStore(dir.path(), 4, 2).string();
+  const std::string store = test::writeTimeStore(dir.path(), 4, 2).string();
   Session s("native");
   useLook(s);
   std::set<int> arrived{0};
