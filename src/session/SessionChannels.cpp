@@ -1,7 +1,7 @@
 // Session::renderChannels: a multi-channel frame of an OME-Zarr store
 // (docs/channels.md) through the technique the settings name (one that draws
-// channels: raycast, slice3d, slice2d) over layout::ChannelLayout, and its
-// CPU reference.
+// channels: raycast, slice3d, slice2d) over layout::ChannelLayout or the
+// bricks layout (BricksLayout::createChannels), and its CPU reference.
 #include <chrono>
 #include <cstdio>
 #include <optional>
