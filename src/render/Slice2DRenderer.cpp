@@ -575,6 +575,7 @@ TechniqueEntry Slice2DRenderer::registration() {
       .name = "slice2d",
       .summary = "axis-aligned slice stacks",
       .drawsChannels = true,
+      .drawsChannelBricks = true,
       .requirements = &Slice2DRenderer::requirements,
       .create = [](const TechniqueSetup& s) -> std::unique_ptr<Technique> { return create(s); }};
 }

@@ -272,6 +272,7 @@ TechniqueEntry Slice3DRenderer::registration() {
       .name = "slice3d",
       .summary = "view-aligned slicing",
       .drawsChannels = true,
+      .drawsChannelBricks = true,
       .requirements = &Slice3DRenderer::requirements,
       .create = [](const TechniqueSetup& s) -> std::unique_ptr<Technique> { return create(s); }};
 }

@@ -1,7 +1,7 @@
 // Session::renderChannels: a multi-channel frame of an OME-Zarr store
 // (docs/channels.md) through the technique the settings name (one that draws
-// channels: raycast, slice3d, slice2d) over layout::ChannelLayout, and its
-// CPU reference.
+// channels: raycast, slice3d, slice2d) over layout::ChannelLayout or the
+// bricks layout (BricksLayout::createChannels), and its CPU reference.
 #include <chrono>
 #include <cstdio>
 #include <optional>
@@ -121,12 +121,7 @@ ChannelFrame Session::renderChannels(const std::string& spec, int width, int hei
   const auto layout = layout::createChannelLayout(
       s.layout, set, [&] { return sources = open(); }, device_.limits, gl.ledger());
   frame.layout = layout->plan().reason;
-  if (layout->streaming() && !entry.drawsChannelBricks) {
-    throw InputError("--technique " + s.technique + " cannot draw channels from bricks (" +
-                     frame.layout +
-                     "): use --technique raycast, or --layout texture3d (ES 3) or mosaic (ES 2) "
-                     "where the channels fit in core");
-  }
+  if (layout->streaming()) requireChannelBricks(entry, frame.layout);
   const auto t0 = std::chrono::steady_clock::now();
   std::optional<ChannelLevels> levels;  // a streamed frame's, read after it is drawn
   {

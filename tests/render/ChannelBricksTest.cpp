@@ -12,6 +12,7 @@
 #include <memory>
 #include <set>
 
+#include "support/ChannelBricks.h"
 #include "support/ChannelStore.h"
 #include "support/ExpectError.h"
 #include "support/GpuTestContext.h"
@@ -22,8 +23,6 @@
 #include "tessera/io/ZarrChannels.h"
 #include "tessera/layout/BricksLayout.h"
 #include "tessera/layout/ChannelLayouts.h"
-#include "tessera/lod/InCoreMultiresSource.h"
-#include "tessera/lod/ReadLevel.h"
 #include "tessera/reference/ChannelReference.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/render/Raycaster.h"
@@ -50,10 +49,7 @@ RenderSettings channelSettings() {
 }
 
 std::vector<std::shared_ptr<const lod::MultiresSource>> pyramids(const ChannelSet& set) {
-  std::vector<std::shared_ptr<const lod::MultiresSource>> out;
-  for (const Channel& c : set.channels())
-    out.push_back(std::make_shared<lod::InCoreMultiresSource>(c.volume));
-  return out;
+  return test::channelPyramids(set);
 }
 
 struct BricksImage {
@@ -130,22 +126,6 @@ TEST_F(ChannelBricks, GpuEqualsReferenceOnEs3AndEs2) {
   }
 }
 
-// The levels `layout`'s page table shows, each read from the channels'
-// pyramids: what the reference of its frame reads (Session::renderChannels).
-ChannelLevels levelsShown(const ChannelSet& set, const layout::StreamingLayout& layout) {
-  const lod::BrickGrid& grid = layout.grid();
-  ChannelLevels out;
-  out.cells = {grid.dims(0), grid.brickSize(), grid.bricks(0), layout.cellLevels()};
-  for (int l = 0; l < grid.levelCount(); ++l) out.scales.push_back(grid.scale(l));
-  for (const Channel& c : set.channels()) {
-    const lod::InCoreMultiresSource pyramid(c.volume);
-    out.volumes.emplace_back();
-    for (int l = 0; l < grid.levelCount(); ++l)
-      out.volumes.back().push_back(std::make_shared<const Volume>(lod::readLevel(pyramid, l)));
-  }
-  return out;
-}
-
 // An atlas of about 40 slots holds a third of the 108 level-0 bricks the
 // view wants: the frame shows level 0 in some cells and level 1 in the
 // rest, and equals the reference that reads each cell's level (not the
@@ -173,7 +153,7 @@ TEST_F(ChannelBricks, MixedLevelFrameEqualsTheReferenceOfItsLevels) {
       RenderSettings s = channelSettings();
       s.mode = renderModeFor(mode);
       const Image image = caster.renderImage(camera, s, kSize, kSize);
-      const ChannelLevels levels = levelsShown(shown, *layout);
+      const ChannelLevels levels = test::channelLevelsShown(shown, *layout);
       ASSERT_TRUE(levels.cells.mixed()) << layout->plan().reason;
       const std::vector<int> n = levels.cells.cellsPerLevel();
       const double mixed = psnr(image, renderChannelsReference(shown, levels, channelRamp(), camera,

@@ -4,13 +4,15 @@
 // ES 3, RGBA8 mosaics on ES 2) against the CPU reference of the same
 // channels (which ray marches with the same step, as for one volume), in
 // additive and max mode, a channel's toggle, and the combinations the
-// session refuses.
+// session refuses. Over the bricks layout (BricksLayout::createChannels)
+// the same, against the reference of the levels the frame shows.
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
 
+#include "support/ChannelBricks.h"
 #include "support/ChannelStore.h"
 #include "support/ExpectError.h"
 #include "support/GpuTestContext.h"
@@ -18,6 +20,7 @@
 #include "support/TestSupport.h"
 #include "tessera/gpu/DeviceProfile.h"
 #include "tessera/io/ZarrChannels.h"
+#include "tessera/layout/BricksLayout.h"
 #include "tessera/layout/ChannelLayout.h"
 #include "tessera/reference/ChannelReference.h"
 #include "tessera/reference/ImageMetrics.h"
@@ -72,6 +75,38 @@ class ChannelSlices : public ::testing::Test {
     return image;
   }
 
+  // The slicing technique over the channels' bricks (16^3 bricks: 6 x 6 x 3
+  // cells; `slots` > 0 caps the atlas at about that many slots, so that the
+  // frame mixes levels), refined until complete; `levels` gets the levels
+  // its page table shows. The layout reads windows and visibility from `set`.
+  static Image sliceBricksImage(const std::string& technique, gpu::ApiLevel api,
+                                const ChannelSet& set, const Camera& camera,
+                                ChannelLevels* levels = nullptr, int slots = 0,
+                                std::string* how = nullptr) {
+    test::ApiContext context(api);
+    gpu::GlContext& gl = context.get();
+    const gpu::DeviceLimits limits = gpu::DeviceLimits::of(gl.caps());
+    // A slot: an 18^3 brick with its apron, RGBA16 (ES 3) or RGBA8 (ES 2).
+    const std::uint64_t slot = 18 * 18 * 18 * (api == gpu::ApiLevel::Gles3 ? 8 : 4);
+    layout::BricksOptions options{.brickSize = 16, .workers = 0};
+    if (slots > 0) options.atlasBytesCap = static_cast<std::uint64_t>(slots) * slot;
+    auto bricks = layout::BricksLayout::createChannels(test::channelPyramids(set), set, limits,
+                                                       gl.ledger(), options);
+    layout::BricksFrame f;
+    for (int i = 0; i < 100 && !f.complete; ++i)
+      f = bricks->update(camera, kSize, kSize, channelRamp());
+    EXPECT_TRUE(f.complete) << technique;
+    auto slicer = render::TechniqueRegistry::global().create(
+        technique, {gl, limits, set.geometry(), bricks.get(), render::TechniqueOptions{}});
+    slicer->setTransferFunction(channelRamp());
+    RenderSettings settings = channelSettings();
+    settings.mode = renderModeFor(set.mode);
+    const Image image = slicer->renderImage(camera, settings, kSize, kSize);
+    if (levels) *levels = test::channelLevelsShown(set, *bricks);
+    if (how) *how = bricks->plan().reason + "; " + slicer->report().note;
+    return image;
+  }
+
   static std::unique_ptr<test::TempDir> dir_;
 };
 
@@ -104,6 +139,54 @@ TEST_F(ChannelSlices, AdditiveEqualsReferenceOnTexture3dAndEs2) {
 
 TEST_F(ChannelSlices, MaxEqualsReferenceOnTexture3dAndEs2) {
   expectSlicesEqualReference(ChannelMode::Max);
+}
+
+// Over the bricks layout each fragment of a plane finds its brick cell's
+// page (level and slot) and reads every channel of that slot
+// (layout/channels_bricks.glsl). With the whole atlas (level 0 wherever a
+// channel shows) and with about 40 slots (cells at several levels), slice3d
+// and slice2d equal the reference of the levels the frame shows, on ES 3
+// (RGBA16 3D atlas) and ES 2 (RGBA8 mosaics).
+void expectSlicesOverBricksEqualReference(ChannelMode mode) {
+  ChannelSet set = readZarrChannels(ChannelSlices::store());
+  set.mode = mode;
+  const Camera camera = test::orbitCamera(set.geometry(), 30.0, 20.0);
+  const Image level0 =
+      renderChannelsReference(set, channelRamp(), camera, channelSettings(), kSize, kSize);
+  for (const char* technique : kSlicers) {
+    for (gpu::ApiLevel api : {gpu::ApiLevel::Gles3, gpu::ApiLevel::Gles2}) {
+      for (int slots : {0, 40}) {
+        ChannelLevels levels;
+        std::string how;
+        const Image image =
+            ChannelSlices::sliceBricksImage(technique, api, set, camera, &levels, slots, &how);
+        const std::vector<int> n = levels.cells.cellsPerLevel();
+        const double db = psnr(image, renderChannelsReference(set, levels, channelRamp(), camera,
+                                                              channelSettings(), kSize, kSize));
+        const double db0 = psnr(image, level0);
+        std::printf(
+            "%s channel bricks %s on %s, %s atlas (cells L0 %d L1 %d L2 %d): %.1f dB against "
+            "its levels, %.1f dB against level 0 (%s)\n",
+            technique, channelModeName(mode), test::apiName(api), slots > 0 ? "40-slot" : "whole",
+            n[0], n.size() > 2 ? n[1] : 0, n.size() > 3 ? n[2] : 0, db, db0, how.c_str());
+        EXPECT_GE(db, 40.0) << technique << " " << channelModeName(mode) << " "
+                            << test::apiName(api) << " " << how;
+        EXPECT_GT(n[0], 0) << technique << " " << test::apiName(api);
+        if (slots > 0) {
+          EXPECT_TRUE(levels.cells.mixed()) << how;
+          EXPECT_GT(db, db0 + 1.0) << "the level-0 reference should not fit a mixed frame";
+        }
+      }
+    }
+  }
+}
+
+TEST_F(ChannelSlices, AdditiveOverBricksEqualsReferenceOfItsLevels) {
+  expectSlicesOverBricksEqualReference(ChannelMode::Additive);
+}
+
+TEST_F(ChannelSlices, MaxOverBricksEqualsReferenceOfItsLevels) {
+  expectSlicesOverBricksEqualReference(ChannelMode::Max);
 }
 
 // Six channels: channels 4 and 5 in the layout's second texture and, in max
@@ -151,13 +234,19 @@ std::vector<bool> changed(const Image& a, const Image& b, int tolerance) {
   return out;
 }
 
-// Toggling the slab in `technique`'s frames changes only pixels where the
-// slab shows in its own slab-only frame.
-void expectToggleChangesOnlyTheSlab(const char* technique, ChannelMode mode) {
+// Toggling the slab in `technique`'s frames (on ES 3, over the in-core
+// layout or, with `bricks`, over the bricks layout, refined for each
+// visibility) changes only pixels where the slab shows in its own slab-only
+// frame.
+void expectToggleChangesOnlyTheSlab(const char* technique, ChannelMode mode, bool bricks = false) {
   const gpu::ApiLevel es3 = gpu::ApiLevel::Gles3;
   ChannelSet set = readZarrChannels(ChannelSlices::store());
   set.mode = mode;
   const Camera camera = test::orbitCamera(set.geometry(), 30.0, 20.0);
+  const auto frame = [&](const ChannelSet& shown) {
+    return bricks ? ChannelSlices::sliceBricksImage(technique, es3, shown, camera)
+                  : ChannelSlices::sliceImage(technique, es3, shown, camera);
+  };
   // Where the slab projects: the pixels where the technique's slab-only
   // frame differs from its frame of no channel (its own silhouette; the
   // reference's, printed too, differs in a few edge pixels, because the
@@ -167,17 +256,13 @@ void expectToggleChangesOnlyTheSlab(const char* technique, ChannelMode mode) {
   slabOnly[2].visible = false;
   ChannelSet none = slabOnly;
   none[1].visible = false;
-  const std::vector<bool> slab =
-      changed(ChannelSlices::sliceImage(technique, es3, slabOnly, camera),
-              ChannelSlices::sliceImage(technique, es3, none, camera), 0);
+  const std::vector<bool> slab = changed(frame(slabOnly), frame(none), 0);
   const std::vector<bool> referenceSlab = changed(
       renderChannelsReference(slabOnly, channelRamp(), camera, channelSettings(), kSize, kSize),
       renderChannelsReference(none, channelRamp(), camera, channelSettings(), kSize, kSize), 0);
-  const Image all = ChannelSlices::sliceImage(technique, es3, set, camera);
   ChannelSet noSlab = set;
   noSlab[1].visible = false;
-  const std::vector<bool> diff =
-      changed(all, ChannelSlices::sliceImage(technique, es3, noSlab, camera), 1);
+  const std::vector<bool> diff = changed(frame(set), frame(noSlab), 1);
   int inside = 0, outside = 0, outsideReference = 0;
   for (std::size_t i = 0; i < diff.size(); ++i) {
     if (!diff[i]) continue;
@@ -185,12 +270,14 @@ void expectToggleChangesOnlyTheSlab(const char* technique, ChannelMode mode) {
     outsideReference += referenceSlab[i] ? 0 : 1;
   }
   std::printf(
-      "%s %s: toggling the slab changed %d pixels inside its footprint, %d "
+      "%s %s%s: toggling the slab changed %d pixels inside its footprint, %d "
       "outside (%d outside the reference's)\n",
-      technique, channelModeName(mode), inside, outside, outsideReference);
-  EXPECT_GT(inside, kSize * kSize / 20) << technique << " " << channelModeName(mode);
-  EXPECT_EQ(outside, 0) << technique << " " << channelModeName(mode)
-                        << ": pixels outside the slab's projection";
+      technique, channelModeName(mode), bricks ? " over bricks" : "", inside, outside,
+      outsideReference);
+  const std::string what =
+      std::string(technique) + " " + channelModeName(mode) + (bricks ? " over bricks" : "");
+  EXPECT_GT(inside, kSize * kSize / 20) << what;
+  EXPECT_EQ(outside, 0) << what << ": pixels outside the slab's projection";
 }
 
 TEST_F(ChannelSlices, TogglingAChannelChangesOnlyItsStructuresPixels) {
@@ -201,9 +288,17 @@ TEST_F(ChannelSlices, TogglingAChannelChangesOnlyItsStructuresPixels) {
   }
 }
 
+TEST_F(ChannelSlices, OverBricksTogglingAChannelChangesOnlyItsStructuresPixels) {
+  for (const char* technique : kSlicers) {
+    for (ChannelMode mode : {ChannelMode::Additive, ChannelMode::Max}) {
+      expectToggleChangesOnlyTheSlab(technique, mode, true);
+    }
+  }
+}
+
 // What `render STORE --channels ... --technique slice3d|slice2d` runs: the
 // session's frame equals its reference on ES 3 and an ES 2 profile;
-// slice2d pre-classified, and both over bricks, are refused by name.
+// slice2d pre-classified is refused by name.
 TEST_F(ChannelSlices, SessionDrawsSlicesAndRefusesWhatItCannot) {
   for (const char* technique : kSlicers) {
     for (const char* profile : {"native", "webgl1-desktop-2012"}) {
@@ -224,19 +319,64 @@ TEST_F(ChannelSlices, SessionDrawsSlicesAndRefusesWhatItCannot) {
   EXPECT_EQ(test::inputErrorMessage([&] { session.renderChannels(store(), 64, 64, false); }),
             "slice2d draws channels post-classified (--classify post): pre and palette classify "
             "one volume's values");
-  // Over bricks the slicers are refused (docs/channels.md, "Not done").
-  session.settings().classify = "post";
-  session.settings().layout = "bricks";
+}
+
+// What `render STORE --channels ... --layout bricks --technique
+// slice3d|slice2d [--channel-mode max] --reference` runs: the refined frame
+// equals the reference of the levels it shows on ES 3 and on the ES 2
+// profiles, whose channel atlases are mosaics (16 units on
+// webgl1-desktop-2012, 8 on ipad2).
+TEST_F(ChannelSlices, SessionDrawsSlicesOverBricks) {
   for (const char* technique : kSlicers) {
-    session.settings().technique = technique;
-    const std::string bricks =
-        test::inputErrorMessage([&] { session.renderChannels(store(), 64, 64, false); });
-    EXPECT_EQ(
-        bricks.rfind(
-            "--technique " + std::string(technique) + " cannot draw channels from bricks (", 0),
-        0u)
-        << bricks;
+    for (const char* profile : {"native", "webgl1-desktop-2012", "ipad2"}) {
+      for (ChannelMode mode : {ChannelMode::Additive, ChannelMode::Max}) {
+        session::Session session(profile);
+        session.settings().channels.enabled = true;
+        session.settings().channels.mode = mode;
+        session.settings().technique = technique;
+        session.settings().layout = "bricks";
+        session.settings().tf = channelRamp();
+        session.settings().render.background = {0.0, 0.0, 0.0, 1.0};
+        const session::ChannelFrame f = session.renderChannels(store(), 96, 96, true);
+        std::printf("session %s %s over bricks on %s (%s): %.1f dB\n", technique,
+                    channelModeName(mode), profile, f.layout.c_str(), f.psnr);
+        EXPECT_NE(f.layout.find("^3 bricks (+1 voxel apron)"), std::string::npos) << f.layout;
+        EXPECT_GE(f.psnr, 40.0) << technique << " " << channelModeName(mode) << " " << profile
+                                << " " << f.layout;
+      }
+    }
   }
+}
+
+// A technique that draws channels in core but not from bricks
+// (TechniqueEntry::drawsChannelBricks false: here slice2d's entry so marked
+// for the test, then restored) is refused over bricks in one line naming
+// the techniques that do.
+TEST_F(ChannelSlices, TechniqueWithoutChannelBricksIsRefusedOverBricks) {
+  render::TechniqueRegistry& registry = render::TechniqueRegistry::global();
+  const render::TechniqueEntry slice2d = registry.find("slice2d");
+  struct Restore {
+    render::TechniqueRegistry& registry;
+    const render::TechniqueEntry& entry;
+    ~Restore() { registry.add(entry); }
+  } restore{registry, slice2d};
+  render::TechniqueEntry inCoreOnly = slice2d;
+  inCoreOnly.drawsChannelBricks = false;
+  registry.add(inCoreOnly);
+  session::Session session;
+  session.settings().channels.enabled = true;
+  session.settings().technique = "slice2d";
+  session.settings().layout = "bricks";
+  const std::string message =
+      test::inputErrorMessage([&] { session.renderChannels(store(), 64, 64, false); });
+  const std::string head = "--technique slice2d cannot draw channels from bricks (";
+  const std::string tail =
+      "): use --technique raycast or slice3d, or --layout texture3d (ES 3) or mosaic (ES 2) "
+      "where the channels fit in core";
+  EXPECT_EQ(message.rfind(head, 0), 0u) << message;
+  ASSERT_GE(message.size(), tail.size()) << message;
+  EXPECT_EQ(message.substr(message.size() - tail.size()), tail) << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
 }
 
 }  // namespace

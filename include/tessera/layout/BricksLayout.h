@@ -144,6 +144,9 @@ class BricksLayout final : public Layout, public StreamingLayout {
   ValueBlocks valueBlocks(int blockSize) const override;
   std::uint64_t contentVersion() const override { return contentVersion_; }
   bool walksBricks() const override { return walk_; }
+  // Made by createChannels: its seam defines CHANNELS, so the slicers draw
+  // per channel maxima and slice2d samples the channels, not stacks of its own.
+  bool drawsChannels() const override { return channels_ != nullptr; }
 
   const lod::BrickGrid& grid() const override { return grid_; }
   const lod::MultiresSource& source() const { return *source_; }

@@ -12,4 +12,11 @@ namespace tessera::session {
 // cannot draw channels: channel frames draw with raycast or ...".
 const render::TechniqueEntry& channelTechnique(const std::string& name);
 
+// Refuses a channel frame over the bricks layout (`layoutPlan`, its plan's
+// reason) by a technique that does not draw channel bricks
+// (TechniqueEntry::drawsChannelBricks): InputError "--technique X cannot draw
+// channels from bricks (PLAN): use --technique raycast or ..., or --layout
+// texture3d (ES 3) or mosaic (ES 2) where the channels fit in core".
+void requireChannelBricks(const render::TechniqueEntry& entry, const std::string& layoutPlan);
+
 }  // namespace tessera::session
