@@ -144,7 +144,10 @@ async function storeInputLatency(context, url, tmp, run) {
   page.on('console', (m) => logs.push(`${m.type()}: ${m.text()}`));
   page.on('pageerror', (e) => logs.push(`pageerror: ${e.message}`));
   await page.addInitScript(instrument);
-  await page.goto(`${url}/index.html?size=${SIZE}&slices=0&budget=${BUDGET_MS}&url=/data/ch2.ome.zarr`);
+  // TESSERA_LATENCY_QUERY: more of the page's parameters (a=1&b=2), for
+  // alternating runs of two settings.
+  const extra = process.env.TESSERA_LATENCY_QUERY ? `&${process.env.TESSERA_LATENCY_QUERY}` : '';
+  await page.goto(`${url}/index.html?size=${SIZE}&slices=0&budget=${BUDGET_MS}&url=/data/ch2.ome.zarr${extra}`);
   await page.evaluate(() => window.tessera.ready);
   await page.waitForFunction(() => { const z = window.tessera.zarr(); return z && z.firstImageMs !== null; }, null, { timeout: 60000 });
   const box = await page.locator('#canvas').boundingBox();
