@@ -51,17 +51,6 @@ Image cliFrame(const std::string& store, const std::string& colors, const std::s
   return cli.renderChannels(store, kSize, kSize, false).image;
 }
 
-// Pixels where some component differs by more than `tol` levels.
-std::vector<bool> differing(const Image& a, const Image& b, int tol) {
-  std::vector<bool> out(static_cast<std::size_t>(a.width()) * a.height(), false);
-  for (std::size_t p = 0; p < out.size(); ++p) {
-    for (int k = 0; k < 3; ++k) {
-      if (std::abs(int(a.rgba()[4 * p + k]) - int(b.rgba()[4 * p + k])) > tol) out[p] = true;
-    }
-  }
-  return out;
-}
-
 int count(const std::vector<bool>& pixels) {
   int n = 0;
   for (bool p : pixels) n += p ? 1 : 0;
@@ -120,8 +109,8 @@ TEST_F(PanelsChannels, VisibilityCheckboxHidesOnlyThatChannelsPixels) {
   const Image none = nextFrame();
   clickVisible(1);
   const Image slabAlone = nextFrame();
-  const std::vector<bool> changed = differing(all, withoutSlab, 2);
-  const std::vector<bool> slab = differing(slabAlone, none, 0);
+  const std::vector<bool> changed = test::differing(all, withoutSlab, 2);
+  const std::vector<bool> slab = test::differing(slabAlone, none, 0);
   int inside = 0, outside = 0;
   for (std::size_t p = 0; p < changed.size(); ++p) {
     if (changed[p]) ++(slab[p] ? inside : outside);
@@ -135,7 +124,7 @@ TEST_F(PanelsChannels, VisibilityCheckboxHidesOnlyThatChannelsPixels) {
   clickVisible(0);
   clickVisible(2);
   EXPECT_EQ(s.settings().channels.visible, std::vector<bool>({true, true, true}));
-  EXPECT_EQ(count(differing(nextFrame(), all, 0)), 0);
+  EXPECT_EQ(count(test::differing(nextFrame(), all, 0)), 0);
 }
 
 TEST_F(PanelsChannels, TypedWindowColourAndModeRenderAsTheCommandLine) {
@@ -202,7 +191,7 @@ TEST_F(PanelsChannels, WindowDraggedWithTheMouseRendersAsTheCommandLine) {
   char windows[96];
   std::snprintf(windows, sizeof windows, "100:3000,50:%.0f,100:4000", w.max);
   const double db = psnr(dragged, cliFrame(store(), "ff0000,00ff00,0080ff", windows));
-  const int changed = count(differing(before, dragged, 2));
+  const int changed = count(test::differing(before, dragged, 2));
   std::printf(
       "dragged window: panel's frame vs CLI --channel-windows %s %.1f dB; %d pixels "
       "changed\n",

@@ -45,17 +45,6 @@ Image cliFrame(const std::string& store, const std::string& colors, const std::s
   return cli.renderChannels(store, kSize, kSize, false).image;
 }
 
-// Pixels where some component differs by more than `tol` levels.
-std::vector<bool> differing(const Image& a, const Image& b, int tol) {
-  std::vector<bool> out(static_cast<std::size_t>(a.width()) * a.height(), false);
-  for (std::size_t p = 0; p < out.size(); ++p) {
-    for (int k = 0; k < 3; ++k) {
-      if (std::abs(int(a.rgba()[4 * p + k]) - int(b.rgba()[4 * p + k])) > tol) out[p] = true;
-    }
-  }
-  return out;
-}
-
 class ChannelViewTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -118,8 +107,8 @@ TEST_F(ChannelViewTest, ToggleChangesOnlyThatChannelsPixels) {
   const Image slabAlone = view.readImage();
   const Image black =
       cliFrame(store(), "000000,000000,000000", "100:3000,50:2500,100:4000", {false, false, false});
-  const std::vector<bool> changed = differing(all, withoutSlab, 2);
-  const std::vector<bool> slab = differing(slabAlone, black, 0);
+  const std::vector<bool> changed = test::differing(all, withoutSlab, 2);
+  const std::vector<bool> slab = test::differing(slabAlone, black, 0);
   int inside = 0, outside = 0;
   for (std::size_t p = 0; p < changed.size(); ++p) {
     if (changed[p]) ++(slab[p] ? inside : outside);

@@ -12,6 +12,8 @@
 
 #include <glm/vec3.hpp>
 
+#include "tessera/core/Image.h"
+
 namespace tessera::test {
 
 struct ChannelStoreSpec {
@@ -78,6 +80,18 @@ inline void writeChannelStore(const std::filesystem::path& dir, const ChannelSto
         .write(reinterpret_cast<const char*>(bytes.data()),
                static_cast<std::streamsize>(bytes.size()));
   }
+}
+
+// Pixels where some colour component differs by more than `tol` levels:
+// the footprint a toggled channel changed.
+inline std::vector<bool> differing(const Image& a, const Image& b, int tol) {
+  std::vector<bool> out(static_cast<std::size_t>(a.width()) * a.height(), false);
+  for (std::size_t p = 0; p < out.size(); ++p) {
+    for (int k = 0; k < 3; ++k) {
+      if (std::abs(int(a.rgba()[4 * p + k]) - int(b.rgba()[4 * p + k])) > tol) out[p] = true;
+    }
+  }
+  return out;
 }
 
 }  // namespace tessera::test

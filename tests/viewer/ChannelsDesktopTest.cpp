@@ -12,6 +12,7 @@
 #include <string>
 
 #include "support/ChannelStore.h"
+#include "support/ShellCommand.h"
 #include "support/TestSupport.h"
 #include "tessera/core/Image.h"
 #include "tessera/session/Session.h"
@@ -19,20 +20,8 @@
 namespace tessera::viewer {
 namespace {
 
-struct CommandRun {
-  int status = -1;
-  std::string output;
-};
-
-CommandRun runCommand(const std::string& command) {
-  CommandRun r;
-  FILE* p = popen((command + " 2>&1").c_str(), "r");
-  if (!p) return r;
-  char buf[512];
-  while (std::fgets(buf, sizeof buf, p)) r.output += buf;
-  r.status = pclose(p);
-  return r;
-}
+using test::CommandRun;
+using test::runCommand;
 
 constexpr int kPanel = 390;  // desktop::kPanelWidth
 constexpr int kView = 256;

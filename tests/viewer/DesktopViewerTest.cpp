@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "support/ShellCommand.h"
 #include "support/TestSupport.h"
 #include "tessera/core/Image.h"
 #include "tessera/io/Procedural.h"
@@ -21,20 +22,8 @@
 namespace tessera::viewer {
 namespace {
 
-struct CommandRun {
-  int status = -1;
-  std::string output;
-};
-
-CommandRun run(const std::string& command) {
-  CommandRun r;
-  FILE* p = popen((command + " 2>&1").c_str(), "r");
-  if (!p) return r;
-  char buf[512];
-  while (std::fgets(buf, sizeof buf, p)) r.output += buf;
-  r.status = pclose(p);
-  return r;
-}
+using test::CommandRun;
+const auto run = test::runCommand;
 
 bool desktopViewerBuilt() {
   return run(std::string(TESSERA_CLI_PATH) + " view --help").output.find("--screenshot") !=
