@@ -160,7 +160,9 @@ async function overlay(context, url, tmp) {
   check('a file dropped while ch2 is open is offered as an overlay (replace or add)',
         /ch2\.nii\.gz is open/.test(offer) && /ball\.nii/.test(offer) && /overlay/.test(offer), offer);
   await page.click('#overlayPromptAdd');
-  await page.waitForFunction(() => !window.tessera.overlay.promptShown(), null, { timeout: 30000 });
+  // The offer closes at the click; the file is read and opened after it.
+  await page.waitForFunction(() => !window.tessera.overlay.promptShown() && window.tessera.overlay.info().file === 'ball.nii',
+                             null, { timeout: 30000 }).catch(() => {});  // the check below says what came instead
   const afterDrop = await page.evaluate(() => ({ info: window.tessera.overlay.info(), name: window.tessera.state().name }));
   check('"Add as overlay" keeps ch2 and makes the dropped file the overlay',
         afterDrop.name === 'ch2.nii.gz' && afterDrop.info.open && afterDrop.info.file === 'ball.nii',
