@@ -12,8 +12,8 @@
 # Comments and blank lines are left to the shell.
 #
 # The commands run one after another in one temporary folder (a later command
-# may read what an earlier one wrote, e.g. a converted store), with `build`
-# there a link to this checkout's build/ folder: `build/tessera` is the binary
+# may read what an earlier one wrote, e.g. a converted store), with `build` and
+# `tests` there links to this checkout's folders: `build/tessera` is the binary
 # `scripts/build.sh` made, and the images land in the temporary folder, never
 # in the checkout. Each command gets at most READMECMD_TIMEOUT seconds
 # (default 600).
@@ -92,6 +92,7 @@ fi
 work="$(mktemp -d "${TMPDIR:-/tmp}/tessera-readme.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
 ln -s "$repo/build" "$work/build"
+ln -s "$repo/tests" "$work/tests"  # the test-data generators a command may run (tests/zarr/*.py)
 timeout_s="${READMECMD_TIMEOUT:-600}"
 
 ran=0
