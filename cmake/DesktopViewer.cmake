@@ -27,8 +27,7 @@ if(TESSERA_DESKTOP_FOUND)
 
   # The panels drawn without a window (frontends/desktop/Panels.h), apart so
   # that tests/desktop draws and clicks them in an ImGui context of its own.
-  set(TESSERA_DESKTOP_PANELS ${TESSERA_DESKTOP_DIR}/Panels.cpp
-      ${TESSERA_DESKTOP_DIR}/PanelsChannels.cpp ${TESSERA_DESKTOP_DIR}/PanelsOverlay.cpp)
+  file(GLOB TESSERA_DESKTOP_PANELS CONFIGURE_DEPENDS ${TESSERA_DESKTOP_DIR}/Panels*.cpp)
   add_library(tessera_desktop_panels STATIC ${TESSERA_DESKTOP_PANELS})
   target_compile_options(tessera_desktop_panels PRIVATE ${TESSERA_WARNINGS})
   # SYSTEM: ImGui's and GLFW's headers are not ours to keep free of warnings.

@@ -9,6 +9,7 @@
 #include <memory>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
@@ -30,7 +31,7 @@ namespace {
 Tiles layoutTiles(const DesktopApp& ds, int ww, int wh) {
   const float x0 = kPanelWidth, x1 = static_cast<float>(ww), h = static_cast<float>(wh);
   Tiles t;
-  if (!ds.fourUp) {
+  if (!ds.explore.fourUp) {
     t.view3d = {{x0, 0.0f}, {x1, h}};
     return t;
   }
@@ -43,21 +44,23 @@ Tiles layoutTiles(const DesktopApp& ds, int ww, int wh) {
 }
 
 // The control panel at the window's left edge.
-void drawPanel(DesktopApp& ds, int windowHeight) {
+void drawPanel(DesktopApp& ds, int windowHeight, double nowMs) {
+  session::Session& s = *ds.session;
   beginControlPanel(static_cast<float>(windowHeight));
-  panelFile(ds);
-  panelTime(ds);
-  if (channelsShown(ds)) panelChannels(ds.session->channelView(), ds);
-  panelExplore(ds);
-  panelOverlay(*ds.session, ds.overlayUi, ds);
-  const bool labelsFirst = ds.view().labelsOn();  // the list before the TF it drives
-  if (labelsFirst) panelLabels(ds);
-  panelTransferFunction(ds);
-  panelWindowLevel(ds.view());
-  panelRendering(ds);
-  panelShading(ds.view());
-  panelClipping(ds);
-  if (!labelsFirst) panelLabels(ds);
+  panelFile(s, ds.files, ds);
+  panelTime(s, ds.time, ds, nowMs);
+  if (channelsShown(ds)) panelChannels(s.channelView(), ds);
+  panelExplore(s, ds.explore, ds);
+  panelOverlay(s, ds.overlayUi, ds);
+  viewer::Viewer& v = ds.view();
+  const bool labelsFirst = v.labelsOn();  // the list before the TF it drives
+  if (labelsFirst) panelLabels(v, ds.style, ds);
+  panelTransferFunction(s, ds.style, ds);
+  panelWindowLevel(v);
+  panelRendering(v, ds);
+  panelShading(v);
+  panelClipping(v, ds.style);
+  if (!labelsFirst) panelLabels(v, ds.style, ds);
   ImGui::Separator();
   ImGui::TextWrapped("%s", ds.status.c_str());
   ImGui::End();
@@ -95,37 +98,29 @@ PixelRect toPixels(const Rect& r, double scale, int framebufferHeight) {
 // One pass of the event loop: input, panel, volume, ImGui, screenshot, swap.
 void runFrame(DesktopApp& ds) {
   ds.window->pollEvents();
-  if (!ds.pendingDrop.empty()) {
-    offerDrop(*ds.session, ds.overlayUi, ds, ds.pendingDrop);
-    ds.pendingDrop.clear();
-  }
+  handleDrops(*ds.session, ds.overlayUi, ds);
   const glm::ivec2 fb = ds.window->framebufferSize(), win = ds.window->windowSize();
   const double scale = win.x > 0 ? static_cast<double>(fb.x) / win.x : 1.0;
   const Tiles tiles = layoutTiles(ds, win.x, win.y);
   const PixelRect view = toPixels(tiles.view3d, scale, fb.y);
-  ds.viewPixels = view.height;
+  ds.explore.viewPixels = view.height;
 
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
   // A playing time series moves on when its next time point is due and read.
-  if (ds.session->series()) {
-    const int before = ds.session->timePoint();
-    if (ds.session->stepPlayback(steadyNowMs()) != before) {
-      ++ds.timePointsShown;
-      for (auto& tile : ds.slices) tile.key.clear();
-    }
-  }
+  const double now = steadyNowMs();
+  if (stepTime(*ds.session, ds.time, ds, now)) ++ds.timePointsShown;
   handleViewInput(ds, tiles.view3d, scale);
   handleSliceInput(ds, tiles);
   handleShortcuts(ds);
   handleArrowKeys(ds, tiles);
   updateOverlay(ds);
-  drawPanel(ds, win.y);
+  drawPanel(ds, win.y, now);
   const bool channels = drawChannelView(ds, tiles.view3d, view.width, view.height);
   const bool streamed = !channels && drawStreamedFrames(ds, tiles.view3d, view.width, view.height);
   drawDropOffer(*ds.session, ds.overlayUi, ds);
-  for (int t = 0; t < 3 && ds.fourUp; ++t) drawSliceTile(ds, ds.slices[t], tiles.slice[t]);
+  for (int t = 0; t < 3 && ds.explore.fourUp; ++t) drawSliceTile(ds, ds.slices[t], tiles.slice[t]);
   drawHelpOverlay(ds, kPanelWidth, static_cast<float>(win.x), static_cast<float>(win.y));
   const EdgeLabels labels = ds.view().orientationLabels();
   drawEdgeLetters(labels.left, labels.right, labels.top, labels.bottom, tiles.view3d.p0,
@@ -151,7 +146,7 @@ void runFrame(DesktopApp& ds) {
 void applyOptions(DesktopApp& ds, const ViewOptions& o) {
   std::string recentError;
   try {
-    ds.recent.load();
+    ds.files.recent.load();
   } catch (const Error& e) {
     recentError = e.what();
     std::fprintf(stderr, "tessera view: %s\n", e.what());
@@ -160,7 +155,12 @@ void applyOptions(DesktopApp& ds, const ViewOptions& o) {
   ds.view().tfEditor().setTransferFunction(TransferFunction::fromPresetOrFile(o.tf));
   ds.session->settings().tfIsDefault = !o.tfGiven;
   if (o.bricks) ds.session->settings().layout = "bricks";
-  openVolume(ds, o.file.empty() ? app::defaultVolumeSpec() : o.file, false);
+  ds.files.commandLineFile = o.file;
+  ds.files.commandLine.series = o.series;
+  ds.files.commandLine.time = o.time;
+  ds.files.commandLine.channel = o.channel;
+  ds.style.tf = o.tf;
+  openVolume(*ds.session, ds.files, ds, o.file.empty() ? app::defaultVolumeSpec() : o.file, false);
   if (!ds.error.empty() && !ds.view().hasVolume()) throw InputError(ds.error);
   if (o.bricks && ds.error.empty() && !ds.session->streamedSeries()) {
     throw InputError("--bricks: " + ds.view().description() +
@@ -175,17 +175,17 @@ void applyOptions(DesktopApp& ds, const ViewOptions& o) {
   ds.view().camera().elevationDeg = o.elevation;
   ds.view().settings().shading = app::shadingFrom(o.shading);
   ds.view().settings().clipping = app::clippingFrom(o.clipping);
-  ds.showCropBox = ds.view().settings().clipping.cropped();
+  ds.style.showCropBox = ds.view().settings().clipping.cropped();
   ds.view().settings().mode = session::parseRenderMode(o.projection);
   startExploring(ds, o);
   if (o.labelVolume()) {
     ds.view().setLabels(o.labels.empty() ? render::LabelTable::defaultFor(ds.view().volume())
                                          : render::LabelTable::load(o.labels));
-    std::snprintf(ds.labelPathBuf, sizeof ds.labelPathBuf, "%s", o.labels.c_str());
+    std::snprintf(ds.style.labelPath, sizeof ds.style.labelPath, "%s", o.labels.c_str());
   }
   app::openFusion(*ds.session, o.fusion);
   if (!o.state.empty()) loadState(ds, o.state);
-  if (!o.file.empty()) openChannels(ds, o.file);
+  if (!o.file.empty()) openChannels(*ds.session, ds.files, ds, o.file);
   if (o.play > 0.0) {
     if (!ds.session->series())
       throw InputError("--play: " + ds.view().description() + " is not a time series");
@@ -228,7 +228,8 @@ void runView(const ViewOptions& o) {
   // ES 3 keeps the frame in a cache between window frames, where a full-quality
   // frame can be refined strip by strip; ES 2 redraws every window frame.
   ds.view().progressive = ds.es3;
-  ds.window->onDrop([&ds](const std::string& path) { ds.pendingDrop = path; });
+  ds.window->onDrop(
+      [&ds](const std::vector<std::string>& paths) { filesDropped(ds.overlayUi, paths); });
   applyOptions(ds, o);
   const ImGuiOnWindow imgui(*ds.window, ds.es3);
   while (!ds.window->shouldClose()) runFrame(ds);

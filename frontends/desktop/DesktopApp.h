@@ -9,13 +9,11 @@
 //   DesktopApp.cpp     start-up, the frame loop, the window's layout
 //   VolumeView.cpp     the 3D view: render when it changed, else blit the cache
 //   Input.cpp          keys and mouse on the 3D and slice views, the help overlay
-//   Exploring.cpp      overview / region / grid through session::Exploration
-//   PanelsFile.cpp     open, recent and dropped volumes
-//   PanelsStyle.cpp    TF editor, window/level, rendering, shading, clipping, labels
-//   PanelsExplore.cpp  the slice views and the exploring panel (zoom stages)
-//   Panels.h           the panels drawn without a window (a store's channels,
-//                      the overlay, a dropped file's offer): DesktopApp is
-//                      their PanelHost
+//   Exploring.cpp      where exploring starts (--mode, --crosshair), the view's lines
+//   SliceViews.cpp     the three slice views through the crosshair
+//   Panels.h           the panels, drawn without a window (file, time,
+//                      channels, exploring, overlay, the look; dropped
+//                      files): DesktopApp is their PanelHost
 //   StreamedSeriesView.cpp a time series played over bricks in the 3D view
 #include <chrono>
 #include <memory>
@@ -53,10 +51,13 @@ struct DesktopApp : PanelHost {
   DesktopApp(const ViewOptions& o, std::unique_ptr<gpu::GlfwWindow> w, bool gles3)
       : window(std::move(w)), options(o), es3(gles3) {}
   void setError(const std::string& message) override { error = message; }
-  void openFile(const std::string& path) override;  // PanelsFile.cpp
+  const std::string& errorLine() const override { return error; }
+  void openFile(const std::string& path) override { openVolume(*session, files, *this, path); }
   void overlayChanged() override {
     for (auto& tile : slices) tile.key.clear();  // the slice views mix it in
   }
+  void viewChanged() override;  // Exploring.cpp
+  void stateLoaded() override;
   std::unique_ptr<gpu::GlfwWindow> window;
   const ViewOptions& options;
   bool es3;
@@ -68,16 +69,16 @@ struct DesktopApp : PanelHost {
   viewer::Viewer& view() { return session->view(); }
   bool exploring() const { return session && session->exploring(); }
   session::Exploration& exploration() { return session->exploration(); }
-  std::string pendingDrop;  // a file dropped on the window, opened after the events
   std::string error;
   std::string status;
   gpu::Framebuffer cache;  // ES 3: the last volume frame, blitted while nothing changes
   std::string cacheKey;
-  char pathBuf[512] = "";
-  char tfPathBuf[512] = "transfer-function.json";
-  char labelPathBuf[512] = "labels.txt";
-  char statePathBuf[512] = "tessera-state.json";
-  bool logHistogram = true;
+  // Panels.h: what the panels hold between frames.
+  FileUi files{viewer::RecentFiles::defaultPath()};
+  TimeUi time;
+  StyleUi style;
+  ExploreUi explore;
+  OverlayUi overlayUi;  // the overlay's controls and a dropped file's offer
   int frame = 0;
   // Playback of a time series: time points shown, from the first frame.
   int timePointsShown = 0;
@@ -86,14 +87,6 @@ struct DesktopApp : PanelHost {
   // whose frame was drawn complete, and so recorded (--play-record).
   int completeShows = -1;
   bool showHelp = false;
-  viewer::RecentFiles recent{viewer::RecentFiles::defaultPath()};
-
-  bool fourUp = true;
-  bool sliceColour = false;  // slices in the TF's colour instead of grey
-  // The zoom swaps coarse / medium level / native grid block (the
-  // exploration's zoom swap, session::Exploration::keepZoom).
-  bool zoomSwitchesGrid = false;
-  double viewPixels = 0.0;  // the 3D view's height in pixels (the policy's view)
   double lastFrameMs = 0.0;
   // The three slice views: axial, coronal, sagittal.
   struct SliceTile {
@@ -108,11 +101,9 @@ struct DesktopApp : PanelHost {
   int dragTile = -1;          // a slice view being dragged in (-1: none)
   bool dragRegion = false;    // right button: drawing a region box
   glm::dvec2 dragStart{0.0};  // window units
-  // The crop box drawn with a handle on each face (viewer/CropHandles.h).
-  bool showCropBox = false;
+  // The crop box drawn with a handle on each face (viewer/CropHandles.h),
+  // while style.showCropBox.
   viewer::CropHandles crop;
-  // Panels.h: the overlay's controls and a dropped file's offer.
-  OverlayUi overlayUi;
 };
 
 // A rectangle of the window in ImGui (window) units, top-left origin.
@@ -128,23 +119,9 @@ struct Tiles {
   Rect slice[3];  // axial, coronal, sagittal (empty when not four-up)
 };
 
-using session::Follow;  // how the camera follows a swap of the 3D view's volume
-
-// Exploring.cpp: the keys and panels' steps of session::Exploration.
-void loadVolume(DesktopApp& ds, const std::string& spec);
+// Exploring.cpp: where exploring starts, the 3D view's lines.
 void startExploring(DesktopApp& ds, const ViewOptions& o);
-void showOverview(DesktopApp& ds, Follow follow = Follow::Fill);
-void viewPickedRegion(DesktopApp& ds);
-void enterGrid(DesktopApp& ds);
-void gridMove(DesktopApp& ds, lod::ViewMove move);
-void keepZoomSwap(DesktopApp& ds, const std::vector<lod::ZoomStage>& stages,
-                  const std::string& stagesKey);
 void updateOverlay(DesktopApp& ds);
-
-// PanelsFile.cpp
-// A store with several channels shows them together unless `channels` is
-// false (the command line's file: its channels open after --state).
-void openVolume(DesktopApp& ds, const std::string& spec, bool channels = true);
 // Restores a saved session state (Session::loadState) and what the window
 // shows of it (the crop box, the slice views); throws on error.
 void loadState(DesktopApp& ds, const std::string& path);
@@ -155,25 +132,13 @@ inline double steadyNowMs() {
       .count();
 }
 
-void panelFile(DesktopApp& ds);
-void panelTime(DesktopApp& ds);
-// A store with several channels shown together (session::ChannelView);
-// Panels.h's panelChannels draws their list.
-void openChannels(DesktopApp& ds, const std::string& spec);
+// A store's channels shown together (session::ChannelView); Panels.h's
+// panelChannels draws their list.
 inline bool channelsShown(const DesktopApp& ds) {
   return ds.session && ds.session->hasChannelView() && ds.session->channelView().isOpen();
 }
 
-// PanelsStyle.cpp
-void panelTransferFunction(DesktopApp& ds);
-void panelWindowLevel(viewer::Viewer& v);
-void panelRendering(DesktopApp& ds);
-void panelShading(viewer::Viewer& v);
-void panelClipping(DesktopApp& ds);
-void panelLabels(DesktopApp& ds);
-
-// PanelsExplore.cpp
-void panelExplore(DesktopApp& ds);
+// SliceViews.cpp
 void drawSliceTile(DesktopApp& ds, DesktopApp::SliceTile& tile, const Rect& r);
 
 // StreamedSeriesView.cpp: a series over bricks (session::StreamedFrames)

@@ -112,14 +112,15 @@ constexpr LetterKey kLetterKeys[] = {
        q = q == viewer::Quality::Adaptive ? viewer::Quality::Full : viewer::Quality::Adaptive;
      }},
     {'t', false, nextTechnique},
-    {'v', true, viewPickedRegion},
+    {'v', true, [](DesktopApp& ds) { viewPickedRegion(*ds.session, ds); }},
     {'g', true,
      [](DesktopApp& ds) {
-       ds.exploration().mode() == session::ExploreMode::Grid ? showOverview(ds) : enterGrid(ds);
+       ds.exploration().mode() == session::ExploreMode::Grid ? showOverview(*ds.session, ds)
+                                                             : enterGrid(*ds.session, ds);
      }},
-    {'o', true, [](DesktopApp& ds) { showOverview(ds); }},
-    {'l', true, [](DesktopApp& ds) { ds.fourUp = !ds.fourUp; }},
-    {'c', true, [](DesktopApp& ds) { ds.sliceColour = !ds.sliceColour; }},
+    {'o', true, [](DesktopApp& ds) { showOverview(*ds.session, ds); }},
+    {'l', true, [](DesktopApp& ds) { ds.explore.fourUp = !ds.explore.fourUp; }},
+    {'c', true, [](DesktopApp& ds) { ds.explore.sliceColour = !ds.explore.sliceColour; }},
     {'[', true,
      [](DesktopApp& ds) {
        ds.exploration().explorer().setRegionSide(ds.exploration().explorer().regionSide() - 16);
@@ -142,8 +143,8 @@ void handleShortcuts(DesktopApp& ds) {
   if (io.KeyCtrl) {
     for (int n = 0; n < 9; ++n) {
       if (ImGui::IsKeyPressed(GLFW_KEY_1 + n, false) &&
-          n < static_cast<int>(ds.recent.entries().size())) {
-        openVolume(ds, ds.recent.entries()[static_cast<std::size_t>(n)]);
+          n < static_cast<int>(ds.files.recent.entries().size())) {
+        ds.openFile(ds.files.recent.entries()[static_cast<std::size_t>(n)]);
         return;
       }
     }
@@ -173,8 +174,8 @@ void drawHelpOverlay(DesktopApp& ds, float x0, float x1, float height) {
       }
       ImGui::EndTable();
     }
-    if (!ds.recent.path().empty()) {
-      ImGui::TextDisabled("recent volumes: %s", ds.recent.path().string().c_str());
+    if (!ds.files.recent.path().empty()) {
+      ImGui::TextDisabled("recent volumes: %s", ds.files.recent.path().string().c_str());
     }
   }
   ImGui::End();
@@ -195,7 +196,7 @@ void handleViewInput(DesktopApp& ds, const Rect& view, double scale) {
     return;
   }
   if (!io.WantCaptureMouse && view.contains(io.MousePos)) {
-    if (ds.showCropBox && v.hasVolume() && ImGui::IsMouseClicked(0) && !io.KeyShift) {
+    if (ds.style.showCropBox && v.hasVolume() && ImGui::IsMouseClicked(0) && !io.KeyShift) {
       const glm::dvec3 extent = v.volume().extent();
       if (const auto face =
               viewer::CropHandles::hit(v.camera(), clipping, extent, pos, viewW, viewH)) {
@@ -221,7 +222,7 @@ void handleViewInput(DesktopApp& ds, const Rect& view, double scale) {
 // Mouse input on the slice views: left click/drag moves the crosshair, right
 // drag picks a region, the wheel flips slices.
 void handleSliceInput(DesktopApp& ds, const Tiles& tiles) {
-  if (!ds.exploring() || !ds.fourUp) return;
+  if (!ds.exploring() || !ds.explore.fourUp) return;
   ImGuiIO& io = ImGui::GetIO();
   const glm::dvec2 m(io.MousePos.x, io.MousePos.y);
   if (!io.WantCaptureMouse) {
@@ -260,12 +261,12 @@ void handleArrowKeys(DesktopApp& ds, const Tiles& tiles) {
   if (io.WantTextInput || !ds.exploring()) return;
   auto pressed = [](int key) { return ImGui::IsKeyPressed(key, true); };
   if (ds.exploration().mode() == session::ExploreMode::Grid) {
-    if (pressed(GLFW_KEY_UP)) gridMove(ds, lod::ViewMove::Forward);
-    if (pressed(GLFW_KEY_DOWN)) gridMove(ds, lod::ViewMove::Back);
-    if (pressed(GLFW_KEY_LEFT)) gridMove(ds, lod::ViewMove::Left);
-    if (pressed(GLFW_KEY_RIGHT)) gridMove(ds, lod::ViewMove::Right);
-    if (pressed(GLFW_KEY_PAGE_UP)) gridMove(ds, lod::ViewMove::Up);
-    if (pressed(GLFW_KEY_PAGE_DOWN)) gridMove(ds, lod::ViewMove::Down);
+    if (pressed(GLFW_KEY_UP)) gridMove(*ds.session, ds, lod::ViewMove::Forward);
+    if (pressed(GLFW_KEY_DOWN)) gridMove(*ds.session, ds, lod::ViewMove::Back);
+    if (pressed(GLFW_KEY_LEFT)) gridMove(*ds.session, ds, lod::ViewMove::Left);
+    if (pressed(GLFW_KEY_RIGHT)) gridMove(*ds.session, ds, lod::ViewMove::Right);
+    if (pressed(GLFW_KEY_PAGE_UP)) gridMove(*ds.session, ds, lod::ViewMove::Up);
+    if (pressed(GLFW_KEY_PAGE_DOWN)) gridMove(*ds.session, ds, lod::ViewMove::Down);
   } else {
     if (pressed(GLFW_KEY_UP)) stepSlice(ds, tileUnderPointer(ds, tiles), 1);
     if (pressed(GLFW_KEY_DOWN)) stepSlice(ds, tileUnderPointer(ds, tiles), -1);

@@ -1,14 +1,16 @@
 // The panels that set how the volume looks: the transfer function editor
 // over the histogram, window/level, the rendering mode and sampling,
-// shading, clipping and label volumes. Each edits the viewer's settings;
-// the 3D view re-renders when its key changes (VolumeView.cpp).
+// shading, clipping and label volumes. Each edits the session's view
+// (viewer::Viewer); the 3D view re-renders when its key changes
+// (VolumeView.cpp). tests/desktop/PanelsStyleTest.cpp clicks these widgets
+// without a window.
 #include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "DesktopApp.h"
+#include "Panels.h"
 #include "tessera/render/LabelTable.h"
 #include "tessera/render/TechniqueRegistry.h"
 #include "tessera/session/Settings.h"
@@ -120,17 +122,18 @@ void stepSlider(RenderSettings& settings) {
 
 }  // namespace
 
-void panelTransferFunction(DesktopApp& ds) {
+void panelTransferFunction(session::Session& s, StyleUi& ui, PanelHost& host) {
   section("Transfer function");
-  viewer::TransferFunctionEditor& ed = ds.view().tfEditor();
-  transferFunctionEditor(ed, ds.logHistogram);
+  viewer::TransferFunctionEditor& ed = s.view().tfEditor();
+  transferFunctionEditor(ed, ui.logHistogram);
   if (ImGui::BeginCombo("preset", ed.transferFunction().name.c_str())) {
     for (const std::string& name : TransferFunction::presetNames()) {
-      if (ImGui::Selectable(name.c_str())) ds.session->choosePreset(name);  // with its window
+      // With its window (the look of --tf NAME).
+      if (ImGui::Selectable(name.c_str())) reportErrors(host, [&] { s.choosePreset(name); });
     }
     ImGui::EndCombo();
   }
-  ImGui::Checkbox("log histogram", &ds.logHistogram);
+  ImGui::Checkbox("log histogram", &ui.logHistogram);
   const auto sel = ed.selection();
   ImGui::BeginDisabled(sel.index < 0);
   if (ImGui::Button("Delete point")) ed.removeSelected();
@@ -144,12 +147,12 @@ void panelTransferFunction(DesktopApp& ds) {
       ed.setSelectedColor(glm::dvec3(rgb[0], rgb[1], rgb[2]));
     }
   }
-  ImGui::InputText("##tfpath", ds.tfPathBuf, sizeof ds.tfPathBuf);
+  ImGui::InputText("##tfpath", ui.tfPath, sizeof ui.tfPath);
   ImGui::SameLine();
-  if (ImGui::Button("Save")) reportErrors(ds, [&] { ed.transferFunction().save(ds.tfPathBuf); });
+  if (ImGui::Button("Save")) reportErrors(host, [&] { ed.transferFunction().save(ui.tfPath); });
   ImGui::SameLine();
   if (ImGui::Button("Load")) {
-    reportErrors(ds, [&] { ed.setTransferFunction(TransferFunction::load(ds.tfPathBuf)); });
+    reportErrors(host, [&] { ed.setTransferFunction(TransferFunction::load(ui.tfPath)); });
   }
 }
 
@@ -167,8 +170,7 @@ void panelWindowLevel(viewer::Viewer& v) {
   if (ImGui::Button("Full range")) v.resetWindow();
 }
 
-void panelRendering(DesktopApp& ds) {
-  viewer::Viewer& v = ds.view();
+void panelRendering(viewer::Viewer& v, PanelHost& host) {
   section("Rendering");
   int mode = static_cast<int>(v.settings().mode);
   if (ImGui::Combo("mode", &mode, "composite\0MIP\0MinIP\0average\0")) {
@@ -177,7 +179,7 @@ void panelRendering(DesktopApp& ds) {
   if (ImGui::BeginCombo("technique", v.technique().c_str())) {
     for (const std::string& t : render::TechniqueRegistry::global().names()) {
       if (ImGui::Selectable(t.c_str(), t == v.technique())) {
-        reportErrors(ds, [&] { v.setTechnique(t); });
+        reportErrors(host, [&] { v.setTechnique(t); });
       }
     }
     ImGui::EndCombo();
@@ -209,10 +211,9 @@ void panelRendering(DesktopApp& ds) {
 
 // The crop box (fractions of each axis; handles to drag in the 3D view) and a
 // clip plane that follows the camera.
-void panelClipping(DesktopApp& ds) {
-  viewer::Viewer& v = ds.view();
+void panelClipping(viewer::Viewer& v, StyleUi& ui) {
   section("Clipping");
-  ImGui::Checkbox("crop box handles (drag in 3D)", &ds.showCropBox);
+  ImGui::Checkbox("crop box handles (drag in 3D)", &ui.showCropBox);
   Clipping& c = v.settings().clipping;
   for (int a = 0; a < 3; ++a) {
     float range[2] = {static_cast<float>(c.cropMin[a]), static_cast<float>(c.cropMax[a])};
@@ -236,24 +237,23 @@ void panelClipping(DesktopApp& ds) {
 
 // Label volumes: on/off (the default palette), a table file, and every
 // label with its colour and a visibility box (aal has 116: scrollable).
-void panelLabels(DesktopApp& ds) {
-  viewer::Viewer& v = ds.view();
+void panelLabels(viewer::Viewer& v, StyleUi& ui, PanelHost& host) {
   section("Labels");
   bool on = v.labelsOn();
   if (ImGui::Checkbox("label volume (atlas)", &on)) {
-    reportErrors(ds, [&] {
+    reportErrors(host, [&] {
       if (on) {
         v.setLabelsDefault();
       } else {
         v.clearLabels();
-        v.tfEditor().setTransferFunction(TransferFunction::fromPresetOrFile(ds.options.tf));
+        v.tfEditor().setTransferFunction(TransferFunction::fromPresetOrFile(ui.tf));
       }
     });
   }
-  ImGui::InputText("##labeltable", ds.labelPathBuf, sizeof ds.labelPathBuf);
+  ImGui::InputText("##labeltable", ui.labelPath, sizeof ui.labelPath);
   ImGui::SameLine();
   if (ImGui::Button("load table")) {
-    reportErrors(ds, [&] { v.setLabels(render::LabelTable::load(ds.labelPathBuf)); });
+    reportErrors(host, [&] { v.setLabels(render::LabelTable::load(ui.labelPath)); });
   }
   if (!v.labelsOn()) return;
   if (ImGui::Button("show all")) v.setAllLabelsVisible(true);

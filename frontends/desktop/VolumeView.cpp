@@ -136,7 +136,7 @@ void drawVolumeView(DesktopApp& ds, glm::ivec2 origin, int viewW, int viewH) {
     if (zooming) {
       // A stage that cannot be read or uploaded: the exploration ended the
       // swap (instead of trying again every frame); the last volume stays.
-      ds.zoomSwitchesGrid = false;
+      ds.explore.zoomSwitchesGrid = false;
       ds.error += " (zoom swap turned off)";
     }
   }

@@ -105,11 +105,11 @@ double GlfwWindow::seconds() const {
   return glfwGetTime();
 }
 
-void GlfwWindow::onDrop(std::function<void(const std::string& path)> handler) {
+void GlfwWindow::onDrop(std::function<void(const std::vector<std::string>& paths)> handler) {
   drop_ = std::move(handler);
   glfwSetDropCallback(window_, [](GLFWwindow* w, int count, const char** paths) {
     auto* self = static_cast<GlfwWindow*>(glfwGetWindowUserPointer(w));
-    if (count > 0 && self->drop_) self->drop_(paths[0]);
+    if (count > 0 && self->drop_) self->drop_(std::vector<std::string>(paths, paths + count));
   });
 }
 

@@ -8,6 +8,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <glm/vec2.hpp>
 
@@ -49,13 +50,14 @@ class GlfwWindow {
   glm::ivec2 framebufferSize() const;  // pixels
   glm::ivec2 windowSize() const;       // screen units (differ on high-DPI screens)
   double seconds() const;              // since GLFW started
-  // Called from pollEvents() with the first path dropped on the window.
-  void onDrop(std::function<void(const std::string& path)> handler);
+  // Called from pollEvents() with the paths dropped on the window at once,
+  // in GLFW's order.
+  void onDrop(std::function<void(const std::vector<std::string>& paths)> handler);
 
  private:
   GLFWwindow* window_ = nullptr;
   std::unique_ptr<GlContext> context_;
-  std::function<void(const std::string&)> drop_;
+  std::function<void(const std::vector<std::string>&)> drop_;
 };
 
 }  // namespace tessera::gpu

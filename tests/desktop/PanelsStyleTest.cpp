@@ -1,0 +1,160 @@
+// The desktop viewer's look panels (frontends/desktop/PanelsStyle.cpp),
+// drawn in an ImGui context without a window (HeadlessImGui.h) and clicked:
+// a preset chosen from the TF's menu, a window and level typed in, the
+// technique's menu and the mode's give the frame of the command line with
+// the same flags (`tessera render FILE --tf ct-bone --window 40,160
+// --technique slice3d --mode mip`), to the bit: the session's look as the
+// panels left it (what Save state writes) rendered as `render` renders, and
+// the 3D view's frame against the view of a session given those settings.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "desktop/HeadlessImGui.h"
+#include "desktop/PanelFrames.h"
+#include "desktop/Panels.h"
+#include "desktop/RecordingHost.h"
+#include "support/TestSupport.h"
+#include "tessera/io/NiftiWriter.h"
+#include "tessera/io/Procedural.h"
+#include "tessera/session/Session.h"
+
+namespace tessera::desktop {
+namespace {
+
+using test::HeadlessImGui;
+constexpr int kSize = test::kPanelFrameSize;
+
+// The camera the user turned the view to (--azimuth 40 --elevation 25).
+void look(session::Settings& s) {
+  s.camera.azimuthDeg = 40.0;
+  s.camera.elevationDeg = 25.0;
+}
+void turn(viewer::Viewer& v) {
+  v.camera().azimuthDeg = 40.0;
+  v.camera().elevationDeg = 25.0;
+}
+
+// The flags' settings (`--tf TF --window LO,HI --technique T --mode M`).
+struct Flags {
+  std::string tf = "mr-default";
+  std::optional<ValueRange> window;
+  std::string technique = "raycast";
+  RenderMode mode = RenderMode::Composite;
+  void applyTo(session::Settings& s) const {
+    look(s);
+    s.tf = TransferFunction::preset(tf);
+    s.tfIsDefault = false;
+    s.window = window;
+    s.technique = technique;
+    s.render.mode = mode;
+  }
+};
+
+class PanelsStyle : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = std::make_unique<test::TempDir>();
+    writeNifti(makeProcedural("gen:shepp-logan:48"), dir_->path() / "phantom.nii.gz");
+  }
+  static void TearDownTestSuite() { dir_.reset(); }
+  static std::string file() { return (dir_->path() / "phantom.nii.gz").string(); }
+
+  void SetUp() override {
+    host.openFile(file());
+    ASSERT_EQ(host.error, "");
+    turn(s.view());
+    ui.frame();
+  }
+  // `tessera render FILE` with the flags: a fresh session.
+  static Image renderFrame(const Flags& flags) {
+    session::Session cli("native");
+    flags.applyTo(cli.settings());
+    cli.open(file());
+    return cli.render(kSize, kSize);
+  }
+  // The 3D view of a session that opened the file and was given the
+  // flags' settings (Session::setSettings: what a state with them restores).
+  static Image flagsViewFrame(const Flags& flags) {
+    session::Session cli("native");
+    cli.openInView(file());
+    session::Settings settings = cli.currentSettings();
+    flags.applyTo(settings);
+    cli.setSettings(settings);
+    return test::viewFrame(cli);
+  }
+  // Both comparisons: the panel session's view and its look rendered.
+  void expectFlagsFrame(const Flags& flags, const char* what) {
+    const Image view = test::viewFrame(s);
+    const Image flagsView = flagsViewFrame(flags);
+    const Image rendered = renderFrame(flags);
+    EXPECT_GT(test::differingPixels(rendered, renderFrame(Flags{}), 2), 0);
+    const int viewOff = test::differingPixels(view, flagsView);
+    s.setSettings(s.currentSettings());
+    const int lookOff = test::differingPixels(s.render(kSize, kSize), rendered);
+    std::printf(
+        "%s: %d pixels differ between the panel's look rendered and `render`'s frame, %d "
+        "between the 3D view and the view of a session given the flags\n",
+        what, lookOff, viewOff);
+    EXPECT_EQ(viewOff, 0);
+    EXPECT_EQ(lookOff, 0);
+  }
+  void typeInto(const char* label, const char* text) {
+    ui.click(kPanelTitle, {label}, true);  // Ctrl+click: the slider's text input
+    ui.type(text);
+    ui.clickAway();
+  }
+
+  session::Session s{"native"};
+  test::RecordingHost host{s};
+  StyleUi styleUi;
+  // The look's panels in the control panel, as DesktopApp draws them.
+  HeadlessImGui ui{[this] {
+    beginControlPanel(HeadlessImGui::kHeight);
+    if (s.hasVolume()) {
+      panelTransferFunction(s, styleUi, host);
+      panelWindowLevel(s.view());
+      panelRendering(s.view(), host);
+    }
+    ImGui::End();
+  }};
+  static std::unique_ptr<test::TempDir> dir_;
+};
+std::unique_ptr<test::TempDir> PanelsStyle::dir_;
+
+TEST_F(PanelsStyle, PresetWindowTechniqueAndModeGiveTheCommandLinesFrame) {
+  Flags flags;
+  const Image before = test::viewFrame(s);
+
+  ui.click(kPanelTitle, {"preset"});
+  ui.click("##Combo_00", {"ct-bone"});
+  EXPECT_EQ(s.view().tfEditor().transferFunction().name, "ct-bone");
+  flags.tf = "ct-bone";
+  EXPECT_GT(test::differingPixels(before, test::viewFrame(s), 2), kSize * kSize / 50);
+  expectFlagsFrame(flags, "--tf ct-bone");
+
+  typeInto("window", "120");
+  typeInto("level", "100");
+  EXPECT_EQ(s.view().window().min, 40.0);
+  EXPECT_EQ(s.view().window().max, 160.0);
+  flags.window = ValueRange{40.0, 160.0};
+  expectFlagsFrame(flags, "--tf ct-bone --window 40,160");
+
+  ui.click(kPanelTitle, {"technique"});
+  ui.click("##Combo_00", {"slice3d"});
+  EXPECT_EQ(host.error, "");
+  EXPECT_EQ(s.view().technique(), "slice3d");
+  flags.technique = "slice3d";
+  expectFlagsFrame(flags, "... --technique slice3d");
+
+  ui.click(kPanelTitle, {"mode"});
+  ui.click("##Combo_00", {1, "MIP"});
+  EXPECT_EQ(s.view().settings().mode, RenderMode::Mip);
+  flags.mode = RenderMode::Mip;
+  expectFlagsFrame(flags, "... --mode mip");
+}
+
+}  // namespace
+}  // namespace tessera::desktop
