@@ -4,8 +4,10 @@
 // technique's menu and the mode's give the frame of the command line with
 // the same flags (`tessera render FILE --tf ct-bone --window 40,160
 // --technique slice3d --mode mip`), to the bit: the session's look as the
-// panels left it (what Save state writes) rendered as `render` renders, and
-// the 3D view's frame against the view of a session given those settings.
+// panels left it (what Save state writes) rendered by `render --state`, and
+// the 3D view's frame against the view of a session given those settings;
+// and so do shading's checkbox, the crop box's range and the label volume's
+// checkbox (`--shade --crop ... --labels`).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -19,6 +21,7 @@
 #include "support/TestSupport.h"
 #include "tessera/io/NiftiWriter.h"
 #include "tessera/io/Procedural.h"
+#include "tessera/render/LabelTable.h"
 #include "tessera/session/Session.h"
 
 namespace tessera::desktop {
@@ -43,6 +46,9 @@ struct Flags {
   std::optional<ValueRange> window;
   std::string technique = "raycast";
   RenderMode mode = RenderMode::Composite;
+  bool shade = false;     // --shade
+  double cropMaxZ = 1.0;  // --crop 0:1,0:1,0:Z
+  bool labels = false;    // --labels
   void applyTo(session::Settings& s) const {
     look(s);
     s.tf = TransferFunction::preset(tf);
@@ -50,6 +56,10 @@ struct Flags {
     s.window = window;
     s.technique = technique;
     s.render.mode = mode;
+    s.render.shading.enabled = shade;
+    s.render.clipping.cropMax.z = cropMaxZ;
+    s.labels = labels;
+    if (labels) render::applyLabelSettings(s.render);  // as RenderCommand.cpp does
   }
 };
 
@@ -92,8 +102,12 @@ class PanelsStyle : public ::testing::Test {
     const Image rendered = renderFrame(flags);
     EXPECT_GT(test::differingPixels(rendered, renderFrame(Flags{}), 2), 0);
     const int viewOff = test::differingPixels(view, flagsView);
-    s.setSettings(s.currentSettings());
-    const int lookOff = test::differingPixels(s.render(kSize, kSize), rendered);
+    // The look as Save state writes it, given to a fresh session that opens
+    // the file (`render FILE --state STATE`).
+    session::Session again("native");
+    again.setSettings(s.currentSettings());
+    again.open(file());
+    const int lookOff = test::differingPixels(again.render(kSize, kSize), rendered);
     std::printf(
         "%s: %d pixels differ between the panel's look rendered and `render`'s frame, %d "
         "between the 3D view and the view of a session given the flags\n",
@@ -110,13 +124,20 @@ class PanelsStyle : public ::testing::Test {
   session::Session s{"native"};
   test::RecordingHost host{s};
   StyleUi styleUi;
+  // The panels below Rendering in the window (Shading, Clipping, Labels),
+  // drawn alone: the control panel is taller than the window.
+  bool lower = false;
   // The look's panels in the control panel, as DesktopApp draws them.
   HeadlessImGui ui{[this] {
     beginControlPanel(HeadlessImGui::kHeight);
-    if (s.hasVolume()) {
+    if (s.hasVolume() && !lower) {
       panelTransferFunction(s, styleUi, host);
       panelWindowLevel(s.view());
       panelRendering(s.view(), host);
+    } else if (s.hasVolume()) {
+      panelShading(s.view());
+      panelClipping(s.view(), styleUi);
+      panelLabels(s.view(), styleUi, host);
     }
     ImGui::End();
   }};
@@ -154,6 +175,33 @@ TEST_F(PanelsStyle, PresetWindowTechniqueAndModeGiveTheCommandLinesFrame) {
   EXPECT_EQ(s.view().settings().mode, RenderMode::Mip);
   flags.mode = RenderMode::Mip;
   expectFlagsFrame(flags, "... --mode mip");
+}
+
+// Shading's checkbox, the crop box's z range typed in and the label
+// volume's checkbox, each step: `render --shade`, `--crop 0:1,0:1,0:0.6`,
+// `--labels`'s frame.
+TEST_F(PanelsStyle, ShadingCropAndLabelsGiveTheCommandLinesFrame) {
+  Flags flags;
+  lower = true;
+  ui.frame();
+  ui.click(kPanelTitle, {"shade (gradient lighting)"});
+  EXPECT_TRUE(s.view().settings().shading.enabled);
+  flags.shade = true;
+  expectFlagsFrame(flags, "--shade");
+
+  ui.click(kPanelTitle, {"crop z", 1, ""}, true);  // the range's upper end, typed
+  ui.type("0.6");
+  ui.clickAway();
+  EXPECT_FLOAT_EQ(static_cast<float>(s.view().settings().clipping.cropMax.z), 0.6f);
+  EXPECT_EQ(s.view().settings().clipping.cropMin, glm::dvec3(0.0));
+  flags.cropMaxZ = s.view().settings().clipping.cropMax.z;  // 0.6 as a float holds it
+  expectFlagsFrame(flags, "--shade --crop 0:1,0:1,0:0.6");
+
+  ui.click(kPanelTitle, {"label volume (atlas)"});
+  EXPECT_EQ(host.error, "");
+  EXPECT_TRUE(s.view().labelsOn());
+  flags.labels = true;
+  expectFlagsFrame(flags, "--shade --crop 0:1,0:1,0:0.6 --labels");
 }
 
 }  // namespace
