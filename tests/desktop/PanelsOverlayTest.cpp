@@ -19,10 +19,10 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "desktop/HeadlessImGui.h"
+#include "desktop/PanelFrames.h"
 #include "desktop/Panels.h"
 #include "desktop/RecordingHost.h"
 #include "support/TestSupport.h"
-#include "tessera/gpu/GlObjects.h"
 #include "tessera/io/NiftiWriter.h"
 #include "tessera/reference/ImageMetrics.h"
 #include "tessera/session/OverlayPanel.h"
@@ -32,24 +32,8 @@ namespace tessera::desktop {
 namespace {
 
 using test::HeadlessImGui;
-constexpr int kSize = 96;
-
-// Pixels whose colour differs by more than `tol` in any component.
-int differing(const Image& a, const Image& b, int tol) {
-  int n = 0;
-  for (int y = 0; y < a.height(); ++y) {
-    for (int x = 0; x < a.width(); ++x) {
-      const std::uint8_t *p = a.pixel(x, y), *q = b.pixel(x, y);
-      for (int c = 0; c < 3; ++c) {
-        if (std::abs(int(p[c]) - int(q[c])) > tol) {
-          ++n;
-          break;
-        }
-      }
-    }
-  }
-  return n;
-}
+constexpr int kSize = test::kPanelFrameSize;
+using test::viewFrame;
 
 // The overlay's labels by world position (RAS+ mm): 1 on the right (x > 4),
 // 2 on the left (x < -4), within 22 mm of the centre; 0 elsewhere. The
@@ -149,18 +133,6 @@ class PanelsOverlay : public ::testing::Test {
     return direct.render(kSize, kSize);
   }
 
-  // The 3D view's frame as the window draws it (the viewer the desktop
-  // renders, session::Session::view()), at full quality.
-  static Image viewFrame(session::Session& session) {
-    viewer::Viewer& v = session.view();
-    v.quality = viewer::Quality::Full;
-    gpu::Framebuffer fb = gpu::Framebuffer::create(session.device().context->ledger(),
-                                                   "panel test view", kSize, kSize);
-    v.render(kSize, kSize, fb.id());
-    Image img(kSize, kSize);
-    fb.readRgba8(img.rgba().data());
-    return img;
-  }
   // The same view with the volume explored and the overlay opened by the
   // session's own calls (null controls: no overlay).
   static Image directViewFrame(const session::OverlayControls* controls) {
@@ -208,8 +180,8 @@ TEST_F(PanelsOverlay, AddOverlayOpensTheTypedFileAlignedByWorldCoordinates) {
 
   const Image added = s.render(kSize, kSize);
   const double db = psnr(added, s.renderReference(kSize, kSize));
-  const int shows = differing(alone, added, 2);
-  const int direct = differing(added, directFrame(overlayUi.controls), 0);
+  const int shows = test::differingPixels(alone, added, 2);
+  const int direct = test::differingPixels(added, directFrame(overlayUi.controls), 0);
   std::printf(
       "add overlay: %d of %d pixels coloured, GPU vs reference %.2f dB, %d pixels differ "
       "from Session::openOverlay's frame\n",
@@ -224,7 +196,7 @@ TEST_F(PanelsOverlay, AddOverlayOpensTheTypedFileAlignedByWorldCoordinates) {
   EXPECT_EQ(s.overlay()->options.opacity, 1.0);
   const Image opaque = s.render(kSize, kSize);
   const double opaqueDb = psnr(opaque, s.renderReference(kSize, kSize));
-  const int changed = differing(added, opaque, 2);
+  const int changed = test::differingPixels(added, opaque, 2);
   std::printf("alpha 0.5 -> 1: %d pixels changed, GPU vs reference %.2f dB\n", changed, opaqueDb);
   EXPECT_GE(opaqueDb, 40.0);
   EXPECT_GT(changed, 0);
@@ -235,7 +207,7 @@ TEST_F(PanelsOverlay, AddOverlayOpensTheTypedFileAlignedByWorldCoordinates) {
   ui.click(kPanelTitle, {"Remove overlay"});
   EXPECT_EQ(s.overlay(), nullptr);
   EXPECT_EQ(host.overlayChanges, changes + 1);
-  EXPECT_EQ(differing(alone, s.render(kSize, kSize), 0), 0);
+  EXPECT_EQ(test::differingPixels(alone, s.render(kSize, kSize), 0), 0);
 }
 
 // Another modality's look: the colour map's menu, the window's checkbox
@@ -271,13 +243,13 @@ TEST_F(PanelsOverlay, ColourMapAndWindowControlsRestyleTheOverlay) {
 
   const Image restyled = s.render(kSize, kSize);
   const double db = psnr(restyled, s.renderReference(kSize, kSize));
-  const int direct = differing(restyled, directFrame(overlayUi.controls), 0);
+  const int direct = test::differingPixels(restyled, directFrame(overlayUi.controls), 0);
   std::printf(
       "ct-bone, window 1..2: GPU vs reference %.2f dB, %d pixels changed from hot, %d "
       "differ from Session::openOverlay's frame\n",
-      db, differing(hot, restyled, 2), direct);
+      db, test::differingPixels(hot, restyled, 2), direct);
   EXPECT_GE(db, 40.0);
-  EXPECT_GT(differing(hot, restyled, 2), 0);
+  EXPECT_GT(test::differingPixels(hot, restyled, 2), 0);
   EXPECT_EQ(direct, 0);
 }
 
@@ -324,7 +296,7 @@ TEST_F(PanelsOverlay, ASecondFileDroppedIsOfferedAndAddedAsTheOverlay) {
   expectPlacedByWorldCoordinates();
   const Image fused = s.render(kSize, kSize);
   const double db = psnr(fused, s.renderReference(kSize, kSize));
-  const int direct = differing(fused, directFrame(overlayUi.controls), 0);
+  const int direct = test::differingPixels(fused, directFrame(overlayUi.controls), 0);
   std::printf(
       "dropped and added: GPU vs reference %.2f dB, %d pixels differ from "
       "Session::openOverlay's frame\n",
@@ -351,9 +323,9 @@ TEST_F(PanelsOverlay, FilesDroppedInTurnShowTheSecondOverTheFirstInTheView) {
   EXPECT_EQ(host.error, "");
   expectPlacedByWorldCoordinates();
   const Image fused = viewFrame(s);
-  const int shows = differing(alone, fused, 2);
-  const int aloneOff = differing(alone, directViewFrame(nullptr), 0);
-  const int fusedOff = differing(fused, directViewFrame(&overlayUi.controls), 0);
+  const int shows = test::differingPixels(alone, fused, 2);
+  const int aloneOff = test::differingPixels(alone, directViewFrame(nullptr), 0);
+  const int fusedOff = test::differingPixels(fused, directViewFrame(&overlayUi.controls), 0);
   std::printf(
       "dropped in turn: %d of %d pixels of the view coloured; %d / %d pixels differ from "
       "the view of the session's own calls (alone / with the overlay)\n",
@@ -363,7 +335,7 @@ TEST_F(PanelsOverlay, FilesDroppedInTurnShowTheSecondOverTheFirstInTheView) {
   EXPECT_EQ(fusedOff, 0);
   ui.click(kPanelTitle, {"Remove overlay"});
   EXPECT_EQ(s.overlay(), nullptr);
-  EXPECT_EQ(differing(alone, viewFrame(s), 0), 0);
+  EXPECT_EQ(test::differingPixels(alone, viewFrame(s), 0), 0);
 }
 
 TEST_F(PanelsOverlay, TheOffersReplaceOpensTheFileAndCancelKeepsTheVolume) {
