@@ -169,12 +169,29 @@ bool Session::showTimePoint(int t) {
     view_->setWindow(v->window());
     settings_ = look;
   }
+  // The slice views' crosshair, region side and picked box carry over to
+  // the next time point, and a region or grid block is shown again from it.
+  std::optional<nlohmann::json> explored;
+  if (exploration_) explored = exploration_->state();
   inCore_ = std::move(next);
   exploration_.reset();
   again_.reset();
   timePoint_ = t;
   applyVolumeSettings();
+  if (explored) showExplorationAgain(*explored);
   return true;
+}
+
+void Session::showExplorationAgain(const nlohmann::json& state) {
+  Exploration& e = exploration();
+  const std::optional<ExploreStep> step = e.restore(state);
+  if (!step || !view_) return;
+  // The same box of this time point; the camera stays where the user left it.
+  const Camera camera = view_->camera();
+  const ValueRange window = view_->window();
+  e.showIn(*view_, e.read(*step), {step->box, step->mode, Follow::Keep});
+  view_->setWindow(window);
+  view_->camera() = camera;
 }
 
 void Session::waitTimePoint(int t) {

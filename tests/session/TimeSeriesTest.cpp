@@ -264,6 +264,67 @@ TEST(SessionSeries, EachTimePointRendersAsThatTimePointReadAloneInTheFirstOnesWi
   expectInputError([&] { flat.openSeries(one.string()); }, {"one.nii", "not a time series"});
 }
 
+// The voxels of `box` in `whole` against `region` (a read of that box):
+// how many differ.
+int differingInBox(const Volume& whole, const lod::VoxelBox& box, const Volume& region) {
+  EXPECT_EQ(region.dims(), box.size());
+  int differ = 0;
+  for (int z = box.begin.z; z < box.end.z; ++z)
+    for (int y = box.begin.y; y < box.end.y; ++y)
+      for (int x = box.begin.x; x < box.end.x; ++x) {
+        const glm::ivec3 r = glm::ivec3(x, y, z) - box.begin;
+        differ += whole.valueAt(x, y, z) != region.valueAt(r.x, r.y, r.z);
+      }
+  return differ;
+}
+
+// Playing a series keeps what the slice views explore: the crosshair and
+// the picked box carry over to the next time point, the overview is that
+// time point's volume, and a region shown in the 3D view is read again from
+// it, the camera staying where the user left it.
+TEST(SessionSeries, TheCrosshairAndARegionShownFollowEachTimePoint) {
+  const test::TempDir dir;
+  const auto path = writeSeries(dir, 4);
+  auto alone = [&](int t) {
+    return readVolume(path.string(), {.dicomSeries = "", .time = t, .channel = 0});
+  };
+  Session s("native");
+  s.openSeries(path.string());
+  s.view();
+  s.exploration().explorer().setCrosshair({5, 6, 7});
+  s.waitTimePoint(2);
+  ASSERT_TRUE(s.exploring()) << "the exploration was dropped with the time point";
+  EXPECT_EQ(s.exploration().explorer().crosshair(), glm::ivec3(5, 6, 7));
+  EXPECT_EQ(s.exploration().mode(), ExploreMode::Overview);
+  const Volume two = alone(2);
+  ASSERT_NE(s.exploration().overview(), nullptr);
+  EXPECT_EQ(differingInBox(two, {glm::ivec3(0), two.dims()}, *s.exploration().overview()), 0)
+      << "the overview is not time point 2";
+
+  const ExploreStep step = s.exploration().pickedRegion(Follow::Fill);
+  s.exploration().show(s.view(), step);
+  ASSERT_EQ(s.exploration().mode(), ExploreMode::Region);
+  EXPECT_EQ(differingInBox(two, step.box, s.view().volume()), 0);
+  s.view().camera().azimuthDeg += 25.0;
+  s.view().camera().elevationDeg += 10.0;
+  const Camera turned = s.view().camera();
+  s.waitTimePoint(3);
+  ASSERT_TRUE(s.exploring());
+  EXPECT_EQ(s.exploration().mode(), ExploreMode::Region);
+  ASSERT_TRUE(s.exploration().shown().has_value());
+  EXPECT_EQ(s.exploration().shown()->begin, step.box.begin);
+  EXPECT_EQ(s.exploration().shown()->end, step.box.end);
+  EXPECT_EQ(s.exploration().explorer().crosshair(), glm::ivec3(5, 6, 7));
+  const Volume three = alone(3);
+  EXPECT_EQ(differingInBox(three, step.box, s.view().volume()), 0)
+      << "the region shown is not time point 3's";
+  EXPECT_GT(differingInBox(two, step.box, s.view().volume()), 0)
+      << "time points 2 and 3 do not differ in the region: the check proves nothing";
+  EXPECT_EQ(s.view().camera().azimuthDeg, turned.azimuthDeg);
+  EXPECT_EQ(s.view().camera().elevationDeg, turned.elevationDeg);
+  EXPECT_EQ(s.view().camera().eye(), turned.eye());
+}
+
 TEST(SessionSeries, PlaybackThroughTheSessionShowsEveryTimePoint) {
   const test::TempDir dir;
   const auto path = writeSeries(dir, 5);

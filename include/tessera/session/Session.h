@@ -140,7 +140,9 @@ class Session {
   // Shows time point `t` when it has been read, keeping the view's camera,
   // window and look, and returns true; otherwise asks for it and returns
   // false (the time point shown stays). The exploration is of the time
-  // point shown. InputError without a series or for t out of range.
+  // point shown: its crosshair, region side and picked box carry over, and
+  // a region or grid block in the 3D view is shown again from time point t.
+  // InputError without a series or for t out of range.
   bool showTimePoint(int t);
   // As showTimePoint, waiting for the read (headless runs, benchmarks).
   void waitTimePoint(int t);
@@ -359,6 +361,9 @@ class Session {
   // entry point that touches GL makes it current first (a no-op when it is).
   void makeCurrent();
   void applyVolumeSettings();
+  // A new time point's exploration given the last one's state (crosshair,
+  // region side, picked box, grid): a region or block is read again from it.
+  void showExplorationAgain(const nlohmann::json& state);
   void closeChannelView();
   bool applyModalityDefault(const Volume& v);  // true when it changed the TF
   void showDefaultInView(bool tfChanged);
