@@ -26,8 +26,18 @@ void WebSession::beginStore(const std::string& url) {
   zoomStop();
   session_->endExploration();
   session_->drawPyramid(nullptr);
-  zarr_ = std::make_unique<ZarrStoreView>(context(), viewer().limits(), url);
+  zarr_ = std::make_unique<ZarrStoreView>(context(), viewer().limits(), url, storeCacheBytes_);
   storeReopened_ = false;
+}
+
+void WebSession::setStoreCacheBytes(double bytes) {
+  if (!(bytes >= double(kStoreCacheMinBytes) && bytes <= double(kStoreFetchedBytes))) {
+    throw InputError("the chunk cache of a store: " + std::to_string(bytes / 1048576.0) +
+                     " MiB asked for, it takes " +
+                     std::to_string(double(kStoreCacheMinBytes) / 1048576.0) + " to " +
+                     std::to_string(kStoreFetchedBytes >> 20) + " MiB");
+  }
+  storeCacheBytes_ = static_cast<std::uint64_t>(bytes);
 }
 
 void WebSession::reopenStore(ZarrStoreView::Host host) {
@@ -41,7 +51,11 @@ void WebSession::reopenStore(ZarrStoreView::Host host) {
 bool WebSession::storeOpenStep() {
   ZarrStoreView& z = theStore();
   if (!z.open()) return false;
-  session_->drawPyramid(z.sharedSource());  // what an overlay goes over and the probe reads
+  // What an overlay goes over and the probe reads. A store opened again
+  // after a context loss keeps what the session drew: a series over bricks
+  // plays on from the time point it showed (the session kept it; storeFrame
+  // shows that time point through the new view's bricks).
+  if (!storeReopened_ || !session_->streamedSeries()) session_->drawPyramid(z.sharedSource());
   viewer::Viewer& v = viewer();
   v.tfEditor().setHistogram(Histogram::compute(z.coarsest(), 256, z.store().shape().window()));
   if (!storeReopened_) v.resetCamera();
@@ -142,7 +156,10 @@ StoreFrame WebSession::storeFrame(int width, int height, bool viewChanged) {
 namespace tessera::web {
 
 bool WebSession::storeTimeFinished() {
-  if (!zarr_ || !zarr_->isOpen() || !session_->streamedSeries()) return true;
+  if (!zarr_ || !session_->streamedSeries()) return true;
+  // Being opened again after a context loss: the time point shown is not
+  // on the canvas yet, and playback waits for it.
+  if (!zarr_->isOpen()) return false;
   return zarr_->finished(session_->timePoint());
 }
 

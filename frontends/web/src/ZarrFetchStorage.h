@@ -69,6 +69,7 @@ class FetchStorage final : public ZarrStorage {
   void putMissing(const std::string& key);
   void putFailed(const std::string& key, const std::string& message);
   FetchStats stats() const { return stats_; }
+  std::uint64_t budgetBytes() const { return budget_; }
 
  private:
   enum class State { Bytes, Missing, Failed };
