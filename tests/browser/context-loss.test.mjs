@@ -106,7 +106,7 @@ function prepareFiles(tmps) {
   }
   // The head in 32³ chunks (uncompressed, 32 KiB each): 36 chunks at level 0.
   const small = path.join(made, SMALL);
-  if (!fs.existsSync(small)) run('convert', head, small, '--compressor', 'none', '--chunk', '32');
+  if (!fs.existsSync(small)) run('convert', head, small, '--compressor', 'none', '--chunk', '32,32,32');
   const link = (to, tmp, name) => { if (!fs.existsSync(path.join(tmp, name))) fs.symlinkSync(to, path.join(tmp, name)); };
   tmps.forEach((tmp, i) => {
     link(store, tmp, storeName(VERSIONS[i]));
@@ -483,7 +483,7 @@ async function evictedRegion(c, context, url, tmp, webgl) {
   const what = `WebGL ${webgl}, a store with a 0.75 MiB chunk cache, a region evicted by its limit`;
   await storeRefined(page);
   await page.evaluate(() => window.tessera.slices.setPanelPixels(1));  // the slices from the coarsest level
-  const [rb, re] = [[0, 0, 0], [60, 60, 60]];
+  const [rb, re] = [[16, 16, 16], [62, 62, 62]];
   await page.evaluate(([b, e]) => window.tessera.zarrRegion(b, e), [rb, re]);
   await page.evaluate(() => window.tessera.setCamera(35, 12, 1.25));
   const s0 = await page.evaluate(() => window.tessera.state());

@@ -50,6 +50,12 @@ void WebSession::reopenStore(ZarrStoreView::Host host) {
 // context loss keeps the restored camera).
 bool WebSession::storeOpenStep() {
   ZarrStoreView& z = theStore();
+  // After a context loss the region or grid block it showed is asked for in
+  // the same step as the store's coarsest level (and shown at once when its
+  // chunks are held): every chunk the restore reads is wanted, or marked
+  // used, before any is fetched, so that the chunk cache makes room for
+  // those it let go by letting others go, not the ones held for it.
+  if (storeReopened_ && session_->regionAgainPending()) session_->showRegionAgain();
   if (!z.open()) return false;
   // What an overlay goes over and the probe reads. A store opened again
   // after a context loss keeps what the session drew: a series over bricks

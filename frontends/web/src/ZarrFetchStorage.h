@@ -52,8 +52,8 @@ class FetchStorage final : public ZarrStorage {
   bool decodesChunks(ZarrCompressor c) const override;
   void setPageDecodes(ZarrCompressor c) { pageDecodes_[static_cast<int>(c)] = true; }
 
-  // True when `key` has arrived (bytes, a 404 or an error); otherwise
-  // records it as wanted.
+  // True when `key` has arrived (bytes, a 404 or an error), and it becomes
+  // the most recently used; otherwise records it as wanted.
   bool ready(const std::string& key) const;
   // Whether the key has arrived (or is known missing), without asking for it.
   bool holds(const std::string& key) const { return entries_.count(key) != 0; }
