@@ -20,7 +20,7 @@
 //    plays, it comes back at the time point it showed and plays on in
 //    order; lost while paused, the same image, time slider and label, and
 //    playing on works;
-//  - a store whose chunk cache is small (?zarrcache=0.75, 24 of its 32³
+//  - (WebGL 2) a store whose chunk cache is small (?zarrcache=0.75, 24 of its 32³
 //    chunks): a region of level 0 shown, then the slice views read level-0
 //    slabs elsewhere and the cache's own limit lets the region's chunks go;
 //    the restore fetches exactly the chunks it needs that were let go (the
@@ -56,13 +56,14 @@ test('the WebGL context lost and restored in WebGL 2 and WebGL 1 side by side: a
   if (!fs.existsSync(CH2)) assert.fail(`the context loss test needs ${CH2} (mricron-data)`);
   prepareFiles(browsers.map((b) => b.tmp));
   await Promise.all(VERSIONS.map((webgl, i) => t.test(`WebGL ${webgl}: the store, its region and grid block, the head ` +
-    'and its region, the channels, a series over bricks, a region evicted', async () => {
+    `and its region, the channels, a series over bricks${webgl === 2 ? ', a region evicted' : ''}`, async () => {
     const c = checker();
     const { context, url, tmp } = browsers[i];
     await storeThenFile(c, context, url, tmp, webgl);
     await channels(c, context, url, webgl);
     await brickedSeries(c, context, url, webgl);
-    await evictedRegion(c, context, url, tmp, webgl);
+    // The chunk cache is the same in both versions: in the shorter run only.
+    if (webgl === 2) await evictedRegion(c, context, url, tmp, webgl);
     assert.deepEqual(c.failed, [], `failed checks: ${c.failed.join('; ')}`);
   })));
 });

@@ -102,6 +102,7 @@ class WebSession {
   viewer::Viewer& viewer() { return session_->view(); }
   gpu::GlContext& context() { return context_->gl(); }
   int webglVersion() const { return context_->webglVersion(); }
+  bool contextLost() const { return context_->lost(); }
   // After the browser restored a lost WebGL context (a phone sent the page to
   // the background, the GPU reset): the context is made again on the canvas
   // and the session's GPU side on it (Session::loseContext, restoreContext:
