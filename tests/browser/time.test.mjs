@@ -298,13 +298,13 @@ async function sliceRefs(store, st, wanted, tmp, tag) {
 // (refs[`${t}-${plane}`]) once none is pending: whether each is read at
 // level 0 and identical, and how many of its pixels differ from time point
 // `other`'s (where the data differ, it must not be that one's).
-async function slicesAgainst(page, refs, t, other) {
+async function slicesAgainst(page, refs, t, other, planes = ['axial', 'coronal', 'sagittal']) {
   await page.waitForFunction(() => Object.values(window.tessera.slices.state().panels).every((p) => p.frame && !p.frame.pending),
     null, { timeout: 30000 }).catch(() => {});
   const st = await page.evaluate(() => window.tessera.slices.state());
   const rows = [];
   let ok = st.explore.time === t;
-  for (const plane of ['axial', 'coronal', 'sagittal']) {
+  for (const plane of planes) {
     const f = st.panels[plane].frame;
     const shown = await page.evaluate((q) => window.tessera.slices.imagePixels(q), plane);
     const ref = await decodePng(page, refs[`${t}-${plane}`]);
@@ -382,13 +382,13 @@ async function storeSeries(context, url, tmp, run) {
   check('store time point 10 equals `tessera render STORE --time 10` (PSNR >= 40 dB) and not time point 19',
         shown === 10 && own.psnr >= 40 && other.psnr < own.psnr - 10,
         own.error || `${own.psnr.toFixed(2)} dB (time point 19: ${other.psnr.toFixed(2)} dB)`);
-  // Its slice views (read at level 0): time point 10's, not the first one's.
+  // Its axial slice view (read at level 0): time point 10's, not the first
+  // one's (all three over bricks, below).
   await page.evaluate(() => window.tessera.slices.setPanelPixels(512 * 512));
   const st = await page.evaluate(() => window.tessera.slices.state());
-  const planes = ['axial', 'coronal', 'sagittal'];
-  const refs = await sliceRefs(store, st, [10, 0].flatMap((t) => planes.map((q) => [t, q])), tmp, 'store');
-  const sl = await slicesAgainst(page, refs, 10, 0);
-  check('in core, the slice views at time point 10 equal `tessera slice STORE --time 10` (identical), not time point 0\'s',
+  const refs = await sliceRefs(store, st, [[10, 'axial'], [0, 'axial']], tmp, 'store');
+  const sl = await slicesAgainst(page, refs, 10, 0, ['axial']);
+  check('in core, the axial slice view at time point 10 equals `tessera slice STORE --time 10` (identical), not time point 0\'s',
         sl.ok, sl.text);
 
   // Playback: a loop and more, every frame drawn sampled.
