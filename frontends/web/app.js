@@ -1057,7 +1057,9 @@ import { attachOverlayPanel } from './overlay-panel.js';
     window.addEventListener('resize', () => { if (fitCanvas()) requestRender(); });
     requestAnimationFrame(loop);
     if (volumeUrls.length === 1 && window.TesseraZarr && TesseraZarr.isStoreUrl(volumeUrls[0])) {
-      if (zarrCacheMiB && !M.ccall('tessera_zarr_set_cache_mib', 'number', ['number'], [zarrCacheMiB])) showError(api.lastError());
+      // (A size refused is said once the store is open with the default.)
+      const cacheRefused = zarrCacheMiB && !M.ccall('tessera_zarr_set_cache_mib', 'number', ['number'], [zarrCacheMiB])
+        ? api.lastError() : '';
       zarr = TesseraZarr.create(M, { showError, clearError,
         status: (t) => { $('status').textContent = contextNote ? `${t} · ${contextNote}` : t; },
         progress: (v, max) => { $('progress').hidden = !(max > 0); if (max > 0) { $('progress').max = max; $('progress').value = v; } } });
@@ -1070,6 +1072,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
         storeTime = TesseraStoreTime.fetchAhead(zarr);  // the channels' time points ahead
       }
       volumeChanged();
+      if (cacheRefused) showError(cacheRefused);
     } else if (volumeUrls.length) {
       if (!(await openUrls(volumeUrls))) volumeChanged();
     } else {

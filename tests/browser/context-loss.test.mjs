@@ -62,8 +62,10 @@ test('the WebGL context lost and restored in WebGL 2 and WebGL 1 side by side: a
     await storeThenFile(c, context, url, tmp, webgl);
     await channels(c, context, url, webgl);
     await brickedSeries(c, context, url, webgl);
-    // The chunk cache is the same in both versions: in the shorter run only.
+    // The chunk cache is the same in both versions: in the shorter run only
+    // (the other checks that a cache size out of range is refused).
     if (webgl === 2) await evictedRegion(c, context, url, tmp, webgl);
+    else await cacheOutOfRange(c, context, url, webgl);
     assert.deepEqual(c.failed, [], `failed checks: ${c.failed.join('; ')}`);
   })));
 });
@@ -535,5 +537,18 @@ async function evictedRegion(c, context, url, tmp, webgl) {
   await checkCase(c, page, what, before, after, kept,
     `region ${JSON.stringify(e1.explore.region)}, shown ${e0.showing_region} -> ${e1.showing_region}`);
   noScriptErrors(c, what, logs);
+  await page.close();
+}
+
+// ?zarrcache out of range: refused with the range, the store opened with the
+// default cache.
+async function cacheOutOfRange(c, context, url, webgl) {
+  const { page } = await phonePage(context, url, `size=32&slices=0&zarrcache=100&url=/data/cube6-webgl${webgl}.ome.zarr`, webgl);
+  await page.waitForFunction(() => window.tessera.time().count === 6, null, { timeout: 30000 }).catch(() => {});
+  const error = await page.evaluate(() => window.tessera.error());
+  const count = await page.evaluate(() => window.tessera.time().count);
+  c(`WebGL ${webgl}: ?zarrcache=100 is refused naming the range, the store opens with the default cache`,
+    error === 'zarrcache 100 MiB: a store\'s chunk cache takes 0.0625 to 48 MiB (default 48)' && count === 6,
+    `error "${error}"; the store's series of ${count}`);
   await page.close();
 }

@@ -6,6 +6,7 @@
 // fetched (asynchronously, by the page), then one readBox, never the level
 // whole.
 #include <algorithm>
+#include <cstdio>
 
 #include "WebSession.h"
 #include "tessera/core/Error.h"
@@ -32,10 +33,12 @@ void WebSession::beginStore(const std::string& url) {
 
 void WebSession::setStoreCacheBytes(double bytes) {
   if (!(bytes >= double(kStoreCacheMinBytes) && bytes <= double(kStoreFetchedBytes))) {
-    throw InputError("the chunk cache of a store: " + std::to_string(bytes / 1048576.0) +
-                     " MiB asked for, it takes " +
-                     std::to_string(double(kStoreCacheMinBytes) / 1048576.0) + " to " +
-                     std::to_string(kStoreFetchedBytes >> 20) + " MiB");
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "zarrcache %g MiB: a store's chunk cache takes %g to %g MiB (default %g)",
+                  bytes / 1048576.0, double(kStoreCacheMinBytes) / 1048576.0,
+                  double(kStoreFetchedBytes) / 1048576.0, double(kStoreFetchedBytes) / 1048576.0);
+    throw InputError(text);
   }
   storeCacheBytes_ = static_cast<std::uint64_t>(bytes);
 }
