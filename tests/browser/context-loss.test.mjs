@@ -24,7 +24,8 @@
 //    chunks): a region of level 0 shown, then the slice views read level-0
 //    slabs elsewhere and the cache's own limit lets the region's chunks go;
 //    the restore fetches exactly the chunks it needs that were let go (the
-//    server's log), each once, and shows the same region.
+//    server's log), each once, and shows the same region; (WebGL 1) a cache
+//    size out of range is refused naming the range.
 // The status line says the context was lost, then restored; the view still
 // turns after. WebGL 2 and WebGL 1 run side by side, each in a Chromium of
 // its own (its pages in turn: the store and the head, then the channels),
