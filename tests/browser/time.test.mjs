@@ -19,7 +19,7 @@ import { execFile, execFileSync } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
 import {
-  bench, check, cli, root, served, psnrAgainst, openPage, openThroughPicker, withoutOverlays, browserSuite, decodePng, differingPixels,
+  bench, check, cli, root, served, psnrAgainst, openPage, openThroughPicker, withoutOverlays, browserSuite,
 } from './fixture.mjs';
 
 const checks = browserSuite();
@@ -294,43 +294,72 @@ async function sliceRefs(store, st, wanted, tmp, tag) {
   return out;
 }
 
-// The page's three slice views against `tessera slice STORE --time t`
-// (refs[`${t}-${plane}`]) once none is pending: whether each is read at
-// level 0 and identical, and how many of its pixels differ from time point
-// `other`'s (where the data differ, it must not be that one's).
+// In the page: each of `pngs` ({key: base64}) decoded to RGBA pixels.
+async function decodeInPage(pngs) {
+  const out = {};
+  for (const [key, b64] of Object.entries(pngs)) {
+    const img = new Image();
+    img.src = `data:image/png;base64,${b64}`;
+    await img.decode();
+    const c = document.createElement('canvas');
+    c.width = img.width;
+    c.height = img.height;
+    const ctx = c.getContext('2d');
+    ctx.drawImage(img, 0, 0);
+    out[key] = ctx.getImageData(0, 0, c.width, c.height).data;
+  }
+  return out;
+}
+const base64Of = (files) => Object.fromEntries(Object.entries(files).map(([k, f]) => [k, fs.readFileSync(f).toString('base64')]));
+
+// The page's slice views (`planes`) against `tessera slice STORE --time t`
+// (refs[`${t}-${plane}`]) once none is pending, compared in the page: whether
+// each is read at level 0 and identical, and how many of its pixels differ
+// from time point `other`'s (where the data differ, it must not be that
+// one's).
 async function slicesAgainst(page, refs, t, other, planes = ['axial', 'coronal', 'sagittal']) {
   await page.waitForFunction(() => Object.values(window.tessera.slices.state().panels).every((p) => p.frame && !p.frame.pending),
     null, { timeout: 30000 }).catch(() => {});
-  const st = await page.evaluate(() => window.tessera.slices.state());
-  const rows = [];
-  let ok = st.explore.time === t;
-  for (const plane of planes) {
-    const f = st.panels[plane].frame;
-    const shown = await page.evaluate((q) => window.tessera.slices.imagePixels(q), plane);
-    const ref = await decodePng(page, refs[`${t}-${plane}`]);
-    const differ = shown.length === ref.data.length ? differingPixels(shown, ref.data, 0) : -1;
-    let fromOther = null;
-    if (refs[`${other}-${plane}`]) {
-      const o = await decodePng(page, refs[`${other}-${plane}`]);
-      fromOther = { shown: differingPixels(shown, o.data, 0), refs: differingPixels(ref.data, o.data, 0) };
-      ok = ok && fromOther.shown === fromOther.refs;  // as time point t's differ from the other's
-    }
-    ok = ok && f.level === 0 && !f.pending && differ === 0;
-    rows.push(`${plane} ${'xyz'[f.axis]}=${st.panels[plane].index}: level ${f.level}${f.pending ? ' (pending)' : ''}, ` +
-      `${differ} pixels differ from time point ${t}'s` +
-      (fromOther ? `, ${fromOther.shown} from time point ${other}'s (the references differ in ${fromOther.refs})` : ''));
+  const files = {};
+  for (const q of planes) {
+    files[`${t}-${q}`] = refs[`${t}-${q}`];
+    if (refs[`${other}-${q}`]) files[`${other}-${q}`] = refs[`${other}-${q}`];
   }
-  return { ok, text: `slices at time point ${st.explore.time}: ${rows.join('; ')}` };
+  const r = await page.evaluate(async ({ pngs, t, other, planes, decode }) => {
+    const images = await (new Function(`return ${decode}`)())(pngs);
+    const differ = (a, b) => {
+      if (a.length !== b.length) return -1;
+      let n = 0;
+      for (let i = 0; i < a.length; i += 4) if (a[i] !== b[i] || a[i + 1] !== b[i + 1] || a[i + 2] !== b[i + 2]) n++;
+      return n;
+    };
+    const st = window.tessera.slices.state();
+    return { time: st.explore.time, planes: planes.map((q) => {
+      const shown = window.tessera.slices.imagePixels(q);
+      const ref = images[`${t}-${q}`];
+      const o = images[`${other}-${q}`];
+      return { plane: q, axis: st.panels[q].axis, index: st.panels[q].index, level: st.panels[q].frame.level,
+        pending: !!st.panels[q].frame.pending, differ: differ(shown, ref),
+        fromOther: o ? { shown: differ(shown, o), refs: differ(ref, o) } : null };
+    }) };
+  }, { pngs: base64Of(files), t, other, planes, decode: decodeInPage.toString() });
+  let ok = r.time === t;
+  const rows = r.planes.map((p) => {
+    ok = ok && p.level === 0 && !p.pending && p.differ === 0 && (!p.fromOther || p.fromOther.shown === p.fromOther.refs);
+    return `${p.plane} ${'xyz'[p.axis]}=${p.index}: level ${p.level}${p.pending ? ' (pending)' : ''}, ` +
+      `${p.differ} pixels differ from time point ${t}'s` +
+      (p.fromOther ? `, ${p.fromOther.shown} from time point ${other}'s (the references differ in ${p.fromOther.refs})` : '');
+  });
+  return { ok, text: `slices at time point ${r.time}: ${rows.join('; ')}` };
 }
 
 // Reference PNGs decoded in the page as window.__sliceRefs[t] (`plane`'s).
 async function loadSliceRefs(page, refs, times, plane) {
-  const decoded = {};
-  for (const t of times) decoded[t] = (await decodePng(page, refs[`${t}-${plane}`])).data;
-  await page.evaluate(({ decoded, plane }) => {
-    window.__sliceRefs = Object.fromEntries(Object.entries(decoded).map(([t, d]) => [t, Uint8ClampedArray.from(d)]));
+  const files = Object.fromEntries(times.map((t) => [t, refs[`${t}-${plane}`]]));
+  await page.evaluate(async ({ pngs, plane, decode }) => {
+    window.__sliceRefs = await (new Function(`return ${decode}`)())(pngs);
     window.__slicePlane = plane;
-  }, { decoded, plane });
+  }, { pngs: base64Of(files), plane, decode: decodeInPage.toString() });
 }
 
 // Every frame drawn checked: the cube where the time point it is labelled
