@@ -29,6 +29,8 @@ import { attachOverlayPanel } from './overlay-panel.js';
   // ?layout=bricks: a store's t axis plays over bricks even when its level
   // 0 would fit in core (as `tessera render --layout bricks`).
   const storeBricks = params.get('layout') === 'bricks';
+  // ?zarrcache=MiB: the chunks a store keeps fetched (default 48).
+  const zarrCacheMiB = parseFloat(params.get('zarrcache') || '0') || 0;
   // ?dicomweb=ROOT: a DICOMweb archive's studies and series to open
   // (frontends/web/dicomweb.js).
   const dicomwebRoot = params.get('dicomweb') || '';
@@ -507,7 +509,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
     $('time-controls').hidden = time.count <= 1;
     $('timePoint').max = Math.max(0, time.count - 1);
     $('timePoint').value = time.shown;
-    $('timePlay').textContent = 'Play';
+    $('timePlay').textContent = t.playing ? 'Pause' : 'Play';  // (playing on after a context loss)
     timeStatus();
   }
 
@@ -1055,6 +1057,9 @@ import { attachOverlayPanel } from './overlay-panel.js';
     window.addEventListener('resize', () => { if (fitCanvas()) requestRender(); });
     requestAnimationFrame(loop);
     if (volumeUrls.length === 1 && window.TesseraZarr && TesseraZarr.isStoreUrl(volumeUrls[0])) {
+      // (A size refused is said once the store is open with the default.)
+      const cacheRefused = zarrCacheMiB && !M.ccall('tessera_zarr_set_cache_mib', 'number', ['number'], [zarrCacheMiB])
+        ? api.lastError() : '';
       zarr = TesseraZarr.create(M, { showError, clearError,
         status: (t) => { $('status').textContent = contextNote ? `${t} · ${contextNote}` : t; },
         progress: (v, max) => { $('progress').hidden = !(max > 0); if (max > 0) { $('progress').max = max; $('progress').value = v; } } });
@@ -1067,6 +1072,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
         storeTime = TesseraStoreTime.fetchAhead(zarr);  // the channels' time points ahead
       }
       volumeChanged();
+      if (cacheRefused) showError(cacheRefused);
     } else if (volumeUrls.length) {
       if (!(await openUrls(volumeUrls))) volumeChanged();
     } else {

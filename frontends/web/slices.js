@@ -63,6 +63,7 @@ window.TesseraSlices = (function () {
     let explore = { has_volume: false };
     let volumeKey = '';
     let windowKey = '';
+    let timeShown = -1;         // the time point the slices show (explore.time)
     let cross = [0, 0, 0];      // the crosshair voxel (the slices' voxels: a store's level 0)
     let region = null;          // the picked box {begin, end} (the slices' voxels, end exclusive)
     let picking = false;        // "Pick region" pressed
@@ -383,7 +384,7 @@ window.TesseraSlices = (function () {
     // ------------------------------------------------------------ state changes
 
     // After every frame of the 3D view (app.js): a new volume resets the
-    // crosshair to its centre; a new window redraws the slices; the 3D
+    // crosshair to its centre; a new window or time point redraws the slices; the 3D
     // marks follow the camera; in colour, a TF edit redraws them too.
     function frameShown(state) {
       explore = JSON.parse(api.explore());
@@ -404,6 +405,8 @@ window.TesseraSlices = (function () {
       // (A label volume's slices are always in its label colours.)
       const wk = `${(state.window || []).join(',')}|${colour() || explore.labels ? explore.tf_revision : 'grey'}`;
       if (wk !== windowKey) { windowKey = wk; redraw = true; }
+      // A series played: the slices show the 3D view's time point.
+      if (explore.time !== timeShown) { timeShown = explore.time; redraw = true; }
       if (redraw) drawAllSlices();
       redrawOverlays();
       if (grid) grid.frameShown(explore);

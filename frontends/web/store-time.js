@@ -33,11 +33,13 @@
   }
 
   // The keys of the time points ahead, as playback asks for them (a
-  // frame's pump lists them), until the store is closed or stop().
+  // frame's pump lists them), until the store is closed or stop(); also
+  // while the store is opened again after a lost WebGL context (the
+  // series plays on from the time point it showed).
   function fetchAhead(zarr) {
     let fetching = true;
     (async () => {
-      while (fetching && zarr.active()) {
+      while (fetching && (zarr.active() || zarr.reopening())) {
         const keys = await zarr.fetchWanted();
         if (keys.length === 0) await new Promise((r) => setTimeout(r, 8));
       }

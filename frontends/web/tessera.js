@@ -105,6 +105,7 @@ export class TesseraViewer {
       init: c('tessera_init', 'number', ['string', 'number']),
       dispose: c('tessera_dispose', null, []),
       contextRestored: c('tessera_context_restored', 'number', []),
+      contextLost: c('tessera_context_lost', 'number', []),
       lastError: c('tessera_last_error', 'string', []),
       loadGenerated: c('tessera_load_generated', 'number', ['string']),
       addFile: c('tessera_add_file', null, ['string', 'number', 'number']),
@@ -182,8 +183,10 @@ export class TesseraViewer {
     for (const [type, handler] of this.#contextEvents) this.#canvas.addEventListener(type, handler);
   }
 
-  // True between the loss of the WebGL context and its restoration.
-  get contextLost() { return this.#lost; }
+  // True between the loss of the WebGL context and its restoration: from
+  // the moment the browser takes it away (a task before its
+  // webglcontextlost event, when a frame would only fail with an error).
+  get contextLost() { return this.#lost || this.#c.contextLost() === 1; }
 
   // The viewer's state (volume, dims, geometry, camera, sampling, …) as the
   // C API's tessera_state_json reports it.

@@ -60,5 +60,9 @@ void WebGlContext::makeCurrent() {
   emscripten_webgl_make_context_current(static_cast<EMSCRIPTEN_WEBGL_CONTEXT_HANDLE>(handle_));
 }
 
+bool WebGlContext::lost() const {
+  return emscripten_is_webgl_context_lost(static_cast<EMSCRIPTEN_WEBGL_CONTEXT_HANDLE>(handle_));
+}
+
 }  // namespace tessera::gpu
 #endif  // __EMSCRIPTEN__

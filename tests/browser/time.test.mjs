@@ -7,7 +7,10 @@
 // A store's t axis over bricks (?layout=bricks, or a level 0 too large for
 // in-core) plays the same way, each time point drawn whole from its own
 // bricks before the next is shown (a late one counted), and a store's
-// channels with a t axis play together.
+// channels with a t axis play together. A store's slice views show the
+// time point the 3D view shows: at every frame of a playback over bricks,
+// and after it, they equal `tessera slice STORE --time T` of that time
+// point (the store opened at T), pixel for pixel; in core too.
 // With TESSERA_BENCH=1 it also plays a 20-time-point 256^3 series at
 // 512x512 (a 4-D NIfTI, a store in core and a store over bricks) and
 // prints the rate reached.
@@ -15,7 +18,9 @@ import { test } from 'node:test';
 import { execFile, execFileSync } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
-import { bench, check, cli, root, served, psnrAgainst, openPage, openThroughPicker, withoutOverlays, browserSuite } from './fixture.mjs';
+import {
+  bench, check, cli, root, served, psnrAgainst, openPage, openThroughPicker, withoutOverlays, browserSuite,
+} from './fixture.mjs';
 
 const checks = browserSuite();
 
@@ -207,6 +212,20 @@ async function playSampled(page, fps, advances, limitMs) {
           // A store drawn over bricks: whether this frame has every brick
           // its view wants (else it shows coarser ones while they come).
           const f = { t, x: n ? sx / n : -1, complete: !(z && z.last) || !!z.last.complete };
+          // The slice views (when the test loaded their references,
+          // window.__sliceRefs[t] of window.__slicePlane): the pixels that
+          // differ from time point t's, and whether the slice is pending.
+          const sliceRef = window.__sliceRefs && window.__sliceRefs[t];
+          if (sliceRef) {
+            const plane = window.__slicePlane;
+            const shown = T.slices.imagePixels(plane);
+            let differ = shown.length === sliceRef.length ? 0 : -1;
+            for (let i = 0; differ >= 0 && i < shown.length; i += 4) {
+              if (shown[i] !== sliceRef[i] || shown[i + 1] !== sliceRef[i + 1] || shown[i + 2] !== sliceRef[i + 2]) differ++;
+            }
+            f.sliceDiffer = differ;
+            f.slicePending = !!T.slices.state().panels[plane].frame.pending;
+          }
           const ref = window.__refs && window.__refs[t];
           if (ref && ref.length === px.length) {
             let sum = 0;
@@ -260,6 +279,89 @@ async function markerOf(page, t) {
   }, { t, MARKER });
 }
 
+// `tessera slice STORE --time T` through the page's crosshair for each
+// [t, plane] asked (PNG paths by `${t}-${plane}`), two at a time.
+async function sliceRefs(store, st, wanted, tmp, tag) {
+  const out = {};
+  const one = ([t, plane]) => new Promise((resolve, reject) => {
+    const p = st.panels[plane];
+    const png = path.join(tmp, `${tag}-slice-t${t}-${plane}.png`);
+    out[`${t}-${plane}`] = png;
+    execFile(cli, ['slice', store, '--time', String(t), '--axis', 'xyz'[p.axis], '--index', String(p.index), '--out', png],
+      (e) => (e ? reject(e) : resolve()));
+  });
+  for (let i = 0; i < wanted.length; i += 2) await Promise.all(wanted.slice(i, i + 2).map(one));
+  return out;
+}
+
+// In the page: each of `pngs` ({key: base64}) decoded to RGBA pixels.
+async function decodeInPage(pngs) {
+  const out = {};
+  for (const [key, b64] of Object.entries(pngs)) {
+    const img = new Image();
+    img.src = `data:image/png;base64,${b64}`;
+    await img.decode();
+    const c = document.createElement('canvas');
+    c.width = img.width;
+    c.height = img.height;
+    const ctx = c.getContext('2d');
+    ctx.drawImage(img, 0, 0);
+    out[key] = ctx.getImageData(0, 0, c.width, c.height).data;
+  }
+  return out;
+}
+const base64Of = (files) => Object.fromEntries(Object.entries(files).map(([k, f]) => [k, fs.readFileSync(f).toString('base64')]));
+
+// The page's slice views (`planes`) against `tessera slice STORE --time t`
+// (refs[`${t}-${plane}`]) once none is pending, compared in the page: whether
+// each is read at level 0 and identical, and how many of its pixels differ
+// from time point `other`'s (where the data differ, it must not be that
+// one's).
+async function slicesAgainst(page, refs, t, other, planes = ['axial', 'coronal', 'sagittal']) {
+  await page.waitForFunction(() => Object.values(window.tessera.slices.state().panels).every((p) => p.frame && !p.frame.pending),
+    null, { timeout: 30000 }).catch(() => {});
+  const files = {};
+  for (const q of planes) {
+    files[`${t}-${q}`] = refs[`${t}-${q}`];
+    if (refs[`${other}-${q}`]) files[`${other}-${q}`] = refs[`${other}-${q}`];
+  }
+  const r = await page.evaluate(async ({ pngs, t, other, planes, decode }) => {
+    const images = await (new Function(`return ${decode}`)())(pngs);
+    const differ = (a, b) => {
+      if (a.length !== b.length) return -1;
+      let n = 0;
+      for (let i = 0; i < a.length; i += 4) if (a[i] !== b[i] || a[i + 1] !== b[i + 1] || a[i + 2] !== b[i + 2]) n++;
+      return n;
+    };
+    const st = window.tessera.slices.state();
+    return { time: st.explore.time, planes: planes.map((q) => {
+      const shown = window.tessera.slices.imagePixels(q);
+      const ref = images[`${t}-${q}`];
+      const o = images[`${other}-${q}`];
+      return { plane: q, axis: st.panels[q].axis, index: st.panels[q].index, level: st.panels[q].frame.level,
+        pending: !!st.panels[q].frame.pending, differ: differ(shown, ref),
+        fromOther: o ? { shown: differ(shown, o), refs: differ(ref, o) } : null };
+    }) };
+  }, { pngs: base64Of(files), t, other, planes, decode: decodeInPage.toString() });
+  let ok = r.time === t;
+  const rows = r.planes.map((p) => {
+    ok = ok && p.level === 0 && !p.pending && p.differ === 0 && (!p.fromOther || p.fromOther.shown === p.fromOther.refs);
+    return `${p.plane} ${'xyz'[p.axis]}=${p.index}: level ${p.level}${p.pending ? ' (pending)' : ''}, ` +
+      `${p.differ} pixels differ from time point ${t}'s` +
+      (p.fromOther ? `, ${p.fromOther.shown} from time point ${other}'s (the references differ in ${p.fromOther.refs})` : '');
+  });
+  return { ok, text: `slices at time point ${r.time}: ${rows.join('; ')}` };
+}
+
+// Reference PNGs decoded in the page as window.__sliceRefs[t] (`plane`'s).
+async function loadSliceRefs(page, refs, times, plane) {
+  const files = Object.fromEntries(times.map((t) => [t, refs[`${t}-${plane}`]]));
+  await page.evaluate(async ({ pngs, plane, decode }) => {
+    window.__sliceRefs = await (new Function(`return ${decode}`)())(pngs);
+    window.__slicePlane = plane;
+  }, { pngs: base64Of(files), plane, decode: decodeInPage.toString() });
+}
+
 // Every frame drawn checked: the cube where the time point it is labelled
 // with puts it (within a third of the step between time points, the
 // expected column interpolated between the references'), so no frame
@@ -309,6 +411,14 @@ async function storeSeries(context, url, tmp, run) {
   check('store time point 10 equals `tessera render STORE --time 10` (PSNR >= 40 dB) and not time point 19',
         shown === 10 && own.psnr >= 40 && other.psnr < own.psnr - 10,
         own.error || `${own.psnr.toFixed(2)} dB (time point 19: ${other.psnr.toFixed(2)} dB)`);
+  // Its axial slice view (read at level 0): time point 10's, not the first
+  // one's (all three over bricks, below).
+  await page.evaluate(() => window.tessera.slices.setPanelPixels(512 * 512));
+  const st = await page.evaluate(() => window.tessera.slices.state());
+  const refs = await sliceRefs(store, st, [[10, 'axial'], [0, 'axial']], tmp, 'store');
+  const sl = await slicesAgainst(page, refs, 10, 0, ['axial']);
+  check('in core, the axial slice view at time point 10 equals `tessera slice STORE --time 10` (identical), not time point 0\'s',
+        sl.ok, sl.text);
 
   // Playback: a loop and more, every frame drawn sampled.
   const p = await playSampled(page, 20, count + 1, 60000);
@@ -364,7 +474,7 @@ async function bricksSeries(context, url, tmp) {
   const refTimes = [0, 3, 5];
   await renderTimes(store, refTimes, SIZE, tmp, undefined, 'bricks');
   const servedBefore = served.paths.length;
-  const { page, logs } = await openPage(context, url, `size=${SIZE}&slices=0&progressive=0&layout=bricks&url=/data/cube6.ome.zarr`);
+  const { page, logs } = await openPage(context, url, `size=${SIZE}&progressive=0&layout=bricks&url=/data/cube6.ome.zarr`);
   await withoutOverlays(page);
   const s = await page.evaluate(() => window.tessera.time());
   check('a store with a t axis of 6 opens as a time series over bricks (?layout=bricks) with the Time panel shown',
@@ -379,6 +489,15 @@ async function bricksSeries(context, url, tmp) {
   check('the cube is seen in every reference, a column per time point apart',
         refTimes.every((t) => refX[t] >= 0) && step > 1, JSON.stringify(refX));
 
+  // The slice views read at level 0 (as panels of 512² pixels), their
+  // references: the axial slice of every time point (checked at every frame
+  // of the playback), all three of time points 0 and 3.
+  await page.evaluate(() => window.tessera.slices.setPanelPixels(512 * 512));
+  const st = await page.evaluate(() => window.tessera.slices.state());
+  const planes = ['axial', 'coronal', 'sagittal'];
+  const refs = await sliceRefs(store, st, [...[0, 3].flatMap((t) => planes.map((q) => [t, q])),
+    ...[1, 2, 4, 5].map((t) => [t, 'axial'])], tmp, 'bricks');
+
   // The slider's path: a time point asked for is drawn from its own bricks.
   const shown = await page.evaluate(() => window.tessera.showTime(3));
   const whole = await storeComplete(page, 20000);
@@ -387,8 +506,12 @@ async function bricksSeries(context, url, tmp) {
   check('over bricks, time point 3 equals `tessera render STORE --time 3` (PSNR >= 40 dB) and not time point 5',
         shown === 3 && whole && own.psnr >= 40 && other.psnr < own.psnr - 10,
         own.error || `shown ${shown}, whole ${whole}: ${own.psnr.toFixed(2)} dB (time point 5: ${other.psnr.toFixed(2)} dB)`);
+  const at3 = await slicesAgainst(page, refs, 3, 0);
+  check('over bricks, the slice views at time point 3 equal `tessera slice STORE --time 3` (identical), not time point 0\'s',
+        at3.ok, at3.text);
 
-  // Playback: a loop and more, every frame drawn sampled.
+  // Playback: a loop and more, every frame drawn sampled (its axial slice too).
+  await loadSliceRefs(page, refs, [0, 1, 2, 3, 4, 5], 'axial');
   const p = await playSampled(page, 20, count + 1, 60000);
   const order = inOrder(p.log, count);
   const c = checkFrames(p, count, expectedX, step);
@@ -409,6 +532,20 @@ async function bricksSeries(context, url, tmp) {
   check('over bricks, the whole frames of referenced time points equal the CLI render (PSNR >= 40 dB)',
         complete.length >= refTimes.length && lowWhole.length === 0,
         `${complete.length} frames, ${lowWhole.length} below 40 dB`);
+  // The slice views in step: at every frame drawn, the axial slice is the
+  // time point's the 3D view shows, none stale, none pending.
+  const sliced = p.frames.filter((f) => f.sliceDiffer !== undefined);
+  const stale = sliced.filter((f) => f.sliceDiffer !== 0 || f.slicePending);
+  check('over bricks, at every frame drawn the axial slice equals `tessera slice STORE --time T` of the time point shown (no stale slice)',
+        sliced.length === p.frames.length && sliced.length >= count && stale.length === 0,
+        `${sliced.length} of ${p.frames.length} frames checked, ${new Set(sliced.map((f) => f.t)).size} time points; ` +
+        `off: ${JSON.stringify(stale.slice(0, 5).map((f) => ({ t: f.t, differ: f.sliceDiffer, pending: f.slicePending })))}`);
+  // After it: paused at time point k, the three slice views are k's.
+  const k = await page.evaluate(() => window.tessera.time().shown);
+  const more = await sliceRefs(store, st, planes.filter((q) => !refs[`${k}-${q}`]).map((q) => [k, q]), tmp, 'bricks');
+  const after = await slicesAgainst(page, { ...refs, ...more }, k, k === 0 ? 3 : 0);
+  check(`over bricks, paused after playback at time point ${k}: the slice views equal \`tessera slice STORE --time ${k}\``,
+        after.ok, after.text);
   // Prefetch within the storage's budget: each time point's level-0 chunk
   // fetched once over the page's life (read ahead, kept until drawn).
   const keys = served.paths.slice(servedBefore).filter((k) => /\/cube6\.ome\.zarr\/0\/\d/.test(k));

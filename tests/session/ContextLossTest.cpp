@@ -5,18 +5,23 @@
 // volume in memory with its look and the view's knobs away from their
 // defaults, a region and a grid block of it, a region of a store the front
 // end draws itself whose chunks were let go while the context was lost
-// (read again before it shows), and a store's channels shown together.
+// (read again before it shows), a store's channels shown together, and a
+// store's t axis the front end plays over bricks (the series and the time
+// point it showed kept, playing on in order).
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "support/ChannelStore.h"
 #include "support/TestSupport.h"
+#include "support/TimeStore.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/DeviceSession.h"
 #include "tessera/gpu/GlObjects.h"
@@ -251,6 +256,65 @@ TEST(ContextLoss, ChannelsShownTogetherComeBackIdentical) {
   std::filesystem::remove_all(store);  // nothing is read again
   after.render(kSize, kSize);
   expectSameFrame(before, after.readImage(), "three channels, one hidden, edited");
+}
+
+// The page's store with a t axis played over bricks
+// (Session::drawStreamedSeries; frontends/web/src/WebSessionTime.cpp): the
+// context lost while time point 3 is shown and playback runs. After the
+// restore the session still draws time point 3's pyramid (the same one, not
+// read again), the series and its playback are kept, and playback goes on
+// from there in order, none skipped; the front end, whose store view is
+// made again, draws what drawnPyramid() says.
+TEST(ContextLoss, SeriesTheFrontEndDrawsKeepsItsTimePointAndPlaysOn) {
+  const test::TempDir dir;
+  const std::string store = test::writeTimeStore(dir.path(), 5, 1).string();
+  Session s(kProfile);
+  s.setVolume(std::make_shared<Volume>(makeSheppLogan({32, 32, 32})), "phantom");
+  std::map<int, std::shared_ptr<const lod::MultiresSource>> opened;
+  int opens = 0;
+  constexpr std::uint64_t kN = test::kTimeStoreSide;
+  constexpr std::uint64_t kWarm = kN * kN * kN + (kN / 2) * (kN / 2) * (kN / 2);
+  s.drawStreamedSeries(
+      5,
+      [&](int t) -> std::shared_ptr<const lod::MultiresSource> {
+        ++opens;
+        return opened[t] = lod::ZarrMultiresSource::open(store, {.time = t});
+      },
+      kWarm, 2 * kWarm, "store", 0, TimeSeries::Reading::OnPump);
+  s.series()->setArrival([](int) { return true; }, 1);
+  ASSERT_FALSE(s.showTimePoint(3));  // read on the next pump
+  ASSERT_TRUE(s.series()->pump());
+  ASSERT_TRUE(s.showTimePoint(3));
+  s.playback().setFps(20.0);
+  s.playback().play(0.0);
+  const auto* shown = s.drawnPyramid().get();
+  ASSERT_EQ(shown, opened.at(3).get());
+  const int opensBefore = opens;
+  const Image before = viewFrame(s);
+
+  loseAndRestore(s);
+  ASSERT_NE(s.series(), nullptr);
+  EXPECT_EQ(s.series()->count(), 5);
+  EXPECT_EQ(s.timePoint(), 3);
+  EXPECT_EQ(s.drawnPyramid().get(), shown);  // the same pyramid, not opened again
+  EXPECT_EQ(opens, opensBefore);
+  EXPECT_TRUE(s.playback().playing());
+  expectSameFrame(before, viewFrame(s), "the session's own view beside a series over bricks");
+
+  // Playing on: each time point once its frame is done, in order.
+  std::vector<int> sequence{s.timePoint()};
+  double now = 1000.0;
+  for (int frame = 0; frame < 40 && sequence.size() < 6; ++frame) {
+    now += 100.0;
+    const int t = s.stepPlayback(now, true);
+    if (t == sequence.back()) continue;
+    sequence.push_back(t);
+    EXPECT_EQ(s.drawnPyramid().get(), opened.at(t).get()) << "time point " << t;
+  }
+  EXPECT_EQ(sequence, (std::vector<int>{3, 4, 0, 1, 2, 3}));
+  std::printf(
+      "a series over bricks lost at time point 3: played on %zu time points after the restore\n",
+      sequence.size() - 1);
 }
 
 }  // namespace

@@ -117,6 +117,10 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_explore_json() {
       j["index_to_world"].push_back({a[0][row], a[1][row], a[2][row], a[3][row]});
     }
     j["showing_region"] = inRegion;
+    // The time point the 3D view shows (a series played; -1: none), which
+    // the slices show too (WebSession::slice): a new one redraws them.
+    const session::Session& r = s->rendering();
+    j["time"] = r.series() ? r.timePoint() : -1;
     // A store: the slices, crosshair and regions are in level-0 voxels (these
     // dims), the slices read at the level their panel shows (tessera_slice);
     // its region is the box read at level 0 (also as region_level0).

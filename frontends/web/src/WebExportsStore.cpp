@@ -66,6 +66,12 @@ std::string frameJson(const web::StoreFrame& f, web::ZarrStoreView& z) {
 
 extern "C" {
 
+// The chunk cache of the stores opened from now on, in MiB (the page's
+// ?zarrcache=MiB; default 48): 0 with the reason outside 1/16..48.
+EMSCRIPTEN_KEEPALIVE int tessera_zarr_set_cache_mib(double mib) {
+  return guarded([&] { web::session().setStoreCacheBytes(mib * 1048576.0); });
+}
+
 // Starts opening the store at `url` (its root, e.g. http://host/ch2.ome.zarr).
 EMSCRIPTEN_KEEPALIVE int tessera_zarr_begin(const char* url) {
   return guarded([&] { web::session().beginStore(url); });

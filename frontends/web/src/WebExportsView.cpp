@@ -50,6 +50,14 @@ EMSCRIPTEN_KEEPALIVE int tessera_context_restored() {
   return guarded([&] { web::session().recoverContext(); });
 }
 
+// 1 once the browser has taken the canvas's WebGL context away, before its
+// webglcontextlost event arrives (a frame drawn then only fails), until
+// the context is restored; 0 otherwise.
+EMSCRIPTEN_KEEPALIVE int tessera_context_lost() {
+  const web::WebSession* s = web::sessionIfAny();
+  return s && s->contextLost() ? 1 : 0;
+}
+
 // Ends the session: the viewer's GPU objects, the WebGL context and every
 // volume, region, grid, zoom swap and store go.
 EMSCRIPTEN_KEEPALIVE void tessera_dispose() {

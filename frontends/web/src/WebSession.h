@@ -102,6 +102,7 @@ class WebSession {
   viewer::Viewer& viewer() { return session_->view(); }
   gpu::GlContext& context() { return context_->gl(); }
   int webglVersion() const { return context_->webglVersion(); }
+  bool contextLost() const { return context_->lost(); }
   // After the browser restored a lost WebGL context (a phone sent the page to
   // the background, the GPU reset): the context is made again on the canvas
   // and the session's GPU side on it (Session::loseContext, restoreContext:
@@ -159,6 +160,9 @@ class WebSession {
   std::pair<int, std::string> defaultRegionSide(const Volume& volume);
   SliceResult slice(int axis, int index, bool colour, double maxPixels);
   double voxelValue(int x, int y, int z);
+  // An open store's levels at the time point the session shows (its t
+  // axis played), which the slices and the readout read.
+  const FetchedZarrSource& storeSliceSource();
   // The name shown for the overview (a store's URL, the file's name).
   std::string overviewName();
   // Shows `box` of the overview at native resolution as the 3D view; back
@@ -184,6 +188,11 @@ class WebSession {
   // The open store's coarsest level (null when no store is open).
   const Volume* storeOverview();
   void beginStore(const std::string& url);
+  // The stored bytes the next store's chunk cache keeps (FetchStorage's
+  // budget, least recently used first out): kStoreFetchedBytes unless the
+  // page asks for less (?zarrcache=MiB). InputError outside
+  // kStoreCacheMinBytes..kStoreFetchedBytes.
+  void setStoreCacheBytes(double bytes);
   // The store of a lost context on the restored one: its chunks, metadata
   // and levels kept, its GPU side (atlas, page table, ray caster) made again
   // by storeOpenStep, which then keeps the restored camera and TF.
@@ -251,6 +260,7 @@ class WebSession {
   std::string exploreKey_;      // the overview it was made for: name and dims
   int askedCell_ = 0;           // the grid cell side asked for (0: the default)
   bool storeReopened_ = false;  // the store being opened again keeps the view's camera
+  std::uint64_t storeCacheBytes_ = kStoreFetchedBytes;
   int zoomMediumLevel_ = 0;
   double zoomLastFrameMs_ = -1.0;
   CropState crop_;

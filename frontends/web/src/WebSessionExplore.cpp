@@ -85,11 +85,25 @@ std::pair<int, std::string> WebSession::defaultRegionSide(const Volume& volume) 
   return {16, "16³ voxels: the " + l.profile + " profile leaves little texture memory"};
 }
 
+// The store's levels at the time point the session shows (its t axis
+// played, in core or over bricks, or its channels' together), so that the
+// slices and the readout show what the 3D view shows; the open selection's
+// otherwise.
+const FetchedZarrSource& WebSession::storeSliceSource() {
+  ZarrStoreView& z = theStore();
+  const int open = z.store().selection().time;
+  const int t = session_->series() ? session_->timePoint() : open;
+  if (t < 0 || t == open) return z.source();
+  return *z.sourceAt(t);
+}
+
 // A store's slice (indices of level 0) is read at the finest level whose
 // slice has at most `maxPixels` pixels, as one slab with bounded reads;
 // until that slab's chunks have arrived the coarsest level (in memory)
 // stands in and `pending` is set. A chunk that keeps failing leaves the
-// coarse slice, with `note` naming it.
+// coarse slice, with `note` naming it. A store's time point other than
+// the one opened (its t axis played) is read the same from its own levels,
+// its coarsest level's slab standing in (held with the time point).
 SliceResult WebSession::slice(int axis, int index, bool colour, double maxPixels) {
   if (axis < 0 || axis > 2) throw InputError("slice: the axis must be 0, 1 or 2");
   const Volume& volume = sliceShape();
@@ -118,7 +132,9 @@ SliceResult WebSession::slice(int axis, int index, bool colour, double maxPixels
     }
     return out;
   }
-  const FetchedZarrSource& src = theStore().source();
+  const FetchedZarrSource& src = storeSliceSource();
+  // The open time point's coarsest level is in memory (storeOverview).
+  const bool opened = &src == &theStore().source();
   const int coarsest = src.levelCount() - 1;
   int level = 0;
   while (level < coarsest && maxPixels > 0.0) {
@@ -132,23 +148,39 @@ SliceResult WebSession::slice(int axis, int index, bool colour, double maxPixels
     const int n = src.levelInfo(l).dims[axis];
     return std::clamp(static_cast<int>((index + 0.5) * n / d[axis]), 0, n - 1);
   };
-  const lod::LevelInfo li = src.levelInfo(level);
-  lod::VoxelBox slab{{0, 0, 0}, li.dims};
-  slab.begin[axis] = indexAt(level);
-  slab.end[axis] = slab.begin[axis] + 1;
+  const auto slabAt = [&](int l) {
+    lod::VoxelBox slab{{0, 0, 0}, src.levelInfo(l).dims};
+    slab.begin[axis] = indexAt(l);
+    slab.end[axis] = slab.begin[axis] + 1;
+    return slab;
+  };
+  const auto render = [&](int l) {
+    const lod::LevelInfo li = src.levelInfo(l);
+    const viewer::SliceGeometry g(li.dims, li.spacing, volume.direction(), axis);
+    return g.render(src, l, indexAt(l), window, tf);
+  };
   bool ready = false;
   try {
-    ready = level == coarsest || src.prefetch(level, slab);
+    ready = (level == coarsest && opened) || src.prefetch(level, slabAt(level));
   } catch (const Error& e) {
     out.note = e.what();
   }
-  if (ready && level < coarsest) {
-    const viewer::SliceGeometry g(li.dims, li.spacing, volume.direction(), axis);
-    image = g.render(src, level, slab.begin[axis], window, tf);
+  if (ready && !(level == coarsest && opened)) {
+    image = render(level);
   } else {
     out.pending = out.note.empty() && level < coarsest;
     level = coarsest;
-    image = sliceImage(*store, f, indexAt(coarsest), window, tf);
+    if (opened) {
+      image = sliceImage(*store, f, indexAt(coarsest), window, tf);
+    } else if (src.resident(coarsest, slabAt(coarsest))) {
+      image = render(coarsest);
+    } else {
+      // Let go by the chunk cache since the time point was read: wanted,
+      // and no image of another time point shown meanwhile.
+      src.prefetch(coarsest, slabAt(coarsest));
+      image = Image(std::max(1, image.width()), std::max(1, image.height()));
+      out.pending = true;
+    }
   }
   out.level = level;
   if (const session::Overlay* o = session_->overlay()) {
@@ -159,19 +191,24 @@ SliceResult WebSession::slice(int axis, int index, bool colour, double maxPixels
 
 // A store's level-0 voxel once its chunk has arrived (the slices fetch it
 // when they show level 0; the readout asks for nothing), the coarsest
-// level's otherwise. NaN outside.
+// level's otherwise; of the time point the session shows. NaN outside.
 double WebSession::voxelValue(int x, int y, int z) {
   const glm::ivec3 d = sliceShape().dims();
   if (!(x >= 0 && y >= 0 && z >= 0 && x < d.x && y < d.y && z < d.z)) return std::nan("");
   const Volume* store = storeOverview();
   if (!store) return overviewVolume().valueAt(x, y, z);
-  const FetchedZarrSource& src = theStore().source();
+  const FetchedZarrSource& src = storeSliceSource();
   const lod::VoxelBox voxel{{x, y, z}, {x + 1, y + 1, z + 1}};
   if (src.resident(0, voxel)) return src.readBox(0, voxel).valueAt(0, 0, 0);
-  const glm::ivec3 c = glm::clamp(
-      glm::ivec3((glm::dvec3(x, y, z) + 0.5) * glm::dvec3(store->dims()) / glm::dvec3(d)),
-      glm::ivec3(0), store->dims() - 1);
-  return store->valueAt(c.x, c.y, c.z);
+  const int top = src.levelCount() - 1;
+  const glm::ivec3 td = src.levelInfo(top).dims;
+  const glm::ivec3 c =
+      glm::clamp(glm::ivec3((glm::dvec3(x, y, z) + 0.5) * glm::dvec3(td) / glm::dvec3(d)),
+                 glm::ivec3(0), td - 1);
+  if (&src == &theStore().source()) return store->valueAt(c.x, c.y, c.z);
+  const lod::VoxelBox coarse{c, c + 1};
+  if (src.resident(top, coarse)) return src.readBox(top, coarse).valueAt(0, 0, 0);
+  return std::nan("");
 }
 
 // The exploration of what the slices show, made anew for another overview

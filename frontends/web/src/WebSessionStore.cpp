@@ -6,6 +6,7 @@
 // fetched (asynchronously, by the page), then one readBox, never the level
 // whole.
 #include <algorithm>
+#include <cstdio>
 
 #include "WebSession.h"
 #include "tessera/core/Error.h"
@@ -26,8 +27,20 @@ void WebSession::beginStore(const std::string& url) {
   zoomStop();
   session_->endExploration();
   session_->drawPyramid(nullptr);
-  zarr_ = std::make_unique<ZarrStoreView>(context(), viewer().limits(), url);
+  zarr_ = std::make_unique<ZarrStoreView>(context(), viewer().limits(), url, storeCacheBytes_);
   storeReopened_ = false;
+}
+
+void WebSession::setStoreCacheBytes(double bytes) {
+  if (!(bytes >= double(kStoreCacheMinBytes) && bytes <= double(kStoreFetchedBytes))) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "zarrcache %g MiB: a store's chunk cache takes %g to %g MiB (default %g)",
+                  bytes / 1048576.0, double(kStoreCacheMinBytes) / 1048576.0,
+                  double(kStoreFetchedBytes) / 1048576.0, double(kStoreFetchedBytes) / 1048576.0);
+    throw InputError(text);
+  }
+  storeCacheBytes_ = static_cast<std::uint64_t>(bytes);
 }
 
 void WebSession::reopenStore(ZarrStoreView::Host host) {
@@ -40,8 +53,18 @@ void WebSession::reopenStore(ZarrStoreView::Host host) {
 // context loss keeps the restored camera).
 bool WebSession::storeOpenStep() {
   ZarrStoreView& z = theStore();
+  // After a context loss the region or grid block it showed is asked for in
+  // the same step as the store's coarsest level (and shown at once when its
+  // chunks are held): every chunk the restore reads is wanted, or marked
+  // used, before any is fetched, so that the chunk cache makes room for
+  // those it let go by letting others go, not the ones held for it.
+  if (storeReopened_ && session_->regionAgainPending()) session_->showRegionAgain();
   if (!z.open()) return false;
-  session_->drawPyramid(z.sharedSource());  // what an overlay goes over and the probe reads
+  // What an overlay goes over and the probe reads. A store opened again
+  // after a context loss keeps what the session drew: a series over bricks
+  // plays on from the time point it showed (the session kept it; storeFrame
+  // shows that time point through the new view's bricks).
+  if (!storeReopened_ || !session_->streamedSeries()) session_->drawPyramid(z.sharedSource());
   viewer::Viewer& v = viewer();
   v.tfEditor().setHistogram(Histogram::compute(z.coarsest(), 256, z.store().shape().window()));
   if (!storeReopened_) v.resetCamera();
@@ -142,7 +165,10 @@ StoreFrame WebSession::storeFrame(int width, int height, bool viewChanged) {
 namespace tessera::web {
 
 bool WebSession::storeTimeFinished() {
-  if (!zarr_ || !zarr_->isOpen() || !session_->streamedSeries()) return true;
+  if (!zarr_ || !session_->streamedSeries()) return true;
+  // Being opened again after a context loss: the time point shown is not
+  // on the canvas yet, and playback waits for it.
+  if (!zarr_->isOpen()) return false;
   return zarr_->finished(session_->timePoint());
 }
 

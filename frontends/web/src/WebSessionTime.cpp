@@ -86,7 +86,8 @@ bool levelsArrived(ZarrStoreView& view, int t) {
   try {
     const std::shared_ptr<const FetchedZarrSource> source = view.sourceAt(t);
     bool ready = true;
-    for (const int level : session::StreamedSeries::levelsWithin(*source, kStoreFetchAheadBytes)) {
+    const std::uint64_t ahead = view.storage().budgetBytes() / 2;
+    for (const int level : session::StreamedSeries::levelsWithin(*source, ahead)) {
       ready = source->prefetch(level, {glm::ivec3(0), source->levelInfo(level).dims}) && ready;
     }
     return ready;
@@ -98,16 +99,23 @@ bool levelsArrived(ZarrStoreView& view, int t) {
 // The store's t axis over bricks: a series the page draws
 // (Session::drawStreamedSeries) of the store view's time points, read
 // ahead one at a time as their levels arrive, as many held as two fit
-// what the storage keeps. The store view outlives it (closeStore ends the
-// series first).
-void openBrickedSeries(session::Session& s, ZarrStoreView& view) {
+// what the storage keeps. The time points are asked of the page's store
+// view of the moment: after a lost WebGL context it is another one, over
+// the same host side (ZarrStoreView::Host: the same time points' levels),
+// and the series plays on (the session keeps it, and the time point it
+// showed, over the loss). closeStore ends the series first.
+void openBrickedSeries(WebSession& web) {
+  ZarrStoreView& view = web.theStore();
   const int count = view.store().timePoints();
+  session::Session& s = web.rendering();
   s.drawStreamedSeries(
       count,
-      [&view](int t) -> std::shared_ptr<const lod::MultiresSource> { return view.sourceAt(t); },
-      kStoreFetchAheadBytes, kStoreFetchedBytes, view.storage().describe(), view.timePoint(),
-      session::TimeSeries::Reading::OnPump);
-  s.series()->setArrival([&view](int t) { return levelsArrived(view, t); }, 1);
+      [&web](int t) -> std::shared_ptr<const lod::MultiresSource> {
+        return web.theStore().sourceAt(t);
+      },
+      view.storage().budgetBytes() / 2, view.storage().budgetBytes(), view.storage().describe(),
+      view.timePoint(), session::TimeSeries::Reading::OnPump);
+  s.series()->setArrival([&web](int t) { return levelsArrived(web.theStore(), t); }, 1);
 }
 
 }  // namespace
@@ -123,7 +131,7 @@ int openStoreSeries(WebSession& web, bool bricks) {
   const int count = store.timePoints();
   if (count < 2) return 2;
   if (bricks || store.finestLevelWithin(HostBudget::global().limitBytes() / 4) != 0) {
-    openBrickedSeries(web.rendering(), *view);
+    openBrickedSeries(web);
     return 3;
   }
   // The view's storage, kept alive by its source as long as the series is.
@@ -137,7 +145,7 @@ int openStoreSeries(WebSession& web, bool bricks) {
       session::TimeSeries::Reading::OnPump);
   const std::uint64_t each = std::max<std::uint64_t>(1, points->bytesPerTimePoint(first));
   const int ahead = static_cast<int>(std::clamp<std::uint64_t>(
-      kStoreFetchAheadBytes / each, 1, static_cast<std::uint64_t>(s.series()->keep())));
+      view->storage().budgetBytes() / 2 / each, 1, static_cast<std::uint64_t>(s.series()->keep())));
   s.series()->setArrival([points](int t) { return points->arrived(t); }, ahead);
   return 1;
 }

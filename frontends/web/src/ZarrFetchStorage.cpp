@@ -31,7 +31,12 @@ bool FetchStorage::ready(const std::string& key) const {
   const auto it = entries_.find(key);
   if (it != entries_.end()) {
     const Entry& e = it->second;
-    if (e.state != State::Failed || nowMs() - e.failedAtMs < retryMs_) return true;
+    if (e.state != State::Failed || nowMs() - e.failedAtMs < retryMs_) {
+      // Asked for now: the most recently used, so that the keys fetched for
+      // the same read (those it lacks) push others out first, not it.
+      uses_.splice(uses_.begin(), uses_, e.use);
+      return true;
+    }
     erase(key);  // failed a while ago: fetched again
   }
   want(key);

@@ -52,8 +52,8 @@ class FetchStorage final : public ZarrStorage {
   bool decodesChunks(ZarrCompressor c) const override;
   void setPageDecodes(ZarrCompressor c) { pageDecodes_[static_cast<int>(c)] = true; }
 
-  // True when `key` has arrived (bytes, a 404 or an error); otherwise
-  // records it as wanted.
+  // True when `key` has arrived (bytes, a 404 or an error), and it becomes
+  // the most recently used; otherwise records it as wanted.
   bool ready(const std::string& key) const;
   // Whether the key has arrived (or is known missing), without asking for it.
   bool holds(const std::string& key) const { return entries_.count(key) != 0; }
@@ -69,6 +69,7 @@ class FetchStorage final : public ZarrStorage {
   void putMissing(const std::string& key);
   void putFailed(const std::string& key, const std::string& message);
   FetchStats stats() const { return stats_; }
+  std::uint64_t budgetBytes() const { return budget_; }
 
  private:
   enum class State { Bytes, Missing, Failed };

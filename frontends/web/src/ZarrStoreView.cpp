@@ -55,17 +55,18 @@ bool FetchedZarrSource::resident(int level, const lod::VoxelBox& box) const {
 }
 
 ZarrStoreView::ZarrStoreView(gpu::GlContext& context, const gpu::DeviceLimits& limits,
-                             const std::string& url)
+                             const std::string& url, std::uint64_t cacheBytes)
     : context_(context),
       limits_(limits),
-      storage_(std::make_shared<FetchStorage>(url, kStoreFetchedBytes)) {}
+      storage_(std::make_shared<FetchStorage>(url, cacheBytes)) {}
 
 ZarrStoreView::ZarrStoreView(gpu::GlContext& context, const gpu::DeviceLimits& limits, Host host)
     : context_(context),
       limits_(limits),
       storage_(std::move(host.storage)),
       store_(std::move(host.store)),
-      source_(std::move(host.source)) {}
+      source_(std::move(host.source)),
+      times_(std::move(host.times)) {}
 
 bool ZarrStoreView::open() {
   if (isOpen()) return true;

@@ -35,6 +35,8 @@ namespace tessera::web {
 // for the next one's.
 inline constexpr std::uint64_t kStoreFetchedBytes = 48ull << 20;
 inline constexpr std::uint64_t kStoreFetchAheadBytes = kStoreFetchedBytes / 2;
+// The least a page may set its stores' chunk cache to (?zarrcache=MiB).
+inline constexpr std::uint64_t kStoreCacheMinBytes = 64ull << 10;
 
 // A store's levels read through a FetchStorage: prefetch() lists the
 // chunks a box needs that have not arrived.
@@ -92,20 +94,24 @@ struct StorePace {
 class ZarrStoreView {
  public:
   // What a store view holds in host memory: the fetched chunks, the store's
-  // metadata and its levels. It outlives a lost WebGL context.
+  // metadata and its levels, and the time points opened (sourceAt: those a
+  // series plays, the same objects after a lost WebGL context).
   struct Host {
     std::shared_ptr<FetchStorage> storage;
     std::shared_ptr<const ZarrStore> store;
     std::shared_ptr<const FetchedZarrSource> source;
+    std::map<int, std::shared_ptr<const FetchedZarrSource>> times;
   };
 
-  ZarrStoreView(gpu::GlContext& context, const gpu::DeviceLimits& limits, const std::string& url);
+  // `cacheBytes`: the fetched chunks kept (FetchStorage's budget).
+  ZarrStoreView(gpu::GlContext& context, const gpu::DeviceLimits& limits, const std::string& url,
+                std::uint64_t cacheBytes = kStoreFetchedBytes);
   // A view of a store already read, on another context (the restored one
   // after a context loss): open() makes its atlas, page table and ray
   // caster again, and the bricks are read again from the chunks held (the
   // page fetches only those the host cache let go).
   ZarrStoreView(gpu::GlContext& context, const gpu::DeviceLimits& limits, Host host);
-  Host host() const { return {storage_, store_, source_}; }
+  Host host() const { return {storage_, store_, source_, times_}; }
 
   FetchStorage& storage() { return *storage_; }
   // One step of opening: the metadata, then the coarsest level (pinned in

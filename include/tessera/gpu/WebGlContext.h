@@ -26,6 +26,9 @@ class WebGlContext {
   GlContext& gl() { return *context_; }
   int webglVersion() const { return version_; }
   void makeCurrent();
+  // Whether the browser took the context away: at once when it does, a
+  // task before its webglcontextlost event (GL calls then only fail).
+  bool lost() const;
 
  private:
   std::intptr_t handle_ = 0;
