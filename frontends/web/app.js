@@ -92,13 +92,6 @@ import { attachOverlayPanel } from './overlay-panel.js';
   let frames = 0;
   let renderWaiters = [];
   let refineNotBefore = 0;  // performance.now() before which no strip is rendered
-  // A store's pending frame is not refined while input streams in (a drag's
-  // moves, wheel turns: ?inputhold= ms after the last, 50 by default, 0
-  // refines at once): the next input replaces it with a preview, and its
-  // steps (streaming, tables, strips of half the budget) would hold the
-  // main thread and the GPU process when that input arrives.
-  const inputHoldMs = Math.max(0, parseFloat(params.get('inputhold') ?? '50') || 0);
-  let lastInputAt = -Infinity;
   let slices = null;        // frontends/web/slices.js, once the module is up
   let zarr = null;  // an open OME-Zarr store (frontends/web/zarr-url.js)
   let storeTime = null;  // its t axis played as a time series (frontends/web/store-time.js)
@@ -318,7 +311,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
       needsRender = false;
       fitCanvas();
       f = zarr.frame(canvas.width, canvas.height, viewChanged);
-    } else if (zarr.refining() && performance.now() >= Math.max(refineNotBefore, lastInputAt + inputHoldMs)) {
+    } else if (zarr.refining() && performance.now() >= refineNotBefore) {
       f = zarr.refine();
       // As for in-core strips: one that cost more than the budget is
       // followed by as much idle time.
@@ -802,7 +795,6 @@ import { attachOverlayPanel } from './overlay-panel.js';
     }
     api.pointerMove(e.pointerId, ...cameraPos(e));
     if (api.interacting()) {
-      lastInputAt = performance.now();
       setCameraDragged(true);
       requestRender();
     }
@@ -824,7 +816,6 @@ import { attachOverlayPanel } from './overlay-panel.js';
   canvas.addEventListener('wheel', (e) => {
     if (!api) return;
     api.wheel(Math.sign(e.deltaY));
-    lastInputAt = performance.now();
     requestRender();
     e.preventDefault();
   }, { passive: false });
