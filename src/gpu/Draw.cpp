@@ -153,7 +153,12 @@ void finish() {
   glFinish();
 }
 
+namespace {
+bool errorChecksDeferred = false;
+}  // namespace
+
 void checkErrors(const std::string& what) {
+  if (errorChecksDeferred) return;
   const GLenum e = glGetError();
   if (e == GL_NO_ERROR) return;
   char code[16];
@@ -165,6 +170,20 @@ void checkErrors(const std::string& what) {
 void clearErrors() {
   for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) {
   }
+}
+
+DeferredErrorChecks::DeferredErrorChecks() {
+  errorChecksDeferred = true;
+}
+
+DeferredErrorChecks::~DeferredErrorChecks() {
+  errorChecksDeferred = false;
+}
+
+void DeferredErrorChecks::check(const std::string& what) {
+  errorChecksDeferred = false;
+  checkErrors(what);
+  errorChecksDeferred = true;
 }
 
 namespace {

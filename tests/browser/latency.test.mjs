@@ -11,7 +11,12 @@
 // animation frame (up to 16.7 ms: Chromium dispatches moves and wheel turns
 // with it) is part of every latency, so nothing else may hold the main
 // thread for long: chunks are inflated in slices in idle time, and the
-// worst events are explained frame by frame (explainWorst).
+// worst events are explained frame by frame (explainWorst). A wheel turn
+// sent through DevTools, as here, waits for one frame more before it
+// reaches the page (explainTrace): its latency is at least a frame
+// interval plus the answering callback, whatever the page does.
+// TESSERA_LATENCY_TRACE=FILE records a Chrome trace of the input sequence
+// and prints each input's way through Chromium.
 import { test } from 'node:test';
 import fs from 'node:fs';
 import os from 'node:os';
@@ -126,6 +131,50 @@ function explainWorst(lat, z) {
               `animation-frame callbacks ${lat.callbacks.length}: ${text(lat.callbacks.map((c) => c.end - c.start))} ms`);
 }
 
+// Each input event's way through Chromium, from a trace of the input
+// sequence (TESSERA_LATENCY_TRACE): from its timestamp to the browser
+// forwarding it to the page's renderer, to its dispatch on the page's main
+// thread (at the start of an animation frame: Chromium aligns moves and
+// wheel turns with them), and to the end of the animation-frame callback
+// after it. A wheel turn sent through DevTools (Input.dispatchMouseEvent)
+// is forwarded only once the renderer has committed a frame
+// (InputHandler::HandleMouseEvent: InsertVisualStateCallback), so it is
+// dispatched at the second frame after its timestamp, never the first.
+function explainTrace(trace) {
+  const ev = trace.traceEvents || trace;
+  const dispatch = ev.filter((e) => e.name === 'EventDispatch' && e.args && e.args.data);
+  if (!dispatch.length) { console.log('latency trace: no input events dispatched in the trace'); return; }
+  const renderer = dispatch[0].pid;
+  const byTs = (a, b) => a.ts - b.ts;
+  const frames = ev.filter((e) => e.name === 'BeginMainThreadFrame' && e.pid === renderer).map((e) => e.ts).sort((a, b) => a - b);
+  const callbacks = ev.filter((e) => e.name === 'FireAnimationFrame' && e.pid === renderer && e.dur !== undefined).sort(byTs);
+  const forwards = ev.filter((e) => e.name === 'RenderWidgetHostImpl::ForwardWheelEvent' && e.args && e.args.dy !== 0).sort(byTs);
+  const generated = (type) => [...new Set(ev.filter((e) => e.name === 'EventLatency' && e.ph === 'b' &&
+    e.args && e.args.event_latency && e.args.event_latency.event_type === type).map((e) => e.ts))].sort((a, b) => a - b);
+  const ms = (us) => us / 1000;
+  const text = (v) => { const s = stats(v); return `median ${s.median.toFixed(1)}, worst ${s.worst.toFixed(1)}`; };
+  for (const [type, dom] of [['MOUSE_DRAGGED', 'pointermove'], ['MOUSE_WHEEL', 'wheel']]) {
+    const rows = [];
+    for (const g of generated(type)) {
+      const d = dispatch.find((e) => e.ts >= g && e.args.data.type === dom);
+      if (!d) continue;
+      const cb = callbacks.find((c) => c.ts >= d.ts);
+      const f = forwards.find((e) => e.ts >= g);
+      rows.push({ forward: type === 'MOUSE_WHEEL' && f ? ms(f.ts - g) : 0, dispatch: ms(d.ts - g),
+        frameIndex: frames.filter((t) => t > g && t <= d.ts + 1000).length,
+        callback: cb ? ms(cb.dur) : NaN, end: cb ? ms(cb.ts + cb.dur - g) : NaN });
+    }
+    if (!rows.length) continue;
+    const nth = {};
+    rows.forEach((r) => { nth[r.frameIndex] = (nth[r.frameIndex] || 0) + 1; });
+    console.log(`latency trace: ${dom} ${rows.length}: ` +
+      (type === 'MOUSE_WHEEL' ? `forwarded by the browser after ${text(rows.map((r) => r.forward))} ms (its wait for a committed frame); ` : '') +
+      `dispatched after ${text(rows.map((r) => r.dispatch))} ms, at the Nth frame after its timestamp ` +
+      `${Object.entries(nth).map(([n, c]) => `${n}: ${c}`).join(', ')}; the answering callback ${text(rows.map((r) => r.callback))} ms; ` +
+      `timestamp to its end ${text(rows.map((r) => r.end))} ms`);
+  }
+}
+
 function stats(values) {
   const v = [...values].sort((a, b) => a - b);
   const at = (q) => (v.length ? v[Math.min(v.length - 1, Math.floor(q * v.length))] : NaN);
@@ -158,6 +207,15 @@ async function storeInputLatency(context, url, tmp, run) {
   const sent = [];
   const send = (type, params) => sent.push(cdp.send(type, { ...params, timestamp: Date.now() / 1000 }));
   const at = async (ms) => { const due = t0 + ms; if (Date.now() < due) await new Promise((r) => setTimeout(r, due - Date.now())); };
+  // TESSERA_LATENCY_TRACE=FILE: a Chrome trace of the input sequence (input,
+  // latencyInfo, scheduler, cc, viz and gpu categories) written to FILE, to
+  // follow an event from the browser process to the frame that answered it.
+  const traceFile = process.env.TESSERA_LATENCY_TRACE || '';
+  if (traceFile) {
+    await cdp.send('Tracing.start', { transferMode: 'ReturnAsStream', traceConfig: { recordMode: 'recordAsMuchAsPossible',
+      includedCategories: ['input', 'latencyInfo', 'benchmark', 'devtools.timeline', 'toplevel', 'gpu', 'cc', 'viz',
+        'blink', 'renderer.scheduler', 'disabled-by-default-devtools.timeline.frame', 'v8.execute'] } });
+  }
   const t0 = Date.now();
   send('Input.dispatchMouseEvent', { type: 'mousePressed', x: cx, y: cy, button: 'left', buttons: 1, clickCount: 1 });
   const MOVES = 40;
@@ -174,9 +232,26 @@ async function storeInputLatency(context, url, tmp, run) {
   }
   await Promise.all(sent);
   await new Promise((r) => setTimeout(r, 3000));  // the last events' frames
+  if (traceFile) {
+    const done = new Promise((resolve) => cdp.once('Tracing.tracingComplete', resolve));
+    await cdp.send('Tracing.end');
+    const { stream } = await done;
+    const parts = [];
+    for (;;) {
+      const r = await cdp.send('IO.read', { handle: stream, size: 1 << 20 });
+      parts.push(r.base64Encoded ? Buffer.from(r.data, 'base64').toString() : r.data);
+      if (r.eof) break;
+    }
+    await cdp.send('IO.close', { handle: stream });
+    fs.writeFileSync(traceFile, parts.join(''));
+    console.log(`latency: trace written to ${traceFile}`);
+    explainTrace(JSON.parse(parts.join('')));
+  }
   const lat = await page.evaluate(() => window.latency);
   const z = await page.evaluate(() => window.tessera.zarr());
   served.delayMs = () => 0;
+  // TESSERA_LATENCY_DUMP=FILE: the page's events, frames and the store's calls as JSON.
+  if (process.env.TESSERA_LATENCY_DUMP) fs.writeFileSync(process.env.TESSERA_LATENCY_DUMP, JSON.stringify({ lat, z }));
   // The store's own calls meanwhile (zarr-url.js): the work each did.
   const during = (z.calls || []).filter((c) => c.t > z.firstImageMs);
   const work = stats(during.map((c) => c.ms));

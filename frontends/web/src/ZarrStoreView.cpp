@@ -247,18 +247,19 @@ layout::BricksFrame ZarrStoreView::stream(const FrameView& v, double ms) {
 void ZarrStoreView::show(const gpu::Texture& image, const FrameView& v) {
   compositor_->composeInto(image, v.camera, v.background, store_->shape().extent(), 0,
                            glm::ivec4(0, 0, v.width, v.height));
-  // Waits for the frame (glFinish does not), and checks the errors since
-  // the compositor's: each query is a wait for the browser's GPU process,
-  // one more in the preview that answers input.
+  // Waits for the frame (glFinish does not); the callers ask for its errors
+  // once, after this read-back (gpu::DeferredErrorChecks).
   std::uint8_t pixel[4];
   gpu::readPixelsRgba8({0, 0, 1, 1}, pixel);
 }
 
 StoreFrame ZarrStoreView::drawWhole(const FrameView& v, StoreFrame f,
                                     std::chrono::steady_clock::time_point t0) {
+  gpu::DeferredErrorChecks deferred;
   f.tablesMs = prepareTables(v);
   const auto t1 = std::chrono::steady_clock::now();
   show(active_.technique->render(v.camera, v.pass, v.renderWidth, v.renderHeight, 0.0), v);
+  deferred.check("OME-Zarr frame");
   shownVersion_ = active_.upload.layout->contentVersion();
   framedWhole_ = true;
   msPerPixel_ = msSince(t1) / (static_cast<double>(v.renderWidth) * v.renderHeight);
@@ -292,9 +293,13 @@ void ZarrStoreView::preview(const FrameView& v, StoreFrame& f) {
   p.renderWidth = std::max(1, static_cast<int>(std::lround(v.renderWidth * level.resolutionScale)));
   p.renderHeight =
       std::max(1, static_cast<int>(std::lround(v.renderHeight * level.resolutionScale)));
+  // Its passes' errors are asked for once, after the read-back that waits
+  // for them (each glGetError is a round trip to the browser's GPU process).
+  gpu::DeferredErrorChecks deferred;
   f.tablesMs = prepareTables(v);
   const auto t0 = std::chrono::steady_clock::now();
   show(active_.technique->render(p.camera, p.pass, p.renderWidth, p.renderHeight, 0.0), p);
+  deferred.check("OME-Zarr preview");
   f.previewMs = msSince(t0);
   previewQuality_->report(level, f.previewMs);
   previewMeasured_ = true;
@@ -374,6 +379,7 @@ StoreFrame ZarrStoreView::strip() {
   if (p.rows > 0.0) rows = std::min(rows, 2.0 * p.rows);
   rows = std::clamp(rows, minStrip, 1.0 - p.done);
   if (1.0 - (p.done + rows) < 0.5 * minStrip) rows = 1.0 - p.done;
+  gpu::DeferredErrorChecks deferred;  // asked for once, after the read-back
   const double tablesMs = prepareTables(v);
   const gpu::Texture* image = nullptr;
   {
@@ -381,8 +387,9 @@ StoreFrame ZarrStoreView::strip() {
         glm::vec4(0.0f, static_cast<float>(p.done), 1.0f, static_cast<float>(p.done + rows)));
     image = &active_.technique->render(v.camera, v.pass, v.renderWidth, v.renderHeight, 0.0);
     std::uint8_t pixel[4];
-    gpu::readPixelsRgba8({0, 0, 1, 1}, pixel);  // waits for the strip; checks its errors
+    gpu::readPixelsRgba8({0, 0, 1, 1}, pixel);  // waits for the strip
   }
+  deferred.check("OME-Zarr strip");
   // A strip's time varies with what its rows cover: a dearer one is taken
   // at once, a cheaper one only in part, so that strips overrun seldom.
   const double perPixel = (msSince(t0) - tablesMs) / (rows * pixels);
@@ -397,6 +404,7 @@ StoreFrame ZarrStoreView::strip() {
   f.pending = p.done < 1.0;
   if (!f.pending) {
     show(*image, v);
+    deferred.check("OME-Zarr frame");
     shownVersion_ = active_.upload.layout->contentVersion();
     framedWhole_ = true;
     f.shown = true;

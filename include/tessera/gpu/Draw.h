@@ -75,6 +75,20 @@ void checkErrors(const std::string& what);
 // Forgets recorded errors (front ends such as ImGui's GL backend may leave
 // some that a later check would blame on the engine).
 void clearErrors();
+// While one is alive, checkErrors() does not ask GL: in a browser each
+// glGetError is a round trip to the GPU process that waits for every
+// command before it, and a frame of several passes waited once per pass.
+// check() asks once for all of them (GL keeps the errors until asked).
+// Scopes do not nest.
+class DeferredErrorChecks {
+ public:
+  DeferredErrorChecks();
+  ~DeferredErrorChecks();
+  DeferredErrorChecks(const DeferredErrorChecks&) = delete;
+  DeferredErrorChecks& operator=(const DeferredErrorChecks&) = delete;
+  // GpuError naming `what` if GL recorded an error since the scope began.
+  void check(const std::string& what);
+};
 
 enum class Primitive { Triangles, Lines, Points };
 
