@@ -43,6 +43,56 @@ std::string techniqueKey(const Settings& s, int width, int height, ValueRange wi
 StreamedFrames::StreamedFrames(Session& session) : session_(session) {}
 StreamedFrames::~StreamedFrames() = default;
 
+// The last layout's textures go first: one atlas on the GPU at a time.
+void StreamedFrames::makeLayout(const std::shared_ptr<const lod::MultiresSource>& pyramid,
+                                const Settings& s, int width, int height, ValueRange window,
+                                const std::string& key) {
+  gpu::DeviceSession& device = session_.device();
+  gpu_.reset();
+  complete_ = false;
+  auto next = std::make_unique<Gpu>();
+  next->pyramid = pyramid;
+  next->source = std::make_unique<lod::MultiresVolumeSource>(
+      std::make_shared<lod::WindowedSource>(pyramid, window));
+  next->technique =
+      render::createTechnique(s.technique, *device.context, device.limits, *next->source,
+                              s.techniqueOptions({width, height}), "bricks");
+  layout::StreamingLayout* bricks =
+      next->technique.upload.layout ? next->technique.upload.layout->streaming() : nullptr;
+  if (!bricks) {
+    throw InputError("technique " + s.technique + " keeps its own storage (" +
+                     next->technique.storageName() +
+                     "), which does not stream bricks: a series over bricks is drawn by one "
+                     "that samples a layout (raycast, slice3d)");
+  }
+  // A viewer keeps asking for a brick whose reads failed, after its back-off.
+  bricks->retryFailingReads(true);
+  next->refinement = std::make_unique<BrickRefinement>(*bricks);
+  next->key = key;
+  gpu_ = std::move(next);
+  timePoint_ = session_.timePoint();
+  ++layoutsMade_;
+}
+
+// Another time point of the same store: its bricks streamed into the
+// atlas, page table and technique already on the GPU (no texture made, no
+// shader compiled); a pyramid of another grid keeps gpu_ as it was, and
+// render() makes a layout for it.
+void StreamedFrames::streamInto(const std::shared_ptr<const lod::MultiresSource>& pyramid,
+                                ValueRange window) {
+  layout::StreamingLayout& bricks = gpu_->refinement->layout();
+  auto windowed = std::make_shared<lod::WindowedSource>(pyramid, window);
+  if (!bricks.replaceSources({windowed})) return;
+  gpu_->technique.upload.pyramid = windowed;
+  gpu_->source = std::make_unique<lod::MultiresVolumeSource>(std::move(windowed));
+  gpu_->pyramid = pyramid;
+  gpu_->frame = nullptr;
+  gpu_->frameKey.clear();
+  complete_ = false;
+  timePoint_ = session_.timePoint();
+  ++timePointsStreamedIn_;
+}
+
 const gpu::Texture& StreamedFrames::render(int width, int height) {
   checkImageSize(width, height);
   const std::shared_ptr<const lod::MultiresSource> pyramid = session_.sharedPyramid();
@@ -51,34 +101,12 @@ const gpu::Texture& StreamedFrames::render(int width, int height) {
   s.validate();
   const ValueRange window = s.window.value_or(pyramid->shape().window());
   const std::string key = techniqueKey(s, width, height, window);
-  gpu::DeviceSession& device = session_.device();
-  device.context->makeCurrent();
+  session_.device().context->makeCurrent();
+  if (gpu_ && gpu_->pyramid != pyramid && gpu_->key == key && reuseLayout) {
+    streamInto(pyramid, window);
+  }
   if (!gpu_ || gpu_->pyramid != pyramid || gpu_->key != key) {
-    // The last layout's textures go first: one atlas on the GPU at a time.
-    gpu_.reset();
-    complete_ = false;
-    auto next = std::make_unique<Gpu>();
-    next->pyramid = pyramid;
-    next->source = std::make_unique<lod::MultiresVolumeSource>(
-        std::make_shared<lod::WindowedSource>(pyramid, window));
-    next->technique =
-        render::createTechnique(s.technique, *device.context, device.limits, *next->source,
-                                s.techniqueOptions({width, height}), "bricks");
-    layout::StreamingLayout* bricks =
-        next->technique.upload.layout ? next->technique.upload.layout->streaming() : nullptr;
-    if (!bricks) {
-      throw InputError("technique " + s.technique + " keeps its own storage (" +
-                       next->technique.storageName() +
-                       "), which does not stream bricks: a series over bricks is drawn by one "
-                       "that samples a layout (raycast, slice3d)");
-    }
-    // A viewer keeps asking for a brick whose reads failed, after its back-off.
-    bricks->retryFailingReads(true);
-    next->refinement = std::make_unique<BrickRefinement>(*bricks);
-    next->key = key;
-    gpu_ = std::move(next);
-    timePoint_ = session_.timePoint();
-    ++layoutsMade_;
+    makeLayout(pyramid, s, width, height, window, key);
   }
   const std::string frameKey = s.toJson().dump();
   if (gpu_->frame && complete_ && frameKey == gpu_->frameKey) return *gpu_->frame;

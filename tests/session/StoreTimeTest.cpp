@@ -135,12 +135,16 @@ TEST(StoreTime, PlaybackOverBricksShowsEveryTimePointOnceInOrderNeverStale) {
 // in the view over bricks, its frames drawn by streamedFrames() one step
 // per front-end frame. Playback moves on only once the time point shown
 // has been drawn complete, so every time point's complete frame is shown,
-// in order, each equal to that time point in core; one layout per time
-// point shown, the last one's textures let go before the next is made.
+// in order, each equal to that time point in core; every time point is
+// streamed into the one layout made for the first (its atlas, page table
+// and technique kept on the GPU).
 struct ShownOverBricks {
   std::vector<int> sequence;  // time points drawn complete, in the order shown
   std::vector<Image> frames;
-  std::vector<std::uint64_t> textureBytes;  // the ledger at each
+  std::vector<std::uint64_t> textureBytes;        // the ledger at each
+  std::vector<std::size_t> textures;              // textures and buffers held at each
+  std::vector<unsigned> frameTextures;            // the GL name of the frame shown
+  std::vector<const gpu::Texture*> frameObjects;  // and the object holding it
 };
 
 ShownOverBricks playInView(Session& s, int shows, int size) {
@@ -164,6 +168,10 @@ ShownOverBricks playInView(Session& s, int shows, int size) {
       shown.sequence.push_back(t);
       shown.frames.push_back(frames.readImage());
       shown.textureBytes.push_back(ledger.totalBytes());
+      shown.textures.push_back(ledger.count());
+      const gpu::Texture& frame = frames.render(size, size);  // complete: drawn already
+      shown.frameTextures.push_back(frame.id());
+      shown.frameObjects.push_back(&frame);
     }
   }
   return shown;
@@ -205,15 +213,63 @@ TEST(StoreTime, ViewPlaysOverBricksEveryTimePointCompleteInOrder) {
     EXPECT_GE(own, 45.0) << "time point " << t;
     EXPECT_LT(other, 40.0) << "time point " << t << " looks like another";
   }
-  // A layout per time point shown, one on the GPU at a time: the textures
-  // held are the same at every time point, and never more in between.
-  EXPECT_EQ(s.streamedFrames().layoutsMade(), 7);
+  // One layout, made for the first time point; the six after it streamed
+  // into its textures: the same textures held at every time point (their
+  // count and bytes), never more in between, and the frame drawn into the
+  // same render target by the same technique.
+  EXPECT_EQ(s.streamedFrames().layoutsMade(), 1);
+  EXPECT_EQ(s.streamedFrames().timePointsStreamedIn(), 6);
   const auto [low, high] =
       std::minmax_element(shown.textureBytes.begin(), shown.textureBytes.end());
   EXPECT_EQ(*low, *high);
   EXPECT_LE(s.device().context->ledger().peakBytes(), *high);
-  std::printf("%llu late time points\n",
-              static_cast<unsigned long long>(s.playback().lateTimePoints()));
+  for (std::size_t i = 1; i < shown.sequence.size(); ++i) {
+    EXPECT_EQ(shown.textures[i], shown.textures[0]) << "shown " << i;
+    EXPECT_EQ(shown.frameTextures[i], shown.frameTextures[0]) << "shown " << i;
+    EXPECT_EQ(shown.frameObjects[i], shown.frameObjects[0]) << "shown " << i;
+  }
+  std::printf("%llu late time points, %zu textures held throughout (%llu bytes)\n",
+              static_cast<unsigned long long>(s.playback().lateTimePoints()), shown.textures[0],
+              static_cast<unsigned long long>(*high));
+}
+
+// A time point's frame after playing from time point 0 (its bricks streamed
+// into the atlas the earlier ones used) against the same time point opened
+// alone over bricks and refined to the end (Session::render, what `tessera
+// render STORE --time T --layout bricks` draws): the same bricks in other
+// slots of the atlas, the same image.
+TEST(StoreTime, ATimePointPlayedIntoTheAtlasEqualsItRenderedAlone) {
+  const test::TempDir dir;
+  const std::string store = test::writeTimeStore(dir.path(), 5, 1).string();
+  std::vector<Image> alone;
+  {
+    Session fresh("native");
+    useLook(fresh);
+    fresh.settings().layout = "bricks";
+    for (int t = 0; t < 5; ++t) {
+      fresh.open(store, atTime(t));
+      ASSERT_TRUE(fresh.streamed());
+      alone.push_back(fresh.render(64, 64));
+    }
+  }
+  Session s("native");
+  s.settings().layout = "bricks";
+  s.openInView(store);
+  useLookInView(s);
+  const ShownOverBricks shown = playInView(s, 6, 64);
+  ASSERT_EQ(shown.sequence, (std::vector<int>{0, 1, 2, 3, 4, 0})) << "playback stalled";
+  EXPECT_EQ(s.streamedFrames().layoutsMade(), 1);
+  for (std::size_t i = 0; i < shown.sequence.size(); ++i) {
+    const int t = shown.sequence[i];
+    const double db = psnr(shown.frames[i], alone[static_cast<std::size_t>(t)]);
+    const double other = psnr(shown.frames[i], alone[static_cast<std::size_t>((t + 1) % 5)]);
+    std::printf(
+        "shown %zu: time point %d played vs rendered alone over bricks: %.1f dB (vs the "
+        "next time point %.1f dB)\n",
+        i, t, db, other);
+    EXPECT_GE(db, 60.0) << "time point " << t;
+    EXPECT_LT(other, 40.0) << "time point " << t;
+  }
 }
 
 // A store whose level 0 does not fit a quarter of the host budget plays
