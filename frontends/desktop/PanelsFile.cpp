@@ -58,9 +58,8 @@ void DesktopApp::openFile(const std::string& path) {
 }
 
 void openChannels(DesktopApp& ds, const std::string& spec) {
-  // A series over bricks plays the one channel it was opened at (--channel):
-  // the list reads every channel of each time point in core.
-  if (ds.session->streamedSeries()) return;
+  // A series over bricks streams its channels together (the session's
+  // streamed frames draw them); otherwise the list reads them in core.
   // --time chooses within the file given on the command line.
   const int time = spec == ds.options.file ? ds.options.time : 0;
   reportErrors(ds, [&] { ds.session->channelView().open(spec, time); });

@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "support/ChannelStore.h"
 #include "support/TestSupport.h"
 #include "support/TimeStore.h"
 #include "tessera/io/ZarrChannels.h"
@@ -270,6 +271,102 @@ TEST(StoreTime, ATimePointPlayedIntoTheAtlasEqualsItRenderedAlone) {
     EXPECT_GE(db, 60.0) << "time point " << t;
     EXPECT_LT(other, 40.0) << "time point " << t;
   }
+}
+
+// Three channels with a t axis played over bricks, as `view STORE --bricks`
+// plays them (the store opened in the view over bricks, then its channel
+// list): every channel of a time point streamed into one atlas (one
+// layout for the series), each time point's frame against the CPU
+// reference of that time point's channels (Session::renderChannels over
+// bricks), and a channel toggled while playback pauses changes only the
+// pixels of its own cube. The windows leave the dim shell out, so that
+// each channel's footprint is its cube alone.
+TEST(StoreTime, ThreeChannelsPlayOverBricksEachTimePointAsItsReference) {
+  const test::TempDir dir;
+  const std::string store = test::writeTimeStore(dir.path(), 5, 3).string();
+  constexpr int kSize = 64;
+  const std::vector<ValueRange> windows(3, ValueRange{100.0, 255.0});
+  std::vector<ChannelFrame> references;
+  {
+    Session fresh("native");
+    useLook(fresh);
+    fresh.settings().layout = "bricks";
+    fresh.settings().channels.windows = windows;
+    for (int t = 0; t < 5; ++t) {
+      references.push_back(fresh.renderChannels(store, kSize, kSize, true, t));
+    }
+  }
+  Session s("native");
+  s.settings().layout = "bricks";
+  s.settings().channels.windows = windows;
+  s.openInView(store);
+  ASSERT_NE(s.streamedSeries(), nullptr);
+  ChannelView& view = s.channelView();
+  ASSERT_TRUE(view.open(store));
+  ASSERT_TRUE(view.overBricks());
+  ASSERT_EQ(view.channels().size(), 3);
+  EXPECT_EQ(view.series(), nullptr);  // the session's streamed series plays them
+  ASSERT_EQ(s.streamedChannels().size(), 3u);
+  useLookInView(s);
+  const ShownOverBricks shown = playInView(s, 6, kSize);
+  ASSERT_EQ(shown.sequence, (std::vector<int>{0, 1, 2, 3, 4, 0})) << "playback stalled";
+  EXPECT_EQ(s.streamedFrames().layoutsMade(), 1);
+  EXPECT_EQ(s.streamedFrames().timePointsStreamedIn(), 5);
+  for (std::size_t i = 0; i < shown.sequence.size(); ++i) {
+    const int t = shown.sequence[i];
+    const ChannelFrame& r = references[static_cast<std::size_t>(t)];
+    const double db = psnr(shown.frames[i], *r.reference);
+    const double gpu = psnr(shown.frames[i], r.image);
+    const double other =
+        psnr(shown.frames[i], *references[static_cast<std::size_t>((t + 1) % 5)].reference);
+    std::printf(
+        "3 channels over bricks, shown %zu: time point %d, %.1f dB against its "
+        "reference (%.1f dB against it rendered alone, %.1f against the next time "
+        "point's reference)\n",
+        i, t, db, gpu, other);
+    EXPECT_GE(db, 40.0) << "time point " << t;
+    EXPECT_LT(other, db - 10.0) << "time point " << t << " looks like the next";
+    EXPECT_EQ(shown.textures[i], shown.textures[0]) << "shown " << i;
+  }
+
+  // Paused at time point 3 (the cubes apart), each channel toggled.
+  s.playback().pause();
+  ASSERT_TRUE(s.showTimePoint(3));
+  StreamedFrames& frames = s.streamedFrames();
+  auto refined = [&] {
+    for (int step = 0; step < 2000; ++step) {
+      frames.render(kSize, kSize);
+      if (frames.shownComplete(3)) return frames.readImage();
+    }
+    ADD_FAILURE() << "the frame did not refine";
+    return frames.readImage();
+  };
+  const Image all = refined();
+  auto showOnly = [&](int only) {
+    for (int c = 0; c < 3; ++c) view.setVisible(c, only < 0 || c == only);
+  };
+  for (int c = 0; c < 3; ++c) {
+    view.setVisible(c, false);
+    const Image without = refined();
+    showOnly(c);
+    const Image alone = refined();
+    for (int k = 0; k < 3; ++k) view.setVisible(k, false);
+    const Image black = refined();
+    showOnly(-1);
+    const std::vector<bool> changed = test::differing(all, without, 2);
+    const std::vector<bool> cube = test::differing(alone, black, 0);
+    int inside = 0, outside = 0;
+    for (std::size_t p = 0; p < changed.size(); ++p) {
+      if (changed[p]) ++(cube[p] ? inside : outside);
+    }
+    std::printf(
+        "time point 3, channel %d toggled over bricks: %d pixels changed inside its "
+        "cube's projection, %d outside\n",
+        c, inside, outside);
+    EXPECT_GT(inside, 20) << "channel " << c;
+    EXPECT_EQ(outside, 0) << "channel " << c;
+  }
+  EXPECT_EQ(s.streamedFrames().layoutsMade(), 1);  // toggles change uniforms, not textures
 }
 
 // A store whose level 0 does not fit a quarter of the host budget plays

@@ -12,7 +12,12 @@
 // between time points, and no brick of another time point is drawn. A
 // pyramid of another grid, or other settings, gets a layout of its own,
 // made after the last one's textures are let go: one atlas on the GPU at
-// a time.
+// a time. With the channel view's channels over bricks
+// (ChannelView::overBricks, Session::streamChannels) it draws them
+// together, as Session::renderChannels does: one bricks layout over every
+// channel's pyramid of the time point (BricksLayout::createChannels), each
+// time point streamed into it the same way, with the channel view's
+// colours, windows and visibility.
 // Session::stepPlayback moves on only once the time point shown has been
 // drawn complete (every brick its view wants resident): every time point
 // is shown refined, none skipped.
@@ -79,6 +84,7 @@ class StreamedFrames {
   void makeLayout(const std::shared_ptr<const lod::MultiresSource>& pyramid, const Settings& s,
                   int width, int height, ValueRange window, const std::string& key);
   void streamInto(const std::shared_ptr<const lod::MultiresSource>& pyramid, ValueRange window);
+  bool drawsChannels() const;
 
   Session& session_;
   std::unique_ptr<Gpu> gpu_;
