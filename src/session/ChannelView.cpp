@@ -78,12 +78,15 @@ bool ChannelView::open(const std::string& spec, int time) {
   const ZarrStore store(openZarrStorage(spec));
   if (store.channelCount() < 2) return false;
   const std::vector<int> indices = session_.settings().channels.indices;
+#ifndef __EMSCRIPTEN__
+  // Native only, as openStreamedSeries: the page draws its streamed stores itself.
   if (session_.streamedSeries() && session_.streamed() && session_.name() == spec) {
     ChannelSet set = session_.streamChannels(indices);
     if (set.size() < 2) return false;
     showOverBricks(std::move(set), spec);
     return true;
   }
+#endif
   const int count = store.timePoints();
   if (count < 2) {
     series_.reset();
