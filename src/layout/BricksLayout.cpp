@@ -613,6 +613,9 @@ bool BricksLayout::replaceSources(std::vector<std::shared_ptr<const lod::Multire
       if (g.dims(l) != grid_.dims(l) || g.scale(l) != grid_.scale(l)) return false;
     }
   }
+  // An error a caller left pending (a front end's own drawing between
+  // frames) is not this call's: only what the uploads below raise is.
+  gpu::clearErrors();
   // The readers of the old pyramids stop before their bricks go.
   streamer_.reset();
   channelStreamers_.clear();
