@@ -242,34 +242,39 @@ TEST(StoreTime, ViewPlaysOverBricksEveryTimePointCompleteInOrder) {
 TEST(StoreTime, ATimePointPlayedIntoTheAtlasEqualsItRenderedAlone) {
   const test::TempDir dir;
   const std::string store = test::writeTimeStore(dir.path(), 5, 1).string();
-  std::vector<Image> alone;
-  {
-    Session fresh("native");
-    useLook(fresh);
-    fresh.settings().layout = "bricks";
-    for (int t = 0; t < 5; ++t) {
-      fresh.open(store, atTime(t));
-      ASSERT_TRUE(fresh.streamed());
-      alone.push_back(fresh.render(64, 64));
+  // ES 3 (one 3D atlas) and ES 2 (the atlas as mosaics of z-slices).
+  for (const std::string profile : {"native", "webgl1-desktop-2012"}) {
+    SCOPED_TRACE(profile);
+    std::vector<Image> alone;
+    {
+      Session fresh(profile);
+      useLook(fresh);
+      fresh.settings().layout = "bricks";
+      for (int t = 0; t < 5; ++t) {
+        fresh.open(store, atTime(t));
+        ASSERT_TRUE(fresh.streamed());
+        alone.push_back(fresh.render(64, 64));
+      }
     }
-  }
-  Session s("native");
-  s.settings().layout = "bricks";
-  s.openInView(store);
-  useLookInView(s);
-  const ShownOverBricks shown = playInView(s, 6, 64);
-  ASSERT_EQ(shown.sequence, (std::vector<int>{0, 1, 2, 3, 4, 0})) << "playback stalled";
-  EXPECT_EQ(s.streamedFrames().layoutsMade(), 1);
-  for (std::size_t i = 0; i < shown.sequence.size(); ++i) {
-    const int t = shown.sequence[i];
-    const double db = psnr(shown.frames[i], alone[static_cast<std::size_t>(t)]);
-    const double other = psnr(shown.frames[i], alone[static_cast<std::size_t>((t + 1) % 5)]);
-    std::printf(
-        "shown %zu: time point %d played vs rendered alone over bricks: %.1f dB (vs the "
-        "next time point %.1f dB)\n",
-        i, t, db, other);
-    EXPECT_GE(db, 60.0) << "time point " << t;
-    EXPECT_LT(other, 40.0) << "time point " << t;
+    Session s(profile);
+    s.settings().layout = "bricks";
+    s.openInView(store);
+    useLookInView(s);
+    const ShownOverBricks shown = playInView(s, 6, 64);
+    ASSERT_EQ(shown.sequence, (std::vector<int>{0, 1, 2, 3, 4, 0})) << "playback stalled";
+    EXPECT_EQ(s.streamedFrames().layoutsMade(), 1);
+    for (std::size_t i = 0; i < shown.sequence.size(); ++i) {
+      const int t = shown.sequence[i];
+      const double db = psnr(shown.frames[i], alone[static_cast<std::size_t>(t)]);
+      const double other = psnr(shown.frames[i], alone[static_cast<std::size_t>((t + 1) % 5)]);
+      std::printf(
+          "%s, shown %zu: time point %d played vs rendered alone over bricks: %.1f dB "
+          "(vs the next time point %.1f dB)\n",
+          profile.c_str(), i, t, db, other);
+      EXPECT_GE(db, 60.0) << "time point " << t;
+      EXPECT_LT(other, 40.0) << "time point " << t;
+      EXPECT_EQ(shown.textures[i], shown.textures[0]) << "shown " << i;
+    }
   }
 }
 
