@@ -2,13 +2,15 @@
 // A streamed store's t axis played over bricks (layout/BricksLayout.h):
 // each time point is a pyramid of its own, read from that time point's
 // chunks only (lod::ZarrMultiresSource::atTime), and a frame of time point t
-// is drawn by a bricks layout made over t's pyramid, so its brick cache and
-// atlas hold t's bricks alone: no brick of another time point is drawn for
-// it. The time points ahead of the one shown are read ahead as a
-// TimeSeries reads in-core ones (its window, thread or pump, late-never-
-// skipped playback): each is opened and its levels, coarsest first, read
-// into its decoded-chunk cache while they fit `warmBytes`, so that when
-// playback moves on, the next time point's bricks come from memory.
+// is drawn by a bricks layout streaming t's pyramid alone (made for it, or
+// made for an earlier time point and t streamed into it:
+// StreamingLayout::replaceSources), so its brick cache and atlas hold t's
+// bricks alone: no brick of another time point is drawn for it. The time
+// points ahead of the one shown are read ahead as a TimeSeries reads
+// in-core ones (its window, thread or pump, late-never-skipped playback):
+// each is opened and its levels, coarsest first, read into its
+// decoded-chunk cache while they fit `warmBytes`, so that when playback
+// moves on, the next time point's bricks come from memory.
 //
 //   StreamedSeries s(store.timePoints(), [&](int t) { return store.atTime(t); },
 //                    hostBudget / 8, 2);
