@@ -13,6 +13,7 @@
 #include "bench/BenchHybrid.h"
 #include "bench/BenchJson.h"
 #include "bench/BenchPeers.h"
+#include "bench/BenchPlayback.h"
 #include "bench/BenchRoofline.h"
 #include "bench/BenchSampling.h"
 #include "bench/BenchScale.h"
@@ -453,8 +454,10 @@ void addBenchCommand(CLI::App& app) {
                      "With --sampling(-sweep): views whose worst PSNR counts");
   addExploreBenchOptions(cmd);
   addPeersBenchOptions(cmd);
+  addPlaybackBenchOptions(cmd);
   cmd->callback([o] {
     if (runExploreBenchIfAsked()) return;
+    if (runPlaybackBenchIfAsked()) return;
     if (runPeersBenchIfAsked()) return;
     if (o->sampling || o->samplingSweep) {
       SamplingBenchOptions s;

@@ -84,9 +84,8 @@ void openVolume(session::Session& s, FileUi& ui, PanelHost& host, const std::str
 }
 
 void openChannels(session::Session& s, const FileUi& ui, PanelHost& host, const std::string& spec) {
-  // A series over bricks plays the one channel it was opened at (--channel):
-  // the list reads every channel of each time point in core.
-  if (s.streamedSeries()) return;
+  // A series over bricks streams its channels together (the session's
+  // streamed frames draw them); otherwise the list reads them in core.
   // --time chooses within the file given on the command line.
   const int time = ui.optionsFor(spec).time;
   reportErrors(host, [&] { s.channelView().open(spec, time); });

@@ -64,8 +64,11 @@ bool drawStreamedFrames(DesktopApp& ds, const Rect& rect, int viewW, int viewH) 
   }
   const layout::BricksFrame& b = frames.lastBricks();
   char line[200];
-  std::snprintf(line, sizeof line, "time point %d over bricks: %s, %d of %d bricks missing (%s)",
-                s.timePoint(), frames.complete() ? "complete" : "refining", b.missing, b.wanted,
+  const int channels = s.streamedChannels().size();
+  std::snprintf(line, sizeof line, "time point %d over bricks%s: %s, %d of %d bricks missing (%s)",
+                s.timePoint(),
+                channels > 1 ? (", " + std::to_string(channels) + " channels").c_str() : "",
+                frames.complete() ? "complete" : "refining", b.missing, b.wanted,
                 ds.context().caps().renderer.c_str());
   ds.status = line;
   return true;

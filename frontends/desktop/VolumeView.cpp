@@ -149,7 +149,8 @@ void drawVolumeView(DesktopApp& ds, glm::ivec2 origin, int viewW, int viewH) {
 }
 
 bool drawChannelView(DesktopApp& ds, const Rect& rect, int viewW, int viewH) {
-  if (!channelsShown(ds)) return false;
+  // Channels over bricks: drawStreamedFrames draws (and records) them.
+  if (!channelsShown(ds) || ds.session->channelView().overBricks()) return false;
   try {
     const gpu::Texture& frame = ds.session->channelView().render(viewW, viewH);
     // Row 0 of the frame is its bottom row: ImGui's v runs down.

@@ -32,11 +32,9 @@ std::vector<int> parseChannelList(const std::string& text) {
   return out;
 }
 
-namespace {
-
 // The channels chosen (every one when `indices` is empty), checked.
-std::vector<int> chosenChannels(const ZarrStore& store, const std::string& spec,
-                                const std::vector<int>& indices) {
+std::vector<int> zarrChannelIndices(const ZarrStore& store, const std::string& spec,
+                                    const std::vector<int>& indices) {
   const int count = store.channelCount();
   std::vector<int> chosen = indices;
   if (chosen.empty()) {
@@ -61,7 +59,7 @@ std::vector<int> chosenChannels(const ZarrStore& store, const std::string& spec,
   return chosen;
 }
 
-Channel channelFrom(const ZarrStore& store, int c, Volume volume) {
+Channel zarrChannel(const ZarrStore& store, int c, Volume volume) {
   const std::vector<ZarrChannel>& omero = store.channels();
   Channel ch;
   ch.label = "channel " + std::to_string(c);
@@ -78,8 +76,6 @@ Channel channelFrom(const ZarrStore& store, int c, Volume volume) {
   return ch;
 }
 
-}  // namespace
-
 ChannelSet readZarrChannels(const std::string& spec, const std::vector<int>& indices, int time) {
   return readZarrChannels(openZarrStorage(spec), spec, indices, time);
 }
@@ -88,10 +84,10 @@ ChannelSet readZarrChannels(std::shared_ptr<const ZarrStorage> storage, const st
                             const std::vector<int>& indices, int time) {
   const ZarrStore first(storage, ZarrSelection{.time = time, .channel = 0});
   ChannelSet set;
-  for (int c : chosenChannels(first, name, indices)) {
+  for (int c : zarrChannelIndices(first, name, indices)) {
     const ZarrStore store(storage, ZarrSelection{.time = time, .channel = c});
     Volume volume = store.readLevel(store.finestLevelInHostBudget(name));
-    set.add(channelFrom(store, c, std::move(volume)), name + " channel " + std::to_string(c));
+    set.add(zarrChannel(store, c, std::move(volume)), name + " channel " + std::to_string(c));
   }
   return set;
 }
@@ -101,7 +97,7 @@ std::vector<std::string> zarrChannelKeys(std::shared_ptr<const ZarrStorage> stor
                                          int time) {
   const ZarrStore first(storage, ZarrSelection{.time = time, .channel = 0});
   std::vector<std::string> keys;
-  for (int c : chosenChannels(first, name, indices)) {
+  for (int c : zarrChannelIndices(first, name, indices)) {
     const ZarrStore store(storage, ZarrSelection{.time = time, .channel = c});
     const int l = store.finestLevelInHostBudget(name);
     for (std::string& k : store.chunkKeys(l, glm::ivec3(0), store.level(l).dims)) {

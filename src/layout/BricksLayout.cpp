@@ -541,51 +541,100 @@ std::unique_ptr<BricksLayout> BricksLayout::build(
   l->slotPinned_.assign(l->slotKey_.size(), false);
   l->slotFine_.assign(l->slotKey_.size(), {});
 
-  lod::BrickStreamerOptions so;
-  so.workers = options.workers;
   std::uint64_t chunksWanted = 0;
   for (const auto& s : sources) chunksWanted += s->decodedCacheWanted();
   // The walk's float pages count with the page table (texture and host).
   l->hostSplit_ = splitHost(limits, options, a.bytes, tableBytes(l->plan_), chunksWanted);
-  // One brick cache per channel, the same in all; each source's decoded
-  // chunks within an equal part of the chunks' share.
-  so.cacheBytes = l->hostSplit_.brickCache / sources.size();
-  for (const auto& s : sources) s->limitDecodedCache(l->hostSplit_.chunkCache / sources.size());
-  l->streamer_ = std::make_unique<lod::BrickStreamer>(source, l->grid_, so);
-  for (std::size_t c = 1; c < sources.size(); ++c) {
-    l->channelStreamers_.push_back(std::make_unique<lod::BrickStreamer>(sources[c], l->grid_, so));
-  }
-  for (std::size_t c = 0; set && c < sources.size(); ++c) {
-    const lod::StoredMapping m = lod::StoredMapping::of(sources[c]->shape());
-    glm::dvec2 packing(0.0, m.maxStored());
-    const ValueRange r = sources[c]->shape().valueRange();
-    if (format.format != gpu::TexelFormat::RGBA16 && format.format != gpu::TexelFormat::RGBA16F &&
-        r.max > r.min) {
-      packing = {m.store(r.min), m.store(r.max)};
-    }
-    l->channelPacking_.push_back(packing);
-  }
-  // The coarsest level, pinned: what every cell falls back to.
-  const int top = l->grid_.levelCount() - 1;
-  const glm::ivec3 n = l->grid_.bricks(top);
-  for (int z = 0; z < n.z; ++z) {
-    for (int y = 0; y < n.y; ++y) {
-      for (int x = 0; x < n.x; ++x) {
-        const lod::BrickKey key{top, {x, y, z}};
-        const int slot = l->slotFor(key.id(), 0);
-        if (set) {
-          l->uploadChannels(slot, l->channelBricks(key, true));
-        } else {
-          l->upload(slot, *l->streamer_->readNow(key));
-        }
-        l->slotPinned_[static_cast<std::size_t>(slot)] = true;
-      }
-    }
-  }
+  l->streamFrom(sources);
+  l->pinCoarsest();
   BricksFrame unused;
   l->rebuildPages(TransferFunction(), unused);
   gpu::checkErrors("bricks layout: allocating the atlas and the coarsest level");
   return l;
+}
+
+void BricksLayout::streamFrom(
+    const std::vector<std::shared_ptr<const lod::MultiresSource>>& sources) {
+  lod::BrickStreamerOptions so;
+  so.workers = options_.workers;
+  if (inlineReads_ >= 0) so.inlineReadsPerRequest = inlineReads_;
+  // One brick cache per channel, the same in all; each source's decoded
+  // chunks within an equal part of the chunks' share.
+  so.cacheBytes = hostSplit_.brickCache / sources.size();
+  for (const auto& s : sources) s->limitDecodedCache(hostSplit_.chunkCache / sources.size());
+  source_ = sources.front();
+  streamer_ = std::make_unique<lod::BrickStreamer>(source_, grid_, so);
+  streamer_->retryFailing(retryFailing_);
+  for (std::size_t c = 1; c < sources.size(); ++c) {
+    channelStreamers_.push_back(std::make_unique<lod::BrickStreamer>(sources[c], grid_, so));
+    channelStreamers_.back()->retryFailing(retryFailing_);
+  }
+  channelPacking_.clear();
+  for (std::size_t c = 0; channels_ && c < sources.size(); ++c) {
+    const lod::StoredMapping m = lod::StoredMapping::of(sources[c]->shape());
+    glm::dvec2 packing(0.0, m.maxStored());
+    const ValueRange r = sources[c]->shape().valueRange();
+    if (channelFormat_ != gpu::TexelFormat::RGBA16 && channelFormat_ != gpu::TexelFormat::RGBA16F &&
+        r.max > r.min) {
+      packing = {m.store(r.min), m.store(r.max)};
+    }
+    channelPacking_.push_back(packing);
+  }
+}
+
+// The coarsest level, pinned: what every cell falls back to.
+void BricksLayout::pinCoarsest() {
+  const int top = grid_.levelCount() - 1;
+  const glm::ivec3 n = grid_.bricks(top);
+  for (int z = 0; z < n.z; ++z) {
+    for (int y = 0; y < n.y; ++y) {
+      for (int x = 0; x < n.x; ++x) {
+        const lod::BrickKey key{top, {x, y, z}};
+        const int slot = slotFor(key.id(), 0);
+        if (channels_) {
+          uploadChannels(slot, channelBricks(key, true));
+        } else {
+          upload(slot, *streamer_->readNow(key));
+        }
+        slotPinned_[static_cast<std::size_t>(slot)] = true;
+      }
+    }
+  }
+}
+
+bool BricksLayout::replaceSources(std::vector<std::shared_ptr<const lod::MultiresSource>> sources) {
+  if (sources.size() != 1 + channelStreamers_.size()) return false;
+  for (const auto& s : sources) {
+    if (!s || s->levelCount() != grid_.levelCount()) return false;
+    if (s->shape().type() != source_->shape().type()) return false;
+    if (lod::StoredMapping::of(s->shape()).bits != streamer_->mapping().bits) return false;
+    const lod::BrickGrid g = lod::BrickGrid::of(*s, grid_.brickSize());
+    for (int l = 0; l < grid_.levelCount(); ++l) {
+      if (g.dims(l) != grid_.dims(l) || g.scale(l) != grid_.scale(l)) return false;
+    }
+  }
+  // An error a caller left pending (a front end's own drawing between
+  // frames) is not this call's: only what the uploads below raise is.
+  gpu::clearErrors();
+  // The readers of the old pyramids stop before their bricks go.
+  streamer_.reset();
+  channelStreamers_.clear();
+  std::fill(slotKey_.begin(), slotKey_.end(), -1);
+  std::fill(slotUsed_.begin(), slotUsed_.end(), 0);
+  std::fill(slotPinned_.begin(), slotPinned_.end(), false);
+  for (auto& f : slotFine_) f.clear();
+  slotOf_.clear();
+  streamFrom(sources);
+  pinCoarsest();
+  // As after create(): the page table shows the new coarsest level until
+  // the next update() judges bricks by its transfer function.
+  classified_ = false;
+  BricksFrame unused;
+  rebuildPages(TransferFunction(), unused);
+  ++contentVersion_;  // the atlas changed even where the page table did not
+  ++sourcesReplaced_;
+  gpu::checkErrors("bricks layout: streaming other pyramids into the atlas");
+  return true;
 }
 
 glm::ivec3 BricksLayout::slotOrigin(int slot) const {

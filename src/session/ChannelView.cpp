@@ -78,6 +78,15 @@ bool ChannelView::open(const std::string& spec, int time) {
   const ZarrStore store(openZarrStorage(spec));
   if (store.channelCount() < 2) return false;
   const std::vector<int> indices = session_.settings().channels.indices;
+#ifndef __EMSCRIPTEN__
+  // Native only, as openStreamedSeries: the page draws its streamed stores itself.
+  if (session_.streamedSeries() && session_.streamed() && session_.name() == spec) {
+    ChannelSet set = session_.streamChannels(indices);
+    if (set.size() < 2) return false;
+    showOverBricks(std::move(set), spec);
+    return true;
+  }
+#endif
   const int count = store.timePoints();
   if (count < 2) {
     series_.reset();
@@ -126,7 +135,26 @@ bool ChannelView::showTime(int t) {
   return true;
 }
 
+void ChannelView::showOverBricks(ChannelSet set, const std::string& name) {
+  ChannelSettings& c = session_.settings().channels;
+  c.applyTo(set, name);
+  if (gpu_) session_.device().context->makeCurrent();
+  gpu_.reset();
+  series_.reset();  // the session's streamed series plays them
+  set_ = std::make_unique<ChannelSet>(std::move(set));
+  overBricks_ = true;
+  name_ = name;
+  c.enabled = true;
+  c.mode = set_->mode;
+  edited();
+}
+
+int ChannelView::timePoint() const {
+  return overBricks_ ? session_.timePoint() : time_;
+}
+
 void ChannelView::show(ChannelSet set, const std::string& name) {
+  overBricks_ = false;
   ChannelSettings& c = session_.settings().channels;
   c.applyTo(set, name);
   auto owned = std::make_unique<ChannelSet>(std::move(set));
@@ -149,6 +177,7 @@ void ChannelView::close() {
   set_.reset();
   series_.reset();
   time_ = 0;
+  overBricks_ = false;
   name_.clear();
   session_.settings().channels.enabled = false;
   edited();
@@ -157,7 +186,8 @@ void ChannelView::close() {
 // The GPU objects go first (the layout reads the set); on a lost context
 // their deletion only raises GL errors, which the caller clears.
 std::optional<ChannelView::Shown> ChannelView::takeShown() {
-  if (!set_) return std::nullopt;
+  // Over bricks the set holds no voxels: the session streams them again.
+  if (!set_ || overBricks_) return std::nullopt;
   gpu_.reset();
   Shown shown{std::move(*set_), std::move(name_)};
   set_.reset();
@@ -233,6 +263,7 @@ void ChannelView::setMode(ChannelMode mode) {
 
 const gpu::Texture& ChannelView::render(int width, int height) {
   const ChannelSet& set = channels();
+  if (overBricks_) return session_.streamedFrames().render(width, height);
   const Settings s = session_.currentSettings();
   Camera camera = s.camera;
   camera.frame(set.geometry());
@@ -255,6 +286,7 @@ const gpu::Texture& ChannelView::render(int width, int height) {
 }
 
 Image ChannelView::readImage() const {
+  if (overBricks_) return session_.streamedFrames().readImage();
   if (!gpu_ || !gpu_->frame) throw InputError("no channel frame has been rendered");
   session_.device().context->makeCurrent();
   return gpu_->technique->readImage();

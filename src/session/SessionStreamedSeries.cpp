@@ -8,6 +8,7 @@
 
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/io/ZarrChannels.h"
 #include "tessera/lod/MultiresVolumeSource.h"
 #include "tessera/lod/WindowedSource.h"
 #include "tessera/lod/ZarrMultiresSource.h"
@@ -48,11 +49,54 @@ void Session::openStreamedSeries(const std::string& spec, const OpenOptions& opt
   // Every time point in the first one's window, unless the settings say one.
   seriesWindow_ = settings_.window ? *settings_.window : first->shape().window();
   streamedSeries_ = std::move(series);
+  streamedChannels_.clear();
   seriesDrawn_ = false;
   name_ = spec;
   timePoint_ = -1;
   if (!showStreamedTimePoint(firstTime))
     throw Error(spec + ": its first time point was not opened");
+}
+
+ChannelSet Session::streamChannels(const std::vector<int>& indices) {
+  if (!streamedSeries_ || seriesDrawn_ || !streamed_) {
+    throw InputError("no store is played over bricks: its channels cannot stream together");
+  }
+  const std::string spec = name_;
+  const int time = timePoint_;
+  const int count = streamedSeries_->count();
+  std::vector<std::shared_ptr<const lod::ZarrMultiresSource>> firsts;
+  ChannelSet set;
+  {
+    const auto store = lod::ZarrMultiresSource::open(spec, {.time = time, .channel = 0});
+    for (int c : zarrChannelIndices(store->store(), spec, indices)) {
+      firsts.push_back(lod::ZarrMultiresSource::open(spec, {.time = time, .channel = c}));
+      const lod::ZarrMultiresSource& f = *firsts.back();
+      set.add(zarrChannel(f.store(), c, Volume(f.shape())), spec + " channel " + std::to_string(c));
+    }
+  }
+  if (set.size() < 2) return set;
+  // As openStreamedSeries, the budget shared by the channels: each time
+  // point's decoded chunks of every channel, as many ahead as a quarter of
+  // the host budget holds.
+  const std::uint64_t host = HostBudget::global().limitBytes();
+  std::uint64_t each = 0;
+  for (const auto& f : firsts) {
+    each += lod::ZarrMultiresSource::decodedChunkBudget(f->store(), host);
+  }
+  const int keep = TimeSeries::keepWithin(host / 4, each, count);
+  streamedSeries_ = std::make_unique<StreamedSeries>(
+      count,
+      [firsts, time](int t) {
+        StreamedSeries::Pyramids out;
+        for (const auto& f : firsts) {
+          out.push_back(t == time ? std::shared_ptr<const lod::MultiresSource>(f) : f->atTime(t));
+        }
+        return out;
+      },
+      each, keep);
+  timePoint_ = -1;
+  if (!showStreamedTimePoint(time)) throw Error(spec + ": its channels were not opened");
+  return set;
 }
 
 // The view holds the time point's coarsest level, read with it ahead (its
@@ -131,6 +175,11 @@ std::uint64_t Session::explorationOverviewVoxels() const {
   return viewer::overviewVoxelBudget(device_.limits);
 }
 
+const StreamedSeries::Pyramids& Session::streamedChannels() const {
+  static const StreamedSeries::Pyramids none;
+  return streamedSeries_ && !seriesDrawn_ ? streamedChannels_ : none;
+}
+
 TimeSeries* Session::series() {
   if (channelView_ && channelView_->series()) return &channelView_->series()->series();
   if (series_) return series_.get();
@@ -147,7 +196,13 @@ bool Session::showStreamedTimePoint(int t) {
   if (t == timePoint_ && streamed_) return true;
   // The shown one is opened now if it has to be (a jump); playback asks
   // only for one warmed ahead (stepPlayback waits for isRead).
-  std::shared_ptr<const lod::MultiresSource> source = streamedSeries_->source(t);
+  StreamedSeries::Pyramids all = streamedSeries_->sources(t);
+  std::shared_ptr<const lod::MultiresSource> source = all.front();
+  if (all.size() > 1) {
+    streamedChannels_ = std::move(all);
+  } else {
+    streamedChannels_.clear();
+  }
   if (!settings_.window && seriesWindow_) {
     source = std::make_shared<lod::WindowedSource>(std::move(source), *seriesWindow_);
   }

@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "support/ChannelStore.h"
 #include "support/TestSupport.h"
 #include "support/TimeStore.h"
 #include "tessera/io/ZarrChannels.h"
@@ -135,12 +136,16 @@ TEST(StoreTime, PlaybackOverBricksShowsEveryTimePointOnceInOrderNeverStale) {
 // in the view over bricks, its frames drawn by streamedFrames() one step
 // per front-end frame. Playback moves on only once the time point shown
 // has been drawn complete, so every time point's complete frame is shown,
-// in order, each equal to that time point in core; one layout per time
-// point shown, the last one's textures let go before the next is made.
+// in order, each equal to that time point in core; every time point is
+// streamed into the one layout made for the first (its atlas, page table
+// and technique kept on the GPU).
 struct ShownOverBricks {
   std::vector<int> sequence;  // time points drawn complete, in the order shown
   std::vector<Image> frames;
-  std::vector<std::uint64_t> textureBytes;  // the ledger at each
+  std::vector<std::uint64_t> textureBytes;        // the ledger at each
+  std::vector<std::size_t> textures;              // textures and buffers held at each
+  std::vector<unsigned> frameTextures;            // the GL name of the frame shown
+  std::vector<const gpu::Texture*> frameObjects;  // and the object holding it
 };
 
 ShownOverBricks playInView(Session& s, int shows, int size) {
@@ -164,6 +169,10 @@ ShownOverBricks playInView(Session& s, int shows, int size) {
       shown.sequence.push_back(t);
       shown.frames.push_back(frames.readImage());
       shown.textureBytes.push_back(ledger.totalBytes());
+      shown.textures.push_back(ledger.count());
+      const gpu::Texture& frame = frames.render(size, size);  // complete: drawn already
+      shown.frameTextures.push_back(frame.id());
+      shown.frameObjects.push_back(&frame);
     }
   }
   return shown;
@@ -205,15 +214,164 @@ TEST(StoreTime, ViewPlaysOverBricksEveryTimePointCompleteInOrder) {
     EXPECT_GE(own, 45.0) << "time point " << t;
     EXPECT_LT(other, 40.0) << "time point " << t << " looks like another";
   }
-  // A layout per time point shown, one on the GPU at a time: the textures
-  // held are the same at every time point, and never more in between.
-  EXPECT_EQ(s.streamedFrames().layoutsMade(), 7);
+  // One layout, made for the first time point; the six after it streamed
+  // into its textures: the same textures held at every time point (their
+  // count and bytes), never more in between, and the frame drawn into the
+  // same render target by the same technique.
+  EXPECT_EQ(s.streamedFrames().layoutsMade(), 1);
+  EXPECT_EQ(s.streamedFrames().timePointsStreamedIn(), 6);
   const auto [low, high] =
       std::minmax_element(shown.textureBytes.begin(), shown.textureBytes.end());
   EXPECT_EQ(*low, *high);
   EXPECT_LE(s.device().context->ledger().peakBytes(), *high);
-  std::printf("%llu late time points\n",
-              static_cast<unsigned long long>(s.playback().lateTimePoints()));
+  for (std::size_t i = 1; i < shown.sequence.size(); ++i) {
+    EXPECT_EQ(shown.textures[i], shown.textures[0]) << "shown " << i;
+    EXPECT_EQ(shown.frameTextures[i], shown.frameTextures[0]) << "shown " << i;
+    EXPECT_EQ(shown.frameObjects[i], shown.frameObjects[0]) << "shown " << i;
+  }
+  std::printf("%llu late time points, %zu textures held throughout (%llu bytes)\n",
+              static_cast<unsigned long long>(s.playback().lateTimePoints()), shown.textures[0],
+              static_cast<unsigned long long>(*high));
+}
+
+// A time point's frame after playing from time point 0 (its bricks streamed
+// into the atlas the earlier ones used) against the same time point opened
+// alone over bricks and refined to the end (Session::render, what `tessera
+// render STORE --time T --layout bricks` draws): the same bricks in other
+// slots of the atlas, the same image.
+TEST(StoreTime, ATimePointPlayedIntoTheAtlasEqualsItRenderedAlone) {
+  const test::TempDir dir;
+  const std::string store = test::writeTimeStore(dir.path(), 5, 1).string();
+  // ES 3 (one 3D atlas) and ES 2 (the atlas as mosaics of z-slices).
+  for (const std::string profile : {"native", "webgl1-desktop-2012"}) {
+    SCOPED_TRACE(profile);
+    std::vector<Image> alone;
+    {
+      Session fresh(profile);
+      useLook(fresh);
+      fresh.settings().layout = "bricks";
+      for (int t = 0; t < 5; ++t) {
+        fresh.open(store, atTime(t));
+        ASSERT_TRUE(fresh.streamed());
+        alone.push_back(fresh.render(64, 64));
+      }
+    }
+    Session s(profile);
+    s.settings().layout = "bricks";
+    s.openInView(store);
+    useLookInView(s);
+    const ShownOverBricks shown = playInView(s, 6, 64);
+    ASSERT_EQ(shown.sequence, (std::vector<int>{0, 1, 2, 3, 4, 0})) << "playback stalled";
+    EXPECT_EQ(s.streamedFrames().layoutsMade(), 1);
+    for (std::size_t i = 0; i < shown.sequence.size(); ++i) {
+      const int t = shown.sequence[i];
+      const double db = psnr(shown.frames[i], alone[static_cast<std::size_t>(t)]);
+      const double other = psnr(shown.frames[i], alone[static_cast<std::size_t>((t + 1) % 5)]);
+      std::printf(
+          "%s, shown %zu: time point %d played vs rendered alone over bricks: %.1f dB "
+          "(vs the next time point %.1f dB)\n",
+          profile.c_str(), i, t, db, other);
+      EXPECT_GE(db, 60.0) << "time point " << t;
+      EXPECT_LT(other, 40.0) << "time point " << t;
+      EXPECT_EQ(shown.textures[i], shown.textures[0]) << "shown " << i;
+    }
+  }
+}
+
+// Three channels with a t axis played over bricks, as `view STORE --bricks`
+// plays them (the store opened in the view over bricks, then its channel
+// list): every channel of a time point streamed into one atlas (one
+// layout for the series), each time point's frame against the CPU
+// reference of that time point's channels (Session::renderChannels over
+// bricks), and a channel toggled while playback pauses changes only the
+// pixels of its own cube. The windows leave the dim shell out, so that
+// each channel's footprint is its cube alone.
+TEST(StoreTime, ThreeChannelsPlayOverBricksEachTimePointAsItsReference) {
+  const test::TempDir dir;
+  const std::string store = test::writeTimeStore(dir.path(), 5, 3).string();
+  constexpr int kSize = 64;
+  const std::vector<ValueRange> windows(3, ValueRange{100.0, 255.0});
+  std::vector<ChannelFrame> references;
+  {
+    Session fresh("native");
+    useLook(fresh);
+    fresh.settings().layout = "bricks";
+    fresh.settings().channels.windows = windows;
+    for (int t = 0; t < 5; ++t) {
+      references.push_back(fresh.renderChannels(store, kSize, kSize, true, t));
+    }
+  }
+  Session s("native");
+  s.settings().layout = "bricks";
+  s.settings().channels.windows = windows;
+  s.openInView(store);
+  ASSERT_NE(s.streamedSeries(), nullptr);
+  ChannelView& view = s.channelView();
+  ASSERT_TRUE(view.open(store));
+  ASSERT_TRUE(view.overBricks());
+  ASSERT_EQ(view.channels().size(), 3);
+  EXPECT_EQ(view.series(), nullptr);  // the session's streamed series plays them
+  ASSERT_EQ(s.streamedChannels().size(), 3u);
+  useLookInView(s);
+  const ShownOverBricks shown = playInView(s, 6, kSize);
+  ASSERT_EQ(shown.sequence, (std::vector<int>{0, 1, 2, 3, 4, 0})) << "playback stalled";
+  EXPECT_EQ(s.streamedFrames().layoutsMade(), 1);
+  EXPECT_EQ(s.streamedFrames().timePointsStreamedIn(), 5);
+  for (std::size_t i = 0; i < shown.sequence.size(); ++i) {
+    const int t = shown.sequence[i];
+    const ChannelFrame& r = references[static_cast<std::size_t>(t)];
+    const double db = psnr(shown.frames[i], *r.reference);
+    const double gpu = psnr(shown.frames[i], r.image);
+    const double other =
+        psnr(shown.frames[i], *references[static_cast<std::size_t>((t + 1) % 5)].reference);
+    std::printf(
+        "3 channels over bricks, shown %zu: time point %d, %.1f dB against its "
+        "reference (%.1f dB against it rendered alone, %.1f against the next time "
+        "point's reference)\n",
+        i, t, db, gpu, other);
+    EXPECT_GE(db, 40.0) << "time point " << t;
+    EXPECT_LT(other, db - 10.0) << "time point " << t << " looks like the next";
+    EXPECT_EQ(shown.textures[i], shown.textures[0]) << "shown " << i;
+  }
+
+  // Paused at time point 3 (the cubes apart), each channel toggled.
+  s.playback().pause();
+  ASSERT_TRUE(s.showTimePoint(3));
+  StreamedFrames& frames = s.streamedFrames();
+  auto refined = [&] {
+    for (int step = 0; step < 2000; ++step) {
+      frames.render(kSize, kSize);
+      if (frames.shownComplete(3)) return frames.readImage();
+    }
+    ADD_FAILURE() << "the frame did not refine";
+    return frames.readImage();
+  };
+  const Image all = refined();
+  auto showOnly = [&](int only) {
+    for (int c = 0; c < 3; ++c) view.setVisible(c, only < 0 || c == only);
+  };
+  for (int c = 0; c < 3; ++c) {
+    view.setVisible(c, false);
+    const Image without = refined();
+    showOnly(c);
+    const Image alone = refined();
+    for (int k = 0; k < 3; ++k) view.setVisible(k, false);
+    const Image black = refined();
+    showOnly(-1);
+    const std::vector<bool> changed = test::differing(all, without, 2);
+    const std::vector<bool> cube = test::differing(alone, black, 0);
+    int inside = 0, outside = 0;
+    for (std::size_t p = 0; p < changed.size(); ++p) {
+      if (changed[p]) ++(cube[p] ? inside : outside);
+    }
+    std::printf(
+        "time point 3, channel %d toggled over bricks: %d pixels changed inside its "
+        "cube's projection, %d outside\n",
+        c, inside, outside);
+    EXPECT_GT(inside, 20) << "channel " << c;
+    EXPECT_EQ(outside, 0) << "channel " << c;
+  }
+  EXPECT_EQ(s.streamedFrames().layoutsMade(), 1);  // toggles change uniforms, not textures
 }
 
 // A store whose level 0 does not fit a quarter of the host budget plays

@@ -1,7 +1,7 @@
 #pragma once
 // A generated OME-Zarr store with a t axis (and optionally a c axis): 64^3
 // u8 per time point, a dim smooth sphere shell and a bright 8^3 cube whose
-// x (channel 0) or y (channel 1) position moves with t, so that each time
+// x (channel 0), y (channel 1) or z (channel 2) position moves with t, so that each time
 // point renders differently and a frame shows which one it is. NGFF 0.4 on
 // Zarr v2, uncompressed 32^3 chunks written byte by byte, two levels (the
 // second the 2x2x2 mean), an omero window 0..255.
@@ -21,16 +21,26 @@ inline void writeTimeStoreText(const std::filesystem::path& path, const std::str
   std::ofstream(path, std::ios::binary) << text;
 }
 
-// Voxel (x, y, z) of channel c at time t: a dim smooth sphere shell and a
-// bright 8^3 cube, moving along x (channel 0) or y (channel 1) with t.
+// Whether voxel (x, y, z) lies in channel c's bright 8^3 cube at time t:
+// moving along x (channel 0), y (1) or z (2), centred on the other axes.
+inline bool inTimeStoreCube(int x, int y, int z, int t, int c) {
+  const int p[3] = {x, y, z};
+  const int moving = c % 3;
+  const int m = 8 + 10 * t;  // the moving axis's first voxel
+  bool in = p[moving] >= m && p[moving] < m + 8;
+  for (int k = 0; k < 3; ++k) {
+    if (k != moving) in = in && p[k] >= 28 && p[k] < 36;
+  }
+  return in;
+}
+
+// Voxel (x, y, z) of channel c at time t: a dim smooth sphere shell and
+// the channel's bright cube.
 inline std::uint8_t timeStoreVoxel(int x, int y, int z, int t, int c) {
   const double r =
       std::sqrt((x - 31.5) * (x - 31.5) + (y - 31.5) * (y - 31.5) + (z - 31.5) * (z - 31.5)) - 24.0;
   double v = 50.0 * std::exp(-(r / 2.0) * (r / 2.0));
-  const int m = 8 + 10 * t;  // the moving axis's first voxel
-  const int along = c == 0 ? x : y;
-  const int across = c == 0 ? y : x;
-  if (along >= m && along < m + 8 && across >= 28 && across < 36 && z >= 28 && z < 36) v = 220.0;
+  if (inTimeStoreCube(x, y, z, t, c)) v = 220.0;
   return static_cast<std::uint8_t>(std::lround(v));
 }
 
@@ -45,7 +55,10 @@ inline std::filesystem::path writeTimeStore(const std::filesystem::path& dir, in
   std::string omero;
   for (int c = 0; c < channels; ++c) {
     omero += std::string(c ? ", " : "") + R"({"label": "ch)" + std::to_string(c) +
-             R"(", "color": ")" + (c ? "00FF00" : "FF00FF") +
+             R"(", "color": ")" +
+             (c == 0   ? "FF00FF"
+              : c == 1 ? "00FF00"
+                       : "0080FF") +
              R"(", "active": true, "window": {"start": 0, "end": 255, "min": 0, "max": 255}})";
   }
   writeTimeStoreText(

@@ -98,6 +98,67 @@ TEST(DesktopStreamedSeries, PlaysEveryTimePointOverBricksInOrderEachAsInCore) {
   EXPECT_NE(view.output.find("time points late"), std::string::npos) << view.output;
 }
 
+// A store with three channels and a t axis: `view STORE --bricks --play`
+// opens its channel list over the series and plays every channel together
+// over bricks, into one layout; each time point's frame against the CPU
+// reference of that time point's channels (Session::renderChannels, as
+// `render STORE --time T --layout bricks` with the channels draws them).
+TEST(DesktopStreamedSeries, PlaysThreeChannelsOverBricksEachAsItsReference) {
+  if (runCommand("command -v xvfb-run").status != 0) GTEST_SKIP() << "xvfb-run not installed";
+  if (runCommand(std::string(TESSERA_CLI_PATH) + " view --help").output.find("--screenshot") ==
+      std::string::npos) {
+    GTEST_SKIP() << "tessera built without GLFW/ImGui";
+  }
+  test::TempDir dir;
+  const std::string store = test::writeTimeStore(dir.path(), kTimes, 3).string();
+  std::vector<Image> references;
+  {
+    session::Session s("gles3");
+    s.settings().tf = TransferFunction::preset("grey");
+    s.settings().camera.azimuthDeg = 30.0;
+    s.settings().camera.elevationDeg = 20.0;
+    s.settings().layout = "bricks";
+    for (int t = 0; t < kTimes; ++t) {
+      references.push_back(*s.renderChannels(store, kView, kView, true, t).reference);
+    }
+  }
+  const std::string shots = (dir / "shown").string();
+  const CommandRun view = runCommand(
+      "timeout 300 xvfb-run -a -s '-screen 0 1024x640x24' " + std::string(TESSERA_CLI_PATH) +
+      " view " + store + " --bricks --layout single --tf grey --azimuth 30 --elevation 20 --size " +
+      std::to_string(kPanel + kView) + "x" + std::to_string(kView) +
+      " --play 30 --play-time-points 6 --play-record " + shots + " --screenshot " +
+      (dir / "view.png").string());
+  ASSERT_EQ(view.status, 0) << view.output;
+  std::printf("%s", view.output.c_str());
+  const std::regex line(R"(shown (\d+): time point (\d+) complete)");
+  std::vector<int> sequence;
+  for (auto it = std::sregex_iterator(view.output.begin(), view.output.end(), line);
+       it != std::sregex_iterator(); ++it) {
+    sequence.push_back(std::stoi((*it)[2].str()));
+  }
+  ASSERT_EQ(sequence.size(), 7u) << view.output;
+  for (std::size_t i = 0; i < sequence.size(); ++i) {
+    const int t = sequence[i];
+    EXPECT_EQ(t, static_cast<int>(i % kTimes)) << "at " << i << ": skipped or out of order";
+    char name[64];
+    std::snprintf(name, sizeof name, "%04zu-t%d.png", i, t);
+    const Image shown = Image::readPng(std::filesystem::path(shots) / name);
+    const double own = psnr(shown, references[static_cast<std::size_t>(t)]);
+    double other = 0.0;
+    for (int u = 0; u < kTimes; ++u) {
+      if (u != t) other = std::max(other, psnr(shown, references[static_cast<std::size_t>(u)]));
+    }
+    std::printf(
+        "  [measured] desktop, 3 channels over bricks, shown %zu: time point %d, %.1f dB "
+        "against its reference, %.1f dB against the nearest other\n",
+        i, t, own, other);
+    EXPECT_GE(own, 40.0) << "time point " << t;
+    EXPECT_GT(own, other + 5.0) << "time point " << t << " shows another's bricks";
+  }
+  EXPECT_NE(view.output.find("over bricks: 1 layouts made"), std::string::npos) << view.output;
+}
+
 // --bricks names what it plays: a volume that is not a store with a t axis
 // is refused in one line.
 TEST(DesktopStreamedSeries, BricksWithoutATimeSeriesIsRefused) {

@@ -11,6 +11,8 @@
 
 namespace tessera {
 
+class ZarrStore;
+
 // Channels `indices` of time point `time` (empty: every channel of the c
 // axis), each read at the finest level that fits the host budget (all at
 // the same level). InputError naming the store and the channel for an
@@ -28,6 +30,15 @@ ChannelSet readZarrChannels(std::shared_ptr<const ZarrStorage> storage, const st
 std::vector<std::string> zarrChannelKeys(std::shared_ptr<const ZarrStorage> storage,
                                          const std::string& name,
                                          const std::vector<int>& indices = {}, int time = 0);
+
+// What readZarrChannels checks and makes, for a caller that reads the
+// voxels itself (a store's channels streamed over bricks): the channels
+// `indices` chooses of `store`'s c axis (empty: every one; InputError as
+// readZarrChannels), and channel c as its omero metadata describes it, its
+// voxels (or only its shape) `volume`.
+std::vector<int> zarrChannelIndices(const ZarrStore& store, const std::string& spec,
+                                    const std::vector<int>& indices);
+Channel zarrChannel(const ZarrStore& store, int c, Volume volume);
 
 // "0,2,3" as channel indices; InputError naming the text otherwise.
 std::vector<int> parseChannelList(const std::string& text);

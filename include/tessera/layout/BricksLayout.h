@@ -154,15 +154,20 @@ class BricksLayout final : public Layout, public StreamingLayout {
   int slotCount() const override { return static_cast<int>(slotKey_.size()); }
   lod::StreamerStats streamerStats() const override { return streamer_->stats(); }
   void retryFailingReads(bool retry) override {
+    retryFailing_ = retry;
     streamer_->retryFailing(retry);
     for (auto& s : channelStreamers_) s->retryFailing(retry);
   }
   void setUpdatePace(const UpdatePace& pace) override {
     options_.uploadMsPerFrame = pace.uploadMs;
     options_.uploadBytesPerFrame = pace.uploadBytes;
+    inlineReads_ = pace.inlineReads;
     streamer_->setInlineReadsPerRequest(pace.inlineReads);
     for (auto& s : channelStreamers_) s->setInlineReadsPerRequest(pace.inlineReads);
   }
+  bool replaceSources(std::vector<std::shared_ptr<const lod::MultiresSource>> sources) override;
+  // How many times replaceSources() has streamed other pyramids in.
+  int sourcesReplaced() const { return sourcesReplaced_; }
   // The page table as uploaded (RGBA texels, row 0 first; cell c at
   // pageGeometry().addressOf(c)): the CPU twin of the lookup in bricks.glsl
   // reads it.
@@ -192,6 +197,11 @@ class BricksLayout final : public Layout, public StreamingLayout {
   std::vector<std::shared_ptr<const lod::StoredBrick>> channelBricks(const lod::BrickKey& key,
                                                                      bool readNow);
   void bindChannels(const gpu::Program& program, int firstUnit) const;
+  // The streamers over `sources` (one per channel), their caches within
+  // the host split, and the channels' packing of their values.
+  void streamFrom(const std::vector<std::shared_ptr<const lod::MultiresSource>>& sources);
+  // The coarsest level read and uploaded into the first free slots, pinned.
+  void pinCoarsest();
   // The channel atlases (layout/ChannelBricks.cpp): per group of four
   // channels one 3D texture (ES 3) or slots.x mosaics (ES 2), atlases_[k *
   // groups + g]; the units they take; the mosaics per group; their GLSL.
@@ -257,6 +267,10 @@ class BricksLayout final : public Layout, public StreamingLayout {
   bool walk_ = true;
   int atlasTexel_ = 0;       // BRICKS_TEXEL: how bricks.glsl reads a stored value
   bool classified_ = false;  // update() has seen a TF: transparent() may judge bricks
+  // What the streamers were told (kept for the streamers of replaceSources).
+  bool retryFailing_ = true;
+  int inlineReads_ = -1;  // -1: the streamer's default
+  int sourcesReplaced_ = 0;
 };
 
 }  // namespace tessera::layout

@@ -5,6 +5,7 @@
 // far the refinement has come. A caller asks Layout::streaming() for it
 // rather than knowing the layout's class or name.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "tessera/core/Camera.h"
@@ -59,6 +60,15 @@ class StreamingLayout {
   // shows there now, or -1 where it shows a transparent cell's constant:
   // the levels a frame drawn now samples, which its reference reads.
   virtual std::vector<int> cellLevels() const = 0;
+  // Streams other pyramids of the same grid (another time point of a
+  // store: one per channel the layout was made with) into the same
+  // textures: every brick of the old ones is let go, the new coarsest
+  // level read and pinned in the same slots, and the finer bricks streamed
+  // by the next update()s as at the start; nothing is allocated on the GPU.
+  // false, with nothing changed, when a pyramid's levels, brick grid or
+  // stored precision differ (the caller makes a layout for them instead).
+  // Throws what reading the coarsest level throws.
+  virtual bool replaceSources(std::vector<std::shared_ptr<const lod::MultiresSource>> sources) = 0;
 };
 
 }  // namespace tessera::layout

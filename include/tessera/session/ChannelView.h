@@ -38,12 +38,18 @@ class ChannelView {
   // indices, colours, windows and visibility over the store's omero
   // defaults) and shows them; false, with nothing changed, when `spec` is
   // not a store or has one channel. InputError as readZarrChannels.
+  // The store the session plays over bricks (Session::openStreamedSeries,
+  // `view --bricks`) is not read in core: its channels stream together
+  // (Session::streamChannels) at the session's time point, and the frame is
+  // the session's streamedFrames() (overBricks()).
   bool open(const std::string& spec, int time = 0);
+  // Whether the channels shown are the session's streamed ones.
+  bool overBricks() const { return overBricks_; }
   // A store with a t axis: open() shows time point `time` and reads the
   // ones after it ahead (session/ChannelSeries.h), so that its channels play
   // together through Session::stepPlayback; null otherwise.
   ChannelSeries* series() { return series_.get(); }
-  int timePoint() const { return time_; }
+  int timePoint() const;
   // Shows time point t's channels when they are read (the colours, windows
   // and visibility stay: they are the settings'), else asks for them and
   // returns false. InputError without a series or for t out of range.
@@ -96,13 +102,15 @@ class ChannelView {
   const gpu::Texture& render(int width, int height);
   // The last frame, top row first.
   Image readImage() const;
-  // Draws the last frame into `framebuffer`'s box (x, y, width, height; 0:
+  // Draws the last frame (in core; over bricks the front end draws
+  // streamedFrames()'s) into `framebuffer`'s box (x, y, width, height; 0:
   // the window or canvas), scaled to it (the page's canvas).
   void present(unsigned framebuffer, glm::ivec4 box);
 
  private:
   struct Gpu;
   void requireOpen(int i) const;
+  void showOverBricks(ChannelSet set, const std::string& name);
   void edited();
 
   Session& session_;
@@ -111,6 +119,7 @@ class ChannelView {
   std::unique_ptr<Gpu> gpu_;
   std::unique_ptr<ChannelSeries> series_;
   int time_ = 0;
+  bool overBricks_ = false;
   std::uint64_t revision_ = 0;
   std::string frameKey_;
 };

@@ -117,6 +117,17 @@ class Session {
   // (SessionStreamedSeries.cpp). With a view, openInView opens it and
   // streamedFrames() draws it.
   void openStreamedSeries(const std::string& spec, const OpenOptions& options = {});
+  // The store played over bricks (openStreamedSeries) with channels
+  // `indices` (empty: every one) streamed together: per time point every
+  // chosen channel's pyramid, read ahead together, drawn by
+  // streamedFrames() as the bricks layout's channels (ChannelView::open
+  // calls this). Their set (shapes, no voxels; omero colours, windows,
+  // visibility); with fewer than 2 channels the set and nothing changed.
+  // InputError when no store plays over bricks, or as readZarrChannels.
+  ChannelSet streamChannels(const std::vector<int>& indices);
+  // The shown time point's pyramids of the channels streamed (empty
+  // unless streamChannels did).
+  const StreamedSeries::Pyramids& streamedChannels() const;
   // A store's t axis over bricks that a front end draws itself (the page's
   // store over fetch(), whose reads never wait): time point t's pyramid is
   // opened by `at` and read ahead as StreamedSeries reads (its levels that
@@ -381,6 +392,7 @@ class Session {
   std::unique_ptr<nlohmann::json> region_;
   std::unique_ptr<TimeSeries> series_;
   std::unique_ptr<StreamedSeries> streamedSeries_;
+  StreamedSeries::Pyramids streamedChannels_;  // streamChannels' of the time point shown
   bool showStreamedTimePoint(int t);
   bool showDrawnTimePoint(int t);
   bool seriesDrawn_ = false;  // streamedSeries_ is drawn by the front end
