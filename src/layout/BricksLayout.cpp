@@ -133,6 +133,18 @@ int pageTableSide(const gpu::DeviceLimits& limits, const BricksOptions& options)
 // larger brick is cheaper than a finer cut.
 constexpr std::int64_t kMaxChosenCells = std::int64_t(1) << 21;
 
+// The brick of a volume held in host memory (lod::InCoreMultiresSource: a
+// file drawn with `--layout bricks`, the in-core half of `tessera bench
+// --bricks-vs-incore`). It has no chunk to align to and a read is a copy, so
+// the brick size decides neither what is read nor how often; it decides how
+// many cells a ray walks (raycast.frag.glsl: each cell a ray enters costs an
+// outer iteration, and the SIMD lanes that leave their cell first wait for
+// the others) and the apron's share of a slot ((66/64)^3 = 1.10 of the
+// brick's voxels, (34/32)^3 = 1.20). On llvmpipe 64^3 instead of 32^3 took
+// the bricked frame from 1.24-1.32x to 1.09-1.23x of in-core (CPU time, ch2,
+// a 384^3 and a 512^3 u16 phantom; docs/large-data.md, the brick walk).
+constexpr int kInCoreBrickSize = 64;
+
 // The page table holds one texel per level-0 brick cell, its z-slices tiled
 // in 2D (BricksLayout::pageTableGeometry). For a source without a natural
 // chunk, the brick doubles from 32 up to 128 until the table fits the
@@ -446,6 +458,12 @@ std::unique_ptr<BricksLayout> BricksLayout::create(
     gpu::MemoryLedger& ledger, const BricksOptions& options) {
   BricksOptions single = options;
   single.channels = 0;
+  // Only a pyramid in host memory: a store's or a virtual volume's brick
+  // also sets what is read and how finely levels mix (brickSizeFor).
+  if (single.brickSize == 0 && source && source->levelInfo(0).chunk == glm::ivec3(0) &&
+      dynamic_cast<const lod::InCoreMultiresSource*>(source.get()) != nullptr) {
+    single.brickSize = kInCoreBrickSize;
+  }
   return build({std::move(source)}, nullptr, limits, ledger, single);
 }
 

@@ -46,7 +46,10 @@
 namespace tessera::layout {
 
 struct BricksOptions {
-  int brickSize = 0;  // B; 0: the source's chunk if cubic 16..128, else 32
+  // B; 0: the source's chunk if cubic 16..128, else 64 for a pyramid in host
+  // memory (create: lod::InCoreMultiresSource), else 32 (doubled while the
+  // page table does not fit)
+  int brickSize = 0;
   // 0: min(texture budget, 256 MiB, host budget - overhead - a minimal cache)
   std::uint64_t atlasBytesCap = 0;
   // Host cache; 0: the host budget less the atlas and a fixed overhead, at
