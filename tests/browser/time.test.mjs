@@ -251,20 +251,9 @@ async function playSampled(page, fps, advances, limitMs) {
 
 // The references' PNGs decoded in the page, as window.__refs[t].
 async function loadRefs(page, files) {
-  await page.evaluate(async (pngs) => {
-    window.__refs = {};
-    for (const [t, b64] of Object.entries(pngs)) {
-      const img = new Image();
-      img.src = `data:image/png;base64,${b64}`;
-      await img.decode();
-      const c = document.createElement('canvas');
-      c.width = img.width;
-      c.height = img.height;
-      const ctx = c.getContext('2d');
-      ctx.drawImage(img, 0, 0);
-      window.__refs[t] = ctx.getImageData(0, 0, c.width, c.height).data;
-    }
-  }, Object.fromEntries(Object.entries(files).map(([t, f]) => [t, fs.readFileSync(f).toString('base64')])));
+  await page.evaluate(async ({ pngs, decode }) => {
+    window.__refs = await (new Function(`return ${decode}`)())(pngs);
+  }, { pngs: base64Of(files), decode: decodeInPage.toString() });
 }
 
 // The cube's column in a reference PNG (decoded in the page).

@@ -137,6 +137,13 @@ class HeadlessImGui {
     ImGui::GetIO().AddInputCharactersUTF8(text);
     frame();
   }
+  // Ctrl+click on a slider or drag (its text input), `text` typed, and a
+  // click away that ends the edit.
+  void typeInto(const std::string& name, const char* label, const char* text) {
+    click(name, {label}, true);
+    type(text);
+    clickAway();
+  }
   // A click where no panel is (the 3D view's place): ends an edit, closes a
   // popup that is not modal.
   void clickAway() {

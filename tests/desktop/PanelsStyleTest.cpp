@@ -115,11 +115,7 @@ class PanelsStyle : public ::testing::Test {
     EXPECT_EQ(viewOff, 0);
     EXPECT_EQ(lookOff, 0);
   }
-  void typeInto(const char* label, const char* text) {
-    ui.click(kPanelTitle, {label}, true);  // Ctrl+click: the slider's text input
-    ui.type(text);
-    ui.clickAway();
-  }
+  void typeInto(const char* label, const char* text) { ui.typeInto(kPanelTitle, label, text); }
 
   session::Session s{"native"};
   test::RecordingHost host{s};

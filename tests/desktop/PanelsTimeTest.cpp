@@ -139,11 +139,7 @@ class PanelsTime : public ::testing::Test {
     }
     return true;
   }
-  void typeInto(const char* label, const char* text) {
-    ui.click(kPanelTitle, {label}, true);  // Ctrl+click: the slider's text input
-    ui.type(text);
-    ui.clickAway();
-  }
+  void typeInto(const char* label, const char* text) { ui.typeInto(kPanelTitle, label, text); }
 
   session::Session s{"native"};
   test::RecordingHost host{s};

@@ -32,6 +32,53 @@ constexpr int kPanel = 390;  // desktop::kPanelWidth
 constexpr int kView = 96;
 constexpr int kTimes = 5;
 
+// `tessera view STORE --bricks --play 30` of 6 time points after the first,
+// recording each complete frame into `shots` (exit status checked by the
+// caller).
+CommandRun playOverBricks(const std::string& store, const std::string& shots,
+                          const std::filesystem::path& dir) {
+  return runCommand("timeout 300 xvfb-run -a -s '-screen 0 1024x640x24' " +
+                    std::string(TESSERA_CLI_PATH) + " view " + store +
+                    " --bricks --layout single --tf grey --azimuth 30 --elevation 20 --size " +
+                    std::to_string(kPanel + kView) + "x" + std::to_string(kView) +
+                    " --play 30 --play-time-points 6 --play-record " + shots + " --screenshot " +
+                    (dir / "view.png").string());
+}
+
+// The time points the viewer printed as shown ("shown N: time point T
+// complete"), each N in turn; every loop must show 0..kTimes-1 in order.
+// Each recorded frame against `expected` of its time point (>= 40 dB) and
+// nearer it than any other time point's by 5 dB (no stale bricks).
+void expectEveryTimePointShownAsExpected(const std::string& output, const std::string& shots,
+                                         const std::vector<Image>& expected, const char* what) {
+  const std::regex line(R"(shown (\d+): time point (\d+) complete)");
+  std::vector<int> sequence;
+  for (auto it = std::sregex_iterator(output.begin(), output.end(), line);
+       it != std::sregex_iterator(); ++it) {
+    EXPECT_EQ(std::stoi((*it)[1].str()), static_cast<int>(sequence.size()));
+    sequence.push_back(std::stoi((*it)[2].str()));
+  }
+  ASSERT_EQ(sequence.size(), 7u) << output;
+  for (std::size_t i = 0; i < sequence.size(); ++i) {
+    const int t = sequence[i];
+    EXPECT_EQ(t, static_cast<int>(i % kTimes)) << "at " << i << ": skipped or out of order";
+    char name[64];
+    std::snprintf(name, sizeof name, "%04zu-t%d.png", i, t);
+    const Image shown = Image::readPng(std::filesystem::path(shots) / name);
+    const double own = psnr(shown, expected[static_cast<std::size_t>(t)]);
+    double other = 0.0;
+    for (int u = 0; u < kTimes; ++u) {
+      if (u != t) other = std::max(other, psnr(shown, expected[static_cast<std::size_t>(u)]));
+    }
+    std::printf(
+        "  [measured] %s, shown %zu: time point %d, %.1f dB against it, %.1f dB against the "
+        "nearest other\n",
+        what, i, t, own, other);
+    EXPECT_GE(own, 40.0) << "time point " << t;
+    EXPECT_GT(own, other + 5.0) << "time point " << t << " shows another's bricks";
+  }
+}
+
 TEST(DesktopStreamedSeries, PlaysEveryTimePointOverBricksInOrderEachAsInCore) {
   if (runCommand("command -v xvfb-run").status != 0) GTEST_SKIP() << "xvfb-run not installed";
   if (runCommand(std::string(TESSERA_CLI_PATH) + " view --help").output.find("--screenshot") ==
@@ -56,41 +103,11 @@ TEST(DesktopStreamedSeries, PlaysEveryTimePointOverBricksInOrderEachAsInCore) {
     }
   }
   const std::string shots = (dir / "shown").string();
-  const CommandRun view = runCommand(
-      "timeout 300 xvfb-run -a -s '-screen 0 1024x640x24' " + std::string(TESSERA_CLI_PATH) +
-      " view " + store + " --bricks --layout single --tf grey --azimuth 30 --elevation 20 --size " +
-      std::to_string(kPanel + kView) + "x" + std::to_string(kView) +
-      " --play 30 --play-time-points 6 --play-record " + shots + " --screenshot " +
-      (dir / "view.png").string());
+  const CommandRun view = playOverBricks(store, shots, dir.path());
   ASSERT_EQ(view.status, 0) << view.output;
   std::printf("%s", view.output.c_str());
-  // "shown N: time point T complete at S s, frame F", one per time point shown.
-  const std::regex line(R"(shown (\d+): time point (\d+) complete)");
-  std::vector<int> sequence;
-  for (auto it = std::sregex_iterator(view.output.begin(), view.output.end(), line);
-       it != std::sregex_iterator(); ++it) {
-    EXPECT_EQ(std::stoi((*it)[1].str()), static_cast<int>(sequence.size()));
-    sequence.push_back(std::stoi((*it)[2].str()));
-  }
-  ASSERT_EQ(sequence.size(), 7u) << view.output;
-  for (std::size_t i = 0; i < sequence.size(); ++i) {
-    const int t = sequence[i];
-    EXPECT_EQ(t, static_cast<int>(i % kTimes)) << "at " << i << ": skipped or out of order";
-    char name[64];
-    std::snprintf(name, sizeof name, "%04zu-t%d.png", i, t);
-    const Image shown = Image::readPng(std::filesystem::path(shots) / name);
-    const double own = psnr(shown, inCore[static_cast<std::size_t>(t)]);
-    double other = 0.0;
-    for (int u = 0; u < kTimes; ++u) {
-      if (u != t) other = std::max(other, psnr(shown, inCore[static_cast<std::size_t>(u)]));
-    }
-    std::printf(
-        "  [measured] desktop over bricks, shown %zu: time point %d, %.1f dB against it "
-        "in core, %.1f dB against the nearest other\n",
-        i, t, own, other);
-    EXPECT_GE(own, 40.0) << "time point " << t;
-    EXPECT_GT(own, other + 5.0) << "time point " << t << " shows another's bricks";
-  }
+  expectEveryTimePointShownAsExpected(view.output, shots, inCore,
+                                      "desktop over bricks, against in core");
   // The profile's texture budget held (gles3: 512 MiB), and the playback's
   // figures printed.
   const std::regex budgets(R"(budgets: textures peak ([0-9.]+ [KMG]?i?B) of 512 MiB)");
@@ -123,39 +140,11 @@ TEST(DesktopStreamedSeries, PlaysThreeChannelsOverBricksEachAsItsReference) {
     }
   }
   const std::string shots = (dir / "shown").string();
-  const CommandRun view = runCommand(
-      "timeout 300 xvfb-run -a -s '-screen 0 1024x640x24' " + std::string(TESSERA_CLI_PATH) +
-      " view " + store + " --bricks --layout single --tf grey --azimuth 30 --elevation 20 --size " +
-      std::to_string(kPanel + kView) + "x" + std::to_string(kView) +
-      " --play 30 --play-time-points 6 --play-record " + shots + " --screenshot " +
-      (dir / "view.png").string());
+  const CommandRun view = playOverBricks(store, shots, dir.path());
   ASSERT_EQ(view.status, 0) << view.output;
   std::printf("%s", view.output.c_str());
-  const std::regex line(R"(shown (\d+): time point (\d+) complete)");
-  std::vector<int> sequence;
-  for (auto it = std::sregex_iterator(view.output.begin(), view.output.end(), line);
-       it != std::sregex_iterator(); ++it) {
-    sequence.push_back(std::stoi((*it)[2].str()));
-  }
-  ASSERT_EQ(sequence.size(), 7u) << view.output;
-  for (std::size_t i = 0; i < sequence.size(); ++i) {
-    const int t = sequence[i];
-    EXPECT_EQ(t, static_cast<int>(i % kTimes)) << "at " << i << ": skipped or out of order";
-    char name[64];
-    std::snprintf(name, sizeof name, "%04zu-t%d.png", i, t);
-    const Image shown = Image::readPng(std::filesystem::path(shots) / name);
-    const double own = psnr(shown, references[static_cast<std::size_t>(t)]);
-    double other = 0.0;
-    for (int u = 0; u < kTimes; ++u) {
-      if (u != t) other = std::max(other, psnr(shown, references[static_cast<std::size_t>(u)]));
-    }
-    std::printf(
-        "  [measured] desktop, 3 channels over bricks, shown %zu: time point %d, %.1f dB "
-        "against its reference, %.1f dB against the nearest other\n",
-        i, t, own, other);
-    EXPECT_GE(own, 40.0) << "time point " << t;
-    EXPECT_GT(own, other + 5.0) << "time point " << t << " shows another's bricks";
-  }
+  expectEveryTimePointShownAsExpected(view.output, shots, references,
+                                      "desktop, 3 channels over bricks, against the reference");
   EXPECT_NE(view.output.find("over bricks: 1 layouts made"), std::string::npos) << view.output;
 }
 
