@@ -1142,8 +1142,6 @@ import { attachOverlayPanel } from './overlay-panel.js';
     openUrls,
     lastLoad: () => lastLoad,
     zarr: () => (zarr ? zarr.stats() : null),
-    // The open store's chunk cache lets these keys go (see zarr-url.js).
-    zarrLetGo: (keys) => (zarr ? zarr.letGo(keys) : 0),
     zarrHolds: (key) => (zarr ? zarr.holds(key) : false),
     // The channels shown together ({open, name, mode, channels}), or null.
     channels: () => (channelList ? channelList.state() : null),

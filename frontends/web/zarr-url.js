@@ -163,7 +163,6 @@
       openStep: c('tessera_zarr_open_step', 'number', []),
       wanted: c('tessera_zarr_wanted', 'string', []),
       holds: c('tessera_zarr_holds', 'number', ['string']),
-      letGo: c('tessera_zarr_let_go', 'number', ['string']),
       put: c('tessera_zarr_put', null, ['string', 'number', 'number']),
       putMissing: c('tessera_zarr_put_missing', null, ['string']),
       putFailed: c('tessera_zarr_put_failed', null, ['string', 'string']),
@@ -566,9 +565,6 @@
       frame,
       refine,
       refining: () => open && api.refining() === 1,
-      // For tests: lets the module's chunk cache drop these keys (relative
-      // to the store's root) as its budget would; the number it held.
-      letGo: (keys) => keys.reduce((n, k) => n + api.letGo(k), 0),
       holds: (key) => api.holds(key) === 1,
       // For tests: what was fetched and the frames' timeline.
       stats: () => ({ ...record, last, inFlight: inFlight.size, queued: queue.length, t0,

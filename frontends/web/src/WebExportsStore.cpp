@@ -109,13 +109,6 @@ EMSCRIPTEN_KEEPALIVE int tessera_zarr_holds(const char* key) {
   return z && z->storage().holds(key) ? 1 : 0;
 }
 
-// Lets a held key go, as the chunk cache's budget would (tests of a region
-// whose chunks were let go, then read again): 1 when it was held.
-EMSCRIPTEN_KEEPALIVE int tessera_zarr_let_go(const char* key) {
-  web::ZarrStoreView* z = storeIfAny();
-  return z && z->storage().letGo(key) ? 1 : 0;
-}
-
 // A fetched key: its bytes (malloc'ed by the page, freed here), a 404, or
 // the page's error after its retries (naming the URL).
 EMSCRIPTEN_KEEPALIVE void tessera_zarr_put(const char* key, std::uint8_t* bytes, int size) {

@@ -51,12 +51,6 @@ void FetchStorage::erase(const std::string& key) const {
   entries_.erase(it);
 }
 
-bool FetchStorage::letGo(const std::string& key) {
-  if (!holds(key)) return false;
-  erase(key);
-  return true;
-}
-
 std::vector<std::string> FetchStorage::takeWanted() const {
   std::vector<std::string> keys;
   keys.swap(wanted_);

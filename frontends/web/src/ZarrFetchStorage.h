@@ -57,9 +57,6 @@ class FetchStorage final : public ZarrStorage {
   bool ready(const std::string& key) const;
   // Whether the key has arrived (or is known missing), without asking for it.
   bool holds(const std::string& key) const { return entries_.count(key) != 0; }
-  // Lets the key go as the budget would (the least recently used first
-  // out); false when it was not held. The next get() or ready() wants it.
-  bool letGo(const std::string& key);
   // The keys wanted since the last call, in the order they were first
   // wanted (most urgent first), and forgets them.
   std::vector<std::string> takeWanted() const;
