@@ -65,4 +65,23 @@ function(tessera_desktop_tests)
                         GTest::gtest_main nlohmann_json::nlohmann_json ZLIB::ZLIB)
   tessera_precompile(test_desktop <gtest/gtest.h>)
   gtest_discover_tests(test_desktop DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 600)
+
+  # tests/glfw: a real X drag-and-drop onto a GlfwWindow (the test is the
+  # XDND source), under xvfb-run where it is installed; skipped without a display.
+  pkg_check_modules(X11 IMPORTED_TARGET x11)
+  if(NOT X11_FOUND)
+    return()
+  endif()
+  add_executable(test_glfw_window ${CMAKE_SOURCE_DIR}/tests/glfw/GlfwDropTest.cpp)
+  target_compile_options(test_glfw_window PRIVATE ${TESSERA_WARNINGS})
+  target_include_directories(test_glfw_window SYSTEM PRIVATE ${GLFW3_INCLUDE_DIRS})
+  target_link_libraries(test_glfw_window PRIVATE tessera_gpu_glfw PkgConfig::GLFW3 PkgConfig::X11
+                        GTest::gtest GTest::gtest_main)
+  # Listed and run through xvfb-run (an X server of its own per run).
+  find_program(TESSERA_XVFB_RUN xvfb-run)
+  if(TESSERA_XVFB_RUN)
+    set_target_properties(test_glfw_window PROPERTIES CROSSCOMPILING_EMULATOR
+                          "${TESSERA_XVFB_RUN};-a;-s;-screen 0 640x480x24")
+  endif()
+  gtest_discover_tests(test_glfw_window DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 120 RESOURCE_LOCK xvfb)
 endfunction()
