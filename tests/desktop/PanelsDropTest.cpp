@@ -4,10 +4,11 @@
 // next frame's desktop::handleDrops (DesktopApp's runFrame, after the
 // window's events) opens or offers them. GLFW itself needs a display, so the
 // test calls filesDropped with the path lists a drop gives and runs the
-// frames headless (HeadlessImGui.h); tests/glfw/GlfwDropTest.cpp drops files
-// on a real GlfwWindow under Xvfb and checks the path lists it hands over: one file opens, two open
-// the first and offer the second as its overlay, a folder of DICOM files opens as its series, a
-// path that cannot be read is named on the error line.
+// frames headless (HeadlessImGui.h): one file opens, two open the first and
+// offer the second as its overlay, a folder of DICOM files opens as its
+// series, a path that cannot be read is named on the error line.
+// tests/glfw/GlfwDropTest.cpp drops files on a real GlfwWindow under Xvfb
+// and checks the path lists the window hands over.
 #include <gtest/gtest.h>
 
 #include <cstdio>
