@@ -460,8 +460,7 @@ std::unique_ptr<BricksLayout> BricksLayout::create(
   single.channels = 0;
   // Only a pyramid in host memory: a store's or a virtual volume's brick
   // also sets what is read and how finely levels mix (brickSizeFor).
-  if (single.brickSize == 0 && source && source->levelInfo(0).chunk == glm::ivec3(0) &&
-      dynamic_cast<const lod::InCoreMultiresSource*>(source.get()) != nullptr) {
+  if (single.brickSize == 0 && source && source->readsFromHostMemory()) {
     single.brickSize = kInCoreBrickSize;
   }
   return build({std::move(source)}, nullptr, limits, ledger, single);

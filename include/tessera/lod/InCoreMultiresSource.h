@@ -25,6 +25,7 @@ class InCoreMultiresSource final : public MultiresSource {
   Volume readBox(int level, const VoxelBox& box) const override;
   std::string describe() const override;
   bool meanPyramid() const override { return true; }  // lod::downsample
+  bool readsFromHostMemory() const override { return true; }
 
   // The level's voxels (level 0 is the volume given).
   const Volume& level(int level) const;

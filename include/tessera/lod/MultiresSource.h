@@ -78,6 +78,11 @@ class MultiresSource {
   // say nothing of finer values: such bricks are read before they can be
   // skipped. Default false.
   virtual bool meanPyramid() const { return false; }
+  // Whether readBox is a copy out of host memory: no storage, no decode, no
+  // chunk grid. Then what a consumer cuts the levels into decides nothing
+  // about what is read (the bricks layout sizes its bricks for the ray march
+  // alone). Default false.
+  virtual bool readsFromHostMemory() const { return false; }
   // Decoded data the source keeps between reads (a store's decoded chunks,
   // io/ZarrChunkCache.h), which the bricks layout counts inside the device
   // profile's host budget beside its own brick cache: the bytes the source
