@@ -388,8 +388,13 @@ async function storeInputLatency(context, url, tmp, run) {
   // TESSERA_LATENCY_INPUT=x11 (with TESSERA_HEADFUL=1 under xvfb-run): the
   // input goes through the X server as a mouse's would (x11_input.py,
   // XTest), not DevTools.
+  // TESSERA_LATENCY_INPUT=touch: the drag is one finger's (DevTools' touch
+  // events, touch emulated), the wheel turns as before.
   const inputMode = process.env.TESSERA_LATENCY_INPUT || 'devtools';
-  if (!['devtools', 'x11'].includes(inputMode)) throw new Error(`TESSERA_LATENCY_INPUT=${inputMode}: devtools (the default) or x11`);
+  if (!['devtools', 'touch', 'x11'].includes(inputMode)) {
+    throw new Error(`TESSERA_LATENCY_INPUT=${inputMode}: devtools (the default), touch or x11`);
+  }
+  if (inputMode === 'touch') await cdp.send('Emulation.setTouchEmulationEnabled', { enabled: true, maxTouchPoints: 5 });
   if (inputMode === 'x11' && process.env.TESSERA_HEADFUL !== '1') {
     throw new Error('TESSERA_LATENCY_INPUT=x11 needs Chromium on an X display: TESSERA_HEADFUL=1, under xvfb-run');
   }
@@ -420,6 +425,7 @@ async function storeInputLatency(context, url, tmp, run) {
     const t0 = Date.now();
     const at = async (ms) => { const due = t0 + ms; if (Date.now() < due) await new Promise((r) => setTimeout(r, due - Date.now())); };
     const cdpEvent = { press: 'mousePressed', move: 'mouseMoved', release: 'mouseReleased', wheel: 'mouseWheel' };
+    const touchEvent = { press: 'touchStart', move: 'touchMove', release: 'touchEnd' };
     let captured = false;
     for (const e of plan) {
       if (!captured && e.at >= captureAt) {
@@ -429,6 +435,7 @@ async function storeInputLatency(context, url, tmp, run) {
       }
       await at(e.at);
       if (e.kind === 'wheel') send('Input.dispatchMouseEvent', { type: 'mouseWheel', x: e.x, y: e.y, deltaX: 0, deltaY: e.up ? -100 : 100 });
+      else if (inputMode === 'touch') send('Input.dispatchTouchEvent', { type: touchEvent[e.kind], touchPoints: e.kind === 'release' ? [] : [{ x: e.x, y: e.y, id: 1 }] });
       else send('Input.dispatchMouseEvent', { type: cdpEvent[e.kind], x: e.x, y: e.y, button: 'left', buttons: e.kind === 'release' ? 0 : 1, clickCount: 1 });
     }
   }
