@@ -276,7 +276,8 @@ function explainTrace(trace) {
 // origin and each event sent, with its epoch times before and after the X
 // server took it.
 async function sendThroughX(page, plan, captureAt) {
-  for (const other of page.context().pages()) if (other !== page) await other.close();
+  // (The context's first tab stays open: Chromium on a display quits with
+  // its last window.)
   await page.bringToFront();
   await page.evaluate(() => {
     window.latencyLastMove = null;
@@ -481,11 +482,13 @@ async function storeInputLatency(context, url, tmp, run) {
 
   const latencies = { pointermove: [], pointerup: [], wheel: [] };
   const toCommit = { pointermove: [], pointerup: [], wheel: [] };
+  const toHandled = { pointermove: [], pointerup: [], wheel: [] };
   let unanswered = 0, duringRefinement = 0, rawAnswered = 0;
   for (const { e, f, latency, toCommit: c } of answers(lat)) {
     if (!f) { unanswered++; continue; }
     latencies[e.type].push(latency);
     toCommit[e.type].push(c);
+    toHandled[e.type].push(e.handled - e.stamp);
     if (f.raw) rawAnswered++;
     if (e.refining) duringRefinement++;
   }
@@ -499,6 +502,8 @@ async function storeInputLatency(context, url, tmp, run) {
   // in animation-frame callbacks).
   console.log(`latency: ${rawAnswered} events answered as they arrived (pointerrawupdate); until the frame that commits the answer: ` +
               Object.entries(toCommit).map(([t, v]) => `${t}: ${text(stats(v))}`).join('; '));
+  console.log('latency: from the stamp until the page handled it (the way through the browser, and the task it waited for): ' +
+              Object.entries(toHandled).map(([t, v]) => `${t}: ${text(stats(v))}`).join('; '));
   console.log(`latency: ${lat.frames.length} canvas frames; frame callbacks that drew took median ${stats(lat.frames.map((f) => f.end - f.start)).median.toFixed(1)} ms, ` +
               `worst ${stats(lat.frames.map((f) => f.end - f.start)).worst.toFixed(1)} ms; refined ${z.completeMs === null ? 'not yet' : `after ${z.completeMs.toFixed(0)} ms`}`);
   console.log(`latency: the store's calls while refining: ${work.n}, work median ${work.median.toFixed(1)} ms, worst ${work.worst.toFixed(1)} ms; ` +
