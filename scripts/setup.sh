@@ -12,7 +12,7 @@ PACKAGES=(
   clang-14 libclang-rt-14-dev                            # fuzzing: libFuzzer + sanitizers (scripts/fuzz.sh)
   mricron-data                                           # the default volume (ch2 T1 MRI head)
   libglfw3-dev libimgui-dev xvfb xauth libx11-dev        # desktop viewer (tessera view), tested under Xvfb (an X drop: Xlib)
-  emscripten nodejs chromium                             # web viewer (scripts/web.sh) and its browser test
+  emscripten nodejs chromium libxtst6                    # web viewer (scripts/web.sh), its browser test (X input: XTest)
   python3-nibabel python3-pydicom python3-numpy          # independent NIfTI/DICOM readers in geometry tests
   libblosc-dev libzstd-dev libcurl4-openssl-dev          # OME-Zarr chunks (blosc, zstd) and HTTP(S) stores
   libopenjp2-7-dev                                       # DICOM frames in JPEG 2000

@@ -44,6 +44,10 @@ import { attachOverlayPanel } from './overlay-panel.js';
   // 66 ms, since the browser composes the page after each frame (on a
   // phone's software GL, about 30 ms more at 390x844 ratio 3).
   const dragGoalMs = Math.max(5, parseFloat(params.get('dragms') || '40') || 40);
+  // A store's camera drag is answered as each move arrives (pointerrawupdate:
+  // secure contexts, localhost included), not at the next animation frame
+  // as pointermove is dispatched (?rawinput=0: at the animation frame).
+  const rawInput = params.get('rawinput') !== '0' && 'onpointerrawupdate' in window;
 
   const $ = (id) => document.getElementById(id);
   const canvas = $('canvas');
@@ -94,6 +98,11 @@ import { attachOverlayPanel } from './overlay-panel.js';
   let frames = 0;
   let renderWaiters = [];
   let refineNotBefore = 0;  // performance.now() before which no strip is rendered
+  // The store's preview drawn by a move as it arrived (rawInput), and when
+  // the last animation frame began: at most one preview per frame interval.
+  let frameBeganAt = 0;
+  let rawDrawnAt = -Infinity;
+  let storeDrawnAt = -Infinity;  // the last store frame or preview drawn in an animation frame
   let slices = null;        // frontends/web/slices.js, once the module is up
   let zarr = null;  // an open OME-Zarr store (frontends/web/zarr-url.js)
   let storeTime = null;  // its t axis played as a time series (frontends/web/store-time.js)
@@ -252,6 +261,8 @@ import { attachOverlayPanel } from './overlay-panel.js';
   // of the pending full-quality one; render() promises resolve once the
   // frame is complete.
   function loop() {
+    const previousFrameAt = frameBeganAt;
+    frameBeganAt = performance.now();
     if (viewer && viewer.contextLost) {
       requestAnimationFrame(loop);  // nothing to draw on until it is restored
       return;
@@ -261,7 +272,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
       channelFrameStep();
     } else if (api && zarr && zarr.active() && (!storeTime || storeTime.bricks)) {
       if (storeTime && time.count > 1) timeStep();
-      storeFrameStep();
+      storeFrameStep(rawDrawnAt >= previousFrameAt);
     } else if (api) {
       let ms = -1;
       if (time.count > 1) timeStep();
@@ -306,13 +317,19 @@ import { attachOverlayPanel } from './overlay-panel.js';
   // a changed view shows a preview at once and its full frame follows
   // (bricks that arrived streamed first, then strips of the ray march);
   // render() promises resolve once the full frame is on the canvas.
-  function storeFrameStep() {
+  // `answered`: a move drew its preview since the last animation frame
+  // (storeMoved), which is this frame's work when no input came after it.
+  function storeFrameStep(answered) {
     let f = null;
     if (needsRender || (!zarr.refining() && zarr.wantsFrame())) {
       const viewChanged = needsRender;
       needsRender = false;
       fitCanvas();
       f = zarr.frame(canvas.width, canvas.height, viewChanged);
+      if (viewChanged) storeDrawnAt = performance.now();
+    } else if (answered) {
+      // The preview drawn as the move arrived is on the canvas: its full
+      // frame follows from the next animation frame.
     } else if (zarr.refining() && performance.now() >= refineNotBefore) {
       f = zarr.refine();
       // As for in-core strips: one that cost more than the budget is
@@ -771,6 +788,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
   canvas.addEventListener('contextmenu', (e) => e.preventDefault());
   // A left press on a crop box handle drags that face instead of the camera.
   let cropPointer = null;
+  const cameraPointers = new Set();  // pressed on the view, moving the camera
   canvas.addEventListener('pointerdown', (e) => {
     if (!api) return;
     const [x, y] = canvasPos(e);
@@ -785,6 +803,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
     }
     contextNote = '';
     api.pointerDown(e.pointerId, ...cameraPos(e), e.button === 2 || e.shiftKey ? 1 : 0);
+    cameraPointers.add(e.pointerId);
     canvas.setPointerCapture(e.pointerId);
     e.preventDefault();
   });
@@ -795,12 +814,50 @@ import { attachOverlayPanel } from './overlay-panel.js';
       if (api.cropMove(x, y)) { syncCropControls(); requestRender(); }
       return;
     }
+    if (rawPointers.has(e.pointerId)) return;  // moved the camera as it arrived (storeMoved)
     api.pointerMove(e.pointerId, ...cameraPos(e));
     if (api.interacting()) {
       setCameraDragged(true);
       requestRender();
     }
   });
+  // rawInput: a camera drag over a store moves the camera as each move
+  // arrives, and the first move in a frame interval draws the store's
+  // preview at once (tessera_zarr_frame, as the animation frame would), so
+  // that it is on the canvas at the next frame; a later move in the same
+  // interval is drawn by the next animation frame. Pointers whose moves
+  // come here skip pointermove (it follows with the same position).
+  const rawPointers = new Set();
+  function storeDrawn() {
+    return api && zarr && zarr.active() && (!storeTime || storeTime.bricks) && !(channelList && channelList.active());
+  }
+  function storeMoved(e) {
+    if (!cameraPointers.has(e.pointerId) || !storeDrawn() || (viewer && viewer.contextLost)) {
+      rawPointers.delete(e.pointerId);  // its pointermove moves the camera
+      return;
+    }
+    rawPointers.add(e.pointerId);
+    api.pointerMove(e.pointerId, ...cameraPos(e));
+    const pending = needsRender;
+    setCameraDragged(true);  // (asks for a frame at the drag's backing size: drawn here)
+    if (pending || rawDrawnAt >= frameBeganAt || storeDrawnAt >= frameBeganAt) {
+      requestRender();  // this frame interval has its preview
+      return;
+    }
+    needsRender = false;
+    fitCanvas();
+    const f = zarr.frame(canvas.width, canvas.height, true);
+    rawDrawnAt = performance.now();
+    if (f && f.shown) {
+      frames++;
+      if (slices) slices.frameShown(refreshState());
+    }
+  }
+  if (rawInput) canvas.addEventListener('pointerrawupdate', storeMoved);
+  const forgetRaw = (e) => {
+    rawPointers.delete(e.pointerId);
+    cameraPointers.delete(e.pointerId);
+  };
   const viewEnd = (e) => {
     if (!api) return;
     if (e.pointerId === cropPointer) {
@@ -810,6 +867,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
       return;
     }
     api.pointerUp(e.pointerId);
+    forgetRaw(e);
     if (!api.interacting()) setCameraDragged(false);
     requestRender();  // full quality once released
   };

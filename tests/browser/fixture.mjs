@@ -9,7 +9,11 @@
 // Environment: TESSERA_CLI (native tessera, for the reference images and
 // test files; default build/tessera), TESSERA_SITE (default build-web/site),
 // CHROMIUM (default /usr/bin/chromium), TESSERA_SHOTS (write screenshots
-// there), TESSERA_BENCH=1 (render.test.mjs also times ch2 at 512x512).
+// there), TESSERA_BENCH=1 (render.test.mjs also times ch2 at 512x512),
+// TESSERA_HEADFUL=1 (Chromium with its window on the X display $DISPLAY, at
+// the screen's top left, the page at the window's size: for input sent
+// through the X server, latency.test.mjs's TESSERA_LATENCY_INPUT=x11; run
+// under xvfb-run).
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
 import fs from 'node:fs';
@@ -71,14 +75,17 @@ export async function startBrowser() {
   if (shots) fs.mkdirSync(shots, { recursive: true });
   const { server, url } = await serve(site, { '/data/': tmp, '/templates/': path.dirname(CH2) });
   const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'tessera-chromium-'));
+  const headful = process.env.TESSERA_HEADFUL === '1';
+  if (headful && !process.env.DISPLAY) throw new Error('TESSERA_HEADFUL=1 needs an X display (run under xvfb-run)');
   const context = await chromium.launchPersistentContext(profile, {
     executablePath: chromiumPath,
-    headless: true,
-    viewport: { width: 1280, height: 900 },
+    headless: !headful,
+    viewport: headful ? null : { width: 1280, height: 900 },
     acceptDownloads: true,
     args: ['--no-sandbox', '--no-first-run', '--disable-background-networking',
       '--disable-component-update', '--disable-sync', '--disable-quic',
-      '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+      '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+      ...(headful ? ['--ozone-platform=x11', '--window-position=0,0', '--window-size=1280,1000'] : [])],
   });
   return {
     context, url, tmp, run,

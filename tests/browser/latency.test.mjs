@@ -3,25 +3,36 @@
 // Chromium). The store's finest chunks are served late, so bricks keep
 // arriving while a drag and wheel turns are sent; each input event's
 // latency is the time from the event (its timeStamp, the earliest of the
-// pointer moves coalesced into it) to the end of the first animation-frame
-// callback after it was handled that drew on the canvas (a preview, or a
-// finished frame). Whole ray marches per frame (0.6-2.5 s on SwiftShader)
-// hold input up that long; frames in strips of about the budget answer it
-// with a preview, and the target is two budgets. The wait for the next
-// animation frame (up to 16.7 ms: Chromium dispatches moves and wheel turns
-// with it) is part of every latency, so nothing else may hold the main
+// pointer moves coalesced into it) to the end of the first draw on the
+// canvas after it was handled (a preview, or a finished frame): an
+// animation-frame callback, or the page's pointerrawupdate handler that
+// answered a drag move as it arrived (its read-back included; such a draw
+// reaches the compositor with the next animation frame, and the test
+// reports the time until then too). Whole ray marches per frame (0.6-2.5
+// s on SwiftShader) hold input up that long; frames in strips of about the
+// budget answer it with a preview, and the target is two budgets. The wait
+// for the next animation frame (up to 16.7 ms: Chromium dispatches
+// pointermove and wheel turns with it; pointerrawupdate comes as the move
+// arrives) is part of every latency answered by one, and a move's raw
+// handler waits for the task running, so nothing else may hold the main
 // thread for long: chunks are inflated in slices in idle time, and the
 // worst events are explained frame by frame (explainWorst). A wheel turn
 // sent through DevTools, as here, waits for one frame more before it
 // reaches the page (explainTrace): its latency is at least a frame
 // interval plus the answering callback, whatever the page does.
 // TESSERA_LATENCY_TRACE=FILE records a Chrome trace of the input sequence
-// and prints each input's way through Chromium.
+// and prints each input's way through Chromium. TESSERA_LATENCY_INPUT=x11
+// sends the same input through the X server instead (XTest, as a mouse
+// would: x11_input.py), with Chromium on a display of its own
+// (TESSERA_HEADFUL=1 xvfb-run -a node --test tests/browser/latency.test.mjs):
+// wheel turns then reach the page without DevTools' wait.
 import { test } from 'node:test';
+import { execFile } from 'node:child_process';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import { CH2, check, served, browserSuite, snapshot, differingPixels } from './fixture.mjs';
+import { fileURLToPath } from 'node:url';
+import { CH2, check, served, browserSuite, snapshot, differingPixels, psnrOf } from './fixture.mjs';
 
 const checks = browserSuite();
 
@@ -34,10 +45,39 @@ test('input during a store\'s refinement: every event answered by the next frame
 // Runs in the page before its scripts: which animation-frame callbacks drew
 // on the canvas (a draw, clear or blit into the default framebuffer), and
 // when input events were stamped and handled.
+// A draw outside an animation-frame callback (the page answering a move as
+// it arrives, in its pointerrawupdate handler) counts as a frame too, from
+// its first draw call to the end of the handler that made it (a microtask
+// after it: the page's handler ends with the preview's read-back, which
+// waits for the GPU). window.latencyCaptureNext = true: the next frame's
+// pixels (top row first) are kept in latency.capture.
 function instrument() {
-  const lat = { frames: [], events: [], callbacks: [] };
+  const lat = { frames: [], events: [], callbacks: [], capture: null };
   window.latency = lat;
   let drew = false;
+  let inCallback = false;
+  let outside = null;  // a draw outside an animation-frame callback, until its task's microtask
+  let gl = null;
+  const capture = (raw) => {
+    if (!window.latencyCaptureNext || !gl) return;
+    window.latencyCaptureNext = false;
+    const w = gl.drawingBufferWidth, h = gl.drawingBufferHeight;
+    const p = new Uint8Array(w * h * 4);
+    const two = typeof WebGL2RenderingContext !== 'undefined' && gl instanceof WebGL2RenderingContext;
+    const draw = gl.getParameter(two ? gl.DRAW_FRAMEBUFFER_BINDING : gl.FRAMEBUFFER_BINDING);
+    const read = two ? gl.getParameter(gl.READ_FRAMEBUFFER_BINDING) : draw;
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, p);
+    if (two) {
+      gl.bindFramebuffer(gl.DRAW_FRAMEBUFFER, draw);
+      gl.bindFramebuffer(gl.READ_FRAMEBUFFER, read);
+    } else {
+      gl.bindFramebuffer(gl.FRAMEBUFFER, draw);
+    }
+    const top = new Uint8Array(w * h * 4);
+    for (let y = 0; y < h; y++) top.set(p.subarray((h - 1 - y) * w * 4, (h - y) * w * 4), y * w * 4);
+    lat.capture = { raw, pixels: Array.from(top) };
+  };
   for (const Ctx of [window.WebGL2RenderingContext, window.WebGLRenderingContext]) {
     if (!Ctx) continue;
     const p = Ctx.prototype;
@@ -50,7 +90,18 @@ function instrument() {
       const f = p[name];
       if (!f) continue;
       p[name] = function (...args) {
-        if (this.latencyDefault !== false) drew = true;
+        if (this.latencyDefault !== false) {
+          drew = true;
+          gl = this;
+          if (!inCallback && !outside) {
+            outside = { start: performance.now() };
+            queueMicrotask(() => {
+              lat.frames.push({ start: outside.start, end: performance.now(), raw: true });
+              capture(true);
+              outside = null;
+            });
+          }
+        }
         return f.apply(this, args);
       };
     }
@@ -59,11 +110,16 @@ function instrument() {
   window.requestAnimationFrame = (cb) => raf((ts) => {
     const start = performance.now();
     drew = false;
+    inCallback = true;
     try {
       cb(ts);
     } finally {
+      inCallback = false;
       const end = performance.now();
-      if (drew) lat.frames.push({ start, end });
+      if (drew) {
+        lat.frames.push({ start, end });
+        capture(false);
+      }
       lat.callbacks.push({ start, end, drew });
       if (lat.callbacks.length > 20000) lat.callbacks.splice(0, 5000);
     }
@@ -76,6 +132,46 @@ function instrument() {
       refining: !!(z && z.last && !z.last.complete), buttons: e.buttons });
   };
   for (const type of ['pointermove', 'pointerup', 'wheel']) window.addEventListener(type, note, { capture: true, passive: true });
+  // Raw moves are noted only when the page listens for them (Chromium sends
+  // them only then).
+  const add = EventTarget.prototype.addEventListener;
+  let rawNoted = false;
+  EventTarget.prototype.addEventListener = function (type, ...rest) {
+    if (type === 'pointerrawupdate' && !rawNoted) {
+      rawNoted = true;
+      add.call(window, type, note, { capture: true, passive: true });
+    }
+    return add.call(this, type, ...rest);
+  };
+}
+
+// Each drag move, release and wheel turn: its stamp, when the page first
+// handled it (a drag move: as it arrived, pointerrawupdate, when the page
+// listens for it; else at its pointermove), the first frame drawn after
+// that, and when that frame reached the compositor: at the end of its
+// animation-frame callback, or, drawn outside one, at the start of the next
+// animation frame (the frame it is committed with).
+function answers(lat) {
+  const raw = lat.events.filter((e) => e.type === 'pointerrawupdate');
+  const rows = [];
+  for (const e0 of lat.events) {
+    if (e0.type === 'pointerrawupdate') continue;
+    if (e0.type === 'pointermove' && !e0.buttons) continue;  // a move without a drag asks for no frame
+    let e = e0;
+    if (e0.type === 'pointermove') {
+      const r = raw.find((x) => Math.abs(x.stamp - e0.stamp) < 0.01 && x.handled <= e0.handled);
+      if (r) e = { ...e0, handled: r.handled, raw: true };
+    }
+    const f = lat.frames.find((fr) => fr.start >= e.handled);
+    if (!f) { rows.push({ e, f: null }); continue; }
+    let committed = f.end;
+    if (f.raw) {
+      const next = lat.callbacks.find((cb) => cb.start >= f.end);
+      committed = next ? next.start : NaN;
+    }
+    rows.push({ e, f, latency: f.end - e.stamp, toCommit: committed - e.stamp });
+  }
+  return rows;
 }
 
 // Where the worst latencies came from, frame by frame: for each of the five
@@ -96,23 +192,22 @@ function explainWorst(lat, z) {
   const decodeTasks = (z.decodeTasks || []).map((d) => ({ start: d.t + z.t0, end: d.t + z.t0 + d.ms }));
   const overlap = (list, a, b) => list.reduce((sum, x) => sum + Math.max(0, Math.min(b, x.end) - Math.max(a, x.start)), 0);
   const rows = [];
-  for (const e of lat.events) {
-    if (e.type === 'pointermove' && !e.buttons) continue;
-    const f = lat.frames.find((fr) => fr.start >= e.handled);
+  for (const { e, f, latency } of answers(lat)) {
     if (!f) continue;
     const held = lat.callbacks.filter((cb) => cb.end > e.stamp && cb.start < e.handled);
     const longest = held.reduce((a, b) => (!a || b.end - b.start > a.end - a.start ? b : a), null);
-    rows.push({ e, f, latency: f.end - e.stamp, longest,
+    rows.push({ e, f, latency, longest,
       frameMs: overlap(lat.callbacks, e.stamp, e.handled), decodeMs: overlap(decodeTasks, e.stamp, e.handled) });
   }
   rows.sort((a, b) => b.latency - a.latency);
   for (const r of rows.slice(0, 5)) {
     const wait = r.e.handled - r.e.stamp;
     const held = r.longest ? `; the longest ${(r.longest.end - r.longest.start).toFixed(1)} ms: ${parts(callAt(r.longest))}` : '';
-    console.log(`latency: worst ${r.e.type} ${r.latency.toFixed(1)} ms = handled after ${wait.toFixed(1)} ms ` +
+    console.log(`latency: worst ${r.e.type}${r.e.raw ? ' (raw)' : ''} ${r.latency.toFixed(1)} ms = handled after ${wait.toFixed(1)} ms ` +
                 `(frame callbacks ${r.frameMs.toFixed(1)}, chunk decodes ${r.decodeMs.toFixed(1)}, ` +
                 `other tasks or the wait for a frame ${Math.max(0, wait - r.frameMs - r.decodeMs).toFixed(1)}${held}); ` +
-                `answered ${(r.f.start - r.e.handled).toFixed(1)} ms later by a ${(r.f.end - r.f.start).toFixed(1)} ms frame: ${parts(callAt(r.f))}`);
+                `answered ${(r.f.start - r.e.handled).toFixed(1)} ms later by a ${(r.f.end - r.f.start).toFixed(1)} ms ` +
+                `${r.f.raw ? 'draw as it arrived' : 'frame'}: ${parts(callAt(r.f))}`);
   }
   const calls = (z.calls || []).filter((c) => c.t > z.firstImageMs);
   const kinds = { preview: (c) => c.preview, streaming: (c) => !c.preview && c.stream_ms > 0,
@@ -175,6 +270,90 @@ function explainTrace(trace) {
   }
 }
 
+// TESSERA_LATENCY_INPUT=x11: the plan sent through the X server
+// (x11_input.py), at the screen position of the page's coordinates
+// (calibrated by one move: where the page saw it). Returns the page's time
+// origin and each event sent, with its epoch times before and after the X
+// server took it.
+async function sendThroughX(page, plan, captureAt) {
+  // (The context's first tab stays open: Chromium on a display quits with
+  // its last window.)
+  await page.bringToFront();
+  await page.evaluate(() => {
+    window.latencyLastMove = null;
+    window.addEventListener('pointermove', (e) => {
+      window.latencyLastMove = { x: e.clientX, y: e.clientY, t: performance.timeOrigin + e.timeStamp };
+    }, { capture: true });
+  });
+  const driver = path.join(path.dirname(fileURLToPath(import.meta.url)), 'x11_input.py');
+  const drive = (events, start) => new Promise((resolve, reject) => {
+    execFile('python3', [driver, JSON.stringify(events), String(start)], { timeout: 60000 }, (err, stdout, stderr) => {
+      if (err) reject(new Error(`x11_input.py: ${stderr || err.message}`));
+      else resolve(stdout.trim().split('\n').filter((l) => l).map((l) => JSON.parse(l)));
+    });
+  });
+  const guess = await page.evaluate(() => ({ x: window.screenX + (window.outerWidth - window.innerWidth) / 2,
+    y: window.screenY + window.outerHeight - window.innerHeight }));
+  // Where the page sees a move to `to` (screen pixels): the first move
+  // stamped after it was sent (the pointer may have moved the page before).
+  const seenAt = async (to) => {
+    const [r] = await drive([{ at: 0, kind: 'move', ...to }], Date.now());
+    await page.waitForFunction((t) => window.latencyLastMove && window.latencyLastMove.t >= t, r.before - 2, { timeout: 5000 });
+    return page.evaluate(() => window.latencyLastMove);
+  };
+  const probe = { x: Math.round(guess.x + plan[0].x - 40), y: Math.round(guess.y + plan[0].y - 40) };
+  const seen = await seenAt(probe);
+  const off = { x: probe.x - seen.x, y: probe.y - seen.y };
+  const centre = { x: Math.round(plan[0].x + off.x), y: Math.round(plan[0].y + off.y) };
+  const atCentre = await seenAt(centre);
+  if (Math.abs(atCentre.x - plan[0].x) > 1 || Math.abs(atCentre.y - plan[0].y) > 1) {
+    throw new Error(`x11 input: a move to the view's centre (${plan[0].x}, ${plan[0].y} in the page) reached it at ${atCentre.x}, ${atCentre.y}`);
+  }
+  console.log(`latency: x11 input: the page at screen offset ${off.x.toFixed(0)}, ${off.y.toFixed(0)} (window ${guess.x.toFixed(0)}, ${guess.y.toFixed(0)})`);
+  const events = [{ at: -150, kind: 'move', x: plan[0].x + off.x, y: plan[0].y + off.y }];
+  for (const e of plan) {
+    const x = Math.round(e.x + off.x), y = Math.round(e.y + off.y);
+    if (e.kind === 'move') events.push({ at: e.at, kind: 'move', x, y });
+    else if (e.kind === 'wheel') events.push({ at: e.at, kind: 'press', button: e.up ? 4 : 5 }, { at: e.at, kind: 'release', button: e.up ? 4 : 5 });
+    else events.push({ at: e.at, kind: e.kind, button: 1 });
+  }
+  const timeOrigin = await page.evaluate(() => performance.timeOrigin);
+  const start = Date.now() + 400;
+  const capture = new Promise((resolve) => setTimeout(() => resolve(page.evaluate(() => { window.latencyCaptureNext = true; })),
+    start + captureAt - Date.now()));
+  const sentEvents = await drive(events, start);
+  await capture;
+  return { timeOrigin, sent: sentEvents.map((r) => ({ ...events[r.i], before: r.before, after: r.after })) };
+}
+
+// x11 mode: each page event's own timeStamp against the time the X server
+// took it (the page's clock: performance.timeOrigin + timeStamp), and the
+// latencies again from the time it was sent.
+function explainX(x11, lat) {
+  const sentAt = (kind) => x11.sent.filter((e) => e.kind === kind && (kind !== 'press' || e.button >= 4))
+    .map((e) => ({ before: e.before - x11.timeOrigin, after: e.after - x11.timeOrigin }));
+  const moves = sentAt('move').slice(1), wheels = sentAt('press');
+  // The last one sent before the page's stamp (X server time is in whole
+  // milliseconds: up to 1 ms early).
+  const match = (sent, stamp) => sent.filter((x) => x.before <= stamp + 2).pop() || null;
+  const text = (v) => { const s = stats(v); return `median ${s.median.toFixed(1)}, min ${Math.min(...v).toFixed(1)}, worst ${s.worst.toFixed(1)} over ${s.n}`; };
+  const stampOffsets = { pointermove: [], wheel: [] };
+  const fromSend = { pointermove: [], wheel: [] };
+  for (const { e, f } of answers(lat)) {
+    if (!f || !(e.type in stampOffsets)) continue;
+    const s = match(e.type === 'wheel' ? wheels : moves, e.stamp);
+    if (!s) continue;
+    stampOffsets[e.type].push(e.stamp - s.before);
+    fromSend[e.type].push(f.end - s.before);
+  }
+  for (const t of Object.keys(stampOffsets)) {
+    console.log(`latency: x11 ${t}: its timeStamp after the X server was sent it: ${text(stampOffsets[t])} ms ` +
+                `(the XSync took ${text((t === 'wheel' ? wheels : moves).map((s) => s.after - s.before))} ms); ` +
+                `from sending it to the end of the draw that answered it: ${text(fromSend[t])} ms`);
+  }
+  return stampOffsets;
+}
+
 function stats(values) {
   const v = [...values].sort((a, b) => a - b);
   const at = (q) => (v.length ? v[Math.min(v.length - 1, Math.floor(q * v.length))] : NaN);
@@ -199,6 +378,7 @@ async function storeInputLatency(context, url, tmp, run) {
   await page.goto(`${url}/index.html?size=${SIZE}&slices=0&budget=${BUDGET_MS}&url=/data/ch2.ome.zarr${extra}`);
   await page.evaluate(() => window.tessera.ready);
   await page.waitForFunction(() => { const z = window.tessera.zarr(); return z && z.firstImageMs !== null; }, null, { timeout: 60000 });
+  const before = await snapshot(page);  // the first view, for the drag's last preview below
   const box = await page.locator('#canvas').boundingBox();
   const cdp = await context.newCDPSession(page);
   const cx = box.x + box.width / 2, cy = box.y + box.height / 2;
@@ -206,7 +386,19 @@ async function storeInputLatency(context, url, tmp, run) {
   // the page's main thread), each stamped with its time of sending.
   const sent = [];
   const send = (type, params) => sent.push(cdp.send(type, { ...params, timestamp: Date.now() / 1000 }));
-  const at = async (ms) => { const due = t0 + ms; if (Date.now() < due) await new Promise((r) => setTimeout(r, due - Date.now())); };
+  // TESSERA_LATENCY_INPUT=x11 (with TESSERA_HEADFUL=1 under xvfb-run): the
+  // input goes through the X server as a mouse's would (x11_input.py,
+  // XTest), not DevTools.
+  // TESSERA_LATENCY_INPUT=touch: the drag is one finger's (DevTools' touch
+  // events, touch emulated), the wheel turns as before.
+  const inputMode = process.env.TESSERA_LATENCY_INPUT || 'devtools';
+  if (!['devtools', 'touch', 'x11'].includes(inputMode)) {
+    throw new Error(`TESSERA_LATENCY_INPUT=${inputMode}: devtools (the default), touch or x11`);
+  }
+  if (inputMode === 'touch') await cdp.send('Emulation.setTouchEmulationEnabled', { enabled: true, maxTouchPoints: 5 });
+  if (inputMode === 'x11' && process.env.TESSERA_HEADFUL !== '1') {
+    throw new Error('TESSERA_LATENCY_INPUT=x11 needs Chromium on an X display: TESSERA_HEADFUL=1, under xvfb-run');
+  }
   // TESSERA_LATENCY_TRACE=FILE: a Chrome trace of the input sequence (input,
   // latencyInfo, scheduler, cc, viz and gpu categories) written to FILE, to
   // follow an event from the browser process to the frame that answered it.
@@ -216,19 +408,37 @@ async function storeInputLatency(context, url, tmp, run) {
       includedCategories: ['input', 'latencyInfo', 'benchmark', 'devtools.timeline', 'toplevel', 'gpu', 'cc', 'viz',
         'blink', 'renderer.scheduler', 'disabled-by-default-devtools.timeline.frame', 'v8.execute'] } });
   }
-  const t0 = Date.now();
-  send('Input.dispatchMouseEvent', { type: 'mousePressed', x: cx, y: cy, button: 'left', buttons: 1, clickCount: 1 });
-  const MOVES = 40;
-  for (let i = 1; i <= MOVES; i++) {
-    await at(i * 70);
-    send('Input.dispatchMouseEvent', { type: 'mouseMoved', x: cx + 3 * i, y: cy + (i % 5), button: 'left', buttons: 1 });
-  }
-  await at((MOVES + 1) * 70);
-  send('Input.dispatchMouseEvent', { type: 'mouseReleased', x: cx + 3 * MOVES, y: cy, button: 'left', buttons: 0, clickCount: 1 });
-  const WHEELS = 12;
-  for (let i = 0; i < WHEELS; i++) {
-    await at((MOVES + 4) * 70 + i * 200);
-    send('Input.dispatchMouseEvent', { type: 'mouseWheel', x: cx, y: cy, deltaX: 0, deltaY: i % 2 ? 100 : -100 });
+  // The input sequence (ms from its start, page coordinates): a drag of
+  // MOVES moves 70 ms apart, its release, and WHEELS wheel turns 200 ms
+  // apart, in and out.
+  const MOVES = 40, WHEELS = 12;
+  const plan = [{ at: 0, kind: 'press', x: cx, y: cy }];
+  for (let i = 1; i <= MOVES; i++) plan.push({ at: i * 70, kind: 'move', x: cx + 3 * i, y: cy + (i % 5) });
+  plan.push({ at: (MOVES + 1) * 70, kind: 'release', x: cx + 3 * MOVES, y: cy });
+  for (let i = 0; i < WHEELS; i++) plan.push({ at: (MOVES + 4) * 70 + i * 200, kind: 'wheel', x: cx, y: cy, up: i % 2 === 0 });
+  // The last move's answer is kept (its pixels: checked against the
+  // refined frame of the same view below); asked for 30 ms before it.
+  const captureAt = MOVES * 70 - 30;
+  let x11 = null;
+  if (inputMode === 'x11') {
+    x11 = await sendThroughX(page, plan, captureAt);
+  } else {
+    const t0 = Date.now();
+    const at = async (ms) => { const due = t0 + ms; if (Date.now() < due) await new Promise((r) => setTimeout(r, due - Date.now())); };
+    const cdpEvent = { press: 'mousePressed', move: 'mouseMoved', release: 'mouseReleased', wheel: 'mouseWheel' };
+    const touchEvent = { press: 'touchStart', move: 'touchMove', release: 'touchEnd' };
+    let captured = false;
+    for (const e of plan) {
+      if (!captured && e.at >= captureAt) {
+        await at(captureAt);
+        sent.push(page.evaluate(() => { window.latencyCaptureNext = true; }));
+        captured = true;
+      }
+      await at(e.at);
+      if (e.kind === 'wheel') send('Input.dispatchMouseEvent', { type: 'mouseWheel', x: e.x, y: e.y, deltaX: 0, deltaY: e.up ? -100 : 100 });
+      else if (inputMode === 'touch') send('Input.dispatchTouchEvent', { type: touchEvent[e.kind], touchPoints: e.kind === 'release' ? [] : [{ x: e.x, y: e.y, id: 1 }] });
+      else send('Input.dispatchMouseEvent', { type: cdpEvent[e.kind], x: e.x, y: e.y, button: 'left', buttons: e.kind === 'release' ? 0 : 1, clickCount: 1 });
+    }
   }
   await Promise.all(sent);
   await new Promise((r) => setTimeout(r, 3000));  // the last events' frames
@@ -249,6 +459,17 @@ async function storeInputLatency(context, url, tmp, run) {
   }
   const lat = await page.evaluate(() => window.latency);
   const z = await page.evaluate(() => window.tessera.zarr());
+  if (x11) {
+    const offsets = explainX(x11, lat);
+    // On the page's clock: stamped when the X server took the event (a
+    // loaded server may take tens of ms now and then), not on another clock.
+    const all = [...offsets.pointermove, ...offsets.wheel];
+    const median = stats(all).median;
+    check('latency: x11 input reached the page, its timeStamps on the page\'s clock (median within -2 to 5 ms of sending it)',
+          offsets.pointermove.length >= 5 && offsets.wheel.length >= 6 && median >= -2 && median <= 5,
+          `${offsets.pointermove.length} moves, ${offsets.wheel.length} wheel turns matched; median ${median.toFixed(1)} ms, ` +
+          `from ${Math.min(...all).toFixed(1)} to ${Math.max(...all).toFixed(1)} ms`);
+  }
   served.delayMs = () => 0;
   // TESSERA_LATENCY_DUMP=FILE: the page's events, frames and the store's calls as JSON.
   if (process.env.TESSERA_LATENCY_DUMP) fs.writeFileSync(process.env.TESSERA_LATENCY_DUMP, JSON.stringify({ lat, z }));
@@ -260,12 +481,15 @@ async function storeInputLatency(context, url, tmp, run) {
   const stripCalls = stats(during.filter((c) => !c.preview && !(c.stream_ms > 0)).map((c) => c.ms));
 
   const latencies = { pointermove: [], pointerup: [], wheel: [] };
-  let unanswered = 0, duringRefinement = 0;
-  for (const e of lat.events) {
-    if (e.type === 'pointermove' && !e.buttons) continue;  // a move without a drag asks for no frame
-    const f = lat.frames.find((fr) => fr.start >= e.handled);
+  const toCommit = { pointermove: [], pointerup: [], wheel: [] };
+  const toHandled = { pointermove: [], pointerup: [], wheel: [] };
+  let unanswered = 0, duringRefinement = 0, rawAnswered = 0;
+  for (const { e, f, latency, toCommit: c } of answers(lat)) {
     if (!f) { unanswered++; continue; }
-    latencies[e.type].push(f.end - e.stamp);
+    latencies[e.type].push(latency);
+    toCommit[e.type].push(c);
+    toHandled[e.type].push(e.handled - e.stamp);
+    if (f.raw) rawAnswered++;
     if (e.refining) duringRefinement++;
   }
   const all = stats([...latencies.pointermove, ...latencies.pointerup, ...latencies.wheel]);
@@ -273,6 +497,13 @@ async function storeInputLatency(context, url, tmp, run) {
   const text = (s) => `median ${s.median.toFixed(1)} ms, 90th percentile ${s.p90.toFixed(1)} ms, worst ${s.worst.toFixed(1)} ms over ${s.n}`;
   const perType = Object.entries(latencies).map(([t, v]) => `${t}: ${text(stats(v))}`).join('; ');
   console.log(`latency: store refining at ${SIZE}x${SIZE}, budget ${BUDGET_MS} ms: all events ${text(all)}; ${perType}`);
+  // A draw outside an animation frame reaches the compositor with the next
+  // one: the time until then, per type (the same as above for frames drawn
+  // in animation-frame callbacks).
+  console.log(`latency: ${rawAnswered} events answered as they arrived (pointerrawupdate); until the frame that commits the answer: ` +
+              Object.entries(toCommit).map(([t, v]) => `${t}: ${text(stats(v))}`).join('; '));
+  console.log('latency: from the stamp until the page handled it (the way through the browser, and the task it waited for): ' +
+              Object.entries(toHandled).map(([t, v]) => `${t}: ${text(stats(v))}`).join('; '));
   console.log(`latency: ${lat.frames.length} canvas frames; frame callbacks that drew took median ${stats(lat.frames.map((f) => f.end - f.start)).median.toFixed(1)} ms, ` +
               `worst ${stats(lat.frames.map((f) => f.end - f.start)).worst.toFixed(1)} ms; refined ${z.completeMs === null ? 'not yet' : `after ${z.completeMs.toFixed(0)} ms`}`);
   console.log(`latency: the store's calls while refining: ${work.n}, work median ${work.median.toFixed(1)} ms, worst ${work.worst.toFixed(1)} ms; ` +
@@ -317,6 +548,21 @@ async function storeInputLatency(context, url, tmp, run) {
     return ms;
   });
   const wholePixels = await snapshot(page);
+  // The drag's last answer (drawn as the move arrived, or by the animation
+  // frame: the same tessera_zarr_frame call) is an image of the view the
+  // refined frame shows (the wheel turns zoom in and out again): nearer to
+  // it than the first view's image.
+  const shot = lat.capture;
+  const previewDb = shot ? psnrOf(shot.pixels, strips.pixels) : NaN;
+  const firstDb = psnrOf(before.pixels, strips.pixels);
+  // Its pixels' FNV-1a hash: the same for both ways of answering (?rawinput=0
+  // and 1) when the preview's size is the same.
+  const hash = shot ? shot.pixels.reduce((h, v) => Math.imul(h ^ v, 16777619) >>> 0, 2166136261).toString(16) : '';
+  console.log(`latency: the drag's last answer (${shot ? (shot.raw ? 'drawn as the move arrived' : 'drawn by an animation frame') : 'not kept'}, ` +
+              `pixels hash ${hash}) against the refined frame of its view: PSNR ${previewDb.toFixed(2)} dB (the first view's image: ${firstDb.toFixed(2)} dB)`);
+  check('latency: the drag\'s last answer shows the view that the refined frame shows (PSNR at least 3 dB above the first view\'s image)',
+        shot && shot.pixels.length === strips.pixels.length && previewDb >= firstDb + 3,
+        `${previewDb.toFixed(1)} dB against ${firstDb.toFixed(1)} dB`);
   const calls = (await page.evaluate(() => window.tessera.zarr())).calls || [];
   const last = calls[calls.length - 1];
   const differing = differingPixels(strips.pixels, wholePixels.pixels, 0);

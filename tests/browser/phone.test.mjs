@@ -178,10 +178,14 @@ function ch2Store(tmp, run) {
 
 // Runs in the page before its scripts: when each animation-frame callback
 // that drew on the canvas (a draw, clear or blit into the default
-// framebuffer) ended, in window.drawnFrames.
+// framebuffer) ended, in window.drawnFrames; and each draw outside one (a
+// store's drag move answered as it arrived: app.js, pointerrawupdate),
+// when its task's code ended.
 function recordDrawnFrames() {
   window.drawnFrames = [];
   let drew = false;
+  let inCallback = false;
+  let outside = false;  // a draw outside an animation-frame callback (a move answered as it arrived)
   for (const Ctx of [window.WebGL2RenderingContext, window.WebGLRenderingContext]) {
     if (!Ctx) continue;
     const p = Ctx.prototype;
@@ -194,7 +198,13 @@ function recordDrawnFrames() {
       const f = p[name];
       if (!f) continue;
       p[name] = function (...args) {
-        if (this.drawsOnCanvas !== false) drew = true;
+        if (this.drawsOnCanvas !== false) {
+          drew = true;
+          if (!inCallback && !outside) {
+            outside = true;
+            queueMicrotask(() => { window.drawnFrames.push(performance.now()); outside = false; });
+          }
+        }
         return f.apply(this, args);
       };
     }
@@ -202,9 +212,11 @@ function recordDrawnFrames() {
   const raf = window.requestAnimationFrame.bind(window);
   window.requestAnimationFrame = (cb) => raf((ts) => {
     drew = false;
+    inCallback = true;
     try {
       cb(ts);
     } finally {
+      inCallback = false;
       if (drew) window.drawnFrames.push(performance.now());
     }
   });
