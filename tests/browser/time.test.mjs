@@ -551,6 +551,13 @@ async function bricksSeries(context, url, tmp) {
   await page.close();
 }
 
+// Time point t asked for by the slider (tessera.showTime) once drawn, or
+// -1 when it is not within `ms` (the check then fails instead of waiting).
+function showTimeWithin(page, t, ms = 30000) {
+  return page.evaluate(({ t, ms }) => Promise.race([window.tessera.showTime(t),
+    new Promise((resolve) => setTimeout(() => resolve(-1), ms))]), { t, ms });
+}
+
 // A region (the slice views' "view region") and a grid block of a store
 // with a t axis, over bricks (?layout=bricks) and in core: picked while
 // paused at time point 3, each is read from time point 3's level 0 (its
@@ -579,38 +586,53 @@ async function storeRegions(context, url, tmp) {
   // the CLI's (llvmpipe); time points apart are 15 to 18 dB.
   const MIN_DB = 55;
 
-  for (const bricks of [true, false]) {
-    const how = bricks ? 'over bricks' : 'in core';
+  // Without the slice views (?slices=0) the region is picked through
+  // tessera.zarrRegion, and nothing explored the store before it.
+  for (const [bricks, slices] of [[true, true], [false, true], [false, false]]) {
+    const how = `${bricks ? 'over bricks' : 'in core'}${slices ? '' : ', no slice views'}`;
     const { page, logs } = await openPage(context, url,
-      `size=${SIZE}&progressive=0${bricks ? '&layout=bricks' : ''}&url=/data/cuber.ome.zarr`);
+      `size=${SIZE}&progressive=0${bricks ? '&layout=bricks' : ''}${slices ? '' : '&slices=0'}&url=/data/cuber.ome.zarr`);
+    // What the 3D view shows: {showing (a region), time, region}.
+    const shownNow = () => page.evaluate(({ slices, box }) => {
+      if (slices) {
+        const ex = window.tessera.slices.state().explore;
+        return { showing: ex.showing_region, time: ex.time, region: JSON.stringify(ex.region) };
+      }
+      const dims = window.tessera.state().dims;
+      const showing = [0, 1, 2].every((a) => dims[a] === box.end[a] - box.begin[a]);
+      return { showing, time: window.tessera.time().shown, region: showing ? JSON.stringify(box) : null };
+    }, { slices, box });
     await withoutOverlays(page);
     const s = await page.evaluate(() => window.tessera.time());
     check(`${how}: the store opens as a series of ${count}`, s.count === count && !!s.bricks === bricks, JSON.stringify(s));
 
     // Paused at time point 3, a region picked: time point 3's.
-    await page.evaluate(() => window.tessera.showTime(3));
+    await showTimeWithin(page, 3);
     if (bricks) await storeComplete(page, 20000);
-    const picked = await page.evaluate((b) => window.tessera.slices.showRegion(b), box);
+    const picked = await page.evaluate(async ({ b, slices }) => {
+      if (slices) return window.tessera.slices.showRegion(b);
+      return window.tessera.zarrRegion(b.begin, b.end).then(() => true, () => false);
+    }, { b: box, slices });
     await page.evaluate(() => window.tessera.setCamera(30, 20, 1));
-    const ex = await page.evaluate(() => window.tessera.slices.state().explore);
+    const ex = await shownNow();
     const at3 = await psnrAgainst(page, refOf(3));
     const as0 = await psnrAgainst(page, refOf(0));
     check(`${how}: a region picked at time point 3 equals \`tessera render STORE --time 3 --region ${spec}\` ` +
           `(>= ${MIN_DB} dB), not time point 0's`,
-          picked && ex.showing_region && ex.time === 3 && at3.psnr >= MIN_DB && as0.psnr < at3.psnr - 10,
-          `${dBs(at3)} (time point 0's region: ${dBs(as0)}); shown ${ex.showing_region}, time ${ex.time}, ` +
-          `region ${JSON.stringify(ex.region)}${picked ? '' : `; ${await page.evaluate(() => window.tessera.error())}`}`);
+          picked && ex.showing && ex.time === 3 && at3.psnr >= MIN_DB && as0.psnr < at3.psnr - 10,
+          `${dBs(at3)} (time point 0's region: ${dBs(as0)}); shown ${ex.showing}, time ${ex.time}, ` +
+          `region ${ex.region}${picked ? '' : `; ${await page.evaluate(() => window.tessera.error())}`}`);
 
     // The slider: time point 4, the region follows (the same box).
-    const shown4 = await page.evaluate(() => window.tessera.showTime(4));
-    const ex4 = await page.evaluate(() => window.tessera.slices.state().explore);
+    const shown4 = await showTimeWithin(page, 4);
+    const ex4 = await shownNow();
     const at4 = await psnrAgainst(page, refOf(4));
     const as3 = await psnrAgainst(page, refOf(3));
     check(`${how}: the slider to time point 4 with the region shown: it equals \`--time 4 --region ${spec}\` ` +
           `(>= ${MIN_DB} dB), not time point 3's`,
-          shown4 === 4 && ex4.showing_region && ex4.time === 4 && JSON.stringify(ex4.region) === JSON.stringify(ex.region) &&
+          shown4 === 4 && ex4.showing && ex4.time === 4 && ex4.region === ex.region &&
           at4.psnr >= MIN_DB && as3.psnr < at4.psnr - 10,
-          `${dBs(at4)} (time point 3's: ${dBs(as3)}); shown ${ex4.showing_region}, time ${ex4.time}, region ${JSON.stringify(ex4.region)}`);
+          `${dBs(at4)} (time point 3's: ${dBs(as3)}); shown ${ex4.showing}, time ${ex4.time}, region ${ex4.region}`);
 
     // Playback with the region shown: every frame drawn is its time
     // point's region, each time point in order.
@@ -630,9 +652,15 @@ async function storeRegions(context, url, tmp) {
           `${order || `log ${p.log.join(',')}`}; ${scored.length} frames, ` +
           `low: ${JSON.stringify(low.slice(0, 5).map((f) => ({ t: f.t, db: +f.psnr.toFixed(1) })))}${p.error ? `; ${p.error}` : ''}`);
 
+    if (!slices) {
+      check(`${how}: no page errors`, !logs.some((l) => l.startsWith('pageerror')) && !(await page.evaluate(() => window.tessera.error())),
+            `${logs.filter((l) => l.startsWith('pageerror')).join('; ')} ${await page.evaluate(() => window.tessera.error())}`);
+      await page.close();
+      continue;  // the grid view is the slice views'
+    }
     // A grid block entered at time point 3 (cells of 16 around the
     // crosshair): time point 3's; the slider to 4: time point 4's.
-    await page.evaluate(() => window.tessera.showTime(3));
+    await showTimeWithin(page, 3);
     await page.evaluate(() => window.tessera.slices.overview());
     await page.evaluate(() => window.tessera.slices.setCross(34, 32, 32));
     const entered = await page.evaluate(() => window.tessera.slices.grid.enter(16));
@@ -658,7 +686,7 @@ async function storeRegions(context, url, tmp) {
           `(>= ${MIN_DB} dB), not time point 0's`,
           gt === 3 && b3.psnr >= MIN_DB && b0.psnr < b3.psnr - 10,
           `time point ${gt}; ${dBs(b3)} (time point 0's block: ${dBs(b0)}); block ${blockSpec}, point ${g.point.join(',')}`);
-    const gshown = await page.evaluate(() => window.tessera.showTime(4));
+    const gshown = await showTimeWithin(page, 4);
     const g4 = await page.evaluate(() => window.tessera.slices.grid.state());
     const b4 = await psnrAgainst(page, blockRef(4));
     const b43 = await psnrAgainst(page, blockRef(3));
