@@ -34,12 +34,14 @@
 
   // The keys of the time points ahead, as playback asks for them (a
   // frame's pump lists them), until the store is closed or stop(); also
+  // while a region or grid block of it is shown (the session reads it again
+  // from each time point once its chunks, asked for here, have arrived) and
   // while the store is opened again after a lost WebGL context (the
   // series plays on from the time point it showed).
   function fetchAhead(zarr) {
     let fetching = true;
     (async () => {
-      while (fetching && (zarr.active() || zarr.reopening())) {
+      while (fetching && (zarr.active() || zarr.showingRegion() || zarr.reopening())) {
         const keys = await zarr.fetchWanted();
         if (keys.length === 0) await new Promise((r) => setTimeout(r, 8));
       }

@@ -220,17 +220,18 @@ int Session::stepPlayback(double nowMs, bool shownComplete) {
   series->want(shownNow);
   // Without a reading thread, one time point ahead is read per frame.
   series->pump();
-  const bool ready = series->isRead(next);
+  bool ready = series->isRead(next);
   // A time point that cannot be read stops playback with the reader's
-  // message, rather than holding the one shown for ever.
-  if (!ready) {
-    try {
-      series->rethrowFailure(next);
-    } catch (const std::exception& e) {
-      playback_.pause();
-      throw InputError(name_ + ": playback stopped: time point " + std::to_string(next) +
-                       " could not be read: " + e.what());
-    }
+  // message, rather than holding the one shown for ever. A series the
+  // front end draws with a region or grid block in the view waits for that
+  // box's chunks of the next time point too.
+  try {
+    if (!ready) series->rethrowFailure(next);
+    ready = ready && drawnBoxArrived(next);
+  } catch (const std::exception& e) {
+    playback_.pause();
+    throw InputError(name_ + ": playback stopped: time point " + std::to_string(next) +
+                     " could not be read: " + e.what());
   }
   const int shown = playback_.step(nowMs, shownNow, count, ready && shownComplete);
   if (shown != shownNow) showTimePoint(shown);

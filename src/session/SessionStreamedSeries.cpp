@@ -153,15 +153,70 @@ void Session::drawPyramid(std::shared_ptr<const lod::MultiresSource> pyramid) {
 }
 
 // The front end's reads never wait: a time point is shown once it is read
-// (its pyramid opened and its levels at hand), a jump too; until then the
-// one shown stays.
+// (its pyramid opened and its levels at hand), a jump too, and a region or
+// grid block in the view once its level-0 chunks of that time point have
+// arrived; until then the one shown stays. The exploration of the drawn
+// pyramid follows (its crosshair, region side, picked box and grid), and
+// the region or block in the view is read again from the new time point,
+// the camera and window staying where the user left them.
 bool Session::showDrawnTimePoint(int t) {
   const bool read = streamedSeries_->series().want(t) != nullptr;  // checks t
   if (t == timePoint_) return true;
   if (!read) return false;
-  drawn_ = streamedSeries_->source(t);
+  std::shared_ptr<const lod::MultiresSource> next = streamedSeries_->source(t);
+  const std::optional<lod::VoxelBox> box = drawnBoxInView();
+  if (box && !next->prefetch(0, *box)) return false;
+  const bool explored = exploration_ && &exploration_->explorer().source() == drawn_.get();
+  drawn_ = std::move(next);
   timePoint_ = t;
+  if (!explored) return true;
+  const nlohmann::json state = exploration_->state();
+  const std::string label = exploration_->label();
+  // A region to show again after a lost context (again_) is shown from
+  // this time point's pyramid too (showRegionAgain reads the exploration's).
+  exploration_ =
+      std::make_unique<Exploration>(drawn_, viewer::regionBudgetBytes(device_.limits), 0, label);
+  if (box) {
+    showExplorationAgain(state);
+  } else {
+    exploration_->restore(state);
+  }
   return true;
+}
+
+std::optional<lod::VoxelBox> Session::drawnBoxInView() const {
+  const Exploration* e = exploration_.get();
+  if (!drawn_ || !e || &e->explorer().source() != drawn_.get()) return std::nullopt;
+  if (e->mode() == ExploreMode::Overview || !e->shown() || !view_ || !view_->hasVolume() ||
+      view_->volumeName() != e->shownName()) {
+    return std::nullopt;
+  }
+  return e->shown();
+}
+
+bool Session::drawnBoxArrived(int t) const {
+  if (!seriesDrawn_ || !streamedSeries_) return true;
+  const std::optional<lod::VoxelBox> box = drawnBoxInView();
+  if (!box) return true;
+  // Read ahead, so held; one that is not is opened when shown
+  // (showDrawnTimePoint checks the box again then).
+  const std::shared_ptr<const lod::MultiresSource> next = streamedSeries_->held(t);
+  return !next || next->prefetch(0, *box);
+}
+
+Exploration& Session::exploreDrawn(const std::string& label) {
+  makeCurrent();
+  // Read in core (a store whose level 0 fits, its time points read by
+  // openSeries): the time point's level 0 is the session's volume, which
+  // showTimePoint carries the exploration over to. (Another series left in
+  // the session, a dropped file's, has another grid than the drawn one.)
+  if (series_ && inCore_ && (!drawn_ || inCore_->volume().dims() == drawn_->levelInfo(0).dims)) {
+    exploration_ = std::make_unique<Exploration>(inCore_->level(glm::ivec3(1)),
+                                                 viewer::regionBudgetBytes(device_.limits), label);
+    return *exploration_;
+  }
+  if (!drawn_) throw InputError("exploring: no pyramid is drawn");
+  return explore(drawn_, 0, label);
 }
 
 std::uint64_t Session::explorationOverviewVoxels() const {

@@ -84,6 +84,12 @@ std::shared_ptr<const lod::MultiresSource> StreamedSeries::source(int t) {
   return sources(t).front();
 }
 
+std::shared_ptr<const lod::MultiresSource> StreamedSeries::held(int t) const {
+  std::lock_guard lock(mutex_);
+  const auto it = sources_.find(t);
+  return it == sources_.end() ? nullptr : it->second.front();
+}
+
 std::vector<std::vector<int>> StreamedSeries::warmedLevels() const {
   std::lock_guard lock(mutex_);
   return warmed_;

@@ -19,7 +19,8 @@
 //  - a store's t axis played over bricks (?layout=bricks): lost while it
 //    plays, it comes back at the time point it showed and plays on in
 //    order; lost while paused, the same image, time slider and label, and
-//    playing on works;
+//    playing on works; a region of it shown at time point 3 comes back at
+//    time point 3;
 //  - (WebGL 2) a store whose chunk cache is small (?zarrcache=0.75, 24 of its 32³
 //    chunks): a region of level 0 shown, then the slice views read level-0
 //    slabs elsewhere and the cache's own limit lets the region's chunks go;
@@ -468,6 +469,28 @@ async function brickedSeries(c, context, url, webgl) {
   c(`${what}, paused: playing on after the restore goes on from time point ${from} in order`,
     t2.log[0] === from && t2.log.length >= 4 && !order2 && error === '',
     `${t2.log.join(',')}${order2 ? ` (out of order: ${order2})` : ''}; error "${error}"`);
+
+  // A region of level 0 shown at time point 3, lost and restored: it comes
+  // back at time point 3 (the same frame), not the first time point's; the
+  // slider to time point 0 then shows another frame (the cube elsewhere).
+  await page.evaluate(() => window.tessera.showTime(3));
+  await page.evaluate(() => window.tessera.zarrRegion([4, 20, 20], [64, 44, 44]));
+  await page.evaluate(() => window.tessera.setCamera(30, 20, 1));
+  const r0 = await page.evaluate(() => ({ time: window.tessera.time().shown, dims: window.tessera.state().dims }));
+  const regionBefore = await pixelsOf(page);
+  const regionAfter = await loseAndRestore(page, webgl, { settled: () => storeReopened(page, 3) });
+  const r1 = await page.evaluate(() => ({ time: window.tessera.time().shown, dims: window.tessera.state().dims }));
+  await checkCase(c, page, `${what}, a region at time point 3`, regionBefore, regionAfter,
+    r0.time === 3 && r1.time === 3 && same(r0.dims, [60, 24, 24]) && same(r1.dims, r0.dims),
+    `time point ${r0.time} -> ${r1.time}, the view's volume ${r0.dims.join('x')} -> ${r1.dims.join('x')}`);
+  await page.evaluate(() => window.tessera.setCamera(30, 20, 1));
+  await page.evaluate(() => Promise.race([window.tessera.showTime(0), new Promise((r) => setTimeout(r, 30000))]));
+  const at0 = await pixelsOf(page);
+  const r2 = await page.evaluate(() => ({ time: window.tessera.time().shown, dims: window.tessera.state().dims }));
+  const apart = psnrOf(regionBefore, at0);
+  c(`${what}, a region at time point 3: time point 0's region differs from it (the restore was time point 3's)`,
+    r2.time === 0 && same(r2.dims, r0.dims) && apart < 40,
+    `time point ${r2.time}, ${r2.dims.join('x')}; time points 3 and 0 of the region: ${dB(apart)} apart`);
   noScriptErrors(c, what, logs);
   await page.close();
 }

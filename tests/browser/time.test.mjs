@@ -10,7 +10,10 @@
 // channels with a t axis play together. A store's slice views show the
 // time point the 3D view shows: at every frame of a playback over bricks,
 // and after it, they equal `tessera slice STORE --time T` of that time
-// point (the store opened at T), pixel for pixel; in core too.
+// point (the store opened at T), pixel for pixel; in core too. A region
+// and a grid block picked at a time point are that time point's (as
+// `tessera render STORE --time T --region BOX`) and follow the time point
+// shown, by the slider and in playback, over bricks and in core.
 // With TESSERA_BENCH=1 it also plays a 20-time-point 256^3 series at
 // 512x512 (a 4-D NIfTI, a store in core and a store over bricks) and
 // prints the rate reached.
@@ -30,6 +33,8 @@ test('an OME-Zarr store with a t axis over bricks (?layout=bricks): each time po
   checks(bricksSeries));
 test('an OME-Zarr store with channels and a t axis: the channels play together, each frame as the CLI renders it',
   checks(channelSeries));
+test('an OME-Zarr store with a t axis, over bricks and in core: a region and a grid block picked at time point 3 are time point 3\'s, ' +
+     'and follow the time point shown (slider and playback)', checks(storeRegions));
 test('benchmark: 20 time points of 256^3 at 512x512 (TESSERA_BENCH=1)', { skip: !bench }, checks(benchmark));
 test('benchmark: an OME-Zarr store of 20 time points of 256^3 at 512x512 (TESSERA_BENCH=1)', { skip: !bench },
   checks((...a) => storeBenchmark(...a, 'in core')));
@@ -544,6 +549,155 @@ async function bricksSeries(context, url, tmp) {
         p.error || logs.filter((l) => l.startsWith('pageerror')).join('; '));
   console.log(`store series over bricks test: ${((Date.now() - started) / 1000).toFixed(1)} s`);
   await page.close();
+}
+
+// Time point t asked for by the slider (tessera.showTime) once drawn, or
+// -1 when it is not within `ms` (the check then fails instead of waiting).
+function showTimeWithin(page, t, ms = 30000) {
+  return page.evaluate(({ t, ms }) => Promise.race([window.tessera.showTime(t),
+    new Promise((resolve) => setTimeout(() => resolve(-1), ms))]), { t, ms });
+}
+
+// A region (the slice views' "view region") and a grid block of a store
+// with a t axis, over bricks (?layout=bricks) and in core: picked while
+// paused at time point 3, each is read from time point 3's level 0 (its
+// frame equals `tessera render STORE --time 3 --region BOX`, and differs
+// from time point 0's), and it follows the time point shown, by the slider
+// and at every frame of a playback (each frame equals its time point's
+// region), as Session::showTimePoint carries the exploration over.
+async function storeRegions(context, url, tmp) {
+  const SIZE = 128;
+  const count = 6;
+  const store = path.join(tmp, 'cuber.ome.zarr');
+  const started = Date.now();
+  writeStore(store, 64, count);
+  // The cube (x from 6 + 8.64 t, y and z 28..36) lies in the box at every
+  // time point, so that each time point's region frame is its own.
+  const box = { begin: [4, 20, 20], end: [64, 44, 44] };
+  const specOf = (b) => [0, 1, 2].map((a) => `${b.begin[a]}:${b.end[a]}`).join(',');
+  const spec = specOf(box);
+  const cam = ['--azimuth', '30', '--elevation', '20'];
+  const times = [...Array(count).keys()];
+  await renderTimes(store, times, SIZE, tmp, ['--tf', 'mr-default', '--region', spec, ...cam], 'region');
+  const refOf = (t) => path.join(tmp, `region-t${t}.png`);
+  const blockRefs = new Map();  // the grid block's references by box, made once
+  const dBs = (m) => (m.error ? m.error : m.psnr >= 999 ? 'identical' : `${m.psnr.toFixed(2)} dB`);
+  // The page's region frames (SwiftShader) measured 60.0 to 73 dB against
+  // the CLI's (llvmpipe); time points apart are 15 to 18 dB.
+  const MIN_DB = 55;
+
+  // Without the slice views (?slices=0) the region is picked through
+  // tessera.zarrRegion, and nothing explored the store before it.
+  for (const [bricks, slices] of [[true, true], [false, true], [false, false]]) {
+    const how = `${bricks ? 'over bricks' : 'in core'}${slices ? '' : ', no slice views'}`;
+    const { page, logs } = await openPage(context, url,
+      `size=${SIZE}&progressive=0${bricks ? '&layout=bricks' : ''}${slices ? '' : '&slices=0'}&url=/data/cuber.ome.zarr`);
+    // What the 3D view shows: {showing (a region), time, region}.
+    const shownNow = () => page.evaluate(({ slices, box }) => {
+      if (slices) {
+        const ex = window.tessera.slices.state().explore;
+        return { showing: ex.showing_region, time: ex.time, region: JSON.stringify(ex.region) };
+      }
+      const dims = window.tessera.state().dims;
+      const showing = [0, 1, 2].every((a) => dims[a] === box.end[a] - box.begin[a]);
+      return { showing, time: window.tessera.time().shown, region: showing ? JSON.stringify(box) : null };
+    }, { slices, box });
+    await withoutOverlays(page);
+    const s = await page.evaluate(() => window.tessera.time());
+    check(`${how}: the store opens as a series of ${count}`, s.count === count && !!s.bricks === bricks, JSON.stringify(s));
+
+    // Paused at time point 3, a region picked: time point 3's.
+    await showTimeWithin(page, 3);
+    if (bricks) await storeComplete(page, 20000);
+    const picked = await page.evaluate(async ({ b, slices }) => {
+      if (slices) return window.tessera.slices.showRegion(b);
+      return window.tessera.zarrRegion(b.begin, b.end).then(() => true, () => false);
+    }, { b: box, slices });
+    await page.evaluate(() => window.tessera.setCamera(30, 20, 1));
+    const ex = await shownNow();
+    const at3 = await psnrAgainst(page, refOf(3));
+    const as0 = await psnrAgainst(page, refOf(0));
+    check(`${how}: a region picked at time point 3 equals \`tessera render STORE --time 3 --region ${spec}\` ` +
+          `(>= ${MIN_DB} dB), not time point 0's`,
+          picked && ex.showing && ex.time === 3 && at3.psnr >= MIN_DB && as0.psnr < at3.psnr - 10,
+          `${dBs(at3)} (time point 0's region: ${dBs(as0)}); shown ${ex.showing}, time ${ex.time}, ` +
+          `region ${ex.region}${picked ? '' : `; ${await page.evaluate(() => window.tessera.error())}`}`);
+
+    // The slider: time point 4, the region follows (the same box).
+    const shown4 = await showTimeWithin(page, 4);
+    const ex4 = await shownNow();
+    const at4 = await psnrAgainst(page, refOf(4));
+    const as3 = await psnrAgainst(page, refOf(3));
+    check(`${how}: the slider to time point 4 with the region shown: it equals \`--time 4 --region ${spec}\` ` +
+          `(>= ${MIN_DB} dB), not time point 3's`,
+          shown4 === 4 && ex4.showing && ex4.time === 4 && ex4.region === ex.region &&
+          at4.psnr >= MIN_DB && as3.psnr < at4.psnr - 10,
+          `${dBs(at4)} (time point 3's: ${dBs(as3)}); shown ${ex4.showing}, time ${ex4.time}, region ${ex4.region}`);
+
+    // Playback with the region shown: every frame drawn is its time
+    // point's region, each time point in order.
+    await loadRefs(page, Object.fromEntries(times.map((t) => [t, refOf(t)])));
+    const p = await playSampled(page, 20, count + 1, 60000);
+    await page.evaluate(() => window.tessera.setProgressive(false));
+    const order = inOrder(p.log, count);
+    const scored = p.frames.filter((f) => f.psnr !== undefined);
+    const low = scored.filter((f) => f.psnr < MIN_DB);
+    const min = scored.length ? Math.min(...scored.map((f) => f.psnr)) : NaN;
+    console.log(`${how}, a region shown: ${p.advances} time points in ${p.seconds.toFixed(2)} s, ${p.drawn} frames drawn, ` +
+                `${p.late} late frames; every frame against its time point's region: min ${min.toFixed(2)} dB`);
+    check(`${how}: playback with a region shown plays every time point in order, each frame its time point's region ` +
+          `(>= ${MIN_DB} dB)`,
+          p.log.length >= count + 2 && !order && new Set(p.frames.map((f) => f.t)).size === count &&
+          scored.length >= count && low.length === 0 && !p.error,
+          `${order || `log ${p.log.join(',')}`}; ${scored.length} frames, ` +
+          `low: ${JSON.stringify(low.slice(0, 5).map((f) => ({ t: f.t, db: +f.psnr.toFixed(1) })))}${p.error ? `; ${p.error}` : ''}`);
+
+    if (!slices) {
+      check(`${how}: no page errors`, !logs.some((l) => l.startsWith('pageerror')) && !(await page.evaluate(() => window.tessera.error())),
+            `${logs.filter((l) => l.startsWith('pageerror')).join('; ')} ${await page.evaluate(() => window.tessera.error())}`);
+      await page.close();
+      continue;  // the grid view is the slice views'
+    }
+    // A grid block entered at time point 3 (cells of 16 around the
+    // crosshair): time point 3's; the slider to 4: time point 4's.
+    await showTimeWithin(page, 3);
+    await page.evaluate(() => window.tessera.slices.overview());
+    await page.evaluate(() => window.tessera.slices.setCross(34, 32, 32));
+    const entered = await page.evaluate(() => window.tessera.slices.grid.enter(16));
+    await page.evaluate(() => window.tessera.setCamera(30, 20, 1));
+    const g = await page.evaluate(() => window.tessera.slices.grid.state());
+    if (!entered || !g.active || !g.block) {
+      check(`${how}: the grid view entered at time point 3`, false,
+            `${await page.evaluate(() => window.tessera.error())} ${JSON.stringify(g)}`);
+      await page.close();
+      continue;
+    }
+    const blockSpec = specOf(g.block);
+    if (!blockRefs.has(blockSpec)) {
+      const tag = `block${blockRefs.size}`;
+      await renderTimes(store, [0, 3, 4], SIZE, tmp, ['--tf', 'mr-default', '--region', blockSpec, ...cam], tag);
+      blockRefs.set(blockSpec, (t) => path.join(tmp, `${tag}-t${t}.png`));
+    }
+    const blockRef = blockRefs.get(blockSpec);
+    const b3 = await psnrAgainst(page, blockRef(3));
+    const b0 = await psnrAgainst(page, blockRef(0));
+    const gt = await page.evaluate(() => window.tessera.time().shown);
+    check(`${how}: a grid block entered at time point 3 equals \`tessera render STORE --time 3 --region ${blockSpec}\` ` +
+          `(>= ${MIN_DB} dB), not time point 0's`,
+          gt === 3 && b3.psnr >= MIN_DB && b0.psnr < b3.psnr - 10,
+          `time point ${gt}; ${dBs(b3)} (time point 0's block: ${dBs(b0)}); block ${blockSpec}, point ${g.point.join(',')}`);
+    const gshown = await showTimeWithin(page, 4);
+    const g4 = await page.evaluate(() => window.tessera.slices.grid.state());
+    const b4 = await psnrAgainst(page, blockRef(4));
+    const b43 = await psnrAgainst(page, blockRef(3));
+    check(`${how}: the slider to time point 4 in the grid view: the same block, time point 4's (>= ${MIN_DB} dB), not 3's`,
+          gshown === 4 && g4.active && specOf(g4.block) === blockSpec && b4.psnr >= MIN_DB && b43.psnr < b4.psnr - 10,
+          `${dBs(b4)} (time point 3's: ${dBs(b43)}); active ${g4.active}, block ${g4.block ? specOf(g4.block) : 'none'}`);
+    check(`${how}: no page errors`, !logs.some((l) => l.startsWith('pageerror')) && !(await page.evaluate(() => window.tessera.error())),
+          `${logs.filter((l) => l.startsWith('pageerror')).join('; ')} ${await page.evaluate(() => window.tessera.error())}`);
+    await page.close();
+  }
+  console.log(`store regions over time test: ${((Date.now() - started) / 1000).toFixed(1)} s`);
 }
 
 async function channelSeries(context, url, tmp) {

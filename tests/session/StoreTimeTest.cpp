@@ -564,6 +564,153 @@ TEST(StoreTime, ASeriesTheFrontEndDrawsShowsATimePointOnlyOnceItArrived) {
   EXPECT_EQ(s.volume().dims(), glm::ivec3(16));
 }
 
+// A time point's pyramid whose level-0 chunks arrive when the test says
+// (the page's store over fetch(): prefetch lists what it lacks).
+class ArrivingSource final : public lod::MultiresSource {
+ public:
+  ArrivingSource(std::shared_ptr<const lod::MultiresSource> inner, const std::set<int>& arrived,
+                 int time)
+      : inner_(std::move(inner)), arrived_(arrived), time_(time) {}
+  const Volume& shape() const override { return inner_->shape(); }
+  int levelCount() const override { return inner_->levelCount(); }
+  lod::LevelInfo levelInfo(int level) const override { return inner_->levelInfo(level); }
+  Volume readBox(int level, const lod::VoxelBox& box) const override {
+    return inner_->readBox(level, box);
+  }
+  bool prefetch(int level, const lod::VoxelBox& box) const override {
+    (void)box;
+    if (level > 0 || arrived_.count(time_)) return true;
+    ++asked;
+    return false;
+  }
+  std::string describe() const override { return inner_->describe(); }
+  mutable int asked = 0;
+
+ private:
+  std::shared_ptr<const lod::MultiresSource> inner_;
+  const std::set<int>& arrived_;
+  int time_;
+};
+
+// How many voxels of `box` of time point t's level 0 differ from `shown`.
+int differingFrom(const std::string& store, int t, const lod::VoxelBox& box, const Volume& shown) {
+  const Volume want = lod::ZarrMultiresSource::open(store, {.time = t})->readBox(0, box);
+  EXPECT_EQ(want.dims(), shown.dims());
+  if (want.dims() != shown.dims()) return -1;
+  int differ = 0;
+  for (int z = 0; z < want.dims().z; ++z)
+    for (int y = 0; y < want.dims().y; ++y)
+      for (int x = 0; x < want.dims().x; ++x)
+        differ += want.valueAt(x, y, z) != shown.valueAt(x, y, z);
+  return differ;
+}
+
+// The page's store with a t axis played over bricks, explored
+// (Session::exploreDrawn): the exploration is of the time point shown, and
+// a region shown in the view follows each time point as in core, read
+// again from it once its level-0 chunks of that time point have arrived
+// (asked for until then: the time point waits, by the slider and in
+// playback), the camera and window staying where the user left them.
+TEST(StoreTime, ARegionOfASeriesTheFrontEndDrawsFollowsEachTimePointOnceItsChunksArrived) {
+  const test::TempDir dir;
+  const std::string store = test::writeTimeStore(dir.path(), 5, 1).string();
+  Session s("native");
+  s.open("gen:sphere:16");
+  std::set<int> arrived{0, 1, 2, 3};
+  std::map<int, std::shared_ptr<const ArrivingSource>> opened;
+  constexpr std::uint64_t kHalf = test::kTimeStoreSide / 2;
+  constexpr std::uint64_t kWarm = kHalf * kHalf * kHalf;  // the coarsest level
+  s.drawStreamedSeries(
+      5,
+      [&](int t) -> std::shared_ptr<const lod::MultiresSource> {
+        auto p = std::make_shared<const ArrivingSource>(
+            lod::ZarrMultiresSource::open(store, {.time = t}), arrived, t);
+        opened[t] = p;
+        return p;
+      },
+      kWarm, 2 * kWarm, "store", 0, TimeSeries::Reading::OnPump);
+  s.series()->setArrival([](int) { return true; }, 1);
+  Exploration& first = s.exploreDrawn("store");
+  EXPECT_EQ(&first.explorer().source(), s.drawnPyramid().get());
+  first.explorer().setCrosshair({40, 30, 31});
+
+  // Time point 3 by the slider: the exploration follows it.
+  ASSERT_FALSE(s.showTimePoint(3));
+  ASSERT_TRUE(s.series()->pump());
+  ASSERT_TRUE(s.showTimePoint(3));
+  ASSERT_TRUE(s.exploring());
+  EXPECT_EQ(&s.exploration().explorer().source(), opened.at(3).get());
+  EXPECT_EQ(s.exploration().explorer().crosshair(), glm::ivec3(40, 30, 31));
+  EXPECT_EQ(s.exploration().mode(), ExploreMode::Overview);
+
+  // A region picked there is time point 3's voxels.
+  const lod::VoxelBox box{{4, 20, 20}, {64, 44, 44}};
+  Exploration& e = s.exploration();
+  e.show(s.view(), e.region(box, Follow::Fill));
+  EXPECT_EQ(differingFrom(store, 3, box, s.view().volume()), 0) << "not time point 3's region";
+  s.view().camera().azimuthDeg += 25.0;
+  s.view().setWindow({10.0, 200.0});
+  const Camera turned = s.view().camera();
+
+  // Time point 4, read ahead, but the region's chunks have not arrived:
+  // playback waits (a late frame), the region of time point 3 stays.
+  s.playback().setFps(20.0);
+  s.playback().play(0.0);
+  double now = 0.0;
+  for (int frame = 0; frame < 4; ++frame) {
+    now += 100.0;
+    EXPECT_EQ(s.stepPlayback(now, true), 3) << "frame " << frame;
+  }
+  ASSERT_TRUE(opened.count(4));
+  EXPECT_GT(opened.at(4)->asked, 0) << "the region's chunks of time point 4 were not asked for";
+  EXPECT_EQ(s.exploration().mode(), ExploreMode::Region);
+  EXPECT_EQ(differingFrom(store, 3, box, s.view().volume()), 0);
+  EXPECT_GT(s.playback().lateFrames(), 0u);
+
+  // They arrive: time point 4's region, the same box, camera and window.
+  arrived.insert(4);
+  now += 100.0;
+  ASSERT_EQ(s.stepPlayback(now, true), 4);
+  ASSERT_EQ(s.exploration().mode(), ExploreMode::Region);
+  ASSERT_TRUE(s.exploration().shown().has_value());
+  EXPECT_EQ(s.exploration().shown()->begin, box.begin);
+  EXPECT_EQ(s.exploration().shown()->end, box.end);
+  EXPECT_EQ(&s.exploration().explorer().source(), opened.at(4).get());
+  EXPECT_EQ(s.exploration().explorer().crosshair(), glm::ivec3(40, 30, 31));
+  EXPECT_EQ(differingFrom(store, 4, box, s.view().volume()), 0) << "not time point 4's region";
+  EXPECT_GT(differingFrom(store, 3, box, s.view().volume()), 0)
+      << "time points 3 and 4 do not differ in the box: the check proves nothing";
+  EXPECT_EQ(s.view().camera().eye(), turned.eye());
+  EXPECT_EQ(s.view().window().min, 10.0);
+  EXPECT_EQ(s.view().window().max, 200.0);
+}
+
+// The page's store whose level 0 fits in core (Session::openSeries of its
+// time points, the store's pyramid drawn as well): explored at time point
+// 2, a region is time point 2's, not the drawn pyramid's (time point 0).
+TEST(StoreTime, ASeriesReadInCoreIsExploredAtTheTimePointShown) {
+  const test::TempDir dir;
+  const std::string store = test::writeTimeStore(dir.path(), 4, 1).string();
+  Session s("native");
+  s.drawPyramid(lod::ZarrMultiresSource::open(store, {.time = 0}));
+  s.openSeries(
+      4,
+      [&](int t) { return lod::readLevel(*lod::ZarrMultiresSource::open(store, {.time = t}), 0); },
+      "store", 0, TimeSeries::Reading::OnPump);
+  s.view();
+  ASSERT_FALSE(s.showTimePoint(2));
+  while (!s.showTimePoint(2)) ASSERT_TRUE(s.series()->pump());
+  Exploration& e = s.exploreDrawn("store");
+  const lod::VoxelBox box{{4, 20, 20}, {64, 44, 44}};
+  e.show(s.view(), e.region(box, Follow::Fill));
+  EXPECT_EQ(differingFrom(store, 2, box, s.view().volume()), 0) << "not time point 2's region";
+  EXPECT_GT(differingFrom(store, 0, box, s.view().volume()), 0);
+  // Playing on, it follows (Session::showTimePoint in core).
+  while (!s.showTimePoint(3)) ASSERT_TRUE(s.series()->pump());
+  EXPECT_EQ(s.exploration().mode(), ExploreMode::Region);
+  EXPECT_EQ(differingFrom(store, 3, box, s.view().volume()), 0) << "not time point 3's region";
+}
+
 // The page's channels of a store with a t axis: a time point's channels
 // are read once all their bytes arrived (the arrival the page gives), and
 // shown together.

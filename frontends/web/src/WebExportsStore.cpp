@@ -196,9 +196,10 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_info() {
 }
 
 // The bread-slice region of a store: voxels [x0,x1) x [y0,y1) x [z0,z1) of
-// level 0, read with bounded reads. 1 when every level-0 chunk of the box
-// has arrived, 0 when some are wanted (tessera_zarr_wanted lists them: the
-// page fetches them and asks again), -1 on error (tessera_last_error).
+// level 0 of the time point shown (its t axis played), read with bounded
+// reads. 1 when every level-0 chunk of the box has arrived, 0 when some are wanted
+// (tessera_zarr_wanted lists them: the page fetches them and asks again), -1 on error
+// (tessera_last_error).
 EMSCRIPTEN_KEEPALIVE int tessera_zarr_region_prefetch(int x0, int x1, int y0, int y1, int z0,
                                                       int z1) {
   int state = -1;
@@ -208,9 +209,11 @@ EMSCRIPTEN_KEEPALIVE int tessera_zarr_region_prefetch(int x0, int x1, int y0, in
 }
 
 // Reads the box (its chunks fetched: tessera_zarr_region_prefetch) at level
-// 0 and makes it the viewer's volume, placed and windowed as in the store
-// (what `tessera render STORE --region` reads); the page then draws the
-// viewer instead of the store until it goes back to the store's overview.
+// 0 of the time point shown and makes it the viewer's volume, placed and
+// windowed as in the store (what `tessera render STORE --time T --region`
+// reads); the page then draws the viewer instead of the store until it goes
+// back to the store's overview. Playing on, the session reads it again from
+// each time point (Session::showTimePoint).
 EMSCRIPTEN_KEEPALIVE int tessera_zarr_region_show(int x0, int x1, int y0, int y1, int z0, int z1) {
   return guarded([&] { web::session().showStoreRegion(boxOf(x0, x1, y0, y1, z0, z1)); });
 }

@@ -218,8 +218,10 @@ session::Exploration& WebSession::exploration(int cellSide) {
   const std::string key = overviewKey(volume);
   if (!explore() || exploreKey_ != key) {
     if (storeOverview()) {
-      // The store draws its own overview: none is read here.
-      session_->explore(theStore().sharedSource(), 0, theStore().storage().describe());
+      // The store draws its own overview: none is read here. Of the time
+      // point shown (its t axis played), which the session carries the
+      // exploration over to as it plays.
+      session_->exploreDrawn(theStore().storage().describe());
     } else {
       // The file's: the session's volume, shared.
       session_->endExploration();

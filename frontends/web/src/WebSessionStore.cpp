@@ -90,23 +90,26 @@ lod::VoxelBox WebSession::storeRegionBox(const lod::VoxelBox& asked) {
   return exploration().clampBox(asked, z.storage().describe() + ": region (level 0)");
 }
 
+// The explored pyramid's: the time point shown (WebSession::exploration).
 bool WebSession::storeRegionPrefetch(const lod::VoxelBox& asked) {
-  return theStore().source().prefetch(0, storeRegionBox(asked));
+  const lod::VoxelBox box = storeRegionBox(asked);
+  return exploration().explorer().source().prefetch(0, box);
 }
 
-// Reads the box (its chunks fetched: storeRegionPrefetch) at level 0 and
-// makes it the viewer's volume, placed and windowed as in the store (what
-// `tessera render STORE --region` reads); the page then draws the viewer
+// Reads the box (its chunks fetched: storeRegionPrefetch) at level 0 of
+// the time point the session shows and makes it the viewer's volume,
+// placed and windowed as in the store (what `tessera render STORE --time T
+// --region` reads); the page then draws the viewer
 // instead of the store until it goes back to the store's overview. The
 // grid's pending block is shown as the grid's; any other box as a region.
 // Seen from the store view's direction, projection and zoom.
 void WebSession::showStoreRegion(const lod::VoxelBox& asked) {
   ZarrStoreView& z = theStore();
   const lod::VoxelBox box = storeRegionBox(asked);
-  if (!z.source().prefetch(0, box)) {
+  session::Exploration& e = exploration();
+  if (!e.explorer().source().prefetch(0, box)) {
     throw Error(z.storage().describe() + ": region: its chunks have not all arrived");
   }
-  session::Exploration& e = exploration();
   const auto& pending = e.pending();
   session::ExploreStep step =
       gridStoreWanted() && pending->box.begin == box.begin && pending->box.end == box.end
@@ -165,7 +168,9 @@ StoreFrame WebSession::storeFrame(int width, int height, bool viewChanged) {
 namespace tessera::web {
 
 bool WebSession::storeTimeFinished() {
-  if (!zarr_ || !session_->streamedSeries()) return true;
+  // A region or grid block of the store is the viewer's frame (the
+  // session reads it again from each time point once its chunks arrived).
+  if (!zarr_ || !session_->streamedSeries() || storeRegionShown()) return true;
   // Being opened again after a context loss: the time point shown is not
   // on the canvas yet, and playback waits for it.
   if (!zarr_->isOpen()) return false;

@@ -152,7 +152,9 @@ class Session {
   // window and look, and returns true; otherwise asks for it and returns
   // false (the time point shown stays). The exploration is of the time
   // point shown: its crosshair, region side and picked box carry over, and
-  // a region or grid block in the 3D view is shown again from time point t.
+  // a region or grid block in the 3D view is shown again from time point t
+  // (of a series the front end draws, whose reads never wait: t is shown
+  // once that box's level-0 chunks of t have arrived, asked for until then).
   // InputError without a series or for t out of range.
   bool showTimePoint(int t);
   // As showTimePoint, waiting for the read (headless runs, benchmarks).
@@ -286,6 +288,14 @@ class Session {
   // is read only when `overviewVoxels` > 0. Replaces the exploration.
   Exploration& explore(std::shared_ptr<const lod::MultiresSource> source,
                        std::uint64_t overviewVoxels, const std::string& label);
+  // Explores what a front end that draws its own pyramid shows
+  // (drawPyramid) at the time point shown: the shown time point's pyramid
+  // of a series it draws over bricks (drawStreamedSeries), the session's
+  // volume (that time point's level 0) of a series read in core
+  // (openSeries), the drawn pyramid otherwise; no overview level is read.
+  // Replaces the exploration; it follows each time point shown from then
+  // on (showTimePoint). InputError when nothing is drawn.
+  Exploration& exploreDrawn(const std::string& label);
   // Forgets the exploration (the next exploration() starts anew).
   void endExploration() {
     exploration_.reset();
@@ -395,6 +405,13 @@ class Session {
   StreamedSeries::Pyramids streamedChannels_;  // streamChannels' of the time point shown
   bool showStreamedTimePoint(int t);
   bool showDrawnTimePoint(int t);
+  // The region or grid block of the drawn pyramid's exploration that the
+  // view shows (null: none), which a series the front end draws over
+  // bricks reads again from each time point it shows.
+  std::optional<lod::VoxelBox> drawnBoxInView() const;
+  // Whether time point t's drawn pyramid holds drawnBoxInView()'s level-0
+  // chunks (asked for otherwise); true when no box is in the view.
+  bool drawnBoxArrived(int t) const;
   bool seriesDrawn_ = false;  // streamedSeries_ is drawn by the front end
   void openStreamedSeriesInView(const std::string& spec, const OpenOptions& options);
   // The voxels of the overview an exploration of the volume reads.

@@ -55,6 +55,9 @@ class StreamedSeries {
   std::shared_ptr<const lod::MultiresSource> source(int t);
   // Every channel's pyramid of time point t (one without channels).
   Pyramids sources(int t);
+  // Time point t's pyramid if it is open (read ahead or shown), else null;
+  // unlike source(), the window stays where it is.
+  std::shared_ptr<const lod::MultiresSource> held(int t) const;
 
   // The levels, coarsest first, whose voxels fit `bytes` together (at least
   // the coarsest): what warming a time point reads.
