@@ -59,6 +59,8 @@ class SliceAccumulator {
   std::string accumulationFormat() const {
     return floatTarget_ ? gpu::texelFormatName(*floatTarget_) : "RGBA8";
   }
+  // Whether every blend rounds to 8 bits (no half-float target).
+  bool roundsTo8Bits() const { return !floatTarget_; }
   std::uint64_t ownTextureBytes() const;
 
  private:
