@@ -12,6 +12,14 @@
 // perspective ray crosses consecutive planes ds / cos(theta) apart, so each
 // fragment corrects its opacity once more by that ratio (DESIGN.md,
 // Rendering semantics). No early termination (blending has no way to stop).
+// Slabs: where the accumulation target is RGBA8 (a device without float
+// render targets) every blend rounds to 8 bits, and a thin plane's
+// contribution is a fraction of a level. There each quad stands for
+// kRgba8SlabSamples consecutive planes: its fragment samples the planes
+// where its view ray crosses them, composites them front to back in the
+// shader and blends once, dithered by half a level (slice3d.frag.glsl). The
+// samples are the N planes' own; only the roundings drop K-fold
+// (docs/rendering.md, docs/channels.md for the measurements).
 // Over a layout that draws channels (docs/channels.md) each fragment combines
 // them as the ray caster's samples do; their MIP keeps per channel maxima in
 // two targets and colours them in a resolve pass.
