@@ -72,7 +72,7 @@ void main() {
     planeStep = (p - u_eyeTexture) * (u_planeSpacing / depth);
   }
   vec4 acc = vec4(0.0);
-  for (int j = 0; j < SLAB_SAMPLES; ++j) {
+  for (int j = 0; j < SLAB_SAMPLES; j++) {
     vec3 pj = p + float(j) * planeStep;
     vec4 c = classifiedSample(clamp(pj, 0.0, 1.0));
     c = correctOpacity(vec4(c.rgb * c.a, c.a) * insideVolume(pj), ratio);
