@@ -31,6 +31,26 @@ void Slice3DRenderer::setTransferFunction(const TransferFunction& tf) {
   lookupKey_.clear();
 }
 
+void Slice3DRenderer::setSlabSamples(int samples) {
+  if (samples < 0 || samples > kMaxSlabSamples) {
+    throw InputError("samples a slab must be 1.." + std::to_string(kMaxSlabSamples) +
+                     " (0 = from the accumulation target), got " + std::to_string(samples));
+  }
+  requestedSlabSamples_ = samples;
+}
+
+int Slice3DRenderer::slabSamplesFor(const RenderSettings& settings) const {
+  // MIP's maxima are exact in any target; a half-float target keeps every
+  // plane's small contribution.
+  if (settings.mode == RenderMode::Mip) return 1;
+  if (requestedSlabSamples_ > 0) return requestedSlabSamples_;
+  return accumulator_.roundsTo8Bits() ? kRgba8SlabSamples : 1;
+}
+
+bool Slice3DRenderer::ditherFor(const RenderSettings& settings) const {
+  return settings.mode != RenderMode::Mip && accumulator_.roundsTo8Bits();
+}
+
 void Slice3DRenderer::setSliceCount(int slices) {
   if (slices < 0 || slices > kMaxSlices) {
     throw InputError("slice count must be 1.." + std::to_string(kMaxSlices) +
@@ -60,14 +80,18 @@ std::uint64_t Slice3DRenderer::ownTextureBytes() const {
          gradient_.bytes();
 }
 
-void Slice3DRenderer::buildGeometry(int slices) {
-  // Two triangles per slice in cube units: x, y in [-0.5, 0.5], slice k at
-  // z = 0.5 - (k + 0.5) / N, so the buffer's order is front to back.
+void Slice3DRenderer::buildGeometry(int slices, int slabSamples) {
+  // Two triangles per slab in cube units: x, y in [-0.5, 0.5], the planes
+  // at z = 0.5 - (k + 0.5) / N, a slab's quad on its first plane
+  // (k = m * slabSamples), so the buffer's order is front to back. The last
+  // slab's planes past the cube's back lie outside the volume.
+  const int slabs = (slices + slabSamples - 1) / slabSamples;
   std::vector<float> v;
-  v.reserve(static_cast<std::size_t>(slices) * 18);
+  v.reserve(static_cast<std::size_t>(slabs) * 18);
   constexpr float corners[6][2] = {{-0.5f, -0.5f}, {0.5f, -0.5f}, {0.5f, 0.5f},
                                    {-0.5f, -0.5f}, {0.5f, 0.5f},  {-0.5f, 0.5f}};
-  for (int k = 0; k < slices; ++k) {
+  for (int m = 0; m < slabs; ++m) {
+    const double k = static_cast<double>(m) * slabSamples;
     const float z = static_cast<float>(0.5 - (k + 0.5) / slices);
     for (const auto& c : corners) {
       v.push_back(c[0]);
@@ -80,6 +104,8 @@ void Slice3DRenderer::buildGeometry(int slices) {
       gpu::Buffer::create(context_.ledger(), "slice3d proxy cube", gpu::BufferKind::Vertices,
                           v.size() * sizeof(float), v.data(), gpu::BufferUsage::Static);
   builtSlices_ = slices;
+  builtSlabSamples_ = slabSamples;
+  builtSlabs_ = slabs;
   ++geometryBuilds_;
 }
 
@@ -109,6 +135,8 @@ std::vector<gpu::ShaderPart> Slice3DRenderer::fragmentParts(const RenderSettings
   gradient_.addDefines(settings, defines);
   addClippingDefines(settings, defines);
   if (settings.nearest) defines.push_back("NEAREST 1");
+  defines.push_back("SLAB_SAMPLES " + std::to_string(slabSamplesFor(settings)));
+  if (ditherFor(settings)) defines.push_back("DITHER_8BIT 1");
   std::vector<gpu::ShaderPart> parts = {gpu::shaderPreamble(context_.caps().api, true, defines)};
   addSampleParts(parts, gradient_, layout_);
   parts.push_back(gpu::embeddedShaderPart("render/slice_opacity.glsl"));
@@ -117,12 +145,13 @@ std::vector<gpu::ShaderPart> Slice3DRenderer::fragmentParts(const RenderSettings
 }
 
 const gpu::Program& Slice3DRenderer::programFor(const RenderSettings& settings) {
-  const std::string key = layout_.name() + (settings.mode == RenderMode::Mip ? "|mip" : "") +
-                          (shadingActive(settings) ? "|shade" : "") +
-                          (gradient_.precomputed(settings) ? "|gradient-texture" : "") +
-                          (gradient_.valuesFromGradient(settings) ? "|values" : "") +
-                          (settings.clipping.active() ? "|clip" : "") +
-                          (settings.nearest ? "|nearest" : "");
+  const std::string key =
+      layout_.name() + (settings.mode == RenderMode::Mip ? "|mip" : "") +
+      (shadingActive(settings) ? "|shade" : "") +
+      (gradient_.precomputed(settings) ? "|gradient-texture" : "") +
+      (gradient_.valuesFromGradient(settings) ? "|values" : "") +
+      (settings.clipping.active() ? "|clip" : "") + (settings.nearest ? "|nearest" : "") +
+      "|slab " + std::to_string(slabSamplesFor(settings)) + (ditherFor(settings) ? "|dither" : "");
   return programs_.get(key, [&] {
     return gpu::Program::build("slice3d(" + key + ")", vertexParts(), fragmentParts(settings));
   });
@@ -135,7 +164,8 @@ void Slice3DRenderer::prepare(const RenderSettings& settings) {
         "caster (--technique raycast)");
   }
   const int n = sliceCountFor(settings);
-  if (n != builtSlices_) buildGeometry(n);
+  const int k = slabSamplesFor(settings);
+  if (n != builtSlices_ || k != builtSlabSamples_) buildGeometry(n, k);
   updateLookup(settings, settings.mode == RenderMode::Mip ? tf_.opacityUnitLength
                                                           : sliceSpacingFor(settings));
   gradient_.prepare(settings);
@@ -166,9 +196,18 @@ void Slice3DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
   const gpu::Program& prog = programFor(settings);
   prog.use();
   prog.set("u_cubeToClip", glm::mat4(projection * cubeToView));
-  prog.set("u_cubeToTexture", glm::mat4(worldToTexture * cubeToWorld));
+  const glm::dmat4 cubeToTexture = worldToTexture * cubeToWorld;
+  prog.set("u_cubeToTexture", glm::mat4(cubeToTexture));
   prog.set("u_cubeToView", glm::mat4(cubeToView));
   prog.set("u_ortho", camera.projection == Projection::Orthographic ? 1.0f : 0.0f);
+  // A slab's planes behind its first (slice3d.frag.glsl): one plane's step
+  // along the cube's -z (orthographic), or the eye's texture position and
+  // the planes' spacing (perspective).
+  prog.set("u_planeStep",
+           glm::vec3(cubeToTexture * glm::dvec4(0.0, 0.0, -1.0 / builtSlices_, 0.0)));
+  prog.set("u_eyeTexture", glm::vec3(worldToTexture * glm::dvec4(camera.eye(), 1.0)));
+  prog.set("u_slabsPerCube", static_cast<float>(builtSlices_) / builtSlabSamples_);
+  prog.set("u_planeSpacing", static_cast<float>(d / builtSlices_));
   const layout::ValueMapping m = layout_.rawFromStored();
   const ValueRange w = volume_.window();
   const double ww = w.max - w.min;
@@ -187,7 +226,7 @@ void Slice3DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
     drawChannelMaxima(prog, settings);
     return;
   }
-  gpu::drawArrays(gpu::Primitive::Triangles, vertices_, {{0, 3, 0}}, 3, 0, builtSlices_ * 6);
+  gpu::drawArrays(gpu::Primitive::Triangles, vertices_, {{0, 3, 0}}, 3, 0, builtSlabs_ * 6);
   accumulator_.resolve(settings, &lut_.texture(), lut_.entries());
 }
 
@@ -200,7 +239,7 @@ void Slice3DRenderer::drawChannelMaxima(const gpu::Program& slices,
   for (int group = 0; group < 2; ++group) {
     if (group == 1) accumulator_.beginSecond(settings.mode);
     slices.set("u_channelGroup", static_cast<float>(group));
-    gpu::drawArrays(gpu::Primitive::Triangles, vertices_, {{0, 3, 0}}, 3, 0, builtSlices_ * 6);
+    gpu::drawArrays(gpu::Primitive::Triangles, vertices_, {{0, 3, 0}}, 3, 0, builtSlabs_ * 6);
   }
   const gpu::Program& resolve = channelResolveProgram();
   resolve.use();
@@ -240,8 +279,12 @@ const gpu::Texture& Slice3DRenderer::render(const Camera& camera, const RenderSe
 
 TechniqueReport Slice3DRenderer::report() const {
   TechniqueReport r;
-  r.note = "slice3d: " + std::to_string(builtSlices_) + " view-aligned slices, accumulation " +
-           accumulationFormat() + ", no early termination";
+  r.note = "slice3d: " + std::to_string(builtSlices_) + " view-aligned slices";
+  if (builtSlabSamples_ > 1) {
+    r.note += " in " + std::to_string(builtSlabs_) + " slabs of " +
+              std::to_string(builtSlabSamples_) + " samples";
+  }
+  r.note += ", accumulation " + accumulationFormat() + ", no early termination";
   r.gradient = gradient_.plan().reason;
   return r;
 }

@@ -1,8 +1,14 @@
-// View-aligned slices: one sample per fragment through the layout's
-// sampleVolume(), classified through the TF table baked for the slice
-// spacing and corrected for the perspective ray's longer path between the
-// planes. Outside the volume the fragment keeps alpha 0 instead of
-// discarding (discard is slow on tiled mobile GPUs; Noguera et al. 2012).
+// View-aligned slices: each fragment of a proxy slice takes SLAB_SAMPLES
+// samples along its view ray through the layout's sampleVolume(), the
+// slice's own plane first and then the planes behind it, ds apart in depth,
+// classified through the TF table baked for ds and corrected for the
+// perspective ray's longer path between the planes, and composites them
+// front to back in the shader (render/composite.glsl) before the one blend
+// of the slab. With SLAB_SAMPLES 1 that is one sample a slice; an 8-bit
+// accumulation target takes several (render/Slice3DRenderer.h: a slab's
+// contribution is rounded to 8 bits once instead of once per plane).
+// Outside the volume a sample keeps alpha 0 instead of discarding (discard
+// is slow on tiled mobile GPUs; Noguera et al. 2012).
 // With CHANNELS (docs/channels.md) classifiedSample() combines the channels
 // as the ray caster does; their MIP writes the per channel maxima, channels
 // 0-3 in one pass and 4-5 with the hit flag in a second (u_channelGroup),
@@ -10,23 +16,39 @@
 #if TESSERA_GLSL == 300
 in vec3 v_texCoord;
 in vec3 v_view;
+in float v_slab;
 #else
 varying vec3 v_texCoord;
 varying vec3 v_view;
+varying float v_slab;
 #endif
 uniform float u_ortho;
 #if defined(CHANNELS) && defined(MODE_MIP)
 uniform float u_channelGroup;  // 0: channels 0-3; 1: channels 4-5 and the hit flag
 #endif
+#ifndef SLAB_SAMPLES
+#define SLAB_SAMPLES 1
+#endif
+uniform vec3 u_planeStep;      // orthographic: the texture step to the next plane
+uniform vec3 u_eyeTexture;     // perspective: the eye in texture coordinates
+uniform float u_planeSpacing;  // perspective: ds, the planes' distance in depth
 
-void main() {
-  vec3 p = v_texCoord;
+// 1 where p lies in the volume (and the clipping keeps it), else 0.
+float insideVolume(vec3 p) {
   vec3 inside3 = step(vec3(0.0), p) * step(p, vec3(1.0));
   float inside = inside3.x * inside3.y * inside3.z;
 #ifdef CLIPPING
   if (!clipKeeps(p)) inside = 0.0;
 #endif
+  return inside;
+}
+
+void main() {
+  vec3 p = v_texCoord;
+#if defined(MODE_MIP)
+  float inside = insideVolume(p);
   vec3 q = clamp(p, 0.0, 1.0);
+#endif
 #if defined(MODE_MIP) && defined(CHANNELS)
   vec4 n0;
   vec4 n1;
@@ -39,10 +61,35 @@ void main() {
 #elif defined(MODE_MIP)
   FRAG_COLOR = vec4(normalizedValue(fieldValue(q)) * inside, 0.0, 0.0, inside);
 #else
-  vec4 c = classifiedSample(q);
-  c = vec4(c.rgb * c.a, c.a) * inside;
-  // Planes ds apart are ds / cos(theta) apart along a perspective ray.
-  float ratio = u_ortho > 0.5 ? 1.0 : length(v_view) / max(-v_view.z, 1e-6);
-  FRAG_COLOR = correctOpacity(c, ratio);
+  // Planes ds apart are ds / cos(theta) apart along a perspective ray, and
+  // the ray from the eye through p meets the plane j * ds deeper at
+  // p + (p - eye) * j * ds / depth.
+  float ratio = 1.0;
+  vec3 planeStep = u_planeStep;
+  if (u_ortho < 0.5) {
+    float depth = max(-v_view.z, 1e-6);
+    ratio = length(v_view) / depth;
+    planeStep = (p - u_eyeTexture) * (u_planeSpacing / depth);
+  }
+  vec4 acc = vec4(0.0);
+  for (int j = 0; j < SLAB_SAMPLES; j++) {
+    vec3 pj = p + float(j) * planeStep;
+    vec4 c = classifiedSample(clamp(pj, 0.0, 1.0));
+    c = correctOpacity(vec4(c.rgb * c.a, c.a) * insideVolume(pj), ratio);
+    // Front to back in premultiplied colour, as the accumulator blends.
+    acc += (1.0 - acc.a) * c;
+  }
+#ifdef DITHER_8BIT
+  // The 8-bit target rounds each blend; a slab's small contribution would
+  // round the same way in every slab of a uniform region. An offset of
+  // -0.5..0.5 of a level, interleaved gradient noise over the pixel shifted
+  // per slab (Jimenez 2014), makes the rounding unbiased on average. Empty
+  // fragments stay exactly 0 (negative values round to 0 as well).
+  float slab = floor(v_slab);
+  vec2 noisePixel = gl_FragCoord.xy + 5.588238 * slab;
+  float noise = fract(52.9829189 * fract(dot(noisePixel, vec2(0.06711056, 0.00583715))));
+  if (acc.a > 0.0) acc = max(acc + (noise - 0.5) / 255.0, 0.0);
+#endif
+  FRAG_COLOR = acc;
 #endif
 }

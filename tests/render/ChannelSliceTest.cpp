@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <string>
 
 #include "support/ChannelBricks.h"
 #include "support/ChannelStore.h"
@@ -24,6 +25,7 @@
 #include "tessera/layout/ChannelLayout.h"
 #include "tessera/reference/ChannelReference.h"
 #include "tessera/reference/ImageMetrics.h"
+#include "tessera/render/Slice3DRenderer.h"
 #include "tessera/render/TechniqueRegistry.h"
 #include "tessera/session/Session.h"
 
@@ -139,6 +141,45 @@ TEST_F(ChannelSlices, AdditiveEqualsReferenceOnTexture3dAndEs2) {
 
 TEST_F(ChannelSlices, MaxEqualsReferenceOnTexture3dAndEs2) {
   expectSlicesEqualReference(ChannelMode::Max);
+}
+
+// On the ES 2 profiles without float render targets (webgl1-desktop-2012,
+// ipad2) slice3d accumulates in RGBA8 and composites slabs of planes in the
+// shader before each blend (render/Slice3DRenderer.h): the three channels
+// additive at a high opacity scale through many planes, orthographic,
+// against the reference;
+// one plane a slice (no slabs) is printed beside it.
+TEST_F(ChannelSlices, Slice3dAdditiveHolds40DbInRgba8OnEs2Profiles) {
+  ChannelSet set = readZarrChannels(store());
+  set.mode = ChannelMode::Additive;
+  Camera camera = test::orbitCamera(set.geometry(), 30.0, 20.0);
+  camera.projection = Projection::Orthographic;
+  RenderSettings settings = channelSettings();
+  settings.stepVoxels = 0.1;  // 1440 planes, as many as the 512x512x200 store takes at 0.5
+  settings.opacityScale = 20.0;
+  const TransferFunction grey = TransferFunction::preset("grey");
+  const Image ref = renderChannelsReference(set, grey, camera, settings, kSize, kSize);
+  for (const char* profile : {"webgl1-desktop-2012", "ipad2"}) {
+    test::ApiContext context(gpu::ApiLevel::Gles2);
+    gpu::GlContext& gl = context.get();
+    const gpu::DeviceLimits limits =
+        gpu::effectiveLimits(gpu::DeviceProfile::find(profile), gl.caps());
+    auto layout = layout::ChannelLayout::create(set, limits, gl.ledger());
+    double db[2] = {0.0, 0.0};
+    std::string note;
+    for (int slab : {1, 0}) {
+      auto slicer = render::Slice3DRenderer::create(
+          {gl, limits, set.geometry(), layout.get(), render::TechniqueOptions{}});
+      slicer->setTransferFunction(grey);
+      slicer->setSlabSamples(slab);
+      db[slab == 0 ? 1 : 0] = psnr(slicer->renderImage(camera, settings, kSize, kSize), ref);
+      note = slicer->report().note;
+    }
+    std::printf("slice3d channels additive on %s (%s): %.1f dB, one plane a slice %.1f dB\n",
+                profile, note.c_str(), db[1], db[0]);
+    EXPECT_NE(note.find("accumulation RGBA8"), std::string::npos) << note;
+    EXPECT_GE(db[1], 40.0) << profile << " " << note;
+  }
 }
 
 // Over the bricks layout each fragment of a plane finds its brick cell's

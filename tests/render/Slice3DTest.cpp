@@ -5,13 +5,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 #include <glm/geometric.hpp>
 
+#include "support/ChannelStore.h"
 #include "support/GpuTestContext.h"
 #include "support/TestCameras.h"
 #include "support/TestTransferFunctions.h"
 #include "tessera/core/Error.h"
+#include "tessera/gpu/DeviceProfile.h"
 #include "tessera/gpu/TexelFormat.h"
 #include "tessera/io/Procedural.h"
 #include "tessera/layout/MosaicLayout.h"
@@ -179,4 +182,103 @@ TEST(Slice3D, MipMatchesReference) {
   const Image ref = renderReference(v, TransferFunction::preset("grey"), cam, s, 80, 80);
   std::printf("  [measured] slice3d MIP vs reference: %.2f dB\n", psnr(img, ref));
   EXPECT_GE(psnr(img, ref), 30.0);
+}
+
+// A u16 volume whose voxels are channel 1 of the test channel store (a
+// slab across x and z on a background of 100): seen obliquely through a
+// grey ramp at a high opacity scale, each plane adds a fraction of an 8-bit
+// level to a dim pixel.
+Volume slabVolume() {
+  const glm::ivec3 d{96, 96, 48};
+  Volume v = Volume::allocate(d, ScalarType::U16, "slab");
+  std::size_t i = 0;
+  for (int z = 0; z < d.z; ++z) {
+    for (int y = 0; y < d.y; ++y) {
+      for (int x = 0; x < d.x; ++x, ++i)
+        v.setValueAtIndex(i, test::channelStoreValue(1, d, x, y, z));
+    }
+  }
+  v.invalidateRange();
+  return v;
+}
+
+// On an ES 2 profile without float render targets (webgl1-desktop-2012)
+// the slices accumulate in RGBA8, where each blend rounds to 8 bits: each
+// proxy slice composites a slab of kRgba8SlabSamples planes in the shader,
+// dithers and blends once. The translucent slab through 1440 planes (a
+// tenth of a voxel apart, as many as the 512x512x200 store takes at half a
+// voxel), orthographic and perspective, against the reference; one plane a
+// slice (no slabs, dithered) is printed beside it.
+TEST(Slice3D, Rgba8AccumulationHolds40DbWithSlabs) {
+  gpu::GlContext::Options o;
+  o.api = gpu::ApiLevel::Gles2;
+  auto c = gpu::GlContext::createHeadless(o);
+  {
+    const gpu::DeviceLimits limits =
+        gpu::effectiveLimits(gpu::DeviceProfile::find("webgl1-desktop-2012"), c->caps());
+    ASSERT_FALSE(limits.halfFloatRenderTargets);
+    RenderSettings s = halfVoxel();
+    s.stepVoxels = 0.1;
+    s.opacityScale = 5.0;
+    const TransferFunction tf = TransferFunction::preset("grey");
+    const Volume v = slabVolume();
+    auto mosaic = layout::MosaicLayout::create(v, limits, c->ledger());
+    for (Projection projection : {Projection::Orthographic, Projection::Perspective}) {
+      Camera cam = test::orbitCamera(v.extent(), 30, 20);
+      cam.projection = projection;
+      const Image ref = renderReference(v, tf, cam, s, 96, 96);
+      double db[2] = {0.0, 0.0};
+      int planes = 0;
+      for (int slab : {1, 0}) {
+        render::Slice3DRenderer r(*c, v, *mosaic, limits.halfFloatRenderTargets);
+        ASSERT_EQ(r.accumulationFormat(), "RGBA8");
+        r.setTransferFunction(tf);
+        r.setSlabSamples(slab);
+        db[slab == 0 ? 1 : 0] = psnr(r.render(cam, s, 96, 96), ref);
+        planes = r.sliceCountFor(s);
+        if (slab == 0) {
+          EXPECT_EQ(r.slabSamplesFor(s), render::Slice3DRenderer::kRgba8SlabSamples);
+          EXPECT_TRUE(r.ditherFor(s));
+          EXPECT_NE(r.report().note.find("slabs of"), std::string::npos) << r.report().note;
+        }
+      }
+      std::printf(
+          "  [measured] slice3d RGBA8 %s, %d planes: %.2f dB in slabs of %d, %.2f dB one plane "
+          "a slice\n",
+          projection == Projection::Perspective ? "perspective" : "orthographic", planes, db[1],
+          render::Slice3DRenderer::kRgba8SlabSamples, db[0]);
+      EXPECT_GE(db[1], 40.0);
+    }
+  }
+  c.reset();
+  test::gpuContext();
+}
+
+// Slabs take the same planes as single slices: on a half-float target the
+// slabs' frame equals the one-plane-a-slice frame up to half-float rounding,
+// for any slab length that does or does not divide the plane count, and MIP
+// takes no slabs.
+TEST(Slice3D, SlabsSampleTheSamePlanesAsSingleSlices) {
+  gpu::GlContext& c = test::gpuContext();
+  const Volume v = makeSheppLogan({30, 36, 26});
+  auto t3d = layout::Texture3DLayout::create(v, gpu::DeviceLimits::of(c.caps()), c.ledger());
+  render::Slice3DRenderer r(c, v, *t3d);
+  r.setTransferFunction(visibleTf());
+  RenderSettings s = halfVoxel();
+  for (Projection projection : {Projection::Orthographic, Projection::Perspective}) {
+    Camera cam = obliqueCamera(v);
+    cam.projection = projection;
+    r.setSlabSamples(1);
+    const Image single = r.render(cam, s, 64, 64);
+    for (int slab : {4, 7}) {
+      r.setSlabSamples(slab);
+      const double db = psnr(r.render(cam, s, 64, 64), single);
+      std::printf("  [measured] slice3d slabs of %d vs single slices (%s): %.2f dB\n", slab,
+                  projection == Projection::Perspective ? "perspective" : "orthographic", db);
+      EXPECT_GE(db, 50.0) << slab;
+    }
+  }
+  s.mode = RenderMode::Mip;
+  EXPECT_EQ(r.slabSamplesFor(s), 1);
+  EXPECT_THROW(r.setSlabSamples(render::Slice3DRenderer::kMaxSlabSamples + 1), InputError);
 }

@@ -12,6 +12,14 @@
 // perspective ray crosses consecutive planes ds / cos(theta) apart, so each
 // fragment corrects its opacity once more by that ratio (DESIGN.md,
 // Rendering semantics). No early termination (blending has no way to stop).
+// Slabs: where the accumulation target is RGBA8 (a device without float
+// render targets) every blend rounds to 8 bits, and a thin plane's
+// contribution is a fraction of a level. There each quad stands for
+// kRgba8SlabSamples consecutive planes: its fragment samples the planes
+// where its view ray crosses them, composites them front to back in the
+// shader and blends once, dithered by half a level (slice3d.frag.glsl). The
+// samples are the N planes' own; only the roundings drop K-fold
+// (docs/rendering.md, docs/channels.md for the measurements).
 // Over a layout that draws channels (docs/channels.md) each fragment combines
 // them as the ray caster's samples do; their MIP keeps per channel maxima in
 // two targets and colours them in a resolve pass.
@@ -53,7 +61,14 @@ class Slice3DRenderer final : public Technique {
   // Number of slices over the cube's side; 0 (the default) derives it from
   // RenderSettings::stepVoxels: N = ceil(diagonal / ds).
   void setSliceCount(int slices);
-  // Slices a frame with these settings draws (1..kMaxSlices).
+  // Samples each proxy slice composites along its view ray before its one
+  // blend (1..kMaxSlabSamples); 0 (the default): kRgba8SlabSamples where the
+  // accumulation target is RGBA8, else 1. MIP always takes 1.
+  void setSlabSamples(int samples);
+  int slabSamplesFor(const RenderSettings& settings) const;
+  // Whether slabs dither their 8-bit rounding (slice3d.frag.glsl).
+  bool ditherFor(const RenderSettings& settings) const;
+  // Planes a frame with these settings samples (1..kMaxSlices).
   int sliceCountFor(const RenderSettings& settings) const;
   // World distance between slices for these settings.
   double sliceSpacingFor(const RenderSettings& settings) const;
@@ -88,6 +103,8 @@ class Slice3DRenderer final : public Technique {
   std::uint64_t ownTextureBytes() const override;
 
   static constexpr int kMaxSlices = 8192;
+  static constexpr int kMaxSlabSamples = 64;
+  static constexpr int kRgba8SlabSamples = 32;
   static constexpr int kOwnTextureUnits = 1;  // the TF table
 
   // The Technique interface. The target keeps the screen's shape (see
@@ -109,7 +126,7 @@ class Slice3DRenderer final : public Technique {
 
  private:
   const gpu::Program& programFor(const RenderSettings& settings);
-  void buildGeometry(int slices);
+  void buildGeometry(int slices, int slabSamples);
   void updateLookup(const RenderSettings& settings, double spacing);
   void drawChannelMaxima(const gpu::Program& slices, const RenderSettings& settings);
   const gpu::Program& channelResolveProgram();
@@ -119,7 +136,10 @@ class Slice3DRenderer final : public Technique {
   const layout::Layout& layout_;
   TransferFunction tf_;
   int requestedSlices_ = 0;
+  int requestedSlabSamples_ = 0;
   int builtSlices_ = 0;
+  int builtSlabSamples_ = 0;
+  int builtSlabs_ = 0;
   std::uint64_t geometryBuilds_ = 0;
   gpu::Buffer vertices_;
   gpu::LookupTexture lut_;

@@ -11,7 +11,9 @@
 // opacities used here that would not match the ray caster.)
 // The target is RGBA16F where the device renders to float targets (ES 3 with
 // EXT_color_buffer_float): hundreds of thin slices rounded to 8 bits each
-// would drift. ES 2 devices accumulate in RGBA8, as the papers' devices did.
+// would drift. ES 2 devices accumulate in RGBA8, as the papers' devices did;
+// slice3d then blends slabs of planes composited in its shader
+// (Slice3DRenderer.h), so that fewer, larger contributions are rounded.
 // MIP blends with GL_MAX (ES 3, or ES 2 with EXT_blend_minmax): slices write
 // (n * inside, 0, 0, inside) and the resolve pass classifies the maximum.
 // Several channels' maxima (docs/channels.md) take two targets: channels 0-3
@@ -59,6 +61,8 @@ class SliceAccumulator {
   std::string accumulationFormat() const {
     return floatTarget_ ? gpu::texelFormatName(*floatTarget_) : "RGBA8";
   }
+  // Whether every blend rounds to 8 bits (no half-float target).
+  bool roundsTo8Bits() const { return !floatTarget_; }
   std::uint64_t ownTextureBytes() const;
 
  private:
