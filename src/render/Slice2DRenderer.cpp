@@ -70,6 +70,23 @@ void Slice2DRenderer::setSliceCount(int slices) {
   requestedSlices_ = slices;
 }
 
+void Slice2DRenderer::setSlabPlanes(int planes) {
+  if (planes < 0 || planes > kMaxSlabPlanes) {
+    throw InputError("planes a slab must be 1.." + std::to_string(kMaxSlabPlanes) +
+                     " (0 = from the accumulation target), got " + std::to_string(planes));
+  }
+  requestedSlabPlanes_ = planes;
+}
+
+int Slice2DRenderer::slabPlanesFor(const RenderSettings& settings) const {
+  // MIP's maxima are exact in any target; a half-float target keeps every
+  // plane's small contribution; the single-volume stacks' planes are atlas
+  // tiles (render/Slice2DRenderer.h).
+  if (!options_.channels || settings.mode == RenderMode::Mip) return 1;
+  if (requestedSlabPlanes_ > 0) return requestedSlabPlanes_;
+  return accumulator_.roundsTo8Bits() ? kRgba8SlabPlanes : 1;
+}
+
 int Slice2DRenderer::stackAxisFor(const Camera& camera) {
   const glm::dvec3 f = glm::abs(camera.basis()[2]);
   // Ties go to the later axis, so that a view straight down a diagonal is stable.
@@ -153,31 +170,35 @@ const Slice2DRenderer::DrawList& Slice2DRenderer::drawList(int axis, bool descen
 }
 
 // Channel frames: n planes across the axis at (k + 0.5) / n of the extent,
-// each quad its own (no tiles), front to back.
+// front to back. One quad a slab of slabPlanes planes, on the slab's first
+// (nearest) plane, widened by 2 (K - 1) plane spacings on each side (none
+// for K = 1) so that its fragments reach the farther planes of oblique rays
+// (render/Slice2DRenderer.h); its slab index in a_tile.z for the dither.
 const Slice2DRenderer::DrawList& Slice2DRenderer::channelPlanes(int axis, bool descending,
-                                                                int planes) {
-  const std::string key =
-      "channels " + std::to_string(axis) + (descending ? "-" : "+") + std::to_string(planes);
+                                                                int planes, int slabPlanes) {
+  const std::string key = "channels " + std::to_string(axis) + (descending ? "-" : "+") +
+                          std::to_string(planes) + "/" + std::to_string(slabPlanes);
   auto it = drawLists_.find(key);
   if (it != drawLists_.end()) return it->second;
   const glm::ivec2 a = sliceTileAxes(axis);
   const glm::dvec3 extent = volume_.extent();
+  const double margin = 2.0 * (slabPlanes - 1) * extent[axis] / planes;
+  const int slabs = (planes + slabPlanes - 1) / slabPlanes;
   std::vector<float> v;
   std::vector<std::uint16_t> indices;
   constexpr int corners[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-  for (int s = 0; s < planes; ++s) {
+  for (int m = 0; m < slabs; ++m) {
+    const int k = m * slabPlanes;
+    const int s = descending ? planes - 1 - k : k;
     glm::dvec3 pos(0.0);
     pos[axis] = ((s + 0.5) / planes - 0.5) * extent[axis];
     for (const auto& c : corners) {
-      pos[a.x] = (c[0] - 0.5) * extent[a.x];
-      pos[a.y] = (c[1] - 0.5) * extent[a.y];
+      pos[a.x] = (c[0] - 0.5) * extent[a.x] + (c[0] * 2 - 1) * margin;
+      pos[a.y] = (c[1] - 0.5) * extent[a.y] + (c[1] * 2 - 1) * margin;
       v.insert(v.end(), {static_cast<float>(pos.x), static_cast<float>(pos.y),
-                         static_cast<float>(pos.z), 0.0f, 0.0f, 0.0f, 0.0f});
+                         static_cast<float>(pos.z), 0.0f, 0.0f, static_cast<float>(m), 0.0f});
     }
-  }
-  for (int k = 0; k < planes; ++k) {
-    const int s = descending ? planes - 1 - k : k;
-    for (int i : {0, 1, 2, 0, 2, 3}) indices.push_back(static_cast<std::uint16_t>(s * 4 + i));
+    for (int i : {0, 1, 2, 0, 2, 3}) indices.push_back(static_cast<std::uint16_t>(m * 4 + i));
   }
   DrawList list;
   list.gapRatio = static_cast<double>(plans_[axis].slices) / planes;
@@ -321,6 +342,11 @@ std::vector<gpu::ShaderPart> Slice2DRenderer::channelFragmentParts(
     const RenderSettings& settings) const {
   std::vector<std::string> defines;
   if (settings.mode == RenderMode::Mip) defines.push_back("MODE_MIP 1");
+  defines.push_back("SLAB_PLANES " + std::to_string(slabPlanesFor(settings)));
+  // Slabs dither their 8-bit rounding (slice2d_channels.frag.glsl).
+  if (settings.mode != RenderMode::Mip && accumulator_.roundsTo8Bits()) {
+    defines.push_back("DITHER_8BIT 1");
+  }
   std::vector<gpu::ShaderPart> parts = {gpu::shaderPreamble(context_.caps().api, true, defines)};
   for (gpu::ShaderPart& part : options_.channels->seamParts()) parts.push_back(std::move(part));
   for (const char* file : {"render/classify.glsl", "render/channels.glsl",
@@ -352,8 +378,9 @@ const gpu::Program& Slice2DRenderer::channelResolveProgram() {
 
 const gpu::Program& Slice2DRenderer::programFor(const RenderSettings& settings) {
   if (options_.channels) {
-    const std::string key =
-        std::string("channels") + (settings.mode == RenderMode::Mip ? "|mip" : "");
+    const std::string key = std::string("channels") +
+                            (settings.mode == RenderMode::Mip ? "|mip" : "") + "|slab " +
+                            std::to_string(slabPlanesFor(settings));
     return programs_.get(key, [&] {
       return gpu::Program::build("slice2d(" + key + ")", vertexParts(), fragmentParts(settings));
     });
@@ -425,10 +452,12 @@ void Slice2DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
                      : requestedSlices_ > 0 ? std::min(requestedSlices_, plan.slices)
                                             : plan.slices;
   lastSlicesDrawn_ = slices;
+  lastSlabPlanes_ = slabPlanesFor(settings);
   const glm::dvec3 forward = -camera.basis()[2];
   // Front to back: looking towards +axis, the low slices are nearest.
-  const DrawList& list = options_.channels ? channelPlanes(axis, forward[axis] < 0.0, slices)
-                                           : drawList(axis, forward[axis] < 0.0, slices);
+  const DrawList& list = options_.channels
+                             ? channelPlanes(axis, forward[axis] < 0.0, slices, lastSlabPlanes_)
+                             : drawList(axis, forward[axis] < 0.0, slices);
 
   const bool shade = !options_.channels && shadingActive(settings);
   accumulator_.begin(width, height, settings.mode);
@@ -449,6 +478,9 @@ void Slice2DRenderer::renderFrame(const Camera& camera, const RenderSettings& se
   prog.set("u_ortho", camera.projection == Projection::Orthographic ? 1.0f : 0.0f);
   if (options_.channels) {
     prog.set("u_invExtent", glm::vec3(1.0 / volume_.extent()));
+    // A slab's next plane is this far along the stack axis (front to back).
+    prog.set("u_planeStep", static_cast<float>((forward[axis] < 0.0 ? -1.0 : 1.0) *
+                                               volume_.extent()[axis] / slices));
     const int unit = options_.channels->bindSeam(prog, 0);
     table_.texture().bind(unit);
     prog.set("u_tf", unit);
@@ -534,7 +566,13 @@ TechniqueReport Slice2DRenderer::report() const {
   if (options_.channels) {
     r.note = "slice2d: " + std::to_string(lastSlicesDrawn_) + " " +
              (lastAxis_ >= 0 ? std::string(1, "xyz"[lastAxis_]) : std::string("?")) +
-             " planes of the channel layout drawn, accumulation " + accumulationFormat();
+             " planes of the channel layout drawn";
+    if (lastSlabPlanes_ > 1) {
+      r.note += " in " +
+                std::to_string((lastSlicesDrawn_ + lastSlabPlanes_ - 1) / lastSlabPlanes_) +
+                " slabs of " + std::to_string(lastSlabPlanes_);
+    }
+    r.note += ", accumulation " + accumulationFormat();
     return r;
   }
   r.storage = "slice-stacks";

@@ -6,6 +6,12 @@
 // travels between drawn planes as for one volume. Max: the windowed values,
 // channels 0-3 in one pass and 4-5 with the hit flag in a second
 // (u_channelGroup), which render/slice_channels_resolve.frag.glsl colours.
+// Additive slabs: a quad stands for SLAB_PLANES consecutive planes (1 but
+// on an 8-bit accumulation target, render/Slice2DRenderer.h); its fragment
+// takes them where its view ray crosses them, u_planeStep apart along the
+// axis, composites them front to back at float precision and blends once,
+// dithered as slice3d.frag.glsl does. Samples off the volume (the slab's
+// widened quad, the last slab's planes past the stack) keep alpha 0.
 #if TESSERA_GLSL == 300
 in vec3 v_world;
 in vec2 v_local;
@@ -24,10 +30,14 @@ uniform float u_ortho;
 #ifdef MODE_MIP
 uniform float u_channelGroup;  // 0: channels 0-3; 1: channels 4-5 and the hit flag
 #endif
+#ifndef SLAB_PLANES
+#define SLAB_PLANES 1
+#endif
+uniform float u_planeStep;  // world distance between drawn planes along the axis, front to back
 
 void main() {
-  vec3 p = clamp(v_world * u_invExtent + 0.5, 0.0, 1.0);
 #ifdef MODE_MIP
+  vec3 p = clamp(v_world * u_invExtent + 0.5, 0.0, 1.0);
   vec4 n0;
   vec4 n1;
   sampleChannels(p, n0, n1);
@@ -37,10 +47,31 @@ void main() {
     FRAG_COLOR = n0 * u_layoutChannelOn0;
   }
 #else
-  vec4 c = classifiedChannels(p);
-  c.rgb *= c.a;
   vec3 dir = u_ortho > 0.5 ? u_forward : normalize(v_world - u_eye);
-  float ratio = u_gap / max(abs(dot(dir, u_axis)), 1e-3);
-  FRAG_COLOR = correctOpacity(c, ratio);
+  float cosine = max(abs(dot(dir, u_axis)), 1e-3);
+  float ratio = u_gap / cosine;
+  // The ray meets the next plane |u_planeStep| / cos further on.
+  vec3 rayStep = dir * (abs(u_planeStep) / cosine) * u_invExtent;
+  vec3 p0 = v_world * u_invExtent + 0.5;
+  vec4 acc = vec4(0.0);
+  for (int j = 0; j < SLAB_PLANES; j++) {
+    vec3 p = p0 + float(j) * rayStep;
+    vec3 inside3 = step(vec3(0.0), p) * step(p, vec3(1.0));
+    vec4 c = classifiedChannels(clamp(p, 0.0, 1.0));
+    c.rgb *= c.a;
+    c = correctOpacity(c * (inside3.x * inside3.y * inside3.z), ratio);
+    // Front to back in premultiplied colour, as the accumulator blends.
+    acc += (1.0 - acc.a) * c;
+  }
+#ifdef DITHER_8BIT
+  // The 8-bit target rounds each blend; an offset of -0.5..0.5 of a level,
+  // interleaved gradient noise over the pixel shifted per slab (Jimenez
+  // 2014; slice3d.frag.glsl), makes the rounding unbiased on average. Empty
+  // fragments stay exactly 0.
+  vec2 noisePixel = gl_FragCoord.xy + 5.588238 * v_tileOrigin.x;
+  float noise = fract(52.9829189 * fract(dot(noisePixel, vec2(0.06711056, 0.00583715))));
+  if (acc.a > 0.0) acc = max(acc + (noise - 0.5) / 255.0, 0.0);
+#endif
+  FRAG_COLOR = acc;
 #endif
 }

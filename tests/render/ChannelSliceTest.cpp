@@ -25,6 +25,7 @@
 #include "tessera/layout/ChannelLayout.h"
 #include "tessera/reference/ChannelReference.h"
 #include "tessera/reference/ImageMetrics.h"
+#include "tessera/render/Slice2DRenderer.h"
 #include "tessera/render/Slice3DRenderer.h"
 #include "tessera/render/TechniqueRegistry.h"
 #include "tessera/session/Session.h"
@@ -180,6 +181,82 @@ TEST_F(ChannelSlices, Slice3dAdditiveHolds40DbInRgba8OnEs2Profiles) {
     EXPECT_NE(note.find("accumulation RGBA8"), std::string::npos) << note;
     EXPECT_GE(db[1], 40.0) << profile << " " << note;
   }
+}
+
+// slice2d the same way (render/Slice2DRenderer.h): on the ES 2 profiles its
+// channel planes accumulate in RGBA8, each quad compositing a slab of planes
+// of the stack in the shader before its one blend; the same view and
+// settings as above, against the reference; one plane a blend (no slabs)
+// is printed beside it.
+TEST_F(ChannelSlices, Slice2dAdditiveHolds40DbInRgba8OnEs2Profiles) {
+  ChannelSet set = readZarrChannels(store());
+  set.mode = ChannelMode::Additive;
+  Camera camera = test::orbitCamera(set.geometry(), 30.0, 20.0);
+  camera.projection = Projection::Orthographic;
+  RenderSettings settings = channelSettings();
+  settings.stepVoxels = 0.1;
+  settings.opacityScale = 20.0;
+  const TransferFunction grey = TransferFunction::preset("grey");
+  const Image ref = renderChannelsReference(set, grey, camera, settings, kSize, kSize);
+  for (const char* profile : {"webgl1-desktop-2012", "ipad2"}) {
+    test::ApiContext context(gpu::ApiLevel::Gles2);
+    gpu::GlContext& gl = context.get();
+    const gpu::DeviceLimits limits =
+        gpu::effectiveLimits(gpu::DeviceProfile::find(profile), gl.caps());
+    auto layout = layout::ChannelLayout::create(set, limits, gl.ledger());
+    double db[2] = {0.0, 0.0};
+    std::string note;
+    for (int slab : {1, 0}) {
+      auto slicer = render::Slice2DRenderer::create(
+          {gl, limits, set.geometry(), layout.get(), render::TechniqueOptions{}});
+      slicer->setTransferFunction(grey);
+      slicer->setSlabPlanes(slab);
+      db[slab == 0 ? 1 : 0] = psnr(slicer->renderImage(camera, settings, kSize, kSize), ref);
+      note = slicer->report().note;
+    }
+    std::printf("slice2d channels additive on %s (%s): %.1f dB, one plane a blend %.1f dB\n",
+                profile, note.c_str(), db[1], db[0]);
+    EXPECT_NE(note.find("accumulation RGBA8"), std::string::npos) << note;
+    EXPECT_GE(db[1], 40.0) << profile << " " << note;
+  }
+}
+
+// A slab's fragment takes the planes behind its quad where its view ray
+// crosses them: in a half-float target (no dither) slabs of 4 and 7 planes
+// equal one plane a blend, orthographic and perspective, at oblique views
+// whose rays reach past the slab's first plane's face (the widened quads).
+TEST_F(ChannelSlices, Slice2dSlabsSampleTheSamePlanesAsSinglePlanes) {
+  ChannelSet set = readZarrChannels(store());
+  set.mode = ChannelMode::Additive;
+  RenderSettings settings = channelSettings();
+  test::ApiContext context(gpu::ApiLevel::Gles3);
+  gpu::GlContext& gl = context.get();
+  const gpu::DeviceLimits limits = gpu::DeviceLimits::of(gl.caps());
+  auto layout = layout::ChannelLayout::create(set, limits, gl.ledger());
+  auto slicer = render::Slice2DRenderer::create(
+      {gl, limits, set.geometry(), layout.get(), render::TechniqueOptions{}});
+  slicer->setTransferFunction(channelRamp());
+  for (Projection projection : {Projection::Orthographic, Projection::Perspective}) {
+    for (double elevation : {20.0, 40.0}) {
+      Camera camera = test::orbitCamera(set.geometry(), 40.0, elevation);
+      camera.projection = projection;
+      slicer->setSlabPlanes(1);
+      const Image single = slicer->renderImage(camera, settings, kSize, kSize);
+      for (int slab : {4, 7}) {
+        slicer->setSlabPlanes(slab);
+        const double db = psnr(slicer->renderImage(camera, settings, kSize, kSize), single);
+        std::printf(
+            "  [measured] slice2d channel slabs of %d vs one plane a blend (%s, %.0f deg): "
+            "%.2f dB (%s)\n",
+            slab, projection == Projection::Perspective ? "perspective" : "orthographic", elevation,
+            db, slicer->report().note.c_str());
+        EXPECT_GE(db, 50.0) << slab << " " << elevation;
+      }
+    }
+  }
+  settings.mode = RenderMode::Mip;
+  EXPECT_EQ(slicer->slabPlanesFor(settings), 1);
+  EXPECT_THROW(slicer->setSlabPlanes(render::Slice2DRenderer::kMaxSlabPlanes + 1), InputError);
 }
 
 // Over the bricks layout each fragment of a plane finds its brick cell's

@@ -119,6 +119,9 @@ void expectSlicingConformant(gpu::GlContext& c, const Volume& v, const layout::L
       sources.push_back(gpu::assembleShader(slice2d.fragmentParts(s)));
     }
     sources.push_back(gpu::assembleShader(slice2d.channelResolveParts()));
+    // In an RGBA8 target: slabs of kRgba8SlabPlanes planes, dithered.
+    render::Slice2DRenderer slabs(c, v, {.halfFloatAccumulation = false, .channels = &layout});
+    sources.push_back(gpu::assembleShader(slabs.fragmentParts(RenderSettings{})));
   }
   for (const std::string& src : sources) {
     const bool vertex = src.find("gl_Position") != std::string::npos;

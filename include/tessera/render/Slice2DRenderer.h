@@ -38,6 +38,19 @@
 // caster's. Post-classified only; the additive fragment is
 // classifiedChannels(), the max mode draws the stack twice (channels 0-3,
 // then 4-5 and the hit flag) and resolves as slice3d does.
+// Slabs (channels, additive): where the accumulation target is RGBA8 (no
+// float render targets) every blend rounds to 8 bits and a thin plane's
+// contribution is a fraction of a level. There, as slice3d does, each quad
+// stands for kRgba8SlabPlanes consecutive planes of the stack: its fragment
+// samples the planes where its view ray crosses them, composites them front
+// to back in the shader and blends once, dithered by half a level
+// (slice2d_channels.frag.glsl). The samples are the N planes' own; only the
+// roundings drop K-fold. A slab's quad lies on its first plane, widened by
+// 2 (K - 1) plane spacings on each side so that rays up to 63 degrees off
+// the stack axis in either tile direction still meet its farther planes
+// (docs/channels.md for the measurements). The single-volume stacks keep
+// one plane a blend: their planes are atlas tiles, possibly in different
+// atlases, which a fragment cannot reach from one draw.
 #include <array>
 #include <cstdint>
 #include <map>
@@ -93,6 +106,14 @@ class Slice2DRenderer final : public Technique {
   // Slices drawn per frame: 0 (the default) draws every slice of the stack;
   // fewer picks evenly spaced ones (the opacity corrected for the gap).
   void setSliceCount(int slices);
+  // Channel planes each quad composites before its one blend
+  // (1..kMaxSlabPlanes); 0 (the default): kRgba8SlabPlanes where the
+  // accumulation target is RGBA8, else 1. MIP and the single-volume stacks
+  // always take 1.
+  void setSlabPlanes(int planes);
+  int slabPlanesFor(const RenderSettings& settings) const;
+  static constexpr int kMaxSlabPlanes = 64;
+  static constexpr int kRgba8SlabPlanes = 32;
 
   // The stack for a view: the axis along which the view direction is largest.
   static int stackAxisFor(const Camera& camera);
@@ -161,7 +182,7 @@ class Slice2DRenderer final : public Technique {
   const gpu::Program& programFor(const RenderSettings& settings);
   std::vector<gpu::ShaderPart> channelFragmentParts(const RenderSettings& settings) const;
   const gpu::Program& channelResolveProgram();
-  const DrawList& channelPlanes(int axis, bool descending, int planes);
+  const DrawList& channelPlanes(int axis, bool descending, int planes, int slabPlanes);
   int channelPlaneCount(const RenderSettings& settings, int axis) const;
   void drawStack(const gpu::Program& prog, int axis, const DrawList& list);
   void drawChannelMaxima(const gpu::Program& prog, int axis, const DrawList& list,
@@ -182,6 +203,8 @@ class Slice2DRenderer final : public Technique {
   std::map<std::string, DrawList> drawLists_;
   TransferFunction tf_;
   int requestedSlices_ = 0;
+  int requestedSlabPlanes_ = 0;
+  int lastSlabPlanes_ = 1;
   std::string classificationKey_;
   std::vector<std::uint8_t> palette8_;  // pre: premultiplied RGBA8, 256 entries
   gpu::LookupTexture table_;            // palette or post-classification LUT
