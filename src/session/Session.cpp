@@ -208,8 +208,10 @@ int Session::stepPlayback(double nowMs, bool shownComplete) {
   // it (progressive strips), the next one waits.
   if (view_ && view_->refining()) return timePoint();
   // Over bricks the same: the front end's frame of the time point shown
-  // must have been drawn with every brick its view wants.
-  if (streamedSeries_ && streamedFrames_ && !streamedFrames_->shownComplete(timePoint_)) {
+  // must have been drawn with every brick its view wants (unless the view
+  // shows a region or grid block of it instead, which refines as above).
+  if (streamedSeries_ && streamedFrames_ && !boxInView() &&
+      !streamedFrames_->shownComplete(timePoint_)) {
     return timePoint();
   }
   const int count = series->count();

@@ -184,14 +184,19 @@ bool Session::showDrawnTimePoint(int t) {
   return true;
 }
 
-std::optional<lod::VoxelBox> Session::drawnBoxInView() const {
+std::optional<lod::VoxelBox> Session::boxInView() const {
   const Exploration* e = exploration_.get();
-  if (!drawn_ || !e || &e->explorer().source() != drawn_.get()) return std::nullopt;
-  if (e->mode() == ExploreMode::Overview || !e->shown() || !view_ || !view_->hasVolume() ||
+  if (!e || e->mode() == ExploreMode::Overview || !e->shown() || !view_ || !view_->hasVolume() ||
       view_->volumeName() != e->shownName()) {
     return std::nullopt;
   }
   return e->shown();
+}
+
+std::optional<lod::VoxelBox> Session::drawnBoxInView() const {
+  const Exploration* e = exploration_.get();
+  if (!drawn_ || !e || &e->explorer().source() != drawn_.get()) return std::nullopt;
+  return boxInView();
 }
 
 bool Session::drawnBoxArrived(int t) const {
@@ -252,6 +257,11 @@ bool Session::showStreamedTimePoint(int t) {
   // The shown one is opened now if it has to be (a jump); playback asks
   // only for one warmed ahead (stepPlayback waits for isRead).
   StreamedSeries::Pyramids all = streamedSeries_->sources(t);
+  // The exploration carries over (its crosshair, region side, picked box
+  // and grid), and a region or grid block in the view is read again from
+  // time point t, the camera and window staying where the user left them.
+  std::optional<nlohmann::json> explored;
+  if (exploration_) explored = exploration_->state();
   std::shared_ptr<const lod::MultiresSource> source = all.front();
   if (all.size() > 1) {
     streamedChannels_ = std::move(all);
@@ -265,6 +275,7 @@ bool Session::showStreamedTimePoint(int t) {
   exploration_.reset();
   timePoint_ = t;
   applyVolumeSettings();  // streamedView_: this time point, through the settings' window
+  if (explored) showExplorationAgain(*explored);
   return true;
 }
 

@@ -685,6 +685,78 @@ TEST(StoreTime, ARegionOfASeriesTheFrontEndDrawsFollowsEachTimePointOnceItsChunk
   EXPECT_EQ(s.view().window().max, 200.0);
 }
 
+// The desktop's way (`view STORE --bricks`: the store opened in the view
+// over bricks, its frames drawn by streamedFrames()): a region picked at a
+// time point is that time point's voxels, and playback with it shown moves
+// on, the region read again from each time point shown (the same box, the
+// camera and window where the user left them), never waiting for a frame
+// of the whole volume that the view does not draw while the region is
+// shown; back to the overview, the streamed frames play on.
+TEST(StoreTime, ARegionShownInTheViewOverBricksFollowsEachTimePoint) {
+  const test::TempDir dir;
+  const std::string store = test::writeTimeStore(dir.path(), 5, 1).string();
+  Session s("native");
+  s.settings().layout = "bricks";
+  s.openInView(store);
+  ASSERT_NE(s.streamedSeries(), nullptr);
+  ASSERT_TRUE(s.streamed());
+  useLookInView(s);
+  s.waitTimePoint(2);
+  // The desktop has drawn time point 2's frames over bricks before the pick.
+  for (int i = 0; i < 400 && !s.streamedFrames().shownComplete(2); ++i) {
+    s.streamedFrames().render(64, 64);
+  }
+  ASSERT_TRUE(s.streamedFrames().shownComplete(2));
+  s.exploration().explorer().setCrosshair({40, 30, 31});
+  const lod::VoxelBox box{{4, 20, 20}, {64, 44, 44}};
+  Exploration& e = s.exploration();
+  e.show(s.view(), e.region(box, Follow::Fill));
+  ASSERT_EQ(differingFrom(store, 2, box, s.view().volume()), 0) << "not time point 2's region";
+  s.view().camera().azimuthDeg += 25.0;
+  s.view().setWindow({10.0, 200.0});
+  const Camera turned = s.view().camera();
+
+  s.playback().setFps(30.0);
+  const auto start = std::chrono::steady_clock::now();
+  auto nowMs = [&] {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+        .count();
+  };
+  s.playback().play(nowMs());
+  std::vector<int> shown{2};
+  while (shown.size() < 5 && nowMs() < 20000.0) {
+    const int t = s.stepPlayback(nowMs());
+    if (t == shown.back()) continue;
+    shown.push_back(t);
+    ASSERT_EQ(s.exploration().mode(), ExploreMode::Region) << "time point " << t;
+    ASSERT_TRUE(s.exploration().shown().has_value());
+    EXPECT_EQ(s.exploration().shown()->begin, box.begin);
+    EXPECT_EQ(s.exploration().shown()->end, box.end);
+    EXPECT_EQ(s.exploration().explorer().crosshair(), glm::ivec3(40, 30, 31));
+    EXPECT_EQ(differingFrom(store, t, box, s.view().volume()), 0)
+        << "the region shown at time point " << t << " is not its own";
+    EXPECT_GT(differingFrom(store, shown[shown.size() - 2], box, s.view().volume()), 0)
+        << "time points " << shown[shown.size() - 2] << " and " << t
+        << " do not differ in the box: the check proves nothing";
+    EXPECT_EQ(s.view().camera().eye(), turned.eye());
+    EXPECT_EQ(s.view().window().min, 10.0);
+    EXPECT_EQ(s.view().window().max, 200.0);
+  }
+  EXPECT_EQ(shown, (std::vector<int>{2, 3, 4, 0, 1})) << "playback with a region shown stalled";
+
+  // Back to the overview: the streamed frames of the time point shown play on.
+  s.exploration().showOverview(s.view(), Follow::Back);
+  ASSERT_EQ(s.exploration().mode(), ExploreMode::Overview);
+  const int before = s.timePoint();
+  bool moved = false;
+  while (!moved && nowMs() < 40000.0) {
+    const int t = s.stepPlayback(nowMs());
+    s.streamedFrames().render(64, 64);
+    moved = t != before;
+  }
+  EXPECT_TRUE(moved) << "playback stalled after the region";
+}
+
 // The page's store whose level 0 fits in core (Session::openSeries of its
 // time points, the store's pyramid drawn as well): explored at time point
 // 2, a region is time point 2's, not the drawn pyramid's (time point 0).

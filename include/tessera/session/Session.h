@@ -405,9 +405,11 @@ class Session {
   StreamedSeries::Pyramids streamedChannels_;  // streamChannels' of the time point shown
   bool showStreamedTimePoint(int t);
   bool showDrawnTimePoint(int t);
-  // The region or grid block of the drawn pyramid's exploration that the
-  // view shows (null: none), which a series the front end draws over
-  // bricks reads again from each time point it shows.
+  // The region or grid block of the exploration that the view shows (null:
+  // none, or the overview), drawn by the view rather than streamed frames.
+  std::optional<lod::VoxelBox> boxInView() const;
+  // That box when the exploration is of the drawn pyramid, which a series
+  // the front end draws over bricks reads again from each time point.
   std::optional<lod::VoxelBox> drawnBoxInView() const;
   // Whether time point t's drawn pyramid holds drawnBoxInView()'s level-0
   // chunks (asked for otherwise); true when no box is in the view.
