@@ -144,14 +144,13 @@ TEST_F(ChannelSlices, MaxEqualsReferenceOnTexture3dAndEs2) {
   expectSlicesEqualReference(ChannelMode::Max);
 }
 
-// On the ES 2 profiles without float render targets (webgl1-desktop-2012,
-// ipad2) slice3d accumulates in RGBA8 and composites slabs of planes in the
-// shader before each blend (render/Slice3DRenderer.h): the three channels
-// additive at a high opacity scale through many planes, orthographic,
-// against the reference;
-// one plane a slice (no slabs) is printed beside it.
-TEST_F(ChannelSlices, Slice3dAdditiveHolds40DbInRgba8OnEs2Profiles) {
-  ChannelSet set = readZarrChannels(store());
+// The frame of both ES 2 profiles' slicers (`Slicer`: Slice3DRenderer or
+// Slice2DRenderer, `setSlab` its slab setter) against the reference, in
+// slabs (0: the RGBA8 target's default) and one plane a blend (1, printed
+// beside it): the accumulation is RGBA8 and the slabs' frame >= 40 dB.
+template <class Slicer, class SetSlab>
+void expectEs2SlabsHold40Db(const std::string& store, const char* what, SetSlab setSlab) {
+  ChannelSet set = readZarrChannels(store);
   set.mode = ChannelMode::Additive;
   Camera camera = test::orbitCamera(set.geometry(), 30.0, 20.0);
   camera.projection = Projection::Orthographic;
@@ -169,18 +168,29 @@ TEST_F(ChannelSlices, Slice3dAdditiveHolds40DbInRgba8OnEs2Profiles) {
     double db[2] = {0.0, 0.0};
     std::string note;
     for (int slab : {1, 0}) {
-      auto slicer = render::Slice3DRenderer::create(
-          {gl, limits, set.geometry(), layout.get(), render::TechniqueOptions{}});
+      auto slicer =
+          Slicer::create({gl, limits, set.geometry(), layout.get(), render::TechniqueOptions{}});
       slicer->setTransferFunction(grey);
-      slicer->setSlabSamples(slab);
+      setSlab(*slicer, slab);
       db[slab == 0 ? 1 : 0] = psnr(slicer->renderImage(camera, settings, kSize, kSize), ref);
       note = slicer->report().note;
     }
-    std::printf("slice3d channels additive on %s (%s): %.1f dB, one plane a slice %.1f dB\n",
+    std::printf("%s channels additive on %s (%s): %.1f dB, one plane a blend %.1f dB\n", what,
                 profile, note.c_str(), db[1], db[0]);
     EXPECT_NE(note.find("accumulation RGBA8"), std::string::npos) << note;
     EXPECT_GE(db[1], 40.0) << profile << " " << note;
   }
+}
+
+// On the ES 2 profiles without float render targets (webgl1-desktop-2012,
+// ipad2) slice3d accumulates in RGBA8 and composites slabs of planes in the
+// shader before each blend (render/Slice3DRenderer.h): the three channels
+// additive at a high opacity scale through many planes, orthographic,
+// against the reference;
+// one plane a slice (no slabs) is printed beside it.
+TEST_F(ChannelSlices, Slice3dAdditiveHolds40DbInRgba8OnEs2Profiles) {
+  expectEs2SlabsHold40Db<render::Slice3DRenderer>(
+      store(), "slice3d", [](render::Slice3DRenderer& r, int n) { r.setSlabSamples(n); });
 }
 
 // slice2d the same way (render/Slice2DRenderer.h): on the ES 2 profiles its
@@ -189,36 +199,8 @@ TEST_F(ChannelSlices, Slice3dAdditiveHolds40DbInRgba8OnEs2Profiles) {
 // settings as above, against the reference; one plane a blend (no slabs)
 // is printed beside it.
 TEST_F(ChannelSlices, Slice2dAdditiveHolds40DbInRgba8OnEs2Profiles) {
-  ChannelSet set = readZarrChannels(store());
-  set.mode = ChannelMode::Additive;
-  Camera camera = test::orbitCamera(set.geometry(), 30.0, 20.0);
-  camera.projection = Projection::Orthographic;
-  RenderSettings settings = channelSettings();
-  settings.stepVoxels = 0.1;
-  settings.opacityScale = 20.0;
-  const TransferFunction grey = TransferFunction::preset("grey");
-  const Image ref = renderChannelsReference(set, grey, camera, settings, kSize, kSize);
-  for (const char* profile : {"webgl1-desktop-2012", "ipad2"}) {
-    test::ApiContext context(gpu::ApiLevel::Gles2);
-    gpu::GlContext& gl = context.get();
-    const gpu::DeviceLimits limits =
-        gpu::effectiveLimits(gpu::DeviceProfile::find(profile), gl.caps());
-    auto layout = layout::ChannelLayout::create(set, limits, gl.ledger());
-    double db[2] = {0.0, 0.0};
-    std::string note;
-    for (int slab : {1, 0}) {
-      auto slicer = render::Slice2DRenderer::create(
-          {gl, limits, set.geometry(), layout.get(), render::TechniqueOptions{}});
-      slicer->setTransferFunction(grey);
-      slicer->setSlabPlanes(slab);
-      db[slab == 0 ? 1 : 0] = psnr(slicer->renderImage(camera, settings, kSize, kSize), ref);
-      note = slicer->report().note;
-    }
-    std::printf("slice2d channels additive on %s (%s): %.1f dB, one plane a blend %.1f dB\n",
-                profile, note.c_str(), db[1], db[0]);
-    EXPECT_NE(note.find("accumulation RGBA8"), std::string::npos) << note;
-    EXPECT_GE(db[1], 40.0) << profile << " " << note;
-  }
+  expectEs2SlabsHold40Db<render::Slice2DRenderer>(
+      store(), "slice2d", [](render::Slice2DRenderer& r, int n) { r.setSlabPlanes(n); });
 }
 
 // A slab's fragment takes the planes behind its quad where its view ray

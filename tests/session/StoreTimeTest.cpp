@@ -605,6 +605,44 @@ int differingFrom(const std::string& store, int t, const lod::VoxelBox& box, con
   return differ;
 }
 
+// The region the series tests pick (the cube lies in it at every time
+// point), shown in the view from the exploration: how many of its voxels
+// differ from time point t's.
+const lod::VoxelBox kRegion{{4, 20, 20}, {64, 44, 44}};
+int showRegion(Session& s, const std::string& store, int t) {
+  Exploration& e = s.exploration();
+  e.show(s.view(), e.region(kRegion, Follow::Fill));
+  return differingFrom(store, t, kRegion, s.view().volume());
+}
+
+// Turns the camera and sets a window, as a user looking at the region; the
+// turned camera.
+Camera turnAndWindow(Session& s) {
+  s.view().camera().azimuthDeg += 25.0;
+  s.view().setWindow({10.0, 200.0});
+  return s.view().camera();
+}
+
+// The region carried over to time point t from `previous`: the same box and
+// crosshair (40, 30, 31), t's voxels (not previous's), the turned camera
+// and the window kept.
+void expectRegionCarriedOver(Session& s, const std::string& store, int t, int previous,
+                             const Camera& turned) {
+  ASSERT_EQ(s.exploration().mode(), ExploreMode::Region) << "time point " << t;
+  ASSERT_TRUE(s.exploration().shown().has_value());
+  EXPECT_EQ(s.exploration().shown()->begin, kRegion.begin);
+  EXPECT_EQ(s.exploration().shown()->end, kRegion.end);
+  EXPECT_EQ(s.exploration().explorer().crosshair(), glm::ivec3(40, 30, 31));
+  EXPECT_EQ(differingFrom(store, t, kRegion, s.view().volume()), 0)
+      << "the region shown at time point " << t << " is not its own";
+  EXPECT_GT(differingFrom(store, previous, kRegion, s.view().volume()), 0)
+      << "time points " << previous << " and " << t
+      << " do not differ in the box: the check proves nothing";
+  EXPECT_EQ(s.view().camera().eye(), turned.eye());
+  EXPECT_EQ(s.view().window().min, 10.0);
+  EXPECT_EQ(s.view().window().max, 200.0);
+}
+
 // The page's store with a t axis played over bricks, explored
 // (Session::exploreDrawn): the exploration is of the time point shown, and
 // a region shown in the view follows each time point as in core, read
@@ -644,13 +682,8 @@ TEST(StoreTime, ARegionOfASeriesTheFrontEndDrawsFollowsEachTimePointOnceItsChunk
   EXPECT_EQ(s.exploration().mode(), ExploreMode::Overview);
 
   // A region picked there is time point 3's voxels.
-  const lod::VoxelBox box{{4, 20, 20}, {64, 44, 44}};
-  Exploration& e = s.exploration();
-  e.show(s.view(), e.region(box, Follow::Fill));
-  EXPECT_EQ(differingFrom(store, 3, box, s.view().volume()), 0) << "not time point 3's region";
-  s.view().camera().azimuthDeg += 25.0;
-  s.view().setWindow({10.0, 200.0});
-  const Camera turned = s.view().camera();
+  EXPECT_EQ(showRegion(s, store, 3), 0) << "not time point 3's region";
+  const Camera turned = turnAndWindow(s);
 
   // Time point 4, read ahead, but the region's chunks have not arrived:
   // playback waits (a late frame), the region of time point 3 stays.
@@ -664,25 +697,15 @@ TEST(StoreTime, ARegionOfASeriesTheFrontEndDrawsFollowsEachTimePointOnceItsChunk
   ASSERT_TRUE(opened.count(4));
   EXPECT_GT(opened.at(4)->asked, 0) << "the region's chunks of time point 4 were not asked for";
   EXPECT_EQ(s.exploration().mode(), ExploreMode::Region);
-  EXPECT_EQ(differingFrom(store, 3, box, s.view().volume()), 0);
+  EXPECT_EQ(differingFrom(store, 3, kRegion, s.view().volume()), 0);
   EXPECT_GT(s.playback().lateFrames(), 0u);
 
   // They arrive: time point 4's region, the same box, camera and window.
   arrived.insert(4);
   now += 100.0;
   ASSERT_EQ(s.stepPlayback(now, true), 4);
-  ASSERT_EQ(s.exploration().mode(), ExploreMode::Region);
-  ASSERT_TRUE(s.exploration().shown().has_value());
-  EXPECT_EQ(s.exploration().shown()->begin, box.begin);
-  EXPECT_EQ(s.exploration().shown()->end, box.end);
+  expectRegionCarriedOver(s, store, 4, 3, turned);
   EXPECT_EQ(&s.exploration().explorer().source(), opened.at(4).get());
-  EXPECT_EQ(s.exploration().explorer().crosshair(), glm::ivec3(40, 30, 31));
-  EXPECT_EQ(differingFrom(store, 4, box, s.view().volume()), 0) << "not time point 4's region";
-  EXPECT_GT(differingFrom(store, 3, box, s.view().volume()), 0)
-      << "time points 3 and 4 do not differ in the box: the check proves nothing";
-  EXPECT_EQ(s.view().camera().eye(), turned.eye());
-  EXPECT_EQ(s.view().window().min, 10.0);
-  EXPECT_EQ(s.view().window().max, 200.0);
 }
 
 // The desktop's way (`view STORE --bricks`: the store opened in the view
@@ -708,13 +731,8 @@ TEST(StoreTime, ARegionShownInTheViewOverBricksFollowsEachTimePoint) {
   }
   ASSERT_TRUE(s.streamedFrames().shownComplete(2));
   s.exploration().explorer().setCrosshair({40, 30, 31});
-  const lod::VoxelBox box{{4, 20, 20}, {64, 44, 44}};
-  Exploration& e = s.exploration();
-  e.show(s.view(), e.region(box, Follow::Fill));
-  ASSERT_EQ(differingFrom(store, 2, box, s.view().volume()), 0) << "not time point 2's region";
-  s.view().camera().azimuthDeg += 25.0;
-  s.view().setWindow({10.0, 200.0});
-  const Camera turned = s.view().camera();
+  ASSERT_EQ(showRegion(s, store, 2), 0) << "not time point 2's region";
+  const Camera turned = turnAndWindow(s);
 
   s.playback().setFps(30.0);
   const auto start = std::chrono::steady_clock::now();
@@ -728,19 +746,8 @@ TEST(StoreTime, ARegionShownInTheViewOverBricksFollowsEachTimePoint) {
     const int t = s.stepPlayback(nowMs());
     if (t == shown.back()) continue;
     shown.push_back(t);
-    ASSERT_EQ(s.exploration().mode(), ExploreMode::Region) << "time point " << t;
-    ASSERT_TRUE(s.exploration().shown().has_value());
-    EXPECT_EQ(s.exploration().shown()->begin, box.begin);
-    EXPECT_EQ(s.exploration().shown()->end, box.end);
-    EXPECT_EQ(s.exploration().explorer().crosshair(), glm::ivec3(40, 30, 31));
-    EXPECT_EQ(differingFrom(store, t, box, s.view().volume()), 0)
-        << "the region shown at time point " << t << " is not its own";
-    EXPECT_GT(differingFrom(store, shown[shown.size() - 2], box, s.view().volume()), 0)
-        << "time points " << shown[shown.size() - 2] << " and " << t
-        << " do not differ in the box: the check proves nothing";
-    EXPECT_EQ(s.view().camera().eye(), turned.eye());
-    EXPECT_EQ(s.view().window().min, 10.0);
-    EXPECT_EQ(s.view().window().max, 200.0);
+    expectRegionCarriedOver(s, store, t, shown[shown.size() - 2], turned);
+    if (::testing::Test::HasFatalFailure()) return;
   }
   EXPECT_EQ(shown, (std::vector<int>{2, 3, 4, 0, 1})) << "playback with a region shown stalled";
 
