@@ -64,13 +64,7 @@ void main() {
     acc += (1.0 - acc.a) * c;
   }
 #ifdef DITHER_8BIT
-  // The 8-bit target rounds each blend; an offset of -0.5..0.5 of a level,
-  // interleaved gradient noise over the pixel shifted per slab (Jimenez
-  // 2014; slice3d.frag.glsl), makes the rounding unbiased on average. Empty
-  // fragments stay exactly 0.
-  vec2 noisePixel = gl_FragCoord.xy + 5.588238 * v_tileOrigin.x;
-  float noise = fract(52.9829189 * fract(dot(noisePixel, vec2(0.06711056, 0.00583715))));
-  if (acc.a > 0.0) acc = max(acc + (noise - 0.5) / 255.0, 0.0);
+  acc = ditherTo8Bits(acc, v_tileOrigin.x);  // slice_opacity.glsl, as slice3d does
 #endif
   FRAG_COLOR = acc;
 #endif

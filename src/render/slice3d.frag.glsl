@@ -80,15 +80,7 @@ void main() {
     acc += (1.0 - acc.a) * c;
   }
 #ifdef DITHER_8BIT
-  // The 8-bit target rounds each blend; a slab's small contribution would
-  // round the same way in every slab of a uniform region. An offset of
-  // -0.5..0.5 of a level, interleaved gradient noise over the pixel shifted
-  // per slab (Jimenez 2014), makes the rounding unbiased on average. Empty
-  // fragments stay exactly 0 (negative values round to 0 as well).
-  float slab = floor(v_slab);
-  vec2 noisePixel = gl_FragCoord.xy + 5.588238 * slab;
-  float noise = fract(52.9829189 * fract(dot(noisePixel, vec2(0.06711056, 0.00583715))));
-  if (acc.a > 0.0) acc = max(acc + (noise - 0.5) / 255.0, 0.0);
+  acc = ditherTo8Bits(acc, floor(v_slab));  // slice_opacity.glsl
 #endif
   FRAG_COLOR = acc;
 #endif
