@@ -13,12 +13,21 @@
 // fill_value, as Zarr defines); a key that keeps failing is handed over as
 // an error naming its URL (the coarser level stays on screen; it is fetched
 // again later).
+//
+// Zarr v3 shards are read with Range requests, as the native reader reads
+// them: the module asks for "KEY#bytes=A-B" (an inner chunk) or
+// "KEY#bytes=-N" (an index at the shard's end), never the whole shard. A
+// server that ignores Range (200 with the whole body) still works: from its
+// first such answer on, each shard is fetched whole once, kept a while
+// (WHOLE_BUDGET) and the ranges cut out of it here.
 'use strict';
 
 (function () {
   const CONNECTIONS = 6;
   const ATTEMPTS = 4;
   const TIMEOUT_MS = 60000;
+  // Whole shards held for a server that ignores Range.
+  const WHOLE_BUDGET = 64 * 1048576;
 
   // A URL whose path ends in .zarr (NAME.zarr, NAME.ome.zarr, with or
   // without a trailing slash).
@@ -33,16 +42,24 @@
   const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
   const retryable = (status) => status >= 500 || status === 408 || status === 429;
 
-  // {bytes} or {missing: true}; throws an Error naming the URL.
-  async function fetchKey(url) {
+  // {bytes, status, total} or {missing: true}; throws an Error naming the
+  // URL (and the range). `range`: a Range header's value ("bytes=0-99"),
+  // or none; `total` is the value's size a 206 states (Content-Range), or
+  // null.
+  async function fetchKey(url, range) {
+    const label = range ? `${url} (${range})` : url;
     let why = '';
     for (let attempt = 1; attempt <= ATTEMPTS; attempt++) {
       if (attempt > 1) await sleep(100 * 2 ** (attempt - 2) * (0.75 + 0.5 * Math.random()));
       const abort = new AbortController();
       const timer = setTimeout(() => abort.abort(), TIMEOUT_MS);
       try {
-        const r = await fetch(url, { signal: abort.signal });
+        const r = await fetch(url, { signal: abort.signal, headers: range ? { Range: range } : {} });
         if (r.status === 404) return { missing: true };
+        if (r.status === 416) {
+          why = 'HTTP 416: the range lies outside the value (a shard index that lies about its chunks?)';
+          break;
+        }
         if (!r.ok) {
           why = `HTTP ${r.status} ${r.statusText}`.trim();
           if (retryable(r.status)) continue;
@@ -54,7 +71,8 @@
           why = `truncated body (${bytes.length} of ${declared} bytes)`;
           continue;
         }
-        return { bytes };
+        const m = /\/(\d+)\s*$/.exec(r.headers.get('Content-Range') || '');
+        return { bytes, status: r.status, total: m ? parseInt(m[1], 10) : null };
       } catch (e) {
         why = e.name === 'AbortError' ? `no answer in ${TIMEOUT_MS / 1000} s`
           : `cannot fetch it (${e.message}): the server is unreachable, or it does not let this page read it (CORS)`;
@@ -62,8 +80,59 @@
         clearTimeout(timer);
       }
     }
-    throw new Error(`${url}: ${why} (after at most ${ATTEMPTS} attempts)`);
+    throw new Error(`${label}: ${why} (after at most ${ATTEMPTS} attempts)`);
   }
+
+  // crc32c (Castagnoli) of bytes, as Zarr v3's crc32c codec writes it.
+  const CRC32C = (() => {
+    const t = new Uint32Array(256);
+    for (let n = 0; n < 256; n++) {
+      let c = n;
+      for (let k = 0; k < 8; k++) c = c & 1 ? 0x82f63b78 ^ (c >>> 1) : c >>> 1;
+      t[n] = c >>> 0;
+    }
+    return t;
+  })();
+  function crc32c(bytes) {
+    let c = 0xffffffff;
+    for (let i = 0; i < bytes.length; i++) c = CRC32C[(c ^ bytes[i]) & 0xff] ^ (c >>> 8);
+    return (c ^ 0xffffffff) >>> 0;
+  }
+
+  // A v3 array's zarr.json as the page decodes its chunks: the compressor
+  // (the first bytes-to-bytes codec; only crc32c may follow it), the
+  // decoded chunk's bytes, and for a sharded array its index's place and
+  // size. null: nothing for the page to decode.
+  const V3_SIZES = { bool: 1, int8: 1, uint8: 1, int16: 2, uint16: 2, float16: 2, int32: 4, uint32: 4,
+    float32: 4, int64: 8, uint64: 8, float64: 8 };
+  function v3Array(meta) {
+    if (!meta || meta.node_type !== 'array' || !Array.isArray(meta.codecs)) return null;
+    let codecs = meta.codecs;
+    let chunk = meta.chunk_grid && meta.chunk_grid.configuration && meta.chunk_grid.configuration.chunk_shape;
+    let shard = null;
+    const sharding = codecs.find((c) => c && c.name === 'sharding_indexed');
+    if (sharding) {
+      const cfg = sharding.configuration || {};
+      if (!Array.isArray(cfg.chunk_shape) || !Array.isArray(chunk) || !Array.isArray(cfg.codecs)) return null;
+      const n = chunk.reduce((k, c, i) => k * Math.ceil(c / cfg.chunk_shape[i]), 1);
+      const crc = (cfg.index_codecs || []).some((c) => c && c.name === 'crc32c');
+      shard = { atEnd: (cfg.index_location || 'end') === 'end', indexBytes: n * 16 + (crc ? 4 : 0) };
+      chunk = cfg.chunk_shape;
+      codecs = cfg.codecs;
+    }
+    const at = codecs.findIndex((c) => c && c.name === 'bytes');
+    if (at < 0 || !Array.isArray(chunk)) return null;
+    const chain = codecs.slice(at + 1).map((c) => c && c.name);
+    const id = chain[0];
+    if (!['gzip', 'zstd', 'blosc'].includes(id) || chain.slice(1).some((c) => c !== 'crc32c')) {
+      return { shard, id: null };
+    }
+    const size = V3_SIZES[meta.data_type] || 0;
+    return { shard, id, crcs: chain.length - 1, chunkBytes: chunk.reduce((k, c) => k * c, size) };
+  }
+  // Whether "A-B" or "-N" of a sharded array's shard is its index.
+  const isIndexRange = (shard, range) => (shard.atEnd ? range.startsWith('-')
+    : range === `0-${shard.indexBytes - 1}`);
 
   // Chunks are decoded here as they arrive, once each (a brick read with
   // its apron touches up to 27 chunks: decoding them in every read cost
@@ -166,6 +235,7 @@
       put: c('tessera_zarr_put', null, ['string', 'number', 'number']),
       putMissing: c('tessera_zarr_put_missing', null, ['string']),
       putFailed: c('tessera_zarr_put_failed', null, ['string', 'string']),
+      putRange: c('tessera_zarr_put_range', null, ['string', 'number', 'number', 'number', 'number']),
       frame: c('tessera_zarr_frame', 'string', ['number', 'number', 'number']),
       refine: c('tessera_zarr_refine', 'string', []),
       refining: c('tessera_zarr_refining', 'number', []),
@@ -192,10 +262,16 @@
     let bricksRead = 0;
     let regionShown = false;  // the viewer shows a region read from the store
     let pinned = [];          // a region's chunk keys not arrived yet: fetched first
-    const arrays = new Map();  // array path ('' for a root array) -> {id, config, chunkBytes, codec}
+    const arrays = new Map();  // array path ('' for a root array) -> {id, codec, chunkBytes, crcs, shard}
+    let rangesIgnored = false;  // the server answered a Range request with the whole body
+    const wholes = new Map();   // key -> Promise of its whole body ({bytes} or {missing}), oldest first
+    const wholeSizes = new Map();  // key -> bytes of a whole body arrived
+    let wholeBytes = 0;
     const record = { url: '', requests: 0, bytes: 0, timeline: [], calls: [], firstImageMs: null, completeMs: null,
-      openMs: null, info: null, errors: [], decodes: [], tasks: [] };
+      openMs: null, info: null, errors: [], decodes: [], tasks: [], rangeRequests: 0, wholeBodies: 0 };
 
+    // `r`: {missing}, or {bytes} of a key, or of a range key {bytes, total,
+    // decoded}.
     function put(key, r) {
       if (r.missing) {
         api.putMissing(key);
@@ -207,19 +283,111 @@
         return;
       }
       M.HEAPU8.set(r.bytes, p);
-      api.put(key, p, r.bytes.length);  // owned (and freed) by the module
+      // Owned (and freed) by the module.
+      if (r.total !== undefined) api.putRange(key, p, r.bytes.length, r.total, r.decoded ? 1 : 0);
+      else api.put(key, p, r.bytes.length);
+    }
+
+    const isMeta = (key) => /(^|\/)(\.zarray|\.zattrs|\.zgroup|zarr\.json)$/.test(key);
+
+    // The whole value of `key` (a shard, for a server that ignores Range):
+    // fetched once while it is held.
+    function wholeBody(key, url) {
+      let p = wholes.get(key);
+      if (!p) {
+        p = fetchKey(url).then((r) => {
+          record.requests++;
+          record.wholeBodies++;
+          if (r.bytes) record.bytes += r.bytes.length;
+          return r;
+        });
+        keepWhole(key, p);
+      }
+      return p;
+    }
+    function keepWhole(key, p) {
+      wholes.set(key, p);
+      p.then((r) => {
+        if (wholes.get(key) !== p || !r.bytes) return;
+        wholeSizes.set(key, r.bytes.length);
+        wholeBytes += r.bytes.length;
+        // The oldest out while over the budget; this one stays.
+        for (const k of wholes.keys()) {
+          if (wholeBytes <= WHOLE_BUDGET || k === key) break;
+          wholes.delete(k);
+          wholeBytes -= wholeSizes.get(k) || 0;
+          wholeSizes.delete(k);
+        }
+      }, () => {
+        if (wholes.get(key) === p) wholes.delete(key);
+      });
+    }
+
+    // Bytes `range` ("A-B" or "-N") of `key`: {bytes, total} or {missing}.
+    async function fetchRange(key, url, range) {
+      const [a, b] = range.split('-');
+      const length = a === '' ? parseInt(b, 10) : parseInt(b, 10) - parseInt(a, 10) + 1;
+      let whole;
+      if (!rangesIgnored && !wholes.has(key)) {
+        const r = await fetchKey(url, `bytes=${range}`);
+        record.requests++;
+        record.rangeRequests++;
+        if (r.missing) return r;
+        record.bytes += r.bytes.length;
+        if (r.status === 206) {
+          if (r.total === null) {
+            throw new Error(`${url} (bytes ${range}): HTTP 206 without a readable Content-Range total ` +
+              '(a server on another origin must expose it: Access-Control-Expose-Headers: Content-Range)');
+          }
+          if (r.bytes.length !== length) {
+            throw new Error(`${url}: range ${range} answered with ${r.bytes.length} bytes, expected ${length}`);
+          }
+          return { bytes: r.bytes, total: r.total };
+        }
+        // 200: the server ignores Range; the whole body is here.
+        rangesIgnored = true;
+        record.wholeBodies++;
+        whole = r;
+        if (!wholes.has(key)) keepWhole(key, Promise.resolve(r));
+      } else {
+        whole = await wholeBody(key, url);
+        if (whole.missing) return whole;
+      }
+      const total = whole.bytes.length;
+      const begin = a === '' ? total - length : parseInt(a, 10);
+      if (begin < 0 || begin + length > total) {
+        throw new Error(`${url}: bytes ${range} asked of a value of ${total} bytes`);
+      }
+      return { bytes: whole.bytes.slice(begin, begin + length), total };
     }
 
     async function start(key) {
       inFlight.add(key);
-      const url = `${base}/${key}`;
+      const hash = key.indexOf('#bytes=');
+      const path = hash < 0 ? key : key.slice(0, hash);
+      const range = hash < 0 ? '' : key.slice(hash + '#bytes='.length);
+      const url = `${base}/${path}`;
       try {
-        let r = await fetchKey(url);
-        record.requests++;
-        if (r.bytes) {
-          record.bytes += r.bytes.length;
-          if (key === '.zarray' || key.endsWith('/.zarray')) await noteArray(key, r.bytes);
-          else r = await decodeInPage(key, url, r);
+        let r;
+        if (range) {
+          r = await fetchRange(path, url, range);
+          const array = r.bytes ? arrayOf(path) : null;
+          if (array && array.shard && array.codec && !isIndexRange(array.shard, range)) {
+            r = { ...(await decodeInPage(path, `${url} (bytes ${range})`, r)), total: r.total, decoded: true };
+          }
+        } else {
+          r = await fetchKey(url);
+          record.requests++;
+          if (r.bytes) {
+            record.bytes += r.bytes.length;
+            if (key === '.zarray' || key.endsWith('/.zarray') || key === 'zarr.json' || key.endsWith('/zarr.json')) {
+              await noteArray(key, r.bytes);
+            } else if (!isMeta(key)) {
+              const array = arrayOf(key);
+              if (!array || !array.shard) r = await decodeInPage(key, url, r);
+            }
+            r = { bytes: r.bytes };
+          }
         }
         const putAt = performance.now();
         if (base) put(key, r);
@@ -236,9 +404,11 @@
       }
     }
 
-    // A .zarray's compressor: blosc and zstd chunks are decoded here when
-    // numcodecs loads (the wasm side is told so); otherwise its decoder
-    // says that it cannot decode them.
+    // A .zarray's compressor, or a v3 zarr.json's (its shard's inner
+    // chunks'): blosc and zstd chunks are decoded here when numcodecs loads
+    // (the wasm side is told so), gzip and zlib with pako; otherwise its
+    // decoder says that it cannot decode them. A v3 chunk's crc32c is
+    // checked here before it is decoded.
     async function noteArray(key, bytes) {
       let meta;
       try {
@@ -246,12 +416,16 @@
       } catch {
         return;  // the store reader reports it
       }
-      const path = key.slice(0, key.length - '.zarray'.length).replace(/\/$/, '');
-      const id = meta && meta.compressor && meta.compressor.id;
-      const Codec = PAGE_CODECS.has(id) && Array.isArray(meta.chunks) ? await loadCodec(id) : null;
-      const codec = Codec ? Codec.fromConfig(meta.compressor) : null;
+      const v3 = key === 'zarr.json' || key.endsWith('/zarr.json');
+      const path = key.slice(0, key.length - (v3 ? 'zarr.json' : '.zarray').length).replace(/\/$/, '');
+      const a3 = v3 ? v3Array(meta) : null;
+      if (v3 && !a3) return;  // a group, or not read (the store reader says why)
+      const id = v3 ? a3.id : meta && meta.compressor && meta.compressor.id;
+      const Codec = PAGE_CODECS.has(id) && (v3 || Array.isArray(meta.chunks)) ? await loadCodec(id) : null;
+      const codec = Codec ? Codec.fromConfig(v3 ? {} : meta.compressor) : null;
       arrays.set(path, { id, codec: codec && (Codec === pakoCodec ? codec : { decode: inIdleTime((b) => codec.decode(b)) }),
-        chunkBytes: Codec ? chunkBytesOf(meta) : 0 });
+        chunkBytes: Codec ? (v3 ? a3.chunkBytes : chunkBytesOf(meta)) : 0, crcs: v3 ? a3.crcs || 0 : 0,
+        shard: v3 ? a3.shard : null });
       if (Codec && base) api.pageDecodes(id);
     }
 
@@ -272,9 +446,23 @@
       const array = arrayOf(key);
       if (!array || !array.codec) return r;
       let raw;
+      let stored = r.bytes;
+      for (let k = 0; k < array.crcs; k++) {
+        // crc32c codecs after the compressor: the last one applied first.
+        if (stored.length < 4) throw new Error(`${url}: chunk of ${stored.length} bytes has no room for its crc32c`);
+        const body = stored.subarray(0, stored.length - 4);
+        const tail = stored.subarray(stored.length - 4);
+        const want = (tail[0] | (tail[1] << 8) | (tail[2] << 16) | (tail[3] << 24)) >>> 0;
+        const got = crc32c(body);
+        if (got !== want) {
+          throw new Error(`${url}: crc32c mismatch (stored ${want.toString(16).padStart(8, '0')}, ` +
+            `computed ${got.toString(16).padStart(8, '0')})`);
+        }
+        stored = body;
+      }
       const decodeAt = performance.now();
       try {
-        const d = await array.codec.decode(r.bytes);
+        const d = await array.codec.decode(stored);
         raw = d.raw;
         // busy: the decoder's own time; slice_ms: its longest task; ms: until done.
         record.decodes.push({ t: decodeAt - t0, ms: performance.now() - decodeAt, busy_ms: d.busyMs,
@@ -326,7 +514,8 @@
       base = resolved;
       name = decodeURIComponent(resolved.split('/').pop() || 'store');
       Object.assign(record, { url: resolved, requests: 0, bytes: 0, timeline: [], calls: [], firstImageMs: null,
-        completeMs: null, openMs: null, info: null, errors: [], decodes: [], tasks: [] });
+        completeMs: null, openMs: null, info: null, errors: [], decodes: [], tasks: [], rangeRequests: 0,
+        wholeBodies: 0 });
       t0 = performance.now();
       ui.progress(0, 0);
       ui.status(`opening ${resolved}…`);
@@ -455,6 +644,10 @@
       regionShown = false;
       pinned = [];
       arrays.clear();
+      wholes.clear();
+      wholeSizes.clear();
+      wholeBytes = 0;
+      rangesIgnored = false;
       if (base) api.close();
       base = '';
       open = false;

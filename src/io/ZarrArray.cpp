@@ -278,6 +278,7 @@ std::string zarrayJson(const std::vector<std::int64_t>& shape,
 
 std::vector<std::byte> decodedZarrChunk(const ZarrArrayMeta& meta, std::vector<std::byte> raw,
                                         const std::string& where) {
+  if (meta.format == 3) return io_detail::decodedZarrV3Chunk(meta, std::move(raw), where);
   if (raw.size() != meta.chunkBytes()) {
     throw InputError(where + ": decoded " + meta.compressorText + " chunk has " +
                      std::to_string(raw.size()) + " bytes, expected " +

@@ -92,19 +92,17 @@ ChannelSet readZarrChannels(std::shared_ptr<const ZarrStorage> storage, const st
   return set;
 }
 
-std::vector<std::string> zarrChannelKeys(std::shared_ptr<const ZarrStorage> storage,
-                                         const std::string& name, const std::vector<int>& indices,
-                                         int time) {
+bool holdsZarrChannelReads(std::shared_ptr<const ZarrStorage> storage, const std::string& name,
+                           const std::vector<int>& indices, int time,
+                           const std::function<bool(const ZarrStoredRead&)>& holds) {
   const ZarrStore first(storage, ZarrSelection{.time = time, .channel = 0});
-  std::vector<std::string> keys;
+  bool all = true;
   for (int c : zarrChannelIndices(first, name, indices)) {
     const ZarrStore store(storage, ZarrSelection{.time = time, .channel = c});
     const int l = store.finestLevelInHostBudget(name);
-    for (std::string& k : store.chunkKeys(l, glm::ivec3(0), store.level(l).dims)) {
-      keys.push_back(std::move(k));
-    }
+    all = store.holdsReads(l, glm::ivec3(0), store.level(l).dims, holds) && all;
   }
-  return keys;
+  return all;
 }
 
 }  // namespace tessera

@@ -41,5 +41,10 @@ namespace io_detail {
 std::vector<std::byte> decodeZarrV3Chunk(const ZarrArrayMeta& meta,
                                          std::span<const std::byte> stored,
                                          const std::string& where);
+// A Zarr v3 chunk whose storage applied its compressor (and checked its
+// crc32c) already (ZarrStorage::decodesChunks): its size checked, then
+// the transpose codec undone.
+std::vector<std::byte> decodedZarrV3Chunk(const ZarrArrayMeta& meta, std::vector<std::byte> raw,
+                                          const std::string& where);
 }  // namespace io_detail
 }  // namespace tessera

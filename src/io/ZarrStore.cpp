@@ -751,7 +751,7 @@ ZarrChunkCache::Chunk ZarrStore::decodeChunk(const ZarrArrayMeta& m, const std::
   }
   const std::string where =
       storage_->locate(key) + (inner >= 0 ? " (inner chunk " + std::to_string(inner) + ")" : "");
-  const bool decoded = m.format == 2 && storage_->decodesChunks(m.compressor);
+  const bool decoded = storage_->decodesChunks(m.compressor);
   for (int attempt = 0;; ++attempt) {
     std::optional<std::vector<std::byte>> stored;
     if (inner >= 0) {
@@ -820,6 +820,62 @@ std::vector<std::string> ZarrStore::chunkKeys(int l, glm::ivec3 begin, glm::ivec
     }
   }
   return keys;
+}
+
+bool ZarrStore::holdsReads(int l, glm::ivec3 begin, glm::ivec3 end,
+                           const std::function<bool(const ZarrStoredRead&)>& holds) const {
+  const ZarrLevel& lv = level(l);
+  const ZarrArrayMeta& m = lv.array;
+  const std::string prefix = lv.path.empty() ? "" : lv.path + "/";
+  const glm::ivec3 c0 = glm::max(begin, glm::ivec3(0)) / lv.chunk;
+  const glm::ivec3 c1 = (glm::min(end, lv.dims) - 1) / lv.chunk + 1;
+  bool all = true;
+  // Sharded: each shard's index once known (nullptr: an absent shard), or
+  // not held yet (absent from the map's values: `pendingShards`).
+  std::map<std::string, std::shared_ptr<const ShardIndex>> indexes;
+  std::vector<std::string> pendingShards;
+  for (int z = c0.z; z < c1.z; ++z) {
+    for (int y = c0.y; y < c1.y; ++y) {
+      for (int x = c0.x; x < c1.x; ++x) {
+        const std::vector<std::int64_t> index = chunkIndexAt(l, {x, y, z});
+        std::string key = prefix + m.chunkKey(index);
+        if (!m.sharded()) {
+          all = holds(ZarrStoredRead{.key = std::move(key)}) && all;
+          continue;
+        }
+        if (std::find(pendingShards.begin(), pendingShards.end(), key) != pendingShards.end()) {
+          continue;
+        }
+        auto it = indexes.find(key);
+        if (it == indexes.end()) {
+          bool known = false;
+          {
+            const std::lock_guard lock(shardMutex_);
+            known = shards_.count(key) != 0;
+          }
+          const std::uint64_t n = m.shardIndexBytes();
+          if (!known && !holds(ZarrStoredRead{.key = key,
+                                              .whole = false,
+                                              .offset = m.indexAtEnd ? -std::int64_t(n) : 0,
+                                              .length = n})) {
+            all = false;
+            pendingShards.push_back(std::move(key));
+            continue;
+          }
+          it = indexes.emplace(key, shardIndex(m, key)).first;
+        }
+        if (!it->second) continue;  // an absent shard: fill_value
+        const ZarrShardEntry& e = it->second->entries[std::size_t(m.innerChunkIndex(index))];
+        if (e.missing()) continue;
+        all = holds(ZarrStoredRead{.key = std::move(key),
+                                   .whole = false,
+                                   .offset = std::int64_t(e.offset),
+                                   .length = e.bytes}) &&
+              all;
+      }
+    }
+  }
+  return all;
 }
 
 void ZarrStore::readChunkInto(int l, const std::vector<std::int64_t>& spatial, glm::ivec3 begin,

@@ -475,6 +475,17 @@ std::vector<std::byte> decodeZarrV3Chunk(const ZarrArrayMeta& m, std::span<const
   return buf;
 }
 
+std::vector<std::byte> decodedZarrV3Chunk(const ZarrArrayMeta& m, std::vector<std::byte> raw,
+                                          const std::string& where) {
+  if (raw.size() != m.chunkBytes()) {
+    throw InputError(where + ": decoded " + m.compressorText + " chunk has " +
+                     std::to_string(raw.size()) + " bytes, expected " +
+                     std::to_string(m.chunkBytes()) + " (" + m.dtype + " chunk)");
+  }
+  if (!m.transpose.empty()) return untranspose(m, std::move(raw));
+  return raw;
+}
+
 }  // namespace io_detail
 
 std::vector<ZarrShardEntry> parseShardIndex(const ZarrArrayMeta& m,

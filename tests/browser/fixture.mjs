@@ -104,7 +104,11 @@ const TYPES = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/ja
   '.css': 'text/css', '.wasm': 'application/wasm', '.png': 'image/png', '.json': 'application/json' };
 // Data prefixes serve their folder trees (an OME-Zarr store is one); a test
 // may slow some paths down (served.delayMs) and count what was served.
-export const served = { delayMs: () => 0, fails: () => false, requests: 0, bytes: 0, paths: [] };
+// A single-range Range header ("bytes=A-B", "bytes=A-", "bytes=-N") is
+// answered 206 with Content-Range, as nginx does, unless served.ranges is
+// false (a server that ignores Range: 200 with the whole body); `log` has
+// each answer's path, range, status and body bytes.
+export const served = { delayMs: () => 0, fails: () => false, ranges: true, requests: 0, bytes: 0, paths: [], log: [] };
 export async function serve(dir, dataDirs) {
   const server = http.createServer((req, res) => {
     const p = decodeURIComponent(new URL(req.url, 'http://x').pathname);
@@ -117,18 +121,39 @@ export async function serve(dir, dataDirs) {
       served.requests++;
       served.paths.push(p);
       if (served.fails(p)) {
+        served.log.push({ path: p, range: req.headers.range || '', status: 500, bytes: 0 });
         res.writeHead(500, { 'Content-Type': 'text/plain' });
         res.end('injected failure');
         return;
       }
       if (err || !st.isFile()) {
+        served.log.push({ path: p, range: req.headers.range || '', status: 404, bytes: 0 });
         res.writeHead(404, { 'Content-Type': 'text/plain' });
         res.end('not found');
         return;
       }
+      const type = TYPES[path.extname(file)] || 'application/octet-stream';
+      const range = /^bytes=(\d*)-(\d*)$/.exec(req.headers.range || '');
+      if (range && served.ranges && (range[1] !== '' || range[2] !== '')) {
+        const size = st.size;
+        const start = range[1] === '' ? Math.max(0, size - parseInt(range[2], 10)) : parseInt(range[1], 10);
+        const end = range[1] === '' || range[2] === '' ? size - 1 : Math.min(size - 1, parseInt(range[2], 10));
+        if (start >= size || end < start) {
+          served.log.push({ path: p, range: req.headers.range, status: 416, bytes: 0 });
+          res.writeHead(416, { 'Content-Range': `bytes */${size}` });
+          res.end();
+          return;
+        }
+        served.bytes += end - start + 1;
+        served.log.push({ path: p, range: req.headers.range, status: 206, bytes: end - start + 1 });
+        res.writeHead(206, { 'Content-Type': type, 'Content-Length': end - start + 1,
+          'Content-Range': `bytes ${start}-${end}/${size}`, 'Cache-Control': 'no-store' });
+        fs.createReadStream(file, { start, end }).pipe(res);
+        return;
+      }
       served.bytes += st.size;
-      res.writeHead(200, { 'Content-Type': TYPES[path.extname(file)] || 'application/octet-stream',
-        'Content-Length': st.size, 'Cache-Control': 'no-store' });
+      served.log.push({ path: p, range: req.headers.range || '', status: 200, bytes: st.size });
+      res.writeHead(200, { 'Content-Type': type, 'Content-Length': st.size, 'Cache-Control': 'no-store' });
       fs.createReadStream(file).pipe(res);
     }, served.delayMs(p)));
   });

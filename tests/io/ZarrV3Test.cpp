@@ -8,6 +8,8 @@
 #include <bit>
 #include <cstring>
 #include <fstream>
+#include <mutex>
+#include <set>
 
 #include <nlohmann/json.hpp>
 
@@ -208,6 +210,138 @@ TEST(ZarrV3, AMissingShardIsFillValueAndKeysFollowTheEncoding) {
       "v2keys/zarr.json");
   const std::int64_t idx[3] = {1, 0, 1};
   EXPECT_EQ(meta.chunkKey(idx), "1.0.1");
+}
+
+// A storage that records the reads a store makes of it (metadata aside).
+class RecordingStorage final : public ZarrStorage {
+ public:
+  explicit RecordingStorage(std::shared_ptr<const ZarrStorage> inner) : inner_(std::move(inner)) {}
+  std::optional<std::vector<std::byte>> get(const std::string& key,
+                                            std::uint64_t maxBytes) const override {
+    const bool metadata = key.ends_with("zarr.json") || key.ends_with(".zattrs") ||
+                          key.ends_with(".zgroup") || key.ends_with(".zarray");
+    if (!metadata) note({.key = key});
+    return inner_->get(key, maxBytes);
+  }
+  std::optional<ZarrRange> getRange(const std::string& key, std::int64_t offset,
+                                    std::uint64_t length, std::uint64_t maxWhole) const override {
+    note({.key = key, .whole = false, .offset = offset, .length = length});
+    return inner_->getRange(key, offset, length, maxWhole);
+  }
+  std::string locate(const std::string& key) const override { return inner_->locate(key); }
+  std::string describe() const override { return inner_->describe(); }
+  int parallelism() const override { return 1; }
+  std::set<std::string> reads() const {
+    const std::lock_guard lock(mutex_);
+    return reads_;
+  }
+  void clear() {
+    const std::lock_guard lock(mutex_);
+    reads_.clear();
+  }
+
+ private:
+  void note(const ZarrStoredRead& r) const {
+    const std::lock_guard lock(mutex_);
+    reads_.insert(describeRead(r));
+  }
+  std::shared_ptr<const ZarrStorage> inner_;
+  mutable std::mutex mutex_;
+  mutable std::set<std::string> reads_;
+
+ public:
+  static std::string describeRead(const ZarrStoredRead& r) {
+    return r.whole ? r.key
+                   : r.key + "@" + std::to_string(r.offset) + "+" + std::to_string(r.length);
+  }
+};
+
+// What an asynchronous storage is told to fetch before a read
+// (ZarrStore::holdsReads) is exactly what the read then reads: each
+// shard's index, then the ranges of the inner chunks the box touches
+// (absent ones and absent shards need none); an index not held yet keeps
+// its shard's chunks unasked, and one the store has read is not asked again.
+TEST(ZarrV3, HoldsReadsListsExactlyTheReadsOfReadBox) {
+  const auto asks = [](const ZarrStore& store, int l, glm::ivec3 begin, glm::ivec3 end,
+                       const std::function<bool(const ZarrStoredRead&)>& holds, bool* all) {
+    std::set<std::string> asked;
+    *all = store.holdsReads(l, begin, end, [&](const ZarrStoredRead& r) {
+      asked.insert(RecordingStorage::describeRead(r));
+      return holds(r);
+    });
+    return asked;
+  };
+  const auto everything = [](const ZarrStoredRead&) { return true; };
+  bool all = false;
+  // Hand-built shards, the index at either end, absent inner chunks and an
+  // absent shard: what is asked equals what readBox reads.
+  const struct {
+    glm::ivec3 begin, end;
+  } boxes[] = {{{0, 0, 0}, {7, 5, 6}},
+               {{1, 1, 1}, {3, 4, 3}},
+               {{4, 0, 4}, {7, 5, 6}},
+               {{3, 3, 3}, {5, 5, 5}}};
+  for (int variant = 0; variant < 2; ++variant) {
+    HandShards h;
+    h.indexAtStart = variant == 1;
+    h.gzip = true;
+    h.skip = {1, 6};
+    auto memory = h.storage();
+    auto partial = std::make_shared<MemoryStorage>("mem://hand.zarr");  // shard (1,1,1) absent
+    for (const char* k : {"zarr.json", "c/0/0/0", "c/0/0/1", "c/0/1/0", "c/0/1/1", "c/1/0/0",
+                          "c/1/0/1", "c/1/1/0"}) {
+      partial->put(k, *memory->get(k, 1 << 20));
+    }
+    for (const auto& storage : {std::shared_ptr<const ZarrStorage>(memory),
+                                std::shared_ptr<const ZarrStorage>(partial)}) {
+      for (const auto& box : boxes) {
+        SCOPED_TRACE(std::to_string(variant) + " box " + std::to_string(box.begin.x) + "," +
+                     std::to_string(box.begin.y) + "," + std::to_string(box.begin.z));
+        // Opening this lone array read its range, so every index: both
+        // stores read only inner chunks after that.
+        auto recording = std::make_shared<RecordingStorage>(storage);
+        const ZarrStore reader(recording);
+        recording->clear();
+        reader.readBox(0, box.begin, box.end);
+        const ZarrStore asker(storage);
+        EXPECT_EQ(asks(asker, 0, box.begin, box.end, everything, &all), recording->reads());
+        EXPECT_TRUE(all);
+      }
+    }
+  }
+  // Tessera's own sharded store: level 0's indexes are not read when it
+  // opens. Not held, only they are asked for; then exactly the reads of
+  // readBox; once read, never again.
+  TempDir tmp;
+  OmeZarrWriteOptions o;
+  o.chunk = 16;
+  o.zarrFormat = 3;
+  o.shard = 2;
+  writeOmeZarr(test::randomVolume({90, 70, 50}, ScalarType::I16, 3), tmp / "s.ome.zarr", o);
+  const auto storage = openZarrStorage((tmp / "s.ome.zarr").string());
+  const std::string index = "@-" + std::to_string(8 * 16 + 4) + "+" + std::to_string(8 * 16 + 4);
+  for (const auto& box : {std::pair{glm::ivec3(0), glm::ivec3(90, 70, 50)},
+                          std::pair{glm::ivec3(5, 13, 9), glm::ivec3(71, 50, 33)},
+                          std::pair{glm::ivec3(31, 31, 31), glm::ivec3(33, 33, 33)}}) {
+    auto recording = std::make_shared<RecordingStorage>(storage);
+    const ZarrStore reader(recording);
+    recording->clear();  // what opening read (the coarsest level)
+    reader.readBox(0, box.first, box.second);
+    const ZarrStore asker(storage);
+    const auto noIndexes = [&](const ZarrStoredRead& r) { return r.offset >= 0; };
+    const std::set<std::string> indexes = asks(asker, 0, box.first, box.second, noIndexes, &all);
+    EXPECT_FALSE(all);
+    std::size_t shards = 0;
+    for (const std::string& r : recording->reads()) shards += r.ends_with(index) ? 1 : 0;
+    EXPECT_GT(shards, 0u);
+    EXPECT_EQ(indexes.size(), shards);
+    for (const std::string& a : indexes) EXPECT_TRUE(a.ends_with(index)) << a;
+    EXPECT_EQ(asks(asker, 0, box.first, box.second, everything, &all), recording->reads());
+    EXPECT_TRUE(all);
+    const std::set<std::string> again = asks(asker, 0, box.first, box.second, everything, &all);
+    EXPECT_EQ(again.size(), recording->reads().size() - shards);
+    for (const std::string& a : again) EXPECT_FALSE(a.ends_with(index)) << a;
+  }
 }
 
 // Tessera's v3 stores (zstd sharded, blosc unsharded, gzip sharded) read

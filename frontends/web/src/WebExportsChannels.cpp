@@ -28,11 +28,10 @@ session::ChannelView& channelView() {
 bool channelKeysReady(const std::shared_ptr<const ZarrStorage>& storage,
                       const web::FetchStorage& fetch, const std::string& name,
                       const std::vector<int>& indices, int time) {
-  bool ready = true;
-  for (const std::string& key : zarrChannelKeys(storage, name, indices, time)) {
-    ready = fetch.ready(key) && ready;  // lists every key still to fetch
-  }
-  return ready;
+  // Lists every read still to fetch.
+  return holdsZarrChannelReads(storage, name, indices, time, [&](const ZarrStoredRead& read) {
+    return fetch.ready(web::FetchStorage::keyOf(read));
+  });
 }
 
 // A store with a t axis: its channels play together (ChannelView::showSeries),

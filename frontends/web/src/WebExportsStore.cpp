@@ -118,6 +118,18 @@ EMSCRIPTEN_KEEPALIVE void tessera_zarr_put(const char* key, std::uint8_t* bytes,
   const auto* b = reinterpret_cast<const std::byte*>(bytes);
   z->storage().put(key, std::vector<std::byte>(b, b + std::max(0, size)));
 }
+// A fetched range of a key (its key from tessera_zarr_wanted, "KEY#bytes=A-B"):
+// its bytes (freed here), the whole value's size, and 1 when the page
+// decoded them (a shard's inner chunk of a compressor it decodes).
+EMSCRIPTEN_KEEPALIVE void tessera_zarr_put_range(const char* key, std::uint8_t* bytes, int size,
+                                                 double total, int decoded) {
+  const std::unique_ptr<std::uint8_t, decltype(&std::free)> owned(bytes, &std::free);
+  web::ZarrStoreView* z = storeIfAny();
+  if (!z) return;
+  const auto* b = reinterpret_cast<const std::byte*>(bytes);
+  z->storage().putRange(key, std::vector<std::byte>(b, b + std::max(0, size)),
+                        static_cast<std::uint64_t>(std::max(0.0, total)), decoded != 0);
+}
 EMSCRIPTEN_KEEPALIVE void tessera_zarr_put_missing(const char* key) {
   if (web::ZarrStoreView* z = storeIfAny()) z->storage().putMissing(key);
 }

@@ -41,11 +41,10 @@ class StoreTimePoints {
   bool arrived(int t) {
     try {
       const ZarrStore& s = at(t);
-      bool ready = true;
-      for (const std::string& key : s.chunkKeys(0, glm::ivec3(0), s.level(0).dims)) {
-        ready = storage_->ready(key) && ready;  // lists every key it lacks
-      }
-      return ready;
+      // Lists every read it lacks.
+      return s.holdsReads(0, glm::ivec3(0), s.level(0).dims, [&](const ZarrStoredRead& read) {
+        return storage_->ready(FetchStorage::keyOf(read));
+      });
     } catch (const KeyNotFetched&) {
       return false;
     }

@@ -58,28 +58,68 @@ std::vector<std::string> FetchStorage::takeWanted() const {
   return keys;
 }
 
-std::optional<std::vector<std::byte>> FetchStorage::get(const std::string& key,
-                                                        std::uint64_t maxBytes) const {
+const FetchStorage::Entry* FetchStorage::arrived(const std::string& key) const {
   const auto it = entries_.find(key);
   if (it == entries_.end()) {
     want(key);
     throw KeyNotFetched(locate(key) + ": not fetched yet");
   }
-  Entry& e = it->second;
+  const Entry& e = it->second;
   uses_.splice(uses_.begin(), uses_, e.use);
   switch (e.state) {
     case State::Missing:
-      return std::nullopt;
+      return nullptr;
     case State::Failed:
       throw Error(e.error);
     case State::Bytes:
       break;
   }
-  if (e.bytes.size() > maxBytes) {
-    throw InputError(locate(key) + ": " + std::to_string(e.bytes.size()) +
+  return &e;
+}
+
+std::optional<std::vector<std::byte>> FetchStorage::get(const std::string& key,
+                                                        std::uint64_t maxBytes) const {
+  const Entry* e = arrived(key);
+  if (!e) return std::nullopt;
+  if (e->bytes.size() > maxBytes) {
+    throw InputError(locate(key) + ": " + std::to_string(e->bytes.size()) +
                      " bytes, more than the " + std::to_string(maxBytes) + " this key may hold");
   }
-  return e.bytes;
+  return e->bytes;
+}
+
+std::string FetchStorage::rangeKey(const std::string& key, std::int64_t offset,
+                                   std::uint64_t length) {
+  std::string range = key;
+  range.append("#bytes=");
+  if (offset < 0) return range.append("-").append(std::to_string(length));
+  return range.append(std::to_string(offset))
+      .append("-")
+      .append(std::to_string(std::uint64_t(offset) + length - 1));
+}
+
+std::string FetchStorage::keyOf(const ZarrStoredRead& read) {
+  return read.whole ? read.key : rangeKey(read.key, read.offset, read.length);
+}
+
+std::optional<ZarrRange> FetchStorage::getRange(const std::string& key, std::int64_t offset,
+                                                std::uint64_t length,
+                                                std::uint64_t maxWhole) const {
+  if (length == 0) throw InputError(locate(key) + ": an empty range asked");
+  const std::string range = rangeKey(key, offset, length);
+  const Entry* e = arrived(range);
+  if (!e) return std::nullopt;
+  const std::string where = url_ + "/" + range;
+  if (e->total > maxWhole) {
+    throw InputError(where + ": " + std::to_string(e->total) + " bytes, more than the " +
+                     std::to_string(maxWhole) + " any valid content of this key can have");
+  }
+  // An inner chunk the page decoded is checked by the store's decoder.
+  if (!e->decoded && e->bytes.size() != length) {
+    throw InputError(where + ": answered with " + std::to_string(e->bytes.size()) +
+                     " bytes, expected " + std::to_string(length));
+  }
+  return ZarrRange{e->bytes, e->total};
 }
 
 void FetchStorage::insert(const std::string& key, Entry entry) {
@@ -103,6 +143,18 @@ void FetchStorage::put(const std::string& key, std::vector<std::byte> bytes) {
   Entry e;
   e.bytes = std::move(bytes);
   insert(key, std::move(e));
+}
+
+void FetchStorage::putRange(const std::string& rangeKey, std::vector<std::byte> bytes,
+                            std::uint64_t total, bool decoded) {
+  ++stats_.keys;
+  ++stats_.ranges;
+  stats_.bytes += bytes.size();
+  Entry e;
+  e.bytes = std::move(bytes);
+  e.total = total;
+  e.decoded = decoded;
+  insert(rangeKey, std::move(e));
 }
 
 void FetchStorage::putMissing(const std::string& key) {

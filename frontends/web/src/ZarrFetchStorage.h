@@ -9,6 +9,11 @@
 // holds its error, which get() throws (the streamer keeps the coarser
 // level on screen), until ready() asks for it again after retryMs.
 // Arrived bytes are kept least recently used first out within a budget.
+// Part of a key (a shard's index, one inner chunk: getRange) is a key of
+// its own, "KEY#bytes=A-B" or "KEY#bytes=-N" (rangeKey), which the page
+// fetches with a Range request and hands over with the value's whole size
+// (putRange); a server that ignores Range is the page's to cope with
+// (it cuts the range out of the whole body).
 #include <cstdint>
 #include <list>
 #include <optional>
@@ -30,6 +35,7 @@ class KeyNotFetched : public Error {
 struct FetchStats {
   std::uint64_t keys = 0;       // keys that arrived (bytes or 404)
   std::uint64_t bytes = 0;      // stored bytes that arrived
+  std::uint64_t ranges = 0;     // of the keys, ranges of a value (putRange)
   std::uint64_t missing = 0;    // of them 404s
   std::uint64_t failed = 0;     // fetches that gave up
   std::uint64_t heldBytes = 0;  // bytes held now
@@ -42,6 +48,12 @@ class FetchStorage final : public ZarrStorage {
 
   std::optional<std::vector<std::byte>> get(const std::string& key,
                                             std::uint64_t maxBytes) const override;
+  std::optional<ZarrRange> getRange(const std::string& key, std::int64_t offset,
+                                    std::uint64_t length, std::uint64_t maxWhole) const override;
+  // The key under which the range of `key` is fetched and held.
+  static std::string rangeKey(const std::string& key, std::int64_t offset, std::uint64_t length);
+  // The key a read is fetched under: its key, or its rangeKey.
+  static std::string keyOf(const ZarrStoredRead& read);
   std::string locate(const std::string& key) const override { return url_ + "/" + key; }
   std::string describe() const override { return url_; }
   int parallelism() const override { return 1; }  // no threads; the page fetches in parallel
@@ -63,6 +75,11 @@ class FetchStorage final : public ZarrStorage {
   bool hasWanted() const { return !wanted_.empty(); }
 
   void put(const std::string& key, std::vector<std::byte> bytes);
+  // A range key's bytes, `total` the whole value's size (Content-Range);
+  // `decoded`: an inner chunk the page decoded (decodesChunks), else the
+  // range's bytes as stored.
+  void putRange(const std::string& rangeKey, std::vector<std::byte> bytes, std::uint64_t total,
+                bool decoded);
   void putMissing(const std::string& key);
   void putFailed(const std::string& key, const std::string& message);
   FetchStats stats() const { return stats_; }
@@ -73,11 +90,16 @@ class FetchStorage final : public ZarrStorage {
   struct Entry {
     State state = State::Bytes;
     std::vector<std::byte> bytes;
+    std::uint64_t total = 0;  // a range's: the whole value's size
+    bool decoded = false;     // a range the page decoded
     std::string error;
     double failedAtMs = 0.0;
     std::list<std::string>::iterator use;
   };
   void insert(const std::string& key, Entry entry);
+  // The entry of `key`, the most recently used now; KeyNotFetched (and
+  // wanted) when it has not arrived; its error when it failed.
+  const Entry* arrived(const std::string& key) const;
   void want(const std::string& key) const;
   void erase(const std::string& key) const;
 

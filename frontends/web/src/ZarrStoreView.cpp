@@ -40,18 +40,32 @@ FetchedZarrSource::FetchedZarrSource(std::shared_ptr<const ZarrStore> store,
     : zarr_(store), store_(std::move(store)), storage_(std::move(storage)) {}
 
 bool FetchedZarrSource::prefetch(int level, const lod::VoxelBox& box) const {
-  bool ready = true;
-  for (const std::string& key : store_->chunkKeys(level, box.begin, box.end)) {
-    ready = storage_->ready(key) && ready;  // lists every key the box lacks
+  // Lists every read the box lacks (a sharded level's index first, then
+  // its inner chunks' ranges).
+  try {
+    return store_->holdsReads(level, box.begin, box.end, [&](const ZarrStoredRead& read) {
+      return storage_->ready(FetchStorage::keyOf(read));
+    });
+  } catch (const KeyNotFetched&) {
+    return false;
+  } catch (const std::exception&) {
+    // A shard index that failed or is corrupt: the read reports it (the
+    // brick fails, naming the key) as a failed chunk's does.
+    return true;
   }
-  return ready;
 }
 
 bool FetchedZarrSource::resident(int level, const lod::VoxelBox& box) const {
-  for (const std::string& key : store_->chunkKeys(level, box.begin, box.end)) {
-    if (!storage_->holds(key)) return false;
+  bool all = true;
+  try {
+    store_->holdsReads(level, box.begin, box.end, [&](const ZarrStoredRead& read) {
+      all = all && storage_->holds(FetchStorage::keyOf(read));
+      return all;
+    });
+  } catch (const std::exception&) {
+    return false;
   }
-  return true;
+  return all;
 }
 
 ZarrStoreView::ZarrStoreView(gpu::GlContext& context, const gpu::DeviceLimits& limits,

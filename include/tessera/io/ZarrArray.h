@@ -138,7 +138,8 @@ std::vector<std::byte> decodeZarrChunk(const ZarrArrayMeta& meta, std::span<cons
                                        const std::string& where);
 
 // A chunk its storage decoded already (ZarrStorage::decodesChunks): checked
-// to hold exactly meta.chunkBytes() bytes (InputError naming `where`).
+// to hold exactly meta.chunkBytes() bytes (InputError naming `where`); a
+// Zarr v3 chunk's transpose codec is undone here.
 std::vector<std::byte> decodedZarrChunk(const ZarrArrayMeta& meta, std::vector<std::byte> raw,
                                         const std::string& where);
 

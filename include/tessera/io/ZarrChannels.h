@@ -2,6 +2,7 @@
 // Several channels of an OME-Zarr image read together (core/ChannelSet.h),
 // with the store's omero rendering metadata as their defaults: colour,
 // window (start/end) and visibility (active).
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -25,11 +26,12 @@ ChannelSet readZarrChannels(const std::string& spec, const std::vector<int>& ind
 // `name` naming the store in the messages.
 ChannelSet readZarrChannels(std::shared_ptr<const ZarrStorage> storage, const std::string& name,
                             const std::vector<int>& indices = {}, int time = 0);
-// The storage keys of the chunks readZarrChannels(storage, ...) reads: what
-// an asynchronous storage must hold before the read (the same checks).
-std::vector<std::string> zarrChannelKeys(std::shared_ptr<const ZarrStorage> storage,
-                                         const std::string& name,
-                                         const std::vector<int>& indices = {}, int time = 0);
+// Whether the storage holds every read readZarrChannels(storage, ...)
+// makes (ZarrStore::holdsReads, `holds` asked about each): what an
+// asynchronous storage must hold before the read (the same checks).
+bool holdsZarrChannelReads(std::shared_ptr<const ZarrStorage> storage, const std::string& name,
+                           const std::vector<int>& indices, int time,
+                           const std::function<bool(const ZarrStoredRead&)>& holds);
 
 // What readZarrChannels checks and makes, for a caller that reads the
 // voxels itself (a store's channels streamed over bricks): the channels

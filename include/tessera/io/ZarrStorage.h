@@ -22,6 +22,16 @@ struct ZarrRange {
   std::uint64_t total = 0;
 };
 
+// One read a store makes of its storage: a whole key's value, or bytes
+// [offset, offset + length) of it (offset < 0: its last `length` bytes),
+// as getRange reads them.
+struct ZarrStoredRead {
+  std::string key;
+  bool whole = true;
+  std::int64_t offset = 0;
+  std::uint64_t length = 0;
+};
+
 class ZarrStorage {
  public:
   virtual ~ZarrStorage() = default;
@@ -55,7 +65,9 @@ class ZarrStorage {
   // decoded already: the browser's storage, whose page decodes each chunk
   // once as it arrives (pako; numcodecs' WebAssembly blosc and zstd, as
   // Debian's libblosc and libzstd are native only). ZarrStore then checks
-  // their size instead of decoding them.
+  // their size instead of decoding them. For Zarr v3 that is the chunk's
+  // compressor undone and its crc32c checked (the bytes and transpose
+  // codecs are ZarrStore's); a shard's inner chunk read as a range too.
   virtual bool decodesChunks(ZarrCompressor compressor) const {
     (void)compressor;
     return false;

@@ -99,6 +99,16 @@ class ZarrStore {
   // order: what an asynchronous storage (the browser's fetch()) must hold
   // before the read.
   std::vector<std::string> chunkKeys(int l, glm::ivec3 begin, glm::ivec3 end) const;
+  // Whether the storage holds every read readBox(l, begin, end) makes,
+  // `holds` asked about each in readBox's order (an asynchronous storage
+  // notes those it lacks as wanted, and the caller asks again once they
+  // arrived). Unsharded: each chunk's key. Sharded: each shard's index
+  // (asked only until this store has read it) and, once it is held, the
+  // byte ranges of the inner chunks the box touches; inner chunks the
+  // index marks absent (fill_value) and absent shards need no read. A
+  // corrupt index: InputError as readBox.
+  bool holdsReads(int l, glm::ivec3 begin, glm::ivec3 end,
+                  const std::function<bool(const ZarrStoredRead&)>& holds) const;
 
   // The finest level whose voxels (plus one chunk per reader) fit the host
   // budget; -1 if none does.
