@@ -12,6 +12,7 @@ import path from 'node:path';
 import {
   SIZE, PAGE_SAMPLING, CH2, check, served, psnrAgainst, openPage, withoutOverlays, browserSuite,
 } from './fixture.mjs';
+import { crc32c } from '../support/crc32c.mjs';
 
 const checks = browserSuite();
 
@@ -279,22 +280,6 @@ async function v3Codecs(context, url, tmp, run) {
         r.z.last ? `complete ${r.z.last.complete}, ${r.z.last.failing} bricks failing: "${r.z.last.last_error}" ` +
           `(corrupted ${key}); page error "${r.error}"` : r.error);
   await r.page.close();
-}
-
-// crc32c (Castagnoli), as the crc32c codec appends it (little-endian).
-const CRC_TABLE = (() => {
-  const t = new Uint32Array(256);
-  for (let n = 0; n < 256; n++) {
-    let c = n;
-    for (let k = 0; k < 8; k++) c = c & 1 ? 0x82f63b78 ^ (c >>> 1) : c >>> 1;
-    t[n] = c >>> 0;
-  }
-  return t;
-})();
-function crc32c(bytes) {
-  let c = 0xffffffff;
-  for (const b of bytes) c = CRC_TABLE[(c ^ b) & 0xff] ^ (c >>> 8);
-  return (c ^ 0xffffffff) >>> 0;
 }
 
 // A copy of an unsharded v3 store with crc32c after each array's codecs

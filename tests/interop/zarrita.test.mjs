@@ -18,6 +18,7 @@ import zlib from "node:zlib";
 
 import FileSystemStore from "@zarrita/storage/fs";
 import * as zarr from "zarrita";
+import { crc32c } from "../support/crc32c.mjs";
 
 const tessera = process.env.TESSERA ?? path.resolve("../../build/tessera");
 const tmp = fs.mkdtempSync(path.join(os.tmpdir(), "tessera-zarrita-"));
@@ -137,20 +138,6 @@ for (const [dtype, chain] of cases) {
 
 // --- sharded stores built from the spec ----------------------------------
 
-const CRC_TABLE = (() => {
-  const t = new Uint32Array(256);
-  for (let i = 0; i < 256; i++) {
-    let c = i;
-    for (let k = 0; k < 8; k++) c = c & 1 ? 0x82f63b78 ^ (c >>> 1) : c >>> 1;
-    t[i] = c >>> 0;
-  }
-  return t;
-})();
-function crc32c(bytes) {
-  let c = 0xffffffff;
-  for (const b of bytes) c = CRC_TABLE[(c ^ b) & 0xff] ^ (c >>> 8);
-  return (c ^ 0xffffffff) >>> 0;
-}
 function le32(v) {
   const b = Buffer.alloc(4);
   b.writeUInt32LE(v >>> 0);
