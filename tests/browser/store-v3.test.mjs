@@ -11,6 +11,7 @@ import fs from 'node:fs';
 import path from 'node:path';
 import {
   SIZE, PAGE_SAMPLING, CH2, check, served, psnrAgainst, openPage, withoutOverlays, browserSuite,
+  writeChannelStore,
 } from './fixture.mjs';
 import { crc32c } from '../support/crc32c.mjs';
 
@@ -19,6 +20,7 @@ const checks = browserSuite();
 test('OME-Zarr v3 sharded: Range requests for indexes and inner chunks, renders as the CLI', checks(shardedRanges));
 test('OME-Zarr v3 sharded from a server that ignores Range: whole shards once each, same image', checks(rangesIgnored));
 test('OME-Zarr v3 sharded region: only the inner chunks overlapping the box are read', checks(shardedRegion));
+test('OME-Zarr v3 sharded, three channels: listed and rendered as the CLI renders them, read by ranges', checks(shardedChannels));
 test('OME-Zarr v3 unsharded and sharded, zstd, blosc and gzip: the page decodes them, same images', checks(v3Codecs));
 
 // The store, its native render (the page's profile and sampling) and the
@@ -205,6 +207,96 @@ async function shardedRegion(context, url, tmp, run) {
   check('no script errors on the v3 region page', errors.length === 0, errors.join(' | '));
   console.log(`zarr v3 region ${spec}: ${innerAfter.length} inner chunks + ${indexesAfter.length} indexes, ` +
               `${bytes} of ${shardBytes} shard bytes, ${m.psnr.toFixed(2)} dB`);
+  await page.close();
+}
+
+// The three-channel v2 store of the channels test as NGFF 0.5 on Zarr v3,
+// built here from the spec: one shard per channel and level (its whole
+// 1 x Z x Y x X chunk), 2 x 2 x 2 inner chunks of raw little-endian u16
+// in it, the index (with its crc32c) at the end.
+function shardedChannelStore(v2, v3) {
+  fs.rmSync(v3, { recursive: true, force: true });
+  fs.mkdirSync(v3, { recursive: true });
+  const attrs = JSON.parse(fs.readFileSync(path.join(v2, '.zattrs'), 'utf8'));
+  const multiscales = attrs.multiscales.map(({ version, ...m }) => m);
+  fs.writeFileSync(path.join(v3, 'zarr.json'), JSON.stringify({ zarr_format: 3, node_type: 'group',
+    attributes: { ome: { version: '0.5', multiscales, omero: attrs.omero } } }));
+  for (const level of ['0', '1']) {
+    const a = JSON.parse(fs.readFileSync(path.join(v2, level, '.zarray'), 'utf8'));
+    const [, lz, ly, lx] = a.shape;
+    const inner = [1, lz / 2, ly / 2, lx / 2];
+    fs.mkdirSync(path.join(v3, level), { recursive: true });
+    fs.writeFileSync(path.join(v3, level, 'zarr.json'), JSON.stringify({
+      zarr_format: 3, node_type: 'array', shape: a.shape, data_type: 'uint16',
+      chunk_grid: { name: 'regular', configuration: { chunk_shape: [1, lz, ly, lx] } },
+      chunk_key_encoding: { name: 'default', configuration: { separator: '/' } }, fill_value: 0,
+      codecs: [{ name: 'sharding_indexed', configuration: { chunk_shape: inner,
+        codecs: [{ name: 'bytes', configuration: { endian: 'little' } }],
+        index_codecs: [{ name: 'bytes', configuration: { endian: 'little' } }, { name: 'crc32c' }],
+        index_location: 'end' } }],
+      dimension_names: ['c', 'z', 'y', 'x'] }));
+    for (let c = 0; c < 3; c++) {
+      const whole = fs.readFileSync(path.join(v2, level, String(c), '0', '0', '0'));
+      const parts = [];
+      const index = Buffer.alloc(8 * 16 + 4);
+      let offset = 0;
+      for (let n = 0; n < 8; n++) {
+        const [iz, iy, ix] = [n >> 2, (n >> 1) & 1, n & 1];  // C order of the 2 x 2 x 2 inner grid
+        const part = Buffer.alloc(inner[1] * inner[2] * inner[3] * 2);
+        let o = 0;
+        for (let z = 0; z < inner[1]; z++) {
+          for (let y = 0; y < inner[2]; y++) {
+            const row = (((iz * inner[1] + z) * ly + iy * inner[2] + y) * lx + ix * inner[3]) * 2;
+            whole.copy(part, o, row, row + inner[3] * 2);
+            o += inner[3] * 2;
+          }
+        }
+        index.writeBigUInt64LE(BigInt(offset), n * 16);
+        index.writeBigUInt64LE(BigInt(part.length), n * 16 + 8);
+        offset += part.length;
+        parts.push(part);
+      }
+      index.writeUInt32LE(crc32c(index.subarray(0, 8 * 16)), 8 * 16);
+      const dir = path.join(v3, level, 'c', String(c), '0', '0');
+      fs.mkdirSync(dir, { recursive: true });
+      fs.writeFileSync(path.join(dir, '0'), Buffer.concat([...parts, index]));
+    }
+  }
+}
+
+// A sharded v3 store of three u16 channels in the page: the channel list
+// from its omero metadata, the frame equal to `tessera render STORE
+// --channels 0,1,2` of the same store, every shard read by Range requests.
+async function shardedChannels(context, url, tmp, run) {
+  const v2 = path.join(tmp, 'three.ome.zarr');
+  writeChannelStore(v2, [48, 48, 24]);
+  const name = 'three-v3.ome.zarr';
+  const store = path.join(tmp, name);
+  shardedChannelStore(v2, store);
+  const from = served.log.length;
+  const { page, logs } = await openPage(context, url, `size=${SIZE}&slices=0&url=/data/${name}`);
+  await page.waitForFunction(() => window.tessera.channels() !== null || window.tessera.error() !== '', null,
+                             { timeout: 30000 }).catch(() => {});
+  const listed = await page.evaluate(() => window.tessera.channels());
+  check('v3 sharded channels: the page lists the three channels with their omero labels',
+        listed && listed.open && listed.channels.map((c) => c.label).join(',') === 'sphere,slab,rod',
+        JSON.stringify(listed) + (await page.evaluate(() => window.tessera.error())));
+  await page.evaluate(() => window.tessera.setCamera(30, 20, 1));
+  const tfPath = path.join(tmp, 'page-tf-v3.json');
+  fs.writeFileSync(tfPath, JSON.stringify(await page.evaluate(() => window.tessera.tf())));
+  const png = path.join(tmp, 'v3-channels.png');
+  run('render', store, '--channels', '0,1,2', '--tf', tfPath, '--azimuth', '30', '--elevation', '20',
+      '--size', `${SIZE}x${SIZE}`, '--profile', 'webgl2', ...PAGE_SAMPLING, '--out', png);
+  const m = await psnrAgainst(page, png);
+  check('v3 sharded channels: the frame renders as `tessera render STORE --channels 0,1,2` (PSNR >= 40 dB)',
+        m.psnr >= 40, m.error || `${m.psnr.toFixed(2)} dB`);
+  const shards = served.log.slice(from).filter((e) => /\/c\/\d\/0\/0\/0$/.test(e.path));
+  check('v3 sharded channels: every shard read by Range requests, none whole',
+        shards.length > 0 && shards.every((e) => e.status === 206 && e.range),
+        `${shards.length} shard requests: ${shards.filter((e) => e.status === 206).length} x 206, ` +
+        `${shards.filter((e) => e.status === 200).length} whole`);
+  const errors = logs.filter((l) => l.startsWith('pageerror') || (l.startsWith('error') && !/status of 404/.test(l)));
+  check('no script errors on the v3 channels page', errors.length === 0, errors.join(' | '));
   await page.close();
 }
 
