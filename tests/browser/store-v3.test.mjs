@@ -213,7 +213,8 @@ async function shardedRegion(context, url, tmp, run) {
 // The three-channel v2 store of the channels test as NGFF 0.5 on Zarr v3,
 // built here from the spec: one shard per channel and level (its whole
 // 1 x Z x Y x X chunk), 2 x 2 x 2 inner chunks of raw little-endian u16
-// in it, the index (with its crc32c) at the end.
+// in it, the index (with its crc32c) at the start (Tessera writes it at
+// the end: the other case of the page's index range).
 function shardedChannelStore(v2, v3) {
   fs.rmSync(v3, { recursive: true, force: true });
   fs.mkdirSync(v3, { recursive: true });
@@ -233,13 +234,13 @@ function shardedChannelStore(v2, v3) {
       codecs: [{ name: 'sharding_indexed', configuration: { chunk_shape: inner,
         codecs: [{ name: 'bytes', configuration: { endian: 'little' } }],
         index_codecs: [{ name: 'bytes', configuration: { endian: 'little' } }, { name: 'crc32c' }],
-        index_location: 'end' } }],
+        index_location: 'start' } }],
       dimension_names: ['c', 'z', 'y', 'x'] }));
     for (let c = 0; c < 3; c++) {
       const whole = fs.readFileSync(path.join(v2, level, String(c), '0', '0', '0'));
       const parts = [];
       const index = Buffer.alloc(8 * 16 + 4);
-      let offset = 0;
+      let offset = index.length;
       for (let n = 0; n < 8; n++) {
         const [iz, iy, ix] = [n >> 2, (n >> 1) & 1, n & 1];  // C order of the 2 x 2 x 2 inner grid
         const part = Buffer.alloc(inner[1] * inner[2] * inner[3] * 2);
@@ -259,7 +260,7 @@ function shardedChannelStore(v2, v3) {
       index.writeUInt32LE(crc32c(index.subarray(0, 8 * 16)), 8 * 16);
       const dir = path.join(v3, level, 'c', String(c), '0', '0');
       fs.mkdirSync(dir, { recursive: true });
-      fs.writeFileSync(path.join(dir, '0'), Buffer.concat([...parts, index]));
+      fs.writeFileSync(path.join(dir, '0'), Buffer.concat([index, ...parts]));
     }
   }
 }
@@ -291,10 +292,14 @@ async function shardedChannels(context, url, tmp, run) {
   check('v3 sharded channels: the frame renders as `tessera render STORE --channels 0,1,2` (PSNR >= 40 dB)',
         m.psnr >= 40, m.error || `${m.psnr.toFixed(2)} dB`);
   const shards = served.log.slice(from).filter((e) => /\/c\/\d\/0\/0\/0$/.test(e.path));
-  check('v3 sharded channels: every shard read by Range requests, none whole',
-        shards.length > 0 && shards.every((e) => e.status === 206 && e.range),
+  const indexReads = shards.filter((e) => e.range === `bytes=0-${8 * 16 + 4 - 1}`);
+  check('v3 sharded channels: every shard read by Range requests, its index at the start once, none whole',
+        shards.length > 0 && shards.every((e) => e.status === 206 && e.range) &&
+        new Set(indexReads.map((e) => e.path)).size === indexReads.length &&
+        indexReads.length === new Set(shards.map((e) => e.path)).size,
         `${shards.length} shard requests: ${shards.filter((e) => e.status === 206).length} x 206, ` +
-        `${shards.filter((e) => e.status === 200).length} whole`);
+        `${shards.filter((e) => e.status === 200).length} whole; ${indexReads.length} index reads for the ` +
+        `${new Set(shards.map((e) => e.path)).size} shards read`);
   const errors = logs.filter((l) => l.startsWith('pageerror') || (l.startsWith('error') && !/status of 404/.test(l)));
   check('no script errors on the v3 channels page', errors.length === 0, errors.join(' | '));
   await page.close();
