@@ -25,22 +25,23 @@ test('OME-Zarr v3 unsharded and sharded, zstd, blosc and gzip: the page decodes 
 
 // The store, its native render (the page's profile and sampling) and the
 // page's refined view of it.
-async function openV3(context, url, tmp, run, name, args, query = `size=${SIZE}`, untilComplete = false) {
+// `native: false`: no reference render (a store the CLI refuses).
+async function openV3(context, url, tmp, run, name, args, { size = SIZE, untilComplete = false, native = true } = {}) {
   const store = path.join(tmp, name);
   if (!fs.existsSync(store)) run('convert', CH2, store, '--zarr-format', '3', ...args);
-  const png = path.join(tmp, `native-${name}.png`);
-  if (!fs.existsSync(png)) {
-    run('render', store, '--layout', 'bricks', '--tf', 'mr-default', '--size', `${SIZE}x${SIZE}`,
+  const png = path.join(tmp, `native-${size}-${name}.png`);
+  if (native && !fs.existsSync(png)) {
+    run('render', store, '--layout', 'bricks', '--tf', 'mr-default', '--size', `${size}x${size}`,
         '--profile', 'webgl2', ...PAGE_SAMPLING, '--out', png);
   }
   const from = served.log.length;
-  const { page, logs } = await openPage(context, url, `${query}&url=/data/${name}`);
+  const { page, logs } = await openPage(context, url, `size=${size}&url=/data/${name}`);
   await page.waitForFunction((until) => (window.tessera.zarr() && window.tessera.zarr().completeMs !== null) ||
                              (!until && window.tessera.error() !== ''), untilComplete, { timeout: 90000 });
   await withoutOverlays(page);
   const z = await page.evaluate(() => window.tessera.zarr());
   const error = await page.evaluate(() => window.tessera.error());
-  const m = await psnrAgainst(page, png);
+  const m = native ? await psnrAgainst(page, png) : { psnr: 0, error: 'no reference' };
   const errors = logs.filter((l) => (l.startsWith('pageerror') || l.startsWith('error')) && !/status of 404/.test(l));
   return { store, page, z, error, psnr: m.psnr || 0, psnrError: m.error, log: served.log.slice(from), errors };
 }
@@ -337,7 +338,6 @@ async function v3Codecs(context, url, tmp, run) {
   if (!fs.existsSync(CH2)) { check(`OME-Zarr v3 test needs ${CH2} (mricron-data)`, false); return; }
   const cases = [
     { name: 'ch2-v3-zstd.ome.zarr', args: ['--compressor', 'zstd'] },
-    { name: 'ch2-v3-blosc.ome.zarr', args: ['--compressor', 'blosc'] },
     { name: 'ch2-v3-gzip-sharded.ome.zarr', args: ['--compressor', 'zlib', '--shard', '2'] },
     { name: 'ch2-v3-blosc-sharded.ome.zarr', args: ['--compressor', 'blosc', '--shard', '2'] },
   ];
@@ -350,7 +350,7 @@ async function v3Codecs(context, url, tmp, run) {
   withCrc32c(zstd, crcStore);
   cases.push({ name: 'ch2-v3-zstd-crc.ome.zarr', args: [] });
   for (const c of cases) {
-    const r = await openV3(context, url, tmp, run, c.name, c.args);
+    const r = await openV3(context, url, tmp, run, c.name, c.args, { size: 128 });
     const meta = fs.readFileSync(path.join(r.store, '0', 'zarr.json'), 'utf8');
     check(`v3 ${c.name}: the page renders what \`tessera render\` renders (PSNR >= 50 dB)`,
           !r.error && r.z.last && r.z.last.complete && r.psnr >= 50 && r.errors.length === 0,
@@ -368,8 +368,7 @@ async function v3Codecs(context, url, tmp, run) {
   const bytes = fs.readFileSync(victim);
   bytes[bytes.length - 1] ^= 0xff;
   fs.writeFileSync(victim, bytes);
-  fs.copyFileSync(path.join(tmp, 'native-ch2-v3-zstd-crc.ome.zarr.png'), path.join(tmp, 'native-ch2-v3-zstd-badcrc.ome.zarr.png'));
-  const r = await openV3(context, url, tmp, run, 'ch2-v3-zstd-badcrc.ome.zarr', [], `size=${SIZE}`, true);
+  const r = await openV3(context, url, tmp, run, 'ch2-v3-zstd-badcrc.ome.zarr', [], { untilComplete: true, native: false });
   const key = path.relative(bad, victim);
   check('v3 chunk whose crc32c does not match: its bricks fail with a message naming the chunk, the rest renders',
         r.z.last && r.z.last.complete && r.z.last.failing > 0 && /crc32c mismatch/.test(r.z.last.last_error) &&
