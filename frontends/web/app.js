@@ -31,6 +31,9 @@ import { attachOverlayPanel } from './overlay-panel.js';
   const storeBricks = params.get('layout') === 'bricks';
   // ?zarrcache=MiB: the chunks a store keeps fetched (default 48).
   const zarrCacheMiB = parseFloat(params.get('zarrcache') || '0') || 0;
+  // ?stripshare=S: the share of the frame budget a store's strips take
+  // (default 0.25; for comparisons).
+  const stripShare = parseFloat(params.get('stripshare') || '0') || 0;
   // ?dicomweb=ROOT: a DICOMweb archive's studies and series to open
   // (frontends/web/dicomweb.js).
   const dicomwebRoot = params.get('dicomweb') || '';
@@ -48,6 +51,9 @@ import { attachOverlayPanel } from './overlay-panel.js';
   // secure contexts, localhost included), not at the next animation frame
   // as pointermove is dispatched (?rawinput=0: at the animation frame).
   const rawInput = params.get('rawinput') !== '0' && 'onpointerrawupdate' in window;
+  // The 3D view's WebGL context is a low-latency one (tessera.js:
+  // lowLatencyContext; ?lowlatency=0: an ordinary one, for comparisons).
+  const lowLatency = params.get('lowlatency') !== '0';
 
   const $ = (id) => document.getElementById(id);
   const canvas = $('canvas');
@@ -98,10 +104,11 @@ import { attachOverlayPanel } from './overlay-panel.js';
   let frames = 0;
   let renderWaiters = [];
   let refineNotBefore = 0;  // performance.now() before which no strip is rendered
-  // The store's preview drawn by a move as it arrived (rawInput), and when
-  // the last animation frame began: at most one preview per frame interval.
+  // The store's preview drawn by an input handler as the input arrived
+  // (answerStoreInput), and when the last animation frame began: at most
+  // one preview per frame interval.
   let frameBeganAt = 0;
-  let rawDrawnAt = -Infinity;
+  let inputDrawnAt = -Infinity;
   let storeDrawnAt = -Infinity;  // the last store frame or preview drawn in an animation frame
   let slices = null;        // frontends/web/slices.js, once the module is up
   let zarr = null;  // an open OME-Zarr store (frontends/web/zarr-url.js)
@@ -272,7 +279,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
       channelFrameStep();
     } else if (api && zarr && zarr.active() && (!storeTime || storeTime.bricks)) {
       if (storeTime && time.count > 1) timeStep();
-      storeFrameStep(rawDrawnAt >= previousFrameAt);
+      storeFrameStep(inputDrawnAt >= previousFrameAt);
     } else if (api) {
       let ms = -1;
       if (time.count > 1) timeStep();
@@ -821,16 +828,35 @@ import { attachOverlayPanel } from './overlay-panel.js';
       requestRender();
     }
   });
-  // rawInput: a camera drag over a store moves the camera as each move
-  // arrives, and the first move in a frame interval draws the store's
-  // preview at once (tessera_zarr_frame, as the animation frame would), so
-  // that it is on the canvas at the next frame; a later move in the same
-  // interval is drawn by the next animation frame. Pointers whose moves
-  // come here skip pointermove (it follows with the same position).
-  const rawPointers = new Set();
+  // Input on a store's view (a move as it arrives, a release, a wheel turn)
+  // is answered at once: the first in a frame interval draws the store's
+  // preview in its handler (tessera_zarr_frame, as the animation frame
+  // would), so that it is on the canvas at the next frame, not a frame
+  // later; a later one in the same interval, or one that comes while a
+  // frame is pending (`pending`: needsRender before the input), is drawn by
+  // the next animation frame. The full frame follows from there.
   function storeDrawn() {
     return api && zarr && zarr.active() && (!storeTime || storeTime.bricks) && !(channelList && channelList.active());
   }
+  function answerStoreInput(pending) {
+    if (pending || !storeDrawn() || (viewer && viewer.contextLost) ||
+        inputDrawnAt >= frameBeganAt || storeDrawnAt >= frameBeganAt) {
+      requestRender();
+      return;
+    }
+    needsRender = false;
+    fitCanvas();
+    const f = zarr.frame(canvas.width, canvas.height, true);
+    inputDrawnAt = performance.now();
+    if (f && f.shown) {
+      frames++;
+      if (slices) slices.frameShown(refreshState());
+    }
+  }
+  // rawInput: a camera drag over a store moves the camera as each move
+  // arrives (answerStoreInput). Pointers whose moves come here skip
+  // pointermove (it follows with the same position).
+  const rawPointers = new Set();
   function storeMoved(e) {
     if (!cameraPointers.has(e.pointerId) || !storeDrawn() || (viewer && viewer.contextLost)) {
       rawPointers.delete(e.pointerId);  // its pointermove moves the camera
@@ -840,18 +866,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
     api.pointerMove(e.pointerId, ...cameraPos(e));
     const pending = needsRender;
     setCameraDragged(true);  // (asks for a frame at the drag's backing size: drawn here)
-    if (pending || rawDrawnAt >= frameBeganAt || storeDrawnAt >= frameBeganAt) {
-      requestRender();  // this frame interval has its preview
-      return;
-    }
-    needsRender = false;
-    fitCanvas();
-    const f = zarr.frame(canvas.width, canvas.height, true);
-    rawDrawnAt = performance.now();
-    if (f && f.shown) {
-      frames++;
-      if (slices) slices.frameShown(refreshState());
-    }
+    answerStoreInput(pending);
   }
   if (rawInput) canvas.addEventListener('pointerrawupdate', storeMoved);
   const forgetRaw = (e) => {
@@ -866,17 +881,19 @@ import { attachOverlayPanel } from './overlay-panel.js';
       requestRender();
       return;
     }
+    const pending = needsRender;
     api.pointerUp(e.pointerId);
     forgetRaw(e);
     if (!api.interacting()) setCameraDragged(false);
-    requestRender();  // full quality once released
+    answerStoreInput(pending);  // full quality once released (in-core: at the next frame)
   };
   canvas.addEventListener('pointerup', viewEnd);
   canvas.addEventListener('pointercancel', viewEnd);
   canvas.addEventListener('wheel', (e) => {
     if (!api) return;
+    const pending = needsRender;
     api.wheel(Math.sign(e.deltaY));
-    requestRender();
+    answerStoreInput(pending);
     e.preventDefault();
   }, { passive: false });
 
@@ -1076,7 +1093,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
 
   const ready = (async () => {
     try {
-      viewer = await TesseraViewer.create(canvas, { profile: forceWebgl1 ? 'webgl1' : 'auto' });
+      viewer = await TesseraViewer.create(canvas, { profile: forceWebgl1 ? 'webgl1' : 'auto', lowLatency });
     } catch (e) {
       showError(e.message);
       throw e;
@@ -1118,6 +1135,8 @@ import { attachOverlayPanel } from './overlay-panel.js';
       // (A size refused is said once the store is open with the default.)
       const cacheRefused = zarrCacheMiB && !M.ccall('tessera_zarr_set_cache_mib', 'number', ['number'], [zarrCacheMiB])
         ? api.lastError() : '';
+      const shareRefused = stripShare && !M.ccall('tessera_zarr_set_strip_share', 'number', ['number'], [stripShare])
+        ? api.lastError() : '';
       zarr = TesseraZarr.create(M, { showError, clearError,
         status: (t) => { $('status').textContent = contextNote ? `${t} · ${contextNote}` : t; },
         progress: (v, max) => { $('progress').hidden = !(max > 0); if (max > 0) { $('progress').max = max; $('progress').value = v; } } });
@@ -1130,7 +1149,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
         storeTime = TesseraStoreTime.fetchAhead(zarr);  // the channels' time points ahead
       }
       volumeChanged();
-      if (cacheRefused) showError(cacheRefused);
+      if (cacheRefused || shareRefused) showError([cacheRefused, shareRefused].filter((t) => t).join('; '));
     } else if (volumeUrls.length) {
       if (!(await openUrls(volumeUrls))) volumeChanged();
     } else {

@@ -29,6 +29,22 @@ function loadPako() {
   return pakoLoading;
 }
 
+// Makes the canvas's WebGL `version` context a low-latency one before the
+// module adopts it (the module asks for the same context, and a canvas
+// hands out the one it has; this emscripten's context attributes cannot ask
+// for `desynchronized`). The other attributes are the module's
+// (src/gpu/GlContextWebGL.cpp). Chromium presents a desynchronized canvas's
+// frames as they are drawn, not with the page's next commit, and while a
+// pointer pressed on the canvas is down it dispatches that pointer's moves
+// as they arrive, not at the next animation frame: a drag is answered
+// sooner (tests/browser/latency.test.mjs). Browsers without it ignore it.
+function lowLatencyContext(canvas, version) {
+  canvas.getContext(version === 2 ? 'webgl2' : 'webgl', {
+    alpha: false, depth: false, stencil: false, antialias: false, preserveDrawingBuffer: true,
+    desynchronized: true,
+  });
+}
+
 // The module's WebGL context is made on a canvas named by a CSS selector:
 // a canvas without an id gets one.
 let canvasCount = 0;
@@ -76,15 +92,21 @@ export class TesseraViewer {
   // Loads a module instance and makes the WebGL context on `canvas`.
   // profile: 'auto' (WebGL 2, else WebGL 1), 'webgl2' or 'webgl1'.
   // Rejects with an Error saying why when the browser offers no WebGL.
-  static async create(canvas, { profile = 'auto' } = {}) {
+  // lowLatency (default true): the context is a low-latency
+  // ("desynchronized") one, see lowLatencyContext.
+  static async create(canvas, { profile = 'auto', lowLatency = true } = {}) {
     if (!['auto', 'webgl2', 'webgl1'].includes(profile)) {
       throw new Error(`TesseraViewer.create: profile "${profile}" is not auto, webgl2 or webgl1`);
     }
     const [module] = await Promise.all([createTesseraModule({ canvas }), loadPako()]);
     const viewer = new TesseraViewer(module, canvas);
     const selector = selectorOf(canvas);
-    let ok = profile === 'webgl1' ? 0 : viewer.#c.init(selector, 2);
-    if (!ok && profile !== 'webgl2') ok = viewer.#c.init(selector, 1);  // the ES 2.0 path
+    const init = (version) => {
+      if (lowLatency) lowLatencyContext(canvas, version);
+      return viewer.#c.init(selector, version);
+    };
+    let ok = profile === 'webgl1' ? 0 : init(2);
+    if (!ok && profile !== 'webgl2') ok = init(1);  // the ES 2.0 path
     if (!ok) throw new Error(viewer.#c.lastError());
     viewer.#watchContext();
     return viewer;

@@ -5,10 +5,14 @@
 // latency is the time from the event (its timeStamp, the earliest of the
 // pointer moves coalesced into it) to the end of the first draw on the
 // canvas after it was handled (a preview, or a finished frame): an
-// animation-frame callback, or the page's pointerrawupdate handler that
-// answered a drag move as it arrived (its read-back included; such a draw
-// reaches the compositor with the next animation frame, and the test
-// reports the time until then too). Whole ray marches per frame (0.6-2.5
+// animation-frame callback, or the page's input handler that answered the
+// event as it arrived (a drag's move in pointerrawupdate, a release, a
+// wheel turn; its read-back included; such a draw reaches the compositor
+// with the next animation frame, and the test reports the time until then
+// too). The page's canvas is a desynchronized (low-latency) one, so a
+// drag's moves are not held for the next animation frame either
+// (?lowlatency=0 in TESSERA_LATENCY_QUERY: an ordinary one; bench/
+// web_latency.py alternates the two). Whole ray marches per frame (0.6-2.5
 // s on SwiftShader) hold input up that long; frames in strips of about the
 // budget answer it with a preview, and the target is two budgets. The wait
 // for the next animation frame (up to 16.7 ms: Chromium dispatches
@@ -188,7 +192,8 @@ function explainWorst(lat, z) {
   const parts = (c) => (!c ? 'no store call' : `${c.preview ? 'preview' : c.stream_ms > 0 ? 'streaming' : c.tables_ms > 0.5 && !c.shown ? 'tables' : 'strip'} ` +
     `${c.ms.toFixed(1)} ms (setup ${(c.setup_ms || 0).toFixed(1)}, update ${(c.update_ms || 0).toFixed(1)}, upload wait ${(c.upload_wait_ms || 0).toFixed(1)}, ` +
     `tables ${(c.tables_ms || 0).toFixed(1)}, preview ${(c.preview_ms || 0).toFixed(1)}` +
-    `${c.preview ? ` at ${c.preview_size.join('x')}` : ''}, ${c.uploaded || 0} bricks uploaded)`);
+    `${c.preview ? ` at ${c.preview_size.join('x')}` : ''}, ${c.uploaded || 0} bricks uploaded` +
+    `${c.strip_rows > 0 ? `, ${(100 * c.strip_rows).toFixed(1)} % of the rows` : ''})`);
   const decodeTasks = (z.decodeTasks || []).map((d) => ({ start: d.t + z.t0, end: d.t + z.t0 + d.ms }));
   const overlap = (list, a, b) => list.reduce((sum, x) => sum + Math.max(0, Math.min(b, x.end) - Math.max(a, x.start)), 0);
   const rows = [];
@@ -377,6 +382,15 @@ async function storeInputLatency(context, url, tmp, run) {
   const extra = process.env.TESSERA_LATENCY_QUERY ? `&${process.env.TESSERA_LATENCY_QUERY}` : '';
   await page.goto(`${url}/index.html?size=${SIZE}&slices=0&budget=${BUDGET_MS}&url=/data/ch2.ome.zarr${extra}`);
   await page.evaluate(() => window.tessera.ready);
+  // The 3D view's context is a low-latency (desynchronized) one unless the
+  // page is asked for an ordinary one (tessera.js: lowLatencyContext).
+  const attributes = await page.evaluate(() => {
+    const c = document.getElementById('canvas');
+    return (c.getContext('webgl2') || c.getContext('webgl')).getContextAttributes();
+  });
+  const lowLatency = !/(^|&)lowlatency=0(&|$)/.test(extra.slice(1));
+  check(`latency: the canvas's WebGL context is ${lowLatency ? 'a low-latency (desynchronized)' : 'an ordinary'} one`,
+        attributes.desynchronized === lowLatency, `desynchronized: ${attributes.desynchronized}`);
   await page.waitForFunction(() => { const z = window.tessera.zarr(); return z && z.firstImageMs !== null; }, null, { timeout: 60000 });
   const before = await snapshot(page);  // the first view, for the drag's last preview below
   const box = await page.locator('#canvas').boundingBox();

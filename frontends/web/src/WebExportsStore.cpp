@@ -39,6 +39,7 @@ std::string frameJson(const web::StoreFrame& f, web::ZarrStoreView& z) {
   j["tables_ms"] = f.tablesMs;
   j["preview_ms"] = f.previewMs;
   j["setup_ms"] = f.setupMs;
+  j["strip_rows"] = f.stripRows;
   j["shown"] = f.shown;
   j["pending"] = f.pending;
   j["streamed"] = f.streamed;
@@ -70,6 +71,12 @@ extern "C" {
 // ?zarrcache=MiB; default 48): 0 with the reason outside 1/16..48.
 EMSCRIPTEN_KEEPALIVE int tessera_zarr_set_cache_mib(double mib) {
   return guarded([&] { web::session().setStoreCacheBytes(mib * 1048576.0); });
+}
+
+// The share of the frame budget a store's strips take (the page's
+// ?stripshare=; default 0.25): 0 with the reason outside 0.05..1.
+EMSCRIPTEN_KEEPALIVE int tessera_zarr_set_strip_share(double share) {
+  return guarded([&] { web::session().setStoreStripShare(share); });
 }
 
 // Starts opening the store at `url` (its root, e.g. http://host/ch2.ome.zarr).

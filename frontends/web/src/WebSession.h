@@ -193,6 +193,10 @@ class WebSession {
   // page asks for less (?zarrcache=MiB). InputError outside
   // kStoreCacheMinBytes..kStoreFetchedBytes.
   void setStoreCacheBytes(double bytes);
+  // The share of the frame budget a store's strips take (StorePace::
+  // stripShare), from the next frame on: the page's ?stripshare=, for
+  // comparisons. InputError outside kStoreStripShareMin..1.
+  void setStoreStripShare(double share);
   // The store of a lost context on the restored one: its chunks, metadata
   // and levels kept, its GPU side (atlas, page table, ray caster) made again
   // by storeOpenStep, which then keeps the restored camera and TF.
@@ -261,6 +265,7 @@ class WebSession {
   int askedCell_ = 0;           // the grid cell side asked for (0: the default)
   bool storeReopened_ = false;  // the store being opened again keeps the view's camera
   std::uint64_t storeCacheBytes_ = kStoreFetchedBytes;
+  double storeStripShare_ = StorePace{}.stripShare;
   int zoomMediumLevel_ = 0;
   double zoomLastFrameMs_ = -1.0;
   CropState crop_;

@@ -43,6 +43,17 @@ void WebSession::setStoreCacheBytes(double bytes) {
   storeCacheBytes_ = static_cast<std::uint64_t>(bytes);
 }
 
+void WebSession::setStoreStripShare(double share) {
+  if (!(share >= kStoreStripShareMin && share <= 1.0)) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "stripshare %g: a store's strips take %g to 1 of the frame budget (default %g)",
+                  share, kStoreStripShareMin, StorePace{}.stripShare);
+    throw InputError(text);
+  }
+  storeStripShare_ = share;
+}
+
 void WebSession::reopenStore(ZarrStoreView::Host host) {
   zarr_ = std::make_unique<ZarrStoreView>(context(), viewer().limits(), std::move(host));
   storeReopened_ = true;
@@ -157,10 +168,13 @@ StoreFrame WebSession::storeFrame(int width, int height, bool viewChanged) {
   }
   const session::Overlay* overlay = session_->overlay();
   z.setFusion(overlay ? overlay->fused : nullptr);  // fused in the store's ray march
-  return z.frame(
-      v.camera(), v.frameSettings(), v.tfEditor().transferFunction(), v.tfEditor().revision(),
-      v.showBoundingBox, v.showAxes, width, height, v.maxVolumePixels, marks,
-      {.progressive = v.progressive, .budgetMs = v.frameBudgetMs, .viewChanged = viewChanged});
+  return z.frame(v.camera(), v.frameSettings(), v.tfEditor().transferFunction(),
+                 v.tfEditor().revision(), v.showBoundingBox, v.showAxes, width, height,
+                 v.maxVolumePixels, marks,
+                 {.progressive = v.progressive,
+                  .budgetMs = v.frameBudgetMs,
+                  .stripShare = storeStripShare_,
+                  .viewChanged = viewChanged});
 }
 
 }  // namespace tessera::web

@@ -27,11 +27,6 @@ constexpr double kPreviewShare = 0.5;
 constexpr double kPreviewMinScale = 1.0 / 16.0;
 // The first strip's rows (a fraction of the frame) before any cost is known.
 constexpr double kFirstStrip = 1.0 / 64.0;
-// A strip's share of the budget: its cost varies with what its rows cover
-// and with the GPU process's other work (the page's compositing), and one
-// that overruns the animation frame holds the next input up a frame more
-// (strips of the whole budget took up to 40 ms at a load of 5 on 2 cores).
-constexpr double kStripShare = 0.5;
 
 }  // namespace
 
@@ -199,6 +194,7 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
   f.renderHeight = v.renderHeight;
   gpu::clearErrors();
   budgetMs_ = pace.budgetMs;
+  stripShare_ = pace.stripShare;
   if (!pace.progressive) {
     bricks_->setUpdatePace({});
     // A ray march costs far more than an update (SwiftShader: most of a
@@ -387,7 +383,7 @@ StoreFrame ZarrStoreView::strip() {
   const FrameView& v = p.view;
   const double pixels = static_cast<double>(v.renderWidth) * v.renderHeight;
   const double minStrip = 1.0 / v.renderHeight;
-  double rows = msPerPixel_ > 0.0 ? kStripShare * budgetMs_ / (msPerPixel_ * pixels) : kFirstStrip;
+  double rows = msPerPixel_ > 0.0 ? stripShare_ * budgetMs_ / (msPerPixel_ * pixels) : kFirstStrip;
   // At most twice the last strip's rows: the rows below may cover more of
   // the volume than those the cost was learnt on.
   if (p.rows > 0.0) rows = std::min(rows, 2.0 * p.rows);
@@ -412,6 +408,7 @@ StoreFrame ZarrStoreView::strip() {
   p.done = p.done + rows >= 1.0 - 1e-9 ? 1.0 : p.done + rows;
   StoreFrame f;
   f.tablesMs = tablesMs;
+  f.stripRows = rows;
   f.bricks = p.bricks;
   f.renderWidth = v.renderWidth;
   f.renderHeight = v.renderHeight;

@@ -37,6 +37,9 @@ inline constexpr std::uint64_t kStoreFetchedBytes = 48ull << 20;
 inline constexpr std::uint64_t kStoreFetchAheadBytes = kStoreFetchedBytes / 2;
 // The least a page may set its stores' chunk cache to (?zarrcache=MiB).
 inline constexpr std::uint64_t kStoreCacheMinBytes = 64ull << 10;
+// The least share of the frame budget a page may give a store's strips
+// (?stripshare=): below it a strip is mostly its fixed cost.
+inline constexpr double kStoreStripShareMin = 0.05;
 
 // A store's levels read through a FetchStorage: prefetch() lists the
 // chunks a box needs that have not arrived.
@@ -77,6 +80,8 @@ struct StoreFrame {
   // wait); and a frame()'s own work before its preview (the view, the
   // transfer function, the overlay lines).
   double updateMs = 0.0, uploadWaitMs = 0.0, tablesMs = 0.0, previewMs = 0.0, setupMs = 0.0;
+  // A strip's rows, as a fraction of the frame's (0: no strip).
+  double stripRows = 0.0;
 };
 
 // How store frames are paced, as the viewer core paces its progressive
@@ -86,6 +91,13 @@ struct StoreFrame {
 struct StorePace {
   bool progressive = false;  // false: each frame streams and draws whole
   double budgetMs = 12.0;
+  // A strip's share of the budget: its cost varies with what its rows cover
+  // and with the GPU process's other work (the page's compositing), and an
+  // input that arrives during one waits for it (strips of the whole budget
+  // took up to 40 ms at a load of 5 on 2 cores; a quarter keeps a drag's
+  // answers within two budgets: tests/browser/latency.test.mjs). The page's
+  // ?stripshare= sets it (tessera_zarr_set_strip_share), for comparisons.
+  double stripShare = 0.25;
   // The view, the settings or the canvas changed: a preview at once. Else
   // (bricks arrived) the canvas keeps its image until the new one is done.
   bool viewChanged = true;
@@ -220,6 +232,7 @@ class ZarrStoreView {
   std::uint64_t tablesVersion_ = ~std::uint64_t(0);
   layout::BricksFrame shownBricks_;  // the bricks' state after the last update
   double budgetMs_ = 12.0;
+  double stripShare_ = StorePace{}.stripShare;
   double msPerPixel_ = 0.0;  // the ray march at full quality, from strips and whole frames
   // The preview's resolution and step, fed back to meet its share of the budget.
   std::unique_ptr<render::QualityController> previewQuality_;

@@ -1,0 +1,111 @@
+#!/usr/bin/env python3
+"""Input-to-frame latency in the web page while a store refines (a
+benchmark, not a test): tests/browser/latency.test.mjs run again and again,
+alternating two settings of the page in each round (their order swapped
+every round), with input sent through DevTools and, under xvfb-run with
+headful Chromium, through the X server as a mouse's would be (XTest). Prints
+a table per input path and setting: the median of the runs' medians, the
+range of the runs' worsts, per event type, and how many runs kept every
+event within two frame budgets (24 ms); then one JSON line.
+
+The settings are page parameters (frontends/web/app.js): by default
+`lowlatency=0&stripshare=0.5` (an ordinary WebGL context and strips of
+half the budget, as the page had them before) against the defaults (a
+desynchronized context, strips of a quarter of the budget).
+
+    /usr/bin/python3 bench/web_latency.py                 # 3 rounds, both input paths
+    /usr/bin/python3 bench/web_latency.py --rounds 5 --inputs x11
+
+Needs build/tessera, build-web/site (scripts/web.sh), tests/browser's
+node_modules and, for x11, xvfb-run and libXtst (scripts/setup.sh).
+"""
+import argparse
+import json
+import os
+import re
+import shutil
+import statistics
+import subprocess
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+TARGET_MS = 24.0  # two frame budgets of the page's 12 ms (app.js ?budget=)
+TYPES = ("all", "pointermove", "pointerup", "wheel")
+SUMMARY = re.compile(r"latency: store refining at \S+, budget [\d.]+ ms: (.*)")
+STATS = re.compile(r"(all events|pointermove|pointerup|wheel): median ([\d.]+) ms, 90th percentile [\d.]+ ms, "
+                   r"worst ([\d.]+) ms over (\d+)")
+
+
+def run_once(query, inputs):
+    """One latency test run; {type: (median, worst, n)} from its summary line."""
+    env = dict(os.environ, TESSERA_LATENCY_QUERY=query, TESSERA_LATENCY_INPUT=inputs,
+               TESSERA_CLI=os.environ.get("TESSERA_CLI", os.path.join(ROOT, "build/tessera")))
+    cmd = ["node", "--test", "tests/browser/latency.test.mjs"]
+    if inputs == "x11":
+        env["TESSERA_HEADFUL"] = "1"
+        cmd = ["xvfb-run", "-a"] + cmd
+    p = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=300)
+    m = SUMMARY.search(p.stdout)
+    if not m:
+        tail = "\n".join((p.stdout + p.stderr).splitlines()[-15:])
+        raise RuntimeError(f"latency test ({inputs}, ?{query}) printed no summary (exit {p.returncode}):\n{tail}")
+    out = {}
+    for name, median, worst, n in STATS.findall(m.group(1)):
+        out["all" if name == "all events" else name] = (float(median), float(worst), int(n))
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--rounds", type=int, default=3, help="rounds, each running every setting once per input path")
+    ap.add_argument("--inputs", default="devtools,x11", help="input paths: devtools, x11, touch (comma-separated)")
+    ap.add_argument("--before", default="lowlatency=0&stripshare=0.5", help="page parameters of the baseline")
+    ap.add_argument("--after", default="", help="page parameters of the setting compared (default: the defaults)")
+    args = ap.parse_args()
+    inputs = [i for i in args.inputs.split(",") if i]
+    for i in inputs:
+        if i not in ("devtools", "x11", "touch"):
+            sys.exit(f"web_latency.py: --inputs {i}: devtools, x11 or touch")
+    if "x11" in inputs and not shutil.which("xvfb-run"):
+        sys.exit("web_latency.py: --inputs x11 needs xvfb-run (scripts/setup.sh installs it)")
+    if args.rounds < 1:
+        sys.exit("web_latency.py: --rounds must be at least 1")
+    settings = {"before": args.before, "after": args.after}
+    runs = {(i, s): [] for i in inputs for s in settings}
+    t0 = time.time()
+    for r in range(args.rounds):
+        order = list(settings) if r % 2 == 0 else list(settings)[::-1]
+        for i in inputs:
+            for s in order:
+                res = run_once(settings[s], i)
+                runs[(i, s)].append(res)
+                a = res["all"]
+                print(f"round {r + 1}/{args.rounds} {i:8} {s:6} all events median {a[0]:.1f} ms, worst {a[1]:.1f} ms "
+                      f"({time.time() - t0:.0f} s)", file=sys.stderr, flush=True)
+
+    def cell(rs, t):
+        got = [x[t] for x in rs if t in x]
+        if not got:
+            return "-"
+        med = statistics.median(g[0] for g in got)
+        worsts = [g[1] for g in got]
+        return f"{med:.1f} ({min(worsts):.1f}-{max(worsts):.1f})"
+
+    print(f"\nInput-to-frame latency while a store refines, ms: median of the runs' medians "
+          f"(range of the runs' worsts); {args.rounds} alternating rounds")
+    print(f"before: ?{settings['before'] or '(defaults)'}   after: ?{settings['after'] or '(defaults)'}\n")
+    head = ["input", "setting"] + [t if t != "all" else "all events" for t in TYPES] + [f"runs worst <= {TARGET_MS:.0f}"]
+    rows = []
+    for (i, s), rs in runs.items():
+        met = sum(1 for x in rs if x["all"][1] <= TARGET_MS)
+        rows.append([i, s] + [cell(rs, t) for t in TYPES] + [f"{met} of {len(rs)}"])
+    widths = [max(len(str(c)) for c in col) for col in zip(head, *rows)]
+    for line in [head, ["-" * w for w in widths]] + rows:
+        print(" | ".join(str(c).ljust(w) for c, w in zip(line, widths)))
+    print(json.dumps({"rounds": args.rounds, "settings": settings, "target_ms": TARGET_MS,
+                      "runs": {f"{i}/{s}": rs for (i, s), rs in runs.items()}}))
+
+
+if __name__ == "__main__":
+    main()
