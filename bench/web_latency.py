@@ -9,9 +9,10 @@ range of the runs' worsts, per event type, and how many runs kept every
 event within two frame budgets (24 ms); then one JSON line.
 
 The settings are page parameters (frontends/web/app.js): by default
-`lowlatency=0&stripshare=0.5` (an ordinary WebGL context and strips of
-half the budget, as the page had them before) against the defaults (a
-desynchronized context, strips of a quarter of the budget).
+`stripshare=0.5` (a store's strips of half the frame budget, as the page
+had them before) against the defaults (a quarter); `--before lowlatency=1`
+compares a desynchronized (low-latency) WebGL context with the ordinary
+one.
 
     /usr/bin/python3 bench/web_latency.py                 # 3 rounds, both input paths
     /usr/bin/python3 bench/web_latency.py --rounds 5 --inputs x11
@@ -33,12 +34,13 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TARGET_MS = 24.0  # two frame budgets of the page's 12 ms (app.js ?budget=)
 TYPES = ("all", "pointermove", "pointerup", "wheel")
 SUMMARY = re.compile(r"latency: store refining at \S+, budget [\d.]+ ms: (.*)")
-STATS = re.compile(r"(all events|pointermove|pointerup|wheel): median ([\d.]+) ms, 90th percentile [\d.]+ ms, "
+STATS = re.compile(r"(all events|pointermove|pointerup|wheel):? median ([\d.]+) ms, 90th percentile [\d.]+ ms, "
                    r"worst ([\d.]+) ms over (\d+)")
 
 
-def run_once(query, inputs):
-    """One latency test run; {type: (median, worst, n)} from its summary line."""
+def run_once(query, inputs, log=None):
+    """One latency test run; {type: (median, worst, n)} from its summary line.
+    `log`: a file for the test's output (the worst events explained)."""
     env = dict(os.environ, TESSERA_LATENCY_QUERY=query, TESSERA_LATENCY_INPUT=inputs,
                TESSERA_CLI=os.environ.get("TESSERA_CLI", os.path.join(ROOT, "build/tessera")))
     cmd = ["node", "--test", "tests/browser/latency.test.mjs"]
@@ -46,6 +48,9 @@ def run_once(query, inputs):
         env["TESSERA_HEADFUL"] = "1"
         cmd = ["xvfb-run", "-a"] + cmd
     p = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=300)
+    if log:
+        with open(log, "w") as f:
+            f.write(p.stdout + p.stderr)
     m = SUMMARY.search(p.stdout)
     if not m:
         tail = "\n".join((p.stdout + p.stderr).splitlines()[-15:])
@@ -60,8 +65,9 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--rounds", type=int, default=3, help="rounds, each running every setting once per input path")
     ap.add_argument("--inputs", default="devtools,x11", help="input paths: devtools, x11, touch (comma-separated)")
-    ap.add_argument("--before", default="lowlatency=0&stripshare=0.5", help="page parameters of the baseline")
+    ap.add_argument("--before", default="stripshare=0.5", help="page parameters of the baseline")
     ap.add_argument("--after", default="", help="page parameters of the setting compared (default: the defaults)")
+    ap.add_argument("--logs", default="", help="a folder for each run's test output (ROUND-INPUT-SETTING.log)")
     args = ap.parse_args()
     inputs = [i for i in args.inputs.split(",") if i]
     for i in inputs:
@@ -72,13 +78,16 @@ def main():
     if args.rounds < 1:
         sys.exit("web_latency.py: --rounds must be at least 1")
     settings = {"before": args.before, "after": args.after}
+    if args.logs:
+        os.makedirs(args.logs, exist_ok=True)
     runs = {(i, s): [] for i in inputs for s in settings}
     t0 = time.time()
     for r in range(args.rounds):
         order = list(settings) if r % 2 == 0 else list(settings)[::-1]
         for i in inputs:
             for s in order:
-                res = run_once(settings[s], i)
+                log = os.path.join(args.logs, f"{r + 1}-{i}-{s}.log") if args.logs else None
+                res = run_once(settings[s], i, log)
                 runs[(i, s)].append(res)
                 a = res["all"]
                 print(f"round {r + 1}/{args.rounds} {i:8} {s:6} all events median {a[0]:.1f} ms, worst {a[1]:.1f} ms "

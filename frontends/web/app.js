@@ -51,9 +51,9 @@ import { attachOverlayPanel } from './overlay-panel.js';
   // secure contexts, localhost included), not at the next animation frame
   // as pointermove is dispatched (?rawinput=0: at the animation frame).
   const rawInput = params.get('rawinput') !== '0' && 'onpointerrawupdate' in window;
-  // The 3D view's WebGL context is a low-latency one (tessera.js:
-  // lowLatencyContext; ?lowlatency=0: an ordinary one, for comparisons).
-  const lowLatency = params.get('lowlatency') !== '0';
+  // ?lowlatency=1: the 3D view's WebGL context is a low-latency one
+  // (tessera.js: lowLatencyContext; for comparisons).
+  const lowLatency = params.get('lowlatency') === '1';
 
   const $ = (id) => document.getElementById(id);
   const canvas = $('canvas');

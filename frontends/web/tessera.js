@@ -36,8 +36,12 @@ function loadPako() {
 // (src/gpu/GlContextWebGL.cpp). Chromium presents a desynchronized canvas's
 // frames as they are drawn, not with the page's next commit, and while a
 // pointer pressed on the canvas is down it dispatches that pointer's moves
-// as they arrive, not at the next animation frame: a drag is answered
-// sooner (tests/browser/latency.test.mjs). Browsers without it ignore it.
+// as they arrive, not at the next animation frame. Not the default: the
+// page answers a store's drag in pointerrawupdate, which Chromium sends as
+// moves arrive anyway, and in alternating runs through the X server
+// (bench/web_latency.py) a desynchronized context kept every input within
+// two frame budgets no more often (5 of 9 runs either way) and its worst
+// runs were worse (46 ms against 28). Browsers without it ignore it.
 function lowLatencyContext(canvas, version) {
   canvas.getContext(version === 2 ? 'webgl2' : 'webgl', {
     alpha: false, depth: false, stencil: false, antialias: false, preserveDrawingBuffer: true,
@@ -92,9 +96,9 @@ export class TesseraViewer {
   // Loads a module instance and makes the WebGL context on `canvas`.
   // profile: 'auto' (WebGL 2, else WebGL 1), 'webgl2' or 'webgl1'.
   // Rejects with an Error saying why when the browser offers no WebGL.
-  // lowLatency (default true): the context is a low-latency
+  // lowLatency (default false): the context is a low-latency
   // ("desynchronized") one, see lowLatencyContext.
-  static async create(canvas, { profile = 'auto', lowLatency = true } = {}) {
+  static async create(canvas, { profile = 'auto', lowLatency = false } = {}) {
     if (!['auto', 'webgl2', 'webgl1'].includes(profile)) {
       throw new Error(`TesseraViewer.create: profile "${profile}" is not auto, webgl2 or webgl1`);
     }

@@ -26,7 +26,7 @@
 //    slabs elsewhere and the cache's own limit lets the region's chunks go;
 //    the restore fetches exactly the chunks it needs that were let go (the
 //    server's log), each once, and shows the same region; (WebGL 1) a cache
-//    size out of range is refused naming the range.
+//    size and a strip share out of range are refused naming their ranges.
 // The status line says the context was lost, then restored; the view still
 // turns after. WebGL 2 and WebGL 1 run side by side, each in a Chromium of
 // its own (its pages in turn: the store and the head, then the channels),
@@ -65,7 +65,8 @@ test('the WebGL context lost and restored in WebGL 2 and WebGL 1 side by side: a
     await channels(c, context, url, webgl);
     await brickedSeries(c, context, url, webgl);
     // The chunk cache is the same in both versions: in the shorter run only
-    // (the other checks that a cache size out of range is refused).
+    // (the other checks that a cache size and a strip share out of range
+    // are refused).
     if (webgl === 2) await evictedRegion(c, context, url, tmp, webgl);
     else await cacheOutOfRange(c, context, url, webgl);
     assert.deepEqual(c.failed, [], `failed checks: ${c.failed.join('; ')}`);
@@ -564,15 +565,17 @@ async function evictedRegion(c, context, url, tmp, webgl) {
   await page.close();
 }
 
-// ?zarrcache out of range: refused with the range, the store opened with the
-// default cache.
+// ?zarrcache and ?stripshare out of range: each refused with its range, the
+// store opened with the defaults.
 async function cacheOutOfRange(c, context, url, webgl) {
-  const { page } = await phonePage(context, url, `size=32&slices=0&zarrcache=100&url=/data/cube6-webgl${webgl}.ome.zarr`, webgl);
+  const { page } = await phonePage(context, url,
+    `size=32&slices=0&zarrcache=100&stripshare=2&url=/data/cube6-webgl${webgl}.ome.zarr`, webgl);
   await page.waitForFunction(() => window.tessera.time().count === 6, null, { timeout: 30000 }).catch(() => {});
   const error = await page.evaluate(() => window.tessera.error());
   const count = await page.evaluate(() => window.tessera.time().count);
-  c(`WebGL ${webgl}: ?zarrcache=100 is refused naming the range, the store opens with the default cache`,
-    error === 'zarrcache 100 MiB: a store\'s chunk cache takes 0.0625 to 48 MiB (default 48)' && count === 6,
+  c(`WebGL ${webgl}: ?zarrcache=100 and ?stripshare=2 are refused naming their ranges, the store opens with the defaults`,
+    error === 'zarrcache 100 MiB: a store\'s chunk cache takes 0.0625 to 48 MiB (default 48); ' +
+      'stripshare 2: a store\'s strips take 0.05 to 1 of the frame budget (default 0.25)' && count === 6,
     `error "${error}"; the store's series of ${count}`);
   await page.close();
 }

@@ -9,10 +9,9 @@
 // event as it arrived (a drag's move in pointerrawupdate, a release, a
 // wheel turn; its read-back included; such a draw reaches the compositor
 // with the next animation frame, and the test reports the time until then
-// too). The page's canvas is a desynchronized (low-latency) one, so a
-// drag's moves are not held for the next animation frame either
-// (?lowlatency=0 in TESSERA_LATENCY_QUERY: an ordinary one; bench/
-// web_latency.py alternates the two). Whole ray marches per frame (0.6-2.5
+// too). TESSERA_LATENCY_QUERY=lowlatency=1 asks the page for a
+// desynchronized (low-latency) canvas (bench/web_latency.py alternates
+// such settings). Whole ray marches per frame (0.6-2.5
 // s on SwiftShader) hold input up that long; frames in strips of about the
 // budget answer it with a preview, and the target is two budgets. The wait
 // for the next animation frame (up to 16.7 ms: Chromium dispatches
@@ -382,13 +381,13 @@ async function storeInputLatency(context, url, tmp, run) {
   const extra = process.env.TESSERA_LATENCY_QUERY ? `&${process.env.TESSERA_LATENCY_QUERY}` : '';
   await page.goto(`${url}/index.html?size=${SIZE}&slices=0&budget=${BUDGET_MS}&url=/data/ch2.ome.zarr${extra}`);
   await page.evaluate(() => window.tessera.ready);
-  // The 3D view's context is a low-latency (desynchronized) one unless the
-  // page is asked for an ordinary one (tessera.js: lowLatencyContext).
+  // The 3D view's context is an ordinary one unless the page is asked for
+  // a low-latency (desynchronized) one (tessera.js: lowLatencyContext).
   const attributes = await page.evaluate(() => {
     const c = document.getElementById('canvas');
     return (c.getContext('webgl2') || c.getContext('webgl')).getContextAttributes();
   });
-  const lowLatency = !/(^|&)lowlatency=0(&|$)/.test(extra.slice(1));
+  const lowLatency = /(^|&)lowlatency=1(&|$)/.test(extra.slice(1));
   check(`latency: the canvas's WebGL context is ${lowLatency ? 'a low-latency (desynchronized)' : 'an ordinary'} one`,
         attributes.desynchronized === lowLatency, `desynchronized: ${attributes.desynchronized}`);
   await page.waitForFunction(() => { const z = window.tessera.zarr(); return z && z.firstImageMs !== null; }, null, { timeout: 60000 });

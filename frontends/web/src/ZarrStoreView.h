@@ -94,9 +94,10 @@ struct StorePace {
   // A strip's share of the budget: its cost varies with what its rows cover
   // and with the GPU process's other work (the page's compositing), and an
   // input that arrives during one waits for it (strips of the whole budget
-  // took up to 40 ms at a load of 5 on 2 cores; a quarter keeps a drag's
-  // answers within two budgets: tests/browser/latency.test.mjs). The page's
-  // ?stripshare= sets it (tessera_zarr_set_strip_share), for comparisons.
+  // took up to 40 ms at a load of 5 on 2 cores; with half of it no run of
+  // bench/web_latency.py kept every input within two budgets, with a
+  // quarter 4 of 6 did). The page's ?stripshare= sets it
+  // (tessera_zarr_set_strip_share), for comparisons.
   double stripShare = 0.25;
   // The view, the settings or the canvas changed: a preview at once. Else
   // (bricks arrived) the canvas keeps its image until the new one is done.
