@@ -12,10 +12,14 @@ The settings are page parameters (frontends/web/app.js): by default
 `stripshare=0.5` (a store's strips of half the frame budget, as the page
 had them before) against the defaults (a quarter); `--before lowlatency=1`
 compares a desynchronized (low-latency) WebGL context with the ordinary
-one.
+one. `--before-site DIR` serves another build of the page for the
+baseline (a copy of build-web/site made before a change), so that two
+builds are compared in the same alternating run.
 
     /usr/bin/python3 bench/web_latency.py                 # 3 rounds, both input paths
     /usr/bin/python3 bench/web_latency.py --rounds 5 --inputs x11
+    cp -r build-web/site /tmp/site-before   # ... change, scripts/web.sh, then:
+    /usr/bin/python3 bench/web_latency.py --before '' --before-site /tmp/site-before
 
 Needs build/tessera, build-web/site (scripts/web.sh), tests/browser's
 node_modules and, for x11, xvfb-run and libXtst (scripts/setup.sh).
@@ -38,11 +42,14 @@ STATS = re.compile(r"(all events|pointermove|pointerup|wheel):? median ([\d.]+) 
                    r"worst ([\d.]+) ms over (\d+)")
 
 
-def run_once(query, inputs, log=None):
+def run_once(query, inputs, log=None, site=""):
     """One latency test run; {type: (median, worst, n)} from its summary line.
-    `log`: a file for the test's output (the worst events explained)."""
+    `log`: a file for the test's output (the worst events explained); `site`:
+    the page's build (default build-web/site)."""
     env = dict(os.environ, TESSERA_LATENCY_QUERY=query, TESSERA_LATENCY_INPUT=inputs,
                TESSERA_CLI=os.environ.get("TESSERA_CLI", os.path.join(ROOT, "build/tessera")))
+    if site:
+        env["TESSERA_SITE"] = site
     cmd = ["node", "--test", "tests/browser/latency.test.mjs"]
     if inputs == "x11":
         env["TESSERA_HEADFUL"] = "1"
@@ -67,6 +74,7 @@ def main():
     ap.add_argument("--inputs", default="devtools,x11", help="input paths: devtools, x11, touch (comma-separated)")
     ap.add_argument("--before", default="stripshare=0.5", help="page parameters of the baseline")
     ap.add_argument("--after", default="", help="page parameters of the setting compared (default: the defaults)")
+    ap.add_argument("--before-site", default="", help="the baseline's build of the page (default: build-web/site)")
     ap.add_argument("--logs", default="", help="a folder for each run's test output (ROUND-INPUT-SETTING.log)")
     args = ap.parse_args()
     inputs = [i for i in args.inputs.split(",") if i]
@@ -77,6 +85,9 @@ def main():
         sys.exit("web_latency.py: --inputs x11 needs xvfb-run (scripts/setup.sh installs it)")
     if args.rounds < 1:
         sys.exit("web_latency.py: --rounds must be at least 1")
+    if args.before_site and not os.path.isfile(os.path.join(args.before_site, "tessera-core.wasm")):
+        sys.exit(f"web_latency.py: --before-site {args.before_site}: no web build there (tessera-core.wasm)")
+    sites = {"before": os.path.abspath(args.before_site) if args.before_site else "", "after": ""}
     settings = {"before": args.before, "after": args.after}
     if args.logs:
         os.makedirs(args.logs, exist_ok=True)
@@ -87,7 +98,7 @@ def main():
         for i in inputs:
             for s in order:
                 log = os.path.join(args.logs, f"{r + 1}-{i}-{s}.log") if args.logs else None
-                res = run_once(settings[s], i, log)
+                res = run_once(settings[s], i, log, sites[s])
                 runs[(i, s)].append(res)
                 a = res["all"]
                 print(f"round {r + 1}/{args.rounds} {i:8} {s:6} all events median {a[0]:.1f} ms, worst {a[1]:.1f} ms "
@@ -103,7 +114,8 @@ def main():
 
     print(f"\nInput-to-frame latency while a store refines, ms: median of the runs' medians "
           f"(range of the runs' worsts); {args.rounds} alternating rounds")
-    print(f"before: ?{settings['before'] or '(defaults)'}   after: ?{settings['after'] or '(defaults)'}\n")
+    print(f"before: ?{settings['before'] or '(defaults)'}{' of ' + sites['before'] if sites['before'] else ''}   "
+          f"after: ?{settings['after'] or '(defaults)'}\n")
     head = ["input", "setting"] + [t if t != "all" else "all events" for t in TYPES] + [f"runs worst <= {TARGET_MS:.0f}"]
     rows = []
     for (i, s), rs in runs.items():
@@ -112,7 +124,7 @@ def main():
     widths = [max(len(str(c)) for c in col) for col in zip(head, *rows)]
     for line in [head, ["-" * w for w in widths]] + rows:
         print(" | ".join(str(c).ljust(w) for c, w in zip(line, widths)))
-    print(json.dumps({"rounds": args.rounds, "settings": settings, "target_ms": TARGET_MS,
+    print(json.dumps({"rounds": args.rounds, "settings": settings, "sites": sites, "target_ms": TARGET_MS,
                       "runs": {f"{i}/{s}": rs for (i, s), rs in runs.items()}}))
 
 

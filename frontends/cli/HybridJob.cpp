@@ -23,7 +23,7 @@ namespace {
 // Frame 0 against the CPU ground truth: the volume and, in composite mode,
 // rays stopped at the overlay lines at full resolution.
 void compareWithGroundTruth(const Volume& volume, const TransferFunction& tf,
-                            const RenderRequest& req, const render::HybridCompositor& compositor,
+                            const RenderRequest& req, render::HybridCompositor& compositor,
                             HybridResult& result) {
   const auto tRef = std::chrono::steady_clock::now();
   if (req.settings.render.mode == RenderMode::Composite) {

@@ -33,7 +33,7 @@ window.TesseraGrid = (function () {
   const KEYS = { ArrowUp: 0, ArrowDown: 1, ArrowLeft: 2, ArrowRight: 3, PageUp: 4, PageDown: 5 };
 
   function attach(opts) {
-    const { M, canvas, requestRender, showError, clearError, slices, storeRegion, storeOverview } = opts;
+    const { M, canvas, requestRender, showError, clearError, slices, storeRegion, storeOverview, setText, setDisabled } = opts;
     const $ = (id) => document.getElementById(id);
     const c = (name, ret, args) => M.cwrap(name, ret, args);
     const api = {
@@ -89,26 +89,29 @@ window.TesseraGrid = (function () {
     // ------------------------------------------------------------ drawing
 
     function updatePad() {
+      // (After every frame: what did not change is left alone.)
       const active = !!grid.active;
-      pad.hidden = !active;
-      $('gridEnter').textContent = active ? 'Leave grid view (G)' : 'Grid view (G)';
-      $('gridEnter').disabled = !grid.has_volume;
+      if (pad.hidden !== !active) pad.hidden = !active;
+      setText($('gridEnter'), active ? 'Leave grid view (G)' : 'Grid view (G)');
+      setDisabled($('gridEnter'), !grid.has_volume);
       $('views').classList.toggle('grid-shown', active);
-      if (!grid.has_volume) { $('gridInfo').textContent = ''; return; }
+      if (!grid.has_volume) { setText($('gridInfo'), ''); return; }
       for (const b of moveButtons) {
         const m = grid.moves[parseInt(b.dataset.move, 10)];
-        b.querySelector('.move-axis').textContent = m.move;
+        setText(b.querySelector('.move-axis'), m.move);
         // Refused moves stay pressable (a tap shows why), marked.
         b.classList.toggle('illegal', !m.legal);
-        b.setAttribute('aria-label', `${m.view}: ${m.move}${m.legal ? '' : ` (${m.reason})`}`);
-        b.title = m.legal ? `move the block one cell along ${m.move}` : m.reason;
+        const label = `${m.view}: ${m.move}${m.legal ? '' : ` (${m.reason})`}`;
+        if (b.getAttribute('aria-label') !== label) b.setAttribute('aria-label', label);
+        const title = m.legal ? `move the block one cell along ${m.move}` : m.reason;
+        if (b.title !== title) b.title = title;
       }
       const cells = grid.cells.join('×');
       const cell = grid.cell_size.join('×');
       const where = grid.block ? `block ${grid.block_text} (overview voxels, native resolution)` : 'no block shown yet';
-      $('gridInfo').textContent = `${cells} cells of ${cell} voxels; point ${grid.describe}; ${where}`;
+      setText($('gridInfo'), `${cells} cells of ${cell} voxels; point ${grid.describe}; ${where}`);
       const note = $('gridNote');
-      note.textContent = grid.note;
+      setText(note, grid.note);
       note.classList.toggle('refused', !!grid.refused);
     }
 
@@ -129,13 +132,13 @@ window.TesseraGrid = (function () {
       zoom = JSON.parse(api.zoomJson());
       $('zoomSwap').checked = !!zoom.active;
       const info = $('zoomInfo');
-      if (!zoom.active) { info.textContent = ''; return; }
+      if (!zoom.active) { setText(info, ''); return; }
       const stages = zoom.stages.map((st, i) => {
         const what = st.native ? 'native block' : `${st.name} L${st.level}`;
         const text = `${what} from zoom ${st.enter_zoom.toFixed(2)}`;
         return i === zoom.shown_stage ? `[${text}]` : text;
       });
-      info.textContent = `zoom ${zoom.zoom.toFixed(2)}: ${stages.join(' · ')}${zoom.fading ? ' (fading)' : ''}`;
+      setText(info, `zoom ${zoom.zoom.toFixed(2)}: ${stages.join(' · ')}${zoom.fading ? ' (fading)' : ''}`);
       if (zoom.fading || zoom.target !== zoom.shown_stage) requestRender();
     }
     async function setZoomSwap(on, opts) {

@@ -57,6 +57,11 @@ window.TesseraSlices = (function () {
       return true;
     }
 
+    // Text that is redrawn after every frame is set only when it changed
+    // (assigning the same text still replaces the node: layout and paint).
+    const setText = (el, text) => { if (el.textContent !== text) el.textContent = text; };
+    const setDisabled = (el, on) => { if (el.disabled !== on) el.disabled = on; };
+
     const views = $('views');
     views.classList.add('quad');
     const overlay3d = $('overlay3d');
@@ -123,6 +128,7 @@ window.TesseraSlices = (function () {
       if (p.overlay.width !== bw || p.overlay.height !== bh) {
         p.overlay.width = bw;
         p.overlay.height = bh;
+        p.overlayKey = null;  // (resizing cleared it)
       }
     }
 
@@ -228,13 +234,23 @@ window.TesseraSlices = (function () {
       return [Math.min(x0, x1), Math.min(y0, y1), Math.abs(x1 - x0), Math.abs(y1 - y0)];
     }
 
+    // Drawn again only when what it shows changed (it is redrawn after every
+    // frame of the 3D view, and a canvas drawn on is raster and composite
+    // work for the browser's GPU process, which the 3D view's next frame
+    // then waits for).
     function drawPanelOverlay(p) {
       const f = p.frame;
-      const ctx = p.overlay.getContext('2d');
       const dpr = window.devicePixelRatio || 1;
+      const block = grid && grid.block();
+      const shown = f && explore.has_volume;
+      const key = JSON.stringify([p.overlay.width, p.overlay.height, dpr, shown && [f, p.fit, cross, region, block,
+        rubber && rubber.panel === p ? rubberBox(p) : null]]);
+      if (key === p.overlayKey) return;
+      p.overlayKey = key;
+      const ctx = p.overlay.getContext('2d');
       ctx.setTransform(1, 0, 0, 1, 0, 0);
       ctx.clearRect(0, 0, p.overlay.width, p.overlay.height);
-      if (!f || !explore.has_volume) return;
+      if (!shown) return;
       // Image pixels -> overlay pixels.
       ctx.setTransform(dpr * p.fit.scale, 0, 0, dpr * p.fit.scale, dpr * p.fit.left, dpr * p.fit.top);
       const px = 1 / p.fit.scale;  // one CSS pixel in image pixels
@@ -253,7 +269,6 @@ window.TesseraSlices = (function () {
         ctx.setLineDash([]);
       }
       // The grid view's block (frontends/web/grid.js), cyan, where this slice cuts it.
-      const block = grid && grid.block();
       if (block && cross[p.axis] >= block.begin[p.axis] && cross[p.axis] < block.end[p.axis]) {
         const [x, y, w, h] = boxRect(p, block);
         ctx.lineWidth = 2 * px;
@@ -292,25 +307,46 @@ window.TesseraSlices = (function () {
     // The 3D view's marks, over its canvas: the crosshair as a small 3D
     // cross (x red, y green, z blue, as the axes). The picked region's red
     // box in the overview is drawn by the viewer (syncMark), by depth.
+    // Like the panels' overlays, drawn again only when what it shows
+    // changed: the crosshair follows the camera, and without it nothing is
+    // drawn on a clear overlay.
+    let overlay3dPlace = '';
+    let overlay3dKey = null;
     function draw3dOverlay() {
       const dpr = window.devicePixelRatio || 1;
       const W = canvas.clientWidth, H = canvas.clientHeight;
       // Over the canvas's content box (inside its border).
-      Object.assign(overlay3d.style, {
-        left: `${canvas.offsetLeft + canvas.clientLeft}px`, top: `${canvas.offsetTop + canvas.clientTop}px`,
-        width: `${W}px`, height: `${H}px`,
-      });
+      const place = [canvas.offsetLeft + canvas.clientLeft, canvas.offsetTop + canvas.clientTop, W, H];
+      if (place.join() !== overlay3dPlace) {
+        overlay3dPlace = place.join();
+        Object.assign(overlay3d.style, { left: `${place[0]}px`, top: `${place[1]}px`, width: `${W}px`, height: `${H}px` });
+      }
       const bw = Math.max(1, Math.round(W * dpr)), bh = Math.max(1, Math.round(H * dpr));
       if (overlay3d.width !== bw || overlay3d.height !== bh) {
         overlay3d.width = bw;
         overlay3d.height = bh;
+        overlay3dKey = null;  // (resizing cleared it)
       }
+      let shown = null;  // what the crosshair's drawing depends on, or null: a clear overlay
+      let pj = null;
+      let showing = null;
+      if (explore.has_volume) {
+        const text = api.projection(canvas.width, canvas.height) || '{}';
+        pj = JSON.parse(text) || {};
+        if (pj.mvp) {
+          showing = explore.showing_region ? explore.region : null;
+          if (syncMark(region && !showing ? region : null)) requestRender();
+          const inside = $('crosshair3d').checked && (!showing || [0, 1, 2].every((a) => cross[a] >= showing.begin[a] && cross[a] < showing.end[a]));
+          if (inside) shown = JSON.stringify([text, cross, showing, explore.dims, explore.spacing]);
+        }
+      }
+      const key = `${bw}x${bh}@${dpr}|${shown}`;
+      if (key === overlay3dKey) return;
+      overlay3dKey = key;
       const ctx = overlay3d.getContext('2d');
       ctx.setTransform(1, 0, 0, 1, 0, 0);
       ctx.clearRect(0, 0, bw, bh);
-      if (!explore.has_volume) return;
-      const pj = JSON.parse(api.projection(canvas.width, canvas.height) || '{}') || {};
-      if (!pj.mvp) return;
+      if (!shown) return;
       const m = pj.mvp;
       const project = (v) => {
         const p = v.map((x, a) => x * pj.spacing[a] + pj.offset[a]);
@@ -326,27 +362,22 @@ window.TesseraSlices = (function () {
         ctx.moveTo(pa[0], pa[1]);
         ctx.lineTo(pb[0], pb[1]);
       };
-      const showing = explore.showing_region ? explore.region : null;
-      if (syncMark(region && !showing ? region : null)) requestRender();
-      const inside = $('crosshair3d').checked && (!showing || [0, 1, 2].every((a) => cross[a] >= showing.begin[a] && cross[a] < showing.end[a]));
-      if (inside) {
-        const dims = showing ? [0, 1, 2].map((a) => showing.end[a] - showing.begin[a]) : explore.dims;
-        const arm = 0.08 * Math.max(...dims.map((d, a) => d * explore.spacing[a]));
-        const centre = cross.map((v) => v + 0.5);
-        ['#ff5050', '#50ff50', '#5c8cff'].forEach((color, a) => {
-          const lo = centre.slice(), hi = centre.slice();
-          lo[a] -= arm / explore.spacing[a];
-          hi[a] += arm / explore.spacing[a];
-          ctx.beginPath();
-          line(lo, hi);
-          ctx.strokeStyle = '#000';
-          ctx.lineWidth = 4 * dpr;
-          ctx.stroke();
-          ctx.strokeStyle = color;
-          ctx.lineWidth = 2 * dpr;
-          ctx.stroke();
-        });
-      }
+      const dims = showing ? [0, 1, 2].map((a) => showing.end[a] - showing.begin[a]) : explore.dims;
+      const arm = 0.08 * Math.max(...dims.map((d, a) => d * explore.spacing[a]));
+      const centre = cross.map((v) => v + 0.5);
+      ['#ff5050', '#50ff50', '#5c8cff'].forEach((color, a) => {
+        const lo = centre.slice(), hi = centre.slice();
+        lo[a] -= arm / explore.spacing[a];
+        hi[a] += arm / explore.spacing[a];
+        ctx.beginPath();
+        line(lo, hi);
+        ctx.strokeStyle = '#000';
+        ctx.lineWidth = 4 * dpr;
+        ctx.stroke();
+        ctx.strokeStyle = color;
+        ctx.lineWidth = 2 * dpr;
+        ctx.stroke();
+      });
     }
 
     // The crosshair voxel's position in RAS+ millimetres (the volume's affine).
@@ -359,17 +390,17 @@ window.TesseraSlices = (function () {
 
     function updateInfo() {
       const v = explore.has_volume ? api.value(cross[0], cross[1], cross[2]) : NaN;
-      $('crosshairInfo').textContent = explore.has_volume
+      setText($('crosshairInfo'), explore.has_volume
         ? `crosshair voxel (${cross.join(', ')})${crossMm()}: value ${Number.isFinite(v) ? +v.toPrecision(6) : '–'}` +
-          (opts.crosshairNote ? opts.crosshairNote(cross) : '') : '';
+          (opts.crosshairNote ? opts.crosshairNote(cross) : '') : '');
       const r = region;
       const text = r ? `region x ${r.begin[0]}:${r.end[0]}, y ${r.begin[1]}:${r.end[1]}, z ${r.begin[2]}:${r.end[2]} ` +
         `(${r.end.map((e, a) => e - r.begin[a]).join('×')} voxels, native resolution)` : 'no region picked';
       const gridShown = grid && grid.active();
-      $('regionInfo').textContent = explore.showing_region && !gridShown ? `3D view: ${text}` : text;
-      $('overview').disabled = !explore.showing_region;
-      $('showRegion').disabled = !region || explore.showing_region;
-      $('pickRegion').setAttribute('aria-pressed', picking ? 'true' : 'false');
+      setText($('regionInfo'), explore.showing_region && !gridShown ? `3D view: ${text}` : text);
+      setDisabled($('overview'), !explore.showing_region);
+      setDisabled($('showRegion'), !region || !!explore.showing_region);
+      if ($('pickRegion').getAttribute('aria-pressed') !== String(picking)) $('pickRegion').setAttribute('aria-pressed', String(picking));
       $('pickRegion').classList.toggle('pressed', picking);
       views.classList.toggle('picking', picking);
       views.classList.toggle('region-shown', !!explore.showing_region && !gridShown);
@@ -638,7 +669,7 @@ window.TesseraSlices = (function () {
     // the overview's return with the region.
     if (window.TesseraGrid) {
       grid = window.TesseraGrid.attach({
-        M, canvas, requestRender, showError, clearError, slices: testApi,
+        M, canvas, requestRender, showError, clearError, slices: testApi, setText, setDisabled,
         storeRegion: opts.storeRegion, storeOverview: opts.storeOverview,
       });
       testApi.grid = grid.testApi;

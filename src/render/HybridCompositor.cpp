@@ -12,7 +12,6 @@
 #include "tessera/core/Error.h"
 #include "tessera/core/Timing.h"
 #include "tessera/gpu/Draw.h"
-#include "tessera/render/CameraRay.h"
 
 namespace tessera::render {
 
@@ -113,7 +112,7 @@ HybridCompositor::HybridCompositor(gpu::GlContext& context)
   composite_ = gpu::Program::build(
       "hybrid composite",
       {gpu::shaderPreamble(api, false, {}), gpu::embeddedShaderPart("render/fullscreen.vert.glsl")},
-      {gpu::shaderPreamble(api, true, {}), gpu::embeddedShaderPart("render/camera_ray.glsl"),
+      {gpu::shaderPreamble(api, true, {}),
        gpu::embeddedShaderPart("render/hybrid_composite.frag.glsl")});
 }
 
@@ -202,7 +201,7 @@ void HybridCompositor::render(Technique& technique, const Camera& camera,
   // 2. The lines at full resolution.
   const auto tOverlay = std::chrono::steady_clock::now();
   const bool hasLines = !lines_.empty();
-  if (hasLines) overlay_.draw(lines_, camera, width, height);
+  if (hasLines) overlay_.draw(lines_, camera, width, height, volumeExtent);
   gpu::finish();
   timings_.overlayMs = msSince(tOverlay);
 
@@ -210,48 +209,26 @@ void HybridCompositor::render(Technique& technique, const Camera& camera,
   const auto tComposite = std::chrono::steady_clock::now();
   ensureTarget(context_, image_, "hybrid image", width, height);
   image_.bind();
-  drawComposite(resolved_.color(), camera, glm::vec4(settings.background), volumeExtent, width,
-                height, {0, 0});
+  drawComposite(resolved_.color(), glm::vec4(settings.background), width, height, {0, 0});
   gpu::finish();
   gpu::checkErrors("hybrid compositing");
   timings_.compositeMs = msSince(tComposite);
   timings_.totalMs = msSince(tStart);
 }
 
-void HybridCompositor::drawComposite(const gpu::Texture& volumeLayer, const Camera& camera,
-                                     glm::vec4 background, glm::dvec3 volumeExtent, int width,
-                                     int height, glm::ivec2 origin) {
+void HybridCompositor::drawComposite(const gpu::Texture& volumeLayer, glm::vec4 background,
+                                     int width, int height, glm::ivec2 origin) {
   const bool hasLines = !lines_.empty();
-  const double aspect = static_cast<double>(width) / height;
   composite_.use();
-  setCameraRayUniforms(composite_, camera, aspect, width, height, volumeExtent);
+  composite_.set("u_viewport", glm::vec2(width, height));
   composite_.set("u_origin", glm::vec2(origin));
   composite_.set("u_background", background);
   volumeLayer.bind(0);
   composite_.set("u_volume", 0);
   composite_.set("u_hasLines", hasLines ? 1.0f : 0.0f);
-  if (hasLines) {
-    overlay_.colorTexture().bind(1);
-    overlay_.distanceTexture().bind(2);
-    composite_.set("u_lineColor", 1);
-    composite_.set("u_lineDistance", 2);
-    composite_.set("u_distanceScale", static_cast<float>(overlay_.distanceScale()));
-    // A line on the box's front faces is "in front"; allow for the pixel's
-    // ray meeting the box up to a couple of pixels' footprint away from the
-    // line's point, and for packing and float rounding.
-    const double tanHalfFov = std::tan(0.5 * camera.fovYDeg * glm::pi<double>() / 180.0);
-    const double viewHeight = camera.projection == Projection::Perspective
-                                  ? 2.0 * camera.distance() * tanHalfFov
-                                  : 2.0 * camera.orthoHalfHeight();
-    const double tolerance = std::max(2.0 * viewHeight / height, 0.005 * glm::length(volumeExtent));
-    composite_.set("u_frontTolerance", static_cast<float>(tolerance));
-  } else {
-    // Samplers must still name distinct units of the right type.
-    volumeLayer.bind(1);
-    volumeLayer.bind(2);
-    composite_.set("u_lineColor", 1);
-    composite_.set("u_lineDistance", 2);
-  }
+  // (Without lines the sampler must still name a unit with a 2D texture.)
+  (hasLines ? overlay_.colorTexture() : volumeLayer).bind(1);
+  composite_.set("u_lineColor", 1);
   gpu::apply({});
   triangle_.draw();
 }
@@ -260,9 +237,9 @@ void HybridCompositor::composeInto(const gpu::Texture& volumeLayer, const Camera
                                    glm::vec4 background, glm::dvec3 volumeExtent,
                                    unsigned framebuffer, glm::ivec4 box) {
   if (box.z <= 0 || box.w <= 0) throw InputError("hybrid: image size must be positive");
-  if (!lines_.empty()) overlay_.draw(lines_, camera, box.z, box.w);
+  if (!lines_.empty()) overlay_.draw(lines_, camera, box.z, box.w, volumeExtent);
   gpu::bindFramebuffer(framebuffer, box);
-  drawComposite(volumeLayer, camera, background, volumeExtent, box.z, box.w, {box.x, box.y});
+  drawComposite(volumeLayer, background, box.z, box.w, {box.x, box.y});
   gpu::checkErrors("hybrid compositing");
 }
 

@@ -10,6 +10,7 @@
 #include "render/FramebufferImage.h"
 #include "tessera/core/Error.h"
 #include "tessera/gpu/Draw.h"
+#include "tessera/render/CameraRay.h"
 
 namespace tessera::render {
 
@@ -51,9 +52,10 @@ OverlayRenderer::OverlayRenderer(gpu::GlContext& context) : context_(context) {
   const gpu::ApiLevel api = context.caps().api;
   const std::vector<gpu::ShaderPart> vertex{gpu::shaderPreamble(api, false, {}),
                                             gpu::embeddedShaderPart("render/overlay.vert.glsl")};
-  colorProgram_ = gpu::Program::build("overlay colour", vertex,
-                                      {gpu::shaderPreamble(api, true, {}),
-                                       gpu::embeddedShaderPart("render/overlay_color.frag.glsl")});
+  colorProgram_ = gpu::Program::build(
+      "overlay colour", vertex,
+      {gpu::shaderPreamble(api, true, {}), gpu::embeddedShaderPart("render/camera_ray.glsl"),
+       gpu::embeddedShaderPart("render/overlay_color.frag.glsl")});
   distanceProgram_ =
       gpu::Program::build("overlay distance", vertex,
                           {gpu::shaderPreamble(api, true, {}),
@@ -64,39 +66,37 @@ OverlayRenderer::~OverlayRenderer() = default;
 
 void OverlayRenderer::allocate(int width, int height) {
   if (color_.id() != 0 && color_.width() == width && color_.height() == height) return;
-  const gpu::TexelFormat format = gpu::rgba8For(context_.caps().api);
   color_ = gpu::Framebuffer();
-  distance_ = gpu::Framebuffer();
   // Each target has its depth buffer, cleared before its pass, so that where
-  // lines cross the nearest one wins in colour and distance alike.
-  color_ =
-      gpu::Framebuffer::create(context_.ledger(), "overlay colour", width, height, format, true);
-  distance_ =
-      gpu::Framebuffer::create(context_.ledger(), "overlay distance", width, height, format, true);
-  // Sampled at pixel centres only: never blend two lines' packed distances.
+  // lines cross the nearest one wins in colour and distance alike (the
+  // distance target is made by readDistance, which needs it).
+  color_ = gpu::Framebuffer::create(context_.ledger(), "overlay colour", width, height,
+                                    gpu::rgba8For(context_.caps().api), true);
+  // Sampled at pixel centres only: never blend two lines.
   color_.color().setFilter(gpu::Filter::Nearest);
-  distance_.color().setFilter(gpu::Filter::Nearest);
 }
 
-void OverlayRenderer::drawPass(const gpu::Program& program, const glm::mat4& mvp,
-                               const Camera& camera, std::size_t vertexCount) {
-  program.use();
-  program.set("u_viewProjection", mvp);
-  const glm::dmat3 b = camera.basis();
-  program.set("u_eye", glm::vec3(camera.eye()));
-  program.set("u_forward", glm::vec3(-b[2]));
-  program.set("u_ortho", camera.projection == Projection::Orthographic ? 1 : 0);
-  program.set("u_distanceScale", static_cast<float>(distanceScale_));
+double overlayFrontTolerance(const Camera& camera, int height, glm::dvec3 volumeExtent) {
+  const double tanHalfFov = std::tan(0.5 * camera.fovYDeg * glm::pi<double>() / 180.0);
+  const double viewHeight = camera.projection == Projection::Perspective
+                                ? 2.0 * camera.distance() * tanHalfFov
+                                : 2.0 * camera.orthoHalfHeight();
+  return std::max(2.0 * viewHeight / height, 0.005 * glm::length(volumeExtent));
+}
+
+// The program's uniforms are set by the caller.
+void OverlayRenderer::drawPass(const gpu::Program& program) {
+  program.set("u_viewProjection", mvp_);
   gpu::clearColorAndDepth(glm::vec4(0.0f));
-  if (vertexCount == 0) return;
+  if (vertexCount_ == 0) return;
   gpu::drawArrays(gpu::Primitive::Lines, vertices_,
                   {{program.attributeLocation("a_position"), 3, 0},
                    {program.attributeLocation("a_color"), 4, 3}},
-                  7, 0, static_cast<int>(vertexCount));
+                  7, 0, static_cast<int>(vertexCount_));
 }
 
 void OverlayRenderer::draw(const std::vector<OverlayLine>& lines, const Camera& camera, int width,
-                           int height) {
+                           int height, glm::dvec3 volumeExtent) {
   if (width <= 0 || height <= 0) throw InputError("overlay: image size must be positive");
   allocate(width, height);
   std::vector<float> data;
@@ -120,13 +120,18 @@ void OverlayRenderer::draw(const std::vector<OverlayLine>& lines, const Camera& 
   } else if (!data.empty()) {
     vertices_.update(0, data.size() * sizeof(float), data.data());
   }
-  const glm::mat4 mvp(viewProjection(camera, static_cast<double>(width) / height, sceneRadius));
+  const double aspect = static_cast<double>(width) / height;
+  mvp_ = glm::mat4(viewProjection(camera, aspect, sceneRadius));
+  camera_ = camera;
+  vertexCount_ = data.size() / 7;
 
   gpu::apply({.depthTest = true, .lineWidth = 1.0f});
   color_.bind();
-  drawPass(colorProgram_, mvp, camera, data.size() / 7);
-  distance_.bind();
-  drawPass(distanceProgram_, mvp, camera, data.size() / 7);
+  colorProgram_.use();
+  setCameraRayUniforms(colorProgram_, camera, aspect, width, height, volumeExtent);
+  colorProgram_.set("u_frontTolerance",
+                    static_cast<float>(overlayFrontTolerance(camera, height, volumeExtent)));
+  drawPass(colorProgram_);
   gpu::apply({});
   gpu::checkErrors("overlay lines");
 }
@@ -135,7 +140,25 @@ Image OverlayRenderer::readColor() const {
   return render::readImage(color_);
 }
 
-std::vector<float> OverlayRenderer::readDistance() const {
+std::vector<float> OverlayRenderer::readDistance() {
+  if (color_.id() == 0) throw InputError("overlay: no lines drawn yet to read distances of");
+  if (distance_.id() == 0 || distance_.width() != color_.width() ||
+      distance_.height() != color_.height()) {
+    distance_ = gpu::Framebuffer();
+    distance_ = gpu::Framebuffer::create(context_.ledger(), "overlay distance", color_.width(),
+                                         color_.height(), gpu::rgba8For(context_.caps().api), true);
+  }
+  gpu::apply({.depthTest = true, .lineWidth = 1.0f});
+  distance_.bind();
+  distanceProgram_.use();
+  const glm::dmat3 b = camera_.basis();
+  distanceProgram_.set("u_eye", glm::vec3(camera_.eye()));
+  distanceProgram_.set("u_forward", glm::vec3(-b[2]));
+  distanceProgram_.set("u_ortho", camera_.projection == Projection::Orthographic ? 1 : 0);
+  distanceProgram_.set("u_distanceScale", static_cast<float>(distanceScale_));
+  drawPass(distanceProgram_);
+  gpu::apply({});
+  gpu::checkErrors("overlay distance");
   const Image packed = render::readImage(distance_);
   std::vector<float> out(static_cast<std::size_t>(packed.width()) * packed.height(),
                          std::numeric_limits<float>::infinity());

@@ -222,10 +222,10 @@ TEST(GlslConformance, OverlayAndHybridShadersPassTheReferenceCompiler) {
         {gpu::shaderPreamble(api, false, {}), part("render/overlay.vert.glsl")},
         {gpu::shaderPreamble(api, false, {}), part("render/fullscreen.vert.glsl")}};
     std::vector<std::vector<gpu::ShaderPart>> fragment = {
-        {gpu::shaderPreamble(api, true, {}), part("render/overlay_color.frag.glsl")},
-        {gpu::shaderPreamble(api, true, {}), part("render/overlay_distance.frag.glsl")},
         {gpu::shaderPreamble(api, true, {}), part("render/camera_ray.glsl"),
-         part("render/hybrid_composite.frag.glsl")}};
+         part("render/overlay_color.frag.glsl")},
+        {gpu::shaderPreamble(api, true, {}), part("render/overlay_distance.frag.glsl")},
+        {gpu::shaderPreamble(api, true, {}), part("render/hybrid_composite.frag.glsl")}};
     for (const char* method : {"METHOD_COPY 1", "METHOD_ALPHA 1", "METHOD_TWO_PASS 1",
                                "METHOD_LUMA_AVG 1", "METHOD_LUMA_601 1"}) {
       fragment.push_back(

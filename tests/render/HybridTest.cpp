@@ -174,7 +174,10 @@ TEST(Hybrid, OpacityMethodsAgainstGroundTruth) {
     Image img = scene.hybrid(w, h, OffscreenSize::ofSize(128, 128), OverlayOpacity::Alpha);
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x)
-        if (lines.pixel(x, y)[3]) std::copy_n(lines.pixel(x, y), 4, img.pixel(x, y));
+        if (lines.pixel(x, y)[3]) {
+          std::copy_n(lines.pixel(x, y), 3, img.pixel(x, y));
+          img.pixel(x, y)[3] = 255;
+        }
     return img;
   }();
   const double pasted = psnr(noAttenuation, truth);

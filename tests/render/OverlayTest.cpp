@@ -70,9 +70,29 @@ TEST(Overlay, BoxAxesAndRoiHaveTheirSegments) {
   EXPECT_DOUBLE_EQ(lines[14].b.z, 1.3 * half.z);
 }
 
+// Where a ray enters the box of `extent` centred at the origin (its ray
+// parameter), or +infinity when it misses.
+double boxEntry(const Ray& r, glm::dvec3 extent) {
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    if (r.direction[a] == 0.0) {
+      if (std::abs(r.origin[a]) > 0.5 * extent[a]) return hi;
+      continue;
+    }
+    const double t0 = (-0.5 * extent[a] - r.origin[a]) / r.direction[a];
+    const double t1 = (0.5 * extent[a] - r.origin[a]) / r.direction[a];
+    lo = std::max(lo, std::min(t0, t1));
+    hi = std::min(hi, std::max(t0, t1));
+  }
+  return lo < hi ? lo : std::numeric_limits<double>::infinity();
+}
+
 // Every line pixel's distance, taken along that pixel's ray, lands on a line
 // segment (within the pixel's footprint): the packing, the projection and the
-// ray parameter agree with Camera::pixelRay.
+// ray parameter agree with Camera::pixelRay. Its alpha says whether the line
+// is in front of the volume box as the CPU says from that distance and the
+// pixel's ray (up to lines within a pixel's footprint of the threshold).
 TEST(Overlay, LineLayerDistanceLiesOnTheLines) {
   gpu::GlContext& c = test::gpuContext();
   const Volume v = makeSphere({48, 40, 32});
@@ -85,33 +105,52 @@ TEST(Overlay, LineLayerDistanceLiesOnTheLines) {
     cam.projection = projection;
     const int w = 160, h = 120;
     render::OverlayRenderer overlay(c);
-    overlay.draw(lines, cam, w, h);
+    overlay.draw(lines, cam, w, h, v.extent());
     const Image color = overlay.readColor();
+    const double tolerance = render::overlayFrontTolerance(cam, h, v.extent());
     const std::vector<float> dist = overlay.readDistance();
     // World size of one pixel at the target's distance.
     const double pixel =
         2.0 * cam.orthoHalfHeight() / h * (projection == Projection::Perspective ? 1.3 : 1.0);
     int linePixels = 0;
+    int front = 0;
+    int behind = 0;
+    int borderline = 0;
     double worst = 0.0;
     for (int y = 0; y < h; ++y) {
       for (int x = 0; x < w; ++x) {
         const std::size_t i = static_cast<std::size_t>(y) * w + x;
-        if (color.pixel(x, y)[3] == 0) {
+        const int alpha = color.pixel(x, y)[3];
+        if (alpha == 0) {
           EXPECT_TRUE(std::isinf(dist[i]));
           continue;
         }
         ++linePixels;
         const Ray r = cam.pixelRay(x, y, w, h);
+        const double entry = boxEntry(r, v.extent());
+        const double threshold = std::max(entry, 0.0) + tolerance;
+        const bool inFront = std::isinf(entry) || dist[i] <= threshold;
+        if (std::abs(dist[i] - threshold) < pixel) {
+          ++borderline;
+        } else {
+          EXPECT_EQ(alpha, inFront ? 255 : 128) << x << "," << y;
+        }
+        (inFront ? front : behind)++;
         const glm::dvec3 p = r.origin + static_cast<double>(dist[i]) * r.direction;
         double nearest = std::numeric_limits<double>::infinity();
         for (const auto& l : lines) nearest = std::min(nearest, segmentDistance(p, l.a, l.b));
         worst = std::max(worst, nearest);
       }
     }
-    std::printf("  [measured] %s: %d line pixels, farthest from a segment %.3f (pixel %.3f)\n",
-                projection == Projection::Perspective ? "perspective" : "orthographic", linePixels,
-                worst, pixel);
+    std::printf(
+        "  [measured] %s: %d line pixels (%d in front of the box, %d in or behind it, %d within a "
+        "pixel of the threshold), farthest from a segment %.3f (pixel %.3f)\n",
+        projection == Projection::Perspective ? "perspective" : "orthographic", linePixels, front,
+        behind, borderline, worst, pixel);
     EXPECT_GT(linePixels, 600);
+    EXPECT_GT(front, 100);
+    EXPECT_GT(behind, 100);
+    EXPECT_LT(borderline, linePixels / 10);
     EXPECT_LT(worst, 1.5 * pixel);
   }
 }

@@ -19,11 +19,14 @@ constexpr int kPlanImageSize = 1024;
 constexpr int kSkipBlock = 8;
 // Streaming (reading and uploading arrived bricks) before a frame is drawn.
 constexpr double kStreamMs = 150.0;
-// The preview's share of the budget (the rest: the update before it), and
-// its least resolution. It keeps the full frame's sample distance: another
-// would rebuild the ray caster's tables (classification per block) twice
-// per preview, costing more than the preview itself.
-constexpr double kPreviewShare = 0.5;
+// The preview's share of the budget, and its least resolution. The preview
+// answers input that has already waited (for the strip running when it
+// came, a wheel turn for its animation frame: up to 17 ms), so it takes
+// about a third of the budget, leaving the input's wait and the
+// presentation within two budgets. It keeps the full frame's sample
+// distance: another would rebuild the ray caster's tables (classification
+// per block) twice per preview, costing more than the preview itself.
+constexpr double kPreviewShare = 0.35;
 constexpr double kPreviewMinScale = 1.0 / 16.0;
 // The first strip's rows (a fraction of the frame) before any cost is known.
 constexpr double kFirstStrip = 1.0 / 64.0;

@@ -94,14 +94,15 @@ class HybridCompositor {
   // A = the opacity estimate, at the offscreen size (top row first).
   Image readOpacityLayer() const;
   const OverlayRenderer& overlays() const { return overlay_; }
+  OverlayRenderer& overlays() { return overlay_; }  // (readDistance draws its pass)
   const HybridTimings& timings() const { return timings_; }
 
  private:
   const gpu::Program& resolveProgram(const std::string& method);
   // The full-resolution composite into the bound framebuffer, whose
   // viewport is width x height at `origin`.
-  void drawComposite(const gpu::Texture& volumeLayer, const Camera& camera, glm::vec4 background,
-                     glm::dvec3 volumeExtent, int width, int height, glm::ivec2 origin);
+  void drawComposite(const gpu::Texture& volumeLayer, glm::vec4 background, int width, int height,
+                     glm::ivec2 origin);
 
   gpu::GlContext& context_;
   std::vector<OverlayLine> lines_;

@@ -1,13 +1,14 @@
 #pragma once
 // Rasterises overlay lines at full resolution into a "line layer": the
-// nearest line's colour per pixel, and its distance along the pixel's ray
-// (the ray parameter t of the ray caster: from the eye for perspective, from
-// the eye plane for orthographic views). The hybrid compositor decides from
-// that distance whether a line lies in front of the volume or must be
-// attenuated, and the CPU ground truth (reference/ReferenceOverlay.h)
-// terminates each ray at it — both see exactly the same line pixels.
-// The distance is packed into the RGB bytes of an RGBA8 target (24 bits of
-// t / distanceScale), which every ES 2.0 device can render to.
+// nearest line's colour per pixel, with whether it lies in front of the
+// volume box (decided per line fragment from its distance along the pixel's
+// ray: the ray parameter t of the ray caster, from the eye for perspective,
+// from the eye plane for orthographic views), which is all the hybrid
+// compositor needs. The distance itself is drawn on request (readDistance):
+// the CPU ground truth (reference/ReferenceOverlay.h) terminates each ray at
+// it, so both see exactly the same line pixels. It is packed into the RGB
+// bytes of an RGBA8 target (24 bits of t / distanceScale), which every
+// ES 2.0 device can render to.
 #include <vector>
 
 #include <glm/mat4x4.hpp>
@@ -33,24 +34,27 @@ class OverlayRenderer {
   OverlayRenderer(const OverlayRenderer&) = delete;
   OverlayRenderer& operator=(const OverlayRenderer&) = delete;
 
-  // Draws `lines` (depth-tested among themselves) into width x height colour
-  // and distance targets; pixels without a line get colour (0,0,0,0).
-  void draw(const std::vector<OverlayLine>& lines, const Camera& camera, int width, int height);
+  // Draws `lines` (depth-tested among themselves) into a width x height
+  // colour target: RGB the nearest line's colour, alpha 1 where it lies in
+  // front of the volume box (`volumeExtent`, world units, centred at the
+  // origin) and 0.5 where it lies in or behind it; (0,0,0,0) without a line.
+  void draw(const std::vector<OverlayLine>& lines, const Camera& camera, int width, int height,
+            glm::dvec3 volumeExtent);
 
   const gpu::Texture& colorTexture() const { return color_.color(); }
-  const gpu::Texture& distanceTexture() const { return distance_.color(); }
   // World length that a packed distance of 1 stands for.
   double distanceScale() const { return distanceScale_; }
 
-  // Read-backs, top row first: colour (alpha 255 on line pixels), and the
-  // distance per pixel (+infinity where there is no line).
+  // Read-backs of the last draw, top row first: colour (alpha 255 on line
+  // pixels in front of the volume, 128 on the others, 0 elsewhere), and the
+  // distance per pixel (+infinity where there is no line), whose pass is
+  // drawn here.
   Image readColor() const;
-  std::vector<float> readDistance() const;
+  std::vector<float> readDistance();
 
  private:
   void allocate(int width, int height);
-  void drawPass(const gpu::Program& program, const glm::mat4& mvp, const Camera& camera,
-                std::size_t vertexCount);
+  void drawPass(const gpu::Program& program);
 
   gpu::GlContext& context_;
   gpu::Framebuffer color_;
@@ -59,6 +63,16 @@ class OverlayRenderer {
   gpu::Program colorProgram_;
   gpu::Program distanceProgram_;
   double distanceScale_ = 1.0;
+  // The last draw's view, for its distance pass.
+  Camera camera_;
+  glm::mat4 mvp_{1.0f};
+  std::size_t vertexCount_ = 0;
 };
+
+// How far behind the point where a pixel's ray enters the volume box a line
+// still counts as in front of it (world units): the ray may meet the box up
+// to a couple of pixels' footprint away from the line's point (a line on the
+// box's front faces), and packing and float rounding.
+double overlayFrontTolerance(const Camera& camera, int height, glm::dvec3 volumeExtent);
 
 }  // namespace tessera::render
