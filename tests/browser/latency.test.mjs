@@ -422,13 +422,20 @@ async function storeInputLatency(context, url, tmp, run) {
         'blink', 'renderer.scheduler', 'disabled-by-default-devtools.timeline.frame', 'v8.execute'] } });
   }
   // The input sequence (ms from its start, page coordinates): a drag of
-  // MOVES moves 70 ms apart, its release, and WHEELS wheel turns 200 ms
-  // apart, in and out.
+  // MOVES moves 70 ms apart, its release, and WHEELS wheel turns about
+  // 200 ms apart, in and out. Chromium holds moves and wheel turns for the
+  // next animation frame, so an event's wait depends on where in the frame
+  // interval (16.7 ms at 60 Hz) it comes: the moves' 70 ms steps fall at
+  // five points of it, and the wheel turns' steps are 200 ms plus a
+  // twelfth of an interval (200 ms alone is twelve intervals: every turn
+  // would fall at the same point, and a run's worst turn would depend on
+  // that point alone), so that they sample the whole interval.
   const MOVES = 40, WHEELS = 12;
+  const WHEEL_STEP_MS = 200 + 1000 / 60 / WHEELS;
   const plan = [{ at: 0, kind: 'press', x: cx, y: cy }];
   for (let i = 1; i <= MOVES; i++) plan.push({ at: i * 70, kind: 'move', x: cx + 3 * i, y: cy + (i % 5) });
   plan.push({ at: (MOVES + 1) * 70, kind: 'release', x: cx + 3 * MOVES, y: cy });
-  for (let i = 0; i < WHEELS; i++) plan.push({ at: (MOVES + 4) * 70 + i * 200, kind: 'wheel', x: cx, y: cy, up: i % 2 === 0 });
+  for (let i = 0; i < WHEELS; i++) plan.push({ at: (MOVES + 4) * 70 + i * WHEEL_STEP_MS, kind: 'wheel', x: cx, y: cy, up: i % 2 === 0 });
   // The last move's answer is kept (its pixels: checked against the
   // refined frame of the same view below); asked for 30 ms before it.
   const captureAt = MOVES * 70 - 30;
