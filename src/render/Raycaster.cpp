@@ -60,8 +60,10 @@ void Raycaster::setLutSize(int entries) {
 }
 
 std::uint64_t Raycaster::ownTextureBytes() const {
-  return lut_.bytes() + preint_.bytes() + blockTexture_.bytes() + target_.color().bytes() +
-         spareTarget_.color().bytes() + gradient_.bytes() + fusion_.bytes();
+  std::uint64_t spares = 0;
+  for (const gpu::Framebuffer& f : spareTargets_) spares += f.color().bytes();
+  return lut_.bytes() + preint_.bytes() + blockTexture_.bytes() + target_.color().bytes() + spares +
+         gradient_.bytes() + fusion_.bytes();
 }
 
 void Raycaster::setPreintegrationEntries(int entries) {
@@ -316,27 +318,7 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
   updateLookup(settings, isProjection(settings.mode) ? tf_.opacityUnitLength : ds);
   gradient_.prepare(settings);
 
-  if (target_.id() == 0 || target_.width() != width || target_.height() != height) {
-    // Previews and full frames alternate between two sizes (the page's
-    // store view, the viewer's interactive frames): of a pair of targets
-    // one at most a sixteenth of the other's pixels (a preview at a
-    // quarter of the width or less), neither is made again (three waits
-    // for the GPU process each: the errors before and after, the
-    // completeness check), for at most a sixteenth more memory. Any other
-    // is let go first.
-    if (spareTarget_.id() != 0 && spareTarget_.width() == width &&
-        spareTarget_.height() == height) {
-      std::swap(target_, spareTarget_);
-    } else {
-      const long long had = static_cast<long long>(target_.width()) * target_.height();
-      const long long wants = static_cast<long long>(width) * height;
-      const bool pair = target_.id() != 0 && (16 * had <= wants || 16 * wants <= had);
-      spareTarget_ = pair ? std::move(target_) : gpu::Framebuffer();
-      target_ = gpu::Framebuffer();
-      target_ = gpu::Framebuffer::create(context_.ledger(), "ray-cast target", width, height,
-                                         gpu::rgba8For(context_.caps().api));
-    }
-  }
+  useTarget(width, height);
   target_.bind();
   const gpu::Program& prog = programFor(settings);
   prog.use();
@@ -400,6 +382,50 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
   triangle_.draw();
   gpu::finish();
   gpu::checkErrors("ray casting");
+}
+
+// Makes target_ a width x height target. Previews and full frames alternate
+// (the page's store view, the viewer's interactive frames), and a preview's
+// size follows its quality controller (16, 17, 18 pixels...): the full
+// frame's target and the previews' (each at most a sixteenth of its pixels,
+// together at most a sixteenth more memory) are kept and used again, the
+// most recent first, since making one costs three waits for a browser's
+// GPU process (the errors before and after, the completeness check). Any
+// other is let go before a new one is made.
+void Raycaster::useTarget(int width, int height) {
+  if (target_.id() != 0 && target_.width() == width && target_.height() == height) return;
+  const auto pixels = [](const gpu::Framebuffer& f) {
+    return static_cast<long long>(f.width()) * f.height();
+  };
+  gpu::Framebuffer next;
+  for (auto it = spareTargets_.begin(); it != spareTargets_.end(); ++it) {
+    if (it->width() == width && it->height() == height) {
+      next = std::move(*it);
+      spareTargets_.erase(it);
+      break;
+    }
+  }
+  if (target_.id() != 0) spareTargets_.insert(spareTargets_.begin(), std::move(target_));
+  const long long wants = static_cast<long long>(width) * height;
+  long long full = wants;
+  for (const gpu::Framebuffer& f : spareTargets_) full = std::max(full, pixels(f));
+  if (16 * wants > full) full = wants;  // not a preview: larger targets are let go
+  bool fullKept = wants == full;
+  long long previews = wants < full ? wants : 0;
+  std::vector<gpu::Framebuffer> kept;
+  for (gpu::Framebuffer& f : spareTargets_) {
+    if (!fullKept && pixels(f) == full) {
+      fullKept = true;
+      kept.push_back(std::move(f));
+    } else if (16 * (previews + pixels(f)) <= full) {
+      previews += pixels(f);
+      kept.push_back(std::move(f));
+    }
+  }
+  spareTargets_ = std::move(kept);  // the rest let go here
+  target_ = next.id() != 0 ? std::move(next)
+                           : gpu::Framebuffer::create(context_.ledger(), "ray-cast target", width,
+                                                      height, gpu::rgba8For(context_.caps().api));
 }
 
 Image Raycaster::readImage() const {

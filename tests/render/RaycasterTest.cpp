@@ -191,3 +191,44 @@ TEST(Raycaster, NanVoxelsAreTransparentLikeTheReference) {
   const Comparison r = compare(v, visibleTf(), cam, RenderSettings{}, 128);
   EXPECT_GE(r.psnr, 55.0);
 }
+
+// Previews and full frames alternate, a preview's size following its
+// quality controller: the full frame's target and the previews' are kept
+// (each preview at most a sixteenth of the full frame's pixels, together
+// at most a sixteenth more), the most recent first, and drawn into again
+// with the same images; a size that is neither lets the others go.
+TEST(Raycaster, PreviewTargetsAreKeptBesideTheFullFramesAndDrawnIntoAgain) {
+  gpu::GlContext& c = context();
+  const Volume v = makeSheppLogan({32, 32, 32});
+  auto layout = layout::Texture3DLayout::create(v, gpu::DeviceLimits::of(c.caps()), c.ledger());
+  render::Raycaster caster(c, v, *layout);
+  caster.setTransferFunction(visibleTf());
+  Camera cam;
+  cam.azimuthDeg = 30;
+  cam.elevationDeg = 20;
+  cam.frame(v.extent());
+  const RenderSettings s;
+  const auto rgba8 = [](long long pixels) { return static_cast<std::uint64_t>(4 * pixels); };
+
+  const Image full = caster.render(cam, s, 128, 128);
+  const std::uint64_t base = caster.ownTextureBytes();  // the tables and the 128x128 target
+  const Image preview16 = caster.render(cam, s, 16, 16);
+  caster.render(cam, s, 17, 17);
+  caster.render(cam, s, 18, 18);
+  const Image again16 = caster.render(cam, s, 16, 16);
+  const Image fullAgain = caster.render(cam, s, 128, 128);
+  EXPECT_EQ(caster.ownTextureBytes(), base + rgba8(16 * 16 + 17 * 17 + 18 * 18))
+      << "the full frame's target and three previews' held";
+  EXPECT_EQ(again16.rgba(), preview16.rgba()) << "a preview's target drawn into again";
+  EXPECT_EQ(fullAgain.rgba(), full.rgba()) << "the full frame's target drawn into again";
+
+  // A fourth preview would hold more than a sixteenth: the least recently
+  // used (17x17) is let go.
+  caster.render(cam, s, 19, 19);
+  EXPECT_EQ(caster.ownTextureBytes(), base + rgba8(19 * 19 + 16 * 16 + 18 * 18));
+  // 64x64 is more than a sixteenth of 128x128, not a preview of it: the
+  // 128x128 target is let go, and of the previews only 16x16 (a sixteenth
+  // of 64x64) is kept, as 64x64's.
+  caster.render(cam, s, 64, 64);
+  EXPECT_EQ(caster.ownTextureBytes(), base - rgba8(128 * 128) + rgba8(64 * 64 + 16 * 16));
+}

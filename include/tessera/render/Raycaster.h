@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "tessera/core/Camera.h"
 #include "tessera/core/Image.h"
@@ -137,6 +138,7 @@ class Raycaster final : public Technique {
   bool logTransmittance(const RenderSettings& settings) const;
   void uploadLut();
   void uploadBlocks(const std::vector<std::uint8_t>& cells);
+  void useTarget(int width, int height);
 
   gpu::GlContext& context_;
   const Volume& volume_;
@@ -155,7 +157,9 @@ class Raycaster final : public Technique {
   FusionTexture fusion_;
   gpu::Texture blockTexture_;
   gpu::Framebuffer target_;
-  gpu::Framebuffer spareTarget_;  // a preview's or a full frame's beside it (render())
+  // Targets held beside target_, the most recently used first: a full
+  // frame's and previews' (useTarget()).
+  std::vector<gpu::Framebuffer> spareTargets_;
   gpu::FullscreenTriangle triangle_;
   gpu::ProgramCache programs_;
   // What the LUT/block texture were built for, to rebuild only on change.
