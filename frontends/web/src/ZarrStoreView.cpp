@@ -386,10 +386,24 @@ StoreFrame ZarrStoreView::strip() {
   const FrameView& v = p.view;
   const double pixels = static_cast<double>(v.renderWidth) * v.renderHeight;
   const double minStrip = 1.0 / v.renderHeight;
-  double rows = msPerPixel_ > 0.0 ? stripShare_ * budgetMs_ / (msPerPixel_ * pixels) : kFirstStrip;
-  // At most twice the last strip's rows: the rows below may cover more of
-  // the volume than those the cost was learnt on.
-  if (p.rows > 0.0) rows = std::min(rows, 2.0 * p.rows);
+  // Strips are sized by what their rows cost (render::RowCosts: rows across
+  // the volume's box are dear, those beside it cheap), so that a cost learnt
+  // on the rows below the volume does not size a strip across it several
+  // budgets long.
+  if (p.costs.empty()) {
+    p.costs = render::RowCosts(v.camera, store_->shape().extent(), v.renderWidth, v.renderHeight);
+    if (msPerWeight_ <= 0.0 && msPerPixel_ > 0.0) {
+      msPerWeight_ = msPerPixel_ * pixels / p.costs.weight(0.0, 1.0);
+    }
+  }
+  double rows = kFirstStrip;
+  if (msPerWeight_ > 0.0) {
+    double weight = stripShare_ * budgetMs_ / msPerWeight_;
+    // At most twice the last strip's weight: the rows above may cover
+    // denser parts of the volume than those the cost was learnt on.
+    if (p.weight > 0.0) weight = std::min(weight, 2.0 * p.weight);
+    rows = p.costs.reach(p.done, weight) - p.done;
+  }
   rows = std::clamp(rows, minStrip, 1.0 - p.done);
   if (1.0 - (p.done + rows) < 0.5 * minStrip) rows = 1.0 - p.done;
   gpu::DeferredErrorChecks deferred;  // asked for once, after the read-back
@@ -405,9 +419,16 @@ StoreFrame ZarrStoreView::strip() {
   deferred.check("OME-Zarr strip");
   // A strip's time varies with what its rows cover: a dearer one is taken
   // at once, a cheaper one only in part, so that strips overrun seldom.
-  const double perPixel = (msSince(t0) - tablesMs) / (rows * pixels);
+  const double marchMs = msSince(t0) - tablesMs;
+  const double perPixel = marchMs / (rows * pixels);
   msPerPixel_ = perPixel > msPerPixel_ ? perPixel : 0.75 * msPerPixel_ + 0.25 * perPixel;
+  const double weight = p.costs.weight(p.done, p.done + rows);
+  if (weight > 0.0) {
+    const double perWeight = marchMs / weight;
+    msPerWeight_ = perWeight > msPerWeight_ ? perWeight : 0.75 * msPerWeight_ + 0.25 * perWeight;
+  }
   p.rows = rows;
+  p.weight = weight;
   p.done = p.done + rows >= 1.0 - 1e-9 ? 1.0 : p.done + rows;
   StoreFrame f;
   f.tablesMs = tablesMs;

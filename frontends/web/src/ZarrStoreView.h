@@ -24,6 +24,7 @@
 #include "tessera/render/HybridCompositor.h"
 #include "tessera/render/Overlay.h"
 #include "tessera/render/QualityController.h"
+#include "tessera/render/RowCosts.h"
 #include "tessera/render/TechniqueRegistry.h"
 
 namespace tessera::web {
@@ -214,8 +215,10 @@ class ZarrStoreView {
     FrameView view;
     layout::BricksFrame bricks;
     double streamedMs = 0.0;
-    double done = 0.0;  // fraction of the rows drawn
-    double rows = 0.0;  // the last strip's
+    double done = 0.0;       // fraction of the rows drawn
+    double rows = 0.0;       // the last strip's
+    double weight = 0.0;     // the last strip's rows' weight (costs)
+    render::RowCosts costs;  // the view's rows (at the first strip)
   };
   void createBricks();
   layout::UpdatePace streamPace() const;
@@ -234,7 +237,8 @@ class ZarrStoreView {
   layout::BricksFrame shownBricks_;  // the bricks' state after the last update
   double budgetMs_ = 12.0;
   double stripShare_ = StorePace{}.stripShare;
-  double msPerPixel_ = 0.0;  // the ray march at full quality, from strips and whole frames
+  double msPerPixel_ = 0.0;   // the ray march at full quality, from strips and whole frames
+  double msPerWeight_ = 0.0;  // the same per unit of render::RowCosts weight, from strips
   // The preview's resolution and step, fed back to meet its share of the budget.
   std::unique_ptr<render::QualityController> previewQuality_;
   bool previewMeasured_ = false;

@@ -1,0 +1,45 @@
+#pragma once
+// What each row of a ray-cast frame is expected to cost, for sizing the
+// strips a progressive frame is drawn in (the page's store view): a ray
+// that misses the volume's box costs a small fixed part of one that
+// enters it, so rows below and above the volume are cheap and rows across
+// it dear. A cost per row learnt on the cheap rows then does not size a
+// strip across the volume several times its budget, as a cost per pixel
+// of the whole image did.
+#include <glm/vec3.hpp>
+#include <vector>
+
+#include "tessera/core/Camera.h"
+
+namespace tessera::render {
+
+class RowCosts {
+ public:
+  // A missing ray's cost as a fraction of an entering one's.
+  static constexpr double kMissWeight = 0.05;
+
+  RowCosts() = default;
+  // The rows of a width x height frame of a box of `extent` (centred at the
+  // origin, model frame) seen by `camera`; each row's rays sampled at up to
+  // `columns` evenly spaced pixels.
+  RowCosts(const Camera& camera, glm::dvec3 extent, int width, int height, int columns = 32);
+
+  bool empty() const { return height_ == 0; }
+  int height() const { return height_; }
+  // The weight of a row counted from the bottom: its pixels, each 1 when
+  // its ray enters the box and kMissWeight when it misses.
+  double row(int fromBottom) const;
+  // The weight of the rows between fractions `from` and `to` of the height,
+  // from the bottom (row edges at round(fraction x height), as
+  // gpu::RegionScope draws them).
+  double weight(double from, double to) const;
+  // The fraction up to which the rows from `from` weigh about `w`: whole
+  // rows, at least one, at most up to the top (1).
+  double reach(double from, double w) const;
+
+ private:
+  int height_ = 0;
+  std::vector<double> prefix_;  // prefix_[r]: the weight of rows [0, r)
+};
+
+}  // namespace tessera::render

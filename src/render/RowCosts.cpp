@@ -1,0 +1,60 @@
+#include "tessera/render/RowCosts.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "tessera/core/Error.h"
+#include "tessera/reference/ReferenceRaycaster.h"
+
+namespace tessera::render {
+
+RowCosts::RowCosts(const Camera& camera, glm::dvec3 extent, int width, int height, int columns) {
+  if (width <= 0 || height <= 0 || columns <= 0) {
+    throw InputError("row costs of a " + std::to_string(width) + "x" + std::to_string(height) +
+                     " frame sampled at " + std::to_string(columns) + " columns");
+  }
+  const int n = std::min(columns, width);
+  height_ = height;
+  prefix_.assign(static_cast<std::size_t>(height) + 1, 0.0);
+  for (int r = 0; r < height; ++r) {
+    const int py = height - 1 - r;  // Camera::pixelRay counts rows from the top
+    int hits = 0;
+    for (int c = 0; c < n; ++c) {
+      const int px = std::min(width - 1, static_cast<int>((c + 0.5) * width / n));
+      const Ray ray = camera.pixelRay(px, py, width, height);
+      // Texture space, t in world units, as the ray caster and the reference.
+      const auto [enter, leave] = unitBoxSpan(ray.origin / extent + 0.5, ray.direction / extent);
+      hits += enter < leave;
+    }
+    const double hitShare = static_cast<double>(hits) / n;
+    prefix_[static_cast<std::size_t>(r) + 1] =
+        prefix_[static_cast<std::size_t>(r)] +
+        width * (kMissWeight + (1.0 - kMissWeight) * hitShare);
+  }
+}
+
+double RowCosts::row(int fromBottom) const {
+  const auto r = static_cast<std::size_t>(std::clamp(fromBottom, 0, height_ - 1));
+  return prefix_[r + 1] - prefix_[r];
+}
+
+double RowCosts::weight(double from, double to) const {
+  const auto edge = [this](double f) {
+    return static_cast<std::size_t>(
+        std::clamp(static_cast<int>(std::lround(f * height_)), 0, height_));
+  };
+  const std::size_t a = edge(from), b = edge(to);
+  return b > a ? prefix_[b] - prefix_[a] : 0.0;
+}
+
+double RowCosts::reach(double from, double w) const {
+  const int start = std::clamp(static_cast<int>(std::lround(from * height_)), 0, height_);
+  if (start >= height_) return 1.0;
+  const double goal = prefix_[static_cast<std::size_t>(start)] + w;
+  // The first row end whose prefix reaches the goal, at least one row on.
+  const auto it = std::lower_bound(prefix_.begin() + start + 1, prefix_.end(), goal);
+  const auto end = it == prefix_.end() ? height_ : static_cast<int>(it - prefix_.begin());
+  return static_cast<double>(end) / height_;
+}
+
+}  // namespace tessera::render
