@@ -3,17 +3,24 @@
 #include <algorithm>
 #include <cmath>
 
+#include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
+
 #include "tessera/core/Error.h"
 #include "tessera/reference/ReferenceRaycaster.h"
 
 namespace tessera::render {
 
-RowCosts::RowCosts(const Camera& camera, glm::dvec3 extent, int width, int height, int columns) {
+RowCosts::RowCosts(const Camera& camera, glm::dvec3 extent, int width, int height,
+                   Footprint footprint, int columns) {
   if (width <= 0 || height <= 0 || columns <= 0) {
     throw InputError("row costs of a " + std::to_string(width) + "x" + std::to_string(height) +
                      " frame sampled at " + std::to_string(columns) + " columns");
   }
   const int n = std::min(columns, width);
+  // The view cube's frame: the camera's basis, its side the box's diagonal.
+  const glm::dmat3 toView = glm::transpose(camera.basis());
+  const glm::dvec3 cube(glm::length(extent));
   height_ = height;
   prefix_.assign(static_cast<std::size_t>(height) + 1, 0.0);
   for (int r = 0; r < height; ++r) {
@@ -23,7 +30,10 @@ RowCosts::RowCosts(const Camera& camera, glm::dvec3 extent, int width, int heigh
       const int px = std::min(width - 1, static_cast<int>((c + 0.5) * width / n));
       const Ray ray = camera.pixelRay(px, py, width, height);
       // Texture space, t in world units, as the ray caster and the reference.
-      const auto [enter, leave] = unitBoxSpan(ray.origin / extent + 0.5, ray.direction / extent);
+      const auto [enter, leave] =
+          footprint == Footprint::VolumeBox
+              ? unitBoxSpan(ray.origin / extent + 0.5, ray.direction / extent)
+              : unitBoxSpan(toView * ray.origin / cube + 0.5, toView * ray.direction / cube);
       hits += enter < leave;
     }
     const double hitShare = static_cast<double>(hits) / n;

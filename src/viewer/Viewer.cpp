@@ -155,7 +155,7 @@ void Viewer::setVolume(std::shared_ptr<Volume> volume, const std::string& name) 
   active_ = std::move(next);
   pending_ = {};
   drawn_ = {};
-  frameMsPerPixel_ = stripMsPerPixel_ = 0.0;
+  frameMsPerPixel_ = stripMsPerWeight_ = 0.0;
   volume_ = source.level(glm::ivec3(1));
   volumeName_ = name;
   ++volumeRevision_;
@@ -217,7 +217,7 @@ void Viewer::setTechnique(const std::string& name) {
   }
   pending_ = {};
   drawn_ = {};
-  frameMsPerPixel_ = stripMsPerPixel_ = 0.0;
+  frameMsPerPixel_ = stripMsPerWeight_ = 0.0;
   techniqueName_ = name;
 }
 
@@ -228,7 +228,7 @@ void Viewer::recreateActive() {
   uploadedTfRevision_ = tfEditor_.revision();
   pending_ = {};
   drawn_ = {};
-  frameMsPerPixel_ = stripMsPerPixel_ = 0.0;
+  frameMsPerPixel_ = stripMsPerWeight_ = 0.0;
 }
 
 void Viewer::setLabels(render::LabelTable table) {
@@ -458,7 +458,8 @@ FrameStats Viewer::render(int width, int height, unsigned framebuffer, glm::ivec
                   .height = height,
                   .framebuffer = framebuffer,
                   .origin = origin,
-                  .pass = full};
+                  .pass = full,
+                  .costs = {}};
       last_ = stats;
       return stats;
     }
@@ -481,10 +482,21 @@ FrameStats Viewer::refine() {
   const gpu::Texture* image = nullptr;
   gpu::clearErrors();
   drawn_ = {};  // the strips write the whole target
-  // One strip per call, as many rows as the budget affords at the cost per
-  // pixel of the strips before (a single draw keeps the per-call overhead
-  // of multi-pass techniques, such as the slicers' hundreds of slices, once).
-  double strip = stripMsPerPixel_ > 0.0 ? frameBudgetMs / (stripMsPerPixel_ * pixels) : 1.0 / 16.0;
+  // One strip per call, as many rows as the budget affords at the cost of
+  // the strips before (a single draw keeps the per-call overhead of
+  // multi-pass techniques, such as the slicers' hundreds of slices, once).
+  // The cost is per unit of what the rows are expected to cost
+  // (render::RowCosts: rows across what the technique draws, the volume's
+  // box or the slicer's proxy, are dear, those beside it cheap), not per
+  // pixel: a cost learnt on the rows below the volume would size a strip
+  // across it several budgets long.
+  if (p.costs.empty()) {
+    p.costs = render::RowCosts(camera_, volume().extent(), p.pass.width, p.pass.height,
+                               active_.technique->footprint());
+  }
+  double strip = stripMsPerWeight_ > 0.0
+                     ? p.costs.reach(p.done, frameBudgetMs / stripMsPerWeight_) - p.done
+                     : 1.0 / 16.0;
   strip = std::clamp(strip, minStrip, 1.0 - p.done);
   if (1.0 - (p.done + strip) < 0.5 * minStrip) strip = 1.0 - p.done;
   {
@@ -496,8 +508,11 @@ FrameStats Viewer::refine() {
   }
   const double ms = msSince(t0);
   // Smoothed: a strip's time varies with what its rows cover.
-  const double perPixel = ms / (strip * pixels);
-  stripMsPerPixel_ = stripMsPerPixel_ > 0.0 ? 0.5 * (stripMsPerPixel_ + perPixel) : perPixel;
+  const double weight = p.costs.weight(p.done, p.done + strip);
+  if (weight > 0.0) {
+    const double perWeight = ms / weight;
+    stripMsPerWeight_ = stripMsPerWeight_ > 0.0 ? 0.5 * (stripMsPerWeight_ + perWeight) : perWeight;
+  }
   p.ms += ms;
   p.done = p.done + strip >= 1.0 - 1e-9 ? 1.0 : p.done + strip;
   gpu::checkErrors("progressive frame");

@@ -27,7 +27,8 @@ Camera straightOrtho() {
 TEST(RowCosts, RowsAcrossTheBoxWeighTheirEnteringRaysOthersTheMissWeight) {
   const Camera cam = straightOrtho();
   const int size = 200;
-  const render::RowCosts costs(cam, glm::dvec3(1.0), size, size, size);
+  const render::RowCosts costs(cam, glm::dvec3(1.0), size, size, render::Footprint::VolumeBox,
+                               size);
   const double side = size / (2.0 * cam.orthoHalfHeight());  // the square's side in pixels
   const double lo = 0.5 * (size - side), hi = 0.5 * (size + side);
   int across = 0;
@@ -52,8 +53,10 @@ TEST(RowCosts, FewerColumnsSampledGiveAboutTheSameRows) {
   cam.azimuthDeg = 35;
   cam.elevationDeg = 20;
   cam.frame(glm::dvec3(1.0, 1.2, 0.8));
-  const render::RowCosts every(cam, glm::dvec3(1.0, 1.2, 0.8), 256, 192, 256);
-  const render::RowCosts sampled(cam, glm::dvec3(1.0, 1.2, 0.8), 256, 192, 32);
+  const render::RowCosts every(cam, glm::dvec3(1.0, 1.2, 0.8), 256, 192,
+                               render::Footprint::VolumeBox, 256);
+  const render::RowCosts sampled(cam, glm::dvec3(1.0, 1.2, 0.8), 256, 192,
+                                 render::Footprint::VolumeBox, 32);
   for (int r = 0; r < 192; ++r) {
     EXPECT_NEAR(sampled.row(r), every.row(r), 256.0 / 32.0 * 2.0) << "row " << r;
   }
@@ -92,4 +95,36 @@ TEST(RowCosts, WeightsAndReachAgreeWithDirectSums) {
   }
   EXPECT_EQ(costs.reach(1.0, 10.0), 1.0);
   EXPECT_THROW(render::RowCosts(cam, glm::dvec3(1.0), 0, 10), tessera::InputError);
+}
+
+// The view-aligned slicer's proxy: a cube of the box's diagonal turned with
+// the view, so straight on (orthographic) a centred square of that side,
+// at any angle.
+TEST(RowCosts, TheViewCubeIsASquareOfTheDiagonalAtAnyAngle) {
+  const int size = 200;
+  const glm::dvec3 extent(1.0, 0.6, 0.8);
+  for (double azimuth : {0.0, 35.0, 80.0}) {
+    Camera cam;
+    cam.projection = Projection::Orthographic;
+    cam.azimuthDeg = azimuth;
+    cam.elevationDeg = 25.0;
+    cam.frame(extent);
+    cam.zoom = 0.5;  // the whole cube in view
+    const render::RowCosts costs(cam, extent, size, size, render::Footprint::ViewCube, size);
+    const double side = size * glm::length(extent) / (2.0 * cam.orthoHalfHeight());
+    ASSERT_LT(side, size - 4.0);
+    const double lo = 0.5 * (size - side), hi = 0.5 * (size + side);
+    for (int r = 0; r < size; ++r) {
+      const double centre = r + 0.5;
+      if (centre < lo - 1.0 || centre > hi + 1.0) {
+        EXPECT_DOUBLE_EQ(costs.row(r), render::RowCosts::kMissWeight * size) << "row " << r;
+      } else if (centre > lo + 1.0 && centre < hi - 1.0) {
+        EXPECT_NEAR(costs.row(r), side + render::RowCosts::kMissWeight * (size - side), 2.0)
+            << "azimuth " << azimuth << ", row " << r;
+      }
+    }
+    // The box itself covers less.
+    const render::RowCosts box(cam, extent, size, size, render::Footprint::VolumeBox, size);
+    EXPECT_LT(box.weight(0.0, 1.0), costs.weight(0.0, 1.0));
+  }
 }

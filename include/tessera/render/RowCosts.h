@@ -13,21 +13,28 @@
 
 namespace tessera::render {
 
+// Which pixels a technique's frames cost at: those whose rays enter the
+// volume's box (ray casters, object-aligned slices), or those its proxy
+// covers (view-aligned slices: a cube about the volume's bounding sphere,
+// turned with the view, its side the box's diagonal).
+enum class Footprint { VolumeBox, ViewCube };
+
 class RowCosts {
  public:
-  // A missing ray's cost as a fraction of an entering one's.
+  // A missing pixel's cost as a fraction of a covered one's.
   static constexpr double kMissWeight = 0.05;
 
   RowCosts() = default;
   // The rows of a width x height frame of a box of `extent` (centred at the
   // origin, model frame) seen by `camera`; each row's rays sampled at up to
   // `columns` evenly spaced pixels.
-  RowCosts(const Camera& camera, glm::dvec3 extent, int width, int height, int columns = 32);
+  RowCosts(const Camera& camera, glm::dvec3 extent, int width, int height,
+           Footprint footprint = Footprint::VolumeBox, int columns = 32);
 
   bool empty() const { return height_ == 0; }
   int height() const { return height_; }
   // The weight of a row counted from the bottom: its pixels, each 1 when
-  // its ray enters the box and kMissWeight when it misses.
+  // its ray enters the footprint and kMissWeight when it misses.
   double row(int fromBottom) const;
   // The weight of the rows between fractions `from` and `to` of the height,
   // from the bottom (row edges at round(fraction x height), as

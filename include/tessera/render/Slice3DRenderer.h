@@ -110,6 +110,8 @@ class Slice3DRenderer final : public Technique {
   // The Technique interface. The target keeps the screen's shape (see
   // sliceTargetSize): the projection always fills it.
   std::string name() const override { return "slice3d"; }
+  // Its static proxy cube covers the volume's bounding sphere at any angle.
+  Footprint footprint() const override { return Footprint::ViewCube; }
   void prepare(const Camera& camera, const RenderSettings& settings) override;
   const gpu::Texture& render(const Camera& camera, const RenderSettings& settings, int width,
                              int height, double viewAspect) override;

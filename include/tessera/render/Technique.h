@@ -23,6 +23,7 @@
 #include "tessera/reference/AdaptiveSteps.h"
 #include "tessera/reference/FusedVolume.h"
 #include "tessera/reference/VoxelGradients.h"
+#include "tessera/render/RowCosts.h"
 
 namespace tessera::render {
 
@@ -94,6 +95,8 @@ class Technique {
 
   // GPU bytes of its own resources, alive now.
   virtual std::uint64_t ownTextureBytes() const = 0;
+  // Which pixels its frames cost at (RowCosts sizes progressive strips by it).
+  virtual Footprint footprint() const { return Footprint::VolumeBox; }
   virtual TechniqueReport report() const { return {}; }
   // A technique that honours RenderSettings::sampling says what its frames
   // with `settings` did; the default: every sample, post-classified.

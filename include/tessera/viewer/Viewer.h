@@ -22,6 +22,7 @@
 #include "tessera/render/LabelTable.h"
 #include "tessera/render/Overlay.h"
 #include "tessera/render/QualityController.h"
+#include "tessera/render/RowCosts.h"
 #include "tessera/render/TechniqueRegistry.h"
 #include "tessera/viewer/CameraController.h"
 #include "tessera/viewer/TransferFunctionEditor.h"
@@ -211,12 +212,13 @@ class Viewer {
     unsigned framebuffer = 0;
     glm::ivec2 origin{0, 0};
     VolumePass pass;
-    double done = 0.0;  // fraction of the rows rendered
-    double ms = 0.0;    // spent on its strips
+    double done = 0.0;       // fraction of the rows rendered
+    double ms = 0.0;         // spent on its strips
+    render::RowCosts costs;  // what its rows are expected to cost (at the first strip)
   };
   Pending pending_;
-  double frameMsPerPixel_ = 0.0;  // last full-quality frame's cost (0: unknown)
-  double stripMsPerPixel_ = 0.0;  // the refinement's strips'
+  double frameMsPerPixel_ = 0.0;   // last full-quality frame's cost (0: unknown)
+  double stripMsPerWeight_ = 0.0;  // the refinement's strips', per render::RowCosts weight
   std::vector<render::OverlayLine> overlayLines() const;  // box and axes as shown
 
   gpu::GlContext& context_;
