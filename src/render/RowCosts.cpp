@@ -48,17 +48,17 @@ double RowCosts::row(int fromBottom) const {
   return prefix_[r + 1] - prefix_[r];
 }
 
+int RowCosts::edge(double fraction) const {
+  return std::clamp(static_cast<int>(std::lround(fraction * height_)), 0, height_);
+}
+
 double RowCosts::weight(double from, double to) const {
-  const auto edge = [this](double f) {
-    return static_cast<std::size_t>(
-        std::clamp(static_cast<int>(std::lround(f * height_)), 0, height_));
-  };
-  const std::size_t a = edge(from), b = edge(to);
-  return b > a ? prefix_[b] - prefix_[a] : 0.0;
+  const int a = edge(from), b = edge(to);
+  return b > a ? prefix_[static_cast<std::size_t>(b)] - prefix_[static_cast<std::size_t>(a)] : 0.0;
 }
 
 double RowCosts::reach(double from, double w) const {
-  const int start = std::clamp(static_cast<int>(std::lround(from * height_)), 0, height_);
+  const int start = edge(from);
   if (start >= height_) return 1.0;
   const double goal = prefix_[static_cast<std::size_t>(start)] + w;
   // The first row end whose prefix reaches the goal, at least one row on.

@@ -1,11 +1,11 @@
 #pragma once
-// What each row of a ray-cast frame is expected to cost, for sizing the
-// strips a progressive frame is drawn in (the page's store view): a ray
-// that misses the volume's box costs a small fixed part of one that
-// enters it, so rows below and above the volume are cheap and rows across
-// it dear. A cost per row learnt on the cheap rows then does not size a
-// strip across the volume several times its budget, as a cost per pixel
-// of the whole image did.
+// What each row of a frame is expected to cost, for sizing the strips a
+// progressive frame is drawn in (the page's store view, viewer::Viewer): a
+// pixel outside what the technique draws (the volume's box, a slicer's
+// proxy) costs a small fixed part of one inside it, so rows below and
+// above the volume are cheap and rows across it dear. A cost per row learnt on the cheap rows then
+// does not size a strip across the volume several times its budget, as a cost per pixel of the
+// whole image did.
 #include <glm/vec3.hpp>
 #include <vector>
 
@@ -45,6 +45,7 @@ class RowCosts {
   double reach(double from, double w) const;
 
  private:
+  int edge(double fraction) const;  // the row edge at round(fraction x height)
   int height_ = 0;
   std::vector<double> prefix_;  // prefix_[r]: the weight of rows [0, r)
 };
