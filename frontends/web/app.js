@@ -110,6 +110,11 @@ import { attachOverlayPanel } from './overlay-panel.js';
   let frameBeganAt = 0;
   let inputDrawnAt = -Infinity;
   let storeDrawnAt = -Infinity;  // the last store frame or preview drawn in an animation frame
+  // The time stamp of the oldest input on a store's view that no preview
+  // has answered yet (the earliest of the moves coalesced into an event):
+  // the preview that answers it is due within two budgets of it
+  // (tessera_zarr_frame's inputWaitedMs; noteStoreInput, storeViewFrame).
+  let storeInputStamp = Infinity;
   let slices = null;        // frontends/web/slices.js, once the module is up
   let zarr = null;  // an open OME-Zarr store (frontends/web/zarr-url.js)
   let storeTime = null;  // its t axis played as a time series (frontends/web/store-time.js)
@@ -332,7 +337,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
       const viewChanged = needsRender;
       needsRender = false;
       fitCanvas();
-      f = zarr.frame(canvas.width, canvas.height, viewChanged);
+      f = viewChanged ? storeViewFrame() : zarr.frame(canvas.width, canvas.height, false);
       if (viewChanged) storeDrawnAt = performance.now();
     } else if (answered) {
       // The preview drawn as the move arrived is on the canvas: its full
@@ -824,6 +829,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
     if (rawPointers.has(e.pointerId)) return;  // moved the camera as it arrived (storeMoved)
     api.pointerMove(e.pointerId, ...cameraPos(e));
     if (api.interacting()) {
+      noteStoreInput(e);
       setCameraDragged(true);
       requestRender();
     }
@@ -838,7 +844,19 @@ import { attachOverlayPanel } from './overlay-panel.js';
   function storeDrawn() {
     return api && zarr && zarr.active() && (!storeTime || storeTime.bricks) && !(channelList && channelList.active());
   }
-  function answerStoreInput(pending) {
+  function noteStoreInput(e) {
+    if (!storeDrawn()) return;
+    const coalesced = e.getCoalescedEvents ? e.getCoalescedEvents() : [];
+    storeInputStamp = Math.min(storeInputStamp, e.timeStamp, ...coalesced.map((c) => c.timeStamp));
+  }
+  // A store frame that shows a changed view: it answers the inputs noted.
+  function storeViewFrame() {
+    const waited = Number.isFinite(storeInputStamp) ? Math.max(0, performance.now() - storeInputStamp) : -1;
+    storeInputStamp = Infinity;
+    return zarr.frame(canvas.width, canvas.height, true, waited);
+  }
+  function answerStoreInput(pending, e) {
+    noteStoreInput(e);
     if (pending || !storeDrawn() || (viewer && viewer.contextLost) ||
         inputDrawnAt >= frameBeganAt || storeDrawnAt >= frameBeganAt) {
       requestRender();
@@ -846,7 +864,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
     }
     needsRender = false;
     fitCanvas();
-    const f = zarr.frame(canvas.width, canvas.height, true);
+    const f = storeViewFrame();
     inputDrawnAt = performance.now();
     if (f && f.shown) {
       frames++;
@@ -866,7 +884,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
     api.pointerMove(e.pointerId, ...cameraPos(e));
     const pending = needsRender;
     setCameraDragged(true);  // (asks for a frame at the drag's backing size: drawn here)
-    answerStoreInput(pending);
+    answerStoreInput(pending, e);
   }
   if (rawInput) canvas.addEventListener('pointerrawupdate', storeMoved);
   const forgetRaw = (e) => {
@@ -885,7 +903,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
     api.pointerUp(e.pointerId);
     forgetRaw(e);
     if (!api.interacting()) setCameraDragged(false);
-    answerStoreInput(pending);  // full quality once released (in-core: at the next frame)
+    answerStoreInput(pending, e);  // full quality once released (in-core: at the next frame)
   };
   canvas.addEventListener('pointerup', viewEnd);
   canvas.addEventListener('pointercancel', viewEnd);
@@ -893,7 +911,7 @@ import { attachOverlayPanel } from './overlay-panel.js';
     if (!api) return;
     const pending = needsRender;
     api.wheel(Math.sign(e.deltaY));
-    answerStoreInput(pending);
+    answerStoreInput(pending, e);
     e.preventDefault();
   }, { passive: false });
 

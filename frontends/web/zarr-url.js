@@ -236,7 +236,7 @@
       putMissing: c('tessera_zarr_put_missing', null, ['string']),
       putFailed: c('tessera_zarr_put_failed', null, ['string', 'string']),
       putRange: c('tessera_zarr_put_range', null, ['string', 'number', 'number', 'number', 'number']),
-      frame: c('tessera_zarr_frame', 'string', ['number', 'number', 'number']),
+      frame: c('tessera_zarr_frame', 'string', ['number', 'number', 'number', 'number']),
       refine: c('tessera_zarr_refine', 'string', []),
       refining: c('tessera_zarr_refining', 'number', []),
       info: c('tessera_zarr_info', 'string', []),
@@ -685,10 +685,12 @@
     // A frame of the view on the canvas, paced as the viewer's progressive
     // frames: a preview at once when `viewChanged` (else the canvas keeps
     // its image), then the full frame through refine() while refining().
-    // Returns {ms, shown, pending}, or null on error.
-    function frame(width, height, viewChanged) {
+    // `inputWaitedMs`: how long the input it answers has waited since its
+    // time stamp (omitted or negative: none; its preview is due within two
+    // budgets of it). Returns {ms, shown, pending}, or null on error.
+    function frame(width, height, viewChanged, inputWaitedMs = -1) {
       if (!open) return null;  // being opened again after a context loss
-      return handle(api.frame(width, height, viewChanged ? 1 : 0));
+      return handle(api.frame(width, height, viewChanged ? 1 : 0, inputWaitedMs));
     }
 
     // About a budget of the pending frame (streaming what arrived, then a

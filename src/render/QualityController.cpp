@@ -16,6 +16,9 @@ QualityController::QualityController(Options options) : options_(options) {
   if (!(options_.gain > 0.0 && options_.gain <= 1.0)) {
     throw InputError("quality: gain must be in (0, 1]");
   }
+  if (!(options_.resolutionStepsPerOctave >= 0.0 && options_.resolutionStepsPerOctave <= 64.0)) {
+    throw InputError("quality: resolution steps per octave must be in [0, 64]");
+  }
 }
 
 void QualityController::setInteracting(bool interacting) {
@@ -35,6 +38,14 @@ QualityLevel QualityController::levelFor(double work) const {
   const double floorWork = options_.minResolutionScale * options_.minResolutionScale;
   if (work >= floorWork) {
     level.resolutionScale = std::sqrt(work);
+    const double steps = options_.resolutionStepsPerOctave;
+    if (steps > 0.0 && work < 1.0) {
+      // Rounded down (a small tolerance keeps a rung from rounding below
+      // itself).
+      const double k =
+          std::floor(steps * std::log2(level.resolutionScale / options_.minResolutionScale) + 1e-9);
+      level.resolutionScale = options_.minResolutionScale * std::exp2(std::max(0.0, k) / steps);
+    }
   } else {
     level.resolutionScale = options_.minResolutionScale;
     level.stepScale = floorWork / work;
@@ -45,6 +56,11 @@ QualityLevel QualityController::levelFor(double work) const {
 QualityLevel QualityController::next() const {
   if (state_ == State::Idle) return QualityLevel{};
   return levelFor(work_);
+}
+
+QualityLevel QualityController::nextWithin(double ms) const {
+  if (state_ == State::Idle || !(ms < options_.goalMs)) return next();
+  return levelFor(work_ * std::max(0.0, ms) / options_.goalMs);
 }
 
 void QualityController::report(const QualityLevel& level, double ms) {

@@ -81,9 +81,36 @@ function instrument() {
     for (let y = 0; y < h; y++) top.set(p.subarray((h - 1 - y) * w * 4, (h - y) * w * 4), y * w * 4);
     lat.capture = { raw, pixels: Array.from(top) };
   };
+  // GL errors asked for (getError: a round trip to the GPU process each)
+  // and textures and buffers made (each checks its allocation: two
+  // getErrors), outside animation-frame callbacks per task (an input
+  // handler's), and inside them in all.
+  lat.handlerGl = [];
+  lat.frameGetErrors = 0;
+  let glTask = null;
+  const countGl = (key) => {
+    if (inCallback) {
+      if (key === 'getError') lat.frameGetErrors++;
+      return;
+    }
+    if (!glTask) {
+      glTask = { getError: 0, made: 0, drew: false, start: performance.now() };
+      lat.handlerGl.push(glTask);
+      queueMicrotask(() => { glTask = null; });
+    }
+    if (key === 'draw') glTask.drew = true;
+    else glTask[key]++;
+  };
   for (const Ctx of [window.WebGL2RenderingContext, window.WebGLRenderingContext]) {
     if (!Ctx) continue;
     const p = Ctx.prototype;
+    for (const name of ['getError', 'createTexture', 'createBuffer']) {
+      const f = p[name];
+      p[name] = function (...args) {
+        countGl(name === 'getError' ? name : 'made');
+        return f.apply(this, args);
+      };
+    }
     const bind = p.bindFramebuffer;
     p.bindFramebuffer = function (target, fb) {
       if (target !== this.READ_FRAMEBUFFER) this.latencyDefault = fb === null;
@@ -96,6 +123,7 @@ function instrument() {
         if (this.latencyDefault !== false) {
           drew = true;
           gl = this;
+          countGl('draw');
           if (!inCallback && !outside) {
             outside = { start: performance.now() };
             queueMicrotask(() => {
@@ -530,6 +558,18 @@ async function storeInputLatency(context, url, tmp, run) {
               `previews ${previews.n}, median ${previews.median.toFixed(1)} ms, worst ${previews.worst.toFixed(1)} ms; ` +
               `streaming steps ${streaming.n}, median ${streaming.median.toFixed(1)} ms, worst ${streaming.worst.toFixed(1)} ms; ` +
               `strips ${stripCalls.n}, median ${stripCalls.median.toFixed(1)} ms, worst ${stripCalls.worst.toFixed(1)} ms`);
+  // A preview drawn as its input arrived asks GL for no errors: each
+  // getError waits for the GPU process (0.3-0.6 ms on SwiftShader), inside
+  // the input's latency; the store's next call asks for them. Only a new
+  // render target's texture, or a grown buffer of lines, checks its own
+  // allocation (clears, then asks).
+  const drawnAsArrived = (lat.handlerGl || []).filter((t) => t.drew);
+  const asking = drawnAsArrived.filter((t) => t.getError !== 2 * t.made);
+  check('latency: previews drawn as input arrived asked GL for no errors beyond a new texture\'s or buffer\'s allocation check, and the animation frames\' store calls asked',
+        drawnAsArrived.length >= 5 && asking.length === 0 && lat.frameGetErrors > 0,
+        `${drawnAsArrived.length} drawn as input arrived: getError ${drawnAsArrived.reduce((a, t) => a + t.getError, 0)} times, ` +
+        `with ${drawnAsArrived.reduce((a, t) => a + t.made, 0)} textures or buffers made; ${asking.length} asked otherwise ` +
+        `(${asking.slice(0, 3).map((t) => `${t.getError} for ${t.made}`).join(', ')}); in animation frames ${lat.frameGetErrors} times`);
   check('latency: the drag and the wheel turns were handled while the store refined',
         latencies.pointermove.length >= 5 && latencies.wheel.length >= WHEELS / 2 && duringRefinement >= all.n / 2 && unanswered === 0,
         `${all.n} events answered (${duringRefinement} while refining), ${unanswered} without a frame after them`);

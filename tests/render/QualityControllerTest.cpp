@@ -5,9 +5,11 @@
 // full-quality frame when the interaction ends.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <vector>
 
 #include "tessera/core/Error.h"
 #include "tessera/render/QualityController.h"
@@ -101,6 +103,102 @@ TEST(QualityController, DeliversOneFullQualityFrameWhenIdle) {
   std::printf("  [measured] idle frame %.0f ms; first interacting frame predicted %.0f ms\n",
               idleMs, firstMs);
   EXPECT_NEAR(firstMs, qc.options().goalMs, 0.3 * qc.options().goalMs);
+}
+
+// A frame due sooner than the goal (an input that has waited) takes the
+// settled level's work shrunk in proportion: on a renderer that costs only
+// its work it meets the time asked for; with a fixed cost it lands between
+// that and the goal; the cheapest level when nothing is left; the settled
+// level unchanged when the time is the goal or more.
+TEST(QualityController, ShrinksTheWorkOfAFrameDueBeforeTheGoal) {
+  for (double overheadMs : {0.0, 3.0}) {
+    SimulatedRenderer r{overheadMs, 400.0};
+    r.noise = 0.0;
+    QualityController::Options o;
+    o.goalMs = 12.0;
+    o.minResolutionScale = 1.0 / 16.0;
+    o.maxStepScale = 1.0;
+    QualityController qc(o);
+    qc.setInteracting(true);
+    for (int f = 0; f < 40; ++f) {
+      const QualityLevel q = qc.next();
+      qc.report(q, r.frame(q));
+    }
+    const QualityLevel settled = qc.next();
+    EXPECT_NEAR(r.frame(settled), o.goalMs, 0.05 * o.goalMs);
+    for (double within : {9.0, 6.0}) {
+      const QualityLevel q = qc.nextWithin(within);
+      EXPECT_NEAR(q.work(), settled.work() * within / o.goalMs, 1e-12);
+      EXPECT_DOUBLE_EQ(q.stepScale, 1.0);
+      const double ms = r.frame(q);
+      std::printf(
+          "  [measured] overhead %.0f ms: a frame due in %.0f ms of a %.0f ms goal took %.2f ms\n",
+          overheadMs, within, o.goalMs, ms);
+      if (overheadMs == 0.0) {
+        EXPECT_NEAR(ms, within, 1e-9);
+      } else {
+        EXPECT_GT(ms, within);
+        EXPECT_LT(ms, r.frame(settled));
+      }
+    }
+    const QualityLevel least = qc.nextWithin(-2.0);
+    EXPECT_DOUBLE_EQ(least.resolutionScale, o.minResolutionScale);
+    EXPECT_DOUBLE_EQ(least.stepScale, 1.0);
+    EXPECT_DOUBLE_EQ(qc.nextWithin(o.goalMs).work(), settled.work());
+    EXPECT_DOUBLE_EQ(qc.nextWithin(50.0).work(), settled.work());
+  }
+  // Idle: the full-quality frame, whatever is asked.
+  QualityController idle;
+  EXPECT_TRUE(idle.nextWithin(1.0).full());
+}
+
+// With a ladder, reduced resolutions are rungs minResolutionScale x
+// 2^(k / steps), at most the continuous resolution and within one step of
+// it; the full resolution stays full. Settling on a simulated renderer
+// then uses few sizes, where the continuous controller uses a new one for
+// nearly every frame.
+TEST(QualityController, RoundsResolutionsDownToALadderOfRepeatingSizes) {
+  QualityController::Options o;
+  o.minResolutionScale = 1.0 / 16.0;
+  o.maxStepScale = 1.0;
+  QualityController continuous(o);
+  o.resolutionStepsPerOctave = 4.0;
+  QualityController ladder(o);
+  for (double work = 1.0 / 256.0; work <= 1.0; work *= 1.07) {
+    const double free = continuous.levelFor(work).resolutionScale;
+    const double rung = ladder.levelFor(work).resolutionScale;
+    const double k = 4.0 * std::log2(rung * 16.0);
+    EXPECT_NEAR(k, std::round(k), 1e-9) << "work " << work;
+    EXPECT_LE(rung, free + 1e-12);
+    EXPECT_GT(rung, free * std::exp2(-0.25) - 1e-12);
+  }
+  EXPECT_DOUBLE_EQ(ladder.levelFor(1.0).resolutionScale, 1.0);
+  EXPECT_DOUBLE_EQ(ladder.levelFor(1.0 / 256.0).resolutionScale, 1.0 / 16.0);
+  // Preview sizes of a 256-pixel view while settling at the goal.
+  auto sizes = [](QualityController qc) {
+    SimulatedRenderer r{2.5, 800.0};
+    r.noise = 0.3;
+    qc.setInteracting(true);
+    std::vector<int> seen;
+    for (int f = 0; f < 60; ++f) {
+      const QualityLevel q = qc.next();
+      const int size = static_cast<int>(std::lround(256 * q.resolutionScale));
+      if (std::find(seen.begin(), seen.end(), size) == seen.end()) seen.push_back(size);
+      qc.report(q, r.frame(q));
+    }
+    return seen.size();
+  };
+  o.goalMs = 4.2;
+  o.resolutionStepsPerOctave = 0.0;
+  const std::size_t freeSizes = sizes(QualityController(o));
+  o.resolutionStepsPerOctave = 4.0;
+  const std::size_t ladderSizes = sizes(QualityController(o));
+  std::printf("  [measured] 60 frames at a 4.2 ms goal: %zu sizes continuous, %zu on the ladder\n",
+              freeSizes, ladderSizes);
+  EXPECT_LE(ladderSizes, 4u);
+  EXPECT_GE(freeSizes, 2 * ladderSizes);
+  o.resolutionStepsPerOctave = -1.0;
+  EXPECT_THROW(QualityController{o}, tessera::InputError);
 }
 
 TEST(QualityController, RejectsBadOptions) {

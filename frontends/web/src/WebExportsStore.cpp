@@ -159,11 +159,15 @@ EMSCRIPTEN_KEEPALIVE int tessera_zarr_page_decodes(const char* compressor) {
 // JSON with the bricks' state ("complete", "wanted", "missing", "failing",
 // "uploaded", cells per level), "shown" (drew on the canvas) and "pending"
 // (the full frame is still to come), or "" on error (tessera_last_error).
-EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_frame(int width, int height, int viewChanged) {
+// `inputWaitedMs`: how long the input event it answers has waited since its
+// time stamp (negative: it answers none); see StorePace::inputWaitedMs.
+EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_frame(int width, int height, int viewChanged,
+                                                    double inputWaitedMs) {
   web::scratch().clear();
   guarded([&] {
     web::WebSession& s = web::session();
-    web::scratch() = frameJson(s.storeFrame(width, height, viewChanged != 0), s.theStore());
+    web::scratch() =
+        frameJson(s.storeFrame(width, height, viewChanged != 0, inputWaitedMs), s.theStore());
   });
   return web::scratch().c_str();
 }

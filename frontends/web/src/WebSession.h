@@ -212,8 +212,9 @@ class WebSession {
   void storeRegionOverview();
   // The store's frame with the region and grid block marked, paced as the
   // viewer's progressive frames (its frameBudgetMs); `viewChanged`: a
-  // preview at once, else the canvas keeps its image until the frame is done.
-  StoreFrame storeFrame(int width, int height, bool viewChanged);
+  // preview at once, else the canvas keeps its image until the frame is done;
+  // `inputWaitedMs`: StorePace::inputWaitedMs.
+  StoreFrame storeFrame(int width, int height, bool viewChanged, double inputWaitedMs = -1.0);
   // Whether the time point shown is on the canvas whole, as playback's
   // next one waits for (Session::stepPlayback): the store's, when its t
   // axis plays over bricks; true otherwise.

@@ -144,7 +144,7 @@ std::optional<lod::VoxelBox> WebSession::storeGridBlock() {
   return explore()->gridBlock();
 }
 
-StoreFrame WebSession::storeFrame(int width, int height, bool viewChanged) {
+StoreFrame WebSession::storeFrame(int width, int height, bool viewChanged, double inputWaitedMs) {
   viewer::Viewer& v = viewer();
   ZarrStoreView& z = theStore();
   // The store's t axis over bricks (WebSessionTime.cpp): the time point
@@ -174,7 +174,8 @@ StoreFrame WebSession::storeFrame(int width, int height, bool viewChanged) {
                  {.progressive = v.progressive,
                   .budgetMs = v.frameBudgetMs,
                   .stripShare = storeStripShare_,
-                  .viewChanged = viewChanged});
+                  .viewChanged = viewChanged,
+                  .inputWaitedMs = inputWaitedMs});
 }
 
 }  // namespace tessera::web

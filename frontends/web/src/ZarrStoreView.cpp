@@ -28,6 +28,13 @@ constexpr double kStreamMs = 150.0;
 // per block) twice per preview, costing more than the preview itself.
 constexpr double kPreviewShare = 0.35;
 constexpr double kPreviewMinScale = 1.0 / 16.0;
+// Its sizes on a ladder of quarter octaves: the ray caster keeps a target
+// per size (Raycaster::useTarget), and a new one is a texture allocated and
+// checked (two glGetError round trips) and a framebuffer checked, about
+// 1 ms inside the input's latency. With any size, nearly every preview
+// that answered input made one (22 of 24 in a latency run through the X
+// server).
+constexpr double kPreviewStepsPerOctave = 4.0;
 // The first strip's rows (a fraction of the frame) before any cost is known.
 constexpr double kFirstStrip = 1.0 / 64.0;
 
@@ -195,7 +202,15 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
   compositor_->setOverlayLines(std::move(lines));
   f.renderWidth = v.renderWidth;
   f.renderHeight = v.renderHeight;
-  gpu::clearErrors();
+  // Errors that other drawing left are forgotten, not blamed on the store;
+  // a call answering input skips the round trip (its wait is the input's):
+  // while a store is drawn its view is the page's only GL user (the
+  // in-core viewer and a store's channels draw when no store is drawn), and
+  // each of its calls ends asking for its errors or leaves them to the
+  // next (askPreviewErrors).
+  askPreviewErrors();
+  const bool answersInput = pace.inputWaitedMs >= 0.0;
+  if (!answersInput) gpu::clearErrors();
   budgetMs_ = pace.budgetMs;
   stripShare_ = pace.stripShare;
   if (!pace.progressive) {
@@ -237,7 +252,7 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
       f.streamMs = msSince(t0);
     }
     f.setupMs = msSince(t0) - f.streamMs;
-    preview(v, f);
+    preview(v, f, answersInput ? pace.inputWaitedMs + msSince(t0) : -1.0);
   }
   f.pending = true;
   f.ms = msSince(t0);
@@ -291,17 +306,27 @@ double ZarrStoreView::prepareTables(const FrameView& v) {
 }
 
 // At the resolution that met the preview's share of the budget before
-// (render::QualityController's feedback; the first at the least).
-void ZarrStoreView::preview(const FrameView& v, StoreFrame& f) {
+// (render::QualityController's feedback; the first at the least). One
+// answering an input that waited `inputWaitedMs` (negative: none) takes at
+// most what is left of two budgets since the input's stamp (less work when
+// that is under its share; its time then not fed back), and leaves its GL
+// errors to the next call: each glGetError is a round trip to the GPU
+// process (0.3-0.6 ms on SwiftShader), inside the input's latency.
+void ZarrStoreView::preview(const FrameView& v, StoreFrame& f, double inputWaitedMs) {
   if (!previewQuality_) {
     previewQuality_ = std::make_unique<render::QualityController>(
         render::QualityController::Options{.goalMs = kPreviewShare * budgetMs_,
                                            .minResolutionScale = kPreviewMinScale,
-                                           .maxStepScale = 1.0});
+                                           .maxStepScale = 1.0,
+                                           .resolutionStepsPerOctave = kPreviewStepsPerOctave});
     previewQuality_->setInteracting(true);
   }
-  const render::QualityLevel level =
-      previewMeasured_ ? previewQuality_->next() : previewQuality_->levelFor(0.0);
+  const double shareMs = kPreviewShare * budgetMs_;
+  const double dueMs = inputWaitedMs >= 0.0 ? 2.0 * budgetMs_ - inputWaitedMs : shareMs;
+  const bool hurried = previewMeasured_ && dueMs < shareMs;
+  const render::QualityLevel level = !previewMeasured_ ? previewQuality_->levelFor(0.0)
+                                     : hurried         ? previewQuality_->nextWithin(dueMs)
+                                                       : previewQuality_->next();
   FrameView p = v;
   p.renderWidth = std::max(1, static_cast<int>(std::lround(v.renderWidth * level.resolutionScale)));
   p.renderHeight =
@@ -312,13 +337,23 @@ void ZarrStoreView::preview(const FrameView& v, StoreFrame& f) {
   f.tablesMs = prepareTables(v);
   const auto t0 = std::chrono::steady_clock::now();
   show(active_.technique->render(p.camera, p.pass, p.renderWidth, p.renderHeight, 0.0), p);
-  deferred.check("OME-Zarr preview");
+  if (inputWaitedMs >= 0.0) {
+    previewErrorsUnasked_ = true;
+  } else {
+    deferred.check("OME-Zarr preview");
+  }
   f.previewMs = msSince(t0);
-  previewQuality_->report(level, f.previewMs);
+  if (!hurried) previewQuality_->report(level, f.previewMs);
   previewMeasured_ = true;
   f.shown = true;
   f.previewWidth = p.renderWidth;
   f.previewHeight = p.renderHeight;
+}
+
+void ZarrStoreView::askPreviewErrors() {
+  if (!previewErrorsUnasked_) return;
+  previewErrorsUnasked_ = false;
+  gpu::checkErrors("OME-Zarr preview");
 }
 
 StoreFrame ZarrStoreView::refine() {
@@ -326,7 +361,9 @@ StoreFrame ZarrStoreView::refine() {
   const auto t0 = std::chrono::steady_clock::now();
   Pending& p = pending_;
   // No gpu::clearErrors() here: every step ends checking them, and each
-  // query waits for the browser's GPU process.
+  // query waits for the browser's GPU process. A preview's that answered
+  // input are asked for first.
+  askPreviewErrors();
   if (!p.streaming) {
     if (active_.upload.layout->contentVersion() == tablesVersion_) return strip();
     // The bricks changed what the ray caster samples: its tables (empty-

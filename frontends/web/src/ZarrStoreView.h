@@ -103,6 +103,12 @@ struct StorePace {
   // The view, the settings or the canvas changed: a preview at once. Else
   // (bricks arrived) the canvas keeps its image until the new one is done.
   bool viewChanged = true;
+  // The input event this frame answers (a move, a release, a wheel turn):
+  // how long it has waited since its time stamp (a wheel turn waits for
+  // the animation frame Chromium dispatches it with), ms; negative: the
+  // frame answers no input. Its preview is due within two budgets of the
+  // stamp, and its GL errors are asked for by the next call.
+  double inputWaitedMs = -1.0;
 };
 
 class ZarrStoreView {
@@ -226,7 +232,8 @@ class ZarrStoreView {
   // The technique's image of `v` composed into the canvas, waited for.
   void show(const gpu::Texture& image, const FrameView& v);
   StoreFrame drawWhole(const FrameView& v, StoreFrame f, std::chrono::steady_clock::time_point t0);
-  void preview(const FrameView& v, StoreFrame& f);
+  void preview(const FrameView& v, StoreFrame& f, double inputWaitedMs);
+  void askPreviewErrors();
   double prepareTables(const FrameView& v);
   StoreFrame strip();
   Pending pending_;
@@ -242,6 +249,9 @@ class ZarrStoreView {
   // The preview's resolution and step, fed back to meet its share of the budget.
   std::unique_ptr<render::QualityController> previewQuality_;
   bool previewMeasured_ = false;
+  // The GL errors of the last call (a preview that answered input) were
+  // not asked for: the next call asks first, in the preview's name.
+  bool previewErrorsUnasked_ = false;
 };
 
 }  // namespace tessera::web

@@ -33,6 +33,12 @@ class QualityController {
     double minResolutionScale = 0.125;  // below this, the sample distance grows instead
     double maxStepScale = 4.0;
     double gain = 0.8;  // fraction of the log error corrected per frame
+    // > 0: reduced resolutions are rounded down to a ladder of this many
+    // steps per octave from minResolutionScale, so that the frames' sizes
+    // repeat (a front end that keeps a render target per size then makes
+    // few: in a browser each is an allocation checked by round trips to
+    // the GPU process). 0: any resolution.
+    double resolutionStepsPerOctave = 0.0;
   };
 
   QualityController() : QualityController(Options{}) {}
@@ -47,6 +53,13 @@ class QualityController {
   bool needsFrame() const { return state_ == State::Interacting || !idleFrameDone_; }
   // The level of the next frame: full quality when idle.
   QualityLevel next() const;
+  // The next level for a frame that must take at most `ms`, less than the
+  // goal (an input that has already waited, due within its deadline): its
+  // work shrunk in proportion, which meets `ms` when the frame costs only
+  // its work (a fixed cost makes it take longer; the cheapest level at
+  // most). next() for `ms` at or above the goal, and when idle. Such a
+  // frame's time is not a measure of the goal's level: not reported.
+  QualityLevel nextWithin(double ms) const;
   // The measured time of a frame rendered at `level` (as returned by next()).
   void report(const QualityLevel& level, double ms);
 
@@ -54,7 +67,8 @@ class QualityController {
   double targetWork() const { return work_; }
   const Options& options() const { return options_; }
 
-  // The level for a work fraction: resolution first, then sample distance.
+  // The level for a work fraction: resolution first (on the ladder, when
+  // the options ask for one), then sample distance.
   QualityLevel levelFor(double work) const;
 
  private:
