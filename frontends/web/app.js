@@ -279,6 +279,9 @@ import { attachOverlayPanel } from './overlay-panel.js';
       requestAnimationFrame(loop);  // nothing to draw on until it is restored
       return;
     }
+    // An input's stamp is the store's view's until a store frame answers
+    // it; any other frame forgets it.
+    if (!storeDrawn()) storeInputStamp = Infinity;
     if (api && channelList && channelList.active()) {
       if (time.count > 1) timeStep();  // a store's channels with a t axis
       channelFrameStep();
