@@ -137,6 +137,7 @@ std::shared_ptr<const FetchedZarrSource> ZarrStoreView::sourceAt(int time) {
 
 void ZarrStoreView::showTime(int time) {
   if (time == time_ && shown_) return;
+  askPreviewErrors();  // before GL work of its own (an allocation clears errors first)
   std::shared_ptr<const FetchedZarrSource> next = sourceAt(time);
   const int top = next->levelCount() - 1;
   if (!next->resident(top, {glm::ivec3(0), next->levelInfo(top).dims})) {
@@ -162,6 +163,7 @@ bool ZarrStoreView::finished(int time) const {
 
 void ZarrStoreView::setFusion(std::shared_ptr<const FusedVolume> fused) {
   if (fused == fused_) return;
+  askPreviewErrors();
   fused_ = std::move(fused);
   if (active_.technique) active_.technique->setFusion(fused_);
 }
@@ -172,6 +174,9 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
                                 const std::vector<render::OverlayLine>& marks,
                                 const StorePace& pace) {
   const auto t0 = std::chrono::steady_clock::now();
+  // The last preview's errors, if it left them (before this call's GL work:
+  // a buffer or texture made clears errors before its own check).
+  askPreviewErrors();
   layout::BricksFrame bricks = pending_.active ? pending_.bricks : shownBricks_;
   bricks.uploaded = 0;  // by this frame
   pending_ = {};
@@ -208,7 +213,6 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
   // in-core viewer and a store's channels draw when no store is drawn), and
   // each of its calls ends asking for its errors or leaves them to the
   // next (askPreviewErrors).
-  askPreviewErrors();
   const bool answersInput = pace.inputWaitedMs >= 0.0;
   if (!answersInput) gpu::clearErrors();
   budgetMs_ = pace.budgetMs;
