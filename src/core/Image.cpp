@@ -12,6 +12,7 @@
 
 #include "tessera/core/Error.h"
 #include "tessera/core/HostBudget.h"
+#include "tessera/core/OutputPath.h"
 
 namespace tessera {
 
@@ -78,6 +79,13 @@ void Image::writePng(const std::filesystem::path& path) const {
   image.height = static_cast<png_uint_32>(height_);
   image.format = PNG_FORMAT_RGBA;
 
+  // A device or FIFO (/dev/null, /dev/stdout) is written directly.
+  if (writesInPlace(path)) {
+    if (png_image_write_to_file(&image, path.c_str(), 0, rgba_.data(), 0, nullptr) == 0) {
+      throw Error(name + ": cannot write PNG: " + image.message);
+    }
+    return;
+  }
   // Write a sibling and rename it over the target: a reader never sees a
   // half-written PNG, and a failed write leaves any previous file intact.
   const std::filesystem::path tmp = temporarySibling(path);

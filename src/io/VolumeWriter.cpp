@@ -6,6 +6,7 @@
 #include <string>
 
 #include "tessera/core/Error.h"
+#include "tessera/core/OutputPath.h"
 #include "tessera/io/FormatRegistry.h"
 
 namespace tessera {
@@ -19,6 +20,12 @@ std::vector<std::string> writeLossNotes(const Volume& volume, const fs::path& ou
 }
 
 void writeAtomically(const fs::path& path, const std::function<void(const fs::path&)>& write) {
+  // A device or FIFO (/dev/null) is written directly: a rename would
+  // replace it with the file.
+  if (writesInPlace(path)) {
+    write(path);
+    return;
+  }
   static std::atomic<int> counter{0};
   const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
   std::error_code ec;

@@ -1,7 +1,9 @@
 #include "support/TestSupport.h"
 #include "tessera/core/Image.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -117,6 +119,42 @@ TEST(Image, FailedRenameLeavesNoTemporaryFile) {
   EXPECT_THROW(pattern(4, 4, 0).writePng(path), Error);
   EXPECT_EQ(entries(dir.path()), std::vector<std::string>{"taken"});
   EXPECT_TRUE(fs::is_directory(path));
+}
+
+// A FIFO (as /dev/stdout may be) gets the PNG itself and stays a FIFO:
+// renaming a temporary file over it would replace it, as it would replace
+// /dev/null (which `render --out /dev/null` did when run as root).
+TEST(Image, WritesAFifoOrDeviceInPlaceWithoutReplacingIt) {
+  TempDir dir;
+  const fs::path fifo = dir.file("out.png");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  // Its read end open first (without waiting for a writer), so that the
+  // writer does not wait either; the pipe holds the small PNG.
+  const int readEnd = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+  ASSERT_GE(readEnd, 0);
+  const Image original = pattern(9, 7, 3);
+  original.writePng(fifo);
+  std::vector<char> received;
+  char buffer[4096];
+  for (ssize_t n; (n = ::read(readEnd, buffer, sizeof buffer)) > 0;) {
+    received.insert(received.end(), buffer, buffer + n);
+  }
+  ::close(readEnd);
+  EXPECT_TRUE(fs::is_fifo(fifo));
+  EXPECT_EQ(entries(dir.path()), std::vector<std::string>{"out.png"});  // no temporary left
+  // What came through the FIFO is the image.
+  const fs::path copy = dir.file("copy.png");
+  std::ofstream(copy, std::ios::binary).write(received.data(), static_cast<long>(received.size()));
+  const Image back = Image::readPng(copy);
+  EXPECT_EQ(back.width(), 9);
+  EXPECT_EQ(back.height(), 7);
+  EXPECT_EQ(back.rgba(), original.rgba());
+  // /dev/null, where it is the device: still the device afterwards (tried
+  // only once the FIFO was kept, so that a regression cannot replace it).
+  if (fs::is_fifo(fifo) && fs::is_character_file("/dev/null")) {
+    pattern(4, 4, 0).writePng("/dev/null");
+    EXPECT_TRUE(fs::is_character_file("/dev/null"));
+  }
 }
 
 TEST(Image, WritingAnEmptyImageThrows) {

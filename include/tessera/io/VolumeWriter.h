@@ -28,7 +28,8 @@ std::vector<std::string> writeLossNotes(const Volume& volume, const std::filesys
 
 // Runs `write(tempPath)` and renames tempPath to `path` on success (removes
 // it on failure). tempPath is in the same directory and ends with the same
-// file name, so extension-based writers behave the same.
+// file name, so extension-based writers behave the same. A path that names
+// a device or FIFO (writesInPlace: /dev/null) is written directly.
 void writeAtomically(const std::filesystem::path& path,
                      const std::function<void(const std::filesystem::path&)>& write);
 

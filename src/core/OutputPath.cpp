@@ -1,0 +1,12 @@
+#include "tessera/core/OutputPath.h"
+
+namespace tessera {
+
+bool writesInPlace(const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::filesystem::file_status s = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(s)) return false;
+  return !std::filesystem::is_regular_file(s) && !std::filesystem::is_directory(s);
+}
+
+}  // namespace tessera
