@@ -1,3 +1,4 @@
+#include "support/ReadableFifo.h"
 #include "support/TestSupport.h"
 #include "tessera/core/Image.h"
 
@@ -126,25 +127,16 @@ TEST(Image, FailedRenameLeavesNoTemporaryFile) {
 // /dev/null (which `render --out /dev/null` did when run as root).
 TEST(Image, WritesAFifoOrDeviceInPlaceWithoutReplacingIt) {
   TempDir dir;
-  const fs::path fifo = dir.file("out.png");
-  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-  // Its read end open first (without waiting for a writer), so that the
-  // writer does not wait either; the pipe holds the small PNG.
-  const int readEnd = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
-  ASSERT_GE(readEnd, 0);
+  test::ReadableFifo out(dir.file("out.png"));
+  const fs::path& fifo = out.path();
   const Image original = pattern(9, 7, 3);
   original.writePng(fifo);
-  std::vector<char> received;
-  char buffer[4096];
-  for (ssize_t n; (n = ::read(readEnd, buffer, sizeof buffer)) > 0;) {
-    received.insert(received.end(), buffer, buffer + n);
-  }
-  ::close(readEnd);
+  const std::string received = out.drain();
   EXPECT_TRUE(fs::is_fifo(fifo));
   EXPECT_EQ(entries(dir.path()), std::vector<std::string>{"out.png"});  // no temporary left
   // What came through the FIFO is the image.
   const fs::path copy = dir.file("copy.png");
-  std::ofstream(copy, std::ios::binary).write(received.data(), static_cast<long>(received.size()));
+  std::ofstream(copy, std::ios::binary) << received;
   const Image back = Image::readPng(copy);
   EXPECT_EQ(back.width(), 9);
   EXPECT_EQ(back.height(), 7);

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "support/ReadableFifo.h"
 #include "support/TestSupport.h"
 #include "tessera/core/Error.h"
 #include "tessera/io/VolumeWriter.h"
@@ -67,20 +68,13 @@ TEST(WriteAtomically, RenamesAFinishedFileIntoPlaceAndLeavesNothingOnFailure) {
 // rename over it, as root, replaced it with the file).
 TEST(WriteAtomically, WritesAFifoOrDeviceDirectlyWithoutReplacingIt) {
   TempDir dir;
-  const fs::path fifo = dir.file("volume.nii");
-  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-  // Its read end open first (without waiting for a writer), so that the
-  // writer does not wait either.
-  const int readEnd = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
-  ASSERT_GE(readEnd, 0);
+  test::ReadableFifo out(dir.file("volume.nii"));
+  const fs::path& fifo = out.path();
   writeAtomically(fifo, [&](const fs::path& to) {
     EXPECT_EQ(to, fifo);
     writeText(to, "the voxels");
   });
-  std::string received;
-  char buffer[256];
-  for (ssize_t n; (n = ::read(readEnd, buffer, sizeof buffer)) > 0;) received.append(buffer, n);
-  ::close(readEnd);
+  const std::string received = out.drain();
   EXPECT_EQ(received, "the voxels");
   EXPECT_TRUE(fs::is_fifo(fifo));
   EXPECT_EQ(entries(dir.path()), std::vector<std::string>{"volume.nii"});
