@@ -3,9 +3,9 @@
 // progressive frame is drawn in (the page's store view, viewer::Viewer): a
 // pixel outside what the technique draws (the volume's box, a slicer's
 // proxy) costs a small fixed part of one inside it, so rows below and
-// above the volume are cheap and rows across it dear. A cost per row learnt on the cheap rows then
-// does not size a strip across the volume several times its budget, as a cost per pixel of the
-// whole image did.
+// above the volume are cheap and rows across it dear. A cost learnt on
+// the cheap rows then does not size a strip across the volume several
+// times its budget, as a cost per pixel of the whole image did.
 #include <glm/vec3.hpp>
 #include <vector>
 
