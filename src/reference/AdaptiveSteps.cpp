@@ -2,6 +2,7 @@
 
 #include <limits>
 #include <string>
+#include <unordered_map>
 
 #include <glm/common.hpp>
 
@@ -172,30 +173,37 @@ std::vector<std::uint8_t> classifyStepBlocks(const std::vector<float>& mins,
   const RangeExtremes rTau(tau), rR(er), rG(eg), rB(eb);
   const double ww = window.max - window.min;
   const double n1 = tableEntries - 1;
+  // The code of a block whose values mix table cells lo..hi (normalised).
+  const auto classifyCells = [&](double lo, double hi) -> std::uint8_t {
+    if (maxOpacity(tf, lo, hi) * opacityScale <= 0.0) return 0;
+    if (!adaptive) return kUnitStepCode;
+    const auto i0 = static_cast<std::size_t>(std::floor(lo * kR));
+    const auto i1 =
+        std::min(static_cast<std::size_t>(kR), static_cast<std::size_t>(std::ceil(hi * kR)));
+    const double v =
+        rTau.spread(i0, i1) + std::max({rR.spread(i0, i1), rG.spread(i0, i1), rB.spread(i0, i1)});
+    // s = tolerance / (ds V), rounded down to an eighth of an octave.
+    const double eighths =
+        v > 0.0 ? std::floor(8.0 * std::log2(sampling.tolerance / (sampleDistance * v))) : 1000.0;
+    return static_cast<std::uint8_t>(std::clamp(64.0 + eighths, 1.0, 255.0));
+  };
   std::vector<std::uint8_t> codes(mins.size());
+  // A block's code depends only on the table cells it mixes: blocks share
+  // few pairs of them (those of one value range), so each pair is
+  // classified once.
+  std::unordered_map<std::uint32_t, std::uint8_t> codeOfCells;
   for (std::size_t b = 0; b < mins.size(); ++b) {
     const double nlo = std::clamp((mins[b] - window.min) / ww, 0.0, 1.0);
     const double nhi = std::clamp((maxs[b] - window.min) / ww, 0.0, 1.0);
     // The table cells a linear lookup of these values mixes.
-    const double lo = std::floor(nlo * n1) / n1;
-    const double hi = std::min(1.0, std::ceil(nhi * n1) / n1);
-    if (maxOpacity(tf, lo, hi) * opacityScale <= 0.0) {
-      codes[b] = 0;
-      continue;
-    }
-    std::uint8_t code = kUnitStepCode;
-    if (adaptive) {
-      const auto i0 = static_cast<std::size_t>(std::floor(lo * kR));
-      const auto i1 =
-          std::min(static_cast<std::size_t>(kR), static_cast<std::size_t>(std::ceil(hi * kR)));
-      const double v =
-          rTau.spread(i0, i1) + std::max({rR.spread(i0, i1), rG.spread(i0, i1), rB.spread(i0, i1)});
-      // s = tolerance / (ds V), rounded down to an eighth of an octave.
-      const double eighths =
-          v > 0.0 ? std::floor(8.0 * std::log2(sampling.tolerance / (sampleDistance * v))) : 1000.0;
-      code = static_cast<std::uint8_t>(std::clamp(64.0 + eighths, 1.0, 255.0));
-    }
-    codes[b] = code;
+    const double cellLo = std::floor(nlo * n1);
+    const double cellHi = std::min(n1, std::ceil(nhi * n1));
+    const auto cells =
+        static_cast<std::uint32_t>(cellLo) * static_cast<std::uint32_t>(tableEntries) +
+        static_cast<std::uint32_t>(cellHi);
+    const auto [known, first] = codeOfCells.try_emplace(cells, std::uint8_t{0});
+    if (first) known->second = classifyCells(cellLo / n1, cellHi / n1);
+    codes[b] = known->second;
   }
   return codes;
 }

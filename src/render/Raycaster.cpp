@@ -47,6 +47,20 @@ void Raycaster::setSkipBlockSize(int voxels) {
   blocksVersion_ = layout_.contentVersion();
   blockTexture_ = gpu::Texture();
   lookupKey_.clear();
+  blocksKey_.clear();
+}
+
+// A streamed layout (bricks) changed what it samples: its value blocks
+// again, classified at the next lookup update. The TF's tables stay, and
+// so does the blocks' texture (the same grid: updated in place), so that a
+// refinement's rebuild is the blocks' work alone (and in a browser no new
+// texture's allocation checks).
+void Raycaster::refreshValueBlocks() {
+  layout::ValueBlocks blocks = layout_.valueBlocks(blockSize_);
+  if (blocks.blockCount() != blocks_.blockCount()) blockTexture_ = gpu::Texture();
+  blocks_ = std::move(blocks);
+  blocksVersion_ = layout_.contentVersion();
+  blocksKey_.clear();
 }
 
 void Raycaster::setLutSize(int entries) {
@@ -89,7 +103,7 @@ bool Raycaster::logTransmittance(const RenderSettings& settings) const {
 }
 
 void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistance) {
-  if (blockSize_ > 0 && layout_.contentVersion() != blocksVersion_) setSkipBlockSize(blockSize_);
+  if (blockSize_ > 0 && layout_.contentVersion() != blocksVersion_) refreshValueBlocks();
   const ValueRange w = volume_.window();
   const bool pre = usesPreintegration(settings);
   const bool adaptive = blockSize_ > 0 && usesAdaptiveSampling(settings);
@@ -100,9 +114,18 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
       << lutSize_ << '|' << blockSize_ << '|' << pre << '|' << preintEntries_ << '|' << adaptive
       << '|' << adaptiveTolerance(settings) << '|' << settings.sampling.maxMultiplier << '|' << logT
       << '|' << tf_.toJson();
-  if (key.str() == lookupKey_) return;
-  lookupKey_ = key.str();
+  if (key.str() != lookupKey_) {
+    lookupKey_ = key.str();
+    updateTables(settings, sampleDistance, pre, logT);
+  }
+  // The blocks are classified for these tables and this content.
+  if (blocksKey_ == lookupKey_) return;
+  blocksKey_ = lookupKey_;
+  classifyBlocks(settings, sampleDistance, pre, adaptive);
+}
 
+void Raycaster::updateTables(const RenderSettings& settings, double sampleDistance, bool pre,
+                             bool logT) {
   // Composite with pre-integration classifies segments through the 2D table
   // and needs no 1D one; everything else samples the 1D table.
   if (pre) {
@@ -113,7 +136,11 @@ void Raycaster::updateLookup(const RenderSettings& settings, double sampleDistan
     if (logT) toLog2Transmittance(lutValues_);
     uploadLut();
   }
+}
 
+void Raycaster::classifyBlocks(const RenderSettings& settings, double sampleDistance, bool pre,
+                               bool adaptive) {
+  const ValueRange w = volume_.window();
   occupiedFraction_ = 1.0;
   stepGrid_ = StepGrid();
   if (blockSize_ == 0) return;
@@ -302,7 +329,7 @@ void Raycaster::renderFrame(const Camera& camera, const RenderSettings& settings
     return renderFrame(camera, everySample(settings), width, height);
   }
   // A streamed layout (bricks) changed what it samples: new value blocks.
-  if (blockSize_ > 0 && layout_.contentVersion() != blocksVersion_) setSkipBlockSize(blockSize_);
+  if (blockSize_ > 0 && layout_.contentVersion() != blocksVersion_) refreshValueBlocks();
   if (width <= 0 || height <= 0 || width > context_.caps().maxRenderbufferSize ||
       height > context_.caps().maxRenderbufferSize) {
     throw InputError("image size " + std::to_string(width) + "x" + std::to_string(height) +

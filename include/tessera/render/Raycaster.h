@@ -137,6 +137,10 @@ class Raycaster final : public Technique {
   // base step's transmittance (raycast.frag.glsl, LOG_TRANSMITTANCE).
   bool logTransmittance(const RenderSettings& settings) const;
   void uploadLut();
+  void refreshValueBlocks();
+  void updateTables(const RenderSettings& settings, double sampleDistance, bool pre, bool logT);
+  void classifyBlocks(const RenderSettings& settings, double sampleDistance, bool pre,
+                      bool adaptive);
   void uploadBlocks(const std::vector<std::uint8_t>& cells);
   void useTarget(int width, int height);
 
@@ -164,6 +168,9 @@ class Raycaster final : public Technique {
   gpu::ProgramCache programs_;
   // What the LUT/block texture were built for, to rebuild only on change.
   std::string lookupKey_;
+  // The lookupKey_ the blocks were classified for (cleared when the layout's
+  // content changed them).
+  std::string blocksKey_;
   double occupiedFraction_ = 1.0;
   double viewAspect_ = 0.0;
   int blockTilesX_ = 1;
