@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "gpu/ErrorQueries.h"
 #include "gpu/gl.h"
 
 namespace tessera::gpu {
@@ -31,7 +32,7 @@ DeviceCaps DeviceCaps::query(ApiLevel api) {
   std::istringstream ext(glString(GL_EXTENSIONS));
   for (std::string e; ext >> e;) caps.extensions.insert(e);
   if (api == ApiLevel::Gles3) caps.max3DTextureSize = glInt(GL_MAX_3D_TEXTURE_SIZE);
-  glGetError();  // a GLES2 context may flag the ES3-only enums
+  queryError();  // a GLES2 context may flag the ES3-only enums
   return caps;
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "gpu/ErrorQueries.h"
 #include "gpu/gl.h"
 #include "tessera/core/Error.h"
 
@@ -154,36 +155,75 @@ void finish() {
 }
 
 namespace {
+
+std::uint64_t errorQueryCount = 0;
 bool errorChecksDeferred = false;
+// The live DeferredErrorChecks scope's name ("" none): its work after any
+// query is unasked again.
+std::string deferredScope;
+// The earliest GL work whose errors are not asked for yet ("" none).
+std::string unasked;
+
+// Asks GL once: GpuError naming `what` (and the unasked work before it).
+void askErrors(const std::string& what) {
+  const GLenum e = queryError();
+  std::string earlier = deferredScope;
+  earlier.swap(unasked);
+  if (e == GL_NO_ERROR) return;
+  if (earlier == what) earlier.clear();
+  char code[16];
+  std::snprintf(code, sizeof code, "0x%04X", e);
+  throw GpuError(what + (earlier.empty() ? "" : " (or " + earlier + " before it)") + ": GL error " +
+                 code + (e == GL_OUT_OF_MEMORY ? " (out of GPU memory)" : ""));
+}
+
 }  // namespace
+
+GLenum queryError() {
+  ++errorQueryCount;
+  return glGetError();
+}
+
+std::uint64_t errorQueries() {
+  return errorQueryCount;
+}
 
 void checkErrors(const std::string& what) {
   if (errorChecksDeferred) return;
-  const GLenum e = glGetError();
-  if (e == GL_NO_ERROR) return;
-  char code[16];
-  std::snprintf(code, sizeof code, "0x%04X", e);
-  throw GpuError(what + ": GL error " + code +
-                 (e == GL_OUT_OF_MEMORY ? " (out of GPU memory)" : ""));
+  askErrors(what);
 }
 
 void clearErrors() {
-  for (int i = 0; i < 16 && glGetError() != GL_NO_ERROR; ++i) {
+  if (!unasked.empty()) {
+    // One query: GpuError for any error, or none left to forget.
+    askErrors(std::string(unasked));
+    return;
+  }
+  for (int i = 0; i < 16 && queryError() != GL_NO_ERROR; ++i) {
   }
 }
 
-DeferredErrorChecks::DeferredErrorChecks() {
+void leaveErrorsUnasked(const std::string& what) {
+  if (unasked.empty()) unasked = what;
+}
+
+DeferredErrorChecks::DeferredErrorChecks(std::string what) {
   errorChecksDeferred = true;
+  deferredScope = std::move(what);
+  leaveErrorsUnasked(deferredScope);
 }
 
 DeferredErrorChecks::~DeferredErrorChecks() {
   errorChecksDeferred = false;
+  // Ended by a check: nothing of it is unasked. Otherwise its work stays
+  // unasked under its name (a preview answering input).
+  if (checkedLast_ && unasked == deferredScope) unasked.clear();
+  deferredScope.clear();
 }
 
 void DeferredErrorChecks::check(const std::string& what) {
-  errorChecksDeferred = false;
-  checkErrors(what);
-  errorChecksDeferred = true;
+  askErrors(what);
+  checkedLast_ = true;
 }
 
 namespace {

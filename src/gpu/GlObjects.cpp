@@ -2,6 +2,7 @@
 
 #include <utility>
 
+#include "gpu/ErrorQueries.h"
 #include "gpu/GlFormats.h"
 #include "gpu/gl.h"
 #include "tessera/core/Error.h"
@@ -61,7 +62,7 @@ Texture::~Texture() {
 
 namespace {
 void checkGl(const std::string& what) {
-  const GLenum e = glGetError();
+  const GLenum e = queryError();
   if (e == GL_OUT_OF_MEMORY) throw GpuError(what + ": GL_OUT_OF_MEMORY");
   if (e != GL_NO_ERROR)
     throw GpuError(what + ": GL error 0x" + [&] {
@@ -79,7 +80,7 @@ Texture Texture::create2D(MemoryLedger& ledger, const std::string& label, GLenum
       static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height) * texelBytes;
   Texture t;
   t.entry_ = LedgerEntry(ledger, GpuResource::Texture, bytes, label);  // budget check first
-  glGetError();
+  clearErrors();  // earlier errors are not this allocation's (Draw.h: unasked work's are reported)
   glGenTextures(1, &t.id_);
   t.target_ = GL_TEXTURE_2D;
   t.width_ = width;
@@ -105,7 +106,7 @@ Texture Texture::create3D(MemoryLedger& ledger, const std::string& label, GLenum
                               static_cast<std::uint64_t>(depth) * texelBytes;
   Texture t;
   t.entry_ = LedgerEntry(ledger, GpuResource::Texture, bytes, label);
-  glGetError();
+  clearErrors();  // earlier errors are not this allocation's (Draw.h: unasked work's are reported)
   glGenTextures(1, &t.id_);
   t.target_ = GL_TEXTURE_3D;
   t.width_ = width;
@@ -198,7 +199,7 @@ Buffer Buffer::create(MemoryLedger& ledger, const std::string& label, BufferKind
   const GLenum target = kind == BufferKind::Vertices ? GL_ARRAY_BUFFER : GL_ELEMENT_ARRAY_BUFFER;
   Buffer b;
   b.entry_ = LedgerEntry(ledger, GpuResource::Buffer, bytes, label);
-  glGetError();
+  clearErrors();  // earlier errors are not this allocation's (Draw.h: unasked work's are reported)
   glGenBuffers(1, &b.id_);
   b.target_ = target;
   glBindBuffer(target, b.id_);

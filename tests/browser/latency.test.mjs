@@ -584,9 +584,12 @@ async function storeInputLatency(context, url, tmp, run) {
               `strips ${stripCalls.n}, median ${stripCalls.median.toFixed(1)} ms, worst ${stripCalls.worst.toFixed(1)} ms`);
   // A preview drawn as its input arrived asks GL for no errors: each
   // getError waits for the GPU process (0.3-0.6 ms on SwiftShader), inside
-  // the input's latency; the store's next call asks for them. Only a new
-  // render target's texture, or a grown buffer of lines, checks its own
-  // allocation (clears, then asks).
+  // the input's latency; the store's next query that waits anyway (a
+  // strip's read-back, an upload's) reports them too (gpu::
+  // leaveErrorsUnasked): asked at the next animation frame they waited for
+  // the GPU process's composition of the page. Only a new render target's
+  // texture, or a grown buffer of lines, checks its own allocation (clears,
+  // then asks).
   const drawnAsArrived = (lat.handlerGl || []).filter((t) => t.drew);
   const asking = drawnAsArrived.filter((t) => t.getError !== 2 * t.made);
   check('latency: previews drawn as input arrived asked GL for no errors beyond a new texture\'s or buffer\'s allocation check, and the animation frames\' store calls asked',
@@ -594,6 +597,15 @@ async function storeInputLatency(context, url, tmp, run) {
         `${drawnAsArrived.length} drawn as input arrived: getError ${drawnAsArrived.reduce((a, t) => a + t.getError, 0)} times, ` +
         `with ${drawnAsArrived.reduce((a, t) => a + t.made, 0)} textures or buffers made; ${asking.length} asked otherwise ` +
         `(${asking.slice(0, 3).map((t) => `${t.getError} for ${t.made}`).join(', ')}); in animation frames ${lat.frameGetErrors} times`);
+  // A streaming step that uploaded nothing has nothing to wait for: a GL
+  // error query there waits for the GPU process's composition of the page
+  // (asked there, a preview's errors cost a median 5.5 ms, up to 23 ms, in
+  // the animation frame after each input).
+  const idleSteps = (z.calls || []).filter((c) => !c.preview && c.stream_ms > 0 && !c.shown && c.uploaded_now === 0);
+  const waited = idleSteps.filter((c) => c.error_queries > 0);
+  check('latency: streaming steps that uploaded nothing asked GL for no errors',
+        idleSteps.length >= 5 && waited.length === 0,
+        `${idleSteps.length} such steps, ${waited.length} asked (${waited.slice(0, 3).map((c) => `${c.error_queries} queries in ${c.ms.toFixed(1)} ms`).join(', ')})`);
   check('latency: the drag and the wheel turns were handled while the store refined',
         latencies.pointermove.length >= 5 && latencies.wheel.length >= WHEELS / 2 && duringRefinement >= all.n / 2 && unanswered === 0,
         `${all.n} events answered (${duringRefinement} while refining), ${unanswered} without a frame after them`);

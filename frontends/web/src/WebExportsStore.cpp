@@ -11,6 +11,7 @@
 
 #include "WebExports.h"
 #include "tessera/core/Error.h"
+#include "tessera/gpu/Draw.h"
 
 using namespace tessera;
 using web::guarded;
@@ -28,7 +29,8 @@ lod::VoxelBox boxOf(int x0, int x1, int y0, int y1, int z0, int z1) {
   return {{x0, y0, z0}, {x1, y1, z1}};
 }
 
-std::string frameJson(const web::StoreFrame& f, web::ZarrStoreView& z) {
+// `errorQueries`: the GL error queries the call made (gpu::errorQueries).
+std::string frameJson(const web::StoreFrame& f, web::ZarrStoreView& z, std::uint64_t errorQueries) {
   const lod::StreamerStats st = z.bricks().streamerStats();
   const web::FetchStats fetched = z.storage().stats();
   nlohmann::json j;
@@ -50,6 +52,8 @@ std::string frameJson(const web::StoreFrame& f, web::ZarrStoreView& z) {
   j["missing"] = f.bricks.missing;
   j["failing"] = f.bricks.failing;
   j["uploaded"] = f.bricks.uploaded;
+  j["uploaded_now"] = f.uploadedNow;
+  j["error_queries"] = errorQueries;
   j["limited_by_budget"] = f.bricks.limitedByBudget;
   j["wanted_per_level"] = f.bricks.wantedPerLevel;
   j["cells_per_level"] = f.bricks.cellsPerLevel;  // last: transparent cells
@@ -157,8 +161,10 @@ EMSCRIPTEN_KEEPALIVE int tessera_zarr_page_decodes(const char* compressor) {
 // frame costs more than the budget, a preview now if `viewChanged` (else the
 // canvas keeps its image), and the full frame through tessera_zarr_refine.
 // JSON with the bricks' state ("complete", "wanted", "missing", "failing",
-// "uploaded", cells per level), "shown" (drew on the canvas) and "pending"
-// (the full frame is still to come), or "" on error (tessera_last_error).
+// "uploaded", cells per level; "uploaded_now": by this call), "shown" (drew
+// on the canvas), "pending" (the full frame is still to come) and
+// "error_queries" (the GL error queries it made, each a wait for the GPU
+// process), or "" on error (tessera_last_error).
 // `inputWaitedMs`: how long the input event it answers has waited since its
 // time stamp (negative: it answers none); see StorePace::inputWaitedMs.
 EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_frame(int width, int height, int viewChanged,
@@ -166,8 +172,9 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_frame(int width, int height, int v
   web::scratch().clear();
   guarded([&] {
     web::WebSession& s = web::session();
-    web::scratch() =
-        frameJson(s.storeFrame(width, height, viewChanged != 0, inputWaitedMs), s.theStore());
+    const std::uint64_t asked = gpu::errorQueries();
+    const web::StoreFrame f = s.storeFrame(width, height, viewChanged != 0, inputWaitedMs);
+    web::scratch() = frameJson(f, s.theStore(), gpu::errorQueries() - asked);
   });
   return web::scratch().c_str();
 }
@@ -185,7 +192,9 @@ EMSCRIPTEN_KEEPALIVE const char* tessera_zarr_refine() {
   web::scratch().clear();
   guarded([&] {
     web::WebSession& s = web::session();
-    web::scratch() = frameJson(s.storeRefine(), s.theStore());
+    const std::uint64_t asked = gpu::errorQueries();
+    const web::StoreFrame f = s.storeRefine();
+    web::scratch() = frameJson(f, s.theStore(), gpu::errorQueries() - asked);
   });
   return web::scratch().c_str();
 }

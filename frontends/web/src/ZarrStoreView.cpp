@@ -137,7 +137,6 @@ std::shared_ptr<const FetchedZarrSource> ZarrStoreView::sourceAt(int time) {
 
 void ZarrStoreView::showTime(int time) {
   if (time == time_ && shown_) return;
-  askPreviewErrors();  // before GL work of its own (an allocation clears errors first)
   std::shared_ptr<const FetchedZarrSource> next = sourceAt(time);
   const int top = next->levelCount() - 1;
   if (!next->resident(top, {glm::ivec3(0), next->levelInfo(top).dims})) {
@@ -163,7 +162,6 @@ bool ZarrStoreView::finished(int time) const {
 
 void ZarrStoreView::setFusion(std::shared_ptr<const FusedVolume> fused) {
   if (fused == fused_) return;
-  askPreviewErrors();
   fused_ = std::move(fused);
   if (active_.technique) active_.technique->setFusion(fused_);
 }
@@ -174,9 +172,6 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
                                 const std::vector<render::OverlayLine>& marks,
                                 const StorePace& pace) {
   const auto t0 = std::chrono::steady_clock::now();
-  // The last preview's errors, if it left them (before this call's GL work:
-  // a buffer or texture made clears errors before its own check).
-  askPreviewErrors();
   layout::BricksFrame bricks = pending_.active ? pending_.bricks : shownBricks_;
   bricks.uploaded = 0;  // by this frame
   pending_ = {};
@@ -207,12 +202,11 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
   compositor_->setOverlayLines(std::move(lines));
   f.renderWidth = v.renderWidth;
   f.renderHeight = v.renderHeight;
-  // Errors that other drawing left are forgotten, not blamed on the store;
+  // Errors that other drawing left are forgotten, not blamed on the store
+  // (those of a preview left unasked are reported: gpu::leaveErrorsUnasked);
   // a call answering input skips the round trip (its wait is the input's):
   // while a store is drawn its view is the page's only GL user (the
-  // in-core viewer and a store's channels draw when no store is drawn), and
-  // each of its calls ends asking for its errors or leaves them to the
-  // next (askPreviewErrors).
+  // in-core viewer and a store's channels draw when no store is drawn).
   const bool answersInput = pace.inputWaitedMs >= 0.0;
   if (!answersInput) gpu::clearErrors();
   budgetMs_ = pace.budgetMs;
@@ -223,6 +217,7 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
     // second), so stream for up to kStreamMs before drawing, and a frame
     // shows everything that has arrived; the page fetches between frames.
     f.bricks = stream(v, kStreamMs);
+    f.uploadedNow = f.bricks.uploaded;
     f.streamed = true;
     f.streamMs = msSince(t0);
     return drawWhole(v, f, t0);
@@ -231,6 +226,7 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
   if (msPerPixel_ > 0.0 && wholeMs <= 0.5 * budgetMs_) {
     bricks_->setUpdatePace(streamPace());
     f.bricks = stream(v, 0.0);
+    f.uploadedNow = f.bricks.uploaded;
     f.streamed = true;
     f.streamMs = msSince(t0);
     return drawWhole(v, f, t0);
@@ -252,6 +248,7 @@ StoreFrame ZarrStoreView::frame(const Camera& viewerCamera, const RenderSettings
     if (shownBricks_.cellsPerLevel.empty()) {
       bricks_->setUpdatePace({.uploadMs = 0.0, .uploadBytes = 0, .inlineReads = 0});
       pending_.bricks = f.bricks = stream(v, 0.0);
+      f.uploadedNow = f.bricks.uploaded;
       f.streamed = true;
       f.streamMs = msSince(t0);
     }
@@ -287,7 +284,7 @@ void ZarrStoreView::show(const gpu::Texture& image, const FrameView& v) {
 
 StoreFrame ZarrStoreView::drawWhole(const FrameView& v, StoreFrame f,
                                     std::chrono::steady_clock::time_point t0) {
-  gpu::DeferredErrorChecks deferred;
+  gpu::DeferredErrorChecks deferred("OME-Zarr frame");
   f.tablesMs = prepareTables(v);
   const auto t1 = std::chrono::steady_clock::now();
   show(active_.technique->render(v.camera, v.pass, v.renderWidth, v.renderHeight, 0.0), v);
@@ -336,16 +333,16 @@ void ZarrStoreView::preview(const FrameView& v, StoreFrame& f, double inputWaite
   p.renderHeight =
       std::max(1, static_cast<int>(std::lround(v.renderHeight * level.resolutionScale)));
   // Its passes' errors are asked for once, after the read-back that waits
-  // for them (each glGetError is a round trip to the browser's GPU process).
-  gpu::DeferredErrorChecks deferred;
+  // for them (each glGetError is a round trip to the browser's GPU process);
+  // one answering input leaves them to the next check that waits anyway (a
+  // strip's read-back, an upload's), which reports them in its name too:
+  // asked at the next animation frame, the query waited for the GPU
+  // process's composition of the page (a median 5.5 ms, up to 23 ms).
+  gpu::DeferredErrorChecks deferred("OME-Zarr preview");
   f.tablesMs = prepareTables(v);
   const auto t0 = std::chrono::steady_clock::now();
   show(active_.technique->render(p.camera, p.pass, p.renderWidth, p.renderHeight, 0.0), p);
-  if (inputWaitedMs >= 0.0) {
-    previewErrorsUnasked_ = true;
-  } else {
-    deferred.check("OME-Zarr preview");
-  }
+  if (inputWaitedMs < 0.0) deferred.check("OME-Zarr preview");
   f.previewMs = msSince(t0);
   if (!hurried) previewQuality_->report(level, f.previewMs);
   previewMeasured_ = true;
@@ -354,20 +351,14 @@ void ZarrStoreView::preview(const FrameView& v, StoreFrame& f, double inputWaite
   f.previewHeight = p.renderHeight;
 }
 
-void ZarrStoreView::askPreviewErrors() {
-  if (!previewErrorsUnasked_) return;
-  previewErrorsUnasked_ = false;
-  gpu::checkErrors("OME-Zarr preview");
-}
-
 StoreFrame ZarrStoreView::refine() {
   if (!pending_.active) return {};
   const auto t0 = std::chrono::steady_clock::now();
   Pending& p = pending_;
-  // No gpu::clearErrors() here: every step ends checking them, and each
-  // query waits for the browser's GPU process. A preview's that answered
-  // input are asked for first.
-  askPreviewErrors();
+  // No gpu::clearErrors() here: each query waits for the browser's GPU
+  // process. A step asks for its errors where it waits anyway (a strip's
+  // read-back, an upload's), and they include what a preview that answered
+  // input left unasked (gpu::leaveErrorsUnasked).
   if (!p.streaming) {
     if (active_.upload.layout->contentVersion() == tablesVersion_) return strip();
     // The bricks changed what the ray caster samples: its tables (empty-
@@ -400,6 +391,7 @@ StoreFrame ZarrStoreView::refine() {
   // GPU process does meanwhile, such as composing the page).
   if (p.bricks.uploaded > 0) gpu::checkErrors("OME-Zarr streaming");
   f.uploadWaitMs = msSince(t0) - f.updateMs;
+  f.uploadedNow = p.bricks.uploaded;
   p.bricks.uploaded += uploadedBefore;
   p.streamedMs += msSince(t0);
   const bool progress =
@@ -447,7 +439,7 @@ StoreFrame ZarrStoreView::strip() {
   }
   rows = std::clamp(rows, minStrip, 1.0 - p.done);
   if (1.0 - (p.done + rows) < 0.5 * minStrip) rows = 1.0 - p.done;
-  gpu::DeferredErrorChecks deferred;  // asked for once, after the read-back
+  gpu::DeferredErrorChecks deferred("OME-Zarr strip");  // asked once, after the read-back
   const double tablesMs = prepareTables(v);
   const gpu::Texture* image = nullptr;
   {

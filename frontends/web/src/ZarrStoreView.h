@@ -83,6 +83,8 @@ struct StoreFrame {
   double updateMs = 0.0, uploadWaitMs = 0.0, tablesMs = 0.0, previewMs = 0.0, setupMs = 0.0;
   // A strip's rows, as a fraction of the frame's (0: no strip).
   double stripRows = 0.0;
+  // Bricks this call uploaded (bricks.uploaded: those of the pending frame).
+  int uploadedNow = 0;
 };
 
 // How store frames are paced, as the viewer core paces its progressive
@@ -233,7 +235,6 @@ class ZarrStoreView {
   void show(const gpu::Texture& image, const FrameView& v);
   StoreFrame drawWhole(const FrameView& v, StoreFrame f, std::chrono::steady_clock::time_point t0);
   void preview(const FrameView& v, StoreFrame& f, double inputWaitedMs);
-  void askPreviewErrors();
   double prepareTables(const FrameView& v);
   StoreFrame strip();
   Pending pending_;
@@ -249,9 +250,6 @@ class ZarrStoreView {
   // The preview's resolution and step, fed back to meet its share of the budget.
   std::unique_ptr<render::QualityController> previewQuality_;
   bool previewMeasured_ = false;
-  // The GL errors of the last call (a preview that answered input) were
-  // not asked for: the next call asks first, in the preview's name.
-  bool previewErrorsUnasked_ = false;
 };
 
 }  // namespace tessera::web

@@ -70,24 +70,42 @@ void readPixelsRgba32F(glm::ivec4 region, float* out);
 
 // Waits for the GPU (where the driver honours it; browsers do not).
 void finish();
-// GpuError naming `what` if GL has recorded an error.
+// GpuError naming `what` if GL has recorded an error (and the work left
+// unasked before it, if any: leaveErrorsUnasked).
 void checkErrors(const std::string& what);
 // Forgets recorded errors (front ends such as ImGui's GL backend may leave
-// some that a later check would blame on the engine).
+// some that a later check would blame on the engine). Errors of work left
+// unasked are not forgotten: GpuError naming that work. Every new texture
+// or buffer does this before its own allocation check.
 void clearErrors();
+// GL work named `what` has not asked for its errors: in a browser each
+// glGetError is a round trip that waits for the GPU process, which a call
+// answering input leaves to the next check that waits anyway (a read-back's,
+// an upload's). That check, or a clear before it, reports them under this
+// name as well as its own, so that no error is lost or blamed on the wrong
+// work alone. The earliest unasked work keeps the name until asked.
+void leaveErrorsUnasked(const std::string& what);
+// GL error queries made so far (each glGetError: in a browser a round trip
+// that waits for the GPU process), for records of what a call waited for.
+std::uint64_t errorQueries();
 // While one is alive, checkErrors() does not ask GL: in a browser each
 // glGetError is a round trip to the GPU process that waits for every
 // command before it, and a frame of several passes waited once per pass.
-// check() asks once for all of them (GL keeps the errors until asked).
-// Scopes do not nest.
+// check() asks once for all of them (GL keeps the errors until asked); the
+// scope's work is left unasked (leaveErrorsUnasked) under `what` until
+// then. A scope ends with a check, or leaves its work unasked on purpose
+// (work after its last check is not named). Scopes do not nest.
 class DeferredErrorChecks {
  public:
-  DeferredErrorChecks();
+  explicit DeferredErrorChecks(std::string what);
   ~DeferredErrorChecks();
   DeferredErrorChecks(const DeferredErrorChecks&) = delete;
   DeferredErrorChecks& operator=(const DeferredErrorChecks&) = delete;
   // GpuError naming `what` if GL recorded an error since the scope began.
   void check(const std::string& what);
+
+ private:
+  bool checkedLast_ = false;
 };
 
 enum class Primitive { Triangles, Lines, Points };
