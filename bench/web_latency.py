@@ -20,6 +20,7 @@ builds are compared in the same alternating run.
     /usr/bin/python3 bench/web_latency.py --rounds 5 --inputs x11
     cp -r build-web/site /tmp/site-before   # ... change, scripts/web.sh, then:
     /usr/bin/python3 bench/web_latency.py --before '' --before-site /tmp/site-before
+    /usr/bin/python3 bench/web_latency.py --inputs x11 --wheel-ms 25   # a wheel spun fast
 
 Needs build/tessera, build-web/site (scripts/web.sh), tests/browser's
 node_modules and, for x11, xvfb-run and libXtst (scripts/setup.sh).
@@ -76,6 +77,8 @@ def main():
     ap.add_argument("--after", default="", help="page parameters of the setting compared (default: the defaults)")
     ap.add_argument("--before-site", default="", help="the baseline's build of the page (default: build-web/site)")
     ap.add_argument("--logs", default="", help="a folder for each run's test output (ROUND-INPUT-SETTING.log)")
+    ap.add_argument("--wheel-ms", type=float, default=0.0,
+                    help="the wheel turns' step in ms (default: the test's, about 200; a wheel spun fast: 20-50)")
     args = ap.parse_args()
     inputs = [i for i in args.inputs.split(",") if i]
     for i in inputs:
@@ -91,6 +94,8 @@ def main():
     settings = {"before": args.before, "after": args.after}
     if args.logs:
         os.makedirs(args.logs, exist_ok=True)
+    if args.wheel_ms > 0:
+        os.environ["TESSERA_LATENCY_WHEEL_MS"] = str(args.wheel_ms)
     runs = {(i, s): [] for i in inputs for s in settings}
     t0 = time.time()
     for r in range(args.rounds):

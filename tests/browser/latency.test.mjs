@@ -482,8 +482,10 @@ async function storeInputLatency(context, url, tmp, run) {
   // twelfth of an interval (200 ms alone is twelve intervals: every turn
   // would fall at the same point, and a run's worst turn would depend on
   // that point alone), so that they sample the whole interval.
+  // TESSERA_LATENCY_WHEEL_MS sets the turns' step instead (a wheel spun
+  // fast sends them tens of ms apart: bench/web_latency.py --wheel-ms).
   const MOVES = 40, WHEELS = 12;
-  const WHEEL_STEP_MS = 200 + 1000 / 60 / WHEELS;
+  const WHEEL_STEP_MS = Number(process.env.TESSERA_LATENCY_WHEEL_MS) || 200 + 1000 / 60 / WHEELS;
   const plan = [{ at: 0, kind: 'press', x: cx, y: cy }];
   for (let i = 1; i <= MOVES; i++) plan.push({ at: i * 70, kind: 'move', x: cx + 3 * i, y: cy + (i % 5) });
   plan.push({ at: (MOVES + 1) * 70, kind: 'release', x: cx + 3 * MOVES, y: cy });

@@ -20,15 +20,6 @@ using namespace tessera;
 
 namespace {
 
-// Leaves a GL error recorded: the caller's deferred scope keeps the read
-// from asking for it.
-void recordAnError(gpu::GlContext& c, gpu::Framebuffer& target) {
-  target = gpu::Framebuffer::create(c.ledger(), "error test", 4, 4, gpu::TexelFormat::RGBA8);
-  target.bind();
-  std::array<float, 4> pixel{};
-  gpu::readPixelsRgba32F({0, 0, 1, 1}, pixel.data());
-}
-
 // The GpuError's message, or "" when `f` threw none.
 template <typename F>
 std::string gpuErrorOf(F&& f) {
@@ -40,55 +31,60 @@ std::string gpuErrorOf(F&& f) {
   return "";
 }
 
+class GpuErrorChecks : public ::testing::Test {
+ protected:
+  void SetUp() override { gpu::clearErrors(); }
+
+  gpu::Framebuffer make(const std::string& label) {
+    return gpu::Framebuffer::create(context_.get().ledger(), label, 4, 4, gpu::TexelFormat::RGBA8);
+  }
+  // Leaves a GL error recorded: the caller's deferred scope keeps the read
+  // from asking for it.
+  void recordAnError() {
+    target_ = make("error test");
+    target_.bind();
+    std::array<float, 4> pixel{};
+    gpu::readPixelsRgba32F({0, 0, 1, 1}, pixel.data());
+  }
+  // The same by work named `what` that ends without asking (a preview that
+  // answers input).
+  void leaveAnErrorUnasked(const std::string& what) {
+    gpu::DeferredErrorChecks deferred(what);
+    recordAnError();
+  }
+
+ private:
+  test::ApiContext context_{gpu::ApiLevel::Gles3};
+  gpu::Framebuffer target_;
+};
+
 }  // namespace
 
-TEST(GpuErrorChecks, ANewTexturesAllocationReportsTheErrorOfWorkLeftUnasked) {
-  test::ApiContext context(gpu::ApiLevel::Gles3);
-  gpu::GlContext& c = context.get();
-  gpu::clearErrors();
-  gpu::Framebuffer target;
+TEST_F(GpuErrorChecks, ANewTexturesAllocationReportsTheErrorOfWorkLeftUnasked) {
   gpu::DeferredErrorChecks deferred("the scope's passes");
-  recordAnError(c, target);
+  recordAnError();
   // The allocation clears errors before its own check: that clear reports
   // the scope's error instead of forgetting it.
-  const std::string message = gpuErrorOf([&] {
-    gpu::Framebuffer::create(c.ledger(), "made after the error", 4, 4, gpu::TexelFormat::RGBA8);
-  });
+  const std::string message = gpuErrorOf([&] { make("made after the error"); });
   EXPECT_NE(message.find("the scope's passes"), std::string::npos) << message;
   EXPECT_NE(message.find("GL error 0x0502"), std::string::npos) << message;  // INVALID_OPERATION
   // Reported once: the next allocation and check find nothing.
   EXPECT_EQ(gpuErrorOf([&] {
-              gpu::Framebuffer::create(c.ledger(), "made after the report", 4, 4,
-                                       gpu::TexelFormat::RGBA8);
+              make("made after the report");
               deferred.check("the scope's check");
             }),
             "");
 }
 
-TEST(GpuErrorChecks, ALaterCheckNamesTheUnaskedWorkBeforeItsOwn) {
-  test::ApiContext context(gpu::ApiLevel::Gles3);
-  gpu::GlContext& c = context.get();
-  gpu::clearErrors();
-  gpu::Framebuffer target;
-  {
-    // A preview answering input ends without asking.
-    gpu::DeferredErrorChecks deferred("a preview");
-    recordAnError(c, target);
-  }
+TEST_F(GpuErrorChecks, ALaterCheckNamesTheUnaskedWorkBeforeItsOwn) {
+  leaveAnErrorUnasked("a preview");
   const std::string message = gpuErrorOf([] { gpu::checkErrors("the next strip"); });
   EXPECT_NE(message.find("the next strip (or a preview before it)"), std::string::npos) << message;
   EXPECT_EQ(gpuErrorOf([] { gpu::checkErrors("the strip after"); }), "");
 }
 
-TEST(GpuErrorChecks, AClearReportsUnaskedWorksErrorsAndOtherwiseForgetsThem) {
-  test::ApiContext context(gpu::ApiLevel::Gles3);
-  gpu::GlContext& c = context.get();
-  gpu::clearErrors();
-  gpu::Framebuffer target;
-  {
-    gpu::DeferredErrorChecks deferred("a preview");
-    recordAnError(c, target);
-  }
+TEST_F(GpuErrorChecks, AClearReportsUnaskedWorksErrorsAndOtherwiseForgetsThem) {
+  leaveAnErrorUnasked("a preview");
   gpu::leaveErrorsUnasked("a later call");  // the earliest keeps the name
   const std::string message = gpuErrorOf([] { gpu::clearErrors(); });
   EXPECT_NE(message.find("a preview"), std::string::npos) << message;
@@ -105,7 +101,7 @@ TEST(GpuErrorChecks, AClearReportsUnaskedWorksErrorsAndOtherwiseForgetsThem) {
   {
     gpu::DeferredErrorChecks deferred("a frame");
     deferred.check("a frame");
-    recordAnError(c, target);
+    recordAnError();
   }
   EXPECT_EQ(gpuErrorOf([] { gpu::clearErrors(); }), "");
   EXPECT_EQ(gpuErrorOf([] { gpu::checkErrors("the next call"); }), "");
