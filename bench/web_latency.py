@@ -14,13 +14,19 @@ had them before) against the defaults (a quarter); `--before lowlatency=1`
 compares a desynchronized (low-latency) WebGL context with the ordinary
 one. `--before-site DIR` serves another build of the page for the
 baseline (a copy of build-web/site made before a change), so that two
-builds are compared in the same alternating run.
+builds are compared in the same alternating run. `--floor` makes the
+baseline the floor page instead (TESSERA_LATENCY_FLOOR: the same window,
+canvas box and input, each answered by a clear of the canvas and a
+one-pixel read-back): what Chromium, its GPU process and the display take
+on this machine whatever a page does, so that the page's latencies are
+read against the floor measured in the same run.
 
     /usr/bin/python3 bench/web_latency.py                 # 3 rounds, both input paths
     /usr/bin/python3 bench/web_latency.py --rounds 5 --inputs x11
     cp -r build-web/site /tmp/site-before   # ... change, scripts/web.sh, then:
     /usr/bin/python3 bench/web_latency.py --before '' --before-site /tmp/site-before
     /usr/bin/python3 bench/web_latency.py --inputs x11 --wheel-ms 25   # a wheel spun fast
+    /usr/bin/python3 bench/web_latency.py --inputs x11 --floor --rounds 4   # the page against the floor
 
 Needs build/tessera, build-web/site (scripts/web.sh), tests/browser's
 node_modules and, for x11, xvfb-run and libXtst (scripts/setup.sh).
@@ -38,16 +44,17 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TARGET_MS = 24.0  # two frame budgets of the page's 12 ms (app.js ?budget=)
 TYPES = ("all", "pointermove", "pointerup", "wheel")
-SUMMARY = re.compile(r"latency: store refining at \S+, budget [\d.]+ ms: (.*)")
+SUMMARY = re.compile(r"latency: (?:store refining|the floor page) at \S+, budget [\d.]+ ms: (.*)")
 STATS = re.compile(r"(all events|pointermove|pointerup|wheel):? median ([\d.]+) ms, 90th percentile [\d.]+ ms, "
                    r"worst ([\d.]+) ms over (\d+)")
 
 
-def run_once(query, inputs, log=None, site=""):
+def run_once(query, inputs, log=None, site="", floor=False):
     """One latency test run; {type: (median, worst, n)} from its summary line.
     `log`: a file for the test's output (the worst events explained); `site`:
-    the page's build (default build-web/site)."""
+    the page's build (default build-web/site); `floor`: the floor page."""
     env = dict(os.environ, TESSERA_LATENCY_QUERY=query, TESSERA_LATENCY_INPUT=inputs,
+               TESSERA_LATENCY_FLOOR="1" if floor else "0",
                TESSERA_CLI=os.environ.get("TESSERA_CLI", os.path.join(ROOT, "build/tessera")))
     if site:
         env["TESSERA_SITE"] = site
@@ -76,6 +83,8 @@ def main():
     ap.add_argument("--before", default="stripshare=0.5", help="page parameters of the baseline")
     ap.add_argument("--after", default="", help="page parameters of the setting compared (default: the defaults)")
     ap.add_argument("--before-site", default="", help="the baseline's build of the page (default: build-web/site)")
+    ap.add_argument("--floor", action="store_true",
+                    help="the baseline is the floor page (the least a WebGL page can do), not --before")
     ap.add_argument("--logs", default="", help="a folder for each run's test output (ROUND-INPUT-SETTING.log)")
     ap.add_argument("--wheel-ms", type=float, default=0.0,
                     help="the wheel turns' step in ms (default: the test's, about 200; a wheel spun fast: 20-50)")
@@ -88,10 +97,15 @@ def main():
         sys.exit("web_latency.py: --inputs x11 needs xvfb-run (scripts/setup.sh installs it)")
     if args.rounds < 1:
         sys.exit("web_latency.py: --rounds must be at least 1")
+    if args.floor and args.before_site:
+        sys.exit("web_latency.py: --floor is the baseline: it takes no --before-site")
     if args.before_site and not os.path.isfile(os.path.join(args.before_site, "tessera-core.wasm")):
         sys.exit(f"web_latency.py: --before-site {args.before_site}: no web build there (tessera-core.wasm)")
     sites = {"before": os.path.abspath(args.before_site) if args.before_site else "", "after": ""}
     settings = {"before": args.before, "after": args.after}
+    if args.floor:
+        sites = {"floor": "", "after": ""}
+        settings = {"floor": "", "after": args.after}
     if args.logs:
         os.makedirs(args.logs, exist_ok=True)
     if args.wheel_ms > 0:
@@ -103,7 +117,7 @@ def main():
         for i in inputs:
             for s in order:
                 log = os.path.join(args.logs, f"{r + 1}-{i}-{s}.log") if args.logs else None
-                res = run_once(settings[s], i, log, sites[s])
+                res = run_once(settings[s], i, log, sites[s], floor=s == "floor")
                 runs[(i, s)].append(res)
                 a = res["all"]
                 print(f"round {r + 1}/{args.rounds} {i:8} {s:6} all events median {a[0]:.1f} ms, worst {a[1]:.1f} ms "
@@ -119,8 +133,12 @@ def main():
 
     print(f"\nInput-to-frame latency while a store refines, ms: median of the runs' medians "
           f"(range of the runs' worsts); {args.rounds} alternating rounds")
-    print(f"before: ?{settings['before'] or '(defaults)'}{' of ' + sites['before'] if sites['before'] else ''}   "
-          f"after: ?{settings['after'] or '(defaults)'}\n")
+    if args.floor:
+        print(f"floor: the floor page (a clear and a one-pixel read-back per input)   "
+              f"after: the page, ?{settings['after'] or '(defaults)'}\n")
+    else:
+        print(f"before: ?{settings['before'] or '(defaults)'}{' of ' + sites['before'] if sites['before'] else ''}   "
+              f"after: ?{settings['after'] or '(defaults)'}\n")
     head = ["input", "setting"] + [t if t != "all" else "all events" for t in TYPES] + [f"runs worst <= {TARGET_MS:.0f}"]
     rows = []
     for (i, s), rs in runs.items():

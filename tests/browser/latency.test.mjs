@@ -24,7 +24,12 @@
 // reaches the page (explainTrace): its latency is at least a frame
 // interval plus the answering callback, whatever the page does.
 // TESSERA_LATENCY_TRACE=FILE records a Chrome trace of the input sequence
-// and prints each input's way through Chromium. TESSERA_LATENCY_INPUT=x11
+// and prints each input's way through Chromium (TESSERA_LATENCY_TRACE_MORE:
+// more trace categories, comma-separated, such as the GPU process's
+// disabled-by-default-gpu.decoder and gpu.angle). TESSERA_LATENCY_FLOOR=1
+// answers the same input with a page that does the least a WebGL page can
+// (floorPage): the floor under the page's latencies on this machine.
+// TESSERA_LATENCY_INPUT=x11
 // sends the same input through the X server instead (XTest, as a mouse
 // would: x11_input.py), with Chromium on a display of its own
 // (TESSERA_HEADFUL=1 xvfb-run -a node --test tests/browser/latency.test.mjs):
@@ -410,6 +415,70 @@ function explainX(x11, lat) {
   return stampOffsets;
 }
 
+// TESSERA_LATENCY_FLOOR=1: the page is replaced, in the same tab and
+// window, by one with a canvas of the 3D view's box and context whose
+// handlers answer each input with the least any WebGL page must do to show
+// an answer: a clear of its canvas to a new colour and a one-pixel
+// read-back (which waits for the GPU process, as the store's preview
+// does), a drag's moves as they arrive (pointerrawupdate), a release and a
+// wheel turn in their handlers, and an animation-frame loop that draws
+// nothing (the store's refinement asks for every frame). Its latencies are
+// what Chromium, the GPU process and the display take on this machine
+// whatever a page does: the floor under the page's.
+async function floorPage(page, url, tmp, box, attributes, webgl2) {
+  const html = `<!doctype html><html><head><meta charset="utf-8"><title>latency floor</title><style>
+html, body { margin: 0; overflow: hidden; background: #202020; }
+canvas { position: absolute; left: ${box.x}px; top: ${box.y}px; width: ${box.width}px; height: ${box.height}px; touch-action: none; }
+</style></head><body><canvas id="canvas"></canvas><script>
+const canvas = document.getElementById('canvas');
+canvas.width = Math.round(${box.width} * devicePixelRatio);
+canvas.height = Math.round(${box.height} * devicePixelRatio);
+const gl = canvas.getContext('${webgl2 ? 'webgl2' : 'webgl'}', ${JSON.stringify(attributes)});
+const pixel = new Uint8Array(4);
+let answers = 0;
+function answer() {
+  answers++;
+  gl.clearColor((answers * 37 % 256) / 255, (answers * 91 % 256) / 255, 0.5, 1);
+  gl.clear(gl.COLOR_BUFFER_BIT);
+  gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel);
+}
+canvas.addEventListener('pointerdown', (e) => { canvas.setPointerCapture(e.pointerId); answer(); });
+canvas.addEventListener('pointerrawupdate', (e) => { if (e.buttons) answer(); });
+canvas.addEventListener('pointerup', answer);
+canvas.addEventListener('wheel', (e) => { e.preventDefault(); answer(); }, { passive: false });
+(function loop() { requestAnimationFrame(loop); })();
+window.floorReady = true;
+</script></body></html>`;
+  fs.writeFileSync(path.join(tmp, 'floor.html'), html);
+  await page.goto(`${url}/data/floor.html`);
+  await page.waitForFunction(() => window.floorReady === true);
+  const placed = await page.locator('#canvas').boundingBox();
+  if (Math.abs(placed.x - box.x) > 0.5 || Math.abs(placed.y - box.y) > 0.5 || Math.abs(placed.width - box.width) > 0.5) {
+    throw new Error(`latency floor: the canvas at ${JSON.stringify(placed)}, not the 3D view's ${JSON.stringify(box)}`);
+  }
+}
+
+// The floor page's latencies (floorPage), as the store's are reported, with
+// the same target; every event must have been answered.
+function reportFloor(lat, x11, box) {
+  if (x11) explainX(x11, lat);
+  const latencies = { pointermove: [], pointerup: [], wheel: [] };
+  let unanswered = 0;
+  for (const { e, f, latency } of answers(lat)) {
+    if (!f) { unanswered++; continue; }
+    latencies[e.type].push(latency);
+  }
+  const all = stats([...latencies.pointermove, ...latencies.pointerup, ...latencies.wheel]);
+  const text = (s) => `median ${s.median.toFixed(1)} ms, 90th percentile ${s.p90.toFixed(1)} ms, worst ${s.worst.toFixed(1)} ms over ${s.n}`;
+  console.log(`latency: the floor page at ${Math.round(box.width)}x${Math.round(box.height)}, budget ${BUDGET_MS} ms: all events ${text(all)}; ` +
+              Object.entries(latencies).map(([t, v]) => `${t}: ${text(stats(v))}`).join('; '));
+  console.log(`latency: the floor page: target worst <= ${2 * BUDGET_MS} ms (2 frame budgets): ${all.worst <= 2 * BUDGET_MS ? 'met' : 'NOT met'} ` +
+              `(worst ${all.worst.toFixed(1)} ms, median ${all.median.toFixed(1)} ms; load average ${os.loadavg()[0].toFixed(1)} on ${os.cpus().length} cores)`);
+  check('latency floor: the drag, its release and the wheel turns were each answered by a frame',
+        latencies.pointermove.length >= 5 && latencies.pointerup.length === 1 && latencies.wheel.length >= 6 && unanswered === 0,
+        `${all.n} answered, ${unanswered} without a frame after them`);
+}
+
 function stats(values) {
   const v = [...values].sort((a, b) => a - b);
   const at = (q) => (v.length ? v[Math.min(v.length - 1, Math.floor(q * v.length))] : NaN);
@@ -435,9 +504,10 @@ async function storeInputLatency(context, url, tmp, run) {
   await page.evaluate(() => window.tessera.ready);
   // The 3D view's context is an ordinary one unless the page is asked for
   // a low-latency (desynchronized) one (tessera.js: lowLatencyContext).
-  const attributes = await page.evaluate(() => {
+  const [attributes, webgl2] = await page.evaluate(() => {
     const c = document.getElementById('canvas');
-    return (c.getContext('webgl2') || c.getContext('webgl')).getContextAttributes();
+    const gl2 = c.getContext('webgl2');
+    return [(gl2 || c.getContext('webgl')).getContextAttributes(), !!gl2];
   });
   const lowLatency = /(^|&)lowlatency=1(&|$)/.test(extra.slice(1));
   check(`latency: the canvas's WebGL context is ${lowLatency ? 'a low-latency (desynchronized)' : 'an ordinary'} one`,
@@ -445,6 +515,11 @@ async function storeInputLatency(context, url, tmp, run) {
   await page.waitForFunction(() => { const z = window.tessera.zarr(); return z && z.firstImageMs !== null; }, null, { timeout: 60000 });
   const before = await snapshot(page);  // the first view, for the drag's last preview below
   const box = await page.locator('#canvas').boundingBox();
+  // TESSERA_LATENCY_FLOOR=1: the same window, canvas box and input,
+  // answered by a page that does the least any WebGL page must to show an
+  // answer (floorPage): what the browser alone takes, for comparison.
+  const floor = process.env.TESSERA_LATENCY_FLOOR === '1';
+  if (floor) await floorPage(page, url, tmp, box, attributes, webgl2);
   const cdp = await context.newCDPSession(page);
   const cx = box.x + box.width / 2, cy = box.y + box.height / 2;
   // Sent on a clock, never awaiting the page (an acknowledgement waits for
@@ -471,7 +546,8 @@ async function storeInputLatency(context, url, tmp, run) {
   if (traceFile) {
     await cdp.send('Tracing.start', { transferMode: 'ReturnAsStream', traceConfig: { recordMode: 'recordAsMuchAsPossible',
       includedCategories: ['input', 'latencyInfo', 'benchmark', 'devtools.timeline', 'toplevel', 'gpu', 'cc', 'viz',
-        'blink', 'renderer.scheduler', 'disabled-by-default-devtools.timeline.frame', 'v8.execute'] } });
+        'blink', 'renderer.scheduler', 'disabled-by-default-devtools.timeline.frame', 'v8.execute',
+        ...(process.env.TESSERA_LATENCY_TRACE_MORE || '').split(',').filter((c) => c)] } });
   }
   // The input sequence (ms from its start, page coordinates): a drag of
   // MOVES moves 70 ms apart, its release, and WHEELS wheel turns about
@@ -532,6 +608,12 @@ async function storeInputLatency(context, url, tmp, run) {
     explainTrace(JSON.parse(parts.join('')));
   }
   const lat = await page.evaluate(() => window.latency);
+  if (floor) {
+    served.delayMs = () => 0;
+    reportFloor(lat, x11, box);
+    await page.close();
+    return;
+  }
   const z = await page.evaluate(() => window.tessera.zarr());
   if (x11) {
     const offsets = explainX(x11, lat);
