@@ -61,18 +61,34 @@ test('input during a store\'s refinement: every event answered by the next frame
 const xvfbRun = ['/usr/bin/xvfb-run', '/usr/local/bin/xvfb-run'].find((p) => fs.existsSync(p));
 test('the same input through the X server (xvfb-run, headful Chromium, XTest): the same checks (worst vs 2 frame budgets reported)',
   { skip: process.env.TESSERA_LATENCY_INPUT ? 'this run chose its input' : !xvfbRun ? 'no xvfb-run (scripts/setup.sh)' : false },
+  () => runAgain('x11', { TESSERA_HEADFUL: '1', TESSERA_LATENCY_INPUT: 'x11' }, true));
+
+// The floor under the page's latencies in this run: the floor page
+// (TESSERA_LATENCY_FLOOR=1, floorPage) answers the same input, through
+// DevTools and through the X server, and its latencies are reported beside
+// the page's (bench/web_latency.py --floor alternates them).
+test('the floor page (the least any page can do) through DevTools and the X server: every input answered (its worst reported)',
+  { skip: process.env.TESSERA_LATENCY_INPUT || process.env.TESSERA_LATENCY_FLOOR ? 'this run chose its input or page' : false },
   async () => {
-    const run = await new Promise((resolve) => {
-      execFile(xvfbRun, ['-a', process.execPath, '--test', '--test-reporter=spec', fileURLToPath(import.meta.url)],
-        // (Without the test runner's NODE_TEST_CONTEXT: the run is a test run of its own.)
-        { env: { ...Object.fromEntries(Object.entries(process.env).filter(([k]) => k !== 'NODE_TEST_CONTEXT')),
-          TESSERA_HEADFUL: '1', TESSERA_LATENCY_INPUT: 'x11' }, timeout: 300000, maxBuffer: 64 << 20 },
-        (err, stdout, stderr) => resolve({ err, out: `${stdout}${stderr}` }));
-    });
-    const lines = run.out.split('\n').filter((l) => /latency|FAIL|Error|not ok/.test(l));
-    for (const l of lines) console.log(`x11 ${l.trim()}`);
-    if (run.err) throw new Error(`the run through the X server failed (${run.err.code ?? run.err.signal ?? run.err.message}):\n${run.out.slice(-4000)}`);
+    await runAgain('floor devtools', { TESSERA_LATENCY_FLOOR: '1', TESSERA_LATENCY_INPUT: 'devtools' }, false);
+    if (xvfbRun) await runAgain('floor x11', { TESSERA_LATENCY_FLOOR: '1', TESSERA_HEADFUL: '1', TESSERA_LATENCY_INPUT: 'x11' }, true);
   });
+
+// This file run again as a test run of its own with `env` added (under
+// xvfb-run when `onDisplay`), its latency lines printed with `prefix`.
+async function runAgain(prefix, env, onDisplay) {
+  const args = ['--test', '--test-reporter=spec', fileURLToPath(import.meta.url)];
+  const run = await new Promise((resolve) => {
+    execFile(onDisplay ? xvfbRun : process.execPath, onDisplay ? ['-a', process.execPath, ...args] : args,
+      // (Without the test runner's NODE_TEST_CONTEXT: the run is a test run of its own.)
+      { env: { ...Object.fromEntries(Object.entries(process.env).filter(([k]) => k !== 'NODE_TEST_CONTEXT')), ...env },
+        timeout: 300000, maxBuffer: 64 << 20 },
+      (err, stdout, stderr) => resolve({ err, out: `${stdout}${stderr}` }));
+  });
+  const lines = run.out.split('\n').filter((l) => /latency|FAIL|Error|not ok/.test(l));
+  for (const l of lines) console.log(`${prefix} ${l.trim()}`);
+  if (run.err) throw new Error(`the ${prefix} run failed (${run.err.code ?? run.err.signal ?? run.err.message}):\n${run.out.slice(-4000)}`);
+}
 
 // Runs in the page before its scripts: which animation-frame callbacks drew
 // on the canvas (a draw, clear or blit into the default framebuffer), and
