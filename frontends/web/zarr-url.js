@@ -733,7 +733,7 @@
       record.calls.push({ t: performance.now() - t0, ms: f.ms, stream_ms: f.stream_ms, shown: f.shown, pending: f.pending,
         preview: f.preview_size[0] > 0, uploaded: f.uploaded, update_ms: f.update_ms, upload_wait_ms: f.upload_wait_ms,
         tables_ms: f.tables_ms, preview_ms: f.preview_ms, setup_ms: f.setup_ms, preview_size: f.preview_size,
-        strip_rows: f.strip_rows, uploaded_now: f.uploaded_now, error_queries: f.error_queries });
+        strip_rows: f.strip_rows, uploaded_now: f.uploaded_now, tables_rebuilt: f.tables_rebuilt, error_queries: f.error_queries });
       if (record.calls.length > 4000) record.calls.splice(0, 1000);
       if (!f.shown && !f.pending) {
         // Streamed, and nothing new to draw: the canvas shows these bricks.

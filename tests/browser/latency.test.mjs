@@ -697,15 +697,27 @@ async function storeInputLatency(context, url, tmp, run) {
         `${drawnAsArrived.length} drawn as input arrived: getError ${drawnAsArrived.reduce((a, t) => a + t.getError, 0)} times, ` +
         `with ${drawnAsArrived.reduce((a, t) => a + t.made, 0)} textures or buffers made; ${asking.length} asked otherwise ` +
         `(${asking.slice(0, 3).map((t) => `${t.getError} for ${t.made}`).join(', ')}); in animation frames ${lat.frameGetErrors} times`);
-  // A streaming step that uploaded nothing has nothing to wait for: a GL
-  // error query there waits for the GPU process's composition of the page
-  // (asked there, a preview's errors cost a median 5.5 ms, up to 23 ms, in
-  // the animation frame after each input).
-  const idleSteps = (z.calls || []).filter((c) => !c.preview && c.stream_ms > 0 && !c.shown && c.uploaded_now === 0);
+  // A streaming step that uploaded nothing (no brick, and no tables rebuilt
+  // for what changed) has nothing to wait for: a GL error query there waits
+  // for the GPU process's composition of the page (asked there, a preview's
+  // errors cost a median 5.5 ms, up to 23 ms, in the animation frame after
+  // each input).
+  const idleSteps = (z.calls || []).filter((c) => !c.preview && c.stream_ms > 0 && !c.shown && c.uploaded_now === 0 &&
+    !c.tables_rebuilt);
   const waited = idleSteps.filter((c) => c.error_queries > 0);
   check('latency: streaming steps that uploaded nothing asked GL for no errors',
         idleSteps.length >= 5 && waited.length === 0,
         `${idleSteps.length} such steps, ${waited.length} asked (${waited.slice(0, 3).map((c) => `${c.error_queries} queries in ${c.ms.toFixed(1)} ms`).join(', ')})`);
+  // Bricks that arrived (or the new view's levels) change the ray caster's
+  // empty-space blocks: the streaming step that changed them rebuilds them,
+  // so that no preview answering input pays for it (3-5 ms each in 2-3 of
+  // 53 previews when a step of their own after the streaming did).
+  const rebuilt = during.filter((c) => c.tables_rebuilt);
+  const previewsRebuilding = rebuilt.filter((c) => c.preview);
+  check('latency: no preview answering input rebuilt the ray caster\'s tables for bricks that changed (the streaming steps did)',
+        previews.n > 0 && rebuilt.length > 0 && previewsRebuilding.length === 0,
+        `${rebuilt.length} calls rebuilt them (${rebuilt.filter((c) => c.stream_ms > 0).length} streaming steps), ` +
+        `${previewsRebuilding.length} previews (${previewsRebuilding.slice(0, 3).map((c) => `${c.tables_ms.toFixed(1)} ms`).join(', ')})`);
   check('latency: the drag and the wheel turns were handled while the store refined',
         latencies.pointermove.length >= 5 && latencies.wheel.length >= WHEELS / 2 && duringRefinement >= all.n / 2 && unanswered === 0,
         `${all.n} events answered (${duringRefinement} while refining), ${unanswered} without a frame after them`);

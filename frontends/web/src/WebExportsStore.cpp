@@ -53,6 +53,7 @@ std::string frameJson(const web::StoreFrame& f, web::ZarrStoreView& z, std::uint
   j["failing"] = f.bricks.failing;
   j["uploaded"] = f.bricks.uploaded;
   j["uploaded_now"] = f.uploadedNow;
+  j["tables_rebuilt"] = f.tablesRebuilt;
   j["error_queries"] = errorQueries;
   j["limited_by_budget"] = f.bricks.limitedByBudget;
   j["wanted_per_level"] = f.bricks.wantedPerLevel;

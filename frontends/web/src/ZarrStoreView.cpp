@@ -297,6 +297,10 @@ StoreFrame ZarrStoreView::drawWhole(const FrameView& v, StoreFrame f,
   return f;
 }
 
+bool ZarrStoreView::tablesStale() const {
+  return active_.upload.layout->contentVersion() != tablesVersion_;
+}
+
 // The ray caster's tables for `v` (rebuilt when bricks changed what it
 // samples: its empty-space blocks), apart from its ray march; ms.
 double ZarrStoreView::prepareTables(const FrameView& v) {
@@ -339,6 +343,7 @@ void ZarrStoreView::preview(const FrameView& v, StoreFrame& f, double inputWaite
   // asked at the next animation frame, the query waited for the GPU
   // process's composition of the page (a median 5.5 ms, up to 23 ms).
   gpu::DeferredErrorChecks deferred("OME-Zarr preview");
+  f.tablesRebuilt = tablesStale();
   f.tablesMs = prepareTables(v);
   const auto t0 = std::chrono::steady_clock::now();
   show(active_.technique->render(p.camera, p.pass, p.renderWidth, p.renderHeight, 0.0), p);
@@ -360,13 +365,15 @@ StoreFrame ZarrStoreView::refine() {
   // read-back, an upload's), and they include what a preview that answered
   // input left unasked (gpu::leaveErrorsUnasked).
   if (!p.streaming) {
-    if (active_.upload.layout->contentVersion() == tablesVersion_) return strip();
-    // The bricks changed what the ray caster samples: its tables (empty-
-    // space blocks) are rebuilt in a step of their own, not in a strip or
-    // in the preview that answers the next input.
+    if (!tablesStale()) return strip();
+    // The bricks changed what the ray caster samples since its tables were
+    // built, outside a streaming step (which rebuilds them itself): they
+    // are rebuilt in a step of their own, not in a strip or in the preview
+    // that answers the next input.
     // Its uploads waited for here, as a streaming step's: this step's
     // cost, not the next one's (the preview that answers input).
     StoreFrame f;
+    f.tablesRebuilt = true;
     f.tablesMs = prepareTables(p.view);
     gpu::checkErrors("OME-Zarr tables");
     f.pending = true;
@@ -385,12 +392,20 @@ StoreFrame ZarrStoreView::refine() {
   p.bricks = stream(p.view, 0.0);
   StoreFrame f;
   f.updateMs = msSince(t0);
-  // An upload is done in the browser's GPU process after this call returns:
-  // waited for here, it is this step's cost, not the next one's. Without
-  // one there is nothing to wait for (a query would wait for whatever the
-  // GPU process does meanwhile, such as composing the page).
-  if (p.bricks.uploaded > 0) gpu::checkErrors("OME-Zarr streaming");
-  f.uploadWaitMs = msSince(t0) - f.updateMs;
+  // Bricks that arrived, or the new view's levels, change what the ray
+  // caster samples: its tables (empty-space blocks) are rebuilt in this
+  // step, so that the preview answering the next input never pays for
+  // them (rebuilt in a step of their own after the streaming, 2-3 of a
+  // drag's 53 previews did, 3-5 ms each).
+  f.tablesRebuilt = tablesStale();
+  if (f.tablesRebuilt) f.tablesMs = prepareTables(p.view);
+  // An upload (bricks, the blocks' texture) is done in the browser's GPU
+  // process after this call returns: waited for here, it is this step's
+  // cost, not the next one's. Without one there is nothing to wait for (a
+  // query would wait for whatever the GPU process does meanwhile, such as
+  // composing the page).
+  if (p.bricks.uploaded > 0 || f.tablesRebuilt) gpu::checkErrors("OME-Zarr streaming");
+  f.uploadWaitMs = msSince(t0) - f.updateMs - f.tablesMs;
   f.uploadedNow = p.bricks.uploaded;
   p.bricks.uploaded += uploadedBefore;
   p.streamedMs += msSince(t0);

@@ -85,6 +85,10 @@ struct StoreFrame {
   double stripRows = 0.0;
   // Bricks this call uploaded (bricks.uploaded: those of the pending frame).
   int uploadedNow = 0;
+  // This call rebuilt the ray caster's tables for bricks that changed (its
+  // empty-space blocks): a streaming or tables step's work, never a
+  // preview's.
+  bool tablesRebuilt = false;
 };
 
 // How store frames are paced, as the viewer core paces its progressive
@@ -236,6 +240,8 @@ class ZarrStoreView {
   StoreFrame drawWhole(const FrameView& v, StoreFrame f, std::chrono::steady_clock::time_point t0);
   void preview(const FrameView& v, StoreFrame& f, double inputWaitedMs);
   double prepareTables(const FrameView& v);
+  // The bricks changed what the ray caster samples since its tables were built.
+  bool tablesStale() const;
   StoreFrame strip();
   Pending pending_;
   // What the last full frame on the canvas sampled (Layout::contentVersion).
