@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Input-to-frame latency in the web page while a store refines (a
 benchmark, not a test): tests/browser/latency.test.mjs run again and again,
-alternating two settings of the page in each round (their order swapped
+alternating two settings of the page in each round (their order rotated
 every round), with input sent through DevTools and, under xvfb-run with
 headful Chromium, through the X server as a mouse's would be (XTest). Prints
 a table per input path and setting: the median of the runs' medians, the
@@ -19,7 +19,10 @@ baseline the floor page instead (TESSERA_LATENCY_FLOOR: the same window,
 canvas box and input, each answered by a clear of the canvas and a
 one-pixel read-back): what Chromium, its GPU process and the display take
 on this machine whatever a page does, so that the page's latencies are
-read against the floor measured in the same run.
+read against the floor measured in the same run. `--floor window` makes it
+the floor page on a copy of the page's window (its markup and style sheet,
+without its scripts: what presenting the page's controls adds), `--floor
+both` runs the two floors and the page in each round.
 
     /usr/bin/python3 bench/web_latency.py                 # 3 rounds, both input paths
     /usr/bin/python3 bench/web_latency.py --rounds 5 --inputs x11
@@ -27,6 +30,7 @@ read against the floor measured in the same run.
     /usr/bin/python3 bench/web_latency.py --before '' --before-site /tmp/site-before
     /usr/bin/python3 bench/web_latency.py --inputs x11 --wheel-ms 25   # a wheel spun fast
     /usr/bin/python3 bench/web_latency.py --inputs x11 --floor --rounds 4   # the page against the floor
+    /usr/bin/python3 bench/web_latency.py --inputs x11 --floor both --wheel-ms 25   # and the floor in the page's window
 
 Needs build/tessera, build-web/site (scripts/web.sh), tests/browser's
 node_modules and, for x11, xvfb-run and libXtst (scripts/setup.sh).
@@ -49,12 +53,13 @@ STATS = re.compile(r"(all events|pointermove|pointerup|wheel):? median ([\d.]+) 
                    r"worst ([\d.]+) ms over (\d+)")
 
 
-def run_once(query, inputs, log=None, site="", floor=False):
+def run_once(query, inputs, log=None, site="", floor=""):
     """One latency test run; {type: (median, worst, n)} from its summary line.
     `log`: a file for the test's output (the worst events explained); `site`:
-    the page's build (default build-web/site); `floor`: the floor page."""
+    the page's build (default build-web/site); `floor`: the floor page ("1",
+    or "window": in a copy of the page's window), else the page."""
     env = dict(os.environ, TESSERA_LATENCY_QUERY=query, TESSERA_LATENCY_INPUT=inputs,
-               TESSERA_LATENCY_FLOOR="1" if floor else "0",
+               TESSERA_LATENCY_FLOOR=floor or "0",
                TESSERA_CLI=os.environ.get("TESSERA_CLI", os.path.join(ROOT, "build/tessera")))
     if site:
         env["TESSERA_SITE"] = site
@@ -83,8 +88,9 @@ def main():
     ap.add_argument("--before", default="stripshare=0.5", help="page parameters of the baseline")
     ap.add_argument("--after", default="", help="page parameters of the setting compared (default: the defaults)")
     ap.add_argument("--before-site", default="", help="the baseline's build of the page (default: build-web/site)")
-    ap.add_argument("--floor", action="store_true",
-                    help="the baseline is the floor page (the least a WebGL page can do), not --before")
+    ap.add_argument("--floor", nargs="?", const="plain", default="", choices=("plain", "window", "both"),
+                    help="the baseline is the floor page (the least a WebGL page can do), not --before; "
+                         "window: the floor page in a copy of the page's window; both: the two floors")
     ap.add_argument("--logs", default="", help="a folder for each run's test output (ROUND-INPUT-SETTING.log)")
     ap.add_argument("--wheel-ms", type=float, default=0.0,
                     help="the wheel turns' step in ms (default: the test's, about 200; a wheel spun fast: 20-50)")
@@ -103,9 +109,12 @@ def main():
         sys.exit(f"web_latency.py: --before-site {args.before_site}: no web build there (tessera-core.wasm)")
     sites = {"before": os.path.abspath(args.before_site) if args.before_site else "", "after": ""}
     settings = {"before": args.before, "after": args.after}
-    if args.floor:
-        sites = {"floor": "", "after": ""}
-        settings = {"floor": "", "after": args.after}
+    # The floor pages by setting name: TESSERA_LATENCY_FLOOR's value.
+    floors = {"plain": {"floor": "1"}, "window": {"floor-window": "window"},
+              "both": {"floor": "1", "floor-window": "window"}}.get(args.floor, {})
+    if floors:
+        sites = {**{f: "" for f in floors}, "after": ""}
+        settings = {**{f: "" for f in floors}, "after": args.after}
     if args.logs:
         os.makedirs(args.logs, exist_ok=True)
     if args.wheel_ms > 0:
@@ -113,14 +122,15 @@ def main():
     runs = {(i, s): [] for i in inputs for s in settings}
     t0 = time.time()
     for r in range(args.rounds):
-        order = list(settings) if r % 2 == 0 else list(settings)[::-1]
+        names = list(settings)
+        order = names[r % len(names):] + names[:r % len(names)]  # each first in turn
         for i in inputs:
             for s in order:
                 log = os.path.join(args.logs, f"{r + 1}-{i}-{s}.log") if args.logs else None
-                res = run_once(settings[s], i, log, sites[s], floor=s == "floor")
+                res = run_once(settings[s], i, log, sites[s], floor=floors.get(s, ""))
                 runs[(i, s)].append(res)
                 a = res["all"]
-                print(f"round {r + 1}/{args.rounds} {i:8} {s:6} all events median {a[0]:.1f} ms, worst {a[1]:.1f} ms "
+                print(f"round {r + 1}/{args.rounds} {i:8} {s:12} all events median {a[0]:.1f} ms, worst {a[1]:.1f} ms "
                       f"({time.time() - t0:.0f} s)", file=sys.stderr, flush=True)
 
     def cell(rs, t):
@@ -133,9 +143,10 @@ def main():
 
     print(f"\nInput-to-frame latency while a store refines, ms: median of the runs' medians "
           f"(range of the runs' worsts); {args.rounds} alternating rounds")
-    if args.floor:
-        print(f"floor: the floor page (a clear and a one-pixel read-back per input)   "
-              f"after: the page, ?{settings['after'] or '(defaults)'}\n")
+    if floors:
+        print("floor: the floor page (a clear and a one-pixel read-back per input)   " if "floor" in floors else "", end="")
+        print("floor-window: the same, in a copy of the page's window   " if "floor-window" in floors else "", end="")
+        print(f"after: the page, ?{settings['after'] or '(defaults)'}\n")
     else:
         print(f"before: ?{settings['before'] or '(defaults)'}{' of ' + sites['before'] if sites['before'] else ''}   "
               f"after: ?{settings['after'] or '(defaults)'}\n")

@@ -28,8 +28,9 @@
 // more trace categories, comma-separated, such as the GPU process's
 // disabled-by-default-gpu.decoder and gpu.angle). TESSERA_LATENCY_FLOOR=1
 // answers the same input with a page that does the least a WebGL page can
-// (floorPage): the floor under the page's latencies on this machine.
-// TESSERA_LATENCY_INPUT=x11
+// (floorPage): the floor under the page's latencies on this machine;
+// TESSERA_LATENCY_FLOOR=window, the same in a copy of the page's window
+// (what presenting its controls adds). TESSERA_LATENCY_INPUT=x11
 // sends the same input through the X server instead (XTest, as a mouse
 // would: x11_input.py), with Chromium on a display of its own
 // (TESSERA_HEADFUL=1 xvfb-run -a node --test tests/browser/latency.test.mjs):
@@ -441,14 +442,22 @@ function explainX(x11, lat) {
 // nothing (the store's refinement asks for every frame). Its latencies are
 // what Chromium, the GPU process and the display take on this machine
 // whatever a page does: the floor under the page's.
-async function floorPage(page, url, tmp, box, attributes, webgl2) {
-  const html = `<!doctype html><html><head><meta charset="utf-8"><title>latency floor</title><style>
+// TESSERA_LATENCY_FLOOR=window: the same answers, on a copy of the page's
+// window (its markup as it stands, with its style sheet and without its
+// scripts; the 3D view's canvas answers as above): what presenting a
+// window with the page's controls adds on this machine, the preview aside.
+async function floorPage(page, url, tmp, box, attributes, webgl2, withWindow) {
+  const content = withWindow
+    ? (await page.evaluate(() => document.body.innerHTML)).replace(/<script\b[^>]*>[\s\S]*?<\/script>/gi, '')
+    : '<canvas id="canvas"></canvas>';
+  const style = withWindow ? '<link rel="stylesheet" href="/style.css">' : `<style>
 html, body { margin: 0; overflow: hidden; background: #202020; }
 canvas { position: absolute; left: ${box.x}px; top: ${box.y}px; width: ${box.width}px; height: ${box.height}px; touch-action: none; }
-</style></head><body><canvas id="canvas"></canvas><script>
+</style>`;
+  const html = `<!doctype html><html><head><meta charset="utf-8"><title>latency floor</title>${style}</head><body>${content}<script>
 const canvas = document.getElementById('canvas');
-canvas.width = Math.round(${box.width} * devicePixelRatio);
-canvas.height = Math.round(${box.height} * devicePixelRatio);
+${withWindow ? '' : `canvas.width = Math.round(${box.width} * devicePixelRatio);
+canvas.height = Math.round(${box.height} * devicePixelRatio);`}
 const gl = canvas.getContext('${webgl2 ? 'webgl2' : 'webgl'}', ${JSON.stringify(attributes)});
 const pixel = new Uint8Array(4);
 let answers = 0;
@@ -534,8 +543,10 @@ async function storeInputLatency(context, url, tmp, run) {
   // TESSERA_LATENCY_FLOOR=1: the same window, canvas box and input,
   // answered by a page that does the least any WebGL page must to show an
   // answer (floorPage): what the browser alone takes, for comparison.
-  const floor = process.env.TESSERA_LATENCY_FLOOR === '1';
-  if (floor) await floorPage(page, url, tmp, box, attributes, webgl2);
+  const floorMode = process.env.TESSERA_LATENCY_FLOOR || '';
+  if (!['', '0', '1', 'window'].includes(floorMode)) throw new Error(`TESSERA_LATENCY_FLOOR=${floorMode}: 1 or window`);
+  const floor = floorMode === '1' || floorMode === 'window';
+  if (floor) await floorPage(page, url, tmp, box, attributes, webgl2, floorMode === 'window');
   const cdp = await context.newCDPSession(page);
   const cx = box.x + box.width / 2, cy = box.y + box.height / 2;
   // Sent on a clock, never awaiting the page (an acknowledgement waits for
